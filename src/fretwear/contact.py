@@ -1,0 +1,267 @@
+"""DLFT contact law in the time domain and its quasi-analytic Jacobian (paper eq. 23-28).
+
+Sign convention (see :mod:`fretwear.model.core`): ``lambda`` is the force the structure exerts
+on the rigid obstacle in the node's local frame ``[N, T1, (T2)]``; ``lambda_N >= 0`` in
+compression (the paper's ``lambda_N`` is negative in compression, so its "separation when
+``lambda_pre,N >= 0``" reads "``<= 0``" here).
+
+For every contact node and every instant ``n`` of ``N`` per period, given the time samples of
+
+    lambda_u = F - Z U + eps (U - W)                      (eq. 23)
+
+the correction ``lambda_x`` is built by prediction / correction:
+
+* prediction (eq. 24): ``pre_T = lambda_u,T(n) - lambda_x,T(n-1)``, ``pre_N = lambda_u,N(n)``;
+* separation ``pre_N <= 0``: ``lambda_x(n) = lambda_u(n)`` (eq. 26), so ``lambda(n) = 0``;
+* stick ``|pre_T| < mu pre_N``: ``lambda_x,N = 0``, ``lambda_x,T(n) = lambda_x,T(n-1)`` (eq. 27);
+* slip: ``lambda_x,N = 0``, ``lambda_x,T(n) = lambda_x,T(n-1) + pre_T (1 - mu pre_N/|pre_T|)``
+  (eq. 28), i.e. ``lambda_T(n) = mu pre_N pre_T/|pre_T|`` on the Coulomb cone (vector norm in 3D);
+
+and ``lambda = lambda_u - lambda_x`` (eq. 25, corrected), ``X = lambda_x / eps``.
+
+Periodicity: the state before ``n = 0`` is the state at the end of the period. Each node's
+period is swept repeatedly, each pass starting from where the last one ended, until the start
+state repeats to a tolerance. A node that sticks for the whole period keeps the start state it
+was given: its *stick anchor* ``eps * X_a`` (``X_a`` = where it sticks), which selects the mean
+tangential position when it is not unique (docs/theory.md, "Full stick").
+
+Jacobian (Salles et al. 2009, as the method notes describe it): the recursion is differentiated
+with respect to the real Fourier coefficients of ``lambda_u``; stick carries the derivative of
+``lambda_x(n-1)``, including across the wrap-around of the period (solved exactly as a small
+linear fixed point), slip differentiates the projection on the cone, separation gives a zero
+force derivative.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+SEPARATION = 0
+STICK = 1
+SLIP = 2
+STATE_NAMES = ("separation", "stick", "slip")
+
+
+@njit(cache=True)
+def _sweep(lu, mu, xprev, lx, state):
+    """One pass over the period for one node; returns the final tangential correction.
+
+    lu : (d, N) lambda_u samples; xprev : (d-1,) lambda_x,T before n = 0 (overwritten);
+    lx : (d, N) output; state : (N,) output.
+    """
+    d, N = lu.shape
+    dt = d - 1
+    pre = np.empty(dt)
+    for n in range(N):
+        pn = lu[0, n]
+        if pn <= 0.0:
+            for c in range(d):
+                lx[c, n] = lu[c, n]
+            state[n] = SEPARATION
+        else:
+            nrm2 = 0.0
+            for c in range(dt):
+                pre[c] = lu[1 + c, n] - xprev[c]
+                nrm2 += pre[c] * pre[c]
+            nrm = np.sqrt(nrm2)
+            lx[0, n] = 0.0
+            cap = mu * pn
+            if nrm < cap:
+                for c in range(dt):
+                    lx[1 + c, n] = xprev[c]
+                state[n] = STICK
+            else:
+                f = 1.0 - cap / nrm
+                for c in range(dt):
+                    lx[1 + c, n] = xprev[c] + pre[c] * f
+                state[n] = SLIP
+        for c in range(dt):
+            xprev[c] = lx[1 + c, n]
+    return xprev
+
+
+@njit(cache=True)
+def dlft_time(lam_u, mu, x_start, tol, max_sweeps):
+    """Corrections ``lambda_x`` for all nodes over one period, made periodic (eq. 24-28).
+
+    Parameters
+    ----------
+    lam_u : (nc, d, N) samples of ``lambda_u`` [N].
+    mu : (nc,) friction coefficients.
+    x_start : (nc, d-1) stick anchors ``eps X_a`` [N]: the tangential correction before the
+        first pass (kept by nodes that stick all period).
+    tol : relative tolerance of the periodicity test (on ``max |lambda_u|`` of the node).
+    max_sweeps : passes allowed per node.
+
+    Returns
+    -------
+    lam_x : (nc, d, N); state : (nc, N) int8; sweeps : (nc,) passes used (``> max_sweeps``
+    flags a node whose start state did not repeat).
+    """
+    nc, d, N = lam_u.shape
+    dt = d - 1
+    lam_x = np.empty((nc, d, N))
+    state = np.empty((nc, N), dtype=np.int8)
+    sweeps = np.zeros(nc, dtype=np.int64)
+    start = np.empty(dt)
+    for p in range(nc):
+        scale = 0.0
+        for c in range(d):
+            for n in range(N):
+                a = abs(lam_u[p, c, n])
+                if a > scale:
+                    scale = a
+        thr = tol * max(scale, 1e-300)
+        for c in range(dt):
+            start[c] = x_start[p, c]
+        k = 0
+        while True:
+            k += 1
+            xprev = start.copy()
+            end = _sweep(lam_u[p], mu[p], xprev, lam_x[p], state[p])
+            diff = 0.0
+            for c in range(dt):
+                diff = max(diff, abs(end[c] - start[c]))
+            if diff <= thr:
+                break
+            if k > max_sweeps:
+                k += 1
+                break
+            for c in range(dt):
+                start[c] = end[c]
+        sweeps[p] = k
+    return lam_x, state, sweeps
+
+
+@njit(cache=True)
+def dlft_jacobian(lam_u, lam_x, state, mu, P, Q):
+    """Derivative ``G = d lambda_x~ / d lambda_u~`` per node (nc, d*H, d*H).
+
+    Rows and columns are ordered ``c*H + h`` (component ``c`` of the node, real Fourier
+    coefficient ``h``). ``P`` (H, N) is the forward DFT, ``Q`` (N, H) the inverse.
+    Differentiates the converged periodic recursion of :func:`dlft_time`; the dependence on
+    the state before ``n = 0`` (equal to the state at ``n = N-1``) is solved exactly. A node
+    that sticks all period keeps its anchor, which does not depend on ``U``.
+    """
+    nc, d, N = lam_u.shape
+    H = P.shape[0]
+    dt = d - 1
+    dH = d * H
+    G = np.zeros((nc, dH, dH))
+    A0 = np.zeros((d, dH))  # d lambda_x(n) / d lambda_u~ (part independent of the seed)
+    S = np.zeros((d, dt))  # d lambda_x(n) / d seed, seed = d lambda_x,T(-1)
+    PS = np.zeros((dH, dt))
+    B = np.zeros((dt, dt))
+    that = np.zeros(dt)
+    tmpA = np.zeros((dt, dH))
+    tmpS = np.zeros((dt, dt))
+    for p in range(nc):
+        A0[:, :] = 0.0
+        S[:, :] = 0.0
+        for c in range(dt):
+            S[1 + c, c] = 1.0
+        PS[:, :] = 0.0
+        all_stick = True
+        Gp = G[p]
+        for n in range(N):
+            st = state[p, n]
+            if st == SEPARATION:
+                all_stick = False
+                A0[:, :] = 0.0
+                for c in range(d):
+                    for h in range(H):
+                        A0[c, c * H + h] = Q[n, h]
+                S[:, :] = 0.0
+            elif st == STICK:
+                A0[0, :] = 0.0
+                S[0, :] = 0.0
+            else:
+                all_stick = False
+                pn = lam_u[p, 0, n]
+                # pre_T = lam_u,T(n) - lam_x,T(n-1); lam_x,T(n-1) = lam_x,T(n) - pre_T(1 - mu pn/|pre_T|)
+                # so pre_T is recovered from lam_u,T(n) - lam_x,T(n) = mu pn t^  (on the cone)
+                nrm2 = 0.0
+                for c in range(dt):
+                    that[c] = lam_u[p, 1 + c, n] - lam_x[p, 1 + c, n]
+                    nrm2 += that[c] * that[c]
+                lam_t = np.sqrt(nrm2)
+                for c in range(dt):
+                    that[c] = that[c] / lam_t if lam_t > 0.0 else 0.0
+                # |pre_T| from the previous correction
+                nrm2 = 0.0
+                for c in range(dt):
+                    prev = lam_x[p, 1 + c, n - 1] if n > 0 else lam_x[p, 1 + c, N - 1]
+                    v = lam_u[p, 1 + c, n] - prev
+                    nrm2 += v * v
+                rho = np.sqrt(nrm2)
+                g = mu[p] * pn / rho if rho > 0.0 else 0.0
+                for a in range(dt):
+                    for b in range(dt):
+                        B[a, b] = g * ((1.0 if a == b else 0.0) - that[a] * that[b])
+                # A0_T(n) = (I - B) e_T phi - mu t^ e_N phi + B A0_T(n-1);  S_T(n) = B S_T(n-1)
+                for a in range(dt):
+                    for j in range(dH):
+                        acc = 0.0
+                        for b in range(dt):
+                            acc += B[a, b] * A0[1 + b, j]
+                        tmpA[a, j] = acc
+                    for j in range(dt):
+                        acc = 0.0
+                        for b in range(dt):
+                            acc += B[a, b] * S[1 + b, j]
+                        tmpS[a, j] = acc
+                for a in range(dt):
+                    for j in range(dH):
+                        A0[1 + a, j] = tmpA[a, j]
+                    for h in range(H):
+                        qh = Q[n, h]
+                        for b in range(dt):
+                            A0[1 + a, (1 + b) * H + h] += ((1.0 if a == b else 0.0) - B[a, b]) * qh
+                        A0[1 + a, h] += -mu[p] * that[a] * qh
+                    for j in range(dt):
+                        S[1 + a, j] = tmpS[a, j]
+                A0[0, :] = 0.0
+                S[0, :] = 0.0
+            # accumulate the DFT of the derivative
+            for c in range(d):
+                for h in range(H):
+                    w = P[h, n]
+                    if w != 0.0:
+                        row = c * H + h
+                        for j in range(dH):
+                            Gp[row, j] += w * A0[c, j]
+                        for j in range(dt):
+                            PS[row, j] += w * S[c, j]
+        if all_stick:
+            continue  # the start state is the anchor: no dependence on U
+        # seed = A_T(-1) = A_T(N-1) = A0_T(N-1) + S_T(N-1) seed  ->  (I - S_T) seed = A0_T
+        M = np.eye(dt)
+        for a in range(dt):
+            for b in range(dt):
+                M[a, b] -= S[1 + a, b]
+        seed = np.linalg.solve(M, A0[1:, :].copy())
+        for row in range(dH):
+            for j in range(dH):
+                acc = 0.0
+                for b in range(dt):
+                    acc += PS[row, b] * seed[b, j]
+                Gp[row, j] += acc
+    return G
+
+
+def friction_work(lam, x, state):
+    """Energy dissipated by friction per period and node [J]: ``sum_n lambda_T(n).(X_T(n) -
+    X_T(n-1))`` over slip instants (zero where the node sticks), (nc,)."""
+    dx = x[:, 1:, :] - np.roll(x[:, 1:, :], 1, axis=2)
+    work = np.einsum("pcn,pcn->pn", lam[:, 1:, :], dx)
+    work[state != SLIP] = 0.0
+    return work.sum(axis=1)
+
+
+def slip_increments(x, state):
+    """Corrected slip ``|X_T(n) - X_T(n-1)|`` per node and instant (nc, N) [m] (0 unless slip)."""
+    dx = x[:, 1:, :] - np.roll(x[:, 1:, :], 1, axis=2)
+    s = np.sqrt(np.einsum("pcn,pcn->pn", dx, dx))
+    s[state != SLIP] = 0.0
+    return s

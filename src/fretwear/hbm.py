@@ -1,0 +1,340 @@
+"""DLFT harmonic balance: residual, Jacobian and the periodic solve (paper eq. 19-28).
+
+Unknowns are the real Fourier coefficients ``U~`` of the contact-local displacements
+(``m = n_contact * d`` DOFs, ``H = 1 + 2k`` coefficients each), stored *DOF-major* as an
+``(m, H)`` array. The residual is (eq. 22)
+
+    f(U~) = eps (U~ - W~ - X~),         X~ = lambda_x~ / eps,
+
+with ``lambda_x`` from the time-domain law of :mod:`fretwear.contact` applied to
+``lambda_u = F~ - Z U~ + eps (U~ - W~)`` (eq. 23). ``W~`` holds gap + wear on the normal DOFs
+(static term). The Jacobian is ``J = eps I - G (eps I - Z)`` with ``G = d lambda_x~/d lambda_u~``
+block-diagonal per node.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from fretwear import contact as law
+from fretwear.errors import InputError
+from fretwear.fourier import FourierBasis, amplitude
+from fretwear.model.core import ContactInterface, Model
+from fretwear.reduce import Reduced, condense, loads_to_real, to_real_blocks
+from fretwear.solvers import SolveStats, solve
+
+
+class DLFTProblem:
+    """Residual and Jacobian of the DLFT balance for one reduced model (one frequency).
+
+    Parameters
+    ----------
+    reduced : :class:`~fretwear.reduce.Reduced` on the orders ``[0] + basis.harmonics``.
+    contact : the interface (friction coefficient per node is ``contact.mu``).
+    basis : Fourier basis.
+    gap : (nc,) normal gap + wear ``W`` [m].
+    eps : DLFT penalty [N/m]; ``None`` = spectral radius of ``Z_r`` (paper, section 3.2).
+    anchor : (nc, d-1) stick anchors: where a node that sticks all period sticks [m]
+        (tangential, contact-local). Default 0.
+    """
+
+    def __init__(self, reduced: Reduced, contact: ContactInterface, basis: FourierBasis,
+                 gap=None, eps=None, anchor=None, periodicity_tol=1e-12, max_sweeps=200):
+        nc, d = contact.dofs.shape
+        self.nc, self.d, self.basis = nc, d, basis
+        self.H = basis.size
+        self.m = nc * d
+        exp = np.array([0, *basis.harmonics])
+        if not np.array_equal(np.asarray(reduced.orders), exp):
+            raise InputError(f"reduced model orders {list(reduced.orders)} != basis {list(exp)}")
+        self.reduced = reduced
+        self.Z = to_real_blocks(reduced.Z, reduced.orders)
+        self.F = loads_to_real(reduced.F)
+        self.eps = float(reduced.spectral_radius() if eps is None else eps)
+        if not self.eps > 0:
+            raise InputError(f"eps = {eps}: expected a positive penalty [N/m]")
+        self.mu = np.full(nc, float(contact.mu))
+        self.set_gap(contact.gap if gap is None else gap)
+        self.anchor = np.zeros((nc, d - 1)) if anchor is None else np.array(anchor, float)
+        self.P = basis.forward_matrix()
+        self.Q = basis.inverse_matrix()
+        self.tol = periodicity_tol
+        self.max_sweeps = max_sweeps
+        self.nfev = 0
+
+    def set_gap(self, gap):
+        gap = np.broadcast_to(np.asarray(gap, dtype=float), (self.nc,))
+        W = np.zeros((self.m, self.H))
+        W[0 :: self.d, 0] = gap
+        self.gap = np.array(gap)
+        self.W = W
+
+    # -- evaluation ---------------------------------------------------------------------
+    def lambda_u(self, U):
+        """``lambda_u~ = F~ - Z U~ + eps (U~ - W~)`` (m, H) (eq. 23)."""
+        ZU = (self.Z @ U.reshape(-1)).reshape(self.m, self.H)
+        return self.F - ZU + self.eps * (U - self.W)
+
+    def time_law(self, U):
+        """Time-domain law: ``(lam_u, lam_x, state, sweeps)`` with samples (nc, d, N)."""
+        lu = self.basis.to_time(self.lambda_u(U)).reshape(self.nc, self.d, -1)
+        lu = np.ascontiguousarray(lu)
+        lx, state, sweeps = law.dlft_time(lu, self.mu, self.eps * self.anchor, self.tol,
+                                          self.max_sweeps)
+        return lu, lx, state, sweeps
+
+    def residual(self, U, jacobian=True):
+        """``f`` (m*H,) and, if asked, ``J`` (m*H, m*H) at ``U`` (m, H)."""
+        self.nfev += 1
+        lu, lx, state, _ = self.time_law(U)
+        Lx = self.basis.to_freq(lx.reshape(self.m, -1))
+        f = (self.eps * (U - self.W) - Lx).reshape(-1)
+        if not jacobian:
+            return f, None
+        G = law.dlft_jacobian(lu, lx, state, self.mu, self.P, self.Q)
+        n = self.m * self.H
+        dH = self.d * self.H
+        # J = eps I - G (eps I - Z) = eps (I - G) + G Z, G block-diagonal per node
+        GZ = np.matmul(G, self.Z.reshape(self.nc, dH, n)).reshape(n, n)
+        J = GZ
+        for p in range(self.nc):
+            sl = slice(p * dH, (p + 1) * dH)
+            J[sl, sl] -= self.eps * G[p]
+        J[np.diag_indices(n)] += self.eps
+        return f, J
+
+    def scale(self, U):
+        """Reference magnitude of the convergence test: ``|Z_r U~|`` (section 3.2), or |F~|
+        when that vanishes."""
+        zu = np.linalg.norm(self.Z @ U.reshape(-1))
+        return max(zu, np.linalg.norm(self.F), 1e-300)
+
+    def initial_guess(self):
+        """Contact closed, tangential positions at the anchors, no vibration."""
+        U = np.zeros((self.m, self.H))
+        U[0 :: self.d, 0] = self.gap
+        for c in range(self.d - 1):
+            U[1 + c :: self.d, 0] = self.anchor[:, c]
+        return U
+
+
+@dataclass
+class PeriodicSolution:
+    """A converged periodic solution of the DLFT balance at one frequency.
+
+    All contact quantities are in contact-local frames ``[N, T1, (T2)]``; forces are those the
+    structure exerts on the obstacle (``N`` >= 0 in compression).
+
+    Attributes
+    ----------
+    omega : circular frequency [rad/s] (0 for quasi-static).
+    quasi_static : inertia and damping dropped.
+    basis : the Fourier basis.
+    U : (nc, d, H) displacement harmonics of the contact nodes [m].
+    lam : (nc, d, H) contact force harmonics [N].
+    X : (nc, d, H) corrected displacement harmonics [m] (satisfy the contact law).
+    lam_t : (nc, d, N) contact forces in time [N].
+    x_t : (nc, d, N) corrected displacements in time [m].
+    state : (nc, N) int8: 0 separation, 1 stick, 2 slip.
+    gap : (nc,) gap + wear ``W`` used [m].
+    anchor : (nc, d-1) stick anchors used [m].
+    eps : DLFT penalty [N/m].
+    observed : name -> (d, H) displacement harmonics of observed points [m].
+    area : (nc,) tributary areas [m^2].
+    stats : solver statistics.
+    """
+
+    omega: float
+    quasi_static: bool
+    basis: FourierBasis
+    U: np.ndarray
+    lam: np.ndarray
+    X: np.ndarray
+    lam_t: np.ndarray
+    x_t: np.ndarray
+    state: np.ndarray
+    gap: np.ndarray
+    anchor: np.ndarray
+    eps: float
+    observed: dict
+    area: np.ndarray
+    coords: np.ndarray
+    stats: SolveStats
+    flags: list = field(default_factory=list)
+
+    @property
+    def frequency_hz(self) -> float:
+        return self.omega / (2 * np.pi)
+
+    @property
+    def tau(self):
+        return self.basis.tau
+
+    @property
+    def time(self):
+        """Sample times over one period [s] (angles ``tau`` when quasi-static)."""
+        return self.tau / self.omega if self.omega > 0 else self.tau
+
+    # -- interface quantities ----------------------------------------------------------------
+    def pressure_t(self):
+        """Normal contact pressure per node and instant (nc, N) [Pa]."""
+        return self.lam_t[:, 0, :] / self.area[:, None]
+
+    def pressure_stats(self):
+        """Pressure per node: ``(mean, max, amplitude of harmonic 1..)`` [Pa]."""
+        p = self.pressure_t()
+        return p.mean(axis=1), p.max(axis=1), 0.5 * (p.max(axis=1) - p.min(axis=1))
+
+    def slip_t(self):
+        """Corrected slip increments per node and instant (nc, N) [m]."""
+        return law.slip_increments(self.x_t, self.state)
+
+    def slip_stats(self):
+        """Per node: total slip path per period [m], peak-to-peak tangential displacement
+        amplitude (half range) [m] and mean tangential position [m] (first tangent)."""
+        xt = self.x_t[:, 1, :]
+        return self.slip_t().sum(axis=1), 0.5 * (xt.max(axis=1) - xt.min(axis=1)), xt.mean(1)
+
+    def friction_energy(self):
+        """Energy dissipated by friction per period and node (nc,) [J]."""
+        return law.friction_work(self.lam_t, self.x_t, self.state)
+
+    def state_fractions(self):
+        """Fraction of the period in separation, stick, slip per node (nc, 3)."""
+        return np.stack([(self.state == s).mean(axis=1) for s in range(3)], axis=1)
+
+    # -- observed points --------------------------------------------------------------------
+    def observed_time(self, name):
+        """Displacement (d, N) [m] and velocity (d, N) [m/s] of an observed point over a period."""
+        c = self.observed[name]
+        u = self.basis.to_time(c)
+        v = self.basis.to_time(c @ self.basis.derivative_matrix(max(self.omega, 0.0)).T)
+        return u, v
+
+    def observed_amplitude(self, name):
+        """Amplitude per kept harmonic (d, k) [m]."""
+        return amplitude(self.observed[name], self.basis)
+
+    def stops_per_period(self, name, axis=0, rel_tol=1e-3):
+        """Number of intervals per period during which the point's velocity along ``axis`` is
+        zero (below ``rel_tol`` times its peak): the paper's "P_e stops twice per period"."""
+        _, v = self.observed_time(name)
+        va = np.abs(v[axis])
+        stopped = va <= rel_tol * max(va.max(), 1e-300)
+        if stopped.all() or not stopped.any():
+            return 0 if not stopped.any() else 1
+        # count runs of True on the circle
+        starts = stopped & ~np.roll(stopped, 1)
+        return int(starts.sum())
+
+
+def _orders(basis):
+    return np.array([0, *basis.harmonics], dtype=np.int64)
+
+
+def static_anchor(model: Model, *, quasi: Reduced | None = None) -> np.ndarray:
+    """Tangential positions of the contact nodes after the static loads are applied from rest.
+
+    Solves the static contact problem (one instant) starting from a stress-free state in which
+    every node that touches sticks where it is (anchor 0): the loading history "preload first,
+    then vibrate". Returns (nc, d-1) [m].
+    """
+    basis = FourierBasis((), 1)
+    red = quasi if quasi is not None else condense(model, 0.0, [0], quasi_static=True)
+    prob = DLFTProblem(red, model.contact, basis)
+    U0 = prob.initial_guess()
+
+    def fun(x, jac=True):
+        return prob.residual(x.reshape(prob.m, prob.H), jac)
+
+    x, _, st = solve(fun, U0.reshape(-1), lambda x: prob.scale(x.reshape(prob.m, prob.H)),
+                     method="powell", tol=1e-10, max_iter=100)
+    if not st.converged:
+        return np.zeros((prob.nc, prob.d - 1))
+    U = x.reshape(prob.nc, prob.d, 1)
+    return U[:, 1:, 0].copy()
+
+
+def solve_periodic(model: Model, basis: FourierBasis, *, omega: float = 0.0,
+                   quasi_static: bool = False, reduced: Reduced | None = None, gap=None,
+                   eps=None, anchor=None, U0=None, solver="powell", tol=1e-8, max_iter=200,
+                   raise_on_failure=False) -> tuple[PeriodicSolution | None, SolveStats]:
+    """Periodic response of ``model`` at ``omega`` [rad/s] with the DLFT (section 3.1-3.2).
+
+    Parameters
+    ----------
+    basis : kept harmonics and samples per period.
+    quasi_static : drop inertia and damping (slow cyclic loading; ``omega`` only scales time).
+    reduced : a precomputed condensation on ``[0] + basis.harmonics`` (else computed here).
+    gap : (nc,) gap + wear [m] (default: the model's initial gap).
+    eps : DLFT penalty [N/m] (default: spectral radius of ``Z_r``).
+    anchor : (nc, d-1) stick anchors [m]; default: the static preload state
+        (:func:`static_anchor`), the documented rule for the mean tangential position.
+    U0 : (nc, d, H) starting point (e.g. a neighbouring solution).
+    solver : ``"powell"`` (dog-leg at LAPACK speed), ``"newton"`` or ``"hybr"`` (MINPACK).
+    tol : relative residual ``eps_r`` of the test ``|f| <= eps_r |Z_r U|``.
+
+    Returns
+    -------
+    (solution, stats): ``solution`` is None when the solve did not converge (then
+    ``stats.converged`` is False and ``stats.message`` says why), unless ``raise_on_failure``.
+    """
+    if reduced is None:
+        reduced = condense(model, omega, _orders(basis), quasi_static=quasi_static)
+    if anchor is None:
+        anchor = static_anchor(model)
+    prob = DLFTProblem(reduced, model.contact, basis, gap=gap, eps=eps, anchor=anchor)
+    x0 = (prob.initial_guess() if U0 is None else np.asarray(U0, float).reshape(prob.m, prob.H))
+
+    def fun(x, jac=True):
+        return prob.residual(x.reshape(prob.m, prob.H), jac)
+
+    t0 = time.perf_counter()
+    x, _, st = solve(fun, x0.reshape(-1), lambda x: prob.scale(x.reshape(prob.m, prob.H)),
+                     method=solver, tol=tol, max_iter=max_iter)
+    st.wall_time = time.perf_counter() - t0
+    if not st.converged:
+        if raise_on_failure:
+            from fretwear.errors import ConvergenceError
+
+            raise ConvergenceError(
+                f"periodic solve at f = {omega / 2 / np.pi:.6g} Hz did not converge: "
+                f"{st.message} (relative residual {st.residual:.3g} > {tol:g})"
+            )
+        return None, st
+    return assemble_solution(prob, x.reshape(prob.m, prob.H), model, st), st
+
+
+def assemble_solution(prob: DLFTProblem, U, model: Model, stats: SolveStats) -> PeriodicSolution:
+    """Post-process a converged ``U`` (m, H) into a :class:`PeriodicSolution`."""
+    lu, lx, state, _ = prob.time_law(U)
+    lam_t = lu - lx
+    x_t = lx / prob.eps
+    b = prob.basis
+    nc, d, H = prob.nc, prob.d, prob.H
+    lam = b.to_freq(lam_t.reshape(prob.m, -1)).reshape(nc, d, H)
+    X = b.to_freq(lx.reshape(prob.m, -1)).reshape(nc, d, H) / prob.eps
+    X[:, 0, 0] += prob.gap  # X~ = U~ - W~ at convergence; report positions
+    x_t = x_t.copy()
+    x_t[:, 0, :] += prob.gap[:, None]
+    red = prob.reduced
+    observed = {}
+    if red.obs_dofs.size:
+        Uc = b.to_complex(U)  # (k+1, m) complex
+        Uo = np.einsum("bom,bm->bo", red.obs_A, Uc) + red.obs_b
+        real = b.from_complex(Uo)  # (no, H)
+        i = 0
+        for p in model.observed:
+            nd = len(p.dofs)
+            observed[p.name] = real[i : i + nd]
+            i += nd
+    return PeriodicSolution(
+        omega=red.omega, quasi_static=red.quasi_static, basis=b, U=U.reshape(nc, d, H).copy(),
+        lam=lam, X=X, lam_t=lam_t, x_t=x_t, state=state, gap=prob.gap.copy(),
+        anchor=prob.anchor.copy(), eps=prob.eps, observed=observed,
+        area=np.asarray(model.contact.area, float), coords=np.asarray(model.contact.coords),
+        stats=stats,
+    )

@@ -1,0 +1,461 @@
+"""Linear analyses of a model with a linearised contact interface: normal modes and FRFs.
+
+The frictional interface is replaced by one of three linear limits (:data:`INTERFACES`):
+
+* ``"free"``: no contact constraint at all;
+* ``"sliding"``: frictionless bilateral contact: the normal displacement of every contact node
+  is held (``n . u = 0``), its tangential displacement is free;
+* ``"stuck"``: every contact DOF is held (full stick, no separation).
+
+Constraints are written in the contact-local frames (row 0 the normal, see
+:mod:`fretwear.model.core`), exactly, for any orientation of the frame: the displacement is
+written ``U = T q`` where ``q`` equals ``U`` except at the contact nodes, where it holds the
+local components ``[u_N, u_T1, (u_T2)]`` at the positions of that node's global DOFs
+(``q[dofs[p, k]] = frame[p, k] . U[dofs[p]]``); a held component is a removed coordinate of
+``q``. For axis-aligned frames ``T`` is a signed permutation and ``q`` the global DOFs.
+
+Damping enters exactly as in :func:`fretwear.reduce.dynamic_stiffness` (hysteretic ``D`` and
+viscous ``C``); the FRF is that of the harmonic ``n = 1`` part of the model loads, with the
+complex amplitude convention ``u(t) = Re U e^{i w t}``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from scipy.signal import find_peaks
+
+from fretwear.errors import InputError
+from fretwear.model.core import Model
+from fretwear.reduce import condense, dynamic_stiffness
+
+INTERFACES = ("free", "sliding", "stuck")
+FRF_METHODS = ("direct", "condensed")
+_AXES = {"x": 0, "y": 1, "z": 2}
+#: constrained systems with at most this many unknowns are solved by dense ``eigh``
+DENSE_EIG_LIMIT = 600
+
+
+# --- constraints --------------------------------------------------------------------------
+def _check_interface(interface: str) -> str:
+    if interface not in INTERFACES:
+        raise InputError(f"unknown interface {interface!r}: expected one of {INTERFACES}")
+    return interface
+
+
+def _check_contact(model: Model) -> None:
+    """The contact DOFs must be distinct, not fixed, with orthonormal frames."""
+    c = model.contact
+    dofs = np.asarray(c.dofs, dtype=np.int64).reshape(-1)
+    if np.unique(dofs).size != dofs.size:
+        raise InputError("contact DOFs must be distinct: a DOF appears in two contact nodes")
+    if dofs.size and (dofs.min() < 0 or dofs.max() >= model.ndof):
+        raise InputError(f"contact DOFs must lie in 0..{model.ndof - 1}")
+    if np.intersect1d(dofs, np.asarray(model.fixed_dofs, dtype=np.int64)).size:
+        raise InputError("contact DOFs cannot also be fixed (Dirichlet) DOFs")
+    frame = np.asarray(c.frame, dtype=float)
+    gram = frame @ np.swapaxes(frame, 1, 2)
+    if frame.size and not np.allclose(gram, np.eye(c.dim), atol=1e-10):
+        raise InputError("each contact frame must have orthonormal rows [n, t1(, t2)]")
+
+
+def local_transform(model: Model) -> sp.csr_matrix:
+    """Orthogonal ``T`` (ndof, ndof) with ``U = T q`` (see module docstring).
+
+    Returns
+    -------
+    T : sparse (ndof, ndof); ``q = T.T @ U`` holds the contact-local components at the
+        positions of the contact nodes' global DOFs and the global components elsewhere.
+    """
+    _check_contact(model)
+    c = model.contact
+    nc, d = c.dofs.shape
+    other = np.setdiff1d(np.arange(model.ndof), c.dofs.reshape(-1))
+    # U[dofs[p, a]] = sum_k frame[p, k, a] q[dofs[p, k]]
+    rows = np.broadcast_to(c.dofs[:, None, :], (nc, d, d)).reshape(-1)  # a varies fastest
+    cols = np.broadcast_to(c.dofs[:, :, None], (nc, d, d)).reshape(-1)  # k
+    vals = np.asarray(c.frame, dtype=float).reshape(-1)  # frame[p, k, a]
+    rows = np.concatenate([rows, other])
+    cols = np.concatenate([cols, other])
+    vals = np.concatenate([vals, np.ones(other.size)])
+    return sp.csr_matrix((vals, (rows, cols)), shape=(model.ndof, model.ndof))
+
+
+def _held_local(model: Model, interface: str) -> np.ndarray:
+    """(nc, d) bool: which contact-local components the interface holds."""
+    nc, d = model.contact.dofs.shape
+    held = np.zeros((nc, d), dtype=bool)
+    if interface == "sliding":
+        held[:, 0] = True
+    elif interface == "stuck":
+        held[:] = True
+    return held
+
+
+def constrained_dofs(model: Model, interface: str) -> np.ndarray:
+    """Coordinates held for ``interface``, including the model's fixed DOFs.
+
+    Parameters
+    ----------
+    model : the model.
+    interface : one of :data:`INTERFACES`.
+
+    Returns
+    -------
+    (nh,) sorted int array of indices into ``q = T.T @ U`` (:func:`local_transform`): the
+    global DOF numbers, where a contact node's DOF ``dofs[p, k]`` stands for its local
+    component ``k`` (0 = normal). For axis-aligned frames these are plain global DOFs; for a
+    tilted frame, holding ``dofs[p, 0]`` means the exact constraint ``n . u = 0``.
+    """
+    _check_interface(interface)
+    _check_contact(model)
+    held = model.contact.dofs[_held_local(model, interface)]
+    fixed = np.asarray(model.fixed_dofs, dtype=np.int64)
+    return np.unique(np.concatenate([fixed, held.astype(np.int64)]))
+
+
+def _reduced_basis(model: Model, interface: str):
+    """``(T, Tf, free)``: ``U = Tf @ q_f`` spans the displacements allowed by the interface."""
+    T = local_transform(model).tocsc()
+    held = constrained_dofs(model, interface)
+    free = np.setdiff1d(np.arange(model.ndof), held)
+    return T, T[:, free], free
+
+
+# --- modes --------------------------------------------------------------------------------
+@dataclass
+class ModesResult:
+    """Normal modes of the undamped structure with a linear interface.
+
+    Attributes
+    ----------
+    interface : one of :data:`INTERFACES`.
+    frequency_hz : (nm,) natural frequencies [Hz], ascending; rigid-body modes at ~0.
+    shapes : (nm, ndof) mode shapes in the structure's axes, mass-normalised
+        (``phi^T M phi = 1`` [1/kg], so shapes are in [kg^-1/2]).
+    observed : name -> (nm, d) shapes at each observed point.
+    """
+
+    interface: str
+    frequency_hz: np.ndarray
+    shapes: np.ndarray
+    observed: dict
+
+
+def _shift(K: sp.spmatrix, M: sp.spmatrix) -> float:
+    """A small negative shift [rad^2/s^2] that makes ``K - sigma M`` positive definite when
+    ``K`` only has rigid-body null vectors with mass."""
+    tm = abs(M.diagonal()).sum()
+    tk = abs(K.diagonal()).sum()
+    return -1e-8 * (tk / tm if tm > 0 else 1.0)
+
+
+def _eig_dense(K, M, sigma: float):
+    """All finite eigenpairs of ``K x = lam M x`` via ``M x = nu (K - sigma M) x``."""
+    A = (K - sigma * M).toarray()
+    try:
+        nu, X = sla.eigh(M.toarray(), A)
+    except np.linalg.LinAlgError as exc:
+        raise InputError(
+            "the constrained structure has a motion with neither stiffness nor mass "
+            "(e.g. a massless DOF with no spring): add stiffness, mass or fixed DOFs"
+        ) from exc
+    keep = nu > 1e-12 * max(nu.max(), 0.0)
+    nu, X = nu[keep], X[:, keep]
+    return sigma + 1.0 / nu, X / np.sqrt(nu)
+
+
+def _eig_sparse(K, M, k: int, sigma: float):
+    """The ``k`` eigenpairs nearest ``sigma`` by shift-invert Lanczos (M may be singular)."""
+    try:
+        lam, X = spla.eigsh(K, k=k, M=M, sigma=sigma, which="LM")
+    except RuntimeError as exc:  # singular K - sigma M
+        raise InputError(
+            "the constrained structure has a motion with neither stiffness nor mass "
+            "(e.g. a massless DOF with no spring): add stiffness, mass or fixed DOFs"
+        ) from exc
+    return lam, X
+
+
+def _lowest_modes(K, M, n_modes: int, lam_max: float | None):
+    """Lowest eigenpairs ``(lam, X)`` of the pencil; all below ``lam_max`` when given."""
+    n = K.shape[0]
+    sigma = _shift(K, M)
+    if n <= DENSE_EIG_LIMIT:
+        lam, X = _eig_dense(K, M, sigma)
+    else:
+        k = max(1, n_modes)
+        while True:
+            if k >= n - 1:
+                lam, X = _eig_dense(K, M, sigma)
+                break
+            lam, X = _eig_sparse(K, M, k, sigma)
+            if lam_max is None or lam.max() > lam_max:
+                break
+            k = min(2 * k, n - 1)
+    order = np.argsort(lam)
+    lam, X = lam[order], X[:, order]
+    if lam_max is None:
+        return lam[:n_modes], X[:, :n_modes]
+    keep = lam <= lam_max
+    return lam[keep], X[:, keep]
+
+
+def _normalise(X: np.ndarray, M) -> np.ndarray:
+    """Columns scaled to unit modal mass; sign chosen so the largest entry is positive."""
+    X = X / np.sqrt(np.einsum("ij,ij->j", X, M @ X))
+    big = X[np.argmax(np.abs(X), axis=0), np.arange(X.shape[1])]
+    return X * np.where(big < 0, -1.0, 1.0)
+
+
+def modes(model: Model, n_modes: int = 10, *, interface: str = "sliding",
+          f_max: float | None = None) -> ModesResult:
+    """Normal modes of the undamped structure with the given linear interface.
+
+    Solves ``K phi = w^2 M phi`` on the displacements allowed by ``interface`` (exact
+    constraints in the contact-local frames). Shift-invert with a small negative shift: rigid
+    body modes are found (at ~0 Hz) and a singular ``M`` (massless DOFs) is allowed. Small
+    systems (<= :data:`DENSE_EIG_LIMIT` unknowns) use a dense symmetric solver.
+
+    Parameters
+    ----------
+    model : the model (``K``, ``M``; damping is ignored).
+    n_modes : number of lowest modes returned (ignored when ``f_max`` is given).
+    interface : one of :data:`INTERFACES`.
+    f_max : if given, every mode with frequency <= ``f_max`` [Hz] is returned.
+
+    Returns
+    -------
+    ModesResult
+    """
+    _check_interface(interface)
+    if f_max is None and n_modes < 1:
+        raise InputError(f"n_modes must be >= 1, got {n_modes}")
+    _, Tf, _ = _reduced_basis(model, interface)
+    if Tf.shape[1] == 0:
+        raise InputError(f"interface {interface!r} holds every DOF: the structure cannot move")
+    K = (Tf.T @ model.K @ Tf).tocsc()
+    M = (Tf.T @ model.M @ Tf).tocsc()
+    K, M = 0.5 * (K + K.T), 0.5 * (M + M.T)
+    lam_max = None if f_max is None else (2.0 * np.pi * f_max) ** 2
+    lam, X = _lowest_modes(K.tocsc(), M.tocsc(), n_modes, lam_max)
+    X = _normalise(X, M)
+    shapes = np.asarray((Tf @ X).T)
+    freq = np.sqrt(np.clip(lam, 0.0, None)) / (2.0 * np.pi)
+    obs = {p.name: shapes[:, np.asarray(p.dofs, dtype=np.int64)] for p in model.observed}
+    return ModesResult(interface, freq, shapes, obs)
+
+
+# --- FRF ----------------------------------------------------------------------------------
+@dataclass
+class FRFResult:
+    """Forced response to the harmonic (n = 1) part of the loads, ``u(t) = Re U e^{i w t}``.
+
+    Attributes
+    ----------
+    interface : one of :data:`INTERFACES`.
+    frequency_hz : (nf,) excitation frequencies [Hz].
+    observed : name -> (nf, d) complex displacement amplitudes [m] in the structure's axes.
+    contact : (nf, nc, d) complex contact-local displacement amplitudes [m] (0 where held).
+    reaction : (nf, nc, d) complex contact-local forces [N] the structure exerts on the
+        obstacle on the held components (``lambda`` of :mod:`fretwear.model.core`, positive
+        in compression); 0 on free components.
+    method : ``"direct"`` or ``"condensed"``.
+    """
+
+    interface: str
+    frequency_hz: np.ndarray
+    observed: dict
+    contact: np.ndarray
+    reaction: np.ndarray
+    method: str = "direct"
+
+
+def _harmonic_load(model: Model) -> np.ndarray:
+    F = model.load_harmonics(1)[1]
+    if not np.any(F):
+        raise InputError(
+            "the model has no harmonic load: an FRF needs a load with a harmonic n = 1 "
+            "part (waveform 'cos', 'sin', 'triangle' or 'fourier' with n = 1)"
+        )
+    return F
+
+
+def _check_frequencies(frequencies_hz) -> np.ndarray:
+    f = np.atleast_1d(np.asarray(frequencies_hz, dtype=float))
+    if f.ndim != 1 or f.size == 0 or not np.all(np.isfinite(f)) or np.any(f <= 0):
+        raise InputError("frequencies_hz must be a non-empty 1D array of positive values [Hz]")
+    return f
+
+
+def _singular_message(interface: str, f_hz: float) -> str:
+    return (
+        f"the {interface!r} structure is singular at {f_hz:.6g} Hz: an undamped "
+        "eigenfrequency, or a rigid-body motion (add damping, springs or fixed DOFs)"
+    )
+
+
+def _solve(Z, rhs, f_hz: float, interface: str):
+    """Sparse complex solve with a clear message at an undamped resonance."""
+    try:
+        x = spla.splu(sp.csc_matrix(Z, dtype=complex)).solve(rhs.astype(complex))
+    except RuntimeError as exc:
+        x = None
+        cause = exc
+    else:
+        cause = None
+    if x is None or not np.all(np.isfinite(x)):
+        raise InputError(_singular_message(interface, f_hz)) from cause
+    return x
+
+
+def _solve_dense(Z: np.ndarray, rhs: np.ndarray, f_hz: float, interface: str):
+    """Dense complex solve of the reduced system, same message as :func:`_solve`."""
+    try:
+        x = np.linalg.solve(Z, rhs)
+    except np.linalg.LinAlgError:
+        x = None
+    if x is None or not np.all(np.isfinite(x)):
+        raise InputError(_singular_message(interface, f_hz))
+    return x
+
+
+def _frf_direct(model: Model, freqs: np.ndarray, interface: str, F: np.ndarray):
+    T, Tf, free = _reduced_basis(model, interface)
+    Fq = T.T @ F
+    cd = model.contact.dofs
+    held = _held_local(model, interface)
+    obs, con, rea = [], [], []
+    for f in freqs:
+        Zq = (T.T @ dynamic_stiffness(model, 2.0 * np.pi * f, 1) @ T).tocsr()
+        q = np.zeros(model.ndof, dtype=complex)
+        q[free] = _solve(Zq[free][:, free], Fq[free], f, interface)
+        residual = Fq - Zq @ q  # = T^T (F - Z U): the constraint forces in q coordinates
+        obs.append(T @ q)
+        con.append(q[cd])
+        rea.append(np.where(held, residual[cd], 0.0))
+    U = np.array(obs)
+    observed = {p.name: U[:, np.asarray(p.dofs, dtype=np.int64)] for p in model.observed}
+    return observed, np.array(con), np.array(rea)
+
+
+def _frf_condensed(model: Model, freqs: np.ndarray, interface: str):
+    nc, d = model.contact.dofs.shape
+    held = _held_local(model, interface).reshape(-1)
+    keep = np.flatnonzero(~held)
+    obs, con, rea = [], [], []
+    for f in freqs:
+        red = condense(model, 2.0 * np.pi * f, [1])
+        Z, Fr = red.Z[0], red.F[0]
+        u = np.zeros(nc * d, dtype=complex)
+        if keep.size:
+            u[keep] = _solve_dense(Z[np.ix_(keep, keep)], Fr[keep], f, interface)
+        lam = np.where(held, Fr - Z @ u, 0.0)  # Z_r u + lambda = F_r
+        obs.append(red.obs_A[0] @ u + red.obs_b[0])
+        con.append(u.reshape(nc, d))
+        rea.append(lam.reshape(nc, d))
+    Uo = np.array(obs).reshape(freqs.size, -1)
+    observed, start = {}, 0
+    for p in model.observed:
+        n = len(p.dofs)
+        observed[p.name] = Uo[:, start : start + n]
+        start += n
+    return observed, np.array(con), np.array(rea)
+
+
+def frf(model: Model, frequencies_hz, *, interface: str = "sliding",
+        method: str = "direct") -> FRFResult:
+    """Frequency response to the harmonic (n = 1) part of the model loads.
+
+    Parameters
+    ----------
+    model : the model; its loads must have a harmonic ``n = 1`` part.
+    frequencies_hz : (nf,) excitation frequencies [Hz] (> 0).
+    interface : one of :data:`INTERFACES`.
+    method : ``"direct"`` (sparse complex solve of the whole constrained model per
+        frequency) or ``"condensed"`` (:func:`fretwear.reduce.condense` at harmonic 1, then
+        the constraint applied to the reduced contact-local coordinates). Both are exact and
+        agree to rounding.
+
+    Returns
+    -------
+    FRFResult
+    """
+    _check_interface(interface)
+    if method not in FRF_METHODS:
+        raise InputError(f"unknown FRF method {method!r}: expected one of {FRF_METHODS}")
+    freqs = _check_frequencies(frequencies_hz)
+    F = _harmonic_load(model)
+    _check_contact(model)
+    if method == "direct":
+        observed, con, rea = _frf_direct(model, freqs, interface, F)
+    else:
+        observed, con, rea = _frf_condensed(model, freqs, interface)
+    return FRFResult(interface, freqs, observed, con, rea, method)
+
+
+def frequency_grid(f_min: float, f_max: float, n: int, spacing: str = "log") -> np.ndarray:
+    """``n`` frequencies [Hz] from ``f_min`` to ``f_max`` (both included).
+
+    Parameters
+    ----------
+    f_min, f_max : band limits [Hz], ``0 < f_min < f_max``.
+    n : number of points (>= 2).
+    spacing : ``"log"`` (geometric) or ``"linear"``.
+    """
+    if spacing not in ("log", "linear"):
+        raise InputError(f"unknown spacing {spacing!r}: expected 'log' or 'linear'")
+    if not (0 < f_min < f_max) or not np.isfinite(f_max):
+        raise InputError(f"expected 0 < f_min < f_max, got f_min = {f_min}, f_max = {f_max}")
+    if int(n) < 2:
+        raise InputError(f"a frequency grid needs n >= 2 points, got {n}")
+    if spacing == "log":
+        return np.geomspace(f_min, f_max, int(n))
+    return np.linspace(f_min, f_max, int(n))
+
+
+def _axis_index(axis) -> int:
+    if isinstance(axis, str):
+        if axis.lower() not in _AXES:
+            raise InputError(f"unknown axis {axis!r}: expected 'x', 'y', 'z' or an index")
+        return _AXES[axis.lower()]
+    return int(axis)
+
+
+def count_resonances(frf_result: FRFResult, point: str, axis, *,
+                     prominence: float = 1.0) -> tuple[int, np.ndarray]:
+    """Resonance peaks of ``|U|`` of one observed component over the computed band.
+
+    A peak is a local maximum of ``log10 |U|`` whose topographic prominence is at least
+    ``prominence`` decades (:func:`scipy.signal.find_peaks`); this rejects ripples and the
+    shoulders of neighbouring peaks. A peak at either end of the band is not counted. The
+    frequency grid must resolve the peaks (spacing well below the half-power bandwidth
+    ``eta f`` is not needed, but a peak falling between two grid points loses height).
+
+    Parameters
+    ----------
+    frf_result : an :class:`FRFResult`.
+    point : name of an observed point.
+    axis : ``"x"``, ``"y"``, ``"z"`` or a component index.
+    prominence : minimum prominence [decades of amplitude].
+
+    Returns
+    -------
+    (n, frequencies) : the number of peaks and their grid frequencies [Hz].
+    """
+    if point not in frf_result.observed:
+        raise InputError(
+            f"no observed point {point!r} in the FRF; it has {list(frf_result.observed)}"
+        )
+    U = frf_result.observed[point]
+    k = _axis_index(axis)
+    if not 0 <= k < U.shape[1]:
+        raise InputError(f"axis {axis!r} out of range for a point with {U.shape[1]} components")
+    amp = np.abs(U[:, k])
+    logamp = np.log10(np.maximum(amp, np.finfo(float).tiny))
+    peaks, _ = find_peaks(logamp, prominence=prominence)
+    return int(peaks.size), frf_result.frequency_hz[peaks]

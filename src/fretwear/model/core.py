@@ -1,0 +1,249 @@
+"""Plain data objects describing a linear structure with a frictional contact interface.
+
+Everything downstream (condensation, harmonic balance, wear, time integration, output)
+takes a :class:`Model`. A model is built either from a finite element mesh
+(:mod:`fretwear.model.build`) or from user matrices (:mod:`fretwear.model.matrices`); both
+paths end here, so the solvers never know which one was used.
+
+Conventions (SI units throughout):
+
+* ``U`` is the vector of nodal displacements [m] in the structure's own axes; DOF ``2*i + c``
+  (2D) or ``3*i + c`` (3D) for mesh node ``i`` and component ``c``; user matrices use their
+  own numbering.
+* A contact node has a local frame of ``d`` orthonormal rows: row 0 is the *normal* ``n``,
+  pointing from the structure into the obstacle (the direction that closes the gap); rows
+  ``1..d-1`` are the tangential directions. Local displacement ``u_loc = frame @ U[dofs]``.
+* Signorini with wear (paper eq. 5): ``u_N - w - g <= 0``; ``g`` is the initial gap (>= 0 open).
+* Contact forces ``lambda`` are the forces the structure exerts on the obstacle, in the local
+  frame: ``lambda_N >= 0`` in compression (the paper uses the opposite sign), and the
+  equation of motion is ``M U'' + C U' + K U + (frame^T lambda on contact DOFs) = F(t)``
+  (paper eq. 11 and 19).
+* Loads are ``F(t) = sum_k vector_k * g_k(omega t)`` with ``g_k`` a periodic waveform of
+  period ``2 pi`` (:class:`Load`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+WAVEFORMS = ("constant", "cos", "sin", "triangle", "fourier")
+
+
+@dataclass
+class Load:
+    """A load vector times a periodic waveform of ``tau = omega t``.
+
+    Attributes
+    ----------
+    vector : (ndof,) float array, nodal forces [N].
+    waveform : one of ``"constant"`` (static part), ``"cos"``, ``"sin"``, ``"triangle"``
+        (amplitude 1, zero at ``tau = 0``, rising like ``sin``; Stromberg's linear load
+        evolution), or ``"fourier"`` (user coefficients).
+    coefficients : for ``"fourier"`` only: dict ``{n: (a_n, b_n)}`` so that
+        ``g(tau) = sum_n a_n cos(n tau) + b_n sin(n tau)`` (``n = 0`` gives the mean, ``b_0``
+        ignored).
+    name : label used in output.
+    """
+
+    vector: np.ndarray
+    waveform: str = "cos"
+    coefficients: dict | None = None
+    name: str = "load"
+
+    def fourier_coefficients(self, nmax: int) -> tuple[np.ndarray, np.ndarray]:
+        """Real Fourier coefficients ``a_n, b_n`` (n = 0..nmax) of the waveform.
+
+        ``g(tau) = a_0 + sum_{n>=1} a_n cos(n tau) + b_n sin(n tau)``. Exact for the analytic
+        waveforms; the triangle uses its closed-form series ``8/(pi^2 n^2) (-1)^((n-1)/2)``
+        on odd sines.
+        """
+        a = np.zeros(nmax + 1)
+        b = np.zeros(nmax + 1)
+        w = self.waveform
+        if w == "constant":
+            a[0] = 1.0
+        elif w == "cos":
+            if nmax >= 1:
+                a[1] = 1.0
+        elif w == "sin":
+            if nmax >= 1:
+                b[1] = 1.0
+        elif w == "triangle":
+            for n in range(1, nmax + 1, 2):
+                b[n] = 8.0 / (np.pi**2 * n**2) * (-1.0) ** ((n - 1) // 2)
+        elif w == "fourier":
+            for n, (an, bn) in (self.coefficients or {}).items():
+                n = int(n)
+                if 0 <= n <= nmax:
+                    a[n] = an
+                    b[n] = 0.0 if n == 0 else bn
+        else:
+            raise ValueError(
+                f"load {self.name!r}: unknown waveform {w!r}; expected one of {WAVEFORMS}"
+            )
+        return a, b
+
+    def waveform_samples(self, tau: np.ndarray) -> np.ndarray:
+        """The waveform ``g(tau)`` evaluated at the angles ``tau`` [rad] (exact, no truncation)."""
+        w = self.waveform
+        tau = np.asarray(tau, dtype=float)
+        if w == "constant":
+            return np.ones_like(tau)
+        if w == "cos":
+            return np.cos(tau)
+        if w == "sin":
+            return np.sin(tau)
+        if w == "triangle":
+            return (2.0 / np.pi) * np.arcsin(np.sin(tau))
+        if w == "fourier":
+            out = np.zeros_like(tau)
+            for n, (an, bn) in (self.coefficients or {}).items():
+                n = int(n)
+                out += an * np.cos(n * tau) + (0.0 if n == 0 else bn * np.sin(n * tau))
+            return out
+        raise ValueError(f"load {self.name!r}: unknown waveform {w!r}; expected one of {WAVEFORMS}")
+
+
+@dataclass
+class ContactInterface:
+    """Contact nodes against a rigid obstacle (node-to-rigid-surface).
+
+    Attributes
+    ----------
+    dofs : (nc, d) int array, global DOFs of each contact node in the structure's axes.
+    frame : (nc, d, d) float array, rows ``[n, t1(, t2)]`` (see module docstring).
+    gap : (nc,) initial normal gap [m] (>= 0 means open).
+    area : (nc,) tributary area [m^2] (2D plane strain: tributary length x width).
+    mu : Coulomb friction coefficient [-].
+    coords : (nc, d) node positions [m] (for output; zeros for user matrices if unknown).
+    node_ids : (nc,) mesh node numbers, or -1 when built from matrices.
+    wear_coefficient : Archard coefficient k_w [1/Pa] (eq. 29), used by wear analyses.
+    name : label.
+    """
+
+    dofs: np.ndarray
+    frame: np.ndarray
+    gap: np.ndarray
+    area: np.ndarray
+    mu: float
+    coords: np.ndarray
+    node_ids: np.ndarray | None = None
+    wear_coefficient: float = 0.0
+    name: str = "contact"
+
+    @property
+    def n_nodes(self) -> int:
+        return int(self.dofs.shape[0])
+
+    @property
+    def dim(self) -> int:
+        return int(self.dofs.shape[1])
+
+    def local_transform(self, ndof: int) -> sp.csr_matrix:
+        """Sparse ``T`` (nc*d x ndof) with ``u_loc = T @ U``; rows node-major ``[N, T1, (T2)]``."""
+        nc, d = self.dofs.shape
+        rows = np.repeat(np.arange(nc * d), d)
+        cols = np.broadcast_to(self.dofs[:, None, :], (nc, d, d)).reshape(-1)
+        vals = self.frame.reshape(-1)
+        return sp.csr_matrix((vals, (rows, cols)), shape=(nc * d, ndof))
+
+
+@dataclass
+class ObservedPoint:
+    """A point whose motion is reported: its DOFs (one per axis) and position [m]."""
+
+    name: str
+    dofs: np.ndarray
+    coords: np.ndarray
+
+
+@dataclass
+class Mesh:
+    """A finite element mesh kept with the model for output (ParaView fields, profiles).
+
+    points : (nn, d) node coordinates [m]; cells : (ne, k) connectivity; cell_type : meshio
+    name (``"quad"``, ``"triangle"``, ``"hexahedron"``, ``"tetra"``); boundaries : name ->
+    (nf, kf) facet connectivity; node_sets : name -> node numbers.
+    """
+
+    points: np.ndarray
+    cells: np.ndarray
+    cell_type: str
+    boundaries: dict[str, np.ndarray] = field(default_factory=dict)
+    node_sets: dict[str, np.ndarray] = field(default_factory=dict)
+
+    @property
+    def dim(self) -> int:
+        return int(self.points.shape[1])
+
+
+@dataclass
+class Model:
+    """A linear structure with one frictional contact interface (paper eq. 11).
+
+    K, M : (ndof, ndof) sparse stiffness [N/m] and mass [kg] (M may be singular).
+    C : viscous damping [N s/m] or None.
+    D : hysteretic damping matrix [N/m] or None: on harmonic ``n >= 1`` the dynamic stiffness
+        is ``K + i D - (n w)^2 M + i n w C`` (a loss factor eta gives ``D = eta K``); it
+        has no static part.
+    loads : list of :class:`Load`.
+    contact : the interface.
+    observed : points whose motion is reported.
+    fixed_dofs : DOFs held at zero (Dirichlet), removed before any solve.
+    dim : 2 (plane strain) or 3.
+    mesh : the mesh, when built from one.
+    thickness : out-of-plane width [m] (2D only; 1 for matrices).
+    """
+
+    K: sp.csr_matrix
+    M: sp.csr_matrix
+    contact: ContactInterface
+    C: sp.csr_matrix | None = None
+    D: sp.csr_matrix | None = None
+    loads: list[Load] = field(default_factory=list)
+    observed: list[ObservedPoint] = field(default_factory=list)
+    fixed_dofs: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    dim: int = 2
+    mesh: Mesh | None = None
+    thickness: float = 1.0
+    name: str = "model"
+    meta: dict = field(default_factory=dict)
+
+    @property
+    def ndof(self) -> int:
+        return int(self.K.shape[0])
+
+    def free_dofs(self) -> np.ndarray:
+        mask = np.ones(self.ndof, dtype=bool)
+        mask[np.asarray(self.fixed_dofs, dtype=np.int64)] = False
+        return np.flatnonzero(mask)
+
+    def load_harmonics(self, nmax: int) -> np.ndarray:
+        """Complex load amplitudes ``F_n`` (nmax+1, ndof) [N]: ``F(t) = Re sum F_n e^{i n w t}``.
+
+        ``F_0`` is the static load (real); for ``n >= 1``, ``F_n = a_n - i b_n`` in terms of the
+        real cosine/sine coefficients.
+        """
+        out = np.zeros((nmax + 1, self.ndof), dtype=complex)
+        for load in self.loads:
+            a, b = load.fourier_coefficients(nmax)
+            out += np.outer(a - 1j * b, load.vector)
+        return out
+
+    def load_time(self, tau: np.ndarray) -> np.ndarray:
+        """Load vectors at angles ``tau`` (len(tau), ndof) [N], exact (no truncation)."""
+        tau = np.atleast_1d(np.asarray(tau, dtype=float))
+        out = np.zeros((tau.size, self.ndof))
+        for load in self.loads:
+            out += np.outer(load.waveform_samples(tau), load.vector)
+        return out
+
+    def observed_point(self, name: str) -> ObservedPoint:
+        for p in self.observed:
+            if p.name == name:
+                return p
+        names = [p.name for p in self.observed]
+        raise KeyError(f"no observed point named {name!r}; the model has {names}")
