@@ -10,17 +10,20 @@ The frictional interface is replaced by one of three linear limits (:data:`INTER
 Constraints are written in the contact-local frames (row 0 the normal, see
 :mod:`fretwear.model.core`), exactly, for any orientation of the frame: the displacement is
 written ``U = T q`` where ``q`` equals ``U`` except at the contact nodes, where it holds the
-local components ``[u_N, u_T1, (u_T2)]`` at the positions of that node's global DOFs
-(``q[dofs[p, k]] = frame[p, k] . U[dofs[p]]``); a held component is a removed coordinate of
-``q``. For axis-aligned frames ``T`` is a signed permutation and ``q`` the global DOFs.
+local components ``[u_N, u_T1, (u_T2)]`` at the positions of that node's global DOFs: local
+component ``k`` sits at the global DOF of the axis that frame row ``k`` is closest to
+(:func:`local_positions`), ``q[pos[p, k]] = frame[p, k] . U[dofs[p]]``. A held component is a
+removed coordinate of ``q``. For axis-aligned frames ``T`` is a signed permutation and the
+held coordinates are the global DOFs along the held directions.
 
 Damping enters exactly as in :func:`fretwear.reduce.dynamic_stiffness` (hysteretic ``D`` and
-viscous ``C``); the FRF is that of the harmonic ``n = 1`` part of the model loads, with the
-complex amplitude convention ``u(t) = Re U e^{i w t}``.
+viscous ``C``: ``Z = K + i D - w^2 M + i w C``); the FRF is that of the harmonic ``n = 1``
+part of the model loads, with the complex amplitude convention ``u(t) = Re U e^{i w t}``.
 """
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -31,7 +34,7 @@ from scipy.signal import find_peaks
 
 from fretwear.errors import InputError
 from fretwear.model.core import Model
-from fretwear.reduce import condense, dynamic_stiffness
+from fretwear.reduce import condense
 
 INTERFACES = ("free", "sliding", "stuck")
 FRF_METHODS = ("direct", "condensed")
@@ -63,6 +66,25 @@ def _check_contact(model: Model) -> None:
         raise InputError("each contact frame must have orthonormal rows [n, t1(, t2)]")
 
 
+def local_positions(model: Model) -> np.ndarray:
+    """Where each contact-local component lives in ``q`` (see module docstring).
+
+    Returns
+    -------
+    (nc, d) int array ``pos``: local component ``k`` of contact node ``p`` is ``q[pos[p, k]]``.
+    ``pos[p]`` is a permutation of ``dofs[p]`` maximising ``sum_k |frame[p, k, perm[k]]|``, so
+    that an axis-aligned normal sits at the global DOF along that axis (e.g. a normal
+    ``(0, -1)`` at the node's y DOF).
+    """
+    c = model.contact
+    frame = np.abs(np.asarray(c.frame, dtype=float))
+    d = c.dim
+    perms = np.array(list(itertools.permutations(range(d))), dtype=np.int64)  # (np, d)
+    scores = frame[:, np.arange(d)[None, :], perms].sum(axis=-1)  # (nc, np)
+    best = perms[np.argmax(scores, axis=1)]  # (nc, d)
+    return np.take_along_axis(np.asarray(c.dofs, dtype=np.int64), best, axis=1)
+
+
 def local_transform(model: Model) -> sp.csr_matrix:
     """Orthogonal ``T`` (ndof, ndof) with ``U = T q`` (see module docstring).
 
@@ -75,9 +97,10 @@ def local_transform(model: Model) -> sp.csr_matrix:
     c = model.contact
     nc, d = c.dofs.shape
     other = np.setdiff1d(np.arange(model.ndof), c.dofs.reshape(-1))
-    # U[dofs[p, a]] = sum_k frame[p, k, a] q[dofs[p, k]]
+    pos = local_positions(model)
+    # U[dofs[p, a]] = sum_k frame[p, k, a] q[pos[p, k]]
     rows = np.broadcast_to(c.dofs[:, None, :], (nc, d, d)).reshape(-1)  # a varies fastest
-    cols = np.broadcast_to(c.dofs[:, :, None], (nc, d, d)).reshape(-1)  # k
+    cols = np.broadcast_to(pos[:, :, None], (nc, d, d)).reshape(-1)  # k
     vals = np.asarray(c.frame, dtype=float).reshape(-1)  # frame[p, k, a]
     rows = np.concatenate([rows, other])
     cols = np.concatenate([cols, other])
@@ -107,13 +130,14 @@ def constrained_dofs(model: Model, interface: str) -> np.ndarray:
     Returns
     -------
     (nh,) sorted int array of indices into ``q = T.T @ U`` (:func:`local_transform`): the
-    global DOF numbers, where a contact node's DOF ``dofs[p, k]`` stands for its local
-    component ``k`` (0 = normal). For axis-aligned frames these are plain global DOFs; for a
-    tilted frame, holding ``dofs[p, 0]`` means the exact constraint ``n . u = 0``.
+    global DOF numbers, where at a contact node ``pos[p, k]`` (:func:`local_positions`)
+    stands for its local component ``k`` (0 = normal). For axis-aligned frames these are the
+    plain global DOFs along the held directions; for a tilted frame, holding ``pos[p, 0]``
+    means the exact constraint ``n . u = 0``.
     """
     _check_interface(interface)
     _check_contact(model)
-    held = model.contact.dofs[_held_local(model, interface)]
+    held = local_positions(model)[_held_local(model, interface)]
     fixed = np.asarray(model.fixed_dofs, dtype=np.int64)
     return np.unique(np.concatenate([fixed, held.astype(np.int64)]))
 
@@ -197,6 +221,10 @@ def _lowest_modes(K, M, n_modes: int, lam_max: float | None):
             if lam_max is None or lam.max() > lam_max:
                 break
             k = min(2 * k, n - 1)
+    # drop spurious pairs of a singular M (infinite eigenvalues: no modal mass)
+    mm = np.einsum("ij,ij->j", X, M @ X)
+    ok = np.isfinite(lam) & (mm > 1e-12 * mm.max(initial=0.0))
+    lam, X = lam[ok], X[:, ok]
     order = np.argsort(lam)
     lam, X = lam[order], X[:, order]
     if lam_max is None:
@@ -240,10 +268,16 @@ def modes(model: Model, n_modes: int = 10, *, interface: str = "sliding",
         raise InputError(f"interface {interface!r} holds every DOF: the structure cannot move")
     K = (Tf.T @ model.K @ Tf).tocsc()
     M = (Tf.T @ model.M @ Tf).tocsc()
+    if not np.any(M.diagonal() > 0):
+        raise InputError(f"the model has no mass on the DOFs left free by the {interface!r} "
+                         "interface: modes need a mass matrix (material density > 0)")
     K, M = 0.5 * (K + K.T), 0.5 * (M + M.T)
     lam_max = None if f_max is None else (2.0 * np.pi * f_max) ** 2
     lam, X = _lowest_modes(K.tocsc(), M.tocsc(), n_modes, lam_max)
     X = _normalise(X, M)
+    # Rayleigh quotients: second-order accurate in the shapes, they remove the loss of
+    # relative accuracy of 1/nu - |sigma| for modes far from the shift
+    lam = np.einsum("ij,ij->j", X, K @ X)
     shapes = np.asarray((Tf @ X).T)
     freq = np.sqrt(np.clip(lam, 0.0, None)) / (2.0 * np.pi)
     obs = {p.name: shapes[:, np.asarray(p.dofs, dtype=np.int64)] for p in model.observed}
@@ -302,7 +336,9 @@ def _singular_message(interface: str, f_hz: float) -> str:
 def _solve(Z, rhs, f_hz: float, interface: str):
     """Sparse complex solve with a clear message at an undamped resonance."""
     try:
-        x = spla.splu(sp.csc_matrix(Z, dtype=complex)).solve(rhs.astype(complex))
+        lu = spla.splu(sp.csc_matrix(Z, dtype=complex), permc_spec="MMD_AT_PLUS_A",
+                       options={"SymmetricMode": True})  # Z is (complex) symmetric
+        x = lu.solve(np.asarray(rhs, dtype=complex))
     except RuntimeError as exc:
         x = None
         cause = exc
@@ -324,23 +360,77 @@ def _solve_dense(Z: np.ndarray, rhs: np.ndarray, f_hz: float, interface: str):
     return x
 
 
+def _on_pattern(A: sp.spmatrix, pattern: sp.csc_matrix) -> np.ndarray:
+    """Entries of ``A`` as a data array aligned with the canonical CSC ``pattern``."""
+    A = sp.coo_matrix(A)
+    A.eliminate_zeros()  # explicit zeros may be missing from the pattern
+    n = pattern.shape[0]
+    cols = np.repeat(np.arange(pattern.shape[1]), np.diff(pattern.indptr))
+    keys = cols.astype(np.int64) * n + pattern.indices
+    pos = np.searchsorted(keys, A.col.astype(np.int64) * n + A.row)
+    out = np.zeros(keys.size, dtype=float)
+    np.add.at(out, pos, A.data)
+    return out
+
+
+class _Pencil:
+    """``Z(w) = K + i D - w^2 M + i w C`` (as :func:`fretwear.reduce.dynamic_stiffness` at
+    ``n = 1``) of a sub-block, assembled per frequency on a fixed sparsity pattern."""
+
+    def __init__(self, mats: dict):
+        present = {k: sp.csc_matrix(A) for k, A in mats.items() if A is not None}
+        pattern = sum(abs(A) for A in present.values()).tocsc()
+        pattern.sum_duplicates()
+        pattern.sort_indices()
+        self.indices, self.indptr, self.shape = pattern.indices, pattern.indptr, pattern.shape
+        zero = np.zeros(pattern.nnz)
+        self.data = {k: _on_pattern(present[k], pattern) if k in present else zero
+                     for k in "KMDC"}
+
+    def __call__(self, w: float) -> sp.csc_matrix:
+        d = self.data
+        z = d["K"] - (w * w) * d["M"] + 1j * (d["D"] + w * d["C"])
+        return sp.csc_matrix((z, self.indices, self.indptr), shape=self.shape)
+
+
 def _frf_direct(model: Model, freqs: np.ndarray, interface: str, F: np.ndarray):
     T, Tf, free = _reduced_basis(model, interface)
-    Fq = T.T @ F
-    cd = model.contact.dofs
+    pos = local_positions(model)
     held = _held_local(model, interface)
-    obs, con, rea = [], [], []
+    mats = {"K": model.K, "M": model.M, "D": model.D, "C": model.C}
+    # Z_ff q_f = T_f^T F on the allowed coordinates; T_c^T (F - Z T_f q_f) on the contact
+    # coordinates gives the constraint forces (lambda), T_o T_f q_f the observed DOFs
+    Tc = T[:, pos.reshape(-1)]
+    ff = _Pencil({k: None if A is None else Tf.T @ A @ Tf for k, A in mats.items()})
+    cf = _Pencil({k: None if A is None else Tc.T @ A @ Tf for k, A in mats.items()})
+    obs = np.concatenate([np.asarray(p.dofs, dtype=np.int64) for p in model.observed]
+                         or [np.zeros(0, dtype=np.int64)])
+    To = Tf[obs]
+    Ff, Fc = Tf.T @ F, Tc.T @ F
+    fpos = np.full(model.ndof, -1)
+    fpos[free] = np.arange(free.size)
+    cfree = fpos[pos.reshape(-1)]  # index of each contact coordinate among the free ones
+    Uo, con, rea = [], [], []
     for f in freqs:
-        Zq = (T.T @ dynamic_stiffness(model, 2.0 * np.pi * f, 1) @ T).tocsr()
-        q = np.zeros(model.ndof, dtype=complex)
-        q[free] = _solve(Zq[free][:, free], Fq[free], f, interface)
-        residual = Fq - Zq @ q  # = T^T (F - Z U): the constraint forces in q coordinates
-        obs.append(T @ q)
-        con.append(q[cd])
-        rea.append(np.where(held, residual[cd], 0.0))
-    U = np.array(obs)
-    observed = {p.name: U[:, np.asarray(p.dofs, dtype=np.int64)] for p in model.observed}
-    return observed, np.array(con), np.array(rea)
+        w = 2.0 * np.pi * f
+        qf = _solve(ff(w), Ff, f, interface)
+        qc = np.where(cfree >= 0, qf[np.maximum(cfree, 0)], 0.0)
+        lam = np.where(held.reshape(-1), Fc - cf(w) @ qf, 0.0)
+        Uo.append(To @ qf)
+        con.append(qc.reshape(pos.shape))
+        rea.append(lam.reshape(pos.shape))
+    Uo = np.array(Uo).reshape(freqs.size, -1)
+    return _split_observed(model, Uo), np.array(con), np.array(rea)
+
+
+def _split_observed(model: Model, Uo: np.ndarray) -> dict:
+    """name -> (nf, d) columns of ``Uo`` (nf, no) in the order of ``model.observed``."""
+    observed, start = {}, 0
+    for p in model.observed:
+        n = len(p.dofs)
+        observed[p.name] = Uo[:, start : start + n]
+        start += n
+    return observed
 
 
 def _frf_condensed(model: Model, freqs: np.ndarray, interface: str):
@@ -359,12 +449,7 @@ def _frf_condensed(model: Model, freqs: np.ndarray, interface: str):
         con.append(u.reshape(nc, d))
         rea.append(lam.reshape(nc, d))
     Uo = np.array(obs).reshape(freqs.size, -1)
-    observed, start = {}, 0
-    for p in model.observed:
-        n = len(p.dofs)
-        observed[p.name] = Uo[:, start : start + n]
-        start += n
-    return observed, np.array(con), np.array(rea)
+    return _split_observed(model, Uo), np.array(con), np.array(rea)
 
 
 def frf(model: Model, frequencies_hz, *, interface: str = "sliding",
@@ -427,7 +512,7 @@ def _axis_index(axis) -> int:
 
 
 def count_resonances(frf_result: FRFResult, point: str, axis, *,
-                     prominence: float = 1.0) -> tuple[int, np.ndarray]:
+                     prominence: float = 0.5) -> tuple[int, np.ndarray]:
     """Resonance peaks of ``|U|`` of one observed component over the computed band.
 
     A peak is a local maximum of ``log10 |U|`` whose topographic prominence is at least

@@ -68,8 +68,9 @@ def type_name(value: Any) -> str:
 
 def suggest(word: str, choices, quote: Callable[[str], str] = repr) -> str:
     """``" (did you mean 'x'?)"`` when a choice is close to ``word``, else ``""``."""
-    close = difflib.get_close_matches(str(word), [str(c) for c in choices], n=1, cutoff=0.6)
-    return f" (did you mean {quote(close[0])}?)" if close else ""
+    names = {str(c).lower(): str(c) for c in choices}
+    close = difflib.get_close_matches(str(word).lower(), list(names), n=1, cutoff=0.6)
+    return f" (did you mean {quote(names[close[0]])}?)" if close else ""
 
 
 def fail(path: str, value: Any, expected: str, detail: str = "") -> None:
@@ -129,7 +130,8 @@ class Number(Spec):
         text = self.noun[1 if plural else 0]
         lo, hi = self.lo, self.hi
         if lo is not None and hi is not None:
-            text += f" in {'(' if self.lo_open else '['}{lo:g}, {hi:g}{')' if self.hi_open else ']'}"
+            left, right = "(" if self.lo_open else "[", ")" if self.hi_open else "]"
+            text += f" in {left}{lo:g}, {hi:g}{right}"
         elif lo is not None:
             text += f" {'>' if self.lo_open else '>='} {lo:g}"
         elif hi is not None:
@@ -196,6 +198,26 @@ class Text(Spec):
 
 
 @dataclass
+class Choice(Spec):
+    """One of a few fixed integer values (e.g. a sign: -1 or 1)."""
+
+    values: tuple
+
+    def expected(self, plural: bool = False) -> str:
+        return ("integers from " if plural else "one of ") + ", ".join(map(str, self.values))
+
+    def matches(self, value) -> bool:
+        return isinstance(value, int) and not isinstance(value, bool)
+
+    def check(self, value, path, ctx):
+        if not self.matches(value):
+            self._type_error(value, path)
+        if value not in self.values:
+            fail(path, value, self.expected())
+        return value
+
+
+@dataclass
 class Flag(Spec):
     """``true`` or ``false``."""
 
@@ -249,7 +271,7 @@ class ListOf(Spec):
         return out
 
 
-def Vector(sizes=(2, 3)) -> ListOf:  # noqa: N802 (reads like a type in schemas)
+def Vector(sizes=(2, 3)) -> ListOf:
     """A list of 2 or 3 finite numbers (a point, a direction, a traction)."""
     return ListOf(Number(), sizes=tuple(sizes))
 
@@ -289,7 +311,15 @@ class AnyOf(Spec):
     def check(self, value, path, ctx):
         for option in self.options:
             if option.matches(value):
-                return option.check(value, path, ctx)
+                if isinstance(value, list | tuple | Mapping):
+                    return option.check(value, path, ctx)  # its message names the item
+                try:
+                    return option.check(value, path, ctx)
+                except InputError:
+                    hint = ""
+                    if isinstance(option, Text) and option.choices:
+                        hint = suggest(value, option.choices, show)
+                    fail(path, value, self.expected(), hint)
         self._type_error(value, path)
 
 
@@ -443,6 +473,56 @@ class Variant(Spec):
         table = self.tables()[kind]
         full = Table({self.key: sel, **table.fields}, table.checks, table.doc)
         return full.check(value, path, ctx)
+
+
+# --- rules across keys of a table (for Table.checks) ---------------------------------
+def exactly_one(*keys: str):
+    """Rule: exactly one of ``keys`` is given."""
+
+    def rule(out, path):
+        given = [k for k in keys if k in out]
+        if len(given) != 1:
+            names = ", ".join(repr(k) for k in keys)
+            got = ", ".join(repr(k) for k in given) or "none"
+            raise InputError(f"{table_label(path)}: give exactly one of {names} (got {got})")
+
+    return rule
+
+
+def requires(key: str, partner: str, *, excludes: str | None = None):
+    """Rule: when ``key`` is given, ``partner`` must be given (and ``excludes`` must not)."""
+
+    def rule(out, path):
+        if key not in out:
+            return
+        if partner not in out:
+            raise InputError(f"{table_label(path)}: {key!r} needs {partner!r}")
+        if excludes is not None and excludes in out:
+            raise InputError(f"{table_label(path)}: {key!r} cannot be used with {excludes!r}")
+
+    return rule
+
+
+def non_zero(*keys: str):
+    """Rule: the vectors ``keys`` (when given) are not all zeros."""
+
+    def rule(out, path):
+        for k in keys:
+            if k in out and not any(out[k]):
+                fail(join(path, k), out[k], "a non-zero vector")
+
+    return rule
+
+
+def increasing(lo: str, hi: str, unit: str = ""):
+    """Rule: ``out[lo] < out[hi]`` when both are given (e.g. a frequency band)."""
+
+    def rule(out, path):
+        if lo in out and hi in out and not out[lo] < out[hi]:
+            fail(join(path, hi), out[hi], f"a value above {lo} = {show(out[lo])}"
+                 + (f" {unit}" if unit else ""))
+
+    return rule
 
 
 # --- documentation --------------------------------------------------------------------

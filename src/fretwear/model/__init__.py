@@ -1,5 +1,53 @@
 """Linear models: FE meshes (scikit-fem) or user matrices, loads, springs, contact interface."""
 
+from fretwear.model.build import (
+    ContactSpec,
+    Damping,
+    Material,
+    NodalForce,
+    Spring,
+    Traction,
+    check_supported,
+    from_mesh,
+    rigid_motion_check,
+)
 from fretwear.model.core import ContactInterface, Load, Mesh, Model, ObservedPoint
+from fretwear.model.fem import assemble
+from fretwear.model.loads import (
+    boundary_load,
+    boundary_measure,
+    nodal_areas,
+    nodal_force,
+    resultant,
+)
+from fretwear.model.matrices import from_matrices, read_matrix_market
+from fretwear.model.mesh import box, rectangle
+from fretwear.model.mesh import read as read_mesh
 
-__all__ = ["ContactInterface", "Load", "Mesh", "Model", "ObservedPoint"]
+__all__ = [
+    "ContactInterface",
+    "ContactSpec",
+    "Damping",
+    "Load",
+    "Material",
+    "Mesh",
+    "Model",
+    "NodalForce",
+    "ObservedPoint",
+    "Spring",
+    "Traction",
+    "assemble",
+    "boundary_load",
+    "boundary_measure",
+    "box",
+    "check_supported",
+    "from_matrices",
+    "from_mesh",
+    "nodal_areas",
+    "nodal_force",
+    "read_matrix_market",
+    "read_mesh",
+    "rectangle",
+    "resultant",
+    "rigid_motion_check",
+]

@@ -38,14 +38,14 @@ def check_material(E, nu, rho) -> tuple[float, float, float]:
         vals.append(v)
     E, nu, rho = vals
     if E <= 0.0:
-        raise InputError(f"Young's modulus E = {E!r} Pa; expected E > 0")
+        raise InputError(f"Young's modulus E = {E:g} Pa; expected E > 0")
     if not -1.0 < nu < 0.5:
         raise InputError(
-            f"Poisson's ratio nu = {nu!r}; expected -1 < nu < 0.5 (nu = 0.5 is incompressible, "
+            f"Poisson's ratio nu = {nu:g}; expected -1 < nu < 0.5 (nu = 0.5 is incompressible, "
             "which this displacement formulation cannot represent)"
         )
     if rho < 0.0:
-        raise InputError(f"density rho = {rho!r} kg/m^3; expected rho >= 0")
+        raise InputError(f"density rho = {rho:g} kg/m^3; expected rho >= 0")
     return E, nu, rho
 
 

@@ -142,8 +142,12 @@ def boundary_load(mesh: Mesh, boundary: str, *, pressure=None, traction=None,
         def form(v, w):
             return -_evaluate(value, w, d, what, False) * dot(w.n, v)
 
-    f = skfem.asm(form, basis)
-    return thickness * f[node_major(basis)]
+    f = thickness * skfem.asm(form, basis)[node_major(basis)]
+    # shape functions of nodes off the boundary vanish there: clear their rounding residue
+    off = np.ones(mesh.points.shape[0], dtype=bool)
+    off[np.unique(_boundary(mesh, boundary))] = False
+    f.reshape(-1, d)[off] = 0.0
+    return f
 
 
 def nodal_areas(mesh: Mesh, boundary: str, thickness=1.0) -> tuple[np.ndarray, np.ndarray]:

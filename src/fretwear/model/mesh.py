@@ -12,6 +12,8 @@ counter-clockwise seen from outside (right-hand rule gives the outward normal).
 
 from __future__ import annotations
 
+import contextlib
+import io
 from pathlib import Path
 
 import numpy as np
@@ -296,11 +298,16 @@ def read(path) -> Mesh:
     path = Path(path)
     if not path.is_file():
         raise InputError(f"mesh file {str(path)!r} does not exist")
+    chatter = io.StringIO()
     try:
-        m = meshio.read(path)
-    except Exception as exc:  # meshio raises several exception types
+        # meshio prints to stdout/stderr and may call sys.exit() on a file it cannot parse
+        with contextlib.redirect_stdout(chatter), contextlib.redirect_stderr(chatter):
+            m = meshio.read(path)
+    except (Exception, SystemExit) as exc:
+        why = " ".join((str(exc) if not isinstance(exc, SystemExit) else "").split()
+                       + chatter.getvalue().split()) or type(exc).__name__
         raise InputError(
-            f"cannot read mesh file {str(path)!r} with meshio: {exc}; expected a Gmsh .msh "
+            f"cannot read mesh file {str(path)!r} with meshio ({why}); expected a Gmsh .msh "
             "(v2.2 or v4.1) or another format meshio reads"
         ) from None
 

@@ -1,0 +1,769 @@
+"""Case files: a TOML description of a model and an analysis, validated on load (SI units).
+
+:func:`load_case` reads and validates a case file against the schema below (see
+:mod:`fretwear.schema`); :func:`build_model` turns it into a :class:`~fretwear.model.core.Model`.
+Every mistake (wrong value, wrong type, missing or unknown key, unknown boundary name) gives
+one :class:`~fretwear.errors.InputError` naming the key path, e.g.
+``material.nu = 0.5: expected a number in (-1, 0.5)``.
+
+A model is either a finite element mesh (``model.type`` = ``"rectangle"``, ``"box"`` or
+``"mesh"``) or user matrices (``"matrices"``); the sections that describe the interface,
+the loads and the observed points differ between the two. The ``[analysis]`` table is
+checked against the schema its analysis type registered in :mod:`fretwear.runner`.
+The documentation ``docs/case-files.md`` is generated from these schemas
+(:func:`case_docs`, :func:`write_case_docs`).
+"""
+
+from __future__ import annotations
+
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from fretwear.errors import InputError
+from fretwear.model.core import WAVEFORMS
+from fretwear.schema import (
+    AnyOf,
+    Choice,
+    Context,
+    Dict,
+    Field,
+    FilePath,
+    Flag,
+    Integer,
+    ListOf,
+    Number,
+    Table,
+    TableList,
+    Text,
+    Variant,
+    Vector,
+    exactly_one,
+    fail,
+    non_zero,
+    render_table,
+    requires,
+    show,
+    suggest,
+    table_label,
+)
+
+AXES = ("x", "y", "z")
+FIGURE_FORMATS = ("png", "pdf", "svg")
+
+
+# --- rules across keys ------------------------------------------------------------------
+def _fourier_coefficients(out, path):
+    """Rule: ``coefficients`` is given exactly when ``waveform = "fourier"``."""
+    if out.get("waveform") == "fourier" and not out.get("coefficients"):
+        raise InputError(
+            f"{table_label(path)}: waveform = \"fourier\" needs coefficients = "
+            '{"1" = [a1, b1], ...}'
+        )
+    if "coefficients" in out and out.get("waveform") != "fourier":
+        raise InputError(
+            f"{table_label(path)}: 'coefficients' is only used with waveform = \"fourier\" "
+            f"(waveform = {show(out.get('waveform'))})"
+        )
+
+
+# --- shared pieces ----------------------------------------------------------------------
+_POSITIVE = Number(lo=0, lo_open=True)
+_NON_NEG = Number(lo=0)
+_DOF = Integer(lo=0)
+_WAVEFORM = Field(
+    Text(WAVEFORMS),
+    '"constant" is a static load; "cos", "sin", "triangle" (amplitude 1, rising like sin) and '
+    '"fourier" (with `coefficients`) are periodic in tau = omega t',
+    default="constant",
+)
+_COEFFICIENTS = Field(
+    Dict(Vector((2,)), key_ok=lambda k: str(k).isdigit(), key_doc='harmonic numbers "0", "1", ...'),
+    'waveform = "fourier" only: g(tau) = sum over n of a_n cos(n tau) + b_n sin(n tau), written '
+    '{"1" = [a1, b1], "3" = [a3, b3]} ("0" gives the mean; its b is ignored)',
+)
+_LOAD_NAME = Field(Text(), "label used in output")
+_MU = Field(_NON_NEG, "Coulomb friction coefficient", required=True, unit="-")
+_WEAR = Field(_NON_NEG, "Archard wear coefficient k_w (paper eq. 29)", default=0.0, unit="1/Pa")
+_CONTACT_NAME = Field(Text(), "label of the interface in output", default="contact")
+_THICKNESS = Field(
+    _POSITIVE,
+    "out-of-plane width of a 2D (plane strain) model; the default 1 m gives results per metre "
+    "of width",
+    default=1.0,
+    unit="m",
+)
+
+# --- [model] --------------------------------------------------------------------------
+MODEL_TYPES = {
+    "rectangle": Table(
+        {
+            "length": Field(_POSITIVE, "size along x", required=True, unit="m"),
+            "height": Field(_POSITIVE, "size along y", required=True, unit="m"),
+            "nx": Field(Integer(lo=1), "number of elements along x", required=True),
+            "ny": Field(Integer(lo=1), "number of elements along y", required=True),
+            "thickness": _THICKNESS,
+        },
+        doc="A 2D plane strain rectangle [0, length] x [0, height] of 4-node quadrilaterals. "
+        'Boundaries (and node sets): "bottom", "top", "left", "right"; one-node sets '
+        '"bottom_left", "bottom_right", "top_left", "top_right".',
+    ),
+    "box": Table(
+        {
+            "lx": Field(_POSITIVE, "size along x", required=True, unit="m"),
+            "ly": Field(_POSITIVE, "size along y", required=True, unit="m"),
+            "lz": Field(_POSITIVE, "size along z", required=True, unit="m"),
+            "nx": Field(Integer(lo=1), "number of elements along x", required=True),
+            "ny": Field(Integer(lo=1), "number of elements along y", required=True),
+            "nz": Field(Integer(lo=1), "number of elements along z", required=True),
+        },
+        doc="A 3D box [0, lx] x [0, ly] x [0, lz] of 8-node hexahedra. Boundaries (and node "
+        'sets): "xmin", "xmax", "ymin", "ymax", "zmin", "zmax".',
+    ),
+    "mesh": Table(
+        {
+            "file": Field(FilePath(), "mesh file read with meshio (Gmsh .msh v2.2/v4.1, ...)",
+                          required=True),
+            "thickness": _THICKNESS,
+        },
+        doc="A mesh file with linear cells (triangle or quad in the plane z = 0: 2D plane "
+        "strain; tetra or hexahedron: 3D). Named groups (Gmsh physical groups) of facets "
+        "become boundaries, named groups of points become node sets.",
+    ),
+    "matrices": Table(
+        {
+            "K": Field(FilePath(), "stiffness matrix (Matrix Market .mtx)", required=True,
+                       unit="N/m"),
+            "M": Field(FilePath(), "mass matrix (Matrix Market .mtx)", required=True,
+                       unit="kg"),
+            "C": Field(FilePath(), "viscous damping matrix (Matrix Market .mtx)", unit="N s/m"),
+            "D": Field(FilePath(), "hysteretic damping matrix (Matrix Market .mtx): adds i D "
+                       "to the dynamic stiffness of harmonics n >= 1", unit="N/m"),
+            "fixed_dofs": Field(ListOf(_DOF, unique=True), "DOFs held at zero (Dirichlet)",
+                                default=[]),
+            "first_dof": Field(Choice((0, 1)), "number of the first DOF in every DOF list "
+                               "of this case file: 0 (Python) or 1 (Matlab, Matrix Market rows)",
+                               default=0),
+        },
+        doc="User matrices: DOF numbers are row numbers of K (counted from `first_dof`).",
+    ),
+}
+MODEL = Variant(MODEL_TYPES, key_doc="kind of model")
+
+# --- mesh models ----------------------------------------------------------------------
+MATERIAL = Table(
+    {
+        "E": Field(_POSITIVE, "Young's modulus", required=True, unit="Pa"),
+        "nu": Field(Number(lo=-1, hi=0.5, lo_open=True, hi_open=True), "Poisson's ratio",
+                    required=True, unit="-"),
+        "rho": Field(_NON_NEG, "density (0: no inertia; modes and FRFs need rho > 0)",
+                     default=0.0, unit="kg/m^3"),
+    },
+    doc="Isotropic linear elastic material.",
+)
+DAMPING = Table(
+    {
+        "loss_factor": Field(_NON_NEG, "hysteretic loss factor eta: D = eta K on harmonics "
+                             "n >= 1 (no static part)", default=0.0, unit="-"),
+        "rayleigh_mass": Field(_NON_NEG, "viscous Rayleigh coefficient a in C = a M + b K",
+                               default=0.0, unit="1/s"),
+        "rayleigh_stiffness": Field(_NON_NEG, "viscous Rayleigh coefficient b in C = a M + b K",
+                                    default=0.0, unit="s"),
+    },
+    doc="Structural damping (optional; all zero by default). For a `matrices` model the "
+    "Rayleigh part is added to the matrix C and the loss factor to the matrix D.",
+)
+_AT = AnyOf((Text(), Vector()))
+SPRING = Table(
+    {
+        "at": Field(_AT, "node set or boundary name, or the coordinates [x, y(, z)] of a node",
+                    required=True, unit="m"),
+        "direction": Field(AnyOf((Text(AXES), Vector())), '"x", "y", "z" or a vector',
+                           required=True),
+        "stiffness": Field(Number(lo=0, lo_open=True, allow_inf=True),
+                           "total stiffness to the ground, shared equally by the nodes of `at`; "
+                           "inf holds them (Dirichlet; axis directions only)",
+                           required=True, unit="N/m"),
+    },
+    checks=(non_zero("direction"),),
+    doc="Grounded springs, one `[[springs]]` block each.",
+)
+FIXED = Table(
+    {
+        "at": Field(_AT, "node set or boundary name, or the coordinates [x, y(, z)] of a node",
+                    required=True, unit="m"),
+        "direction": Field(Text(AXES + ("all",)), "the component held at zero", default="all"),
+    },
+    doc="Dirichlet conditions (held displacement components), one `[[fixed]]` block each.",
+)
+LOAD_MESH = Table(
+    {
+        "boundary": Field(Text(), "boundary carrying a distributed load"),
+        "pressure": Field(Number(), "pressure on the boundary, positive pushing on the face "
+                          "(along the inward normal)", unit="Pa"),
+        "traction": Field(Vector(), "traction vector on the boundary", unit="Pa"),
+        "at": Field(_AT, "nodal force: node set name or coordinates of a node", unit="m"),
+        "force": Field(Vector(), "total force vector, shared equally by the nodes of `at`",
+                       unit="N"),
+        "waveform": _WAVEFORM,
+        "coefficients": _COEFFICIENTS,
+        "name": _LOAD_NAME,
+    },
+    checks=(
+        exactly_one("pressure", "traction", "force"),
+        requires("pressure", "boundary", excludes="at"),
+        requires("traction", "boundary", excludes="at"),
+        requires("force", "at", excludes="boundary"),
+        _fourier_coefficients,
+    ),
+    doc="Loads `F(t) = vector * g(omega t)`, one `[[loads]]` block each: `boundary` with "
+    "`pressure` or `traction`, or `at` with `force`.",
+)
+CONTACT_MESH = Table(
+    {
+        "boundary": Field(Text(), "boundary in contact with the rigid obstacle", required=True),
+        "mu": _MU,
+        "normal": Field(Vector(), "normal pointing from the structure into the obstacle "
+                        "(default: the outward normal of the boundary, which must then be flat)"),
+        "tangent": Field(Vector(), "3D: first tangential direction (default: chosen from the "
+                         "normal)"),
+        "gap": Field(Number(), "initial normal gap (>= 0 open, < 0 interference)", default=0.0,
+                     unit="m"),
+        "wear_coefficient": _WEAR,
+        "name": _CONTACT_NAME,
+    },
+    checks=(non_zero("normal", "tangent"),),
+    doc="The frictional interface: the nodes of one boundary against a rigid flat.",
+)
+OBSERVED_MESH = Dict(AnyOf((Vector(), Text())), key_doc="point names")
+
+# --- matrices models ------------------------------------------------------------------
+_DOFS_OR_FILE = AnyOf((ListOf(_DOF, non_empty=True, unique=True), FilePath()))
+LOAD_MATRICES = Table(
+    {
+        "file": Field(FilePath(), "load vector (Matrix Market .mtx, or a text file of one "
+                      "number per DOF)", required=True, unit="N"),
+        "waveform": _WAVEFORM,
+        "coefficients": _COEFFICIENTS,
+        "name": _LOAD_NAME,
+    },
+    checks=(_fourier_coefficients,),
+    doc="Loads `F(t) = vector * g(omega t)`, one `[[loads]]` block each.",
+)
+CONTACT_MATRICES = Table(
+    {
+        "normal_dofs": Field(_DOFS_OR_FILE, "normal DOF of each contact node (or a text file "
+                             "of them)", required=True),
+        "tangential_dofs": Field(
+            AnyOf((ListOf(AnyOf((_DOF, ListOf(_DOF, sizes=(2,)))), non_empty=True), FilePath())),
+            "tangential DOF of each contact node (2D), or [t1, t2] pairs (3D), or a text file "
+            "with one row per node",
+            required=True,
+        ),
+        "mu": _MU,
+        "gap": Field(AnyOf((Number(), ListOf(Number(), non_empty=True))),
+                     "initial normal gap, one value or one per node", default=0.0, unit="m"),
+        "area": Field(AnyOf((_POSITIVE, ListOf(_POSITIVE, non_empty=True))),
+                      "tributary area, one value or one per node (turns forces into "
+                      "pressures for wear)", default=1.0, unit="m^2"),
+        "normal_sign": Field(Choice((1, -1)), "+1 if a positive normal DOF closes the "
+                             "gap (moves into the obstacle), -1 otherwise", default=1),
+        "wear_coefficient": _WEAR,
+        "name": _CONTACT_NAME,
+    },
+    doc="The frictional interface: DOFs of the contact nodes against a rigid obstacle.",
+)
+OBSERVED_MATRICES = Dict(AnyOf((_DOF, ListOf(_DOF, non_empty=True))), key_doc="point names")
+
+# --- [output] and the whole file --------------------------------------------------------
+OUTPUT = Table(
+    {
+        "directory": Field(Text(), "folder for the results (relative to the case file); "
+                           'default "<case name>-results" beside the case file'),
+        "figures": Field(Flag(), "write figures", default=True),
+        "figure_format": Field(Text(FIGURE_FORMATS), "figure file format", default="png"),
+        "vtu": Field(Flag(), "write ParaView files (.vtu/.pvd) of fields when the model has a "
+                     "mesh", default=True),
+    },
+    doc="Where and what to write. `fretwear run -o DIR` overrides `directory`.",
+)
+
+
+def _analysis_tables() -> dict:
+    from fretwear.runner import analysis_tables  # the registry fills up when it is imported
+
+    return analysis_tables()
+
+
+ANALYSIS = Variant(_analysis_tables, key_doc="analysis type")
+_TITLE = Field(Text(), "one line describing the case (used in figures and results)")
+
+
+def _case_table(model_kind: str) -> Table:
+    if model_kind == "matrices":
+        fields = {
+            "title": _TITLE,
+            "model": Field(MODEL, "the structure", required=True),
+            "damping": Field(DAMPING, "structural damping"),
+            "loads": Field(TableList(LOAD_MATRICES), "loads", default=[]),
+            "contact": Field(CONTACT_MATRICES, "the frictional interface", required=True),
+            "observed": Field(OBSERVED_MATRICES, "DOFs whose motion is reported", default={}),
+        }
+    else:
+        fields = {
+            "title": _TITLE,
+            "model": Field(MODEL, "the structure", required=True),
+            "material": Field(MATERIAL, "elastic material", required=True),
+            "damping": Field(DAMPING, "structural damping"),
+            "springs": Field(TableList(SPRING), "grounded springs", default=[]),
+            "fixed": Field(TableList(FIXED), "held displacement components", default=[]),
+            "loads": Field(TableList(LOAD_MESH), "loads", default=[]),
+            "contact": Field(CONTACT_MESH, "the frictional interface", required=True),
+            "observed": Field(OBSERVED_MESH, "points whose motion is reported", default={}),
+        }
+    fields["analysis"] = Field(ANALYSIS, "what to compute", required=True)
+    fields["output"] = Field(OUTPUT, "what to write")
+    return Table(fields)
+
+
+def validate(raw: Mapping, base_dir: Path | str = ".") -> dict:
+    """Validate a parsed case file; return the normalised dict (defaults filled in).
+
+    Relative file paths are resolved against ``base_dir`` (the case file's folder).
+
+    Raises
+    ------
+    InputError
+        At the first mistake, naming its key path.
+    """
+    model = raw.get("model")
+    kind = model.get("type") if isinstance(model, Mapping) else None
+    raw = {"damping": {}, "output": {}, **raw}  # absent tables get their defaults
+    return _case_table("matrices" if kind == "matrices" else "mesh").check(
+        raw, "", Context(Path(base_dir))
+    )
+
+
+# --- loading ----------------------------------------------------------------------------
+_MODEL_SECTIONS = ("model", "material", "damping", "springs", "fixed", "loads", "contact",
+                   "observed")
+
+
+@dataclass
+class Case:
+    """A validated case file.
+
+    Attributes
+    ----------
+    path : the case file (absolute).
+    title : its title (the file name when it has none).
+    text : the file text (stored in the results file).
+    raw : the parsed TOML, as written.
+    model : the validated sections that define the model (``model``, ``material``,
+        ``damping``, ``springs``, ``fixed``, ``loads``, ``contact``, ``observed``; those of
+        the model kind), with defaults filled in and file paths absolute.
+    analysis : the validated ``[analysis]`` table (with ``type``).
+    output : the validated ``[output]`` table.
+    resume : set by :func:`fretwear.runner.run_case`: continue from a checkpoint if any.
+    """
+
+    path: Path
+    title: str
+    text: str
+    raw: dict
+    model: dict
+    analysis: dict
+    output: dict
+    resume: bool = False
+
+    @property
+    def folder(self) -> Path:
+        return self.path.parent
+
+    @property
+    def name(self) -> str:
+        """The case file name without its extension."""
+        return self.path.stem
+
+    @property
+    def model_kind(self) -> str:
+        """``"matrices"`` or ``"mesh"`` (rectangle, box or mesh file)."""
+        return "matrices" if self.model["model"]["type"] == "matrices" else "mesh"
+
+    def output_dir(self, override: Path | str | None = None) -> Path:
+        """Results folder: ``override`` (relative to the working directory), else
+        ``output.directory`` (relative to the case file), else ``<name>-results`` beside it."""
+        if override is not None:
+            return Path(override).expanduser().resolve()
+        d = self.output.get("directory")
+        if d is None:
+            return self.folder / f"{self.name}-results"
+        d = Path(d).expanduser()
+        return d if d.is_absolute() else (self.folder / d).resolve()
+
+
+def read_toml(path: Path | str) -> tuple[str, dict]:
+    """The text and the parsed content of a TOML file; every failure is an InputError."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise InputError(f"case file {str(path)!r} does not exist") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"cannot read case file {str(path)!r}: {exc}") from None
+    try:
+        raw = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{path.name}: invalid TOML: {exc}") from None
+    return text, raw
+
+
+def load_case(path: Path | str) -> Case:
+    """Read and validate a case file.
+
+    Parameters
+    ----------
+    path : the ``.toml`` case file; relative paths inside it start from its folder.
+
+    Returns
+    -------
+    Case
+
+    Raises
+    ------
+    InputError
+        The file is missing or is not TOML, or a value is wrong (the message names the key).
+    """
+    path = Path(path).expanduser().resolve()
+    text, raw = read_toml(path)
+    v = validate(raw, path.parent)
+    return Case(
+        path=path,
+        title=v.get("title") or path.stem,
+        text=text,
+        raw=raw,
+        model={k: v[k] for k in _MODEL_SECTIONS if k in v},
+        analysis=v["analysis"],
+        output=v["output"],
+    )
+
+
+# --- building the model -------------------------------------------------------------------
+def build_model(case: Case):
+    """The :class:`~fretwear.model.core.Model` a validated case describes.
+
+    Names (boundaries, node sets, observed points) and vector sizes are checked against
+    the mesh here so that the message names the case-file key.
+    """
+    if case.model_kind == "matrices":
+        return _build_from_matrices(case.model, case.title)
+    return _build_from_mesh(case.model, case.title, given=case.raw["model"])
+
+
+def observed_notes(case: Case, model, rtol: float = 1e-6) -> list[str]:
+    """Lines telling where an observed point was moved to the nearest mesh node.
+
+    A point given by coordinates is the node nearest to them; when that node is farther than
+    ``rtol`` times the model size, the user should know which point is reported.
+    """
+    if model.mesh is None:
+        return []
+    size = float(np.linalg.norm(np.ptp(model.mesh.points, axis=0)))
+    notes = []
+    for name, where in case.model.get("observed", {}).items():
+        if not isinstance(where, list):
+            continue
+        node = np.asarray(model.observed_point(name).coords, dtype=float)
+        if np.linalg.norm(node - np.asarray(where, dtype=float)) > rtol * size:
+            at = ", ".join(f"{c:.6g}" for c in node)
+            notes.append(f"note: observed.{name} = {show(where)} is not a mesh node; "
+                         f"reporting the nearest node, at ({at})")
+    return notes
+
+
+def _make_mesh(spec: dict):
+    from fretwear.model import mesh as meshes
+
+    kind = spec["type"]
+    if kind == "rectangle":
+        return meshes.rectangle(spec["length"], spec["height"], spec["nx"], spec["ny"])
+    if kind == "box":
+        return meshes.box(spec["lx"], spec["ly"], spec["lz"], spec["nx"], spec["ny"], spec["nz"])
+    return meshes.read(spec["file"])
+
+
+def _check_name(name: str, path: str, names) -> None:
+    names = sorted(names)
+    if name not in names:
+        fail(path, name, "one of " + ", ".join(show(n) for n in names), suggest(name, names, show))
+
+
+def _check_vector(value, path: str, dim: int) -> None:
+    if isinstance(value, list) and len(value) != dim:
+        fail(path, value, f"{dim} components for a {dim}D model")
+
+
+def _check_against_mesh(m: dict, mesh, given: Mapping) -> None:
+    """Names and vector sizes of the mesh-model sections, with key paths in messages."""
+    dim = mesh.dim
+    bnames = list(mesh.boundaries)
+    anywhere = sorted(set(mesh.boundaries) | set(mesh.node_sets))
+    for section in ("springs", "fixed"):
+        for i, item in enumerate(m.get(section, [])):
+            path = f"{section}[{i + 1}]"
+            if isinstance(item["at"], str):
+                _check_name(item["at"], f"{path}.at", anywhere)
+            _check_vector(item["at"], f"{path}.at", dim)
+            _check_vector(item.get("direction"), f"{path}.direction", dim)
+            if item.get("direction") == "z" and dim == 2:
+                fail(f"{path}.direction", "z", 'one of "x", "y" for a 2D model')
+    for i, load in enumerate(m.get("loads", [])):
+        path = f"loads[{i + 1}]"
+        if "boundary" in load:
+            _check_name(load["boundary"], f"{path}.boundary", bnames)
+        if isinstance(load.get("at"), str):
+            _check_name(load["at"], f"{path}.at", anywhere)
+        for key in ("at", "traction", "force"):
+            _check_vector(load.get(key), f"{path}.{key}", dim)
+    contact = m["contact"]
+    _check_name(contact["boundary"], "contact.boundary", bnames)
+    if len(mesh.boundaries[contact["boundary"]]) == 0:
+        fail("contact.boundary", contact["boundary"], "a boundary with at least one facet")
+    for key in ("normal", "tangent"):
+        _check_vector(contact.get(key), f"contact.{key}", dim)
+    for name, where in m.get("observed", {}).items():
+        if isinstance(where, str):
+            _check_name(where, f"observed.{name}", mesh.node_sets)
+        _check_vector(where, f"observed.{name}", dim)
+    spec = m["model"]
+    if spec["type"] == "mesh" and dim == 3 and "thickness" in given:
+        fail("model.thickness", spec["thickness"], "no thickness for a 3D mesh")
+
+
+def _build_from_mesh(m: dict, title: str, given: Mapping):
+    from fretwear.model import build
+
+    mesh = _make_mesh(m["model"])
+    _check_against_mesh(m, mesh, given)
+    mat = m["material"]
+    damp = m["damping"]
+    springs = [build.Spring(_at(s["at"]), s["direction"], s["stiffness"])
+               for s in m.get("springs", [])]
+    fixed = [(_at(f["at"]), f["direction"]) for f in m.get("fixed", [])]
+    loads = []
+    for i, ld in enumerate(m.get("loads", [])):
+        name = ld.get("name") or f"load{i + 1}"
+        coefficients = _coefficients(ld.get("coefficients"))
+        if "force" in ld:
+            loads.append(build.NodalForce(_at(ld["at"]), ld["force"], waveform=ld["waveform"],
+                                          name=name, **coefficients))
+        else:
+            loads.append(build.Traction(ld["boundary"], pressure=ld.get("pressure"),
+                                        traction=ld.get("traction"), waveform=ld["waveform"],
+                                        name=name, **coefficients))
+    c = m["contact"]
+    contact = build.ContactSpec(c["boundary"], c["mu"], normal=c.get("normal"),
+                                tangent=c.get("tangent"), gap=c["gap"],
+                                wear_coefficient=c["wear_coefficient"], name=c["name"])
+    observed = {k: _at(v) for k, v in m.get("observed", {}).items()} or None
+    thickness = m["model"].get("thickness", 1.0) if mesh.dim == 2 else 1.0
+    return build.from_mesh(
+        mesh,
+        build.Material(mat["E"], mat["nu"], mat["rho"]),
+        thickness=thickness,
+        damping=build.Damping(damp["loss_factor"], damp["rayleigh_mass"],
+                              damp["rayleigh_stiffness"]),
+        springs=springs,
+        fixed=fixed,
+        loads=loads,
+        contact=contact,
+        observed=observed,
+        name=title,
+    )
+
+
+def _at(value):
+    return tuple(value) if isinstance(value, list) else value
+
+
+def _coefficients(coeffs) -> dict:
+    """``{"coefficients": {n: (a, b)}}`` for a Fourier waveform, else ``{}``."""
+    if not coeffs:
+        return {}
+    return {"coefficients": {int(k): (float(v[0]), float(v[1])) for k, v in coeffs.items()}}
+
+
+def _read_dofs(value, path: str, base: int) -> np.ndarray:
+    """DOF numbers from a list or a text file, shifted to count from 0."""
+    if isinstance(value, Path):
+        try:
+            arr = np.loadtxt(value, dtype=float, ndmin=1)
+        except (OSError, ValueError) as exc:
+            raise InputError(f"{path}: cannot read DOF numbers from {str(value)!r}: {exc}") \
+                from None
+        if arr.size == 0 or np.any(arr != np.round(arr)):
+            fail(path, str(value), "a text file of integer DOF numbers")
+        arr = arr.astype(np.int64)
+    else:
+        arr = np.asarray(value, dtype=np.int64)
+    arr = arr - base
+    if np.any(arr < 0):
+        fail(path, value if not isinstance(value, Path) else str(value),
+             f"DOF numbers >= {base} (first_dof = {base})")
+    return arr
+
+
+def _read_vector(path: Path, key: str, n: int) -> np.ndarray:
+    from fretwear.model.matrices import read_matrix_market
+
+    try:
+        if path.suffix.lower() == ".mtx":
+            v = read_matrix_market(path)
+            v = v.toarray() if hasattr(v, "toarray") else np.asarray(v)
+        else:
+            v = np.loadtxt(path, dtype=float, ndmin=1)
+    except (OSError, ValueError) as exc:
+        raise InputError(f"{key}: cannot read {str(path)!r}: {exc}") from None
+    v = np.asarray(v, dtype=float).reshape(-1)
+    if v.size != n:
+        fail(key, str(path), f"a vector of {n} values (one per DOF of K), got {v.size}")
+    return v
+
+
+def _build_from_matrices(m: dict, title: str):
+    from fretwear.model.core import Load
+    from fretwear.model.matrices import from_matrices, read_matrix_market
+
+    spec = m["model"]
+    base = spec["first_dof"]
+    K = read_matrix_market(spec["K"])
+    M = read_matrix_market(spec["M"])
+    C = read_matrix_market(spec["C"]) if "C" in spec else None
+    D = read_matrix_market(spec["D"]) if "D" in spec else None
+    damp = m["damping"]
+    if damp["rayleigh_mass"] or damp["rayleigh_stiffness"]:
+        rayleigh = damp["rayleigh_mass"] * M + damp["rayleigh_stiffness"] * K
+        C = rayleigh if C is None else C + rayleigh
+    if damp["loss_factor"]:
+        D = damp["loss_factor"] * K if D is None else D + damp["loss_factor"] * K
+    ndof = K.shape[0]
+    loads = []
+    for i, ld in enumerate(m.get("loads", [])):
+        vec = _read_vector(ld["file"], f"loads[{i + 1}].file", ndof)
+        loads.append(Load(vec, ld["waveform"], _coefficients(ld.get("coefficients")).get(
+            "coefficients"), ld.get("name") or f"load{i + 1}"))
+    c = m["contact"]
+    normal = _read_dofs(c["normal_dofs"], "contact.normal_dofs", base)
+    tangential = _read_dofs(c["tangential_dofs"], "contact.tangential_dofs", base)
+    observed = {name: _read_dofs(d if isinstance(d, list) else [d], f"observed.{name}",
+                                 base).tolist()
+                for name, d in m.get("observed", {}).items()}
+    gap, area = c["gap"], c["area"]
+    return from_matrices(
+        K,
+        M,
+        contact_normal_dofs=normal,
+        contact_tangential_dofs=tangential,
+        gap=np.asarray(gap, dtype=float) if isinstance(gap, list) else gap,
+        area=np.asarray(area, dtype=float) if isinstance(area, list) else area,
+        mu=c["mu"],
+        normal_sign=c["normal_sign"],
+        C=C,
+        D=D,
+        loads=loads,
+        fixed_dofs=_read_dofs(spec["fixed_dofs"], "model.fixed_dofs", base),
+        observed=observed or None,
+        wear_coefficient=c["wear_coefficient"],
+        name=title,
+    )
+
+
+# --- documentation --------------------------------------------------------------------------
+_DOC_HEAD = """\
+# Case files
+
+<!-- Generated by fretwear.case.write_case_docs() from the schema in src/fretwear/case.py and
+the analysis schemas registered in src/fretwear/runner.py: do not edit by hand. -->
+
+A case file is a [TOML](https://toml.io) file that describes a model, an analysis and what to
+write. Run it with `fretwear run CASE.toml`; the shipped examples (`fretwear example list`) are
+case files too. Units are SI throughout (m, kg, s, N, Pa, Hz).
+
+Every key is checked when the file is loaded: a wrong value, a wrong type, a missing required
+key or an unknown key (a typo) stops the run with one line naming the key, e.g.
+
+```
+error: material.nu = 0.5: expected a number in (-1, 0.5)
+error: unknown key 'materal' in [top level]; expected one of: title, model, material, ... \
+(did you mean 'material'?)
+```
+
+A complete example with every modelling choice commented: `fretwear example show
+beam-linear-frf`.
+
+Items of arrays of tables are numbered from 1 in messages: `loads[2]` is the second
+`[[loads]]` block. Relative file paths are relative to the folder of the case file.
+
+A model is either a finite element mesh (`model.type` = `"rectangle"`, `"box"` or `"mesh"`)
+or user matrices (`"matrices"`). The sections `[contact]`, `[[loads]]` and `[observed]`
+differ between the two; `[material]`, `[[springs]]` and `[[fixed]]` exist for meshes only.
+
+## Top level
+
+| key | what |
+|---|---|
+| `title` | one line describing the case (optional) |
+| `[model]` | the structure (required) |
+| `[material]` | elastic material (meshes, required) |
+| `[damping]` | structural damping (optional) |
+| `[[springs]]` | grounded springs (meshes, optional) |
+| `[[fixed]]` | held displacement components (meshes, optional) |
+| `[[loads]]` | loads (optional) |
+| `[contact]` | the frictional interface (required) |
+| `[observed]` | points (meshes) or DOFs (matrices) whose motion is reported (optional) |
+| `[analysis]` | what to compute (required) |
+| `[output]` | where and what to write (optional) |
+"""
+
+
+def case_docs() -> str:
+    """The Markdown of ``docs/case-files.md``, generated from the schemas."""
+    parts = [_DOC_HEAD]
+    parts.append("## [model]\n\n`type` selects one of the tables below.\n")
+    for kind, table in MODEL_TYPES.items():
+        parts.append(render_table(table, f'### type = "{kind}"'))
+    parts.append(render_table(MATERIAL, "## [material] (meshes)"))
+    parts.append(render_table(DAMPING, "## [damping]"))
+    parts.append(render_table(SPRING, "## [[springs]] (meshes)"))
+    parts.append(render_table(FIXED, "## [[fixed]] (meshes)"))
+    parts.append(render_table(LOAD_MESH, "## [[loads]] (meshes)"))
+    parts.append(render_table(LOAD_MATRICES, "## [[loads]] (matrices)"))
+    parts.append(render_table(CONTACT_MESH, "## [contact] (meshes)"))
+    parts.append(render_table(CONTACT_MATRICES, "## [contact] (matrices)"))
+    parts.append(
+        "## [observed]\n\nOne key per point. Meshes: `name = [x, y(, z)]`, the node nearest "
+        "to these coordinates [m] (its exact position is in the results), or `name = "
+        '"set"`, a node set of one node. Matrices: `name = dof` or `name = [dofs]`. '
+        "Results and figures use these names.\n"
+    )
+    parts.append("## [analysis]\n\n`type` selects one of the analyses below (those registered "
+                 "in this version).\n")
+    for kind, table in _analysis_tables().items():
+        parts.append(render_table(table, f'### type = "{kind}"'))
+    parts.append(render_table(OUTPUT, "## [output]"))
+    return "\n".join(parts)
+
+
+def docs_path() -> Path:
+    """``docs/case-files.md`` of the source tree (the package is installed editable)."""
+    return Path(__file__).resolve().parents[2] / "docs" / "case-files.md"
+
+
+def write_case_docs(path: Path | str | None = None) -> Path:
+    """Write :func:`case_docs` to ``path`` (default: :func:`docs_path`)."""
+    path = Path(path) if path is not None else docs_path()
+    path.write_text(case_docs(), encoding="utf-8")
+    return path

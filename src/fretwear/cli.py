@@ -1,0 +1,129 @@
+"""The command line: ``fretwear run``, ``fretwear example``, ``fretwear --version``.
+
+Exit status: 0 success; 1 the run finished but some solve did not converge (the results file
+says ``converged = 0``); 2 bad input or a failed solve (one line ``error: ...`` on stderr,
+never a traceback); 130 interrupted by Ctrl-C (a line says what was saved).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from importlib import resources
+from pathlib import Path
+
+from fretwear import __version__
+from fretwear.errors import FretwearError, InputError
+from fretwear.schema import suggest
+
+
+# --- examples -----------------------------------------------------------------------------
+def examples() -> dict[str, Path]:
+    """Shipped example case files: name (file stem) -> path, sorted by name."""
+    folder = Path(str(resources.files("fretwear") / "examples"))
+    return {p.stem: p for p in sorted(folder.glob("*.toml"))}
+
+
+def example_path(name: str) -> Path:
+    """The case file of example ``name``; an InputError lists the available ones."""
+    found = examples()
+    if name not in found:
+        raise InputError(f"unknown example {name!r}; expected one of: {', '.join(found)}"
+                         f"{suggest(name, found)}")
+    return found[name]
+
+
+def _example_title(path: Path) -> str:
+    from fretwear.case import read_toml
+
+    try:
+        return str(read_toml(path)[1].get("title", ""))
+    except InputError:
+        return "(unreadable)"
+
+
+# --- commands -----------------------------------------------------------------------------
+def _run(case: Path, outdir, resume: bool, progress: bool) -> int:
+    from fretwear.runner import run_case
+
+    out = run_case(case, outdir=outdir, progress=progress, resume=resume)
+    return 0 if out.converged else 1
+
+
+def cmd_run(args) -> int:
+    return _run(Path(args.case), args.output, args.resume, not args.no_progress)
+
+
+def cmd_example_list(args) -> int:
+    found = examples()
+    width = max((len(n) for n in found), default=0)
+    for name, path in found.items():
+        print(f"{name:<{width}}  {_example_title(path)}")
+    return 0
+
+
+def cmd_example_show(args) -> int:
+    sys.stdout.write(example_path(args.name).read_text(encoding="utf-8"))
+    return 0
+
+
+def cmd_example_run(args) -> int:
+    path = example_path(args.name)
+    outdir = args.output if args.output is not None else Path.cwd() / f"{args.name}-results"
+    return _run(path, outdir, args.resume, not args.no_progress)
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="fretwear",
+        description="Coupled vibration and fretting wear of frictional contact interfaces "
+        "(DLFT with wear, Salles et al. 2011).",
+    )
+    p.add_argument("--version", action="version", version=f"fretwear {__version__}")
+    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    def run_options(q):
+        q.add_argument("-o", "--output", metavar="DIR", type=Path, default=None,
+                       help="results folder (default: [output] directory of the case)")
+        q.add_argument("--resume", action="store_true",
+                       help="skip a run whose results are complete; continue from a checkpoint")
+        q.add_argument("--no-progress", action="store_true", help="no progress bars")
+
+    r = sub.add_parser("run", help="run a case file", description="Run a TOML case file.")
+    r.add_argument("case", metavar="CASE.toml", help="the case file")
+    run_options(r)
+    r.set_defaults(func=cmd_run)
+
+    e = sub.add_parser("example", help="list, show or run the shipped examples",
+                       description="The shipped examples are ordinary case files.")
+    esub = e.add_subparsers(dest="action", required=True, metavar="ACTION")
+    esub.add_parser("list", help="list the examples").set_defaults(func=cmd_example_list)
+    s = esub.add_parser("show", help="print an example case file")
+    s.add_argument("name")
+    s.set_defaults(func=cmd_example_show)
+    x = esub.add_parser("run", help="run an example (results in ./NAME-results or -o DIR)")
+    x.add_argument("name")
+    run_options(x)
+    x.set_defaults(func=cmd_example_run)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``fretwear`` command; returns the exit status."""
+    args = _parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except FretwearError as exc:
+        print(f"error: {' '.join(str(exc).split())}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt as exc:
+        print(getattr(exc, "message", "interrupted: nothing was saved"), file=sys.stderr)
+        return 130
+    except BrokenPipeError:  # e.g. `fretwear example show NAME | head`: not an error
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,303 @@
+"""Build a :class:`~fretwear.model.core.Model` from user matrices (any FE code, or by hand).
+
+The user gives ``K`` and ``M`` in their own DOF numbering and says which DOFs are the normal
+and tangential DOFs of each contact node. Each contact node's local frame is the identity
+on ``[normal, tangential(s)]``, with the sign of the normal DOF flipped when
+``normal_sign = -1`` (a *negative* displacement of that DOF closes the gap).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import scipy.io
+import scipy.sparse as sp
+
+from fretwear.errors import InputError
+from fretwear.model.build import rigid_motion_check
+from fretwear.model.core import WAVEFORMS, ContactInterface, Load, Model, ObservedPoint
+
+SYMMETRY_TOL = 1e-9  # max |A - A^T| relative to max |A|
+
+
+def _matrix(A, what: str, n: int | None = None) -> sp.csr_matrix:
+    try:
+        A = sp.csr_matrix(A, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{what}: cannot be read as a real matrix ({exc})") from None
+    if A.shape[0] != A.shape[1]:
+        raise InputError(f"{what} has shape {A.shape}; expected a square matrix")
+    if n is not None and A.shape != (n, n):
+        raise InputError(f"{what} has shape {A.shape}; expected ({n}, {n}) like K")
+    if not np.all(np.isfinite(A.data)):
+        raise InputError(f"{what} has non-finite entries (inf or nan)")
+    A.eliminate_zeros()
+    A.sort_indices()
+    return A
+
+
+def _symmetric(A: sp.csr_matrix, what: str) -> sp.csr_matrix:
+    asym = abs(A - A.T).tocoo()
+    big = abs(A).max() if A.nnz else 0.0
+    if asym.nnz and asym.data.max() > SYMMETRY_TOL * big:
+        k = int(np.argmax(asym.data))
+        i, j = int(asym.row[k]), int(asym.col[k])
+        raise InputError(
+            f"{what} is not symmetric: {what}[{i}, {j}] = {float(A[i, j]):g} but {what}[{j}, {i}] "
+            f"= {float(A[j, i]):g} (tolerance {SYMMETRY_TOL:g} x max |{what}|); expected a "
+            "symmetric matrix"
+        )
+    S = (0.5 * (A + A.T)).tocsr()
+    S.sort_indices()
+    if np.any(S.diagonal() < 0.0):
+        i = int(np.flatnonzero(S.diagonal() < 0.0)[0])
+        raise InputError(f"{what}[{i}, {i}] = {float(S[i, i]):g} < 0; expected a positive "
+                         "semi-definite matrix")
+    return S
+
+
+def _dofs(values, ndof: int, what: str) -> np.ndarray:
+    try:
+        a = np.asarray(values)
+        ok = a.size == 0 or (np.issubdtype(a.dtype, np.number) and np.all(a == np.round(a)))
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise InputError(f"{what} = {values!r}; expected integer DOF indices")
+    a = a.astype(np.int64)
+    bad = a[(a < 0) | (a >= ndof)]
+    if bad.size:
+        raise InputError(f"{what}: DOF {int(bad.ravel()[0])} is out of range; expected "
+                         f"indices in [0, {ndof - 1}] (the matrices have {ndof} DOFs)")
+    return a
+
+
+def _per_node(value, nc: int, what: str, *, positive=False, signs=False) -> np.ndarray:
+    try:
+        a = np.broadcast_to(np.asarray(value, dtype=float), (nc,)).copy()
+    except (TypeError, ValueError):
+        raise InputError(f"{what} = {value!r}; expected a number or {nc} numbers (one per "
+                         "contact node)") from None
+    if not np.all(np.isfinite(a)):
+        raise InputError(f"{what} = {value!r}; expected finite values")
+    if positive and np.any(a <= 0.0):
+        raise InputError(f"{what}: {float(a[a <= 0][0]):g}; expected values > 0")
+    if signs and not np.all(np.isin(a, (-1.0, 1.0))):
+        raise InputError(f"{what} = {value!r}; expected +1 or -1 (scalar or per node)")
+    return a
+
+
+def _nonnegative(value, what: str) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{what} = {value!r} is not a number") from None
+    if not np.isfinite(v) or v < 0.0:
+        raise InputError(f"{what} = {value!r}; expected a finite value >= 0")
+    return v
+
+
+def from_matrices(K, M, *, contact_normal_dofs, contact_tangential_dofs, gap=0.0, area=1.0,
+                  mu, normal_sign=1, C=None, D=None, loss_factor=None, loads=(),
+                  fixed_dofs=(), observed=None, wear_coefficient=0.0, coords=None,
+                  name: str = "matrices", contact_name: str = "contact") -> Model:
+    """A model from stiffness and mass matrices and a list of contact DOFs.
+
+    Parameters
+    ----------
+    K, M : (n, n) array or scipy.sparse
+        Symmetric stiffness [N/m] and mass [kg] (``M`` may be singular, e.g. massless contact
+        DOFs). Symmetry is checked to ``1e-9`` relative and then enforced exactly.
+    contact_normal_dofs : (nc,) int
+        The normal DOF of each contact node.
+    contact_tangential_dofs : (nc,) int (2D) or (nc, 2) int (3D)
+        Its tangential DOF(s).
+    gap : float or (nc,)
+        Initial normal gap [m] (>= 0 open; negative = initial interference).
+    area : float or (nc,)
+        Contact area of each node [m^2] (> 0); pressures are forces divided by it.
+    mu : float
+        Coulomb friction coefficient [-] (>= 0).
+    normal_sign : +1, -1 or (nc,) of them
+        +1 if a positive displacement of the normal DOF closes the gap, else -1.
+    C, D : (n, n), optional
+        Viscous [N s/m] and hysteretic [N/m] damping matrices.
+    loss_factor : float, optional
+        Hysteretic loss factor eta: ``D = eta K`` (not with ``D``).
+    loads : sequence of :class:`~fretwear.model.core.Load` with (n,) vectors [N].
+    fixed_dofs : int sequence
+        DOFs held at zero (never contact DOFs).
+    observed : dict, optional
+        name -> DOF index or list of DOF indices.
+    wear_coefficient : float
+        Archard coefficient k_w [1/Pa].
+    coords : (nc, d), optional
+        Positions of the contact nodes [m], for output (zeros if not given).
+    name : str
+        Label of the model.
+    contact_name : str
+        Label of the contact interface.
+
+    Returns
+    -------
+    Model
+        ``dim`` = 2 or 3 from the number of tangential DOFs; no mesh; ``thickness = 1``.
+
+    Raises
+    ------
+    InputError
+        Bad shapes, asymmetric matrices, DOFs out of range or repeated, contact DOFs fixed,
+        or a stiffness left singular with the contact normal DOFs and fixed DOFs held.
+    """
+    K = _symmetric(_matrix(K, "K"), "K")
+    n = K.shape[0]
+    M = _symmetric(_matrix(M, "M", n), "M")
+
+    normal = _dofs(contact_normal_dofs, n, "contact_normal_dofs").reshape(-1)
+    tang = _dofs(contact_tangential_dofs, n, "contact_tangential_dofs")
+    nc = normal.size
+    if nc == 0:
+        raise InputError("contact_normal_dofs is empty; expected at least one contact node")
+    if tang.shape == (nc,):
+        tang = tang[:, None]
+    if tang.ndim != 2 or tang.shape[0] != nc or tang.shape[1] not in (1, 2):
+        raise InputError(
+            f"contact_tangential_dofs has shape {np.shape(contact_tangential_dofs)}; expected "
+            f"({nc},) in 2D or ({nc}, 2) in 3D for {nc} contact normal DOFs"
+        )
+    dofs = np.column_stack([normal, tang])
+    dim = dofs.shape[1]
+    values, counts = np.unique(dofs, return_counts=True)
+    if np.any(counts > 1):
+        raise InputError(f"contact DOF {int(values[counts > 1][0])} is listed more than once; "
+                         "each contact DOF must be distinct")
+
+    fixed = _dofs(fixed_dofs, n, "fixed_dofs").reshape(-1)
+    values, counts = np.unique(fixed, return_counts=True)
+    if np.any(counts > 1):
+        raise InputError(f"fixed_dofs lists DOF {int(values[counts > 1][0])} more than once")
+    clash = np.intersect1d(fixed, dofs)
+    if clash.size:
+        raise InputError(f"DOF {int(clash[0])} is both a contact DOF and a fixed DOF; contact "
+                         "DOFs cannot be fixed")
+
+    sign = _per_node(normal_sign, nc, "normal_sign", signs=True)
+    frame = np.broadcast_to(np.eye(dim), (nc, dim, dim)).copy()
+    frame[:, 0, 0] = sign
+    if coords is None:
+        xyz = np.zeros((nc, dim))
+    else:
+        xyz = np.asarray(coords, dtype=float)
+        if xyz.shape != (nc, dim) or not np.all(np.isfinite(xyz)):
+            raise InputError(f"coords has shape {xyz.shape}; expected ({nc}, {dim}) finite "
+                             "positions [m] of the contact nodes")
+    interface = ContactInterface(
+        dofs=dofs,
+        frame=frame,
+        gap=_per_node(gap, nc, "gap"),
+        area=_per_node(area, nc, "area", positive=True),
+        mu=_nonnegative(mu, "friction coefficient mu"),
+        coords=xyz,
+        node_ids=np.full(nc, -1, dtype=np.int64),
+        wear_coefficient=_nonnegative(wear_coefficient, "wear_coefficient"),
+        name=str(contact_name),
+    )
+
+    if C is not None:
+        C = _matrix(C, "C", n)
+    if D is not None and loss_factor is not None:
+        raise InputError("give either D or loss_factor (D = loss_factor * K), not both")
+    if D is not None:
+        D = _matrix(D, "D", n)
+    elif loss_factor is not None and _nonnegative(loss_factor, "loss_factor") > 0.0:
+        D = (float(loss_factor) * K).tocsr()
+
+    model = Model(
+        K=K,
+        M=M,
+        contact=interface,
+        C=C,
+        D=D,
+        loads=_loads(loads, n),
+        observed=_observed(observed, n),
+        fixed_dofs=fixed,
+        dim=dim,
+        mesh=None,
+        thickness=1.0,
+        name=str(name),
+        meta={"source": "matrices"},
+    )
+    rigid_motion_check(K, np.union1d(normal, fixed))
+    return model
+
+
+def _loads(loads, n: int) -> list[Load]:
+    out = []
+    for load in loads:
+        if not isinstance(load, Load):
+            raise InputError(f"loads: {load!r} is not a fretwear Load(vector, waveform, ...)")
+        vec = np.asarray(load.vector, dtype=float)
+        if vec.shape != (n,) or not np.all(np.isfinite(vec)):
+            raise InputError(f"load {load.name!r}: vector of shape {vec.shape}; expected ({n},) "
+                             "finite nodal forces [N]")
+        if load.waveform not in WAVEFORMS:
+            raise InputError(f"load {load.name!r}: waveform {load.waveform!r}; expected one of "
+                             f"{list(WAVEFORMS)}")
+        out.append(Load(vec.copy(), load.waveform, load.coefficients, load.name))
+    return out
+
+
+def _observed(observed, n: int) -> list[ObservedPoint]:
+    if observed is None:
+        return []
+    if not isinstance(observed, dict):
+        raise InputError(f"observed = {observed!r}; expected a dict name -> DOF index or list "
+                         "of DOF indices")
+    out = []
+    for key, dofs in observed.items():
+        d = _dofs(dofs, n, f"observed {key!r}").reshape(-1)
+        if d.size == 0:
+            raise InputError(f"observed {key!r} lists no DOF")
+        out.append(ObservedPoint(str(key), d, np.zeros(d.size)))
+    return out
+
+
+def read_matrix_market(path, *, shape: tuple | None = None):
+    """Read a Matrix Market file (``scipy.io.mmread``).
+
+    Parameters
+    ----------
+    path : str or Path
+    shape : tuple, optional
+        Expected shape: ``(n, n)`` for a matrix, ``(n,)`` for a vector.
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix or (n,) float array
+        A single row or column is returned as a dense vector; anything else as a sparse
+        matrix.
+
+    Raises
+    ------
+    InputError
+        Missing or malformed file, complex entries, or a shape other than ``shape``.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"Matrix Market file {str(path)!r} does not exist")
+    try:
+        A = scipy.io.mmread(str(path))
+    except Exception as exc:  # scipy raises ValueError, IndexError, ... on bad files
+        raise InputError(f"cannot read Matrix Market file {str(path)!r}: {exc}") from None
+    if np.iscomplexobj(A.data if sp.issparse(A) else A):
+        raise InputError(f"Matrix Market file {str(path)!r} holds complex values; expected "
+                         "real ones")
+    if 1 in A.shape:
+        out = np.asarray(A.toarray() if sp.issparse(A) else A, dtype=float).reshape(-1)
+    else:
+        out = sp.csr_matrix(A, dtype=float)
+    if shape is not None and tuple(out.shape) != tuple(shape):
+        raise InputError(f"Matrix Market file {str(path)!r} holds shape {out.shape}; expected "
+                         f"{tuple(shape)}")
+    return out

@@ -1,0 +1,193 @@
+"""Figures of computed results (matplotlib, files only, no screen).
+
+Each function takes result objects or a results dataset and the path of the figure file,
+writes it and returns the path. Common style: :func:`new_figure` and :func:`save`; one curve
+per interface with the colours of :data:`INTERFACE_STYLE`; axis labels carry units.
+Figures are made with :class:`matplotlib.figure.Figure` directly (rendered by Agg), not
+with ``pyplot``: no window, no global backend switch, nothing left open.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from matplotlib.collections import LineCollection, PolyCollection
+from matplotlib.figure import Figure
+
+#: line style of each linear interface, shared by all figures
+INTERFACE_STYLE = {
+    "free": {"color": "tab:green", "linestyle": ":"},
+    "sliding": {"color": "tab:blue", "linestyle": "-"},
+    "stuck": {"color": "tab:red", "linestyle": "--"},
+}
+AXIS_NAMES = ("x", "y", "z")
+
+
+def new_figure(nrows: int = 1, ncols: int = 1, *, title: str | None = None,
+               panel_size=(5.5, 3.6), sharex: bool = False):
+    """A figure with a grid of axes (always a 2D array) and an optional title.
+
+    Parameters
+    ----------
+    nrows, ncols : grid of panels.
+    title : figure title (e.g. the case title).
+    panel_size : (width, height) of one panel [inches].
+    """
+    fig = Figure(figsize=(panel_size[0] * ncols, panel_size[1] * nrows))
+    axes = fig.subplots(nrows, ncols, squeeze=False, sharex=sharex)
+    if title:
+        fig.suptitle(title)
+    return fig, axes
+
+
+def save(fig, path: Path | str) -> Path:
+    """Lay out and write ``fig``; the format follows the file extension."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.tight_layout()
+    fig.savefig(path, dpi=150)
+    return path
+
+
+def format_frequency(f_hz: float) -> str:
+    """``"56.99 Hz"``, ``"27.13 kHz"``, ``"1.008 MHz"``: 4 significant digits."""
+    for factor, unit in ((1e6, "MHz"), (1e3, "kHz")):
+        if abs(f_hz) >= factor:
+            return f"{f_hz / factor:.4g} {unit}"
+    return f"{f_hz:.4g} Hz"
+
+
+# --- FRF -------------------------------------------------------------------------------
+def plot_frf(ds, path: Path | str, point: str, *, title: str | None = None) -> Path:
+    """Amplitude of the FRF at one observed point, log-log, one panel per axis.
+
+    Parameters
+    ----------
+    ds : an ``frf`` results dataset (``displacement_amplitude`` over interface, frequency,
+        point, axis; see ``docs/results.md``).
+    path : figure file.
+    point : observed point name.
+    title : figure title.
+    """
+    amp = ds["displacement_amplitude"].sel(point=point)
+    axes_labels = [str(a) for a in ds["axis"].values]
+    fig, axes = new_figure(len(axes_labels), 1, title=title, sharex=True)
+    f = ds["frequency"].values
+    for ax, axis in zip(axes[:, 0], axes_labels, strict=True):
+        for interface in ds["interface"].values:
+            y = amp.sel(interface=interface, axis=axis).values
+            if np.all(np.isnan(y)):
+                continue
+            ax.loglog(f, np.where(y > 0, y, np.nan), label=str(interface),
+                      **INTERFACE_STYLE.get(str(interface), {}))
+        ax.set_ylabel(f"|u_{axis}| at {point} [m]")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(title="interface")
+    axes[-1, 0].set_xlabel("frequency [Hz]")
+    return save(fig, path)
+
+
+# --- mode shapes -------------------------------------------------------------------------
+def _mesh_edges(mesh) -> np.ndarray:
+    """Unique cell edges ``(ne, 2)`` of a mesh (for 3D: the edges of its boundary facets)."""
+    if mesh.dim == 2:
+        k = mesh.cells.shape[1]
+        pairs = [(i, (i + 1) % k) for i in range(k)]
+        edges = np.vstack([mesh.cells[:, list(p)] for p in pairs])
+    else:
+        facets = [np.asarray(f) for f in mesh.boundaries.values() if len(f)]
+        if not facets:
+            return np.zeros((0, 2), dtype=np.int64)
+        edges = []
+        for f in facets:
+            k = f.shape[1]
+            edges += [f[:, [i, (i + 1) % k]] for i in range(k)]
+        edges = np.vstack(edges)
+    return np.unique(np.sort(edges, axis=1), axis=0)
+
+
+def deformed(points: np.ndarray, displacement: np.ndarray, fraction: float = 0.1):
+    """Points moved by ``displacement`` scaled so that its largest value is ``fraction`` of
+    the model size; returns ``(moved points, scale factor)``."""
+    size = float(np.linalg.norm(np.ptp(points, axis=0)))
+    peak = float(np.max(np.linalg.norm(displacement, axis=1))) if displacement.size else 0.0
+    scale = fraction * size / peak if peak > 0 else 0.0
+    return points + scale * displacement, scale
+
+
+def _draw_mesh(ax, mesh, points, *, color, lw, fill=None):
+    if mesh.dim == 2:
+        polys = points[mesh.cells]
+        ax.add_collection(PolyCollection(polys, facecolors=fill or "none", edgecolors=color,
+                                         linewidths=lw))
+    else:  # 3D: projection on the x-y plane of the surface edges
+        edges = _mesh_edges(mesh)
+        ax.add_collection(LineCollection(points[edges][:, :, :2], colors=color, linewidths=lw))
+    ax.autoscale_view()
+
+
+def plot_mode_shapes(mesh, frequency_hz, shapes, path: Path | str, *, n: int = 6,
+                     title: str | None = None) -> Path:
+    """Deformed mesh of the first ``n`` modes over the undeformed mesh (grey).
+
+    Parameters
+    ----------
+    mesh : the model's :class:`~fretwear.model.core.Mesh`.
+    frequency_hz : (nm,) natural frequencies [Hz].
+    shapes : (nm, ndof) mode shapes with node-major DOFs.
+    path : figure file.
+    n : number of modes drawn (at most).
+    title : figure title.
+
+    Notes
+    -----
+    Shapes are drawn to a common visual scale (largest displacement 10 % of the model size);
+    3D meshes are drawn as their surface edges projected on the x-y plane.
+    """
+    nm = min(n, len(frequency_hz))
+    ncols = min(nm, 2) if nm else 1
+    nrows = max(1, -(-nm // ncols))
+    size = mesh.points.max(axis=0) - mesh.points.min(axis=0)
+    aspect = size[1] / size[0] if size[0] > 0 else 1.0
+    panel = (6.0, float(np.clip(6.0 * aspect + 1.8, 2.4, 5.0)))
+    fig, axes = new_figure(nrows, ncols, title=title, panel_size=panel)
+    for k, ax in enumerate(axes.ravel()):
+        if k >= nm:
+            ax.set_axis_off()
+            continue
+        u = np.asarray(shapes[k]).reshape(mesh.points.shape[0], mesh.dim)
+        moved, _ = deformed(mesh.points, u)
+        _draw_mesh(ax, mesh, mesh.points, color="0.75", lw=0.5)
+        _draw_mesh(ax, mesh, moved, color="tab:blue", lw=0.8, fill=(0.12, 0.47, 0.71, 0.15))
+        ax.set_aspect("equal")
+        ax.set_title(f"mode {k + 1}: {format_frequency(frequency_hz[k])}")
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("y [m]" if mesh.dim == 2 else "y [m] (surface edges seen along z)")
+    return save(fig, path)
+
+
+def plot_natural_frequencies(ds, path: Path | str, *, title: str | None = None) -> Path:
+    """Natural frequencies per interface (a ``modes`` results dataset), log scale.
+
+    Rigid-body modes (below 1e-6 of the highest frequency of the dataset) cannot be drawn on
+    a log scale: the legend says how many were left out.
+    """
+    fig, axes = new_figure(title=title, panel_size=(8.0, 3.6))
+    ax = axes[0, 0]
+    rigid_below = 1e-6 * float(np.nanmax(ds["natural_frequency"].values, initial=0.0))
+    for interface in ds["interface"].values:
+        f = ds["natural_frequency"].sel(interface=interface).values
+        ok = np.isfinite(f) & (f > rigid_below)
+        n_rigid = int(np.sum(np.isfinite(f) & ~ok))
+        label = str(interface) + (f"\n({n_rigid} rigid-body modes\nat ~0 Hz not shown)"
+                                  if n_rigid else "")
+        style = INTERFACE_STYLE.get(str(interface), {})
+        ax.semilogy(ds["mode"].values[ok], f[ok], marker="o", color=style.get("color"),
+                    linestyle=style.get("linestyle", "-"), label=label)
+    ax.set_xlabel("mode number")
+    ax.set_ylabel("natural frequency [Hz]")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(title="interface", loc="upper left", bbox_to_anchor=(1.01, 1.0),
+              fontsize="small")
+    return save(fig, path)

@@ -1,0 +1,1076 @@
+"""Time-domain reference solvers, independent of the harmonic balance.
+
+* :func:`integrate` -- fixed-step time integration of ``M U'' + C U' + K U + T^T lam = F(t)``
+  with unilateral contact and Coulomb friction solved exactly at every step (no penalty, no
+  regularisation).
+* :func:`steady_state` -- integrate until the response repeats every period, and classify it
+  (periodic, subharmonic, drifting, quasi-periodic), with the harmonics of the last period.
+* :func:`incremental_wear` -- quasi-static load steps through each cycle with exact contact and
+  friction and Archard wear applied as it goes (in the spirit of Stromberg 1997), optionally
+  with cycle jumps.
+
+Scheme (see ``docs/transient.md`` for the derivation and the choices)
+-------------------------------------------------------------------
+The linear part is Newmark's rule written in its two-step form (``beta = 1/4, gamma = 1/2``
+by default: the trapezoidal rule, second order, energy conserving)::
+
+    M (q+ - 2q + q-) + h C [g q+ + (1-2g) q + (g-1) q-]
+        + h^2 K [b q+ + (1/2-2b+g) q + (1/2+b-g) q-] = h^2 (F~_n - T^T lam_n)
+
+with ``q+- = q_{n+-1}``, ``F~_n`` the same weighted average of the loads, and the contact
+force ``lam_n`` (the force at ``t_n``) chosen so that the positions ``q_{n+1}`` satisfy
+Signorini exactly and the slip increment ``x_T(n+1) - x_T(n)`` satisfies Coulomb exactly
+(stick: the increment is exactly zero). With ``gamma = 1/2`` the discrete energy
+``E_{n+1/2} = 1/2 w^T M w + 1/2 qm^T K qm`` (``w = (q_{n+1} - q_n)/h``,
+``qm = (q_{n+1} + q_n)/2``) obeys exactly
+``E_{n+1/2} - E_{n-1/2} = F~_n . (q_{n+1} - q_{n-1})/2 - damping - lam_n . (x_{n+1} - x_{n-1})/2``.
+
+Speed: for a fixed step the step matrix is constant, so the structure is reduced exactly
+(Craig-Bampton on the contact DOFs with the fixed-interface modes below a cutoff and one
+static mode per load vector), diagonalised, and each step is a small dense update plus one
+contact problem (numba kernels in :mod:`fretwear.transient_kernels`).
+
+Damping: the viscous ``C`` as given; the hysteretic ``D`` has no causal time-domain form and
+is replaced by the equivalent viscous damping at the forcing frequency, ``C_eq = D / omega``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from fretwear.errors import ConvergenceError, InputError
+from fretwear.model.core import Model
+from fretwear.transient_kernels import OPEN, STICK, run_dynamic, run_quasistatic
+
+__all__ = [
+    "Classification",
+    "IncrementalWearResult",
+    "SteadyStateResult",
+    "TransientResult",
+    "classify_sequence",
+    "fourier_coefficients",
+    "incremental_wear",
+    "integrate",
+    "steady_state",
+]
+
+DEFAULT_STEPS = 128
+CUTOFF_STEPS = 8  # default cutoff: modes whose period spans at least this many steps
+DENSE_EIG_LIMIT = 3000  # interior DOFs up to which the fixed-interface modes are found densely
+CHUNK_STEPS = 2_000_000  # steps per kernel call (progress, interruption)
+
+
+# --------------------------------------------------------------------------------------------
+# results
+# --------------------------------------------------------------------------------------------
+@dataclass
+class TransientResult:
+    """Output of :func:`integrate`.
+
+    Samples are taken at ``t_n = n h`` (``h = T / steps_per_period``) for every step of the
+    recorded periods (the last ``record`` periods), ``t`` counted from the start of the run.
+
+    Attributes
+    ----------
+    t : (ns,) times [s].
+    observed : name -> (ns, d) displacement of each observed point [m].
+    velocities : name -> (ns, d) velocity [m/s] (``(U_{n+1} - U_{n-1}) / 2h``).
+    u_loc : (ns, nc, d) local contact displacements ``[u_N, u_T...]`` [m].
+    lam : (ns, nc, d) contact forces in the local frame [N] (the force at ``t_n``).
+    state : (ns, nc) int8: 0 = separation, 1 = stick, 2 = slip (over the step ``t_n -> t_n+1``).
+    energy : name -> (ns,) [J]: ``"external"`` work of the loads, ``"friction"`` dissipation,
+        ``"normal"`` work of the normal contact forces (impacts, >= 0), ``"damping"``
+        dissipation, each cumulative from the first recorded sample; ``"mechanical"`` kinetic +
+        elastic energy at ``t_n + h/2``; ``"numerical"`` the algorithmic dissipation (zero to
+        round-off for ``gamma = 1/2``). Balance:
+        ``mechanical[j] - mechanical[0] = external - friction - normal - damping - numerical``.
+    n_periods : forcing periods simulated. steps_per_period : steps per period.
+    omega : forcing angular frequency [rad/s]. wall_time : [s].
+    U, V : (ndof,) final displacement [m] and velocity [m/s] (pass them as ``U0, V0`` to
+        continue the run exactly).
+    poincare : name -> (np, d) observed displacement at the start of each kept period [m].
+    period_mean : name -> (np, d) mean over each kept period [m].
+    info : reduction and solver statistics.
+    """
+
+    t: np.ndarray
+    observed: dict
+    velocities: dict
+    u_loc: np.ndarray
+    lam: np.ndarray
+    state: np.ndarray
+    energy: dict
+    n_periods: int
+    steps_per_period: int
+    omega: float
+    wall_time: float
+    U: np.ndarray
+    V: np.ndarray
+    poincare: dict = field(default_factory=dict)
+    period_mean: dict = field(default_factory=dict)
+    info: dict = field(default_factory=dict)
+
+    def energy_residual(self) -> float:
+        """Largest ``|dE - (W_ext - D_fric - D_normal - D_damp - D_num)|`` over the record [J]."""
+        e = self.energy
+        if self.t.size == 0:
+            return 0.0
+        lhs = e["mechanical"] - e["mechanical"][0]
+        rhs = e["external"] - e["friction"] - e["normal"] - e["damping"] - e["numerical"]
+        return float(np.max(np.abs(lhs - rhs)))
+
+
+@dataclass
+class Classification:
+    """Verdict of :func:`classify_sequence` on a sequence of once-per-period samples.
+
+    kind : ``"periodic"`` (repeats every period to ``tol``), ``"subharmonic"`` (repeats every
+        ``order`` periods), ``"drifting"`` (the period means move steadily: ratcheting),
+        ``"quasi-periodic"`` (bounded, not decaying, not repeating, with a spectral peak at a
+        non-zero frequency of the Poincare sequence), ``"irregular"`` (bounded, not decaying,
+        no dominant peak), or ``"transient"`` (still converging: undecided).
+    periodicity_error : ``max |P_k - P_{k-1}| / scale`` over the last ``n_confirm`` periods.
+    scale : amplitude used to make the errors relative (unit of the samples).
+    order : repetition period in forcing periods (1 if periodic, 0 if none).
+    drift_rate : largest slope of the period means [unit per period].
+    decay : rms deviation of the Poincare samples in the second half of the window over that
+        in the first half (< 1: decaying transient; ~1: sustained).
+    rotation : dominant frequency of the Poincare sequence [cycles per period], in (0, 0.5];
+        the physical frequency is ``(j +- rotation) f`` for an unknown integer ``j`` (aliasing).
+    peak_ratio : spectral peak over the median of the spectrum.
+    n : number of samples used.
+    """
+
+    kind: str
+    periodicity_error: float
+    scale: float
+    order: int = 0
+    drift_rate: float = 0.0
+    decay: float = float("nan")
+    rotation: float = 0.0
+    peak_ratio: float = 0.0
+    n: int = 0
+
+
+@dataclass
+class SteadyStateResult:
+    """Output of :func:`steady_state`.
+
+    Attributes
+    ----------
+    classification : see :class:`Classification` (``kind``).
+    n_periods : periods integrated (including the recorded last one).
+    converged : True for ``"periodic"`` (and ``"subharmonic"``).
+    last : :class:`TransientResult` of the last period (every step recorded).
+    harmonics : name -> (2 nh + 1, d) real Fourier coefficients of the observed displacement
+        over the last period [m], basis ``[a0, a1..a_nh, b1..b_nh]``
+        (``x(t) = a0 + sum a_n cos(n w t) + b_n sin(n w t)``, t from the period start).
+    contact_harmonics : ``"lam"`` -> (2 nh + 1, nc, d) [N], ``"u_loc"`` -> (2 nh + 1, nc, d) [m].
+    diagnostics : the final :class:`Classification`.
+    poincare : (np, nmon) once-per-period samples of the monitored quantities (observed DOFs
+        then contact local displacements) over the last window [m].
+    U, V : final state [m], [m/s]. wall_time : [s]. info : solver statistics.
+    """
+
+    classification: str
+    n_periods: int
+    converged: bool
+    last: TransientResult
+    harmonics: dict
+    contact_harmonics: dict
+    diagnostics: Classification
+    poincare: np.ndarray
+    U: np.ndarray
+    V: np.ndarray
+    wall_time: float
+    info: dict = field(default_factory=dict)
+
+
+@dataclass
+class IncrementalWearResult:
+    """Output of :func:`incremental_wear` (one row per recorded computed cycle).
+
+    cycles : (nrec,) number of load cycles done (computed cycles times their jumps).
+    wear : (nrec, nc) wear depth [m] at the end of the cycle.
+    pressure : (nrec, nc) contact pressure ``lam_N / area`` averaged over the cycle [Pa].
+    slip : (nrec, nc) slip distance over the computed cycle [m].
+    worn_volume : (nrec,) ``sum wear * area`` [m^3].
+    dissipation : (nrec,) friction dissipation over the computed cycle [J].
+    computed_cycles, cycle_jump, steps_per_cycle, k_w [1/Pa], wall_time [s].
+    U : (ndof,) final displacement [m] (end of the last cycle, phase 0).
+    lam : (nc, d) final contact forces [N]. info : solver statistics.
+    """
+
+    cycles: np.ndarray
+    wear: np.ndarray
+    pressure: np.ndarray
+    slip: np.ndarray
+    worn_volume: np.ndarray
+    dissipation: np.ndarray
+    computed_cycles: int
+    cycle_jump: int
+    steps_per_cycle: int
+    k_w: float
+    wall_time: float
+    U: np.ndarray
+    lam: np.ndarray
+    info: dict = field(default_factory=dict)
+
+
+# --------------------------------------------------------------------------------------------
+# small helpers
+# --------------------------------------------------------------------------------------------
+def fourier_coefficients(samples: np.ndarray, n_harmonics: int) -> np.ndarray:
+    """Real Fourier coefficients of samples over exactly one period (axis 0).
+
+    Returns ``(2 nh + 1, ...)``: ``[a0, a1..a_nh, b1..b_nh]`` with ``a0`` the mean,
+    ``a_n = 2 Re X_n / N``, ``b_n = -2 Im X_n / N`` (``X = rfft(samples)``), so that
+    ``x(t_k) = a0 + sum a_n cos(2 pi n k / N) + b_n sin(2 pi n k / N)``.
+    """
+    x = np.asarray(samples, dtype=float)
+    N = x.shape[0]
+    nh = int(n_harmonics)
+    if nh < 0 or 2 * nh >= N:
+        raise InputError(f"n_harmonics = {n_harmonics}: need 0 <= n_harmonics < N/2 = {N / 2:g} "
+                         "(samples per period)")
+    X = np.fft.rfft(x, axis=0)
+    out = np.empty((2 * nh + 1,) + x.shape[1:])
+    out[0] = X[0].real / N
+    out[1:nh + 1] = 2.0 * X[1:nh + 1].real / N
+    out[nh + 1:] = -2.0 * X[1:nh + 1].imag / N
+    return out
+
+
+def _positive(value, what: str) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{what} = {value!r}; expected a positive number") from None
+    if not (math.isfinite(v) and v > 0.0):
+        raise InputError(f"{what} = {value!r}; expected a positive finite number")
+    return v
+
+
+def _count(value, what: str, minimum: int = 1) -> int:
+    if isinstance(value, bool) or not isinstance(value, int | np.integer):
+        raise InputError(f"{what} = {value!r}; expected an integer >= {minimum}")
+    if value < minimum:
+        raise InputError(f"{what} = {value}; expected an integer >= {minimum}")
+    return int(value)
+
+
+def _check_contact(model: Model) -> None:
+    c = model.contact
+    dofs = np.asarray(c.dofs)
+    if dofs.ndim != 2 or dofs.shape[0] == 0 or dofs.shape[1] not in (2, 3):
+        raise InputError(f"contact.dofs has shape {dofs.shape}; expected (nc >= 1, 2 or 3)")
+    if np.unique(dofs).size != dofs.size:
+        raise InputError("contact.dofs: a DOF belongs to two contact nodes (or twice to one); "
+                         "the time-domain solver needs distinct contact DOFs")
+    fixed = np.intersect1d(dofs.ravel(), np.asarray(model.fixed_dofs, dtype=np.int64))
+    if fixed.size:
+        raise InputError(f"contact DOF {int(fixed[0])} is also a fixed DOF; a contact node must "
+                         "be free to move in all its directions for the time-domain solver")
+    if not (np.isfinite(c.mu) and c.mu >= 0.0):
+        raise InputError(f"contact.mu = {c.mu!r}; expected a friction coefficient >= 0")
+
+
+def _node_wear(wear, nc: int, what: str = "wear") -> np.ndarray:
+    if wear is None:
+        return np.zeros(nc)
+    w = np.asarray(wear, dtype=float)
+    if w.shape != (nc,) or not np.all(np.isfinite(w)):
+        raise InputError(f"{what} has shape {w.shape}; expected ({nc},) finite depths [m] (one "
+                         "per contact node)")
+    return w.copy()
+
+
+# --------------------------------------------------------------------------------------------
+# reduction (Craig-Bampton on the contact DOFs + static load modes, then diagonalised)
+# --------------------------------------------------------------------------------------------
+@dataclass
+class _Reduced:
+    free: np.ndarray  # free DOFs of the model
+    basis: np.ndarray  # (nf, r): U_free = basis @ q
+    K: np.ndarray  # (r,) if diag else (r, r)
+    M: np.ndarray
+    C: np.ndarray
+    diag: bool
+    Tx: np.ndarray  # (m, r) local contact displacements
+    obs: np.ndarray  # (no, r) rows of the observed DOFs
+    obs_names: list
+    obs_slices: list
+    info: dict
+
+
+def _sub(A, rows, cols):
+    return A[rows][:, cols]
+
+
+def _fixed_interface_modes(Kii, Mii, w_cut: float | None, n_modes: int | None):
+    """Eigenpairs of ``Kii phi = w^2 Mii phi`` (mass-normalised), below ``w_cut`` or the first
+    ``n_modes``."""
+    ni = Kii.shape[0]
+    if ni == 0 or n_modes == 0:
+        return np.zeros(0), np.zeros((ni, 0))
+    if ni <= DENSE_EIG_LIMIT:
+        Kd, Md = Kii.toarray(), Mii.toarray()
+        try:
+            if n_modes is not None:
+                k = min(n_modes, ni)
+                w2, V = sla.eigh(Kd, Md, subset_by_index=(0, k - 1))
+            else:
+                w2, V = sla.eigh(Kd, Md, subset_by_value=(-np.inf, w_cut**2))
+        except np.linalg.LinAlgError as exc:
+            raise InputError("the interior mass matrix (contact DOFs held) is not positive "
+                             f"definite ({exc}); use modal_cutoff='all'") from None
+        return w2, V
+    # large models: shift-invert Lanczos, increasing the count until past the cutoff
+    k = n_modes if n_modes is not None else 20
+    while True:
+        k = min(k, ni - 2)
+        w2, V = spla.eigsh(Kii.tocsc(), k=k, M=Mii.tocsc(), sigma=0.0, which="LM")
+        order = np.argsort(w2)
+        w2, V = w2[order], V[:, order]
+        if n_modes is not None:
+            return w2, V
+        if w2[-1] > w_cut**2 or k >= ni - 2:
+            keep = w2 <= w_cut**2
+            return w2[keep], V[:, keep]
+        k *= 2
+
+
+def _reduce(model: Model, omega: float, *, modal_cutoff, n_modes, steps_per_period) -> _Reduced:
+    """Reduce the free structure onto the contact DOFs (see module docstring)."""
+    _check_contact(model)
+    n = model.ndof
+    free = model.free_dofs()
+    nf = free.size
+    pos = -np.ones(n, dtype=np.int64)
+    pos[free] = np.arange(nf)
+    K = _sub(model.K.tocsr(), free, free)
+    M = _sub(model.M.tocsr(), free, free)
+    C = sp.csr_matrix((nf, nf))
+    if model.C is not None:
+        C = C + _sub(model.C.tocsr(), free, free)
+    if model.D is not None:
+        C = C + _sub(model.D.tocsr(), free, free) / omega  # equivalent viscous at omega
+    T = model.contact.local_transform(n).tocsr()[:, free]
+    bnd = pos[np.asarray(model.contact.dofs).ravel()]
+    nb = bnd.size
+    mask = np.ones(nf, dtype=bool)
+    mask[bnd] = False
+    inner = np.flatnonzero(mask)
+    ni = inner.size
+    f = omega / (2.0 * np.pi)
+    if modal_cutoff is None:
+        f_cut = steps_per_period * f / CUTOFF_STEPS
+    elif isinstance(modal_cutoff, str):
+        if modal_cutoff != "all":
+            raise InputError(f"modal_cutoff = {modal_cutoff!r}; expected a frequency [Hz], "
+                             "None (default) or 'all'")
+        f_cut = np.inf
+    else:
+        f_cut = _positive(modal_cutoff, "modal_cutoff")
+    if n_modes is not None:
+        n_modes = _count(n_modes, "n_modes", 0)
+    info = {"n_dof_free": nf, "n_boundary": nb, "n_interior": ni}
+    if ni == 0 or (np.isinf(f_cut) and n_modes is None):
+        # no reduction: all free DOFs kept (boundary first)
+        order = np.concatenate([bnd, inner])
+        Phi = np.zeros((nf, nf))
+        Phi[order, np.arange(nf)] = 1.0
+        info.update(n_modes=ni, n_load_modes=0, cutoff_hz=np.inf, reduction="none")
+    else:
+        Kii = _sub(K, inner, inner).tocsc()
+        Kib = _sub(K, inner, bnd)
+        Mii = _sub(M, inner, inner).tocsc()
+        try:
+            lu = spla.splu(Kii)
+        except RuntimeError:
+            raise InputError("the stiffness with the contact DOFs held is singular (a part of "
+                             "the structure moves freely without touching the contact); use "
+                             "modal_cutoff='all' or hold that part") from None
+        Psi = -lu.solve(Kib.toarray())
+        w2, Vm = _fixed_interface_modes(Kii, Mii, 2 * np.pi * f_cut, n_modes)
+        # static response of the interior to each load vector (contact DOFs held), with the
+        # retained modes removed: the quasi-static contribution of the truncated modes
+        extra = []
+        for load in model.loads:
+            Fi = np.asarray(load.vector, dtype=float)[free][inner]
+            if not np.any(Fi):
+                continue
+            psi = lu.solve(Fi)
+            nrm0 = math.sqrt(abs(psi @ (Kii @ psi))) or 1.0
+            for _ in range(2):  # twice for round-off
+                if Vm.shape[1]:
+                    psi -= Vm @ (Vm.T @ (Mii @ psi))
+                for v in extra:
+                    psi -= v * (v @ (Mii @ psi))
+            nrm = math.sqrt(abs(psi @ (Mii @ psi)))
+            if math.sqrt(abs(psi @ (Kii @ psi))) > 1e-8 * nrm0 and nrm > 0.0:
+                extra.append(psi / nrm)
+        Pl = np.column_stack(extra) if extra else np.zeros((ni, 0))
+        r = nb + Vm.shape[1] + Pl.shape[1]
+        Phi = np.zeros((nf, r))
+        Phi[bnd, np.arange(nb)] = 1.0
+        Phi[np.ix_(inner, np.arange(nb))] = Psi
+        Phi[np.ix_(inner, np.arange(nb, nb + Vm.shape[1]))] = Vm
+        Phi[np.ix_(inner, np.arange(nb + Vm.shape[1], r))] = Pl
+        info.update(n_modes=int(Vm.shape[1]), n_load_modes=int(Pl.shape[1]), cutoff_hz=f_cut,
+                    reduction="craig-bampton",
+                    highest_mode_hz=float(np.sqrt(max(w2[-1], 0.0)) / (2 * np.pi))
+                    if w2.size else 0.0)
+    Kr = Phi.T @ (K @ Phi)
+    Mr = Phi.T @ (M @ Phi)
+    Cr = Phi.T @ (C @ Phi)
+    Kr = 0.5 * (Kr + Kr.T)
+    Mr = 0.5 * (Mr + Mr.T)
+    Cr = 0.5 * (Cr + Cr.T)
+    diag = False
+    try:
+        w2, V = sla.eigh(Kr, Mr)
+    except np.linalg.LinAlgError:
+        V = None
+    if V is not None:
+        Cm = V.T @ Cr @ V
+        Cm = 0.5 * (Cm + Cm.T)
+        dC = np.diag(Cm).copy()
+        off = np.abs(Cm - np.diag(dC)).max() if Cm.size else 0.0
+        big = np.abs(Cm).max() if Cm.size else 0.0
+        basis = Phi @ V
+        if off <= 1e-9 * big or big == 0.0:
+            diag = True
+            Kred, Mred, Cred = w2.copy(), np.ones_like(w2), dC
+        else:
+            Kred, Mred, Cred = np.diag(w2), np.eye(w2.size), Cm
+        info["highest_frequency_hz"] = float(np.sqrt(max(w2.max(), 0.0)) / (2 * np.pi))
+    else:
+        basis, Kred, Mred, Cred = Phi, Kr, Mr, Cr
+    info["r"] = int(basis.shape[1])
+    info["diagonal"] = diag
+    Tx = np.asarray(T @ basis)
+    names, slices, rows = [], [], []
+    for p in model.observed:
+        d = np.asarray(p.dofs, dtype=np.int64).ravel()
+        rr = np.zeros((d.size, basis.shape[1]))
+        for i, dof in enumerate(d):
+            if pos[dof] >= 0:
+                rr[i] = basis[pos[dof]]
+        slices.append(slice(sum(x.shape[0] for x in rows), sum(x.shape[0] for x in rows) + d.size))
+        rows.append(rr)
+        names.append(p.name)
+    obs = np.vstack(rows) if rows else np.zeros((0, basis.shape[1]))
+    return _Reduced(free=free, basis=basis, K=Kred, M=Mred, C=Cred, diag=diag, Tx=Tx, obs=obs,
+                    obs_names=names, obs_slices=slices, info=info)
+
+
+# --------------------------------------------------------------------------------------------
+# the time stepper
+# --------------------------------------------------------------------------------------------
+class _Integrator:
+    """Holds the reduced step operator and the current state; runs whole periods."""
+
+    def __init__(self, model: Model, omega: float, *, steps_per_period, modal_cutoff, n_modes,
+                 gamma, tol, wear, U0, V0, stick_anchor):
+        self.model = model
+        self.omega = _positive(omega, "omega")
+        self.N = N = _count(steps_per_period, "steps_per_period", 4)
+        gamma = float(gamma)
+        if not (0.5 <= gamma <= 1.0):
+            raise InputError(f"gamma = {gamma!r}; expected 0.5 (trapezoidal, default) to 1")
+        beta = 0.25 * (gamma + 0.5) ** 2
+        self.gamma, self.beta = gamma, beta
+        self.tol = _positive(tol, "tol")
+        t0 = time.perf_counter()
+        red = self.red = _reduce(model, self.omega, modal_cutoff=modal_cutoff, n_modes=n_modes,
+                                 steps_per_period=N)
+        c = model.contact
+        self.nc, self.d = c.dofs.shape
+        self.m = self.nc * self.d
+        self.h = h = 2.0 * np.pi / (self.omega * N)
+        # loads per phase, reduced, and the two-step weighted average F~_k
+        tau = 2.0 * np.pi * np.arange(N) / N
+        Ft = model.load_time(tau)[:, red.free] if model.loads else np.zeros((N, red.free.size))
+        self.fscale = float(np.abs(Ft).max()) if Ft.size else 0.0
+        Fr = Ft @ red.basis
+        self.Fr = Fr
+        w1, w0, wm = beta, 0.5 - 2 * beta + gamma, 0.5 + beta - gamma
+        self.ftil = w1 * np.roll(Fr, -1, axis=0) + w0 * Fr + wm * np.roll(Fr, 1, axis=0)
+        r = red.basis.shape[1]
+        if red.diag:
+            k, mm, cc = red.K, red.M, red.C
+            s = mm + gamma * h * cc + beta * h * h * k
+            self.bq_v = -h * h * k / s
+            self.bd_v = (mm - (1 - gamma) * h * cc + wm * h * h * k) / s
+            self.bq_m = self.bd_m = np.zeros((0, 0))
+            self.ftab = h * h * self.ftil / s
+            G = h * h * red.Tx.T / s[:, None]
+        else:
+            S2 = red.M + gamma * h * red.C + beta * h * h * red.K
+            lu = sla.lu_factor(S2)
+            self.bq_m = -h * h * sla.lu_solve(lu, red.K)
+            self.bd_m = sla.lu_solve(lu, red.M - (1 - gamma) * h * red.C + wm * h * h * red.K)
+            self.bq_v = self.bd_v = np.zeros(0)
+            self.ftab = h * h * sla.lu_solve(lu, self.ftil.T).T
+            G = h * h * sla.lu_solve(lu, red.Tx.T)
+        self.G = np.ascontiguousarray(G)
+        W = red.Tx @ G
+        W = 0.5 * (W + W.T)
+        try:
+            cf = sla.cho_factor(W)
+            self.A = sla.cho_solve(cf, np.eye(self.m))
+        except np.linalg.LinAlgError:
+            raise InputError("the contact DOFs' step mobility (Delassus operator) is singular: "
+                             "a contact direction carries no mass nor stiffness") from None
+        self.A = np.ascontiguousarray(0.5 * (self.A + self.A.T))
+        self.gap = np.asarray(c.gap, dtype=float) + _node_wear(wear, self.nc)
+        if red.diag:
+            self.m_v, self.k_v, self.c_v = red.M, red.K, red.C
+            self.m_m = self.k_m = self.c_m = np.zeros((0, 0))
+        else:
+            self.m_v = self.k_v = self.c_v = np.zeros(0)
+            self.m_m, self.k_m, self.c_m = red.M, red.K, red.C
+        self.setup_time = time.perf_counter() - t0
+        self.r = r
+        # initial state
+        self._set_state(U0, V0, stick_anchor)
+        self.periods_done = 0
+        self.n_fail = 0
+        self.max_it = 0
+        self.first_fail_time = None
+
+    # state <-> full vectors ------------------------------------------------------------------
+    def _project(self, U, what):
+        n = self.model.ndof
+        U = np.asarray(U, dtype=float)
+        if U.shape != (n,) or not np.all(np.isfinite(U)):
+            raise InputError(f"{what} has shape {U.shape}; expected ({n},) finite values")
+        Uf = U[self.red.free]
+        if self.red.diag or self.red.M.ndim == 1 or np.allclose(self.red.M, np.eye(self.r)):
+            Mf = _sub(self.model.M.tocsr(), self.red.free, self.red.free)
+            return self.red.basis.T @ (Mf @ Uf)
+        return np.linalg.lstsq(self.red.basis, Uf, rcond=None)[0]
+
+    def _accel(self, q, k):
+        """Reduced acceleration without damping and contact at phase k (restart convention)."""
+        red = self.red
+        if red.diag:
+            return (self.Fr[k] - red.K * q) / red.M
+        try:
+            return np.linalg.solve(red.M, self.Fr[k] - red.K @ q)
+        except np.linalg.LinAlgError:
+            return np.zeros(self.r)
+
+    def _set_state(self, U0, V0, stick_anchor):
+        q = np.zeros(self.r) if U0 is None else self._project(U0, "U0")
+        v = np.zeros(self.r) if V0 is None else self._project(V0, "V0")
+        # midpoint velocity w_{-1/2} = V0 - h/2 a0 (a0 without damping and contact)
+        w = v - 0.5 * self.h * self._accel(q, 0)
+        self.q = q
+        self.dq = self.h * w
+        Tx = self.red.Tx
+        self.xprev = Tx @ q
+        self.xprev2 = Tx @ (q - self.dq)
+        d = self.d
+        if stick_anchor is not None:
+            a = np.asarray(stick_anchor, dtype=float)
+            if a.shape == (self.nc,) and d == 2:
+                a = a[:, None]
+            if a.shape != (self.nc, d - 1):
+                raise InputError(f"stick_anchor has shape {a.shape}; expected ({self.nc}, "
+                                 f"{d - 1}) tangential positions [m]")
+            xp = self.xprev.reshape(self.nc, d)
+            xp[:, 1:] = a
+        xN = self.xprev.reshape(self.nc, d)[:, 0]
+        tolx = 1e-9 * max(np.abs(self.xprev).max(initial=0.0), np.abs(self.gap).max(initial=0.0),
+                          1e-30)
+        self.status = np.where(xN >= self.gap - tolx, STICK, OPEN).astype(np.int8)
+        self.tdir = np.zeros((self.nc, d - 1))
+        self.tdir[:, 0] = 1.0
+
+    def full_state(self):
+        """Final ``(U, V)`` full vectors with the restart convention ``V = w + h/2 a``."""
+        n = self.model.ndof
+        U = np.zeros(n)
+        V = np.zeros(n)
+        U[self.red.free] = self.red.basis @ self.q
+        w = self.dq / self.h
+        v = w + 0.5 * self.h * self._accel(self.q, 0)
+        V[self.red.free] = self.red.basis @ v
+        return U, V
+
+    # running -----------------------------------------------------------------------------------
+    def run(self, n_periods: int, n_record: int = 0, n_keep: int = 0, progress=False):
+        """Run ``n_periods`` periods; record every step of the last ``n_record`` periods and
+        keep the once-per-period monitors of the last ``n_keep`` periods."""
+        N, m, nc = self.N, self.m, self.nc
+        no = self.red.obs.shape[0]
+        ns = n_record * N
+        r_obs = np.zeros((ns, no))
+        r_vobs = np.zeros((ns, no))
+        r_x = np.zeros((ns, m))
+        r_lam = np.zeros((ns, m))
+        r_state = np.zeros((ns, nc), dtype=np.int8)
+        r_energy = np.zeros((ns, 6))
+        nmon = no + m
+        mon_start = np.zeros((n_keep, nmon))
+        mon_mean = np.zeros((n_keep, nmon))
+        mon_ptp = np.zeros((n_keep, nmon))
+        q_last = np.zeros(self.r)
+        dq_last = np.zeros(self.r)
+        p0 = self.periods_done
+        rec_from = (p0 + n_periods - n_record) * N
+        keep_from = p0 + n_periods - n_keep
+        chunk = max(1, CHUNK_STEPS // N)
+        bar = None
+        if progress:
+            try:
+                from tqdm import tqdm
+
+                bar = tqdm(total=n_periods, unit="period")
+            except ImportError:  # pragma: no cover
+                bar = None
+        done = 0
+        while done < n_periods:
+            k = min(chunk, n_periods - done)
+            nfail, maxit, ff = run_dynamic(
+                self.q, self.dq, self.red.diag, self.bq_v, self.bd_v, self.bq_m, self.bd_m,
+                self.ftab, self.G, self.red.Tx, self.A, self.gap, self.xprev, self.xprev2,
+                float(self.model.contact.mu), self.d, self.status, self.tdir, k,
+                (self.periods_done) * N, self.tol, self.fscale, 60 + 4 * nc,
+                self.red.obs, keep_from, mon_start, mon_mean, mon_ptp, q_last, dq_last,
+                rec_from, self.h, self.ftil, self.m_v, self.k_v, self.c_v, self.m_m, self.k_m,
+                self.c_m, r_obs, r_vobs, r_x, r_lam, r_state, r_energy)
+            if nfail and self.first_fail_time is None:
+                self.first_fail_time = ff * self.h
+            self.n_fail += nfail
+            self.max_it = max(self.max_it, maxit)
+            self.periods_done += k
+            done += k
+            if bar is not None:
+                bar.update(k)
+        if bar is not None:
+            bar.close()
+        self.q_last, self.dq_last = q_last, dq_last
+        return dict(obs=r_obs, vobs=r_vobs, x=r_x, lam=r_lam, state=r_state, energy=r_energy,
+                    mon_start=mon_start, mon_mean=mon_mean, mon_ptp=mon_ptp,
+                    t0=rec_from * self.h)
+
+    def result(self, raw, n_periods, wall) -> TransientResult:
+        N, nc, d = self.N, self.nc, self.d
+        ns = raw["obs"].shape[0]
+        t = raw["t0"] + self.h * np.arange(ns)
+        observed, velocities, poinc, pmean = {}, {}, {}, {}
+        for name, sl in zip(self.red.obs_names, self.red.obs_slices, strict=True):
+            observed[name] = raw["obs"][:, sl].copy()
+            velocities[name] = raw["vobs"][:, sl].copy()
+            poinc[name] = raw["mon_start"][:, sl].copy()
+            pmean[name] = raw["mon_mean"][:, sl].copy()
+        e = raw["energy"]
+        energy = {"external": e[:, 0].copy(), "friction": e[:, 1].copy(),
+                  "normal": e[:, 2].copy(), "damping": e[:, 3].copy(),
+                  "mechanical": e[:, 4].copy(), "numerical": e[:, 5].copy()}
+        if self.gamma == 0.5:
+            energy["numerical"][:] = 0.0
+        U, V = self.full_state()
+        info = dict(self.red.info)
+        info.update(h=self.h, gamma=self.gamma, beta=self.beta, setup_time=self.setup_time,
+                    failed_steps=self.n_fail, max_active_set_iterations=self.max_it,
+                    first_failure_time=self.first_fail_time, periods_total=self.periods_done)
+        if self.n_fail:
+            warnings.warn(f"{self.n_fail} contact solves did not settle (first at t = "
+                          f"{self.first_fail_time:.6g} s); results there are approximate",
+                          RuntimeWarning, stacklevel=3)
+        return TransientResult(
+            t=t, observed=observed, velocities=velocities,
+            u_loc=raw["x"].reshape(ns, nc, d), lam=raw["lam"].reshape(ns, nc, d),
+            state=raw["state"], energy=energy, n_periods=n_periods, steps_per_period=N,
+            omega=self.omega, wall_time=wall, U=U, V=V, poincare=poinc, period_mean=pmean,
+            info=info)
+
+
+def integrate(model: Model, omega: float, *, n_periods: int, steps_per_period: int = DEFAULT_STEPS,
+              record="last", U0=None, V0=None, wear=None, stick_anchor=None, modal_cutoff=None,
+              n_modes=None, gamma: float = 0.5, keep_poincare: int = 10_000, tol: float = 1e-10,
+              progress: bool = False) -> TransientResult:
+    """Integrate the forced response in time with exact contact and friction.
+
+    Parameters
+    ----------
+    model : the structure (:class:`~fretwear.model.core.Model`).
+    omega : forcing angular frequency [rad/s]; the loads are ``F(omega t)``.
+    n_periods : number of forcing periods ``T = 2 pi / omega`` to simulate.
+    steps_per_period : fixed steps per period (``h = T / steps_per_period``). Guidance: >= 20
+        steps per period of the highest harmonic you want accurate (phase error of the
+        trapezoidal rule ``(omega h)^2 / 12``); stick-slip events are first order in ``h``.
+    record : ``"last"`` (the last period) or the number of periods recorded at the end
+        (every step), 0 for none.
+    U0, V0 : (ndof,) initial displacement [m] and velocity [m/s] at ``t = 0``; default rest.
+        ``result.U, result.V`` continue a run exactly.
+    wear : (nc,) wear depth per contact node [m] (opens the gap).
+    stick_anchor : (nc, d-1) tangential positions [m] from which the first step's slip is
+        measured (default: those of ``U0``).
+    modal_cutoff : frequency [Hz] below which the fixed-interface modes are kept
+        (Craig-Bampton); default ``steps_per_period * f / 8`` (modes the step resolves with at
+        least 8 steps per period); ``"all"`` for no reduction. The truncated modes keep their
+        static contribution (constraint modes and one static mode per load vector).
+    n_modes : keep exactly this many fixed-interface modes instead (overrides the cutoff).
+    gamma : Newmark gamma (``beta = (gamma + 1/2)^2 / 4``); 0.5 (default) is the trapezoidal
+        rule (second order, energy conserving); larger values damp the highest frequencies
+        (first order).
+    keep_poincare : once-per-period samples kept (the last ones).
+    tol : relative tolerance of the contact solver status tests.
+    progress : show a progress bar.
+
+    Returns
+    -------
+    :class:`TransientResult`.
+    """
+    n_periods = _count(n_periods, "n_periods", 1)
+    if record == "last":
+        n_rec = 1
+    else:
+        n_rec = _count(record, "record", 0)
+        if n_rec > n_periods:
+            raise InputError(f"record = {record} periods but n_periods = {n_periods}")
+    n_keep = min(_count(keep_poincare, "keep_poincare", 0), n_periods)
+    integ = _Integrator(model, omega, steps_per_period=steps_per_period,
+                        modal_cutoff=modal_cutoff, n_modes=n_modes, gamma=gamma, tol=tol,
+                        wear=wear, U0=U0, V0=V0, stick_anchor=stick_anchor)
+    t0 = time.perf_counter()
+    raw = integ.run(n_periods, n_rec, n_keep, progress=progress)
+    wall = time.perf_counter() - t0
+    return integ.result(raw, n_periods, wall)
+
+
+# --------------------------------------------------------------------------------------------
+# steady state and its classification
+# --------------------------------------------------------------------------------------------
+def classify_sequence(poincare, means=None, *, tol: float = 1e-6, scale: float | None = None,
+                      n_confirm: int = 3, min_window: int = 64, max_order: int = 8,
+                      decay_limit: float = 0.95, peak_limit: float = 20.0) -> Classification:
+    """Classify a sequence of once-per-period samples (Poincare section).
+
+    Parameters
+    ----------
+    poincare : (K, nmon) samples at the start of each period, oldest first.
+    means : (K, nmon) mean over each period (default: ``poincare``), used for the drift.
+    tol : relative tolerance of "repeats" (relative to ``scale``).
+    scale : amplitude of the response (e.g. the peak-to-peak over one period); default the
+        largest absolute sample.
+    n_confirm : consecutive periods that must repeat.
+    min_window : fewest samples before "drifting", "quasi-periodic" or "irregular" is said.
+    max_order : largest subharmonic order tested.
+    decay_limit : ``decay`` above which the deviations are taken as sustained.
+    peak_limit : spectral peak over median above which a peak is dominant.
+
+    Returns
+    -------
+    :class:`Classification`. Rules, in order: periodic if the last ``n_confirm`` differences
+    ``|P_k - P_{k-1}|`` are below ``tol * scale``; subharmonic of order p if ``|P_k - P_{k-p}|``
+    are; with at least ``min_window`` samples, drifting if the period means follow a straight
+    line (residual < 10 % of the change) whose change over the window exceeds
+    ``10 tol scale`` and whose increments do not decay (second half / first half > 0.8);
+    quasi-periodic if the detrended deviations are sustained (``decay > decay_limit``), above
+    ``tol * scale``, and their spectrum has a dominant peak at a non-zero frequency; irregular
+    if sustained without a dominant peak; otherwise transient.
+    """
+    P = np.asarray(poincare, dtype=float)
+    if P.ndim == 1:
+        P = P[:, None]
+    K = P.shape[0]
+    Mn = P if means is None else np.asarray(means, dtype=float).reshape(K, -1)
+    if scale is None or not scale > 0:
+        scale = float(np.abs(P).max(initial=0.0)) or 1.0
+    thr = tol * scale
+
+    def rep_err(p):
+        if K < p + n_confirm:
+            return np.inf
+        d = np.abs(P[K - n_confirm:] - P[K - n_confirm - p:K - p]).max()
+        return float(d)
+
+    e1 = rep_err(1)
+    out = Classification(kind="transient", periodicity_error=e1 / scale, scale=scale, n=K)
+    if e1 <= thr:
+        out.kind, out.order = "periodic", 1
+        return out
+    for p in range(2, max_order + 1):
+        if rep_err(p) <= thr:
+            out.kind, out.order = "subharmonic", p
+            return out
+    if K < max(min_window, 8):
+        return out
+    k = np.arange(K, dtype=float)
+    kc = k - k.mean()
+    # drift of the period means
+    slope = (kc @ (Mn - Mn.mean(axis=0))) / (kc @ kc)
+    j = int(np.argmax(np.abs(slope)))
+    s = float(slope[j])
+    out.drift_rate = s
+    fit = Mn[:, j].mean() + s * kc
+    resid = float(np.sqrt(np.mean((Mn[:, j] - fit) ** 2)))
+    inc = np.diff(Mn[:, j])
+    h2 = inc.size // 2
+    grow = abs(inc[h2:].mean()) / max(abs(inc[:h2].mean()), 1e-300)
+    change = abs(s) * (K - 1)
+    if change > 10.0 * thr and resid < 0.1 * change and grow > 0.8:
+        out.kind = "drifting"
+        return out
+    # sustained deviations of the Poincare samples (detrended)
+    slopes = (kc @ (P - P.mean(axis=0))) / (kc @ kc)
+    D = P - P.mean(axis=0) - np.outer(kc, slopes)
+    half = K // 2
+    a1 = float(np.sqrt(np.mean(D[:half] ** 2)))
+    a2 = float(np.sqrt(np.mean(D[half:] ** 2)))
+    out.decay = a2 / a1 if a1 > 0 else float("nan")
+    if not (a2 > thr and out.decay > decay_limit):
+        return out
+    win = np.hanning(K)
+    spec = (np.abs(np.fft.rfft(D * win[:, None], axis=0)) ** 2).sum(axis=1)
+    spec[0] = 0.0
+    ib = int(np.argmax(spec))
+    med = float(np.median(spec[1:])) if spec.size > 2 else 0.0
+    out.peak_ratio = float(spec[ib] / med) if med > 0 else np.inf
+    nu = ib / K
+    if 0 < ib < spec.size - 1:  # parabolic refinement on the log spectrum
+        y0, y1, y2 = np.log(spec[ib - 1:ib + 2] + 1e-300)
+        den = y0 - 2 * y1 + y2
+        if den < 0:
+            nu = (ib + 0.5 * (y0 - y2) / den) / K
+    out.rotation = float(min(max(nu, 0.0), 0.5))
+    out.kind = "quasi-periodic" if out.peak_ratio > peak_limit else "irregular"
+    return out
+
+
+def steady_state(model: Model, omega: float, *, max_periods: int = 20_000, tol: float = 1e-6,
+                 steps_per_period: int = DEFAULT_STEPS, n_harmonics: int = 7,
+                 check_every: int = 16, window: int = 512, min_periods: int = 128, U0=None,
+                 V0=None, wear=None, stick_anchor=None, modal_cutoff=None, n_modes=None,
+                 gamma: float = 0.5, contact_tol: float = 1e-10,
+                 progress: bool = False) -> SteadyStateResult:
+    """Integrate until the response is periodic (or classified otherwise).
+
+    The monitored quantities are the observed DOFs and the local contact displacements,
+    sampled once per period (Poincare section) and averaged over each period. Every
+    ``check_every`` periods (the interval doubles up to 512) the last ``window`` periods are
+    classified by :func:`classify_sequence` with ``scale`` = the largest peak-to-peak of the
+    monitored quantities over the last period. The run stops when the response is periodic
+    (or subharmonic), or when it is drifting / quasi-periodic / irregular at two consecutive
+    checks with at least ``min_periods`` samples, or at ``max_periods``. One more period is
+    then recorded at every step and its harmonics computed (:func:`fourier_coefficients`).
+
+    Parameters
+    ----------
+    model, omega : as :func:`integrate`.
+    max_periods : give up after this many periods (classification then as found).
+    tol : relative periodicity tolerance (see :func:`classify_sequence`).
+    n_harmonics : harmonics of the last period reported.
+    Others as :func:`integrate` (``contact_tol`` is its ``tol``).
+
+    Returns
+    -------
+    :class:`SteadyStateResult`.
+    """
+    max_periods = _count(max_periods, "max_periods", 1)
+    check_every = _count(check_every, "check_every", 1)
+    window = _count(window, "window", 8)
+    tol = _positive(tol, "tol")
+    t_start = time.perf_counter()
+    integ = _Integrator(model, omega, steps_per_period=steps_per_period,
+                        modal_cutoff=modal_cutoff, n_modes=n_modes, gamma=gamma, tol=contact_tol,
+                        wear=wear, U0=U0, V0=V0, stick_anchor=stick_anchor)
+    P = np.zeros((0, integ.red.obs.shape[0] + integ.m))
+    Mn = P.copy()
+    chunk = check_every
+    prev = None
+    cls = Classification(kind="transient", periodicity_error=np.inf, scale=1.0)
+    history = []
+    done = 0
+    while done < max_periods:
+        k = min(chunk, max_periods - done)
+        raw = integ.run(k, 0, k, progress=False)
+        done += k
+        P = np.vstack([P, raw["mon_start"]])[-window:]
+        Mn = np.vstack([Mn, raw["mon_mean"]])[-window:]
+        scale = float(raw["mon_ptp"][-1].max())
+        cls = classify_sequence(P, Mn, tol=tol, scale=scale, min_window=min_periods)
+        history.append((done, cls.kind, cls.periodicity_error))
+        if progress:
+            print(f"[steady_state] {done} periods: {cls.kind}, periodicity error "
+                  f"{cls.periodicity_error:.3g}")
+        if cls.kind in ("periodic", "subharmonic"):
+            break
+        if cls.kind in ("drifting", "quasi-periodic", "irregular") and cls.kind == prev:
+            break
+        prev = cls.kind
+        chunk = min(2 * chunk, 512)
+    t0 = time.perf_counter()
+    raw = integ.run(1, 1, 1)
+    last = integ.result(raw, 1, time.perf_counter() - t0)
+    harm = {name: fourier_coefficients(x, n_harmonics) for name, x in last.observed.items()}
+    charm = {"lam": fourier_coefficients(last.lam, n_harmonics),
+             "u_loc": fourier_coefficients(last.u_loc, n_harmonics)}
+    info = dict(last.info)
+    info["history"] = history
+    return SteadyStateResult(
+        classification=cls.kind, n_periods=done + 1,
+        converged=cls.kind in ("periodic", "subharmonic"), last=last, harmonics=harm,
+        contact_harmonics=charm, diagnostics=cls, poincare=P, U=last.U, V=last.V,
+        wall_time=time.perf_counter() - t_start, info=info)
+
+
+# --------------------------------------------------------------------------------------------
+# quasi-static incremental wear
+# --------------------------------------------------------------------------------------------
+def _static_condensation(model: Model):
+    """Exact static condensation of the free structure onto the contact DOFs.
+
+    Returns ``(A, Tb, load_r, recover)`` with ``A = Tb K_r Tb^T`` [N/m] in the local frame,
+    ``load_r(F_full) -> Tb F_r`` the condensed load [N] and ``recover(x, F_full) -> U``.
+    """
+    _check_contact(model)
+    n = model.ndof
+    free = model.free_dofs()
+    nf = free.size
+    pos = -np.ones(n, dtype=np.int64)
+    pos[free] = np.arange(nf)
+    K = _sub(model.K.tocsr(), free, free)
+    bnd = pos[np.asarray(model.contact.dofs).ravel()]
+    mask = np.ones(nf, dtype=bool)
+    mask[bnd] = False
+    inner = np.flatnonzero(mask)
+    Tb = np.asarray(model.contact.local_transform(n).tocsr()[:, free][:, bnd].todense())
+    Kbb = _sub(K, bnd, bnd).toarray()
+    if inner.size:
+        Kii = _sub(K, inner, inner).tocsc()
+        Kib = _sub(K, inner, bnd)
+        try:
+            lu = spla.splu(Kii)
+        except RuntimeError:
+            raise InputError("the stiffness with the contact DOFs held is singular (a part of "
+                             "the structure is not held by springs, supports or the contact)"
+                             ) from None
+        X = lu.solve(Kib.toarray())
+        Kr = Kbb - Kib.T @ X
+    else:
+        lu, X, Kr = None, None, Kbb
+    Kr = 0.5 * (Kr + Kr.T)
+    A = Tb @ Kr @ Tb.T
+
+    def load_r(F):
+        Ff = F[..., free]
+        Fr = Ff[..., bnd]
+        if inner.size:
+            Fr = Fr - Ff[..., inner] @ X
+        return Fr @ Tb.T
+
+    def recover(x, F):
+        ub = Tb.T @ x
+        U = np.zeros(n)
+        U[free[bnd]] = ub
+        if inner.size:
+            Ff = F[free]
+            U[free[inner]] = lu.solve(Ff[inner] - Kib @ ub)
+        return U
+
+    return np.ascontiguousarray(A), load_r, recover
+
+
+def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int = 100,
+                     cycle_jump: int = 1, k_w: float | None = None, record_every: int = 1,
+                     wear0=None, tol: float = 1e-10,
+                     progress: bool = False) -> IncrementalWearResult:
+    """Quasi-static fretting wear by load steps (in the spirit of Stromberg 1997).
+
+    At every load step ``tau_k = 2 pi k / steps_per_cycle`` the static equilibrium
+    ``K U + T^T lam = F(tau_k)`` is solved with exact Signorini and incremental Coulomb
+    friction (the slip is the tangential increment since the previous step), after an exact
+    static condensation onto the contact DOFs (``K`` is constant, so each step is a small dense
+    contact problem, solved by the same numba kernel as the dynamic solver). After each step,
+    every node's wear grows by Archard's law ``dW = k_w * p_N * |delta u_T|``
+    (``p_N = lam_N / area``), which opens its gap for the next step. The run starts from the
+    unloaded, unworn state (``U = 0``) with one step at ``tau = 0``.
+
+    With ``cycle_jump = J > 1`` the wear of each computed cycle (after the first, which
+    includes the initial loading) is counted ``J`` times (explicit Euler on the slow scale):
+    ``ceil((n_cycles - 1) / J) + 1`` cycles are computed, the last jump shortened so that the
+    total is ``n_cycles``.
+
+    Parameters
+    ----------
+    model : the structure (inertia and damping are ignored).
+    steps_per_cycle : load steps per cycle.
+    n_cycles : number of load cycles (physical, counting the jumps).
+    cycle_jump : cycles represented by each computed cycle.
+    k_w : Archard coefficient [1/Pa]; default ``model.contact.wear_coefficient``.
+    record_every : record every this many computed cycles (and the last).
+    wear0 : (nc,) initial wear [m].
+    tol : relative tolerance of the contact solver.
+
+    Returns
+    -------
+    :class:`IncrementalWearResult`.
+    """
+    N = _count(steps_per_cycle, "steps_per_cycle", 2)
+    n_cycles = _count(n_cycles, "n_cycles", 1)
+    J = _count(cycle_jump, "cycle_jump", 1)
+    rec_every = _count(record_every, "record_every", 1)
+    kw = model.contact.wear_coefficient if k_w is None else k_w
+    kw = float(kw)
+    if not (math.isfinite(kw) and kw >= 0.0):
+        raise InputError(f"k_w = {k_w!r}; expected an Archard coefficient >= 0 [1/Pa]")
+    t0 = time.perf_counter()
+    c = model.contact
+    nc, d = c.dofs.shape
+    area = np.asarray(c.area, dtype=float)
+    if area.shape != (nc,) or np.any(area <= 0):
+        raise InputError(f"contact.area must be ({nc},) positive areas [m^2]")
+    A, load_r, recover = _static_condensation(model)
+    tau = 2.0 * np.pi * np.arange(N) / N
+    Ft = model.load_time(tau) if model.loads else np.zeros((N, model.ndof))
+    btab = np.ascontiguousarray(load_r(Ft))
+    fscale = float(np.abs(btab).max(initial=0.0))
+    jumps = [1]
+    left = n_cycles - 1
+    while left > 0:
+        jumps.append(min(J, left))
+        left -= jumps[-1]
+    jumps = np.asarray(jumps, dtype=np.int64)
+    ncomp = jumps.size
+    nrec = sum(1 for i in range(ncomp) if (i + 1) % rec_every == 0 or i == ncomp - 1)
+    wear = _node_wear(wear0, nc, "wear0")
+    gap = np.asarray(c.gap, dtype=float).copy()
+    x = np.zeros(nc * d)
+    status = np.where(gap <= 0.0, STICK, OPEN).astype(np.int8)
+    tdir = np.zeros((nc, d - 1))
+    tdir[:, 0] = 1.0
+    r_wear = np.zeros((nrec, nc))
+    r_press = np.zeros((nrec, nc))
+    r_slip = np.zeros((nrec, nc))
+    r_diss = np.zeros(nrec)
+    r_cycle = np.zeros(nrec, dtype=np.int64)
+    nr, nfail, maxit = run_quasistatic(A, btab, gap, wear, area, float(c.mu), kw, d, jumps, x,
+                                       status, tdir, tol, fscale, 60 + 4 * nc, rec_every,
+                                       r_wear, r_press, r_slip, r_diss, r_cycle)
+    if nfail:
+        raise ConvergenceError(f"incremental_wear: {nfail} load steps where the contact active "
+                               "set did not settle (singular or cycling); check that the "
+                               "contact holds the structure (rigid motions) and the loads")
+    lam = np.asarray(A @ (-x) + btab[0]).reshape(nc, d)
+    U = recover(x, model.load_time(np.zeros(1))[0] if model.loads else np.zeros(model.ndof))
+    return IncrementalWearResult(
+        cycles=r_cycle, wear=r_wear, pressure=r_press, slip=r_slip,
+        worn_volume=r_wear @ area, dissipation=r_diss, computed_cycles=ncomp, cycle_jump=J,
+        steps_per_cycle=N, k_w=kw, wall_time=time.perf_counter() - t0, U=U, lam=lam,
+        info={"max_active_set_iterations": int(maxit), "records": int(nr)})
+

@@ -1,0 +1,355 @@
+"""Case files: every validation message names the key, the value and what is expected.
+
+The messages are compared with the exact wording users see (`fretwear run` prints them on
+one line), since their wording is the interface.
+"""
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import scipy.io
+import scipy.sparse as sp
+
+from fretwear.case import build_model, case_docs, docs_path, load_case, validate
+from fretwear.errors import InputError
+
+BASE = """\
+title = "small beam"
+
+[model]
+type = "rectangle"
+length = 0.1
+height = 0.01
+nx = 6
+ny = 2
+thickness = 0.01
+
+[material]
+E = 210e9
+nu = 0.3
+rho = 7800.0
+
+[damping]
+loss_factor = 0.001
+
+[[springs]]
+at = "bottom_left"
+direction = "x"
+stiffness = 1e4
+
+[[loads]]
+boundary = "top"
+pressure = 1e4
+
+[[loads]]
+boundary = "right"
+pressure = 1e4
+waveform = "sin"
+
+[contact]
+boundary = "bottom"
+normal = [0.0, -1.0]
+mu = 0.3
+wear_coefficient = 1e-11
+
+[observed]
+Pe = [0.1, 0.005]
+
+[analysis]
+type = "frf"
+f_min = 10.0
+f_max = 1e5
+n_points = 3
+"""
+
+
+def write(tmp_path: Path, text: str, name: str = "case.toml") -> Path:
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def error_of(tmp_path: Path, text: str, build: bool = False) -> str:
+    """The message of the InputError that loading (and building) ``text`` raises."""
+    with pytest.raises(InputError) as info:
+        case = load_case(write(tmp_path, text))
+        if build:
+            build_model(case)
+    return str(info.value)
+
+
+def test_valid_case_loads_with_defaults_and_builds(tmp_path):
+    case = load_case(write(tmp_path, BASE))
+    assert case.title == "small beam"
+    assert case.model_kind == "mesh"
+    assert case.analysis == {
+        "type": "frf", "f_min": 10.0, "f_max": 1e5, "n_points": 3, "spacing": "log",
+        "interfaces": ["sliding", "stuck"], "method": "direct",
+    }
+    assert case.output == {"figures": True, "figure_format": "png", "vtu": True}
+    assert case.model["loads"][0]["waveform"] == "constant"
+    assert case.model["contact"]["gap"] == 0.0
+    assert case.output_dir() == tmp_path / "case-results"
+    model = build_model(case)
+    assert model.contact.n_nodes == 7  # nx + 1 nodes on the bottom face
+    assert model.thickness == 0.01
+    assert [p.name for p in model.observed] == ["Pe"]
+    assert model.D is not None and model.C is None
+
+
+def test_unknown_top_level_key_suggests_the_close_match(tmp_path):
+    msg = error_of(tmp_path, BASE.replace("[material]", "[materal]"))
+    assert msg.startswith("unknown key 'materal' in [top level]; expected one of: title, "
+                          "model, material, damping,")
+    assert msg.endswith("(did you mean 'material'?)")
+
+
+def test_unknown_nested_key_names_its_table(tmp_path):
+    msg = error_of(tmp_path, BASE.replace("nu = 0.3", "nuu = 0.3"))
+    assert msg == ("unknown key 'nuu' in [material]; expected one of: E, nu, rho "
+                   "(did you mean 'nu'?)")
+
+
+def test_unknown_key_in_an_array_of_tables_names_the_item(tmp_path):
+    msg = error_of(tmp_path, BASE.replace('waveform = "sin"', 'wavefrom = "sin"'))
+    assert msg.startswith("unknown key 'wavefrom' in [loads[2]];")
+    assert msg.endswith("(did you mean 'waveform'?)")
+
+
+def test_wrong_type(tmp_path):
+    msg = error_of(tmp_path, BASE.replace("E = 210e9", 'E = "210e9"'))
+    assert msg == 'material.E = "210e9": expected a number > 0, got a string'
+    msg = error_of(tmp_path, BASE.replace("nx = 6", "nx = 6.0"))
+    assert msg == "model.nx = 6.0: expected an integer >= 1, got a number"
+
+
+def test_poisson_ratio_of_one_half_is_refused(tmp_path):
+    msg = error_of(tmp_path, BASE.replace("nu = 0.3", "nu = 0.5"))
+    assert msg == "material.nu = 0.5: expected a number in (-1, 0.5)"
+
+
+def test_negative_young_modulus(tmp_path):
+    msg = error_of(tmp_path, BASE.replace("E = 210e9", "E = -210e9"))
+    assert msg == "material.E = -210000000000.0: expected a number > 0"
+
+
+def test_out_of_range_in_an_array_item(tmp_path):
+    msg = error_of(tmp_path, BASE.replace("stiffness = 1e4", "stiffness = -1.0"))
+    assert msg == 'springs[1].stiffness = -1.0: expected a number > 0 or inf (also "inf")'
+
+
+def test_missing_required_key(tmp_path):
+    msg = error_of(tmp_path, BASE.replace("mu = 0.3\n", ""))
+    assert msg == ("missing required key 'contact.mu' (Coulomb friction coefficient: "
+                   "a number >= 0)")
+    msg = error_of(tmp_path, BASE.replace("[contact]", "[contacts]"))
+    assert msg.endswith("(did you mean 'contact'?)")
+
+
+def test_wrong_choice_suggests(tmp_path):
+    msg = error_of(tmp_path, BASE.replace('direction = "x"', 'direction = "X"'))
+    assert msg == ('springs[1].direction = "X": expected one of "x", "y", "z" or a list of '
+                   '2 or 3 numbers (did you mean "x"?)')
+    msg = error_of(tmp_path, BASE.replace('type = "rectangle"', 'type = "rectangel"'))
+    assert msg == ('model.type = "rectangel": expected one of "rectangle", "box", "mesh", '
+                   '"matrices" (did you mean "rectangle"?)')
+
+
+def test_unknown_boundary_is_reported_with_its_key(tmp_path):
+    msg = error_of(tmp_path, BASE.replace('boundary = "bottom"', 'boundary = "botom"'),
+                   build=True)
+    assert msg == ('contact.boundary = "botom": expected one of "bottom", "left", "right", '
+                   '"top" (did you mean "bottom"?)')
+    msg = error_of(tmp_path, BASE.replace('boundary = "top"', 'boundary = "tpo"'), build=True)
+    assert msg.startswith('loads[1].boundary = "tpo": expected one of')
+
+
+def test_vector_size_is_checked_against_the_mesh(tmp_path):
+    msg = error_of(tmp_path, BASE.replace("Pe = [0.1, 0.005]", "Pe = [0.1, 0.005, 0.0]"),
+                   build=True)
+    assert msg == "observed.Pe = [0.1, 0.005, 0.0]: expected 2 components for a 2D model"
+
+
+def test_rules_across_keys(tmp_path):
+    msg = error_of(tmp_path, BASE.replace("pressure = 1e4\n\n[[loads]]",
+                                          "pressure = 1e4\ntraction = [1.0, 0.0]\n\n[[loads]]"))
+    assert msg == ("[loads[1]]: give exactly one of 'pressure', 'traction', 'force' "
+                   "(got 'pressure', 'traction')")
+    msg = error_of(tmp_path, BASE.replace('waveform = "sin"', 'waveform = "fourier"'))
+    assert msg.startswith('[loads[2]]: waveform = "fourier" needs coefficients')
+    msg = error_of(tmp_path, BASE.replace("f_max = 1e5", "f_max = 5.0"))
+    assert msg == "analysis.f_max = 5.0: expected a value above f_min = 10.0 Hz"
+
+
+def test_fourier_coefficients_and_infinite_spring(tmp_path):
+    text = BASE.replace('waveform = "sin"', 'waveform = "fourier"\ncoefficients = {"1" = '
+                        "[0.0, 1.0], \"3\" = [0.0, -0.1]}")
+    text = text.replace("stiffness = 1e4", 'stiffness = "inf"')
+    text = text.replace('at = "bottom_left"', 'at = "top_left"')  # contact DOFs can't be fixed
+    case = load_case(write(tmp_path, text))
+    assert case.model["springs"][0]["stiffness"] == math.inf
+    model = build_model(case)
+    assert model.loads[1].coefficients == {1: (0.0, 1.0), 3: (0.0, -0.1)}
+    assert model.fixed_dofs.tolist() == [2 * 14]  # x of the top-left node, (nx + 1) * ny
+
+
+def test_unregistered_analysis_lists_the_available_ones(tmp_path):
+    msg = error_of(tmp_path, BASE.replace('type = "frf"', 'type = "no-such-analysis"'))
+    assert msg.startswith('analysis.type = "no-such-analysis": expected one of "modes", "frf"')
+
+
+def test_invalid_toml_and_missing_file(tmp_path):
+    msg = error_of(tmp_path, BASE.replace("nu = 0.3", "nu = "))
+    assert msg.startswith("case.toml: invalid TOML: ")
+    with pytest.raises(InputError, match="does not exist"):
+        load_case(tmp_path / "nope.toml")
+
+
+# --- matrices models: DOF lists and relative paths ------------------------------------------
+MATRICES = """\
+[model]
+type = "matrices"
+K = "K.mtx"
+M = "M.mtx"
+
+[contact]
+normal_dofs = [0, 2]
+tangential_dofs = [1, 3]
+mu = 0.2
+
+[output]
+directory = "out"
+
+[analysis]
+type = "modes"
+"""
+
+
+def matrices_folder(tmp_path: Path) -> Path:
+    folder = tmp_path / "model"
+    folder.mkdir()
+    K = sp.diags([np.full(6, 2.0), np.full(5, -1.0), np.full(5, -1.0)], [0, -1, 1])
+    scipy.io.mmwrite(folder / "K.mtx", K.tocoo())
+    scipy.io.mmwrite(folder / "M.mtx", sp.identity(6).tocoo())
+    return folder
+
+
+def test_relative_paths_start_from_the_case_folder(tmp_path, monkeypatch):
+    folder = matrices_folder(tmp_path)
+    path = write(folder, MATRICES)
+    monkeypatch.chdir(tmp_path)  # not the case folder
+    case = load_case(Path("model") / "case.toml")
+    assert case.model_kind == "matrices"
+    assert case.model["model"]["K"] == folder.resolve() / "K.mtx"
+    assert case.output_dir() == folder.resolve() / "out"
+    assert case.output_dir("elsewhere") == (tmp_path / "elsewhere").resolve()
+    assert case.path == path.resolve()
+
+
+def test_missing_matrix_file(tmp_path):
+    folder = matrices_folder(tmp_path)
+    msg = error_of(folder, MATRICES.replace('"M.mtx"', '"Mass.mtx"'))
+    assert msg.startswith('model.M = "Mass.mtx": expected the path of an existing file (no file '
+                          "at ")
+
+
+def test_empty_contact_set(tmp_path):
+    folder = matrices_folder(tmp_path)
+    msg = error_of(folder, MATRICES.replace("normal_dofs = [0, 2]", "normal_dofs = []"))
+    assert msg == ("contact.normal_dofs = []: expected a non-empty list of integers >= 0 "
+                   "(no repeats)")
+
+
+def test_mesh_sections_are_unknown_in_a_matrices_case(tmp_path):
+    folder = matrices_folder(tmp_path)
+    msg = error_of(folder, MATRICES + "\n[material]\nE = 1.0\nnu = 0.3\n")
+    assert msg.startswith("unknown key 'material' in [top level]; expected one of: title, "
+                          "model, damping, loads, contact, observed, analysis, output")
+
+
+def test_validate_a_dict():
+    out = validate({"model": {"type": "box", "lx": 1.0, "ly": 1.0, "lz": 1.0, "nx": 1,
+                              "ny": 1, "nz": 1},
+                    "material": {"E": 1.0, "nu": 0.0},
+                    "contact": {"boundary": "zmin", "mu": 0.1},
+                    "analysis": {"type": "modes"}})
+    assert out["material"]["rho"] == 0.0
+    assert out["analysis"] == {"type": "modes", "n_modes": 10, "interfaces": ["sliding", "stuck"]}
+    assert out["damping"] == {"loss_factor": 0.0, "rayleigh_mass": 0.0,
+                              "rayleigh_stiffness": 0.0}
+
+
+def test_case_files_doc_is_up_to_date():
+    committed = docs_path().read_text(encoding="utf-8")
+    assert committed == case_docs(), (
+        "docs/case-files.md is out of date; regenerate it with\n"
+        "  python -c 'from fretwear.case import write_case_docs; write_case_docs()'"
+    )
+
+
+def test_matrices_case_reproduces_the_mesh_case(tmp_path):
+    """The beam exported as matrices and described by a `matrices` case gives the same FRF
+    as the mesh case (same K, M, D, loads, contact DOFs): agreement to rounding."""
+    from fretwear import linear
+
+    mesh_model = build_model(load_case(write(tmp_path, BASE)))
+    folder = tmp_path / "mtx"
+    folder.mkdir()
+    for key in ("K", "M", "D"):
+        scipy.io.mmwrite(folder / f"{key}.mtx", getattr(mesh_model, key).tocoo())
+    for i, load in enumerate(mesh_model.loads):
+        np.savetxt(folder / f"f{i}.txt", load.vector)
+    c = mesh_model.contact
+    first = 1  # Matlab numbering in the case file
+    text = f"""\
+[model]
+type = "matrices"
+K = "K.mtx"
+M = "M.mtx"
+D = "D.mtx"
+first_dof = {first}
+
+[[loads]]
+file = "f0.txt"
+
+[[loads]]
+file = "f1.txt"
+waveform = "sin"
+
+[contact]
+normal_dofs = {(c.dofs[:, 1] + first).tolist()}
+tangential_dofs = {(c.dofs[:, 0] + first).tolist()}
+normal_sign = -1
+area = {c.area.tolist()}
+mu = 0.3
+
+[observed]
+Pe = {(mesh_model.observed[0].dofs + first).tolist()}
+
+[analysis]
+type = "frf"
+f_min = 10.0
+f_max = 1e5
+"""
+    model = build_model(load_case(write(folder, text)))
+    np.testing.assert_array_equal(model.contact.dofs, c.dofs[:, ::-1])  # [normal, tangent]
+    np.testing.assert_array_equal(model.observed[0].dofs, mesh_model.observed[0].dofs)
+    freqs = [100.0, 3e4]
+    for interface in ("sliding", "stuck"):
+        a = linear.frf(mesh_model, freqs, interface=interface).observed["Pe"]
+        b = linear.frf(model, freqs, interface=interface).observed["Pe"]
+        np.testing.assert_allclose(b, a, rtol=1e-9)
+
+
+def test_note_when_an_observed_point_is_not_a_node(tmp_path):
+    from fretwear.case import observed_notes
+
+    case = load_case(write(tmp_path, BASE))
+    assert observed_notes(case, build_model(case)) == []  # ny = 2: a node at h/2
+    case = load_case(write(tmp_path, BASE.replace("ny = 2", "ny = 3")))
+    assert observed_notes(case, build_model(case)) == [
+        "note: observed.Pe = [0.1, 0.005] is not a mesh node; reporting the nearest node, "
+        "at (0.1, 0.00333333)"
+    ]

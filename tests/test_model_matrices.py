@@ -1,0 +1,152 @@
+"""Models from user matrices (fretwear.model.matrices).
+
+The reference is a spring-mass chain whose Model is written out by hand from the core
+data-object conventions, and Matrix Market files written by scipy itself. All comparisons
+are exact: the function only copies, symmetrises (already symmetric input) and validates.
+"""
+
+import numpy as np
+import pytest
+import scipy.io
+import scipy.sparse as sp
+
+from fretwear.errors import InputError
+from fretwear.model.core import ContactInterface, Load, Model, ObservedPoint
+from fretwear.model.matrices import from_matrices, read_matrix_market
+
+k1, k2, k3 = 2e6, 1e6, 5e5
+m1, m2 = 0.3, 0.1
+
+
+def chain():
+    """Ground -k1- mass 1 -k2- mass 2 (contact node, normal DOF 1) with a tangential DOF 2
+    held to ground by k3 and massless."""
+    K = np.array([[k1 + k2, -k2, 0.0], [-k2, k2, 0.0], [0.0, 0.0, k3]])
+    M = np.diag([m1, m2, 0.0])
+    return K, M
+
+
+def test_chain_matches_hand_built_model():
+    """from_matrices against the Model written by hand: contact node with DOFs [1, 2],
+    frame diag(-1, 1) for normal_sign = -1, gap, area, mu, D = eta K, the load and the
+    observed DOF."""
+    K, M = chain()
+    f = np.array([1.0, 0.0, 0.0])
+    got = from_matrices(K, sp.csr_matrix(M), contact_normal_dofs=[1],
+                        contact_tangential_dofs=[2], gap=1e-6, area=2e-4, mu=0.4,
+                        normal_sign=-1, loss_factor=0.01,
+                        loads=[Load(f, "cos", name="drive")], observed={"mass 1": 0},
+                        wear_coefficient=1e-11, coords=[[0.5, 0.0]], name="chain")
+    hand = Model(
+        K=sp.csr_matrix(K), M=sp.csr_matrix(M),
+        contact=ContactInterface(dofs=np.array([[1, 2]]), frame=np.array([[[-1.0, 0.0],
+                                                                           [0.0, 1.0]]]),
+                                 gap=np.array([1e-6]), area=np.array([2e-4]), mu=0.4,
+                                 coords=np.array([[0.5, 0.0]]), node_ids=np.array([-1]),
+                                 wear_coefficient=1e-11),
+        D=sp.csr_matrix(0.01 * K), loads=[Load(f, "cos", name="drive")],
+        observed=[ObservedPoint("mass 1", np.array([0]), np.zeros(1))], dim=2, name="chain")
+    for a in ("K", "M", "D"):
+        assert abs(getattr(got, a) - getattr(hand, a)).max() == 0.0, a
+    assert got.C is None and got.mesh is None and got.thickness == 1.0 and got.dim == 2
+    for a in ("dofs", "frame", "gap", "area", "coords", "node_ids"):
+        np.testing.assert_array_equal(getattr(got.contact, a), getattr(hand.contact, a))
+    assert (got.contact.mu, got.contact.wear_coefficient) == (0.4, 1e-11)
+    assert got.loads[0].vector.tolist() == f.tolist() and got.loads[0].waveform == "cos"
+    assert got.observed[0].name == "mass 1" and got.observed[0].dofs.tolist() == [0]
+    assert got.name == "chain" and got.fixed_dofs.size == 0
+    np.testing.assert_array_equal(got.load_harmonics(1), hand.load_harmonics(1))
+
+
+def test_3d_contact_and_fixed_dofs():
+    """Two tangential DOFs per node give a 3D interface with an identity frame; fixed DOFs
+    are kept sorted."""
+    K = sp.diags([1.0, 2.0, 3.0, 4.0, 5.0]) * 1e5
+    model = from_matrices(K, sp.eye(5), contact_normal_dofs=[0], contact_tangential_dofs=[[1, 2]],
+                          mu=0.1, fixed_dofs=[4, 3], observed={"pair": [1, 2]})
+    assert model.dim == 3 and model.contact.dofs.tolist() == [[0, 1, 2]]
+    np.testing.assert_array_equal(model.contact.frame[0], np.eye(3))
+    assert model.fixed_dofs.tolist() == [4, 3] and model.free_dofs().tolist() == [0, 1, 2]
+    assert model.observed[0].dofs.tolist() == [1, 2]
+
+
+def test_matrix_market_round_trip(tmp_path):
+    """scipy.io.mmwrite -> read_matrix_market: the same sparse matrix (exact) and a vector
+    written as a column comes back as a 1-D array; shape checks."""
+    K, _ = chain()
+    scipy.io.mmwrite(tmp_path / "K.mtx", sp.coo_matrix(K))
+    scipy.io.mmwrite(tmp_path / "f.mtx", np.array([[1.0], [2.0], [3.0]]))
+    Kr = read_matrix_market(tmp_path / "K.mtx", shape=(3, 3))
+    assert sp.issparse(Kr) and abs(Kr - K).max() == 0.0
+    f = read_matrix_market(tmp_path / "f.mtx", shape=(3,))
+    assert f.tolist() == [1.0, 2.0, 3.0]
+    with pytest.raises(InputError, match=r"holds shape \(3, 3\); expected \(4, 4\)"):
+        read_matrix_market(tmp_path / "K.mtx", shape=(4, 4))
+    with pytest.raises(InputError, match="does not exist"):
+        read_matrix_market(tmp_path / "nope.mtx")
+    (tmp_path / "bad.mtx").write_text("%%MatrixMarket matrix coordinate real general\n3 3\n")
+    with pytest.raises(InputError, match="cannot read Matrix Market file"):
+        read_matrix_market(tmp_path / "bad.mtx")
+
+
+# --------------------------------------------------------------------------------------------
+# bad inputs
+# --------------------------------------------------------------------------------------------
+def build(K=None, M=None, **kw):
+    K0, M0 = chain()
+    args = dict(contact_normal_dofs=[1], contact_tangential_dofs=[2], mu=0.3) | kw
+    return from_matrices(K0 if K is None else K, M0 if M is None else M, **args)
+
+
+def test_mismatched_sizes():
+    with pytest.raises(InputError, match=r"M has shape \(2, 2\); expected \(3, 3\) like K"):
+        build(M=np.eye(2))
+    with pytest.raises(InputError, match=r"K has shape \(3, 2\); expected a square matrix"):
+        build(K=np.ones((3, 2)))
+
+
+def test_non_symmetric_K():
+    K, _ = chain()
+    K[0, 1] = -1.5e6
+    with pytest.raises(InputError, match=r"K is not symmetric: K\[.*\] = -1.5e\+06 but"):
+        build(K=K)
+
+
+def test_contact_dof_out_of_range():
+    with pytest.raises(InputError, match=r"contact_normal_dofs: DOF 3 is out of range; "
+                                         r"expected indices in \[0, 2\]"):
+        build(contact_normal_dofs=[3])
+    with pytest.raises(InputError, match=r"DOF -1 is out of range"):
+        build(contact_tangential_dofs=[-1])
+
+
+def test_other_bad_inputs():
+    with pytest.raises(InputError, match="contact DOF 1 is listed more than once"):
+        build(contact_tangential_dofs=[1])
+    with pytest.raises(InputError, match="DOF 2 is both a contact DOF and a fixed DOF"):
+        build(fixed_dofs=[2])
+    with pytest.raises(InputError, match="contact_normal_dofs is empty"):
+        build(contact_normal_dofs=[], contact_tangential_dofs=[])
+    with pytest.raises(InputError, match=r"shape \(1, 3\); expected \(1,\) in 2D or \(1, 2\)"):
+        build(contact_tangential_dofs=[[0, 2, 2]])
+    with pytest.raises(InputError, match="either D or loss_factor"):
+        build(D=np.eye(3), loss_factor=0.1)
+    with pytest.raises(InputError, match="normal_sign"):
+        build(normal_sign=2)
+    with pytest.raises(InputError, match="area: 0; expected values > 0"):
+        build(area=0.0)
+    with pytest.raises(InputError, match=r"mu = -1; expected a finite value >= 0"):
+        build(mu=-1)
+    with pytest.raises(InputError, match=r"load 'f': vector of shape \(2,\)"):
+        build(loads=[Load(np.ones(2), name="f")])
+
+
+def test_singular_stiffness_is_refused():
+    """Mass 1 and 2 joined by k2 only, no ground spring, contact on the massless DOF 2:
+    nothing but friction holds DOFs 0 and 1."""
+    K = np.array([[k2, -k2, 0.0], [-k2, k2, 0.0], [0.0, 0.0, k3]])
+    with pytest.raises(InputError, match=r"singular .* DOFs \[0, 1\] can move with nothing to "
+                                         r"hold them but friction"):
+        build(K=K, contact_normal_dofs=[2], contact_tangential_dofs=[1])
+    with pytest.raises(InputError, match=r"DOF\(s\) \[0\] have no stiffness"):
+        build(K=np.diag([0.0, 1.0, 1.0]))

@@ -1,0 +1,251 @@
+"""Tests of the exact per-harmonic condensation on the contact DOFs (fretwear.reduce).
+
+The model is a hand-assembled 2D truss (independent of the FE layer). Every reference is a
+*dense* solve of the full model written from the equation of motion in core.py,
+
+    Z_n U + T^T lambda = F_n   on the free DOFs,   u_loc = T U,
+
+with numpy.linalg (not the sparse LU used by reduce), for arbitrary contact forces lambda, so
+that the condensed relation ``Z_r u_loc + lambda = F_r`` is checked for every contact state.
+Tolerances: relative errors of a well-conditioned dense solve are ~ cond * 1e-16; near a
+resonance (0.999 f) the amplification is ~1e3, so 1e-9 relative leaves a wide margin while any
+formula error (a missing term, a wrong sign or frame) gives O(1) errors.
+"""
+
+import numpy as np
+import pytest
+import scipy.linalg as sla
+import scipy.sparse as sp
+
+from fretwear.errors import InputError
+from fretwear.fourier import FourierBasis
+from fretwear.model.core import ContactInterface, Load, Model, ObservedPoint
+from fretwear.reduce import condense, loads_to_real, recover, to_real_blocks
+
+RTOL = 1e-9
+RNG = np.random.default_rng(7)
+THETA = 0.3  # tilt of the contact frames [rad]: normal not along an axis
+
+
+def truss(nx=6, ny=3, a=0.01, k=1e7, m=0.01, damping="hysteretic", theta=THETA,
+          dangling=False):
+    """Braced 2D truss on an nx x ny grid (spacing a [m]), bar stiffness k*a/L [N/m], lumped
+    mass m [kg] per node; bottom row = contact nodes with frames tilted by theta; statically
+    supported by three fixed DOFs on the top row. ``dangling`` adds a node hanging on a single
+    bar from a contact node (a mechanism that the contact does not hold)."""
+    xs, ys = np.meshgrid(np.arange(nx) * a, np.arange(ny) * a)
+    pts = np.column_stack([xs.ravel(), ys.ravel()])
+    nid = lambda i, j: j * nx + i
+    bars = []
+    for j in range(ny):
+        for i in range(nx):
+            if i + 1 < nx:
+                bars.append((nid(i, j), nid(i + 1, j)))
+            if j + 1 < ny:
+                bars.append((nid(i, j), nid(i, j + 1)))
+            if i + 1 < nx and j + 1 < ny:
+                bars += [(nid(i, j), nid(i + 1, j + 1)), (nid(i + 1, j), nid(i, j + 1))]
+    if dangling:
+        pts = np.vstack([pts, [[-a, 0.0]]])
+        bars.append((nid(0, 0), len(pts) - 1))
+    nd = 2 * len(pts)
+    K = np.zeros((nd, nd))
+    for p, q in bars:
+        e = pts[q] - pts[p]
+        L = np.linalg.norm(e)
+        c = e / L
+        kb = k * a / L * np.outer(c, c)
+        idx = np.r_[2 * p : 2 * p + 2, 2 * q : 2 * q + 2]
+        K[np.ix_(idx, idx)] += np.block([[kb, -kb], [-kb, kb]])
+    M = m * (1.0 + 0.1 * np.arange(nd) / nd)  # slightly non-uniform: no degenerate modes
+    bottom = np.arange(nx)
+    n = np.array([np.sin(theta), -np.cos(theta)])
+    t = np.array([np.cos(theta), np.sin(theta)])
+    contact = ContactInterface(
+        dofs=np.column_stack([2 * bottom, 2 * bottom + 1]),
+        frame=np.tile(np.array([n, t]), (nx, 1, 1)),
+        gap=np.zeros(nx), area=np.full(nx, a), mu=0.3, coords=pts[bottom])
+    top_left, top_right = nid(0, ny - 1), nid(nx - 1, ny - 1)
+    fixed = np.array([2 * top_left, 2 * top_left + 1, 2 * top_right + 1])
+    loads = [Load(RNG.standard_normal(nd), "constant", name="static"),
+             Load(RNG.standard_normal(nd), "cos", name="c"),
+             Load(RNG.standard_normal(nd), "sin", name="s"),
+             Load(RNG.standard_normal(nd), "fourier", {2: (0.5, -0.2), 3: (0.0, 1.0)}, "f")]
+    for ld in loads:
+        ld.vector[fixed] = 0.0
+    Ks = sp.csr_matrix(K)
+    kw = {}
+    if damping == "hysteretic":
+        kw["D"] = 2e-3 * Ks
+    elif damping == "rayleigh":
+        kw["C"] = sp.csr_matrix(30.0 * np.diag(M) + 2e-7 * K)
+    elif damping == "both":
+        kw["D"] = 1e-3 * Ks
+        kw["C"] = sp.csr_matrix(1e-7 * K)
+    mid = nid(nx // 2, ny - 1)
+    observed = [ObservedPoint("top", np.array([2 * mid, 2 * mid + 1]), pts[mid]),
+                ObservedPoint("contact1", np.array([2, 3]), pts[1]),
+                ObservedPoint("fixed", fixed[:2], pts[top_left])]
+    return Model(K=Ks, M=sp.diags(M).tocsr(), contact=contact, loads=loads,
+                 observed=observed, fixed_dofs=fixed, **kw)
+
+
+def dense_Z(model, omega, n):
+    """Z_n written from the docstring of core.Model (independent of reduce.dynamic_stiffness)."""
+    K = model.K.toarray()
+    if n == 0:
+        return K.astype(complex)
+    w = n * omega
+    Z = K - w**2 * model.M.toarray() + 0j
+    if model.D is not None:
+        Z += 1j * model.D.toarray()
+    if model.C is not None:
+        Z += 1j * w * model.C.toarray()
+    return Z
+
+
+def full_solve(model, Z, F, lam):
+    """Dense solve of Z U + T^T lam = F with the fixed DOFs held; returns all DOFs."""
+    T = model.contact.local_transform(model.ndof).toarray()
+    free = model.free_dofs()
+    U = np.zeros(model.ndof, dtype=complex)
+    U[free] = np.linalg.solve(Z[np.ix_(free, free)], (F - T.T @ lam)[free])
+    return U
+
+
+def free_eigenfrequencies(model):
+    """Undamped eigenfrequencies [rad/s] of the structure with a free interface (dense)."""
+    free = model.free_dofs()
+    lam = sla.eigh(model.K.toarray()[np.ix_(free, free)], model.M.toarray()[np.ix_(free, free)],
+                   eigvals_only=True)
+    return np.sqrt(lam)
+
+
+def rel(a, b):
+    return np.max(np.abs(a - b)) / np.max(np.abs(b))
+
+
+@pytest.mark.parametrize("damping", ["hysteretic", "rayleigh", "both"])
+def test_condensed_response_equals_full_solve(damping):
+    """For random contact forces lambda, the reduced equation Z_r u + lambda = F_r gives the
+    contact-local displacements of the full dense solve, and obs_A u + obs_b the observed DOFs,
+    at several frequencies including 0.999 x an eigenfrequency, harmonics 0..3 (static, cos,
+    sin and 'fourier' loads), with tilted contact frames."""
+    model = truss(damping=damping)
+    T = model.contact.local_transform(model.ndof).toarray()
+    wn = free_eigenfrequencies(model)
+    orders = np.array([0, 1, 2, 3])
+    obs = np.concatenate([p.dofs for p in model.observed])
+    for omega in (0.31 * wn[0], 0.999 * wn[2], 1.7 * wn[4]):
+        red = condense(model, omega, orders)
+        F_all = model.load_harmonics(3)
+        for b, n in enumerate(orders):
+            lam = RNG.standard_normal(red.m) + 1j * RNG.standard_normal(red.m) * (n > 0)
+            U = full_solve(model, dense_Z(model, omega, n), F_all[n], lam)
+            u_ref = T @ U
+            u = np.linalg.solve(red.Z[b], red.F[b] - lam)
+            assert rel(u, u_ref) < RTOL
+            np.testing.assert_allclose(red.obs_A[b] @ u + red.obs_b[b], U[obs], rtol=0,
+                                       atol=RTOL * np.abs(U).max())
+        np.testing.assert_array_equal(red.obs_dofs, obs)
+
+
+def test_recover_equals_full_solve():
+    """recover() from the contact solution gives every DOF of the full dense solve (fixed DOFs
+    exactly zero), here with a stuck-like state lambda != 0 and a tilted frame."""
+    model = truss(damping="both")
+    T = model.contact.local_transform(model.ndof).toarray()
+    omega = 0.8 * free_eigenfrequencies(model)[1]
+    orders = np.array([0, 1, 3])
+    F_all = model.load_harmonics(3)
+    lams = RNG.standard_normal((orders.size, 2 * 6))
+    U_ref = np.array([full_solve(model, dense_Z(model, omega, n), F_all[n], lam)
+                      for n, lam in zip(orders, lams, strict=True)])
+    U = recover(model, omega, orders, U_ref @ T.T)
+    assert rel(U, U_ref) < RTOL
+    assert np.all(U[:, model.fixed_dofs] == 0)
+
+
+def test_quasi_static_equals_static_solve_for_every_harmonic():
+    """quasi_static=True drops inertia and damping: for every harmonic the reduced equation
+    must reproduce the static solve K U + T^T lambda = F_n (dense), and Z_r be the same for all
+    harmonics (the static condensation of K)."""
+    model = truss(damping="both")
+    T = model.contact.local_transform(model.ndof).toarray()
+    orders = np.array([0, 1, 2, 3])
+    red = condense(model, 1234.0, orders, quasi_static=True)
+    assert red.quasi_static
+    K = model.K.toarray().astype(complex)
+    F_all = model.load_harmonics(3)
+    obs = np.concatenate([p.dofs for p in model.observed])
+    for b, n in enumerate(orders):
+        np.testing.assert_allclose(red.Z[b], red.Z[0], rtol=0, atol=0)
+        lam = RNG.standard_normal(red.m) + 1j * RNG.standard_normal(red.m)
+        U = full_solve(model, K, F_all[n], lam)
+        u = np.linalg.solve(red.Z[b], red.F[b] - lam)
+        assert rel(u, T @ U) < RTOL
+        assert rel(red.obs_A[b] @ u + red.obs_b[b], U[obs]) < RTOL
+    # the static reduced stiffness is real and symmetric
+    assert np.abs(red.Z[0].imag).max() == 0
+    np.testing.assert_allclose(red.Z[0], red.Z[0].T, rtol=1e-12, atol=0)
+
+
+def test_spectral_radius_against_flexibility():
+    """Largest |eig Z_r| computed independently: Z_r^-1 is the contact block of the full
+    dense flexibility Z^-1 in local frames (inverse of a Schur complement = block of the
+    inverse), so rho(Z_r) = 1 / min |eig(T Z^-1 T^T)|."""
+    model = truss(damping="hysteretic")
+    omega = 0.5 * free_eigenfrequencies(model)[0]
+    orders = np.array([0, 1, 2])
+    red = condense(model, omega, orders)
+    T = model.contact.local_transform(model.ndof).toarray()
+    free = model.free_dofs()
+    Tf = T[:, free]
+    rho = 0.0
+    for n in orders:
+        Z = dense_Z(model, omega, n)[np.ix_(free, free)]
+        G = Tf @ np.linalg.solve(Z, Tf.T)
+        rho = max(rho, 1.0 / np.min(np.abs(np.linalg.eigvals(G))))
+    assert red.spectral_radius() == pytest.approx(rho, rel=1e-9)
+
+
+def test_singular_interior_raises_input_error():
+    """A node hanging on one bar from a contact node has a transverse mechanism the contact
+    does not hold: its static (n = 0, or quasi-static) interior stiffness is singular."""
+    model = truss(dangling=True)
+    with pytest.raises(InputError, match="singular"):
+        condense(model, 100.0, [0, 1])
+    with pytest.raises(InputError, match="singular"):
+        condense(model, 100.0, [1], quasi_static=True)
+    # with inertia (n >= 1, omega > 0) the mass holds it: no error
+    condense(model, 100.0, [1])
+
+
+def test_contact_dof_cannot_be_fixed():
+    """A contact DOF that is also a Dirichlet DOF is contradictory input: InputError."""
+    model = truss()
+    model.fixed_dofs = np.append(model.fixed_dofs, 0)
+    with pytest.raises(InputError, match="fixed"):
+        condense(model, 10.0, [0])
+
+
+def test_real_blocks_match_time_domain_operator():
+    """to_real_blocks/loads_to_real vs the time-domain operator K u + C u' + M u'' applied to
+    the real Fourier coefficients with the derivative matrix of fretwear.fourier (tested on its
+    own in test_fourier): the sign convention of eq. (18) for viscous damping."""
+    model = truss(nx=3, ny=2, damping="rayleigh")
+    omega = 900.0
+    basis = FourierBasis((1, 2, 3), 16)
+    orders = basis.orders
+    Zc = np.array([dense_Z(model, omega, n) for n in orders])
+    R = to_real_blocks(Zc, orders)
+    nd, H = model.ndof, basis.size
+    c = RNG.standard_normal((nd, H))  # coefficients per DOF, [0, cos.., sin..]
+    D = basis.derivative_matrix(omega)
+    K, C, M = (A.toarray() for A in (model.K, model.C, model.M))
+    ref = K @ c + C @ c @ D.T + M @ c @ (D @ D).T
+    np.testing.assert_allclose((R @ c.reshape(-1)).reshape(nd, H), ref, rtol=0,
+                               atol=1e-12 * np.abs(ref).max())
+    F = model.load_harmonics(3)
+    samples = model.load_time(basis.tau)  # exact load samples (N, ndof)
+    np.testing.assert_allclose(loads_to_real(F), basis.to_freq(samples.T), rtol=0, atol=1e-12)
