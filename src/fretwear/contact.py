@@ -41,6 +41,7 @@ SEPARATION = 0
 STICK = 1
 SLIP = 2
 STATE_NAMES = ("separation", "stick", "slip")
+ROUND = 1e-13  # relative rounding margin of the stick test (see _sweep)
 
 
 @njit(cache=True)
@@ -67,7 +68,13 @@ def _sweep(lu, mu, xprev, lx, state):
             nrm = np.sqrt(nrm2)
             lx[0, n] = 0.0
             cap = mu * pn
-            if nrm < cap:
+            # rounding margin: a periodic state set by a slip at this instant in an earlier
+            # pass sits on the cone up to the rounding of lam_u,T - lam_x,T; it must stay
+            # "slip" (with a vanishing increment) so that its dependence on U is kept.
+            mag = 0.0
+            for c in range(dt):
+                mag += abs(lu[1 + c, n]) + abs(xprev[c])
+            if nrm < cap - ROUND * mag:
                 for c in range(dt):
                     lx[1 + c, n] = xprev[c]
                 state[n] = STICK
@@ -179,8 +186,7 @@ def dlft_jacobian(lam_u, lam_x, state, mu, P, Q):
             else:
                 all_stick = False
                 pn = lam_u[p, 0, n]
-                # pre_T = lam_u,T(n) - lam_x,T(n-1); lam_x,T(n-1) = lam_x,T(n) - pre_T(1 - mu pn/|pre_T|)
-                # so pre_T is recovered from lam_u,T(n) - lam_x,T(n) = mu pn t^  (on the cone)
+                # on the cone lam_T(n) = lam_u,T(n) - lam_x,T(n) = mu pn t^: gives the direction t^
                 nrm2 = 0.0
                 for c in range(dt):
                     that[c] = lam_u[p, 1 + c, n] - lam_x[p, 1 + c, n]

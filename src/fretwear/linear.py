@@ -30,7 +30,6 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
-from scipy.signal import find_peaks
 
 from fretwear.errors import InputError
 from fretwear.model.core import Model
@@ -542,5 +541,7 @@ def count_resonances(frf_result: FRFResult, point: str, axis, *,
         raise InputError(f"axis {axis!r} out of range for a point with {U.shape[1]} components")
     amp = np.abs(U[:, k])
     logamp = np.log10(np.maximum(amp, np.finfo(float).tiny))
+    from scipy.signal import find_peaks  # lazy: scipy.signal is slow to import
+
     peaks, _ = find_peaks(logamp, prominence=prominence)
     return int(peaks.size), frf_result.frequency_hz[peaks]

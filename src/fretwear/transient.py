@@ -302,7 +302,9 @@ class _Reduced:
     basis: np.ndarray  # (nf, r): U_free = basis @ q
     K: np.ndarray  # (r,) if diag else (r, r)
     M: np.ndarray
-    C: np.ndarray
+    C: np.ndarray  # (r,) diagonal part if diag (the damping is diag(C) + U R U^T)
+    U: np.ndarray  # (r, s) low-rank damping factor (diag only)
+    R: np.ndarray  # (s, s)
     diag: bool
     Tx: np.ndarray  # (m, r) local contact displacements
     obs: np.ndarray  # (no, r) rows of the observed DOFs
@@ -346,6 +348,60 @@ def _fixed_interface_modes(Kii, Mii, w_cut: float | None, n_modes: int | None):
             keep = w2 <= w_cut**2
             return w2[keep], V[:, keep]
         k *= 2
+
+
+def _damping_split(K, M, C):
+    """Write ``C = a K + b M + R`` with ``R`` non-zero on few DOFs.
+
+    Structural damping is usually Rayleigh-like (``a K0 + b M``, or ``eta K0 / omega`` for a
+    hysteretic loss factor) while springs to ground are undamped, so ``C - a K - b M`` lives
+    on the spring DOFs only. ``a, b`` are fitted on the entries of the matrices, leaving out
+    the rows that do not fit (robust least squares). Returns ``(a, b, S, R_SS)`` with ``S``
+    the DOFs where ``R`` is non-zero; ``S`` may be large when ``C`` has no such structure.
+    """
+    scale = abs(C).max() if C.nnz else 0.0
+    if scale == 0.0:
+        return 0.0, 0.0, np.zeros(0, dtype=np.int64), np.zeros((0, 0))
+    pat = (abs(K) + abs(M) + abs(C)).tocoo()
+    rows, cols = pat.row, pat.col
+    kv = np.asarray(K[rows, cols]).ravel()
+    mv = np.asarray(M[rows, cols]).ravel()
+    cv = np.asarray(C[rows, cols]).ravel()
+    sk = np.abs(kv).max() or 1.0
+    sm = np.abs(mv).max() or 1.0
+    kn, mn = kv / sk, mv / sm
+    # per-row 2x2 least squares, then the median over the rows (outlier rows are few)
+    n = K.shape[0]
+    skk = np.bincount(rows, kn * kn, n)
+    skm = np.bincount(rows, kn * mn, n)
+    smm = np.bincount(rows, mn * mn, n)
+    skc = np.bincount(rows, kn * cv, n)
+    smc = np.bincount(rows, mn * cv, n)
+    det = skk * smm - skm**2
+    ok = det > 1e-12 * (skk * smm + 1e-300)
+    if ok.any():
+        a = float(np.median((smm * skc - skm * smc)[ok] / det[ok]))
+        b = float(np.median((skk * smc - skm * skc)[ok] / det[ok]))
+    else:
+        coef = np.linalg.lstsq(np.column_stack([kn, mn]), cv, rcond=None)[0]
+        a, b = float(coef[0]), float(coef[1])
+    # refit on the entries of the rows that agree
+    bad = np.abs(cv - a * kn - b * mn) > 1e-8 * scale
+    out = np.union1d(rows[bad], cols[bad])
+    keep = ~(np.isin(rows, out) | np.isin(cols, out))
+    if keep.sum() >= 2:
+        coef = np.linalg.lstsq(np.column_stack([kn[keep], mn[keep]]), cv[keep], rcond=None)[0]
+        a, b = float(coef[0]), float(coef[1])
+    a, b = a / sk, b / sm
+    if abs(b) * sm <= 1e-13 * scale:
+        b = 0.0
+    if abs(a) * sk <= 1e-13 * scale:
+        a = 0.0
+    Rm = (C - a * K - b * M).tocoo()
+    big = np.abs(Rm.data) > 1e-12 * scale
+    S = np.union1d(Rm.row[big], Rm.col[big]).astype(np.int64)
+    Rs = np.asarray((C - a * K - b * M).tocsr()[S][:, S].todense()) if S.size else np.zeros((0, 0))
+    return float(a), float(b), S, 0.5 * (Rs + Rs.T)
 
 
 def _reduce(model: Model, omega: float, *, modal_cutoff, n_modes, steps_per_period) -> _Reduced:
@@ -436,22 +492,28 @@ def _reduce(model: Model, omega: float, *, modal_cutoff, n_modes, steps_per_peri
     Mr = 0.5 * (Mr + Mr.T)
     Cr = 0.5 * (Cr + Cr.T)
     diag = False
+    Ul, Rl = np.zeros((0, 0)), np.zeros((0, 0))
     try:
         w2, V = sla.eigh(Kr, Mr)
     except np.linalg.LinAlgError:
         V = None
     if V is not None:
+        basis = Phi @ V
         Cm = V.T @ Cr @ V
         Cm = 0.5 * (Cm + Cm.T)
-        dC = np.diag(Cm).copy()
-        off = np.abs(Cm - np.diag(dC)).max() if Cm.size else 0.0
         big = np.abs(Cm).max() if Cm.size else 0.0
-        basis = Phi @ V
-        if off <= 1e-9 * big or big == 0.0:
+        # damping in modal coordinates: a w^2 + b + low rank (undamped springs), if it fits
+        a, b, S, Rs = _damping_split(K, M, C)
+        Ul = basis[S].T if S.size else np.zeros((basis.shape[1], 0))
+        approx = a * np.diag(w2) + b * np.eye(w2.size) + Ul @ Rs @ Ul.T
+        fits = big == 0.0 or np.abs(Cm - approx).max() <= 1e-9 * big
+        if fits and S.size <= max(8, basis.shape[1] // 4):
             diag = True
-            Kred, Mred, Cred = w2.copy(), np.ones_like(w2), dC
+            Kred, Mred, Cred, Rl = w2.copy(), np.ones_like(w2), a * w2 + b, Rs
+            info["damping"] = {"a_K": a, "b_M": b, "low_rank": int(S.size)}
         else:
             Kred, Mred, Cred = np.diag(w2), np.eye(w2.size), Cm
+            Ul = np.zeros((0, 0))
         info["highest_frequency_hz"] = float(np.sqrt(max(w2.max(), 0.0)) / (2 * np.pi))
     else:
         basis, Kred, Mred, Cred = Phi, Kr, Mr, Cr
@@ -469,7 +531,10 @@ def _reduce(model: Model, omega: float, *, modal_cutoff, n_modes, steps_per_peri
         rows.append(rr)
         names.append(p.name)
     obs = np.vstack(rows) if rows else np.zeros((0, basis.shape[1]))
-    return _Reduced(free=free, basis=basis, K=Kred, M=Mred, C=Cred, diag=diag, Tx=Tx, obs=obs,
+    if not diag:
+        Ul, Rl = np.zeros((basis.shape[1], 0)), np.zeros((0, 0))
+    return _Reduced(free=free, basis=basis, K=Kred, M=Mred, C=Cred, U=np.ascontiguousarray(Ul),
+                    R=np.ascontiguousarray(Rl), diag=diag, Tx=Tx, obs=obs,
                     obs_names=names, obs_slices=slices, info=info)
 
 
@@ -480,15 +545,14 @@ class _Integrator:
     """Holds the reduced step operator and the current state; runs whole periods."""
 
     def __init__(self, model: Model, omega: float, *, steps_per_period, modal_cutoff, n_modes,
-                 gamma, tol, wear, U0, V0, stick_anchor):
+                 gamma, tol, wear, U0, V0, stick_anchor, hf_gamma=None, hf_limit=None):
         self.model = model
         self.omega = _positive(omega, "omega")
         self.N = N = _count(steps_per_period, "steps_per_period", 4)
         gamma = float(gamma)
         if not (0.5 <= gamma <= 1.0):
             raise InputError(f"gamma = {gamma!r}; expected 0.5 (trapezoidal, default) to 1")
-        beta = 0.25 * (gamma + 0.5) ** 2
-        self.gamma, self.beta = gamma, beta
+        self.gamma = gamma
         self.tol = _positive(tol, "tol")
         t0 = time.perf_counter()
         red = self.red = _reduce(model, self.omega, modal_cutoff=modal_cutoff, n_modes=n_modes,
@@ -497,31 +561,52 @@ class _Integrator:
         self.nc, self.d = c.dofs.shape
         self.m = self.nc * self.d
         self.h = h = 2.0 * np.pi / (self.omega * N)
+        r = red.basis.shape[1]
+        # Newmark parameters, per mode in modal coordinates (high modes may get more damping)
+        g = np.full(r, gamma)
+        if red.diag and hf_gamma is not None:
+            g[np.sqrt(np.maximum(red.K, 0.0)) * h > hf_limit] = hf_gamma
+        b = 0.25 * (g + 0.5) ** 2
+        self.g_modes = g
+        w1, w0, wm = b, 0.5 - 2 * b + g, 0.5 + b - g
         # loads per phase, reduced, and the two-step weighted average F~_k
         tau = 2.0 * np.pi * np.arange(N) / N
         Ft = model.load_time(tau)[:, red.free] if model.loads else np.zeros((N, red.free.size))
         self.fscale = float(np.abs(Ft).max()) if Ft.size else 0.0
         Fr = Ft @ red.basis
         self.Fr = Fr
-        w1, w0, wm = beta, 0.5 - 2 * beta + gamma, 0.5 + beta - gamma
         self.ftil = w1 * np.roll(Fr, -1, axis=0) + w0 * Fr + wm * np.roll(Fr, 1, axis=0)
-        r = red.basis.shape[1]
+        z0 = np.zeros((0, 0))
         if red.diag:
-            k, mm, cc = red.K, red.M, red.C
-            s = mm + gamma * h * cc + beta * h * h * k
-            self.bq_v = -h * h * k / s
-            self.bd_v = (mm - (1 - gamma) * h * cc + wm * h * h * k) / s
-            self.bq_m = self.bd_m = np.zeros((0, 0))
-            self.ftab = h * h * self.ftil / s
-            G = h * h * red.Tx.T / s[:, None]
+            k, mm, cc, U, R = red.K, red.M, red.C, red.U, red.R
+            ds = mm + g * h * cc + b * h * h * k
+            self.a_v = mm - (1 - g) * h * cc + wm * h * h * k
+            self.b_v = -h * h * k
+            self.ds = ds
+            self.hc = (1 - g) * h
+            # S^-1 = (Ds + Gam U R U^T)^-1 = Ds^-1 - P Qt (Woodbury), Gam = diag(g h)
+            self.P = np.ascontiguousarray((g * h / ds)[:, None] * U)
+            core = np.eye(U.shape[1]) + R @ (U.T @ self.P)
+            self.Qt = np.ascontiguousarray(np.linalg.solve(core, R @ (U.T / ds[None, :])))
+            self.U, self.R = U, R
+
+            def s_inv(Y):
+                return Y / ds[:, None] - self.P @ (self.Qt @ Y)
+
+            self.bq_m = self.bd_m = z0
+            self.ftab = h * h * s_inv(self.ftil.T).T
+            G = h * h * s_inv(red.Tx.T)
         else:
-            S2 = red.M + gamma * h * red.C + beta * h * h * red.K
+            S2 = red.M + gamma * h * red.C + b[0] * h * h * red.K
             lu = sla.lu_factor(S2)
             self.bq_m = -h * h * sla.lu_solve(lu, red.K)
-            self.bd_m = sla.lu_solve(lu, red.M - (1 - gamma) * h * red.C + wm * h * h * red.K)
-            self.bq_v = self.bd_v = np.zeros(0)
+            self.bd_m = sla.lu_solve(lu, red.M - (1 - gamma) * h * red.C
+                                     + wm[0] * h * h * red.K)
+            self.a_v = self.b_v = self.ds = self.hc = np.zeros(0)
+            self.U, self.R, self.P, self.Qt = np.zeros((r, 0)), z0, np.zeros((r, 0)), z0
             self.ftab = h * h * sla.lu_solve(lu, self.ftil.T).T
             G = h * h * sla.lu_solve(lu, red.Tx.T)
+        self.ftab = np.ascontiguousarray(self.ftab)
         self.G = np.ascontiguousarray(G)
         W = red.Tx @ G
         W = 0.5 * (W + W.T)
@@ -535,7 +620,7 @@ class _Integrator:
         self.gap = np.asarray(c.gap, dtype=float) + _node_wear(wear, self.nc)
         if red.diag:
             self.m_v, self.k_v, self.c_v = red.M, red.K, red.C
-            self.m_m = self.k_m = self.c_m = np.zeros((0, 0))
+            self.m_m = self.k_m = self.c_m = z0
         else:
             self.m_v = self.k_v = self.c_v = np.zeros(0)
             self.m_m, self.k_m, self.c_m = red.M, red.K, red.C
@@ -643,8 +728,8 @@ class _Integrator:
         while done < n_periods:
             k = min(chunk, n_periods - done)
             nfail, maxit, ff = run_dynamic(
-                self.q, self.dq, self.red.diag, self.bq_v, self.bd_v, self.bq_m, self.bd_m,
-                self.ftab, self.G, self.red.Tx, self.A, self.gap, self.xprev, self.xprev2,
+                self.q, self.dq, self.red.diag, self.a_v, self.b_v, self.ds, self.hc, self.U,
+                self.R, self.P, self.Qt, self.bq_m, self.bd_m, self.ftab, self.G, self.red.Tx, self.A, self.gap, self.xprev, self.xprev2,
                 float(self.model.contact.mu), self.d, self.status, self.tdir, k,
                 (self.periods_done) * N, self.tol, self.fscale, 60 + 4 * nc,
                 self.red.obs, keep_from, mon_start, mon_mean, mon_ptp, q_last, dq_last,
@@ -679,11 +764,9 @@ class _Integrator:
         energy = {"external": e[:, 0].copy(), "friction": e[:, 1].copy(),
                   "normal": e[:, 2].copy(), "damping": e[:, 3].copy(),
                   "mechanical": e[:, 4].copy(), "numerical": e[:, 5].copy()}
-        if self.gamma == 0.5:
-            energy["numerical"][:] = 0.0
         U, V = self.full_state()
         info = dict(self.red.info)
-        info.update(h=self.h, gamma=self.gamma, beta=self.beta, setup_time=self.setup_time,
+        info.update(h=self.h, gamma=self.gamma, setup_time=self.setup_time,
                     failed_steps=self.n_fail, max_active_set_iterations=self.max_it,
                     first_failure_time=self.first_fail_time, periods_total=self.periods_done)
         if self.n_fail:

@@ -316,25 +316,28 @@ def solve_contact(A, b, xref, gap, xprev, mu, d, status, tdir, x, lam, tol, fsca
 
 
 @njit(cache=True, fastmath=_FAST)
-def run_dynamic(q, dq, diag, bq_v, bd_v, bq_m, bd_m, ftab, G, Tx, A, gap, xprev, xprev2, mu, d,
-                status, tdir, n_periods, step0, tol, fscale, maxit,
+def run_dynamic(q, dq, diag, a_v, b_v, ds, hc, U, R, P, Qt, bq_m, bd_m, ftab, G, Tx, A, gap,
+                xprev, xprev2, mu, d, status, tdir, n_periods, step0, tol, fscale, maxit,
                 obs, keep_from, mon_start, mon_mean, mon_ptp, q_last, dq_last,
                 rec_from, h, ftil, m_v, k_v, c_v, m_m, k_m, c_m,
                 r_obs, r_vobs, r_x, r_lam, r_state, r_energy):
     """Advance the reduced dynamic model ``n_periods`` forcing periods with fixed steps.
 
-    Scheme (two-step form of Newmark's rule, beta/gamma, contact force ``lam_n`` at t_n and
-    constraints on ``q_{n+1}``)::
+    Scheme (two-step form of Newmark's rule, contact force ``lam_n`` at t_n and constraints on
+    ``q_{n+1}``; see :mod:`fretwear.transient`)::
 
-        dq_{n+1} = Bq q_n + Bd dq_n + ftab[k] - G lam_n,   q_{n+1} = q_n + dq_{n+1}
-        x_{n+1} = Tx q_{n+1} = xref - W lam_n,  A = W^-1
+        dq_{n+1} = S^-1 (B_d dq_n + B_q q_n) + ftab[k] - G lam_n,   q_{n+1} = q_n + dq_{n+1}
+        x_{n+1} = Tx q_{n+1} = xref - W lam_n,   A = W^-1
 
-    with ``dq_n = q_n - q_{n-1}``. See :mod:`fretwear.transient` for the derivation.
+    with ``dq_n = q_n - q_{n-1}``.
 
     Parameters
     ----------
     q, dq : (r,) reduced state (in/out) [m].
-    diag : bool, the step matrices are diagonal (``bq_v, bd_v``) or dense (``bq_m, bd_m``).
+    diag : bool. True: modal coordinates, diagonal mass and stiffness and damping
+        ``diag(c) + U R U^T``; the free increment is
+        ``y = a_v dq + b_v q - hc * (U R U^T dq)``, ``S^-1 y = y / ds - P (Qt y)`` (Woodbury).
+        False: dense ``bq_m q + bd_m dq``.
     ftab : (N, r) free-motion forcing increment per phase of the period [m].
     G : (r, m) response of the increment to the contact forces [m/N].
     Tx : (m, r) local contact displacements of the reduced coordinates.
@@ -347,7 +350,8 @@ def run_dynamic(q, dq, diag, bq_v, bd_v, bq_m, bd_m, ftab, G, Tx, A, gap, xprev,
     q_last, dq_last : (r,) out: state at the start of the last period.
     rec_from : first global step recorded in ``r_*`` (every step from there).
     h : step [s]; ftil : (N, r) applied generalised forces [N] (energy); m_*, k_*, c_* : mass,
-        stiffness, damping (diagonal ``_v`` or dense ``_m``) for the energy.
+        stiffness, damping (diagonal ``_v``, with ``U R U^T`` added to the damping, or dense
+        ``_m``) for the energy.
     r_obs, r_vobs : (ns, no); r_x, r_lam : (ns, m); r_state : (ns, nc) int8;
     r_energy : (ns, 6): external work, friction, normal contact work, damping, mechanical
         energy at t_n + h/2, numerical residual (cumulative from the first recorded step) [J].
@@ -363,7 +367,11 @@ def run_dynamic(q, dq, diag, bq_v, bd_v, bq_m, bd_m, ftab, G, Tx, A, gap, xprev,
     N = ftab.shape[0]
     nmon = no + m
     ns = r_obs.shape[0]
+    nl = U.shape[1]
     dqf = np.zeros(r)
+    y = np.zeros(r)
+    z = np.zeros(nl)
+    z2 = np.zeros(nl)
     xref = np.zeros(m)
     x = np.zeros(m)
     lam = np.zeros(m)
@@ -393,7 +401,36 @@ def run_dynamic(q, dq, diag, bq_v, bd_v, bq_m, bd_m, ftab, G, Tx, A, gap, xprev,
             # free increment
             if diag:
                 for j in range(r):
-                    dqf[j] = bq_v[j] * q[j] + bd_v[j] * dq[j] + ftab[k, j]
+                    y[j] = a_v[j] * dq[j] + b_v[j] * q[j]
+                if nl > 0:
+                    for l in range(nl):
+                        s = 0.0
+                        for j in range(r):
+                            s += U[j, l] * dq[j]
+                        z[l] = s
+                    for l in range(nl):
+                        s = 0.0
+                        for l2 in range(nl):
+                            s += R[l, l2] * z[l2]
+                        z2[l] = s
+                    for j in range(r):
+                        s = 0.0
+                        for l in range(nl):
+                            s += U[j, l] * z2[l]
+                        y[j] -= hc[j] * s
+                    for l in range(nl):
+                        s = 0.0
+                        for j in range(r):
+                            s += Qt[l, j] * y[j]
+                        z[l] = s
+                    for j in range(r):
+                        s = 0.0
+                        for l in range(nl):
+                            s += P[j, l] * z[l]
+                        dqf[j] = y[j] / ds[j] - s + ftab[k, j]
+                else:
+                    for j in range(r):
+                        dqf[j] = y[j] / ds[j] + ftab[k, j]
             else:
                 for j in range(r):
                     s = ftab[k, j]
@@ -461,12 +498,7 @@ def run_dynamic(q, dq, diag, bq_v, bd_v, bq_m, bd_m, ftab, G, Tx, A, gap, xprev,
                     r_x[js, i] = xprev[i]
                     r_lam[js, i] = lam[i]
                 for i in range(nc):
-                    if status[i] == OPEN:
-                        r_state[js, i] = 0
-                    elif status[i] == STICK:
-                        r_state[js, i] = 1
-                    else:
-                        r_state[js, i] = 2
+                    r_state[js, i] = status[i]
                 # energy: E_{n+1/2} and the works of this step
                 emech = 0.0
                 if diag:
@@ -487,20 +519,27 @@ def run_dynamic(q, dq, diag, bq_v, bd_v, bq_m, bd_m, ftab, G, Tx, A, gap, xprev,
                 if js > 0:
                     wext = 0.0
                     wdmp = 0.0
+                    for j in range(r):
+                        tmp[j] = dqf[j] + dq[j]
+                        wext += 0.5 * ftil[k, j] * tmp[j]
                     if diag:
                         for j in range(r):
-                            a2 = dqf[j] + dq[j]
-                            wext += 0.5 * ftil[k, j] * a2
-                            wdmp += c_v[j] * a2 * a2 / (4.0 * h)
+                            wdmp += c_v[j] * tmp[j] * tmp[j]
+                        for l in range(nl):
+                            s = 0.0
+                            for j in range(r):
+                                s += U[j, l] * tmp[j]
+                            z[l] = s
+                        for l in range(nl):
+                            for l2 in range(nl):
+                                wdmp += z[l] * R[l, l2] * z[l2]
                     else:
                         for j in range(r):
-                            tmp[j] = dqf[j] + dq[j]
-                        for j in range(r):
-                            wext += 0.5 * ftil[k, j] * tmp[j]
                             sc = 0.0
                             for l in range(r):
                                 sc += c_m[j, l] * tmp[l]
-                            wdmp += sc * tmp[j] / (4.0 * h)
+                            wdmp += sc * tmp[j]
+                    wdmp /= 4.0 * h
                     wn = 0.0
                     wt = 0.0
                     for i in range(nc):

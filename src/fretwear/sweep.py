@@ -1,0 +1,314 @@
+"""Frequency sweeps of the DLFT periodic response: the nonlinear FRF (paper Fig. 14, 15, 22).
+
+Each grid frequency starts from its converged neighbours (secant predictor in frequency). When a
+grid step fails, the sweep falls back, in order, to: the neighbour itself as start, the other
+solver, pseudo-arclength continuation from the last converged point (which passes folds of the
+response curve, where frequency is not a good parameter), and finally bisection of the step. A
+point that still does not converge is kept in the result as *not converged*, with the reason,
+and never used as a solution.
+
+Mean tangential position (stick anchors): the sweep follows the loading history; the first
+point starts from the static preload (:func:`fretwear.hbm.static_anchor`) and every later point
+takes the mean tangential positions of the previous converged point as its anchors (a node that
+sticks all period stays where it was). See docs/theory.md, "Full stick and the mean position".
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from fretwear.fourier import FourierBasis
+from fretwear.hbm import DLFTProblem, PeriodicSolution, assemble_solution, static_anchor
+from fretwear.model.core import Model
+from fretwear.reduce import condense
+from fretwear.solvers import SolveStats, solve
+
+
+@dataclass
+class SweepPoint:
+    """One frequency of a sweep.
+
+    frequency_hz : the frequency [Hz]; solution : the periodic solution or None when the solve
+    did not converge; stats : solver statistics; how : ``"grid"``, ``"retry"``, ``"arclength"``
+    or ``"bisection"``; flags : reasons for caution (``"not converged: ..."``, stability checks).
+    """
+
+    frequency_hz: float
+    solution: PeriodicSolution | None
+    stats: SolveStats
+    how: str = "grid"
+    flags: list = field(default_factory=list)
+
+    @property
+    def converged(self) -> bool:
+        return self.solution is not None
+
+
+@dataclass
+class SweepResult:
+    """The points of a sweep, in the order computed (increasing frequency)."""
+
+    points: list
+    wall_time: float = 0.0
+
+    @property
+    def frequency_hz(self) -> np.ndarray:
+        return np.array([p.frequency_hz for p in self.points])
+
+    @property
+    def converged(self) -> np.ndarray:
+        return np.array([p.converged for p in self.points], dtype=bool)
+
+    def amplitude(self, point: str, axis: int = 0, harmonic: int | None = 1) -> np.ndarray:
+        """Amplitude of an observed point [m] per sweep point (nan where not converged):
+        of one harmonic, or (``harmonic=None``) half the peak-to-peak range over the period."""
+        out = np.full(len(self.points), np.nan)
+        for i, p in enumerate(self.points):
+            s = p.solution
+            if s is None:
+                continue
+            c = s.observed[point][axis]
+            if harmonic is None:
+                u = s.basis.to_time(c)
+                out[i] = 0.5 * (u.max() - u.min())
+            else:
+                j = s.basis.harmonics.index(harmonic)
+                out[i] = np.hypot(c[1 + j], c[1 + s.basis.k + j])
+        return out
+
+    def summary(self) -> str:
+        n = len(self.points)
+        k = int(self.converged.sum())
+        lines = [f"sweep_converged={k}/{n}"]
+        for p in self.points:
+            if p.flags:
+                lines.append(f"  {p.frequency_hz:12.6g} Hz: " + "; ".join(p.flags))
+        return "\n".join(lines)
+
+
+def frequency_grid(f_min: float, f_max: float, n: int, spacing: str = "log") -> np.ndarray:
+    """``n`` frequencies [Hz] from ``f_min`` to ``f_max``, log or linear spacing."""
+    if spacing == "log":
+        return np.geomspace(f_min, f_max, n)
+    return np.linspace(f_min, f_max, n)
+
+
+class _Problems:
+    """DLFT problems per frequency, condensed once and cached (the sweep revisits them)."""
+
+    def __init__(self, model, basis, gap, eps, cache_size=8):
+        self.model, self.basis, self.gap, self.eps = model, basis, gap, eps
+        self.orders = np.array([0, *basis.harmonics])
+        self.cache: dict = {}
+        self.size = cache_size
+
+    def get(self, omega: float, anchor) -> DLFTProblem:
+        key = float(omega)
+        red = self.cache.get(key)
+        if red is None:
+            red = condense(self.model, omega, self.orders)
+            if len(self.cache) >= self.size:
+                self.cache.pop(next(iter(self.cache)))
+            self.cache[key] = red
+        return DLFTProblem(red, self.model.contact, self.basis, gap=self.gap, eps=self.eps,
+                           anchor=anchor)
+
+
+def _solve_at(probs, omega, anchor, U0, solver, tol, max_iter):
+    prob = probs.get(omega, anchor)
+    x0 = prob.initial_guess() if U0 is None else np.asarray(U0, float).reshape(prob.m, prob.H)
+
+    def fun(x, jac=True):
+        return prob.residual(x.reshape(prob.m, prob.H), jac)
+
+    x, _, st = solve(fun, x0.reshape(-1), lambda x: prob.scale(x.reshape(prob.m, prob.H)),
+                     method=solver, tol=tol, max_iter=max_iter)
+    return prob, x.reshape(prob.m, prob.H), st
+
+
+def _arclength(probs, model, anchor, y_prev, y_last, omega_target, solver_tol, max_steps=20,
+               max_iter=20):
+    """Pseudo-arclength continuation from ``y_last`` (secant from ``y_prev``) until the
+    frequency passes ``omega_target``. ``y = (U (m*H,), omega)``. Returns the list of converged
+    ``(U, omega, stats)`` along the branch (the last one is past or at the target) or []."""
+    U1, w1 = y_last
+    U0, w0 = y_prev
+    sx = max(np.linalg.norm(U1), 1e-30)
+    sw = max(abs(w1), 1e-30)
+
+    def scaled(U, w):
+        return np.concatenate([U / sx, [w / sw]])
+
+    t = scaled(U1, w1) - scaled(U0, w0)
+    ds = np.linalg.norm(t)
+    if ds == 0:
+        return []
+    t /= ds
+    if t[-1] * (omega_target - w1) < 0:  # march towards the target
+        t = -t
+    out = []
+    yk = scaled(U1, w1)
+    for _ in range(max_steps):
+        converged = False
+        for _shrink in range(4):
+            yp = yk + ds * t
+            y = yp.copy()
+            t0 = time.perf_counter()
+            nit = nf = 0
+            for _it in range(max_iter):
+                U, w = y[:-1] * sx, y[-1] * sw
+                prob = probs.get(w, anchor)
+                f, J = prob.residual(U.reshape(prob.m, prob.H))
+                nf += 1
+                dw = 1e-7 * w
+                f2, _ = probs.get(w + dw, anchor).residual(U.reshape(prob.m, prob.H), False)
+                fw = (f2 - f) / dw
+                g = t @ (y - yp)
+                if np.linalg.norm(f) <= solver_tol * prob.scale(U.reshape(prob.m, prob.H)):
+                    converged = True
+                    break
+                n = f.size
+                A = np.zeros((n + 1, n + 1))
+                A[:n, :n] = J * sx
+                A[:n, n] = fw * sw
+                A[n] = t
+                rhs = -np.concatenate([f, [g]])
+                try:
+                    dy = np.linalg.solve(A, rhs)
+                except np.linalg.LinAlgError:
+                    break
+                y = y + dy
+                nit += 1
+            if converged:
+                break
+            ds *= 0.5
+        if not converged:
+            return out
+        U, w = y[:-1] * sx, y[-1] * sw
+        st = SolveStats(True, float(np.linalg.norm(f) / prob.scale(U.reshape(prob.m, prob.H))),
+                        nit, nf * 2, nf, time.perf_counter() - t0, "converged (arclength)",
+                        "arclength")
+        out.append((U, w, st))
+        tn = y - yk
+        tn /= np.linalg.norm(tn)
+        t = tn
+        yk = y
+        if (w - omega_target) * (omega_target - w1) >= 0:  # passed the target frequency
+            break
+        if nit <= 3:
+            ds *= 1.5
+    return out
+
+
+def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_points: int, *,
+          spacing: str = "log", gap=None, eps=None, anchor=None, solver: str = "powell",
+          tol: float = 1e-8, max_iter: int = 40, continuation: bool = True,
+          max_bisections: int = 4, check=None, progress=None) -> SweepResult:
+    """Nonlinear FRF: periodic solutions from ``f_min`` to ``f_max`` [Hz].
+
+    Parameters
+    ----------
+    model, basis : the structure and the Fourier basis.
+    n_points, spacing : the frequency grid (``"log"`` or ``"linear"``).
+    gap : (nc,) gap + wear [m] (a worn interface); default the model's initial gap.
+    eps : DLFT penalty [N/m] (default: spectral radius of ``Z_r`` at each frequency).
+    anchor : stick anchors of the first point (default: static preload state).
+    solver, tol, max_iter : nonlinear solver settings (:func:`fretwear.solvers.solve`).
+    continuation : use pseudo-arclength continuation when a grid step fails.
+    max_bisections : halvings of a failed frequency step (the intermediate converged
+        points are kept in the result, ``how = "substep"``).
+    check : optional callable ``(PeriodicSolution) -> list[str]`` returning flags (e.g. the
+        time-domain stability check of :mod:`fretwear.stability`).
+    progress : optional callable ``(i, n, point)`` called after each grid point.
+    """
+    t_start = time.perf_counter()
+    grid = frequency_grid(f_min, f_max, n_points, spacing)
+    probs = _Problems(model, basis, gap, eps)
+    if anchor is None:
+        anchor = static_anchor(model)
+    history: list = []  # converged (omega, U (m, H)) in order
+    points: list = []
+    other = {"powell": "newton", "newton": "powell", "hybr": "powell"}[solver]
+
+    def record(omega, prob, U, st, how, flags=()):
+        sol = assemble_solution(prob, U, model, st)
+        pt = SweepPoint(omega / (2 * np.pi), sol, st, how, list(flags))
+        if check is not None:
+            pt.flags.extend(check(sol))
+        history.append((omega, U))
+        return pt
+
+    def predict(omega):
+        if not history:
+            return None
+        if len(history) == 1:
+            return history[-1][1]
+        (w0, U0), (w1, U1) = history[-2], history[-1]
+        if w1 == w0:
+            return U1
+        return U1 + (U1 - U0) * (omega - w1) / (w1 - w0)
+
+    def current_anchor():
+        if not history:
+            return anchor
+        U = history[-1][1].reshape(model.contact.n_nodes, model.contact.dim, -1)
+        return U[:, 1:, 0].copy()
+
+    for i, f in enumerate(grid):
+        omega = 2 * np.pi * f
+        prob, U, st = _solve_at(probs, omega, current_anchor(), predict(omega), solver, tol,
+                                max_iter)
+        how = "grid"
+        if not st.converged and history:
+            # adaptive step: halve the frequency step from the last converged point
+            w_lo = history[-1][0]
+            for level in range(1, max_bisections + 1):
+                w_try = w_lo + (omega - w_lo) / 2**level
+                pb, Ub, stb = _solve_at(probs, w_try, current_anchor(), predict(w_try), solver,
+                                        tol, max_iter)
+                if not stb.converged:
+                    continue
+                points.append(record(w_try, pb, Ub, stb, "substep"))
+                # march on to the grid frequency with the step that worked
+                w_step = w_try - w_lo
+                ok = True
+                while history[-1][0] + 1.5 * w_step < omega and ok:
+                    w_next = history[-1][0] + w_step
+                    pb, Ub, stb = _solve_at(probs, w_next, current_anchor(), predict(w_next),
+                                            solver, tol, max_iter)
+                    ok = stb.converged
+                    if ok:
+                        points.append(record(w_next, pb, Ub, stb, "substep"))
+                if ok:
+                    prob, U, st = _solve_at(probs, omega, current_anchor(), predict(omega),
+                                            solver, tol, max_iter)
+                    how = "substep"
+                break
+        if not st.converged and history:
+            prob, U, st = _solve_at(probs, omega, current_anchor(), history[-1][1], other, tol,
+                                    max_iter)
+            how = "retry"
+        if not st.converged and continuation and len(history) >= 2:
+            anc = current_anchor()
+            branch = _arclength(probs, model, anc, (history[-2][1].reshape(-1), history[-2][0]),
+                                (history[-1][1].reshape(-1), history[-1][0]), omega, tol)
+            for Ub, wb, stb in branch:
+                pb = probs.get(wb, anc)
+                points.append(record(wb, pb, Ub.reshape(pb.m, pb.H), stb, "arclength"))
+            if branch:
+                prob, U, st = _solve_at(probs, omega, current_anchor(), history[-1][1], solver,
+                                        tol, max_iter)
+                how = "arclength"
+        if st.converged:
+            pt = record(omega, prob, U, st, how)
+        else:
+            pt = SweepPoint(f, None, st, how, [f"not converged: {st.message} "
+                                                f"(relative residual {st.residual:.2e})"])
+        points.append(pt)
+        if progress is not None:
+            progress(i, len(grid), pt)
+    points.sort(key=lambda p: p.frequency_hz)
+    return SweepResult(points, time.perf_counter() - t_start)

@@ -1,0 +1,838 @@
+"""Fretting wear on the slow time scale: "DLFT with wear" (paper section 3.3, eq. 29-30).
+
+Two time scales (paper section 2): the vibration period (fast) is solved by the DLFT harmonic
+balance (:mod:`fretwear.hbm`); the wear depth ``W`` of every contact node evolves over the
+cycle count ``N`` (slow) by
+
+    dW/dN = g(W),       g_p = dW1_p = wear depth per cycle of node p on the periodic
+                        solution balanced with the normal gap ``gap + W``          (eq. 29)
+
+Wear laws (per node, per cycle, evaluated on the converged DLFT samples with the *corrected*
+slip ``X_T(n) - X_T(n-1)``, which is exactly zero in stick):
+
+* Archard (eq. 29): ``dW1_p = k_w sum_n p_N(n) |X_T(n) - X_T(n-1)|``, ``p_N = lambda_N/area``;
+* energy (Fouvry et al. 2003): worn volume = ``k_e`` x friction energy, so
+  ``dW1_p = k_e E_p / area_p`` with ``E_p = sum_n lambda_T(n).(X_T(n) - X_T(n-1))``.
+
+With Coulomb slip ``E_p = mu sum_n lambda_N |dX_T|`` exactly, so both laws are ``c_p S_p`` with
+the slip work ``S_p`` of :mod:`fretwear.wear_kernels` and ``c_p = k_w / area_p`` or
+``k_e mu / area_p``; the worn volume per cycle of Archard's law is ``k_w / mu`` times the
+friction energy per cycle.
+
+Slow-scale schemes (:func:`simulate_wear`):
+
+* ``"explicit"``: explicit Euler with cycle jumps ``dN`` (eq. 30), as the paper;
+* ``"implicit"``: backward Euler solved together with the periodic balance. Unknowns
+  ``(U~, W_{k+1})``, residuals ``f(U~; W_{k+1}) = 0`` (DLFT, eq. 22) and
+  ``eps (W_{k+1} - W_k - dN g(U~, W_{k+1})) = 0``, Newton (Powell's dog-leg) on the coupled
+  system with the analytic Jacobian. It is stable for any jump (L-stable), which the explicit
+  scheme is not: docs/wear.md measures both.
+
+Either scheme may adapt its jump to a tolerance on the local error, estimated by the
+difference with the trapezoidal rule ``0.5 dN |g(W_{k+1}) - g(W_k)|`` (no extra solve),
+relative to the current maximum wear depth.
+
+Each step starts from the previous periodic solution (warm start) and keeps the stick anchors
+of its mean tangential position (the loading history rule of :mod:`fretwear.sweep`). A step
+whose solve fails is retried with a smaller jump; when that fails too the run stops, says so,
+and keeps every converged step. A checkpoint (``.npz``, written atomically) holds the complete
+state, so that an interrupted run resumes to the same result.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from fretwear import contact as law
+from fretwear.errors import ConvergenceError, InputError
+from fretwear.fourier import FourierBasis
+from fretwear.hbm import DLFTProblem, PeriodicSolution, assemble_solution, static_anchor
+from fretwear.model.core import Model
+from fretwear.reduce import Reduced, condense
+from fretwear.results import atomic_write
+from fretwear.solvers import SOLVERS, SolveStats, solve
+from fretwear.wear_kernels import slip_work, slip_work_gradient
+
+LAWS = ("archard", "energy")
+SCHEMES = ("implicit", "explicit")
+STOP_REASONS = ("max_cycles", "max_depth", "plateau", "no_wear", "max_steps", "solver_failed")
+CHECKPOINT_VERSION = 1
+
+
+# --------------------------------------------------------------------------------------------
+# wear laws
+# --------------------------------------------------------------------------------------------
+def wear_coefficients(model: Model, law_name: str = "archard",
+                      energy_coefficient: float | None = None) -> np.ndarray:
+    """Per-node factor ``c_p`` [1/N] with ``dW1_p = c_p S_p`` (module docstring).
+
+    Parameters
+    ----------
+    model : the model (``contact.wear_coefficient`` k_w [1/Pa], ``contact.area`` [m^2],
+        ``contact.mu``).
+    law_name : ``"archard"`` (eq. 29, ``c = k_w / area``) or ``"energy"``
+        (``c = k_e mu / area``).
+    energy_coefficient : ``k_e`` [m^3/J] of the energy law.
+    """
+    c = model.contact
+    area = np.asarray(c.area, dtype=float)
+    if law_name == "archard":
+        k = float(c.wear_coefficient)
+        if not k >= 0:
+            raise InputError(f"wear_coefficient = {k!r}: expected k_w >= 0 [1/Pa]")
+        return k / area
+    if law_name == "energy":
+        if energy_coefficient is None or not float(energy_coefficient) >= 0:
+            raise InputError(f"energy_coefficient = {energy_coefficient!r}: the energy law needs "
+                             "k_e >= 0 [m^3/J]")
+        return float(energy_coefficient) * float(c.mu) / area
+    raise InputError(f"law = {law_name!r}: expected one of {LAWS}")
+
+
+def wear_per_cycle(sol: PeriodicSolution, *, law_name: str = "archard",
+                   wear_coefficient: float = 0.0,
+                   energy_coefficient: float | None = None) -> np.ndarray:
+    """Wear depth per cycle ``dW1`` per node (nc,) [m] of a converged periodic solution.
+
+    Archard (eq. 29 with the corrected slip): ``k_w sum_n p_N(n) |X_T(n) - X_T(n-1)|``, from
+    :meth:`~fretwear.hbm.PeriodicSolution.pressure_t` and
+    :meth:`~fretwear.hbm.PeriodicSolution.slip_t` (zero in stick, so a node that sticks all
+    period does not wear). Energy law (Fouvry et al. 2003): ``k_e E_p / area_p`` with ``E_p``
+    from :meth:`~fretwear.hbm.PeriodicSolution.friction_energy`.
+
+    This is the post-processing route; the integrators use the kernel
+    :func:`fretwear.wear_kernels.slip_work`, which gives the same numbers.
+    """
+    if law_name == "archard":
+        return float(wear_coefficient) * np.sum(sol.pressure_t() * sol.slip_t(), axis=1)
+    if law_name == "energy":
+        if energy_coefficient is None:
+            raise InputError("the energy law needs energy_coefficient k_e [m^3/J]")
+        return float(energy_coefficient) * sol.friction_energy() / sol.area
+    raise InputError(f"law = {law_name!r}: expected one of {LAWS}")
+
+
+def worn_volume(wear: np.ndarray, area: np.ndarray) -> float:
+    """Worn volume ``sum_p area_p W_p`` [m^3] of wear depths ``W`` [m]."""
+    return float(np.dot(np.asarray(area, float), np.asarray(wear, float)))
+
+
+# --------------------------------------------------------------------------------------------
+# the coupled problem of one slow step
+# --------------------------------------------------------------------------------------------
+class SlowProblem:
+    """The DLFT balance with wear as a function of the wear depths (one frequency).
+
+    Parameters
+    ----------
+    model : the model; reduced : its condensation on ``[0] + basis.harmonics``.
+    basis : Fourier basis.
+    coef : (nc,) wear factors ``c_p`` [1/N] (:func:`wear_coefficients`).
+    eps : DLFT penalty [N/m] (None: spectral radius of ``Z_r``).
+    anchor : (nc, d-1) stick anchors [m].
+
+    The wear depths ``W`` (nc,) [m] enter the DLFT as the normal gap ``gap0 + W``; ``E_W`` puts
+    ``W_p`` into the static coefficient of the normal DOF of node ``p``.
+    """
+
+    def __init__(self, model: Model, reduced: Reduced, basis: FourierBasis, coef, *, eps=None,
+                 anchor=None):
+        self.model = model
+        self.gap0 = np.broadcast_to(np.asarray(model.contact.gap, float),
+                                    (model.contact.n_nodes,)).copy()
+        self.prob = DLFTProblem(reduced, model.contact, basis, gap=self.gap0, eps=eps,
+                                anchor=anchor)
+        p = self.prob
+        self.nc, self.d, self.H, self.m = p.nc, p.d, p.H, p.m
+        self.n = p.m * p.H
+        self.dH = p.d * p.H
+        self.eps = p.eps
+        self.coef = np.asarray(coef, float)
+        # index of (node p, normal component, static coefficient) in the DOF-major unknowns
+        self.iw = np.arange(self.nc) * self.dH
+        self._epsI_Z = None
+
+    # -- helpers --------------------------------------------------------------------------
+    def set_state(self, W, anchor):
+        self.prob.set_gap(self.gap0 + np.asarray(W, float))
+        self.prob.anchor = np.array(anchor, float)
+
+    def epsI_minus_Z(self):
+        """``d lambda_u~ / dU~ = eps I - Z`` (n, n), cached."""
+        if self._epsI_Z is None:
+            A = -self.prob.Z.copy()
+            A[np.diag_indices(self.n)] += self.eps
+            self._epsI_Z = A
+        return self._epsI_Z
+
+    def rate(self, U):
+        """Wear depth per cycle ``g = c S`` (nc,) [m] at ``U`` (m, H) with the current gap."""
+        lu, lx, state, _ = self.prob.time_law(U)
+        return self.coef * slip_work(lu, lx, state, self.eps)
+
+    def rate_and_gradient(self, U):
+        """``g`` (nc,) [m], ``dg/dU~`` (nc, n) [m/m] and ``dg/dW`` (nc,) [-] (diagonal) at the
+        current gap: ``dg/dU~ = c dS/dlambda_u~ (eps I - Z)``, ``dg/dW = -eps c dS/dlambda_u,N0``.
+        """
+        p = self.prob
+        lu, lx, state, _ = p.time_law(U)
+        S, dS = slip_work_gradient(lu, lx, state, p.mu, p.Q, self.eps)
+        g = self.coef * S
+        A = self.epsI_minus_Z().reshape(self.nc, self.dH, self.n)
+        gU = self.coef[:, None] * np.einsum("pi,pij->pj", dS, A)
+        gW = -self.eps * self.coef * dS[:, 0]
+        return g, gU, gW, (lu, lx, state)
+
+    def dfdW(self, lu, lx, state):
+        """``df/dW`` (n, nc) = ``-eps E_W + eps G E_W`` (G block-diagonal per node)."""
+        p = self.prob
+        G = law.dlft_jacobian(lu, lx, state, p.mu, p.P, p.Q)
+        out = np.zeros((self.n, self.nc))
+        for q in range(self.nc):
+            rows = slice(q * self.dH, (q + 1) * self.dH)
+            out[rows, q] = self.eps * G[q][:, 0]
+            out[q * self.dH, q] -= self.eps
+        return out
+
+    # -- residuals -------------------------------------------------------------------------
+    def balance(self, U, jacobian=True):
+        """DLFT residual ``f`` (n,) and Jacobian (n, n) at ``U`` (m, H), current gap."""
+        return self.prob.residual(U, jacobian)
+
+    def coupled(self, x, W_k, dN, jacobian=True):
+        """Backward Euler residual on ``x = [U~ (n), W (nc)]``.
+
+        ``R = [f(U~; W), eps (W - W_k - dN g(U~, W))]`` and its Jacobian
+        ``[[J, df/dW], [-eps dN dg/dU~, eps (I - dN dg/dW)]]``.
+        """
+        U = x[: self.n].reshape(self.m, self.H)
+        W = x[self.n :]
+        self.prob.set_gap(self.gap0 + W)
+        f, J = self.prob.residual(U, jacobian)
+        if not jacobian:
+            g = self.rate(U)
+            return np.concatenate([f, self.eps * (W - W_k - dN * g)]), None
+        g, gU, gW, (lu, lx, state) = self.rate_and_gradient(U)
+        R = np.concatenate([f, self.eps * (W - W_k - dN * g)])
+        n, nc = self.n, self.nc
+        JJ = np.empty((n + nc, n + nc))
+        JJ[:n, :n] = J
+        JJ[:n, n:] = self.dfdW(lu, lx, state)
+        JJ[n:, :n] = -self.eps * dN * gU
+        JJ[n:, n:] = 0.0
+        JJ[n + np.arange(nc), n + np.arange(nc)] = self.eps * (1.0 - dN * gW)
+        return R, JJ
+
+    def slow_jacobian(self, U):
+        """Total ``dg/dW`` (nc, nc) [-] along the balanced solution at ``U``:
+        ``dg/dW + dg/dU~ dU~/dW`` with ``dU~/dW = -J^-1 df/dW``. Its eigenvalues set the
+        stability limit of explicit Euler, ``dN < 2 / rho``."""
+        f, J = self.balance(U, True)
+        g, gU, gW, (lu, lx, state) = self.rate_and_gradient(U)
+        dUdW = -np.linalg.solve(J, self.dfdW(lu, lx, state))
+        return np.diag(gW) + gU @ dUdW
+
+    # -- solves --------------------------------------------------------------------------
+    def solve_balance(self, W, anchor, U0, *, solver, tol, max_iter):
+        """Periodic solution at wear ``W`` from ``U0``: ``(U (m, H), stats)``."""
+        self.set_state(W, anchor)
+        p = self.prob
+
+        def fun(x, jac=True):
+            return p.residual(x.reshape(self.m, self.H), jac)
+
+        x, _, st = solve(fun, np.asarray(U0, float).reshape(-1),
+                         lambda x: p.scale(x.reshape(self.m, self.H)), method=solver, tol=tol,
+                         max_iter=max_iter)
+        return x.reshape(self.m, self.H), st
+
+    def solve_implicit(self, W_k, dN, anchor, U0, W0, *, solver, tol, max_iter):
+        """Backward Euler step: ``(U, W_{k+1}, stats)`` from the guess ``(U0, W0)``."""
+        self.set_state(W0, anchor)
+        p = self.prob
+        W_k = np.asarray(W_k, float)
+
+        def fun(x, jac=True):
+            return self.coupled(x, W_k, dN, jac)
+
+        x0 = np.concatenate([np.asarray(U0, float).reshape(-1), np.asarray(W0, float)])
+        x, _, st = solve(fun, x0, lambda x: p.scale(x[: self.n].reshape(self.m, self.H)),
+                         method=solver, tol=tol, max_iter=max_iter)
+        return x[: self.n].reshape(self.m, self.H), x[self.n :].copy(), st
+
+    def solution(self, U, W, anchor, stats) -> PeriodicSolution:
+        """Post-processed periodic solution at ``(U, W)``."""
+        self.set_state(W, anchor)
+        return assemble_solution(self.prob, U, self.model, stats)
+
+    def shift_guess(self, U, dW):
+        """Warm start for a wear change ``dW``: nodes in contact follow the gap (``X_N = 0``
+        means ``U_N,0 = gap + W``)."""
+        U1 = np.array(U, float).reshape(self.nc, self.d, self.H)
+        U1[:, 0, 0] += dW
+        return U1.reshape(self.m, self.H)
+
+
+# --------------------------------------------------------------------------------------------
+# options, history, result
+# --------------------------------------------------------------------------------------------
+@dataclass
+class WearOptions:
+    """Settings of a wear simulation (:func:`simulate_wear`).
+
+    Attributes
+    ----------
+    law : ``"archard"`` (eq. 29, coefficient ``model.contact.wear_coefficient`` [1/Pa]) or
+        ``"energy"`` (Fouvry et al. 2003, ``energy_coefficient`` [m^3/J]).
+    energy_coefficient : ``k_e`` [m^3/J] of the energy law.
+    scheme : ``"implicit"`` (backward Euler coupled with the balance) or ``"explicit"``
+        (explicit Euler, eq. 30).
+    adaptive : adapt the jump to ``tolerance``; otherwise every jump is ``initial_jump``.
+    tolerance : local error allowed per step, relative to the current maximum wear depth.
+    initial_jump : first jump [cycles]; None: ``2 tolerance / rho`` with ``rho`` the spectral
+        radius of the slow Jacobian at the start (adaptive), or ``1 / rho`` (fixed jumps: half
+        the explicit stability limit).
+    max_jump : cap on the jump [cycles] (the paper's 1e8 / 1e7).
+    min_jump : smallest jump tried when retrying failed solves [cycles].
+    max_cycles : stop at this cycle count.
+    max_depth : stop when a wear depth reaches this [m].
+    plateau_rate : stop when the worn-volume rate falls below this fraction of its initial
+        value (the plateau of paper Fig. 25).
+    max_steps : stop after this many slow steps.
+    solver, tol, max_iter : nonlinear solver (:func:`fretwear.solvers.solve`), its relative
+        residual tolerance ``eps_r`` and iteration cap.
+    max_retries : jump reductions (by 4) tried after a failed solve before stopping.
+    checkpoint_every_s : write the checkpoint at most this often [s] (0: every step).
+    """
+
+    law: str = "archard"
+    energy_coefficient: float | None = None
+    scheme: str = "implicit"
+    adaptive: bool = True
+    tolerance: float = 1e-2
+    initial_jump: float | None = None
+    max_jump: float = math.inf
+    min_jump: float = 1.0
+    max_cycles: float = 1e15
+    max_depth: float = math.inf
+    plateau_rate: float = 1e-3
+    max_steps: int = 100_000
+    solver: str = "powell"
+    tol: float = 1e-9
+    max_iter: int = 60
+    max_retries: int = 6
+    checkpoint_every_s: float = 10.0
+
+    def check(self) -> WearOptions:
+        """Validate; raise InputError naming the bad value."""
+        if self.law not in LAWS:
+            raise InputError(f"law = {self.law!r}: expected one of {LAWS}")
+        if self.scheme not in SCHEMES:
+            raise InputError(f"scheme = {self.scheme!r}: expected one of {SCHEMES}")
+        if self.solver not in SOLVERS:
+            raise InputError(f"solver = {self.solver!r}: expected one of {SOLVERS}")
+        for name in ("tolerance", "max_jump", "min_jump", "max_cycles", "max_depth", "tol"):
+            v = getattr(self, name)
+            if not (isinstance(v, int | float) and v > 0):
+                raise InputError(f"{name} = {v!r}: expected a positive number")
+        if self.initial_jump is not None and not self.initial_jump > 0:
+            raise InputError(f"initial_jump = {self.initial_jump!r}: expected > 0 cycles")
+        if not self.plateau_rate >= 0:
+            raise InputError(f"plateau_rate = {self.plateau_rate!r}: expected >= 0")
+        return self
+
+    def trajectory_key(self) -> dict:
+        """The options that change the computed trajectory (for checkpoint matching)."""
+        d = asdict(self)
+        d.pop("checkpoint_every_s")
+        return d
+
+
+#: per-step arrays of :class:`WearHistory`: name -> (units, long name)
+HISTORY_FIELDS = {
+    "cycles": ("1", "physical cycle count N"),
+    "jump": ("1", "cycles jumped by the step (0 for the initial state)"),
+    "wear_depth": ("m", "wear depth W"),
+    "wear_rate": ("m", "wear depth per cycle dW1 (eq. 29)"),
+    "pressure_mean": ("Pa", "normal contact pressure, mean over the period"),
+    "pressure_max": ("Pa", "normal contact pressure, maximum over the period"),
+    "slip_amplitude": ("m", "tangential displacement amplitude (half range over the period)"),
+    "slip_path": ("m", "slip path per cycle, sum of |X_T(n) - X_T(n-1)| over slip instants"),
+    "state_fraction": ("1", "fraction of the period in separation, stick, slip"),
+    "friction_energy": ("J", "energy dissipated by friction per cycle"),
+    "worn_volume": ("m^3", "worn volume sum area W"),
+    "volume_rate": ("m^3", "worn volume per cycle"),
+    "newton_iterations": ("1", "nonlinear solver iterations of the step, retries included"),
+    "rejected": ("1", "attempts of the step rejected (error test or failed solve)"),
+    "error_estimate": ("1", "local error estimate relative to the maximum wear depth"),
+    "wall_time": ("s", "wall time of the step"),
+    "U": ("m", "Fourier coefficients of the contact displacements"),
+    "lam": ("N", "Fourier coefficients of the contact forces"),
+    "anchor": ("m", "stick anchors used by the periodic solve"),
+}
+
+
+@dataclass
+class WearHistory:
+    """The wear history, one row per slow step (step 0 is the unworn start).
+
+    Arrays (s = steps, nc = contact nodes, d = components, H = Fourier coefficients): see
+    :data:`HISTORY_FIELDS` for units; ``wear_depth``, ``wear_rate``, ``pressure_*``,
+    ``slip_*``, ``friction_energy`` are (s, nc); ``state_fraction`` (s, nc, 3);
+    ``U``, ``lam`` (s, nc, d, H); ``anchor`` (s, nc, d-1); the others (s,).
+    ``stop_reason`` says why the run ended (one of :data:`STOP_REASONS`, or "" while running).
+    """
+
+    cycles: np.ndarray
+    jump: np.ndarray
+    wear_depth: np.ndarray
+    wear_rate: np.ndarray
+    pressure_mean: np.ndarray
+    pressure_max: np.ndarray
+    slip_amplitude: np.ndarray
+    slip_path: np.ndarray
+    state_fraction: np.ndarray
+    friction_energy: np.ndarray
+    worn_volume: np.ndarray
+    volume_rate: np.ndarray
+    newton_iterations: np.ndarray
+    rejected: np.ndarray
+    error_estimate: np.ndarray
+    wall_time: np.ndarray
+    U: np.ndarray
+    lam: np.ndarray
+    anchor: np.ndarray
+    stop_reason: str = ""
+
+    @classmethod
+    def from_rows(cls, rows: list[dict], stop_reason: str = "") -> WearHistory:
+        return cls(**{k: np.array([r[k] for r in rows]) for k in HISTORY_FIELDS},
+                   stop_reason=stop_reason)
+
+    def rows(self) -> list[dict]:
+        return [{k: getattr(self, k)[i] for k in HISTORY_FIELDS} for i in range(self.n_steps)]
+
+    @property
+    def n_steps(self) -> int:
+        return int(self.cycles.shape[0])
+
+
+@dataclass
+class WearResult:
+    """Outcome of :func:`simulate_wear`.
+
+    history : :class:`WearHistory`; initial, final : periodic solutions at the first and last
+    recorded steps; stop_reason : why it stopped; message : one line for the user;
+    converged : False when it stopped on a failed solve (every recorded step converged);
+    wall_time : [s]; stability_jump : explicit Euler's stability limit ``2/rho`` estimated
+    from the slow Jacobian at the start [cycles] (nan if not computed).
+    """
+
+    history: WearHistory
+    initial: PeriodicSolution
+    final: PeriodicSolution
+    stop_reason: str
+    message: str
+    converged: bool
+    wall_time: float
+    stability_jump: float = math.nan
+    resumed_from: int = -1
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def final_wear(self) -> np.ndarray:
+        return self.history.wear_depth[-1]
+
+
+def _row(sol: PeriodicSolution, W, g, cycles, jump, iters, rejected, err, wall) -> dict:
+    """One history row from a converged periodic solution."""
+    p = sol.pressure_t()
+    xt = sol.x_t[:, 1:, :]
+    half = 0.5 * (xt.max(axis=2) - xt.min(axis=2))
+    area = sol.area
+    return {
+        "cycles": float(cycles), "jump": float(jump), "wear_depth": np.array(W, float),
+        "wear_rate": np.array(g, float), "pressure_mean": p.mean(axis=1),
+        "pressure_max": p.max(axis=1), "slip_amplitude": np.sqrt((half**2).sum(axis=1)),
+        "slip_path": sol.slip_t().sum(axis=1), "state_fraction": sol.state_fractions(),
+        "friction_energy": sol.friction_energy(), "worn_volume": worn_volume(W, area),
+        "volume_rate": float(np.dot(area, g)), "newton_iterations": int(iters),
+        "rejected": int(rejected), "error_estimate": float(err), "wall_time": float(wall),
+        "U": sol.U.copy(), "lam": sol.lam.copy(), "anchor": np.array(sol.anchor, float),
+    }
+
+
+# --------------------------------------------------------------------------------------------
+# checkpoints
+# --------------------------------------------------------------------------------------------
+def fingerprint(model: Model, reduced: Reduced, basis: FourierBasis, eps: float, coef,
+                options: WearOptions, W0, anchor0) -> str:
+    """SHA-256 of everything that determines the trajectory (model data after condensation,
+    basis, penalty, wear factors, options, initial state)."""
+    h = hashlib.sha256()
+    for a in (reduced.Z, reduced.F, np.asarray(model.contact.gap, float),
+              np.asarray(model.contact.area, float), np.asarray(coef, float),
+              np.asarray(W0, float), np.asarray(anchor0, float)):
+        h.update(np.ascontiguousarray(a).tobytes())
+    meta = {"basis": [list(basis.harmonics), basis.n_samples], "eps": float(eps),
+            "mu": float(model.contact.mu), "omega": float(reduced.omega),
+            "quasi_static": bool(reduced.quasi_static), "options": options.trajectory_key()}
+    h.update(json.dumps(meta, sort_keys=True, default=str).encode())
+    return h.hexdigest()
+
+
+def save_checkpoint(path: Path | str, state: dict, rows: list[dict], key: str) -> Path:
+    """Write the state and the history so far to ``path`` (``.npz``) atomically."""
+    arrays = {f"state_{k}": np.asarray(v) for k, v in state.items()}
+    hist = WearHistory.from_rows(rows)
+    arrays.update({f"hist_{k}": getattr(hist, k) for k in HISTORY_FIELDS})
+    arrays["fingerprint"] = np.asarray(key)
+    arrays["version"] = np.asarray(CHECKPOINT_VERSION)
+
+    def write(tmp: Path):
+        with open(tmp, "wb") as fh:
+            np.savez(fh, **arrays)
+
+    return atomic_write(path, write)
+
+
+def load_checkpoint(path: Path | str, key: str) -> tuple[dict, list[dict]]:
+    """Read a checkpoint written by :func:`save_checkpoint` for the same trajectory ``key``.
+
+    Raises
+    ------
+    InputError
+        The file is unreadable, of another version, or written for a different case.
+    """
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            data = {k: z[k] for k in z.files}
+    except (OSError, ValueError) as exc:
+        raise InputError(f"cannot read the wear checkpoint {str(path)!r}: {exc}") from None
+    if int(data.get("version", -1)) != CHECKPOINT_VERSION:
+        raise InputError(f"wear checkpoint {str(path)!r} has another format version; delete it "
+                         "to start again")
+    if str(data["fingerprint"]) != key:
+        raise InputError(f"wear checkpoint {str(path)!r} was written for a different model or "
+                         "different wear settings; delete it (or run without --resume) to start "
+                         "again")
+    state = {k[6:]: data[k] for k in data if k.startswith("state_")}
+    hist = WearHistory(**{k: data[f"hist_{k}"] for k in HISTORY_FIELDS})
+    return state, hist.rows()
+
+
+# --------------------------------------------------------------------------------------------
+# the slow-scale driver
+# --------------------------------------------------------------------------------------------
+def _error(dN, g1, g0, W1) -> float:
+    """Local error estimate ``0.5 dN max|g1 - g0|`` relative to ``max W1`` (BE/FE vs the
+    trapezoidal rule)."""
+    scale = float(np.max(np.abs(W1))) if np.size(W1) else 0.0
+    num = 0.5 * dN * float(np.max(np.abs(np.asarray(g1) - np.asarray(g0))))
+    if num == 0.0:
+        return 0.0
+    return num / scale if scale > 0 else math.inf
+
+
+def _progress_fraction(cycles, vrate, vrate0, wmax, opts: WearOptions) -> float:
+    """How far the run is towards its nearest stop criterion, in [0, 1]."""
+    fr = [math.log1p(cycles) / math.log1p(opts.max_cycles)]
+    if vrate0 > 0 and opts.plateau_rate > 0 and vrate > 0:
+        fr.append(math.log(vrate / vrate0) / math.log(opts.plateau_rate))
+    if math.isfinite(opts.max_depth):
+        fr.append(wmax / opts.max_depth)
+    return min(1.0, max(0.0, max(fr)))
+
+
+def _stop_reason(st: dict, opts: WearOptions) -> str:
+    if float(st["vrate0"]) <= 0.0:
+        return "no_wear"
+    if float(st["cycles"]) >= opts.max_cycles * (1 - 1e-12):
+        return "max_cycles"
+    if float(np.max(st["W"])) >= opts.max_depth:
+        return "max_depth"
+    if float(st["vrate"]) <= opts.plateau_rate * float(st["vrate0"]):
+        return "plateau"
+    if int(st["step"]) >= opts.max_steps:
+        return "max_steps"
+    return ""
+
+
+def _message(reason: str, st: dict, opts: WearOptions, extra: str = "") -> str:
+    n = float(st["cycles"])
+    txt = {
+        "max_cycles": f"reached max_cycles = {opts.max_cycles:.4g}",
+        "max_depth": f"a wear depth reached max_depth = {opts.max_depth:.4g} m",
+        "plateau": (f"plateau: worn-volume rate {float(st['vrate']):.3g} m^3/cycle <= "
+                    f"{opts.plateau_rate:g} x initial {float(st['vrate0']):.3g}"),
+        "no_wear": "no wear: no contact node slips (worn-volume rate 0)",
+        "max_steps": f"reached max_steps = {opts.max_steps}",
+        "solver_failed": "stopped: a periodic solve failed even with smaller jumps",
+    }[reason]
+    return f"{txt} after {int(st['step'])} steps, N = {n:.4g} cycles{extra}"
+
+
+def simulate_wear(model: Model, basis: FourierBasis, *, omega: float = 2 * np.pi,
+                  quasi_static: bool = False, options: WearOptions | None = None,
+                  reduced: Reduced | None = None, eps: float | None = None, anchor=None,
+                  W0=None, U0=None, checkpoint: Path | str | None = None, resume: bool = False,
+                  progress: bool = False, callback: Callable | None = None) -> WearResult:
+    """Integrate fretting wear over the slow time scale (paper Fig. 3, eq. 29-30).
+
+    Parameters
+    ----------
+    model : the structure (``contact.wear_coefficient`` k_w [1/Pa] for Archard's law).
+    basis : Fourier basis of the periodic solutions.
+    omega : excitation circular frequency [rad/s] (only scales time when ``quasi_static``).
+    quasi_static : drop inertia and damping.
+    options : :class:`WearOptions` (defaults: adaptive implicit, tolerance 1e-2).
+    reduced : precomputed condensation on ``[0] + basis.harmonics``.
+    eps : DLFT penalty [N/m] (default: spectral radius of ``Z_r``).
+    anchor : (nc, d-1) stick anchors of the first solve [m] (default: static preload state).
+    W0 : (nc,) initial wear [m] (default 0).
+    U0 : (nc, d, H) or (m, H) start of the first periodic solve.
+    checkpoint : ``.npz`` file for the state (written atomically as the run goes).
+    resume : continue from ``checkpoint`` when it exists (same model and options).
+    progress : show a tqdm bar (cycles, worn volume, rate, time left).
+    callback : ``callback(step, history_row)`` after each accepted step (and after the
+        checkpoint is written); raising ``KeyboardInterrupt`` there stops the run as Ctrl-C.
+
+    Returns
+    -------
+    :class:`WearResult`.
+
+    Raises
+    ------
+    ConvergenceError
+        The first periodic solve (unworn interface) did not converge: nothing to integrate.
+    KeyboardInterrupt
+        On Ctrl-C (the last accepted state is in the checkpoint first).
+    """
+    opts = (options or WearOptions()).check()
+    t_start = time.perf_counter()
+    nc, d = model.contact.dofs.shape
+    if reduced is None:
+        reduced = condense(model, omega, basis.orders, quasi_static=quasi_static)
+    coef = wear_coefficients(model, opts.law, opts.energy_coefficient)
+    W0 = np.zeros(nc) if W0 is None else np.broadcast_to(np.asarray(W0, float), (nc,)).copy()
+    if anchor is None:
+        anchor = static_anchor(model)
+    anchor = np.array(anchor, float).reshape(nc, d - 1)
+    sp = SlowProblem(model, reduced, basis, coef, eps=eps, anchor=anchor)
+    key = fingerprint(model, reduced, basis, sp.eps, coef, opts, W0, anchor)
+    ckpt = Path(checkpoint) if checkpoint is not None else None
+
+    state, rows, resumed_from = None, [], -1
+    if resume and ckpt is not None and ckpt.is_file():
+        state, rows = load_checkpoint(ckpt, key)
+        resumed_from = int(state["step"])
+    if state is None:
+        state, rows = _start(sp, W0, anchor, U0, opts)
+    initial = _assemble(sp, rows[0])
+
+    bar = _Bar(progress, opts)
+    last_ckpt = -math.inf
+    reason = _stop_reason(state, opts)
+    extra = ""
+    try:
+        bar.show(state)
+        while not reason:
+            new_state, row, failure = _advance(sp, state, opts)
+            if failure:
+                reason, extra = "solver_failed", f": {failure}"
+                break
+            state = new_state
+            rows.append(row)
+            bar.show(state)
+            if ckpt is not None and (time.perf_counter() - last_ckpt >= opts.checkpoint_every_s):
+                save_checkpoint(ckpt, state, rows, key)
+                last_ckpt = time.perf_counter()
+            if callback is not None:
+                callback(int(state["step"]), row)
+            reason = _stop_reason(state, opts)
+    except KeyboardInterrupt:
+        if ckpt is not None:
+            save_checkpoint(ckpt, state, rows, key)
+        bar.close()
+        raise
+    bar.close()
+    state["stop_reason"] = np.asarray(reason)
+    if ckpt is not None:
+        save_checkpoint(ckpt, state, rows, key)
+    hist = WearHistory.from_rows(rows, reason)
+    final = _assemble(sp, rows[-1])
+    return WearResult(hist, initial, final, reason, _message(reason, state, opts, extra),
+                      reason != "solver_failed", time.perf_counter() - t_start,
+                      float(state["stability_jump"]), resumed_from)
+
+
+def _assemble(sp: SlowProblem, row: dict) -> PeriodicSolution:
+    """The periodic solution of a recorded step (no solve: ``U`` is converged)."""
+    U = np.asarray(row["U"], float).reshape(sp.m, sp.H)
+    stats = SolveStats(True, 0.0, int(row["newton_iterations"]), 0, 0, float(row["wall_time"]),
+                       "recorded", "")
+    return sp.solution(U, row["wear_depth"], row["anchor"], stats)
+
+
+def _start(sp: SlowProblem, W0, anchor, U0, opts: WearOptions) -> tuple[dict, list[dict]]:
+    """The balanced initial state (step 0)."""
+    t0 = time.perf_counter()
+    sp.set_state(W0, anchor)
+    guess = sp.prob.initial_guess() if U0 is None else np.asarray(U0, float).reshape(sp.m, sp.H)
+    U, st = sp.solve_balance(W0, anchor, guess, solver=opts.solver, tol=opts.tol,
+                             max_iter=max(opts.max_iter, 200))
+    if not st.converged:
+        raise ConvergenceError(
+            f"the periodic solve of the unworn interface did not converge ({st.message}, "
+            f"relative residual {st.residual:.3g} > {opts.tol:g}): no wear computed"
+        )
+    g = sp.rate(U)
+    rho = 0.0
+    if np.any(g > 0):
+        ev = np.linalg.eigvals(sp.slow_jacobian(U))
+        rho = float(np.max(np.abs(ev)))
+    stab = 2.0 / rho if rho > 0 else math.inf
+    if opts.initial_jump is not None:
+        jump = float(opts.initial_jump)
+    elif opts.adaptive:
+        jump = opts.tolerance * stab if math.isfinite(stab) else 1.0
+    else:
+        jump = 0.5 * stab if math.isfinite(stab) else 1.0
+    sol = sp.solution(U, W0, anchor, st)
+    row = _row(sol, W0, g, 0.0, 0.0, st.iterations, 0, 0.0, time.perf_counter() - t0)
+    state = {
+        "step": 0, "cycles": 0.0, "W": np.array(W0, float), "U": U.copy(),
+        "anchor": np.array(anchor, float), "g": g, "jump": float(jump),
+        "vrate": row["volume_rate"], "vrate0": row["volume_rate"],
+        "stability_jump": float(stab), "stop_reason": np.asarray(""),
+    }
+    return state, [row]
+
+
+def _advance(sp: SlowProblem, st: dict, opts: WearOptions):
+    """One accepted slow step from state ``st``: ``(new_state, row, failure_message)``.
+
+    Retries a failed solve with the jump divided by 4 (up to ``max_retries`` times, not below
+    ``min_jump``); with ``adaptive``, rejects a step whose error estimate exceeds the
+    tolerance and retries with the jump the controller proposes.
+    """
+    t0 = time.perf_counter()
+    W_k, U_k, g_k = st["W"], st["U"], st["g"]
+    anchor = U_k.reshape(sp.nc, sp.d, sp.H)[:, 1:, 0].copy()  # history rule: previous mean
+    dN = min(float(st["jump"]), opts.max_jump, opts.max_cycles - float(st["cycles"]))
+    iters = rejected = failures = 0
+    while True:
+        if opts.scheme == "explicit":
+            W1 = W_k + dN * g_k
+            U1, stats = sp.solve_balance(W1, anchor, sp.shift_guess(U_k, W1 - W_k),
+                                         solver=opts.solver, tol=opts.tol,
+                                         max_iter=opts.max_iter)
+        else:
+            Wp = W_k + dN * g_k  # explicit predictor
+            U1, W1, stats = sp.solve_implicit(W_k, dN, anchor, sp.shift_guess(U_k, Wp - W_k),
+                                              Wp, solver=opts.solver, tol=opts.tol,
+                                              max_iter=opts.max_iter)
+        iters += stats.iterations
+        if not stats.converged:
+            failures += 1
+            rejected += 1
+            if failures > opts.max_retries or dN <= opts.min_jump:
+                return None, None, (f"{stats.message} at N = {float(st['cycles']):.4g} with a "
+                                    f"jump of {dN:.3g} cycles after {failures} attempts")
+            dN = max(dN / 4.0, opts.min_jump)
+            continue
+        sp.set_state(W1, anchor)
+        g1 = sp.rate(U1)
+        err = _error(dN, g1, g_k, W1)
+        if opts.adaptive and err > opts.tolerance and dN > opts.min_jump:
+            rejected += 1
+            dN = max(dN * max(0.1, 0.9 * math.sqrt(opts.tolerance / err)), opts.min_jump)
+            continue
+        break
+    if opts.adaptive:
+        grow = 5.0 if err == 0.0 else min(5.0, max(0.2, 0.9 * math.sqrt(opts.tolerance / err)))
+        jump = dN * grow
+    else:
+        jump = float(st["jump"])
+    sol = sp.solution(U1, W1, anchor, stats)
+    cycles = float(st["cycles"]) + dN
+    row = _row(sol, W1, g1, cycles, dN, iters, rejected, err, time.perf_counter() - t0)
+    new = dict(st)
+    new.update({"step": int(st["step"]) + 1, "cycles": cycles, "W": np.array(W1, float),
+                "U": U1.copy(), "anchor": anchor, "g": g1, "jump": float(jump),
+                "vrate": row["volume_rate"]})
+    return new, row, ""
+
+
+class _Bar:
+    """tqdm progress towards the nearest stop criterion, with cycles, worn volume and rate."""
+
+    def __init__(self, enabled: bool, opts: WearOptions):
+        self.opts = opts
+        self.bar = None
+        if enabled:
+            from tqdm import tqdm
+
+            self.bar = tqdm(total=1000, desc="wear", unit="", leave=False,
+                            bar_format="{desc}: {percentage:3.0f}%|{bar}| {postfix} "
+                            "[{elapsed}<{remaining}]")
+
+    def show(self, st: dict):
+        if self.bar is None:
+            return
+        frac = _progress_fraction(float(st["cycles"]), float(st["vrate"]), float(st["vrate0"]),
+                                  float(np.max(st["W"])), self.opts)
+        self.bar.n = max(self.bar.n, int(1000 * frac))
+        self.bar.set_postfix_str(f"N={float(st['cycles']):.3g} V={float(st['vrate']):.3g}"
+                                 f"/cycle step={int(st['step'])}", refresh=False)
+        self.bar.refresh()
+
+    def close(self):
+        if self.bar is not None:
+            self.bar.close()
+
+
+# --------------------------------------------------------------------------------------------
+# FRF of a worn interface (paper Fig. 24)
+# --------------------------------------------------------------------------------------------
+def frf_worn(model: Model, wear, frequencies_hz, basis: FourierBasis, *, anchor=None,
+             point: str | None = None, solver: str = "powell", spacing: str = "linear",
+             **kwargs):
+    """Nonlinear FRF with the worn gap ``gap + wear`` (paper Fig. 24).
+
+    Parameters
+    ----------
+    model : the structure; wear : (nc,) wear depths [m] (e.g. ``result.final_wear``, or 0).
+    frequencies_hz : ``(f_min, f_max, n_points)`` [Hz].
+    basis : Fourier basis.
+    anchor : stick anchors of the first point (default: static preload).
+    point : unused here (kept for the documented signature); read amplitudes with
+        ``SweepResult.amplitude(point, axis)``.
+    solver, spacing, **kwargs : passed to :func:`fretwear.sweep.sweep`.
+
+    Returns
+    -------
+    :class:`fretwear.sweep.SweepResult`.
+    """
+    from fretwear.sweep import sweep
+
+    f_min, f_max, n_points = frequencies_hz
+    gap = np.broadcast_to(np.asarray(model.contact.gap, float), (model.contact.n_nodes,))
+    gap = gap + np.asarray(wear, float)
+    return sweep(model, basis, float(f_min), float(f_max), int(n_points), spacing=spacing,
+                 gap=gap, anchor=anchor, solver=solver, **kwargs)
+
+
+__all__ = [
+    "HISTORY_FIELDS", "LAWS", "SCHEMES", "STOP_REASONS", "SlowProblem", "WearHistory",
+    "WearOptions", "WearResult", "frf_worn", "load_checkpoint", "save_checkpoint",
+    "simulate_wear", "wear_coefficients", "wear_per_cycle", "worn_volume",
+]
