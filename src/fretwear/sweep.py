@@ -206,7 +206,8 @@ def _arclength(probs, model, anchor, y_prev, y_last, omega_target, solver_tol, m
 def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_points: int, *,
           spacing: str = "log", gap=None, eps=None, anchor=None, solver: str = "powell",
           tol: float = 1e-8, max_iter: int = 40, continuation: bool = True,
-          max_bisections: int = 4, check=None, progress=None) -> SweepResult:
+          max_bisections: int = 4, check=None, diagnose=None,
+          progress=None) -> SweepResult:
     """Nonlinear FRF: periodic solutions from ``f_min`` to ``f_max`` [Hz].
 
     Parameters
@@ -214,7 +215,15 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
     model, basis : the structure and the Fourier basis.
     n_points, spacing : the frequency grid (``"log"`` or ``"linear"``).
     gap : (nc,) gap + wear [m] (a worn interface); default the model's initial gap.
-    eps : DLFT penalty [N/m] (default: spectral radius of ``Z_r`` at each frequency).
+    eps : DLFT penalty [N/m]. Default (``None`` or ``"static"``): the spectral radius of the
+        static reduced stiffness ``Z_r(0) = K_r``, the same at every frequency.
+        ``"per-frequency"``: the spectral radius of ``Z_r`` over the kept harmonics at each
+        frequency (the paper's rule applied point by point). Why the default differs: the
+        harmonics of ``Z_r(n w)`` have poles at the clamped-interface resonances, so its
+        spectral radius jumps by orders of magnitude between neighbouring frequencies (x30
+        between 21.1 and 21.4 kHz on the paper's beam); with 7 harmonics the solution depends
+        measurably on eps, so a per-frequency eps makes the FRF jagged and the continuation
+        lose its way (docs/theory.md, "The penalty eps").
     anchor : stick anchors of the first point (default: static preload state).
     solver, tol, max_iter : nonlinear solver settings (:func:`fretwear.solvers.solve`).
     continuation : use pseudo-arclength continuation when a grid step fails.
@@ -222,14 +231,22 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
         points are kept in the result, ``how = "substep"``).
     check : optional callable ``(PeriodicSolution) -> list[str]`` returning flags (e.g. the
         time-domain stability check of :mod:`fretwear.stability`).
+    diagnose : optional callable ``(omega, neighbour PeriodicSolution | None) -> str`` called
+        at a point that did not converge, whose answer is added to the point's flags (e.g.
+        :func:`fretwear.stability.diagnose_frequency`: what the time integration does there).
     progress : optional callable ``(i, n, point)`` called after each grid point.
     """
     t_start = time.perf_counter()
     grid = frequency_grid(f_min, f_max, n_points, spacing)
+    if eps is None or eps == "static":
+        eps = condense(model, 0.0, [0], quasi_static=True).spectral_radius()
+    elif eps == "per-frequency":
+        eps = None
     probs = _Problems(model, basis, gap, eps)
     if anchor is None:
         anchor = static_anchor(model)
     history: list = []  # converged (omega, U (m, H)) in order
+    last_solution: list = [None]
     points: list = []
     other = {"powell": "newton", "newton": "powell", "hybr": "powell"}[solver]
 
@@ -239,6 +256,7 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
         if check is not None:
             pt.flags.extend(check(sol))
         history.append((omega, U))
+        last_solution[0] = sol
         return pt
 
     def predict(omega):
@@ -263,30 +281,30 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
                                 max_iter)
         how = "grid"
         if not st.converged and history:
-            # adaptive step: halve the frequency step from the last converged point
-            w_lo = history[-1][0]
-            for level in range(1, max_bisections + 1):
-                w_try = w_lo + (omega - w_lo) / 2**level
+            # adaptive step from the last converged point: halve on failure, grow on success
+            w_cur = history[-1][0]
+            step = 0.5 * (omega - w_cur)
+            min_step = (omega - w_cur) / 2**max_bisections
+            budget = 6 * max_bisections
+            while budget > 0 and abs(step) >= abs(min_step) * (1 - 1e-12):
+                budget -= 1
+                w_try = w_cur + step
+                last = abs(omega - w_try) <= 1e-9 * abs(omega)
+                if last:
+                    w_try = omega
                 pb, Ub, stb = _solve_at(probs, w_try, current_anchor(), predict(w_try), solver,
                                         tol, max_iter)
                 if not stb.converged:
+                    step *= 0.5
                     continue
+                if last:
+                    prob, U, st, how = pb, Ub, stb, "substep"
+                    break
                 points.append(record(w_try, pb, Ub, stb, "substep"))
-                # march on to the grid frequency with the step that worked
-                w_step = w_try - w_lo
-                ok = True
-                while history[-1][0] + 1.5 * w_step < omega and ok:
-                    w_next = history[-1][0] + w_step
-                    pb, Ub, stb = _solve_at(probs, w_next, current_anchor(), predict(w_next),
-                                            solver, tol, max_iter)
-                    ok = stb.converged
-                    if ok:
-                        points.append(record(w_next, pb, Ub, stb, "substep"))
-                if ok:
-                    prob, U, st = _solve_at(probs, omega, current_anchor(), predict(omega),
-                                            solver, tol, max_iter)
-                    how = "substep"
-                break
+                w_cur = w_try
+                step = step * 1.5
+                if abs(step) > abs(omega - w_cur):
+                    step = omega - w_cur
         if not st.converged and history:
             prob, U, st = _solve_at(probs, omega, current_anchor(), history[-1][1], other, tol,
                                     max_iter)
@@ -307,6 +325,8 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
         else:
             pt = SweepPoint(f, None, st, how, [f"not converged: {st.message} "
                                                 f"(relative residual {st.residual:.2e})"])
+            if diagnose is not None:
+                pt.flags.append(diagnose(omega, last_solution[0]))
         points.append(pt)
         if progress is not None:
             progress(i, len(grid), pt)

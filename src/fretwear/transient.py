@@ -66,6 +66,8 @@ DEFAULT_STEPS = 128
 CUTOFF_STEPS = 8  # default cutoff: modes whose period spans at least this many steps
 DENSE_EIG_LIMIT = 3000  # interior DOFs up to which the fixed-interface modes are found densely
 CHUNK_STEPS = 2_000_000  # steps per kernel call (progress, interruption)
+HF_LIMIT = 1.0  # hf_damping: modes with omega_j h above this (< 2 pi steps per period) ...
+HF_GAMMA = 1.0  # ... are integrated with this Newmark gamma (spectral radius 1/3 at infinity)
 
 
 # --------------------------------------------------------------------------------------------
@@ -545,7 +547,7 @@ class _Integrator:
     """Holds the reduced step operator and the current state; runs whole periods."""
 
     def __init__(self, model: Model, omega: float, *, steps_per_period, modal_cutoff, n_modes,
-                 gamma, tol, wear, U0, V0, stick_anchor, hf_gamma=None, hf_limit=None):
+                 gamma, tol, wear, U0, V0, stick_anchor, hf_damping=False):
         self.model = model
         self.omega = _positive(omega, "omega")
         self.N = N = _count(steps_per_period, "steps_per_period", 4)
@@ -564,8 +566,8 @@ class _Integrator:
         r = red.basis.shape[1]
         # Newmark parameters, per mode in modal coordinates (high modes may get more damping)
         g = np.full(r, gamma)
-        if red.diag and hf_gamma is not None:
-            g[np.sqrt(np.maximum(red.K, 0.0)) * h > hf_limit] = hf_gamma
+        if red.diag and hf_damping:
+            g[np.sqrt(np.maximum(red.K, 0.0)) * h > HF_LIMIT] = HF_GAMMA
         b = 0.25 * (g + 0.5) ** 2
         self.g_modes = g
         w1, w0, wm = b, 0.5 - 2 * b + g, 0.5 + b - g
@@ -729,12 +731,12 @@ class _Integrator:
             k = min(chunk, n_periods - done)
             nfail, maxit, ff = run_dynamic(
                 self.q, self.dq, self.red.diag, self.a_v, self.b_v, self.ds, self.hc, self.U,
-                self.R, self.P, self.Qt, self.bq_m, self.bd_m, self.ftab, self.G, self.red.Tx, self.A, self.gap, self.xprev, self.xprev2,
-                float(self.model.contact.mu), self.d, self.status, self.tdir, k,
-                (self.periods_done) * N, self.tol, self.fscale, 60 + 4 * nc,
-                self.red.obs, keep_from, mon_start, mon_mean, mon_ptp, q_last, dq_last,
-                rec_from, self.h, self.ftil, self.m_v, self.k_v, self.c_v, self.m_m, self.k_m,
-                self.c_m, r_obs, r_vobs, r_x, r_lam, r_state, r_energy)
+                self.R, self.P, self.Qt, self.bq_m, self.bd_m, self.ftab, self.G, self.red.Tx,
+                self.A, self.gap, self.xprev, self.xprev2, float(self.model.contact.mu), self.d,
+                self.status, self.tdir, k, self.periods_done * N, self.tol, self.fscale,
+                60 + 4 * nc, self.red.obs, keep_from, mon_start, mon_mean, mon_ptp, q_last,
+                dq_last, rec_from, self.h, self.ftil, self.m_v, self.k_v, self.c_v, self.m_m,
+                self.k_m, self.c_m, r_obs, r_vobs, r_x, r_lam, r_state, r_energy)
             if nfail and self.first_fail_time is None:
                 self.first_fail_time = ff * self.h
             self.n_fail += nfail
@@ -766,7 +768,11 @@ class _Integrator:
                   "mechanical": e[:, 4].copy(), "numerical": e[:, 5].copy()}
         U, V = self.full_state()
         info = dict(self.red.info)
+        wmax = float(np.sqrt(max(np.max(np.diag(self.red.K) if self.red.K.ndim == 2
+                                        else self.red.K), 0.0)))
         info.update(h=self.h, gamma=self.gamma, setup_time=self.setup_time,
+                    steps_per_highest_period=(2 * np.pi / (wmax * self.h)) if wmax > 0 else np.inf,
+                    hf_damped_modes=int(np.sum(self.g_modes > self.gamma)),
                     failed_steps=self.n_fail, max_active_set_iterations=self.max_it,
                     first_failure_time=self.first_fail_time, periods_total=self.periods_done)
         if self.n_fail:
@@ -783,7 +789,8 @@ class _Integrator:
 
 def integrate(model: Model, omega: float, *, n_periods: int, steps_per_period: int = DEFAULT_STEPS,
               record="last", U0=None, V0=None, wear=None, stick_anchor=None, modal_cutoff=None,
-              n_modes=None, gamma: float = 0.5, keep_poincare: int = 10_000, tol: float = 1e-10,
+              n_modes=None, gamma: float = 0.5, hf_damping: bool = False,
+              keep_poincare: int = 10_000, tol: float = 1e-10,
               progress: bool = False) -> TransientResult:
     """Integrate the forced response in time with exact contact and friction.
 
@@ -810,6 +817,11 @@ def integrate(model: Model, omega: float, *, n_periods: int, steps_per_period: i
     gamma : Newmark gamma (``beta = (gamma + 1/2)^2 / 4``); 0.5 (default) is the trapezoidal
         rule (second order, energy conserving); larger values damp the highest frequencies
         (first order).
+    hf_damping : integrate the modes of the reduced model that the step does not resolve
+        (``omega_j h > 1``, fewer than 2 pi steps per period) with ``gamma = 1`` (spectral
+        radius 1/3 at infinity) instead of ``gamma``: removes their spurious ringing, at the
+        cost of numerical dissipation (``energy["numerical"]``) and of whatever physics they
+        carry (a friction-induced self-excited oscillation may need them: off by default).
     keep_poincare : once-per-period samples kept (the last ones).
     tol : relative tolerance of the contact solver status tests.
     progress : show a progress bar.
@@ -828,7 +840,8 @@ def integrate(model: Model, omega: float, *, n_periods: int, steps_per_period: i
     n_keep = min(_count(keep_poincare, "keep_poincare", 0), n_periods)
     integ = _Integrator(model, omega, steps_per_period=steps_per_period,
                         modal_cutoff=modal_cutoff, n_modes=n_modes, gamma=gamma, tol=tol,
-                        wear=wear, U0=U0, V0=V0, stick_anchor=stick_anchor)
+                        wear=wear, U0=U0, V0=V0, stick_anchor=stick_anchor,
+                        hf_damping=hf_damping)
     t0 = time.perf_counter()
     raw = integ.run(n_periods, n_rec, n_keep, progress=progress)
     wall = time.perf_counter() - t0
@@ -939,7 +952,7 @@ def steady_state(model: Model, omega: float, *, max_periods: int = 20_000, tol: 
                  steps_per_period: int = DEFAULT_STEPS, n_harmonics: int = 7,
                  check_every: int = 16, window: int = 512, min_periods: int = 128, U0=None,
                  V0=None, wear=None, stick_anchor=None, modal_cutoff=None, n_modes=None,
-                 gamma: float = 0.5, contact_tol: float = 1e-10,
+                 gamma: float = 0.5, hf_damping: bool = False, contact_tol: float = 1e-10,
                  progress: bool = False) -> SteadyStateResult:
     """Integrate until the response is periodic (or classified otherwise).
 
@@ -971,7 +984,8 @@ def steady_state(model: Model, omega: float, *, max_periods: int = 20_000, tol: 
     t_start = time.perf_counter()
     integ = _Integrator(model, omega, steps_per_period=steps_per_period,
                         modal_cutoff=modal_cutoff, n_modes=n_modes, gamma=gamma, tol=contact_tol,
-                        wear=wear, U0=U0, V0=V0, stick_anchor=stick_anchor)
+                        wear=wear, U0=U0, V0=V0, stick_anchor=stick_anchor,
+                        hf_damping=hf_damping)
     P = np.zeros((0, integ.red.obs.shape[0] + integ.m))
     Mn = P.copy()
     chunk = check_every

@@ -123,6 +123,8 @@ def solve_contact(A, b, xref, gap, xprev, mu, d, status, tdir, x, lam, tol, fsca
     e = np.zeros(3)
     de = np.zeros((3, 3))
     xi = np.zeros(3)
+    new_st = np.zeros(nc, dtype=np.int8)
+    new_dir = np.zeros((nc, d - 1))
     it = 0
     while it < maxit:
         it += 1
@@ -223,12 +225,10 @@ def solve_contact(A, b, xref, gap, xprev, mu, d, status, tdir, x, lam, tol, fsca
         resid = 0.0
         for i in range(nc):
             i0 = i * d
-            cn = A[i0, i0]
-            ct = A[i0 + 1, i0 + 1]
-            sn = lam[i0] + cn * (x[i0] - gap[i])
+            sn = lam[i0] + A[i0, i0] * (x[i0] - gap[i])
             nt = 0.0
             for c in range(1, d):
-                e[c - 1] = lam[i0 + c] + ct * (x[i0 + c] - xprev[i0 + c])
+                e[c - 1] = lam[i0 + c] + A[i0 + 1, i0 + 1] * (x[i0 + c] - xprev[i0 + c])
                 nt += e[c - 1] ** 2
             nt = np.sqrt(nt)
             st = status[i]
@@ -245,27 +245,42 @@ def solve_contact(A, b, xref, gap, xprev, mu, d, status, tdir, x, lam, tol, fsca
                 if nt > mu * sn + eps_f:
                     new = SLIP
                     viol = (nt - mu * sn) / eps_f
+            elif nt < mu * sn - eps_f:
+                new = STICK
+                viol = (mu * sn - nt) / eps_f
             else:
-                if nt < mu * sn - eps_f:
-                    new = STICK
-                    viol = (mu * sn - nt) / eps_f
-                else:
-                    dot = 0.0
+                dot = 0.0
+                for c in range(d - 1):
+                    dot += e[c] * tdir[i, c]
+                if d == 2 and dot < 0.0 and nt > eps_f:
+                    viol = nt / eps_f  # the slip reverses
+                elif d == 3:
+                    # residual of the cone equation with the current slip direction
+                    nxi = 0.0
+                    for c in range(1, d):
+                        nxi += (x[i0 + c] - xprev[i0 + c]) ** 2
+                    nxi = np.sqrt(nxi)
                     for c in range(d - 1):
-                        dot += e[c] * tdir[i, c]
-                    if d == 2 and dot < 0.0 and nt > eps_f:
-                        viol = nt / eps_f  # slip reverses
-                    elif d == 3:
-                        nxi = 0.0
+                        xi[c] = tdir[i, c]
+                    if nxi > eps_x:
                         for c in range(1, d):
-                            nxi += (x[i0 + c] - xprev[i0 + c]) ** 2
-                        nxi = np.sqrt(nxi)
-                        if nxi > eps_x:
-                            for c in range(1, d):
-                                r_ = abs(lam[i0 + c] - mu * lam[i0] * (x[i0 + c] - xprev[i0 + c])
-                                         / nxi)
-                                if r_ > resid:
-                                    resid = r_
+                            r_ = abs(lam[i0 + c] - mu * lam[i0] * (x[i0 + c] - xprev[i0 + c])
+                                     / nxi)
+                            if r_ > resid:
+                                resid = r_
+                        for c in range(1, d):
+                            xi[c - 1] = (x[i0 + c] - xprev[i0 + c]) / nxi
+            new_st[i] = new
+            if new == SLIP:
+                if viol > 0.0 and nt > 0.0:
+                    for c in range(d - 1):
+                        new_dir[i, c] = e[c] / nt
+                elif d == 3 and st == SLIP:
+                    for c in range(d - 1):
+                        new_dir[i, c] = xi[c]
+                else:
+                    for c in range(d - 1):
+                        new_dir[i, c] = tdir[i, c]
             if viol > 0.0:
                 n_change += 1
                 if viol > best:
@@ -273,45 +288,16 @@ def solve_contact(A, b, xref, gap, xprev, mu, d, status, tdir, x, lam, tol, fsca
                     best_node = i
         if n_change == 0 and resid <= eps_f:
             return it
-        one_only = it > maxit // 2
+        # apply the changes (only the largest one once many iterations have passed, which
+        # breaks cycles); with no change (3D), Newton goes on with the new slip directions
+        one_only = n_change > 0 and it > maxit // 2
         for i in range(nc):
-            i0 = i * d
-            if n_change == 0:
-                # 3D: statuses settled, Newton continues on the slip directions
-                if status[i] == SLIP:
-                    nxi = 0.0
-                    for c in range(1, d):
-                        nxi += (x[i0 + c] - xprev[i0 + c]) ** 2
-                    nxi = np.sqrt(nxi)
-                    if nxi > eps_x:
-                        for c in range(1, d):
-                            tdir[i, c - 1] = (x[i0 + c] - xprev[i0 + c]) / nxi
-                continue
             if one_only and i != best_node:
                 continue
-            cn = A[i0, i0]
-            ct = A[i0 + 1, i0 + 1]
-            sn = lam[i0] + cn * (x[i0] - gap[i])
-            nt = 0.0
-            for c in range(1, d):
-                e[c - 1] = lam[i0 + c] + ct * (x[i0 + c] - xprev[i0 + c])
-                nt += e[c - 1] ** 2
-            nt = np.sqrt(nt)
-            st = status[i]
-            if st == OPEN:
-                if sn > eps_f:
-                    status[i] = STICK if nt <= mu * sn else SLIP
-            elif sn < -eps_f:
-                status[i] = OPEN
-            elif st == STICK:
-                if nt > mu * sn + eps_f:
-                    status[i] = SLIP
-            else:
-                if nt < mu * sn - eps_f:
-                    status[i] = STICK
-            if status[i] == SLIP and nt > 0.0:
+            status[i] = new_st[i]
+            if new_st[i] == SLIP:
                 for c in range(d - 1):
-                    tdir[i, c] = e[c] / nt
+                    tdir[i, c] = new_dir[i, c]
     return -1
 
 

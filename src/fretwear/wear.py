@@ -62,7 +62,7 @@ from fretwear.solvers import SOLVERS, SolveStats, solve
 from fretwear.wear_kernels import slip_work, slip_work_gradient
 
 LAWS = ("archard", "energy")
-SCHEMES = ("implicit", "explicit")
+SCHEMES = ("implicit", "rosenbrock", "explicit")
 STOP_REASONS = ("max_cycles", "max_depth", "plateau", "no_wear", "max_steps", "solver_failed")
 CHECKPOINT_VERSION = 1
 
@@ -231,14 +231,16 @@ class SlowProblem:
         JJ[n + np.arange(nc), n + np.arange(nc)] = self.eps * (1.0 - dN * gW)
         return R, JJ
 
-    def slow_jacobian(self, U):
-        """Total ``dg/dW`` (nc, nc) [-] along the balanced solution at ``U``:
-        ``dg/dW + dg/dU~ dU~/dW`` with ``dU~/dW = -J^-1 df/dW``. Its eigenvalues set the
-        stability limit of explicit Euler, ``dN < 2 / rho``."""
+    def slow_jacobian(self, U, with_dUdW=False):
+        """Total ``dg/dW`` (nc, nc) [-] along the balanced solution at ``U`` (current gap):
+        ``dg/dW + dg/dU~ dU~/dW`` with ``dU~/dW = -J^-1 df/dW`` (implicit function theorem on
+        the DLFT balance). Its eigenvalues set the stability limit of explicit Euler,
+        ``dN < 2 / rho``. With ``with_dUdW`` also returns ``dU~/dW`` (n, nc)."""
         f, J = self.balance(U, True)
         g, gU, gW, (lu, lx, state) = self.rate_and_gradient(U)
         dUdW = -np.linalg.solve(J, self.dfdW(lu, lx, state))
-        return np.diag(gW) + gU @ dUdW
+        Js = np.diag(gW) + gU @ dUdW
+        return (Js, dUdW) if with_dUdW else Js
 
     # -- solves --------------------------------------------------------------------------
     def solve_balance(self, W, anchor, U0, *, solver, tol, max_iter):
@@ -328,6 +330,9 @@ class WearOptions:
     solver: str = "powell"
     tol: float = 1e-9
     max_iter: int = 60
+    max_iter_coupled: int = 20
+    max_iter_implicit: int = 8
+    implicit_newton: str = "nested"
     max_retries: int = 6
     checkpoint_every_s: float = 10.0
 
@@ -532,11 +537,17 @@ def load_checkpoint(path: Path | str, key: str) -> tuple[dict, list[dict]]:
 # --------------------------------------------------------------------------------------------
 # the slow-scale driver
 # --------------------------------------------------------------------------------------------
-def _error(dN, g1, g0, W1) -> float:
-    """Local error estimate ``0.5 dN max|g1 - g0|`` relative to ``max W1`` (BE/FE vs the
-    trapezoidal rule)."""
+def _error(dN, W1, W_k, g1, g0) -> float:
+    """Local error estimate: the defect of the step against the trapezoidal rule,
+    ``max |W1 - W_k - dN (g0 + g1) / 2|``, relative to ``max W1``.
+
+    For explicit and backward Euler it is ``0.5 dN max|g1 - g0|`` (the classical estimate of
+    their local error); for the linearly implicit step it also catches an increment that does
+    not match the rates at either end (a slow Jacobian made stale by a change of contact states).
+    """
     scale = float(np.max(np.abs(W1))) if np.size(W1) else 0.0
-    num = 0.5 * dN * float(np.max(np.abs(np.asarray(g1) - np.asarray(g0))))
+    defect = np.asarray(W1) - np.asarray(W_k) - 0.5 * dN * (np.asarray(g0) + np.asarray(g1))
+    num = float(np.max(np.abs(defect))) if np.size(defect) else 0.0
     if num == 0.0:
         return 0.0
     return num / scale if scale > 0 else math.inf
@@ -729,17 +740,13 @@ def _advance(sp: SlowProblem, st: dict, opts: WearOptions):
     anchor = U_k.reshape(sp.nc, sp.d, sp.H)[:, 1:, 0].copy()  # history rule: previous mean
     dN = min(float(st["jump"]), opts.max_jump, opts.max_cycles - float(st["cycles"]))
     iters = rejected = failures = 0
+    lin = None
+    if opts.scheme != "explicit":
+        sp.set_state(W_k, anchor)
+        lin = sp.slow_jacobian(U_k, with_dUdW=True)  # Js, dU/dW at the start of the step
+        iters += 1
     while True:
-        if opts.scheme == "explicit":
-            W1 = W_k + dN * g_k
-            U1, stats = sp.solve_balance(W1, anchor, sp.shift_guess(U_k, W1 - W_k),
-                                         solver=opts.solver, tol=opts.tol,
-                                         max_iter=opts.max_iter)
-        else:
-            Wp = W_k + dN * g_k  # explicit predictor
-            U1, W1, stats = sp.solve_implicit(W_k, dN, anchor, sp.shift_guess(U_k, Wp - W_k),
-                                              Wp, solver=opts.solver, tol=opts.tol,
-                                              max_iter=opts.max_iter)
+        W1, U1, stats = _attempt(sp, opts, W_k, U_k, g_k, anchor, dN, lin)
         iters += stats.iterations
         if not stats.converged:
             failures += 1
@@ -751,7 +758,7 @@ def _advance(sp: SlowProblem, st: dict, opts: WearOptions):
             continue
         sp.set_state(W1, anchor)
         g1 = sp.rate(U1)
-        err = _error(dN, g1, g_k, W1)
+        err = _error(dN, W1, W_k, g1, g_k)
         if opts.adaptive and err > opts.tolerance and dN > opts.min_jump:
             rejected += 1
             dN = max(dN * max(0.1, 0.9 * math.sqrt(opts.tolerance / err)), opts.min_jump)
@@ -770,6 +777,80 @@ def _advance(sp: SlowProblem, st: dict, opts: WearOptions):
                 "U": U1.copy(), "anchor": anchor, "g": g1, "jump": float(jump),
                 "vrate": row["volume_rate"]})
     return new, row, ""
+
+
+def _attempt(sp: SlowProblem, opts: WearOptions, W_k, U_k, g_k, anchor, dN, lin):
+    """One try of a slow step of ``dN`` cycles: ``(W1, U1, stats)``.
+
+    explicit (eq. 30): ``W1 = W_k + dN g_k``, then the balance at ``W1``;
+    rosenbrock: ``W1 = W_k + dN (I - dN Js)^-1 g_k``, then the balance at ``W1``;
+    implicit: backward Euler from the Rosenbrock predictor (:func:`_backward_euler`, or the
+    Newton method on the coupled unknowns ``(U~, W1)`` when ``implicit_newton = "coupled"``).
+    """
+    kw = {"solver": opts.solver, "tol": opts.tol, "max_iter": opts.max_iter}
+    if opts.scheme == "explicit":
+        W1 = W_k + dN * g_k
+        U1, stats = sp.solve_balance(W1, anchor, sp.shift_guess(U_k, W1 - W_k), **kw)
+        return W1, U1, stats
+    Js, dUdW = lin
+    dW = dN * np.linalg.solve(np.eye(sp.nc) - dN * Js, g_k)
+    dW = np.maximum(dW, 0.0)  # a node's wear never decreases (g >= 0)
+    Wp = W_k + dW
+    Up = U_k + (dUdW @ dW).reshape(sp.m, sp.H)
+    if opts.scheme == "rosenbrock":
+        U1, stats = sp.solve_balance(Wp, anchor, Up, **kw)
+        return Wp, U1, stats
+    if opts.implicit_newton == "coupled":
+        kw["max_iter"] = opts.max_iter_coupled
+        U1, W1, stats = sp.solve_implicit(W_k, dN, anchor, Up, Wp, **kw)
+        return W1, U1, stats
+    return _backward_euler(sp, opts, W_k, dN, anchor, Up, Wp, Js, dUdW)
+
+
+def _backward_euler(sp: SlowProblem, opts: WearOptions, W_k, dN, anchor, U, W, Js, dUdW):
+    """Backward Euler ``W1 = W_k + dN g(W1)`` by a simplified Newton method on ``W``.
+
+    Every iterate is a converged periodic balance at its ``W`` (the ordinary DLFT solve,
+    warm-started); the BE defect ``r = W - W_k - dN g`` is reduced with the frozen iteration
+    matrix ``I - dN Js`` (refreshed once if the contraction is poor), until
+    ``max|r| <= 0.1 tolerance max W`` (the algebraic error an order below the local error
+    allowed, as in stiff ODE codes). Returns ``(W1, U1, stats)``; ``stats.converged`` is False
+    when the balance or the iteration fails.
+    """
+    t0 = time.perf_counter()
+    kw = {"solver": opts.solver, "tol": opts.tol, "max_iter": opts.max_iter}
+    M = np.eye(sp.nc) - dN * Js
+    its = 0
+    prev = math.inf
+    refreshed = False
+    msg = "backward Euler iteration did not converge"
+    for _k in range(opts.max_iter_implicit):
+        U, st = sp.solve_balance(W, anchor, U, **kw)
+        its += st.iterations
+        if not st.converged:
+            msg = f"balance failed inside backward Euler: {st.message}"
+            break
+        g = sp.rate(U)
+        r = W - W_k - dN * g
+        rn = float(np.max(np.abs(r)))
+        if rn <= 0.1 * opts.tolerance * max(float(np.max(np.abs(W))), 1e-300):
+            stats = SolveStats(True, st.residual, its, 0, 0, time.perf_counter() - t0,
+                               "converged", st.solver)
+            return W, U, stats
+        if rn > 0.5 * prev and not refreshed:  # poor contraction: Jacobian at this iterate
+            Js, dUdW = sp.slow_jacobian(U, with_dUdW=True)
+            M = np.eye(sp.nc) - dN * Js
+            refreshed = True
+            its += 1
+        elif rn >= prev:
+            break
+        prev = rn
+        dW = -np.linalg.solve(M, r)
+        W_new = np.maximum(W + dW, W_k)  # BE keeps W1 >= W_k since g >= 0
+        U = U + (dUdW @ (W_new - W)).reshape(sp.m, sp.H)
+        W = W_new
+    stats = SolveStats(False, math.inf, its, 0, 0, time.perf_counter() - t0, msg, opts.solver)
+    return W, U, stats
 
 
 class _Bar:

@@ -1,0 +1,185 @@
+"""Does the structure settle to a DLFT periodic solution? A time-domain check.
+
+A converged harmonic-balance solution is a periodic orbit of the truncated problem; it may be
+unstable, one member of a family of periodic states (the mean tangential position is not
+unique), or absent from what the structure does in time (a self-excited friction oscillation
+at an incommensurate frequency riding on the forced response). The analytic tools for the
+stability of non-smooth periodic orbits are not robust enough to trust blindly, so fretwear
+checks the way a careful analyst would: it starts the exact time integration of the same model
+(:mod:`fretwear.transient`, unilateral contact and Coulomb friction without regularisation)
+from the periodic solution, slightly perturbed, and lets it run until its response is
+classified (periodic, drifting, quasi-periodic, irregular). The verdict compares the settled
+response with the periodic solution.
+
+See docs/theory.md, "Checking a periodic solution in time".
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from fretwear.hbm import PeriodicSolution
+from fretwear.model.core import Model
+from fretwear.reduce import recover
+
+VERDICTS = ("stable", "settles elsewhere", "drifting", "quasi-periodic", "irregular",
+            "undecided")
+
+
+@dataclass
+class StabilityCheck:
+    """Verdict of :func:`check_periodic`.
+
+    verdict : one of :data:`VERDICTS`: ``"stable"`` (the time integration settles back to the
+        periodic solution), ``"settles elsewhere"`` (to another periodic state, e.g. another
+        member of a family in the mean position), ``"drifting"`` (ratchets: the period means
+        move steadily), ``"quasi-periodic"`` (a sustained oscillation at another frequency
+        rides on the forced response: no periodic steady state), ``"irregular"``, or
+        ``"undecided"`` (still converging after ``max_periods``).
+    distance : relative distance between the settled response of the observed points over one
+        period and the periodic solution (max over points/axes of ``max|u_td - u_hb| / ptp``).
+    periods : forcing periods integrated. wall_time : seconds. message : one line for users.
+    """
+
+    verdict: str
+    distance: float
+    periods: int
+    wall_time: float
+    message: str
+
+    def flags(self) -> list[str]:
+        return [] if self.verdict == "stable" else [f"{self.verdict}: {self.message}"]
+
+
+def initial_state(model: Model, sol: PeriodicSolution):
+    """Full-field displacement [m] and velocity [m/s] at ``t = 0`` of a periodic solution."""
+    b = sol.basis
+    m = sol.U.shape[0] * sol.U.shape[1]
+    Uc = b.to_complex(sol.U.reshape(m, -1))  # (k+1, m) complex amplitudes
+    orders = np.array([0, *b.harmonics])
+    Ufull = recover(model, sol.omega, orders, Uc, quasi_static=sol.quasi_static)
+    U0 = Ufull.real.sum(axis=0)
+    V0 = -(orders[:, None] * sol.omega * Ufull.imag).sum(axis=0)
+    return U0, V0
+
+
+def check_periodic(model: Model, sol: PeriodicSolution, *, max_periods: int = 3000,
+                   steps_per_period: int | None = None, perturbation: float = 1e-3,
+                   tolerance: float = 0.2, periodicity_tol: float = 1e-4,
+                   seed: int = 0) -> StabilityCheck:
+    """Integrate in time from the periodic solution and say whether the structure stays on it.
+
+    Parameters
+    ----------
+    model, sol : the model and a converged periodic solution of it (dynamic, not quasi-static).
+    max_periods : forcing periods allowed for the time integration to settle.
+    steps_per_period : time steps per period (default: ``8 x`` the highest kept harmonic, at
+        least 128).
+    perturbation : relative random perturbation of the initial velocity (a stable orbit
+        must attract a perturbed start).
+    tolerance : largest relative distance (see :class:`StabilityCheck`) accepted as "the same
+        periodic state". The harmonic balance truncates a non-smooth response, so the two
+        methods differ by the truncation error even for a stable orbit; 0.2 is well above the
+        truncation error measured on the paper's beam with 7 harmonics (docs/verification.md).
+    """
+    from fretwear.transient import steady_state
+
+    t0 = time.perf_counter()
+    if sol.quasi_static or sol.omega <= 0:
+        return StabilityCheck("stable", 0.0, 0, 0.0, "quasi-static: no dynamics to check")
+    U0, V0 = initial_state(model, sol)
+    rng = np.random.default_rng(seed)
+    vmax = np.abs(V0).max()
+    V0 = V0 + perturbation * vmax * rng.standard_normal(V0.shape)
+    nsteps = steps_per_period or max(128, 8 * max(sol.basis.harmonics))
+    res = steady_state(model, sol.omega, max_periods=max_periods, tol=periodicity_tol,
+                       steps_per_period=nsteps, n_harmonics=max(sol.basis.harmonics),
+                       U0=U0, V0=V0, wear=sol.gap - np.asarray(model.contact.gap, float))
+    kind = res.classification
+    # distance between the settled period and the periodic solution, on the observed points
+    dist = 0.0
+    tau = 2 * np.pi * np.arange(nsteps) / nsteps
+    from fretwear.fourier import FourierBasis
+
+    bt = FourierBasis.up_to(max(sol.basis.harmonics), nsteps)
+    for name, c_hb in sol.observed.items():
+        c_td = np.asarray(res.harmonics[name]).T  # (d, 2nh+1) [a0, a.., b..]
+        u_td = bt.to_time(c_td)
+        u_hb = sol.basis.to_time(c_hb)
+        if u_hb.shape[-1] != u_td.shape[-1]:
+            idx = np.round(tau / (2 * np.pi) * u_hb.shape[-1]).astype(int) % u_hb.shape[-1]
+            u_hb = u_hb[:, idx]
+        ptp = np.ptp(u_hb, axis=-1)
+        scale = np.maximum(ptp, 1e-12 * np.abs(u_hb).max() + 1e-300)
+        dist = max(dist, float(np.max(np.abs(u_td - u_hb).max(axis=-1) / scale)))
+    wall = time.perf_counter() - t0
+    n = res.n_periods
+    if kind in ("periodic", "subharmonic"):
+        if kind == "periodic" and dist <= tolerance:
+            return StabilityCheck("stable", dist, n, wall,
+                                  f"time integration settles back to it in {n} periods "
+                                  f"(distance {dist:.2g})")
+        return StabilityCheck("settles elsewhere", dist, n, wall,
+                              f"time integration settles to another {kind} state after {n} "
+                              f"periods (distance {dist:.2g} > {tolerance:g})")
+    if kind == "drifting":
+        return StabilityCheck("drifting", dist, n, wall,
+                              f"time integration ratchets away (period means drift) over {n} "
+                              "periods: the periodic state is not where the structure settles")
+    if kind == "quasi-periodic":
+        return StabilityCheck("quasi-periodic", dist, n, wall,
+                              f"time integration shows a sustained oscillation at another "
+                              f"frequency after {n} periods (rotation "
+                              f"{res.diagnostics.rotation:.3g} cycles/period): no periodic "
+                              "steady state; the periodic solution is at best an unstable orbit")
+    if kind == "irregular":
+        return StabilityCheck("irregular", dist, n, wall,
+                              f"time integration stays irregular over {n} periods")
+    return StabilityCheck("undecided", dist, n, wall,
+                          f"time integration not settled after {n} periods")
+
+
+def sweep_check(model: Model, **kwargs):
+    """A ``check`` callable for :func:`fretwear.sweep.sweep`: flags from :func:`check_periodic`."""
+
+    def check(sol: PeriodicSolution) -> list[str]:
+        return check_periodic(model, sol, **kwargs).flags()
+
+    return check
+
+
+def diagnose_frequency(model: Model, omega: float, start: PeriodicSolution | None = None, *,
+                       max_periods: int = 3000, steps_per_period: int = 128,
+                       periodicity_tol: float = 1e-4) -> str:
+    """Why might a periodic solve fail at ``omega``? Integrate in time and say what the
+    structure does there (starting from a neighbouring periodic solution when given).
+
+    Returns one line: ``"time integration: periodic ..."`` (then the failure is the solver's:
+    a periodic steady state exists), ``"... drifting ..."`` (ratcheting: no periodic state
+    where the history puts the structure), ``"... quasi-periodic ..."`` (no periodic steady
+    state), ``"... irregular"`` or ``"... undecided"``.
+    """
+    from fretwear.transient import steady_state
+
+    U0 = V0 = None
+    wear = None
+    if start is not None:
+        U0, V0 = initial_state(model, start)
+        wear = start.gap - np.asarray(model.contact.gap, float)
+    res = steady_state(model, omega, max_periods=max_periods, tol=periodicity_tol,
+                       steps_per_period=steps_per_period, U0=U0, V0=V0, wear=wear)
+    kind = res.classification
+    n = res.n_periods
+    if kind in ("periodic", "subharmonic"):
+        return (f"time integration: {kind} steady state after {n} periods (a periodic state "
+                "exists: the harmonic-balance solver did not find it)")
+    if kind == "drifting":
+        return (f"time integration: drifting (ratcheting) over {n} periods: no periodic state "
+                "at the mean position the loading history gives")
+    if kind == "quasi-periodic":
+        return (f"time integration: quasi-periodic over {n} periods (self-excited oscillation at "
+                f"{res.diagnostics.rotation:.3g} cycles/period aliased): no periodic steady state")
+    return f"time integration: {kind} over {n} periods"
