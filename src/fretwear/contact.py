@@ -142,7 +142,110 @@ def dlft_time(lam_u, mu, x_start, tol, max_sweeps):
 
 
 @njit(cache=True)
-def dlft_jacobian(lam_u, lam_x, state, mu, P, Q):
+def _propagate(lu, lx, state, mu, Q, xprev0, D):
+    """Derivative of one pass of :func:`_sweep`: on entry ``D`` (d-1, dH) is
+    ``d lambda_x,T(-1) / d lambda_u~`` (the derivative of the pass's start state); on exit it is
+    the derivative of ``lambda_x,T(N-1)`` (the pass's end state)."""
+    d, N = lu.shape
+    dt = d - 1
+    H = Q.shape[1]
+    dH = d * H
+    that = np.zeros(dt)
+    B = np.zeros((dt, dt))
+    tmp = np.zeros((dt, dH))
+    for n in range(N):
+        st = state[n]
+        if st == SEPARATION:
+            D[:, :] = 0.0
+            for c in range(dt):
+                for h in range(H):
+                    D[c, (1 + c) * H + h] = Q[n, h]
+        elif st == SLIP:
+            pn = lu[0, n]
+            nrm2 = 0.0
+            for c in range(dt):
+                that[c] = lu[1 + c, n] - lx[1 + c, n]
+                nrm2 += that[c] * that[c]
+            lam_t = np.sqrt(nrm2)
+            for c in range(dt):
+                that[c] = that[c] / lam_t if lam_t > 0.0 else 0.0
+            nrm2 = 0.0
+            for c in range(dt):
+                prev = lx[1 + c, n - 1] if n > 0 else xprev0[c]
+                v = lu[1 + c, n] - prev
+                nrm2 += v * v
+            rho = np.sqrt(nrm2)
+            g = mu * pn / rho if rho > 0.0 else 0.0
+            for a in range(dt):
+                for b in range(dt):
+                    B[a, b] = g * ((1.0 if a == b else 0.0) - that[a] * that[b])
+            for a in range(dt):
+                for j in range(dH):
+                    acc = 0.0
+                    for b in range(dt):
+                        acc += B[a, b] * D[b, j]
+                    tmp[a, j] = acc
+            for a in range(dt):
+                for j in range(dH):
+                    D[a, j] = tmp[a, j]
+                for h in range(H):
+                    qh = Q[n, h]
+                    for b in range(dt):
+                        D[a, (1 + b) * H + h] += ((1.0 if a == b else 0.0) - B[a, b]) * qh
+                    D[a, h] += -mu * that[a] * qh
+        # STICK: D carried unchanged
+
+
+@njit(cache=True)
+def _start_derivative(lu, mu, Q, x_start, tol, max_sweeps):
+    """Derivative of the start state of the final pass of :func:`dlft_time`, obtained by
+    differentiating the passes actually made from the fixed ``x_start`` (used when the
+    periodic fixed point is not isolated, e.g. a 3D node that touches the cone without
+    slipping: then the result depends on the history of the passes, not on the fixed point)."""
+    d, N = lu.shape
+    dt = d - 1
+    H = Q.shape[1]
+    scale = 0.0
+    for c in range(d):
+        for n in range(N):
+            a = abs(lu[c, n])
+            if a > scale:
+                scale = a
+    thr = tol * max(scale, 1e-300)
+    start = x_start.copy()
+    D = np.zeros((dt, d * H))
+    lxk = np.empty((d, N))
+    stk = np.empty(N, dtype=np.int8)
+    k = 0
+    while True:
+        k += 1
+        xprev = start.copy()
+        end = _sweep(lu, mu, xprev, lxk, stk)
+        diff = 0.0
+        for c in range(dt):
+            diff = max(diff, abs(end[c] - start[c]))
+        if diff <= thr or k > max_sweeps:
+            return D
+        Dn = D.copy()
+        _propagate(lu, lxk, stk, mu, Q, start, Dn)
+        D = Dn
+        for c in range(dt):
+            start[c] = end[c]
+
+
+def dlft_jacobian(lam_u, lam_x, state, mu, P, Q, x_start=None, tol=1e-12, max_sweeps=200):
+    """Derivative ``G = d lambda_x~ / d lambda_u~`` per node (nc, d*H, d*H); see
+    :func:`_dlft_jacobian`. ``x_start`` (nc, d-1) are the stick anchors ``eps X_a`` given to
+    :func:`dlft_time` (default zero), ``tol`` and ``max_sweeps`` its periodicity settings."""
+    nc, d, _ = lam_u.shape
+    if x_start is None:
+        x_start = np.zeros((nc, d - 1))
+    return _dlft_jacobian(lam_u, lam_x, state, mu, P, Q, np.ascontiguousarray(x_start, float),
+                          float(tol), int(max_sweeps))
+
+
+@njit(cache=True)
+def _dlft_jacobian(lam_u, lam_x, state, mu, P, Q, x_start, tol, max_sweeps):
     """Derivative ``G = d lambda_x~ / d lambda_u~`` per node (nc, d*H, d*H).
 
     Rows and columns are ordered ``c*H + h`` (component ``c`` of the node, real Fourier
@@ -239,14 +342,18 @@ def dlft_jacobian(lam_u, lam_x, state, mu, P, Q):
                             Gp[row, j] += w * A0[c, j]
                         for j in range(dt):
                             PS[row, j] += w * S[c, j]
-        if all_stick:
-            continue  # the start state is the anchor: no dependence on U
         # seed = A_T(-1) = A_T(N-1) = A0_T(N-1) + S_T(N-1) seed  ->  (I - S_T) seed = A0_T
         M = np.eye(dt)
         for a in range(dt):
             for b in range(dt):
                 M[a, b] -= S[1 + a, b]
-        seed = np.linalg.solve(M, A0[1:, :].copy())
+        smin = np.linalg.svd(M)[1].min() if not all_stick else 0.0
+        if smin > 1e-8:
+            seed = np.linalg.solve(M, A0[1:, :].copy())
+        else:
+            # not an isolated fixed point (all stick, or touching the cone without slipping):
+            # the result depends on the passes made from x_start; differentiate them
+            seed = _start_derivative(lam_u[p], mu[p], Q, x_start[p].copy(), tol, max_sweeps)
         for row in range(dH):
             for j in range(dH):
                 acc = 0.0

@@ -94,7 +94,8 @@ class DLFTProblem:
         f = (self.eps * (U - self.W) - Lx).reshape(-1)
         if not jacobian:
             return f, None
-        G = law.dlft_jacobian(lu, lx, state, self.mu, self.P, self.Q)
+        G = law.dlft_jacobian(lu, lx, state, self.mu, self.P, self.Q, self.eps * self.anchor,
+                              self.tol, self.max_sweeps)
         n = self.m * self.H
         dH = self.d * self.H
         # J = eps I - G (eps I - Z) = eps (I - G) + G Z, G block-diagonal per node
@@ -287,6 +288,8 @@ def solve_periodic(model: Model, basis: FourierBasis, *, omega: float = 0.0,
     if anchor is None:
         anchor = static_anchor(model)
     prob = DLFTProblem(reduced, model.contact, basis, gap=gap, eps=eps, anchor=anchor)
+    if U0 is None and basis.k > 3:
+        U0 = _harmonic_continuation_start(model, basis, reduced, prob, solver, tol, max_iter)
     x0 = (prob.initial_guess() if U0 is None else np.asarray(U0, float).reshape(prob.m, prob.H))
 
     def fun(x, jac=True):
@@ -306,6 +309,32 @@ def solve_periodic(model: Model, basis: FourierBasis, *, omega: float = 0.0,
             )
         return None, st
     return assemble_solution(prob, x.reshape(prob.m, prob.H), model, st), st
+
+
+def _harmonic_continuation_start(model, basis, reduced, prob, solver, tol, max_iter):
+    """A starting point for a many-harmonic solve: the solution on the first kept harmonic,
+    embedded in the full basis (None if that fails). From the contact-closed guess, the
+    solvers can stall with 15+ harmonics where the one-harmonic problem converges and then
+    starts the full one within a few iterations (docs/verification.md)."""
+    sub = FourierBasis(basis.harmonics[:1], basis.n_samples)
+    red = Reduced(reduced.omega, reduced.orders[:2], reduced.Z[:2], reduced.F[:2],
+                  reduced.obs_A[:2], reduced.obs_b[:2], reduced.obs_dofs, reduced.quasi_static)
+    p1 = DLFTProblem(red, model.contact, sub, gap=prob.gap, eps=prob.eps, anchor=prob.anchor)
+
+    def fun(x, jac=True):
+        return p1.residual(x.reshape(p1.m, p1.H), jac)
+
+    x, _, st = solve(fun, p1.initial_guess().reshape(-1),
+                     lambda x: p1.scale(x.reshape(p1.m, p1.H)), method=solver, tol=tol,
+                     max_iter=max_iter)
+    if not st.converged:
+        return None
+    U = np.zeros((prob.m, prob.H))
+    x = x.reshape(p1.m, p1.H)
+    U[:, 0] = x[:, 0]
+    U[:, 1] = x[:, 1]
+    U[:, 1 + basis.k] = x[:, 2]
+    return U
 
 
 def assemble_solution(prob: DLFTProblem, U, model: Model, stats: SolveStats) -> PeriodicSolution:

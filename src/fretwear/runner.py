@@ -43,6 +43,7 @@ if TYPE_CHECKING:
 #: modules that register analyses when imported: add one line per analysis module
 ANALYSIS_MODULES = (
     "fretwear.run_linear",  # "modes", "frf"
+    "fretwear.run_dlft",  # "periodic", "sweep"
 )
 
 RESULTS_FILE = "results.nc"

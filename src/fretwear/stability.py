@@ -151,16 +151,20 @@ def sweep_check(model: Model, **kwargs):
     return check
 
 
-def diagnose_frequency(model: Model, omega: float, start: PeriodicSolution | None = None, *,
-                       max_periods: int = 3000, steps_per_period: int = 128,
-                       periodicity_tol: float = 1e-4) -> str:
-    """Why might a periodic solve fail at ``omega``? Integrate in time and say what the
-    structure does there (starting from a neighbouring periodic solution when given).
+def time_domain_start(model: Model, omega: float, basis, start: PeriodicSolution | None = None,
+                      *, max_periods: int = 3000, steps_per_period: int | None = None,
+                      periodicity_tol: float = 1e-4):
+    """Integrate in time at ``omega`` until the response is classified; return what the
+    structure does there and, if it settles to a periodic state, a starting point for the
+    harmonic balance taken from it.
 
-    Returns one line: ``"time integration: periodic ..."`` (then the failure is the solver's:
-    a periodic steady state exists), ``"... drifting ..."`` (ratcheting: no periodic state
-    where the history puts the structure), ``"... quasi-periodic ..."`` (no periodic steady
-    state), ``"... irregular"`` or ``"... undecided"``.
+    This is what a careful analyst does when a periodic solve fails: the time integration (from
+    a neighbouring periodic solution when given) either settles to a periodic state, whose
+    harmonics and mean tangential positions then start the DLFT solve (the loading history
+    selects the member of a family of periodic states), or shows that there is no periodic
+    steady state (drifting, quasi-periodic, irregular).
+
+    Returns ``(message, U0 (nc, d, H) or None, anchor (nc, d-1) or None)``.
     """
     from fretwear.transient import steady_state
 
@@ -169,17 +173,27 @@ def diagnose_frequency(model: Model, omega: float, start: PeriodicSolution | Non
     if start is not None:
         U0, V0 = initial_state(model, start)
         wear = start.gap - np.asarray(model.contact.gap, float)
+    hmax = max(basis.harmonics) if basis.harmonics else 1
+    nsteps = steps_per_period or max(128, 8 * hmax)
     res = steady_state(model, omega, max_periods=max_periods, tol=periodicity_tol,
-                       steps_per_period=steps_per_period, U0=U0, V0=V0, wear=wear)
+                       steps_per_period=nsteps, n_harmonics=hmax, U0=U0, V0=V0, wear=wear)
     kind = res.classification
     n = res.n_periods
-    if kind in ("periodic", "subharmonic"):
-        return (f"time integration: {kind} steady state after {n} periods (a periodic state "
-                "exists: the harmonic-balance solver did not find it)")
+    if kind == "periodic":
+        c = np.asarray(res.contact_harmonics["u_loc"])  # (2 hmax + 1, nc, d): [a0, a.., b..]
+        idx = np.array([0] + [h for h in basis.harmonics] + [hmax + h for h in basis.harmonics])
+        Ut = np.moveaxis(c[idx], 0, -1).copy()  # (nc, d, H)
+        anchor = Ut[:, 1:, 0].copy()
+        return (f"time integration: periodic steady state after {n} periods", Ut, anchor)
+    if kind == "subharmonic":
+        return (f"time integration: subharmonic steady state (order "
+                f"{res.diagnostics.order}) after {n} periods: no periodic state at the forcing "
+                "period", None, None)
     if kind == "drifting":
-        return (f"time integration: drifting (ratcheting) over {n} periods: no periodic state "
-                "at the mean position the loading history gives")
+        return (f"time integration: still drifting (ratcheting) after {n} periods: the "
+                "structure has not settled at the mean position this history gives", None, None)
     if kind == "quasi-periodic":
-        return (f"time integration: quasi-periodic over {n} periods (self-excited oscillation at "
-                f"{res.diagnostics.rotation:.3g} cycles/period aliased): no periodic steady state")
-    return f"time integration: {kind} over {n} periods"
+        return (f"time integration: quasi-periodic over {n} periods (self-excited oscillation, "
+                f"Poincare rotation {res.diagnostics.rotation:.3g} cycles/period): no periodic "
+                "steady state", None, None)
+    return f"time integration: {kind} over {n} periods", None, None

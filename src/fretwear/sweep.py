@@ -206,8 +206,8 @@ def _arclength(probs, model, anchor, y_prev, y_last, omega_target, solver_tol, m
 def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_points: int, *,
           spacing: str = "log", gap=None, eps=None, anchor=None, solver: str = "powell",
           tol: float = 1e-8, max_iter: int = 40, continuation: bool = True,
-          max_bisections: int = 4, check=None, diagnose=None,
-          progress=None) -> SweepResult:
+          max_bisections: int = 4, check=None, time_domain: bool = False,
+          time_domain_periods: int = 3000, progress=None) -> SweepResult:
     """Nonlinear FRF: periodic solutions from ``f_min`` to ``f_max`` [Hz].
 
     Parameters
@@ -231,9 +231,12 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
         points are kept in the result, ``how = "substep"``).
     check : optional callable ``(PeriodicSolution) -> list[str]`` returning flags (e.g. the
         time-domain stability check of :mod:`fretwear.stability`).
-    diagnose : optional callable ``(omega, neighbour PeriodicSolution | None) -> str`` called
-        at a point that did not converge, whose answer is added to the point's flags (e.g.
-        :func:`fretwear.stability.diagnose_frequency`: what the time integration does there).
+    time_domain : at a point that still did not converge, integrate in time from the neighbour
+        (:func:`fretwear.stability.time_domain_start`): if the structure settles to a periodic
+        state, its harmonics and mean positions start one more solve (``how = "time-start"``);
+        otherwise the point is flagged with what the structure does there (drifting,
+        quasi-periodic...).
+    time_domain_periods : periods allowed to the time integration.
     progress : optional callable ``(i, n, point)`` called after each grid point.
     """
     t_start = time.perf_counter()
@@ -320,13 +323,23 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
                 prob, U, st = _solve_at(probs, omega, current_anchor(), history[-1][1], solver,
                                         tol, max_iter)
                 how = "arclength"
+        td_msg = None
+        if not st.converged and time_domain:
+            from fretwear.stability import time_domain_start
+
+            td_msg, Ut, anc_t = time_domain_start(model, omega, basis, last_solution[0],
+                                                  max_periods=time_domain_periods)
+            if Ut is not None:
+                prob, U, st = _solve_at(probs, omega, anc_t, Ut.reshape(-1, basis.size),
+                                        solver, tol, 2 * max_iter)
+                how = "time-start"
         if st.converged:
             pt = record(omega, prob, U, st, how)
         else:
             pt = SweepPoint(f, None, st, how, [f"not converged: {st.message} "
                                                 f"(relative residual {st.residual:.2e})"])
-            if diagnose is not None:
-                pt.flags.append(diagnose(omega, last_solution[0]))
+            if td_msg is not None:
+                pt.flags.append(td_msg)
         points.append(pt)
         if progress is not None:
             progress(i, len(grid), pt)

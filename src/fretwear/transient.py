@@ -139,7 +139,9 @@ class Classification:
         ``"quasi-periodic"`` (bounded, not decaying, not repeating, with a spectral peak at a
         non-zero frequency of the Poincare sequence), ``"irregular"`` (bounded, not decaying,
         no dominant peak), or ``"transient"`` (still converging: undecided).
-    periodicity_error : ``max |P_k - P_{k-1}| / scale`` over the last ``n_confirm`` periods.
+    periodicity_error : estimated distance to a periodic orbit over ``scale``: the largest
+        ``|P_k - P_{k-1}|`` over the last ``n_confirm`` periods divided by ``1 - rho``, rho the
+        observed contraction ratio of these differences (capped at 0.99).
     scale : amplitude used to make the errors relative (unit of the samples).
     order : repetition period in forcing periods (1 if periodic, 0 if none).
     drift_rate : largest slope of the period means [unit per period].
@@ -871,11 +873,13 @@ def classify_sequence(poincare, means=None, *, tol: float = 1e-6, scale: float |
 
     Returns
     -------
-    :class:`Classification`. Rules, in order: periodic if the last ``n_confirm`` differences
-    ``|P_k - P_{k-1}|`` are below ``tol * scale``; subharmonic of order p if ``|P_k - P_{k-p}|``
-    are; with at least ``min_window`` samples, drifting if the period means follow a straight
-    line (residual < 10 % of the change) whose change over the window exceeds
-    ``10 tol scale`` and whose increments do not decay (second half / first half > 0.8);
+    :class:`Classification`. Rules, in order: periodic if the distance to a periodic orbit
+    estimated from the last ``n_confirm`` differences ``|P_k - P_{k-1}|`` (see
+    ``periodicity_error``) is below ``tol * scale``; subharmonic of order p if the same holds
+    for ``|P_k - P_{k-p}|``; with at least ``min_window`` samples, drifting if the period
+    means follow a straight line (residual < 10 % of the change) whose change over the
+    window exceeds ``10 tol scale`` and whose increments do not decay (second half / first
+    half > 0.8);
     quasi-periodic if the detrended deviations are sustained (``decay > decay_limit``), above
     ``tol * scale``, and their spectrum has a dominant peak at a non-zero frequency; irregular
     if sustained without a dominant peak; otherwise transient.
@@ -890,10 +894,17 @@ def classify_sequence(poincare, means=None, *, tol: float = 1e-6, scale: float |
     thr = tol * scale
 
     def rep_err(p):
-        if K < p + n_confirm:
+        """Distance to a p-periodic orbit: the last differences ``|P_k - P_{k-p}|`` divided by
+        ``1 - rho`` (rho, the observed contraction of the differences, capped at 0.99), so that
+        a slow geometric convergence is not taken for convergence."""
+        if K < p + n_confirm + p:
             return np.inf
-        d = np.abs(P[K - n_confirm:] - P[K - n_confirm - p:K - p]).max()
-        return float(d)
+        d = np.abs(P[p:] - P[:-p]).max(axis=1)[-(n_confirm + 1):]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratios = d[1:] / d[:-1]
+        rho = float(np.nanmax(ratios)) if np.any(np.isfinite(ratios)) else 0.0
+        rho = min(max(rho, 0.0), 0.99)
+        return float(d[1:].max() / (1.0 - rho))
 
     e1 = rep_err(1)
     out = Classification(kind="transient", periodicity_error=e1 / scale, scale=scale, n=K)

@@ -160,6 +160,17 @@ def solve_contact(A, b, xref, gap, xprev, mu, d, status, tdir, x, lam, tol, fsca
         for r in range(m):
             if abs(lam[r]) > fs:
                 fs = abs(lam[r])
+        if fs == 0.0:
+            # no load and no force yet: the force of moving a node by the largest displacement
+            for r in range(m):
+                v = dmax * max(abs(xref[r]), abs(x[r]))
+                if v > fs:
+                    fs = v
+            for i in range(nc):
+                if dmax * abs(gap[i]) > fs:
+                    fs = dmax * abs(gap[i])
+            if fs == 0.0:
+                fs = 1e-300
         eps_f = tol * fs
         eps_x = eps_f / dmax
         # residual and Jacobian of the equations of the free components

@@ -1,0 +1,423 @@
+"""The ``"wear"`` analysis of case files: fretting wear on the slow time scale.
+
+Runs :func:`fretwear.wear.simulate_wear` (paper section 3.3, eq. 29-30) at one excitation
+frequency (or quasi-static), with a checkpoint in the results folder so that
+``fretwear run CASE.toml --resume`` continues an interrupted run to the same result; turns the
+:class:`~fretwear.wear.WearHistory` into a results dataset (schema in ``docs/results.md``,
+section ``wear``), draws the figures of the paper's section 4.2 (worn profiles, wear
+kinetics, pressure and slip along the interface, worn volume) and, when asked, the nonlinear
+FRFs before and after wear (paper Fig. 24).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from fretwear import plots
+from fretwear.contact import STATE_NAMES
+from fretwear.fourier import FourierBasis
+from fretwear.results import label_coordinate, variable
+from fretwear.runner import RunOutput, register
+from fretwear.schema import Field, Flag, Integer, ListOf, Number, Table, Text, fail, increasing
+from fretwear.solvers import SOLVERS
+from fretwear.wear import LAWS, SCHEMES, WearOptions, WearResult, frf_worn, simulate_wear
+
+CHECKPOINT_FILE = "wear-checkpoint.npz"
+COMPONENTS = ("N", "T1", "T2")
+AXES = ("x", "y", "z")
+
+
+# --- options ----------------------------------------------------------------------------------
+def options_from_table(a: dict) -> WearOptions:
+    """:class:`~fretwear.wear.WearOptions` from the validated ``[analysis]`` table."""
+    return WearOptions(
+        law=a["law"], energy_coefficient=a.get("energy_coefficient"), scheme=a["scheme"],
+        adaptive=a["adaptive"], tolerance=a["tolerance"], initial_jump=a.get("initial_jump"),
+        max_jump=a["max_jump"], max_cycles=a["max_cycles"],
+        max_depth=a.get("max_depth", math.inf), plateau_rate=a["plateau_rate"],
+        max_steps=a["max_steps"], solver=a["solver"], tol=a["tol"],
+        checkpoint_every_s=a["checkpoint_every_s"],
+    ).check()
+
+
+def _check_table(out: dict, path: str) -> None:
+    """Rules across keys: a frequency unless quasi-static; k_e with the energy law."""
+    if not out.get("quasi_static") and "frequency" not in out:
+        fail(f"{path}.frequency" if path else "frequency", None,
+             "an excitation frequency [Hz] (or quasi_static = true)")
+    if out.get("law") == "energy" and "energy_coefficient" not in out:
+        fail(f"{path}.energy_coefficient" if path else "energy_coefficient", None,
+             "k_e [m^3/J] for law = \"energy\"")
+
+
+# --- dataset ------------------------------------------------------------------------------------
+def _steps_kept(n: int, every: int) -> np.ndarray:
+    """Recorded steps kept in the results file: every ``every``-th and the last."""
+    keep = np.arange(0, n, max(1, int(every)))
+    if keep[-1] != n - 1:
+        keep = np.append(keep, n - 1)
+    return keep
+
+
+def wear_dataset(model, result: WearResult, basis: FourierBasis, *, frequency_hz: float,
+                 record_every: int = 1, frf=None) -> xr.Dataset:
+    """The results dataset of a wear run (``docs/results.md``, section ``wear``)."""
+    h = result.history
+    keep = _steps_kept(h.n_steps, record_every)
+    c = model.contact
+    nc, d = c.dofs.shape
+    coords = {
+        "step": variable("step", keep, "1", "slow-scale (wear) step"),
+        "contact_node": variable("contact_node", np.arange(nc), "1", "contact node, from 0"),
+        "component": label_coordinate("component", COMPONENTS[:d]),
+        "harmonic_coefficient": label_coordinate("harmonic_coefficient", basis.labels()),
+        "contact_state": label_coordinate("contact_state", STATE_NAMES,
+                                          "contact state: separation, stick, slip"),
+        "axis": label_coordinate("axis", AXES[:d]),
+    }
+    sn, sc = ("step", "contact_node"), ("step",)
+    hist = {k: np.asarray(getattr(h, k))[keep] for k in (
+        "cycles", "jump", "wear_depth", "wear_rate", "pressure_mean", "pressure_max",
+        "slip_amplitude", "slip_path", "state_fraction", "friction_energy", "worn_volume",
+        "volume_rate", "newton_iterations", "rejected", "error_estimate", "wall_time", "U",
+        "lam")}
+    cpos = np.asarray(c.coords, float).reshape(nc, -1)[:, :d]
+    data = {
+        "contact_position": variable(("contact_node", "axis"), cpos, "m",
+                                     "position of the contact node"),
+        "contact_area": variable("contact_node", np.asarray(c.area, float), "m^2",
+                                 "tributary area of the contact node"),
+        "excitation_frequency": variable((), frequency_hz, "Hz",
+                                         "excitation frequency (time scale only if quasi-static)"),
+        "penalty": variable((), result.initial.eps, "N/m", "DLFT penalty eps"),
+        "stability_jump": variable((), result.stability_jump, "1",
+                                   "explicit Euler stability limit 2/rho at the start, cycles"),
+        "cycles": variable(sc, hist["cycles"], "1", "physical cycle count N"),
+        "jump": variable(sc, hist["jump"], "1", "cycles jumped by the step"),
+        "wear_depth": variable(sn, hist["wear_depth"], "m", "wear depth W"),
+        "wear_rate": variable(sn, hist["wear_rate"], "m",
+                              "wear depth per cycle dW1 (paper eq. 29)"),
+        "contact_pressure_mean": variable(sn, hist["pressure_mean"], "Pa",
+                                          "normal contact pressure, mean over the period"),
+        "contact_pressure_max": variable(sn, hist["pressure_max"], "Pa",
+                                         "normal contact pressure, maximum over the period"),
+        "slip_amplitude": variable(sn, hist["slip_amplitude"], "m",
+                                   "tangential displacement amplitude (half range)"),
+        "slip_path": variable(sn, hist["slip_path"], "m", "slip path per cycle"),
+        "state_fraction": variable(("step", "contact_node", "contact_state"),
+                                   hist["state_fraction"], "1",
+                                   "fraction of the period in each contact state"),
+        "dissipated_energy": variable(sn, hist["friction_energy"], "J",
+                                      "energy dissipated by friction per period"),
+        "worn_volume": variable(sc, hist["worn_volume"], "m^3", "worn volume"),
+        "worn_volume_rate": variable(sc, hist["volume_rate"], "m^3", "worn volume per cycle"),
+        "newton_iterations": variable(sc, hist["newton_iterations"], "1",
+                                      "nonlinear solver iterations of the step, retries "
+                                      "included"),
+        "rejected_attempts": variable(sc, hist["rejected"], "1",
+                                      "attempts of the step rejected (error test or failed "
+                                      "solve)"),
+        "error_estimate": variable(sc, hist["error_estimate"], "1",
+                                   "local error estimate relative to the maximum wear depth"),
+        "step_wall_time": variable(sc, hist["wall_time"], "s", "wall time of the step"),
+        "contact_displacement_coefficients": variable(
+            ("step", "contact_node", "component", "harmonic_coefficient"), hist["U"], "m",
+            "Fourier coefficients of the contact displacements (normal includes gap + wear)"),
+        "contact_force_coefficients": variable(
+            ("step", "contact_node", "component", "harmonic_coefficient"), hist["lam"], "N",
+            "Fourier coefficients of the contact forces (normal positive in compression)"),
+    }
+    if frf is not None:
+        coords.update(frf["coords"])
+        data.update(frf["data"])
+    ds = xr.Dataset(data, coords=coords)
+    ds.attrs.update({"stop_reason": result.stop_reason, "wear_message": result.message})
+    return ds
+
+
+def _frf_data(model, sweeps: dict, freqs: np.ndarray) -> dict:
+    """FRF variables (wear_state, frequency, point, axis) on the requested grid."""
+    points = [p.name for p in model.observed]
+    n_axes = max([len(p.dofs) for p in model.observed], default=1)
+    states = list(sweeps)
+    amp = np.full((len(states), freqs.size, len(points), n_axes), np.nan)
+    conv = np.zeros((len(states), freqs.size), dtype=np.int8)
+    for i, name in enumerate(states):
+        res = sweeps[name]
+        f = res.frequency_hz
+        idx = [int(np.argmin(np.abs(f - x))) for x in freqs]
+        conv[i] = res.converged[idx]
+        for j, pt in enumerate(points):
+            for k in range(len(model.observed_point(pt).dofs)):
+                amp[i, :, j, k] = res.amplitude(pt, k, harmonic=1)[idx]
+    coords = {
+        "wear_state": label_coordinate("wear_state", states, "interface before / after wear"),
+        "frequency": variable("frequency", freqs, "Hz", "excitation frequency"),
+        "point": label_coordinate("point", points),
+    }
+    data = {
+        "frf_amplitude": variable(("wear_state", "frequency", "point", "axis"), amp, "m",
+                                  "nonlinear FRF: amplitude of harmonic 1 of the observed "
+                                  "displacement (NaN where not converged)"),
+        "frf_converged": variable(("wear_state", "frequency"), conv, "1",
+                                  "1 if the periodic solve converged"),
+    }
+    return {"coords": coords, "data": data}
+
+
+# --- figures --------------------------------------------------------------------------------
+def selected_steps(cycles: np.ndarray, n: int = 5) -> list[int]:
+    """``n`` recorded steps spread on a log scale of cycles, first and last included."""
+    s = len(cycles)
+    if s <= n:
+        return list(range(s))
+    pos = np.log10(np.maximum(cycles, 1.0))
+    targets = np.linspace(pos[1] if s > 1 else 0, pos[-1], n - 1)
+    picks = {0, s - 1}
+    for t in targets:
+        picks.add(int(np.argmin(np.abs(pos - t))))
+    return sorted(picks)
+
+
+def _x_along(ds) -> tuple[np.ndarray, str]:
+    pos = ds["contact_position"].values
+    span = np.ptp(pos, axis=0)
+    k = int(np.argmax(span))
+    return pos[:, k], f"{AXES[k]} [m]"
+
+
+def plot_wear_profiles(ds, path: Path, *, title=None) -> Path:
+    """Wear depth along the interface at selected cycle counts (paper Fig. 7, 21, 23)."""
+    x, xl = _x_along(ds)
+    fig, axes = plots.new_figure(title=title)
+    ax = axes[0, 0]
+    cyc = ds["cycles"].values
+    for i in selected_steps(cyc):
+        ax.plot(x, ds["wear_depth"].values[i] * 1e6, marker=".", label=f"N = {cyc[i]:.3g}")
+    ax.set_xlabel(xl)
+    ax.set_ylabel("wear depth [um]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="small")
+    return plots.save(fig, path)
+
+
+def default_nodes(ds, n: int = 5) -> list[int]:
+    """Nodes to follow: the most worn ones, spread along the interface."""
+    w = ds["wear_depth"].values[-1]
+    order = np.argsort(-w)
+    picks = []
+    for p in order:
+        if w[p] <= 0:
+            break
+        if all(abs(int(p) - q) > 1 for q in picks):
+            picks.append(int(p))
+        if len(picks) == n:
+            break
+    return sorted(picks) or [int(order[0])]
+
+
+def plot_wear_kinetics(ds, path: Path, nodes, *, title=None) -> Path:
+    """Wear depth against cycles for chosen nodes (paper Fig. 8, 9), log cycles."""
+    x, xl = _x_along(ds)
+    fig, axes = plots.new_figure(title=title)
+    ax = axes[0, 0]
+    cyc = ds["cycles"].values
+    for p in nodes:
+        ax.semilogx(cyc[1:], ds["wear_depth"].values[1:, p] * 1e6, marker=".",
+                    label=f"node {p} ({xl[0]} = {x[p]:.4g} m)")
+    ax.set_xlabel("cycles N")
+    ax.set_ylabel("wear depth [um]")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize="small")
+    return plots.save(fig, path)
+
+
+def plot_pressure_slip(ds, path: Path, *, title=None) -> Path:
+    """Maximum pressure and tangential amplitude along the interface at selected cycle counts
+    (paper Fig. 11, 13, 18, 19)."""
+    x, xl = _x_along(ds)
+    fig, axes = plots.new_figure(2, 1, title=title, sharex=True)
+    cyc = ds["cycles"].values
+    for i in selected_steps(cyc):
+        lab = f"N = {cyc[i]:.3g}"
+        axes[0, 0].plot(x, ds["contact_pressure_max"].values[i], marker=".", label=lab)
+        axes[1, 0].plot(x, ds["slip_amplitude"].values[i], marker=".", label=lab)
+    axes[0, 0].set_ylabel("max normal pressure [Pa]")
+    axes[1, 0].set_ylabel("tangential amplitude [m]")
+    axes[1, 0].set_xlabel(xl)
+    for ax in axes[:, 0]:
+        ax.grid(True, alpha=0.3)
+    axes[0, 0].legend(fontsize="small")
+    return plots.save(fig, path)
+
+
+def plot_worn_volume(ds, path: Path, *, title=None) -> Path:
+    """Worn volume against cycles, log cycles (paper Fig. 25)."""
+    fig, axes = plots.new_figure(title=title)
+    ax = axes[0, 0]
+    cyc = ds["cycles"].values
+    ax.semilogx(cyc[1:], ds["worn_volume"].values[1:], marker=".")
+    ax.set_xlabel("cycles N")
+    ax.set_ylabel("worn volume [m^3]")
+    ax.grid(True, which="both", alpha=0.3)
+    return plots.save(fig, path)
+
+
+def plot_frf_before_after(ds, path: Path, point: str, *, title=None) -> Path:
+    """Nonlinear FRF at ``point`` before and after wear (paper Fig. 24)."""
+    amp = ds["frf_amplitude"].sel(point=point)
+    axes_labels = [str(a) for a in ds["axis"].values]
+    fig, axes = plots.new_figure(len(axes_labels), 1, title=title, sharex=True)
+    f = ds["frequency"].values
+    for ax, axis in zip(axes[:, 0], axes_labels, strict=True):
+        for state in ds["wear_state"].values:
+            y = amp.sel(wear_state=state, axis=axis).values
+            ax.semilogy(f, np.where(y > 0, y, np.nan), label=str(state))
+        ax.set_ylabel(f"|u_{axis}| at {point} [m]")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend()
+    axes[-1, 0].set_xlabel("frequency [Hz]")
+    return plots.save(fig, path)
+
+
+# --- the analysis -----------------------------------------------------------------------------
+def run_wear(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOutput:
+    """Fretting wear to a plateau, a depth or a cycle count (see module docstring)."""
+    a = analysis
+    opts = options_from_table(a)
+    quasi = bool(a["quasi_static"])
+    f_hz = float(a.get("frequency", 1.0))
+    basis = FourierBasis.up_to(a["harmonics"], a["n_samples"])
+    nc = model.contact.n_nodes
+    nodes = a.get("plot_nodes")
+    if nodes is not None and any(p >= nc for p in nodes):
+        fail("analysis.plot_nodes", nodes, f"contact node numbers from 0 to {nc - 1}")
+    result = simulate_wear(model, basis, omega=2 * np.pi * f_hz, quasi_static=quasi,
+                           options=opts, eps=a.get("eps"), checkpoint=outdir / CHECKPOINT_FILE,
+                           resume=bool(case.resume), progress=progress)
+    frf, frf_note = None, ""
+    fb = a.get("frf_before_after")
+    if fb is not None and model.observed:
+        grid = (fb["f_min"], fb["f_max"], fb["n_points"])
+        sweeps = {name: frf_worn(model, w, grid, basis, solver=a["solver"], eps=a.get("eps"),
+                                 spacing=fb["spacing"])
+                  for name, w in (("unworn", 0.0), ("worn", result.final_wear))}
+        from fretwear.sweep import frequency_grid
+
+        frf = _frf_data(model, sweeps, frequency_grid(*grid, fb["spacing"]))
+        frf_note = "\n".join(f"FRF {k}: {int(v.converged.sum())}/{len(v.points)} converged"
+                             for k, v in sweeps.items())
+    elif fb is not None:
+        frf_note = "FRF before/after skipped: the model has no observed point"
+    ds = wear_dataset(model, result, basis, frequency_hz=f_hz, record_every=a["record_every"],
+                      frf=frf)
+    figures = _figures(ds, case, outdir, nodes)
+    h = result.history
+    area = np.asarray(model.contact.area, float)
+    w = h.wear_depth[-1]
+    lines = [
+        result.message,
+        f"slow steps {h.n_steps - 1}, Newton iterations {int(h.newton_iterations.sum())}, "
+        f"rejected attempts {int(h.rejected.sum())}, wall {result.wall_time:.1f} s"
+        + (f" (resumed from step {result.resumed_from})" if result.resumed_from >= 0 else ""),
+        f"worn volume {float(area @ w):.4e} m^3, max depth {w.max():.4e} m at contact node "
+        f"{int(np.argmax(w))}; explicit Euler stability limit at the start "
+        f"{result.stability_jump:.3g} cycles",
+    ]
+    if frf_note:
+        lines.append(frf_note)
+    return RunOutput(ds, figures, "\n".join(lines), result.converged,
+                     [outdir / CHECKPOINT_FILE])
+
+
+def _figures(ds, case, outdir: Path, nodes) -> list[Path]:
+    out = case.output
+    if not out["figures"]:
+        return []
+    fmt = out["figure_format"]
+    t = case.title
+    figs = [
+        plot_wear_profiles(ds, outdir / f"wear-profile.{fmt}", title=f"{t}: worn profile"),
+        plot_wear_kinetics(ds, outdir / f"wear-kinetics.{fmt}",
+                           nodes if nodes else default_nodes(ds), title=f"{t}: wear kinetics"),
+        plot_pressure_slip(ds, outdir / f"pressure-slip.{fmt}",
+                           title=f"{t}: pressure and slip"),
+        plot_worn_volume(ds, outdir / f"worn-volume.{fmt}", title=f"{t}: worn volume"),
+    ]
+    if "frf_amplitude" in ds:
+        for p in ds["point"].values:
+            figs.append(plot_frf_before_after(ds, outdir / f"frf-worn-{p}.{fmt}", str(p),
+                                              title=f"{t}: FRF before / after wear"))
+    return figs
+
+
+_POS = Number(lo=0, lo_open=True)
+_FRF = Table(
+    {
+        "f_min": Field(_POS, "lowest frequency", required=True, unit="Hz"),
+        "f_max": Field(_POS, "highest frequency", required=True, unit="Hz"),
+        "n_points": Field(Integer(lo=2), "number of frequencies", default=100),
+        "spacing": Field(Text(("linear", "log")), "frequency spacing", default="linear"),
+    },
+    checks=(increasing("f_min", "f_max", "Hz"),),
+    doc="Nonlinear FRFs (fretwear.sweep) of the unworn and the worn interface.",
+)
+
+register(
+    "wear",
+    {
+        "frequency": Field(_POS, "excitation frequency (with quasi_static: only the time "
+                           "scale; default 1 Hz)", unit="Hz"),
+        "quasi_static": Field(Flag(), "drop inertia and damping (slow cyclic loading)",
+                              default=False),
+        "harmonics": Field(Integer(lo=1), "kept harmonics 1..harmonics", default=7),
+        "n_samples": Field(Integer(lo=3), "time samples per period", default=128),
+        "eps": Field(_POS, "DLFT penalty (default: spectral radius of the reduced dynamic "
+                     "stiffness)", unit="N/m"),
+        "solver": Field(Text(SOLVERS), "nonlinear solver of the first periodic solve and "
+                        "the fallback of the slow steps", default="powell"),
+        "tol": Field(_POS, "relative residual of the periodic solves |f| <= tol |Z U|",
+                     default=1e-9, unit="-"),
+        "law": Field(Text(LAWS), '"archard" (k_w = contact.wear_coefficient, paper eq. 29) '
+                     'or "energy" (worn volume = energy_coefficient x friction energy)',
+                     default="archard"),
+        "energy_coefficient": Field(Number(lo=0), "k_e of the energy law", unit="m^3/J"),
+        "scheme": Field(Text(SCHEMES), '"implicit" (backward Euler, stable for any jump), '
+                        '"rosenbrock" (linearly implicit Euler) or "explicit" (explicit Euler, '
+                        "paper eq. 30)", default="implicit"),
+        "adaptive": Field(Flag(), "adapt the jump to `tolerance`; false: constant jumps of "
+                          "`initial_jump`", default=True),
+        "tolerance": Field(_POS, "local error per step relative to the maximum wear depth",
+                           default=1e-2, unit="-"),
+        "initial_jump": Field(_POS, "first jump (default: from the slow Jacobian's spectral "
+                              "radius)", unit="cycles"),
+        "max_jump": Field(Number(lo=0, lo_open=True, allow_inf=True), "cap on the jump",
+                          default=math.inf, unit="cycles"),
+        "max_cycles": Field(_POS, "stop at this cycle count", default=1e12, unit="cycles"),
+        "max_depth": Field(_POS, "stop when a wear depth reaches this", unit="m"),
+        "plateau_rate": Field(Number(lo=0), "stop when the worn-volume rate falls below this "
+                              "fraction of its initial value", default=1e-3, unit="-"),
+        "max_steps": Field(Integer(lo=1), "stop after this many slow steps", default=10000),
+        "record_every": Field(Integer(lo=1), "keep every n-th step in results.nc (the last "
+                              "always)", default=1),
+        "checkpoint_every_s": Field(Number(lo=0), "checkpoint interval (0: every step)",
+                                    default=10.0, unit="s"),
+        "plot_nodes": Field(ListOf(Integer(lo=0), non_empty=True, unique=True),
+                            "contact nodes of the wear-kinetics figure (default: the most "
+                            "worn)"),
+        "frf_before_after": Field(_FRF, "nonlinear FRFs before and after wear (paper "
+                                  "Fig. 24)"),
+    },
+    run_wear,
+    checks=(_check_table,),
+    doc="Fretting wear on the slow time scale (DLFT with wear, paper section 3.3): the wear "
+    "depth of every contact node evolves with the cycle count until a plateau of the worn "
+    "volume, a depth or a cycle count. A checkpoint `wear-checkpoint.npz` in the results "
+    "folder lets `fretwear run CASE.toml --resume` continue an interrupted run to the same "
+    "result. Writes `wear-profile.png`, `wear-kinetics.png`, `pressure-slip.png`, "
+    "`worn-volume.png` and, with `frf_before_after`, `frf-worn-<point>.png`.",
+)

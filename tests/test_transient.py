@@ -1,0 +1,591 @@
+"""Tests of the time-domain reference solvers (:mod:`fretwear.transient`).
+
+Every test compares with something independent of the code under test (a closed-form
+solution, an event-driven integration written here with ``scipy.integrate.solve_ivp``, a
+direct sparse solve, an energy identity with its terms computed independently, or synthetic
+sequences with a known answer) and says why its tolerance is what it is.
+
+The models are built by hand from scipy.sparse matrices and ``fretwear.model.core`` objects.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from scipy.integrate import solve_ivp
+
+from fretwear import transient as tr
+from fretwear.errors import InputError
+from fretwear.model.core import ContactInterface, Load, Model, ObservedPoint
+
+
+# --------------------------------------------------------------------------------------------
+# models
+# --------------------------------------------------------------------------------------------
+def slider(*, m=1.0, k=1.0, N=1.0, F0=1.0, mu=0.3, mn=1.0, waveform="cos", c=0.0):
+    """Single-DOF friction oscillator: DOF 0 = normal (mass ``mn``, no stiffness, pressed on
+    the obstacle by the constant load ``N``), DOF 1 = tangential (mass m, spring k, optional
+    dashpot c, force ``F0 cos(omega t)``)."""
+    K = sp.csr_matrix(np.diag([0.0, k]))
+    M = sp.csr_matrix(np.diag([mn, m]))
+    C = sp.csr_matrix(np.diag([0.0, c])) if c else None
+    contact = ContactInterface(dofs=np.array([[0, 1]]), frame=np.eye(2)[None],
+                               gap=np.zeros(1), area=np.ones(1), mu=mu, coords=np.zeros((1, 2)))
+    loads = [Load(np.array([N, 0.0]), "constant", name="normal"),
+             Load(np.array([0.0, F0]), waveform, name="Q")]
+    return Model(K=K, M=M, C=C, contact=contact, loads=loads,
+                 observed=[ObservedPoint("x", np.array([1]), np.zeros(1))])
+
+
+def slider3d(*, m=1.0, k=1.0, N=1.0, F0=1.0, mu=0.3):
+    """3D node: normal DOF 0 pressed by N, tangential DOFs 1, 2 with isotropic spring k and a
+    rotating force ``F0 (cos wt, sin wt)``."""
+    K = sp.csr_matrix(np.diag([0.0, k, k]))
+    M = sp.csr_matrix(np.diag([1.0, m, m]))
+    contact = ContactInterface(dofs=np.array([[0, 1, 2]]), frame=np.eye(3)[None],
+                               gap=np.zeros(1), area=np.ones(1), mu=mu, coords=np.zeros((1, 3)))
+    loads = [Load(np.array([N, 0.0, 0.0]), "constant"), Load(np.array([0.0, F0, 0.0]), "cos"),
+             Load(np.array([0.0, 0.0, F0]), "sin")]
+    return Model(K=K, M=M, contact=contact, loads=loads, dim=3,
+                 observed=[ObservedPoint("x", np.array([1, 2]), np.zeros(3))])
+
+
+def chain(*, n=12, k=100.0, kg=30.0, mu=0.3, gap=0.0, N=5.0, F=2.0, ks_normal=0.0, c_a=0.0,
+          c_b=0.0):
+    """A contact node (DOFs 0 = normal, 1 = tangential) on a chain of ``n`` unit masses
+    (DOFs 2..n+1) with springs k, the last mass grounded by ``kg`` (an undamped spring to
+    ground), a force ``F cos(wt)`` on the last mass, and a constant normal load N. Damping
+    ``c_a K0 + c_b M`` with ``K0`` the chain without the ground spring."""
+    nd = n + 2
+    rows, cols, vals = [], [], []
+
+    def spring(i, j, kk):
+        rows.extend([i, j, i, j])
+        cols.extend([i, j, j, i])
+        vals.extend([kk, kk, -kk, -kk])
+
+    spring(1, 2, k)
+    for i in range(2, n + 1):
+        spring(i, i + 1, k)
+    K0 = sp.csr_matrix((vals, (rows, cols)), shape=(nd, nd))
+    Kn = sp.csr_matrix(([ks_normal], ([0], [0])), shape=(nd, nd))
+    Kg = sp.csr_matrix(([kg], ([nd - 1], [nd - 1])), shape=(nd, nd))
+    M = sp.identity(nd, format="csr")
+    C = (c_a * K0 + c_b * M).tocsr() if (c_a or c_b) else None
+    contact = ContactInterface(dofs=np.array([[0, 1]]), frame=np.eye(2)[None],
+                               gap=np.array([gap]), area=np.ones(1), mu=mu,
+                               coords=np.zeros((1, 2)))
+    fN = np.zeros(nd)
+    fN[0] = N
+    fQ = np.zeros(nd)
+    fQ[nd - 1] = F
+    loads = [Load(fN, "constant", name="normal"), Load(fQ, "cos", name="Q")]
+    return Model(K=(K0 + Kn + Kg).tocsr(), M=M, C=C, contact=contact, loads=loads,
+                 observed=[ObservedPoint("end", np.array([nd - 1]), np.zeros(1)),
+                           ObservedPoint("all", np.arange(nd), np.zeros(1))])
+
+
+# --------------------------------------------------------------------------------------------
+# references
+# --------------------------------------------------------------------------------------------
+def den_hartog(t, *, m, k, Ff, F0, w):
+    """Den Hartog's (1931) exact continuous-slip steady state of
+    ``m x'' + k x + Ff sgn(x') = F0 cos(w t)``.
+
+    Derivation: let t' = 0 be a reversal at x = -X with x' = 0, and write the forcing
+    ``F0 cos(w t' + phi)``. On the half period 0 < t' < T/2 (x' > 0)
+    ``x = -Ff/k + P cos(w t' + phi) + C1 cos(w0 t') + C2 sin(w0 t')`` with
+    ``P = F0 / (k (1 - r^2))``, ``r = w / w0``. Symmetry requires ``x(T/2) = X``,
+    ``x'(T/2) = 0``; with ``theta = pi / r`` the four conditions give ``C2 = P r sin(phi)``,
+    ``C1 = Ff / k = P r sin(phi) cot(theta/2)``, ``X = -P cos(phi)``, hence
+    ``sin(phi) = (Ff/F0) (1 - r^2) tan(theta/2) / r`` and
+    ``X = (F0/k) sqrt(1/(1 - r^2)^2 - (Ff/F0)^2 U^2)``, ``U = tan(pi/(2r)) / r``
+    (Den Hartog's U = sin(pi/r) / (r (1 + cos(pi/r)))). The second half period is ``-x``.
+
+    Returns x(t), x'(t) and X.
+    """
+    w0 = np.sqrt(k / m)
+    r = w / w0
+    P = F0 / (k * (1 - r * r))
+    s = Ff * (1 - r * r) * np.tan(np.pi / (2 * r)) / (F0 * r)
+    phi = np.pi - np.arcsin(s) if P > 0 else np.arcsin(s)
+    X = -P * np.cos(phi)
+    T = 2 * np.pi / w
+
+    def half(tp):
+        return (-Ff / k + P * np.cos(w * tp + phi) + Ff / k * np.cos(w0 * tp)
+                + P * r * np.sin(phi) * np.sin(w0 * tp))
+
+    def half_v(tp):
+        return (-P * w * np.sin(w * tp + phi) - Ff / k * w0 * np.sin(w0 * tp)
+                + P * r * np.sin(phi) * w0 * np.cos(w0 * tp))
+
+    tp = np.mod(np.asarray(t) - phi / w, T)
+    second = tp >= T / 2
+    x = np.where(second, -half(tp - T / 2), half(tp))
+    v = np.where(second, -half_v(tp - T / 2), half_v(tp))
+    return x, v, X
+
+
+def event_driven(*, m, k, Ff, F0, w, t_end, t_eval):
+    """Stick-slip oscillator integrated event by event (x(0) = x'(0) = 0): slip phases solve
+    ``m x'' = F0 cos(wt) - k x - s Ff`` until x' = 0; stick phases hold x until
+    ``|F0 cos(wt) - k x| = Ff``. Returns x at ``t_eval`` and the list of stick intervals."""
+    F = lambda t: F0 * np.cos(w * t)
+    t, x, v = 0.0, 0.0, 0.0
+    R = F(0.0) - k * x
+    mode = 0 if abs(R) <= Ff else np.sign(R)
+    out = np.full(t_eval.shape, np.nan)
+    sticks = []
+    while t < t_end:
+        if mode == 0:
+            xs = x
+
+            def g(tt, y, xs=xs):
+                return abs(F(tt) - k * xs) - Ff
+
+            g.terminal, g.direction = True, 1
+            sol = solve_ivp(lambda tt, y: [0.0], (t, t_end), [x], events=g, rtol=1e-12,
+                            atol=1e-14, max_step=0.5)
+            tn = sol.t_events[0][0] if sol.t_events[0].size else t_end
+            sel = (t_eval >= t) & (t_eval <= tn)
+            out[sel] = xs
+            sticks.append((t, tn))
+            t = tn
+            mode = np.sign(F(t) - k * x)
+        else:
+            s = mode
+
+            def rhs(tt, y, s=s):
+                return [y[1], (F(tt) - k * y[0] - s * Ff) / m]
+
+            def ev(tt, y):
+                return y[1]
+
+            ev.terminal, ev.direction = True, -s
+            sol = solve_ivp(rhs, (t, t_end), [x, v], events=ev, rtol=1e-12, atol=1e-14,
+                            dense_output=True, max_step=0.5)
+            tn = sol.t_events[0][0] if sol.t_events[0].size else t_end
+            sel = (t_eval >= t) & (t_eval <= tn)
+            if sel.any():
+                out[sel] = sol.sol(t_eval[sel])[0]
+            x, v, t = sol.sol(tn)[0], 0.0, tn
+            R = F(t) - k * x
+            mode = 0 if abs(R) <= Ff else np.sign(R)
+    return out, sticks
+
+
+# --------------------------------------------------------------------------------------------
+# the 1-DOF friction oscillator
+# --------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("r", [0.7, 1.5])
+def test_den_hartog_continuous_slip(r):
+    """Steady state from rest vs Den Hartog's exact continuous-slip solution.
+
+    Tolerance: in continuous slip the friction force jumps by 2 Ff at each velocity reversal;
+    an event-capturing fixed-step scheme places the jump within one step h, so each reversal
+    carries an impulse error up to 2 Ff h, i.e. a velocity error 2 Ff h / m and a displacement
+    error ~ 2 Ff h / (m w). Allowing two such errors: ``4 Ff h / (m w X)`` relative to X
+    (first order in h; measured 1.2e-3 and 2.2e-3 against 8.0e-3 and 4.5e-3).
+    """
+    m = k = F0 = 1.0
+    Ff = 0.3
+    w = r
+    N = 1024
+    model = slider(mu=Ff, N=1.0)
+    res = tr.integrate(model, w, n_periods=200, steps_per_period=N)
+    xa, va, X = den_hartog(res.t, m=m, k=k, Ff=Ff, F0=F0, w=w)
+    # the analytic solution has no stops: the velocity changes sign twice per period only
+    tt = np.linspace(0, 2 * np.pi / w, 4001)[:-1]
+    _, vv, _ = den_hartog(tt, m=m, k=k, Ff=Ff, F0=F0, w=w)
+    assert np.count_nonzero(np.diff(np.sign(vv)) != 0) <= 2
+    h = 2 * np.pi / (w * N)
+    tol = 4 * Ff * h / (m * w * X)
+    x = res.observed["x"][:, 0]
+    assert np.max(np.abs(x - xa)) / X < tol
+    # friction dissipation per period: Ff times the sliding distance 4 X (same bound)
+    assert abs(res.energy["friction"][-1] / (4 * Ff * X) - 1) < tol
+    # the normal DOF stays pressed with lam_N = N exactly (constant load, closed contact)
+    np.testing.assert_allclose(res.lam[:, 0, 0], 1.0, rtol=1e-12)
+    assert np.all(res.state[:, 0] > 0)
+
+
+@pytest.mark.parametrize("Ff", [0.5, 0.7])
+def test_stick_slip_with_stops_vs_event_driven(Ff):
+    """Oscillator that stops twice per period vs an event-driven solve_ivp integration.
+
+    Tolerance: at a stop (slip -> stick) the velocity is continuous and at a start (stick ->
+    slip) the force is continuous, so an event placed up to one step h late or early gives a
+    local error ``a h^2 / 2`` with ``|a| <= (F0 + Ff + k max|x|) / m``; relative to the
+    amplitude this is the bound used (measured errors are 10 times smaller).
+    """
+    m = k = F0 = 1.0
+    w = 0.5
+    N = 1024
+    n = 25
+    T = 2 * np.pi / w
+    h = T / N
+    res = tr.integrate(slider(mu=Ff), w, n_periods=n, steps_per_period=N)
+    ref, sticks = event_driven(m=m, k=k, Ff=Ff, F0=F0, w=w, t_end=n * T + 1e-9, t_eval=res.t)
+    last = [s for s in sticks if s[0] > (n - 1) * T]
+    assert len(last) == 2  # two stops per period: a genuine stick-slip case
+    amp = 0.5 * (ref.max() - ref.min())
+    a_max = (F0 + Ff + k * np.abs(ref).max()) / m
+    err = np.max(np.abs(res.observed["x"][:, 0] - ref)) / amp
+    assert err < a_max * h * h / (2 * amp)
+    # the scheme reports stick steps where the reference sticks
+    stuck = np.zeros(res.t.size, dtype=bool)
+    for a, b in last:
+        stuck |= (res.t > a + h) & (res.t < b - h)
+    assert np.all(res.state[stuck, 0] == 1)
+
+
+def test_3d_rotating_force_circular_slip():
+    """3D node under a rotating tangential force: exact steady state is a circle of radius
+    ``X = sqrt(F0^2 - mu^2 N^2) / |k - m w^2|`` slipping at constant speed.
+
+    Tolerance: the friction force at t_n takes the direction of the slip over the next step
+    (direction of the velocity at t_n + h/2), a lag of ``delta = w h / 2``; the steady
+    radius then satisfies ``(k - m w^2) X = sqrt(F0^2 - mu^2 N^2 cos^2 d) + mu N sin d``, an
+    error ``mu N delta / sqrt(F0^2 - mu^2 N^2)`` (first order). We check the error against
+    1.5 times this estimate and that halving h halves the error.
+    """
+    mu, w, N, F0, k, m = 0.3, 0.7, 1.0, 1.0, 1.0, 1.0
+    X = np.sqrt(F0**2 - (mu * N) ** 2) / abs(k - m * w * w)
+    errs = []
+    for steps in (128, 256):
+        res = tr.integrate(slider3d(mu=mu), w, n_periods=150, steps_per_period=steps)
+        rad = np.hypot(*res.observed["x"].T)
+        err = np.max(np.abs(rad / X - 1))
+        lag = mu * N * (w * 2 * np.pi / (w * steps) / 2) / np.sqrt(F0**2 - (mu * N) ** 2)
+        assert err < 1.5 * lag
+        assert np.all(res.state[:, 0] == 2)  # slips all the time
+        # friction dissipation per period: mu N times the circumference 2 pi X
+        assert abs(res.energy["friction"][-1] / (mu * N * 2 * np.pi * X) - 1) < lag
+        errs.append(err)
+    assert 0.4 < errs[1] / errs[0] < 0.6
+
+
+# --------------------------------------------------------------------------------------------
+# energy
+# --------------------------------------------------------------------------------------------
+def test_energy_conserved_without_friction_and_damping():
+    """Undamped chain, no loads, initial velocity.
+
+    (a) contact open all the time: the discrete energy ``E_{n+1/2}`` of the trapezoidal rule
+    is an exact invariant, so it is constant to round-off (1e-12 relative) over 200 periods,
+    with and without the Craig-Bampton reduction.
+    (b) frictionless impacts on the obstacle: energy never increases (the normal work of each
+    step is >= 0, a perfectly inelastic impact of the contact node), is constant between
+    impacts, and the identity ``dE = -W_normal`` holds to round-off.
+    """
+    for cut in (None, "all"):
+        model = chain(mu=0.0, gap=1.0, N=0.0, F=0.0)
+        V0 = np.zeros(model.ndof)
+        V0[5] = 1e-3
+        res = tr.integrate(model, 1.0, n_periods=200, steps_per_period=64, V0=V0, record=200,
+                           modal_cutoff=cut)
+        E = res.energy["mechanical"]
+        assert np.all(res.state == 0)
+        assert np.ptp(E) / E[0] < 1e-12
+    model = chain(mu=0.0, gap=2e-4, N=0.0, F=0.0)
+    V0 = np.zeros(model.ndof)
+    V0[1:4] = 1e-3
+    V0[0] = 1e-3  # the contact node moves towards the obstacle
+    res = tr.integrate(model, 1.0, n_periods=50, steps_per_period=64, V0=V0, record=50)
+    E = res.energy["mechanical"]
+    wn = np.diff(res.energy["normal"])
+    assert np.any(res.state > 0)  # it hits
+    assert np.all(wn >= -1e-15 * E[0])
+    dE = np.diff(E)
+    assert np.all(dE <= 1e-13 * E[0])
+    assert np.max(np.abs(dE + wn)) < 1e-12 * E[0]
+    assert E[-1] < E[0]
+
+
+def test_energy_balance_with_friction_and_damping():
+    """Forced chain with friction, Rayleigh damping and an undamped spring to ground (the
+    low-rank damping path): over one period of the steady state
+    ``external work = friction + damping + normal work + change of mechanical energy``.
+
+    The identity is exact for the scheme, so its residual is round-off (1e-9 of the external
+    work). Independently, the damping dissipation is recomputed from the recorded velocities
+    of all DOFs with the model's own (full) ``C``, ``sum_n h v_n^T C v_n`` (the scheme's
+    damping work per step is ``h v_n^T C v_n`` with ``v_n = (U_{n+1} - U_{n-1}) / 2h``): this
+    checks the reduced damping (diagonal + low rank) and its accumulation, to round-off.
+    Friction work is > 0, the work of the normal contact force is 0 (closed contact, the
+    normal position does not move), and the mechanical energy repeats after a period.
+    """
+    model = chain(mu=0.3, N=1.0, F=1.5, c_a=1e-2, c_b=2e-2)
+    steps = 256
+    res = tr.integrate(model, 0.5, n_periods=300, steps_per_period=steps, record=2)
+    assert res.info["diagonal"] and res.info["damping"]["low_rank"] == 1
+    assert np.any(res.state[:, 0] == 1) and np.any(res.state[:, 0] == 2)  # stick and slip
+    e = {key: val[steps] - val[0] for key, val in res.energy.items()}  # over one period
+    ext = e["external"]
+    assert ext > 0
+    assert res.energy_residual() < 1e-9 * ext
+    assert abs(e["numerical"]) < 1e-9 * ext
+    assert e["friction"] > 0
+    assert abs(e["normal"]) < 1e-12 * ext
+    assert abs(e["mechanical"]) < 1e-6 * ext  # steady: the period repeats
+    assert abs(ext - e["friction"] - e["damping"]) < 1e-6 * ext
+    v = res.velocities["all"][1:steps + 1]
+    d_indep = res.info["h"] * np.einsum("ni,ij,nj->", v, model.C.toarray(), v)
+    assert abs(e["damping"] / d_indep - 1) < 1e-9
+
+
+def test_low_rank_damping_step_matches_dense():
+    """The Woodbury form of the step (modal damping ``diag + U R U^T``) against a dense solve
+    of ``S = M + gamma h C + beta h^2 K`` in the same coordinates (round-off)."""
+    model = chain(mu=0.3, c_a=2e-3, c_b=1e-3)
+    integ = tr._Integrator(model, 1.2, steps_per_period=64, modal_cutoff=None, n_modes=None,
+                           gamma=0.5, tol=1e-10, wear=None, U0=None, V0=None,
+                           stick_anchor=None)
+    red, h = integ.red, integ.h
+    C = np.diag(red.C) + red.U @ red.R @ red.U.T
+    S = np.eye(integ.r) + 0.5 * h * C + 0.25 * h * h * np.diag(red.K)
+    G = h * h * np.linalg.solve(S, red.Tx.T)
+    np.testing.assert_allclose(integ.G, G, rtol=1e-10, atol=1e-12 * np.abs(G).max())
+
+
+# --------------------------------------------------------------------------------------------
+# reduction
+# --------------------------------------------------------------------------------------------
+def test_reduction_is_exact_in_statics():
+    """Craig-Bampton on the contact DOFs plus one static mode per load vector: the static
+    response to any contact force and to the loads is exact. Compared with a direct sparse
+    solve of the full model (round-off, 1e-9), with no fixed-interface mode kept."""
+    model = chain(ks_normal=50.0)
+    red = tr._reduce(model, 1.0, modal_cutoff=None, n_modes=0, steps_per_period=64)
+    assert red.basis.shape[1] < model.ndof
+    rng = np.random.default_rng(1)
+    lam = rng.normal(size=2)
+    F = sum(ld.vector for ld in model.loads) - model.contact.local_transform(model.ndof).T @ lam
+    u_full = spla.spsolve(model.K.tocsc(), F)
+    B = red.basis
+    K = B.T @ (model.K @ B)
+    u_red = B @ np.linalg.solve(K, B.T @ F)
+    np.testing.assert_allclose(u_red, u_full, rtol=1e-9, atol=1e-12 * np.abs(u_full).max())
+
+
+def test_linear_limit_against_frequency_domain():
+    """Frictionless, permanently closed contact makes the problem linear (the normal DOF is
+    held, the tangential one is free). For ``F e^{i w t}`` the two-step trapezoidal rule has
+    the exact periodic solution ``Z(w~)^-1 F`` with the warped frequency
+    ``w~ = (2/h) tan(w h / 2)`` (mass, damping and stiffness terms all warp the same way;
+    classical). So the steady first harmonic at the chain end must match a direct complex
+    solve of the full model at ``w~`` to round-off (1e-9) without reduction, and, with the
+    default Craig-Bampton cutoff ``w_c = 8 w`` (64 steps), to the dynamic amplification lost
+    with the truncated modes, at most ``(w / w_c)^2 = 1/64``.
+    """
+    model = chain(mu=0.0, N=5.0, F=1.0, c_b=0.05)
+    w, steps = 1.1, 64
+    h = 2 * np.pi / (w * steps)
+    wt = 2 / h * np.tan(w * h / 2)
+    K, M, C = model.K.toarray(), model.M.toarray(), model.C.toarray()
+    keep = np.arange(1, model.ndof)
+    Z = K - wt * wt * M + 1j * wt * C
+    f = np.zeros(model.ndof)
+    f[-1] = 1.0
+    u = np.linalg.solve(Z[np.ix_(keep, keep)], f[keep])[-1]
+    for cut, tol in (("all", 1e-9), (None, 1.0 / 64)):
+        res = tr.integrate(model, w, n_periods=400, steps_per_period=steps, modal_cutoff=cut)
+        c = tr.fourier_coefficients(res.observed["end"][:, 0], 3)
+        assert abs((c[1] - 1j * c[4]) / u - 1) < tol
+    assert res.info["r"] < model.ndof  # the default did truncate
+
+
+def test_restart_is_exact():
+    """Two runs of 15 periods chained through ``U, V`` equal one run of 30 periods to
+    round-off (the final state encodes the two-step history exactly)."""
+    model = chain(mu=0.3, N=2.0, F=1.5, c_a=2e-3)
+    a = tr.integrate(model, 1.2, n_periods=30, steps_per_period=64)
+    b = tr.integrate(model, 1.2, n_periods=15, steps_per_period=64)
+    b = tr.integrate(model, 1.2, n_periods=15, steps_per_period=64, U0=b.U, V0=b.V)
+    scale = np.abs(a.U).max()
+    np.testing.assert_allclose(b.U, a.U, atol=1e-9 * scale)
+    np.testing.assert_allclose(b.observed["end"], a.observed["end"], atol=1e-9 * scale)
+
+
+# --------------------------------------------------------------------------------------------
+# quasi-static incremental wear
+# --------------------------------------------------------------------------------------------
+def punch(*, p=(1e6, 1e6, 1e6, 4e6), k=1e6, mu=0.5, Q0=120.0, kw=1e-12, area=1e-4):
+    """Contact nodes each held tangentially by a spring k, pressed with pressure p and pulled
+    by ``Q0 sin(tau)``: three slide (Q0 > mu p A), the fourth (higher pressure) sticks."""
+    nc = len(p)
+    p = np.asarray(p, dtype=float)
+    Kd = np.zeros(2 * nc)
+    Kd[1::2] = k
+    contact = ContactInterface(dofs=np.arange(2 * nc).reshape(nc, 2),
+                               frame=np.tile(np.eye(2), (nc, 1, 1)), gap=np.zeros(nc),
+                               area=np.full(nc, area), mu=mu, coords=np.zeros((nc, 2)),
+                               wear_coefficient=kw)
+    vN = np.zeros(2 * nc)
+    vN[0::2] = p * area
+    vT = np.zeros(2 * nc)
+    vT[1::2] = Q0
+    return Model(K=sp.csr_matrix(np.diag(Kd)), M=sp.identity(2 * nc, format="csr"),
+                 contact=contact, loads=[Load(vN, "constant"), Load(vT, "sin")])
+
+
+def test_incremental_wear_flat_punch():
+    """Uniform sliding under constant pressure wears at Archard's rate, exactly.
+
+    Analytic: once the first cycle is over, a sliding node goes between +-X,
+    ``X = (Q0 - mu p A) / k``, so it slides ``4 X`` per cycle and wears ``k_w p 4 X`` per
+    cycle; the sticking node (``Q0 < mu p A``) does not wear. Quasi-static load steps that
+    include the turning points (steps_per_cycle divisible by 4) reproduce this exactly
+    (round-off). The worn volume per cycle equals ``k_w / mu`` times the friction
+    dissipation (Archard with Coulomb slip), and a cycle jump J counts a computed cycle J
+    times, which for a constant wear rate gives the same wear.
+    """
+    p = np.array([1e6, 1e6, 1e6, 4e6])
+    model = punch(p=p)
+    c = model.contact
+    k, mu, Q0, kw = 1e6, c.mu, 120.0, c.wear_coefficient
+    res = tr.incremental_wear(model, steps_per_cycle=16, n_cycles=10)
+    X = (Q0 - mu * p * c.area) / k
+    rate = np.diff(res.wear, axis=0)[1:]
+    expected = np.broadcast_to(kw * p[:3] * 4 * X[:3], rate[:, :3].shape)
+    np.testing.assert_allclose(rate[:, :3], expected, rtol=1e-10)
+    assert np.all(res.wear[:, 3] == 0.0)
+    np.testing.assert_allclose(res.slip[-1, :3], 4 * X[:3], rtol=1e-10)
+    np.testing.assert_allclose(res.pressure[-1], p, rtol=1e-10)
+    np.testing.assert_allclose(np.diff(res.worn_volume)[1:], kw / mu * res.dissipation[2:],
+                               rtol=1e-10)
+    jumped = tr.incremental_wear(model, steps_per_cycle=16, n_cycles=10, cycle_jump=3)
+    assert jumped.computed_cycles == 4 and jumped.cycles[-1] == 10
+    np.testing.assert_allclose(jumped.wear[-1], res.wear[-1], rtol=1e-10, atol=1e-20)
+
+
+def test_incremental_wear_gap_grows_with_wear():
+    """Wear opens the gap as it goes: a sliding node's normal DOF (no stiffness, pressed by a
+    constant load) sits exactly at the wear of the step before the last (the last step's
+    wear is added after its solve), and the normal force stays the applied load."""
+    steps = 8
+    res = tr.incremental_wear(punch(p=[1e6]), steps_per_cycle=steps, n_cycles=5)
+    w_last, w_prev = res.wear[-1, 0], res.wear[-2, 0]
+    assert w_prev < res.U[0] < w_last
+    # one step's wear at most: the slip per step is at most the cycle's slip over 2
+    assert w_last - res.U[0] <= 0.5 * (w_last - w_prev)
+    assert res.lam[0, 0] == pytest.approx(1e6 * 1e-4, rel=1e-12)
+
+
+# --------------------------------------------------------------------------------------------
+# classification
+# --------------------------------------------------------------------------------------------
+def test_classifier_on_synthetic_sequences():
+    """Once-per-period sequences with a known nature (2 monitored signals, scale 1)."""
+    k = np.arange(512)[:, None]
+    base = np.array([[0.3, -0.2]])
+    # geometric convergence, well converged
+    conv = base + 1e-3 * 0.5**k
+    c = tr.classify_sequence(conv, tol=1e-6, scale=1.0)
+    assert c.kind == "periodic"
+    # slower geometric convergence (ratio 0.97): after 100 periods the last difference is
+    # 1.5e-6 but the distance to the limit is 5e-5: not yet periodic at tol 1e-5
+    slow = base + 1e-3 * 0.97**k
+    c = tr.classify_sequence(slow[:100], tol=1e-5, scale=1.0)
+    assert np.abs(np.diff(slow[:100], axis=0)).max(axis=1)[-1] < 1e-5
+    assert c.kind == "transient" and c.periodicity_error > 1e-5
+    # repeats every 3 periods
+    sub = base + 1e-2 * np.cos(2 * np.pi * k / 3)
+    c = tr.classify_sequence(sub, tol=1e-6, scale=1.0)
+    assert c.kind == "subharmonic" and c.order == 3
+    # steady drift (ratcheting) with an oscillation on top
+    rng = np.random.default_rng(0)
+    drift = base + 1e-4 * k + 1e-6 * rng.normal(size=(512, 2))
+    c = tr.classify_sequence(drift, tol=1e-6, scale=1.0)
+    assert c.kind == "drifting" and c.drift_rate == pytest.approx(1e-4, rel=1e-3)
+    # incommensurate oscillation: bounded, sustained, a spectral peak at the rotation number
+    nu = (np.sqrt(5) - 1) / 4  # 0.309...
+    qp = base + 1e-2 * np.cos(2 * np.pi * nu * k + np.array([[0.0, 1.0]]))
+    c = tr.classify_sequence(qp, tol=1e-6, scale=1.0)
+    assert c.kind == "quasi-periodic"
+    assert abs(c.rotation - nu) < 1.0 / 512
+    # the same but decaying (a transient still dying out): not quasi-periodic
+    c = tr.classify_sequence(base + 1e-2 * 0.995**k * np.cos(2 * np.pi * nu * k), tol=1e-6,
+                             scale=1.0)
+    assert c.kind == "transient" and c.decay < 0.5
+    # too few samples to say anything but periodic
+    assert tr.classify_sequence(qp[:20], tol=1e-6, scale=1.0).kind == "transient"
+
+
+def test_fourier_coefficients_convention():
+    """a0 = mean, a_n = 2 Re X_n / N, b_n = -2 Im X_n / N on a known trigonometric signal."""
+    N = 64
+    t = 2 * np.pi * np.arange(N) / N
+    x = 0.5 + 2.0 * np.cos(t) - 3.0 * np.sin(t) + 0.25 * np.sin(3 * t)
+    c = tr.fourier_coefficients(x, 3)
+    np.testing.assert_allclose(c, [0.5, 2.0, 0.0, 0.0, -3.0, 0.0, 0.25], atol=1e-13)
+
+
+def test_steady_state_classifies_real_responses():
+    """steady_state on three oscillators whose nature is known by construction.
+
+    * stick-slip with stops: stops erase the memory, so the response becomes periodic; its
+      first harmonic matches the event-driven reference to the scheme's error (1e-3).
+    * ratcheting: a constant tangential pull below mu N and a normal load that drops below
+      pull/mu once per period, no spring: the node slides forward a little every period.
+    * undamped, stuck: a free vibration at w0 = 1 started by V0 superposes on the forced one
+      at w = (sqrt 5 - 1)/2, never decays and never repeats; the Poincare rotation number is
+      ``w0 / w mod 1`` folded into [0, 1/2] (w0 slightly warped by the trapezoidal rule,
+      ``(w0 h)^2 / 12`` = 2e-4 relative, well inside the spectral resolution 2 / n).
+    """
+    m = k = F0 = 1.0
+    Ff, w = 0.5, 0.5
+    ss = tr.steady_state(slider(mu=Ff), w, steps_per_period=512, tol=1e-8)
+    assert ss.classification == "periodic" and ss.converged
+    T = 2 * np.pi / w
+    n = ss.n_periods
+    ref, _ = event_driven(m=m, k=k, Ff=Ff, F0=F0, w=w, t_end=n * T + 1e-9, t_eval=ss.last.t)
+    cref = tr.fourier_coefficients(ref, 7)
+    c = ss.harmonics["x"][:, 0]
+    assert np.max(np.abs(c - cref)) < 1e-3 * np.abs(cref).max()
+    assert ss.contact_harmonics["lam"].shape == (15, 1, 2)
+
+    # ratcheting
+    Kd = sp.csr_matrix(np.diag([0.0, 0.0]))
+    contact = ContactInterface(dofs=np.array([[0, 1]]), frame=np.eye(2)[None],
+                               gap=np.zeros(1), area=np.ones(1), mu=0.5, coords=np.zeros((1, 2)))
+    loads = [Load(np.array([1.0, 0.3]), "constant"), Load(np.array([0.6, 0.0]), "cos")]
+    rat = Model(K=Kd, M=sp.identity(2, format="csr"), contact=contact, loads=loads,
+                observed=[ObservedPoint("x", np.array([1]), np.zeros(1))])
+    ss = tr.steady_state(rat, 1.0, steps_per_period=64, min_periods=64, check_every=32)
+    assert ss.classification == "drifting"
+    assert ss.diagnostics.drift_rate > 0
+
+    # quasi-periodic: a mass on a spring k = 1 attached to a stuck contact node, undamped
+    wq = (np.sqrt(5) - 1) / 2
+    model = chain(n=1, k=1.0, kg=0.0, mu=10.0, N=1.0, F=0.5)
+    V0 = np.zeros(model.ndof)
+    V0[2] = 0.2
+    ss = tr.steady_state(model, wq, steps_per_period=64, V0=V0, min_periods=64, max_periods=600)
+    assert ss.classification == "quasi-periodic"
+    assert np.all(ss.last.state == 1)
+    nu = np.mod(1.0 / wq, 1.0)
+    nu = min(nu, 1 - nu)
+    assert abs(ss.diagnostics.rotation - nu) < 2.0 / ss.diagnostics.n
+
+
+# --------------------------------------------------------------------------------------------
+# inputs
+# --------------------------------------------------------------------------------------------
+def test_bad_inputs_are_reported():
+    model = slider()
+    with pytest.raises(InputError, match="record"):
+        tr.integrate(model, 1.0, n_periods=2, record=3)
+    with pytest.raises(InputError, match="modal_cutoff"):
+        tr.integrate(model, 1.0, n_periods=1, modal_cutoff="some")
+    with pytest.raises(InputError, match="omega"):
+        tr.integrate(model, -1.0, n_periods=1)
+    with pytest.raises(InputError, match="wear"):
+        tr.integrate(model, 1.0, n_periods=1, wear=[0.0, 1.0])
+    fixed = slider()
+    fixed.fixed_dofs = np.array([1])
+    with pytest.raises(InputError, match="fixed"):
+        tr.integrate(fixed, 1.0, n_periods=1)
