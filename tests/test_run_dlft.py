@@ -50,6 +50,13 @@ def small_case(tmp_path: Path, analysis: str, name: str = "beam.toml") -> Path:
     return path
 
 
+def with_key(analysis: str, line: str) -> str:
+    """``analysis`` with the key of ``line`` set by ``line`` (replaced or added)."""
+    key = line.split("=")[0].strip()
+    kept = [x for x in analysis.splitlines() if x.split("=")[0].strip() != key]
+    return "\n".join(kept + [line]) + "\n"
+
+
 def run(path: Path, capsys) -> tuple[int, str, str]:
     status = cli.main(["run", str(path), "--no-progress"])
     out = capsys.readouterr()
@@ -145,7 +152,7 @@ def test_quasi_static_needs_no_frequency_and_takes_a_list_of_harmonics(tmp_path,
 
 
 def test_a_periodic_solve_that_fails_saves_no_solution(tmp_path, capsys):
-    path = small_case(tmp_path, PERIODIC + "max_iter = 1\n")
+    path = small_case(tmp_path, with_key(PERIODIC, "max_iter = 1"))
     status, out, err = run(path, capsys)
     assert status == 1
     assert err == ""
@@ -187,7 +194,8 @@ def test_sweep_writes_documented_results_and_figures(tmp_path, capsys):
 
 
 def test_sweep_points_that_fail_are_kept_as_nan_with_the_reason(tmp_path, capsys):
-    path = small_case(tmp_path, SWEEP + "max_iter = 1\ncontinuation = false\n")
+    path = small_case(tmp_path, with_key(with_key(SWEEP, "max_iter = 1"),
+                                         "continuation = false"))
     status, out, _ = run(path, capsys)
     assert status == 1
     ds = read_results(tmp_path / "beam-results" / "results.nc")
@@ -200,21 +208,19 @@ def test_sweep_points_that_fail_are_kept_as_nan_with_the_reason(tmp_path, capsys
 
 
 # --- input errors ---------------------------------------------------------------------------
-@pytest.mark.parametrize("extra, message", [
-    ("n_samples = 6\n", "analysis.n_samples = 6: expected more than 6 samples per period "
-                        "(twice the highest harmonic, 3)"),
-    ("frequency = -50.0\n", "analysis.frequency = -50.0: expected a number > 0"),
-    ('solver = "powel"\n', 'analysis.solver = "powel": expected one of "powell", "newton", '
-                           '"hybr" (did you mean "powell"?)'),
-    ('eps = "paper"\n', 'analysis.eps = "paper": expected one of "auto", "static" or a number '
-                        "> 0"),
-    ("harmonics = 0\n", "analysis.harmonics = 0: expected an integer >= 1 or a non-empty list "
-                        "of integers >= 1 (no repeats)"),
+@pytest.mark.parametrize("line, message", [
+    ("n_samples = 6", "analysis.n_samples = 6: expected more than 6 samples per period "
+                      "(twice the highest harmonic, 3)"),
+    ("frequency = -50.0", "analysis.frequency = -50.0: expected a number > 0"),
+    ('solver = "powel"', 'analysis.solver = "powel": expected one of "powell", "newton", '
+                         '"hybr" (did you mean "powell"?)'),
+    ('eps = "paper"', 'analysis.eps = "paper": expected one of "auto", "static" or a number '
+                      "> 0"),
+    ("harmonics = 0", "analysis.harmonics = 0: expected an integer >= 1 or a non-empty list "
+                      "of integers >= 1 (no repeats)"),
 ])
-def test_bad_periodic_input_gives_one_clear_line(tmp_path, capsys, extra, message):
-    analysis = "\n".join(line for line in (PERIODIC + extra).splitlines()
-                         if not (line.split(" = ")[0] in extra and line not in extra)) + "\n"
-    status, out, err = run(small_case(tmp_path, analysis), capsys)
+def test_bad_periodic_input_gives_one_clear_line(tmp_path, capsys, line, message):
+    status, out, err = run(small_case(tmp_path, with_key(PERIODIC, line)), capsys)
     assert status == 2
     assert err == f"error: {message}\n"
     assert not (tmp_path / "beam-results").exists()

@@ -147,8 +147,7 @@ def event_driven(*, m, k, Ff, F0, w, t_end, t_eval):
                 return abs(F(tt) - k * xs) - Ff
 
             g.terminal, g.direction = True, 1
-            sol = solve_ivp(lambda tt, y: [0.0], (t, t_end), [x], events=g, rtol=1e-12,
-                            atol=1e-14, max_step=0.5)
+            sol = solve_ivp(lambda tt, y: [0.0], (t, t_end), [x], events=g, max_step=0.5)
             tn = sol.t_events[0][0] if sol.t_events[0].size else t_end
             sel = (t_eval >= t) & (t_eval <= tn)
             out[sel] = xs
@@ -166,7 +165,7 @@ def event_driven(*, m, k, Ff, F0, w, t_end, t_eval):
 
             ev.terminal, ev.direction = True, -s
             sol = solve_ivp(rhs, (t, t_end), [x, v], events=ev, rtol=1e-12, atol=1e-14,
-                            dense_output=True, max_step=0.5)
+                            method="DOP853", dense_output=True, max_step=0.5)
             tn = sol.t_events[0][0] if sol.t_events[0].size else t_end
             sel = (t_eval >= t) & (t_eval <= tn)
             if sel.any():

@@ -367,57 +367,58 @@ _FRF = Table(
     doc="Nonlinear FRFs (fretwear.sweep) of the unworn and the worn interface.",
 )
 
-register(
-    "wear",
-    {
-        "frequency": Field(_POS, "excitation frequency (with quasi_static: only the time "
-                           "scale; default 1 Hz)", unit="Hz"),
-        "quasi_static": Field(Flag(), "drop inertia and damping (slow cyclic loading)",
-                              default=False),
-        "harmonics": Field(Integer(lo=1), "kept harmonics 1..harmonics", default=7),
-        "n_samples": Field(Integer(lo=3), "time samples per period", default=128),
-        "eps": Field(_POS, "DLFT penalty (default: spectral radius of the reduced dynamic "
-                     "stiffness)", unit="N/m"),
-        "solver": Field(Text(SOLVERS), "nonlinear solver of the first periodic solve and "
-                        "the fallback of the slow steps", default="powell"),
-        "tol": Field(_POS, "relative residual of the periodic solves |f| <= tol |Z U|",
-                     default=1e-9, unit="-"),
-        "law": Field(Text(LAWS), '"archard" (k_w = contact.wear_coefficient, paper eq. 29) '
-                     'or "energy" (worn volume = energy_coefficient x friction energy)',
-                     default="archard"),
-        "energy_coefficient": Field(Number(lo=0), "k_e of the energy law", unit="m^3/J"),
-        "scheme": Field(Text(SCHEMES), '"implicit" (backward Euler, stable for any jump), '
-                        '"rosenbrock" (linearly implicit Euler) or "explicit" (explicit Euler, '
-                        "paper eq. 30)", default="implicit"),
-        "adaptive": Field(Flag(), "adapt the jump to `tolerance`; false: constant jumps of "
-                          "`initial_jump`", default=True),
-        "tolerance": Field(_POS, "local error per step relative to the maximum wear depth",
-                           default=1e-2, unit="-"),
-        "initial_jump": Field(_POS, "first jump (default: from the slow Jacobian's spectral "
-                              "radius)", unit="cycles"),
-        "max_jump": Field(Number(lo=0, lo_open=True, allow_inf=True), "cap on the jump",
-                          default=math.inf, unit="cycles"),
-        "max_cycles": Field(_POS, "stop at this cycle count", default=1e12, unit="cycles"),
-        "max_depth": Field(_POS, "stop when a wear depth reaches this", unit="m"),
-        "plateau_rate": Field(Number(lo=0), "stop when the worn-volume rate falls below this "
-                              "fraction of its initial value", default=1e-3, unit="-"),
-        "max_steps": Field(Integer(lo=1), "stop after this many slow steps", default=10000),
-        "record_every": Field(Integer(lo=1), "keep every n-th step in results.nc (the last "
-                              "always)", default=1),
-        "checkpoint_every_s": Field(Number(lo=0), "checkpoint interval (0: every step)",
-                                    default=10.0, unit="s"),
-        "plot_nodes": Field(ListOf(Integer(lo=0), non_empty=True, unique=True),
-                            "contact nodes of the wear-kinetics figure (default: the most "
-                            "worn)"),
-        "frf_before_after": Field(_FRF, "nonlinear FRFs before and after wear (paper "
-                                  "Fig. 24)"),
-    },
-    run_wear,
-    checks=(_check_table,),
-    doc="Fretting wear on the slow time scale (DLFT with wear, paper section 3.3): the wear "
+#: keys of the ``[analysis]`` table of ``type = "wear"``
+SCHEMA = {
+    "frequency": Field(_POS, "excitation frequency (with quasi_static: only the time "
+                       "scale; default 1 Hz)", unit="Hz"),
+    "quasi_static": Field(Flag(), "drop inertia and damping (slow cyclic loading)",
+                          default=False),
+    "harmonics": Field(Integer(lo=1), "kept harmonics 1..harmonics", default=7),
+    "n_samples": Field(Integer(lo=3), "time samples per period", default=128),
+    "eps": Field(_POS, "DLFT penalty (default: spectral radius of the reduced dynamic "
+                 "stiffness)", unit="N/m"),
+    "solver": Field(Text(SOLVERS), "nonlinear solver of the first periodic solve and "
+                    "the fallback of the slow steps", default="powell"),
+    "tol": Field(_POS, "relative residual of the periodic solves |f| <= tol |Z U|",
+                 default=1e-9, unit="-"),
+    "law": Field(Text(LAWS), '"archard" (k_w = contact.wear_coefficient, paper eq. 29) '
+                 'or "energy" (worn volume = energy_coefficient x friction energy)',
+                 default="archard"),
+    "energy_coefficient": Field(Number(lo=0), "k_e of the energy law", unit="m^3/J"),
+    "scheme": Field(Text(SCHEMES), '"implicit" (backward Euler, stable for any jump), '
+                    '"rosenbrock" (linearly implicit Euler) or "explicit" (explicit Euler, '
+                    "paper eq. 30)", default="implicit"),
+    "adaptive": Field(Flag(), "adapt the jump to `tolerance`; false: constant jumps of "
+                      "`initial_jump`", default=True),
+    "tolerance": Field(_POS, "local error per step relative to the maximum wear depth",
+                       default=1e-2, unit="-"),
+    "initial_jump": Field(_POS, "first jump (default: from the slow Jacobian's spectral "
+                          "radius)", unit="cycles"),
+    "max_jump": Field(Number(lo=0, lo_open=True, allow_inf=True), "cap on the jump",
+                      default=math.inf, unit="cycles"),
+    "max_cycles": Field(_POS, "stop at this cycle count", default=1e12, unit="cycles"),
+    "max_depth": Field(_POS, "stop when a wear depth reaches this", unit="m"),
+    "plateau_rate": Field(Number(lo=0), "stop when the worn-volume rate falls below this "
+                          "fraction of its initial value", default=1e-3, unit="-"),
+    "max_steps": Field(Integer(lo=1), "stop after this many slow steps", default=10000),
+    "record_every": Field(Integer(lo=1), "keep every n-th step in results.nc (the last "
+                          "always)", default=1),
+    "checkpoint_every_s": Field(Number(lo=0), "checkpoint interval (0: every step)",
+                                default=10.0, unit="s"),
+    "plot_nodes": Field(ListOf(Integer(lo=0), non_empty=True, unique=True),
+                        "contact nodes of the wear-kinetics figure (default: the most "
+                        "worn)"),
+    "frf_before_after": Field(_FRF, "nonlinear FRFs before and after wear (paper "
+                              "Fig. 24)"),
+}
+CHECKS = (_check_table,)
+DOC = (
+    "Fretting wear on the slow time scale (DLFT with wear, paper section 3.3): the wear "
     "depth of every contact node evolves with the cycle count until a plateau of the worn "
     "volume, a depth or a cycle count. A checkpoint `wear-checkpoint.npz` in the results "
     "folder lets `fretwear run CASE.toml --resume` continue an interrupted run to the same "
     "result. Writes `wear-profile.png`, `wear-kinetics.png`, `pressure-slip.png`, "
-    "`worn-volume.png` and, with `frf_before_after`, `frf-worn-<point>.png`.",
+    "`worn-volume.png` and, with `frf_before_after`, `frf-worn-<point>.png`."
 )
+
+register("wear", SCHEMA, run_wear, checks=CHECKS, doc=DOC)

@@ -124,6 +124,7 @@ def solve_contact(A, b, xref, gap, xprev, mu, d, status, tdir, x, lam, tol, fsca
     de = np.zeros((3, 3))
     xi = np.zeros(3)
     new_st = np.zeros(nc, dtype=np.int8)
+    xs = np.zeros(m)
     new_dir = np.zeros((nc, d - 1))
     it = 0
     while it < maxit:
@@ -150,12 +151,22 @@ def solve_contact(A, b, xref, gap, xprev, mu, d, status, tdir, x, lam, tol, fsca
                         rows_node[nf] = i
                         rows_comp[nf] = c
                         nf += 1
-        # contact forces at the current iterate
-        for r in range(m):
-            s = b[r]
+        # contact forces at the current iterate: in full at the first iteration, then
+        # updated with the components whose prescribed value changed (A is symmetric)
+        if it == 1:
+            for r in range(m):
+                s = b[r]
+                for c in range(m):
+                    s -= A[r, c] * (x[c] - xref[c])
+                lam[r] = s
+        else:
             for c in range(m):
-                s -= A[r, c] * (x[c] - xref[c])
-            lam[r] = s
+                dx = x[c] - xs[c]
+                if dx != 0.0:
+                    for r in range(m):
+                        lam[r] -= A[c, r] * dx
+        for c in range(m):
+            xs[c] = x[c]
         fs = fscale
         for r in range(m):
             if abs(lam[r]) > fs:
@@ -219,6 +230,7 @@ def solve_contact(A, b, xref, gap, xprev, mu, d, status, tdir, x, lam, tol, fsca
                 return -1
             for k in range(nf):
                 x[cols[k]] += rhs[k]
+                xs[cols[k]] = x[cols[k]]
             # update the forces: lam -= A[:, F] dy
             for r in range(m):
                 s = 0.0
@@ -434,10 +446,12 @@ def run_dynamic(q, dq, diag, a_v, b_v, ds, hc, U, R, P, Qt, bq_m, bd_m, ftab, G,
                     for l in range(r):
                         s += bq_m[j, l] * q[l] + bd_m[j, l] * dq[l]
                     dqf[j] = s
+            for j in range(r):
+                tmp[j] = q[j] + dqf[j]
             for i in range(m):
                 s = 0.0
                 for j in range(r):
-                    s += Tx[i, j] * (q[j] + dqf[j])
+                    s += Tx[i, j] * tmp[j]
                 xref[i] = s
             its = solve_contact(A, zero_b, xref, gap, xprev, mu, d, status, tdir, x, lam, tol,
                                 fscale, maxit, cols, rows_node, rows_comp, J, rhs)

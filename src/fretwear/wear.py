@@ -66,6 +66,8 @@ LAWS = ("archard", "energy")
 SCHEMES = ("implicit", "rosenbrock", "explicit")
 STOP_REASONS = ("max_cycles", "max_depth", "plateau", "no_wear", "max_steps", "solver_failed")
 CHECKPOINT_VERSION = 1
+#: implicit schemes keep dN lam <= this for the growing modes (lam > 0) of the slow Jacobian
+GROWTH_LIMIT = 0.5
 
 
 # --------------------------------------------------------------------------------------------
@@ -842,6 +844,11 @@ def _advance(sp: SlowProblem, st: dict, opts: WearOptions):
         sp.set_state(W_k, anchor)
         lin = sp.slow_jacobian(U_k, with_dUdW=True)  # Js, dU/dW at the start of the step
         iters += 1
+        # a growing mode (eigenvalue lam > 0: wear moving load onto a neighbour) is only
+        # followed accurately with dN lam small, and I - dN Js is singular at dN lam = 1
+        lam_plus = float(np.max(np.linalg.eigvals(lin[0]).real))
+        if lam_plus > 0:
+            dN = min(dN, GROWTH_LIMIT / lam_plus)
     while True:
         W1, U1, stats = _attempt(sp, opts, W_k, U_k, g_k, anchor, dN, lin)
         iters += stats.iterations
@@ -898,70 +905,100 @@ def _attempt(sp: SlowProblem, opts: WearOptions, W_k, U_k, g_k, anchor, dN, lin)
     Up = U_k + (dUdW @ dW).reshape(sp.m, sp.H)
     if opts.scheme == "rosenbrock":
         U1, stats = sp.solve_balance(Wp, anchor, Up, **kw)
+        if not stats.converged:
+            its = stats.iterations
+            U1, stats = sp.solve_balance(Wp, anchor, sp.shift_guess(U_k, dW), **kw)
+            stats.iterations += its
         return Wp, U1, stats
     if opts.implicit_newton == "coupled":
         kw["max_iter"] = opts.max_iter_coupled
         U1, W1, stats = sp.solve_implicit(W_k, dN, anchor, Up, Wp, **kw)
         return W1, U1, stats
-    return _backward_euler(sp, opts, W_k, dN, anchor, Up, Wp, Js, dUdW)
+    return _backward_euler(sp, opts, W_k, U_k, dN, anchor, Up, Wp, Js, dUdW)
 
 
-def _backward_euler(sp: SlowProblem, opts: WearOptions, W_k, dN, anchor, U, W, Js, dUdW):
-    """Backward Euler ``W1 = W_k + dN g(W1)`` by a simplified Newton method on ``W``.
+def _backward_euler(sp: SlowProblem, opts: WearOptions, W_k, U_start, dN, anchor, U, W, Js,
+                    dUdW):
+    """Backward Euler ``W1 = W_k + dN g(W1)`` by a damped Newton method on ``W``.
 
     Every iterate is a converged periodic balance at its ``W`` (the ordinary DLFT solve,
     warm-started), so no unbalanced state is ever returned. The BE defect
-    ``r = W - W_k - dN g(W)`` is reduced with the frozen iteration matrix ``I - dN Js``
-    (refreshed once if the contraction is poor) until ``max|r| <= 0.1 tolerance max W`` (the
-    algebraic error an order below the local error allowed, as in stiff ODE codes). ``g`` is
-    only piecewise smooth (contact states switch), and the iteration can stall in a cycle at a
-    kink: the best iterate is then returned if ``max|r| <= 0.5 tolerance max W``. The step's
-    error estimate (:func:`_error`) contains ``r``, so the error test judges such a step.
+    ``r = W - W_k - dN g(W)`` is reduced with the iteration matrix ``I - dN Js``: frozen while
+    the defect contracts well, refreshed at the current iterate otherwise, with backtracking
+    when a full step does not decrease ``max|r|``. It stops when
+    ``max|r| <= 0.1 tolerance max W`` (the algebraic error an order below the local error
+    allowed, as in stiff ODE codes). ``g`` is only piecewise smooth (contact states switch),
+    and the iteration can stall at a kink: the best iterate is then returned if
+    ``max|r| <= 0.5 tolerance max W``. The step's error estimate (:func:`_error`) contains
+    ``r``, so the error test judges such a step.
 
     Returns ``(W1, U1, stats)``; ``stats.converged`` is False when the balance or the
     iteration fails.
     """
     t0 = time.perf_counter()
     kw = {"solver": opts.solver, "tol": opts.tol, "max_iter": opts.max_iter}
-    M = np.eye(sp.nc) - dN * Js
     its = 0
-    prev = math.inf
-    refreshed = False
-    best = None
     msg = "backward Euler iteration did not converge"
-    for _k in range(opts.max_iter_implicit):
-        U, st = sp.solve_balance(W, anchor, U, **kw)
+
+    def evaluate(W, U):
+        nonlocal its
+        U1, st = sp.solve_balance(W, anchor, U, **kw)
         its += st.iterations
+        if not st.converged:  # retry from the previous balance, shifted by the wear change
+            U1, st = sp.solve_balance(W, anchor, sp.shift_guess(U_start, W - W_k), **kw)
+            its += st.iterations
         if not st.converged:
-            msg = f"balance failed inside backward Euler: {st.message}"
+            return None
+        U = U1
+        r = W - W_k - dN * sp.rate(U)
+        return U, r, float(np.max(np.abs(r))), st.residual
+
+    ev = evaluate(W, U)
+    if ev is None:
+        return W, U, SolveStats(False, math.inf, its, 0, 0, time.perf_counter() - t0,
+                                "balance failed at the predictor", opts.solver)
+    U, r, rn, res = ev
+    best = (rn, W, U, res)
+    M = np.eye(sp.nc) - dN * Js
+    fresh = True
+    for _k in range(opts.max_iter_implicit):
+        if rn <= 0.1 * opts.tolerance * max(float(np.max(W)), 1e-300):
             break
-        g = sp.rate(U)
-        r = W - W_k - dN * g
-        rn = float(np.max(np.abs(r)))
-        wmax = max(float(np.max(np.abs(W))), 1e-300)
-        if best is None or rn < best[0]:
-            best = (rn, W.copy(), U.copy(), st.residual, wmax)
-        if rn <= 0.1 * opts.tolerance * wmax:
-            break
-        if rn > 0.5 * prev:
-            if refreshed:
-                break  # stalled (a cycle at a kink of g)
-            Js, dUdW = sp.slow_jacobian(U, with_dUdW=True)  # Jacobian at this iterate
-            M = np.eye(sp.nc) - dN * Js
-            refreshed = True
-            its += 1
-        prev = rn
         dW = -np.linalg.solve(M, r)
-        W_new = np.maximum(W + dW, W_k)  # BE keeps W1 >= W_k since g >= 0
-        U = U + (dUdW @ (W_new - W)).reshape(sp.m, sp.H)
-        W = W_new
-    if best is not None and best[0] <= 0.5 * opts.tolerance * best[4]:
-        rn, W, U, res, _ = best
-        stats = SolveStats(True, res, its, 0, 0, time.perf_counter() - t0, "converged",
-                           opts.solver)
-        return W, U, stats
-    stats = SolveStats(False, math.inf, its, 0, 0, time.perf_counter() - t0, msg, opts.solver)
-    return W, U, stats
+        t, accepted = 1.0, False
+        for _ls in range(4):
+            W_try = np.maximum(W + t * dW, W_k)  # BE keeps W1 >= W_k since g >= 0
+            ev = evaluate(W_try, U + (dUdW @ (W_try - W)).reshape(sp.m, sp.H))
+            if ev is not None and ev[2] < (1.0 - 1e-4 * t) * rn:
+                accepted = True
+                break
+            t *= 0.5
+        if not accepted:
+            if fresh:
+                msg = "backward Euler iteration stalled (no decrease of the defect)"
+                break
+            Js, dUdW = sp.slow_jacobian(U, with_dUdW=True)  # retry with a fresh Jacobian
+            its += 1
+            M = np.eye(sp.nc) - dN * Js
+            fresh = True
+            continue
+        contraction = ev[2] / rn
+        W, (U, r, rn, res) = W_try, ev
+        if rn < best[0]:
+            best = (rn, W, U, res)
+        if contraction > 0.5:  # poor contraction: Jacobian at the new iterate
+            Js, dUdW = sp.slow_jacobian(U, with_dUdW=True)
+            its += 1
+            M = np.eye(sp.nc) - dN * Js
+            fresh = True
+        else:
+            fresh = False
+    rn, W, U, res = best
+    if rn <= 0.5 * opts.tolerance * max(float(np.max(W)), 1e-300):
+        return W, U, SolveStats(True, res, its, 0, 0, time.perf_counter() - t0, "converged",
+                                opts.solver)
+    return W, U, SolveStats(False, math.inf, its, 0, 0, time.perf_counter() - t0, msg,
+                            opts.solver)
 
 
 class _Bar:
