@@ -378,9 +378,18 @@ def test_linear_limit_against_frequency_domain():
     classical). So the steady first harmonic at the chain end must match a direct complex
     solve of the full model at ``w~`` to round-off (1e-9) without reduction, and, with the
     default Craig-Bampton cutoff ``w_c = 8 w`` (64 steps), to the dynamic amplification lost
-    with the truncated modes, at most ``(w / w_c)^2 = 1/64``.
+    with the truncated modes, at most ``(w / w_c)^2 = 1/64``. Done twice: with Rayleigh
+    damping (diagonal modal step) and with a damping of no such structure (dense step).
     """
     model = chain(mu=0.0, N=5.0, F=1.0, c_b=0.05)
+    _check_linear_limit(model)
+    # a damping with no Rayleigh-plus-low-rank structure: the dense step
+    rng = np.random.default_rng(3)
+    model.C = sp.diags(rng.uniform(0.02, 0.1, model.ndof)).tocsr()
+    assert not _check_linear_limit(model)
+
+
+def _check_linear_limit(model):
     w, steps = 1.1, 64
     h = 2 * np.pi / (w * steps)
     wt = 2 / h * np.tan(w * h / 2)
@@ -395,6 +404,7 @@ def test_linear_limit_against_frequency_domain():
         c = tr.fourier_coefficients(res.observed["end"][:, 0], 3)
         assert abs((c[1] - 1j * c[4]) / u - 1) < tol
     assert res.info["r"] < model.ndof  # the default did truncate
+    return res.info["diagonal"]
 
 
 def test_restart_is_exact():

@@ -123,7 +123,7 @@ def test_kernel_matches_post_processing(blk, sol_block):
 
 def test_sticking_nodes_do_not_wear(blk, sol_block):
     """Partial slip: nodes whose DLFT state is stick for the whole period wear exactly 0, at
-    the start and after a wear run; nodes that slip at some instant wear."""
+    the start and after a wear run; a node that wears has slipped at some step."""
     sol = sol_block
     dw = wear_per_cycle(sol, wear_coefficient=KW)
     stuck = np.all(sol.state == law.STICK, axis=1)
@@ -136,30 +136,34 @@ def test_sticking_nodes_do_not_wear(blk, sol_block):
     never = np.all(h.state_fraction[:, :, law.STICK] == 1.0, axis=0)
     assert never.sum() >= 3
     assert np.all(h.wear_depth[-1, never] == 0.0)
-    assert np.all(h.wear_depth[-1, h.slip_path.max(axis=0) > 0] > 0)
+    worn = h.wear_depth[-1] > 0
+    assert worn.sum() >= 4 and np.all(h.slip_path.max(axis=0)[worn] > 0)
 
 
 def test_uniform_sliding_analytic_rate():
-    """Independent sliders (normal force exactly P A): Archard's rate is k_w P x slip path, and
-    the path tends to the closed form 4 (Q - mu P A)/k_t as harmonics are added (the exact
-    periodic motion has stick corners that truncated harmonics smooth). Measured relative
-    errors: 2.8% (3 harmonics), 0.36% (15), 0.012% (31): the 31-harmonic solve is checked to
-    1e-3 and the error must decrease."""
+    """Independent sliders (normal force exactly P A): Archard's rate is k_w P x slip path,
+    uniform, and the path is the closed form 4 (Q - mu P A)/k_t of the quasi-static Coulomb
+    oscillator. With the default penalty eps = k_t, lambda_u = F - k_t U + eps U = F does not
+    depend on U: the DLFT is then exact at the samples whatever the harmonics (1e-12). With
+    eps = 10 k_t the truncated harmonics smooth the stick corners; measured path errors
+    2.8% (3 harmonics), 1.5% (7), 0.36% (15), 0.012% (31): checked to 1e-3 at 31 and
+    decreasing."""
     P, A, kt, ratio = 1e6, 1e-4, 1e8, 3.0
     m = sliders(P=P, A=A, kt=kt, ratio=ratio)
     exact_path = 4 * (ratio - 1) * MU * P * A / kt
     errors = []
-    for nh in (3, 15, 31):
+    for nh, eps in ((3, None), (3, 10 * kt), (7, 10 * kt), (31, 10 * kt)):
         b = FourierBasis.up_to(nh, 16 * nh + 16)
-        sol, st = solve_periodic(m, b, quasi_static=True, tol=1e-12)
+        sol, st = solve_periodic(m, b, quasi_static=True, tol=1e-12, eps=eps)
         assert st.converged
         np.testing.assert_array_equal(sol.pressure_t(), P)  # exact normal force
         rate = wear_per_cycle(sol, wear_coefficient=KW)
         np.testing.assert_allclose(rate, KW * P * sol.slip_t().sum(axis=1), rtol=1e-13)
         assert np.ptp(rate) <= 1e-12 * rate.max()  # uniform
         errors.append(abs(rate[0] / (KW * P * exact_path) - 1))
-    assert errors[2] < 1e-3
-    assert errors[0] > errors[1] > errors[2]
+    assert errors[0] < 1e-12
+    assert errors[3] < 1e-3
+    assert errors[1] > errors[2] > errors[3]
 
 
 @pytest.mark.parametrize("scheme", ["implicit", "explicit"])
@@ -219,7 +223,9 @@ def test_slip_work_gradient_vs_finite_differences(blk, sol_block):
 def test_coupled_jacobian_vs_finite_differences(blk, sol_block):
     """Every block of the backward Euler Jacobian [[J, df/dW], [-eps dN dg/dU, eps (I - dN
     dg/dW)]] against central differences of the coupled residual, at a worn state. FD steps
-    1e-7 (U) / 1e-6 (W) relative: truncation and rounding ~1e-6 of each block's largest entry."""
+    1e-7 (U) / 1e-6 (W) relative: truncation and rounding ~1e-6 of each block's largest entry.
+    A column whose +-h evaluations change a contact state sits on a kink of the piecewise
+    smooth residual, where no derivative exists: those (at most 2 of 165) are skipped."""
     m, red, anc = blk
     spb = SlowProblem(m, red, BASIS, wear_coefficients(m), anchor=anc)
     U0 = sol_block.U.reshape(spb.m, spb.H)
@@ -232,16 +238,26 @@ def test_coupled_jacobian_vs_finite_differences(blk, sol_block):
     x = np.concatenate([U.ravel(), W])
     R, J = spb.coupled(x, Wk, dN)
     n = spb.n
-    Jfd = np.empty_like(J)
+
+    def states(y):
+        spb.prob.set_gap(spb.gap0 + y[n:])
+        return spb.prob.time_law(y[:n].reshape(spb.m, spb.H))[2]
+
+    Jfd = np.full_like(J, np.nan)
     uscale = np.abs(x[:n]).max()
     for j in range(x.size):
         h = 1e-7 * uscale if j < n else 1e-6 * W.max()
         E = np.zeros_like(x)
-        E[j] = 1.0
-        Jfd[:, j] = _fd(lambda s, E=E: spb.coupled(x + s * E, Wk, dN, False)[0], 0.0, h)
+        E[j] = h
+        if not np.array_equal(states(x + E), states(x - E)):
+            continue
+        Jfd[:, j] = (spb.coupled(x + E, Wk, dN, False)[0]
+                     - spb.coupled(x - E, Wk, dN, False)[0]) / (2 * h)
+    ok = ~np.isnan(Jfd[0])
+    assert (~ok).sum() <= 2
     for rows in (slice(0, n), slice(n, None)):
         for cols in (slice(0, n), slice(n, None)):
-            a, b = J[rows, cols], Jfd[rows, cols]
+            a, b = J[rows, cols][:, ok[cols]], Jfd[rows, cols][:, ok[cols]]
             scale = max(np.abs(b).max(), 1e-300)
             assert np.abs(a - b).max() <= 2e-6 * scale
 

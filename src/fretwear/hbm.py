@@ -219,17 +219,41 @@ class PeriodicSolution:
         """Amplitude per kept harmonic (d, k) [m]."""
         return amplitude(self.observed[name], self.basis)
 
-    def stops_per_period(self, name, axis=0, rel_tol=1e-3):
-        """Number of intervals per period during which the point's velocity along ``axis`` is
-        zero (below ``rel_tol`` times its peak): the paper's "P_e stops twice per period"."""
+    def stops_per_period(self, name, axis=0, rel_tol=5e-2):
+        """How many times per period the point stops along ``axis``: the paper's "P_e stops
+        twice per period at 10 kHz and four times at 79 kHz" (section 4.2.3).
+
+        A stop is an instant where the velocity vanishes: a sign change of the velocity (a
+        turning point) or an interval where ``|v|`` stays below ``rel_tol`` times its peak
+        (a dwell, with or without reversal). A harmonic motion stops twice per period. The
+        velocity is that of the kept harmonics, so a dwell of the true motion shows as a ripple
+        around zero (Gibbs: up to ~9 % of the velocity jump): hence the default ``rel_tol`` of
+        5 %. On the paper's beam at 79 kHz (7 harmonics) the count is 6, 5, 4 for ``rel_tol`` =
+        0.1 %, 2 %, 5 %; at 10 kHz it is 2 for all of them.
+        """
         _, v = self.observed_time(name)
-        va = np.abs(v[axis])
-        stopped = va <= rel_tol * max(va.max(), 1e-300)
-        if stopped.all() or not stopped.any():
-            return 0 if not stopped.any() else 1
-        # count runs of True on the circle
-        starts = stopped & ~np.roll(stopped, 1)
-        return int(starts.sum())
+        va = v[axis]
+        peak = max(np.abs(va).max(), 1e-300)
+        sgn = np.where(np.abs(va) <= rel_tol * peak, 0, np.sign(va)).astype(int)
+        if not sgn.any():
+            return 0
+        # rotate so that the sequence starts on a moving sample, then walk the circle
+        start = int(np.flatnonzero(sgn)[0])
+        seq = np.roll(sgn, -start)
+        stops = 0
+        prev = seq[0]
+        in_dwell = False
+        for s_ in seq[1:].tolist() + [seq[0]]:
+            if s_ == 0:
+                if not in_dwell:
+                    stops += 1
+                    in_dwell = True
+                continue
+            if not in_dwell and s_ != prev:
+                stops += 1  # direct sign change between two samples
+            in_dwell = False
+            prev = s_
+        return stops
 
 
 def _orders(basis):

@@ -45,6 +45,7 @@ DIMENSIONS = {
     "time": ("time", "s"),
     "tau": ("angle tau = omega t over one period", "rad"),
     "step": ("slow-scale (wear) step", "1"),
+    "harmonic": ("kept harmonic number", "1"),
     "point": ("observed point, by name", "1"),
     "axis": ("component in the structure's axes: x, y(, z)", "1"),
     "contact_node": ("contact node, from 0", "1"),

@@ -43,11 +43,12 @@ from fretwear.schema import (
     join,
 )
 from fretwear.solvers import SOLVERS, SolveStats
+from fretwear.stability import sweep_check
 from fretwear.sweep import SweepResult, sweep
 
 #: colours of the contact states (separation, stick, slip) in every figure
 STATE_COLOURS = ("0.85", "tab:blue", "tab:orange")
-STOP_TOL = 1e-3  # |v| below this fraction of its peak counts as stopped (as stops_per_period)
+STOP_TOL = 5e-2  # |v| below this fraction of its peak counts as stopped (as stops_per_period)
 
 
 # --- [analysis] keys shared by both analyses ----------------------------------------------
@@ -121,6 +122,11 @@ def _solver_attributes(stats: SolveStats, analysis: dict, eps: float) -> dict:
         "harmonics": ", ".join(str(h) for h in harmonic_list(analysis["harmonics"])),
         "n_samples": int(analysis["n_samples"]),
     }
+
+
+def titled(title: str, suffix: str) -> str:
+    """``"title: suffix"``, or ``title`` when it already says ``suffix``."""
+    return title if suffix.lower() in title.lower() else f"{title}: {suffix}"
 
 
 # --- small array helpers -------------------------------------------------------------------
@@ -305,8 +311,7 @@ def run_periodic(model, analysis: dict, case, outdir: Path, progress: bool) -> R
     points = [p.name for p in model.observed]
     ds = periodic_dataset(model, sol, points)
     ds.attrs.update(attrs)
-    title = f"{case.title}: {where}"
-    figures = _periodic_figures(ds, case, outdir, title)
+    figures = _periodic_figures(ds, case, outdir, titled(case.title, where))
     files = []
     if model.mesh is not None and case.output["vtu"]:
         files.append(write_period_fields(model, sol, outdir / "periodic.pvd"))
@@ -390,8 +395,10 @@ def plot_observed_period(ds: xr.Dataset, path: Path, point: str, *, title: str |
                          ) -> Path:
     """Displacement and velocity of an observed point over one period (cf. paper Fig. 16).
 
-    One column per axis; grey bands mark the intervals where the point stops (|v| below
-    ``STOP_TOL`` of its peak); the time axis is ``t / T`` (fraction of the period).
+    One column per axis; the displacement is drawn about its mean (given in the panel title:
+    a static offset would hide the vibration); grey bands mark the intervals where the point
+    stops (|v| below ``STOP_TOL`` of its peak); the time axis is ``t / T`` (fraction of the
+    period).
     """
     axes_names = _live_axes(ds, point)
     fig, axes = plots.new_figure(2, max(len(axes_names), 1), title=title, sharex=True)
@@ -400,17 +407,20 @@ def plot_observed_period(ds: xr.Dataset, path: Path, point: str, *, title: str |
     for col, axis in enumerate(axes_names):
         u = ds["displacement"].sel(point=point, axis=axis).values
         v = ds["velocity"].sel(point=point, axis=axis).values
-        for row, (y, name, unit) in enumerate(((u, "u", "m"), (v, "v", "m/s"))):
+        mean = float(u.mean())
+        for row, (y, name, unit) in enumerate(((u - mean, "u", "m"), (v, "v", "m/s"))):
             ax = axes[row, col]
             k, unit = si_scale(y, unit)
             ax.plot(t, k * np.append(y, y[0]), color="tab:blue")
             for a, b in _stopped_spans(v):
                 ax.axvspan(a / n, (b + 1) / n, color="0.85", lw=0)
-            ax.set_ylabel(f"{name}_{axis} at {point} [{unit}]")
+            ax.set_ylabel(f"{name}_{axis}{' - mean' if name == 'u' else ''} at {point} "
+                          f"[{unit}]")
             ax.grid(True, alpha=0.3)
         stops = int(ds["stops_per_period"].sel(point=point, axis=axis))
-        axes[0, col].set_title(f"{axis}: {stops} stop(s) per period"
-                               + (" (grey bands)" if stops else ""))
+        km, um = si_scale(mean, "m")
+        axes[0, col].set_title(f"{axis}: mean {km * mean:.4g} {um}, {stops} stop(s) per period"
+                               + (" (grey)" if stops else ""), fontsize="medium")
         axes[1, col].set_xlabel("t / T [-] (fraction of the period)")
     return plots.save(fig, path)
 
@@ -595,7 +605,7 @@ def _sweep_point_variables(result: SweepResult) -> dict:
                               "the periodic solve converged", flag_values=np.array(
                                   [0, 1], dtype=np.int8), flag_meanings="no yes"),
         "how": variable(f, np.array([p.how for p in result.points], dtype=str), "1",
-                        "how the point was reached: grid, substep, retry, arclength"),
+                        "how the point was reached: grid, substep, retry, arclength, time-start"),
         "flags": variable(f, np.array(["; ".join(p.flags) for p in result.points], dtype=str),
                           "1", "reasons for caution (empty: none)"),
         "friction_energy": variable(
@@ -689,7 +699,12 @@ def run_sweep(model, analysis: dict, case, outdir: Path, progress: bool) -> RunO
         result = sweep(model, basis, analysis["f_min"], analysis["f_max"], n,
                        spacing=analysis["spacing"], eps=eps, solver=analysis["solver"],
                        tol=analysis["tol"], max_iter=analysis["max_iter"],
-                       continuation=analysis["continuation"], progress=tick)
+                       continuation=analysis["continuation"],
+                       time_domain=analysis["time_domain"],
+                       time_domain_periods=analysis["time_domain_periods"],
+                       check=(sweep_check(model, max_periods=analysis["time_domain_periods"])
+                              if analysis["check_stability"] else None),
+                       progress=tick)
     ds = sweep_dataset(model, result, basis, points, analysis["linear_references"])
     k = int(result.converged.sum())
     flagged = [f"{p.frequency_hz:.6g} Hz: " + "; ".join(p.flags)
@@ -707,10 +722,11 @@ def run_sweep(model, analysis: dict, case, outdir: Path, progress: bool) -> RunO
     for point in points:
         p = _figure_path(case, outdir, f"sweep-{point}")
         if p is not None:
-            figures.append(plot_sweep(ds, p, point, title=f"{case.title}: nonlinear FRF"))
+            figures.append(plot_sweep(ds, p, point, title=titled(case.title, "nonlinear FRF")))
     p = _figure_path(case, outdir, "sweep-interface")
     if p is not None:
-        figures.append(plot_sweep_interface(ds, p, title=f"{case.title}: interface"))
+        figures.append(plot_sweep_interface(ds, p, title=titled(case.title,
+                                                                  "contact interface")))
     return RunOutput(ds, figures, _sweep_summary(result, ds), bool(result.converged.all()))
 
 
@@ -833,6 +849,15 @@ register(
         "spacing": Field(Text(("log", "linear")), "frequency spacing", default="log"),
         "continuation": Field(Flag(), "pseudo-arclength continuation when a frequency step "
                               "fails (passes folds of the response curve)", default=True),
+        "time_domain": Field(Flag(), "where a point still fails, integrate in time from the "
+                             "neighbour: a periodic steady state starts one more solve, any "
+                             "other response (drifting, quasi-periodic) is reported as the "
+                             "reason", default=True),
+        "time_domain_periods": Field(Integer(lo=10), "forcing periods allowed to each time "
+                                     "integration (time_domain, check_stability)",
+                                     default=3000),
+        "check_stability": Field(Flag(), "check every converged point in time (does the "
+                                 "structure settle to it?); slow", default=False),
         "points": Field(ListOf(Text(), non_empty=True, unique=True),
                         "observed points to report (default: all)"),
         "linear_references": Field(

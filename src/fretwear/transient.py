@@ -310,6 +310,7 @@ class _Reduced:
     U: np.ndarray  # (r, s) low-rank damping factor (diag only)
     R: np.ndarray  # (s, s)
     diag: bool
+    modal: bool  # basis M-orthonormal (basis^T M basis = I)
     Tx: np.ndarray  # (m, r) local contact displacements
     obs: np.ndarray  # (no, r) rows of the observed DOFs
     obs_names: list
@@ -525,20 +526,21 @@ def _reduce(model: Model, omega: float, *, modal_cutoff, n_modes, steps_per_peri
     info["diagonal"] = diag
     Tx = np.asarray(T @ basis)
     names, slices, rows = [], [], []
+    start = 0
     for p in model.observed:
         d = np.asarray(p.dofs, dtype=np.int64).ravel()
         rr = np.zeros((d.size, basis.shape[1]))
-        for i, dof in enumerate(d):
-            if pos[dof] >= 0:
-                rr[i] = basis[pos[dof]]
-        slices.append(slice(sum(x.shape[0] for x in rows), sum(x.shape[0] for x in rows) + d.size))
+        ok = pos[d] >= 0
+        rr[ok] = basis[pos[d[ok]]]
+        slices.append(slice(start, start + d.size))
+        start += d.size
         rows.append(rr)
         names.append(p.name)
     obs = np.vstack(rows) if rows else np.zeros((0, basis.shape[1]))
     if not diag:
         Ul, Rl = np.zeros((basis.shape[1], 0)), np.zeros((0, 0))
     return _Reduced(free=free, basis=basis, K=Kred, M=Mred, C=Cred, U=np.ascontiguousarray(Ul),
-                    R=np.ascontiguousarray(Rl), diag=diag, Tx=Tx, obs=obs,
+                    R=np.ascontiguousarray(Rl), diag=diag, modal=V is not None, Tx=Tx, obs=obs,
                     obs_names=names, obs_slices=slices, info=info)
 
 
@@ -628,6 +630,12 @@ class _Integrator:
         else:
             self.m_v = self.k_v = self.c_v = np.zeros(0)
             self.m_m, self.k_m, self.c_m = red.M, red.K, red.C
+        # one compiled specialisation: every array the kernel sees is C-contiguous float64
+        for name in ("a_v", "b_v", "ds", "hc", "U", "R", "P", "Qt", "bq_m", "bd_m", "ftab",
+                     "ftil", "m_v", "k_v", "c_v", "m_m", "k_m", "c_m"):
+            setattr(self, name, np.ascontiguousarray(getattr(self, name), dtype=float))
+        red.Tx = np.ascontiguousarray(red.Tx, dtype=float)
+        red.obs = np.ascontiguousarray(red.obs, dtype=float)
         self.setup_time = time.perf_counter() - t0
         self.r = r
         # initial state
@@ -644,7 +652,7 @@ class _Integrator:
         if U.shape != (n,) or not np.all(np.isfinite(U)):
             raise InputError(f"{what} has shape {U.shape}; expected ({n},) finite values")
         Uf = U[self.red.free]
-        if self.red.diag or self.red.M.ndim == 1 or np.allclose(self.red.M, np.eye(self.r)):
+        if self.red.modal:  # M-orthogonal projection (exact for vectors of the basis)
             Mf = _sub(self.model.M.tocsr(), self.red.free, self.red.free)
             return self.red.basis.T @ (Mf @ Uf)
         return np.linalg.lstsq(self.red.basis, Uf, rcond=None)[0]
@@ -714,8 +722,6 @@ class _Integrator:
         mon_start = np.zeros((n_keep, nmon))
         mon_mean = np.zeros((n_keep, nmon))
         mon_ptp = np.zeros((n_keep, nmon))
-        q_last = np.zeros(self.r)
-        dq_last = np.zeros(self.r)
         p0 = self.periods_done
         rec_from = (p0 + n_periods - n_record) * N
         keep_from = p0 + n_periods - n_keep
@@ -736,9 +742,9 @@ class _Integrator:
                 self.R, self.P, self.Qt, self.bq_m, self.bd_m, self.ftab, self.G, self.red.Tx,
                 self.A, self.gap, self.xprev, self.xprev2, float(self.model.contact.mu), self.d,
                 self.status, self.tdir, k, self.periods_done * N, self.tol, self.fscale,
-                60 + 4 * nc, self.red.obs, keep_from, mon_start, mon_mean, mon_ptp, q_last,
-                dq_last, rec_from, self.h, self.ftil, self.m_v, self.k_v, self.c_v, self.m_m,
-                self.k_m, self.c_m, r_obs, r_vobs, r_x, r_lam, r_state, r_energy)
+                60 + 4 * nc, self.red.obs, keep_from, mon_start, mon_mean, mon_ptp, rec_from,
+                self.h, self.ftil, self.m_v, self.k_v, self.c_v, self.m_m, self.k_m, self.c_m,
+                r_obs, r_vobs, r_x, r_lam, r_state, r_energy)
             if nfail and self.first_fail_time is None:
                 self.first_fail_time = ff * self.h
             self.n_fail += nfail
@@ -749,7 +755,6 @@ class _Integrator:
                 bar.update(k)
         if bar is not None:
             bar.close()
-        self.q_last, self.dq_last = q_last, dq_last
         return dict(obs=r_obs, vobs=r_vobs, x=r_x, lam=r_lam, state=r_state, energy=r_energy,
                     mon_start=mon_start, mon_mean=mon_mean, mon_ptp=mon_ptp,
                     t0=rec_from * self.h)

@@ -327,9 +327,8 @@ def solve_contact(A, b, xref, gap, xprev, mu, d, status, tdir, x, lam, tol, fsca
 @njit(cache=True, fastmath=_FAST)
 def run_dynamic(q, dq, diag, a_v, b_v, ds, hc, U, R, P, Qt, bq_m, bd_m, ftab, G, Tx, A, gap,
                 xprev, xprev2, mu, d, status, tdir, n_periods, step0, tol, fscale, maxit,
-                obs, keep_from, mon_start, mon_mean, mon_ptp, q_last, dq_last,
-                rec_from, h, ftil, m_v, k_v, c_v, m_m, k_m, c_m,
-                r_obs, r_vobs, r_x, r_lam, r_state, r_energy):
+                obs, keep_from, mon_start, mon_mean, mon_ptp, rec_from, h, ftil, m_v, k_v, c_v,
+                m_m, k_m, c_m, r_obs, r_vobs, r_x, r_lam, r_state, r_energy):
     """Advance the reduced dynamic model ``n_periods`` forcing periods with fixed steps.
 
     Scheme (two-step form of Newmark's rule, contact force ``lam_n`` at t_n and constraints on
@@ -356,7 +355,6 @@ def run_dynamic(q, dq, diag, a_v, b_v, ds, hc, U, R, P, Qt, bq_m, bd_m, ftab, G,
     n_periods : periods to run; step0 : global index of the first step (for recording).
     obs : (no, r) observed DOFs rows. keep_from : first global period whose once-per-period
         monitors (``mon_*``, (n_keep, no + m)) are stored.
-    q_last, dq_last : (r,) out: state at the start of the last period.
     rec_from : first global step recorded in ``r_*`` (every step from there).
     h : step [s]; ftil : (N, r) applied generalised forces [N] (energy); m_*, k_*, c_* : mass,
         stiffness, damping (diagonal ``_v``, with ``U R U^T`` added to the damping, or dense
@@ -400,12 +398,8 @@ def run_dynamic(q, dq, diag, a_v, b_v, ds, hc, U, R, P, Qt, bq_m, bd_m, ftab, G,
     max_it = 0
     cum = np.zeros(6)
     step = step0
-    for p in range(n_periods):
+    for _ in range(n_periods):
         gp = step // N
-        if p == n_periods - 1:
-            for j in range(r):
-                q_last[j] = q[j]
-                dq_last[j] = dq[j]
         for k in range(N):
             # free increment
             if diag:

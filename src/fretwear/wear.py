@@ -281,7 +281,9 @@ class SlowProblem:
     def dfdW(self, lu, lx, state):
         """``df/dW`` (n, nc) = ``-eps E_W + eps G E_W`` (G block-diagonal per node)."""
         p = self.prob
-        G = law.dlft_jacobian(lu, lx, state, p.mu, p.P, p.Q)
+        # same arguments as DLFTProblem.residual (stick anchors for all-stick nodes)
+        G = law.dlft_jacobian(lu, lx, state, p.mu, p.P, p.Q, self.eps * p.anchor, p.tol,
+                              p.max_sweeps)
         out = np.zeros((self.n, self.nc))
         for q in range(self.nc):
             rows = slice(q * self.dH, (q + 1) * self.dH)

@@ -182,7 +182,16 @@ def slip_work_gradient(lam_u, lam_x, state, mu, Q, eps):
                             grad[j] += ca * (A0[1 + a, j] - A0p[a, j])
                         for j in range(dt):
                             gs[j] += ca * (Sd[1 + a, j] - Sdp[a, j])
+        gs_zero = True
+        for j in range(dt):
+            if gs[j] != 0.0:
+                gs_zero = False
         if not any_slip:
+            continue
+        if gs_zero:  # S does not depend on the state before n = 0
+            S_out[p] = acc / eps
+            for j in range(dH):
+                grad[j] /= eps
             continue
         # seed = A_T(N-1) = A0_T(N-1) + S_T(N-1) seed  ->  (I - S_T) seed = A0_T
         M = np.eye(dt)
