@@ -309,13 +309,14 @@ def explicit_reference(blk):
 
 
 def test_implicit_large_jumps_and_adaptive_match_fine_explicit(blk, explicit_reference):
-    """Implicit Euler with 4 jumps of 5e5 cycles (5x the explicit stability limit), the
-    adaptive implicit and adaptive explicit schemes (tolerance 1e-2) reach the profile of the
-    fine explicit reference at N = 2e6. Measured max differences relative to the maximum
-    depth: 4.1% (4 implicit jumps: first order with dN 25x the reference's), 0.4% and 0.5%
-    (adaptive; the global error of first-order steps at local tolerance 1e-2), so the bounds
-    are 8%, 2% and 2%. Explicit Euler with the same 5e5-cycle jumps is unstable and is off
-    by far more (checked > 3x the implicit error)."""
+    """Implicit Euler with jumps of 5e5 cycles (5.5x the explicit stability limit 2/rho),
+    the adaptive implicit and adaptive explicit schemes (tolerance 1e-2) reach the profile of
+    the fine explicit reference at N = 2e6 (max difference relative to the maximum depth).
+    Measured: 3.7% (7 steps: first order with jumps 25x the reference's), 1.2% and 0.7%
+    (adaptive: the global error of first-order steps at a local tolerance of 1e-2, one-sided
+    because the rates decrease as wear grows); the reference itself is 0.2% from jumps of 2e3.
+    Bounds: 8%, 3%, 3%. Explicit Euler with the same 5e5 jumps is unstable: 76% off (checked
+    > 5x the implicit error)."""
     m, red, anc = blk
     ref = explicit_reference.history.wear_depth[-1]
     assert explicit_reference.stability_jump == pytest.approx(9e4, rel=0.5)
@@ -333,9 +334,9 @@ def test_implicit_large_jumps_and_adaptive_match_fine_explicit(blk, explicit_ref
     e_ex, _ = run(scheme="explicit", tolerance=1e-2)
     e_unstable, _ = run(scheme="explicit", adaptive=False, initial_jump=5e5)
     assert e_big < 0.08
-    assert e_ad < 0.02
-    assert e_ex < 0.02
-    assert e_unstable > 3 * e_big
+    assert e_ad < 0.03
+    assert e_ex < 0.03
+    assert e_unstable > 5 * e_big
 
 
 def test_plateau_stop_and_history(blk):

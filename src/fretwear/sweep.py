@@ -323,6 +323,16 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
                 prob, U, st = _solve_at(probs, omega, current_anchor(), history[-1][1], solver,
                                         tol, max_iter)
                 how = "arclength"
+        if not st.converged and probs.eps is not None:
+            # a larger penalty often converges where the default stalls (measured at 79 kHz
+            # on the paper's beam); the solution differs by the eps-dependence of the
+            # truncated balance, which the point records (its DLFTProblem's eps)
+            big = _Problems(model, basis, gap, 10.0 * probs.eps)
+            start = history[-1][1] if history else None
+            pb, Ub, stb = _solve_at(big, omega, current_anchor(), start, "newton", tol,
+                                    2 * max_iter)
+            if stb.converged:
+                prob, U, st, how = pb, Ub, stb, "eps-x10"
         td_msg = None
         if not st.converged and time_domain:
             from fretwear.stability import time_domain_start
