@@ -55,7 +55,13 @@ import scipy.linalg as sla
 from fretwear import contact as law
 from fretwear.errors import ConvergenceError, InputError
 from fretwear.fourier import FourierBasis
-from fretwear.hbm import DLFTProblem, PeriodicSolution, assemble_solution, static_anchor
+from fretwear.hbm import (
+    DLFTProblem,
+    PeriodicSolution,
+    assemble_solution,
+    solve_periodic,
+    static_anchor,
+)
 from fretwear.model.core import Model
 from fretwear.reduce import Reduced, condense
 from fretwear.results import atomic_write
@@ -798,9 +804,14 @@ def _start(sp: SlowProblem, W0, anchor, U0, opts: WearOptions) -> tuple[dict, li
     """The balanced initial state (step 0)."""
     t0 = time.perf_counter()
     sp.set_state(W0, anchor)
-    guess = sp.prob.initial_guess() if U0 is None else np.asarray(U0, float).reshape(sp.m, sp.H)
-    U, st = sp.solve_balance(W0, anchor, guess, solver=opts.solver, tol=opts.tol,
-                             max_iter=max(opts.max_iter, 200))
+    # the first balance goes through solve_periodic (its start strategies for a cold start)
+    sol0, st = solve_periodic(sp.model, sp.prob.basis, omega=sp.prob.reduced.omega,
+                              quasi_static=sp.prob.reduced.quasi_static,
+                              reduced=sp.prob.reduced, gap=sp.gap0 + W0, eps=sp.eps,
+                              anchor=anchor, U0=U0, solver=opts.solver, tol=opts.tol,
+                              max_iter=max(opts.max_iter, 200))
+    if sol0 is not None:
+        U = sol0.U.reshape(sp.m, sp.H)
     if not st.converged:
         raise ConvergenceError(
             f"the periodic solve of the unworn interface did not converge ({st.message}, "
