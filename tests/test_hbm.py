@@ -15,7 +15,7 @@ references.
   nonlinear solvers, and symmetry / isotropy of a 3D block in gross slip.
 
 Every tolerance is either derived (stated in the docstring) or a measured figure with its
-margin (the measured values are in docs/validation-dlft.md).
+margin (the measured values are in docs/verification.md).
 """
 
 import numpy as np
@@ -62,7 +62,7 @@ def embed(U, b_from, b_to):
 
 def solve_sequence(model, nhs, per=16, **kw):
     """Solve for each number of harmonics, each solve starting from the previous solution
-    (continuation in Nh; see docs/validation-dlft.md, finding 2, for why the default initial
+    (continuation in Nh; see docs/verification.md, finding 2, for why the default initial
     guess is not used beyond a few harmonics)."""
     sols = {}
     prev = None
@@ -397,7 +397,7 @@ def test_fe_convergence_in_harmonics(block_sequence):
     (harmonics 0 and 1 of the observed point P_e and of every contact node, each scaled by
     its largest value): successive changes measured 7.3e-2, 1.2e-2, 2.4e-3, 1.9e-3; asserted
     monotone, last < 4e-3 and first / last > 20. The convergence is slow and not geometric
-    (the slip zone edge moves between samples); docs/validation-dlft.md gives the errors
+    (the slip zone edge moves between samples); docs/verification.md gives the errors
     against an Nh = 63 solution."""
     model, w, sols = block_sequence
     E = np.array([s.friction_energy().sum() for s in sols.values()])
