@@ -58,7 +58,8 @@ def block(q_ratio=0.5):
                      springs=[Spring("bottom_left", "x", 1e5)],
                      loads=[Traction("top", pressure=1e6),
                             Traction("right", pressure=q, waveform="sin")],
-                     contact=ContactSpec("bottom", mu=MU, normal=(0, -1), wear_coefficient=KW))
+                     contact=ContactSpec("bottom", mu=MU, normal=(0, -1), wear_coefficient=KW),
+                     observed={"Pe": (0.02, 0.002)})
 
 
 def sliders(nc=3, P=1e6, A=1e-4, kn=1.0, kt=1e8, ratio=3.0):
@@ -462,6 +463,10 @@ n_samples = 32
 tolerance = 0.05
 max_cycles = 3e5
 checkpoint_every_s = 0.0
+[analysis.frf_before_after]
+f_min = 2e3
+f_max = 3e3
+n_points = 3
 """
 
 
@@ -494,12 +499,14 @@ def test_case_file_run_and_resume(tmp_path, wear_registered):
     out = run_case(case, progress=False, echo=False)
     ds = read_results(out.results)
     assert ds.attrs["analysis_type"] == "wear" and ds.attrs["stop_reason"] == "max_cycles"
-    for name in ("cycles", "wear_depth", "worn_volume", "contact_pressure_max",
+    for name in ("cycles", "wear_depth", "worn_volume", "pressure_max",
                  "slip_amplitude", "state_fraction", "newton_iterations"):
         assert "units" in ds[name].attrs, name
     assert ds["wear_depth"].dims == ("step", "contact_node")
     assert float(ds["cycles"][-1]) == pytest.approx(3e5)
-    assert all(p.is_file() for p in out.figures) and len(out.figures) == 4
+    assert all(p.is_file() for p in out.figures) and len(out.figures) == 5
+    assert ds["frf_amplitude"].dims == ("wear_state", "frequency", "point", "axis")
+    assert int(ds["frf_converged"].sum()) == 6
     assert (case.parent / "w-results" / "wear-checkpoint.npz").is_file()
     again = run_case(case, progress=False, echo=False, resume=True)
     assert again.summary == "up to date"
@@ -513,6 +520,21 @@ def test_case_file_needs_frequency(tmp_path, wear_registered):
     case.write_text(CASE.replace("quasi_static = true", ""))
     with pytest.raises(InputError, match="frequency"):
         load_case(case)
+
+
+def test_frf_worn_uniform_wear_is_a_rigid_shift(blk):
+    """The block is held vertically by the contact only: a uniform wear depth translates it
+    without changing any force, so the nonlinear FRF (fretwear.sweep with the worn gap) is
+    that of the unworn interface, to the solver tolerance (1e-6 relative)."""
+    from fretwear.wear import frf_worn
+
+    m, _, anc = blk
+    grid = (2e3, 3e3, 3)
+    a = frf_worn(m, 0.0, grid, BASIS, anchor=anc)
+    b = frf_worn(m, np.full(m.contact.n_nodes, 1e-9), grid, BASIS, anchor=anc)
+    assert a.converged.all() and b.converged.all()
+    np.testing.assert_allclose(b.frequency_hz, a.frequency_hz)
+    np.testing.assert_allclose(b.amplitude("Pe", 0), a.amplitude("Pe", 0), rtol=1e-6)
 
 
 def test_no_wear_without_slip(tmp_path):

@@ -605,7 +605,8 @@ def _sweep_point_variables(result: SweepResult) -> dict:
                               "the periodic solve converged", flag_values=np.array(
                                   [0, 1], dtype=np.int8), flag_meanings="no yes"),
         "how": variable(f, np.array([p.how for p in result.points], dtype=str), "1",
-                        "how the point was reached: grid, substep, retry, arclength, eps-x10, time-start"),
+                        "how the point was reached: grid, substep, retry, arclength, eps-x10, "
+                        "time-start"),
         "flags": variable(f, np.array(["; ".join(p.flags) for p in result.points], dtype=str),
                           "1", "reasons for caution (empty: none)"),
         "friction_energy": variable(
@@ -706,11 +707,10 @@ def run_sweep(model, analysis: dict, case, outdir: Path, progress: bool) -> RunO
                               if analysis["check_stability"] else None),
                        progress=tick)
     ds = sweep_dataset(model, result, basis, points, analysis["linear_references"])
-    k = int(result.converged.sum())
     flagged = [f"{p.frequency_hz:.6g} Hz: " + "; ".join(p.flags)
                for p in result.points if p.flags]
     ds.attrs.update({
-        "sweep_converged": f"{k}/{len(result.points)}",
+        "sweep_converged": result.summary().splitlines()[0].split("=", 1)[1],
         "flagged_points": "\n".join(flagged),
         "total_wall_time": float(result.wall_time),
         "solver": analysis["solver"], "tol": float(analysis["tol"]),
@@ -727,7 +727,8 @@ def run_sweep(model, analysis: dict, case, outdir: Path, progress: bool) -> RunO
     if p is not None:
         figures.append(plot_sweep_interface(ds, p, title=titled(case.title,
                                                                   "contact interface")))
-    return RunOutput(ds, figures, _sweep_summary(result, ds), bool(result.converged.all()))
+    grid_ok = all(p.converged for p in result.points if p.on_grid)
+    return RunOutput(ds, figures, _sweep_summary(result, ds), grid_ok)
 
 
 # --- sweep: figures -------------------------------------------------------------------------

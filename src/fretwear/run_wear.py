@@ -101,9 +101,9 @@ def wear_dataset(model, result: WearResult, basis: FourierBasis, *, frequency_hz
         "wear_depth": variable(sn, hist["wear_depth"], "m", "wear depth W"),
         "wear_rate": variable(sn, hist["wear_rate"], "m",
                               "wear depth per cycle dW1 (paper eq. 29)"),
-        "contact_pressure_mean": variable(sn, hist["pressure_mean"], "Pa",
+        "pressure_mean": variable(sn, hist["pressure_mean"], "Pa",
                                           "normal contact pressure, mean over the period"),
-        "contact_pressure_max": variable(sn, hist["pressure_max"], "Pa",
+        "pressure_max": variable(sn, hist["pressure_max"], "Pa",
                                          "normal contact pressure, maximum over the period"),
         "slip_amplitude": variable(sn, hist["slip_amplitude"], "m",
                                    "tangential displacement amplitude (half range)"),
@@ -244,7 +244,7 @@ def plot_pressure_slip(ds, path: Path, *, title=None) -> Path:
     cyc = ds["cycles"].values
     for i in selected_steps(cyc):
         lab = f"N = {cyc[i]:.3g}"
-        axes[0, 0].plot(x, ds["contact_pressure_max"].values[i], marker=".", label=lab)
+        axes[0, 0].plot(x, ds["pressure_max"].values[i], marker=".", label=lab)
         axes[1, 0].plot(x, ds["slip_amplitude"].values[i], marker=".", label=lab)
     axes[0, 0].set_ylabel("max normal pressure [Pa]")
     axes[1, 0].set_ylabel("tangential amplitude [m]")

@@ -32,8 +32,10 @@ class SweepPoint:
     """One frequency of a sweep.
 
     frequency_hz : the frequency [Hz]; solution : the periodic solution or None when the solve
-    did not converge; stats : solver statistics; how : ``"grid"``, ``"retry"``, ``"arclength"``
-    or ``"bisection"``; flags : reasons for caution (``"not converged: ..."``, stability checks).
+    did not converge; stats : solver statistics; how : ``"grid"``, ``"substep"``, ``"retry"``,
+    ``"arclength"``, ``"eps-x10"`` or ``"time-start"``; flags : reasons for caution
+    (``"not converged: ..."``, time-domain findings); on_grid : a requested grid frequency
+    (False for the intermediate points the sweep added).
     """
 
     frequency_hz: float
@@ -41,6 +43,7 @@ class SweepPoint:
     stats: SolveStats
     how: str = "grid"
     flags: list = field(default_factory=list)
+    on_grid: bool = False
 
     @property
     def converged(self) -> bool:
@@ -80,9 +83,10 @@ class SweepResult:
         return out
 
     def summary(self) -> str:
-        n = len(self.points)
-        k = int(self.converged.sum())
-        lines = [f"sweep_converged={k}/{n}"]
+        """``sweep_converged=k/n`` over the grid frequencies, then every flagged point."""
+        grid = [p for p in self.points if p.on_grid]
+        k = sum(p.converged for p in grid)
+        lines = [f"sweep_converged={k}/{len(grid)}"]
         for p in self.points:
             if p.flags:
                 lines.append(f"  {p.frequency_hz:12.6g} Hz: " + "; ".join(p.flags))
@@ -345,9 +349,11 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
                 how = "time-start"
         if st.converged:
             pt = record(omega, prob, U, st, how)
+            pt.on_grid = True
         else:
             pt = SweepPoint(f, None, st, how, [f"not converged: {st.message} "
                                                 f"(relative residual {st.residual:.2e})"])
+            pt.on_grid = True
             if td_msg is not None:
                 pt.flags.append(td_msg)
         points.append(pt)
