@@ -1,4 +1,4 @@
-"""The command line: ``fretwear run``, ``fretwear example``, ``fretwear --version``.
+"""The command line: ``fretwear run``, ``compare``, ``example``, ``fretwear --version``.
 
 Exit status: 0 success; 1 the run finished but some solve did not converge (the results file
 says ``converged = 0``); 2 bad input or a failed solve (one line ``error: ...`` on stderr,
@@ -55,6 +55,13 @@ def cmd_run(args) -> int:
     return _run(Path(args.case), args.output, args.resume, not args.no_progress)
 
 
+def cmd_compare(args) -> int:
+    from fretwear.compare import compare_case
+
+    res = compare_case(Path(args.case), args.output, steps_per_period=args.steps)
+    return 0 if res.dlft_converged else 1
+
+
 def cmd_example_list(args) -> int:
     found = examples()
     width = max((len(n) for n in found), default=0)
@@ -94,6 +101,17 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("case", metavar="CASE.toml", help="the case file")
     run_options(r)
     r.set_defaults(func=cmd_run)
+
+    c = sub.add_parser("compare", help="DLFT against the time-domain reference on a case",
+                       description="Run a periodic case (or a quasi-static wear case) with "
+                       "the DLFT and with the time-domain reference; one figure and a table "
+                       "of relative differences.")
+    c.add_argument("case", metavar="CASE.toml", help="the case file")
+    c.add_argument("-o", "--output", metavar="DIR", type=Path, default=None,
+                   help="figure folder (default: CASE-compare next to the case)")
+    c.add_argument("--steps", type=int, default=512, metavar="N",
+                   help="time steps per period (wear: load steps per cycle; default 512)")
+    c.set_defaults(func=cmd_compare)
 
     e = sub.add_parser("example", help="list, show or run the shipped examples",
                        description="The shipped examples are ordinary case files.")

@@ -84,7 +84,7 @@ def wear_dataset(model, result: WearResult, basis: FourierBasis, *, frequency_hz
         "cycles", "jump", "wear_depth", "wear_rate", "pressure_mean", "pressure_max",
         "slip_amplitude", "slip_path", "state_fraction", "friction_energy", "worn_volume",
         "volume_rate", "newton_iterations", "rejected", "error_estimate", "wall_time", "U",
-        "lam")}
+        "lam", "rescued")}
     cpos = np.asarray(c.coords, float).reshape(nc, -1)[:, :d]
     data = {
         "contact_position": variable(("contact_node", "axis"), cpos, "m",
@@ -124,6 +124,9 @@ def wear_dataset(model, result: WearResult, basis: FourierBasis, *, frequency_hz
         "error_estimate": variable(sc, hist["error_estimate"], "1",
                                    "local error estimate relative to the maximum wear depth"),
         "step_wall_time": variable(sc, hist["wall_time"], "s", "wall time of the step"),
+        "time_domain_start": variable(sc, hist["rescued"].astype(np.int8), "1",
+                                      "1 if the step's balance was started from a time "
+                                      "integration (stick anchors from its history)"),
         "contact_displacement_coefficients": variable(
             ("step", "contact_node", "component", "harmonic_coefficient"), hist["U"], "m",
             "Fourier coefficients of the contact displacements (normal includes gap + wear)"),
@@ -385,9 +388,10 @@ SCHEMA = {
                  'or "energy" (worn volume = energy_coefficient x friction energy)',
                  default="archard"),
     "energy_coefficient": Field(Number(lo=0), "k_e of the energy law", unit="m^3/J"),
-    "scheme": Field(Text(SCHEMES), '"implicit" (backward Euler, stable for any jump), '
-                    '"rosenbrock" (linearly implicit Euler) or "explicit" (explicit Euler, '
-                    "paper eq. 30)", default="implicit"),
+    "scheme": Field(Text(SCHEMES), '"rosenbrock" (linearly implicit Euler, stable for any '
+                    'jump, the cheapest), "implicit" (backward Euler) or "explicit" (explicit '
+                    "Euler, paper eq. 30: stable only for jumps below 2/rho)",
+                    default="rosenbrock"),
     "adaptive": Field(Flag(), "adapt the jump to `tolerance`; false: constant jumps of "
                       "`initial_jump`", default=True),
     "tolerance": Field(_POS, "local error per step relative to the maximum wear depth",

@@ -44,6 +44,7 @@ if TYPE_CHECKING:
 ANALYSIS_MODULES = (
     "fretwear.run_linear",  # "modes", "frf"
     "fretwear.run_dlft",  # "periodic", "sweep"
+    "fretwear.run_transient",  # "transient", "incremental-wear"
 )
 
 RESULTS_FILE = "results.nc"

@@ -22,14 +22,18 @@ friction energy per cycle.
 Slow-scale schemes (:func:`simulate_wear`):
 
 * ``"explicit"``: explicit Euler with cycle jumps ``dN`` (eq. 30), as the paper;
-* ``"implicit"``: backward Euler solved together with the periodic balance. Unknowns
-  ``(U~, W_{k+1})``, residuals ``f(U~; W_{k+1}) = 0`` (DLFT, eq. 22) and
-  ``eps (W_{k+1} - W_k - dN g(U~, W_{k+1})) = 0``, Newton (Powell's dog-leg) on the coupled
-  system with the analytic Jacobian. It is stable for any jump (L-stable), which the explicit
-  scheme is not: docs/wear.md measures both.
+* ``"rosenbrock"`` (default): linearly implicit Euler ``W_{k+1} = W_k + dN (I - dN Js)^-1 g``
+  with the slow Jacobian ``Js = dg/dW`` along balanced solutions, then the balance;
+* ``"implicit"``: backward Euler ``W_{k+1} = W_k + dN g(W_{k+1})``, by a damped Newton method
+  on ``W`` over balanced solutions (or, ``implicit_newton = "coupled"``, Newton on the coupled
+  unknowns ``(U~, W_{k+1})`` with residuals ``f(U~; W_{k+1})`` (DLFT, eq. 22) and
+  ``eps (W_{k+1} - W_k - dN g(U~, W_{k+1}))``).
 
-Either scheme may adapt its jump to a tolerance on the local error, estimated by the
-difference with the trapezoidal rule ``0.5 dN |g(W_{k+1}) - g(W_k)|`` (no extra solve),
+The implicit schemes are stable for any jump, which explicit Euler is not (``dN < 2/rho(Js)``):
+docs/wear.md measures all of them.
+
+Every scheme may adapt its jump to a tolerance on the local error, estimated by the defect
+against the trapezoidal rule ``|W_{k+1} - W_k - dN (g(W_k) + g(W_{k+1}))/2|`` (no extra solve),
 relative to the current maximum wear depth.
 
 Each step starts from the previous periodic solution (warm start) and keeps the stick anchors
@@ -46,7 +50,7 @@ import json
 import math
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -72,6 +76,10 @@ LAWS = ("archard", "energy")
 SCHEMES = ("implicit", "rosenbrock", "explicit")
 STOP_REASONS = ("max_cycles", "max_depth", "plateau", "no_wear", "max_steps", "solver_failed")
 CHECKPOINT_VERSION = 1
+#: retried jumps are not cut below this fraction of the cycle count
+MIN_JUMP_FRACTION = 1e-5
+#: the jumps of a time-domain rescue start at this fraction of the cycle count
+RESCUE_START_FRACTION = 1e-3
 #: implicit schemes keep dN lam <= this for the growing modes (lam > 0) of the slow Jacobian
 GROWTH_LIMIT = 0.5
 
@@ -402,15 +410,19 @@ class WearOptions:
     law : ``"archard"`` (eq. 29, coefficient ``model.contact.wear_coefficient`` [1/Pa]) or
         ``"energy"`` (Fouvry et al. 2003, ``energy_coefficient`` [m^3/J]).
     energy_coefficient : ``k_e`` [m^3/J] of the energy law.
-    scheme : ``"implicit"`` (backward Euler coupled with the balance) or ``"explicit"``
-        (explicit Euler, eq. 30).
+    scheme : ``"rosenbrock"`` (linearly implicit Euler with the slow Jacobian; default: the
+        cheapest for a given accuracy, docs/wear.md), ``"implicit"`` (backward Euler, every
+        iterate a balanced solution) or ``"explicit"`` (explicit Euler, eq. 30).
+    implicit_newton : how ``"implicit"`` solves its step: ``"nested"`` (Newton on W over
+        balanced solutions) or ``"coupled"`` (Newton on (U~, W1) together).
     adaptive : adapt the jump to ``tolerance``; otherwise every jump is ``initial_jump``.
     tolerance : local error allowed per step, relative to the current maximum wear depth.
     initial_jump : first jump [cycles]; None: ``2 tolerance / rho`` with ``rho`` the spectral
         radius of the slow Jacobian at the start (adaptive), or ``1 / rho`` (fixed jumps: half
         the explicit stability limit).
     max_jump : cap on the jump [cycles] (the paper's 1e8 / 1e7).
-    min_jump : smallest jump tried when retrying failed solves [cycles].
+    min_jump : smallest jump tried when retrying failed solves [cycles]; the floor is also at
+        least 1e-5 of the cycle count (smaller jumps cannot change the outcome).
     max_cycles : stop at this cycle count.
     max_depth : stop when a wear depth reaches this [m].
     plateau_rate : stop when the worn-volume rate falls below this fraction of its initial
@@ -419,12 +431,15 @@ class WearOptions:
     solver, tol, max_iter : nonlinear solver (:func:`fretwear.solvers.solve`), its relative
         residual tolerance ``eps_r`` and iteration cap.
     max_retries : jump reductions (by 4) tried after a failed solve before stopping.
+    time_domain_rescue : (dynamic cases) when a step still fails, start its balance from a time
+        integration at the predicted wear (:func:`fretwear.stability.time_domain_start`),
+        with the stick anchors the integration gives (see :func:`_rescue`).
     checkpoint_every_s : write the checkpoint at most this often [s] (0: every step).
     """
 
     law: str = "archard"
     energy_coefficient: float | None = None
-    scheme: str = "implicit"
+    scheme: str = "rosenbrock"
     adaptive: bool = True
     tolerance: float = 1e-2
     initial_jump: float | None = None
@@ -441,6 +456,7 @@ class WearOptions:
     max_iter_implicit: int = 8
     implicit_newton: str = "nested"
     max_retries: int = 6
+    time_domain_rescue: bool = True
     checkpoint_every_s: float = 10.0
 
     def check(self) -> WearOptions:
@@ -462,9 +478,12 @@ class WearOptions:
         return self
 
     def trajectory_key(self) -> dict:
-        """The options that change the computed trajectory (for checkpoint matching)."""
+        """The options that change the computed trajectory (for checkpoint matching). The stop
+        criteria are not among them: a finished run can be extended (e.g. a larger
+        ``max_cycles``) by resuming from its checkpoint."""
         d = asdict(self)
-        d.pop("checkpoint_every_s")
+        for k in ("checkpoint_every_s", "max_cycles", "max_depth", "plateau_rate", "max_steps"):
+            d.pop(k)
         return d
 
 
@@ -489,6 +508,7 @@ HISTORY_FIELDS = {
     "U": ("m", "Fourier coefficients of the contact displacements"),
     "lam": ("N", "Fourier coefficients of the contact forces"),
     "anchor": ("m", "stick anchors used by the periodic solve"),
+    "rescued": ("1", "1 if the step's balance was started from a time integration"),
 }
 
 
@@ -522,6 +542,7 @@ class WearHistory:
     U: np.ndarray
     lam: np.ndarray
     anchor: np.ndarray
+    rescued: np.ndarray
     stop_reason: str = ""
 
     @classmethod
@@ -579,6 +600,7 @@ def _row(sol: PeriodicSolution, W, g, cycles, jump, iters, rejected, err, wall) 
         "volume_rate": float(np.dot(area, g)), "newton_iterations": int(iters),
         "rejected": int(rejected), "error_estimate": float(err), "wall_time": float(wall),
         "U": sol.U.copy(), "lam": sol.lam.copy(), "anchor": np.array(sol.anchor, float),
+        "rescued": 0,
     }
 
 
@@ -711,7 +733,7 @@ def simulate_wear(model: Model, basis: FourierBasis, *, omega: float = 2 * np.pi
     basis : Fourier basis of the periodic solutions.
     omega : excitation circular frequency [rad/s] (only scales time when ``quasi_static``).
     quasi_static : drop inertia and damping.
-    options : :class:`WearOptions` (defaults: adaptive implicit, tolerance 1e-2).
+    options : :class:`WearOptions` (defaults: adaptive linearly implicit, tolerance 1e-2).
     reduced : precomputed condensation on ``[0] + basis.harmonics``.
     eps : DLFT penalty [N/m] (default: spectral radius of ``Z_r``).
     anchor : (nc, d-1) stick anchors of the first solve [m] (default: static preload state).
@@ -764,6 +786,9 @@ def simulate_wear(model: Model, basis: FourierBasis, *, omega: float = 2 * np.pi
         bar.show(state)
         while not reason:
             new_state, row, failure = _advance(sp, state, opts)
+            if failure and opts.time_domain_rescue and not sp.prob.reduced.quasi_static:
+                new_state, row, why = _rescue(sp, state, opts)
+                failure = f"{failure}; {why}" if why else ""
             if failure:
                 reason, extra = "solver_failed", f": {failure}"
                 break
@@ -810,13 +835,12 @@ def _start(sp: SlowProblem, W0, anchor, U0, opts: WearOptions) -> tuple[dict, li
                               reduced=sp.prob.reduced, gap=sp.gap0 + W0, eps=sp.eps,
                               anchor=anchor, U0=U0, solver=opts.solver, tol=opts.tol,
                               max_iter=max(opts.max_iter, 200))
-    if sol0 is not None:
-        U = sol0.U.reshape(sp.m, sp.H)
-    if not st.converged:
+    if sol0 is None or not st.converged:
         raise ConvergenceError(
             f"the periodic solve of the unworn interface did not converge ({st.message}, "
             f"relative residual {st.residual:.3g} > {opts.tol:g}): no wear computed"
         )
+    U = sol0.U.reshape(sp.m, sp.H)
     g = sp.rate(U)
     rho = 0.0
     if np.any(g > 0):
@@ -851,6 +875,7 @@ def _advance(sp: SlowProblem, st: dict, opts: WearOptions):
     W_k, U_k, g_k = st["W"], st["U"], st["g"]
     anchor = U_k.reshape(sp.nc, sp.d, sp.H)[:, 1:, 0].copy()  # history rule: previous mean
     dN = min(float(st["jump"]), opts.max_jump, opts.max_cycles - float(st["cycles"]))
+    floor = max(opts.min_jump, MIN_JUMP_FRACTION * float(st["cycles"]))
     iters = rejected = failures = 0
     lin = None
     if opts.scheme != "explicit":
@@ -868,17 +893,17 @@ def _advance(sp: SlowProblem, st: dict, opts: WearOptions):
         if not stats.converged:
             failures += 1
             rejected += 1
-            if failures > opts.max_retries or dN <= opts.min_jump:
+            if failures > opts.max_retries or dN <= floor:
                 return None, None, (f"{stats.message} at N = {float(st['cycles']):.4g} with a "
                                     f"jump of {dN:.3g} cycles after {failures} attempts")
-            dN = max(dN / 4.0, opts.min_jump)
+            dN = max(dN / 4.0, floor)
             continue
         sp.set_state(W1, anchor)
         g1 = sp.rate(U1)
         err = _error(dN, W1, W_k, g1, g_k)
-        if opts.adaptive and err > opts.tolerance and dN > opts.min_jump:
+        if opts.adaptive and err > opts.tolerance and dN > floor:
             rejected += 1
-            dN = max(dN * max(0.1, 0.9 * math.sqrt(opts.tolerance / err)), opts.min_jump)
+            dN = max(dN * max(0.1, 0.9 * math.sqrt(opts.tolerance / err)), floor)
             continue
         break
     if opts.adaptive:
@@ -1012,6 +1037,71 @@ def _backward_euler(sp: SlowProblem, opts: WearOptions, W_k, U_start, dN, anchor
                                 opts.solver)
     return W, U, SolveStats(False, math.inf, its, 0, 0, time.perf_counter() - t0, msg,
                             opts.solver)
+
+
+def _rescue(sp: SlowProblem, st: dict, opts: WearOptions):
+    """A step whose balance is started from a time integration: ``(state, row, failure)``.
+
+    When the warm-started balance fails even for small jumps, the periodic state the structure
+    settles to may need other stick anchors than the carried mean positions (a node going from
+    slip to full stick sticks where its history leaves it). The time integration of
+    :func:`fretwear.stability.time_domain_start` at the predicted wear, from the last periodic
+    solution, supplies that history: its harmonics start the balance and its mean tangential
+    positions are the anchors. The wear increment is the explicit (``"explicit"``) or linearly
+    implicit predictor; the error test applies as usual. The failure zone of the warm-started
+    balance is narrow in ``W`` (on the paper's beam at 79 kHz, about 1e4 cycles of wear at
+    N = 1e7), and a jump *over* it is what succeeds: the jumps tried grow from
+    ``max(proposed, 1e-3 N)`` by factors of 4 (4 tries); the first that converges and passes
+    the error test is taken.
+    """
+    from fretwear.stability import time_domain_start
+
+    t0 = time.perf_counter()
+    W_k, U_k, g_k = st["W"], st["U"], st["g"]
+    anchor_k = U_k.reshape(sp.nc, sp.d, sp.H)[:, 1:, 0].copy()
+    last = sp.solution(U_k, W_k, st["anchor"], SolveStats(True, 0.0, 0, 0, 0, 0.0, "", ""))
+    left = opts.max_cycles - float(st["cycles"])
+    dN0 = max(float(st["jump"]), RESCUE_START_FRACTION * float(st["cycles"]))
+    lin = None
+    if opts.scheme != "explicit":
+        sp.set_state(W_k, anchor_k)
+        lin = sp.slow_jacobian(U_k, with_dUdW=True)
+    why = "time-domain start failed"
+    iters = 0
+    for attempt in range(4):
+        dN = min(dN0 * 4.0**attempt, opts.max_jump, left)
+        if lin is None:
+            W1 = W_k + dN * g_k
+        else:
+            W1 = W_k + np.maximum(dN * np.linalg.solve(np.eye(sp.nc) - dN * lin[0], g_k), 0.0)
+        start = replace(last, gap=sp.gap0 + W1)
+        msg, Ut, anc = time_domain_start(sp.model, sp.prob.reduced.omega, sp.prob.basis, start)
+        if Ut is None:
+            why = f"time-domain start at N + {dN:.3g}: {msg}"
+            continue
+        U1, stats = sp.solve_balance(W1, anc, np.asarray(Ut).reshape(sp.m, sp.H),
+                                     solver=opts.solver, tol=opts.tol,
+                                     max_iter=max(opts.max_iter, 200))
+        iters += stats.iterations
+        if not stats.converged:
+            why = f"balance from the time-domain start at N + {dN:.3g}: {stats.message}"
+            continue
+        sp.set_state(W1, anc)
+        g1 = sp.rate(U1)
+        err = _error(dN, W1, W_k, g1, g_k)
+        if opts.adaptive and err > opts.tolerance:
+            why = f"time-domain start at N + {dN:.3g}: error {err:.2g} > tolerance"
+            break  # larger jumps only make it worse
+        sol = sp.solution(U1, W1, anc, stats)
+        cycles = float(st["cycles"]) + dN
+        row = _row(sol, W1, g1, cycles, dN, iters, attempt, err, time.perf_counter() - t0)
+        row["rescued"] = 1
+        new = dict(st)
+        new.update({"step": int(st["step"]) + 1, "cycles": cycles, "W": np.array(W1, float),
+                    "U": U1.copy(), "anchor": np.array(anc, float), "g": g1,
+                    "jump": float(dN), "vrate": row["volume_rate"]})
+        return new, row, ""
+    return None, None, why
 
 
 class _Bar:
