@@ -51,6 +51,8 @@ DIMENSIONS = {
     "contact_node": ("contact node, from 0", "1"),
     "component": ("contact-local component: N (normal), T1, T2 (tangential)", "1"),
     "dof": ("degree of freedom of the model, from 0", "1"),
+    "contact_state": ("contact state: separation, stick, slip", "1"),
+    "wear_state": ("interface before and after wear: unworn, worn", "1"),
 }
 
 

@@ -40,7 +40,7 @@ def options_from_table(a: dict) -> WearOptions:
         max_jump=a["max_jump"], max_cycles=a["max_cycles"],
         max_depth=a.get("max_depth", math.inf), plateau_rate=a["plateau_rate"],
         max_steps=a["max_steps"], solver=a["solver"], tol=a["tol"],
-        checkpoint_every_s=a["checkpoint_every_s"],
+        checkpoint_every_s=a["checkpoint_every_s"], time_domain_rescue=a["time_domain_rescue"],
     ).check()
 
 
@@ -405,7 +405,9 @@ SCHEMA = {
     "plateau_rate": Field(Number(lo=0), "stop when the worn-volume rate falls below this "
                           "fraction of its initial value", default=1e-3, unit="-"),
     "max_steps": Field(Integer(lo=1), "stop after this many slow steps", default=10000),
-    "record_every": Field(Integer(lo=1), "keep every n-th step in results.nc (the last "
+    "time_domain_rescue": Field(Flag(), "dynamic cases: when a step's balance fails, start it "
+                                "from a time integration (docs/wear.md)", default=True),
+"record_every": Field(Integer(lo=1), "keep every n-th step in results.nc (the last "
                           "always)", default=1),
     "checkpoint_every_s": Field(Number(lo=0), "checkpoint interval (0: every step)",
                                 default=10.0, unit="s"),

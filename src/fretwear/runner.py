@@ -45,6 +45,7 @@ ANALYSIS_MODULES = (
     "fretwear.run_linear",  # "modes", "frf"
     "fretwear.run_dlft",  # "periodic", "sweep"
     "fretwear.run_transient",  # "transient", "incremental-wear"
+    "fretwear.run_wear",  # "wear"
 )
 
 RESULTS_FILE = "results.nc"
