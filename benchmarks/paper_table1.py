@@ -43,18 +43,10 @@ N_QS = 3e9  # quasi-static: the reference's rate is then 1.1e-4 of the initial o
 
 
 def beam():
-    """The beam of the paper's section 4.2 (see src/fretwear/examples/beam-linear-frf.toml)."""
-    from fretwear.model.build import ContactSpec, Damping, Material, Spring, Traction, from_mesh
-    from fretwear.model.mesh import rectangle
+    """The beam of the paper's section 4.2 (as src/fretwear/examples/beam-linear-frf.toml)."""
+    from fretwear.examples.builders import paper_beam
 
-    ms = rectangle(0.1, 0.01, 30, 4)
-    return from_mesh(
-        ms, Material(210e9, 0.3, 7800), thickness=0.01, damping=Damping(loss_factor=1e-3),
-        springs=[Spring("bottom_left", "x", 1e4)],
-        loads=[Traction("top", pressure=1e4), Traction("right", pressure=1e4, waveform="sin")],
-        contact=ContactSpec("bottom", mu=0.3, normal=(0, -1), wear_coefficient=1e-11),
-        observed={"Pe": (0.1, 0.005)},
-    )
+    return paper_beam()
 
 
 def run_case(name, model, basis, *, omega, quasi_static, options):

@@ -9,6 +9,7 @@ with ``pyplot``: no window, no global backend switch, nothing left open.
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -37,7 +38,9 @@ def new_figure(nrows: int = 1, ncols: int = 1, *, title: str | None = None,
     fig = Figure(figsize=(panel_size[0] * ncols, panel_size[1] * nrows))
     axes = fig.subplots(nrows, ncols, squeeze=False, sharex=sharex)
     if title:
-        fig.suptitle(title)
+        # long case titles wrap instead of running off the figure
+        width = max(40, int(11 * panel_size[0] * ncols))
+        fig.suptitle(textwrap.fill(title, width), fontsize="medium")
     return fig, axes
 
 
