@@ -47,15 +47,47 @@ class SolveStats:
     solver: str
 
 
-def _lu_step(J, f):
+def solve_identity_rows(J, B):
+    """Solve ``J X = B`` eliminating the rows of ``J`` that hold only their diagonal entry.
+
+    A node that sticks all period (or is anchored) has ``G_p = 0``, so its rows of the DLFT
+    Jacobian ``J = eps I - G (eps I - Z)`` are ``eps I``: those unknowns follow directly and
+    only the block of the other nodes is factorised with LAPACK (on the paper's beam often
+    less than half of the unknowns). Exact; least squares for a singular block.
+
+    Parameters
+    ----------
+    J : (n, n); B : (n,) or (n, k).
+    """
+    n = J.shape[0]
+    idx = np.arange(n)
+    diag_only = (np.count_nonzero(J, axis=1) == 1) & (J[idx, idx] != 0.0)
+    B = np.asarray(B, float)
+    if not diag_only.any():
+        return _dense_solve(J, B)
+    s = np.flatnonzero(diag_only)
+    a = np.flatnonzero(~diag_only)
+    X = np.empty_like(B)
+    X[s] = B[s] / (J[s, s][:, None] if B.ndim == 2 else J[s, s])
+    if a.size:
+        X[a] = _dense_solve(J[np.ix_(a, a)], B[a] - J[np.ix_(a, s)] @ X[s])
+    return X
+
+
+def _dense_solve(A, B):
     try:
-        lu = sla.lu_factor(J, check_finite=False)
-        s = -sla.lu_solve(lu, f, check_finite=False)
-        if np.all(np.isfinite(s)):
-            return s
+        lu = sla.lu_factor(A, check_finite=False)
+        X = sla.lu_solve(lu, B, check_finite=False)
+        if np.all(np.isfinite(X)):
+            return X
     except (sla.LinAlgError, ValueError):
         pass
-    return np.linalg.lstsq(J, -f, rcond=None)[0]
+    return np.linalg.lstsq(A, B, rcond=None)[0]
+
+
+def _lu_step(J, f):
+    """The Newton step ``-J^-1 f``."""
+    return -solve_identity_rows(J, f)
 
 
 def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None):

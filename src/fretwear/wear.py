@@ -54,9 +54,9 @@ from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
-import scipy.linalg as sla
 
 from fretwear import contact as law
+from fretwear import solvers
 from fretwear.errors import ConvergenceError, InputError
 from fretwear.fourier import FourierBasis
 from fretwear.hbm import (
@@ -69,7 +69,7 @@ from fretwear.hbm import (
 from fretwear.model.core import Model
 from fretwear.reduce import Reduced, condense
 from fretwear.results import atomic_write
-from fretwear.solvers import SOLVERS, SolveStats, solve
+from fretwear.solvers import SOLVERS, SolveStats, solve, solve_identity_rows
 from fretwear.wear_kernels import slip_work, slip_work_gradient
 
 LAWS = ("archard", "energy")
@@ -147,85 +147,12 @@ def worn_volume(wear: np.ndarray, area: np.ndarray) -> float:
 # --------------------------------------------------------------------------------------------
 # linear algebra: identity rows of the DLFT Jacobian
 # --------------------------------------------------------------------------------------------
-def solve_identity_rows(J, B):
-    """Solve ``J X = B`` eliminating the rows of ``J`` that hold only their diagonal entry.
-
-    A node that sticks all period has ``G_p = 0``, so its rows
-    of the DLFT Jacobian ``J = eps I - G (eps I - Z)`` are ``eps I``: those unknowns follow
-    directly, and only the block of the other nodes is factorised (for the paper's beam,
-    about 12 of 31 nodes slip at some instant: the LU shrinks by ~15x). Exact (no
-    approximation); falls back to least squares for a singular block.
-
-    Parameters
-    ----------
-    J : (n, n); B : (n,) or (n, k).
-    """
-    n = J.shape[0]
-    diag_only = np.count_nonzero(J, axis=1) == 1
-    idx = np.arange(n)
-    diag_only &= J[idx, idx] != 0.0
-    B = np.asarray(B, float)
-    if not diag_only.any():
-        return _dense_solve(J, B)
-    s = np.flatnonzero(diag_only)
-    a = np.flatnonzero(~diag_only)
-    X = np.empty_like(B)
-    X[s] = B[s] / (J[s, s][:, None] if B.ndim == 2 else J[s, s])
-    if a.size:
-        X[a] = _dense_solve(J[np.ix_(a, a)], B[a] - J[np.ix_(a, s)] @ X[s])
-    return X
-
-
-def _dense_solve(A, B):
-    try:
-        lu = sla.lu_factor(A, check_finite=False)
-        X = sla.lu_solve(lu, B, check_finite=False)
-        if np.all(np.isfinite(X)):
-            return X
-    except (sla.LinAlgError, ValueError):
-        pass
-    return np.linalg.lstsq(A, B, rcond=None)[0]
-
-
 def newton(fun, x0, scale, *, tol=1e-9, max_iter=30) -> tuple[np.ndarray, SolveStats]:
-    """Newton's method with backtracking on ``|f|^2`` and :func:`solve_identity_rows`.
-
-    For the warm-started balances of the slow steps (close to their solution). Same
-    convergence test as :mod:`fretwear.solvers`: ``|f| <= tol * scale(x)``.
-    Returns ``(x, stats)``.
-    """
-    t0 = time.perf_counter()
-    x = np.array(x0, dtype=float)
-    f, _ = fun(x, False)
-    nfev, njev, it = 1, 0, 0
-    fn = float(np.linalg.norm(f))
-    msg, ok = "maximum number of iterations reached", False
-    while True:
-        if fn <= tol * scale(x):
-            ok, msg = True, "converged"
-            break
-        if it >= max_iter:
-            break
-        it += 1
-        _, J = fun(x, True)
-        njev += 1
-        step = -solve_identity_rows(J, f)
-        t, accepted = 1.0, False
-        for _ in range(20):
-            fnew, _ = fun(x + t * step, False)
-            nfev += 1
-            fnn = float(np.linalg.norm(fnew))
-            if fnn <= (1.0 - 1e-4 * t) * fn:
-                accepted = True
-                break
-            t *= 0.5
-        if not accepted:
-            msg = "line search failed: no decrease of |f| along the Newton direction"
-            break
-        x, f, fn = x + t * step, fnew, fnn
-    stats = SolveStats(ok, float(fn / max(scale(x), 1e-300)), it, nfev, njev,
-                       time.perf_counter() - t0, msg, "newton-wear")
-    return x, stats
+    """Newton's method of :mod:`fretwear.solvers` (backtracking on ``|f|^2``, the LU of the
+    rows that are not plain identity rows) for the warm-started balances of the slow steps.
+    Returns ``(x, stats)``."""
+    x, _, st = solvers.newton(fun, x0, scale, tol=tol, max_iter=max_iter)
+    return x, st
 
 
 # --------------------------------------------------------------------------------------------
