@@ -245,6 +245,65 @@ def dlft_jacobian(lam_u, lam_x, state, mu, P, Q, x_start=None, tol=1e-12, max_sw
 
 
 @njit(cache=True)
+def slip_derivative_step(lu, lx, n, m, mu, Q, A0, S, that, B, tmpA, tmpS):
+    """Advance the derivative of the recursion over a *slip* instant ``n`` (previous ``m``).
+
+    ``A0`` (d, dH) holds ``d lambda_x(n-1) / d lambda_u~`` (seed-free part) and ``S`` (d, d-1)
+    its dependence on the seed ``d lambda_x,T(-1)``; on exit they hold those of instant ``n``:
+    with ``t = pre_T/|pre_T|`` and ``B = mu pre_N (I - t t^T)/|pre_T|``,
+    ``A0_T(n) = (I - B) e_T phi(n) - mu t e_N phi(n) + B A0_T(n-1)``, ``S_T(n) = B S_T(n-1)``,
+    ``A0_N = S_N = 0``. ``lu``, ``lx`` are the node's (d, N) samples; ``that`` (d-1,),
+    ``B`` (d-1, d-1), ``tmpA`` (d-1, dH), ``tmpS`` (d-1, d-1) are work arrays (``that`` is
+    left holding the slip direction).
+    """
+    d = lu.shape[0]
+    dt = d - 1
+    H = Q.shape[1]
+    dH = d * H
+    pn = lu[0, n]
+    # on the cone lam_T(n) = lam_u,T(n) - lam_x,T(n) = mu pn t^: gives the direction t^
+    nrm2 = 0.0
+    for c in range(dt):
+        that[c] = lu[1 + c, n] - lx[1 + c, n]
+        nrm2 += that[c] * that[c]
+    lam_t = np.sqrt(nrm2)
+    for c in range(dt):
+        that[c] = that[c] / lam_t if lam_t > 0.0 else 0.0
+    nrm2 = 0.0
+    for c in range(dt):
+        v = lu[1 + c, n] - lx[1 + c, m]
+        nrm2 += v * v
+    rho = np.sqrt(nrm2)
+    g = mu * pn / rho if rho > 0.0 else 0.0
+    for a in range(dt):
+        for b in range(dt):
+            B[a, b] = g * ((1.0 if a == b else 0.0) - that[a] * that[b])
+    for a in range(dt):
+        for j in range(dH):
+            acc = 0.0
+            for b in range(dt):
+                acc += B[a, b] * A0[1 + b, j]
+            tmpA[a, j] = acc
+        for j in range(dt):
+            acc = 0.0
+            for b in range(dt):
+                acc += B[a, b] * S[1 + b, j]
+            tmpS[a, j] = acc
+    for a in range(dt):
+        for j in range(dH):
+            A0[1 + a, j] = tmpA[a, j]
+        for h in range(H):
+            qh = Q[n, h]
+            for b in range(dt):
+                A0[1 + a, (1 + b) * H + h] += ((1.0 if a == b else 0.0) - B[a, b]) * qh
+            A0[1 + a, h] += -mu * that[a] * qh
+        for j in range(dt):
+            S[1 + a, j] = tmpS[a, j]
+    A0[0, :] = 0.0
+    S[0, :] = 0.0
+
+
+@njit(cache=True)
 def _dlft_jacobian(lam_u, lam_x, state, mu, P, Q, x_start, tol, max_sweeps):
     """Derivative ``G = d lambda_x~ / d lambda_u~`` per node (nc, d*H, d*H).
 
@@ -288,50 +347,8 @@ def _dlft_jacobian(lam_u, lam_x, state, mu, P, Q, x_start, tol, max_sweeps):
                 S[0, :] = 0.0
             else:
                 all_stick = False
-                pn = lam_u[p, 0, n]
-                # on the cone lam_T(n) = lam_u,T(n) - lam_x,T(n) = mu pn t^: gives the direction t^
-                nrm2 = 0.0
-                for c in range(dt):
-                    that[c] = lam_u[p, 1 + c, n] - lam_x[p, 1 + c, n]
-                    nrm2 += that[c] * that[c]
-                lam_t = np.sqrt(nrm2)
-                for c in range(dt):
-                    that[c] = that[c] / lam_t if lam_t > 0.0 else 0.0
-                # |pre_T| from the previous correction
-                nrm2 = 0.0
-                for c in range(dt):
-                    prev = lam_x[p, 1 + c, n - 1] if n > 0 else lam_x[p, 1 + c, N - 1]
-                    v = lam_u[p, 1 + c, n] - prev
-                    nrm2 += v * v
-                rho = np.sqrt(nrm2)
-                g = mu[p] * pn / rho if rho > 0.0 else 0.0
-                for a in range(dt):
-                    for b in range(dt):
-                        B[a, b] = g * ((1.0 if a == b else 0.0) - that[a] * that[b])
-                # A0_T(n) = (I - B) e_T phi - mu t^ e_N phi + B A0_T(n-1);  S_T(n) = B S_T(n-1)
-                for a in range(dt):
-                    for j in range(dH):
-                        acc = 0.0
-                        for b in range(dt):
-                            acc += B[a, b] * A0[1 + b, j]
-                        tmpA[a, j] = acc
-                    for j in range(dt):
-                        acc = 0.0
-                        for b in range(dt):
-                            acc += B[a, b] * S[1 + b, j]
-                        tmpS[a, j] = acc
-                for a in range(dt):
-                    for j in range(dH):
-                        A0[1 + a, j] = tmpA[a, j]
-                    for h in range(H):
-                        qh = Q[n, h]
-                        for b in range(dt):
-                            A0[1 + a, (1 + b) * H + h] += ((1.0 if a == b else 0.0) - B[a, b]) * qh
-                        A0[1 + a, h] += -mu[p] * that[a] * qh
-                    for j in range(dt):
-                        S[1 + a, j] = tmpS[a, j]
-                A0[0, :] = 0.0
-                S[0, :] = 0.0
+                slip_derivative_step(lam_u[p], lam_x[p], n, n - 1 if n > 0 else N - 1, mu[p],
+                                     Q, A0, S, that, B, tmpA, tmpS)
             # accumulate the DFT of the derivative
             for c in range(d):
                 for h in range(H):

@@ -26,9 +26,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-SEPARATION = 0
-STICK = 1
-SLIP = 2
+from fretwear.contact import SEPARATION, SLIP, STICK, slip_derivative_step
 
 
 @njit(cache=True)
@@ -123,48 +121,8 @@ def slip_work_gradient(lam_u, lam_x, state, mu, Q, eps):
                 any_slip = True
                 pn = lam_u[p, 0, n]
                 m = n - 1 if n > 0 else N - 1
-                # direction of the contact force on the cone: lambda_T = mu pn t^
-                nrm2 = 0.0
-                for c in range(dt):
-                    that[c] = lam_u[p, 1 + c, n] - lam_x[p, 1 + c, n]
-                    nrm2 += that[c] * that[c]
-                lt = np.sqrt(nrm2)
-                for c in range(dt):
-                    that[c] = that[c] / lt if lt > 0.0 else 0.0
-                nrm2 = 0.0
-                for c in range(dt):
-                    v = lam_u[p, 1 + c, n] - lam_x[p, 1 + c, m]
-                    nrm2 += v * v
-                rho = np.sqrt(nrm2)
-                g = mu[p] * pn / rho if rho > 0.0 else 0.0
-                for a in range(dt):
-                    for b in range(dt):
-                        B[a, b] = g * ((1.0 if a == b else 0.0) - that[a] * that[b])
-                # A0_T(n) = (I - B) e_T Q_n - mu t^ e_N Q_n + B A0_T(n-1);  S_T(n) = B S_T(n-1)
-                for a in range(dt):
-                    for j in range(dH):
-                        s = 0.0
-                        for b in range(dt):
-                            s += B[a, b] * A0[1 + b, j]
-                        tmpA[a, j] = s
-                    for j in range(dt):
-                        s = 0.0
-                        for b in range(dt):
-                            s += B[a, b] * Sd[1 + b, j]
-                        tmpS[a, j] = s
-                for a in range(dt):
-                    for j in range(dH):
-                        A0[1 + a, j] = tmpA[a, j]
-                    for h in range(H):
-                        qh = Q[n, h]
-                        for b in range(dt):
-                            A0[1 + a, (1 + b) * H + h] += ((1.0 if a == b else 0.0)
-                                                           - B[a, b]) * qh
-                        A0[1 + a, h] += -mu[p] * that[a] * qh
-                    for j in range(dt):
-                        Sd[1 + a, j] = tmpS[a, j]
-                A0[0, :] = 0.0
-                Sd[0, :] = 0.0
+                slip_derivative_step(lam_u[p], lam_x[p], n, m, mu[p], Q, A0, Sd, that, B,
+                                     tmpA, tmpS)
                 # the wear integrand pn |dX| and its derivative
                 s2 = 0.0
                 for a in range(dt):
