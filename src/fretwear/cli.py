@@ -13,9 +13,15 @@ import sys
 from importlib import resources
 from pathlib import Path
 
-from fretwear import __version__
-from fretwear.errors import FretwearError, InputError
-from fretwear.schema import suggest
+# The solves are many dense problems of ~1000 unknowns: threaded BLAS gains little there and
+# oversubscribes small machines (a 10x slower LU was measured on a busy 2-core machine).
+# Set before numpy loads; a user's own setting wins.
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+from fretwear import __version__  # noqa: E402 (after the BLAS thread setting)
+from fretwear.errors import FretwearError, InputError  # noqa: E402 (after the BLAS thread setting)
+from fretwear.schema import suggest  # noqa: E402 (after the BLAS thread setting)
 
 
 # --- examples -----------------------------------------------------------------------------
