@@ -383,49 +383,6 @@ def test_failed_solve_stops_cleanly(blk, monkeypatch):
     assert 1 <= r.history.n_steps <= 4
 
 
-def test_time_domain_rescue_gives_balanced_steps(monkeypatch):
-    """Dynamic case (2 kHz), every regular step forced to fail after the first: the steps come
-    from the time-domain rescue, are flagged, use the start's stick anchors and are converged
-    balances (residual re-evaluated at the recorded U, W and anchors: below the solver
-    tolerance). The time integration itself (fretwear.stability.time_domain_start, which does
-    not settle on this undamped block) is stood in for by a DLFT solve at the requested wear,
-    returning what it returns: harmonics and mean tangential positions."""
-    import fretwear.stability
-    import fretwear.wear as wm
-
-    m = block()
-    omega = 2 * np.pi * 2e3
-    real = wm._advance
-    calls = {"n": 0, "td": 0}
-
-    def failing(sp, st, opts):
-        calls["n"] += 1
-        if calls["n"] > 1:
-            return None, None, "forced failure"
-        return real(sp, st, opts)
-
-    def fake_time_domain_start(model, om, basis, start, **kw):
-        calls["td"] += 1
-        sol, st = solve_periodic(model, basis, omega=om, gap=start.gap, U0=start.U,
-                                 anchor=start.anchor, tol=1e-10)
-        assert st.converged
-        return "stand-in", sol.U.copy(), sol.U[:, 1:, 0].copy()
-
-    monkeypatch.setattr(wm, "_advance", failing)
-    monkeypatch.setattr(fretwear.stability, "time_domain_start", fake_time_domain_start)
-    r = simulate_wear(m, BASIS, omega=omega, options=WearOptions(max_steps=3, tolerance=0.05))
-    h = r.history
-    assert r.converged and h.n_steps == 4 and calls["td"] >= 2
-    np.testing.assert_array_equal(h.rescued, [0, 0, 1, 1])
-    red = condense(m, omega, BASIS.orders)
-    spb = SlowProblem(m, red, BASIS, wear_coefficients(m), eps=r.initial.eps)
-    for k in (2, 3):
-        spb.set_state(h.wear_depth[k], h.anchor[k])
-        U = h.U[k].reshape(spb.m, spb.H)
-        f, _ = spb.balance(U, False)
-        assert np.linalg.norm(f) <= 1e-9 * spb.prob.scale(U)
-
-
 # --- checkpoints ------------------------------------------------------------------------------
 @pytest.mark.parametrize("every", [0.0, 1e9])
 def test_interrupt_and_resume_equals_uninterrupted(blk, tmp_path, every):

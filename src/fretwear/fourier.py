@@ -71,6 +71,15 @@ class FourierBasis:
         """Sample angles ``tau_j = 2 pi j / N`` [rad]."""
         return 2.0 * np.pi * np.arange(self.n_samples) / self.n_samples
 
+    def rows_in_full(self, hmax: int) -> np.ndarray:
+        """Rows of a full real spectrum ``[a0, a1..a_hmax, b1..b_hmax]`` (the layout of
+        :func:`fretwear.transient.fourier_coefficients`) that hold this basis's coefficients
+        ``[0, c_h.., s_h..]``."""
+        h = list(self.harmonics)
+        if h and max(h) > hmax:
+            raise InputError(f"harmonic {max(h)} is not in a spectrum up to {hmax}")
+        return np.array([0] + h + [hmax + k for k in h], dtype=np.int64)
+
     def labels(self) -> list[str]:
         return ["0"] + [f"c{h}" for h in self.harmonics] + [f"s{h}" for h in self.harmonics]
 

@@ -25,6 +25,7 @@ from fretwear.runner import RunOutput, register
 from fretwear.schema import Field, Flag, Integer, ListOf, Number, Table, Text, fail, increasing
 from fretwear.solvers import SOLVERS
 from fretwear.wear import LAWS, SCHEMES, WearOptions, WearResult, frf_worn, simulate_wear
+from fretwear.wear_time import RESPONSE_KINDS
 
 CHECKPOINT_FILE = "wear-checkpoint.npz"
 COMPONENTS = ("N", "T1", "T2")
@@ -41,6 +42,8 @@ def options_from_table(a: dict) -> WearOptions:
         max_depth=a.get("max_depth", math.inf), plateau_rate=a["plateau_rate"],
         max_steps=a["max_steps"], solver=a["solver"], tol=a["tol"],
         checkpoint_every_s=a["checkpoint_every_s"], time_domain_rescue=a["time_domain_rescue"],
+        time_domain_settle=a["time_domain_settle"], time_domain_average=a["time_domain_average"],
+        time_domain_steps=a.get("time_domain_steps"),
     ).check()
 
 
@@ -84,7 +87,7 @@ def wear_dataset(model, result: WearResult, basis: FourierBasis, *, frequency_hz
         "cycles", "jump", "wear_depth", "wear_rate", "pressure_mean", "pressure_max",
         "slip_amplitude", "slip_path", "state_fraction", "friction_energy", "worn_volume",
         "volume_rate", "newton_iterations", "rejected", "error_estimate", "wall_time", "U",
-        "lam", "rescued")}
+        "lam", "rescued", "response")}
     cpos = np.asarray(c.coords, float).reshape(nc, -1)[:, :d]
     data = {
         "contact_position": variable(("contact_node", "axis"), cpos, "m",
@@ -93,7 +96,7 @@ def wear_dataset(model, result: WearResult, basis: FourierBasis, *, frequency_hz
                                  "tributary area of the contact node"),
         "excitation_frequency": variable((), frequency_hz, "Hz",
                                          "excitation frequency (time scale only if quasi-static)"),
-        "penalty": variable((), result.initial.eps, "N/m", "DLFT penalty eps"),
+        "penalty": variable((), result.penalty, "N/m", "DLFT penalty eps"),
         "stability_jump": variable((), result.stability_jump, "1",
                                    "explicit Euler stability limit 2/rho at the start, cycles"),
         "cycles": variable(sc, hist["cycles"], "1", "physical cycle count N"),
@@ -125,8 +128,14 @@ def wear_dataset(model, result: WearResult, basis: FourierBasis, *, frequency_hz
                                    "local error estimate relative to the maximum wear depth"),
         "step_wall_time": variable(sc, hist["wall_time"], "s", "wall time of the step"),
         "time_domain_start": variable(sc, hist["rescued"].astype(np.int8), "1",
-                                      "1 if the step's balance was started from a time "
-                                      "integration (stick anchors from its history)"),
+                                      "0: balanced step; 1: balance started from a time "
+                                      "integration; 2: wear rate averaged over a time "
+                                      "integration (no periodic balance)"),
+        "time_domain_response": variable(sc, hist["response"].astype(np.int8), "1",
+                                         "response of the step's time integration: "
+                                         + ", ".join(f"{i} {k}" for i, k in
+                                                     enumerate(RESPONSE_KINDS))
+                                         + "; -1 none integrated"),
         "contact_displacement_coefficients": variable(
             ("step", "contact_node", "component", "harmonic_coefficient"), hist["U"], "m",
             "Fourier coefficients of the contact displacements (normal includes gap + wear)"),
@@ -405,8 +414,16 @@ SCHEMA = {
     "plateau_rate": Field(Number(lo=0), "stop when the worn-volume rate falls below this "
                           "fraction of its initial value", default=1e-3, unit="-"),
     "max_steps": Field(Integer(lo=1), "stop after this many slow steps", default=10000),
-    "time_domain_rescue": Field(Flag(), "dynamic cases: when a step's balance fails, start it "
-                                "from a time integration (docs/wear.md)", default=True),
+    "time_domain_rescue": Field(Flag(), "dynamic cases: when a step's periodic balance fails, "
+                                "take the step from a time integration: its periodic state, or "
+                                "its wear rate averaged over periods (docs/wear.md)",
+                                default=True),
+    "time_domain_settle": Field(Integer(lo=0), "periods integrated before averaging in such "
+                                "a step", default=300, unit="periods"),
+    "time_domain_average": Field(Integer(lo=2), "periods over which such a step averages "
+                                 "the wear rate", default=500, unit="periods"),
+    "time_domain_steps": Field(Integer(lo=8), "time steps per period of such a step "
+                               "(default: max(128, 8 x the highest harmonic))"),
 "record_every": Field(Integer(lo=1), "keep every n-th step in results.nc (the last "
                           "always)", default=1),
     "checkpoint_every_s": Field(Number(lo=0), "checkpoint interval (0: every step)",

@@ -181,8 +181,7 @@ def time_domain_start(model: Model, omega: float, basis, start: PeriodicSolution
     n = res.n_periods
     if kind == "periodic":
         c = np.asarray(res.contact_harmonics["u_loc"])  # (2 hmax + 1, nc, d): [a0, a.., b..]
-        idx = np.array([0] + [h for h in basis.harmonics] + [hmax + h for h in basis.harmonics])
-        Ut = np.moveaxis(c[idx], 0, -1).copy()  # (nc, d, H)
+        Ut = np.moveaxis(c[basis.rows_in_full(hmax)], 0, -1).copy()  # (nc, d, H)
         anchor = Ut[:, 1:, 0].copy()
         return (f"time integration: periodic steady state after {n} periods", Ut, anchor)
     if kind == "subharmonic":

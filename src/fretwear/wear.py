@@ -50,7 +50,7 @@ import json
 import math
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -75,13 +75,19 @@ from fretwear.wear_kernels import slip_work, slip_work_gradient
 LAWS = ("archard", "energy")
 SCHEMES = ("implicit", "rosenbrock", "explicit")
 STOP_REASONS = ("max_cycles", "max_depth", "plateau", "no_wear", "max_steps", "solver_failed")
-CHECKPOINT_VERSION = 1
+CHECKPOINT_VERSION = 2
 #: retried jumps are not cut below this fraction of the cycle count
 MIN_JUMP_FRACTION = 1e-5
-#: the jumps of a time-domain rescue start at this fraction of the cycle count
+#: with a time-domain step behind, failed solves do not cut the jump below this fraction of N
 RESCUE_START_FRACTION = 1e-3
 #: iteration cap of a balance started from a time integration
 RESCUE_MAX_ITER = 400
+#: periods integrated from rest when the unworn interface has no periodic balance
+START_SETTLE = 2000
+#: first jump of such a run [cycles] (no slow Jacobian to size it)
+START_JUMP = 1e4
+#: responses of a time-domain step from which the balance is tried (see _time_domain_step)
+BALANCE_KINDS = ("periodic", "drifting", "transient")
 #: implicit schemes keep dN lam <= this for the growing modes (lam > 0) of the slow Jacobian
 GROWTH_LIMIT = 0.5
 
@@ -360,9 +366,14 @@ class WearOptions:
     solver, tol, max_iter : nonlinear solver (:func:`fretwear.solvers.solve`), its relative
         residual tolerance ``eps_r`` and iteration cap.
     max_retries : jump reductions (by 4) tried after a failed solve before stopping.
-    time_domain_rescue : (dynamic cases) when a step still fails, start its balance from a time
-        integration at the predicted wear (:func:`fretwear.stability.time_domain_start`),
-        with the stick anchors the integration gives (see :func:`_rescue`).
+    time_domain_rescue : (dynamic cases) when a step's periodic balance fails, take the step
+        from a time integration at the predicted wear (:func:`_time_domain_step`): from its
+        periodic state when it has one and the balance converges from there, otherwise with the
+        wear rate averaged over its periods (:mod:`fretwear.wear_time`).
+    time_domain_settle, time_domain_average : periods integrated before averaging, and
+        averaged, by such a step.
+    time_domain_steps : time steps per period of such a step (default ``max(128, 8 x`` the
+        highest harmonic)); stick-slip events are first order in the step (docs/wear.md).
     checkpoint_every_s : write the checkpoint at most this often [s] (0: every step).
     """
 
@@ -386,6 +397,9 @@ class WearOptions:
     implicit_newton: str = "nested"
     max_retries: int = 6
     time_domain_rescue: bool = True
+    time_domain_settle: int = 300
+    time_domain_average: int = 500
+    time_domain_steps: int | None = None
     checkpoint_every_s: float = 10.0
 
     def check(self) -> WearOptions:
@@ -402,6 +416,15 @@ class WearOptions:
                 raise InputError(f"{name} = {v!r}: expected a positive number")
         if self.initial_jump is not None and not self.initial_jump > 0:
             raise InputError(f"initial_jump = {self.initial_jump!r}: expected > 0 cycles")
+        for name in ("time_domain_settle", "time_domain_average"):
+            v = getattr(self, name)
+            if not (isinstance(v, int) and v >= (0 if name.endswith("settle") else 2)):
+                raise InputError(f"{name} = {v!r}: expected a whole number of periods"
+                                 + (" >= 0" if name.endswith("settle") else " >= 2"))
+        ts = self.time_domain_steps
+        if ts is not None and not (isinstance(ts, int) and ts >= 8):
+            raise InputError(f"time_domain_steps = {ts!r}: expected a whole number >= 8 of "
+                             "time steps per period")
         if not self.plateau_rate >= 0:
             raise InputError(f"plateau_rate = {self.plateau_rate!r}: expected >= 0")
         return self
@@ -437,7 +460,10 @@ HISTORY_FIELDS = {
     "U": ("m", "Fourier coefficients of the contact displacements"),
     "lam": ("N", "Fourier coefficients of the contact forces"),
     "anchor": ("m", "stick anchors used by the periodic solve"),
-    "rescued": ("1", "1 if the step's balance was started from a time integration"),
+    "rescued": ("1", "0: balanced step warm-started from the previous one; 1: balance started "
+                "from a time integration; 2: wear rate averaged over a time integration"),
+    "response": ("1", "kind of the step's time-integrated response (index in "
+                 "fretwear.wear_time.RESPONSE_KINDS), -1 when none was integrated"),
 }
 
 
@@ -472,6 +498,7 @@ class WearHistory:
     lam: np.ndarray
     anchor: np.ndarray
     rescued: np.ndarray
+    response: np.ndarray
     stop_reason: str = ""
 
     @classmethod
@@ -492,7 +519,9 @@ class WearResult:
     """Outcome of :func:`simulate_wear`.
 
     history : :class:`WearHistory`; initial, final : periodic solutions at the first and last
-    recorded steps; stop_reason : why it stopped; message : one line for the user;
+    balanced steps (steps whose rate was averaged over a time integration, ``rescued = 2``,
+    have no periodic solution; None when no step was balanced); penalty : the DLFT eps [N/m];
+    stop_reason : why it stopped; message : one line for the user;
     converged : False when it stopped on a failed solve (every recorded step converged);
     wall_time : [s]; stability_jump : explicit Euler's stability limit ``2/rho`` estimated
     from the slow Jacobian at the start [cycles] (nan if not computed).
@@ -507,6 +536,7 @@ class WearResult:
     wall_time: float
     stability_jump: float = math.nan
     resumed_from: int = -1
+    penalty: float = math.nan
     extra: dict = field(default_factory=dict)
 
     @property
@@ -529,7 +559,7 @@ def _row(sol: PeriodicSolution, W, g, cycles, jump, iters, rejected, err, wall) 
         "volume_rate": float(np.dot(area, g)), "newton_iterations": int(iters),
         "rejected": int(rejected), "error_estimate": float(err), "wall_time": float(wall),
         "U": sol.U.copy(), "lam": sol.lam.copy(), "anchor": np.array(sol.anchor, float),
-        "rescued": 0,
+        "rescued": 0, "response": -1,
     }
 
 
@@ -681,7 +711,8 @@ def simulate_wear(model: Model, basis: FourierBasis, *, omega: float = 2 * np.pi
     Raises
     ------
     ConvergenceError
-        The first periodic solve (unworn interface) did not converge: nothing to integrate.
+        The first periodic solve (unworn interface) did not converge and no time-domain start
+        is allowed (quasi-static, or ``time_domain_rescue = False``): nothing to integrate.
     KeyboardInterrupt
         On Ctrl-C (the last accepted state is in the checkpoint first).
     """
@@ -705,7 +736,8 @@ def simulate_wear(model: Model, basis: FourierBasis, *, omega: float = 2 * np.pi
         resumed_from = int(state["step"])
     if state is None:
         state, rows = _start(sp, W0, anchor, U0, opts)
-    initial = _assemble(sp, rows[0])
+    balanced = [r for r in rows if int(r["rescued"]) != 2]
+    initial = _assemble(sp, balanced[0]) if balanced else None
 
     bar = _Bar(progress, opts)
     last_ckpt = -math.inf
@@ -714,10 +746,13 @@ def simulate_wear(model: Model, basis: FourierBasis, *, omega: float = 2 * np.pi
     try:
         bar.show(state)
         while not reason:
-            new_state, row, failure = _advance(sp, state, opts)
-            if failure and opts.time_domain_rescue and not sp.prob.reduced.quasi_static:
-                new_state, row, why = _rescue(sp, state, opts)
-                failure = f"{failure}; {why}" if why else ""
+            if np.size(state["td_U"]):  # the previous step came from a time integration
+                new_state, row, failure = _time_domain_step(sp, state, opts)
+            else:
+                new_state, row, failure = _advance(sp, state, opts)
+                if failure and opts.time_domain_rescue and not sp.prob.reduced.quasi_static:
+                    new_state, row, why = _time_domain_step(sp, state, opts)
+                    failure = f"{failure}; {why}" if why else ""
             if failure:
                 reason, extra = "solver_failed", f": {failure}"
                 break
@@ -740,10 +775,11 @@ def simulate_wear(model: Model, basis: FourierBasis, *, omega: float = 2 * np.pi
     if ckpt is not None:
         save_checkpoint(ckpt, state, rows, key)
     hist = WearHistory.from_rows(rows, reason)
-    final = _assemble(sp, rows[-1])
+    last = [r for r in rows if int(r["rescued"]) != 2]
+    final = _assemble(sp, last[-1]) if last else None
     return WearResult(hist, initial, final, reason, _message(reason, state, opts, extra),
                       reason != "solver_failed", time.perf_counter() - t_start,
-                      float(state["stability_jump"]), resumed_from)
+                      float(state["stability_jump"]), resumed_from, penalty=sp.eps)
 
 
 def _assemble(sp: SlowProblem, row: dict) -> PeriodicSolution:
@@ -765,6 +801,8 @@ def _start(sp: SlowProblem, W0, anchor, U0, opts: WearOptions) -> tuple[dict, li
                               anchor=anchor, U0=U0, solver=opts.solver, tol=opts.tol,
                               max_iter=max(opts.max_iter, 200))
     if sol0 is None or not st.converged:
+        if opts.time_domain_rescue and not sp.prob.reduced.quasi_static:
+            return _time_domain_start(sp, W0, opts, st, t0)
         raise ConvergenceError(
             f"the periodic solve of the unworn interface did not converge ({st.message}, "
             f"relative residual {st.residual:.3g} > {opts.tol:g}): no wear computed"
@@ -789,6 +827,34 @@ def _start(sp: SlowProblem, W0, anchor, U0, opts: WearOptions) -> tuple[dict, li
         "anchor": np.array(anchor, float), "g": g, "jump": float(jump),
         "vrate": row["volume_rate"], "vrate0": row["volume_rate"],
         "stability_jump": float(stab), "stop_reason": np.asarray(""),
+        "td_U": np.zeros(0), "td_V": np.zeros(0), "td_retry_at": 0.0,
+    }
+    return state, [row]
+
+
+def _time_domain_start(sp: SlowProblem, W0, opts: WearOptions, st: SolveStats, t0: float):
+    """Step 0 from a time integration when the unworn interface has no periodic balance
+    (dynamic cases; e.g. a subharmonic or quasi-periodic response): the structure is integrated
+    from rest for ``START_SETTLE`` periods, then its wear rate is averaged as in
+    :func:`_time_domain_step`, and the run goes on with time-domain steps (which go back to the
+    DLFT as soon as a balance converges). The first jump is ``initial_jump``, default
+    ``START_JUMP`` cycles (no slow Jacobian without a balance; the error control adapts it)."""
+    from fretwear.wear_time import time_averaged_rate
+
+    tr = time_averaged_rate(sp.model, sp.prob.reduced.omega, sp.prob.basis, sp.coef, W0,
+                            U0=None, V0=None,
+                            settle=max(opts.time_domain_settle, START_SETTLE),
+                            average=opts.time_domain_average,
+                            steps_per_period=opts.time_domain_steps)
+    row = _time_row(tr, sp.model.contact.area, W0, 0.0, 0.0, st.iterations, 1, 0.0,
+                    time.perf_counter() - t0)
+    jump = float(opts.initial_jump) if opts.initial_jump is not None else START_JUMP
+    state = {
+        "step": 0, "cycles": 0.0, "W": np.array(W0, float),
+        "U": tr.U.reshape(sp.m, sp.H).copy(), "anchor": np.array(tr.anchor, float), "g": tr.g,
+        "jump": jump, "vrate": row["volume_rate"], "vrate0": row["volume_rate"],
+        "stability_jump": math.nan, "stop_reason": np.asarray(""), "td_U": tr.U_end,
+        "td_V": tr.V_end, "td_retry_at": 0.0,
     }
     return state, [row]
 
@@ -838,13 +904,8 @@ def _advance(sp: SlowProblem, st: dict, opts: WearOptions):
             dN = max(dN * max(0.1, 0.9 * math.sqrt(opts.tolerance / err)), floor)
             continue
         break
-    if opts.adaptive:
-        grow = 5.0 if err == 0.0 else min(5.0, max(0.2, 0.9 * math.sqrt(opts.tolerance / err)))
-        if failures:
-            grow = min(grow, 1.0)  # no growth right after a failed solve (stiff ODE practice)
-        jump = dN * grow
-    else:
-        jump = float(st["jump"])
+    # no growth right after a failed solve (stiff ODE practice)
+    jump = _next_jump(dN, err, opts, float(st["jump"]), 1.0 if failures else 5.0)
     sol = sp.solution(U1, W1, anchor, stats)
     cycles = float(st["cycles"]) + dN
     row = _row(sol, W1, g1, cycles, dN, iters, rejected, err, time.perf_counter() - t0)
@@ -971,71 +1032,110 @@ def _backward_euler(sp: SlowProblem, opts: WearOptions, W_k, U_start, dN, anchor
                             opts.solver)
 
 
-def _rescue(sp: SlowProblem, st: dict, opts: WearOptions):
-    """A step whose balance is started from a time integration: ``(state, row, failure)``.
+def _time_domain_step(sp: SlowProblem, st: dict, opts: WearOptions):
+    """A slow step taken from a time integration: ``(state, row, failure)``.
 
-    When the warm-started balance fails even for small jumps, the periodic state the structure
-    settles to may need other stick anchors than the carried mean positions (a node going from
-    slip to full stick sticks where its history leaves it). The time integration of
-    :func:`fretwear.stability.time_domain_start` at the predicted wear, from the last periodic
-    solution, supplies that history: its harmonics start the balance and its mean tangential
-    positions are the anchors. The wear increment is the explicit (``"explicit"``) or linearly
-    implicit predictor; the error test applies as usual. The failure zone of the warm-started
-    balance is narrow in ``W`` (on the paper's beam at 79 kHz, about 1e4 cycles of wear at
-    N = 1e7), and a jump *over* it is what succeeds: the jumps tried grow from
-    ``max(proposed, 1e-3 N)`` by factors of 4 (4 tries); the first that converges and passes
-    the error test is taken.
+    Used where the periodic balance fails (dynamic cases). The wear is advanced by explicit
+    Euler from the rate at the start of the step (eq. 30), ``W1 = W_k + dN g_k``, and the
+    structure is integrated in time at ``W1`` (:func:`fretwear.wear_time.time_averaged_rate`),
+    continuing the previous time integration when there is one (so that the transient and the
+    slow drift of the mean position carry over), else from the last periodic solution. The rate
+    at ``W1`` is the mean of Archard's integrand over ``time_domain_average`` periods; the
+    error test compares it with ``g_k`` as for every step (:func:`_error`), and a rejected jump
+    is retried smaller.
+
+    Unless the integrated response is clearly not periodic (subharmonic, quasi-periodic,
+    irregular), the balance at ``W1`` is tried from the harmonics of its last period
+    with its mean tangential positions as stick anchors (the history selects where nodes that
+    stop slipping stick): if it converges and passes the error test the step is an ordinary
+    balanced step (``rescued = 1``) and the next step goes back to the DLFT. Otherwise the step
+    keeps the time-averaged rate (``rescued = 2``), and so do the next steps until the balance
+    converges again. A balance that failed is not retried before the cycle count has doubled
+    (each try costs up to hundreds of iterations).
     """
-    from fretwear.stability import time_domain_start
+    from fretwear.stability import initial_state
+    from fretwear.wear_time import time_averaged_rate
 
     t0 = time.perf_counter()
-    W_k, U_k, g_k = st["W"], st["U"], st["g"]
-    anchor_k = U_k.reshape(sp.nc, sp.d, sp.H)[:, 1:, 0].copy()
-    last = sp.solution(U_k, W_k, st["anchor"], SolveStats(True, 0.0, 0, 0, 0, 0.0, "", ""))
-    left = opts.max_cycles - float(st["cycles"])
-    dN0 = max(float(st["jump"]), RESCUE_START_FRACTION * float(st["cycles"]))
-    lin = None
-    if opts.scheme != "explicit":
-        sp.set_state(W_k, anchor_k)
-        lin = sp.slow_jacobian(U_k, with_dUdW=True)
-    why = "time-domain start failed"
-    iters = 0
-    for attempt in range(4):
-        dN = min(dN0 * 4.0**attempt, opts.max_jump, left)
-        if lin is None:
-            W1 = W_k + dN * g_k
-        else:
-            W1 = W_k + np.maximum(dN * np.linalg.solve(np.eye(sp.nc) - dN * lin[0], g_k), 0.0)
-        start = replace(last, gap=sp.gap0 + W1)
-        msg, Ut, anc = time_domain_start(sp.model, sp.prob.reduced.omega, sp.prob.basis, start)
-        if Ut is None:
-            why = f"time-domain start at N + {dN:.3g}: {msg}"
+    W_k, g_k, cycles = st["W"], st["g"], float(st["cycles"])
+    if np.size(st["td_U"]):
+        U0, V0 = st["td_U"], st["td_V"]
+    else:
+        last = sp.solution(st["U"], W_k, st["anchor"], SolveStats(True, 0.0, 0, 0, 0, 0.0, "", ""))
+        U0, V0 = initial_state(sp.model, last)
+    dN = min(float(st["jump"]), opts.max_jump, opts.max_cycles - cycles)
+    floor = max(opts.min_jump, MIN_JUMP_FRACTION * cycles)
+    rejected = iters = 0
+    while True:
+        W1 = W_k + dN * g_k
+        try:
+            tr = time_averaged_rate(sp.model, sp.prob.reduced.omega, sp.prob.basis, sp.coef,
+                                    W1, U0=U0, V0=V0, settle=opts.time_domain_settle,
+                                    average=opts.time_domain_average,
+                                    steps_per_period=opts.time_domain_steps)
+        except ConvergenceError as exc:
+            return None, None, f"time integration at N + {dN:.3g}: {exc}"
+        err = _error(dN, W1, W_k, tr.g, g_k)
+        if opts.adaptive and err > opts.tolerance and dN > floor:
+            rejected += 1
+            dN = max(dN * max(0.1, 0.9 * math.sqrt(opts.tolerance / err)), floor)
             continue
-        # from a time-integration start the balance needs 180-290 Powell iterations on the
-        # paper's beam at 79 kHz (measured), hence the larger cap
-        U1, stats = sp.solve_balance(W1, anc, np.asarray(Ut).reshape(sp.m, sp.H),
+        break
+    cycles1 = cycles + dN
+    new = dict(st)
+    new.update({"step": int(st["step"]) + 1, "cycles": cycles1, "W": np.array(W1, float)})
+    if tr.kind in BALANCE_KINDS and cycles1 >= float(st["td_retry_at"]):
+        U1, stats = sp.solve_balance(W1, tr.anchor, tr.U.reshape(sp.m, sp.H),
                                      solver=opts.solver, tol=opts.tol,
                                      max_iter=max(opts.max_iter, RESCUE_MAX_ITER))
         iters += stats.iterations
-        if not stats.converged:
-            why = f"balance from the time-domain start at N + {dN:.3g}: {stats.message}"
-            continue
-        sp.set_state(W1, anc)
-        g1 = sp.rate(U1)
-        err = _error(dN, W1, W_k, g1, g_k)
-        if opts.adaptive and err > opts.tolerance:
-            why = f"time-domain start at N + {dN:.3g}: error {err:.2g} > tolerance"
-            break  # larger jumps only make it worse
-        sol = sp.solution(U1, W1, anc, stats)
-        cycles = float(st["cycles"]) + dN
-        row = _row(sol, W1, g1, cycles, dN, iters, attempt, err, time.perf_counter() - t0)
-        row["rescued"] = 1
-        new = dict(st)
-        new.update({"step": int(st["step"]) + 1, "cycles": cycles, "W": np.array(W1, float),
-                    "U": U1.copy(), "anchor": np.array(anc, float), "g": g1,
-                    "jump": float(dN), "vrate": row["volume_rate"]})
-        return new, row, ""
-    return None, None, why
+        if stats.converged:
+            sp.set_state(W1, tr.anchor)
+            g1 = sp.rate(U1)
+            err_b = _error(dN, W1, W_k, g1, g_k)
+            if not opts.adaptive or err_b <= opts.tolerance:
+                sol = sp.solution(U1, W1, tr.anchor, stats)
+                row = _row(sol, W1, g1, cycles1, dN, iters, rejected, err_b,
+                           time.perf_counter() - t0)
+                row.update({"rescued": 1, "response": tr.kind_code})
+                new.update({"U": U1.copy(), "anchor": np.array(tr.anchor, float), "g": g1,
+                            "jump": _next_jump(dN, err_b, opts, float(st["jump"]), 1.0),
+                            "vrate": row["volume_rate"], "td_U": np.zeros(0),
+                            "td_V": np.zeros(0), "td_retry_at": 0.0})
+                return new, row, ""
+        new["td_retry_at"] = 2.0 * cycles1
+    row = _time_row(tr, sp.model.contact.area, W1, cycles1, dN, iters, rejected, err,
+                    time.perf_counter() - t0)
+    new.update({"U": tr.U.reshape(sp.m, sp.H).copy(), "anchor": np.array(tr.anchor, float),
+                "g": tr.g, "jump": _next_jump(dN, err, opts, float(st["jump"])),
+                "vrate": row["volume_rate"],
+                "td_U": tr.U_end, "td_V": tr.V_end})
+    return new, row, ""
+
+
+def _time_row(tr, area, W, cycles, jump, iters, rejected, err, wall) -> dict:
+    """One history row from a time-averaged rate (:class:`~fretwear.wear_time.TimeAveragedRate`;
+    ``rescued = 2``)."""
+    return {
+        "cycles": float(cycles), "jump": float(jump), "wear_depth": np.array(W, float),
+        "wear_rate": tr.g, "pressure_mean": tr.pressure_mean, "pressure_max": tr.pressure_max,
+        "slip_amplitude": tr.slip_amplitude, "slip_path": tr.slip_path,
+        "state_fraction": tr.state_fraction, "friction_energy": tr.friction_energy,
+        "worn_volume": worn_volume(W, area), "volume_rate": float(np.dot(area, tr.g)),
+        "newton_iterations": int(iters), "rejected": int(rejected), "error_estimate": float(err),
+        "wall_time": float(wall), "U": tr.U, "lam": tr.lam,
+        "anchor": np.array(tr.anchor, float), "rescued": 2, "response": tr.kind_code,
+    }
+
+
+def _next_jump(dN: float, err: float, opts: WearOptions, fixed: float,
+               grow_limit: float = 5.0) -> float:
+    """The jump proposed after an accepted step of ``dN`` cycles with error estimate ``err``
+    (``fixed``, the jump in force, without ``adaptive``)."""
+    if not opts.adaptive:
+        return fixed
+    grow = 5.0 if err == 0.0 else min(5.0, max(0.2, 0.9 * math.sqrt(opts.tolerance / err)))
+    return dN * min(grow, grow_limit)
 
 
 class _Bar:

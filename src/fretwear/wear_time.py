@@ -1,0 +1,160 @@
+"""Wear rate averaged over a time integration: the slow-scale rate where no periodic balance is.
+
+The "DLFT with wear" method (paper section 3, Fig. 3) takes the wear per cycle (eq. 29) from the
+periodic solution of the harmonic balance. Along a wear history the balance can stop existing:
+the structure may bifurcate to a subharmonic or quasi-periodic response, or the truncated balance
+(a few harmonics, sampled stick-slip transitions) may lose its solution while the structure still
+vibrates periodically. In both cases the wear per cycle is still well defined as the mean, over
+many vibration periods, of Archard's integrand (eq. 12, 29) on what the structure does. This
+module computes that mean with the exact time integration of :mod:`fretwear.transient`
+(Newmark with unilateral contact and Coulomb friction, no regularisation):
+
+    dW1_p = c_p S_p,    S_p = (1/K) sum_n lambda_N,p(t_n) |x_T,p(t_n+1) - x_T,p(t_n)|
+
+over the steps ``n`` of ``K`` periods in which node ``p`` slips
+
+with ``c_p`` the factor of the wear law (:func:`fretwear.wear.wear_coefficients`): ``k_w /
+area`` for Archard, ``k_e mu / area`` for the energy law, exactly as on the DLFT samples. A node
+that sticks wears exactly nothing (its slip increments are zero by the exact stick constraint).
+
+The integration starts from a state the caller gives (the last periodic solution, or the end of
+the previous time-averaged step, so that the slow drift of the mean position and the transient
+carry over), runs ``settle`` periods, then averages over ``average`` periods.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from fretwear import contact as law
+from fretwear.fourier import FourierBasis
+from fretwear.model.core import Model
+
+#: response kinds of :func:`fretwear.transient.classify_sequence`, coded in wear histories
+RESPONSE_KINDS = ("periodic", "subharmonic", "drifting", "quasi-periodic", "irregular",
+                  "transient")
+
+
+@dataclass
+class TimeAveragedRate:
+    """Outcome of :func:`time_averaged_rate` (nc contact nodes, d components).
+
+    Attributes
+    ----------
+    g : (nc,) wear depth per cycle [m] (mean over the averaging window).
+    slip_work : (nc,) ``S_p`` [N m] per cycle.
+    pressure_mean, pressure_max : (nc,) normal pressure over the window [Pa].
+    slip_amplitude : (nc,) half range of the tangential displacement over the window [m].
+    slip_path : (nc,) slip path per cycle [m].
+    state_fraction : (nc, 3) fraction of the window in separation, stick, slip.
+    friction_energy : (nc,) energy dissipated by friction per cycle [J].
+    U, lam : (nc, d, H) Fourier coefficients (on ``basis``) of the contact displacements [m]
+        and forces [N] over the last period of the window.
+    anchor : (nc, d-1) mean tangential positions over the last period [m].
+    kind : response over the window (one of :data:`RESPONSE_KINDS`); rotation : dominant
+        frequency of the once-per-period samples [cycles per period] (quasi-periodic);
+        order : repetition period in forcing periods (periodic 1, subharmonic p, else 0).
+    U_end, V_end : (ndof,) full-field displacement [m] and velocity [m/s] at the end, to
+        continue the integration exactly.
+    periods : periods integrated; wall_time : [s].
+    """
+
+    g: np.ndarray
+    slip_work: np.ndarray
+    pressure_mean: np.ndarray
+    pressure_max: np.ndarray
+    slip_amplitude: np.ndarray
+    slip_path: np.ndarray
+    state_fraction: np.ndarray
+    friction_energy: np.ndarray
+    U: np.ndarray
+    lam: np.ndarray
+    anchor: np.ndarray
+    kind: str
+    rotation: float
+    order: int
+    U_end: np.ndarray
+    V_end: np.ndarray
+    periods: int
+    wall_time: float
+
+    @property
+    def kind_code(self) -> int:
+        return RESPONSE_KINDS.index(self.kind)
+
+
+def window_samples(u_loc, lam, state):
+    """The recorded samples of :func:`fretwear.transient.integrate` in the DLFT layout.
+
+    The integrator records ``x(t_n)``, the force ``lambda_n`` that acts over the step
+    ``t_n -> t_n+1`` and the state of that step. Returns ``(x, lam, state)`` as (nc, d, ns),
+    (nc, d, ns), (nc, ns) with column ``j`` holding ``x(t_j)`` and the force and state of the
+    step that *ends* at ``t_j`` (the DLFT convention: the slip of instant ``j`` is
+    ``X(j) - X(j-1)``). Column 0 has no step before it in the window and is marked as stick.
+    """
+    x = np.moveaxis(np.asarray(u_loc, float), 0, -1)
+    f = np.moveaxis(np.asarray(lam, float), 0, -1)
+    s = np.asarray(state).T
+    f = np.concatenate([f[..., :1], f[..., :-1]], axis=-1)
+    s = np.concatenate([np.full((s.shape[0], 1), law.STICK, s.dtype), s[:, :-1]], axis=1)
+    return x, f, s
+
+
+def time_averaged_rate(model: Model, omega: float, basis: FourierBasis, coef, wear, *, U0, V0,
+                       settle: int = 300, average: int = 500,
+                       steps_per_period: int | None = None,
+                       classify_tol: float = 1e-4) -> TimeAveragedRate:
+    """Mean wear per cycle over a time integration at wear ``wear`` (module docstring).
+
+    Parameters
+    ----------
+    model : the structure; omega : excitation circular frequency [rad/s] (dynamic only).
+    basis : Fourier basis on which the last period's harmonics are returned.
+    coef : (nc,) factor ``c_p`` of the wear law [1/N] (``dW1 = c S``).
+    wear : (nc,) wear depth [m] (opens the normal gap).
+    U0, V0 : (ndof,) start state [m], [m/s].
+    settle : periods integrated before averaging; average : periods averaged (>= 2).
+    steps_per_period : time steps per period (default ``max(128, 8 x`` the highest harmonic)).
+    classify_tol : relative periodicity tolerance of the response classification.
+    """
+    from fretwear.transient import classify_sequence, fourier_coefficients, integrate
+
+    t0 = time.perf_counter()
+    hmax = max(basis.harmonics) if basis.harmonics else 1
+    nsteps = int(steps_per_period or max(128, 8 * hmax))
+    average = max(int(average), 2)
+    r = integrate(model, omega, n_periods=int(settle) + average, steps_per_period=nsteps,
+                  record=average, U0=U0, V0=V0, wear=wear)
+    x, f, s = window_samples(r.u_loc, r.lam, r.state)
+    nc, d, ns = x.shape
+    cycles = (ns - 1) / nsteps  # steps whose slip is counted, in periods
+    inc = law.slip_increments(x, s)  # (nc, ns), zero unless slip; column 0 marked stick
+    S = (f[:, 0, :] * inc).sum(axis=1) / cycles
+    area = np.asarray(model.contact.area, float)
+    p = f[:, 0, :] / area[:, None]
+    xt = x[:, 1:, :]
+    half = 0.5 * (xt.max(axis=2) - xt.min(axis=2))
+    last = slice(ns - nsteps, ns)
+    cu = fourier_coefficients(np.moveaxis(x[..., last], -1, 0), hmax)
+    cl = fourier_coefficients(np.moveaxis(f[..., last], -1, 0), hmax)
+    idx = basis.rows_in_full(hmax)
+    U = np.moveaxis(cu[idx], 0, -1).copy()
+    lam_h = np.moveaxis(cl[idx], 0, -1).copy()
+    # response over the window: once-per-period samples of the contact displacements
+    poinc = x[..., ::nsteps].reshape(nc * d, -1).T
+    ptp = float(np.ptp(x[..., last], axis=-1).max())
+    c = classify_sequence(poinc, tol=classify_tol, scale=max(ptp, 1e-300),
+                          min_window=min(64, poinc.shape[0]))
+    return TimeAveragedRate(
+        g=np.asarray(coef, float) * S, slip_work=S, pressure_mean=p[:, 1:].mean(axis=1),
+        pressure_max=p.max(axis=1), slip_amplitude=np.sqrt((half**2).sum(axis=1)),
+        slip_path=inc.sum(axis=1) / cycles,
+        state_fraction=np.stack([(s[:, 1:] == k).mean(axis=1) for k in range(3)], axis=1),
+        friction_energy=law.friction_work(f, x, s) / cycles, U=U, lam=lam_h,
+        anchor=U[:, 1:, 0].copy(), kind=c.kind, rotation=float(c.rotation), order=int(c.order),
+        U_end=r.U, V_end=r.V, periods=int(settle) + average,
+        wall_time=time.perf_counter() - t0)
+
