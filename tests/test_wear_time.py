@@ -197,3 +197,33 @@ def test_time_averaged_steps_follow_the_time_integration(monkeypatch, tmp_path):
     for name in ("cycles", "wear_depth", "wear_rate", "U", "rescued"):
         np.testing.assert_array_equal(getattr(h, name), getattr(resumed.history, name),
                                       err_msg=name)
+
+
+def test_run_starts_from_a_time_integration_when_the_unworn_balance_fails(monkeypatch):
+    """No balance of the unworn interface (forced): step 0 is the time-averaged rate of the
+    response integrated from rest, which equals what time_averaged_rate gives from rest with
+    the same windows (bitwise: same integration), and the run goes on (here back to balanced
+    steps, the response being periodic)."""
+    import fretwear.hbm
+
+    m = damped_block()
+    real = wm.solve_periodic
+
+    def failing(*args, **kwargs):
+        sol, st = real(*args, **kwargs)
+        st.converged = False
+        return sol, st
+
+    monkeypatch.setattr(wm, "solve_periodic", failing)
+    opts = WearOptions(**OPTS)
+    r = simulate_wear(m, BASIS, omega=OMEGA, options=opts)
+    h = r.history
+    assert r.converged and h.n_steps == 5 and h.rescued[0] == 2
+    ref = time_averaged_rate(m, OMEGA, BASIS, wear_coefficients(m), np.zeros(h.wear_depth.shape[1]),
+                             U0=None, V0=None, settle=wm.START_SETTLE, average=64,
+                             steps_per_period=512)
+    np.testing.assert_array_equal(h.wear_rate[0], ref.g)
+    assert h.jump[1] == wm.START_JUMP
+    # the response is periodic: the balance converges from it at step 1, then ordinary steps
+    assert h.rescued[1] == 1 and np.all(h.rescued[2:] == 0)
+    assert fretwear.hbm.solve_periodic is not failing  # only the wear module's start was forced
