@@ -559,3 +559,14 @@ def test_no_wear_without_slip(tmp_path):
     r = simulate_wear(m, BASIS, quasi_static=True)
     assert r.stop_reason == "no_wear" and r.history.n_steps == 1
     assert np.all(r.final_wear == 0.0) and math.isfinite(r.wall_time)
+
+
+def test_progress_bar_shows_cycles_volume_rate_and_time_left(blk, capsys):
+    """The progress bar (stderr) names the cycles reached, the worn volume, the worn-volume
+    rate and the time left; its worn volume is the history's (area . W)."""
+    m, red, anc = blk
+    r = simulate_wear(m, BASIS, quasi_static=True, reduced=red, anchor=anc, progress=True,
+                      options=WearOptions(max_steps=3, tolerance=0.05))
+    err = capsys.readouterr().err
+    assert "cycles" in err and "m^3/cycle" in err and "<" in err  # tqdm's [elapsed<left]
+    assert f"worn {r.history.worn_volume[-1]:.3g} m^3" in err

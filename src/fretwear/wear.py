@@ -739,7 +739,7 @@ def simulate_wear(model: Model, basis: FourierBasis, *, omega: float = 2 * np.pi
     balanced = [r for r in rows if int(r["rescued"]) != 2]
     initial = _assemble(sp, balanced[0]) if balanced else None
 
-    bar = _Bar(progress, opts)
+    bar = _Bar(progress, opts, model.contact.area)
     last_ckpt = -math.inf
     reason = _stop_reason(state, opts)
     extra = ""
@@ -1141,8 +1141,9 @@ def _next_jump(dN: float, err: float, opts: WearOptions, fixed: float,
 class _Bar:
     """tqdm progress towards the nearest stop criterion, with cycles, worn volume and rate."""
 
-    def __init__(self, enabled: bool, opts: WearOptions):
+    def __init__(self, enabled: bool, opts: WearOptions, area):
         self.opts = opts
+        self.area = np.asarray(area, float)
         self.bar = None
         if enabled:
             from tqdm import tqdm
@@ -1157,8 +1158,10 @@ class _Bar:
         frac = _progress_fraction(float(st["cycles"]), float(st["vrate"]), float(st["vrate0"]),
                                   float(np.max(st["W"])), self.opts)
         self.bar.n = max(self.bar.n, int(1000 * frac))
-        self.bar.set_postfix_str(f"N={float(st['cycles']):.3g} V={float(st['vrate']):.3g}"
-                                 f"/cycle step={int(st['step'])}", refresh=False)
+        vol = worn_volume(st["W"], self.area)
+        self.bar.set_postfix_str(f"N={float(st['cycles']):.3g} cycles, worn {vol:.3g} m^3, "
+                                 f"rate {float(st['vrate']):.3g} m^3/cycle, "
+                                 f"step {int(st['step'])}", refresh=False)
         self.bar.refresh()
 
     def close(self):
