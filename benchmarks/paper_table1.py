@@ -151,8 +151,9 @@ def main(argv=None) -> int:
             print(f"79 kHz did NOT reach the plateau: {msg}")
             if r is not None:
                 report("79 kHz", r, wall)
-                print(f"{'':>12}   (partial run: {wall:.1f} s; the figures above stop where "
-                      "the periodic solve failed)")
+                where = ("where the periodic solve failed" if r.stop_reason == "solver_failed"
+                         else f"at {r.stop_reason} without a plateau")
+                print(f"{'':>12}   (partial run: {wall:.1f} s; the figures above stop {where})")
             walls["79"] = float("nan")
     print(f"wall_79khz_s={walls['79']:.2f}")
     print(f"wall_quasistatic_s={walls['qs']:.2f}")
