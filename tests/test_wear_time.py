@@ -115,7 +115,7 @@ def _forced_failures(monkeypatch, balance_fails: bool, first_ok: bool = True):
     there), so their rates are averaged."""
     monkeypatch.undo()
     real_advance = wm._advance
-    calls = {"n": 0 if first_ok else 1}
+    calls = {"n": 0 if first_ok else 2}
 
     def advance(sp, st, opts):
         calls["n"] += 1
@@ -162,22 +162,32 @@ def test_time_domain_steps_return_to_balanced_solutions(monkeypatch):
         assert np.linalg.norm(f) <= 1e-9 * spb.prob.scale(U)
 
 
-def test_time_averaged_steps_follow_the_time_integration(monkeypatch, tmp_path):
+@pytest.mark.parametrize("scheme", ["explicit", "rosenbrock"])
+def test_time_averaged_steps_follow_the_time_integration(monkeypatch, tmp_path, scheme):
     """With no balance at all after step 1, the run goes on with time-averaged rates
-    (rescued = 2): each step's wear is the explicit Euler update (eq. 30) with the previous
-    step's rate, and each rate is what time_averaged_rate gives at that wear, continued from
-    the previous integration. Interrupting after step 3 and resuming gives the same history
-    bit for bit (the integration state is in the checkpoint)."""
+    (rescued = 2). Each step's wear is the explicit Euler update (eq. 30) with the previous
+    step's rate, or the linearly implicit one with the slow Jacobian of the last balanced step
+    (recomputed here from the recorded step 1). Interrupting after step 3 and resuming gives
+    the same history bit for bit (the integration state is in the checkpoint)."""
     m = damped_block()
     _forced_failures(monkeypatch, balance_fails=True)
-    full = simulate_wear(m, BASIS, omega=OMEGA, options=WearOptions(**OPTS))
+    opts = WearOptions(scheme=scheme, **OPTS)
+    full = simulate_wear(m, BASIS, omega=OMEGA, options=opts)
     h = full.history
     assert full.converged and h.n_steps == 5
     assert np.all(h.rescued[2:] == 2)
-    for k in range(2, 5):  # explicit Euler with the previous rate
-        np.testing.assert_allclose(h.wear_depth[k],
-                                   h.wear_depth[k - 1] + h.jump[k] * h.wear_rate[k - 1],
-                                   rtol=1e-12, atol=0)
+    Js = np.zeros((h.wear_depth.shape[1],) * 2)
+    if scheme == "rosenbrock":
+        red = condense(m, OMEGA, BASIS.orders)
+        spb = SlowProblem(m, red, BASIS, wear_coefficients(m), eps=full.penalty)
+        spb.set_state(h.wear_depth[1], h.anchor[1])
+        Js = spb.slow_jacobian(h.U[1].reshape(spb.m, spb.H))
+    eye = np.eye(Js.shape[0])
+    for k in range(2, 5):
+        dN = h.jump[k]
+        dW = np.maximum(dN * np.linalg.solve(eye - dN * Js, h.wear_rate[k - 1]), 0.0)
+        np.testing.assert_allclose(h.wear_depth[k], h.wear_depth[k - 1] + dW, rtol=1e-9,
+                                   atol=1e-12 * h.wear_depth[k].max())
     assert full.final is not None  # the last balanced step
     # resume
     _forced_failures(monkeypatch, balance_fails=True)
@@ -188,11 +198,9 @@ def test_time_averaged_steps_follow_the_time_integration(monkeypatch, tmp_path):
             raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
-        simulate_wear(m, BASIS, omega=OMEGA, options=WearOptions(**OPTS), checkpoint=ck,
-                      callback=stop)
+        simulate_wear(m, BASIS, omega=OMEGA, options=opts, checkpoint=ck, callback=stop)
     _forced_failures(monkeypatch, balance_fails=True, first_ok=False)
-    resumed = simulate_wear(m, BASIS, omega=OMEGA, options=WearOptions(**OPTS), checkpoint=ck,
-                            resume=True)
+    resumed = simulate_wear(m, BASIS, omega=OMEGA, options=opts, checkpoint=ck, resume=True)
     assert resumed.resumed_from == 3
     for name in ("cycles", "wear_depth", "wear_rate", "U", "rescued"):
         np.testing.assert_array_equal(getattr(h, name), getattr(resumed.history, name),

@@ -827,7 +827,7 @@ def _start(sp: SlowProblem, W0, anchor, U0, opts: WearOptions) -> tuple[dict, li
         "anchor": np.array(anchor, float), "g": g, "jump": float(jump),
         "vrate": row["volume_rate"], "vrate0": row["volume_rate"],
         "stability_jump": float(stab), "stop_reason": np.asarray(""),
-        "td_U": np.zeros(0), "td_V": np.zeros(0), "td_retry_at": 0.0,
+        "td_U": np.zeros(0), "td_V": np.zeros(0), "td_retry_at": 0.0, "Js": np.zeros(0),
     }
     return state, [row]
 
@@ -854,7 +854,7 @@ def _time_domain_start(sp: SlowProblem, W0, opts: WearOptions, st: SolveStats, t
         "U": tr.U.reshape(sp.m, sp.H).copy(), "anchor": np.array(tr.anchor, float), "g": tr.g,
         "jump": jump, "vrate": row["volume_rate"], "vrate0": row["volume_rate"],
         "stability_jump": math.nan, "stop_reason": np.asarray(""), "td_U": tr.U_end,
-        "td_V": tr.V_end, "td_retry_at": 0.0,
+        "td_V": tr.V_end, "td_retry_at": 0.0, "Js": np.zeros(0),
     }
     return state, [row]
 
@@ -1035,8 +1035,13 @@ def _backward_euler(sp: SlowProblem, opts: WearOptions, W_k, U_start, dN, anchor
 def _time_domain_step(sp: SlowProblem, st: dict, opts: WearOptions):
     """A slow step taken from a time integration: ``(state, row, failure)``.
 
-    Used where the periodic balance fails (dynamic cases). The wear is advanced by explicit
-    Euler from the rate at the start of the step (eq. 30), ``W1 = W_k + dN g_k``, and the
+    Used where the periodic balance fails (dynamic cases). The wear is advanced from the rate at
+    the start of the step: by explicit Euler (eq. 30), ``W1 = W_k + dN g_k``, with
+    ``scheme = "explicit"``; otherwise by the linearly implicit predictor
+    ``W1 = W_k + dN (I - dN Js)^-1 g_k`` with the slow Jacobian ``Js`` of the last balanced
+    state (no balance, no fresher one). The stiff part of ``Js`` is local (wear unloads the
+    node that slips) and changes little, and without it the jumps stay at the explicit
+    stability limit with rates that flip from step to step. Then the
     structure is integrated in time at ``W1`` (:func:`fretwear.wear_time.time_averaged_rate`),
     continuing the previous time integration when there is one (so that the transient and the
     slow drift of the mean position carry over), else from the last periodic solution. The rate
@@ -1066,8 +1071,20 @@ def _time_domain_step(sp: SlowProblem, st: dict, opts: WearOptions):
     dN = min(float(st["jump"]), opts.max_jump, opts.max_cycles - cycles)
     floor = max(opts.min_jump, MIN_JUMP_FRACTION * cycles)
     rejected = iters = 0
+    Js = np.asarray(st["Js"], float)
+    if opts.scheme != "explicit" and Js.size == 0 and not np.size(st["td_U"]):
+        sp.set_state(W_k, st["anchor"])  # the last balanced state: its slow Jacobian
+        Js = sp.slow_jacobian(st["U"])
+        iters += 1
+    if Js.size:
+        lam_plus = float(np.max(np.linalg.eigvals(Js).real))
+        if lam_plus > 0:
+            dN = min(dN, GROWTH_LIMIT / lam_plus)
     while True:
-        W1 = W_k + dN * g_k
+        if Js.size:  # linearly implicit (the scheme's predictor) with that Jacobian
+            W1 = W_k + np.maximum(dN * np.linalg.solve(np.eye(sp.nc) - dN * Js, g_k), 0.0)
+        else:
+            W1 = W_k + dN * g_k
         try:
             tr = time_averaged_rate(sp.model, sp.prob.reduced.omega, sp.prob.basis, sp.coef,
                                     W1, U0=U0, V0=V0, settle=opts.time_domain_settle,
@@ -1101,7 +1118,7 @@ def _time_domain_step(sp: SlowProblem, st: dict, opts: WearOptions):
                 new.update({"U": U1.copy(), "anchor": np.array(tr.anchor, float), "g": g1,
                             "jump": _next_jump(dN, err_b, opts, float(st["jump"]), 1.0),
                             "vrate": row["volume_rate"], "td_U": np.zeros(0),
-                            "td_V": np.zeros(0), "td_retry_at": 0.0})
+                            "td_V": np.zeros(0), "td_retry_at": 0.0, "Js": np.zeros(0)})
                 return new, row, ""
         new["td_retry_at"] = 2.0 * cycles1
     row = _time_row(tr, sp.model.contact.area, W1, cycles1, dN, iters, rejected, err,
@@ -1109,7 +1126,7 @@ def _time_domain_step(sp: SlowProblem, st: dict, opts: WearOptions):
     new.update({"U": tr.U.reshape(sp.m, sp.H).copy(), "anchor": np.array(tr.anchor, float),
                 "g": tr.g, "jump": _next_jump(dN, err, opts, float(st["jump"])),
                 "vrate": row["volume_rate"],
-                "td_U": tr.U_end, "td_V": tr.V_end})
+                "td_U": tr.U_end, "td_V": tr.V_end, "Js": Js})
     return new, row, ""
 
 
