@@ -1,10 +1,13 @@
 """The shipped example case files: they all load, validate and build, and fast reduced
 versions of the paper's examples show the qualitative facts Salles et al. (2011) report.
 
-The reduced runs keep the model of the shipped file and cut only the numerics (3 harmonics,
-32 samples per period, a looser slow-scale tolerance) so that each takes a few seconds. They
-check qualitative facts of the paper, not its numbers: the numbers depend on the full
-settings (and on choices the paper leaves open, see the comments in each file).
+Every shipped example has a run here. The reduced runs keep the model of the shipped file and
+cut only the numerics (fewer harmonics and samples, a looser slow-scale tolerance, a shorter
+band or run) so that each takes a few seconds; where the paper's fact needs the shipped
+numerics and they are fast enough, the file runs as is. They check qualitative facts of the
+paper, not its numbers, each against something independent where possible (an eigenvalue
+analysis, load stepping, a conservation identity); the figures quoted in the docstrings were
+measured (docs/examples.md).
 """
 
 import os
@@ -16,8 +19,11 @@ import pytest
 
 from fretwear import linear
 from fretwear.case import build_model, load_case
+from fretwear.errors import ConvergenceError
+from fretwear.examples.builders import stromberg_beam
 from fretwear.results import read_results
 from fretwear.runner import run_case
+from fretwear.transient import incremental_wear
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
@@ -31,12 +37,13 @@ REDUCED = {"harmonics": 3, "n_samples": 32, "tolerance": 5e-2}
 NO_FILES = "\n[output]\nfigures = false\nvtu = false\n"
 
 
-def reduced_copy(name: str, tmp_path: Path, text: str | None = None, **extra) -> Path:
+def reduced_copy(name: str, tmp_path: Path, text: str | None = None, *,
+                 numerics: dict | None = None, **extra) -> Path:
     """A copy of the shipped example ``name`` (or of ``text``) in ``tmp_path`` with the
-    ``[analysis]`` keys of REDUCED (and ``extra``) replaced, and no figures or ParaView
-    files."""
+    ``[analysis]`` keys of ``numerics`` (default REDUCED, for wear runs) and ``extra``
+    replaced, and no figures or ParaView files."""
     text = (EXAMPLES / name).read_text() if text is None else text
-    changes = {**REDUCED, **extra}
+    changes = {**(REDUCED if numerics is None else numerics), **extra}
     head, analysis = text[: text.index("[analysis]")], text[text.index("[analysis]"):]
     lines = [ln for ln in analysis.splitlines() if ln.split("=")[0].strip() not in changes]
     lines += [f"{k} = {v!r}" for k, v in changes.items()]
@@ -48,8 +55,9 @@ def reduced_copy(name: str, tmp_path: Path, text: str | None = None, **extra) ->
     return path
 
 
-def run_reduced(name: str, tmp_path: Path, text: str | None = None, **extra):
-    path = reduced_copy(name, tmp_path, text, **extra)
+def run_reduced(name: str, tmp_path: Path, text: str | None = None, *,
+                numerics: dict | None = None, **extra):
+    path = reduced_copy(name, tmp_path, text, numerics=numerics, **extra)
     out = run_case(path, tmp_path / "results", progress=False, echo=False)
     return read_results(out.results)
 
@@ -92,16 +100,115 @@ def test_dynamic_wear_examples_have_the_paper_settings(khz):
 
 
 # --- (b) the paper's qualitative facts on reduced runs --------------------------------------
-def test_stuck_interface_has_three_resonances_below_100_khz():
-    """Paper section 4.2: "three modes for a fixed interface" between 1 Hz and 100 kHz for the
-    horizontal displacement at P_e. The linear FRF example's own grid (600 log-spaced
-    points) resolves them; it takes about a second."""
-    case = load_case(EXAMPLES / "beam-linear-frf.toml")
-    a = case.analysis
-    freqs = linear.frequency_grid(a["f_min"], a["f_max"], a["n_points"], a["spacing"])
-    result = linear.frf(build_model(case), freqs, interface="stuck")
-    n, _ = linear.count_resonances(result, "Pe", "x")
-    assert n == 3
+def modes_in_band(model, interface: str, f_lo: float, f_hi: float) -> np.ndarray:
+    """Frequencies of the normal modes of ``model`` with the linear ``interface`` in
+    [f_lo, f_hi] that the load Q excites and P_e sees in x (both factors of the modal term
+    of the FRF above 1e-3 of their largest): the peaks an FRF of u_x(P_e) can show."""
+    m = linear.modes(model, interface=interface, f_max=1.2e5)  # every mode of the 4.2 band
+    seen = np.abs(m.observed["Pe"][:, 0])
+    excited = np.abs(m.shapes @ model.load_time(np.array([np.pi / 2]))[0])
+    keep = ((m.frequency_hz >= f_lo) & (m.frequency_hz <= f_hi)
+            & (seen > 1e-3 * seen.max()) & (excited > 1e-3 * excited.max()))
+    return m.frequency_hz[keep]
+
+
+def frf_peaks(freq: np.ndarray, amplitude: np.ndarray) -> np.ndarray:
+    """Peak frequencies of an FRF amplitude: local maxima of log10 |U| with a prominence of
+    at least half a decade (the rule of fretwear.linear.count_resonances), none at the ends."""
+    from scipy.signal import find_peaks
+
+    peaks, _ = find_peaks(np.log10(amplitude), prominence=0.5)
+    return freq[peaks]
+
+
+def test_linear_frf_example_mode_counts(tmp_path):
+    """Paper section 4.2 (Fig. 14): between 1 Hz and 100 kHz the FRF of u_x(P_e) shows "five
+    modes for a free interface without friction versus three modes for a fixed interface".
+    This model has four sliding modes in the band (57 Hz, 27.1, 53.8, 79.0 kHz; the fifth is
+    at 100.6 kHz, just outside: docs/verification.md) and three stuck ones (78.2, 80.9,
+    94.4 kHz). The run of the shipped file (its own 600-point log grid, forced responses by
+    direct solves) is compared with an independent eigenvalue analysis (fretwear.linear.modes):
+    the same number of peaks, each within one grid step (10^(5/599) - 1 = 1.9 %) of a mode."""
+    ds = run_reduced("beam-linear-frf.toml", tmp_path, numerics={})
+    model = build_model(load_case(EXAMPLES / "beam-linear-frf.toml"))
+    freq = ds["frequency"].values
+    step = (freq[1] / freq[0]) - 1.0
+    counts = {}
+    for interface in ("sliding", "stuck"):
+        amp = ds["displacement_amplitude"].sel(interface=interface, point="Pe", axis="x").values
+        peaks = frf_peaks(freq, amp)
+        modal = modes_in_band(model, interface, 1.0, 1e5)
+        assert peaks.size == modal.size, interface
+        np.testing.assert_allclose(peaks, modal, rtol=step)
+        counts[interface] = peaks.size
+    assert counts == {"sliding": 4, "stuck": 3}
+
+
+def test_nonlinear_frf_example_has_a_damped_resonance_near_30_khz(tmp_path):
+    """Paper section 4.2 (Fig. 14): with friction, "strongly damped" resonances near 30, 70
+    and 81 kHz. A full sweep takes minutes; the reduced run of the shipped sweep file keeps
+    the model and the static penalty and sweeps only 20-40 kHz (21 linear points, 1
+    harmonic, 16 samples, ~2 s). Checked: every point converges; the sweep's own linear
+    references peak where the eigenvalue analysis puts the modes (one sliding mode at
+    27.1 kHz, no stuck mode in the band); the frictional response has one peak, above the
+    sliding resonance (friction adds stiffness; measured 32-33 kHz with 1 harmonic) and
+    more than 10 times lower than the sliding FRF on the same grid (measured 66 times)."""
+    ds = run_reduced("salles2011-frf.toml", tmp_path,
+                     numerics={"harmonics": 1, "n_samples": 16}, f_min=2e4, f_max=4e4,
+                     n_points=21, spacing="linear")
+    assert np.all(ds["converged"].values == 1)
+    model = build_model(load_case(EXAMPLES / "salles2011-frf.toml"))
+    freq = ds["frequency"].values
+    lin = ds["linear_response_amplitude"].sel(point="Pe", axis="x")
+    for interface in ("sliding", "stuck"):
+        peaks = frf_peaks(freq, lin.sel(interface=interface).values)
+        modal = modes_in_band(model, interface, freq[0], freq[-1])
+        assert peaks.size == modal.size, interface
+        assert np.all(np.abs(peaks - modal) <= freq[1] - freq[0]), interface
+    sliding_mode = modes_in_band(model, "sliding", freq[0], freq[-1])[0]
+    amp = np.abs(ds["response_amplitude"].sel(point="Pe", axis="x", harmonic=1).values)
+    top = np.argmax(amp)
+    assert 0 < top < freq.size - 1  # an interior maximum: a resonance inside the band
+    assert freq[top] > sliding_mode
+    assert amp[top] < 0.1 * lin.sel(interface="sliding").values.max()
+
+
+@pytest.mark.parametrize("khz, stops, numerics", [
+    (10, 2, {"harmonics": 3, "n_samples": 32}),
+    (79, 4, {}),
+])
+def test_periodic_example_stops_per_period(tmp_path, khz, stops, numerics):
+    """Paper section 4.2 (Fig. 16): P_e stops twice per period at 10 kHz and four times at
+    79 kHz. At 10 kHz the reduced run (3 harmonics, 32 samples) keeps the count 2 (as do 5
+    and 7 harmonics). At 79 kHz the four stops need the paper's numerics: with 3 or 5
+    harmonics the count is 2 (measured; with 7 harmonics and 64 samples the solve does not
+    converge in 400 iterations), so the shipped file is run as is (7 harmonics, 128 samples,
+    ~5 s). The count uses the 5 % velocity threshold of PeriodicSolution.stops_per_period
+    (docs/theory.md, "Stops per period": 6, 5, 4 stops for 0.1 %, 2 %, 5 % at 79 kHz)."""
+    ds = run_reduced("salles2011-79khz-periodic.toml", tmp_path, numerics=numerics,
+                     frequency=khz * 1e3)
+    assert ds.attrs["converged"] == 1
+    assert int(ds["stops_per_period"].sel(point="Pe", axis="x")) == stops
+
+
+def test_quasi_static_periodic_example_agrees_with_load_stepping(tmp_path):
+    """The quasi-static periodic state of the paper's beam (section 4.2, Q / (mu P) = 1/3):
+    partial slip, the nodes next to the spring stick, the slip grows towards x = L. Compared
+    with an independent method: load stepping with exact contact and incremental Coulomb
+    friction (fretwear.transient.incremental_wear without wear, 128 steps per cycle; the
+    third cycle, once the initial loading is over). The shipped settings (7 harmonics, 128
+    samples) take ~1 s, so the file is run as is. The slip path per cycle agrees within 5e-3
+    of the largest: the difference is the harmonic truncation (measured 3.3e-3 with 5
+    harmonics, 1.2e-3 with 7 and 64 samples, 1.5e-3 with 7 and 128; 3.1e-2 with 3 harmonics
+    and 32 samples, too coarse for this check); the stick zone is the same."""
+    ds = run_reduced("beam-quasistatic-periodic.toml", tmp_path, numerics={})
+    assert ds.attrs["converged"] == 1
+    model = build_model(load_case(EXAMPLES / "beam-quasistatic-periodic.toml"))
+    ref = incremental_wear(model, steps_per_cycle=128, n_cycles=3, k_w=0.0).slip[-1]
+    path = ds["slip_path"].values
+    assert np.abs(path - ref).max() <= 5e-3 * ref.max()
+    np.testing.assert_array_equal(path > 1e-3 * ref.max(), ref > 1e-3 * ref.max())
+    assert path[0] == 0.0 and np.argmax(path) == np.argmax(ds["contact_position"].values[:, 0])
 
 
 def test_quasi_static_wear_reaches_a_plateau_with_no_wear_next_to_the_spring(tmp_path):
@@ -118,35 +225,150 @@ def test_quasi_static_wear_reaches_a_plateau_with_no_wear_next_to_the_spring(tmp
     deepest = np.argmax(ds["wear_depth"].values[-1])
     assert x[deepest] == pytest.approx(x.max())
     assert ds["wear_depth"].values[-1, deepest] > 0.0
+    assert_pillar(ds)
 
 
-@pytest.mark.xfail(strict=True, raises=AssertionError, reason=(
-    "with P = 50 MN/m and Q = 20 MN/m read as forces per unit width (pressures P/L, Q/h), "
-    "Q exceeds the friction capacity mu P: the whole interface slips, wear grows without "
-    "a plateau until a periodic solve fails (see the status comment in stromberg1997.toml)"))
-def test_stromberg_wear_reaches_a_plateau_with_no_wear_next_to_the_spring(tmp_path):
-    """Paper section 4.1 (Fig. 5, after Stromberg 1997): the worn profile reaches a final
-    state with no wear next to the spring and the deepest wear at the loaded end. The run is
-    cut at 12 slow steps: with the shipped load reading it slips everywhere from the first
-    cycle, so a longer run shows nothing more (the full run fails a periodic solve)."""
-    ds = run_reduced("stromberg1997.toml", tmp_path, max_steps=12)
-    assert ds.attrs["stop_reason"] == "plateau"
-    assert np.all(near_spring(ds) == 0.0)
+def assert_pillar(ds) -> int:
+    """Paper section 4.2 ("pillars": zones with no wear, high pressure, no slip that hold the
+    plateau), checked on the final state: the node of highest mean pressure carries more than
+    twice the mean pressure of the interface, sticks all period (slip amplitude exactly 0: a
+    node that sticks has no corrected slip, docs/wear.md), borders the worn zone, and has
+    almost no wear: it slips only in the first cycles, before the pressure has moved onto it
+    (measured: 2.3e-4 of the deepest wear on the section 4.2 beam, 1e-16 on Stromberg's), so
+    below 1e-3 of the deepest wear. Returns the pillar node."""
+    p = ds["pressure_mean"].values[-1]
+    w = ds["wear_depth"].values[-1]
+    k = int(np.argmax(p))
+    assert p[k] > 2.0 * p.mean()
+    assert ds["slip_amplitude"].values[-1, k] == 0.0
+    assert w[k] < 1e-3 * w.max()
+    worn = w > 1e-2 * w.max()
+    assert worn[max(k - 1, 0)] or worn[min(k + 1, p.size - 1)]
+    return k
 
 
-def test_stromberg_beam_with_loads_read_as_pressures_reaches_a_plateau(tmp_path):
-    """The other reading of the paper's loads (MN/m as MN/m^2: P = 50 MPa on the top face,
-    Q = 20 MPa on the end face, Q h / (mu P L) = 0.2, partial slip) on the shipped section
-    4.1 model: the qualitative result of paper Fig. 5 (a final worn state, no wear next to
-    the spring, the deepest wear at the loaded end). This backs the status comment of
-    stromberg1997.toml; it is not a shipped example."""
-    text = (EXAMPLES / "stromberg1997.toml").read_text()
-    pressures = {"pressure = 1e9": "pressure = 5e7", "pressure = 4e9": "pressure = 2e7"}
-    for old, new in pressures.items():
-        assert text.count(old) == 1
-        text = text.replace(old, new)
-    ds = run_reduced("stromberg1997.toml", tmp_path, text)
-    assert ds.attrs["stop_reason"] == "plateau"
-    assert np.all(near_spring(ds) == 0.0)
+
+
+@pytest.mark.parametrize("khz", [30, 35])
+def test_dynamic_wear_example_first_steps(tmp_path, khz):
+    """Paper section 4.2, wear at 30 and 35 kHz: a short reduced run (3 harmonics, 32 samples,
+    3 slow steps) must balance the unworn interface and accept three wear steps. The plateau
+    is not checked (the slow-scale solver is being changed; the full runs take minutes).
+    Checked against an identity independent of the wear integration: with Archard's law and
+    Coulomb slip the worn volume per cycle equals k_w / mu times the friction energy
+    dissipated per cycle (method notes, section 4), at every recorded step (round-off:
+    1e-9). No wear next to the spring: on the first 10 % of the interface the wear is
+    round-off (measured 1.2e-28 m at 35 kHz, 2.7e-10 m deepest), below 1e-12 of the
+    deepest."""
+    ds = run_reduced(f"salles2011-{khz}khz.toml", tmp_path, max_steps=3)
+    assert ds.attrs["stop_reason"] == "max_steps"
+    assert ds["step"].size == 4
+    assert np.all(np.diff(ds["worn_volume"].values) > 0.0)
+    k_w, mu = 1e-11, 0.3  # the file's contact.wear_coefficient and mu
+    energy = ds["dissipated_energy"].values  # (step, contact_node) [J per cycle]
+    np.testing.assert_allclose(ds["worn_volume_rate"].values, k_w / mu * energy.sum(axis=1),
+                               rtol=1e-9)
+    assert np.all(near_spring(ds) <= 1e-12 * ds["wear_depth"].values[-1].max())
+
+
+@pytest.mark.xfail(strict=True, raises=ConvergenceError, reason=(
+    "with 3 harmonics and 32 samples the periodic solve of the unworn interface does not "
+    "converge at 70 kHz (residual 0.34) nor at 79 kHz (residual 2.6e-3): no reduced wear run "
+    "near these resonances (the 7-harmonic periodic solve at 79 kHz converges)"))
+@pytest.mark.parametrize("khz", [70, 79])
+def test_dynamic_wear_example_near_resonance_first_steps(tmp_path, khz):
+    """Paper section 4.2, wear at 70 and 79 kHz, reduced as at 30 and 35 kHz."""
+    ds = run_reduced(f"salles2011-{khz}khz.toml", tmp_path, max_steps=3)
+    assert ds.attrs["stop_reason"] == "max_steps"
+
+
+# --- section 4.1: Stromberg (1997) ---------------------------------------------------------
+def test_stromberg_example_partial_slip_to_a_final_state(tmp_path):
+    """Paper section 4.1 with the load reading of stromberg1997.toml (P = 50 MPa, Q = 20 MPa,
+    Q h / (mu P L) = 0.2: partial slip). What physics demands of a fretting problem in partial
+    slip (Ciavarella and Hills 1999): the first cycle has a stick zone next to the spring and
+    slip at the loaded end; wear stays where the slip is, deepest at x = L, none next to the
+    spring; the worn volume reaches a plateau (a final no-wear state), held by a pillar. The
+    depth is microns, as the paper says of its examples (the readings differ by factors of
+    200: 9.5 um with this one). Reduced run (3 harmonics, 32 samples, ~5 s): 9.43 um at
+    x = L against 9.46 um with the shipped 7 harmonics and 64 samples."""
+    ds = run_reduced("stromberg1997.toml", tmp_path)
+    assert ds.attrs["stop_reason"] == "plateau" and ds.attrs["converged"] == 1
     x = ds["contact_position"].values[:, 0]
-    assert x[np.argmax(ds["wear_depth"].values[-1])] == pytest.approx(x.max())
+    L = x.max()
+    slip0 = ds["slip_amplitude"].values[0]
+    assert slip0[np.argmax(x)] > 0.0
+    assert np.all(slip0[x <= 0.5 * L] == 0.0)
+    w = ds["wear_depth"].values[-1]
+    assert np.all(near_spring(ds) == 0.0)
+    assert x[np.argmax(w)] == pytest.approx(L)
+    assert np.all(x[w > 1e-3 * w.max()] >= 0.9 * L)
+    assert 1e-6 < w.max() < 1e-4
+    k = assert_pillar(ds)
+    assert x[k] < x[w > 1e-3 * w.max()].min()
+
+
+STROMBERG_CYCLES = 2000  # before the plateau: the profile still grows (~1.06 um at x = L)
+
+
+def dlft_wear(tmp_path, name: str, harmonics: int, n_samples: int) -> np.ndarray:
+    """Final worn profile of a reduced run of the shipped file ``name`` cut at
+    STROMBERG_CYCLES (slow-scale tolerance 1e-2, the shipped value)."""
+    sub = tmp_path / f"{Path(name).stem}-{harmonics}"
+    sub.mkdir()
+    ds = run_reduced(name, sub,
+                     numerics={"harmonics": harmonics, "n_samples": n_samples,
+                               "tolerance": 1e-2}, max_cycles=float(STROMBERG_CYCLES))
+    assert ds.attrs["stop_reason"] == "max_cycles"
+    assert ds["cycles"].values[-1] == pytest.approx(STROMBERG_CYCLES)
+    return ds["wear_depth"].values[-1]
+
+
+def load_stepping_wear(waveform: str) -> np.ndarray:
+    """Independent reference: fretwear.transient.incremental_wear (exact contact and
+    incremental Coulomb at 64 load steps per cycle, Archard after each step; Stromberg's kind
+    of method) on the same beam, STROMBERG_CYCLES cycles with jumps of 10. Its own error,
+    measured: 1.5e-3 of the deepest wear (jumps of 10 against 2), 5e-4 (64 against 256 steps).
+    """
+    model = stromberg_beam(waveform=waveform)
+    return incremental_wear(model, steps_per_cycle=64, n_cycles=STROMBERG_CYCLES,
+                            cycle_jump=10).wear[-1]
+
+
+def test_stromberg_dlft_wear_agrees_with_load_stepping(tmp_path):
+    """The DLFT wear of stromberg1997.toml with the paper's numerics (7 harmonics, 64
+    samples) against load stepping after 2000 cycles. Tolerance 1.5 % of the deepest wear,
+    the sum of the measured parts: harmonic truncation (7 against 31 harmonics: 5e-3),
+    slow-scale tolerance (1e-2 against 1e-3: 3e-3), the reference's own error (2e-3) and the
+    difference left between the converged methods (31 harmonics: 3.8e-3). Measured: 7.5e-3.
+    The worn nodes (above 1 % of the deepest) are the same."""
+    w = dlft_wear(tmp_path, "stromberg1997.toml", 7, 64)
+    ref = load_stepping_wear("sin")
+    assert np.abs(w - ref).max() <= 1.5e-2 * ref.max()
+    np.testing.assert_array_equal(w > 1e-2 * ref.max(), ref > 1e-2 * ref.max())
+
+
+def test_stromberg_triangle_and_sinusoid(tmp_path):
+    """Paper section 4.1: the differences "at the end of the beam" come from approximating
+    Stromberg's linear load evolution by sinusoids. Quasi-static Coulomb friction and Archard
+    wear are rate independent, so the exact responses to a triangle and a sinusoid of the
+    same amplitude are the same: load stepping gives the same profile for both (measured
+    1.3e-4 of the deepest wear at 64 steps, 5.9e-5 at 128: the sampled loads differ, so
+    tolerance 1e-3). The difference is the harmonic truncation of the triangle's response,
+    which has corners: with the DLFT, the triangle's error against load stepping falls with
+    the harmonics (measured 27 % with 3, 15 % with 7, 8.6 % with 15) and is far larger than
+    the sinusoid's (0.75 % with 7); the sinusoid-triangle difference is largest at the loaded
+    end x = L, as in the paper's Fig. 5."""
+    sin_ref, tri_ref = load_stepping_wear("sin"), load_stepping_wear("triangle")
+    assert np.abs(sin_ref - tri_ref).max() <= 1e-3 * sin_ref.max()
+    sin7 = dlft_wear(tmp_path, "stromberg1997.toml", 7, 64)
+    tri3 = dlft_wear(tmp_path, "stromberg1997-triangle.toml", 3, 32)
+    tri7 = dlft_wear(tmp_path, "stromberg1997-triangle.toml", 7, 64)
+
+    def err(w):
+        return np.abs(w - tri_ref).max() / tri_ref.max()
+
+    assert err(tri7) < err(tri3)
+    assert err(sin7) < 0.2 * err(tri7)
+    x = stromberg_beam().contact.coords[:, 0]
+    assert x[np.argmax(np.abs(sin7 - tri7))] == pytest.approx(x.max())

@@ -36,23 +36,26 @@ def paper_beam(nx: int = 30, ny: int = 4, *, mu: float = 0.3, loss_factor: float
     )
 
 
-def stromberg_beam(nx: int = 30, ny: int = 4, *, waveform: str = "sin") -> Model:
-    """Section 4.1 beam (Stromberg 1997): L = 50 mm, h = 5 mm, width 5 mm, E = 210 GPa,
-    nu = 0.3, mu = 0.2, k_w = 1e-11 1/Pa, P = 50 MN/m and Q = 20 MN/m (forces per unit
-    out-of-plane width, spread uniformly over the top face and the end face x = L), held in x
-    by a stiff spring at x = 0 (a Dirichlet condition on the left face above the contact
-    node, which must stay free to slide vertically... see the case file). Quasi-static."""
+def stromberg_beam(nx: int = 30, ny: int = 4, *, waveform: str = "sin", P: float = 50e6,
+                   Q: float = 20e6) -> Model:
+    """Section 4.1 beam (Stromberg 1997): L = 50 mm, h = 5 mm, width l = 5 mm, E = 210 GPa,
+    nu = 0.3, mu = 0.2, k_w = 1e-11 1/Pa, bottom face on a rigid flat with zero gap,
+    quasi-static. The paper's "P = 50 MN/m" and "Q = 20 MN/m" are read as distributed loads
+    of Stromberg's plane model of unit thickness, i.e. tractions: ``P`` [Pa] uniform on the
+    top face, ``Q`` [Pa] on the end face x = L with the time evolution ``waveform`` ("sin":
+    the paper's sinusoidal approximation; "triangle": Stromberg's linear evolution). Then
+    ``Q h / (mu P L) = 0.2``: partial slip (fretting). The infinitely stiff x-spring holds
+    the top-left node (0, h): the bottom-left node is a contact node, which cannot be held.
+    Every choice is argued in ``examples/stromberg1997.toml`` and docs/examples.md."""
     L, h, w = 0.05, 0.005, 0.005
     mesh = rectangle(L, h, nx, ny)
-    p_top = 50e6 / L  # [Pa]: 50 MN/m per unit width over the top face length L
-    q_end = 20e6 / h  # [Pa]: 20 MN/m per unit width over the end face height h
     return from_mesh(
         mesh,
         Material(210e9, 0.3, 7800.0),
         thickness=w,
         springs=[Spring((0.0, h), "x", float("inf"))],
-        loads=[Traction("top", pressure=p_top, waveform="constant", name="P"),
-               Traction("right", pressure=q_end, waveform=waveform, name="Q")],
+        loads=[Traction("top", pressure=P, waveform="constant", name="P"),
+               Traction("right", pressure=Q, waveform=waveform, name="Q")],
         contact=ContactSpec("bottom", mu=0.2, normal=(0.0, -1.0), gap=0.0,
                             wear_coefficient=1e-11),
         observed={"Pe": (L, h / 2)},
