@@ -347,19 +347,9 @@ class Study:
 
 def zero_zones(x, W, frac=ZERO_FRACTION):
     """Intervals [x_first, x_last] of consecutive nodes with W <= frac max W."""
-    order = np.argsort(x)
-    x, W = x[order], W[order]
-    low = W <= frac * max(W.max(), 1e-300)
-    zones, start = [], None
-    for i, s in enumerate(low):
-        if s and start is None:
-            start = i
-        if not s and start is not None:
-            zones.append([float(x[start]), float(x[i - 1])])
-            start = None
-    if start is not None:
-        zones.append([float(x[start]), float(x[-1])])
-    return zones
+    from fretwear.wear import zero_wear_zones
+
+    return zero_wear_zones(x, W, frac)
 
 
 def profile_difference(xb, Wb, x, W):

@@ -160,18 +160,10 @@ def stability(model, sol) -> dict:
 
 
 def zero_zones(x, w, frac=0.01) -> list[list[float]]:
-    """x-intervals [m] of consecutive contact nodes whose wear is below ``frac`` of the max."""
-    low = w < frac * max(float(w.max()), 1e-300)
-    zones, start = [], None
-    for i, z in enumerate(low):
-        if z and start is None:
-            start = i
-        if not z and start is not None:
-            zones.append([float(x[start]), float(x[i - 1])])
-            start = None
-    if start is not None:
-        zones.append([float(x[start]), float(x[-1])])
-    return zones
+    """x-intervals [m] of consecutive contact nodes whose wear is at most ``frac`` of the max."""
+    from fretwear.wear import zero_wear_zones
+
+    return zero_wear_zones(x, w, frac)
 
 
 def wear_run(name, model, basis, max_cycles, wall_budget, work: Path, fresh: bool) -> dict:

@@ -570,3 +570,14 @@ def test_progress_bar_shows_cycles_volume_rate_and_time_left(blk, capsys):
     err = capsys.readouterr().err
     assert "cycles" in err and "m^3/cycle" in err and "<" in err  # tqdm's [elapsed<left]
     assert f"worn {r.history.worn_volume[-1]:.3g} m^3" in err
+
+
+def test_zero_wear_zones_are_runs_of_unworn_nodes():
+    """Hand-made profile (unordered x): the zones are the runs of nodes at most 1 % of the
+    deepest, in x order, ends included."""
+    from fretwear.wear import zero_wear_zones
+
+    x = np.array([0.5, 0.0, 0.1, 0.2, 0.3, 0.4, 0.6])
+    w = np.array([0.0, 0.0, 0.005, 1.0, 0.0, 0.3, 0.02])
+    assert zero_wear_zones(x, w) == [[0.0, 0.1], [0.3, 0.3], [0.5, 0.5]]
+    assert zero_wear_zones(x, w, fraction=0.03) == [[0.0, 0.1], [0.3, 0.3], [0.5, 0.6]]

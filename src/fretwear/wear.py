@@ -150,6 +150,27 @@ def worn_volume(wear: np.ndarray, area: np.ndarray) -> float:
     return float(np.dot(np.asarray(area, float), np.asarray(wear, float)))
 
 
+def zero_wear_zones(x, wear, fraction: float = 0.01) -> list[list[float]]:
+    """Intervals ``[x_first, x_last]`` [m] of consecutive contact nodes (ordered by ``x``)
+    whose wear depth is at most ``fraction`` of the deepest: the "pillars" and nodal zones of
+    the paper (section 4.2.2-4.2.3)."""
+    x = np.asarray(x, float)
+    w = np.asarray(wear, float)
+    order = np.argsort(x)
+    x, w = x[order], w[order]
+    low = w <= fraction * max(float(w.max()), 1e-300)
+    zones, start = [], None
+    for i, z in enumerate(low):
+        if z and start is None:
+            start = i
+        if not z and start is not None:
+            zones.append([float(x[start]), float(x[i - 1])])
+            start = None
+    if start is not None:
+        zones.append([float(x[start]), float(x[-1])])
+    return zones
+
+
 # --------------------------------------------------------------------------------------------
 # linear algebra: identity rows of the DLFT Jacobian
 # --------------------------------------------------------------------------------------------
