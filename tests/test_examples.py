@@ -20,6 +20,7 @@ import pytest
 from fretwear import linear
 from fretwear.case import build_model, load_case
 from fretwear.examples.builders import stromberg_beam
+from fretwear.reproduce import edit_case_text
 from fretwear.results import read_results
 from fretwear.runner import run_case
 from fretwear.transient import incremental_wear
@@ -43,11 +44,8 @@ def reduced_copy(name: str, tmp_path: Path, text: str | None = None, *,
     replaced, and no figures or ParaView files."""
     text = (EXAMPLES / name).read_text() if text is None else text
     changes = {**(REDUCED if numerics is None else numerics), **extra}
-    head, analysis = text[: text.index("[analysis]")], text[text.index("[analysis]"):]
-    lines = [ln for ln in analysis.splitlines() if ln.split("=")[0].strip() not in changes]
-    lines += [f"{k} = {v!r}" for k, v in changes.items()]
     path = tmp_path / name
-    path.write_text(head + "\n".join(lines) + "\n" + NO_FILES)
+    path.write_text(edit_case_text(text, "analysis", changes) + NO_FILES)
     case = load_case(path)  # the edits must give a valid case with the intended values
     for k, v in changes.items():
         assert case.analysis[k] == v, k

@@ -44,12 +44,12 @@ def new_figure(nrows: int = 1, ncols: int = 1, *, title: str | None = None,
     return fig, axes
 
 
-def save(fig, path: Path | str) -> Path:
+def save(fig, path: Path | str, dpi: int = 150) -> Path:
     """Lay out and write ``fig``; the format follows the file extension."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.tight_layout()
-    fig.savefig(path, dpi=150)
+    fig.savefig(path, dpi=dpi)
     return path
 
 

@@ -1,0 +1,362 @@
+"""Reproduce the examples of Salles et al. (2011), figure by figure.
+
+``fretwear reproduce`` (or ``fretwear example run salles2011 --all``) runs every shipped
+example of the paper (:data:`RUNS`, ordinary case files with a few documented edits), two
+computations that are not case files (load stepping for Fig. 5, the FRF before and after
+wear for Fig. 24), draws one figure per group of the paper's figures and writes a Markdown
+report: for each figure and for Table 1, what the paper states and what fretwear computes,
+side by side, with the cause of every difference (:mod:`fretwear.reproduce_report`).
+
+Every run keeps its results in ``WORKDIR/<key>/`` (``results.nc``, the run's own figures and,
+for wear runs, a checkpoint), so the command is resumable: run it again after an interruption
+and the finished runs are read back, the interrupted wear runs continue from their checkpoint.
+A run that fails or does not converge is reported as such in the report, never compared as a
+result. ``quick = True`` cuts the numerics (fewer harmonics, shorter bands and runs) to check
+the machinery in a minute; its numbers are not the reproduction.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from fretwear.errors import FretwearError, InputError
+
+#: numerics of the quick wear runs (the model part of each file is kept as shipped)
+QUICK_WEAR = {"harmonics": 3, "n_samples": 32, "tolerance": 5e-2}
+#: shorter time integrations where the quick 70 and 79 kHz runs have no periodic balance
+QUICK_TIME_DOMAIN = {"time_domain_settle": 100, "time_domain_average": 100}
+#: load stepping and the short DLFT run it is compared with (paper Fig. 5): cycles, jump
+STROMBERG_CYCLES = 2000
+STROMBERG_JUMP = 2
+#: the FRFs of the mesh comparison (paper Fig. 15), 30 and 100 contact elements
+MESH_FRF = {"f_min": 1e4, "f_max": 1e5, "n_points": 46, "harmonics": 1, "n_samples": 16}
+QUICK_MESH_FRF = {"f_min": 2e4, "f_max": 4e4, "n_points": 11}
+#: the FRF before / after wear at 79 kHz (paper Fig. 24): band [Hz] and points
+FRF_WORN_BAND = (6e4, 1e5, 41)
+
+
+@dataclass(frozen=True)
+class Run:
+    """One run of the reproduction: a shipped example with edits.
+
+    key : folder name in the work directory and name in the report.
+    example : the shipped case file (``fretwear example list``).
+    figures : the paper's figures it reproduces.
+    analysis, model : edits of the ``[analysis]`` and ``[model]`` tables (full reproduction).
+    quick, quick_model : the edits in quick mode (on top of ``analysis`` / ``model``).
+    why : why the edits (shown in the report).
+    """
+
+    key: str
+    example: str
+    figures: str
+    analysis: dict = field(default_factory=dict)
+    model: dict = field(default_factory=dict)
+    quick: dict = field(default_factory=dict)
+    quick_model: dict = field(default_factory=dict)
+    why: str = ""
+
+
+RUNS: tuple[Run, ...] = (
+    Run("frf", "salles2011-frf", "14, 22",
+        quick={"f_min": 2e4, "f_max": 4e4, "n_points": 21, "harmonics": 1, "n_samples": 16},
+        why="as shipped: 1 Hz-100 kHz, 200 log-spaced points, 7 harmonics, 128 samples"),
+    Run("frf-mesh30", "salles2011-frf", "15", analysis=MESH_FRF, quick=QUICK_MESH_FRF,
+        why="10-100 kHz, 46 points, 1 harmonic, 16 samples: the reference of frf-mesh100"),
+    Run("frf-mesh100", "salles2011-frf", "15", analysis=MESH_FRF, model={"nx": 100},
+        quick=QUICK_MESH_FRF,
+        why="as frf-mesh30 with 100 contact elements (with 7 harmonics a solve has 3030 "
+            "unknowns and the sweep takes hours: the mesh is compared at equal, reduced "
+            "numerics)"),
+    Run("wear-79khz", "salles2011-79khz", "17-21, 23d, 25",
+        quick={**QUICK_WEAR, "max_steps": 3, **QUICK_TIME_DOMAIN},
+        why="as shipped (stop at 2e8 cycles)"),
+    Run("wear-79khz-explicit", "salles2011-79khz", "17-21, 25",
+        analysis={"scheme": "explicit", "adaptive": False, "initial_jump": 1e7},
+        quick={**QUICK_WEAR, "max_steps": 3, **QUICK_TIME_DOMAIN, "initial_jump": 1e5},
+        why="the paper's slow-scale scheme: explicit Euler with fixed jumps of 1e7 cycles "
+            "(section 4.2.3), to 2e8 cycles"),
+    Run("wear-70khz", "salles2011-70khz", "23c, 25",
+        quick={**QUICK_WEAR, "max_steps": 3, **QUICK_TIME_DOMAIN},
+        why="as shipped (stop at 2e8 cycles)"),
+    Run("wear-35khz", "salles2011-35khz", "25",
+        quick={**QUICK_WEAR, "max_steps": 3}, why="as shipped (stop at 2e8 cycles)"),
+    Run("wear-30khz", "salles2011-30khz", "23b, 25",
+        quick={**QUICK_WEAR, "max_steps": 3}, why="as shipped (stop at 2e8 cycles)"),
+    Run("stromberg", "stromberg1997", "5", quick=QUICK_WEAR,
+        why="as shipped: 7 harmonics, 64 samples, sinusoidal Q, to the plateau"),
+    Run("stromberg-triangle", "stromberg1997-triangle", "5", quick=QUICK_WEAR,
+        why="as shipped: Stromberg's linear (triangle) evolution of Q, 15 harmonics, 128 "
+            "samples, to the plateau"),
+    Run("stromberg-2000", "stromberg1997", "5",
+        analysis={"max_cycles": float(STROMBERG_CYCLES), "tolerance": 1e-3},
+        quick={**QUICK_WEAR, "max_cycles": 200.0},
+        why=f"stopped at {STROMBERG_CYCLES} cycles with a tight slow-scale tolerance (1e-3), "
+            "for the comparison with load stepping"),
+    Run("wear-quasistatic", "salles2011-quasistatic", "6-13, 23a, 25",
+        quick={**QUICK_WEAR, "max_cycles": 1e12}, why="as shipped"),
+    Run("periodic-79khz", "salles2011-79khz-periodic", "16 b, d", why="as shipped"),
+    Run("periodic-10khz", "salles2011-79khz-periodic", "16 a, c",
+        analysis={"frequency": 1e4}, quick={"harmonics": 3, "n_samples": 32},
+        why="the same file at 10 kHz"),
+)
+RUN_KEYS = tuple(r.key for r in RUNS)
+#: computations that are not case files, run after the case files they need
+EXTRA_KEYS = ("stromberg-load-stepping", "frf-worn-79khz")
+
+
+# --- editing case files -----------------------------------------------------------------------
+def toml_value(value) -> str:
+    """``value`` written as a TOML value (numbers, booleans, strings, lists of them)."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        if math.isinf(value):
+            return "inf" if value > 0 else "-inf"
+        return repr(value)
+    if isinstance(value, str):
+        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(value, list | tuple):
+        return "[" + ", ".join(toml_value(v) for v in value) + "]"
+    raise InputError(f"cannot write {value!r} into a case file; expected a number, a boolean, "
+                     "a string or a list of them")
+
+
+def edit_case_text(text: str, section: str, changes: dict) -> str:
+    """The case file ``text`` with the keys ``changes`` of table ``[section]`` set: a line
+    ``key = ...`` of the table is replaced (its comment dropped), a missing key is appended
+    to the table. Only single-line values are replaced."""
+    if not changes:
+        return text
+    lines = text.splitlines()
+    header = f"[{section}]"
+    try:
+        start = next(i for i, ln in enumerate(lines) if ln.split("#")[0].strip() == header)
+    except StopIteration:
+        raise InputError(f"the case file has no table {header} to edit") from None
+    end = next((i for i in range(start + 1, len(lines)) if lines[i].lstrip().startswith("[")),
+               len(lines))
+    todo = dict(changes)
+    for i in range(start + 1, end):
+        key = lines[i].split("=")[0].strip() if "=" in lines[i].split("#")[0] else None
+        if key in todo:
+            lines[i] = f"{key} = {toml_value(todo.pop(key))}"
+    while end > start + 1 and not lines[end - 1].strip():
+        end -= 1
+    extra = [f"{k} = {toml_value(v)}" for k, v in todo.items()]
+    lines[end:end] = extra
+    return "\n".join(lines) + "\n"
+
+
+def run_case_text(run: Run, quick: bool) -> str:
+    """The case file text of ``run`` (the shipped example with the run's edits)."""
+    from fretwear.examples import example_path
+
+    text = example_path(run.example).read_text(encoding="utf-8")
+    model = {**run.model, **(run.quick_model if quick else {})}
+    analysis = {**run.analysis, **(run.quick if quick else {})}
+    text = edit_case_text(text, "model", model)
+    text = edit_case_text(text, "analysis", analysis)
+    header = (f"# fretwear reproduce: run {run.key!r} (paper Fig. {run.figures}), the shipped "
+              f"example {run.example!r}" + (" in quick mode" if quick else "") + "\n")
+    return header + text
+
+
+# --- running ----------------------------------------------------------------------------------
+@dataclass
+class Outcome:
+    """What happened to one run: ``status`` is "done", "up to date", "not converged" or
+    "failed"; ``message`` says why; ``seconds`` of wall time in this call."""
+
+    key: str
+    status: str
+    message: str = ""
+    seconds: float = 0.0
+
+
+def _save_npz(path: Path, **arrays) -> None:
+    """Write ``path`` atomically (a partial file never has the final name)."""
+    tmp = path.with_name(path.name + ".part.npz")
+    np.savez(tmp, **arrays)
+    os.replace(tmp, path)
+
+
+def _settings_match(path: Path, settings: str) -> bool:
+    if not path.is_file():
+        return False
+    with np.load(path) as z:
+        return str(z["settings"]) == settings
+
+
+def run_one(key: str, workdir: Path | str, quick: bool = False,
+            progress: bool = False) -> Outcome:
+    """Run the case file of run ``key`` (or the extra computation ``key``) into
+    ``workdir/key``; an up-to-date result is kept. Never raises for a failed solve: the
+    outcome says what happened."""
+    from fretwear.runner import run_case
+
+    workdir = Path(workdir)
+    folder = workdir / key
+    folder.mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    try:
+        if key == "stromberg-load-stepping":
+            status = _load_stepping(folder, quick)
+        elif key == "frf-worn-79khz":
+            status = _frf_worn(folder, workdir / "wear-79khz", quick, progress)
+        else:
+            run = next(r for r in RUNS if r.key == key)
+            path = folder / "case.toml"
+            text = run_case_text(run, quick)
+            if not path.is_file() or path.read_text(encoding="utf-8") != text:
+                path.write_text(text, encoding="utf-8")
+            out = run_case(path, folder, progress=progress, resume=True, echo=False)
+            status = ("up to date" if out.summary == "up to date"
+                      else "done" if out.converged else "not converged")
+    except FretwearError as exc:
+        return Outcome(key, "failed", " ".join(str(exc).split()), time.perf_counter() - t0)
+    return Outcome(key, status, "", time.perf_counter() - t0)
+
+
+def _load_stepping(folder: Path, quick: bool) -> str:
+    """Stromberg's kind of method on the section 4.1 beam: load stepping with exact contact,
+    incremental Coulomb friction and Archard after every step (fretwear.transient)."""
+    from fretwear.examples.builders import stromberg_beam
+    from fretwear.transient import incremental_wear
+
+    cycles = 200 if quick else STROMBERG_CYCLES
+    steps = 32 if quick else 64
+    settings = f"cycles={cycles} steps={steps} jump={STROMBERG_JUMP}"
+    path = folder / "load-stepping.npz"
+    if _settings_match(path, settings):
+        return "up to date"
+    model = stromberg_beam()
+    res = incremental_wear(model, steps_per_cycle=steps, n_cycles=cycles,
+                           cycle_jump=STROMBERG_JUMP)
+    x = np.asarray(model.contact.coords, float)[:, 0]
+    _save_npz(path, settings=settings, x=x, wear=np.asarray(res.wear)[-1],
+              cycles=float(cycles), steps=steps, jump=STROMBERG_JUMP)
+    return "done"
+
+
+def _frf_worn(folder: Path, wear_dir: Path, quick: bool, progress: bool) -> str:
+    """The nonlinear FRF of the paper's beam before and after the 79 kHz wear (Fig. 24)."""
+    from fretwear.case import build_model, load_case
+    from fretwear.fourier import FourierBasis
+    from fretwear.results import read_results
+    from fretwear.wear import frf_worn
+
+    results = wear_dir / "results.nc"
+    if not results.is_file():
+        raise InputError(f"{results} does not exist: the 79 kHz wear run did not finish")
+    ds = read_results(results)
+    if int(ds.attrs.get("converged", 0)) != 1:
+        raise InputError("the 79 kHz wear run did not converge: no worn interface to use")
+    wear = ds["wear_depth"].values[-1]
+    f_min, f_max, n = (7e4, 9e4, 5) if quick else FRF_WORN_BAND
+    h, s = (1, 16) if quick else (7, 128)
+    settings = (f"band={f_min},{f_max},{n} h={h} s={s} "
+                f"wear={float(np.sum(wear)):.12e} cycles={float(ds['cycles'].values[-1]):.6e}")
+    path = folder / "frf-worn.npz"
+    if _settings_match(path, settings):
+        return "up to date"
+    model = build_model(load_case(wear_dir / "case.toml"))
+    basis = FourierBasis.up_to(h, s)
+    out = {}
+    for name, w in (("unworn", np.zeros_like(wear)), ("worn", wear)):
+        r = frf_worn(model, w, (f_min, f_max, n), basis, spacing="linear")
+        out[f"{name}_frequency"] = r.frequency_hz
+        out[f"{name}_amplitude"] = r.amplitude("Pe", 0, 1)
+        out[f"{name}_converged"] = r.converged
+    _save_npz(path, settings=settings, wear=wear, **out)
+    bad = sum(int((~out[f"{k}_converged"]).sum()) for k in ("unworn", "worn"))
+    return "done" if bad == 0 else "not converged"
+
+
+def plan(only: Iterable[str] | None = None) -> list[str]:
+    """The keys to run, in order (longest first, the extras after what they need)."""
+    keys = list(RUN_KEYS) + list(EXTRA_KEYS)
+    if only is None:
+        return keys
+    only = list(only)
+    unknown = [k for k in only if k not in keys]
+    if unknown:
+        raise InputError(f"unknown reproduction run(s) {', '.join(unknown)}; expected some "
+                         f"of: {', '.join(keys)}")
+    return [k for k in keys if k in only]
+
+
+def run_all(workdir: Path | str, *, quick: bool = False, jobs: int = 1,
+            only: Iterable[str] | None = None, progress: bool = False,
+            say: Callable[[str], None] = print) -> list[Outcome]:
+    """Run every run of :func:`plan` into ``workdir``; ``jobs`` processes at a time.
+
+    Ctrl-C stops the runs; what was finished (and the wear checkpoints) stays in
+    ``workdir`` and the same call continues from there.
+    """
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+    from multiprocessing import get_context
+
+    from fretwear.runner import RunInterrupted
+
+    if jobs < 1:
+        raise InputError(f"jobs = {jobs}: expected a number of processes >= 1")
+    workdir = Path(workdir).expanduser().resolve()
+    workdir.mkdir(parents=True, exist_ok=True)
+    keys = plan(only)
+    first = [k for k in keys if k != "frf-worn-79khz"]
+    later = [k for k in keys if k == "frf-worn-79khz"]
+    outcomes: list[Outcome] = []
+
+    def note(o: Outcome) -> None:
+        outcomes.append(o)
+        say(f"{o.key:<24} {o.status:<14} {o.seconds:8.1f} s" + (f"  {o.message}"
+                                                                 if o.message else ""))
+
+    saved = f"finished runs and wear checkpoints are kept in {workdir}; run the same " \
+            "command again to continue"
+    try:
+        if jobs == 1:
+            for k in first + later:
+                note(run_one(k, workdir, quick, progress))
+        else:
+            with ProcessPoolExecutor(jobs, mp_context=get_context("spawn")) as pool:
+                futures = [pool.submit(run_one, k, workdir, quick) for k in first]
+                for fut in as_completed(futures):
+                    note(fut.result())
+            for k in later:
+                note(run_one(k, workdir, quick, progress))
+    except KeyboardInterrupt:
+        raise RunInterrupted(f"interrupted: {saved}") from None
+    return outcomes
+
+
+def reproduce(workdir: Path | str, doc: Path | str | None = None, *, quick: bool = False,
+              jobs: int = 1, only: Iterable[str] | None = None, progress: bool = False,
+              say: Callable[[str], None] = print) -> Path:
+    """Run the reproduction into ``workdir`` and write the report ``doc`` (default
+    ``workdir/reproduction.md``, figures in the folder ``<doc stem>/`` beside it).
+    Returns the report's path."""
+    from fretwear.reproduce_report import write_report
+
+    workdir = Path(workdir).expanduser().resolve()
+    t0 = time.perf_counter()
+    outcomes = run_all(workdir, quick=quick, jobs=jobs, only=only, progress=progress, say=say)
+    doc = workdir / "reproduction.md" if doc is None else Path(doc).expanduser().resolve()
+    path = write_report(workdir, doc, outcomes, quick=quick,
+                        wall=time.perf_counter() - t0, jobs=jobs)
+    say(f"report: {path}")
+    return path
+
+
+__all__ = ["EXTRA_KEYS", "RUNS", "RUN_KEYS", "Outcome", "Run", "edit_case_text", "plan",
+           "reproduce", "run_all", "run_case_text", "run_one", "toml_value"]
