@@ -813,6 +813,20 @@ class _Report:
             m = missing("frf-worn-79khz", self.out)
             self.row("24", m, "no result")
             return "\n".join(s + [f"fretwear: {m}."]) + "\n"
+        dead = [k for k in ("unworn", "worn") if not np.any(fw[f"{k}_converged"])]
+        if dead:
+            conv = {k: f"{int(fw[f'{k}_converged'].sum())}/{fw[f'{k}_frequency'].size}"
+                    for k in ("unworn", "worn")}
+            m = (f"the {' and '.join(dead)} FRF did not converge at any point (converged "
+                 f"points: unworn {conv['unworn']}, worn {conv['worn']}); no comparison")
+            self.row("24", m, "no result")
+            return "\n".join(s + [
+                f"fretwear: {m}. The sweep starts cold at "
+                f"{fw['unworn_frequency'][0] / 1e3:.0f} kHz with 7 harmonics; the worn "
+                "interface is the state at 2e8 cycles, where the 79 kHz response is not "
+                "periodic (Fig. 17-21). Open: start the sweeps lower, or from time "
+                "integrations (`fretwear.sweep.sweep(..., time_domain=True)`)."]) + \
+                self.image(fig_frf_worn(self.figdir, fw), "Fig. 24") + "\n"
         res = {}
         for name in ("unworn", "worn"):
             f = fw[f"{name}_frequency"]
