@@ -264,7 +264,7 @@ def _frf_worn(folder: Path, wear_dir: Path, quick: bool, progress: bool) -> str:
     wear = ds["wear_depth"].values[-1]
     f_min, f_max, n = (7e4, 9e4, 5) if quick else FRF_WORN_BAND
     h, s = (1, 16) if quick else (7, 128)
-    settings = (f"band={f_min},{f_max},{n} h={h} s={s} "
+    settings = (f"band={f_min},{f_max},{n} h={h} s={s} time_domain=1 "
                 f"wear={float(np.sum(wear)):.12e} cycles={float(ds['cycles'].values[-1]):.6e}")
     path = folder / "frf-worn.npz"
     if _settings_match(path, settings):
@@ -273,7 +273,9 @@ def _frf_worn(folder: Path, wear_dir: Path, quick: bool, progress: bool) -> str:
     basis = FourierBasis.up_to(h, s)
     out = {}
     for name, w in (("unworn", np.zeros_like(wear)), ("worn", wear)):
-        r = frf_worn(model, w, (f_min, f_max, n), basis, spacing="linear")
+        r = frf_worn(model, w, (f_min, f_max, n), basis, spacing="linear",
+                     time_domain=True)
+        out[f"{name}_summary"] = r.summary()
         out[f"{name}_frequency"] = r.frequency_hz
         out[f"{name}_amplitude"] = r.amplitude("Pe", 0, 1)
         out[f"{name}_converged"] = r.converged
