@@ -820,19 +820,20 @@ class _Report:
             m = (f"the {' and '.join(dead)} FRF did not converge at any point (converged "
                  f"points: unworn {conv['unworn']}, worn {conv['worn']}); no comparison")
             self.row("24", m, "no result")
-            drift = any("drifting" in str(fw.get(f"{k}_summary", "")) for k in dead)
-            found = [ln.strip() for k in dead
-                     for ln in str(fw.get(f"{k}_summary", "")).splitlines()[:4]]
+            lines = [ln for k in dead for ln in str(fw.get(f"{k}_summary", "")).splitlines()]
+            found = [ln.strip() for ln in lines[:4]]
+            n_qp = sum("quasi-periodic" in ln for ln in lines)
+            n_dr = sum("drifting" in ln for ln in lines)
             s += [f"fretwear: {m}. Where a solve failed, the sweep integrated in time from the "
                   "neighbour to find a periodic state to start from; what it found, for the "
                   "first points of the failed sweep(s):", "", "```", *found, "```", "",
-                  "The worn interface is the state at 2e8 cycles, where the 79 kHz response is "
-                  "not periodic (Fig. 17-21)."]
-            if drift:
-                s.append("The time integrations drift (ratchet): a structure that walks under "
-                         "the alternating load has no periodic response, so there is no FRF to "
-                         "draw on this worn interface. The paper's Fig. 24 is drawn after its "
-                         "plateau, which this model does not reach.")
+                  f"Of the {max(len(lines) - len(dead), 0)} failed points, the time "
+                  f"integration found a quasi-periodic (self-excited) response at {n_qp} and a "
+                  f"drifting (ratcheting) one at {n_dr}. The worn interface is the state at 2e8 "
+                  "cycles, where the 79 kHz response is not periodic either (Fig. 17-21). With "
+                  "no periodic response there is no FRF to draw on this worn interface; the "
+                  "paper's Fig. 24 is drawn after its plateau, which this model does not "
+                  "reach."]
             return "\n".join(s) + self.image(fig_frf_worn(self.figdir, fw), "Fig. 24") + "\n"
         res = {}
         for name in ("unworn", "worn"):
