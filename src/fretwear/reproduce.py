@@ -18,7 +18,6 @@ the machinery in a minute; its numbers are not the reproduction.
 from __future__ import annotations
 
 import math
-import os
 import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
@@ -184,10 +183,14 @@ class Outcome:
 
 
 def _save_npz(path: Path, **arrays) -> None:
-    """Write ``path`` atomically (a partial file never has the final name)."""
-    tmp = path.with_name(path.name + ".part.npz")
-    np.savez(tmp, **arrays)
-    os.replace(tmp, path)
+    """Write ``path`` (``.npz``) complete or not at all (:func:`fretwear.results.atomic_write`)."""
+    from fretwear.results import atomic_write
+
+    def write(tmp: Path) -> None:
+        with open(tmp, "wb") as fh:
+            np.savez(fh, **arrays)
+
+    atomic_write(path, write)
 
 
 def _settings_match(path: Path, settings: str) -> bool:
@@ -212,7 +215,7 @@ def run_one(key: str, workdir: Path | str, quick: bool = False,
         if key == "stromberg-load-stepping":
             status = _load_stepping(folder, quick)
         elif key == "frf-worn-79khz":
-            status = _frf_worn(folder, workdir / "wear-79khz", quick, progress)
+            status = _frf_worn(folder, workdir / "wear-79khz", quick)
         else:
             run = next(r for r in RUNS if r.key == key)
             path = folder / "case.toml"
@@ -248,7 +251,7 @@ def _load_stepping(folder: Path, quick: bool) -> str:
     return "done"
 
 
-def _frf_worn(folder: Path, wear_dir: Path, quick: bool, progress: bool) -> str:
+def _frf_worn(folder: Path, wear_dir: Path, quick: bool) -> str:
     """The nonlinear FRF of the paper's beam before and after the 79 kHz wear (Fig. 24)."""
     from fretwear.case import build_model, load_case
     from fretwear.fourier import FourierBasis

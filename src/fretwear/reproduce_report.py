@@ -114,11 +114,10 @@ def linear_facts(model, f_max: float = 1e5) -> dict:
     out = {}
     grid = np.geomspace(10.0, f_max, 4000)
     for itf in ("sliding", "stuck"):
-        m = linear.modes(model, interface=itf, f_max=f_max)
-        f = m.frequency_hz[m.frequency_hz > 1.0]
+        fm = linear.modes(model, interface=itf, f_max=2.0 * f_max).frequency_hz
+        f = fm[(fm > 1.0) & (fm <= f_max)]
+        nxt = fm[fm > f_max]
         _, fp = linear.count_resonances(linear.frf(model, grid, interface=itf), "Pe", "x")
-        nxt = linear.modes(model, n_modes=f.size + 4, interface=itf).frequency_hz
-        nxt = nxt[nxt > f_max]
         out[itf] = {"modes": f, "peaks": fp, "next": float(nxt[0]) if nxt.size else np.nan}
     return out
 
@@ -126,10 +125,10 @@ def linear_facts(model, f_max: float = 1e5) -> dict:
 def wear_facts(ds) -> dict:
     """What the paper reads off a wear run (section 4.2)."""
     from fretwear.wear import zero_wear_zones
+    from fretwear.wear_time import RESPONSE_KINDS
 
     x = ds["contact_position"].values[:, 0]
-    W = ds["wear_depth"].values
-    w = W[-1]
+    w = ds["wear_depth"].values[-1]
     cyc = ds["cycles"].values
     vrate = ds["worn_volume_rate"].values
     zones = zero_wear_zones(x, w, 0.01)
@@ -141,8 +140,6 @@ def wear_facts(ds) -> dict:
     slip = ds["slip_amplitude"].values
     moving = [float(np.mean(s > 1e-2 * max(s.max(), 1e-300))) for s in (slip[0], slip[-1])]
     td = ds["time_domain_start"].values
-    from fretwear.wear_time import RESPONSE_KINDS
-
     resp = ds["time_domain_response"].values
     kinds = ", ".join(f"{RESPONSE_KINDS[k]} {int(np.sum(resp == k))}"
                       for k in range(len(RESPONSE_KINDS)) if np.any(resp == k)) or "none"
@@ -183,6 +180,7 @@ def pillar_text(f: dict) -> tuple[str, str]:
         return (f"zero-wear zone(s) {mm_zones(f['pillars'])} inside the worn zone, pressure "
                 f"up to {max(f['pillar_pressure']):.1f} x the mean", "agrees")
     return "no pillar inside the worn zone", "differs"
+
 
 def khz(f) -> str:
     f = np.atleast_1d(np.asarray(f, float))
@@ -328,17 +326,15 @@ def fig_profiles(figdir, runs: dict) -> str | None:
         return None
     fig, ax = plots.new_figure(1, 2, title="Paper Fig. 23 and 25: final profiles, worn volume")
     for label, ds in runs.items():
-        x = ds["contact_position"].values[:, 0] * 1e3
-        if "explicit" in label:  # the paper's scheme: on the worn-volume panel only
-            c = ds["cycles"].values
-            ax[0, 1].loglog(np.maximum(c[1:], 1), ds["worn_volume"].values[1:] * 1e9, "k:",
-                            label=label)
-            continue
-        w = ds["wear_depth"].values[-1]
-        ax[0, 0].plot(x, w / max(w.max(), 1e-300), ".-", label=f"{label} "
-                      f"(max {w.max() * 1e6:.3g} um)")
+        explicit = "explicit" in label  # the paper's scheme: on the worn-volume panel only
         c = ds["cycles"].values
-        ax[0, 1].loglog(np.maximum(c[1:], 1), ds["worn_volume"].values[1:] * 1e9, label=label)
+        ax[0, 1].loglog(np.maximum(c[1:], 1), ds["worn_volume"].values[1:] * 1e9,
+                        "k:" if explicit else "-", label=label)
+        if not explicit:
+            x = ds["contact_position"].values[:, 0] * 1e3
+            w = ds["wear_depth"].values[-1]
+            ax[0, 0].plot(x, w / max(w.max(), 1e-300), ".-", label=f"{label} "
+                          f"(max {w.max() * 1e6:.3g} um)")
     ax[0, 0].set_xlabel("x [mm]")
     ax[0, 0].set_ylabel("wear depth / deepest [-]")
     ax[0, 1].set_xlabel("cycles")
@@ -369,6 +365,7 @@ def write_report(workdir: Path, doc: Path, outcomes, *, quick: bool, wall: float
                  jobs: int) -> Path:
     """Measure, draw and write the report ``doc``; figures in ``doc.parent/doc.stem``."""
     from fretwear.reproduce import RUNS
+    from fretwear.results import atomic_write
 
     workdir = Path(workdir)
     doc = Path(doc)
@@ -379,7 +376,7 @@ def write_report(workdir: Path, doc: Path, outcomes, *, quick: bool, wall: float
     R = _Report(workdir, figdir, ds, out)
     text = "\n".join([
         _header(quick, wall, jobs, workdir),
-        _runs_table(RUNS, out, workdir),
+        _runs_table(RUNS, out),
         R.summary_placeholder,
         R.stromberg(),
         R.quasistatic(),
@@ -391,10 +388,7 @@ def write_report(workdir: Path, doc: Path, outcomes, *, quick: bool, wall: float
         R.table1(),
     ])
     text = text.replace(R.summary_placeholder, R.summary())
-    tmp = doc.with_name(doc.name + ".part")
-    tmp.write_text(text, encoding="utf-8")
-    os.replace(tmp, doc)
-    return doc
+    return atomic_write(doc, lambda tmp: tmp.write_text(text, encoding="utf-8"))
 
 
 def _header(quick: bool, wall: float, jobs: int, workdir: Path) -> str:
@@ -416,29 +410,26 @@ going on at the same time; `benchmarks/paper_table1.py` times the Table 1 runs a
 """
 
 
-def _runs_table(runs, out: dict, workdir: Path) -> str:
-    rows = ["## The runs", "", "| run | example | paper Fig. | settings | status | wall |",
-            "|---|---|---|---|---|---|"]
-    for r in runs:
-        o = out.get(r.key)
-        st = o.status if o else "not run"
-        msg = f": {o.message}" if o and o.message else ""
-        w = f"{o.seconds:.0f} s" if o and o.status != "up to date" else "-"
-        rows.append(f"| `{r.key}` | `{r.example}` | {r.figures} | {r.why} | {st}{msg} | {w} |")
+def _runs_table(runs, out: dict) -> str:
     from fretwear.reproduce import EXTRA_KEYS
+
+    def status(key: str) -> str:
+        o = out.get(key)
+        st = (o.status + (f": {o.message}" if o.message else "")) if o else "not run"
+        w = f"{o.seconds:.0f} s" if o and o.status != "up to date" else "-"
+        return f"{st} | {w}"
 
     what = {"stromberg-load-stepping": "load stepping with exact contact and incremental "
             "Coulomb friction (`fretwear.transient.incremental_wear`), the kind of method "
             "of Stromberg (1997)",
             "frf-worn-79khz": "nonlinear FRF (7 harmonics, 128 samples) with the unworn and "
             "the 79 kHz worn gap (`fretwear.wear.frf_worn`)"}
-    for k in EXTRA_KEYS:
-        o = out.get(k)
-        st = o.status if o else "not run"
-        msg = f": {o.message}" if o and o.message else ""
-        w = f"{o.seconds:.0f} s" if o and o.status != "up to date" else "-"
-        rows.append(f"| `{k}` | (Python) | {'5' if 'strom' in k else '24'} | {what[k]} | "
-                    f"{st}{msg} | {w} |")
+    rows = ["## The runs", "", "| run | example | paper Fig. | settings | status | wall |",
+            "|---|---|---|---|---|---|"]
+    rows += [f"| `{r.key}` | `{r.example}` | {r.figures} | {r.why} | {status(r.key)} |"
+             for r in runs]
+    rows += [f"| `{k}` | (Python) | {'5' if 'strom' in k else '24'} | {what[k]} | "
+             f"{status(k)} |" for k in EXTRA_KEYS]
     return "\n".join(rows) + "\n"
 
 
