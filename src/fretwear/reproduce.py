@@ -255,15 +255,13 @@ def _frf_worn(folder: Path, wear_dir: Path, quick: bool) -> str:
     """The nonlinear FRF of the paper's beam before and after the 79 kHz wear (Fig. 24)."""
     from fretwear.case import build_model, load_case
     from fretwear.fourier import FourierBasis
-    from fretwear.results import read_results
+    from fretwear.reproduce_report import load
     from fretwear.wear import frf_worn
 
-    results = wear_dir / "results.nc"
-    if not results.is_file():
-        raise InputError(f"{results} does not exist: the 79 kHz wear run did not finish")
-    ds = read_results(results)
-    if int(ds.attrs.get("converged", 0)) != 1:
-        raise InputError("the 79 kHz wear run did not converge: no worn interface to use")
+    ds = load(wear_dir.parent, wear_dir.name)
+    if ds is None:
+        raise InputError(f"{wear_dir / 'results.nc'}: no converged result of the 79 kHz wear "
+                         "run (missing, unreadable or not converged): no worn interface to use")
     wear = ds["wear_depth"].values[-1]
     f_min, f_max, n = (7e4, 9e4, 5) if quick else FRF_WORN_BAND
     h, s = (1, 16) if quick else (7, 128)

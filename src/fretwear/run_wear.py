@@ -316,7 +316,7 @@ def run_wear(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOu
     if fb is not None and model.observed:
         grid = (fb["f_min"], fb["f_max"], fb["n_points"])
         sweeps = {name: frf_worn(model, w, grid, basis, solver=a["solver"], eps=a.get("eps"),
-                                 spacing=fb["spacing"])
+                                 spacing=fb["spacing"], time_domain=fb["time_domain"])
                   for name, w in (("unworn", 0.0), ("worn", result.final_wear))}
         from fretwear.sweep import frequency_grid
 
@@ -374,6 +374,8 @@ _FRF = Table(
         "f_max": Field(_POS, "highest frequency", required=True, unit="Hz"),
         "n_points": Field(Integer(lo=2), "number of frequencies", default=100),
         "spacing": Field(Text(("linear", "log")), "frequency spacing", default="linear"),
+        "time_domain": Field(Flag(), "where a point's balance fails, integrate in time from "
+                             "the neighbour (as in `frf` sweeps)", default=True),
     },
     checks=(increasing("f_min", "f_max", "Hz"),),
     doc="Nonlinear FRFs (fretwear.sweep) of the unworn and the worn interface.",

@@ -1098,12 +1098,15 @@ def _time_domain_step(sp: SlowProblem, st: dict, opts: WearOptions):
         Js = sp.slow_jacobian(st["U"])
         iters += 1
     if Js.size:
-        lam_plus = float(np.max(np.linalg.eigvals(Js).real))
-        if lam_plus > 0:
-            dN = min(dN, GROWTH_LIMIT / lam_plus)
+        # Js is the Jacobian of an older (balanced) state: its growing modes (lam > 0) are not
+        # those of the current wear and must not cap the jump. Shifted by -lam_plus it has none,
+        # and the predictor stays a consistent first-order W-method (any matrix gives first
+        # order; only the stiff decaying part matters for stability); the error test decides.
+        lam_plus = max(float(np.max(np.linalg.eigvals(Js).real)), 0.0)
     while True:
         if Js.size:  # linearly implicit (the scheme's predictor) with that Jacobian
-            W1 = W_k + np.maximum(dN * np.linalg.solve(np.eye(sp.nc) - dN * Js, g_k), 0.0)
+            A = (1.0 + dN * lam_plus) * np.eye(sp.nc) - dN * Js
+            W1 = W_k + np.maximum(dN * np.linalg.solve(A, g_k), 0.0)
         else:
             W1 = W_k + dN * g_k
         try:
