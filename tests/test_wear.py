@@ -12,7 +12,9 @@ References, each independent of the code under test:
   not wear, to the last bit;
 * finite differences for every derivative of the implicit scheme;
 * a fine-jump explicit Euler run for the slow-scale integrators;
-* an uninterrupted run for interrupt-and-resume (bitwise).
+* an uninterrupted run for interrupt-and-resume (bitwise);
+* statics of the mean state of the paper's beam: mean contact forces = preload, resultant at
+  L/2.
 
 Models are small (a 10 x 2 block, 3 harmonics, 32 samples, quasi-static) so that the file runs
 in well under a minute.
@@ -581,3 +583,29 @@ def test_zero_wear_zones_are_runs_of_unworn_nodes():
     w = np.array([0.0, 0.0, 0.005, 1.0, 0.0, 0.3, 0.02])
     assert zero_wear_zones(x, w) == [[0.0, 0.1], [0.3, 0.3], [0.5, 0.5]]
     assert zero_wear_zones(x, w, fraction=0.03) == [[0.0, 0.1], [0.3, 0.3], [0.5, 0.6]]
+
+
+def test_mean_normal_force_balances_the_preload_on_the_paper_beam():
+    """Equilibrium of the mean (zeroth-harmonic) state of the paper's beam at 10 kHz along a
+    short wear history: the mean normal contact forces add up to the preload ``P L l`` and
+    their resultant acts at ``x = L/2``, where the uniform ``P`` acts. Friction and the
+    x-spring act on the contact line ``y = 0`` and ``Q`` has zero mean, so neither moves the
+    resultant: a statics check independent of the solver, at every step (worn or not). The
+    tolerance (1e-6) is far above the balance residual (``tol = 1e-9``; measured deviations
+    are at round-off) and far below what a wrong static part, area or pressure would give
+    (one node's load misplaced by one element moves the resultant by ~1e-3 L)."""
+    from fretwear.examples.builders import paper_beam
+
+    m = paper_beam()
+    basis = FourierBasis.up_to(3, 32)
+    r = simulate_wear(m, basis, omega=2 * np.pi * 10e3,
+                      options=WearOptions(max_steps=3, time_domain_rescue=False))
+    h = r.history
+    area = np.asarray(m.contact.area, float)
+    x = np.asarray(m.contact.coords, float)[:, 0]
+    L, P, width = 0.1, 1e4, 0.01
+    assert r.converged and h.n_steps == 4 and h.wear_depth[-1].max() > 0
+    for p in h.pressure_mean:
+        force = float(area @ p)
+        np.testing.assert_allclose(force, P * L * width, rtol=1e-6)
+        np.testing.assert_allclose(float((area * p) @ x) / force, L / 2, rtol=1e-6)

@@ -1059,8 +1059,9 @@ def _time_domain_step(sp: SlowProblem, st: dict, opts: WearOptions):
     Used where the periodic balance fails (dynamic cases). The wear is advanced from the rate at
     the start of the step: by explicit Euler (eq. 30), ``W1 = W_k + dN g_k``, with
     ``scheme = "explicit"``; otherwise by the linearly implicit predictor
-    ``W1 = W_k + dN (I - dN Js)^-1 g_k`` with the slow Jacobian ``Js`` of the last balanced
-    state (no balance, no fresher one). The stiff part of ``Js`` is local (wear unloads the
+    ``W1 = W_k + dN ((1 + dN lam_+) I - dN Js)^-1 g_k`` with the slow Jacobian ``Js`` of the
+    last balanced state (no balance, no fresher one), shifted by its largest growth rate
+    ``lam_+ >= 0`` (a W-method: first order with any matrix). The stiff part of ``Js`` is local (wear unloads the
     node that slips) and changes little, and without it the jumps stay at the explicit
     stability limit with rates that flip from step to step. Then the
     structure is integrated in time at ``W1`` (:func:`fretwear.wear_time.time_averaged_rate`),

@@ -1,0 +1,172 @@
+"""The 79 kHz wear run of the paper's beam continued far beyond 2e8 cycles: is there a plateau?
+
+The reproduction (``fretwear reproduce``, docs/reproduction.md) stops the 79 kHz runs at 2e8
+cycles without a plateau. The paper's Table 1 counts 6007 computed slow steps with jumps of up
+to 1e7 cycles, i.e. up to 6e10 physical cycles, so its plateau may lie far beyond 2e8. This
+script continues the two reproduction runs, the default adaptive scheme (``wear-79khz``) and
+the paper's explicit Euler with fixed jumps of 1e7 cycles (``wear-79khz-explicit``), to
+``--max-cycles`` with ``fretwear run --resume`` semantics: each run lives in
+``WORKDIR/<key>/`` and continues from its checkpoint, so a run that is interrupted (or seeded
+with the reproduction's folders, ``--seed REPRO_DIR``) goes on where it stopped.
+
+It prints, for each run: the cycle count reached, slow steps and wall time, the worn-volume
+rate over the initial one, the "pillars" (contact nodes that stick all period and carry more
+than twice the mean pressure), the centroid of the mean normal contact force (exactly x = L/2
+for this beam: friction and the spring act on the contact line and Q has zero mean, so the
+mean moment balance fixes it, a check of the results), and whether the pillars straddle it.
+A plateau needs all the load on sticking nodes, so it needs pillars on both sides of L/2.
+It draws ``docs/figures/wear-79khz-long.png``: wear profiles at selected cycle counts and the
+worn-volume rate against cycles for both runs.
+
+Usage::
+
+    python benchmarks/wear_79khz_long.py [--workdir DIR] [--seed REPRO_DIR]
+        [--max-cycles 3e9] [--only KEY] [--plot-only]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import sys
+from pathlib import Path
+
+KEYS = ("wear-79khz", "wear-79khz-explicit")
+FIGURE = Path(__file__).resolve().parents[1] / "docs" / "figures" / "wear-79khz-long.png"
+
+
+def case_text(key: str, max_cycles: float) -> str:
+    from fretwear.reproduce import RUNS, edit_case_text, run_case_text
+
+    run = next(r for r in RUNS if r.key == key)
+    return edit_case_text(run_case_text(run, False), "analysis.max_cycles", float(max_cycles))
+
+
+def run(key: str, workdir: Path, max_cycles: float, seed: Path | None) -> None:
+    from fretwear.runner import run_case
+
+    folder = workdir / key
+    if seed is not None and not (folder / "wear-checkpoint.npz").is_file():
+        src = seed / key
+        if (src / "wear-checkpoint.npz").is_file():
+            folder.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(src / "wear-checkpoint.npz", folder / "wear-checkpoint.npz")
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / "case.toml"
+    path.write_text(case_text(key, max_cycles), encoding="utf-8")
+    out = run_case(path, folder, progress=sys.stderr.isatty(), resume=True, echo=False)
+    print(f"{key}: {out.summary.splitlines()[0] if out.summary else ''}")
+
+
+def history(folder: Path) -> dict | None:
+    import numpy as np
+
+    ck = folder / "wear-checkpoint.npz"
+    if not ck.is_file():
+        return None
+    with np.load(ck, allow_pickle=False) as z:
+        return {k[5:]: z[k] for k in z.files if k.startswith("hist_")}
+
+
+def facts(h: dict, x, area) -> dict:
+    """What the last step says about a plateau (see module docstring)."""
+    import numpy as np
+
+    p, path = h["pressure_mean"][-1], h["slip_path"][-1]
+    pbar = float(np.dot(area, p) / area.sum())
+    pillars = np.flatnonzero((path <= 1e-3 * path.max()) & (p > 2.0 * pbar))
+    centroid = float(np.dot(area * p, x) / np.dot(area, p))
+    vr = h["volume_rate"] / h["volume_rate"][0]
+    return {
+        "cycles": float(h["cycles"][-1]), "steps": len(h["cycles"]) - 1,
+        "wall": float(np.sum(h["wall_time"])), "rate": float(vr[-1]),
+        "rate_min_last_tenth": float(np.min(vr[-max(1, len(vr) // 10):])),
+        "pillars_mm": [round(1e3 * float(x[i]), 1) for i in pillars],
+        "pillar_load": float(np.dot(area[pillars], p[pillars]) / np.dot(area, p)),
+        "centroid_mm": 1e3 * centroid,
+        "straddle": bool(pillars.size and x[pillars].min() < centroid < x[pillars].max()),
+        "max_depth_nm": 1e9 * float(h["wear_depth"][-1].max()),
+    }
+
+
+def plot(workdir: Path, model) -> Path:
+    import numpy as np
+
+    from fretwear import plots
+
+    x = 1e3 * np.asarray(model.contact.coords, float)[:, 0]
+    fig, axes = plots.new_figure(1, 3, panel_size=(4.6, 3.6),
+                                 title="79 kHz wear continued (paper beam, 7 harmonics)")
+    axes = axes[0]
+    for ax, key in zip(axes[:2], KEYS, strict=True):
+        h = history(workdir / key)
+        if h is None:
+            continue
+        n = h["cycles"]
+        picks = [int(np.argmin(abs(n - t))) for t in (2e8, 5e8, 1e9, 2e9, 5e9, 1e10)
+                 if t < 0.9 * n[-1]] + [len(n) - 1]
+        for k in picks:
+            ax.plot(x, 1e9 * h["wear_depth"][k], label=f"N = {n[k]:.3g}")
+        ax.set_xlabel("x [mm]")
+        ax.set_ylabel("wear depth [nm]")
+        ax.set_title(key, fontsize=9)
+        ax.legend(fontsize=7)
+    ax = axes[2]
+    for key in KEYS:
+        h = history(workdir / key)
+        if h is not None:
+            ax.semilogy(h["cycles"], h["volume_rate"] / h["volume_rate"][0], ".", ms=2,
+                        label=key)
+    ax.axhline(1e-3, color="k", lw=0.8, ls="--", label="plateau test (1e-3)")
+    ax.set_xlabel("cycles N")
+    ax.set_ylabel("worn-volume rate / initial")
+    ax.legend(fontsize=7)
+    FIGURE.parent.mkdir(parents=True, exist_ok=True)
+    return plots.save(fig, FIGURE, dpi=90)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--workdir", type=Path, default=Path("/tmp/fretwear-79khz-long"))
+    ap.add_argument("--seed", type=Path, default=None,
+                    help="a `fretwear reproduce` work directory to continue from")
+    ap.add_argument("--max-cycles", type=float, default=3e9)
+    ap.add_argument("--only", choices=KEYS, default=None)
+    ap.add_argument("--plot-only", action="store_true")
+    ap.add_argument("--threads", type=int, default=1)
+    a = ap.parse_args(argv)
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", str(a.threads))
+    import numpy as np
+
+    from fretwear.case import build_model, load_case
+
+    keys = KEYS if a.only is None else (a.only,)
+    if not a.plot_only:
+        for key in keys:
+            run(key, a.workdir, a.max_cycles, a.seed)
+    model = None
+    for key in KEYS:
+        h = history(a.workdir / key)
+        if h is None:
+            print(f"{key}: no checkpoint in {a.workdir / key}")
+            continue
+        if model is None:
+            model = build_model(load_case(a.workdir / key / "case.toml"))
+            x = np.asarray(model.contact.coords, float)[:, 0]
+            area = np.asarray(model.contact.area, float)
+        f = facts(h, x, area)
+        print(f"{key}: N = {f['cycles']:.3g} in {f['steps']} steps, {f['wall']:.0f} s of step "
+              f"wall time; worn-volume rate / initial {f['rate']:.3g} (smallest over the last "
+              f"tenth of the steps {f['rate_min_last_tenth']:.3g}); max depth "
+              f"{f['max_depth_nm']:.1f} nm")
+        print(f"{key}: pillars at x = {f['pillars_mm']} mm carry {100 * f['pillar_load']:.0f} % "
+              f"of the load; mean normal force centroid x = {f['centroid_mm']:.2f} mm; "
+              f"pillars {'straddle' if f['straddle'] else 'do not straddle'} it")
+    if model is not None:
+        print(f"figure: {plot(a.workdir, model)}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
