@@ -40,7 +40,7 @@ def case_text(key: str, max_cycles: float) -> str:
     from fretwear.reproduce import RUNS, edit_case_text, run_case_text
 
     run = next(r for r in RUNS if r.key == key)
-    return edit_case_text(run_case_text(run, False), "analysis.max_cycles", float(max_cycles))
+    return edit_case_text(run_case_text(run, False), "analysis", {"max_cycles": float(max_cycles)})
 
 
 def run(key: str, workdir: Path, max_cycles: float, seed: Path | None) -> None:

@@ -792,7 +792,10 @@ class _Report:
               "problems\"). The paper's dynamic runs were explicit Euler with 1e7-cycle jumps "
               "and a Newton tolerance it does not give; a plateau of the worn volume is only "
               "as reliable as the periodicity of the response, which the paper does not "
-              "check and which we find lost at 79 kHz."]
+              "check and which we find lost at 79 kHz. The two 79 kHz runs continued to "
+              "billions of cycles (`benchmarks/wear_79khz_long.py`, docs/wear.md, open "
+              "problem 1) and why statics rules out their plateau there are documented "
+              "separately: they take hours."]
         return "\n".join(s) + self.image(img, "Fig. 23, 25") + "\n"
 
     # Fig. 24
