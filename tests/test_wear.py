@@ -16,8 +16,9 @@ References, each independent of the code under test:
 * statics of the mean state of the paper's beam: mean contact forces = preload, resultant at
   L/2.
 
-Models are small (a 10 x 2 block, 3 harmonics, 32 samples, quasi-static) so that the file runs
-in well under a minute.
+Models are small (a 10 x 2 block, 3 harmonics, 32 samples, quasi-static; the statics test
+takes three slow steps of the paper's 30 x 4 beam) so that the file runs in well under a
+minute.
 """
 
 from __future__ import annotations

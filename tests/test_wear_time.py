@@ -26,7 +26,13 @@ from fretwear.model.build import ContactSpec, Damping, Material, Spring, Tractio
 from fretwear.model.mesh import rectangle
 from fretwear.reduce import condense
 from fretwear.stability import initial_state
-from fretwear.wear import SlowProblem, WearOptions, simulate_wear, wear_coefficients
+from fretwear.wear import (
+    SlowProblem,
+    WearOptions,
+    simulate_wear,
+    wear_coefficients,
+    without_growth,
+)
 from fretwear.wear_time import RESPONSE_KINDS, time_averaged_rate
 
 KW = 1e-11
@@ -167,9 +173,9 @@ def test_time_averaged_steps_follow_the_time_integration(monkeypatch, tmp_path, 
     """With no balance at all after step 1, the run goes on with time-averaged rates
     (rescued = 2). Each step's wear is the explicit Euler update (eq. 30) with the previous
     step's rate, or the linearly implicit one with the slow Jacobian of the last balanced step
-    (recomputed here from the recorded step 1), shifted by its largest growth rate so that it
-    has no growing mode. Interrupting after step 3 and resuming gives
-    the same history bit for bit (the integration state is in the checkpoint)."""
+    (recomputed here from the recorded step 1) without its growing modes. Interrupting after
+    step 3 and resuming gives the same history bit for bit (the integration state is in the
+    checkpoint)."""
     m = damped_block()
     _forced_failures(monkeypatch, balance_fails=True)
     opts = WearOptions(scheme=scheme, **OPTS)
@@ -184,11 +190,10 @@ def test_time_averaged_steps_follow_the_time_integration(monkeypatch, tmp_path, 
         spb.set_state(h.wear_depth[1], h.anchor[1])
         Js = spb.slow_jacobian(h.U[1].reshape(spb.m, spb.H))
     eye = np.eye(Js.shape[0])
-    lam_plus = max(float(np.max(np.linalg.eigvals(Js).real)), 0.0) if Js.any() else 0.0
+    Js = without_growth(Js)  # checked against eigen-analysis in test_without_growth_*
     for k in range(2, 5):
         dN = h.jump[k]
-        A = (1.0 + dN * lam_plus) * eye - dN * Js
-        dW = np.maximum(dN * np.linalg.solve(A, h.wear_rate[k - 1]), 0.0)
+        dW = np.maximum(dN * np.linalg.solve(eye - dN * Js, h.wear_rate[k - 1]), 0.0)
         np.testing.assert_allclose(h.wear_depth[k], h.wear_depth[k - 1] + dW, rtol=1e-9,
                                    atol=1e-12 * h.wear_depth[k].max())
     assert full.final is not None  # the last balanced step
@@ -238,3 +243,33 @@ def test_run_starts_from_a_time_integration_when_the_unworn_balance_fails(monkey
     # the response is periodic: the balance converges from it at step 1, then ordinary steps
     assert h.rescued[1] == 1 and np.all(h.rescued[2:] == 0)
     assert fretwear.hbm.solve_periodic is not failing  # only the wear module's start was forced
+
+
+def test_without_growth_keeps_decaying_modes_and_makes_growing_ones_explicit():
+    """:func:`without_growth` against a hand-built matrix with known eigenpairs: a growing
+    mode (+2), a neutral one (0), a decaying one (-5) and a decaying oscillatory pair
+    (-1 +- 3i), in a non-orthogonal basis. The predictor ``(I - dN Js+)^-1 g`` must then be,
+    along each eigenvector, explicit Euler (growing: factor 1, even at ``dN mu = 1`` where
+    ``I - dN Js`` is singular), exact for the neutral mode (factor 1) and ``1 / (1 - dN mu)``
+    for the others; the eigenvectors are unchanged. Tolerance: round-off of a 5 x 5 eigen
+    decomposition with condition number ~10."""
+    rng = np.random.default_rng(3)
+    V = np.eye(5) + 0.3 * rng.standard_normal((5, 5))
+    B = np.zeros((5, 5))
+    B[0, 0], B[1, 1], B[2, 2] = 2.0, 0.0, -5.0
+    B[3:, 3:] = [[-1.0, 3.0], [-3.0, -1.0]]  # eigenvalues -1 +- 3i
+    Js = V @ B @ np.linalg.inv(V)
+    Jp = without_growth(Js)
+    assert Jp.dtype == float
+    Bp = B.copy()
+    Bp[0, 0] = 0.0
+    np.testing.assert_allclose(Jp, V @ Bp @ np.linalg.inv(V), atol=1e-12 * np.abs(Js).max())
+    dN = 0.5  # dN mu = 1 for the growing mode
+    for j, factor in ((0, 1.0), (1, 1.0), (2, 1.0 / (1.0 + 5.0 * dN))):
+        step = np.linalg.solve(np.eye(5) - dN * Jp, V[:, j])
+        np.testing.assert_allclose(step, factor * V[:, j], atol=1e-12)
+    # a matrix without growing modes is returned unchanged
+    Bm = B.copy()
+    Bm[0, 0] = -2.0
+    Jm = V @ Bm @ np.linalg.inv(V)
+    np.testing.assert_array_equal(without_growth(Jm), Jm)

@@ -1059,9 +1059,9 @@ def _time_domain_step(sp: SlowProblem, st: dict, opts: WearOptions):
     Used where the periodic balance fails (dynamic cases). The wear is advanced from the rate at
     the start of the step: by explicit Euler (eq. 30), ``W1 = W_k + dN g_k``, with
     ``scheme = "explicit"``; otherwise by the linearly implicit predictor
-    ``W1 = W_k + dN ((1 + dN lam_+) I - dN Js)^-1 g_k`` with the slow Jacobian ``Js`` of the
-    last balanced state (no balance, no fresher one), shifted by its largest growth rate
-    ``lam_+ >= 0`` (a W-method: first order with any matrix). The stiff part of ``Js`` is local (wear unloads the
+    ``W1 = W_k + dN (I - dN Js+)^-1 g_k`` with ``Js+`` the slow Jacobian of the last balanced
+    state (no balance, no fresher one) without its growing modes (:func:`without_growth`; a
+    W-method: first order with any matrix). The stiff part of ``Js`` is local (wear unloads the
     node that slips) and changes little, and without it the jumps stay at the explicit
     stability limit with rates that flip from step to step. Then the
     structure is integrated in time at ``W1`` (:func:`fretwear.wear_time.time_averaged_rate`),
@@ -1099,15 +1099,13 @@ def _time_domain_step(sp: SlowProblem, st: dict, opts: WearOptions):
         Js = sp.slow_jacobian(st["U"])
         iters += 1
     if Js.size:
-        # Js is the Jacobian of an older (balanced) state: its growing modes (lam > 0) are not
-        # those of the current wear and must not cap the jump. Shifted by -lam_plus it has none,
-        # and the predictor stays a consistent first-order W-method (any matrix gives first
-        # order; only the stiff decaying part matters for stability); the error test decides.
-        lam_plus = max(float(np.max(np.linalg.eigvals(Js).real)), 0.0)
+        # Js is the Jacobian of an older (balanced) state: its growing modes are not those of
+        # the current wear and must not cap the jump. Without them the predictor is explicit
+        # Euler along those modes and linearly implicit along the others (a W-method).
+        Js = without_growth(Js)
     while True:
         if Js.size:  # linearly implicit (the scheme's predictor) with that Jacobian
-            A = (1.0 + dN * lam_plus) * np.eye(sp.nc) - dN * Js
-            W1 = W_k + np.maximum(dN * np.linalg.solve(A, g_k), 0.0)
+            W1 = W_k + np.maximum(dN * np.linalg.solve(np.eye(sp.nc) - dN * Js, g_k), 0.0)
         else:
             W1 = W_k + dN * g_k
         try:
@@ -1153,6 +1151,29 @@ def _time_domain_step(sp: SlowProblem, st: dict, opts: WearOptions):
                 "vrate": row["volume_rate"],
                 "td_U": tr.U_end, "td_V": tr.V_end, "Js": Js})
     return new, row, ""
+
+
+def without_growth(Js: np.ndarray, max_condition: float = 1e8) -> np.ndarray:
+    """``Js`` with the real part of every eigenvalue ``mu`` with ``Re mu > 0`` set to zero,
+    eigenvectors unchanged: ``Js - V diag(max(Re mu, 0)) V^-1`` (real: conjugate pairs get
+    the same shift).
+
+    Used as the matrix of the linearly implicit predictor of time-domain steps (an old slow
+    Jacobian): along a growing mode the step is then explicit Euler, along every other mode it
+    is the linearly implicit step with the mode's own eigenvalue, so neutral and decaying
+    modes keep their accuracy and ``I - dN Js+`` is never singular. Where the eigenvectors are
+    too ill-conditioned for the projection (``cond V > max_condition``) the whole matrix is
+    shifted by the largest growth rate instead (stable, but it damps every mode by
+    ``1 / (1 + dN lam_+)``: a first-order error that the error test sees).
+    """
+    Js = np.asarray(Js, float)
+    mu, V = np.linalg.eig(Js)
+    shift = np.maximum(mu.real, 0.0)
+    if not np.any(shift > 0):
+        return Js
+    if np.linalg.cond(V) > max_condition:
+        return Js - float(shift.max()) * np.eye(Js.shape[0])
+    return (Js - (V * shift) @ np.linalg.inv(V)).real
 
 
 def _time_row(tr, area, W, cycles, jump, iters, rejected, err, wall) -> dict:
@@ -1245,5 +1266,5 @@ def frf_worn(model: Model, wear, frequencies_hz, basis: FourierBasis, *, anchor=
 __all__ = [
     "HISTORY_FIELDS", "LAWS", "SCHEMES", "STOP_REASONS", "SlowProblem", "WearHistory",
     "WearOptions", "WearResult", "frf_worn", "load_checkpoint", "save_checkpoint",
-    "simulate_wear", "wear_coefficients", "wear_per_cycle", "worn_volume",
+    "simulate_wear", "wear_coefficients", "wear_per_cycle", "without_growth", "worn_volume",
 ]
