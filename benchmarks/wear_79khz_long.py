@@ -105,7 +105,7 @@ def plot(workdir: Path, model) -> Path:
     from fretwear import plots
 
     x = 1e3 * np.asarray(model.contact.coords, float)[:, 0]
-    fig, axes = plots.new_figure(1, 3, panel_size=(4.6, 3.6),
+    fig, axes = plots.new_figure(1, 4, panel_size=(4.2, 3.6),
                                  title="79 kHz wear continued (paper beam, 7 harmonics)")
     axes = axes[0]
     for ax, key in zip(axes[:2], KEYS, strict=True):
@@ -122,6 +122,14 @@ def plot(workdir: Path, model) -> Path:
         ax.set_title(key, fontsize=9)
         ax.legend(fontsize=7)
     ax = axes[2]
+    for key in KEYS:
+        h = history(workdir / key)
+        if h is not None:
+            ax.plot(h["cycles"], h["worn_volume"], label=key)
+    ax.set_xlabel("cycles N")
+    ax.set_ylabel("worn volume [m^3]")
+    ax.legend(fontsize=7)
+    ax = axes[3]
     for key in KEYS:
         h = history(workdir / key)
         if h is not None:
