@@ -49,45 +49,41 @@ def run(key: str, workdir: Path, max_cycles: float, seed: Path | None) -> None:
     from fretwear.runner import run_case
 
     folder = workdir / key
-    if seed is not None and not (folder / "wear-checkpoint.npz").is_file():
-        src = seed / key
-        if (src / "wear-checkpoint.npz").is_file():
-            folder.mkdir(parents=True, exist_ok=True)
-            shutil.copy2(src / "wear-checkpoint.npz", folder / "wear-checkpoint.npz")
     folder.mkdir(parents=True, exist_ok=True)
+    ck, src = folder / "wear-checkpoint.npz", None if seed is None else seed / key
+    if src is not None and not ck.is_file() and (src / ck.name).is_file():
+        shutil.copy2(src / ck.name, ck)
     path = folder / "case.toml"
     path.write_text(case_text(key, max_cycles), encoding="utf-8")
     out = run_case(path, folder, progress=sys.stderr.isatty(), resume=True, echo=False)
     print(f"{key}: {out.summary.splitlines()[0] if out.summary else ''}")
 
 
-def history(folder: Path) -> dict | None:
-    import numpy as np
+def history(folder: Path):
+    """The run's :class:`fretwear.wear.WearHistory` from its checkpoint, or None."""
+    from fretwear.wear import read_history
 
     ck = folder / "wear-checkpoint.npz"
-    if not ck.is_file():
-        return None
-    with np.load(ck, allow_pickle=False) as z:
-        return {k[5:]: z[k] for k in z.files if k.startswith("hist_")}
+    return read_history(ck) if ck.is_file() else None
 
 
-def facts(h: dict, x, area) -> dict:
+def facts(h, x, area) -> dict:
     """What the last step says about a plateau (see module docstring)."""
     import numpy as np
 
-    p, path = h["pressure_mean"][-1], h["slip_path"][-1]
+    p, path = h.pressure_mean[-1], h.slip_path[-1]
     pbar = float(np.dot(area, p) / area.sum())
     stuck = path <= 1e-3 * path.max()
     pillars = np.flatnonzero(stuck & (p > 2.0 * pbar))
     load = np.dot(area, p)
     centroid = float(np.dot(area * p, x) / load)
-    P = h["pressure_mean"]
+    P = h.pressure_mean
     centroids = (P * area) @ x / (P @ area)
-    vr = h["volume_rate"] / h["volume_rate"][0]
-    late = h["cycles"] >= 2e8
+    vr = h.volume_rate / h.volume_rate[0]
+    late = h.cycles >= 2e8
     return {
-        "cycles": float(h["cycles"][-1]), "steps": len(h["cycles"]) - 1,
-        "wall": float(np.sum(h["wall_time"])), "rate": float(vr[-1]),
+        "cycles": float(h.cycles[-1]), "steps": len(h.cycles) - 1,
+        "wall": float(np.sum(h.wall_time)), "rate": float(vr[-1]),
         "rate_range": (float(vr[late].min()), float(vr[late].max())) if late.any() else None,
         "pillars_mm": [round(1e3 * float(x[i]), 1) for i in pillars],
         "pillar_load": float(np.dot(area[pillars], p[pillars]) / load),
@@ -95,7 +91,7 @@ def facts(h: dict, x, area) -> dict:
         "centroid_mm": 1e3 * centroid,
         "centroid_dev_um": 1e6 * float(np.max(np.abs(centroids - 0.5 * (x.min() + x.max())))),
         "straddle": bool(pillars.size and x[pillars].min() <= centroid <= x[pillars].max()),
-        "max_depth_nm": 1e9 * float(h["wear_depth"][-1].max()),
+        "max_depth_nm": 1e9 * float(h.wear_depth[-1].max()),
     }
 
 
@@ -112,11 +108,11 @@ def plot(workdir: Path, model) -> Path:
         h = history(workdir / key)
         if h is None:
             continue
-        n = h["cycles"]
+        n = h.cycles
         picks = [int(np.argmin(abs(n - t))) for t in (2e8, 5e8, 1e9, 2e9, 5e9, 1e10)
                  if t < 0.9 * n[-1]] + [len(n) - 1]
         for k in picks:
-            ax.plot(x, 1e9 * h["wear_depth"][k], label=f"N = {n[k]:.3g}")
+            ax.plot(x, 1e9 * h.wear_depth[k], label=f"N = {n[k]:.3g}")
         ax.set_xlabel("x [mm]")
         ax.set_ylabel("wear depth [nm]")
         ax.set_title(key, fontsize=9)
@@ -125,7 +121,7 @@ def plot(workdir: Path, model) -> Path:
     for key in KEYS:
         h = history(workdir / key)
         if h is not None:
-            ax.plot(h["cycles"], h["worn_volume"], label=key)
+            ax.plot(h.cycles, h.worn_volume, label=key)
     ax.set_xlabel("cycles N")
     ax.set_ylabel("worn volume [m^3]")
     ax.legend(fontsize=7)
@@ -133,7 +129,7 @@ def plot(workdir: Path, model) -> Path:
     for key in KEYS:
         h = history(workdir / key)
         if h is not None:
-            ax.semilogy(h["cycles"], h["volume_rate"] / h["volume_rate"][0], ".", ms=2,
+            ax.semilogy(h.cycles, h.volume_rate / h.volume_rate[0], ".", ms=2,
                         label=key)
     ax.axhline(1e-3, color="k", lw=0.8, ls="--", label="plateau test (1e-3)")
     ax.set_xlabel("cycles N")

@@ -39,6 +39,7 @@ from fretwear.reduce import condense
 from fretwear.wear import (
     SlowProblem,
     WearOptions,
+    read_history,
     simulate_wear,
     solve_identity_rows,
     wear_coefficients,
@@ -427,6 +428,10 @@ def test_resume_extends_a_finished_run(blk, tmp_path):
     n = a.history.n_steps
     assert b.resumed_from == n - 1 and b.history.cycles[-1] == pytest.approx(6e5)
     np.testing.assert_array_equal(b.history.wear_depth[:n], a.history.wear_depth)
+    # the checkpoint's history, read without the case's fingerprint, is the run's history
+    h = read_history(ck)
+    for name in ("cycles", "wear_depth", "pressure_mean", "volume_rate", "wall_time"):
+        np.testing.assert_array_equal(getattr(h, name), getattr(b.history, name))
 
 
 def test_resume_refuses_other_settings(blk, tmp_path):

@@ -618,14 +618,8 @@ def save_checkpoint(path: Path | str, state: dict, rows: list[dict], key: str) -
     return atomic_write(path, write)
 
 
-def load_checkpoint(path: Path | str, key: str) -> tuple[dict, list[dict]]:
-    """Read a checkpoint written by :func:`save_checkpoint` for the same trajectory ``key``.
-
-    Raises
-    ------
-    InputError
-        The file is unreadable, of another version, or written for a different case.
-    """
+def _read_checkpoint(path: Path | str) -> dict:
+    """The arrays of a checkpoint of this format version (:func:`save_checkpoint`)."""
     try:
         with np.load(path, allow_pickle=False) as z:
             data = {k: z[k] for k in z.files}
@@ -634,6 +628,25 @@ def load_checkpoint(path: Path | str, key: str) -> tuple[dict, list[dict]]:
     if int(data.get("version", -1)) != CHECKPOINT_VERSION:
         raise InputError(f"wear checkpoint {str(path)!r} has another format version; delete it "
                          "to start again")
+    return data
+
+
+def read_history(path: Path | str) -> WearHistory:
+    """The wear history stored in a checkpoint, whatever case wrote it (to look at a run that
+    is going on or was interrupted; :func:`load_checkpoint` to resume one)."""
+    data = _read_checkpoint(path)
+    return WearHistory(**{k: data[f"hist_{k}"] for k in HISTORY_FIELDS})
+
+
+def load_checkpoint(path: Path | str, key: str) -> tuple[dict, list[dict]]:
+    """Read a checkpoint written by :func:`save_checkpoint` for the same trajectory ``key``.
+
+    Raises
+    ------
+    InputError
+        The file is unreadable, of another version, or written for a different case.
+    """
+    data = _read_checkpoint(path)
     if str(data["fingerprint"]) != key:
         raise InputError(f"wear checkpoint {str(path)!r} was written for a different model or "
                          "different wear settings; delete it (or run without --resume) to start "
@@ -1265,6 +1278,7 @@ def frf_worn(model: Model, wear, frequencies_hz, basis: FourierBasis, *, anchor=
 
 __all__ = [
     "HISTORY_FIELDS", "LAWS", "SCHEMES", "STOP_REASONS", "SlowProblem", "WearHistory",
-    "WearOptions", "WearResult", "frf_worn", "load_checkpoint", "save_checkpoint",
+    "WearOptions", "WearResult", "frf_worn", "load_checkpoint", "read_history",
+    "save_checkpoint",
     "simulate_wear", "wear_coefficients", "wear_per_cycle", "without_growth", "worn_volume",
 ]
