@@ -796,7 +796,8 @@ class _Report:
               "(`benchmarks/wear_79khz_long.py`, docs/wear.md, open problem 1: hours of "
               "computing, so not part of this reproduction), the adaptive 79 kHz run reaches "
               "a plateau at 1.03e10 cycles on two sticking pillars; the paper's explicit "
-              "scheme does not by 1e10."]
+              "scheme does not by 1e10; the adaptive run started from scratch follows "
+              "another path and had not by 1.3e10 (the path is sensitive)."]
         return "\n".join(s) + self.image(img, "Fig. 23, 25") + "\n"
 
     # Fig. 24
