@@ -95,7 +95,8 @@ def facts(h, x, area) -> dict:
     }
 
 
-def plot(workdir: Path, model) -> Path:
+def plot(histories: dict, model) -> Path:
+    """The figure from the runs' histories (``{key: WearHistory or None}``)."""
     import numpy as np
 
     from fretwear import plots
@@ -105,7 +106,7 @@ def plot(workdir: Path, model) -> Path:
                                  title="79 kHz wear continued (paper beam, 7 harmonics)")
     axes = axes[0]
     for ax, key in zip(axes[:2], KEYS, strict=True):
-        h = history(workdir / key)
+        h = histories.get(key)
         if h is None:
             continue
         n = h.cycles
@@ -119,7 +120,7 @@ def plot(workdir: Path, model) -> Path:
         ax.legend(fontsize=7)
     ax = axes[2]
     for key in KEYS:
-        h = history(workdir / key)
+        h = histories.get(key)
         if h is not None:
             ax.plot(h.cycles, h.worn_volume, label=key)
     ax.set_xlabel("cycles N")
@@ -127,7 +128,7 @@ def plot(workdir: Path, model) -> Path:
     ax.legend(fontsize=7)
     ax = axes[3]
     for key in KEYS:
-        h = history(workdir / key)
+        h = histories.get(key)
         if h is not None:
             ax.semilogy(h.cycles, h.volume_rate / h.volume_rate[0], ".", ms=2,
                         label=key)
@@ -163,8 +164,8 @@ def main(argv=None) -> int:
         for key in keys:
             run(key, a.workdir, a.max_cycles, a.seed)
     model = None
-    for key in KEYS:
-        h = history(a.workdir / key)
+    histories = {key: history(a.workdir / key) for key in KEYS}  # each checkpoint read once
+    for key, h in histories.items():
         if h is None:
             print(f"{key}: no checkpoint in {a.workdir / key}")
             continue
@@ -185,7 +186,7 @@ def main(argv=None) -> int:
               f"{f['centroid_dev_um']:.2g} um); pillars "
               f"{'straddle' if f['straddle'] else 'do not straddle'} it")
     if model is not None:
-        print(f"figure: {plot(a.workdir, model)}")
+        print(f"figure: {plot(histories, model)}")
     return 0
 
 
