@@ -797,7 +797,8 @@ class _Report:
               "computing, so not part of this reproduction), the adaptive 79 kHz run reaches "
               "a plateau at 1.03e10 cycles on two sticking pillars; the paper's explicit "
               "scheme does not by 1e10; the adaptive run started from scratch follows "
-              "another path and had not by 1.3e10 (the path is sensitive)."]
+              "another path and had not by 2.28e10 (the path is chaotic: twin runs 1e-12 "
+              "apart separate, docs/wear.md)."]
         return "\n".join(s) + self.image(img, "Fig. 23, 25") + "\n"
 
     # Fig. 24

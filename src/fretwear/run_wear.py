@@ -87,7 +87,7 @@ def wear_dataset(model, result: WearResult, basis: FourierBasis, *, frequency_hz
         "cycles", "jump", "wear_depth", "wear_rate", "pressure_mean", "pressure_max",
         "slip_amplitude", "slip_path", "state_fraction", "friction_energy", "worn_volume",
         "volume_rate", "newton_iterations", "rejected", "error_estimate", "wall_time", "U",
-        "lam", "rescued", "response")}
+        "lam", "rescued", "response", "rate_scatter")}
     cpos = np.asarray(c.coords, float).reshape(nc, -1)[:, :d]
     data = {
         "contact_position": variable(("contact_node", "axis"), cpos, "m",
@@ -127,6 +127,10 @@ def wear_dataset(model, result: WearResult, basis: FourierBasis, *, frequency_hz
         "error_estimate": variable(sc, hist["error_estimate"], "1",
                                    "local error estimate relative to the maximum wear depth"),
         "step_wall_time": variable(sc, hist["wall_time"], "s", "wall time of the step"),
+        "rate_scatter": variable(sc, hist["rate_scatter"], "1",
+                                 "time-averaged steps: |v1 - v2| / (v1 + v2) of the worn-volume "
+                                 "rates of the two halves of the averaging window (relative "
+                                 "standard error of the rate); NaN on balanced steps"),
         "time_domain_start": variable(sc, hist["rescued"].astype(np.int8), "1",
                                       "0: balanced step; 1: balance started from a time "
                                       "integration; 2: wear rate averaged over a time "

@@ -485,6 +485,9 @@ HISTORY_FIELDS = {
                 "from a time integration; 2: wear rate averaged over a time integration"),
     "response": ("1", "kind of the step's time-integrated response (index in "
                  "fretwear.wear_time.RESPONSE_KINDS), -1 when none was integrated"),
+    "rate_scatter": ("1", "steps with time-averaged rates: |v1 - v2| / (v1 + v2), v1, v2 the "
+                     "worn-volume rates of the two halves of the averaging window (relative "
+                     "standard error of the rate); NaN on balanced steps (exact periodic rate)"),
 }
 
 
@@ -520,6 +523,7 @@ class WearHistory:
     anchor: np.ndarray
     rescued: np.ndarray
     response: np.ndarray
+    rate_scatter: np.ndarray
     stop_reason: str = ""
 
     @classmethod
@@ -580,7 +584,7 @@ def _row(sol: PeriodicSolution, W, g, cycles, jump, iters, rejected, err, wall) 
         "volume_rate": float(np.dot(area, g)), "newton_iterations": int(iters),
         "rejected": int(rejected), "error_estimate": float(err), "wall_time": float(wall),
         "U": sol.U.copy(), "lam": sol.lam.copy(), "anchor": np.array(sol.anchor, float),
-        "rescued": 0, "response": -1,
+        "rescued": 0, "response": -1, "rate_scatter": math.nan,
     }
 
 
@@ -631,11 +635,18 @@ def _read_checkpoint(path: Path | str) -> dict:
     return data
 
 
+def _history(data) -> WearHistory:
+    """The history arrays of a checkpoint. Checkpoints written before ``rate_scatter`` was
+    recorded lack it: NaN (not measured) for every step."""
+    n = len(data["hist_cycles"])
+    return WearHistory(**{k: data[f"hist_{k}"] if f"hist_{k}" in data
+                          else np.full(n, np.nan) for k in HISTORY_FIELDS})
+
+
 def read_history(path: Path | str) -> WearHistory:
     """The wear history stored in a checkpoint, whatever case wrote it (to look at a run that
     is going on or was interrupted; :func:`load_checkpoint` to resume one)."""
-    data = _read_checkpoint(path)
-    return WearHistory(**{k: data[f"hist_{k}"] for k in HISTORY_FIELDS})
+    return _history(_read_checkpoint(path))
 
 
 def load_checkpoint(path: Path | str, key: str) -> tuple[dict, list[dict]]:
@@ -652,8 +663,7 @@ def load_checkpoint(path: Path | str, key: str) -> tuple[dict, list[dict]]:
                          "different wear settings; delete it (or run without --resume) to start "
                          "again")
     state = {k[6:]: data[k] for k in data if k.startswith("state_")}
-    hist = WearHistory(**{k: data[f"hist_{k}"] for k in HISTORY_FIELDS})
-    return state, hist.rows()
+    return state, _history(data).rows()
 
 
 # --------------------------------------------------------------------------------------------
@@ -1201,6 +1211,7 @@ def _time_row(tr, area, W, cycles, jump, iters, rejected, err, wall) -> dict:
         "newton_iterations": int(iters), "rejected": int(rejected), "error_estimate": float(err),
         "wall_time": float(wall), "U": tr.U, "lam": tr.lam,
         "anchor": np.array(tr.anchor, float), "rescued": 2, "response": tr.kind_code,
+        "rate_scatter": float(tr.scatter),
     }
 
 

@@ -59,6 +59,9 @@ class TimeAveragedRate:
         order : repetition period in forcing periods (periodic 1, subharmonic p, else 0).
     U_end, V_end : (ndof,) full-field displacement [m] and velocity [m/s] at the end, to
         continue the integration exactly.
+    scatter : statistical uncertainty of the averaged worn-volume rate: ``|v1 - v2| / (v1 +
+        v2)`` with ``v1, v2`` the worn-volume rates averaged over the two halves of the window
+        (half their difference is the standard error of their mean); 0 when nothing wears.
     periods : periods integrated; wall_time : [s].
     """
 
@@ -80,6 +83,7 @@ class TimeAveragedRate:
     V_end: np.ndarray
     periods: int
     wall_time: float
+    scatter: float = 0.0
 
     @property
     def kind_code(self) -> int:
@@ -132,8 +136,13 @@ def time_averaged_rate(model: Model, omega: float, basis: FourierBasis, coef, we
     nc, d, ns = x.shape
     cycles = (ns - 1) / nsteps  # steps whose slip is counted, in periods
     inc = law.slip_increments(x, s)  # (nc, ns), zero unless slip; column 0 marked stick
-    S = (f[:, 0, :] * inc).sum(axis=1) / cycles
+    work = f[:, 0, :] * inc  # slip work of each step ending at column j
+    S = work.sum(axis=1) / cycles
     area = np.asarray(model.contact.area, float)
+    mid = ns // 2  # columns 1..mid-1 and mid..ns-1: the steps of each half of the window
+    v = [float(np.dot(area, np.asarray(coef, float) * work[:, cols].sum(axis=1) / (n / nsteps)))
+         for cols, n in ((slice(1, mid), mid - 1), (slice(mid, ns), ns - mid))]
+    scatter = abs(v[0] - v[1]) / (v[0] + v[1]) if v[0] + v[1] > 0 else 0.0
     p = f[:, 0, :] / area[:, None]
     xt = x[:, 1:, :]
     half = 0.5 * (xt.max(axis=2) - xt.min(axis=2))
@@ -156,5 +165,5 @@ def time_averaged_rate(model: Model, omega: float, basis: FourierBasis, coef, we
         friction_energy=law.friction_work(f, x, s) / cycles, U=U, lam=lam_h,
         anchor=U[:, 1:, 0].copy(), kind=c.kind, rotation=float(c.rotation), order=int(c.order),
         U_end=r.U, V_end=r.V, periods=int(settle) + average,
-        wall_time=time.perf_counter() - t0)
+        wall_time=time.perf_counter() - t0, scatter=float(scatter))
 
