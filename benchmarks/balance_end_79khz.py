@@ -29,6 +29,7 @@ Usage::
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import sys
 import tempfile
@@ -92,8 +93,8 @@ def main(argv=None) -> int:
     from fretwear.wear import SlowProblem, read_history, wear_coefficients
     from fretwear.wear_time import time_averaged_rate
 
-    with tempfile.TemporaryDirectory() as tmp:
-        workdir = args.workdir or Path(tmp)
+    with contextlib.ExitStack() as stack:
+        workdir = args.workdir or Path(stack.enter_context(tempfile.TemporaryDirectory()))
         t0 = time.perf_counter()
         folder = run_to_failure(workdir, args.max_cycles)
         print(f"run to N = {args.max_cycles:.3g}: {time.perf_counter() - t0:.1f} s")

@@ -37,6 +37,7 @@ Usage::
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import shutil
 import sys
@@ -93,10 +94,10 @@ def fast_twins(folder: Path, periods: int) -> None:
     from fretwear.case import build_model, load_case
     from fretwear.fourier import FourierBasis
     from fretwear.wear import wear_coefficients
-    from fretwear.wear_time import time_averaged_rate
+    from fretwear.wear_time import default_steps, time_averaged_rate
 
-    data = np.load(folder / "wear-checkpoint.npz")
-    U0, V0, W = data["state_td_U"], data["state_td_V"], data["state_W"]
+    with np.load(folder / "wear-checkpoint.npz") as z:
+        U0, V0, W = z["state_td_U"], z["state_td_V"], z["state_W"]
     if U0.size == 0:
         print("the last step is a balanced one: no time-integration state to start from")
         return
@@ -105,7 +106,7 @@ def fast_twins(folder: Path, periods: int) -> None:
     a = case.analysis
     omega = 2.0 * np.pi * float(a["frequency"])
     basis = FourierBasis.up_to(int(a["harmonics"]), int(a["n_samples"]))
-    steps = max(128, 8 * max(basis.harmonics))
+    steps = default_steps(basis, a.get("time_domain_steps"))
     t0 = time.perf_counter()
     xa, ptp = period_starts(model, omega, U0, V0, W, periods, steps)
     xb, _ = period_starts(model, omega, U0, V0 * (1 + PERTURBATION), W, periods, steps)
@@ -142,7 +143,8 @@ def slow_twins(folder: Path, workdir: Path, steps: int) -> None:
     from fretwear.runner import run_case
     from fretwear.wear import read_history
 
-    data = dict(np.load(folder / "wear-checkpoint.npz"))
+    with np.load(folder / "wear-checkpoint.npz") as z:
+        data = {k: z[k] for k in z.files}
     step0, N0 = int(data["state_step"]), float(data["state_cycles"])
     text = edit_case_text((folder / "case.toml").read_text(encoding="utf-8"), "analysis",
                           {"max_cycles": 1e12, "max_steps": step0 + int(steps)})
@@ -189,8 +191,8 @@ def main(argv=None) -> int:
     ap.add_argument("--steps", type=int, default=40)
     args = ap.parse_args(argv)
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-    with tempfile.TemporaryDirectory() as tmp:
-        workdir = args.workdir or Path(tmp)
+    with contextlib.ExitStack() as stack:
+        workdir = args.workdir or Path(stack.enter_context(tempfile.TemporaryDirectory()))
         if args.source is not None:
             folder = args.source
         else:

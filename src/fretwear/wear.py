@@ -635,12 +635,17 @@ def _read_checkpoint(path: Path | str) -> dict:
     return data
 
 
+#: history fields added within the current checkpoint format: NaN (not measured) when absent
+LATE_HISTORY_FIELDS = ("rate_scatter",)
+
+
 def _history(data) -> WearHistory:
-    """The history arrays of a checkpoint. Checkpoints written before ``rate_scatter`` was
-    recorded lack it: NaN (not measured) for every step."""
+    """The history arrays of a checkpoint (:data:`LATE_HISTORY_FIELDS` filled with NaN in
+    checkpoints written before they were recorded)."""
     n = len(data["hist_cycles"])
-    return WearHistory(**{k: data[f"hist_{k}"] if f"hist_{k}" in data
-                          else np.full(n, np.nan) for k in HISTORY_FIELDS})
+    late = {k: np.full(n, np.nan) for k in LATE_HISTORY_FIELDS if f"hist_{k}" not in data}
+    return WearHistory(**{k: late[k] if k in late else data[f"hist_{k}"]
+                          for k in HISTORY_FIELDS})
 
 
 def read_history(path: Path | str) -> WearHistory:
@@ -1290,6 +1295,6 @@ def frf_worn(model: Model, wear, frequencies_hz, basis: FourierBasis, *, anchor=
 __all__ = [
     "HISTORY_FIELDS", "LAWS", "SCHEMES", "STOP_REASONS", "SlowProblem", "WearHistory",
     "WearOptions", "WearResult", "frf_worn", "load_checkpoint", "read_history",
-    "save_checkpoint",
-    "simulate_wear", "wear_coefficients", "wear_per_cycle", "without_growth", "worn_volume",
+    "save_checkpoint", "simulate_wear", "wear_coefficients", "wear_per_cycle", "without_growth",
+    "worn_volume",
 ]

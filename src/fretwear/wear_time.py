@@ -83,11 +83,19 @@ class TimeAveragedRate:
     V_end: np.ndarray
     periods: int
     wall_time: float
-    scatter: float = 0.0
+    scatter: float
 
     @property
     def kind_code(self) -> int:
         return RESPONSE_KINDS.index(self.kind)
+
+
+def default_steps(basis: FourierBasis, steps: int | None = None) -> int:
+    """Time steps per period of a time-averaged rate: ``steps``, or by default
+    ``max(128, 8 x`` the highest harmonic of ``basis``) (8 steps per period of the highest
+    harmonic the balance resolves)."""
+    hmax = max(basis.harmonics) if basis.harmonics else 1
+    return int(steps or max(128, 8 * hmax))
 
 
 def window_samples(u_loc, lam, state):
@@ -121,14 +129,14 @@ def time_averaged_rate(model: Model, omega: float, basis: FourierBasis, coef, we
     wear : (nc,) wear depth [m] (opens the normal gap).
     U0, V0 : (ndof,) start state [m], [m/s].
     settle : periods integrated before averaging; average : periods averaged (>= 2).
-    steps_per_period : time steps per period (default ``max(128, 8 x`` the highest harmonic)).
+    steps_per_period : time steps per period (default: :func:`default_steps`).
     classify_tol : relative periodicity tolerance of the response classification.
     """
     from fretwear.transient import classify_sequence, fourier_coefficients, integrate
 
     t0 = time.perf_counter()
     hmax = max(basis.harmonics) if basis.harmonics else 1
-    nsteps = int(steps_per_period or max(128, 8 * hmax))
+    nsteps = default_steps(basis, steps_per_period)
     average = max(int(average), 2)
     r = integrate(model, omega, n_periods=int(settle) + average, steps_per_period=nsteps,
                   record=average, U0=U0, V0=V0, wear=wear)
@@ -139,8 +147,9 @@ def time_averaged_rate(model: Model, omega: float, basis: FourierBasis, coef, we
     work = f[:, 0, :] * inc  # slip work of each step ending at column j
     S = work.sum(axis=1) / cycles
     area = np.asarray(model.contact.area, float)
+    c_area = area * np.asarray(coef, float)  # worn volume per unit slip work
     mid = ns // 2  # columns 1..mid-1 and mid..ns-1: the steps of each half of the window
-    v = [float(np.dot(area, np.asarray(coef, float) * work[:, cols].sum(axis=1) / (n / nsteps)))
+    v = [float(c_area @ work[:, cols].sum(axis=1)) * nsteps / n
          for cols, n in ((slice(1, mid), mid - 1), (slice(mid, ns), ns - mid))]
     scatter = abs(v[0] - v[1]) / (v[0] + v[1]) if v[0] + v[1] > 0 else 0.0
     p = f[:, 0, :] / area[:, None]
