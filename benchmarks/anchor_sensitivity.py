@@ -17,9 +17,9 @@ import sys
 import numpy as np
 
 from fretwear.examples.builders import paper_beam
-from fretwear.fourier import FourierBasis
-from fretwear.hbm import solve_periodic, static_anchor
-from fretwear.reduce import condense
+from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.periodic import solve_periodic, static_anchor
+from fretwear.hb.reduce import condense
 
 
 def describe(sol):

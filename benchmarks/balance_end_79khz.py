@@ -2,7 +2,8 @@
 
 The 79 kHz wear run of the paper's beam (example ``salles2011-79khz``) keeps its DLFT balance for
 17 slow steps; the step from N = 1.075e7 cycles fails and the run goes on with time-averaged
-rates (:func:`fretwear.wear._time_domain_step`) that cost 3-5 s each instead of ~0.1 s. This
+rates (:func:`fretwear.wear.simulate._time_domain_step`) that cost 3-5 s each instead of ~0.1 s.
+This
 script finds out whether the balance is lost because the solver needs smaller steps, because its
 tolerance sits at the round-off floor, because of the discretisation (samples, harmonics), or
 because the periodic branch ends:
@@ -41,8 +42,8 @@ KEY = "wear-79khz"
 
 def run_to_failure(workdir: Path, max_cycles: float) -> Path:
     """The reproduction's 79 kHz case run (or resumed) to ``max_cycles``; its folder."""
-    from fretwear.reproduce import RUNS, edit_case_text, run_case_text
-    from fretwear.runner import run_case
+    from fretwear.analyses.run import run_case
+    from fretwear.paper.catalogue import RUNS, edit_case_text, run_case_text
 
     folder = workdir / KEY
     folder.mkdir(parents=True, exist_ok=True)
@@ -85,13 +86,14 @@ def main(argv=None) -> int:
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     import numpy as np
 
-    from fretwear.case import build_model, load_case
-    from fretwear.fourier import FourierBasis
-    from fretwear.reduce import condense
-    from fretwear.solvers import SolveStats
-    from fretwear.stability import initial_state
-    from fretwear.wear import SlowProblem, read_history, wear_coefficients
-    from fretwear.wear_time import time_averaged_rate
+    from fretwear.analyses.run import load_case
+    from fretwear.hb.fourier import FourierBasis
+    from fretwear.hb.periodic import initial_state
+    from fretwear.hb.reduce import condense
+    from fretwear.hb.solvers import SolveStats
+    from fretwear.io.case import build_model
+    from fretwear.timedomain.averaged_rate import time_averaged_rate
+    from fretwear.wear.simulate import SlowProblem, read_history, wear_coefficients
 
     with contextlib.ExitStack() as stack:
         workdir = args.workdir or Path(stack.enter_context(tempfile.TemporaryDirectory()))

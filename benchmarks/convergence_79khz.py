@@ -17,11 +17,12 @@ section 3.2). Each variant changes one setting:
 For each variant:
 
 1. the unworn periodic response (Powell, relative residual 1e-9, 200 iterations: the
-   settings of the first solve of :func:`fretwear.wear.simulate_wear`). When that fails, the
+   settings of the first solve of :func:`fretwear.wear.simulate.simulate_wear`). When that fails,
+   the
    solve is retried from the baseline's 7-harmonic solution (same mesh only) with 400
    iterations, then with Newton; every attempt is reported. Reported: harmonic-1 amplitude
    of u_x at P_e, stops of P_e per period (``PeriodicSolution.stops_per_period``, |v| below 5 %
-   of its peak as in ``fretwear.run_dlft``), friction energy per cycle, contact-state
+   of its peak as in ``fretwear.analyses.periodic``), friction energy per cycle, contact-state
    fractions (node-instants), iterations, wall time;
 2. the wear (default adaptive scheme, tolerance 1e-2) to a common ``N = 5e6`` cycles
    (``max_cycles``, ``plateau_rate = 0``), below the known failure near 1.02e7 cycles
@@ -123,7 +124,7 @@ def load_cache():
 
 
 def save_cache(data, arrays):
-    from fretwear.results import atomic_write
+    from fretwear.files import atomic_write
 
     FIG_DIR.mkdir(parents=True, exist_ok=True)
 
@@ -177,7 +178,7 @@ class Study:
 
     def model(self, nx):
         from fretwear.examples.builders import paper_beam
-        from fretwear.hbm import static_anchor
+        from fretwear.hb.periodic import static_anchor
 
         if nx not in self.models:
             self.models[nx] = paper_beam(nx=nx, ny=4)
@@ -185,7 +186,7 @@ class Study:
         return self.models[nx], self.anchors[nx]
 
     def condensed(self, nx, basis):
-        from fretwear.reduce import condense
+        from fretwear.hb.reduce import condense
 
         key = (nx, tuple(basis.orders))
         if key not in self.reduced:
@@ -194,7 +195,7 @@ class Study:
         return self.reduced[key]
 
     def baseline_eps(self):
-        from fretwear.fourier import FourierBasis
+        from fretwear.hb.fourier import FourierBasis
 
         if self.base_eps is None:
             b = FourierBasis.up_to(BASE["nh"], BASE["ns"])
@@ -202,7 +203,7 @@ class Study:
         return self.base_eps
 
     def penalty(self, v, red):
-        from fretwear.reduce import condense
+        from fretwear.hb.reduce import condense
 
         rule, factor = v["eps"]
         if rule == "auto":
@@ -227,7 +228,7 @@ class Study:
     def embedded_base(self, basis, model):
         """The baseline's 7-harmonic unworn solution in ``basis`` (higher harmonics 0), on
         the contact nodes of ``model`` (linear interpolation along x for another mesh)."""
-        from fretwear.fourier import FourierBasis
+        from fretwear.hb.fourier import FourierBasis
 
         b7 = FourierBasis.up_to(BASE["nh"], BASE["ns"])
         U7 = self.base_U  # (nc, d, H)
@@ -249,8 +250,8 @@ class Study:
     # -- stage 1 ------------------------------------------------------------------------
     def unworn(self, v):
         """Unworn periodic solve; returns (record, solution or None, eps)."""
-        from fretwear.fourier import FourierBasis
-        from fretwear.hbm import solve_periodic
+        from fretwear.hb.fourier import FourierBasis
+        from fretwear.hb.periodic import solve_periodic
 
         model, anchor = self.model(v["nx"])
         basis = FourierBasis.up_to(v["nh"], v["ns"])
@@ -302,8 +303,8 @@ class Study:
     # -- stage 2 and 3 ------------------------------------------------------------------
     def wear(self, v, sol, eps, *, max_cycles, plateau_rate, cap_s, suffix=""):
         """Wear run (resumed from the variant's checkpoint when there is one)."""
-        from fretwear.fourier import FourierBasis
-        from fretwear.wear import WearOptions, simulate_wear
+        from fretwear.hb.fourier import FourierBasis
+        from fretwear.wear.simulate import WearOptions, simulate_wear
 
         model, anchor = self.model(v["nx"])
         basis = FourierBasis.up_to(v["nh"], v["ns"])
@@ -347,7 +348,7 @@ class Study:
 
 def zero_zones(x, W, frac=ZERO_FRACTION):
     """Intervals [x_first, x_last] of consecutive nodes with W <= frac max W."""
-    from fretwear.wear import zero_wear_zones
+    from fretwear.wear.simulate import zero_wear_zones
 
     return zero_wear_zones(x, W, frac)
 
@@ -534,7 +535,7 @@ def table(data):
 
 
 def figures(data, arrays):
-    from fretwear import plots
+    from fretwear.analyses import figures as plots
 
     members = {f: ["base"] + [v["key"] for v in VARIANTS if v["family"] == f] for f in FAMILIES}
     labels = {v["key"]: v["label"] for v in VARIANTS}

@@ -23,10 +23,11 @@ import numpy as np
 import scipy.linalg as sla
 
 from fretwear.examples.builders import paper_beam
-from fretwear.fourier import FourierBasis
-from fretwear.hbm import DLFTProblem, solve_periodic
-from fretwear.reduce import condense
-from fretwear.sweep import sweep
+from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.periodic import DLFTProblem, solve_periodic
+from fretwear.hb.reduce import condense
+from fretwear.hb.sweep import sweep
+from fretwear.timedomain.fallback import FALLBACK
 
 
 def _best(fn, repeat):
@@ -52,7 +53,7 @@ def main():
 
     # JIT warm-up: first call of the kernels on a tiny problem
     t0 = time.perf_counter()
-    from fretwear import contact as law
+    from fretwear.hb import contact as law
 
     lu = np.random.default_rng(0).normal(size=(2, 2, 8))
     lx, st, _ = law.dlft_time(lu, np.full(2, 0.3), np.zeros((2, 1)), 1e-12, 10)
@@ -98,7 +99,7 @@ def main():
 
     if not args.quick:
         t0 = time.perf_counter()
-        res = sweep(model, basis, 1.0, 1e5, args.points, time_domain=True)
+        res = sweep(model, basis, 1.0, 1e5, args.points, time_domain=FALLBACK)
         t_sweep = time.perf_counter() - t0
         print(f"sweep_{args.points}pts_s={t_sweep:.1f} (computed points incl. substeps: "
               f"{len(res.points)})")

@@ -1,6 +1,6 @@
 """Time the full set of the paper's examples (``fretwear reproduce``), run by run.
 
-Runs every run of :data:`fretwear.reproduce.RUNS` and the two extra computations into a fresh
+Runs every run of :data:`fretwear.paper.runs.RUNS` and the two extra computations into a fresh
 work folder (or ``--work DIR``: finished runs there are read back and not timed again), then
 prints the wall time of each, the total, and each run's time as a ratio to the paper's
 quasi-static wear run (``wear-quasistatic``, the Table 1 reference that the same machine ran
@@ -26,8 +26,8 @@ from pathlib import Path
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
-from fretwear.reproduce import run_all  # noqa: E402 (after the BLAS thread setting)
-from fretwear.reproduce_report import write_report  # noqa: E402
+from fretwear.paper.report import write_report  # noqa: E402
+from fretwear.paper.runs import run_all  # noqa: E402 (after the BLAS thread setting)
 
 
 def main(argv=None) -> int:

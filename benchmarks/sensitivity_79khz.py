@@ -57,7 +57,7 @@ def period_starts(model, omega, U0, V0, wear, periods, steps):
     contact motion over the last chunk [m]."""
     import numpy as np
 
-    from fretwear.transient import integrate
+    from fretwear.timedomain.integrate import integrate
 
     out, U, V, ptp = [], U0, V0, 0.0
     done = 0
@@ -91,10 +91,11 @@ def growth_rate(d):
 def fast_twins(folder: Path, periods: int) -> None:
     import numpy as np
 
-    from fretwear.case import build_model, load_case
-    from fretwear.fourier import FourierBasis
-    from fretwear.wear import wear_coefficients
-    from fretwear.wear_time import default_steps, time_averaged_rate
+    from fretwear.analyses.run import load_case
+    from fretwear.hb.fourier import FourierBasis
+    from fretwear.io.case import build_model
+    from fretwear.timedomain.averaged_rate import default_steps, time_averaged_rate
+    from fretwear.wear.simulate import wear_coefficients
 
     with np.load(folder / "wear-checkpoint.npz") as z:
         U0, V0, W = z["state_td_U"], z["state_td_V"], z["state_W"]
@@ -139,9 +140,9 @@ def fast_twins(folder: Path, periods: int) -> None:
 def slow_twins(folder: Path, workdir: Path, steps: int) -> None:
     import numpy as np
 
-    from fretwear.reproduce import edit_case_text
-    from fretwear.runner import run_case
-    from fretwear.wear import read_history
+    from fretwear.analyses.run import run_case
+    from fretwear.paper.catalogue import edit_case_text
+    from fretwear.wear.simulate import read_history
 
     with np.load(folder / "wear-checkpoint.npz") as z:
         data = {k: z[k] for k in z.files}

@@ -12,8 +12,8 @@ through the height, plane strain / plane stress) and, for each variant, records:
 * the unworn periodic solution at 79 kHz (7 harmonics, 128 samples): converged?, Powell
   iterations, harmonic-1 amplitude of u_x(P_e), stops of P_e per period (paper: 4; counted by
   ``PeriodicSolution.stops_per_period`` with the 5 % rule of ``run_dlft``);
-* its time-domain stability (:func:`fretwear.stability.check_periodic`);
-* the wear run (:func:`fretwear.wear.simulate_wear`, adaptive linearly implicit Euler,
+* its time-domain stability (:func:`fretwear.timedomain.stability.check_periodic`);
+* the wear run (:func:`fretwear.wear.simulate.simulate_wear`, adaptive linearly implicit Euler,
   tolerance 1e-2, ``max_cycles`` 1e8 by default): N where the balance first fails (first
   step with ``rescued == 2``), stop reason, N reached, worn volume, max depth, worn-volume rate
   at the end / initial, steps and wall time, zero-wear zones (nodes with wear < 1 % of the
@@ -113,7 +113,7 @@ def load_cache() -> dict:
 
 
 def save_cache(cache: dict) -> None:
-    from fretwear.results import atomic_write
+    from fretwear.files import atomic_write
 
     text = json.dumps(cache, indent=1, default=float)
     atomic_write(CACHE, lambda tmp: tmp.write_text(text))
@@ -136,7 +136,7 @@ def resonances(model) -> dict:
 
 
 def unworn(model, basis) -> tuple[dict, object]:
-    from fretwear.hbm import solve_periodic
+    from fretwear.hb.periodic import solve_periodic
 
     t0 = time.perf_counter()
     sol, st = solve_periodic(model, basis, omega=2 * np.pi * F_HZ)
@@ -152,7 +152,7 @@ def unworn(model, basis) -> tuple[dict, object]:
 
 
 def stability(model, sol) -> dict:
-    from fretwear.stability import check_periodic
+    from fretwear.timedomain.stability import check_periodic
 
     chk = check_periodic(model, sol)
     return {"verdict": chk.verdict, "distance": chk.distance, "periods": chk.periods,
@@ -161,7 +161,7 @@ def stability(model, sol) -> dict:
 
 def zero_zones(x, w, frac=0.01) -> list[list[float]]:
     """x-intervals [m] of consecutive contact nodes whose wear is at most ``frac`` of the max."""
-    from fretwear.wear import zero_wear_zones
+    from fretwear.wear.simulate import zero_wear_zones
 
     return zero_wear_zones(x, w, frac)
 
@@ -169,8 +169,8 @@ def zero_zones(x, w, frac=0.01) -> list[list[float]]:
 def wear_run(name, model, basis, max_cycles, wall_budget, work: Path, fresh: bool) -> dict:
     """The wear run, with a checkpoint; stops (resumably) after ``wall_budget`` seconds."""
     from fretwear.errors import ConvergenceError
-    from fretwear.wear import HISTORY_FIELDS, WearHistory, WearOptions, simulate_wear
-    from fretwear.wear_time import RESPONSE_KINDS
+    from fretwear.timedomain.averaged_rate import RESPONSE_KINDS
+    from fretwear.wear.simulate import HISTORY_FIELDS, WearHistory, WearOptions, simulate_wear
 
     work.mkdir(parents=True, exist_ok=True)
     ckpt = work / f"{name}.npz"
@@ -324,7 +324,7 @@ def main(argv=None) -> int:
         summary(cache)
         plot(cache)
         return 0
-    from fretwear.fourier import FourierBasis
+    from fretwear.hb.fourier import FourierBasis
 
     basis = FourierBasis.up_to(7, 128)
     for name in args.variants.split(","):

@@ -39,14 +39,14 @@ FIGURE = Path(__file__).resolve().parents[1] / "docs" / "figures" / "wear-79khz-
 
 
 def case_text(key: str, max_cycles: float) -> str:
-    from fretwear.reproduce import RUNS, edit_case_text, run_case_text
+    from fretwear.paper.catalogue import RUNS, edit_case_text, run_case_text
 
     run = next(r for r in RUNS if r.key == key)
     return edit_case_text(run_case_text(run, False), "analysis", {"max_cycles": float(max_cycles)})
 
 
 def run(key: str, workdir: Path, max_cycles: float, seed: Path | None) -> None:
-    from fretwear.runner import run_case
+    from fretwear.analyses.run import run_case
 
     folder = workdir / key
     folder.mkdir(parents=True, exist_ok=True)
@@ -60,8 +60,8 @@ def run(key: str, workdir: Path, max_cycles: float, seed: Path | None) -> None:
 
 
 def history(folder: Path):
-    """The run's :class:`fretwear.wear.WearHistory` from its checkpoint, or None."""
-    from fretwear.wear import read_history
+    """The run's :class:`fretwear.wear.simulate.WearHistory` from its checkpoint, or None."""
+    from fretwear.wear.simulate import read_history
 
     ck = folder / "wear-checkpoint.npz"
     return read_history(ck) if ck.is_file() else None
@@ -99,7 +99,7 @@ def plot(histories: dict, model) -> Path:
     """The figure from the runs' histories (``{key: WearHistory or None}``)."""
     import numpy as np
 
-    from fretwear import plots
+    from fretwear.analyses import figures as plots
 
     x = 1e3 * np.asarray(model.contact.coords, float)[:, 0]
     fig, axes = plots.new_figure(1, 4, panel_size=(4.2, 3.6),
@@ -157,7 +157,8 @@ def main(argv=None) -> int:
         os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     import numpy as np
 
-    from fretwear.case import build_model, load_case
+    from fretwear.analyses.run import load_case
+    from fretwear.io.case import build_model
 
     keys = KEYS if a.only is None else (a.only,)
     if not a.plot_only:

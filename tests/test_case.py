@@ -12,8 +12,10 @@ import pytest
 import scipy.io
 import scipy.sparse as sp
 
-from fretwear.case import build_model, case_docs, load_case, validate
+from fretwear.analyses.registry import analysis_tables
+from fretwear.analyses.run import case_docs, load_case
 from fretwear.errors import InputError
+from fretwear.io.case import build_model, validate
 
 BASE = """\
 title = "small beam"
@@ -274,7 +276,7 @@ def test_validate_a_dict():
                               "ny": 1, "nz": 1},
                     "material": {"E": 1.0, "nu": 0.0},
                     "contact": {"boundary": "zmin", "mu": 0.1},
-                    "analysis": {"type": "modes"}})
+                    "analysis": {"type": "modes"}}, analysis_tables())
     assert out["material"]["rho"] == 0.0
     assert out["analysis"] == {"type": "modes", "n_modes": 10, "interfaces": ["sliding", "stuck"]}
     assert out["damping"] == {"loss_factor": 0.0, "rayleigh_mass": 0.0,
@@ -288,7 +290,7 @@ def test_case_files_doc_is_up_to_date():
         encoding="utf-8")
     assert committed == case_docs(), (
         "docs/case-files.md is out of date; regenerate it with\n"
-        "  python -c 'from fretwear.case import write_case_docs; write_case_docs()'"
+        "  python -c 'from fretwear.analyses.run import write_case_docs; write_case_docs()'"
     )
 
 
@@ -347,7 +349,7 @@ f_max = 1e5
 
 
 def test_note_when_an_observed_point_is_not_a_node(tmp_path):
-    from fretwear.case import observed_notes
+    from fretwear.io.case import observed_notes
 
     case = load_case(write(tmp_path, BASE))
     assert observed_notes(case, build_model(case)) == []  # ny = 2: a node at h/2

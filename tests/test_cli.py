@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 from fretwear import __version__, cli
-from fretwear.results import read_results
+from fretwear.io.results import read_results
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "src" / "fretwear" / "examples" / "beam-linear-frf.toml"

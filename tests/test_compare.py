@@ -24,8 +24,9 @@ import pytest
 from test_run_dlft import small_case
 
 from fretwear import cli
-from fretwear.case import build_model, load_case
-from fretwear.compare import compare_periodic
+from fretwear.analyses.compare import compare_periodic
+from fretwear.analyses.run import load_case
+from fretwear.io.case import build_model
 
 PERIODIC = """[analysis]
 type = "periodic"

@@ -1,7 +1,7 @@
 """Validation of the DLFT contact law in time (paper eq. 24-28) and of its Jacobian.
 
-Code under test: :func:`fretwear.contact.dlft_time`, :func:`fretwear.contact.dlft_jacobian`
-and :meth:`fretwear.hbm.DLFTProblem.residual`.
+Code under test: :func:`fretwear.hb.contact.dlft_time`, :func:`fretwear.hb.contact.dlft_jacobian`
+and :meth:`fretwear.hb.periodic.DLFTProblem.residual`.
 
 Independent references used here (none of them calls the code under test):
 
@@ -14,7 +14,7 @@ Independent references used here (none of them calls the code under test):
   cone, which the regular test signals avoid (asserted margins) and where the shakedown
   tests compare corrections, not states;
 * ``trig_matrices``: the real Fourier basis ``[1, cos h tau, sin h tau]`` written with
-  numpy cos/sin (not :mod:`fretwear.fourier`);
+  numpy cos/sin (not :mod:`fretwear.hb.fourier`);
 * central finite differences of the time law / of the residual for the Jacobians;
 * closed forms where the derivative is known by hand (separation: ``G = I``; stick for the
   whole period: ``G = 0``; 2D slip at every instant: ``lambda_x,T = lambda_u,T - mu pN s``).
@@ -29,11 +29,11 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from fretwear import contact as law
-from fretwear.fourier import FourierBasis
-from fretwear.hbm import DLFTProblem
+from fretwear.hb import contact as law
+from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.periodic import DLFTProblem
+from fretwear.hb.reduce import condense
 from fretwear.model.core import ContactInterface, Load, Model
-from fretwear.reduce import condense
 
 HARM = (1, 2, 3)
 NS = 24  # samples per period (> 2 * 3)

@@ -18,12 +18,12 @@ import numpy as np
 import pytest
 
 from fretwear import linear
-from fretwear.case import build_model, load_case
+from fretwear.analyses.run import load_case, run_case
 from fretwear.examples.builders import stromberg_beam
-from fretwear.reproduce import edit_case_text
-from fretwear.results import read_results
-from fretwear.runner import run_case
-from fretwear.transient import incremental_wear
+from fretwear.io.case import build_model
+from fretwear.io.results import read_results
+from fretwear.paper.catalogue import edit_case_text
+from fretwear.timedomain.integrate import incremental_wear
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
@@ -192,7 +192,7 @@ def test_quasi_static_periodic_example_agrees_with_load_stepping(tmp_path):
     """The quasi-static periodic state of the paper's beam (section 4.2, Q / (mu P) = 1/3):
     partial slip, the nodes next to the spring stick, the slip grows towards x = L. Compared
     with an independent method: load stepping with exact contact and incremental Coulomb
-    friction (fretwear.transient.incremental_wear without wear, 128 steps per cycle; the
+    friction (fretwear.timedomain.integrate.incremental_wear without wear, 128 steps per cycle; the
     third cycle, once the initial loading is over). The shipped settings (7 harmonics, 128
     samples) take ~1 s, so the file is run as is. The slip path per cycle agrees within 5e-3
     of the largest: the difference is the harmonic truncation (measured 3.3e-3 with 5
@@ -332,7 +332,7 @@ def dlft_wear(tmp_path, name: str, harmonics: int, n_samples: int) -> np.ndarray
 
 
 def load_stepping_wear(waveform: str) -> np.ndarray:
-    """Independent reference: fretwear.transient.incremental_wear (exact contact and
+    """Independent reference: fretwear.timedomain.integrate.incremental_wear (exact contact and
     incremental Coulomb at 64 load steps per cycle, Archard after each step; Stromberg's kind
     of method) on the same beam, STROMBERG_CYCLES cycles with jumps of 10. Its own error,
     measured: 1.5e-3 of the deepest wear (jumps of 10 against 2), 5e-4 (64 against 256 steps).
@@ -388,12 +388,12 @@ def test_frf_before_and_after_wear_example(tmp_path):
     integrations, as the 79 kHz reduced run above), the FRFs on 12 points of 60-82 kHz (with
     3 or 4 points the worn sweep does not converge: its first points near the resonance have
     no converged neighbour to continue from). Checked: both FRFs converge; the unworn one is
-    the same as a separate sweep of the unworn model (fretwear.sweep on the model built from
+    the same as a separate sweep of the unworn model (fretwear.hb.sweep on the model built from
     the case file; the same solver from the same start, so equal to 1e-12 relative); the
     worn one differs from it (measured: by 6e-4 to 2.6e-3 of the amplitude; threshold 1e-3,
     far above the solver's reproducibility, which the 1e-12 check above bounds)."""
-    from fretwear.fourier import FourierBasis
-    from fretwear.sweep import sweep
+    from fretwear.hb.fourier import FourierBasis
+    from fretwear.hb.sweep import sweep
 
     text = (EXAMPLES / "salles2011-79khz-frf-worn.toml").read_text()
     text = edit_case_text(text, "analysis.frf_before_after",

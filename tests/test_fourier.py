@@ -1,6 +1,6 @@
 """Tests of the real Fourier basis and the alternating frequency/time transforms.
 
-Every reference value is computed independently of :mod:`fretwear.fourier`: trigonometric
+Every reference value is computed independently of :mod:`fretwear.hb.fourier`: trigonometric
 polynomials are evaluated directly with ``numpy.cos``/``numpy.sin``, derivatives by hand, and
 integrals over a period by the rectangle rule, which is exact for trigonometric polynomials of
 degree < N. Tolerances are a few hundred ulps of the data (FFT rounding grows like log N).
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from fretwear.errors import InputError
-from fretwear.fourier import FourierBasis, amplitude
+from fretwear.hb.fourier import FourierBasis, amplitude
 from fretwear.model.core import Load
 
 RNG = np.random.default_rng(12345)

@@ -1,4 +1,4 @@
-"""Validation of the DLFT harmonic balance (fretwear.hbm.solve_periodic) against independent
+"""Validation of the DLFT harmonic balance (fretwear.hb.periodic.solve_periodic) against independent
 references.
 
 * Den Hartog (1931): exact steady state of a mass-spring oscillator with Coulomb friction
@@ -9,8 +9,8 @@ references.
   force-controlled cycling: closed-form dissipation ``4 mu N (F0 - mu N) / k`` and the exact
   return map at the sample instants (a 5-line time stepper written here).
 * Energy balance of a plane-strain FE block on a rigid flat: work of the loads = viscous
-  dissipation (from the full field recovered with fretwear.reduce.recover and C) + friction
-  dissipation (fretwear.contact.friction_work).
+  dissipation (from the full field recovered with fretwear.hb.reduce.recover and C) + friction
+  dissipation (fretwear.hb.contact.friction_work).
 * Self-convergence in the number of harmonics, eps-independence, agreement of the three
   nonlinear solvers, and symmetry / isotropy of a 3D block in gross slip.
 
@@ -23,10 +23,11 @@ import pytest
 import scipy.sparse as sp
 from scipy import integrate, optimize
 
-from fretwear import contact as law
 from fretwear.errors import ConvergenceError
-from fretwear.fourier import FourierBasis
-from fretwear.hbm import solve_periodic
+from fretwear.hb import contact as law
+from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.periodic import solve_periodic
+from fretwear.hb.reduce import condense, recover
 from fretwear.model import (
     ContactSpec,
     Damping,
@@ -38,7 +39,6 @@ from fretwear.model import (
     rectangle,
 )
 from fretwear.model.core import ContactInterface, Load, Model
-from fretwear.reduce import condense, recover
 
 NH_SEQ = (1, 3, 7, 15, 31)
 

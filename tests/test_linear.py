@@ -4,7 +4,7 @@ References, all independent of the code under test:
 
 * closed-form eigenfrequencies of spring-mass chains (fixed-free, fixed-fixed, free-free);
 * closed-form response and reaction of one mass on two springs with a tilted contact frame;
-* the condensed FRF (fretwear.reduce) against the direct sparse solve, two different exact
+* the condensed FRF (fretwear.hb.reduce) against the direct sparse solve, two different exact
   routes to the same numbers;
 * modal superposition with all modes of the constrained structure (exact for hysteretic
   damping ``D = eta K``) against the direct FRF;

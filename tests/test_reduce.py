@@ -1,4 +1,4 @@
-"""Tests of the exact per-harmonic condensation on the contact DOFs (fretwear.reduce).
+"""Tests of the exact per-harmonic condensation on the contact DOFs (fretwear.hb.reduce).
 
 The model is a hand-assembled 2D truss (independent of the FE layer). Every reference is a
 *dense* solve of the full model written from the equation of motion in core.py,
@@ -18,9 +18,9 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 from fretwear.errors import InputError
-from fretwear.fourier import FourierBasis
+from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.reduce import condense, loads_to_real, recover, to_real_blocks
 from fretwear.model.core import ContactInterface, Load, Model, ObservedPoint
-from fretwear.reduce import condense, loads_to_real, recover, to_real_blocks
 
 RTOL = 1e-9
 RNG = np.random.default_rng(7)
@@ -231,7 +231,7 @@ def test_contact_dof_cannot_be_fixed():
 
 def test_real_blocks_match_time_domain_operator():
     """to_real_blocks/loads_to_real vs the time-domain operator K u + C u' + M u'' applied to
-    the real Fourier coefficients with the derivative matrix of fretwear.fourier (tested on its
+    the real Fourier coefficients with the derivative matrix of fretwear.hb.fourier (tested on its
     own in test_fourier): the sign convention of eq. (18) for viscous damping."""
     model = truss(nx=3, ny=2, damping="rayleigh")
     omega = 900.0

@@ -12,11 +12,12 @@ import tomllib
 import numpy as np
 import pytest
 
-from fretwear.case import load_case
+from fretwear.analyses.run import load_case
 from fretwear.cli import main
 from fretwear.errors import InputError
-from fretwear.reproduce import RUNS, edit_case_text, plan, reproduce, run_case_text, toml_value
-from fretwear.results import read_results
+from fretwear.io.results import read_results
+from fretwear.paper.catalogue import RUNS, edit_case_text, run_case_text, toml_value
+from fretwear.paper.runs import plan, reproduce
 
 
 @pytest.mark.parametrize("value", [3, 2e8, 1e-12, float("inf"), True, False, "static",

@@ -8,8 +8,7 @@ import pytest
 import xarray as xr
 
 from fretwear import __version__
-from fretwear.model import mesh as meshes
-from fretwear.results import (
+from fretwear.io.results import (
     atomic_write,
     check_schema,
     complex_variables,
@@ -21,6 +20,7 @@ from fretwear.results import (
     write_results,
     write_vtu,
 )
+from fretwear.model import mesh as meshes
 
 ATTRS = dict(title="t", analysis_type="frf", converged=True, case_text="[model]\n",
              case_path="/x/case.toml", analysis={"type": "frf", "n_points": 3})

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from fretwear import cli
-from fretwear.case import load_case
-from fretwear.results import read_results
+from fretwear.analyses.run import load_case
+from fretwear.io.results import read_results
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "src" / "fretwear" / "examples"

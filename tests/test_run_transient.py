@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from test_run_dlft import check_documented, run, small_case
 
-from fretwear.results import read_results
+from fretwear.io.results import read_results
 
 TRANSIENT = """[analysis]
 type = "transient"

@@ -1,6 +1,7 @@
-"""The time-domain check of periodic solutions (fretwear.stability).
+"""The time-domain check of periodic solutions (fretwear.timedomain.stability).
 
-Compared with: an independent method, the exact time integration of fretwear.transient, on
+Compared with: an independent method, the exact time integration of fretwear.timedomain.integrate,
+on
 a single friction oscillator whose steady state is known to be unique and attracting (viscous
 damping, continuous slip: Den Hartog's regime), so the check must answer "stable"; and the
 time-domain start must hand back harmonics that make the DLFT converge at once.
@@ -9,10 +10,10 @@ time-domain start must hand back harmonics that make the DLFT converge at once.
 import numpy as np
 import scipy.sparse as sp
 
-from fretwear.fourier import FourierBasis
-from fretwear.hbm import solve_periodic
+from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.periodic import initial_state, solve_periodic
 from fretwear.model.core import ContactInterface, Load, Model, ObservedPoint
-from fretwear.stability import check_periodic, initial_state, time_domain_start
+from fretwear.timedomain.stability import check_periodic, time_domain_start
 
 M_, K_, KN, N0, F0, ZETA = 1.0, 1e4, 1e6, 10.0, 20.0, 0.05
 MU = 0.3  # mu N0 / F0 = 0.15: continuous slip

@@ -1,4 +1,4 @@
-"""Tests of the time-domain reference solvers (:mod:`fretwear.transient`).
+"""Tests of the time-domain reference solvers (:mod:`fretwear.timedomain.integrate`).
 
 Every test compares with something independent of the code under test (a closed-form
 solution, an event-driven integration written here with ``scipy.integrate.solve_ivp``, a
@@ -16,9 +16,9 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.integrate import solve_ivp
 
-from fretwear import transient as tr
 from fretwear.errors import InputError
 from fretwear.model.core import ContactInterface, Load, Model, ObservedPoint
+from fretwear.timedomain import integrate as tr
 
 
 # --------------------------------------------------------------------------------------------

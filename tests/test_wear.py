@@ -1,14 +1,15 @@
-"""Tests of fretting wear on the slow scale (fretwear.wear, fretwear.wear_kernels, run_wear).
+"""Tests of fretting wear on the slow scale (fretwear.wear.simulate, fretwear.wear.kernels,
+run_wear).
 
 References, each independent of the code under test:
 
-* the friction energy of :func:`fretwear.contact.friction_work` (a separate code path): with
+* the friction energy of :func:`fretwear.hb.contact.friction_work` (a separate code path): with
   Archard's law and Coulomb slip, worn volume per cycle = k_w / mu x friction energy, exactly
   on the same samples; and the energy law with k_e = k_w / mu gives Archard's wear;
 * the closed-form quasi-static Coulomb oscillator (a contact node on a tangential spring k_t
   under a constant normal load and a sinusoidal tangential load of amplitude Q > mu P A):
   slip path 4 (Q - mu P A) / k_t per cycle, so Archard's rate is k_w P x that path;
-* contact states of the DLFT (:mod:`fretwear.contact`): a node that sticks all period must
+* contact states of the DLFT (:mod:`fretwear.hb.contact`): a node that sticks all period must
   not wear, to the last bit;
 * finite differences for every derivative of the implicit scheme;
 * a fine-jump explicit Euler run for the slow-scale integrators;
@@ -29,14 +30,15 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from fretwear import contact as law
-from fretwear.fourier import FourierBasis
-from fretwear.hbm import solve_periodic, static_anchor
+from fretwear.hb import contact as law
+from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.periodic import solve_periodic, static_anchor
+from fretwear.hb.reduce import condense
 from fretwear.model.build import ContactSpec, Material, Spring, Traction, from_mesh
 from fretwear.model.core import ContactInterface, Load, Model
 from fretwear.model.mesh import rectangle
-from fretwear.reduce import condense
-from fretwear.wear import (
+from fretwear.wear.kernels import slip_work, slip_work_gradient
+from fretwear.wear.simulate import (
     SlowProblem,
     WearOptions,
     read_history,
@@ -45,7 +47,6 @@ from fretwear.wear import (
     wear_coefficients,
     wear_per_cycle,
 )
-from fretwear.wear_kernels import slip_work, slip_work_gradient
 
 KW = 1e-11  # Archard coefficient [1/Pa] (paper section 4)
 MU = 0.3
@@ -365,7 +366,7 @@ def test_plateau_stop_and_history(blk):
 def test_failed_solve_stops_cleanly(blk, monkeypatch):
     """A balance that never converges after step 2: the run stops with "solver_failed", says
     so, and keeps the converged steps only."""
-    import fretwear.wear as wm
+    import fretwear.wear.simulate as wm
 
     m, red, anc = blk
     real = wm.SlowProblem.solve_balance
@@ -507,13 +508,13 @@ n_points = 3
 def wear_registered():
     """Import the analysis for this test only (the registry line in runner.ANALYSIS_MODULES
     and the regenerated docs/case-files.md come with the merge)."""
-    from fretwear import runner
+    from fretwear.analyses import registry as runner
 
     before = "wear" in runner._REGISTRY
-    import fretwear.run_wear  # noqa: F401
+    import fretwear.analyses.wear  # noqa: F401
 
     if "wear" not in runner._REGISTRY:  # imported earlier, then removed by this fixture
-        rw = fretwear.run_wear
+        rw = fretwear.analyses.wear
         runner.register("wear", rw.SCHEMA, rw.run_wear, checks=rw.CHECKS, doc=rw.DOC)
     yield
     if not before:
@@ -524,8 +525,8 @@ def test_case_file_run_and_resume(tmp_path, wear_registered):
     """`analysis = "wear"` end to end: results.nc follows the schema (units on every variable,
     dims step/contact_node), figures exist, the checkpoint is there, and --resume of a finished
     run reports it up to date."""
-    from fretwear.results import read_results
-    from fretwear.runner import run_case
+    from fretwear.analyses.run import run_case
+    from fretwear.io.results import read_results
 
     case = tmp_path / "w.toml"
     case.write_text(CASE)
@@ -546,7 +547,7 @@ def test_case_file_run_and_resume(tmp_path, wear_registered):
 
 
 def test_case_file_needs_frequency(tmp_path, wear_registered):
-    from fretwear.case import load_case
+    from fretwear.analyses.run import load_case
     from fretwear.errors import InputError
 
     case = tmp_path / "w.toml"
@@ -557,9 +558,9 @@ def test_case_file_needs_frequency(tmp_path, wear_registered):
 
 def test_frf_worn_uniform_wear_is_a_rigid_shift(blk):
     """The block is held vertically by the contact only: a uniform wear depth translates it
-    without changing any force, so the nonlinear FRF (fretwear.sweep with the worn gap) is
+    without changing any force, so the nonlinear FRF (fretwear.hb.sweep with the worn gap) is
     that of the unworn interface, to the solver tolerance (1e-6 relative)."""
-    from fretwear.wear import frf_worn
+    from fretwear.wear.simulate import frf_worn
 
     m, _, anc = blk
     grid = (2e3, 3e3, 3)
@@ -592,7 +593,7 @@ def test_progress_bar_shows_cycles_volume_rate_and_time_left(blk, capsys):
 def test_zero_wear_zones_are_runs_of_unworn_nodes():
     """Hand-made profile (unordered x): the zones are the runs of nodes at most 1 % of the
     deepest, in x order, ends included."""
-    from fretwear.wear import zero_wear_zones
+    from fretwear.wear.simulate import zero_wear_zones
 
     x = np.array([0.5, 0.0, 0.1, 0.2, 0.3, 0.4, 0.6])
     w = np.array([0.0, 0.0, 0.005, 1.0, 0.0, 0.3, 0.02])

@@ -1,9 +1,10 @@
-"""Tests of the wear rate averaged over a time integration (fretwear.wear_time) and of the
-time-domain steps of the slow-scale driver (fretwear.wear).
+"""Tests of the wear rate averaged over a time integration (fretwear.timedomain.averaged_rate) and
+of the
+time-domain steps of the slow-scale driver (fretwear.wear.simulate).
 
 References, each independent of the code under test:
 
-* the DLFT wear rate (eq. 29 on the converged harmonic balance, :mod:`fretwear.wear_kernels`),
+* the DLFT wear rate (eq. 29 on the converged harmonic balance, :mod:`fretwear.wear.kernels`),
   a different method (frequency domain, truncated to a few harmonics) for the same periodic
   response: the two agree to the truncation error of the balance;
 * Coulomb's law in the time integrator: in slip the tangential force is mu times the normal
@@ -19,21 +20,20 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import fretwear.wear as wm
-from fretwear.fourier import FourierBasis
-from fretwear.hbm import solve_periodic
+import fretwear.wear.simulate as wm
+from fretwear import simulate_wear  # the public driver: time-domain fallback on
+from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.periodic import initial_state, solve_periodic
+from fretwear.hb.reduce import condense
 from fretwear.model.build import ContactSpec, Damping, Material, Spring, Traction, from_mesh
 from fretwear.model.mesh import rectangle
-from fretwear.reduce import condense
-from fretwear.stability import initial_state
-from fretwear.wear import (
+from fretwear.timedomain.averaged_rate import RESPONSE_KINDS, time_averaged_rate
+from fretwear.wear.simulate import (
     SlowProblem,
     WearOptions,
-    simulate_wear,
     wear_coefficients,
     without_growth,
 )
-from fretwear.wear_time import RESPONSE_KINDS, time_averaged_rate
 
 KW = 1e-11
 MU = 0.3
@@ -244,7 +244,7 @@ def test_run_starts_from_a_time_integration_when_the_unworn_balance_fails(monkey
     response integrated from rest, which equals what time_averaged_rate gives from rest with
     the same windows (bitwise: same integration), and the run goes on (here back to balanced
     steps, the response being periodic)."""
-    import fretwear.hbm
+    import fretwear.hb.periodic
 
     m = damped_block()
     real = wm.solve_periodic
@@ -266,7 +266,8 @@ def test_run_starts_from_a_time_integration_when_the_unworn_balance_fails(monkey
     assert h.jump[1] == wm.START_JUMP
     # the response is periodic: the balance converges from it at step 1, then ordinary steps
     assert h.rescued[1] == 1 and np.all(h.rescued[2:] == 0)
-    assert fretwear.hbm.solve_periodic is not failing  # only the wear module's start was forced
+    # only the wear module's start was forced
+    assert fretwear.hb.periodic.solve_periodic is not failing
 
 
 def test_without_growth_keeps_decaying_modes_and_makes_growing_ones_explicit():

@@ -22,7 +22,7 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 
 from fretwear import __version__  # noqa: E402 (after the BLAS thread setting)
 from fretwear.errors import FretwearError, InputError  # noqa: E402 (after the BLAS thread setting)
-from fretwear.schema import suggest  # noqa: E402 (after the BLAS thread setting)
+from fretwear.io.schema import suggest  # noqa: E402 (after the BLAS thread setting)
 
 
 # --- examples -----------------------------------------------------------------------------
@@ -42,7 +42,7 @@ def example_path(name: str) -> Path:
 
 
 def _example_title(path: Path) -> str:
-    from fretwear.case import read_toml
+    from fretwear.io.case import read_toml
 
     try:
         return str(read_toml(path)[1].get("title", ""))
@@ -52,7 +52,7 @@ def _example_title(path: Path) -> str:
 
 # --- commands -----------------------------------------------------------------------------
 def _run(case: Path, outdir, resume: bool, progress: bool) -> int:
-    from fretwear.runner import run_case
+    from fretwear.analyses.run import run_case
 
     out = run_case(case, outdir=outdir, progress=progress, resume=resume)
     return 0 if out.converged else 1
@@ -63,7 +63,7 @@ def cmd_run(args) -> int:
 
 
 def cmd_compare(args) -> int:
-    from fretwear.compare import compare_case
+    from fretwear.analyses.compare import compare_case
 
     res = compare_case(Path(args.case), args.output, steps_per_period=args.steps)
     return 0 if res.dlft_converged else 1
@@ -94,7 +94,7 @@ def cmd_example_run(args) -> int:
 
 
 def _reproduce(workdir, doc, quick: bool, jobs: int, only, progress: bool) -> int:
-    from fretwear.reproduce import reproduce
+    from fretwear.paper.runs import reproduce
 
     workdir = workdir if workdir is not None else Path.cwd() / "salles2011-reproduction"
     reproduce(workdir, doc, quick=quick, jobs=jobs, only=only, progress=progress)

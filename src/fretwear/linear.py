@@ -16,7 +16,7 @@ component ``k`` sits at the global DOF of the axis that frame row ``k`` is close
 removed coordinate of ``q``. For axis-aligned frames ``T`` is a signed permutation and the
 held coordinates are the global DOFs along the held directions.
 
-Damping enters exactly as in :func:`fretwear.reduce.dynamic_stiffness` (hysteretic ``D`` and
+Damping enters exactly as in :func:`fretwear.hb.reduce.dynamic_stiffness` (hysteretic ``D`` and
 viscous ``C``: ``Z = K + i D - w^2 M + i w C``); the FRF is that of the harmonic ``n = 1``
 part of the model loads, with the complex amplitude convention ``u(t) = Re U e^{i w t}``.
 """
@@ -32,8 +32,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from fretwear.errors import InputError
+from fretwear.hb.reduce import condense
 from fretwear.model.core import Model
-from fretwear.reduce import condense
 
 INTERFACES = ("free", "sliding", "stuck")
 FRF_METHODS = ("direct", "condensed")
@@ -373,7 +373,7 @@ def _on_pattern(A: sp.spmatrix, pattern: sp.csc_matrix) -> np.ndarray:
 
 
 class _Pencil:
-    """``Z(w) = K + i D - w^2 M + i w C`` (as :func:`fretwear.reduce.dynamic_stiffness` at
+    """``Z(w) = K + i D - w^2 M + i w C`` (as :func:`fretwear.hb.reduce.dynamic_stiffness` at
     ``n = 1``) of a sub-block, assembled per frequency on a fixed sparsity pattern."""
 
     def __init__(self, mats: dict):
@@ -461,7 +461,7 @@ def frf(model: Model, frequencies_hz, *, interface: str = "sliding",
     frequencies_hz : (nf,) excitation frequencies [Hz] (> 0).
     interface : one of :data:`INTERFACES`.
     method : ``"direct"`` (sparse complex solve of the whole constrained model per
-        frequency) or ``"condensed"`` (:func:`fretwear.reduce.condense` at harmonic 1, then
+        frequency) or ``"condensed"`` (:func:`fretwear.hb.reduce.condense` at harmonic 1, then
         the constraint applied to the reduced contact-local coordinates). Both are exact and
         agree to rounding.
 

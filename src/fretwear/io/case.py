@@ -1,7 +1,7 @@
 """Case files: a TOML description of a model and an analysis, validated on load (SI units).
 
 :func:`load_case` reads and validates a case file against the schema below (see
-:mod:`fretwear.schema`); :func:`build_model` turns it into a :class:`~fretwear.model.core.Model`.
+:mod:`fretwear.io.schema`); :func:`build_model` turns it into a :class:`~fretwear.model.core.Model`.
 Every mistake (wrong value, wrong type, missing or unknown key, unknown boundary name) gives
 one :class:`~fretwear.errors.InputError` naming the key path, e.g.
 ``material.nu = 0.5: expected a number in (-1, 0.5)``.
@@ -9,7 +9,7 @@ one :class:`~fretwear.errors.InputError` naming the key path, e.g.
 A model is either a finite element mesh (``model.type`` = ``"rectangle"``, ``"box"`` or
 ``"mesh"``) or user matrices (``"matrices"``); the sections that describe the interface,
 the loads and the observed points differ between the two. The ``[analysis]`` table is
-checked against the schema its analysis type registered in :mod:`fretwear.runner`.
+checked against the schema its analysis type registered in :mod:`fretwear.analyses.registry`.
 The documentation ``docs/case-files.md`` is generated from these schemas
 (:func:`case_docs`, :func:`write_case_docs`).
 """
@@ -24,8 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from fretwear.errors import InputError
-from fretwear.model.core import WAVEFORMS
-from fretwear.schema import (
+from fretwear.io.schema import (
     AnyOf,
     Choice,
     Context,
@@ -50,6 +49,7 @@ from fretwear.schema import (
     suggest,
     table_label,
 )
+from fretwear.model.core import WAVEFORMS
 
 AXES = ("x", "y", "z")
 FIGURE_FORMATS = ("png", "pdf", "svg")
@@ -292,17 +292,10 @@ OUTPUT = Table(
 )
 
 
-def _analysis_tables() -> dict:
-    from fretwear.runner import analysis_tables  # the registry fills up when it is imported
-
-    return analysis_tables()
-
-
-ANALYSIS = Variant(_analysis_tables, key_doc="analysis type")
 _TITLE = Field(Text(), "one line describing the case (used in figures and results)")
 
 
-def _case_table(model_kind: str) -> Table:
+def _case_table(model_kind: str, analyses: Mapping[str, Table]) -> Table:
     if model_kind == "matrices":
         fields = {
             "title": _TITLE,
@@ -324,15 +317,18 @@ def _case_table(model_kind: str) -> Table:
             "contact": Field(CONTACT_MESH, "the frictional interface", required=True),
             "observed": Field(OBSERVED_MESH, "points whose motion is reported", default={}),
         }
-    fields["analysis"] = Field(ANALYSIS, "what to compute", required=True)
+    fields["analysis"] = Field(Variant(dict(analyses), key_doc="analysis type"),
+                               "what to compute", required=True)
     fields["output"] = Field(OUTPUT, "what to write")
     return Table(fields)
 
 
-def validate(raw: Mapping, base_dir: Path | str = ".") -> dict:
+def validate(raw: Mapping, analyses: Mapping[str, Table], base_dir: Path | str = ".") -> dict:
     """Validate a parsed case file; return the normalised dict (defaults filled in).
 
-    Relative file paths are resolved against ``base_dir`` (the case file's folder).
+    ``analyses`` maps each analysis type to the schema of its ``[analysis]`` table (the
+    registry of :mod:`fretwear.analyses` passes its own). Relative file paths are resolved
+    against ``base_dir`` (the case file's folder).
 
     Raises
     ------
@@ -342,7 +338,7 @@ def validate(raw: Mapping, base_dir: Path | str = ".") -> dict:
     model = raw.get("model")
     kind = model.get("type") if isinstance(model, Mapping) else None
     raw = {"damping": {}, "output": {}, **raw}  # absent tables get their defaults
-    return _case_table("matrices" if kind == "matrices" else "mesh").check(
+    return _case_table("matrices" if kind == "matrices" else "mesh", analyses).check(
         raw, "", Context(Path(base_dir))
     )
 
@@ -367,7 +363,7 @@ class Case:
         the model kind), with defaults filled in and file paths absolute.
     analysis : the validated ``[analysis]`` table (with ``type``).
     output : the validated ``[output]`` table.
-    resume : set by :func:`fretwear.runner.run_case`: continue from a checkpoint if any.
+    resume : set by :func:`fretwear.analyses.run.run_case`: continue from a checkpoint if any.
     """
 
     path: Path
@@ -421,12 +417,14 @@ def read_toml(path: Path | str) -> tuple[str, dict]:
     return text, raw
 
 
-def load_case(path: Path | str) -> Case:
+def load_case(path: Path | str, analyses: Mapping[str, Table]) -> Case:
     """Read and validate a case file.
 
     Parameters
     ----------
     path : the ``.toml`` case file; relative paths inside it start from its folder.
+    analyses : analysis type -> schema of its ``[analysis]`` table
+        (:func:`fretwear.analyses.load_case` passes the registered ones).
 
     Returns
     -------
@@ -439,7 +437,7 @@ def load_case(path: Path | str) -> Case:
     """
     path = Path(path).expanduser().resolve()
     text, raw = read_toml(path)
-    v = validate(raw, path.parent)
+    v = validate(raw, analyses, path.parent)
     return Case(
         path=path,
         title=v.get("title") or path.stem,
@@ -685,8 +683,8 @@ def _build_from_matrices(m: dict, title: str):
 _DOC_HEAD = """\
 # Case files
 
-<!-- Generated by fretwear.case.write_case_docs() from the schema in src/fretwear/case.py and
-the analysis schemas registered in src/fretwear/runner.py: do not edit by hand. -->
+<!-- Generated by fretwear.io.case.write_case_docs() from the schema in src/fretwear/io/case.py
+and the analysis schemas registered in src/fretwear/analyses/: do not edit by hand. -->
 
 A case file is a [TOML](https://toml.io) file that describes a model, an analysis and what to
 write. Run it with `fretwear run CASE.toml`; the shipped examples (`fretwear example list`) are
@@ -729,8 +727,9 @@ differ between the two; `[material]`, `[[springs]]` and `[[fixed]]` exist for me
 """
 
 
-def case_docs() -> str:
-    """The Markdown of ``docs/case-files.md``, generated from the schemas."""
+def case_docs(analyses: Mapping[str, Table]) -> str:
+    """The Markdown of ``docs/case-files.md``, generated from the schemas (``analyses``: the
+    schema of each analysis type, as for :func:`validate`)."""
     parts = [_DOC_HEAD]
     parts.append("## [model]\n\n`type` selects one of the tables below.\n")
     for kind, table in MODEL_TYPES.items():
@@ -751,7 +750,7 @@ def case_docs() -> str:
     )
     parts.append("## [analysis]\n\n`type` selects one of the analyses below (those registered "
                  "in this version).\n")
-    for kind, table in _analysis_tables().items():
+    for kind, table in analyses.items():
         parts.append(render_table(table, f'### type = "{kind}"'))
     parts.append(render_table(OUTPUT, "## [output]"))
     return "\n".join(parts)
@@ -759,11 +758,11 @@ def case_docs() -> str:
 
 def docs_path() -> Path:
     """``docs/case-files.md`` of the source tree (the package is installed editable)."""
-    return Path(__file__).resolve().parents[2] / "docs" / "case-files.md"
+    return Path(__file__).resolve().parents[3] / "docs" / "case-files.md"
 
 
-def write_case_docs(path: Path | str | None = None) -> Path:
+def write_case_docs(analyses: Mapping[str, Table], path: Path | str | None = None) -> Path:
     """Write :func:`case_docs` to ``path`` (default: :func:`docs_path`)."""
     path = Path(path) if path is not None else docs_path()
-    path.write_text(case_docs(), encoding="utf-8")
+    path.write_text(case_docs(analyses), encoding="utf-8")
     return path

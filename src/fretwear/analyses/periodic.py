@@ -1,9 +1,9 @@
 """The DLFT analyses of case files: ``"periodic"`` (one frequency) and ``"sweep"`` (nonlinear FRF).
 
-Each run function calls the solver (:func:`fretwear.hbm.solve_periodic`,
-:func:`fretwear.sweep.sweep`), turns its result into a results dataset (schema in
+Each run function calls the solver (:func:`fretwear.hb.periodic.solve_periodic`,
+:func:`fretwear.hb.sweep.sweep`), turns its result into a results dataset (schema in
 ``docs/results.md``), figures and ParaView files, and registers itself with
-:mod:`fretwear.runner`.
+:mod:`fretwear.analyses.registry`.
 
 A periodic solve that did not converge is never saved as a result: the run writes a results
 file with the solver diagnostics as attributes and no solution variables, and reports the
@@ -21,16 +21,19 @@ from matplotlib.colors import BoundaryNorm, ListedColormap
 from matplotlib.patches import Patch
 from tqdm import tqdm
 
-from fretwear import linear, plots
-from fretwear.contact import STATE_NAMES
+from fretwear import linear
+from fretwear.analyses import figures as plots
+from fretwear.analyses.linear import _check_points, _figure_path, _geometry
+from fretwear.analyses.registry import RunOutput, register
 from fretwear.errors import InputError
-from fretwear.fourier import FourierBasis
-from fretwear.hbm import PeriodicSolution, solve_periodic
-from fretwear.reduce import condense, recover
-from fretwear.results import label_coordinate, nodal_vectors, variable, write_pvd, write_vtu
-from fretwear.run_linear import _check_points, _figure_path, _geometry
-from fretwear.runner import RunOutput, register
-from fretwear.schema import (
+from fretwear.hb.contact import STATE_NAMES
+from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.periodic import PeriodicSolution, solve_periodic
+from fretwear.hb.reduce import condense, recover
+from fretwear.hb.solvers import SOLVERS, SolveStats
+from fretwear.hb.sweep import SweepResult, sweep
+from fretwear.io.results import label_coordinate, nodal_vectors, variable, write_pvd, write_vtu
+from fretwear.io.schema import (
     AnyOf,
     Field,
     Flag,
@@ -42,9 +45,8 @@ from fretwear.schema import (
     increasing,
     join,
 )
-from fretwear.solvers import SOLVERS, SolveStats
-from fretwear.stability import sweep_check
-from fretwear.sweep import SweepResult, sweep
+from fretwear.timedomain.fallback import FALLBACK
+from fretwear.timedomain.stability import sweep_check
 
 #: colours of the contact states (separation, stick, slip) in every figure
 STATE_COLOURS = ("0.85", "tab:blue", "tab:orange")
@@ -282,7 +284,7 @@ def _periodic_summary(sol: PeriodicSolution, ds: xr.Dataset, analysis: dict, whe
 
 
 def run_periodic(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOutput:
-    """Periodic response at one frequency (:func:`fretwear.hbm.solve_periodic`).
+    """Periodic response at one frequency (:func:`fretwear.hb.periodic.solve_periodic`).
 
     Parameters
     ----------
@@ -335,7 +337,7 @@ def _periodic_figures(ds: xr.Dataset, case, outdir: Path, title: str) -> list[Pa
 def write_period_fields(model, sol: PeriodicSolution, pvd: Path) -> Path:
     """ParaView time series of the whole displacement field over one period.
 
-    Every DOF is recovered from the contact solution (:func:`fretwear.reduce.recover`, exact)
+    Every DOF is recovered from the contact solution (:func:`fretwear.hb.reduce.recover`, exact)
     and sampled at the ``N`` instants of the period: one ``.vtu`` per instant in the folder
     ``pvd.stem`` (point arrays ``displacement`` [m], ``contact_state`` and
     ``contact_pressure`` [Pa], NaN off the interface), stepped through by the ``.pvd`` with
@@ -676,7 +678,7 @@ def _sweep_summary(result: SweepResult, ds: xr.Dataset) -> str:
 
 
 def run_sweep(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOutput:
-    """Nonlinear FRF: periodic solutions over a frequency band (:func:`fretwear.sweep.sweep`).
+    """Nonlinear FRF: periodic solutions over a frequency band (:func:`fretwear.hb.sweep.sweep`).
 
     Parameters
     ----------
@@ -701,7 +703,7 @@ def run_sweep(model, analysis: dict, case, outdir: Path, progress: bool) -> RunO
                        spacing=analysis["spacing"], eps=eps, solver=analysis["solver"],
                        tol=analysis["tol"], max_iter=analysis["max_iter"],
                        continuation=analysis["continuation"],
-                       time_domain=analysis["time_domain"],
+                       time_domain=FALLBACK if analysis["time_domain"] else None,
                        time_domain_periods=analysis["time_domain_periods"],
                        check=(sweep_check(model, max_periods=analysis["time_domain_periods"])
                               if analysis["check_stability"] else None),

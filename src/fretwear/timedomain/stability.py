@@ -6,7 +6,8 @@ unique), or absent from what the structure does in time (a self-excited friction
 at an incommensurate frequency riding on the forced response). The analytic tools for the
 stability of non-smooth periodic orbits are not robust enough to trust blindly, so fretwear
 checks the way a careful analyst would: it starts the exact time integration of the same model
-(:mod:`fretwear.transient`, unilateral contact and Coulomb friction without regularisation)
+(:mod:`fretwear.timedomain.integrate`, unilateral contact and Coulomb friction without
+regularisation)
 from the periodic solution, slightly perturbed, and lets it run until its response is
 classified (periodic, drifting, quasi-periodic, irregular). The verdict compares the settled
 response with the periodic solution.
@@ -21,9 +22,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fretwear.hbm import PeriodicSolution
+from fretwear.hb.periodic import PeriodicSolution, initial_state
 from fretwear.model.core import Model
-from fretwear.reduce import recover
 
 VERDICTS = ("stable", "settles elsewhere", "drifting", "quasi-periodic", "irregular",
             "undecided")
@@ -54,18 +54,6 @@ class StabilityCheck:
         return [] if self.verdict == "stable" else [f"{self.verdict}: {self.message}"]
 
 
-def initial_state(model: Model, sol: PeriodicSolution):
-    """Full-field displacement [m] and velocity [m/s] at ``t = 0`` of a periodic solution."""
-    b = sol.basis
-    m = sol.U.shape[0] * sol.U.shape[1]
-    Uc = b.to_complex(sol.U.reshape(m, -1))  # (k+1, m) complex amplitudes
-    orders = np.array([0, *b.harmonics])
-    Ufull = recover(model, sol.omega, orders, Uc, quasi_static=sol.quasi_static)
-    U0 = Ufull.real.sum(axis=0)
-    V0 = -(orders[:, None] * sol.omega * Ufull.imag).sum(axis=0)
-    return U0, V0
-
-
 def check_periodic(model: Model, sol: PeriodicSolution, *, max_periods: int = 3000,
                    steps_per_period: int | None = None, perturbation: float = 1e-3,
                    tolerance: float = 0.2, periodicity_tol: float = 1e-4,
@@ -85,7 +73,7 @@ def check_periodic(model: Model, sol: PeriodicSolution, *, max_periods: int = 30
         methods differ by the truncation error even for a stable orbit; 0.2 is well above the
         truncation error measured on the paper's beam with 7 harmonics (docs/verification.md).
     """
-    from fretwear.transient import steady_state
+    from fretwear.timedomain.integrate import steady_state
 
     t0 = time.perf_counter()
     if sol.quasi_static or sol.omega <= 0:
@@ -102,7 +90,7 @@ def check_periodic(model: Model, sol: PeriodicSolution, *, max_periods: int = 30
     # distance between the settled period and the periodic solution, on the observed points
     dist = 0.0
     tau = 2 * np.pi * np.arange(nsteps) / nsteps
-    from fretwear.fourier import FourierBasis
+    from fretwear.hb.fourier import FourierBasis
 
     bt = FourierBasis.up_to(max(sol.basis.harmonics), nsteps)
     for name, c_hb in sol.observed.items():
@@ -143,7 +131,8 @@ def check_periodic(model: Model, sol: PeriodicSolution, *, max_periods: int = 30
 
 
 def sweep_check(model: Model, **kwargs):
-    """A ``check`` callable for :func:`fretwear.sweep.sweep`: flags from :func:`check_periodic`."""
+    """A ``check`` callable for :func:`fretwear.hb.sweep.sweep`: flags from
+    :func:`check_periodic`."""
 
     def check(sol: PeriodicSolution) -> list[str]:
         return check_periodic(model, sol, **kwargs).flags()
@@ -166,7 +155,7 @@ def time_domain_start(model: Model, omega: float, basis, start: PeriodicSolution
 
     Returns ``(message, U0 (nc, d, H) or None, anchor (nc, d-1) or None)``.
     """
-    from fretwear.transient import steady_state
+    from fretwear.timedomain.integrate import steady_state
 
     U0 = V0 = None
     wear = None

@@ -1,6 +1,6 @@
 """The report of ``fretwear reproduce``: the paper's figures and Table 1 against fretwear's.
 
-:func:`write_report` reads the results of :mod:`fretwear.reproduce` from the work directory,
+:func:`write_report` reads the results of :mod:`fretwear.paper.runs` from the work directory,
 measures on them what the paper states (mode counts, resonance frequencies, stops of P_e per
 period, zero-wear zones and pillars, plateaus, worn profiles, the FRF shift after wear,
 Newton iterations and time per computed cycle), draws one figure per group of the paper's
@@ -17,7 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
-from fretwear import __version__, plots
+from fretwear import __version__
+from fretwear.analyses import figures as plots
 
 #: what the paper states, by figure (Salles et al. 2011, section 4)
 PAPER = {
@@ -58,7 +59,7 @@ WEAR_FREQS = (("wear-quasistatic", "quasi-static"), ("wear-30khz", "30 kHz"),
 def load(workdir: Path, key: str):
     """The results dataset of run ``key``, or None when it is missing or did not converge."""
     from fretwear.errors import InputError
-    from fretwear.results import read_results
+    from fretwear.io.results import read_results
 
     path = workdir / key / "results.nc"
     if not path.is_file():
@@ -124,8 +125,8 @@ def linear_facts(model, f_max: float = 1e5) -> dict:
 
 def wear_facts(ds) -> dict:
     """What the paper reads off a wear run (section 4.2)."""
-    from fretwear.wear import zero_wear_zones
-    from fretwear.wear_time import RESPONSE_KINDS
+    from fretwear.timedomain.averaged_rate import RESPONSE_KINDS
+    from fretwear.wear.simulate import zero_wear_zones
 
     x = ds["contact_position"].values[:, 0]
     w = ds["wear_depth"].values[-1]
@@ -233,7 +234,7 @@ def fig_stromberg(figdir, sin, tri, short, ls) -> str | None:
 
 def fig_wear_run(figdir, ds, name: str, label: str, figs: str) -> str:
     """Four panels as the paper's figure groups: profiles, kinetics, pressure, slip."""
-    from fretwear.run_wear import default_nodes, selected_steps
+    from fretwear.analyses.wear import default_nodes, selected_steps
 
     fig, ax = plots.new_figure(2, 2, title=f"Paper Fig. {figs}: wear, {label}")
     x = ds["contact_position"].values[:, 0] * 1e3
@@ -364,8 +365,8 @@ def fig_frf_worn(figdir, fw) -> str | None:
 def write_report(workdir: Path, doc: Path, outcomes, *, quick: bool, wall: float,
                  jobs: int) -> Path:
     """Measure, draw and write the report ``doc``; figures in ``doc.parent/doc.stem``."""
-    from fretwear.reproduce import RUNS
-    from fretwear.results import atomic_write
+    from fretwear.files import atomic_write
+    from fretwear.paper.catalogue import RUNS
 
     workdir = Path(workdir)
     doc = Path(doc)
@@ -411,7 +412,7 @@ going on at the same time; `benchmarks/paper_table1.py` times the Table 1 runs a
 
 
 def _runs_table(runs, out: dict) -> str:
-    from fretwear.reproduce import EXTRA_KEYS
+    from fretwear.paper.catalogue import EXTRA_KEYS
 
     def status(key: str) -> str:
         o = out.get(key)
@@ -420,10 +421,11 @@ def _runs_table(runs, out: dict) -> str:
         return f"{st} | {w}"
 
     what = {"stromberg-load-stepping": "load stepping with exact contact and incremental "
-            "Coulomb friction (`fretwear.transient.incremental_wear`), the kind of method "
+            "Coulomb friction (`fretwear.timedomain.integrate.incremental_wear`), the kind of "
+            "method "
             "of Stromberg (1997)",
             "frf-worn-79khz": "nonlinear FRF (7 harmonics, 128 samples) with the unworn and "
-            "the 79 kHz worn gap (`fretwear.wear.frf_worn`)"}
+            "the 79 kHz worn gap (`fretwear.wear.simulate.frf_worn`)"}
     rows = ["## The runs", "", "| run | example | paper Fig. | settings | status | wall |",
             "|---|---|---|---|---|---|"]
     rows += [f"| `{r.key}` | `{r.example}` | {r.figures} | {r.why} | {status(r.key)} |"
@@ -565,7 +567,8 @@ class _Report:
 
     # Fig. 14, 15, 22
     def frf(self) -> str:
-        from fretwear.case import build_model, load_case
+        from fretwear.analyses.run import load_case
+        from fretwear.io.case import build_model
 
         frf = self.ds["frf"]
         s = ["## Fig. 14, 15, 22: FRFs of the unworn beam", "", f"Paper: {PAPER['14']} "

@@ -1,11 +1,12 @@
 """The time-domain analyses of case files: ``"transient"`` and ``"incremental-wear"``.
 
 ``"transient"`` integrates the forced response in time with exact contact and friction
-(:func:`fretwear.transient.steady_state` or :func:`fretwear.transient.integrate`) and writes
+(:func:`fretwear.timedomain.integrate.steady_state` or
+:func:`fretwear.timedomain.integrate.integrate`) and writes
 the last forcing period (observed points, contact nodes, harmonics, contact states, energy
 terms), the once-per-period (Poincare) samples and the classification of the response.
 ``"incremental-wear"`` runs quasi-static load steps with Archard wear applied as it goes
-(:func:`fretwear.transient.incremental_wear`) and writes the wear history.
+(:func:`fretwear.timedomain.integrate.incremental_wear`) and writes the wear history.
 
 Variable names follow ``docs/results.md``: the names of the ``periodic`` analysis where the
 meaning is the same (the last period is sampled at ``tau_j = 2 pi j / steps_per_period``),
@@ -19,15 +20,21 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from fretwear import plots
-from fretwear.contact import STATE_NAMES
-from fretwear.fourier import FourierBasis, amplitude
-from fretwear.results import label_coordinate, variable
-from fretwear.run_dlft import _pad_axes, interface_abscissa, plot_state_map, si_scale, titled
-from fretwear.run_linear import _figure_path, _geometry
-from fretwear.runner import RunOutput, register
-from fretwear.schema import Field, Integer, Number, Text, fail, join
-from fretwear.transient import (
+from fretwear.analyses import figures as plots
+from fretwear.analyses.linear import _figure_path, _geometry
+from fretwear.analyses.periodic import (
+    _pad_axes,
+    interface_abscissa,
+    plot_state_map,
+    si_scale,
+    titled,
+)
+from fretwear.analyses.registry import RunOutput, register
+from fretwear.hb.contact import STATE_NAMES
+from fretwear.hb.fourier import FourierBasis, amplitude
+from fretwear.io.results import label_coordinate, variable
+from fretwear.io.schema import Field, Integer, Number, Text, fail, join
+from fretwear.timedomain.integrate import (
     IncrementalWearResult,
     TransientResult,
     classify_sequence,
@@ -39,7 +46,7 @@ from fretwear.transient import (
 
 #: forcing periods integrated after a steady-state run for the Poincare / drift figure
 POINCARE_PERIODS = 128
-#: energy terms of :class:`~fretwear.transient.TransientResult` -> (variable, long name)
+#: energy terms of :class:`~fretwear.timedomain.integrate.TransientResult` -> (variable, long name)
 ENERGY_TERMS = {
     "external": ("cumulative_external_work", "work of the loads since the period start"),
     "friction": ("cumulative_friction_dissipation",
@@ -76,9 +83,11 @@ def time_run(model, analysis: dict, omega: float, progress: bool):
     Returns
     -------
     ``(last, classification, periods_before, info)``: ``last`` the
-    :class:`~fretwear.transient.TransientResult` whose last recorded period is reported and
+    :class:`~fretwear.timedomain.integrate.TransientResult` whose last recorded period is reported
+    and
     whose Poincare samples are drawn; ``classification`` a
-    :class:`~fretwear.transient.Classification`; ``periods_before`` the periods integrated
+    :class:`~fretwear.timedomain.integrate.Classification`; ``periods_before`` the periods
+    integrated
     before ``last`` started; ``info`` attributes (periods, wall time [s]).
     """
     steps = analysis["steps_per_period"]
@@ -372,7 +381,7 @@ register(
     run_transient,
     checks=(_check_harmonics,),
     doc="Forced response integrated in time from rest with exact unilateral contact and "
-    "Coulomb friction (`fretwear.transient`, no penalty, no harmonic truncation); the "
+    "Coulomb friction (`fretwear.timedomain.integrate`, no penalty, no harmonic truncation); the "
     "hysteretic loss factor becomes the equivalent viscous damping at the forcing frequency. "
     f"A steady-state run is followed by {POINCARE_PERIODS} more periods for the drift figure; "
     "the last one is reported. The run exits with status 1 when a steady-state run is still "
@@ -424,7 +433,7 @@ def plot_incremental_profiles(ds: xr.Dataset, path: Path, *, title: str | None =
 
 def run_incremental_wear(model, analysis: dict, case, outdir: Path, progress: bool
                          ) -> RunOutput:
-    """Quasi-static incremental wear (:func:`fretwear.transient.incremental_wear`)."""
+    """Quasi-static incremental wear (:func:`fretwear.timedomain.integrate.incremental_wear`)."""
     r = incremental_wear(model, steps_per_cycle=analysis["steps_per_cycle"],
                          n_cycles=analysis["n_cycles"], cycle_jump=analysis["cycle_jump"],
                          record_every=analysis["record_every"], progress=progress)
@@ -456,7 +465,8 @@ register(
                               "the last)", default=1),
     },
     run_incremental_wear,
-    doc="Quasi-static fretting wear by load steps (`fretwear.transient.incremental_wear`, in "
+    doc="Quasi-static fretting wear by load steps "
+    "(`fretwear.timedomain.integrate.incremental_wear`, in "
     "the spirit of Stromberg 1997): exact contact and incremental Coulomb friction at every "
     "load step, Archard wear (k_w = contact.wear_coefficient) applied after each step; "
     "inertia and damping are ignored. Writes `wear-profile.png` (wear depth along the "

@@ -2,7 +2,7 @@
 
 Each function turns :mod:`fretwear.linear` results into a results dataset (schema in
 ``docs/results.md``), figures and ParaView files, and registers itself with
-:mod:`fretwear.runner`.
+:mod:`fretwear.analyses.registry`.
 """
 
 from __future__ import annotations
@@ -13,9 +13,11 @@ import numpy as np
 import xarray as xr
 from tqdm import tqdm
 
-from fretwear import linear, plots
+from fretwear import linear
+from fretwear.analyses import figures as plots
+from fretwear.analyses.registry import RunOutput, register
 from fretwear.errors import InputError
-from fretwear.results import (
+from fretwear.io.results import (
     complex_variables,
     label_coordinate,
     nodal_vectors,
@@ -23,8 +25,7 @@ from fretwear.results import (
     write_pvd,
     write_vtu,
 )
-from fretwear.runner import RunOutput, register
-from fretwear.schema import Field, Integer, ListOf, Number, Text, fail, increasing
+from fretwear.io.schema import Field, Integer, ListOf, Number, Text, fail, increasing
 
 COMPONENTS = ("N", "T1", "T2")
 AXES = ("x", "y", "z")

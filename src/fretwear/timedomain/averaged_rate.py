@@ -6,14 +6,14 @@ the structure may bifurcate to a subharmonic or quasi-periodic response, or the 
 (a few harmonics, sampled stick-slip transitions) may lose its solution while the structure still
 vibrates periodically. In both cases the wear per cycle is still well defined as the mean, over
 many vibration periods, of Archard's integrand (eq. 12, 29) on what the structure does. This
-module computes that mean with the exact time integration of :mod:`fretwear.transient`
+module computes that mean with the exact time integration of :mod:`fretwear.timedomain.integrate`
 (Newmark with unilateral contact and Coulomb friction, no regularisation):
 
     dW1_p = c_p S_p,    S_p = (1/K) sum_n lambda_N,p(t_n) |x_T,p(t_n+1) - x_T,p(t_n)|
 
 over the steps ``n`` of ``K`` periods in which node ``p`` slips
 
-with ``c_p`` the factor of the wear law (:func:`fretwear.wear.wear_coefficients`): ``k_w /
+with ``c_p`` the factor of the wear law (:func:`fretwear.wear.simulate.wear_coefficients`): ``k_w /
 area`` for Archard, ``k_e mu / area`` for the energy law, exactly as on the DLFT samples. A node
 that sticks wears exactly nothing (its slip increments are zero by the exact stick constraint).
 
@@ -29,11 +29,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fretwear import contact as law
-from fretwear.fourier import FourierBasis
+from fretwear.hb import contact as law
+from fretwear.hb.fourier import FourierBasis
 from fretwear.model.core import Model
 
-#: response kinds of :func:`fretwear.transient.classify_sequence`, coded in wear histories
+#: response kinds of :func:`fretwear.timedomain.integrate.classify_sequence`, coded in wear
+# histories
 RESPONSE_KINDS = ("periodic", "subharmonic", "drifting", "quasi-periodic", "irregular",
                   "transient")
 
@@ -99,7 +100,7 @@ def default_steps(basis: FourierBasis, steps: int | None = None) -> int:
 
 
 def window_samples(u_loc, lam, state):
-    """The recorded samples of :func:`fretwear.transient.integrate` in the DLFT layout.
+    """The recorded samples of :func:`fretwear.timedomain.integrate.integrate` in the DLFT layout.
 
     The integrator records ``x(t_n)``, the force ``lambda_n`` that acts over the step
     ``t_n -> t_n+1`` and the state of that step. Returns ``(x, lam, state)`` as (nc, d, ns),
@@ -132,7 +133,7 @@ def time_averaged_rate(model: Model, omega: float, basis: FourierBasis, coef, we
     steps_per_period : time steps per period (default: :func:`default_steps`).
     classify_tol : relative periodicity tolerance of the response classification.
     """
-    from fretwear.transient import classify_sequence, fourier_coefficients, integrate
+    from fretwear.timedomain.integrate import classify_sequence, fourier_coefficients, integrate
 
     t0 = time.perf_counter()
     hmax = max(basis.harmonics) if basis.harmonics else 1

@@ -6,7 +6,7 @@ Unknowns are the real Fourier coefficients ``U~`` of the contact-local displacem
 
     f(U~) = eps (U~ - W~ - X~),         X~ = lambda_x~ / eps,
 
-with ``lambda_x`` from the time-domain law of :mod:`fretwear.contact` applied to
+with ``lambda_x`` from the time-domain law of :mod:`fretwear.hb.contact` applied to
 ``lambda_u = F~ - Z U~ + eps (U~ - W~)`` (eq. 23). ``W~`` holds gap + wear on the normal DOFs
 (static term). The Jacobian is ``J = eps I - G (eps I - Z)`` with ``G = d lambda_x~/d lambda_u~``
 block-diagonal per node.
@@ -19,12 +19,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fretwear import contact as law
 from fretwear.errors import InputError
-from fretwear.fourier import FourierBasis, amplitude
+from fretwear.hb import contact as law
+from fretwear.hb.fourier import FourierBasis, amplitude
+from fretwear.hb.reduce import Reduced, condense, loads_to_real, recover, to_real_blocks
+from fretwear.hb.solvers import SolveStats, solve
 from fretwear.model.core import ContactInterface, Model
-from fretwear.reduce import Reduced, condense, loads_to_real, to_real_blocks
-from fretwear.solvers import SolveStats, solve
 
 
 class DLFTProblem:
@@ -32,7 +32,7 @@ class DLFTProblem:
 
     Parameters
     ----------
-    reduced : :class:`~fretwear.reduce.Reduced` on the orders ``[0] + basis.harmonics``.
+    reduced : :class:`~fretwear.hb.reduce.Reduced` on the orders ``[0] + basis.harmonics``.
     contact : the interface (friction coefficient per node is ``contact.mu``).
     basis : Fourier basis.
     gap : (nc,) normal gap + wear ``W`` [m].
@@ -391,3 +391,15 @@ def assemble_solution(prob: DLFTProblem, U, model: Model, stats: SolveStats) -> 
         area=np.asarray(model.contact.area, float), coords=np.asarray(model.contact.coords),
         stats=stats,
     )
+
+
+def initial_state(model: Model, sol: PeriodicSolution):
+    """Full-field displacement [m] and velocity [m/s] at ``t = 0`` of a periodic solution."""
+    b = sol.basis
+    m = sol.U.shape[0] * sol.U.shape[1]
+    Uc = b.to_complex(sol.U.reshape(m, -1))  # (k+1, m) complex amplitudes
+    orders = np.array([0, *b.harmonics])
+    Ufull = recover(model, sol.omega, orders, Uc, quasi_static=sol.quasi_static)
+    U0 = Ufull.real.sum(axis=0)
+    V0 = -(orders[:, None] * sol.omega * Ufull.imag).sum(axis=0)
+    return U0, V0

@@ -4,13 +4,13 @@ For every contact node ``p`` the kernel evaluates the *slip work integral*
 
     S_p = sum over slip instants n of  lambda_N(n) |X_T(n) - X_T(n-1)|        [N m]
 
-on the converged DLFT samples (:mod:`fretwear.contact`): ``lambda_N(n) = lambda_u,N(n)`` in
+on the converged DLFT samples (:mod:`fretwear.hb.contact`): ``lambda_N(n) = lambda_u,N(n)`` in
 slip (``lambda_x,N = 0``), ``X = lambda_x / eps`` and ``X_T(-1) = X_T(N-1)`` (periodic). With
 Archard's law the wear depth per cycle is ``k_w S_p / area_p`` (eq. 29 with the corrected slip);
 with Coulomb slip the friction energy per cycle is exactly ``mu S_p``.
 
 The derivative ``dS_p / d lambda_u~`` (with respect to the real Fourier coefficients of the
-node's ``lambda_u``) follows the recursion of :func:`fretwear.contact.dlft_jacobian`:
+node's ``lambda_u``) follows the recursion of :func:`fretwear.hb.contact.dlft_jacobian`:
 ``A(n) = d lambda_x(n) / d lambda_u~ = A0(n) + S(n) seed`` with ``seed = A_T(-1) = A_T(N-1)``
 (the wrap-around of the period, solved exactly), and
 
@@ -18,7 +18,7 @@ node's ``lambda_u``) follows the recursion of :func:`fretwear.contact.dlft_jacob
 
 ``t(n) = dX_T(n) / |dX_T(n)|`` (zero when the node does not move). Everything here works on
 plain arrays; the bookkeeping (areas, coefficients, chaining with ``d lambda_u~ / dU``) is in
-:mod:`fretwear.wear`.
+:mod:`fretwear.wear.simulate`.
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from fretwear.contact import SEPARATION, SLIP, STICK, slip_derivative_step
+from fretwear.hb.contact import SEPARATION, SLIP, STICK, slip_derivative_step
 
 
 @njit(cache=True)
@@ -72,7 +72,7 @@ def slip_work_gradient(lam_u, lam_x, state, mu, Q, eps):
     -------
     S : (nc,) slip work; dS : (nc, d*H) with columns ordered ``c*H + h`` (component ``c`` of
     the node, real Fourier coefficient ``h``), as the blocks of
-    :func:`fretwear.contact.dlft_jacobian`. Nodes that stick (or are separated) all period
+    :func:`fretwear.hb.contact.dlft_jacobian`. Nodes that stick (or are separated) all period
     have ``S = 0`` and a zero gradient.
     """
     nc, d, N = lam_u.shape

@@ -1,9 +1,9 @@
 """The ``"wear"`` analysis of case files: fretting wear on the slow time scale.
 
-Runs :func:`fretwear.wear.simulate_wear` (paper section 3.3, eq. 29-30) at one excitation
+Runs :func:`fretwear.wear.simulate.simulate_wear` (paper section 3.3, eq. 29-30) at one excitation
 frequency (or quasi-static), with a checkpoint in the results folder so that
 ``fretwear run CASE.toml --resume`` continues an interrupted run to the same result; turns the
-:class:`~fretwear.wear.WearHistory` into a results dataset (schema in ``docs/results.md``,
+:class:`~fretwear.wear.simulate.WearHistory` into a results dataset (schema in ``docs/results.md``,
 section ``wear``), draws the figures of the paper's section 4.2 (worn profiles, wear
 kinetics, pressure and slip along the interface, worn volume) and, when asked, the nonlinear
 FRFs before and after wear (paper Fig. 24).
@@ -17,15 +17,17 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from fretwear import plots
-from fretwear.contact import STATE_NAMES
-from fretwear.fourier import FourierBasis
-from fretwear.results import label_coordinate, variable
-from fretwear.runner import RunOutput, register
-from fretwear.schema import Field, Flag, Integer, ListOf, Number, Table, Text, fail, increasing
-from fretwear.solvers import SOLVERS
-from fretwear.wear import LAWS, SCHEMES, WearOptions, WearResult, frf_worn, simulate_wear
-from fretwear.wear_time import RESPONSE_KINDS
+from fretwear.analyses import figures as plots
+from fretwear.analyses.registry import RunOutput, register
+from fretwear.hb.contact import STATE_NAMES
+from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.solvers import SOLVERS
+from fretwear.hb.sweep import frequency_grid
+from fretwear.io.results import label_coordinate, variable
+from fretwear.io.schema import Field, Flag, Integer, ListOf, Number, Table, Text, fail, increasing
+from fretwear.timedomain.averaged_rate import RESPONSE_KINDS
+from fretwear.timedomain.fallback import FALLBACK
+from fretwear.wear.simulate import LAWS, SCHEMES, WearOptions, WearResult, frf_worn, simulate_wear
 
 CHECKPOINT_FILE = "wear-checkpoint.npz"
 COMPONENTS = ("N", "T1", "T2")
@@ -34,7 +36,7 @@ AXES = ("x", "y", "z")
 
 # --- options ----------------------------------------------------------------------------------
 def options_from_table(a: dict) -> WearOptions:
-    """:class:`~fretwear.wear.WearOptions` from the validated ``[analysis]`` table."""
+    """:class:`~fretwear.wear.simulate.WearOptions` from the validated ``[analysis]`` table."""
     return WearOptions(
         law=a["law"], energy_coefficient=a.get("energy_coefficient"), scheme=a["scheme"],
         adaptive=a["adaptive"], tolerance=a["tolerance"], initial_jump=a.get("initial_jump"),
@@ -314,16 +316,15 @@ def run_wear(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOu
         fail("analysis.plot_nodes", nodes, f"contact node numbers from 0 to {nc - 1}")
     result = simulate_wear(model, basis, omega=2 * np.pi * f_hz, quasi_static=quasi,
                            options=opts, eps=a.get("eps"), checkpoint=outdir / CHECKPOINT_FILE,
-                           resume=bool(case.resume), progress=progress)
+                           resume=bool(case.resume), progress=progress, time_domain=FALLBACK)
     frf, frf_note = None, ""
     fb = a.get("frf_before_after")
     if fb is not None and model.observed:
         grid = (fb["f_min"], fb["f_max"], fb["n_points"])
         sweeps = {name: frf_worn(model, w, grid, basis, solver=a["solver"], eps=a.get("eps"),
-                                 spacing=fb["spacing"], time_domain=fb["time_domain"])
+                                 spacing=fb["spacing"],
+                                 time_domain=FALLBACK if fb["time_domain"] else None)
                   for name, w in (("unworn", 0.0), ("worn", result.final_wear))}
-        from fretwear.sweep import frequency_grid
-
         frf = _frf_data(model, sweeps, frequency_grid(*grid, fb["spacing"]))
         frf_note = "\n".join(f"FRF {k}: {int(v.converged.sum())}/{len(v.points)} converged"
                              for k, v in sweeps.items())
@@ -382,7 +383,7 @@ _FRF = Table(
                              "the neighbour (as in `frf` sweeps)", default=True),
     },
     checks=(increasing("f_min", "f_max", "Hz"),),
-    doc="Nonlinear FRFs (fretwear.sweep) of the unworn and the worn interface.",
+    doc="Nonlinear FRFs (fretwear.hb.sweep) of the unworn and the worn interface.",
 )
 
 #: keys of the ``[analysis]`` table of ``type = "wear"``

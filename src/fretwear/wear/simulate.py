@@ -1,7 +1,7 @@
 """Fretting wear on the slow time scale: "DLFT with wear" (paper section 3.3, eq. 29-30).
 
 Two time scales (paper section 2): the vibration period (fast) is solved by the DLFT harmonic
-balance (:mod:`fretwear.hbm`); the wear depth ``W`` of every contact node evolves over the
+balance (:mod:`fretwear.hb.periodic`); the wear depth ``W`` of every contact node evolves over the
 cycle count ``N`` (slow) by
 
     dW/dN = g(W),       g_p = dW1_p = wear depth per cycle of node p on the periodic
@@ -15,7 +15,7 @@ slip ``X_T(n) - X_T(n-1)``, which is exactly zero in stick):
   ``dW1_p = k_e E_p / area_p`` with ``E_p = sum_n lambda_T(n).(X_T(n) - X_T(n-1))``.
 
 With Coulomb slip ``E_p = mu sum_n lambda_N |dX_T|`` exactly, so both laws are ``c_p S_p`` with
-the slip work ``S_p`` of :mod:`fretwear.wear_kernels` and ``c_p = k_w / area_p`` or
+the slip work ``S_p`` of :mod:`fretwear.wear.kernels` and ``c_p = k_w / area_p`` or
 ``k_e mu / area_p``; the worn volume per cycle of Archard's law is ``k_w / mu`` times the
 friction energy per cycle.
 
@@ -37,7 +37,7 @@ against the trapezoidal rule ``|W_{k+1} - W_k - dN (g(W_k) + g(W_{k+1}))/2|`` (n
 relative to the current maximum wear depth.
 
 Each step starts from the previous periodic solution (warm start) and keeps the stick anchors
-of its mean tangential position (the loading history rule of :mod:`fretwear.sweep`). A step
+of its mean tangential position (the loading history rule of :mod:`fretwear.hb.sweep`). A step
 whose solve fails is retried with a smaller jump; when that fails too the run stops, says so,
 and keeps every converged step. A checkpoint (``.npz``, written atomically) holds the complete
 state, so that an interrupted run resumes to the same result.
@@ -55,22 +55,24 @@ from pathlib import Path
 
 import numpy as np
 
-from fretwear import contact as law
-from fretwear import solvers
 from fretwear.errors import ConvergenceError, InputError
-from fretwear.fourier import FourierBasis
-from fretwear.hbm import (
+from fretwear.files import atomic_write
+from fretwear.hb import contact as law
+from fretwear.hb import solvers
+from fretwear.hb.fallback import TimeDomainFallback
+from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.periodic import (
     DLFTProblem,
     PeriodicSolution,
     assemble_solution,
+    initial_state,
     solve_periodic,
     static_anchor,
 )
+from fretwear.hb.reduce import Reduced, condense
+from fretwear.hb.solvers import SOLVERS, SolveStats, solve, solve_identity_rows
 from fretwear.model.core import Model
-from fretwear.reduce import Reduced, condense
-from fretwear.results import atomic_write
-from fretwear.solvers import SOLVERS, SolveStats, solve, solve_identity_rows
-from fretwear.wear_kernels import slip_work, slip_work_gradient
+from fretwear.wear.kernels import slip_work, slip_work_gradient
 
 LAWS = ("archard", "energy")
 SCHEMES = ("implicit", "rosenbrock", "explicit")
@@ -128,13 +130,13 @@ def wear_per_cycle(sol: PeriodicSolution, *, law_name: str = "archard",
     """Wear depth per cycle ``dW1`` per node (nc,) [m] of a converged periodic solution.
 
     Archard (eq. 29 with the corrected slip): ``k_w sum_n p_N(n) |X_T(n) - X_T(n-1)|``, from
-    :meth:`~fretwear.hbm.PeriodicSolution.pressure_t` and
-    :meth:`~fretwear.hbm.PeriodicSolution.slip_t` (zero in stick, so a node that sticks all
+    :meth:`~fretwear.hb.periodic.PeriodicSolution.pressure_t` and
+    :meth:`~fretwear.hb.periodic.PeriodicSolution.slip_t` (zero in stick, so a node that sticks all
     period does not wear). Energy law (Fouvry et al. 2003): ``k_e E_p / area_p`` with ``E_p``
-    from :meth:`~fretwear.hbm.PeriodicSolution.friction_energy`.
+    from :meth:`~fretwear.hb.periodic.PeriodicSolution.friction_energy`.
 
     This is the post-processing route; the integrators use the kernel
-    :func:`fretwear.wear_kernels.slip_work`, which gives the same numbers.
+    :func:`fretwear.wear.kernels.slip_work`, which gives the same numbers.
     """
     if law_name == "archard":
         return float(wear_coefficient) * np.sum(sol.pressure_t() * sol.slip_t(), axis=1)
@@ -175,7 +177,7 @@ def zero_wear_zones(x, wear, fraction: float = 0.01) -> list[list[float]]:
 # linear algebra: identity rows of the DLFT Jacobian
 # --------------------------------------------------------------------------------------------
 def newton(fun, x0, scale, *, tol=1e-9, max_iter=30) -> tuple[np.ndarray, SolveStats]:
-    """Newton's method of :mod:`fretwear.solvers` (backtracking on ``|f|^2``, the LU of the
+    """Newton's method of :mod:`fretwear.hb.solvers` (backtracking on ``|f|^2``, the LU of the
     rows that are not plain identity rows) for the warm-started balances of the slow steps.
     Returns ``(x, stats)``."""
     x, _, st = solvers.newton(fun, x0, scale, tol=tol, max_iter=max_iter)
@@ -201,8 +203,9 @@ class SlowProblem:
     """
 
     def __init__(self, model: Model, reduced: Reduced, basis: FourierBasis, coef, *, eps=None,
-                 anchor=None):
+                 anchor=None, time_domain: TimeDomainFallback | None = None):
         self.model = model
+        self.time_domain = time_domain  # fallback of failed balances (None: none)
         self.gap0 = np.broadcast_to(np.asarray(model.contact.gap, float),
                                     (model.contact.n_nodes,)).copy()
         self.prob = DLFTProblem(reduced, model.contact, basis, gap=self.gap0, eps=eps,
@@ -306,7 +309,7 @@ class SlowProblem:
         """Periodic solution at wear ``W`` from ``U0``: ``(U (m, H), stats)``.
 
         With ``fast``, :func:`newton` first (warm starts converge in a few steps); if it fails,
-        ``solver`` of :mod:`fretwear.solvers` from the same start."""
+        ``solver`` of :mod:`fretwear.hb.solvers` from the same start."""
         self.set_state(W, anchor)
         p = self.prob
 
@@ -384,13 +387,13 @@ class WearOptions:
     plateau_rate : stop when the worn-volume rate falls below this fraction of its initial
         value (the plateau of paper Fig. 25).
     max_steps : stop after this many slow steps.
-    solver, tol, max_iter : nonlinear solver (:func:`fretwear.solvers.solve`), its relative
+    solver, tol, max_iter : nonlinear solver (:func:`fretwear.hb.solvers.solve`), its relative
         residual tolerance ``eps_r`` and iteration cap.
     max_retries : jump reductions (by 4) tried after a failed solve before stopping.
     time_domain_rescue : (dynamic cases) when a step's periodic balance fails, take the step
         from a time integration at the predicted wear (:func:`_time_domain_step`): from its
         periodic state when it has one and the balance converges from there, otherwise with the
-        wear rate averaged over its periods (:mod:`fretwear.wear_time`).
+        wear rate averaged over its periods (:mod:`fretwear.timedomain.averaged_rate`).
     time_domain_settle, time_domain_average : periods integrated before averaging, and
         averaged, by such a step.
     time_domain_steps : time steps per period of such a step (default ``max(128, 8 x`` the
@@ -484,7 +487,7 @@ HISTORY_FIELDS = {
     "rescued": ("1", "0: balanced step warm-started from the previous one; 1: balance started "
                 "from a time integration; 2: wear rate averaged over a time integration"),
     "response": ("1", "kind of the step's time-integrated response (index in "
-                 "fretwear.wear_time.RESPONSE_KINDS), -1 when none was integrated"),
+                 "fretwear.timedomain.averaged_rate.RESPONSE_KINDS), -1 when none was integrated"),
     "rate_scatter": ("1", "steps with time-averaged rates: |v1 - v2| / (v1 + v2), v1, v2 the "
                      "worn-volume rates of the two halves of the averaging window (relative "
                      "standard error of the rate); NaN on balanced steps (exact periodic rate)"),
@@ -732,7 +735,8 @@ def simulate_wear(model: Model, basis: FourierBasis, *, omega: float = 2 * np.pi
                   quasi_static: bool = False, options: WearOptions | None = None,
                   reduced: Reduced | None = None, eps: float | None = None, anchor=None,
                   W0=None, U0=None, checkpoint: Path | str | None = None, resume: bool = False,
-                  progress: bool = False, callback: Callable | None = None) -> WearResult:
+                  progress: bool = False, callback: Callable | None = None,
+                  time_domain: TimeDomainFallback | None = None) -> WearResult:
     """Integrate fretting wear over the slow time scale (paper Fig. 3, eq. 29-30).
 
     Parameters
@@ -752,6 +756,10 @@ def simulate_wear(model: Model, basis: FourierBasis, *, omega: float = 2 * np.pi
     progress : show a tqdm bar (cycles, worn volume, rate, time left).
     callback : ``callback(step, history_row)`` after each accepted step (and after the
         checkpoint is written); raising ``KeyboardInterrupt`` there stops the run as Ctrl-C.
+    time_domain : the :class:`~fretwear.hb.fallback.TimeDomainFallback` of the steps whose
+        balance fails (``options.time_domain_rescue``, dynamic cases); ``None``: no fallback
+        (a failed balance stops the run). :func:`fretwear.simulate_wear` passes
+        :data:`fretwear.timedomain.fallback.FALLBACK`.
 
     Returns
     -------
@@ -775,7 +783,9 @@ def simulate_wear(model: Model, basis: FourierBasis, *, omega: float = 2 * np.pi
     if anchor is None:
         anchor = static_anchor(model)
     anchor = np.array(anchor, float).reshape(nc, d - 1)
-    sp = SlowProblem(model, reduced, basis, coef, eps=eps, anchor=anchor)
+    sp = SlowProblem(model, reduced, basis, coef, eps=eps, anchor=anchor,
+                     time_domain=time_domain if opts.time_domain_rescue and not quasi_static
+                     else None)
     key = fingerprint(model, reduced, basis, sp.eps, coef, opts, W0, anchor)
     ckpt = Path(checkpoint) if checkpoint is not None else None
 
@@ -799,7 +809,7 @@ def simulate_wear(model: Model, basis: FourierBasis, *, omega: float = 2 * np.pi
                 new_state, row, failure = _time_domain_step(sp, state, opts)
             else:
                 new_state, row, failure = _advance(sp, state, opts)
-                if failure and opts.time_domain_rescue and not sp.prob.reduced.quasi_static:
+                if failure and sp.time_domain is not None:
                     new_state, row, why = _time_domain_step(sp, state, opts)
                     failure = f"{failure}; {why}" if why else ""
             if failure:
@@ -850,7 +860,7 @@ def _start(sp: SlowProblem, W0, anchor, U0, opts: WearOptions) -> tuple[dict, li
                               anchor=anchor, U0=U0, solver=opts.solver, tol=opts.tol,
                               max_iter=max(opts.max_iter, 200))
     if sol0 is None or not st.converged:
-        if opts.time_domain_rescue and not sp.prob.reduced.quasi_static:
+        if sp.time_domain is not None:
             return _time_domain_start(sp, W0, opts, st, t0)
         raise ConvergenceError(
             f"the periodic solve of the unworn interface did not converge ({st.message}, "
@@ -888,9 +898,7 @@ def _time_domain_start(sp: SlowProblem, W0, opts: WearOptions, st: SolveStats, t
     :func:`_time_domain_step`, and the run goes on with time-domain steps (which go back to the
     DLFT as soon as a balance converges). The first jump is ``initial_jump``, default
     ``START_JUMP`` cycles (no slow Jacobian without a balance; the error control adapts it)."""
-    from fretwear.wear_time import time_averaged_rate
-
-    tr = time_averaged_rate(sp.model, sp.prob.reduced.omega, sp.prob.basis, sp.coef, W0,
+    tr = sp.time_domain.averaged_rate(sp.model, sp.prob.reduced.omega, sp.prob.basis, sp.coef, W0,
                             U0=None, V0=None,
                             settle=max(opts.time_domain_settle, START_SETTLE),
                             average=opts.time_domain_average,
@@ -920,7 +928,7 @@ def _advance(sp: SlowProblem, st: dict, opts: WearOptions):
     anchor = U_k.reshape(sp.nc, sp.d, sp.H)[:, 1:, 0].copy()  # history rule: previous mean
     dN = min(float(st["jump"]), opts.max_jump, opts.max_cycles - float(st["cycles"]))
     floor = max(opts.min_jump, MIN_JUMP_FRACTION * float(st["cycles"]))  # error control
-    rescue = opts.time_domain_rescue and not sp.prob.reduced.quasi_static
+    rescue = sp.time_domain is not None
     # failed solves: with a time-domain rescue behind, stop cutting where the rescue starts
     fail_floor = max(floor, RESCUE_START_FRACTION * float(st["cycles"])) if rescue else floor
     iters = rejected = failures = 0
@@ -1092,7 +1100,8 @@ def _time_domain_step(sp: SlowProblem, st: dict, opts: WearOptions):
     W-method: first order with any matrix). The stiff part of ``Js`` is local (wear unloads the
     node that slips) and changes little, and without it the jumps stay at the explicit
     stability limit with rates that flip from step to step. Then the
-    structure is integrated in time at ``W1`` (:func:`fretwear.wear_time.time_averaged_rate`),
+    structure is integrated in time at ``W1``
+    (:func:`fretwear.timedomain.averaged_rate.time_averaged_rate`),
     continuing the previous time integration when there is one (so that the transient and the
     slow drift of the mean position carry over), else from the last periodic solution. The rate
     at ``W1`` is the mean of Archard's integrand over ``time_domain_average`` periods; the
@@ -1108,9 +1117,6 @@ def _time_domain_step(sp: SlowProblem, st: dict, opts: WearOptions):
     converges again. A balance that failed is not retried before the cycle count has doubled
     (each try costs up to hundreds of iterations).
     """
-    from fretwear.stability import initial_state
-    from fretwear.wear_time import time_averaged_rate
-
     t0 = time.perf_counter()
     W_k, g_k, cycles = st["W"], st["g"], float(st["cycles"])
     if np.size(st["td_U"]):
@@ -1137,7 +1143,8 @@ def _time_domain_step(sp: SlowProblem, st: dict, opts: WearOptions):
         else:
             W1 = W_k + dN * g_k
         try:
-            tr = time_averaged_rate(sp.model, sp.prob.reduced.omega, sp.prob.basis, sp.coef,
+            tr = sp.time_domain.averaged_rate(sp.model, sp.prob.reduced.omega, sp.prob.basis,
+            sp.coef,
                                     W1, U0=U0, V0=V0, settle=opts.time_domain_settle,
                                     average=opts.time_domain_average,
                                     steps_per_period=opts.time_domain_steps)
@@ -1205,7 +1212,8 @@ def without_growth(Js: np.ndarray, max_condition: float = 1e8) -> np.ndarray:
 
 
 def _time_row(tr, area, W, cycles, jump, iters, rejected, err, wall) -> dict:
-    """One history row from a time-averaged rate (:class:`~fretwear.wear_time.TimeAveragedRate`;
+    """One history row from a time-averaged rate
+    (:class:`~fretwear.timedomain.averaged_rate.TimeAveragedRate`;
     ``rescued = 2``)."""
     return {
         "cycles": float(cycles), "jump": float(jump), "wear_depth": np.array(W, float),
@@ -1277,13 +1285,13 @@ def frf_worn(model: Model, wear, frequencies_hz, basis: FourierBasis, *, anchor=
     anchor : stick anchors of the first point (default: static preload).
     point : unused here (kept for the documented signature); read amplitudes with
         ``SweepResult.amplitude(point, axis)``.
-    solver, spacing, **kwargs : passed to :func:`fretwear.sweep.sweep`.
+    solver, spacing, **kwargs : passed to :func:`fretwear.hb.sweep.sweep`.
 
     Returns
     -------
-    :class:`fretwear.sweep.SweepResult`.
+    :class:`fretwear.hb.sweep.SweepResult`.
     """
-    from fretwear.sweep import sweep
+    from fretwear.hb.sweep import sweep
 
     f_min, f_max, n_points = frequencies_hz
     gap = np.broadcast_to(np.asarray(model.contact.gap, float), (model.contact.n_nodes,))

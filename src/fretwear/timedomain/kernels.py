@@ -1,4 +1,4 @@
-"""Numba kernels of the time-domain reference solvers (:mod:`fretwear.transient`).
+"""Numba kernels of the time-domain reference solvers (:mod:`fretwear.timedomain.integrate`).
 
 Three pieces, all on plain arrays:
 
@@ -332,7 +332,7 @@ def run_dynamic(q, dq, diag, a_v, b_v, ds, hc, U, R, P, Qt, bq_m, bd_m, ftab, G,
     """Advance the reduced dynamic model ``n_periods`` forcing periods with fixed steps.
 
     Scheme (two-step form of Newmark's rule, contact force ``lam_n`` at t_n and constraints on
-    ``q_{n+1}``; see :mod:`fretwear.transient`)::
+    ``q_{n+1}``; see :mod:`fretwear.timedomain.integrate`)::
 
         dq_{n+1} = S^-1 (B_d dq_n + B_q q_n) + ftab[k] - G lam_n,   q_{n+1} = q_n + dq_{n+1}
         x_{n+1} = Tx q_{n+1} = xref - W lam_n,   A = W^-1

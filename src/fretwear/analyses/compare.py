@@ -1,14 +1,18 @@
 """``fretwear compare CASE.toml``: the DLFT against the time-domain reference on one case.
 
-* A ``periodic`` case at a frequency: the DLFT periodic solve (:func:`fretwear.hbm.solve_periodic`,
+* A ``periodic`` case at a frequency: the DLFT periodic solve
+(:func:`fretwear.hb.periodic.solve_periodic`,
   the case's harmonics, samples, penalty and solver) and the time-domain steady state of the
-  same model (:func:`fretwear.transient.steady_state`). One figure ``compare.png`` (observed
+  same model (:func:`fretwear.timedomain.integrate.steady_state`). One figure ``compare.png``
+  (observed
   displacement over one period by both methods, contact-state maps side by side, harmonic
   amplitudes), and a table of relative differences: harmonic-1 amplitude at the observed
   points, friction energy per cycle, stick fraction, with the classification of the
   time-domain response and the wall times.
-* A quasi-static ``wear`` case: the DLFT wear (:func:`fretwear.wear.simulate_wear`, the case's
-  options) and :func:`fretwear.transient.incremental_wear` to the same cycle count; one figure
+* A quasi-static ``wear`` case: the DLFT wear (:func:`fretwear.wear.simulate.simulate_wear`, the
+case's
+  options) and :func:`fretwear.timedomain.integrate.incremental_wear` to the same cycle count; one
+  figure
   ``compare-wear.png`` overlays the worn profiles.
 
 Relative differences are ``(time - dlft) / |time|``: the time integration is the reference.
@@ -24,12 +28,8 @@ from pathlib import Path
 import numpy as np
 from matplotlib.colors import BoundaryNorm, ListedColormap
 
-from fretwear import plots
-from fretwear.case import build_model, load_case
-from fretwear.errors import InputError
-from fretwear.hbm import PeriodicSolution, solve_periodic
-from fretwear.reduce import condense
-from fretwear.run_dlft import (
+from fretwear.analyses import figures as plots
+from fretwear.analyses.periodic import (
     STATE_COLOURS,
     _edges,
     _penalty,
@@ -37,8 +37,13 @@ from fretwear.run_dlft import (
     interface_abscissa,
     si_scale,
 )
-from fretwear.run_transient import period_friction_energy, state_fractions
-from fretwear.transient import SteadyStateResult, incremental_wear, steady_state
+from fretwear.analyses.run import load_case
+from fretwear.analyses.transient import period_friction_energy, state_fractions
+from fretwear.errors import InputError
+from fretwear.hb.periodic import PeriodicSolution, solve_periodic
+from fretwear.hb.reduce import condense
+from fretwear.io.case import build_model
+from fretwear.timedomain.integrate import SteadyStateResult, incremental_wear, steady_state
 
 #: cycles computed by the incremental wear reference (at most; the jump sets the rest)
 WEAR_COMPUTED_CYCLES = 200
@@ -223,8 +228,8 @@ def _reference_jump(n_cycles: int, stability_jump: float) -> int:
 def compare_wear(model, analysis: dict, outdir: Path | None, *, steps_per_cycle: int = 128,
                  title: str | None = None) -> Comparison:
     """DLFT wear against incremental wear at the DLFT run's final cycle count."""
-    from fretwear.run_wear import options_from_table
-    from fretwear.wear import simulate_wear
+    from fretwear.analyses.wear import options_from_table
+    from fretwear.wear.simulate import simulate_wear
 
     if not analysis.get("quasi_static"):
         raise InputError("compare: the incremental wear reference is quasi-static; set "

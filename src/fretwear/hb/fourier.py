@@ -73,7 +73,8 @@ class FourierBasis:
 
     def rows_in_full(self, hmax: int) -> np.ndarray:
         """Rows of a full real spectrum ``[a0, a1..a_hmax, b1..b_hmax]`` (the layout of
-        :func:`fretwear.transient.fourier_coefficients`) that hold this basis's coefficients
+        :func:`fretwear.timedomain.integrate.fourier_coefficients`) that hold this basis's
+        coefficients
         ``[0, c_h.., s_h..]``."""
         h = list(self.harmonics)
         if h and max(h) > hmax:

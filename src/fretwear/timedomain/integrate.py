@@ -28,7 +28,7 @@ Signorini exactly and the slip increment ``x_T(n+1) - x_T(n)`` satisfies Coulomb
 Speed: for a fixed step the step matrix is constant, so the structure is reduced exactly
 (Craig-Bampton on the contact DOFs with the fixed-interface modes below a cutoff and one
 static mode per load vector), diagonalised, and each step is a small dense update plus one
-contact problem (numba kernels in :mod:`fretwear.transient_kernels`).
+contact problem (numba kernels in :mod:`fretwear.timedomain.kernels`).
 
 Damping: the viscous ``C`` as given; the hysteretic ``D`` has no causal time-domain form and
 is replaced by the equivalent viscous damping at the forcing frequency, ``C_eq = D / omega``.
@@ -48,7 +48,7 @@ import scipy.sparse.linalg as spla
 
 from fretwear.errors import ConvergenceError, InputError
 from fretwear.model.core import Model
-from fretwear.transient_kernels import OPEN, STICK, run_dynamic, run_quasistatic
+from fretwear.timedomain.kernels import OPEN, STICK, run_dynamic, run_quasistatic
 
 __all__ = [
     "Classification",

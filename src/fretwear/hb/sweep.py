@@ -8,7 +8,8 @@ point that still does not converge is kept in the result as *not converged*, wit
 and never used as a solution.
 
 Mean tangential position (stick anchors): the sweep follows the loading history; the first
-point starts from the static preload (:func:`fretwear.hbm.static_anchor`) and every later point
+point starts from the static preload (:func:`fretwear.hb.periodic.static_anchor`) and every later
+point
 takes the mean tangential positions of the previous converged point as its anchors (a node that
 sticks all period stays where it was). See docs/theory.md, "Full stick and the mean position".
 """
@@ -20,11 +21,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fretwear.fourier import FourierBasis
-from fretwear.hbm import DLFTProblem, PeriodicSolution, assemble_solution, static_anchor
+from fretwear.hb.fallback import TimeDomainFallback
+from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.periodic import DLFTProblem, PeriodicSolution, assemble_solution, static_anchor
+from fretwear.hb.reduce import condense
+from fretwear.hb.solvers import SolveStats, solve
 from fretwear.model.core import Model
-from fretwear.reduce import condense
-from fretwear.solvers import SolveStats, solve
 
 
 @dataclass
@@ -210,7 +212,8 @@ def _arclength(probs, model, anchor, y_prev, y_last, omega_target, solver_tol, m
 def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_points: int, *,
           spacing: str = "log", gap=None, eps=None, anchor=None, solver: str = "powell",
           tol: float = 1e-8, max_iter: int = 40, continuation: bool = True,
-          max_bisections: int = 4, check=None, time_domain: bool = False,
+          max_bisections: int = 4, check=None,
+          time_domain: TimeDomainFallback | None = None,
           time_domain_periods: int = 3000, progress=None) -> SweepResult:
     """Nonlinear FRF: periodic solutions from ``f_min`` to ``f_max`` [Hz].
 
@@ -229,14 +232,16 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
         measurably on eps, so a per-frequency eps makes the FRF jagged and the continuation
         lose its way (docs/theory.md, "The penalty eps").
     anchor : stick anchors of the first point (default: static preload state).
-    solver, tol, max_iter : nonlinear solver settings (:func:`fretwear.solvers.solve`).
+    solver, tol, max_iter : nonlinear solver settings (:func:`fretwear.hb.solvers.solve`).
     continuation : use pseudo-arclength continuation when a grid step fails.
     max_bisections : halvings of a failed frequency step (the intermediate converged
         points are kept in the result, ``how = "substep"``).
     check : optional callable ``(PeriodicSolution) -> list[str]`` returning flags (e.g. the
-        time-domain stability check of :mod:`fretwear.stability`).
-    time_domain : at a point that still did not converge, integrate in time from the neighbour
-        (:func:`fretwear.stability.time_domain_start`): if the structure settles to a periodic
+        time-domain stability check of :mod:`fretwear.timedomain.stability`).
+    time_domain : a :class:`~fretwear.hb.fallback.TimeDomainFallback` (e.g.
+        :data:`fretwear.timedomain.fallback.FALLBACK`; ``None``: none). At a point that still
+        did not converge, integrate in time from the neighbour: if the structure settles to a
+        periodic
         state, its harmonics and mean positions start one more solve (``how = "time-start"``);
         otherwise the point is flagged with what the structure does there (drifting,
         quasi-periodic...).
@@ -338,10 +343,8 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
             if stb.converged:
                 prob, U, st, how = pb, Ub, stb, "eps-x10"
         td_msg = None
-        if not st.converged and time_domain:
-            from fretwear.stability import time_domain_start
-
-            td_msg, Ut, anc_t = time_domain_start(model, omega, basis, last_solution[0],
+        if not st.converged and time_domain is not None:
+            td_msg, Ut, anc_t = time_domain.start(model, omega, basis, last_solution[0],
                                                   max_periods=time_domain_periods)
             if Ut is not None:
                 prob, U, st = _solve_at(probs, omega, anc_t, Ut.reshape(-1, basis.size),

@@ -1,0 +1,138 @@
+"""Running a case file from end to end: load and validate it against the registered analyses,
+build the model, run the analysis, write ``results.nc`` (:mod:`fretwear.io.results`) and print
+a short summary.
+
+Long analyses (wear) that want ``--resume`` save their state in ``outdir`` with
+:func:`fretwear.files.atomic_write` as they go, and read it back when ``case.resume`` is
+true; on Ctrl-C, :func:`run_case` reports the files saved during the run.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+from fretwear import __version__
+from fretwear.analyses.registry import RunOutput, analysis_tables, get
+from fretwear.errors import InputError
+from fretwear.io import case as case_files
+from fretwear.io.case import Case, build_model, observed_notes
+from fretwear.io.results import read_results, write_results
+
+RESULTS_FILE = "results.nc"
+
+
+def load_case(path: Path | str) -> Case:
+    """Read and validate a case file against the registered analyses
+    (:func:`fretwear.io.case.load_case`); every mistake is one InputError naming the key."""
+    return case_files.load_case(path, analysis_tables())
+
+
+def case_docs() -> str:
+    """The Markdown of ``docs/case-files.md`` (every key of every registered analysis)."""
+    return case_files.case_docs(analysis_tables())
+
+
+def write_case_docs(path: Path | str | None = None) -> Path:
+    """Write :func:`case_docs` to ``path`` (default: ``docs/case-files.md`` of the source tree)."""
+    return case_files.write_case_docs(analysis_tables(), path)
+
+
+# --- running a case ---------------------------------------------------------------------
+class RunInterrupted(KeyboardInterrupt):
+    """Ctrl-C during a run; ``message`` says what was saved."""
+
+    def __init__(self, message: str):
+        super().__init__(message)
+        self.message = message
+
+
+def _up_to_date(results: Path, case) -> bool:
+    """True when ``results`` holds a converged run of exactly this case file text."""
+    if not results.is_file():
+        return False
+    try:
+        attrs = read_results(results).attrs
+    except InputError:
+        return False
+    return attrs.get("case_file") == case.text and int(attrs.get("converged", 0)) == 1
+
+
+def _saved_since(outdir: Path, start: float) -> list[Path]:
+    if not outdir.is_dir():
+        return []
+    return sorted(p for p in outdir.rglob("*")
+                  if p.is_file() and not p.name.startswith(".") and p.stat().st_mtime >= start)
+
+
+def _interrupted_message(outdir: Path, start: float) -> str:
+    saved = _saved_since(outdir, start)
+    if not saved:
+        return "interrupted: nothing was saved"
+    names = ", ".join(str(p.relative_to(outdir)) for p in saved[:6])
+    more = f" and {len(saved) - 6} more" if len(saved) > 6 else ""
+    return (f"interrupted: saved in {outdir}: {names}{more} (no {RESULTS_FILE} unless listed; "
+            "run again with --resume to continue where it can)")
+
+
+def run_case(path: Path | str, outdir: Path | str | None = None, progress: bool = True,
+             resume: bool = False, echo: bool = True) -> RunOutput:
+    """Load, validate, build, run and save a case file.
+
+    Parameters
+    ----------
+    path : the ``.toml`` case file.
+    outdir : results folder; default from ``[output] directory`` (see
+        :meth:`fretwear.io.case.Case.output_dir`).
+    progress : show progress bars (stderr).
+    resume : skip the run when ``outdir/results.nc`` already holds a converged run of the
+        same case text; analyses that checkpoint continue from their checkpoint
+        (``case.resume``).
+    echo : print the summary (stdout).
+
+    Returns
+    -------
+    RunOutput, with ``results`` the NetCDF file written.
+
+    Raises
+    ------
+    InputError, ConvergenceError
+        With a message for the user.
+    RunInterrupted
+        On Ctrl-C, with a message saying what was saved.
+    """
+    case = load_case(path)
+    case.resume = resume
+    analysis = get(case.analysis["type"])
+    out_dir = case.output_dir(outdir)
+    results_path = out_dir / RESULTS_FILE
+    say = print if echo else (lambda *a, **k: None)
+    say(f"fretwear {__version__}: {case.title} ({case.path.name}, analysis {analysis.name})")
+    if resume and _up_to_date(results_path, case):
+        ds = read_results(results_path)
+        say(f"results are up to date: {results_path}")
+        return RunOutput(ds, summary="up to date", results=results_path)
+    start = time.time()
+    try:
+        model = build_model(case)
+        for note in observed_notes(case, model):
+            say(note)
+        out_dir.mkdir(parents=True, exist_ok=True)
+        out = analysis.run(model, case.analysis, case, out_dir, progress)
+        out.results = write_results(
+            results_path, out.dataset, title=case.title, analysis_type=analysis.name,
+            converged=out.converged, case_text=case.text, case_path=str(case.path),
+            analysis=case.analysis,
+        )
+    except KeyboardInterrupt:
+        raise RunInterrupted(_interrupted_message(out_dir, start)) from None
+    if out.summary:
+        say(out.summary)
+    if not out.converged:
+        say("warning: some solves did not converge (results.nc has converged = 0)")
+    say(f"results: {out.results}  ({time.time() - start:.1f} s)")
+    for p in out.figures:
+        say(f"figure:  {p}")
+    for p in out.files:
+        say(f"file:    {p}")
+    return out
