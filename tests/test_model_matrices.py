@@ -150,3 +150,91 @@ def test_singular_stiffness_is_refused():
         build(K=K, contact_normal_dofs=[2], contact_tangential_dofs=[1])
     with pytest.raises(InputError, match=r"DOF\(s\) \[0\] have no stiffness"):
         build(K=np.diag([0.0, 1.0, 1.0]))
+
+
+# --- refused matrices (references: matrices whose eigenvalues are known by construction) ---
+def _chain(n=6, k=1.0):
+    """A chain of unit springs held at both ends: positive definite (its eigenvalues are
+    2 k (1 - cos(j pi / (n + 1))) > 0)."""
+    return sp.diags([-k * np.ones(n - 1), 2 * k * np.ones(n), -k * np.ones(n - 1)], [-1, 0, 1])
+
+
+def _contact_kw():
+    return dict(contact_normal_dofs=[0], contact_tangential_dofs=[1], mu=0.3)
+
+
+def test_indefinite_stiffness_is_refused_with_its_eigenvalue():
+    """The chain with its first spring's coupling set to -3 holds the block [[2, -3], [-3, 2]]
+    (eigenvalue -1): indefinite with a positive diagonal, so the diagonal test alone would
+    let it through. The expected eigenvalue comes from numpy's dense eigvalsh."""
+    K = _chain().tolil()
+    K[0, 1] = K[1, 0] = -3.0
+    K = K.tocsr()
+    lam = np.linalg.eigvalsh(K.toarray())[0]
+    assert lam < 0 and np.all(K.diagonal() >= 0)
+    with pytest.raises(InputError, match=rf"K is indefinite: .*smallest eigenvalue is "
+                                         rf"{lam:.4g}"):
+        from_matrices(K, sp.identity(6), **_contact_kw())
+
+
+def test_indefinite_mass_is_refused():
+    M = sp.csr_matrix(np.array([[1.0, 2.0], [2.0, 1.0]]))  # eigenvalues 3 and -1
+    K = sp.csr_matrix(np.array([[2.0, -1.0], [-1.0, 2.0]]))
+    with pytest.raises(InputError, match=r"M is indefinite: .*smallest eigenvalue is -1\b"):
+        from_matrices(K, M, **_contact_kw())
+
+
+@pytest.mark.parametrize("which", ["C", "D"])
+def test_damping_that_feeds_energy_in_is_refused(which):
+    K = sp.csr_matrix(np.array([[2.0, -1.0], [-1.0, 2.0]]))
+    bad = -0.01 * sp.identity(2)  # x^T C x < 0 for every x: an energy source
+    with pytest.raises(InputError, match=rf"{which} is indefinite.*no energy source"):
+        from_matrices(K, sp.identity(2), **{which: bad}, **_contact_kw())
+
+
+def test_gyroscopic_damping_is_accepted():
+    """A skew-symmetric part does no work (x^T G x = 0): only the symmetric part counts."""
+    K = sp.csr_matrix(np.array([[2.0, -1.0], [-1.0, 2.0]]))
+    C = sp.csr_matrix(np.array([[0.1, 1.0], [-1.0, 0.1]]))
+    from_matrices(K, sp.identity(2), C=C, **_contact_kw())
+
+
+def test_sparse_inertia_counts_the_negative_eigenvalues():
+    """Above the dense limit the count comes from the LDL^T pivots (Sylvester's law of
+    inertia). Reference: the chain's eigenvalues 2 - 2 cos(j pi / (n + 1)) in closed form;
+    shifted by -0.7 (no leading minor is zero, so no pivoting), exactly those below 0.7 are
+    negative."""
+    from fretwear.model.matrices import negative_eigenvalues
+
+    n = 2500
+    j = np.arange(1, n + 1)
+    lam = 2 - 2 * np.cos(j * np.pi / (n + 1))
+    assert negative_eigenvalues((_chain(n) - 0.7 * sp.identity(n)).tocsr(), 0.0) == int(
+        np.sum(lam < 0.7))
+    assert negative_eigenvalues(_chain(n).tocsr(), 0.0) == 0
+
+
+def test_large_indefinite_stiffness_is_refused():
+    """A chain of 2500 DOFs with one coupling flipped to -3 ([[2, -3], [-3, 2]] has the
+    eigenvalue -1): refused through the sparse path."""
+    n = 2500
+    K = _chain(n).tolil()
+    K[0, 1] = K[1, 0] = -3.0
+    with pytest.raises(InputError, match="K is indefinite"):
+        from_matrices(K.tocsr(), sp.identity(n), **_contact_kw())
+
+
+def test_pattern_only_matrix_market_file_is_refused(tmp_path):
+    path = tmp_path / "K.mtx"
+    path.write_text("%%MatrixMarket matrix coordinate pattern general\n2 2 2\n1 1\n2 2\n")
+    with pytest.raises(InputError, match="pattern only"):
+        read_matrix_market(path)
+
+
+def test_matrix_market_header_too_large_for_the_machine_is_refused(tmp_path):
+    """The header alone says 1e9 x 1e9 with 1e12 entries: refused before reading."""
+    path = tmp_path / "K.mtx"
+    path.write_text("%%MatrixMarket matrix coordinate real general\n"
+                    "1000000000 1000000000 1000000000000\n1 1 1.0\n")
+    with pytest.raises(InputError, match=r"needs about .* GiB of memory; this machine has"):
+        read_matrix_market(path)

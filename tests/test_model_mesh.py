@@ -265,3 +265,61 @@ def test_read_wrong_facet_type(tmp_path):
     meshio.write(path, mm, file_format="gmsh22", binary=False)
     with pytest.raises(InputError, match="group 'tri' holds \\['triangle'\\] facets"):
         read(path)
+
+
+# --- element validity (reference: hand-made elements whose validity is known by geometry) ---
+def test_every_structured_element_is_valid():
+    """rectangle() and box() make positively oriented elements: every corner Jacobian is > 0
+    (a unit square element has 1 at each corner: 1 = cross product of two unit edges)."""
+    from fretwear.model.mesh import check_cells, corner_jacobians
+
+    for m in (rectangle(2.0, 1.0, 4, 2), box(1.0, 2.0, 3.0, 2, 2, 2)):
+        check_cells(m)
+        assert np.all(corner_jacobians(m.points, m.cells, m.cell_type) > 0)
+    unit = rectangle(1.0, 1.0, 1, 1)
+    assert np.allclose(corner_jacobians(unit.points, unit.cells, unit.cell_type), 1.0,
+                       rtol=1e-14)
+
+
+def test_self_intersecting_quadrilateral_is_refused():
+    """A bow-tie quadrilateral (two nodes swapped) has corner Jacobians of both signs."""
+    from fretwear.model.core import Mesh
+    from fretwear.model.mesh import check_cells
+
+    pts = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    bowtie = Mesh(pts, np.array([[0, 1, 3, 2]]), "quad")
+    with pytest.raises(InputError, match=r"quad element 0 with nodes \[0, 1, 3, 2\] is "
+                                         r"inverted or self-intersecting"):
+        check_cells(bowtie)
+
+
+def test_inverted_hexahedron_is_refused():
+    """A hexahedron with its top and bottom faces swapped is inverted (negative volume)."""
+    from fretwear.model.core import Mesh
+    from fretwear.model.mesh import check_cells
+
+    m = box(1.0, 1.0, 1.0, 1, 1, 1)
+    flipped = Mesh(m.points, m.cells[:, [4, 5, 6, 7, 0, 1, 2, 3]], "hexahedron")
+    with pytest.raises(InputError, match="hexahedron element 0 .* inverted"):
+        check_cells(flipped)
+
+
+@pytest.mark.parametrize("value", ["nan", "inf", "-inf"])
+def test_mesh_file_with_non_finite_coordinates_is_refused(tmp_path, value):
+    text = (DATA / "square_tri_v41.msh").read_text()
+    bad = text.replace("\n0.25 0.75 0\n", f"\n{value} 0.75 0\n", 1)
+    assert bad != text
+    path = tmp_path / "bad.msh"
+    path.write_text(bad)
+    with pytest.raises(InputError, match="expected finite coordinates"):
+        read(path)
+
+
+def test_user_mesh_with_non_finite_coordinates_is_refused():
+    from fretwear.model.core import Mesh
+    from fretwear.model.mesh import check_cells
+
+    m = rectangle(1.0, 1.0, 2, 2)
+    m.points[4, 1] = np.nan
+    with pytest.raises(InputError, match=r"node 4 has coordinates .*expected finite"):
+        check_cells(Mesh(m.points, m.cells, m.cell_type))

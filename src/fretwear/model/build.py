@@ -30,7 +30,7 @@ from fretwear.model.core import WAVEFORMS, ContactInterface, Load, Mesh, Model, 
 from fretwear.model.fem import assemble, check_material, check_thickness
 from fretwear.model.loads import boundary_load, nodal_areas
 from fretwear.model.mesh import boundary as _boundary
-from fretwear.model.mesh import facet_normals, model_size, orient_facets
+from fretwear.model.mesh import check_cells, facet_normals, model_size, orient_facets
 
 AXES = "xyz"
 
@@ -534,6 +534,7 @@ def from_mesh(mesh: Mesh, material: Material, *, thickness=1.0, damping: Damping
     """
     if not isinstance(mesh, Mesh):
         raise InputError(f"mesh = {mesh!r} is not a fretwear Mesh")
+    check_cells(mesh)
     if not isinstance(material, Material):
         raise InputError(f"material = {material!r} is not a Material(E, nu, rho)")
     if damping is not None and not isinstance(damping, Damping):

@@ -17,6 +17,7 @@ import scipy.sparse as sp
 from fretwear.errors import InputError
 from fretwear.model.build import rigid_motion_check
 from fretwear.model.core import WAVEFORMS, ContactInterface, Load, Model, ObservedPoint
+from fretwear.resources import require_memory
 
 SYMMETRY_TOL = 1e-9  # max |A - A^T| relative to max |A|
 
@@ -55,6 +56,60 @@ def _symmetric(A: sp.csr_matrix, what: str) -> sp.csr_matrix:
         raise InputError(f"{what}[{i}, {i}] = {float(S[i, i]):g} < 0; expected a positive "
                          "semi-definite matrix")
     return S
+
+
+DENSE_INERTIA_LIMIT = 2000  # matrices up to this size get their eigenvalues densely
+
+
+def _most_negative_eigenvalue(S: sp.csr_matrix) -> float:
+    """The smallest eigenvalue of the symmetric ``S`` (dense, or Lanczos for large ones)."""
+    if S.shape[0] <= DENSE_INERTIA_LIMIT:
+        return float(np.linalg.eigvalsh(S.toarray())[0])
+    import scipy.sparse.linalg as spla
+
+    return float(spla.eigsh(S.tocsc(), k=1, which="SA", return_eigenvectors=False)[0])
+
+
+def negative_eigenvalues(S: sp.csr_matrix, shift: float) -> int | None:
+    """The number of eigenvalues of the symmetric ``S`` below ``-shift`` (``shift >= 0``), or
+    None when it cannot be read off a factorisation.
+
+    Sylvester's law of inertia on ``S + shift I = L D L^T``: the number of negative pivots is
+    the number of negative eigenvalues. The sparse LU is taken on a symmetric ordering without
+    row pivoting (``U = D L^T``); where SuperLU had to pivot anyway (a leading minor is zero)
+    the count is not available (None). Small matrices get their eigenvalues densely.
+    """
+    import scipy.sparse.linalg as spla
+
+    n = S.shape[0]
+    A = (S + shift * sp.identity(n, format="csr")).tocsc()
+    if n <= DENSE_INERTIA_LIMIT:
+        return int(np.sum(np.linalg.eigvalsh(A.toarray()) < 0.0))
+    try:
+        lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                       options={"SymmetricMode": True})
+    except RuntimeError:  # exactly singular
+        return None
+    if not np.array_equal(lu.perm_r, lu.perm_c):
+        return None
+    return int(np.sum(lu.U.diagonal() < 0.0))
+
+
+def check_semidefinite(A: sp.csr_matrix, what: str, rtol: float = 1e-9) -> None:
+    """Refuse a matrix whose symmetric part has an eigenvalue below ``-rtol max|A|``: a stiffness
+    or mass that can store negative energy, or a damping that feeds energy in."""
+    S = (0.5 * (A + A.T)).tocsr()
+    big = float(abs(S).max()) if S.nnz else 0.0
+    if big == 0.0 or negative_eigenvalues(S, rtol * big) == 0:
+        return
+    lam = _most_negative_eigenvalue(S)
+    if lam >= -rtol * big:  # the count was not available and the eigenvalue says fine
+        return
+    raise InputError(
+        f"{what} is indefinite: its (symmetric part's) smallest eigenvalue is {lam:.4g}, "
+        f"below -{rtol:g} x max |{what}| = {-rtol * big:.4g}; expected a positive "
+        "semi-definite matrix (no negative energy"
+        + (", no energy source)" if what in ("C", "D") else ")"))
 
 
 def _dofs(values, ndof: int, what: str) -> np.ndarray:
@@ -147,12 +202,16 @@ def from_matrices(K, M, *, contact_normal_dofs, contact_tangential_dofs, gap=0.0
     Raises
     ------
     InputError
-        Bad shapes, asymmetric matrices, DOFs out of range or repeated, contact DOFs fixed,
-        or a stiffness left singular with the contact normal DOFs and fixed DOFs held.
+        Bad shapes, asymmetric matrices, indefinite K or M (negative energy), damping C or D
+        with an indefinite symmetric part (an energy source), DOFs out of range or repeated,
+        contact DOFs fixed, or a stiffness left singular with the contact normal DOFs and
+        fixed DOFs held.
     """
     K = _symmetric(_matrix(K, "K"), "K")
     n = K.shape[0]
     M = _symmetric(_matrix(M, "M", n), "M")
+    check_semidefinite(K, "K")
+    check_semidefinite(M, "M")
 
     normal = _dofs(contact_normal_dofs, n, "contact_normal_dofs").reshape(-1)
     tang = _dofs(contact_tangential_dofs, n, "contact_tangential_dofs")
@@ -206,10 +265,12 @@ def from_matrices(K, M, *, contact_normal_dofs, contact_tangential_dofs, gap=0.0
 
     if C is not None:
         C = _matrix(C, "C", n)
+        check_semidefinite(C, "C")
     if D is not None and loss_factor is not None:
         raise InputError("give either D or loss_factor (D = loss_factor * K), not both")
     if D is not None:
         D = _matrix(D, "D", n)
+        check_semidefinite(D, "D")
     elif loss_factor is not None and _nonnegative(loss_factor, "loss_factor") > 0.0:
         D = (float(loss_factor) * K).tocsr()
 
@@ -281,11 +342,28 @@ def read_matrix_market(path, *, shape: tuple | None = None):
     Raises
     ------
     InputError
-        Missing or malformed file, complex entries, or a shape other than ``shape``.
+        Missing or malformed file, a pattern-only file (no values), complex entries, a
+        shape other than ``shape``, or a size that cannot fit in memory (checked from the
+        header before reading).
     """
     path = Path(path)
     if not path.is_file():
         raise InputError(f"Matrix Market file {str(path)!r} does not exist")
+    try:
+        rows, cols, entries, fmt, field, symmetry = scipy.io.mminfo(str(path))
+    except Exception as exc:  # scipy raises ValueError, IndexError, ... on bad headers
+        raise InputError(f"cannot read Matrix Market file {str(path)!r}: {exc}") from None
+    if field == "pattern":
+        raise InputError(f"Matrix Market file {str(path)!r} holds a pattern only (no values); "
+                         "expected real values")
+    if shape is not None and (len(shape) == 2 and (rows, cols) != tuple(shape)
+                              or len(shape) == 1 and rows * cols != shape[0]):
+        raise InputError(f"Matrix Market file {str(path)!r} holds shape {(rows, cols)}; "
+                         f"expected {tuple(shape)}")
+    stored = rows * cols if fmt == "array" else entries * (2 if symmetry != "general" else 1)
+    # values and indices as read, then as CSR (values, column indices, row pointers)
+    require_memory(40.0 * stored + 16.0 * (rows + 1),
+                   f"Matrix Market file {str(path)!r} ({rows} x {cols}, {stored} values)")
     try:
         A = scipy.io.mmread(str(path))
     except Exception as exc:  # scipy raises ValueError, IndexError, ... on bad files

@@ -334,6 +334,10 @@ def read(path) -> Mesh:
     cells = _unique_rows(cells)
 
     points = np.asarray(m.points, dtype=float)
+    bad = np.flatnonzero(~np.all(np.isfinite(points), axis=1))
+    if bad.size:
+        raise InputError(f"mesh file {str(path)!r}: node {int(bad[0])} has coordinates "
+                         f"{points[int(bad[0])].tolist()}; expected finite coordinates [m]")
     if body_dim == 2:
         if points.shape[1] == 3:
             size = max(float(np.ptp(points[:, :2], axis=0).max()), 1e-300)
@@ -388,7 +392,64 @@ def read(path) -> Mesh:
             nodes = np.union1d(nodes, node_sets[name])
         node_sets[name] = nodes
     mesh.node_sets = node_sets
+    check_cells(mesh, f"mesh file {str(path)!r}")
     return mesh
+
+
+#: for each corner of a hexahedron (meshio/VTK node order), three neighbours that make a
+#: right-handed triad in a positively oriented element
+_HEX_TRIADS = ((1, 3, 4), (2, 0, 5), (3, 1, 6), (0, 2, 7), (7, 5, 0), (4, 6, 1), (5, 7, 2),
+               (6, 4, 3))
+
+
+def corner_jacobians(points: np.ndarray, cells: np.ndarray, cell_type: str) -> np.ndarray:
+    """(ne, k) determinant of the element map's Jacobian at each corner [m^d] (up to a factor
+    of the reference element): positive at every corner for a valid, positively oriented
+    linear element; a sign change inside the element (a self-intersecting or inverted
+    quadrilateral or hexahedron) shows as a corner value <= 0."""
+    p = points[cells]
+    if cell_type in ("quad", "triangle"):
+        nxt, prv = np.roll(p, -1, axis=1), np.roll(p, 1, axis=1)
+        a, b = nxt - p, prv - p
+        return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    if cell_type == "tetra":
+        e = p[:, 1:] - p[:, :1]
+        return np.abs(np.linalg.det(e))[:, None]  # orientation is free; the volume is not
+    if cell_type == "hexahedron":
+        tri = np.asarray(_HEX_TRIADS)
+        e = p[:, tri, :] - p[:, :, None, :]  # (ne, 8, 3 neighbours, 3)
+        return np.linalg.det(e)
+    raise InputError(f"cell type {cell_type!r}; expected quad, triangle, hexahedron or tetra")
+
+
+def check_cells(mesh: Mesh, what: str = "mesh") -> None:
+    """Refuse a mesh with non-finite coordinates or an element that is degenerate, inverted
+    or self-intersecting (a corner Jacobian <= 0, :func:`corner_jacobians`), naming the first
+    such element, its nodes and the corner."""
+    pts = np.asarray(mesh.points, float)
+    bad = np.flatnonzero(~np.all(np.isfinite(pts), axis=1))
+    if bad.size:
+        i = int(bad[0])
+        raise InputError(f"{what}: node {i} has coordinates {pts[i].tolist()}; expected finite "
+                         f"coordinates [m] ({bad.size} node(s) are not finite)")
+    if mesh.cells.size == 0:
+        raise InputError(f"{what} has no cells")
+    if mesh.cells.min() < 0 or mesh.cells.max() >= pts.shape[0]:
+        raise InputError(f"{what}: a cell refers to a node that does not exist (node numbers "
+                         f"from 0 to {pts.shape[0] - 1} expected)")
+    jac = corner_jacobians(pts, np.asarray(mesh.cells), mesh.cell_type)
+    size = float(np.ptp(pts, axis=0).max()) if pts.size else 0.0
+    tiny = 1e-12 * size ** pts.shape[1]
+    wrong = jac <= tiny
+    if np.any(wrong):
+        e, c = (int(v[0]) for v in np.nonzero(wrong))
+        kind = "degenerate (zero size)" if abs(jac[e, c]) <= tiny else (
+            "inverted or self-intersecting")
+        raise InputError(
+            f"{what}: {mesh.cell_type} element {e} with nodes {mesh.cells[e].tolist()} is "
+            f"{kind}: the Jacobian of its map is {jac[e, c]:.3g} at its corner node "
+            f"{int(mesh.cells[e][c])}; expected > 0 at every corner (a valid, positively "
+            "oriented element)")
 
 
 def meshio_dim(cell_type: str) -> int:
