@@ -15,7 +15,7 @@ run stops at ``--max-cycles-79khz`` (default 2e8) if it has no plateau before: w
 periodic balance fails it goes on with time-domain steps (docs/wear.md). A run continued from
 the reproduction's 2e8 checkpoint reached a plateau at 1.03e10 cycles (about 3200 s of step
 wall time); the run from scratch follows another path and had none by 2.28e10: past 1e8
-cycles the path is chaotic (benchmarks/sensitivity_79khz.py; docs/wear.md, open problem 1).
+cycles the path is chaotic (studies/sensitivity_79khz.py; docs/studies/79khz-wear.md).
 ``--max-cycles-79khz 4e10`` lets the run go on to a plateau if it finds one.
 
 BLAS threads: one by default (``--threads`` to change). On a 2-core machine shared with other

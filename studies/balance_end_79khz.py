@@ -1,4 +1,4 @@
-"""Where and how the periodic balance of the 79 kHz wear run ends (docs/wear.md, open problem 1).
+"""Where and how the periodic balance of the 79 kHz wear run ends (docs/studies/79khz-wear.md).
 
 The 79 kHz wear run of the paper's beam (example ``salles2011-79khz``) keeps its DLFT balance for
 17 slow steps; the step from N = 1.075e7 cycles fails and the run goes on with time-averaged
@@ -24,7 +24,7 @@ because the periodic branch ends:
 
 Usage::
 
-    python benchmarks/balance_end_79khz.py [--workdir DIR] [--max-cycles 1.6e7]
+    python studies/balance_end_79khz.py [--workdir DIR] [--max-cycles 1.6e7]
 """
 
 from __future__ import annotations

@@ -7,7 +7,7 @@ each, whether the solve converged, the harmonic-1 amplitude of u_x at P_e, the f
 per cycle, the mean x position of P_e and the fraction of nodes stuck all period, and the
 relative change against the documented rule.
 
-Run: ``python benchmarks/anchor_sensitivity.py [freq_hz ...]`` (default 10e3 70e3 79e3).
+Run: ``python studies/anchor_sensitivity.py [freq_hz ...]`` (default 10e3 70e3 79e3).
 """
 
 from __future__ import annotations

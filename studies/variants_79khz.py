@@ -19,11 +19,11 @@ through the height, plane strain / plane stress) and, for each variant, records:
   at the end / initial, steps and wall time, zero-wear zones (nodes with wear < 1 % of the
   max, the paper's "pillars").
 
-Everything is cached in ``docs/figures/variants-79khz.json`` after each stage, so an interrupted
-study loses nothing; the wear runs also keep a checkpoint (``--work``) and resume from it.
-``--plot-only`` redraws the figures from the cache:
-``docs/figures/variants-79khz-profiles.png`` (final wear profiles) and
-``docs/figures/variants-79khz-volume.png`` (worn volume vs cycles).
+Everything is cached in ``docs/studies/figures/variants-79khz.json`` after each stage, so an
+interrupted study loses nothing; the wear runs also keep a checkpoint (``--work``) and resume
+from it. ``--plot-only`` redraws the figures from the cache:
+``docs/studies/figures/variants-79khz-profiles.png`` (final wear profiles) and
+``docs/studies/figures/variants-79khz-volume.png`` (worn volume vs cycles).
 
 Plane stress is not a fretwear option (2D meshes are plane strain). The plane-stress variant
 uses the exact equivalence of the isotropic elasticity matrices: plane strain with
@@ -34,7 +34,7 @@ Wall times were measured on a shared 2-core machine: noisy, by up to a factor of
 
 Usage::
 
-    python benchmarks/variants_79khz.py [--variants baseline,rayleigh,...] [--max-cycles 1e8]
+    python studies/variants_79khz.py [--variants baseline,rayleigh,...] [--max-cycles 1e8]
         [--wall-budget 600] [--skip-stability] [--plot-only] [--fresh]
 """
 
@@ -54,7 +54,7 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 import numpy as np  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
-FIG_DIR = ROOT / "docs" / "figures"
+FIG_DIR = ROOT / "docs" / "studies" / "figures"
 CACHE = FIG_DIR / "variants-79khz.json"
 F_HZ = 79e3
 L, H, WIDTH = 0.1, 0.01, 0.01

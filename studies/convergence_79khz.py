@@ -9,7 +9,8 @@ section 3.2). Each variant changes one setting:
 * mesh: nx = 60, 100 (``eps`` by the paper's rule on that mesh, and nx = 100 with the
   baseline's ``eps`` value, to separate mesh and penalty);
 * harmonics: 11 (128 samples) and 15 (256 samples), with the paper's rule and with the
-  baseline's ``eps`` value (the rule gives a 7x larger ``eps`` there, see docs/convergence.md);
+  baseline's ``eps`` value (the rule gives a 7x larger ``eps`` there, see
+  docs/studies/79khz-convergence.md);
 * samples: 256, 512 at 7 harmonics;
 * penalty: 0.1, 0.3, 3, 10 x the spectral radius, and the spectral radius of the *static*
   reduced stiffness (the default of frequency sweeps).
@@ -26,22 +27,22 @@ For each variant:
    fractions (node-instants), iterations, wall time;
 2. the wear (default adaptive scheme, tolerance 1e-2) to a common ``N = 5e6`` cycles
    (``max_cycles``, ``plateau_rate = 0``), below the known failure near 1.02e7 cycles
-   (docs/wear.md, "Open problems"); the worn profile is compared with the baseline's on a
+   (docs/studies/79khz-wear.md); the worn profile is compared with the baseline's on a
    fine grid in x (linear interpolation of the nodal depths), with the worn volume and the
    zero-wear zones (nodes with a depth below 1 % of the maximum);
 3. how far the run goes with the default stop criteria (plateau at 1e-3 of the initial
    worn-volume rate), resumed from the checkpoint of step 2 and cut at a wall-time cap.
 
-Results go to a JSON + NPZ cache (``docs/figures/convergence_79khz.json`` and ``.npz``),
-written atomically after each stage of each variant: an interrupted study resumes where it
-stopped, and ``--plot-only`` redraws the figures from the cache. Wear checkpoints go to
-``--work`` (default: a folder in the temporary directory).
+Results go to a JSON + NPZ cache (``docs/studies/figures/convergence_79khz.json`` and
+``.npz``), written atomically after each stage of each variant: an interrupted study resumes
+where it stopped, and ``--plot-only`` redraws the figures from the cache. Wear checkpoints go
+to ``--work`` (default: a folder in the temporary directory).
 
 BLAS threads: one (set before numpy is imported). Wall times on a shared machine are noisy.
 
 Usage::
 
-    python benchmarks/convergence_79khz.py [--plot-only] [--only KEY,...] [--redo]
+    python studies/convergence_79khz.py [--plot-only] [--only KEY,...] [--redo]
         [--no-extend] [--wear-cap 900] [--extend-cap 150] [--work DIR]
 """
 
@@ -68,7 +69,7 @@ N_COMMON = 5e6  # [cycles] common cycle count of the profile comparison
 ZERO_FRACTION = 1e-2  # a node with W below this fraction of max W is in a zero-wear zone
 PAPER_ZERO_ZONES = "x = 0.005 m and 0.025-0.040 m (paper, 79 kHz, at the plateau)"
 ROOT = Path(__file__).resolve().parents[1]
-FIG_DIR = ROOT / "docs" / "figures"
+FIG_DIR = ROOT / "docs" / "studies" / "figures"
 CACHE_JSON = FIG_DIR / "convergence_79khz.json"
 CACHE_NPZ = FIG_DIR / "convergence_79khz.npz"
 

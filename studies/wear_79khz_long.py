@@ -17,12 +17,12 @@ of the mean normal contact force (x = L/2 for this beam: friction and the spring
 contact line and Q has zero mean, so the mean moment balance fixes it; its largest deviation
 over the history is printed as a check of the results). A plateau needs all the load on
 sticking nodes, so it needs sticking nodes on both sides of L/2 (or at it).
-It draws ``docs/figures/wear-79khz-long.png``: wear profiles at selected cycle counts and the
-worn-volume rate against cycles for both runs.
+It draws ``docs/studies/figures/wear-79khz-long.png``: wear profiles at selected cycle counts
+and the worn-volume rate against cycles for both runs.
 
 Usage::
 
-    python benchmarks/wear_79khz_long.py [--workdir DIR] [--seed REPRO_DIR]
+    python studies/wear_79khz_long.py [--workdir DIR] [--seed REPRO_DIR]
         [--max-cycles 3e9] [--only KEY] [--plot-only]
 """
 
@@ -35,7 +35,8 @@ import sys
 from pathlib import Path
 
 KEYS = ("wear-79khz", "wear-79khz-explicit")
-FIGURE = Path(__file__).resolve().parents[1] / "docs" / "figures" / "wear-79khz-long.png"
+FIGURE = (Path(__file__).resolve().parents[1] / "docs" / "studies" / "figures"
+          / "wear-79khz-long.png")
 
 
 def case_text(key: str, max_cycles: float) -> str:

@@ -1,8 +1,10 @@
-"""How reproducible is the 79 kHz wear path? Twin runs that differ by 1e-12 (docs/wear.md).
+"""How reproducible is the 79 kHz wear path? Twin runs that differ by 1e-12.
+
+Write-up: docs/studies/79khz-wear.md, "How reproducible the path is".
 
 From about 1e8 cycles on, the 79 kHz wear run of the paper's beam (example
 ``salles2011-79khz``) takes its wear rates from time integrations of the structure (the
-periodic balance is lost at ~1.3e7 cycles, ``benchmarks/balance_end_79khz.py``). This script
+periodic balance is lost at ~1.3e7 cycles, ``studies/balance_end_79khz.py``). This script
 measures how sensitive that path is, on two time scales, with the same code and settings:
 
 1. runs the case to ``--max-cycles`` (default 1.5e8, about 40 slow steps) in ``--workdir``
@@ -30,7 +32,7 @@ change of the algorithm, a speed-up included, moves it by that much or more.
 
 Usage::
 
-    python benchmarks/sensitivity_79khz.py [--workdir DIR] [--max-cycles 1.5e8]
+    python studies/sensitivity_79khz.py [--workdir DIR] [--max-cycles 1.5e8]
         [--from RUN_DIR] [--periods 1500] [--steps 40]
 """
 
