@@ -3,7 +3,7 @@
 Runs :func:`fretwear.wear.simulate.simulate_wear` (paper section 3.3, eq. 29-30) at one excitation
 frequency (or quasi-static), with a checkpoint in the results folder so that
 ``fretwear run CASE.toml --resume`` continues an interrupted run to the same result; turns the
-:class:`~fretwear.wear.simulate.WearHistory` into a results dataset (schema in ``docs/results.md``,
+:class:`~fretwear.wear.history.WearHistory` into a results dataset (schema in ``docs/results.md``,
 section ``wear``), draws the figures of the paper's section 4.2 (worn profiles, wear
 kinetics, pressure and slip along the interface, worn volume) and, when asked, the nonlinear
 FRFs before and after wear (paper Fig. 24).
@@ -27,7 +27,7 @@ from fretwear.io.results import label_coordinate, variable
 from fretwear.io.schema import Field, Flag, Integer, ListOf, Number, Table, Text, fail, increasing
 from fretwear.timedomain.averaged_rate import RESPONSE_KINDS
 from fretwear.timedomain.fallback import FALLBACK
-from fretwear.wear.simulate import LAWS, SCHEMES, WearOptions, WearResult, frf_worn, simulate_wear
+from fretwear.wear import LAWS, SCHEMES, WearOptions, WearResult, frf_worn, simulate_wear
 
 CHECKPOINT_FILE = "wear-checkpoint.npz"
 COMPONENTS = ("N", "T1", "T2")
@@ -36,7 +36,7 @@ AXES = ("x", "y", "z")
 
 # --- options ----------------------------------------------------------------------------------
 def options_from_table(a: dict) -> WearOptions:
-    """:class:`~fretwear.wear.simulate.WearOptions` from the validated ``[analysis]`` table."""
+    """:class:`~fretwear.wear.options.WearOptions` from the validated ``[analysis]`` table."""
     return WearOptions(
         law=a["law"], energy_coefficient=a.get("energy_coefficient"), scheme=a["scheme"],
         adaptive=a["adaptive"], tolerance=a["tolerance"], initial_jump=a.get("initial_jump"),
