@@ -1,10 +1,12 @@
-"""Settings of a wear simulation: :class:`WearOptions`, and the fixed constants of the
-slow-scale steps.
+"""Settings of a wear simulation: :class:`WearOptions`, the one definition of every option
+and its default (case files take theirs from it, :mod:`fretwear.analyses.wear`), and the fixed
+constants of the slow-scale steps.
 """
 
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import asdict, dataclass
 
 from fretwear.errors import InputError
@@ -12,6 +14,8 @@ from fretwear.hb.solvers import SOLVERS
 from fretwear.wear.laws import LAWS
 
 SCHEMES = ("implicit", "rosenbrock", "explicit")
+#: how the ``"implicit"`` scheme solves its step (:class:`WearOptions` ``implicit_newton``)
+IMPLICIT_NEWTONS = ("nested", "coupled")
 STOP_REASONS = ("max_cycles", "max_depth", "plateau", "no_wear", "max_steps", "solver_failed")
 #: retried jumps are not cut below this fraction of the cycle count
 MIN_JUMP_FRACTION = 1e-5
@@ -84,10 +88,10 @@ class WearOptions:
     initial_jump: float | None = None
     max_jump: float = math.inf
     min_jump: float = 1.0
-    max_cycles: float = 1e15
+    max_cycles: float = 1e12
     max_depth: float = math.inf
     plateau_rate: float = 1e-3
-    max_steps: int = 100_000
+    max_steps: int = 10_000
     solver: str = "powell"
     tol: float = 1e-9
     max_iter: int = 60
@@ -101,31 +105,49 @@ class WearOptions:
     time_domain_steps: int | None = None
     checkpoint_every_s: float = 10.0
 
+    def __post_init__(self):
+        self.check()
+
     def check(self) -> WearOptions:
-        """Validate; raise InputError naming the bad value."""
-        if self.law not in LAWS:
-            raise InputError(f"law = {self.law!r}: expected one of {LAWS}")
-        if self.scheme not in SCHEMES:
-            raise InputError(f"scheme = {self.scheme!r}: expected one of {SCHEMES}")
-        if self.solver not in SOLVERS:
-            raise InputError(f"solver = {self.solver!r}: expected one of {SOLVERS}")
+        """Validate (also done at construction); raise InputError (a ValueError) naming the
+        option and the bad value."""
+        for name, choices in (("law", LAWS), ("scheme", SCHEMES), ("solver", SOLVERS),
+                              ("implicit_newton", IMPLICIT_NEWTONS)):
+            v = getattr(self, name)
+            if not (isinstance(v, str) and v in choices):
+                raise InputError(f"{name} = {v!r}: expected one of {choices}")
+        for name in ("adaptive", "time_domain_rescue"):
+            v = getattr(self, name)
+            if not isinstance(v, bool):
+                raise InputError(f"{name} = {v!r}: expected True or False")
         for name in ("tolerance", "max_jump", "min_jump", "max_cycles", "max_depth", "tol"):
             v = getattr(self, name)
-            if not (isinstance(v, int | float) and v > 0):
+            if not (_is_number(v) and v > 0):
                 raise InputError(f"{name} = {v!r}: expected a positive number")
-        if self.initial_jump is not None and not self.initial_jump > 0:
+        if self.initial_jump is not None and not (_is_number(self.initial_jump)
+                                                  and self.initial_jump > 0):
             raise InputError(f"initial_jump = {self.initial_jump!r}: expected > 0 cycles")
+        ke = self.energy_coefficient
+        if ke is not None and not (_is_number(ke) and ke >= 0):
+            raise InputError(f"energy_coefficient = {ke!r}: expected k_e >= 0 [m^3/J] or None")
+        for name in ("plateau_rate", "checkpoint_every_s"):
+            v = getattr(self, name)
+            if not (_is_number(v) and v >= 0):
+                raise InputError(f"{name} = {v!r}: expected a number >= 0")
+        for name, lo in (("max_steps", 1), ("max_iter", 1), ("max_iter_coupled", 1),
+                         ("max_iter_implicit", 0), ("max_retries", 0)):
+            v = getattr(self, name)
+            if not (_is_integer(v) and v >= lo):
+                raise InputError(f"{name} = {v!r}: expected a whole number >= {lo}")
         for name in ("time_domain_settle", "time_domain_average"):
             v = getattr(self, name)
-            if not (isinstance(v, int) and v >= (0 if name.endswith("settle") else 2)):
+            if not (_is_integer(v) and v >= (0 if name.endswith("settle") else 2)):
                 raise InputError(f"{name} = {v!r}: expected a whole number of periods"
                                  + (" >= 0" if name.endswith("settle") else " >= 2"))
         ts = self.time_domain_steps
-        if ts is not None and not (isinstance(ts, int) and ts >= 8):
+        if ts is not None and not (_is_integer(ts) and ts >= 8):
             raise InputError(f"time_domain_steps = {ts!r}: expected a whole number >= 8 of "
                              "time steps per period")
-        if not self.plateau_rate >= 0:
-            raise InputError(f"plateau_rate = {self.plateau_rate!r}: expected >= 0")
         return self
 
     def trajectory_key(self) -> dict:
@@ -137,3 +159,12 @@ class WearOptions:
             d.pop(k)
         return d
 
+
+def _is_number(v) -> bool:
+    """A real number (numpy's included), not a boolean."""
+    return isinstance(v, numbers.Real) and not isinstance(v, bool)
+
+
+def _is_integer(v) -> bool:
+    """A whole number of an integer type (numpy's included), not a boolean (2.0 is refused)."""
+    return isinstance(v, numbers.Integral) and not isinstance(v, bool)
