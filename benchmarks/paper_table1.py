@@ -1,7 +1,7 @@
 """Paper Table 1: cost of "DLFT with wear" on the beam of section 4.2, quasi-static and 79 kHz.
 
 Runs the beam (30 x 4 Q4, 7 harmonics, 128 samples per period, Archard k_w = 1e-11 1/Pa)
-to the plateau of the worn volume with the default adaptive scheme of :mod:`fretwear.wear.simulate`
+to the plateau of the worn volume with the default adaptive scheme of :mod:`fretwear.wear`
 (linearly implicit Euler),
 and prints slow steps, Newton iterations and wall time next to the paper's Table 1 (Matlab
 R2009, Core i7 920, explicit Euler with jumps capped at 1e8 / 1e7 cycles), then the final worn
@@ -58,7 +58,7 @@ def beam():
 def run_case(name, model, basis, *, omega, quasi_static, options):
     """Run one case; returns (result or None, wall [s], message)."""
     from fretwear.errors import ConvergenceError
-    from fretwear.wear.simulate import simulate_wear
+    from fretwear.wear import simulate_wear
 
     t0 = time.perf_counter()
     try:
@@ -109,7 +109,7 @@ def main(argv=None) -> int:
     import numpy as np
 
     from fretwear.hb.fourier import FourierBasis
-    from fretwear.wear.simulate import WearOptions
+    from fretwear.wear import WearOptions
 
     model = beam()
     basis = FourierBasis.up_to(7, 128)
@@ -167,7 +167,7 @@ def reference_profile(model, basis):
     """The quasi-static reference: explicit Euler, fixed jumps of 2e5 cycles, to N = 3e9."""
     import numpy as np
 
-    from fretwear.wear.simulate import WearOptions, simulate_wear
+    from fretwear.wear import WearOptions, simulate_wear
 
     t0 = time.perf_counter()
     r = simulate_wear(model, basis, omega=2 * np.pi, quasi_static=True,

@@ -2,7 +2,7 @@
 
 The 79 kHz wear run of the paper's beam (example ``salles2011-79khz``) keeps its DLFT balance for
 17 slow steps; the step from N = 1.075e7 cycles fails and the run goes on with time-averaged
-rates (:func:`fretwear.wear.simulate._time_domain_step`) that cost 3-5 s each instead of ~0.1 s.
+rates (:func:`fretwear.wear.time_steps.time_domain_step`) that cost 3-5 s each instead of ~0.1 s.
 This
 script finds out whether the balance is lost because the solver needs smaller steps, because its
 tolerance sits at the round-off floor, because of the discretisation (samples, harmonics), or
@@ -93,7 +93,7 @@ def main(argv=None) -> int:
     from fretwear.hb.solvers import SolveStats
     from fretwear.io.case import build_model
     from fretwear.timedomain.averaged_rate import time_averaged_rate
-    from fretwear.wear.simulate import SlowProblem, read_history, wear_coefficients
+    from fretwear.wear import SlowProblem, read_history, wear_coefficients
 
     with contextlib.ExitStack() as stack:
         workdir = args.workdir or Path(stack.enter_context(tempfile.TemporaryDirectory()))

@@ -305,7 +305,7 @@ class Study:
     def wear(self, v, sol, eps, *, max_cycles, plateau_rate, cap_s, suffix=""):
         """Wear run (resumed from the variant's checkpoint when there is one)."""
         from fretwear.hb.fourier import FourierBasis
-        from fretwear.wear.simulate import WearOptions, simulate_wear
+        from fretwear.wear import WearOptions, simulate_wear
 
         model, anchor = self.model(v["nx"])
         basis = FourierBasis.up_to(v["nh"], v["ns"])
@@ -349,7 +349,7 @@ class Study:
 
 def zero_zones(x, W, frac=ZERO_FRACTION):
     """Intervals [x_first, x_last] of consecutive nodes with W <= frac max W."""
-    from fretwear.wear.simulate import zero_wear_zones
+    from fretwear.wear import zero_wear_zones
 
     return zero_wear_zones(x, W, frac)
 

@@ -97,7 +97,7 @@ def fast_twins(folder: Path, periods: int) -> None:
     from fretwear.hb.fourier import FourierBasis
     from fretwear.io.case import build_model
     from fretwear.timedomain.averaged_rate import default_steps, time_averaged_rate
-    from fretwear.wear.simulate import wear_coefficients
+    from fretwear.wear import wear_coefficients
 
     with np.load(folder / "wear-checkpoint.npz") as z:
         U0, V0, W = z["state_td_U"], z["state_td_V"], z["state_W"]
@@ -144,7 +144,7 @@ def slow_twins(folder: Path, workdir: Path, steps: int) -> None:
 
     from fretwear.analyses.run import run_case
     from fretwear.paper.catalogue import edit_case_text
-    from fretwear.wear.simulate import read_history
+    from fretwear.wear import read_history
 
     with np.load(folder / "wear-checkpoint.npz") as z:
         data = {k: z[k] for k in z.files}

@@ -161,7 +161,7 @@ def stability(model, sol) -> dict:
 
 def zero_zones(x, w, frac=0.01) -> list[list[float]]:
     """x-intervals [m] of consecutive contact nodes whose wear is at most ``frac`` of the max."""
-    from fretwear.wear.simulate import zero_wear_zones
+    from fretwear.wear import zero_wear_zones
 
     return zero_wear_zones(x, w, frac)
 
@@ -170,7 +170,7 @@ def wear_run(name, model, basis, max_cycles, wall_budget, work: Path, fresh: boo
     """The wear run, with a checkpoint; stops (resumably) after ``wall_budget`` seconds."""
     from fretwear.errors import ConvergenceError
     from fretwear.timedomain.averaged_rate import RESPONSE_KINDS
-    from fretwear.wear.simulate import HISTORY_FIELDS, WearHistory, WearOptions, simulate_wear
+    from fretwear.wear import HISTORY_FIELDS, WearHistory, WearOptions, simulate_wear
 
     work.mkdir(parents=True, exist_ok=True)
     ckpt = work / f"{name}.npz"

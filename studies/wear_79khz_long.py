@@ -61,8 +61,8 @@ def run(key: str, workdir: Path, max_cycles: float, seed: Path | None) -> None:
 
 
 def history(folder: Path):
-    """The run's :class:`fretwear.wear.simulate.WearHistory` from its checkpoint, or None."""
-    from fretwear.wear.simulate import read_history
+    """The run's :class:`fretwear.wear.WearHistory` from its checkpoint, or None."""
+    from fretwear.wear import read_history
 
     ck = folder / "wear-checkpoint.npz"
     return read_history(ck) if ck.is_file() else None

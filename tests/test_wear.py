@@ -1,4 +1,4 @@
-"""Tests of fretting wear on the slow scale (fretwear.wear.simulate, fretwear.wear.kernels,
+"""Tests of fretting wear on the slow scale (the fretwear.wear package: laws, kernels, schemes,
 run_wear).
 
 References, each independent of the code under test:
@@ -34,19 +34,19 @@ from fretwear.hb import contact as law
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import solve_periodic, static_anchor
 from fretwear.hb.reduce import condense
+from fretwear.hb.solvers import solve_identity_rows
 from fretwear.model.build import ContactSpec, Material, Spring, Traction, from_mesh
 from fretwear.model.core import ContactInterface, Load, Model
 from fretwear.model.mesh import rectangle
-from fretwear.wear.kernels import slip_work, slip_work_gradient
-from fretwear.wear.simulate import (
+from fretwear.wear import (
     SlowProblem,
     WearOptions,
     read_history,
     simulate_wear,
-    solve_identity_rows,
     wear_coefficients,
     wear_per_cycle,
 )
+from fretwear.wear.kernels import slip_work, slip_work_gradient
 
 KW = 1e-11  # Archard coefficient [1/Pa] (paper section 4)
 MU = 0.3
@@ -366,10 +366,8 @@ def test_plateau_stop_and_history(blk):
 def test_failed_solve_stops_cleanly(blk, monkeypatch):
     """A balance that never converges after step 2: the run stops with "solver_failed", says
     so, and keeps the converged steps only."""
-    import fretwear.wear.simulate as wm
-
     m, red, anc = blk
-    real = wm.SlowProblem.solve_balance
+    real = SlowProblem.solve_balance  # the class the driver's slow steps call
     calls = {"n": 0}
 
     def flaky(self, *a, **k):
@@ -380,7 +378,7 @@ def test_failed_solve_stops_cleanly(blk, monkeypatch):
             st.message = "forced failure"
         return U, st
 
-    monkeypatch.setattr(wm.SlowProblem, "solve_balance", flaky)
+    monkeypatch.setattr(SlowProblem, "solve_balance", flaky)
     r = simulate_wear(m, BASIS, quasi_static=True, reduced=red, anchor=anc,
                       options=WearOptions(scheme="explicit", max_retries=2))
     assert r.stop_reason == "solver_failed" and not r.converged
@@ -560,7 +558,7 @@ def test_frf_worn_uniform_wear_is_a_rigid_shift(blk):
     """The block is held vertically by the contact only: a uniform wear depth translates it
     without changing any force, so the nonlinear FRF (fretwear.hb.sweep with the worn gap) is
     that of the unworn interface, to the solver tolerance (1e-6 relative)."""
-    from fretwear.wear.simulate import frf_worn
+    from fretwear.wear import frf_worn
 
     m, _, anc = blk
     grid = (2e3, 3e3, 3)
@@ -593,7 +591,7 @@ def test_progress_bar_shows_cycles_volume_rate_and_time_left(blk, capsys):
 def test_zero_wear_zones_are_runs_of_unworn_nodes():
     """Hand-made profile (unordered x): the zones are the runs of nodes at most 1 % of the
     deepest, in x order, ends included."""
-    from fretwear.wear.simulate import zero_wear_zones
+    from fretwear.wear import zero_wear_zones
 
     x = np.array([0.5, 0.0, 0.1, 0.2, 0.3, 0.4, 0.6])
     w = np.array([0.0, 0.0, 0.005, 1.0, 0.0, 0.3, 0.02])

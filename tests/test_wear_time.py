@@ -1,6 +1,6 @@
 """Tests of the wear rate averaged over a time integration (fretwear.timedomain.averaged_rate) and
 of the
-time-domain steps of the slow-scale driver (fretwear.wear.simulate).
+time-domain steps of the slow-scale driver (fretwear.wear.simulate, fretwear.wear.time_steps).
 
 References, each independent of the code under test:
 
@@ -20,7 +20,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import fretwear.wear.simulate as wm
+import fretwear.wear.schemes as wear_schemes  # the first balance calls its solve_periodic
+import fretwear.wear.simulate as wear_driver  # the driver calls its advance (balanced steps)
 from fretwear import simulate_wear  # the public driver: time-domain fallback on
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import initial_state, solve_periodic
@@ -28,12 +29,8 @@ from fretwear.hb.reduce import condense
 from fretwear.model.build import ContactSpec, Damping, Material, Spring, Traction, from_mesh
 from fretwear.model.mesh import rectangle
 from fretwear.timedomain.averaged_rate import RESPONSE_KINDS, time_averaged_rate
-from fretwear.wear.simulate import (
-    SlowProblem,
-    WearOptions,
-    wear_coefficients,
-    without_growth,
-)
+from fretwear.wear import SlowProblem, WearOptions, wear_coefficients, without_growth
+from fretwear.wear.options import START_JUMP, START_SETTLE
 
 KW = 1e-11
 MU = 0.3
@@ -141,7 +138,7 @@ def _forced_failures(monkeypatch, balance_fails: bool, first_ok: bool = True):
     ``balance_fails`` the balances of the time-domain steps fail too (the DLFT has no solution
     there), so their rates are averaged."""
     monkeypatch.undo()
-    real_advance = wm._advance
+    real_advance = wear_driver.advance
     calls = {"n": 0 if first_ok else 2}
 
     def advance(sp, st, opts):
@@ -150,7 +147,7 @@ def _forced_failures(monkeypatch, balance_fails: bool, first_ok: bool = True):
             return None, None, "forced failure"
         return real_advance(sp, st, opts)
 
-    monkeypatch.setattr(wm, "_advance", advance)
+    monkeypatch.setattr(wear_driver, "advance", advance)
     if balance_fails:
         real_solve = SlowProblem.solve_balance
 
@@ -247,23 +244,23 @@ def test_run_starts_from_a_time_integration_when_the_unworn_balance_fails(monkey
     import fretwear.hb.periodic
 
     m = damped_block()
-    real = wm.solve_periodic
+    real = wear_schemes.solve_periodic
 
     def failing(*args, **kwargs):
         sol, st = real(*args, **kwargs)
         st.converged = False
         return sol, st
 
-    monkeypatch.setattr(wm, "solve_periodic", failing)
+    monkeypatch.setattr(wear_schemes, "solve_periodic", failing)
     opts = WearOptions(**OPTS)
     r = simulate_wear(m, BASIS, omega=OMEGA, options=opts)
     h = r.history
     assert r.converged and h.n_steps == 5 and h.rescued[0] == 2
     ref = time_averaged_rate(m, OMEGA, BASIS, wear_coefficients(m), np.zeros(h.wear_depth.shape[1]),
-                             U0=None, V0=None, settle=wm.START_SETTLE, average=64,
+                             U0=None, V0=None, settle=START_SETTLE, average=64,
                              steps_per_period=512)
     np.testing.assert_array_equal(h.wear_rate[0], ref.g)
-    assert h.jump[1] == wm.START_JUMP
+    assert h.jump[1] == START_JUMP
     # the response is periodic: the balance converges from it at step 1, then ordinary steps
     assert h.rescued[1] == 1 and np.all(h.rescued[2:] == 0)
     # only the wear module's start was forced

@@ -46,7 +46,7 @@ _API = {
     "modes": "fretwear.linear", "frf": "fretwear.linear",
     # wear
     "simulate_wear": "fretwear.api", "frf_worn": "fretwear.api",
-    "WearOptions": "fretwear.wear.simulate", "WearResult": "fretwear.wear.simulate",
+    "WearOptions": "fretwear.wear", "WearResult": "fretwear.wear",
     # time domain
     "integrate": "fretwear.timedomain.integrate", "steady_state": "fretwear.timedomain.integrate",
     "incremental_wear": "fretwear.timedomain.integrate",

@@ -9,9 +9,9 @@ passed through unchanged.
 
 from __future__ import annotations
 
+from fretwear import wear as _wear
 from fretwear.hb import sweep as _sweep
 from fretwear.timedomain.fallback import FALLBACK
-from fretwear.wear import simulate as _wear
 
 
 def _fallback(time_domain: bool):
@@ -37,7 +37,7 @@ def simulate_wear(model, basis, *, time_domain: bool = True, **kwargs) -> _wear.
 
 
 def frf_worn(model, wear, frequencies_hz, basis, *, time_domain: bool = True, **kwargs):
-    """Nonlinear FRF with the worn gap (paper Fig. 24): :func:`fretwear.wear.simulate.frf_worn`
+    """Nonlinear FRF with the worn gap (paper Fig. 24): :func:`fretwear.wear.worn_frf.frf_worn`
     with the time-domain fallback (``time_domain=True``)."""
     return _wear.frf_worn(model, wear, frequencies_hz, basis,
                           time_domain=_fallback(time_domain), **kwargs)

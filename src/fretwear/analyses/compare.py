@@ -229,7 +229,7 @@ def compare_wear(model, analysis: dict, outdir: Path | None, *, steps_per_cycle:
                  title: str | None = None) -> Comparison:
     """DLFT wear against incremental wear at the DLFT run's final cycle count."""
     from fretwear.analyses.wear import options_from_table
-    from fretwear.wear.simulate import simulate_wear
+    from fretwear.wear import simulate_wear
 
     if not analysis.get("quasi_static"):
         raise InputError("compare: the incremental wear reference is quasi-static; set "

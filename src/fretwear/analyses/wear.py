@@ -3,7 +3,7 @@
 Runs :func:`fretwear.wear.simulate.simulate_wear` (paper section 3.3, eq. 29-30) at one excitation
 frequency (or quasi-static), with a checkpoint in the results folder so that
 ``fretwear run CASE.toml --resume`` continues an interrupted run to the same result; turns the
-:class:`~fretwear.wear.simulate.WearHistory` into a results dataset (schema in ``docs/results.md``,
+:class:`~fretwear.wear.history.WearHistory` into a results dataset (schema in ``docs/results.md``,
 section ``wear``), draws the figures of the paper's section 4.2 (worn profiles, wear
 kinetics, pressure and slip along the interface, worn volume) and, when asked, the nonlinear
 FRFs before and after wear (paper Fig. 24).
@@ -11,7 +11,7 @@ FRFs before and after wear (paper Fig. 24).
 
 from __future__ import annotations
 
-import math
+from dataclasses import fields
 from pathlib import Path
 
 import numpy as np
@@ -24,10 +24,22 @@ from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.solvers import SOLVERS
 from fretwear.hb.sweep import frequency_grid
 from fretwear.io.results import label_coordinate, variable
-from fretwear.io.schema import Field, Flag, Integer, ListOf, Number, Table, Text, fail, increasing
+from fretwear.io.schema import (
+    MISSING,
+    Field,
+    Flag,
+    Integer,
+    ListOf,
+    Number,
+    Spec,
+    Table,
+    Text,
+    fail,
+    increasing,
+)
 from fretwear.timedomain.averaged_rate import RESPONSE_KINDS
 from fretwear.timedomain.fallback import FALLBACK
-from fretwear.wear.simulate import LAWS, SCHEMES, WearOptions, WearResult, frf_worn, simulate_wear
+from fretwear.wear import LAWS, SCHEMES, WearOptions, WearResult, frf_worn, simulate_wear
 
 CHECKPOINT_FILE = "wear-checkpoint.npz"
 COMPONENTS = ("N", "T1", "T2")
@@ -35,18 +47,25 @@ AXES = ("x", "y", "z")
 
 
 # --- options ----------------------------------------------------------------------------------
+#: the defaults of the wear options: :class:`~fretwear.wear.options.WearOptions` is their one
+#: definition, for case files as for Python
+OPTION_DEFAULTS = {f.name: f.default for f in fields(WearOptions)}
+
+
+def option(name: str, spec: Spec, doc: str, unit: str = "", *, fill: bool = True) -> Field:
+    """The ``[analysis]`` key of the wear option ``name``, with the default of
+    :class:`~fretwear.wear.options.WearOptions`. A default of None (not set), or any with
+    ``fill = False``, is not written into the validated table: the key is then absent and
+    :func:`options_from_table` leaves the option to its default."""
+    default = OPTION_DEFAULTS[name]
+    filled = fill and default is not None
+    return Field(spec, doc, default=default if filled else MISSING, unit=unit)
+
+
 def options_from_table(a: dict) -> WearOptions:
-    """:class:`~fretwear.wear.simulate.WearOptions` from the validated ``[analysis]`` table."""
-    return WearOptions(
-        law=a["law"], energy_coefficient=a.get("energy_coefficient"), scheme=a["scheme"],
-        adaptive=a["adaptive"], tolerance=a["tolerance"], initial_jump=a.get("initial_jump"),
-        max_jump=a["max_jump"], max_cycles=a["max_cycles"],
-        max_depth=a.get("max_depth", math.inf), plateau_rate=a["plateau_rate"],
-        max_steps=a["max_steps"], solver=a["solver"], tol=a["tol"],
-        checkpoint_every_s=a["checkpoint_every_s"], time_domain_rescue=a["time_domain_rescue"],
-        time_domain_settle=a["time_domain_settle"], time_domain_average=a["time_domain_average"],
-        time_domain_steps=a.get("time_domain_steps"),
-    ).check()
+    """:class:`~fretwear.wear.options.WearOptions` from the validated ``[analysis]`` table: its
+    wear options (:data:`OPTION_KEYS`) that are there; the others keep their defaults."""
+    return WearOptions(**{k: a[k] for k in OPTION_KEYS if k in a})
 
 
 def _check_table(out: dict, path: str) -> None:
@@ -396,45 +415,46 @@ SCHEMA = {
     "n_samples": Field(Integer(lo=3), "time samples per period", default=128),
     "eps": Field(_POS, "DLFT penalty (default: spectral radius of the reduced dynamic "
                  "stiffness)", unit="N/m"),
-    "solver": Field(Text(SOLVERS), "nonlinear solver of the first periodic solve and "
-                    "the fallback of the slow steps", default="powell"),
-    "tol": Field(_POS, "relative residual of the periodic solves |f| <= tol |Z U|",
-                 default=1e-9, unit="-"),
-    "law": Field(Text(LAWS), '"archard" (k_w = contact.wear_coefficient, paper eq. 29) '
-                 'or "energy" (worn volume = energy_coefficient x friction energy)',
-                 default="archard"),
-    "energy_coefficient": Field(Number(lo=0), "k_e of the energy law", unit="m^3/J"),
-    "scheme": Field(Text(SCHEMES), '"rosenbrock" (linearly implicit Euler, stable for any '
-                    'jump, the cheapest), "implicit" (backward Euler) or "explicit" (explicit '
-                    "Euler, paper eq. 30: stable only for jumps below 2/rho)",
-                    default="rosenbrock"),
-    "adaptive": Field(Flag(), "adapt the jump to `tolerance`; false: constant jumps of "
-                      "`initial_jump`", default=True),
-    "tolerance": Field(_POS, "local error per step relative to the maximum wear depth",
-                       default=1e-2, unit="-"),
-    "initial_jump": Field(_POS, "first jump (default: from the slow Jacobian's spectral "
-                          "radius)", unit="cycles"),
-    "max_jump": Field(Number(lo=0, lo_open=True, allow_inf=True), "cap on the jump",
-                      default=math.inf, unit="cycles"),
-    "max_cycles": Field(_POS, "stop at this cycle count", default=1e12, unit="cycles"),
-    "max_depth": Field(_POS, "stop when a wear depth reaches this", unit="m"),
-    "plateau_rate": Field(Number(lo=0), "stop when the worn-volume rate falls below this "
-                          "fraction of its initial value", default=1e-3, unit="-"),
-    "max_steps": Field(Integer(lo=1), "stop after this many slow steps", default=10000),
-    "time_domain_rescue": Field(Flag(), "dynamic cases: when a step's periodic balance fails, "
-                                "take the step from a time integration: its periodic state, or "
-                                "its wear rate averaged over periods (docs/wear.md)",
-                                default=True),
-    "time_domain_settle": Field(Integer(lo=0), "periods integrated before averaging in such "
-                                "a step", default=300, unit="periods"),
-    "time_domain_average": Field(Integer(lo=2), "periods over which such a step averages "
-                                 "the wear rate", default=500, unit="periods"),
-    "time_domain_steps": Field(Integer(lo=8), "time steps per period of such a step "
-                               "(default: max(128, 8 x the highest harmonic))"),
-"record_every": Field(Integer(lo=1), "keep every n-th step in results.nc (the last "
+    # wear options: option() takes the default of WearOptions
+    "solver": option("solver", Text(SOLVERS), "nonlinear solver of the first periodic solve "
+                     "and the fallback of the slow steps"),
+    "tol": option("tol", _POS, "relative residual of the periodic solves |f| <= tol |Z U|",
+                  unit="-"),
+    "law": option("law", Text(LAWS), '"archard" (k_w = contact.wear_coefficient, paper '
+                  'eq. 29) or "energy" (worn volume = energy_coefficient x friction energy)'),
+    "energy_coefficient": option("energy_coefficient", Number(lo=0), "k_e of the energy law",
+                                 unit="m^3/J"),
+    "scheme": option("scheme", Text(SCHEMES), '"rosenbrock" (linearly implicit Euler, stable '
+                     'for any jump, the cheapest), "implicit" (backward Euler) or "explicit" '
+                     "(explicit Euler, paper eq. 30: stable only for jumps below 2/rho)"),
+    "adaptive": option("adaptive", Flag(), "adapt the jump to `tolerance`; false: constant "
+                       "jumps of `initial_jump`"),
+    "tolerance": option("tolerance", _POS, "local error per step relative to the maximum wear "
+                        "depth", unit="-"),
+    "initial_jump": option("initial_jump", _POS, "first jump (default: from the slow "
+                           "Jacobian's spectral radius)", unit="cycles"),
+    "max_jump": option("max_jump", Number(lo=0, lo_open=True, allow_inf=True), "cap on the "
+                       "jump", unit="cycles"),
+    "max_cycles": option("max_cycles", _POS, "stop at this cycle count", unit="cycles"),
+    "max_depth": option("max_depth", _POS, "stop when a wear depth reaches this (default: "
+                        "no limit)", unit="m", fill=False),
+    "plateau_rate": option("plateau_rate", Number(lo=0), "stop when the worn-volume rate falls "
+                           "below this fraction of its initial value", unit="-"),
+    "max_steps": option("max_steps", Integer(lo=1), "stop after this many slow steps"),
+    "time_domain_rescue": option("time_domain_rescue", Flag(), "dynamic cases: when a step's "
+                                 "periodic balance fails, take the step from a time "
+                                 "integration: its periodic state, or its wear rate averaged "
+                                 "over periods (docs/wear.md)"),
+    "time_domain_settle": option("time_domain_settle", Integer(lo=0), "periods integrated "
+                                 "before averaging in such a step", unit="periods"),
+    "time_domain_average": option("time_domain_average", Integer(lo=2), "periods over which "
+                                  "such a step averages the wear rate", unit="periods"),
+    "time_domain_steps": option("time_domain_steps", Integer(lo=8), "time steps per period of "
+                                "such a step (default: max(128, 8 x the highest harmonic))"),
+    "record_every": Field(Integer(lo=1), "keep every n-th step in results.nc (the last "
                           "always)", default=1),
-    "checkpoint_every_s": Field(Number(lo=0), "checkpoint interval (0: every step)",
-                                default=10.0, unit="s"),
+    "checkpoint_every_s": option("checkpoint_every_s", Number(lo=0), "checkpoint interval "
+                                 "(0: every step)", unit="s"),
     "plot_nodes": Field(ListOf(Integer(lo=0), non_empty=True, unique=True),
                         "contact nodes of the wear-kinetics figure (default: the most "
                         "worn)"),
@@ -442,6 +462,8 @@ SCHEMA = {
                               "Fig. 24)"),
 }
 CHECKS = (_check_table,)
+#: the keys of :data:`SCHEMA` that are wear options (:class:`~fretwear.wear.options.WearOptions`)
+OPTION_KEYS = tuple(k for k in SCHEMA if k in OPTION_DEFAULTS)
 DOC = (
     "Fretting wear on the slow time scale (DLFT with wear, paper section 3.3): the wear "
     "depth of every contact node evolves with the cycle count until a plateau of the worn "

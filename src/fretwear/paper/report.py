@@ -126,7 +126,7 @@ def linear_facts(model, f_max: float = 1e5) -> dict:
 def wear_facts(ds) -> dict:
     """What the paper reads off a wear run (section 4.2)."""
     from fretwear.timedomain.averaged_rate import RESPONSE_KINDS
-    from fretwear.wear.simulate import zero_wear_zones
+    from fretwear.wear import zero_wear_zones
 
     x = ds["contact_position"].values[:, 0]
     w = ds["wear_depth"].values[-1]
@@ -425,7 +425,7 @@ def _runs_table(runs, out: dict) -> str:
             "method "
             "of Stromberg (1997)",
             "frf-worn-79khz": "nonlinear FRF (7 harmonics, 128 samples) with the unworn and "
-            "the 79 kHz worn gap (`fretwear.wear.simulate.frf_worn`)"}
+            "the 79 kHz worn gap (`fretwear.wear.frf_worn`)"}
     rows = ["## The runs", "", "| run | example | paper Fig. | settings | status | wall |",
             "|---|---|---|---|---|---|"]
     rows += [f"| `{r.key}` | `{r.example}` | {r.figures} | {r.why} | {status(r.key)} |"

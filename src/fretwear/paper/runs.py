@@ -128,7 +128,7 @@ def _frf_worn(folder: Path, wear_dir: Path, quick: bool) -> str:
     from fretwear.io.case import build_model
     from fretwear.paper.report import load
     from fretwear.timedomain.fallback import FALLBACK
-    from fretwear.wear.simulate import frf_worn
+    from fretwear.wear import frf_worn
 
     ds = load(wear_dir.parent, wear_dir.name)
     if ds is None:

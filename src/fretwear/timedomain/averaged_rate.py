@@ -13,7 +13,7 @@ module computes that mean with the exact time integration of :mod:`fretwear.time
 
 over the steps ``n`` of ``K`` periods in which node ``p`` slips
 
-with ``c_p`` the factor of the wear law (:func:`fretwear.wear.simulate.wear_coefficients`): ``k_w /
+with ``c_p`` the factor of the wear law (:func:`fretwear.wear.laws.wear_coefficients`): ``k_w /
 area`` for Archard, ``k_e mu / area`` for the energy law, exactly as on the DLFT samples. A node
 that sticks wears exactly nothing (its slip increments are zero by the exact stick constraint).
 

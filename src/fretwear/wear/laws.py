@@ -1,0 +1,100 @@
+"""Wear laws: the wear depth per cycle of every contact node (paper eq. 29).
+
+Per node, per cycle, evaluated on the converged DLFT samples with the *corrected* slip
+``X_T(n) - X_T(n-1)``, which is exactly zero in stick:
+
+* Archard (eq. 29): ``dW1_p = k_w sum_n p_N(n) |X_T(n) - X_T(n-1)|``, ``p_N = lambda_N/area``;
+* energy (Fouvry et al. 2003): worn volume = ``k_e`` x friction energy, so
+  ``dW1_p = k_e E_p / area_p`` with ``E_p = sum_n lambda_T(n).(X_T(n) - X_T(n-1))``.
+
+With Coulomb slip ``E_p = mu sum_n lambda_N |dX_T|`` exactly, so both laws are ``c_p S_p`` with
+the slip work ``S_p`` of :mod:`fretwear.wear.kernels` and ``c_p = k_w / area_p`` or
+``k_e mu / area_p``; the worn volume per cycle of Archard's law is ``k_w / mu`` times the
+friction energy per cycle.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fretwear.errors import InputError
+from fretwear.hb.periodic import PeriodicSolution
+from fretwear.model.core import Model
+
+LAWS = ("archard", "energy")
+
+
+def wear_coefficients(model: Model, law_name: str = "archard",
+                      energy_coefficient: float | None = None) -> np.ndarray:
+    """Per-node factor ``c_p`` [1/N] with ``dW1_p = c_p S_p`` (module docstring).
+
+    Parameters
+    ----------
+    model : the model (``contact.wear_coefficient`` k_w [1/Pa], ``contact.area`` [m^2],
+        ``contact.mu``).
+    law_name : ``"archard"`` (eq. 29, ``c = k_w / area``) or ``"energy"``
+        (``c = k_e mu / area``).
+    energy_coefficient : ``k_e`` [m^3/J] of the energy law.
+    """
+    c = model.contact
+    area = np.asarray(c.area, dtype=float)
+    if law_name == "archard":
+        k = float(c.wear_coefficient)
+        if not k >= 0:
+            raise InputError(f"wear_coefficient = {k!r}: expected k_w >= 0 [1/Pa]")
+        return k / area
+    if law_name == "energy":
+        if energy_coefficient is None or not float(energy_coefficient) >= 0:
+            raise InputError(f"energy_coefficient = {energy_coefficient!r}: the energy law needs "
+                             "k_e >= 0 [m^3/J]")
+        return float(energy_coefficient) * float(c.mu) / area
+    raise InputError(f"law = {law_name!r}: expected one of {LAWS}")
+
+
+def wear_per_cycle(sol: PeriodicSolution, *, law_name: str = "archard",
+                   wear_coefficient: float = 0.0,
+                   energy_coefficient: float | None = None) -> np.ndarray:
+    """Wear depth per cycle ``dW1`` per node (nc,) [m] of a converged periodic solution.
+
+    Archard (eq. 29 with the corrected slip): ``k_w sum_n p_N(n) |X_T(n) - X_T(n-1)|``, from
+    :meth:`~fretwear.hb.periodic.PeriodicSolution.pressure_t` and
+    :meth:`~fretwear.hb.periodic.PeriodicSolution.slip_t` (zero in stick, so a node that sticks all
+    period does not wear). Energy law (Fouvry et al. 2003): ``k_e E_p / area_p`` with ``E_p``
+    from :meth:`~fretwear.hb.periodic.PeriodicSolution.friction_energy`.
+
+    This is the post-processing route; the integrators use the kernel
+    :func:`fretwear.wear.kernels.slip_work`, which gives the same numbers.
+    """
+    if law_name == "archard":
+        return float(wear_coefficient) * np.sum(sol.pressure_t() * sol.slip_t(), axis=1)
+    if law_name == "energy":
+        if energy_coefficient is None:
+            raise InputError("the energy law needs energy_coefficient k_e [m^3/J]")
+        return float(energy_coefficient) * sol.friction_energy() / sol.area
+    raise InputError(f"law = {law_name!r}: expected one of {LAWS}")
+
+
+def worn_volume(wear: np.ndarray, area: np.ndarray) -> float:
+    """Worn volume ``sum_p area_p W_p`` [m^3] of wear depths ``W`` [m]."""
+    return float(np.dot(np.asarray(area, float), np.asarray(wear, float)))
+
+
+def zero_wear_zones(x, wear, fraction: float = 0.01) -> list[list[float]]:
+    """Intervals ``[x_first, x_last]`` [m] of consecutive contact nodes (ordered by ``x``)
+    whose wear depth is at most ``fraction`` of the deepest: the "pillars" and nodal zones of
+    the paper (section 4.2.2-4.2.3)."""
+    x = np.asarray(x, float)
+    w = np.asarray(wear, float)
+    order = np.argsort(x)
+    x, w = x[order], w[order]
+    low = w <= fraction * max(float(w.max()), 1e-300)
+    zones, start = [], None
+    for i, z in enumerate(low):
+        if z and start is None:
+            start = i
+        if not z and start is not None:
+            zones.append([float(x[start]), float(x[i - 1])])
+            start = None
+    if start is not None:
+        zones.append([float(x[start]), float(x[-1])])
+    return zones
