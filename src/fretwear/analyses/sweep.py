@@ -281,6 +281,7 @@ def plot_sweep_interface(ds: xr.Dataset, path: Path, *, title: str | None = None
     return plots.save(fig, path)
 
 
+# --- registration ---------------------------------------------------------------------------
 register(
     "sweep",
     {
