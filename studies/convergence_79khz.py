@@ -204,14 +204,12 @@ class Study:
         return self.base_eps
 
     def penalty(self, v, red):
-        from fretwear.hb.reduce import condense
+        from fretwear.hb.penalty import penalty
 
         rule, factor = v["eps"]
-        if rule == "auto":
-            return factor * red.spectral_radius()
-        if rule == "static":
+        if rule in ("auto", "static"):
             model, _ = self.model(v["nx"])
-            return factor * condense(model, 0.0, [0], quasi_static=True).spectral_radius()
+            return factor * penalty(rule, model=model, reduced=red)
         return factor * self.baseline_eps()
 
     def modes_near(self, nx):

@@ -11,7 +11,8 @@ through the height, plane strain / plane stress) and, for each variant, records:
   mode of :func:`fretwear.linear.modes`);
 * the unworn periodic solution at 79 kHz (7 harmonics, 128 samples): converged?, Powell
   iterations, harmonic-1 amplitude of u_x(P_e), stops of P_e per period (paper: 4; counted by
-  ``PeriodicSolution.stops_per_period`` with the 5 % rule of ``run_dlft``);
+  ``PeriodicSolution.stops_per_period`` with the 5 % rule of the ``periodic``
+  analysis, ``fretwear.analyses.common.STOP_TOL``);
 * its time-domain stability (:func:`fretwear.timedomain.stability.check_periodic`);
 * the wear run (:func:`fretwear.wear.simulate.simulate_wear`, adaptive linearly implicit Euler,
   tolerance 1e-2, ``max_cycles`` 1e8 by default): N where the balance first fails (first

@@ -29,14 +29,7 @@ import numpy as np
 from matplotlib.colors import BoundaryNorm, ListedColormap
 
 from fretwear.analyses import figures as plots
-from fretwear.analyses.periodic import (
-    STATE_COLOURS,
-    _edges,
-    _penalty,
-    basis_of,
-    interface_abscissa,
-    si_scale,
-)
+from fretwear.analyses.common import basis_of, cell_edges, interface_abscissa, si_scale
 from fretwear.analyses.run import load_case
 from fretwear.analyses.transient import period_friction_energy, state_fractions
 from fretwear.errors import InputError
@@ -125,8 +118,8 @@ def _draw_state(ax, x, state: np.ndarray, label: str) -> None:
     """Contact-state map (nc, N) of one method on ``ax``."""
     order = np.argsort(x, kind="stable")
     n = state.shape[1]
-    cmap = ListedColormap(STATE_COLOURS)
-    ax.pcolormesh(_edges(x[order]), (np.arange(n + 1) - 0.5) / n, state[order].T, cmap=cmap,
+    cmap = ListedColormap(plots.STATE_COLOURS)
+    ax.pcolormesh(cell_edges(x[order]), (np.arange(n + 1) - 0.5) / n, state[order].T, cmap=cmap,
                   norm=BoundaryNorm([-0.5, 0.5, 1.5, 2.5], cmap.N), shading="flat")
     ax.set_title(f"contact state, {label} (blue stick, orange slip, grey separation)",
                  fontsize="small")
@@ -196,8 +189,7 @@ def compare_periodic(model, analysis: dict, outdir: Path | None, *, steps_per_pe
     omega = 2 * np.pi * float(analysis["frequency"])
     t0 = time.perf_counter()
     reduced = condense(model, omega, basis.orders)
-    eps = _penalty(model, analysis["eps"], omega, basis, False, reduced)
-    sol, stats = solve_periodic(model, basis, omega=omega, reduced=reduced, eps=eps,
+    sol, stats = solve_periodic(model, basis, omega=omega, reduced=reduced, eps=analysis["eps"],
                                 solver=analysis["solver"], tol=analysis["tol"],
                                 max_iter=analysis["max_iter"])
     t_dlft = time.perf_counter() - t0

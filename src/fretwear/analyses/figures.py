@@ -14,7 +14,12 @@ from pathlib import Path
 
 import numpy as np
 from matplotlib.collections import LineCollection, PolyCollection
+from matplotlib.colors import BoundaryNorm, ListedColormap
 from matplotlib.figure import Figure
+from matplotlib.patches import Patch
+
+from fretwear.analyses.common import cell_edges, interface_abscissa
+from fretwear.hb.contact import STATE_NAMES
 
 #: line style of each linear interface, shared by all figures
 INTERFACE_STYLE = {
@@ -22,6 +27,8 @@ INTERFACE_STYLE = {
     "sliding": {"color": "tab:blue", "linestyle": "-"},
     "stuck": {"color": "tab:red", "linestyle": "--"},
 }
+#: colours of the contact states (separation, stick, slip) in every figure
+STATE_COLOURS = ("0.85", "tab:blue", "tab:orange")
 AXIS_NAMES = ("x", "y", "z")
 
 
@@ -193,4 +200,30 @@ def plot_natural_frequencies(ds, path: Path | str, *, title: str | None = None) 
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(title="interface", loc="upper left", bbox_to_anchor=(1.01, 1.0),
               fontsize="small")
+    return save(fig, path)
+
+
+# --- contact states ----------------------------------------------------------------------
+def plot_state_map(ds, path: Path | str, *, title: str | None = None) -> Path:
+    """Contact state of every node over one period: separation, stick, slip.
+
+    ``ds`` holds ``contact_state`` (contact_node, tau) and ``contact_position`` (a
+    ``periodic`` or ``transient`` results dataset).
+    """
+    x, xlabel = interface_abscissa(ds)
+    order = np.argsort(x, kind="stable")
+    n = ds.sizes["tau"]
+    t_edges = (np.arange(n + 1) - 0.5) / n
+    state = ds["contact_state"].values[order].T  # (N, nc)
+    fig, axes = new_figure(title=title, panel_size=(7.5, 4.0))
+    ax = axes[0, 0]
+    cmap = ListedColormap(STATE_COLOURS)
+    ax.pcolormesh(cell_edges(x[order]), t_edges, state, cmap=cmap,
+                  norm=BoundaryNorm([-0.5, 0.5, 1.5, 2.5], cmap.N), shading="flat")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("t / T [-] (fraction of the period)")
+    handles = [Patch(facecolor=c, edgecolor="0.5", label=s)
+               for c, s in zip(STATE_COLOURS, STATE_NAMES, strict=True)]
+    ax.legend(handles=handles, title="contact state", loc="upper left",
+              bbox_to_anchor=(1.01, 1.0), fontsize="small")
     return save(fig, path)

@@ -15,6 +15,7 @@ from tqdm import tqdm
 
 from fretwear import linear
 from fretwear.analyses import figures as plots
+from fretwear.analyses.common import AXES, check_points, figure_path, geometry
 from fretwear.analyses.registry import RunOutput, register
 from fretwear.errors import InputError
 from fretwear.io.results import (
@@ -25,10 +26,8 @@ from fretwear.io.results import (
     write_pvd,
     write_vtu,
 )
-from fretwear.io.schema import Field, Integer, ListOf, Number, Text, fail, increasing
+from fretwear.io.schema import Field, Integer, ListOf, Number, Text, increasing
 
-COMPONENTS = ("N", "T1", "T2")
-AXES = ("x", "y", "z")
 _INTERFACES = Field(
     ListOf(Text(linear.INTERFACES), non_empty=True, unique=True),
     'linear limits of the contact: "free" (no contact), "sliding" (normal held, frictionless), '
@@ -37,39 +36,11 @@ _INTERFACES = Field(
 )
 
 
-# --- shared coordinates ---------------------------------------------------------------------
+# --- helpers ------------------------------------------------------------------------------------
 def _need_mass(model) -> None:
     if model.M.nnz == 0 or not np.any(model.M.diagonal()):
         raise InputError("the model has no mass: modes and FRFs need material.rho > 0 (or a "
                          "non-zero mass matrix)")
-
-
-def _geometry(model, points: list[str]) -> tuple[dict, dict]:
-    """Coordinates and position variables of the observed points and contact nodes."""
-    c = model.contact
-    nc, d = c.dofs.shape
-    n_axes = max([d] + [len(model.observed_point(p).dofs) for p in points])
-    coords = {
-        "point": label_coordinate("point", points),
-        "axis": label_coordinate("axis", AXES[:n_axes]),
-        "contact_node": variable("contact_node", np.arange(nc), "1", "contact node, from 0"),
-        "component": label_coordinate("component", COMPONENTS[:d]),
-    }
-    pos = np.full((len(points), n_axes), np.nan)
-    for i, name in enumerate(points):
-        xyz = np.asarray(model.observed_point(name).coords, dtype=float).reshape(-1)
-        pos[i, : min(xyz.size, n_axes)] = xyz[:n_axes]
-    cpos = np.full((nc, n_axes), np.nan)
-    cc = np.asarray(c.coords, dtype=float).reshape(nc, -1)
-    cpos[:, : min(cc.shape[1], n_axes)] = cc[:, :n_axes]
-    data = {
-        "point_position": variable(("point", "axis"), pos, "m", "position of the observed point"),
-        "contact_position": variable(("contact_node", "axis"), cpos, "m",
-                                     "position of the contact node"),
-        "contact_area": variable("contact_node", np.asarray(c.area, dtype=float), "m^2",
-                                 "tributary area of the contact node"),
-    }
-    return coords, data
 
 
 def _pad_points(values_by_point: dict, points: list[str], n_axes: int, shape0) -> np.ndarray:
@@ -81,22 +52,6 @@ def _pad_points(values_by_point: dict, points: list[str], n_axes: int, shape0) -
         v = np.asarray(values_by_point[name])
         out[: v.shape[0], i, : v.shape[1]] = v
     return out
-
-
-def _check_points(model, requested) -> list[str]:
-    names = [p.name for p in model.observed]
-    if requested is None:
-        return names
-    unknown = [p for p in requested if p not in names]
-    if unknown:
-        fail("analysis.points", requested,
-             "names of observed points: " + (", ".join(repr(n) for n in names) or "(none)"))
-    return list(requested)
-
-
-def _figure_path(case, outdir: Path, stem: str) -> Path | None:
-    out = case.output
-    return outdir / f"{stem}.{out['figure_format']}" if out["figures"] else None
 
 
 # --- modes ----------------------------------------------------------------------------------
@@ -123,7 +78,7 @@ def run_modes(model, analysis: dict, case, outdir: Path, progress: bool) -> RunO
         # contact-local components: u_loc[p] = frame[p] @ U[dofs[p]]
         cshape[i, :k] = np.einsum("pab,mpb->mpa", c.frame, r.shapes[:, c.dofs])
         obs.append(r.observed)
-    coords, data = _geometry(model, points)
+    coords, data = geometry(model, points)
     n_axes = coords["axis"].size
     coords["interface"] = label_coordinate("interface", interfaces)
     coords["mode"] = variable("mode", np.arange(1, nm + 1), "1", "mode number")
@@ -145,14 +100,14 @@ def run_modes(model, analysis: dict, case, outdir: Path, progress: bool) -> RunO
     figures, files = [], []
     for interface, r in zip(interfaces, results, strict=True):
         if model.mesh is not None and len(r.frequency_hz):
-            p = _figure_path(case, outdir, f"modes-{interface}")
+            p = figure_path(case, outdir, f"modes-{interface}")
             if p is not None:
                 figures.append(plots.plot_mode_shapes(
                     model.mesh, r.frequency_hz, r.shapes, p,
                     title=f"{case.title}: modes, {interface} interface"))
             if case.output["vtu"]:
                 files.append(_write_mode_files(model.mesh, r, outdir, interface))
-    p = _figure_path(case, outdir, "natural-frequencies")
+    p = figure_path(case, outdir, "natural-frequencies")
     if p is not None:
         figures.append(plots.plot_natural_frequencies(ds, p, title=case.title))
     lines = []
@@ -209,7 +164,7 @@ def _frf_chunked(model, freqs, interface: str, method: str, bar) -> linear.FRFRe
 def run_frf(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOutput:
     """Frequency response functions for each requested interface."""
     _need_mass(model)
-    points = _check_points(model, analysis.get("points"))
+    points = check_points(model, analysis.get("points"))
     freqs = linear.frequency_grid(analysis["f_min"], analysis["f_max"], analysis["n_points"],
                                   analysis["spacing"])
     interfaces = analysis["interfaces"]
@@ -219,7 +174,7 @@ def run_frf(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOut
         for interface in interfaces:
             bar.set_postfix_str(interface)
             results.append(_frf_chunked(model, freqs, interface, analysis["method"], bar))
-    coords, data = _geometry(model, points)
+    coords, data = geometry(model, points)
     n_axes = coords["axis"].size
     coords["interface"] = label_coordinate("interface", interfaces)
     coords["frequency"] = variable("frequency", freqs, "Hz", "excitation frequency")
@@ -238,7 +193,7 @@ def run_frf(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOut
     ds = xr.Dataset(data, coords=coords)
     figures = []
     for point in points:
-        p = _figure_path(case, outdir, f"frf-{point}")
+        p = figure_path(case, outdir, f"frf-{point}")
         if p is not None:
             figures.append(plots.plot_frf(ds, p, point, title=f"{case.title}: FRF at {point}"))
     return RunOutput(ds, figures, _frf_summary(results, points, model), True)

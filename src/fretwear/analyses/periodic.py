@@ -1,14 +1,12 @@
-"""The DLFT analyses of case files: ``"periodic"`` (one frequency) and ``"sweep"`` (nonlinear FRF).
+"""The ``"periodic"`` analysis of case files: the DLFT periodic response at one frequency.
 
-Each run function calls the solver (:func:`fretwear.hb.periodic.solve_periodic`,
-:func:`fretwear.hb.sweep.sweep`), turns its result into a results dataset (schema in
-``docs/results.md``), figures and ParaView files, and registers itself with
-:mod:`fretwear.analyses.registry`.
+:func:`run_periodic` calls :func:`fretwear.hb.periodic.solve_periodic`, turns its result into a
+results dataset (schema in ``docs/results.md``), figures and ParaView files, and registers
+itself with :mod:`fretwear.analyses.registry`.
 
 A periodic solve that did not converge is never saved as a result: the run writes a results
 file with the solver diagnostics as attributes and no solution variables, and reports the
-failure (``converged = 0``, exit status 1). In a sweep, points that did not converge are kept
-as NaN with ``converged = 0`` and the reason in ``flags``.
+failure (``converged = 0``, exit status 1).
 """
 
 from __future__ import annotations
@@ -17,140 +15,35 @@ from pathlib import Path
 
 import numpy as np
 import xarray as xr
-from matplotlib.colors import BoundaryNorm, ListedColormap
-from matplotlib.patches import Patch
-from tqdm import tqdm
 
-from fretwear import linear
 from fretwear.analyses import figures as plots
-from fretwear.analyses.linear import _check_points, _figure_path, _geometry
+from fretwear.analyses.common import (
+    STOP_TOL,
+    basis_of,
+    check_sampling,
+    figure_path,
+    geometry,
+    harmonic_balance_fields,
+    interface_abscissa,
+    live_axes,
+    pad_axes,
+    period_coordinates,
+    si_scale,
+    solver_attributes,
+    titled,
+)
 from fretwear.analyses.registry import RunOutput, register
 from fretwear.errors import InputError
 from fretwear.hb.contact import STATE_NAMES
-from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.penalty import penalty
 from fretwear.hb.periodic import PeriodicSolution, solve_periodic
 from fretwear.hb.reduce import condense, recover
-from fretwear.hb.solvers import SOLVERS, SolveStats
-from fretwear.hb.sweep import SweepResult, sweep
-from fretwear.io.results import label_coordinate, nodal_vectors, variable, write_pvd, write_vtu
-from fretwear.io.schema import (
-    AnyOf,
-    Field,
-    Flag,
-    Integer,
-    ListOf,
-    Number,
-    Text,
-    fail,
-    increasing,
-    join,
-)
-from fretwear.timedomain.fallback import FALLBACK
-from fretwear.timedomain.stability import sweep_check
-
-#: colours of the contact states (separation, stick, slip) in every figure
-STATE_COLOURS = ("0.85", "tab:blue", "tab:orange")
-STOP_TOL = 5e-2  # |v| below this fraction of its peak counts as stopped (as stops_per_period)
+from fretwear.hb.solvers import SolveStats
+from fretwear.io.results import nodal_vectors, variable, write_pvd, write_vtu
+from fretwear.io.schema import Field, Flag, Number, join
 
 
-# --- [analysis] keys shared by both analyses ----------------------------------------------
-def harmonic_list(value) -> list[int]:
-    """Kept harmonics from the ``harmonics`` key: ``Nh`` -> ``[1..Nh]``, a list -> sorted."""
-    if isinstance(value, int):
-        return list(range(1, value + 1))
-    return sorted(int(h) for h in value)
-
-
-def basis_of(analysis: dict) -> FourierBasis:
-    """The Fourier basis an ``[analysis]`` table asks for."""
-    return FourierBasis(tuple(harmonic_list(analysis["harmonics"])), analysis["n_samples"])
-
-
-def _check_sampling(out: dict, path: str) -> None:
-    """Rule: ``n_samples`` exceeds twice the highest kept harmonic (no aliasing)."""
-    if "harmonics" not in out or "n_samples" not in out:
-        return
-    top = max(harmonic_list(out["harmonics"]))
-    if out["n_samples"] <= 2 * top:
-        fail(join(path, "n_samples"), out["n_samples"],
-             f"more than {2 * top} samples per period (twice the highest harmonic, {top})")
-
-
-def _common_fields(eps_default: str, eps_doc: str, max_iter: int) -> dict:
-    return {
-        "harmonics": Field(
-            AnyOf((Integer(lo=1), ListOf(Integer(lo=1), non_empty=True, unique=True))),
-            "kept harmonics: Nh keeps 1, 2, .., Nh; a list keeps those listed (e.g. [1, 3, 5])",
-            default=7),
-        "n_samples": Field(Integer(lo=3), "time samples per period N of the contact law "
-                           "(more than twice the highest harmonic)", default=128),
-        "eps": Field(AnyOf((Text(("auto", "static")), Number(lo=0, lo_open=True))), eps_doc,
-                     default=eps_default, unit="N/m"),
-        "solver": Field(Text(SOLVERS), '"powell" (hybrid dog-leg, LAPACK), "newton" (damped '
-                        'Newton) or "hybr" (MINPACK hybrj, as in the paper)', default="powell"),
-        "tol": Field(Number(lo=0, lo_open=True), "relative residual of the convergence test "
-                     "|f(U)| <= tol |Z_r U| (paper section 3.2)", default=1e-8, unit="-"),
-        "max_iter": Field(Integer(lo=1), "maximum solver iterations per frequency",
-                          default=max_iter),
-    }
-
-
-def _penalty(model, eps, omega: float, basis: FourierBasis, quasi_static: bool = False,
-             reduced=None) -> float:
-    """The DLFT penalty [N/m] of the ``eps`` key: ``"auto"`` the spectral radius of ``Z_r``
-    over the kept harmonics (paper), ``"static"`` that of the static ``K_r``, or the number."""
-    if eps == "auto":
-        red = reduced if reduced is not None else condense(model, omega, basis.orders,
-                                                           quasi_static=quasi_static)
-        return red.spectral_radius()
-    if eps == "static":
-        return condense(model, 0.0, [0], quasi_static=True).spectral_radius()
-    return float(eps)
-
-
-def _solver_attributes(stats: SolveStats, analysis: dict, eps: float) -> dict:
-    """Solver settings and statistics as NetCDF attributes (numbers and strings only)."""
-    return {
-        "solver": str(stats.solver or analysis["solver"]),
-        "solver_message": str(stats.message),
-        "residual": float(stats.residual),
-        "tol": float(analysis["tol"]),
-        "iterations": int(stats.iterations),
-        "nfev": int(stats.nfev),
-        "njev": int(stats.njev),
-        "wall_time": float(stats.wall_time),
-        "eps": float(eps),
-        "eps_rule": str(analysis["eps"]),
-        "harmonics": ", ".join(str(h) for h in harmonic_list(analysis["harmonics"])),
-        "n_samples": int(analysis["n_samples"]),
-    }
-
-
-def titled(title: str, suffix: str) -> str:
-    """``"title: suffix"``, or ``title`` when it already says ``suffix``."""
-    return title if suffix.lower() in title.lower() else f"{title}: {suffix}"
-
-
-# --- small array helpers -------------------------------------------------------------------
-def _pad_axes(arrays: list[np.ndarray], n_axes: int) -> np.ndarray:
-    """Stack per-point arrays ``(d_p, ...)`` into ``(n_points, n_axes, ...)``, NaN-padded."""
-    trailing = arrays[0].shape[1:] if arrays else ()
-    out = np.full((len(arrays), n_axes) + trailing, np.nan)
-    for i, a in enumerate(arrays):
-        out[i, : a.shape[0]] = a
-    return out
-
-
-def _period_coordinates(basis: FourierBasis) -> dict:
-    return {
-        "harmonic_coefficient": label_coordinate("harmonic_coefficient", basis.labels()),
-        "tau": variable("tau", basis.tau, "rad", "angle tau = omega t over one period"),
-        "harmonic": variable("harmonic", np.asarray(basis.harmonics), "1",
-                             "kept harmonic number"),
-    }
-
-
-# --- periodic: dataset ----------------------------------------------------------------------
+# --- dataset -------------------------------------------------------------------------------
 def _observed_variables(sol: PeriodicSolution, points: list[str], n_axes: int) -> dict:
     """Displacement and velocity of the observed points over a period, per harmonic."""
     coeffs, disp, vel, amp, stops = [], [], [], [], []
@@ -166,17 +59,17 @@ def _observed_variables(sol: PeriodicSolution, points: list[str], n_axes: int) -
     pa = ("point", "axis")
     return {
         "displacement_coefficients": variable(
-            pa + ("harmonic_coefficient",), _pad_axes(coeffs, n_axes), "m",
+            pa + ("harmonic_coefficient",), pad_axes(coeffs, n_axes), "m",
             "Fourier coefficients of the displacement of the observed point"),
-        "displacement": variable(pa + ("tau",), _pad_axes(disp, n_axes), "m",
+        "displacement": variable(pa + ("tau",), pad_axes(disp, n_axes), "m",
                                  "displacement of the observed point over one period"),
-        "velocity": variable(pa + ("tau",), _pad_axes(vel, n_axes), "m/s",
+        "velocity": variable(pa + ("tau",), pad_axes(vel, n_axes), "m/s",
                              "velocity of the observed point over one period"),
         "displacement_harmonic_amplitude": variable(
-            pa + ("harmonic",), _pad_axes(amp, n_axes), "m",
+            pa + ("harmonic",), pad_axes(amp, n_axes), "m",
             "amplitude of each kept harmonic of the displacement of the observed point"),
         "stops_per_period": variable(
-            pa, _pad_axes(stops, n_axes), "1",
+            pa, pad_axes(stops, n_axes), "1",
             f"intervals per period with |velocity| <= {STOP_TOL:g} x its peak"),
     }
 
@@ -234,14 +127,14 @@ def _contact_variables(sol: PeriodicSolution) -> dict:
 
 def periodic_dataset(model, sol: PeriodicSolution, points: list[str]) -> xr.Dataset:
     """The results dataset of a converged periodic solution (``docs/results.md``)."""
-    coords, data = _geometry(model, points)
-    coords.update(_period_coordinates(sol.basis))
+    coords, data = geometry(model, points)
+    coords.update(period_coordinates(sol.basis))
     data.update(_observed_variables(sol, points, coords["axis"].size))
     data.update(_contact_variables(sol))
     return xr.Dataset(data, coords=coords)
 
 
-# --- periodic: run --------------------------------------------------------------------------
+# --- run -----------------------------------------------------------------------------------
 def _frequency_text(f_hz: float, quasi_static: bool) -> str:
     return "quasi-static loading" if quasi_static else plots.format_frequency(f_hz)
 
@@ -300,11 +193,11 @@ def run_periodic(model, analysis: dict, case, outdir: Path, progress: bool) -> R
     f_hz = float(analysis.get("frequency", 1.0))
     omega = 2 * np.pi * f_hz
     reduced = condense(model, omega, basis.orders, quasi_static=qs)
-    eps = _penalty(model, analysis["eps"], omega, basis, qs, reduced)
+    eps = penalty(analysis["eps"], model=model, reduced=reduced)
     sol, stats = solve_periodic(model, basis, omega=omega, quasi_static=qs, reduced=reduced,
                                 eps=eps, solver=analysis["solver"], tol=analysis["tol"],
                                 max_iter=analysis["max_iter"])
-    attrs = {**_solver_attributes(stats, analysis, eps), "excitation_frequency": f_hz,
+    attrs = {**solver_attributes(stats, analysis, eps), "excitation_frequency": f_hz,
              "quasi_static": int(qs)}
     where = _frequency_text(f_hz, qs)
     if sol is None:
@@ -323,12 +216,12 @@ def run_periodic(model, analysis: dict, case, outdir: Path, progress: bool) -> R
 def _periodic_figures(ds: xr.Dataset, case, outdir: Path, title: str) -> list[Path]:
     figures = []
     for point in ds["point"].values:
-        p = _figure_path(case, outdir, f"periodic-{point}")
+        p = figure_path(case, outdir, f"periodic-{point}")
         if p is not None:
             figures.append(plot_observed_period(ds, p, str(point), title=title))
-    for stem, plot in (("contact-state", plot_state_map), ("contact-profiles", plot_profiles),
+    for stem, plot in (("contact-state", plots.plot_state_map), ("contact-profiles", plot_profiles),
                        ("hysteresis", plot_hysteresis)):
-        p = _figure_path(case, outdir, stem)
+        p = figure_path(case, outdir, stem)
         if p is not None:
             figures.append(plot(ds, p, title=title))
     return figures
@@ -370,7 +263,7 @@ def write_period_fields(model, sol: PeriodicSolution, pvd: Path) -> Path:
     return write_pvd(pvd, entries)
 
 
-# --- periodic: figures ----------------------------------------------------------------------
+# --- figures -------------------------------------------------------------------------------
 def _stopped_spans(v: np.ndarray, tol: float = STOP_TOL) -> list[tuple[int, int]]:
     """Runs ``(first, last)`` of samples where ``|v| <= tol * max |v|`` (not wrapped)."""
     va = np.abs(v)
@@ -387,12 +280,6 @@ def _stopped_spans(v: np.ndarray, tol: float = STOP_TOL) -> list[tuple[int, int]
     return spans
 
 
-def _live_axes(ds: xr.Dataset, point: str) -> list[str]:
-    """The axes ``point`` has (``point_position`` is NaN on the others)."""
-    pos = ds["point_position"].sel(point=point)
-    return [str(a) for a in ds["axis"].values if np.isfinite(pos.sel(axis=a).values)]
-
-
 def plot_observed_period(ds: xr.Dataset, path: Path, point: str, *, title: str | None = None
                          ) -> Path:
     """Displacement and velocity of an observed point over one period (cf. paper Fig. 16).
@@ -402,7 +289,7 @@ def plot_observed_period(ds: xr.Dataset, path: Path, point: str, *, title: str |
     stops (|v| below ``STOP_TOL`` of its peak); the time axis is ``t / T`` (fraction of the
     period).
     """
-    axes_names = _live_axes(ds, point)
+    axes_names = live_axes(ds, point)
     fig, axes = plots.new_figure(2, max(len(axes_names), 1), title=title, sharex=True)
     n = ds.sizes["tau"]
     t = np.append(ds["tau"].values, 2 * np.pi) / (2 * np.pi)
@@ -424,71 +311,6 @@ def plot_observed_period(ds: xr.Dataset, path: Path, point: str, *, title: str |
         axes[0, col].set_title(f"{axis}: mean {km * mean:.4g} {um}, {stops} stop(s) per period"
                                + (" (grey)" if stops else ""), fontsize="medium")
         axes[1, col].set_xlabel("t / T [-] (fraction of the period)")
-    return plots.save(fig, path)
-
-
-def interface_abscissa(ds: xr.Dataset) -> tuple[np.ndarray, str]:
-    """Where to draw each contact node along a figure's x axis, and the axis label.
-
-    The coordinate along which a straight interface runs, if it runs along an axis; else the
-    distance along the chain of nodes (2D); else the node number.
-    """
-    pos = ds["contact_position"].values
-    nc = pos.shape[0]
-    index = (np.arange(nc, dtype=float), "contact node")
-    if nc < 2 or not np.all(np.isfinite(pos[:, :2])):
-        return index
-    live = [a for a in range(pos.shape[1]) if np.all(np.isfinite(pos[:, a]))]
-    span = [a for a in live if np.ptp(pos[:, a]) > 0]
-    if len(span) == 1 and np.unique(pos[:, span[0]]).size == nc:
-        a = span[0]
-        return pos[:, a], f"{ds['axis'].values[a]} [m]"
-    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pos[:, live], axis=0), axis=1))])
-    if len(live) == 2 and np.all(np.diff(s) > 0):
-        return s, "distance along the interface [m]"
-    return index
-
-
-def _edges(x: np.ndarray) -> np.ndarray:
-    """Cell edges around increasing or decreasing centres ``x``."""
-    if x.size == 1:
-        return np.array([x[0] - 0.5, x[0] + 0.5])
-    mid = 0.5 * (x[1:] + x[:-1])
-    return np.concatenate([[2 * x[0] - mid[0]], mid, [2 * x[-1] - mid[-1]]])
-
-
-_PREFIXES = {-15: "f", -12: "p", -9: "n", -6: "\u00b5", -3: "m", 0: "", 3: "k", 6: "M", 9: "G"}
-
-
-def si_scale(values, unit: str) -> tuple[float, str]:
-    """``(factor, prefixed unit)`` so that ``factor * values`` reads between 1 and 1000
-    (e.g. ``1.2e-9 m`` -> ``1.2 nm``); ``(1, unit)`` when there is nothing to scale."""
-    v = np.abs(np.asarray(values, dtype=float))
-    v = v[np.isfinite(v) & (v > 0)]
-    if v.size == 0:
-        return 1.0, unit
-    e = int(np.clip(3 * np.floor(np.log10(v.max()) / 3), -15, 9))
-    return 10.0 ** -e, _PREFIXES[e] + unit
-
-
-def plot_state_map(ds: xr.Dataset, path: Path, *, title: str | None = None) -> Path:
-    """Contact state of every node over one period: separation, stick, slip."""
-    x, xlabel = interface_abscissa(ds)
-    order = np.argsort(x, kind="stable")
-    n = ds.sizes["tau"]
-    t_edges = (np.arange(n + 1) - 0.5) / n
-    state = ds["contact_state"].values[order].T  # (N, nc)
-    fig, axes = plots.new_figure(title=title, panel_size=(7.5, 4.0))
-    ax = axes[0, 0]
-    cmap = ListedColormap(STATE_COLOURS)
-    ax.pcolormesh(_edges(x[order]), t_edges, state, cmap=cmap,
-                  norm=BoundaryNorm([-0.5, 0.5, 1.5, 2.5], cmap.N), shading="flat")
-    ax.set_xlabel(xlabel)
-    ax.set_ylabel("t / T [-] (fraction of the period)")
-    handles = [Patch(facecolor=c, edgecolor="0.5", label=s)
-               for c, s in zip(STATE_COLOURS, STATE_NAMES, strict=True)]
-    ax.legend(handles=handles, title="contact state", loc="upper left",
-              bbox_to_anchor=(1.01, 1.0), fontsize="small")
     return plots.save(fig, path)
 
 
@@ -566,248 +388,6 @@ def plot_hysteresis(ds: xr.Dataset, path: Path, *, title: str | None = None) -> 
     return plots.save(fig, path)
 
 
-# --- sweep: dataset -------------------------------------------------------------------------
-def _per_point(result: SweepResult, value, fill=np.nan, dtype=float) -> np.ndarray:
-    """``value(point)`` for each converged sweep point (``fill`` elsewhere)."""
-    return np.array([value(p) if p.converged else fill for p in result.points], dtype=dtype)
-
-
-def _state_fractions(sol: PeriodicSolution) -> np.ndarray:
-    """Fractions of contact area x period in separation, stick, slip (3,)."""
-    w = sol.area / sol.area.sum()
-    return w @ sol.state_fractions()
-
-
-def _response_variables(result: SweepResult, basis: FourierBasis, model, points: list[str],
-                        n_axes: int) -> dict:
-    nf, k = len(result.points), basis.k
-    amp = np.full((nf, len(points), n_axes, k), np.nan)
-    ptp = np.full((nf, len(points), n_axes), np.nan)
-    for i, name in enumerate(points):
-        for a in range(len(model.observed_point(name).dofs)):
-            for j, h in enumerate(basis.harmonics):
-                amp[:, i, a, j] = result.amplitude(name, a, h)
-            ptp[:, i, a] = 2.0 * result.amplitude(name, a, None)
-    return {
-        "response_amplitude": variable(
-            ("frequency", "point", "axis", "harmonic"), amp, "m",
-            "amplitude of each kept harmonic of the displacement of the observed point"),
-        "response_peak_to_peak": variable(
-            ("frequency", "point", "axis"), ptp, "m",
-            "peak-to-peak displacement of the observed point over the period"),
-    }
-
-
-def _sweep_point_variables(result: SweepResult) -> dict:
-    fr = np.array([_state_fractions(p.solution) if p.converged else np.full(3, np.nan)
-                   for p in result.points]).reshape(-1, 3)
-    f = "frequency"
-    data = {
-        "converged": variable(f, result.converged.astype(np.int8), "1",
-                              "the periodic solve converged", flag_values=np.array(
-                                  [0, 1], dtype=np.int8), flag_meanings="no yes"),
-        "how": variable(f, np.array([p.how for p in result.points], dtype=str), "1",
-                        "how the point was reached: grid, substep, retry, arclength, eps-x10, "
-                        "time-start"),
-        "flags": variable(f, np.array(["; ".join(p.flags) for p in result.points], dtype=str),
-                          "1", "reasons for caution (empty: none)"),
-        "friction_energy": variable(
-            f, _per_point(result, lambda p: p.solution.friction_energy().sum()), "J",
-            "energy dissipated by friction per period over the interface"),
-        "iterations": variable(f, np.array([p.stats.iterations for p in result.points]), "1",
-                               "solver iterations of the last solve at this frequency"),
-        "wall_time": variable(f, np.array([p.stats.wall_time for p in result.points], float),
-                              "s", "wall time of the last solve at this frequency"),
-        "residual": variable(f, np.array([p.stats.residual for p in result.points], float),
-                             "1", "final relative residual |f(U)| / |Z_r U|"),
-        "penalty": variable(f, _per_point(result, lambda p: p.solution.eps), "N/m",
-                            "DLFT penalty eps used"),
-    }
-    for s, name in enumerate(STATE_NAMES):
-        data[f"{name}_fraction"] = variable(
-            f, fr[:, s], "1", f"fraction of contact area x period in {name}")
-    return data
-
-
-def _linear_references(model, freqs: np.ndarray, interfaces: list[str], points: list[str],
-                       n_axes: int) -> dict:
-    """Amplitudes of the linear FRFs with the requested interfaces at the sweep frequencies."""
-    amp = np.full((len(interfaces), freqs.size, len(points), n_axes), np.nan)
-    for i, interface in enumerate(interfaces):
-        r = linear.frf(model, freqs, interface=interface)
-        for j, name in enumerate(points):
-            u = np.abs(r.observed[name])
-            amp[i, :, j, : u.shape[1]] = u
-    return {"linear_response_amplitude": variable(
-        ("interface", "frequency", "point", "axis"), amp, "m",
-        "amplitude of the linear FRF with the interface held (stuck) or frictionless "
-        "(sliding), harmonic 1 of the loads")}
-
-
-def sweep_dataset(model, result: SweepResult, basis: FourierBasis, points: list[str],
-                  references: list[str]) -> xr.Dataset:
-    """The results dataset of a sweep (``docs/results.md``)."""
-    coords, data = _geometry(model, points)
-    freqs = result.frequency_hz
-    coords["frequency"] = variable("frequency", freqs, "Hz", "excitation frequency")
-    coords["harmonic"] = _period_coordinates(basis)["harmonic"]
-    n_axes = coords["axis"].size
-    data.update(_response_variables(result, basis, model, points, n_axes))
-    data.update(_sweep_point_variables(result))
-    if references:
-        coords["interface"] = label_coordinate("interface", references)
-        data.update(_linear_references(model, freqs, references, points, n_axes))
-    return xr.Dataset(data, coords=coords)
-
-
-# --- sweep: run -----------------------------------------------------------------------------
-def _sweep_summary(result: SweepResult, ds: xr.Dataset) -> str:
-    lines = [result.summary()]
-    h = int(ds["harmonic"].values[0])
-    amp = ds["response_amplitude"].sel(harmonic=h)
-    f = ds["frequency"].values
-    for point in ds["point"].values:
-        for axis in ds["axis"].values:
-            y = amp.sel(point=point, axis=axis).values
-            if np.all(np.isnan(y)):
-                continue
-            i = int(np.nanargmax(y))
-            lines.append(f"{point} {axis}: max |u_{h}| = {y[i]:.4g} m at "
-                         f"{plots.format_frequency(f[i])}")
-    return "\n".join(lines)
-
-
-def run_sweep(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOutput:
-    """Nonlinear FRF: periodic solutions over a frequency band (:func:`fretwear.hb.sweep.sweep`).
-
-    Parameters
-    ----------
-    model : the model; analysis : the validated ``[analysis]`` table; case : the case;
-    outdir : results folder; progress : show a progress bar.
-
-    Returns
-    -------
-    RunOutput; ``converged`` False when some point did not converge.
-    """
-    points = _check_points(model, analysis.get("points"))
-    basis = basis_of(analysis)
-    eps = {"static": "static", "auto": "per-frequency"}.get(analysis["eps"], analysis["eps"])
-    n = analysis["n_points"]
-    with tqdm(total=n, desc="sweep", disable=not progress, leave=False, unit="freq") as bar:
-        def tick(i, total, pt):
-            bar.update(1)
-            bar.set_postfix_str(f"{plots.format_frequency(pt.frequency_hz)}"
-                                f"{'' if pt.converged else ' (not converged)'}")
-
-        result = sweep(model, basis, analysis["f_min"], analysis["f_max"], n,
-                       spacing=analysis["spacing"], eps=eps, solver=analysis["solver"],
-                       tol=analysis["tol"], max_iter=analysis["max_iter"],
-                       continuation=analysis["continuation"],
-                       time_domain=FALLBACK if analysis["time_domain"] else None,
-                       time_domain_periods=analysis["time_domain_periods"],
-                       check=(sweep_check(model, max_periods=analysis["time_domain_periods"])
-                              if analysis["check_stability"] else None),
-                       progress=tick)
-    ds = sweep_dataset(model, result, basis, points, analysis["linear_references"])
-    flagged = [f"{p.frequency_hz:.6g} Hz: " + "; ".join(p.flags)
-               for p in result.points if p.flags]
-    ds.attrs.update({
-        "sweep_converged": result.summary().splitlines()[0].split("=", 1)[1],
-        "flagged_points": "\n".join(flagged),
-        "total_wall_time": float(result.wall_time),
-        "solver": analysis["solver"], "tol": float(analysis["tol"]),
-        "eps_rule": str(analysis["eps"]),
-        "harmonics": ", ".join(str(h) for h in basis.harmonics),
-        "n_samples": int(basis.n_samples),
-    })
-    figures = []
-    for point in points:
-        p = _figure_path(case, outdir, f"sweep-{point}")
-        if p is not None:
-            figures.append(plot_sweep(ds, p, point, title=titled(case.title, "nonlinear FRF")))
-    p = _figure_path(case, outdir, "sweep-interface")
-    if p is not None:
-        figures.append(plot_sweep_interface(ds, p, title=titled(case.title,
-                                                                  "contact interface")))
-    grid_ok = all(p.converged for p in result.points if p.on_grid)
-    return RunOutput(ds, figures, _sweep_summary(result, ds), grid_ok)
-
-
-# --- sweep: figures -------------------------------------------------------------------------
-def _mark_failures(ax, f: np.ndarray, converged: np.ndarray, flagged: np.ndarray, y) -> None:
-    """Red crosses along the bottom at points that did not converge; orange rings on
-    converged points that carry flags."""
-    bad = ~converged
-    if bad.any():
-        ax.plot(f[bad], np.full(bad.sum(), 0.03), "x", color="tab:red",
-                transform=ax.get_xaxis_transform(), label=f"not converged ({bad.sum()})")
-    ring = flagged & converged
-    if ring.any():
-        ax.plot(f[ring], y[ring], "o", mfc="none", color="tab:orange", ms=7,
-                label=f"flagged ({ring.sum()})")
-
-
-def plot_sweep(ds: xr.Dataset, path: Path, point: str, *, title: str | None = None) -> Path:
-    """Nonlinear FRF at one observed point (log-log, one panel per axis), with the linear
-    references of the dataset (cf. paper Fig. 14)."""
-    axes_names = _live_axes(ds, point) or [str(ds["axis"].values[0])]
-    fig, axes = plots.new_figure(len(axes_names), 1, title=title, panel_size=(7.5, 3.8),
-                                 sharex=True)
-    f = ds["frequency"].values
-    h = int(ds["harmonic"].values[0])
-    conv = ds["converged"].values.astype(bool)
-    flagged = np.array([bool(s) for s in ds["flags"].values])
-    for ax, axis in zip(axes[:, 0], axes_names, strict=True):
-        if "linear_response_amplitude" in ds:
-            for interface in ds["interface"].values:
-                y = ds["linear_response_amplitude"].sel(interface=interface, point=point,
-                                                        axis=axis).values
-                ax.plot(f, np.where(y > 0, y, np.nan), label=f"linear, {interface}",
-                        **plots.INTERFACE_STYLE.get(str(interface), {}))
-        y = ds["response_amplitude"].sel(point=point, axis=axis, harmonic=h).values
-        ax.plot(f, np.where(y > 0, y, np.nan), color="k", marker=".", ms=3,
-                label=f"friction, harmonic {h}")
-        half = 0.5 * ds["response_peak_to_peak"].sel(point=point, axis=axis).values
-        ax.plot(f, np.where(half > 0, half, np.nan), color="0.5", lw=0.8, linestyle=":",
-                label="friction, half peak-to-peak")
-        _mark_failures(ax, f, conv, flagged, y)
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_ylabel(f"|u_{axis}| at {point} [m]")
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize="small", loc="best")
-    axes[-1, 0].set_xlabel("frequency [Hz]")
-    return plots.save(fig, path)
-
-
-def plot_sweep_interface(ds: xr.Dataset, path: Path, *, title: str | None = None) -> Path:
-    """Friction energy per cycle and the contact state fractions against frequency."""
-    f = ds["frequency"].values
-    conv = ds["converged"].values.astype(bool)
-    flagged = np.array([bool(s) for s in ds["flags"].values])
-    fig, axes = plots.new_figure(2, 1, title=title, panel_size=(7.5, 3.2), sharex=True)
-    ax = axes[0, 0]
-    e = ds["friction_energy"].values
-    ax.plot(f, np.where(e > 0, e, np.nan), color="tab:purple", marker=".", ms=3)
-    _mark_failures(ax, f, conv, flagged, e)
-    ax.set_yscale("log")
-    ax.set_ylabel("friction energy\nper period [J]")
-    if not conv.all() or (flagged & conv).any():
-        ax.legend(fontsize="small")
-    ax = axes[1, 0]
-    for colour, name in zip(STATE_COLOURS, STATE_NAMES, strict=True):
-        ax.plot(f, ds[f"{name}_fraction"].values, color="0.5" if name == "separation" else
-                colour, label=name)
-    ax.set_ylim(-0.02, 1.02)
-    ax.set_ylabel("fraction of contact\narea x period [-]")
-    ax.legend(fontsize="small", title="contact state")
-    ax.set_xlabel("frequency [Hz]")
-    for ax in axes[:, 0]:
-        ax.set_xscale("log")
-        ax.grid(True, which="both", alpha=0.3)
-    return plots.save(fig, path)
-
-
 # --- registration ---------------------------------------------------------------------------
 def _frequency_needed(out: dict, path: str) -> None:
     """Rule: ``frequency`` is required unless ``quasi_static``."""
@@ -817,8 +397,8 @@ def _frequency_needed(out: dict, path: str) -> None:
                          "without)")
 
 
-_EPS_AUTO = ('"auto": the spectral radius of Z_r over the kept harmonics (the paper); '
-             '"static": that of the static reduced stiffness K_r; or a value')
+_EPS_RULES = ('"auto": the spectral radius of Z_r over the kept harmonics (the paper); '
+              '"static": that of the static reduced stiffness K_r; or a value')
 
 register(
     "periodic",
@@ -828,10 +408,10 @@ register(
         "quasi_static": Field(Flag(), "drop inertia and damping (slow cyclic loading); the "
                               "friction law stays path dependent over the period",
                               default=False),
-        **_common_fields("auto", "DLFT penalty: " + _EPS_AUTO, 200),
+        **harmonic_balance_fields("auto", "DLFT penalty: " + _EPS_RULES, 200),
     },
     run_periodic,
-    checks=(_frequency_needed, _check_sampling),
+    checks=(_frequency_needed, check_sampling),
     doc="Periodic response at one frequency with the frictional interface (DLFT, paper "
     "section 3). A solve that does not converge saves no solution: `results.nc` then holds "
     "the solver diagnostics only, and the run exits with status 1. Writes "
@@ -842,42 +422,3 @@ register(
     "`periodic.pvd` (the displacement field over the period; ParaView's time slider plays it).",
 )
 
-register(
-    "sweep",
-    {
-        "f_min": Field(Number(lo=0, lo_open=True), "lowest frequency", required=True, unit="Hz"),
-        "f_max": Field(Number(lo=0, lo_open=True), "highest frequency", required=True, unit="Hz"),
-        "n_points": Field(Integer(lo=2), "number of grid frequencies (the sweep may add "
-                          "intermediate points where a step fails)", default=200),
-        "spacing": Field(Text(("log", "linear")), "frequency spacing", default="log"),
-        "continuation": Field(Flag(), "pseudo-arclength continuation when a frequency step "
-                              "fails (passes folds of the response curve)", default=True),
-        "time_domain": Field(Flag(), "where a point still fails, integrate in time from the "
-                             "neighbour: a periodic steady state starts one more solve, any "
-                             "other response (drifting, quasi-periodic) is reported as the "
-                             "reason", default=True),
-        "time_domain_periods": Field(Integer(lo=10), "forcing periods allowed to each time "
-                                     "integration (time_domain, check_stability)",
-                                     default=3000),
-        "check_stability": Field(Flag(), "check every converged point in time (does the "
-                                 "structure settle to it?); slow", default=False),
-        "points": Field(ListOf(Text(), non_empty=True, unique=True),
-                        "observed points to report (default: all)"),
-        "linear_references": Field(
-            ListOf(Text(linear.INTERFACES), unique=True),
-            'linear FRFs drawn with the nonlinear one: "sliding" (frictionless), "stuck", '
-            '"free"', default=[]),
-        **_common_fields(
-            "static",
-            'DLFT penalty: "static": the spectral radius of the static reduced stiffness K_r, '
-            'the same at every frequency (a smooth FRF); "auto": the paper\'s rule (spectral '
-            "radius of Z_r) at each frequency; or a value", 40),
-    },
-    run_sweep,
-    checks=(increasing("f_min", "f_max", "Hz"), _check_sampling),
-    doc="Nonlinear FRF: periodic responses with the frictional interface over a frequency "
-    "band, each point starting from its neighbours (continuation). Points that do not "
-    "converge are kept as NaN with `converged = 0` and the reason in `flags`; the run then "
-    "exits with status 1. Writes `sweep-<point>.png` (amplitude against frequency, with the "
-    "linear references) and `sweep-interface.png` (friction energy and contact states).",
-)

@@ -35,7 +35,8 @@ if TYPE_CHECKING:
 #: modules that register analyses when imported: add one line per analysis module
 ANALYSIS_MODULES = (
     "fretwear.analyses.linear",  # "modes", "frf"
-    "fretwear.analyses.periodic",  # "periodic", "sweep"
+    "fretwear.analyses.periodic",  # "periodic"
+    "fretwear.analyses.sweep",  # "sweep"
     "fretwear.analyses.transient",  # "transient", "incremental-wear"
     "fretwear.analyses.wear",  # "wear"
 )
@@ -108,11 +109,18 @@ def register(name: str, schema: Table | Mapping, run: RunFunction, *, doc: str =
 
 
 def _load() -> None:
+    """Import :data:`ANALYSIS_MODULES` once; the analyses are then listed in the order of that
+    tuple (and of registration within a module), whichever module was imported first."""
     global _loaded
     if not _loaded:
         _loaded = True
         for module in ANALYSIS_MODULES:
             importlib.import_module(module)
+        rank = {module: i for i, module in enumerate(ANALYSIS_MODULES)}
+        ordered = sorted(_REGISTRY.items(),
+                         key=lambda item: rank.get(item[1].run.__module__, len(rank)))
+        _REGISTRY.clear()
+        _REGISTRY.update(ordered)
 
 
 def analysis_tables() -> dict[str, Table]:

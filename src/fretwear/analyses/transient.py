@@ -21,11 +21,11 @@ import numpy as np
 import xarray as xr
 
 from fretwear.analyses import figures as plots
-from fretwear.analyses.linear import _figure_path, _geometry
-from fretwear.analyses.periodic import (
-    _pad_axes,
+from fretwear.analyses.common import (
+    figure_path,
+    geometry,
     interface_abscissa,
-    plot_state_map,
+    pad_axes,
     si_scale,
     titled,
 )
@@ -136,17 +136,17 @@ def _observed_variables(last: TransientResult, points: list[str], n_axes: int, n
     coeffs = [fourier_coefficients(last.observed[p], nh).T for p in points]  # (d, 2nh+1)
     pa = ("point", "axis")
     return {
-        "displacement": variable(pa + ("tau",), _pad_axes([last.observed[p].T for p in points],
+        "displacement": variable(pa + ("tau",), pad_axes([last.observed[p].T for p in points],
                                                           n_axes), "m",
                                  "displacement of the observed point over one period"),
-        "velocity": variable(pa + ("tau",), _pad_axes([last.velocities[p].T for p in points],
+        "velocity": variable(pa + ("tau",), pad_axes([last.velocities[p].T for p in points],
                                                       n_axes), "m/s",
                              "velocity of the observed point over one period"),
         "displacement_coefficients": variable(
-            pa + ("harmonic_coefficient",), _pad_axes(coeffs, n_axes), "m",
+            pa + ("harmonic_coefficient",), pad_axes(coeffs, n_axes), "m",
             "Fourier coefficients of the displacement of the observed point"),
         "displacement_harmonic_amplitude": variable(
-            pa + ("harmonic",), _pad_axes([amplitude(c, basis) for c in coeffs], n_axes), "m",
+            pa + ("harmonic",), pad_axes([amplitude(c, basis) for c in coeffs], n_axes), "m",
             "amplitude of each kept harmonic of the displacement of the observed point"),
     }
 
@@ -160,7 +160,7 @@ def _poincare_variables(last: TransientResult, points: list[str], n_axes: int,
     pa = ("time", "point", "axis")
 
     def stack(d):
-        return np.moveaxis(_pad_axes([d[p].T for p in points], n_axes), 2, 0)
+        return np.moveaxis(pad_axes([d[p].T for p in points], n_axes), 2, 0)
 
     return {
         "time": variable("time", (start + np.arange(n_kept)) * T, "s",
@@ -223,7 +223,7 @@ def state_fractions(state: np.ndarray, area: np.ndarray) -> np.ndarray:
 def transient_dataset(model, last: TransientResult, points: list[str], nh: int,
                       periods_before: int) -> xr.Dataset:
     """The results dataset of a ``transient`` run (``docs/results.md``, ``transient``)."""
-    coords, data = _geometry(model, points)
+    coords, data = geometry(model, points)
     n_axes = coords["axis"].size
     coords.update(_period_coordinates(last.steps_per_period, nh))
     pc = _poincare_variables(last, points, n_axes, periods_before)
@@ -298,12 +298,12 @@ def _transient_figures(ds: xr.Dataset, case, outdir: Path, title: str) -> list[P
     figures = []
     for point in ds["point"].values:
         for stem, plot in (("transient", plot_last_period), ("poincare", plot_poincare)):
-            p = _figure_path(case, outdir, f"{stem}-{point}")
+            p = figure_path(case, outdir, f"{stem}-{point}")
             if p is not None:
                 figures.append(plot(ds, p, str(point), title=title))
-    p = _figure_path(case, outdir, "contact-state")
+    p = figure_path(case, outdir, "contact-state")
     if p is not None:
-        figures.append(plot_state_map(ds, p, title=title))
+        figures.append(plots.plot_state_map(ds, p, title=title))
     return figures
 
 
@@ -394,7 +394,7 @@ register(
 # --- incremental wear --------------------------------------------------------------------------
 def incremental_dataset(model, r: IncrementalWearResult) -> xr.Dataset:
     """The results dataset of an ``incremental-wear`` run (``docs/results.md``)."""
-    coords, data = _geometry(model, [p.name for p in model.observed])
+    coords, data = geometry(model, [p.name for p in model.observed])
     coords["step"] = variable("step", np.arange(r.cycles.size), "1",
                               "slow-scale (wear) step: a recorded computed cycle")
     sn = ("step", "contact_node")
@@ -442,7 +442,7 @@ def run_incremental_wear(model, analysis: dict, case, outdir: Path, progress: bo
                      "steps_per_cycle": int(r.steps_per_cycle), "k_w": float(r.k_w),
                      "wall_time": float(r.wall_time)})
     figures = []
-    p = _figure_path(case, outdir, "wear-profile")
+    p = figure_path(case, outdir, "wear-profile")
     if p is not None:
         figures.append(plot_incremental_profiles(ds, p, title=titled(case.title, "wear")))
     w = ds["wear_depth"].values[-1]

@@ -22,6 +22,7 @@ import numpy as np
 from fretwear.errors import InputError
 from fretwear.hb import contact as law
 from fretwear.hb.fourier import FourierBasis, amplitude
+from fretwear.hb.penalty import penalty
 from fretwear.hb.reduce import Reduced, condense, loads_to_real, recover, to_real_blocks
 from fretwear.hb.solvers import SolveStats, solve
 from fretwear.model.core import ContactInterface, Model
@@ -36,13 +37,15 @@ class DLFTProblem:
     contact : the interface (friction coefficient per node is ``contact.mu``).
     basis : Fourier basis.
     gap : (nc,) normal gap + wear ``W`` [m].
-    eps : DLFT penalty [N/m]; ``None`` = spectral radius of ``Z_r`` (paper, section 3.2).
+    eps : DLFT penalty: ``"auto"`` (default) the spectral radius of ``Z_r`` (paper, section
+        3.2), ``"static"`` that of the static ``K_r``, or a positive number [N/m]
+        (:func:`fretwear.hb.penalty.penalty`; ``None`` is the default, ``"auto"``).
     anchor : (nc, d-1) stick anchors: where a node that sticks all period sticks [m]
         (tangential, contact-local). Default 0.
     """
 
     def __init__(self, reduced: Reduced, contact: ContactInterface, basis: FourierBasis,
-                 gap=None, eps=None, anchor=None, periodicity_tol=1e-12, max_sweeps=200):
+                 gap=None, eps="auto", anchor=None, periodicity_tol=1e-12, max_sweeps=200):
         nc, d = contact.dofs.shape
         self.nc, self.d, self.basis = nc, d, basis
         self.H = basis.size
@@ -53,9 +56,7 @@ class DLFTProblem:
         self.reduced = reduced
         self.Z = to_real_blocks(reduced.Z, reduced.orders)
         self.F = loads_to_real(reduced.F)
-        self.eps = float(reduced.spectral_radius() if eps is None else eps)
-        if not self.eps > 0:
-            raise InputError(f"eps = {eps}: expected a positive penalty [N/m]")
+        self.eps = penalty("auto" if eps is None else eps, reduced=reduced)
         self.mu = np.full(nc, float(contact.mu))
         self.set_gap(contact.gap if gap is None else gap)
         self.anchor = np.zeros((nc, d - 1)) if anchor is None else np.array(anchor, float)
@@ -285,7 +286,7 @@ def static_anchor(model: Model, *, quasi: Reduced | None = None) -> np.ndarray:
 
 def solve_periodic(model: Model, basis: FourierBasis, *, omega: float = 0.0,
                    quasi_static: bool = False, reduced: Reduced | None = None, gap=None,
-                   eps=None, anchor=None, U0=None, solver="powell", tol=1e-8, max_iter=200,
+                   eps="auto", anchor=None, U0=None, solver="powell", tol=1e-8, max_iter=200,
                    raise_on_failure=False) -> tuple[PeriodicSolution | None, SolveStats]:
     """Periodic response of ``model`` at ``omega`` [rad/s] with the DLFT (section 3.1-3.2).
 
@@ -295,7 +296,9 @@ def solve_periodic(model: Model, basis: FourierBasis, *, omega: float = 0.0,
     quasi_static : drop inertia and damping (slow cyclic loading; ``omega`` only scales time).
     reduced : a precomputed condensation on ``[0] + basis.harmonics`` (else computed here).
     gap : (nc,) gap + wear [m] (default: the model's initial gap).
-    eps : DLFT penalty [N/m] (default: spectral radius of ``Z_r``).
+    eps : DLFT penalty: ``"auto"`` (default) the spectral radius of ``Z_r`` over the kept
+        harmonics (the paper), ``"static"`` that of the static ``K_r``, or a positive number
+        [N/m] (:func:`fretwear.hb.penalty.penalty`; ``None`` is the default, ``"auto"``).
     anchor : (nc, d-1) stick anchors [m]; default: the static preload state
         (:func:`static_anchor`), the documented rule for the mean tangential position.
     U0 : (nc, d, H) starting point (e.g. a neighbouring solution).
@@ -309,6 +312,7 @@ def solve_periodic(model: Model, basis: FourierBasis, *, omega: float = 0.0,
     """
     if reduced is None:
         reduced = condense(model, omega, _orders(basis), quasi_static=quasi_static)
+    eps = penalty("auto" if eps is None else eps, model=model, reduced=reduced)
     if anchor is None:
         anchor = static_anchor(model)
     prob = DLFTProblem(reduced, model.contact, basis, gap=gap, eps=eps, anchor=anchor)

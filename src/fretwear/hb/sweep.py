@@ -23,6 +23,7 @@ import numpy as np
 
 from fretwear.hb.fallback import TimeDomainFallback
 from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.penalty import check_rule, penalty
 from fretwear.hb.periodic import DLFTProblem, PeriodicSolution, assemble_solution, static_anchor
 from fretwear.hb.reduce import condense
 from fretwear.hb.solvers import SolveStats, solve
@@ -103,7 +104,8 @@ def frequency_grid(f_min: float, f_max: float, n: int, spacing: str = "log") -> 
 
 
 class _Problems:
-    """DLFT problems per frequency, condensed once and cached (the sweep revisits them)."""
+    """DLFT problems per frequency, condensed once and cached (the sweep revisits them).
+    ``eps``: a number [N/m], or ``"auto"`` (the spectral radius of each frequency's ``Z_r``)."""
 
     def __init__(self, model, basis, gap, eps, cache_size=8):
         self.model, self.basis, self.gap, self.eps = model, basis, gap, eps
@@ -210,7 +212,7 @@ def _arclength(probs, model, anchor, y_prev, y_last, omega_target, solver_tol, m
 
 
 def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_points: int, *,
-          spacing: str = "log", gap=None, eps=None, anchor=None, solver: str = "powell",
+          spacing: str = "log", gap=None, eps="static", anchor=None, solver: str = "powell",
           tol: float = 1e-8, max_iter: int = 40, continuation: bool = True,
           max_bisections: int = 4, check=None,
           time_domain: TimeDomainFallback | None = None,
@@ -222,10 +224,11 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
     model, basis : the structure and the Fourier basis.
     n_points, spacing : the frequency grid (``"log"`` or ``"linear"``).
     gap : (nc,) gap + wear [m] (a worn interface); default the model's initial gap.
-    eps : DLFT penalty [N/m]. Default (``None`` or ``"static"``): the spectral radius of the
-        static reduced stiffness ``Z_r(0) = K_r``, the same at every frequency.
-        ``"per-frequency"``: the spectral radius of ``Z_r`` over the kept harmonics at each
-        frequency (the paper's rule applied point by point). Why the default differs: the
+    eps : DLFT penalty (:func:`fretwear.hb.penalty.penalty`). Default ``"static"``: the
+        spectral radius of the static reduced stiffness ``Z_r(0) = K_r``, the same at every
+        frequency (``None`` is the default too). ``"auto"``: the spectral radius of ``Z_r``
+        over the kept harmonics at each frequency (the paper's rule applied point by point).
+        A positive number [N/m]: that penalty everywhere. Why the default differs: the
         harmonics of ``Z_r(n w)`` have poles at the clamped-interface resonances, so its
         spectral radius jumps by orders of magnitude between neighbouring frequencies (x30
         between 21.1 and 21.4 kHz on the paper's beam); with 7 harmonics the solution depends
@@ -250,10 +253,9 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
     """
     t_start = time.perf_counter()
     grid = frequency_grid(f_min, f_max, n_points, spacing)
-    if eps is None or eps == "static":
-        eps = condense(model, 0.0, [0], quasi_static=True).spectral_radius()
-    elif eps == "per-frequency":
-        eps = None
+    eps = check_rule("static" if eps is None else eps)
+    if eps != "auto":
+        eps = penalty(eps, model=model)
     probs = _Problems(model, basis, gap, eps)
     if anchor is None:
         anchor = static_anchor(model)
@@ -332,7 +334,7 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
                 prob, U, st = _solve_at(probs, omega, current_anchor(), history[-1][1], solver,
                                         tol, max_iter)
                 how = "arclength"
-        if not st.converged and probs.eps is not None:
+        if not st.converged and probs.eps != "auto":
             # a larger penalty often converges where the default stalls (measured at 79 kHz
             # on the paper's beam); the solution differs by the eps-dependence of the
             # truncated balance, which the point records (its DLFTProblem's eps)

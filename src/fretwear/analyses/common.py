@@ -1,0 +1,216 @@
+"""Helpers shared by several analyses: observed points, figure paths, the geometry of a results
+dataset, the harmonic-balance keys of ``[analysis]`` tables, solver attributes, array padding,
+interface abscissae, SI prefixes and figure titles.
+
+Figure functions shared by several analyses are in :mod:`fretwear.analyses.figures`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.penalty import RULES
+from fretwear.hb.solvers import SOLVERS, SolveStats
+from fretwear.io.results import label_coordinate, variable
+from fretwear.io.schema import AnyOf, Field, Integer, ListOf, Number, Text, fail, join
+
+#: contact-local components of the contact nodes (normal, tangents)
+COMPONENTS = ("N", "T1", "T2")
+#: structure axes
+AXES = ("x", "y", "z")
+#: |v| below this fraction of its peak counts as stopped (as ``stops_per_period``)
+STOP_TOL = 5e-2
+
+
+# --- observed points, figures, geometry -----------------------------------------------------
+def check_points(model, requested) -> list[str]:
+    """The observed points to report: ``requested`` (the ``points`` key), checked against the
+    model's observed points, or all of them when it is None."""
+    names = [p.name for p in model.observed]
+    if requested is None:
+        return names
+    unknown = [p for p in requested if p not in names]
+    if unknown:
+        fail("analysis.points", requested,
+             "names of observed points: " + (", ".join(repr(n) for n in names) or "(none)"))
+    return list(requested)
+
+
+def figure_path(case, outdir: Path, stem: str) -> Path | None:
+    """``outdir/stem.<figure_format>``, or None when the case's output asks for no figures."""
+    out = case.output
+    return outdir / f"{stem}.{out['figure_format']}" if out["figures"] else None
+
+
+def geometry(model, points: list[str]) -> tuple[dict, dict]:
+    """Coordinates (``point``, ``axis``, ``contact_node``, ``component``) and position variables
+    (``point_position``, ``contact_position``, ``contact_area``) of the observed points and
+    contact nodes: the shared part of every results dataset (``docs/results.md``)."""
+    c = model.contact
+    nc, d = c.dofs.shape
+    n_axes = max([d] + [len(model.observed_point(p).dofs) for p in points])
+    coords = {
+        "point": label_coordinate("point", points),
+        "axis": label_coordinate("axis", AXES[:n_axes]),
+        "contact_node": variable("contact_node", np.arange(nc), "1", "contact node, from 0"),
+        "component": label_coordinate("component", COMPONENTS[:d]),
+    }
+    pos = np.full((len(points), n_axes), np.nan)
+    for i, name in enumerate(points):
+        xyz = np.asarray(model.observed_point(name).coords, dtype=float).reshape(-1)
+        pos[i, : min(xyz.size, n_axes)] = xyz[:n_axes]
+    cpos = np.full((nc, n_axes), np.nan)
+    cc = np.asarray(c.coords, dtype=float).reshape(nc, -1)
+    cpos[:, : min(cc.shape[1], n_axes)] = cc[:, :n_axes]
+    data = {
+        "point_position": variable(("point", "axis"), pos, "m", "position of the observed point"),
+        "contact_position": variable(("contact_node", "axis"), cpos, "m",
+                                     "position of the contact node"),
+        "contact_area": variable("contact_node", np.asarray(c.area, dtype=float), "m^2",
+                                 "tributary area of the contact node"),
+    }
+    return coords, data
+
+
+def live_axes(ds: xr.Dataset, point: str) -> list[str]:
+    """The axes ``point`` has (``point_position`` is NaN on the others)."""
+    pos = ds["point_position"].sel(point=point)
+    return [str(a) for a in ds["axis"].values if np.isfinite(pos.sel(axis=a).values)]
+
+
+def pad_axes(arrays: list[np.ndarray], n_axes: int) -> np.ndarray:
+    """Stack per-point arrays ``(d_p, ...)`` into ``(n_points, n_axes, ...)``, NaN-padded."""
+    trailing = arrays[0].shape[1:] if arrays else ()
+    out = np.full((len(arrays), n_axes) + trailing, np.nan)
+    for i, a in enumerate(arrays):
+        out[i, : a.shape[0]] = a
+    return out
+
+
+def period_coordinates(basis: FourierBasis) -> dict:
+    """Coordinates ``harmonic_coefficient``, ``tau`` [rad] and ``harmonic`` of ``basis``."""
+    return {
+        "harmonic_coefficient": label_coordinate("harmonic_coefficient", basis.labels()),
+        "tau": variable("tau", basis.tau, "rad", "angle tau = omega t over one period"),
+        "harmonic": variable("harmonic", np.asarray(basis.harmonics), "1",
+                             "kept harmonic number"),
+    }
+
+
+# --- harmonic-balance keys of [analysis] tables --------------------------------------------
+def harmonic_list(value) -> list[int]:
+    """Kept harmonics from the ``harmonics`` key: ``Nh`` -> ``[1..Nh]``, a list -> sorted."""
+    if isinstance(value, int):
+        return list(range(1, value + 1))
+    return sorted(int(h) for h in value)
+
+
+def basis_of(analysis: dict) -> FourierBasis:
+    """The Fourier basis an ``[analysis]`` table asks for (``harmonics``, ``n_samples``)."""
+    return FourierBasis(tuple(harmonic_list(analysis["harmonics"])), analysis["n_samples"])
+
+
+def check_sampling(out: dict, path: str) -> None:
+    """Rule: ``n_samples`` exceeds twice the highest kept harmonic (no aliasing)."""
+    if "harmonics" not in out or "n_samples" not in out:
+        return
+    top = max(harmonic_list(out["harmonics"]))
+    if out["n_samples"] <= 2 * top:
+        fail(join(path, "n_samples"), out["n_samples"],
+             f"more than {2 * top} samples per period (twice the highest harmonic, {top})")
+
+
+def harmonic_balance_fields(eps_default: str, eps_doc: str, max_iter: int) -> dict:
+    """The keys of the DLFT analyses' tables (``harmonics``, ``n_samples``, ``eps``,
+    ``solver``, ``tol``, ``max_iter``) with the given ``eps`` default and description and
+    ``max_iter`` default."""
+    return {
+        "harmonics": Field(
+            AnyOf((Integer(lo=1), ListOf(Integer(lo=1), non_empty=True, unique=True))),
+            "kept harmonics: Nh keeps 1, 2, .., Nh; a list keeps those listed (e.g. [1, 3, 5])",
+            default=7),
+        "n_samples": Field(Integer(lo=3), "time samples per period N of the contact law "
+                           "(more than twice the highest harmonic)", default=128),
+        "eps": Field(AnyOf((Text(RULES), Number(lo=0, lo_open=True))), eps_doc,
+                     default=eps_default, unit="N/m"),
+        "solver": Field(Text(SOLVERS), '"powell" (hybrid dog-leg, LAPACK), "newton" (damped '
+                        'Newton) or "hybr" (MINPACK hybrj, as in the paper)', default="powell"),
+        "tol": Field(Number(lo=0, lo_open=True), "relative residual of the convergence test "
+                     "|f(U)| <= tol |Z_r U| (paper section 3.2)", default=1e-8, unit="-"),
+        "max_iter": Field(Integer(lo=1), "maximum solver iterations per frequency",
+                          default=max_iter),
+    }
+
+
+def solver_attributes(stats: SolveStats, analysis: dict, eps: float) -> dict:
+    """Solver settings and statistics of one solve as NetCDF attributes (numbers and strings
+    only): solver, message, residual, iterations, evaluations, wall time, eps and its rule,
+    harmonics, samples."""
+    return {
+        "solver": str(stats.solver or analysis["solver"]),
+        "solver_message": str(stats.message),
+        "residual": float(stats.residual),
+        "tol": float(analysis["tol"]),
+        "iterations": int(stats.iterations),
+        "nfev": int(stats.nfev),
+        "njev": int(stats.njev),
+        "wall_time": float(stats.wall_time),
+        "eps": float(eps),
+        "eps_rule": str(analysis["eps"]),
+        "harmonics": ", ".join(str(h) for h in harmonic_list(analysis["harmonics"])),
+        "n_samples": int(analysis["n_samples"]),
+    }
+
+
+# --- figure helpers ------------------------------------------------------------------------
+def titled(title: str, suffix: str) -> str:
+    """``"title: suffix"``, or ``title`` when it already says ``suffix``."""
+    return title if suffix.lower() in title.lower() else f"{title}: {suffix}"
+
+
+def interface_abscissa(ds: xr.Dataset) -> tuple[np.ndarray, str]:
+    """Where to draw each contact node along a figure's x axis, and the axis label.
+
+    The coordinate along which a straight interface runs, if it runs along an axis; else the
+    distance along the chain of nodes (2D); else the node number.
+    """
+    pos = ds["contact_position"].values
+    nc = pos.shape[0]
+    index = (np.arange(nc, dtype=float), "contact node")
+    if nc < 2 or not np.all(np.isfinite(pos[:, :2])):
+        return index
+    live = [a for a in range(pos.shape[1]) if np.all(np.isfinite(pos[:, a]))]
+    span = [a for a in live if np.ptp(pos[:, a]) > 0]
+    if len(span) == 1 and np.unique(pos[:, span[0]]).size == nc:
+        a = span[0]
+        return pos[:, a], f"{ds['axis'].values[a]} [m]"
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pos[:, live], axis=0), axis=1))])
+    if len(live) == 2 and np.all(np.diff(s) > 0):
+        return s, "distance along the interface [m]"
+    return index
+
+
+def cell_edges(x: np.ndarray) -> np.ndarray:
+    """Cell edges around increasing or decreasing centres ``x`` (for ``pcolormesh``)."""
+    if x.size == 1:
+        return np.array([x[0] - 0.5, x[0] + 0.5])
+    mid = 0.5 * (x[1:] + x[:-1])
+    return np.concatenate([[2 * x[0] - mid[0]], mid, [2 * x[-1] - mid[-1]]])
+
+
+_PREFIXES = {-15: "f", -12: "p", -9: "n", -6: "\u00b5", -3: "m", 0: "", 3: "k", 6: "M", 9: "G"}
+
+
+def si_scale(values, unit: str) -> tuple[float, str]:
+    """``(factor, prefixed unit)`` so that ``factor * values`` reads between 1 and 1000
+    (e.g. ``1.2e-9 m`` -> ``1.2 nm``); ``(1, unit)`` when there is nothing to scale."""
+    v = np.abs(np.asarray(values, dtype=float))
+    v = v[np.isfinite(v) & (v > 0)]
+    if v.size == 0:
+        return 1.0, unit
+    e = int(np.clip(3 * np.floor(np.log10(v.max()) / 3), -15, 9))
+    return 10.0 ** -e, _PREFIXES[e] + unit

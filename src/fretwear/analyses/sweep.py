@@ -1,0 +1,323 @@
+"""The ``"sweep"`` analysis of case files: the nonlinear FRF (DLFT periodic responses over a
+frequency band).
+
+:func:`run_sweep` calls :func:`fretwear.hb.sweep.sweep`, turns its result into a results dataset
+(schema in ``docs/results.md``) and figures, and registers itself with
+:mod:`fretwear.analyses.registry`. Points that did not converge are kept as NaN with
+``converged = 0`` and the reason in ``flags``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+from tqdm import tqdm
+
+from fretwear import linear
+from fretwear.analyses import figures as plots
+from fretwear.analyses.common import (
+    basis_of,
+    check_points,
+    check_sampling,
+    figure_path,
+    geometry,
+    harmonic_balance_fields,
+    live_axes,
+    period_coordinates,
+    titled,
+)
+from fretwear.analyses.registry import RunOutput, register
+from fretwear.hb.contact import STATE_NAMES
+from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.periodic import PeriodicSolution
+from fretwear.hb.sweep import SweepResult, sweep
+from fretwear.io.results import label_coordinate, variable
+from fretwear.io.schema import Field, Flag, Integer, ListOf, Number, Text, increasing
+from fretwear.timedomain.fallback import FALLBACK
+from fretwear.timedomain.stability import sweep_check
+
+
+# --- dataset -------------------------------------------------------------------------------
+def _per_point(result: SweepResult, value, fill=np.nan, dtype=float) -> np.ndarray:
+    """``value(point)`` for each converged sweep point (``fill`` elsewhere)."""
+    return np.array([value(p) if p.converged else fill for p in result.points], dtype=dtype)
+
+
+def _state_fractions(sol: PeriodicSolution) -> np.ndarray:
+    """Fractions of contact area x period in separation, stick, slip (3,)."""
+    w = sol.area / sol.area.sum()
+    return w @ sol.state_fractions()
+
+
+def _response_variables(result: SweepResult, basis: FourierBasis, model, points: list[str],
+                        n_axes: int) -> dict:
+    nf, k = len(result.points), basis.k
+    amp = np.full((nf, len(points), n_axes, k), np.nan)
+    ptp = np.full((nf, len(points), n_axes), np.nan)
+    for i, name in enumerate(points):
+        for a in range(len(model.observed_point(name).dofs)):
+            for j, h in enumerate(basis.harmonics):
+                amp[:, i, a, j] = result.amplitude(name, a, h)
+            ptp[:, i, a] = 2.0 * result.amplitude(name, a, None)
+    return {
+        "response_amplitude": variable(
+            ("frequency", "point", "axis", "harmonic"), amp, "m",
+            "amplitude of each kept harmonic of the displacement of the observed point"),
+        "response_peak_to_peak": variable(
+            ("frequency", "point", "axis"), ptp, "m",
+            "peak-to-peak displacement of the observed point over the period"),
+    }
+
+
+def _sweep_point_variables(result: SweepResult) -> dict:
+    fr = np.array([_state_fractions(p.solution) if p.converged else np.full(3, np.nan)
+                   for p in result.points]).reshape(-1, 3)
+    f = "frequency"
+    data = {
+        "converged": variable(f, result.converged.astype(np.int8), "1",
+                              "the periodic solve converged", flag_values=np.array(
+                                  [0, 1], dtype=np.int8), flag_meanings="no yes"),
+        "how": variable(f, np.array([p.how for p in result.points], dtype=str), "1",
+                        "how the point was reached: grid, substep, retry, arclength, eps-x10, "
+                        "time-start"),
+        "flags": variable(f, np.array(["; ".join(p.flags) for p in result.points], dtype=str),
+                          "1", "reasons for caution (empty: none)"),
+        "friction_energy": variable(
+            f, _per_point(result, lambda p: p.solution.friction_energy().sum()), "J",
+            "energy dissipated by friction per period over the interface"),
+        "iterations": variable(f, np.array([p.stats.iterations for p in result.points]), "1",
+                               "solver iterations of the last solve at this frequency"),
+        "wall_time": variable(f, np.array([p.stats.wall_time for p in result.points], float),
+                              "s", "wall time of the last solve at this frequency"),
+        "residual": variable(f, np.array([p.stats.residual for p in result.points], float),
+                             "1", "final relative residual |f(U)| / |Z_r U|"),
+        "penalty": variable(f, _per_point(result, lambda p: p.solution.eps), "N/m",
+                            "DLFT penalty eps used"),
+    }
+    for s, name in enumerate(STATE_NAMES):
+        data[f"{name}_fraction"] = variable(
+            f, fr[:, s], "1", f"fraction of contact area x period in {name}")
+    return data
+
+
+def _linear_references(model, freqs: np.ndarray, interfaces: list[str], points: list[str],
+                       n_axes: int) -> dict:
+    """Amplitudes of the linear FRFs with the requested interfaces at the sweep frequencies."""
+    amp = np.full((len(interfaces), freqs.size, len(points), n_axes), np.nan)
+    for i, interface in enumerate(interfaces):
+        r = linear.frf(model, freqs, interface=interface)
+        for j, name in enumerate(points):
+            u = np.abs(r.observed[name])
+            amp[i, :, j, : u.shape[1]] = u
+    return {"linear_response_amplitude": variable(
+        ("interface", "frequency", "point", "axis"), amp, "m",
+        "amplitude of the linear FRF with the interface held (stuck) or frictionless "
+        "(sliding), harmonic 1 of the loads")}
+
+
+def sweep_dataset(model, result: SweepResult, basis: FourierBasis, points: list[str],
+                  references: list[str]) -> xr.Dataset:
+    """The results dataset of a sweep (``docs/results.md``)."""
+    coords, data = geometry(model, points)
+    freqs = result.frequency_hz
+    coords["frequency"] = variable("frequency", freqs, "Hz", "excitation frequency")
+    coords["harmonic"] = period_coordinates(basis)["harmonic"]
+    n_axes = coords["axis"].size
+    data.update(_response_variables(result, basis, model, points, n_axes))
+    data.update(_sweep_point_variables(result))
+    if references:
+        coords["interface"] = label_coordinate("interface", references)
+        data.update(_linear_references(model, freqs, references, points, n_axes))
+    return xr.Dataset(data, coords=coords)
+
+
+# --- run -----------------------------------------------------------------------------------
+def _sweep_summary(result: SweepResult, ds: xr.Dataset) -> str:
+    lines = [result.summary()]
+    h = int(ds["harmonic"].values[0])
+    amp = ds["response_amplitude"].sel(harmonic=h)
+    f = ds["frequency"].values
+    for point in ds["point"].values:
+        for axis in ds["axis"].values:
+            y = amp.sel(point=point, axis=axis).values
+            if np.all(np.isnan(y)):
+                continue
+            i = int(np.nanargmax(y))
+            lines.append(f"{point} {axis}: max |u_{h}| = {y[i]:.4g} m at "
+                         f"{plots.format_frequency(f[i])}")
+    return "\n".join(lines)
+
+
+def run_sweep(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOutput:
+    """Nonlinear FRF: periodic solutions over a frequency band (:func:`fretwear.hb.sweep.sweep`).
+
+    Parameters
+    ----------
+    model : the model; analysis : the validated ``[analysis]`` table; case : the case;
+    outdir : results folder; progress : show a progress bar.
+
+    Returns
+    -------
+    RunOutput; ``converged`` False when some point did not converge.
+    """
+    points = check_points(model, analysis.get("points"))
+    basis = basis_of(analysis)
+    n = analysis["n_points"]
+    with tqdm(total=n, desc="sweep", disable=not progress, leave=False, unit="freq") as bar:
+        def tick(i, total, pt):
+            bar.update(1)
+            bar.set_postfix_str(f"{plots.format_frequency(pt.frequency_hz)}"
+                                f"{'' if pt.converged else ' (not converged)'}")
+
+        result = sweep(model, basis, analysis["f_min"], analysis["f_max"], n,
+                       spacing=analysis["spacing"], eps=analysis["eps"],
+                       solver=analysis["solver"], tol=analysis["tol"],
+                       max_iter=analysis["max_iter"],
+                       continuation=analysis["continuation"],
+                       time_domain=FALLBACK if analysis["time_domain"] else None,
+                       time_domain_periods=analysis["time_domain_periods"],
+                       check=(sweep_check(model, max_periods=analysis["time_domain_periods"])
+                              if analysis["check_stability"] else None),
+                       progress=tick)
+    ds = sweep_dataset(model, result, basis, points, analysis["linear_references"])
+    flagged = [f"{p.frequency_hz:.6g} Hz: " + "; ".join(p.flags)
+               for p in result.points if p.flags]
+    ds.attrs.update({
+        "sweep_converged": result.summary().splitlines()[0].split("=", 1)[1],
+        "flagged_points": "\n".join(flagged),
+        "total_wall_time": float(result.wall_time),
+        "solver": analysis["solver"], "tol": float(analysis["tol"]),
+        "eps_rule": str(analysis["eps"]),
+        "harmonics": ", ".join(str(h) for h in basis.harmonics),
+        "n_samples": int(basis.n_samples),
+    })
+    figures = []
+    for point in points:
+        p = figure_path(case, outdir, f"sweep-{point}")
+        if p is not None:
+            figures.append(plot_sweep(ds, p, point, title=titled(case.title, "nonlinear FRF")))
+    p = figure_path(case, outdir, "sweep-interface")
+    if p is not None:
+        figures.append(plot_sweep_interface(ds, p, title=titled(case.title,
+                                                                  "contact interface")))
+    grid_ok = all(p.converged for p in result.points if p.on_grid)
+    return RunOutput(ds, figures, _sweep_summary(result, ds), grid_ok)
+
+
+# --- figures -------------------------------------------------------------------------------
+def _mark_failures(ax, f: np.ndarray, converged: np.ndarray, flagged: np.ndarray, y) -> None:
+    """Red crosses along the bottom at points that did not converge; orange rings on
+    converged points that carry flags."""
+    bad = ~converged
+    if bad.any():
+        ax.plot(f[bad], np.full(bad.sum(), 0.03), "x", color="tab:red",
+                transform=ax.get_xaxis_transform(), label=f"not converged ({bad.sum()})")
+    ring = flagged & converged
+    if ring.any():
+        ax.plot(f[ring], y[ring], "o", mfc="none", color="tab:orange", ms=7,
+                label=f"flagged ({ring.sum()})")
+
+
+def plot_sweep(ds: xr.Dataset, path: Path, point: str, *, title: str | None = None) -> Path:
+    """Nonlinear FRF at one observed point (log-log, one panel per axis), with the linear
+    references of the dataset (cf. paper Fig. 14)."""
+    axes_names = live_axes(ds, point) or [str(ds["axis"].values[0])]
+    fig, axes = plots.new_figure(len(axes_names), 1, title=title, panel_size=(7.5, 3.8),
+                                 sharex=True)
+    f = ds["frequency"].values
+    h = int(ds["harmonic"].values[0])
+    conv = ds["converged"].values.astype(bool)
+    flagged = np.array([bool(s) for s in ds["flags"].values])
+    for ax, axis in zip(axes[:, 0], axes_names, strict=True):
+        if "linear_response_amplitude" in ds:
+            for interface in ds["interface"].values:
+                y = ds["linear_response_amplitude"].sel(interface=interface, point=point,
+                                                        axis=axis).values
+                ax.plot(f, np.where(y > 0, y, np.nan), label=f"linear, {interface}",
+                        **plots.INTERFACE_STYLE.get(str(interface), {}))
+        y = ds["response_amplitude"].sel(point=point, axis=axis, harmonic=h).values
+        ax.plot(f, np.where(y > 0, y, np.nan), color="k", marker=".", ms=3,
+                label=f"friction, harmonic {h}")
+        half = 0.5 * ds["response_peak_to_peak"].sel(point=point, axis=axis).values
+        ax.plot(f, np.where(half > 0, half, np.nan), color="0.5", lw=0.8, linestyle=":",
+                label="friction, half peak-to-peak")
+        _mark_failures(ax, f, conv, flagged, y)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_ylabel(f"|u_{axis}| at {point} [m]")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize="small", loc="best")
+    axes[-1, 0].set_xlabel("frequency [Hz]")
+    return plots.save(fig, path)
+
+
+def plot_sweep_interface(ds: xr.Dataset, path: Path, *, title: str | None = None) -> Path:
+    """Friction energy per cycle and the contact state fractions against frequency."""
+    f = ds["frequency"].values
+    conv = ds["converged"].values.astype(bool)
+    flagged = np.array([bool(s) for s in ds["flags"].values])
+    fig, axes = plots.new_figure(2, 1, title=title, panel_size=(7.5, 3.2), sharex=True)
+    ax = axes[0, 0]
+    e = ds["friction_energy"].values
+    ax.plot(f, np.where(e > 0, e, np.nan), color="tab:purple", marker=".", ms=3)
+    _mark_failures(ax, f, conv, flagged, e)
+    ax.set_yscale("log")
+    ax.set_ylabel("friction energy\nper period [J]")
+    if not conv.all() or (flagged & conv).any():
+        ax.legend(fontsize="small")
+    ax = axes[1, 0]
+    for colour, name in zip(plots.STATE_COLOURS, STATE_NAMES, strict=True):
+        ax.plot(f, ds[f"{name}_fraction"].values, color="0.5" if name == "separation" else
+                colour, label=name)
+    ax.set_ylim(-0.02, 1.02)
+    ax.set_ylabel("fraction of contact\narea x period [-]")
+    ax.legend(fontsize="small", title="contact state")
+    ax.set_xlabel("frequency [Hz]")
+    for ax in axes[:, 0]:
+        ax.set_xscale("log")
+        ax.grid(True, which="both", alpha=0.3)
+    return plots.save(fig, path)
+
+
+# --- registration ---------------------------------------------------------------------------
+register(
+    "sweep",
+    {
+        "f_min": Field(Number(lo=0, lo_open=True), "lowest frequency", required=True, unit="Hz"),
+        "f_max": Field(Number(lo=0, lo_open=True), "highest frequency", required=True, unit="Hz"),
+        "n_points": Field(Integer(lo=2), "number of grid frequencies (the sweep may add "
+                          "intermediate points where a step fails)", default=200),
+        "spacing": Field(Text(("log", "linear")), "frequency spacing", default="log"),
+        "continuation": Field(Flag(), "pseudo-arclength continuation when a frequency step "
+                              "fails (passes folds of the response curve)", default=True),
+        "time_domain": Field(Flag(), "where a point still fails, integrate in time from the "
+                             "neighbour: a periodic steady state starts one more solve, any "
+                             "other response (drifting, quasi-periodic) is reported as the "
+                             "reason", default=True),
+        "time_domain_periods": Field(Integer(lo=10), "forcing periods allowed to each time "
+                                     "integration (time_domain, check_stability)",
+                                     default=3000),
+        "check_stability": Field(Flag(), "check every converged point in time (does the "
+                                 "structure settle to it?); slow", default=False),
+        "points": Field(ListOf(Text(), non_empty=True, unique=True),
+                        "observed points to report (default: all)"),
+        "linear_references": Field(
+            ListOf(Text(linear.INTERFACES), unique=True),
+            'linear FRFs drawn with the nonlinear one: "sliding" (frictionless), "stuck", '
+            '"free"', default=[]),
+        **harmonic_balance_fields(
+            "static",
+            'DLFT penalty: "static": the spectral radius of the static reduced stiffness K_r, '
+            'the same at every frequency (a smooth FRF); "auto": the paper\'s rule (spectral '
+            "radius of Z_r) at each frequency; or a value", 40),
+    },
+    run_sweep,
+    checks=(increasing("f_min", "f_max", "Hz"), check_sampling),
+    doc="Nonlinear FRF: periodic responses with the frictional interface over a frequency "
+    "band, each point starting from its neighbours (continuation). Points that do not "
+    "converge are kept as NaN with `converged = 0` and the reason in `flags`; the run then "
+    "exits with status 1. Writes `sweep-<point>.png` (amplitude against frequency, with the "
+    "linear references) and `sweep-interface.png` (friction energy and contact states).",
+)

@@ -1,0 +1,161 @@
+"""The DLFT penalty rule (fretwear.hb.penalty): one function, one spelling of ``eps``.
+
+The model is a hand-written 2D spring-mass system: two contact nodes joined by springs to an
+interior node held by grounded springs, with hysteretic damping so that ``Z_r`` is complex.
+The reference spectral radius is computed independently of fretwear.hb.reduce: the Schur
+complement of the dense dynamic stiffness on the contact DOFs in the structure's axes (a
+rotation into the contact frames does not change eigenvalues), written as the real block
+matrix of the basis ``[cos, sin]`` per kept harmonic (``[[Re Z, Im Z], [-Im Z, Re Z]]``, the
+static term ``Re Z_0``), whose eigenvalues are those of ``Z_r`` and their conjugates.
+"""
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.penalty import penalty
+from fretwear.hb.periodic import DLFTProblem, solve_periodic
+from fretwear.hb.reduce import condense
+from fretwear.hb.sweep import sweep
+from fretwear.model.core import ContactInterface, Load, Model
+
+ETA = 0.02  # hysteretic loss factor
+ORDERS = [0, 1, 3]
+
+
+def tiny_model() -> Model:
+    """Contact nodes 0 and 1 (DOFs 0-3), interior node 2 (DOFs 4, 5) [N/m, kg]."""
+    K = np.zeros((6, 6))
+
+    def spring(i, j, k):
+        K[i, i] += k
+        K[j, j] += k
+        K[i, j] -= k
+        K[j, i] -= k
+
+    spring(0, 4, 3e6)  # x of node 0 - x of node 2
+    spring(1, 5, 5e6)  # y of node 0 - y of node 2
+    spring(2, 4, 2e6)
+    spring(3, 5, 7e6)
+    spring(0, 2, 1e6)  # between the contact nodes (x)
+    K[4, 4] += 4e6  # interior node grounded
+    K[5, 5] += 9e6
+    M = np.diag([0.01, 0.01, 0.02, 0.02, 0.5, 0.5])
+    frame = np.tile(np.array([[0.0, -1.0], [1.0, 0.0]]), (2, 1, 1))  # normal -y, tangent +x
+    contact = ContactInterface(dofs=np.array([[0, 1], [2, 3]]), frame=frame, gap=np.zeros(2),
+                               area=np.full(2, 1e-4), mu=0.3,
+                               coords=np.array([[0.0, 0.0], [0.01, 0.0]]))
+    loads = [Load(np.array([0, 0, 0, 0, 0, -100.0]), "constant", name="preload"),
+             Load(np.array([0, 0, 0, 0, 10.0, 0]), "cos", name="shaker")]
+    Ks = sp.csr_matrix(K)
+    return Model(K=Ks, M=sp.csr_matrix(M), D=ETA * Ks, contact=contact, loads=loads)
+
+
+def reference_radius(model: Model, omega: float, orders) -> float:
+    """max |eig| of the real block matrix of Z_r over ``orders``, from dense matrices."""
+    K, M = model.K.toarray(), model.M.toarray()
+    c, i = np.arange(4), np.arange(4, 6)
+    blocks = []
+    for n in orders:
+        Z = K.astype(complex) if n == 0 else K * (1 + 1j * ETA) - (n * omega) ** 2 * M
+        Zr = Z[np.ix_(c, c)] - Z[np.ix_(c, i)] @ np.linalg.solve(Z[np.ix_(i, i)],
+                                                                 Z[np.ix_(i, c)])
+        if n == 0:
+            blocks.append(Zr.real)
+        else:
+            blocks.append(np.block([[Zr.real, Zr.imag], [-Zr.imag, Zr.real]]))
+    size = sum(b.shape[0] for b in blocks)
+    R = np.zeros((size, size))
+    at = 0
+    for b in blocks:
+        R[at : at + b.shape[0], at : at + b.shape[0]] = b
+        at += b.shape[0]
+    return float(np.max(np.abs(np.linalg.eigvals(R))))
+
+
+def test_auto_is_the_spectral_radius_of_z_r_over_the_kept_harmonics():
+    model = tiny_model()
+    for omega in (2 * np.pi * 300.0, 2 * np.pi * 2000.0):
+        rho = reference_radius(model, omega, ORDERS)
+        eps = penalty("auto", model=model, omega=omega, orders=ORDERS)
+        assert eps == pytest.approx(rho, rel=1e-10)
+        red = condense(model, omega, ORDERS)
+        assert penalty("auto", reduced=red) == eps
+    # the rule depends on the frequency (inertia of the interior node)
+    assert penalty("auto", model=model, omega=2 * np.pi * 2000.0, orders=ORDERS) != \
+        pytest.approx(penalty("auto", model=model, omega=2 * np.pi * 300.0, orders=ORDERS))
+
+
+def test_auto_quasi_static_is_the_static_radius():
+    model = tiny_model()
+    qs = penalty("auto", model=model, omega=2 * np.pi * 2000.0, orders=ORDERS,
+                 quasi_static=True)
+    assert qs == pytest.approx(reference_radius(model, 0.0, [0]), rel=1e-10)
+
+
+def test_static_is_the_radius_of_k_r_at_every_frequency():
+    model = tiny_model()
+    rho0 = reference_radius(model, 0.0, [0])
+    a = penalty("static", model=model, omega=2 * np.pi * 300.0, orders=ORDERS)
+    b = penalty("static", model=model, omega=2 * np.pi * 2000.0, orders=ORDERS)
+    assert a == b
+    assert a == pytest.approx(rho0, rel=1e-10)
+    # from a condensation alone: its order-0 block is K_r whatever the frequency
+    red = condense(model, 2 * np.pi * 2000.0, ORDERS)
+    assert penalty("static", reduced=red) == pytest.approx(a, rel=1e-14)
+
+
+@pytest.mark.parametrize("value", [3e9, 7, np.float64(2.5e8)])
+def test_a_number_is_used_as_given(value):
+    assert penalty(value, model=tiny_model(), omega=1.0, orders=ORDERS) == float(value)
+    assert isinstance(penalty(value), float)
+
+
+@pytest.mark.parametrize("value", ["paper", "per-frequency", "Auto", 0, -1e9, float("nan"),
+                                   float("inf"), True, None, [1e9]])
+def test_a_bad_value_is_rejected_naming_eps(value):
+    with pytest.raises(ValueError, match=r'eps = .*"auto".*"static".*positive number'):
+        penalty(value, model=tiny_model(), omega=1.0, orders=ORDERS)
+
+
+def test_the_solvers_take_the_same_words():
+    model = tiny_model()
+    basis = FourierBasis((1, 3), 16)
+    omega = 2 * np.pi * 300.0
+    red = condense(model, omega, basis.orders)
+    for rule in ("auto", "static", 4e7):
+        expected = penalty(rule, model=model, reduced=red)
+        assert DLFTProblem(red, model.contact, basis, eps=rule).eps == pytest.approx(
+            expected, rel=1e-14)
+        sol, st = solve_periodic(model, basis, omega=omega, reduced=red, eps=rule)
+        assert st.converged, st.message
+        assert sol.eps == expected
+    assert DLFTProblem(red, model.contact, basis).eps == penalty("auto", reduced=red)
+    for call in (lambda: DLFTProblem(red, model.contact, basis, eps="paper"),
+                 lambda: solve_periodic(model, basis, omega=omega, eps=-1.0),
+                 lambda: sweep(model, basis, 100.0, 200.0, 2, eps="per-frequency")):
+        with pytest.raises(ValueError, match="eps = "):
+            call()
+
+
+def test_sweep_static_is_one_penalty_and_auto_one_per_frequency():
+    model = tiny_model()
+    basis = FourierBasis((1,), 16)
+    # between the resonances of the interior node with the contact held (675 and 1031 Hz),
+    # where Z_r(w) outweighs K_r
+    f = np.array([700.0, 800.0])
+    static = sweep(model, basis, f[0], f[1], 2, spacing="linear", time_domain=None)
+    default = sweep(model, basis, f[0], f[1], 2, spacing="linear", time_domain=None,
+                    eps="static")
+    auto = sweep(model, basis, f[0], f[1], 2, spacing="linear", time_domain=None, eps="auto")
+    for res in (static, default, auto):
+        assert res.converged.all()
+        np.testing.assert_allclose(res.frequency_hz, f, rtol=1e-15)
+    k_r = penalty("static", model=model)
+    assert [p.solution.eps for p in static.points] == [k_r, k_r]
+    assert [p.solution.eps for p in default.points] == [k_r, k_r]
+    per_point = [penalty("auto", model=model, omega=2 * np.pi * x, orders=basis.orders)
+                 for x in f]
+    assert [p.solution.eps for p in auto.points] == per_point
+    assert per_point[0] != pytest.approx(per_point[1])
