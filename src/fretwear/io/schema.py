@@ -150,6 +150,8 @@ class Number(Spec):
             value = math.inf
         if not _is_number(value):
             self._type_error(value, path)
+        if isinstance(value, int) and abs(value) >= 2**1023:  # no float holds it
+            fail(path, value, self.expected(), " (too large for a floating-point number)")
         if math.isnan(value) or (math.isinf(value) and not (self.allow_inf and value > 0)):
             fail(path, value, self.expected())
         if self.lo is not None and (value < self.lo or (self.lo_open and value == self.lo)):
