@@ -148,6 +148,27 @@ def test_ctrl_c_says_what_was_saved(tmp_path, monkeypatch, capsys):
     assert capsys.readouterr().err == "interrupted: nothing was saved\n"
 
 
+def test_sigterm_is_handled_as_ctrl_c(tmp_path, monkeypatch, capsys):
+    """SIGTERM (a batch scheduler's notice) stops a run as Ctrl-C does, with the exit status
+    128 + 15; the previous handler is back afterwards (wear runs: the checkpoint is saved,
+    tests/test_checkpoint_robustness.py)."""
+    import os
+    import signal
+
+    import fretwear.linear
+
+    def terminated(*args, **kwargs):
+        os.kill(os.getpid(), signal.SIGTERM)
+        raise AssertionError("SIGTERM did not interrupt the run")
+
+    before = signal.getsignal(signal.SIGTERM)
+    monkeypatch.setattr(fretwear.linear, "frf", terminated)
+    path = reduced_example(tmp_path)
+    assert cli.main(["run", str(path), "--no-progress"]) == 143
+    assert capsys.readouterr().err == "terminated (SIGTERM): nothing was saved\n"
+    assert signal.getsignal(signal.SIGTERM) is before
+
+
 @pytest.mark.parametrize("argv", [["run"], ["example", "frobnicate"], []])
 def test_usage_errors_exit_2_without_traceback(argv):
     r = fretwear(*argv)

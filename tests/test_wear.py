@@ -513,7 +513,8 @@ def wear_registered():
 
     if "wear" not in runner._REGISTRY:  # imported earlier, then removed by this fixture
         rw = fretwear.analyses.wear
-        runner.register("wear", rw.SCHEMA, rw.run_wear, checks=rw.CHECKS, doc=rw.DOC)
+        runner.register("wear", rw.SCHEMA, rw.run_wear, checks=rw.CHECKS, doc=rw.DOC,
+                        files=(rw.CHECKPOINT_FILE,))
     yield
     if not before:
         runner._REGISTRY.pop("wear", None)

@@ -3,14 +3,18 @@
 
 Exit status: 0 success; 1 the run finished but some solve did not converge (the results file
 says ``converged = 0``); 2 bad input or a failed solve (one line ``error: ...`` on stderr,
-never a traceback); 130 interrupted by Ctrl-C (a line says what was saved).
+never a traceback); 130 interrupted by Ctrl-C, 143 terminated by SIGTERM (e.g. by a batch
+scheduler at the end of a job's time; handled as Ctrl-C: a wear run saves its checkpoint, and a
+line says what was saved).
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import signal
 import sys
+import threading
 from importlib import resources
 from pathlib import Path
 
@@ -179,17 +183,52 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
+class TerminateAsInterrupt:
+    """Within ``with``: SIGTERM raises KeyboardInterrupt, as Ctrl-C does, so that a run
+    stopped by ``kill`` or a batch scheduler saves what it can (a wear checkpoint) and says so.
+
+    ``received`` is then True. Only the first SIGTERM interrupts: later ones are ignored, so
+    that the save they would otherwise cut short completes. The previous handler is restored
+    on exit. Outside the main thread (where Python allows no handler) it does nothing.
+    """
+
+    def __init__(self):
+        self.received = False
+        self._previous = None
+
+    def _handle(self, signum, frame):
+        if not self.received:
+            self.received = True
+            raise KeyboardInterrupt
+
+    def __enter__(self):
+        if threading.current_thread() is threading.main_thread():
+            self._previous = signal.signal(signal.SIGTERM, self._handle)
+        return self
+
+    def __exit__(self, *exc):
+        if self._previous is not None:
+            signal.signal(signal.SIGTERM, self._previous)
+            self._previous = None
+        return False
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``fretwear`` command; returns the exit status."""
     args = _parser().parse_args(argv)
+    term = TerminateAsInterrupt()
     try:
-        return args.func(args)
+        with term:
+            return args.func(args)
     except FretwearError as exc:
         print(f"error: {' '.join(str(exc).split())}", file=sys.stderr)
         return 2
     except KeyboardInterrupt as exc:
-        print(getattr(exc, "message", "interrupted: nothing was saved"), file=sys.stderr)
-        return 130
+        message = getattr(exc, "message", "interrupted: nothing was saved")
+        if term.received:
+            message = message.replace("interrupted", "terminated (SIGTERM)", 1)
+        print(message, file=sys.stderr)
+        return 128 + int(signal.SIGTERM) if term.received else 130
     except BrokenPipeError:  # e.g. `fretwear example show NAME | head`: not an error
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0

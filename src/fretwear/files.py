@@ -8,9 +8,16 @@ from __future__ import annotations
 
 import contextlib
 import os
+import re
+import stat
 import tempfile
+import time
 from collections.abc import Callable
 from pathlib import Path
+
+#: the temporary files of :func:`atomic_write`: ``.<name>.<random>.tmp`` beside the target
+#: (``tempfile.mkstemp`` draws ``<random>`` from lowercase letters, digits and ``_``)
+TEMPORARY = re.compile(r"\.(?P<name>.+)\.[a-z0-9_]+\.tmp")
 
 
 def atomic_write(path: Path | str, write: Callable[[Path], None]) -> Path:
@@ -27,6 +34,7 @@ def atomic_write(path: Path | str, write: Callable[[Path], None]) -> Path:
     path = Path(path).resolve()
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp_name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    # (the name matches TEMPORARY: remove_stale_temporaries clears it if the process is killed)
     os.close(fd)
     tmp = Path(tmp_name)
     try:
@@ -41,6 +49,38 @@ def atomic_write(path: Path | str, write: Callable[[Path], None]) -> Path:
         raise
     _fsync_dir(path.parent)
     return path
+
+
+def remove_stale_temporaries(folder: Path | str, min_age_s: float = 60.0) -> list[Path]:
+    """Remove the temporary files that :func:`atomic_write` left in ``folder`` when its
+    process was killed mid-write (SIGKILL, power loss): the regular files directly in
+    ``folder`` whose name matches :data:`TEMPORARY` (``.<name>.<random>.tmp``) and that were
+    last modified more than ``min_age_s`` seconds ago (a write in progress keeps its file
+    fresh). Nothing else is touched; files that cannot be removed are left.
+
+    Returns
+    -------
+    The files removed.
+    """
+    folder = Path(folder)
+    removed = []
+    try:
+        entries = list(folder.iterdir())
+    except OSError:  # no folder (yet), or not readable: nothing to clean
+        return removed
+    now = time.time()
+    for p in entries:
+        if not TEMPORARY.fullmatch(p.name):
+            continue
+        try:
+            st = p.lstat()  # a link or a folder of that name is not ours
+            if not stat.S_ISREG(st.st_mode) or now - st.st_mtime < min_age_s:
+                continue
+            p.unlink()
+        except OSError:
+            continue
+        removed.append(p)
+    return sorted(removed)
 
 
 def _umask() -> int:

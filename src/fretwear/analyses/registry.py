@@ -69,11 +69,13 @@ RunFunction = Callable[..., RunOutput]
 
 @dataclass(frozen=True)
 class Analysis:
-    """A registered analysis: its ``[analysis]`` table schema and its run function."""
+    """A registered analysis: its ``[analysis]`` table schema, its run function and the files
+    it keeps in the results folder besides ``results.nc`` (e.g. a checkpoint)."""
 
     name: str
     schema: Table
     run: RunFunction
+    files: tuple[str, ...] = ()
 
 
 _REGISTRY: dict[str, Analysis] = {}
@@ -81,7 +83,7 @@ _loaded = False
 
 
 def register(name: str, schema: Table | Mapping, run: RunFunction, *, doc: str = "",
-             checks: tuple = ()) -> None:
+             checks: tuple = (), files: tuple[str, ...] = ()) -> None:
     """Make an analysis available to case files as ``[analysis] type = name``.
 
     Parameters
@@ -98,6 +100,9 @@ def register(name: str, schema: Table | Mapping, run: RunFunction, *, doc: str =
     doc : paragraph for ``docs/case-files.md`` (when ``schema`` is a dict).
     checks : rules across keys (when ``schema`` is a dict), e.g.
         ``fretwear.io.schema.increasing("f_min", "f_max", "Hz")``.
+    files : names of the files the analysis writes in ``outdir`` as it goes (checkpoints);
+        :func:`fretwear.analyses.run.run_case` refuses a folder in their place before
+        anything runs.
     """
     table = schema if isinstance(schema, Table) else Table(dict(schema), tuple(checks), doc)
     if "type" in table.fields:
@@ -105,7 +110,7 @@ def register(name: str, schema: Table | Mapping, run: RunFunction, *, doc: str =
     old = _REGISTRY.get(name)
     if old is not None and old.run is not run:
         raise ValueError(f"analysis {name!r} is already registered by {old.run.__module__}")
-    _REGISTRY[name] = Analysis(name, table, run)
+    _REGISTRY[name] = Analysis(name, table, run, tuple(files))
 
 
 def _load() -> None:

@@ -4,7 +4,9 @@ a short summary.
 
 Long analyses (wear) that want ``--resume`` save their state in ``outdir`` with
 :func:`fretwear.files.atomic_write` as they go, and read it back when ``case.resume`` is
-true; on Ctrl-C, :func:`run_case` reports the files saved during the run.
+true; on Ctrl-C, :func:`run_case` reports the files saved during the run. Before a run, a
+folder standing where a file will be written is refused, and the temporary files of writes
+killed mid-way (:func:`fretwear.files.remove_stale_temporaries`) are removed.
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ from pathlib import Path
 from fretwear import __version__
 from fretwear.analyses.registry import RunOutput, analysis_tables, get
 from fretwear.errors import InputError
+from fretwear.files import remove_stale_temporaries
 from fretwear.io import case as case_files
 from fretwear.io.case import Case, build_model, observed_notes
 from fretwear.io.results import read_results, write_results
@@ -58,6 +61,20 @@ def _up_to_date(results: Path, case) -> bool:
     return attrs.get("case_file") == case.text and int(attrs.get("converged", 0)) == 1
 
 
+def _check_output(out_dir: Path, names: list[str]) -> None:
+    """Refuse, before anything runs, an output folder that is a file and a folder where a
+    file will be written (the run would fail at its first save)."""
+    if out_dir.exists() and not out_dir.is_dir():
+        raise InputError(f"the output folder {str(out_dir)!r} is a file: choose another "
+                         "folder with -o DIR (or [output] directory)")
+    for name in names:
+        p = out_dir / name
+        if p.exists() and not p.is_file():
+            what = "a folder, not a file" if p.is_dir() else "not a regular file"
+            raise InputError(f"{str(p)!r} is {what}: move or delete it (the run writes its "
+                             f"{'results' if name == RESULTS_FILE else 'state'} there)")
+
+
 def _saved_since(outdir: Path, start: float) -> list[Path]:
     if not outdir.is_dir():
         return []
@@ -99,15 +116,19 @@ def run_case(path: Path | str, outdir: Path | str | None = None, progress: bool 
     InputError, ConvergenceError
         With a message for the user.
     RunInterrupted
-        On Ctrl-C, with a message saying what was saved.
+        On Ctrl-C (or SIGTERM through the command line), with a message saying what was
+        saved.
     """
     case = load_case(path)
     case.resume = resume
     analysis = get(case.analysis["type"])
     out_dir = case.output_dir(outdir)
     results_path = out_dir / RESULTS_FILE
+    _check_output(out_dir, [RESULTS_FILE, *analysis.files])
     say = print if echo else (lambda *a, **k: None)
     say(f"fretwear {__version__}: {case.title} ({case.path.name}, analysis {analysis.name})")
+    for p in remove_stale_temporaries(out_dir):
+        say(f"removed {p.name}: temporary file of a write that was killed")
     if resume and _up_to_date(results_path, case):
         ds = read_results(results_path)
         say(f"results are up to date: {results_path}")

@@ -473,4 +473,4 @@ DOC = (
     "`worn-volume.png` and, with `frf_before_after`, `frf-worn-<point>.png`."
 )
 
-register("wear", SCHEMA, run_wear, checks=CHECKS, doc=DOC)
+register("wear", SCHEMA, run_wear, checks=CHECKS, doc=DOC, files=(CHECKPOINT_FILE,))

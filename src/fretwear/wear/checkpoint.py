@@ -1,6 +1,11 @@
 """Checkpoints of a wear simulation: the complete state and the history so far in one ``.npz``
 file, written atomically, so that an interrupted run resumes to the same result.
 
+A checkpoint is read whole and checked before use (every member's CRC, every key, types and
+shapes consistent with one another and with the model): a damaged one (truncated, altered,
+incomplete, not a checkpoint at all) is one :class:`~fretwear.errors.InputError` naming the
+file, never a traceback and never a silent start from zero.
+
 A checkpoint is matched to its run by a fingerprint of everything that determines the
 trajectory (:func:`fingerprint`); the stop criteria are not part of it, so a finished run can be
 extended by resuming with, e.g., a larger ``max_cycles``.
@@ -10,6 +15,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -56,17 +62,116 @@ def save_checkpoint(path: Path | str, state: dict, rows: list[dict], key: str) -
     return atomic_write(path, write)
 
 
+#: the state of a checkpoint (:func:`fretwear.wear.schemes.first_state`) and its shape in
+#: the dimensions of the model: nc contact nodes, d components, H Fourier coefficients
+#: (m = nc d; None: any shape, e.g. the time-integration state ``td_U``, ``td_V``)
+STATE_SHAPES = {
+    "step": (), "cycles": (), "W": ("nc",), "U": ("m", "H"), "anchor": ("nc", "d-1"),
+    "g": ("nc",), "jump": (), "vrate": (), "vrate0": (), "stability_jump": (),
+    "stop_reason": (), "td_U": None, "td_V": None, "td_retry_at": (), "Js": None,
+}
+#: the history arrays whose shape is more than (s,) (s = recorded steps)
+HISTORY_SHAPES = {
+    "wear_depth": ("s", "nc"), "wear_rate": ("s", "nc"), "pressure_mean": ("s", "nc"),
+    "pressure_max": ("s", "nc"), "slip_amplitude": ("s", "nc"), "slip_path": ("s", "nc"),
+    "state_fraction": ("s", "nc", 3), "friction_energy": ("s", "nc"),
+    "U": ("s", "nc", "d", "H"), "lam": ("s", "nc", "d", "H"), "anchor": ("s", "nc", "d-1"),
+}
+_TEXT = ("fingerprint", "state_stop_reason")
+
+
+def _damaged(path: Path | str, why: str) -> InputError:
+    """The one error of a checkpoint that cannot be used: it names the file, says why and
+    what to do."""
+    return InputError(f"the wear checkpoint {str(path)!r} is damaged ({why}); delete it to start "
+                      "the run over (a run without --resume also starts over and replaces it)")
+
+
+def check_checkpoint_path(path: Path | str) -> None:
+    """Refuse a checkpoint path that is a folder (or other non-file): it could be neither
+    read nor written, and the run would fail at its first save."""
+    path = Path(path)
+    if path.exists() and not path.is_file():
+        what = "a folder, not a file" if path.is_dir() else "not a regular file"
+        raise InputError(f"the wear checkpoint {str(path)!r} is {what}: move or delete it (the "
+                         "run writes its checkpoint there)")
+
+
 def _read_checkpoint(path: Path | str) -> dict:
-    """The arrays of a checkpoint of this format version (:func:`save_checkpoint`)."""
+    """The arrays of a checkpoint of this format version (:func:`save_checkpoint`), checked
+    for completeness and consistency (:func:`_check_arrays`).
+
+    Raises
+    ------
+    InputError
+        One message naming the file, whatever is wrong with it (:func:`_damaged`).
+    """
+    path = Path(path)
+    check_checkpoint_path(path)
+    if not path.is_file():
+        raise InputError(f"wear checkpoint {str(path)!r} does not exist")
+    try:
+        with open(path, "rb") as fh:
+            complete = zipfile.is_zipfile(fh)  # its end record is there
+    except OSError as exc:  # e.g. no permission: not damaged
+        raise InputError(f"cannot read the wear checkpoint {str(path)!r}: {exc.strerror}") from None
+    if not complete:
+        raise _damaged(path, "not a complete .npz archive: truncated, empty or another kind of "
+                       "file")
     try:
         with np.load(path, allow_pickle=False) as z:
-            data = {k: z[k] for k in z.files}
-    except (OSError, ValueError) as exc:
-        raise InputError(f"cannot read the wear checkpoint {str(path)!r}: {exc}") from None
-    if int(data.get("version", -1)) != CHECKPOINT_VERSION:
+            data = {k: z[k] for k in z.files}  # reads every member: checks every CRC
+    except Exception as exc:  # zip, npy header, EOF, CRC, memory errors: all say "damaged"
+        raise _damaged(path, _why(exc)) from None
+    version = data.get("version")
+    if version is None or version.shape != () or version.dtype.kind not in "iu":
+        raise _damaged(path, "no format version")
+    if int(version) != CHECKPOINT_VERSION:
         raise InputError(f"wear checkpoint {str(path)!r} has another format version; delete it "
                          "to start again")
+    why = _check_arrays(data)
+    if why:
+        raise _damaged(path, why)
     return data
+
+
+def _why(exc: Exception) -> str:
+    text = " ".join(str(exc).split())
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+
+
+def _dims(data: dict) -> dict:
+    """The dimensions of a checkpoint, read from its history of contact displacements."""
+    s, nc, d, H = data["hist_U"].shape
+    return {"s": s, "nc": nc, "d": d, "H": H, "m": nc * d, "d-1": d - 1}
+
+
+def _check_arrays(data: dict) -> str:
+    """What is wrong with the arrays of a checkpoint ("" if nothing): every key present,
+    numeric (text where text is expected), and shapes consistent with one another."""
+    need = ["fingerprint", *(f"state_{k}" for k in STATE_SHAPES),
+            *(f"hist_{k}" for k in HISTORY_FIELDS if k not in LATE_HISTORY_FIELDS)]
+    missing = [k for k in need if k not in data]
+    if missing:
+        return f"missing {', '.join(missing[:4])}{' ...' if len(missing) > 4 else ''}"
+    for k, a in data.items():
+        if (a.dtype.kind == "U") != (k in _TEXT) or (a.dtype.kind not in "biufU"):
+            return f"{k} has the type {a.dtype}"
+    if data["fingerprint"].shape != () or data["hist_U"].ndim != 4:
+        return "inconsistent arrays"
+    dims = _dims(data)
+    if dims["s"] < 1 or dims["d"] < 2:
+        return "an empty history"  # (or fewer than 2 components)
+    wanted = {f"state_{k}": v for k, v in STATE_SHAPES.items() if v is not None}
+    wanted.update({f"hist_{k}": HISTORY_SHAPES.get(k, ("s",)) for k in HISTORY_FIELDS})
+    for k, shape in wanted.items():
+        if k in data and data[k].shape != tuple(dims.get(n, n) for n in shape):
+            return f"{k} has the shape {data[k].shape}"
+    if data["state_Js"].size and data["state_Js"].shape != (dims["nc"], dims["nc"]):
+        return f"state_Js has the shape {data['state_Js'].shape}"
+    if int(data["state_step"]) != dims["s"] - 1:
+        return f"state at step {int(data['state_step'])} with a history of {dims['s']} steps"
+    return ""
 
 
 def _history(data) -> WearHistory:
@@ -85,18 +190,28 @@ def read_history(path: Path | str) -> WearHistory:
     return _history(_read_checkpoint(path))
 
 
-def load_checkpoint(path: Path | str, key: str) -> tuple[dict, list[dict]]:
-    """Read a checkpoint written by :func:`save_checkpoint` for the same trajectory ``key``.
+def load_checkpoint(path: Path | str, key: str,
+                    shape: tuple[int, int, int] | None = None) -> tuple[dict, list[dict]]:
+    """Read a checkpoint written by :func:`save_checkpoint` for the same trajectory ``key``
+    and, when given, the model's ``shape = (nc, d, H)`` (contact nodes, components, Fourier
+    coefficients).
 
     Raises
     ------
     InputError
-        The file is unreadable, of another version, or written for a different case.
+        The file is damaged (unreadable, truncated, incomplete, inconsistent), of another
+        version, or written for a different case.
     """
     data = _read_checkpoint(path)
     if str(data["fingerprint"]) != key:
         raise InputError(f"wear checkpoint {str(path)!r} was written for a different model or "
                          "different wear settings; delete it (or run without --resume) to start "
                          "again")
+    dims = _dims(data)
+    if shape is not None and (dims["nc"], dims["d"], dims["H"]) != tuple(shape):
+        raise InputError(f"wear checkpoint {str(path)!r} was written for a different model "
+                         f"({dims['nc']} contact nodes, {dims['d']} components, {dims['H']} "
+                         f"Fourier coefficients instead of {shape[0]}, {shape[1]}, {shape[2]}); "
+                         "delete it (or run without --resume) to start again")
     state = {k[6:]: data[k] for k in data if k.startswith("state_")}
     return state, _history(data).rows()

@@ -30,7 +30,12 @@ from fretwear.hb.periodic import PeriodicSolution, static_anchor
 from fretwear.hb.reduce import Reduced, condense
 from fretwear.hb.solvers import SolveStats
 from fretwear.model.core import Model
-from fretwear.wear.checkpoint import fingerprint, load_checkpoint, save_checkpoint
+from fretwear.wear.checkpoint import (
+    check_checkpoint_path,
+    fingerprint,
+    load_checkpoint,
+    save_checkpoint,
+)
 from fretwear.wear.history import WearHistory, WearResult
 from fretwear.wear.laws import wear_coefficients, worn_volume
 from fretwear.wear.options import WearOptions
@@ -60,7 +65,8 @@ def simulate_wear(model: Model, basis: FourierBasis, *, omega: float = 2 * np.pi
     W0 : (nc,) initial wear [m] (default 0).
     U0 : (nc, d, H) or (m, H) start of the first periodic solve.
     checkpoint : ``.npz`` file for the state (written atomically as the run goes).
-    resume : continue from ``checkpoint`` when it exists (same model and options).
+    resume : continue from ``checkpoint`` when it exists (same model and options; a damaged
+        checkpoint is an InputError, never silently replaced).
     progress : show a tqdm bar (cycles, worn volume, rate, time left).
     callback : ``callback(step, history_row)`` after each accepted step (and after the
         checkpoint is written); raising ``KeyboardInterrupt`` there stops the run as Ctrl-C.
@@ -82,6 +88,9 @@ def simulate_wear(model: Model, basis: FourierBasis, *, omega: float = 2 * np.pi
         On Ctrl-C (the last accepted state is in the checkpoint first).
     """
     opts = (options or WearOptions()).check()
+    ckpt = Path(checkpoint) if checkpoint is not None else None
+    if ckpt is not None:
+        check_checkpoint_path(ckpt)  # a folder there: refused before anything is computed
     t_start = time.perf_counter()
     nc, d = model.contact.dofs.shape
     if reduced is None:
@@ -95,11 +104,10 @@ def simulate_wear(model: Model, basis: FourierBasis, *, omega: float = 2 * np.pi
                      time_domain=time_domain if opts.time_domain_rescue and not quasi_static
                      else None)
     key = fingerprint(model, reduced, basis, sp.eps, coef, opts, W0, anchor)
-    ckpt = Path(checkpoint) if checkpoint is not None else None
 
     state, rows, resumed_from = None, [], -1
-    if resume and ckpt is not None and ckpt.is_file():
-        state, rows = load_checkpoint(ckpt, key)
+    if resume and ckpt is not None and ckpt.exists():  # damaged: an InputError, never ignored
+        state, rows = load_checkpoint(ckpt, key, shape=(nc, d, sp.H))
         resumed_from = int(state["step"])
     if state is None:
         state, rows = first_state(sp, W0, anchor, U0, opts)

@@ -1,0 +1,349 @@
+"""Wear checkpoints against a hostile world: runs killed by the batch scheduler's SIGTERM or by
+SIGKILL, damaged checkpoint files, a folder in the checkpoint's place, and the temporary files
+of writes that were killed.
+
+* ``fretwear run CASE`` in a subprocess, killed after its first checkpoint exists, then
+  ``--resume``: ``results.nc`` equals the uninterrupted run's bit for bit (wall times aside);
+  SIGTERM saves the state it has reached (exit 143, no traceback);
+* every kind of damaged checkpoint: exit 2, one line naming the file, the file left as it was;
+* stale temporary files of :func:`fretwear.files.atomic_write` are removed at the next run,
+  nothing else is.
+"""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fretwear import cli
+from fretwear.errors import InputError
+from fretwear.files import TEMPORARY, atomic_write, remove_stale_temporaries
+from fretwear.io.results import read_results
+from fretwear.wear.checkpoint import load_checkpoint, read_history
+
+# A quasi-static wear case of ~400 fixed jumps of 1e4 cycles on an 11-node interface (a few
+# seconds). Its first checkpoint is written after step 1, the next one only on an interrupt or
+# at the end (checkpoint_every_s = 1e9): a checkpoint at a later step than 1 before the end was
+# written by the interrupt.
+CASE = """
+title = "checkpoint robustness: small quasi-static wear"
+[model]
+type = "rectangle"
+length = 0.02
+height = 0.004
+nx = 10
+ny = 2
+thickness = 0.01
+[material]
+E = 210e9
+nu = 0.3
+rho = 7800.0
+[[springs]]
+at = "bottom_left"
+direction = "x"
+stiffness = 1e5
+[[loads]]
+boundary = "top"
+pressure = 1e6
+[[loads]]
+boundary = "right"
+pressure = 7.5e5
+waveform = "sin"
+[contact]
+boundary = "bottom"
+normal = [0.0, -1.0]
+mu = 0.3
+wear_coefficient = 1e-11
+[observed]
+Pe = [0.02, 0.002]
+[analysis]
+type = "wear"
+quasi_static = true
+harmonics = 3
+n_samples = 32
+adaptive = false
+initial_jump = 1e4
+max_cycles = 4e6
+checkpoint_every_s = 1e9
+"""
+CKPT = "wear-checkpoint.npz"
+N_STEPS = 400
+WALL_TIMES = ("step_wall_time",)  # the only variables that differ between identical runs
+
+
+def fretwear(*args, **kw) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, "-m", "fretwear", *map(str, args)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **kw)
+
+
+def finish(proc: subprocess.Popen, timeout: float = 300) -> tuple[int, str, str]:
+    out, err = proc.communicate(timeout=timeout)
+    return proc.returncode, out, err
+
+
+@pytest.fixture(scope="module")
+def case(tmp_path_factory) -> Path:
+    path = tmp_path_factory.mktemp("case") / "wear.toml"
+    path.write_text(CASE)
+    return path
+
+
+@pytest.fixture(scope="module")
+def reference(case) -> Path:
+    """The output folder of the uninterrupted run."""
+    out = case.parent / "reference"
+    code, _, err = finish(fretwear("run", case, "-o", out, "--no-progress"))
+    assert code == 0, err
+    return out
+
+
+def assert_same_results(a: Path, b: Path) -> None:
+    """Every variable and attribute equal bit for bit, but wall times and the creation date."""
+    x, y = read_results(a), read_results(b)
+    assert x.sizes == y.sizes and x.sizes["step"] == N_STEPS + 1
+    assert set(x.variables) == set(y.variables)
+    for name in x.variables:
+        if name not in WALL_TIMES:
+            np.testing.assert_array_equal(x[name].values, y[name].values, err_msg=name)
+            assert x[name].attrs == y[name].attrs, name
+    skip = {"created_utc"}
+    assert {k: v for k, v in x.attrs.items() if k not in skip} == \
+        {k: v for k, v in y.attrs.items() if k not in skip}
+
+
+def wait_for(path: Path, proc: subprocess.Popen, timeout: float = 240.0) -> None:
+    t0 = time.monotonic()
+    while not path.is_file():
+        assert proc.poll() is None, f"the run ended before its first checkpoint: {finish(proc)}"
+        assert time.monotonic() - t0 < timeout, "no checkpoint written in time"
+        time.sleep(0.02)
+
+
+# --- killed runs resume to the uninterrupted result ------------------------------------------
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGKILL], ids=["SIGTERM", "SIGKILL"])
+def test_killed_run_resumes_to_the_uninterrupted_results(case, reference, tmp_path, sig):
+    out = tmp_path / "out"
+    proc = fretwear("run", case, "-o", out, "--no-progress")
+    wait_for(out / CKPT, proc)
+    time.sleep(0.5)  # some steps after the first checkpoint
+    proc.send_signal(sig)
+    code, _, err = finish(proc)
+    assert "Traceback" not in err
+    assert not (out / "results.nc").exists()
+    saved = read_history(out / CKPT).n_steps - 1  # the step the checkpoint holds
+    assert 1 <= saved < N_STEPS
+    if sig == signal.SIGTERM:  # handled as Ctrl-C: the state reached is saved, and said so
+        assert code == 143, err
+        assert saved > 1  # written by the interrupt, not only the first checkpoint
+        assert err.startswith(f"terminated (SIGTERM): saved in {out}: {CKPT}")
+        assert err.count("\n") == 1
+    else:
+        assert code == -signal.SIGKILL and saved == 1
+
+    code, stdout, err = finish(fretwear("run", case, "-o", out, "--resume", "--no-progress"))
+    assert code == 0, err
+    assert f"(resumed from step {saved})" in stdout
+    assert_same_results(out / "results.nc", reference / "results.nc")
+
+
+def test_sigterm_handler_is_restored_and_fires_once():
+    before = signal.getsignal(signal.SIGTERM)
+    term = cli.TerminateAsInterrupt()
+    with pytest.raises(KeyboardInterrupt), term:
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(5)  # the handler raises at once
+    assert term.received and signal.getsignal(signal.SIGTERM) is before
+    with cli.TerminateAsInterrupt() as again:
+        again.received = True  # a second SIGTERM, while the first one's save goes on
+        os.kill(os.getpid(), signal.SIGTERM)  # ignored: no KeyboardInterrupt
+    assert signal.getsignal(signal.SIGTERM) is before
+
+
+# --- damaged checkpoints: one line, exit 2, the file untouched -------------------------------
+def _truncated(ok: bytes, path: Path):
+    path.write_bytes(ok[: len(ok) // 2])
+
+
+def _flipped(ok: bytes, path: Path):
+    data = bytearray(ok)
+    data[len(data) // 2] ^= 0xFF
+    path.write_bytes(bytes(data))
+
+
+def _text(ok: bytes, path: Path):
+    path.write_text("step = 3\nthis is not a checkpoint\n")
+
+
+def _empty(ok: bytes, path: Path):
+    path.write_bytes(b"")
+
+
+def _missing_key(ok: bytes, path: Path):
+    tmp = path.with_name("ok.npz")
+    tmp.write_bytes(ok)
+    with np.load(tmp) as z:
+        arrays = {k: z[k] for k in z.files if k != "state_W"}
+    tmp.unlink()
+    with open(path, "wb") as fh:
+        np.savez(fh, **arrays)
+
+
+def _short_history(ok: bytes, path: Path):
+    """Consistent arrays but the history one step short of the state (an incomplete copy)."""
+    tmp = path.with_name("ok.npz")
+    tmp.write_bytes(ok)
+    with np.load(tmp) as z:
+        arrays = {k: z[k][:-1] if k.startswith("hist_") else z[k] for k in z.files}
+    tmp.unlink()
+    with open(path, "wb") as fh:
+        np.savez(fh, **arrays)
+
+
+DAMAGES = {"truncated": _truncated, "flipped": _flipped, "text": _text, "empty": _empty,
+           "missing-key": _missing_key, "short-history": _short_history}
+
+
+@pytest.mark.parametrize("kind", list(DAMAGES))
+def test_damaged_checkpoint_is_refused_in_one_line(case, reference, tmp_path, kind, capsys):
+    out = tmp_path / "out"
+    out.mkdir()
+    ck = out / CKPT
+    DAMAGES[kind]((reference / CKPT).read_bytes(), ck)
+    damaged = ck.read_bytes()
+    code = cli.main(["run", str(case), "-o", str(out), "--resume", "--no-progress"])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert err.count("\n") == 1 and err.startswith(f"error: the wear checkpoint '{ck}' is "
+                                                   "damaged (")
+    assert "delete it to start the run over" in err
+    assert ck.read_bytes() == damaged  # left as it was
+    assert sorted(p.name for p in out.iterdir()) == [CKPT]  # no results, nothing else
+    # the same error for whoever reads it
+    with pytest.raises(InputError, match="is damaged"):
+        read_history(ck)
+
+
+def test_damaged_checkpoint_through_the_command_line(case, reference, tmp_path):
+    """As users see it: a subprocess, one line on stderr, no traceback."""
+    out = tmp_path / "out"
+    out.mkdir()
+    _flipped((reference / CKPT).read_bytes(), out / CKPT)
+    code, _, err = finish(fretwear("run", case, "-o", out, "--resume", "--no-progress"))
+    assert code == 2 and "Traceback" not in err
+    assert err.startswith(f"error: the wear checkpoint '{out / CKPT}' is damaged (")
+    assert err.count("\n") == 1
+
+
+@pytest.mark.parametrize("resume", [True, False], ids=["resume", "new-run"])
+def test_checkpoint_folder_is_refused_before_computing(case, tmp_path, resume, monkeypatch,
+                                                       capsys):
+    import fretwear.analyses.run as run
+
+    def no_model(*args, **kwargs):
+        raise AssertionError("the model was built")
+
+    monkeypatch.setattr(run, "build_model", no_model)
+    out = tmp_path / "out"
+    (out / CKPT).mkdir(parents=True)
+    argv = ["run", str(case), "-o", str(out), "--no-progress"] + (["--resume"] if resume else [])
+    assert cli.main(argv) == 2
+    err = capsys.readouterr().err
+    assert err == (f"error: '{out / CKPT}' is a folder, not a file: move or delete it (the run "
+                   "writes its state there)\n")
+    assert (out / CKPT).is_dir() and not any((out / CKPT).iterdir())
+
+
+def test_output_folder_that_is_a_file_is_refused(case, tmp_path, capsys):
+    out = tmp_path / "out"
+    out.write_text("not a folder")
+    assert cli.main(["run", str(case), "-o", str(out), "--no-progress"]) == 2
+    assert capsys.readouterr().err.startswith(f"error: the output folder '{out}' is a file")
+    assert out.read_text() == "not a folder"
+
+
+def test_checkpoint_of_another_model_shape(reference):
+    """Shapes are checked against the model's (contact nodes, components, coefficients), as
+    well as the fingerprint."""
+    ck = reference / CKPT
+    with np.load(ck) as z:
+        key = str(z["fingerprint"])
+        nc, d, H = z["hist_U"].shape[1:]
+    state, rows = load_checkpoint(ck, key, shape=(nc, d, H))
+    assert int(state["step"]) == N_STEPS and len(rows) == N_STEPS + 1
+    with pytest.raises(InputError, match="different model .*11 contact nodes"):
+        load_checkpoint(ck, key, shape=(nc + 1, d, H))
+    with pytest.raises(InputError, match="different model"):
+        load_checkpoint(ck, "0" * 64, shape=(nc, d, H))
+
+
+# --- temporary files of killed writes ---------------------------------------------------------
+def test_atomic_write_temporaries_match_the_cleanup_pattern(tmp_path):
+    names = []
+
+    def write(tmp: Path):
+        names.append(tmp.name)
+        tmp.write_text("x")
+
+    atomic_write(tmp_path / "results.nc", write)
+    atomic_write(tmp_path / CKPT, write)
+    assert all(TEMPORARY.fullmatch(n) for n in names) and len(names) == 2
+
+
+def test_stale_temporaries_are_removed_and_nothing_else(tmp_path):
+    old = time.time() - 120
+    files = {
+        ".results.nc.abc123.tmp": True,  # stale: removed
+        f".{CKPT}.k2j_9xq1.tmp": True,  # stale: removed
+        ".results.nc.fresh123.tmp": False,  # a write that may be in progress
+        ".results.tmp": False,  # not the pattern (no random part)
+        ".results.nc.abc123.tmp.bak": False,
+        ".results.nc.ABC123.tmp": False,  # mkstemp draws lowercase
+        "results.nc.abc123.tmp": False,  # not hidden
+        "notes.txt": False,
+    }
+    for name in files:
+        (tmp_path / name).write_text(name)
+        if name != ".results.nc.fresh123.tmp":
+            os.utime(tmp_path / name, (old, old))
+    (tmp_path / ".dir.abc123.tmp").mkdir()  # a folder of that name: kept
+    os.utime(tmp_path / ".dir.abc123.tmp", (old, old))
+    (tmp_path / "sub").mkdir()  # only the folder itself is cleaned, not below
+    (tmp_path / "sub" / ".results.nc.abc123.tmp").write_text("x")
+    os.utime(tmp_path / "sub" / ".results.nc.abc123.tmp", (old, old))
+    removed = remove_stale_temporaries(tmp_path)
+    assert sorted(p.name for p in removed) == sorted(n for n, gone in files.items() if gone)
+    for name, gone in files.items():
+        assert (tmp_path / name).exists() is not gone, name
+        if not gone:
+            assert (tmp_path / name).read_text() == name
+    assert (tmp_path / ".dir.abc123.tmp").is_dir()
+    assert (tmp_path / "sub" / ".results.nc.abc123.tmp").is_file()
+    assert remove_stale_temporaries(tmp_path / "missing") == []
+
+
+def test_next_run_removes_a_stale_temporary(case, reference, tmp_path, capsys):
+    out = tmp_path / "out"
+    out.mkdir()
+    for name in ("results.nc", CKPT):
+        (out / name).write_bytes((reference / name).read_bytes())
+    stale, other = out / ".results.nc.abc123.tmp", out / "notes.txt"
+    stale.write_bytes(b"half a netcdf file")
+    other.write_text("mine")
+    old = time.time() - 120
+    os.utime(stale, (old, old))
+    os.utime(other, (old, old))
+    kept = {p.name: (p.read_bytes(), p.stat().st_mtime_ns) for p in out.iterdir() if p != stale}
+    # (the case text is the reference's: --resume finds the results up to date)
+    (out / "case.toml").write_text(CASE)
+    code = cli.main(["run", str(out / "case.toml"), "-o", str(out), "--resume",
+                     "--no-progress"])
+    assert code == 0
+    assert "removed .results.nc.abc123.tmp" in capsys.readouterr().out
+    assert not stale.exists()
+    for name, (data, mtime) in kept.items():
+        assert (out / name).read_bytes() == data and (out / name).stat().st_mtime_ns == mtime
