@@ -248,18 +248,19 @@ class IncrementalWearResult:
 # --------------------------------------------------------------------------------------------
 # small helpers
 # --------------------------------------------------------------------------------------------
-def fourier_coefficients(samples: np.ndarray, n_harmonics: int) -> np.ndarray:
+def fourier_coefficients(samples: np.ndarray, harmonics: int) -> np.ndarray:
     """Real Fourier coefficients of samples over exactly one period (axis 0).
 
-    Returns ``(2 nh + 1, ...)``: ``[a0, a1..a_nh, b1..b_nh]`` with ``a0`` the mean,
-    ``a_n = 2 Re X_n / N``, ``b_n = -2 Im X_n / N`` (``X = rfft(samples)``), so that
+    ``harmonics`` (``nh``) is the highest harmonic kept. Returns ``(2 nh + 1, ...)``:
+    ``[a0, a1..a_nh, b1..b_nh]`` with ``a0`` the mean, ``a_n = 2 Re X_n / N``,
+    ``b_n = -2 Im X_n / N`` (``X = rfft(samples)``), so that
     ``x(t_k) = a0 + sum a_n cos(2 pi n k / N) + b_n sin(2 pi n k / N)``.
     """
     x = np.asarray(samples, dtype=float)
     N = x.shape[0]
-    nh = int(n_harmonics)
+    nh = int(harmonics)
     if nh < 0 or 2 * nh >= N:
-        raise InputError(f"n_harmonics = {n_harmonics}: need 0 <= n_harmonics < N/2 = {N / 2:g} "
+        raise InputError(f"harmonics = {harmonics}: need 0 <= harmonics < N/2 = {N / 2:g} "
                          "(samples per period)")
     X = np.fft.rfft(x, axis=0)
     out = np.empty((2 * nh + 1,) + x.shape[1:])
@@ -989,7 +990,7 @@ def classify_sequence(poincare, means=None, *, tol: float = 1e-6, scale: float |
 
 
 def steady_state(model: Model, omega: float, *, max_periods: int = 20_000, tol: float = 1e-6,
-                 steps_per_period: int = DEFAULT_STEPS, n_harmonics: int = 7,
+                 steps_per_period: int = DEFAULT_STEPS, harmonics: int = 7,
                  check_every: int = 16, window: int = 512, min_periods: int = 128, U0=None,
                  V0=None, wear=None, stick_anchor=None, modal_cutoff=None, n_modes=None,
                  gamma: float = 0.5, hf_damping: bool = False, contact_tol: float = 1e-10,
@@ -1010,7 +1011,7 @@ def steady_state(model: Model, omega: float, *, max_periods: int = 20_000, tol: 
     model, omega : as :func:`integrate`.
     max_periods : give up after this many periods (classification then as found).
     tol : relative periodicity tolerance (see :func:`classify_sequence`).
-    n_harmonics : harmonics of the last period reported.
+    harmonics : highest harmonic of the last period reported (1 .. harmonics).
     Others as :func:`integrate` (``contact_tol`` is its ``tol``).
 
     Returns
@@ -1054,9 +1055,9 @@ def steady_state(model: Model, omega: float, *, max_periods: int = 20_000, tol: 
     t0 = time.perf_counter()
     raw = integ.run(1, 1, 1)
     last = integ.result(raw, 1, time.perf_counter() - t0)
-    harm = {name: fourier_coefficients(x, n_harmonics) for name, x in last.observed.items()}
-    charm = {"lam": fourier_coefficients(last.lam, n_harmonics),
-             "u_loc": fourier_coefficients(last.u_loc, n_harmonics)}
+    harm = {name: fourier_coefficients(x, harmonics) for name, x in last.observed.items()}
+    charm = {"lam": fourier_coefficients(last.lam, harmonics),
+             "u_loc": fourier_coefficients(last.u_loc, harmonics)}
     info = dict(last.info)
     info["history"] = history
     return SteadyStateResult(
