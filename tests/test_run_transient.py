@@ -16,7 +16,7 @@ TRANSIENT = """[analysis]
 type = "transient"
 frequency = 1e3
 steps_per_period = 256
-n_harmonics = 7
+harmonics = 7
 """
 FIXED = """[analysis]
 type = "transient"
@@ -24,7 +24,7 @@ frequency = 1e3
 mode = "fixed"
 n_periods = 20
 steps_per_period = 64
-n_harmonics = 3
+harmonics = 3
 """
 WEAR = """[analysis]
 type = "incremental-wear"

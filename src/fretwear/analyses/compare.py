@@ -194,7 +194,7 @@ def compare_periodic(model, analysis: dict, outdir: Path | None, *, steps_per_pe
                                 max_iter=analysis["max_iter"])
     t_dlft = time.perf_counter() - t0
     ss = steady_state(model, omega, max_periods=max_periods, steps_per_period=steps_per_period,
-                      n_harmonics=max(basis.harmonics))
+                      harmonics=max(basis.harmonics))
     out = Comparison(periodic_rows(model, sol, ss), ss.classification, sol is not None,
                      {"DLFT": t_dlft, "time domain": ss.wall_time})
     out.notes.append(f"time domain: {ss.n_periods} periods x {steps_per_period} steps")

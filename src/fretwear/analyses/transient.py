@@ -98,7 +98,7 @@ def time_run(model, analysis: dict, omega: float, progress: bool):
         cls = _classify_record(last, analysis["tol"])
         return last, cls, 0, {"periods": n, "time_wall_time": last.wall_time}
     ss = steady_state(model, omega, max_periods=analysis["max_periods"], tol=analysis["tol"],
-                      steps_per_period=steps, n_harmonics=analysis["n_harmonics"])
+                      steps_per_period=steps, harmonics=analysis["harmonics"])
     last = _continue(model, omega, ss.U, ss.V, POINCARE_PERIODS, steps)
     info = {"periods": ss.n_periods + POINCARE_PERIODS,
             "time_wall_time": ss.wall_time + last.wall_time}
@@ -344,7 +344,7 @@ def run_transient(model, analysis: dict, case, outdir: Path, progress: bool) -> 
     omega = 2 * np.pi * f_hz
     last, cls, before, info = time_run(model, analysis, omega, progress)
     points = [p.name for p in model.observed]
-    ds = transient_dataset(model, last, points, analysis["n_harmonics"], before)
+    ds = transient_dataset(model, last, points, analysis["harmonics"], before)
     ds.attrs.update(_transient_attributes(ds, cls, info, f_hz, analysis, last))
     title = titled(case.title, plots.format_frequency(f_hz))
     figures = _transient_figures(ds, case, outdir, title)
@@ -353,10 +353,10 @@ def run_transient(model, analysis: dict, case, outdir: Path, progress: bool) -> 
 
 
 def _check_harmonics(out: dict, path: str) -> None:
-    """Rule: ``steps_per_period`` exceeds twice ``n_harmonics``."""
-    if "n_harmonics" in out and out.get("steps_per_period", 0) <= 2 * out["n_harmonics"]:
+    """Rule: ``steps_per_period`` exceeds twice ``harmonics``."""
+    if "harmonics" in out and out.get("steps_per_period", 0) <= 2 * out["harmonics"]:
         fail(join(path, "steps_per_period"), out["steps_per_period"],
-             f"more than {2 * out['n_harmonics']} steps (twice n_harmonics)")
+             f"more than {2 * out['harmonics']} steps (twice harmonics)")
 
 
 register(
@@ -375,8 +375,8 @@ register(
         "n_periods": Field(Integer(lo=1), "fixed: periods integrated from rest", default=200),
         "tol": Field(Number(lo=0, lo_open=True), "relative periodicity tolerance of the "
                      "classification", default=1e-6, unit="-"),
-        "n_harmonics": Field(Integer(lo=1), "harmonics of the last period reported",
-                             default=7),
+        "harmonics": Field(Integer(lo=1), "highest harmonic of the last period reported: "
+                           "Nh reports 1, 2, .., Nh", default=7),
     },
     run_transient,
     checks=(_check_harmonics,),

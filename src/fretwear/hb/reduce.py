@@ -14,7 +14,10 @@ so (Nacivet et al. 2003; paper eq. 19)
 loses nothing: every other DOF is recovered as ``U_i = Z_ii^-1 (F_i - Z_ic U_c)``. The reduced
 quantities are expressed in the contact-local frames (normal, tangential), node-major.
 The quasi-static variant drops inertia and damping (``Z_n = K`` for every ``n``), keeping the
-time ordering of the friction law over the period.
+time ordering of the friction law over the period; :func:`condense_static` gives the same
+static condensation in real arithmetic with the condensed loads of any load vectors (the
+quasi-static load steps of :mod:`fretwear.timedomain.integrate`). Both use one implementation
+of eq. 19 (:func:`_schur`).
 """
 
 from __future__ import annotations
@@ -118,6 +121,91 @@ def _factor(Zii, n: int, omega: float):
     return lu
 
 
+def _schur(Z, cdofs, idofs, R, n: int, omega: float):
+    """Exact condensation of one (dynamic) stiffness ``Z`` onto the contact DOFs (eq. 19).
+
+    Returns ``(Z_r, lu, X, Z_ci)`` with ``Z_r = R (Z_cc - Z_ci Z_ii^-1 Z_ic) R^T`` in the
+    contact-local frame, ``lu`` the sparse LU of ``Z_ii`` (None without interior DOFs) and
+    ``X = Z_ii^-1 Z_ic``. ``Z`` real (statics) or complex (one harmonic).
+    """
+    m = cdofs.size
+    Zc_rows = Z[cdofs]
+    Zcc = Zc_rows[:, cdofs].toarray()
+    Zci = Zc_rows[:, idofs]
+    if idofs.size:
+        lu = _factor(Z[idofs][:, idofs], n, omega)
+        X = lu.solve(Z[idofs][:, cdofs].toarray())  # Z_ii^-1 Z_ic
+        S = Zcc - Zci @ X
+    else:
+        lu, X, S = None, np.zeros((0, m), dtype=Z.dtype), Zcc
+    return R @ S @ R.T, lu, X, Zci
+
+
+def _condensed_load(F, cdofs, idofs, R, lu, Zci):
+    """``F_r = R (F_c - Z_ci Z_ii^-1 F_i)`` (eq. 19) and ``Z_ii^-1 F_i`` (None without interior
+    DOFs) for a load vector ``F`` (ndof,) or one per column (ndof, k)."""
+    if lu is None:
+        return R @ F[cdofs], None
+    xf = lu.solve(F[idofs])  # Z_ii^-1 F_i
+    return R @ (F[cdofs] - Zci @ xf), xf
+
+
+@dataclass
+class StaticCondensation:
+    """Exact static condensation of the free structure onto the contact DOFs (``Z = K``).
+
+    ``K_r u_loc + lambda = F_r`` with ``u_loc`` the local contact displacements [m] and
+    ``lambda`` the contact forces [N], both node-major ``[N, T1, (T2)]`` (``m = nc * d``).
+    Made by :func:`condense_static`; the per-harmonic :func:`condense` with
+    ``quasi_static=True`` gives the same ``K_r`` for every harmonic.
+
+    Attributes
+    ----------
+    K : (m, m) condensed stiffness in the local frame [N/m], symmetric.
+    """
+
+    K: np.ndarray
+    _model: Model
+    _cdofs: np.ndarray
+    _idofs: np.ndarray
+    _R: np.ndarray
+    _lu: object
+    _Kci: object
+
+    def loads(self, F) -> np.ndarray:
+        """Condensed loads ``F_r`` (..., m) [N] of load vectors ``F`` (..., ndof) [N]."""
+        F = np.asarray(F, dtype=float)
+        cols = F.reshape(-1, F.shape[-1]).T  # one load per column
+        Fr, _ = _condensed_load(cols, self._cdofs, self._idofs, self._R, self._lu, self._Kci)
+        return Fr.T.reshape(F.shape[:-1] + (self._R.shape[0],))
+
+    def recover(self, u_loc, F) -> np.ndarray:
+        """All DOFs ``U`` (ndof,) [m] from the local contact displacements ``u_loc`` (m,) under
+        the load ``F`` (ndof,): ``U_i = K_ii^-1 (F_i - K_ic U_c)``; fixed DOFs are zero."""
+        U = np.zeros(self._model.ndof)
+        Uc = self._R.T @ np.asarray(u_loc, dtype=float)
+        U[self._cdofs] = Uc
+        if self._lu is not None:
+            K = self._model.K.tocsr()
+            U[self._idofs] = self._lu.solve(np.asarray(F, float)[self._idofs]
+                                            - K[self._idofs][:, self._cdofs] @ Uc)
+        return U
+
+
+def condense_static(model: Model) -> StaticCondensation:
+    """Exact static condensation of ``model`` onto its contact DOFs (eq. 19 with ``Z = K``).
+
+    The same computation as :func:`condense` (:func:`_schur`), in real arithmetic, with the
+    condensed loads of any load vectors (e.g. the loads at the phases of a quasi-static
+    cycle) and the exact recovery of every DOF.
+    """
+    cdofs, idofs = _partition(model)
+    R = _frame_matrix(model)
+    Kr, lu, _, Kci = _schur(model.K.tocsc().astype(float), cdofs, idofs, R, 0, 0.0)
+    return StaticCondensation(np.ascontiguousarray(0.5 * (Kr + Kr.T)), model, cdofs, idofs, R,
+                              lu, Kci)
+
+
 def condense(model: Model, omega: float, orders, *, quasi_static: bool = False) -> Reduced:
     """Condense ``model`` onto its contact DOFs for harmonic ``orders`` at ``omega`` [rad/s].
 
@@ -147,15 +235,7 @@ def condense(model: Model, omega: float, orders, *, quasi_static: bool = False) 
         key = 0 if (n == 0 or quasi_static) else int(n)
         if key not in cache:
             Z = dynamic_stiffness(model, omega, int(n), quasi_static)
-            Zc_rows = Z[cdofs]
-            Zcc = Zc_rows[:, cdofs].toarray()
-            Zci = Zc_rows[:, idofs]
-            if idofs.size:
-                lu = _factor(Z[idofs][:, idofs], int(n), omega)
-                X = lu.solve(Z[idofs][:, cdofs].toarray())  # Z_ii^-1 Z_ic
-                S = Zcc - Zci @ X
-            else:
-                lu, X, S = None, np.zeros((0, m), dtype=complex), Zcc
+            Zr_n, lu, X, Zci = _schur(Z, cdofs, idofs, R, int(n), omega)
             A = np.zeros((obs.size, m), dtype=complex)
             for j, g in enumerate(obs):
                 g = int(g)
@@ -163,17 +243,13 @@ def condense(model: Model, omega: float, orders, *, quasi_static: bool = False) 
                     A[j] = R[:, pos_c[g]]  # U_c = R^T u_loc
                 elif g in pos_i:
                     A[j] = -(X[pos_i[g]] @ R.T)
-            cache[key] = (R @ S @ R.T, A, lu, Zci)
+            cache[key] = (Zr_n, A, lu, Zci)
         Zr[b], oA[b], lu, Zci = cache[key]
-        Fn = F_all[n]
-        if lu is not None:
-            xf = lu.solve(Fn[idofs].astype(complex))  # Z_ii^-1 F_i
-            Fr[b] = R @ (Fn[cdofs] - Zci @ xf)
+        Fr[b], xf = _condensed_load(F_all[n].astype(complex), cdofs, idofs, R, lu, Zci)
+        if xf is not None:
             for j, g in enumerate(obs):
                 if int(g) in pos_i:
                     ob[b, j] = xf[pos_i[int(g)]]
-        else:
-            Fr[b] = R @ Fn[cdofs]
     return Reduced(float(omega), orders, Zr, Fr, oA, ob, obs, bool(quasi_static))
 
 

@@ -11,7 +11,8 @@ module computes that mean with the exact time integration of :mod:`fretwear.time
 
     dW1_p = c_p S_p,    S_p = (1/K) sum_n lambda_N,p(t_n) |x_T,p(t_n+1) - x_T,p(t_n)|
 
-over the steps ``n`` of ``K`` periods in which node ``p`` slips
+over the steps ``n`` of ``K`` periods in which node ``p`` slips (the integrand of
+:func:`fretwear.wear.kernels.archard_integrand`)
 
 with ``c_p`` the factor of the wear law (:func:`fretwear.wear.laws.wear_coefficients`): ``k_w /
 area`` for Archard, ``k_e mu / area`` for the energy law, exactly as on the DLFT samples. A node
@@ -32,6 +33,7 @@ import numpy as np
 from fretwear.hb import contact as law
 from fretwear.hb.fourier import FourierBasis
 from fretwear.model.core import Model
+from fretwear.wear.kernels import slip_work_samples
 
 #: response kinds of :func:`fretwear.timedomain.integrate.classify_sequence`, coded in wear
 # histories
@@ -144,8 +146,10 @@ def time_averaged_rate(model: Model, omega: float, basis: FourierBasis, coef, we
     x, f, s = window_samples(r.u_loc, r.lam, r.state)
     nc, d, ns = x.shape
     cycles = (ns - 1) / nsteps  # steps whose slip is counted, in periods
-    inc = law.slip_increments(x, s)  # (nc, ns), zero unless slip; column 0 marked stick
-    work = f[:, 0, :] * inc  # slip work of each step ending at column j
+    # slip and slip work (Archard's integrand) of each step ending at column j, zero unless
+    # slip; column 0 is marked stick
+    inc, work = slip_work_samples(np.ascontiguousarray(f[:, 0, :]), np.ascontiguousarray(x),
+                                  np.ascontiguousarray(s))
     S = work.sum(axis=1) / cycles
     area = np.asarray(model.contact.area, float)
     c_area = area * np.asarray(coef, float)  # worn volume per unit slip work

@@ -47,8 +47,24 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from fretwear.errors import ConvergenceError, InputError
+from fretwear.hb.reduce import condense_static
 from fretwear.model.core import Model
-from fretwear.timedomain.kernels import OPEN, STICK, run_dynamic, run_quasistatic
+from fretwear.timedomain.kernels import (
+    OPEN,
+    STICK,
+    Contact,
+    ContactState,
+    DynamicState,
+    EnergyTerms,
+    LoadCycle,
+    Records,
+    Settings,
+    StepOperator,
+    WearRecords,
+    WearState,
+    run_dynamic,
+    run_quasistatic,
+)
 
 __all__ = [
     "Classification",
@@ -232,18 +248,19 @@ class IncrementalWearResult:
 # --------------------------------------------------------------------------------------------
 # small helpers
 # --------------------------------------------------------------------------------------------
-def fourier_coefficients(samples: np.ndarray, n_harmonics: int) -> np.ndarray:
+def fourier_coefficients(samples: np.ndarray, harmonics: int) -> np.ndarray:
     """Real Fourier coefficients of samples over exactly one period (axis 0).
 
-    Returns ``(2 nh + 1, ...)``: ``[a0, a1..a_nh, b1..b_nh]`` with ``a0`` the mean,
-    ``a_n = 2 Re X_n / N``, ``b_n = -2 Im X_n / N`` (``X = rfft(samples)``), so that
+    ``harmonics`` (``nh``) is the highest harmonic kept. Returns ``(2 nh + 1, ...)``:
+    ``[a0, a1..a_nh, b1..b_nh]`` with ``a0`` the mean, ``a_n = 2 Re X_n / N``,
+    ``b_n = -2 Im X_n / N`` (``X = rfft(samples)``), so that
     ``x(t_k) = a0 + sum a_n cos(2 pi n k / N) + b_n sin(2 pi n k / N)``.
     """
     x = np.asarray(samples, dtype=float)
     N = x.shape[0]
-    nh = int(n_harmonics)
+    nh = int(harmonics)
     if nh < 0 or 2 * nh >= N:
-        raise InputError(f"n_harmonics = {n_harmonics}: need 0 <= n_harmonics < N/2 = {N / 2:g} "
+        raise InputError(f"harmonics = {harmonics}: need 0 <= harmonics < N/2 = {N / 2:g} "
                          "(samples per period)")
     X = np.fft.rfft(x, axis=0)
     out = np.empty((2 * nh + 1,) + x.shape[1:])
@@ -269,6 +286,10 @@ def _count(value, what: str, minimum: int = 1) -> int:
     if value < minimum:
         raise InputError(f"{what} = {value}; expected an integer >= {minimum}")
     return int(value)
+
+
+def _c_float(a) -> np.ndarray:
+    return np.ascontiguousarray(a, dtype=float)
 
 
 def _check_contact(model: Model) -> None:
@@ -625,17 +646,23 @@ class _Integrator:
         self.A = np.ascontiguousarray(0.5 * (self.A + self.A.T))
         self.gap = np.asarray(c.gap, dtype=float) + _node_wear(wear, self.nc)
         if red.diag:
-            self.m_v, self.k_v, self.c_v = red.M, red.K, red.C
-            self.m_m = self.k_m = self.c_m = z0
+            m_v, k_v, c_v = red.M, red.K, red.C
+            m_m = k_m = c_m = z0
         else:
-            self.m_v = self.k_v = self.c_v = np.zeros(0)
-            self.m_m, self.k_m, self.c_m = red.M, red.K, red.C
-        # one compiled specialisation: every array the kernel sees is C-contiguous float64
-        for name in ("a_v", "b_v", "ds", "hc", "U", "R", "P", "Qt", "bq_m", "bd_m", "ftab",
-                     "ftil", "m_v", "k_v", "c_v", "m_m", "k_m", "c_m"):
-            setattr(self, name, np.ascontiguousarray(getattr(self, name), dtype=float))
-        red.Tx = np.ascontiguousarray(red.Tx, dtype=float)
-        red.obs = np.ascontiguousarray(red.obs, dtype=float)
+            m_v = k_v = c_v = np.zeros(0)
+            m_m, k_m, c_m = red.M, red.K, red.C
+        red.Tx = _c_float(red.Tx)
+        red.obs = _c_float(red.obs)
+        # the kernel's records; one compiled specialisation: every array is C-contiguous
+        # float64 and every scalar a Python bool, float or int
+        self.op = StepOperator(
+            bool(red.diag), *(_c_float(a) for a in (
+                self.a_v, self.b_v, self.ds, self.hc, self.U, self.R, self.P, self.Qt,
+                self.bq_m, self.bd_m, self.ftab, self.G, red.Tx, red.obs)))
+        self.energy = EnergyTerms(float(h), *(_c_float(a) for a in (
+            self.ftil, m_v, k_v, c_v, m_m, k_m, c_m)))
+        self.contact = Contact(self.A, _c_float(self.gap), float(c.mu), int(self.d))
+        self.settings = Settings(float(self.tol), float(self.fscale), int(60 + 4 * self.nc))
         self.setup_time = time.perf_counter() - t0
         self.r = r
         # initial state
@@ -734,17 +761,15 @@ class _Integrator:
                 bar = tqdm(total=n_periods, unit="period")
             except ImportError:  # pragma: no cover
                 bar = None
+        state = DynamicState(self.q, self.dq, self.xprev, self.xprev2,
+                             ContactState(self.status, self.tdir))
+        rec = Records(int(keep_from), mon_start, mon_mean, mon_ptp, int(rec_from), r_obs,
+                      r_vobs, r_x, r_lam, r_state, r_energy)
         done = 0
         while done < n_periods:
             k = min(chunk, n_periods - done)
-            nfail, maxit, ff = run_dynamic(
-                self.q, self.dq, self.red.diag, self.a_v, self.b_v, self.ds, self.hc, self.U,
-                self.R, self.P, self.Qt, self.bq_m, self.bd_m, self.ftab, self.G, self.red.Tx,
-                self.A, self.gap, self.xprev, self.xprev2, float(self.model.contact.mu), self.d,
-                self.status, self.tdir, k, self.periods_done * N, self.tol, self.fscale,
-                60 + 4 * nc, self.red.obs, keep_from, mon_start, mon_mean, mon_ptp, rec_from,
-                self.h, self.ftil, self.m_v, self.k_v, self.c_v, self.m_m, self.k_m, self.c_m,
-                r_obs, r_vobs, r_x, r_lam, r_state, r_energy)
+            nfail, maxit, ff = run_dynamic(self.op, self.energy, self.contact, self.settings,
+                                           state, rec, k, self.periods_done * N)
             if nfail and self.first_fail_time is None:
                 self.first_fail_time = ff * self.h
             self.n_fail += nfail
@@ -965,7 +990,7 @@ def classify_sequence(poincare, means=None, *, tol: float = 1e-6, scale: float |
 
 
 def steady_state(model: Model, omega: float, *, max_periods: int = 20_000, tol: float = 1e-6,
-                 steps_per_period: int = DEFAULT_STEPS, n_harmonics: int = 7,
+                 steps_per_period: int = DEFAULT_STEPS, harmonics: int = 7,
                  check_every: int = 16, window: int = 512, min_periods: int = 128, U0=None,
                  V0=None, wear=None, stick_anchor=None, modal_cutoff=None, n_modes=None,
                  gamma: float = 0.5, hf_damping: bool = False, contact_tol: float = 1e-10,
@@ -986,7 +1011,7 @@ def steady_state(model: Model, omega: float, *, max_periods: int = 20_000, tol: 
     model, omega : as :func:`integrate`.
     max_periods : give up after this many periods (classification then as found).
     tol : relative periodicity tolerance (see :func:`classify_sequence`).
-    n_harmonics : harmonics of the last period reported.
+    harmonics : highest harmonic of the last period reported (1 .. harmonics).
     Others as :func:`integrate` (``contact_tol`` is its ``tol``).
 
     Returns
@@ -1030,9 +1055,9 @@ def steady_state(model: Model, omega: float, *, max_periods: int = 20_000, tol: 
     t0 = time.perf_counter()
     raw = integ.run(1, 1, 1)
     last = integ.result(raw, 1, time.perf_counter() - t0)
-    harm = {name: fourier_coefficients(x, n_harmonics) for name, x in last.observed.items()}
-    charm = {"lam": fourier_coefficients(last.lam, n_harmonics),
-             "u_loc": fourier_coefficients(last.u_loc, n_harmonics)}
+    harm = {name: fourier_coefficients(x, harmonics) for name, x in last.observed.items()}
+    charm = {"lam": fourier_coefficients(last.lam, harmonics),
+             "u_loc": fourier_coefficients(last.u_loc, harmonics)}
     info = dict(last.info)
     info["history"] = history
     return SteadyStateResult(
@@ -1045,60 +1070,6 @@ def steady_state(model: Model, omega: float, *, max_periods: int = 20_000, tol: 
 # --------------------------------------------------------------------------------------------
 # quasi-static incremental wear
 # --------------------------------------------------------------------------------------------
-def _static_condensation(model: Model):
-    """Exact static condensation of the free structure onto the contact DOFs.
-
-    Returns ``(A, Tb, load_r, recover)`` with ``A = Tb K_r Tb^T`` [N/m] in the local frame,
-    ``load_r(F_full) -> Tb F_r`` the condensed load [N] and ``recover(x, F_full) -> U``.
-    """
-    _check_contact(model)
-    n = model.ndof
-    free = model.free_dofs()
-    nf = free.size
-    pos = -np.ones(n, dtype=np.int64)
-    pos[free] = np.arange(nf)
-    K = _sub(model.K.tocsr(), free, free)
-    bnd = pos[np.asarray(model.contact.dofs).ravel()]
-    mask = np.ones(nf, dtype=bool)
-    mask[bnd] = False
-    inner = np.flatnonzero(mask)
-    Tb = np.asarray(model.contact.local_transform(n).tocsr()[:, free][:, bnd].todense())
-    Kbb = _sub(K, bnd, bnd).toarray()
-    if inner.size:
-        Kii = _sub(K, inner, inner).tocsc()
-        Kib = _sub(K, inner, bnd)
-        try:
-            lu = spla.splu(Kii)
-        except RuntimeError:
-            raise InputError("the stiffness with the contact DOFs held is singular (a part of "
-                             "the structure is not held by springs, supports or the contact)"
-                             ) from None
-        X = lu.solve(Kib.toarray())
-        Kr = Kbb - Kib.T @ X
-    else:
-        lu, X, Kr = None, None, Kbb
-    Kr = 0.5 * (Kr + Kr.T)
-    A = Tb @ Kr @ Tb.T
-
-    def load_r(F):
-        Ff = F[..., free]
-        Fr = Ff[..., bnd]
-        if inner.size:
-            Fr = Fr - Ff[..., inner] @ X
-        return Fr @ Tb.T
-
-    def recover(x, F):
-        ub = Tb.T @ x
-        U = np.zeros(n)
-        U[free[bnd]] = ub
-        if inner.size:
-            Ff = F[free]
-            U[free[inner]] = lu.solve(Ff[inner] - Kib @ ub)
-        return U
-
-    return np.ascontiguousarray(A), load_r, recover
-
-
 def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int = 100,
                      cycle_jump: int = 1, k_w: float | None = None, record_every: int = 1,
                      wear0=None, tol: float = 1e-10,
@@ -1148,10 +1119,12 @@ def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int =
     area = np.asarray(c.area, dtype=float)
     if area.shape != (nc,) or np.any(area <= 0):
         raise InputError(f"contact.area must be ({nc},) positive areas [m^2]")
-    A, load_r, recover = _static_condensation(model)
+    _check_contact(model)
+    cond = condense_static(model)
+    A = cond.K
     tau = 2.0 * np.pi * np.arange(N) / N
     Ft = model.load_time(tau) if model.loads else np.zeros((N, model.ndof))
-    btab = np.ascontiguousarray(load_r(Ft))
+    btab = np.ascontiguousarray(cond.loads(Ft))
     fscale = float(np.abs(btab).max(initial=0.0))
     jumps = [1]
     left = n_cycles - 1
@@ -1167,23 +1140,22 @@ def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int =
     status = np.where(gap <= 0.0, STICK, OPEN).astype(np.int8)
     tdir = np.zeros((nc, d - 1))
     tdir[:, 0] = 1.0
-    r_wear = np.zeros((nrec, nc))
-    r_press = np.zeros((nrec, nc))
-    r_slip = np.zeros((nrec, nc))
-    r_diss = np.zeros(nrec)
-    r_cycle = np.zeros(nrec, dtype=np.int64)
-    nr, nfail, maxit = run_quasistatic(A, btab, gap, wear, area, float(c.mu), kw, d, jumps, x,
-                                       status, tdir, tol, fscale, 60 + 4 * nc, rec_every,
-                                       r_wear, r_press, r_slip, r_diss, r_cycle)
+    rec = WearRecords(rec_every, np.zeros((nrec, nc)), np.zeros((nrec, nc)),
+                      np.zeros((nrec, nc)), np.zeros(nrec), np.zeros(nrec, dtype=np.int64))
+    nr, nfail, maxit = run_quasistatic(
+        Contact(A, gap, float(c.mu), int(d)), LoadCycle(btab, _c_float(area), kw, jumps),
+        Settings(float(tol), fscale, 60 + 4 * nc), WearState(x, wear, ContactState(status, tdir)),
+        rec)
     if nfail:
         raise ConvergenceError(f"incremental_wear: {nfail} load steps where the contact active "
                                "set did not settle (singular or cycling); check that the "
                                "contact holds the structure (rigid motions) and the loads")
     lam = np.asarray(A @ (-x) + btab[0]).reshape(nc, d)
-    U = recover(x, model.load_time(np.zeros(1))[0] if model.loads else np.zeros(model.ndof))
+    U = cond.recover(x, model.load_time(np.zeros(1))[0] if model.loads
+                     else np.zeros(model.ndof))
     return IncrementalWearResult(
-        cycles=r_cycle, wear=r_wear, pressure=r_press, slip=r_slip,
-        worn_volume=r_wear @ area, dissipation=r_diss, computed_cycles=ncomp, cycle_jump=J,
+        cycles=rec.cycle, wear=rec.wear, pressure=rec.press, slip=rec.slip,
+        worn_volume=rec.wear @ area, dissipation=rec.diss, computed_cycles=ncomp, cycle_jump=J,
         steps_per_cycle=N, k_w=kw, wall_time=time.perf_counter() - t0, U=U, lam=lam,
         info={"max_active_set_iterations": int(maxit), "records": int(nr)})
 

@@ -84,7 +84,7 @@ def check_periodic(model: Model, sol: PeriodicSolution, *, max_periods: int = 30
     V0 = V0 + perturbation * vmax * rng.standard_normal(V0.shape)
     nsteps = steps_per_period or max(128, 8 * max(sol.basis.harmonics))
     res = steady_state(model, sol.omega, max_periods=max_periods, tol=periodicity_tol,
-                       steps_per_period=nsteps, n_harmonics=max(sol.basis.harmonics),
+                       steps_per_period=nsteps, harmonics=max(sol.basis.harmonics),
                        U0=U0, V0=V0, wear=sol.gap - np.asarray(model.contact.gap, float))
     kind = res.classification
     # distance between the settled period and the periodic solution, on the observed points
@@ -165,7 +165,7 @@ def time_domain_start(model: Model, omega: float, basis, start: PeriodicSolution
     hmax = max(basis.harmonics) if basis.harmonics else 1
     nsteps = steps_per_period or max(128, 8 * hmax)
     res = steady_state(model, omega, max_periods=max_periods, tol=periodicity_tol,
-                       steps_per_period=nsteps, n_harmonics=hmax, U0=U0, V0=V0, wear=wear)
+                       steps_per_period=nsteps, harmonics=hmax, U0=U0, V0=V0, wear=wear)
     kind = res.classification
     n = res.n_periods
     if kind == "periodic":

@@ -1,6 +1,11 @@
 """Numba kernels of the wear rate (paper eq. 29) and its derivative for the implicit scheme.
 
-For every contact node ``p`` the kernel evaluates the *slip work integral*
+Archard's integrand ``lambda_N |dx_T|`` of one node over one step is written once,
+:func:`archard_integrand`; the DLFT slip work below, the time-averaged rate
+(:mod:`fretwear.timedomain.averaged_rate`, through :func:`slip_work_samples`) and the quasi-static
+load steps (:func:`fretwear.timedomain.kernels.run_quasistatic`) all sum it.
+
+For every contact node ``p`` the kernel :func:`slip_work` evaluates the *slip work integral*
 
     S_p = sum over slip instants n of  lambda_N(n) |X_T(n) - X_T(n-1)|        [N m]
 
@@ -30,6 +35,59 @@ from fretwear.hb.contact import SEPARATION, SLIP, STICK, slip_derivative_step
 
 
 @njit(cache=True)
+def archard_integrand(lam_n, x_now, x_before):
+    """Archard's integrand for one node over one step (paper eq. 12, 29): ``lambda_N |dx_T|``.
+
+    Parameters
+    ----------
+    lam_n : normal contact force over the step [N] (compression positive).
+    x_now, x_before : (d,) the node's local components ``[N, T1, (T2)]`` at the end and at
+        the start of the step (only the tangential ones are used). Displacements [m]; the DLFT
+        passes ``lambda_x = eps X`` [N] and divides the sum by ``eps``.
+
+    Returns
+    -------
+    ``(slip, work)``: the slip increment length ``|x_T(now) - x_T(before)|`` and
+    ``lam_n * slip``. Every wear integral of fretwear (the DLFT samples, the time integration,
+    the quasi-static load steps) sums this over the slip steps of a node.
+    """
+    s2 = 0.0
+    for c in range(1, x_now.shape[0]):
+        dx = x_now[c] - x_before[c]
+        s2 += dx * dx
+    slip = np.sqrt(s2)
+    return slip, lam_n * slip
+
+
+@njit(cache=True)
+def slip_work_samples(lam_n, x, state):
+    """Archard's integrand at every instant of a periodic sequence of samples.
+
+    Parameters
+    ----------
+    lam_n : (nc, N) normal contact force of the step ending at each instant [N].
+    x : (nc, d, N) local displacements at the instants [m]; the step ending at instant 0
+        starts at instant ``N - 1`` (periodic).
+    state : (nc, N) int8 contact state of the step ending at each instant.
+
+    Returns
+    -------
+    ``(slip, work)``, (nc, N) each: :func:`archard_integrand` of each step, zero unless the
+    node slips over it [m], [N m].
+    """
+    nc, d, N = x.shape
+    slip = np.zeros((nc, N))
+    work = np.zeros((nc, N))
+    for p in range(nc):
+        for n in range(N):
+            if state[p, n] != SLIP:
+                continue
+            m = n - 1 if n > 0 else N - 1
+            slip[p, n], work[p, n] = archard_integrand(lam_n[p, n], x[p, :, n], x[p, :, m])
+    return slip, work
+
+
+@njit(cache=True)
 def slip_work(lam_u, lam_x, state, eps):
     """Slip work integral ``S_p`` per node (nc,) [N m] (see module docstring).
 
@@ -47,11 +105,7 @@ def slip_work(lam_u, lam_x, state, eps):
             if state[p, n] != SLIP:
                 continue
             m = n - 1 if n > 0 else N - 1
-            s2 = 0.0
-            for c in range(1, d):
-                dx = lam_x[p, c, n] - lam_x[p, c, m]
-                s2 += dx * dx
-            acc += lam_u[p, 0, n] * np.sqrt(s2)
+            acc += archard_integrand(lam_u[p, 0, n], lam_x[p, :, n], lam_x[p, :, m])[1]
         out[p] = acc / eps
     return out
 
@@ -124,12 +178,10 @@ def slip_work_gradient(lam_u, lam_x, state, mu, Q, eps):
                 slip_derivative_step(lam_u[p], lam_x[p], n, m, mu[p], Q, A0, Sd, that, B,
                                      tmpA, tmpS)
                 # the wear integrand pn |dX| and its derivative
-                s2 = 0.0
+                sl, w = archard_integrand(pn, lam_x[p, :, n], lam_x[p, :, m])
+                acc += w
                 for a in range(dt):
                     tdx[a] = lam_x[p, 1 + a, n] - lam_x[p, 1 + a, m]
-                    s2 += tdx[a] * tdx[a]
-                sl = np.sqrt(s2)
-                acc += pn * sl
                 for h in range(H):
                     grad[h] += sl * Q[n, h]  # d pn / d lambda_u~ = Q[n, :] on component N
                 if sl > 0.0:
