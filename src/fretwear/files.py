@@ -7,6 +7,7 @@ the file writers share this one rule.
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import os
 import re
 import stat
@@ -101,3 +102,28 @@ def _fsync_dir(folder: Path) -> None:
         pass
     finally:
         os.close(fd)
+
+
+#: longest file name part made from a user's name (most file systems allow 255 bytes)
+MAX_NAME = 100
+
+
+def safe_name(text: str, max_len: int = MAX_NAME) -> str:
+    """``text`` made safe as part of a file name: only letters, digits and ``. _ + -`` kept
+    (anything else, path separators included, becomes ``_``), no leading dot, and at most
+    ``max_len`` characters (a long name is cut and ends with a short hash of the whole, so two
+    long names stay different). A name can then never point outside its folder."""
+    clean = re.sub(r"[^A-Za-z0-9._+-]", "_", str(text)).lstrip(".") or "_"
+    if len(clean) > max_len:
+        digest = hashlib.sha1(str(text).encode("utf-8")).hexdigest()[:8]
+        clean = clean[: max_len - 9] + "-" + digest
+    return clean
+
+
+def inside(folder: Path | str, path: Path | str) -> Path:
+    """``path`` resolved, after checking that it lies in ``folder`` (a guard for every file a
+    run writes: nothing is written outside the output folder)."""
+    folder, path = Path(folder).resolve(), Path(path).resolve()
+    if folder != path and folder not in path.parents:
+        raise ValueError(f"{path} is outside the output folder {folder}")
+    return path

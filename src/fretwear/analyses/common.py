@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from fretwear.files import inside, safe_name
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.penalty import RULES
 from fretwear.hb.solvers import SOLVERS, SolveStats
@@ -41,9 +42,13 @@ def check_points(model, requested) -> list[str]:
 
 
 def figure_path(case, outdir: Path, stem: str) -> Path | None:
-    """``outdir/stem.<figure_format>``, or None when the case's output asks for no figures."""
+    """``outdir/stem.<figure_format>``, or None when the case's output asks for no figures.
+    ``stem`` may hold user names (observed points): it is made safe as a file name
+    (:func:`fretwear.files.safe_name`), so the file is always in ``outdir``."""
     out = case.output
-    return outdir / f"{stem}.{out['figure_format']}" if out["figures"] else None
+    if not out["figures"]:
+        return None
+    return inside(outdir, outdir / f"{safe_name(stem)}.{out['figure_format']}")
 
 
 def geometry(model, points: list[str]) -> tuple[dict, dict]:

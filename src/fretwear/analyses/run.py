@@ -11,6 +11,7 @@ killed mid-way (:func:`fretwear.files.remove_stale_temporaries`) are removed.
 
 from __future__ import annotations
 
+import tempfile
 import time
 from pathlib import Path
 
@@ -61,18 +62,34 @@ def _up_to_date(results: Path, case) -> bool:
     return attrs.get("case_file") == case.text and int(attrs.get("converged", 0)) == 1
 
 
-def _check_output(out_dir: Path, names: list[str]) -> None:
-    """Refuse, before anything runs, an output folder that is a file and a folder where a
-    file will be written (the run would fail at its first save)."""
-    if out_dir.exists() and not out_dir.is_dir():
-        raise InputError(f"the output folder {str(out_dir)!r} is a file: choose another "
-                         "folder with -o DIR (or [output] directory)")
+def _check_output(out_dir: Path, names: list[str]) -> bool:
+    """Refuse, before anything runs, an output folder that cannot be written (a file, a path
+    under a file, no permission, a name too long for the file system) and a folder where a
+    file will be written (the run would fail at its first save). Makes the folder and proves
+    it writable with a probe file; returns whether the folder was made here."""
+    where = "choose another folder with -o DIR (or [output] directory)"
+    try:
+        if out_dir.exists() and not out_dir.is_dir():
+            raise InputError(f"the output folder {str(out_dir)!r} is a file: {where}")
+        made = not out_dir.exists()
+        out_dir.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=out_dir):
+            pass
+    except InputError:
+        raise
+    except OSError as exc:
+        why = exc.strerror or type(exc).__name__
+        if isinstance(exc, FileExistsError | NotADirectoryError):
+            why = "a part of the path is a file, not a folder"
+        raise InputError(f"cannot write in the output folder {str(out_dir)!r} ({why}): "
+                         f"{where}") from None
     for name in names:
         p = out_dir / name
         if p.exists() and not p.is_file():
             what = "a folder, not a file" if p.is_dir() else "not a regular file"
             raise InputError(f"{str(p)!r} is {what}: move or delete it (the run writes its "
                              f"{'results' if name == RESULTS_FILE else 'state'} there)")
+    return made
 
 
 def _saved_since(outdir: Path, start: float) -> list[Path]:
@@ -124,7 +141,7 @@ def run_case(path: Path | str, outdir: Path | str | None = None, progress: bool 
     analysis = get(case.analysis["type"])
     out_dir = case.output_dir(outdir)
     results_path = out_dir / RESULTS_FILE
-    _check_output(out_dir, [RESULTS_FILE, *analysis.files])
+    made = _check_output(out_dir, [RESULTS_FILE, *analysis.files])
     say = print if echo else (lambda *a, **k: None)
     say(f"fretwear {__version__}: {case.title} ({case.path.name}, analysis {analysis.name})")
     for p in remove_stale_temporaries(out_dir):
@@ -138,7 +155,6 @@ def run_case(path: Path | str, outdir: Path | str | None = None, progress: bool 
         model = build_model(case)
         for note in observed_notes(case, model):
             say(note)
-        out_dir.mkdir(parents=True, exist_ok=True)
         out = analysis.run(model, case.analysis, case, out_dir, progress)
         out.results = write_results(
             results_path, out.dataset, title=case.title, analysis_type=analysis.name,
@@ -147,6 +163,10 @@ def run_case(path: Path | str, outdir: Path | str | None = None, progress: bool 
         )
     except KeyboardInterrupt:
         raise RunInterrupted(_interrupted_message(out_dir, start)) from None
+    except Exception:
+        if made and not any(out_dir.iterdir()):  # nothing was written: leave no empty folder
+            out_dir.rmdir()
+        raise
     if out.summary:
         say(out.summary)
     if not out.converged:

@@ -19,6 +19,7 @@ import xarray as xr
 
 from fretwear.analyses import figures as plots
 from fretwear.analyses.registry import RunOutput, register
+from fretwear.files import safe_name
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.solvers import SOLVERS
@@ -386,7 +387,8 @@ def _figures(ds, case, outdir: Path, nodes) -> list[Path]:
     ]
     if "frf_amplitude" in ds:
         for p in ds["point"].values:
-            figs.append(plot_frf_before_after(ds, outdir / f"frf-worn-{p}.{fmt}", str(p),
+            path = outdir / f"frf-worn-{safe_name(str(p))}.{fmt}"
+            figs.append(plot_frf_before_after(ds, path, str(p),
                                               title=f"{t}: FRF before / after wear"))
     return figs
 

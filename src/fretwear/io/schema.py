@@ -293,7 +293,11 @@ class FilePath(Spec):
             self._type_error(value, path)
         p = Path(value).expanduser()
         p = p if p.is_absolute() else (ctx.base_dir / p)
-        if not p.is_file():
+        try:
+            found = p.is_file()
+        except OSError as exc:  # e.g. a name too long for the file system
+            fail(path, value, self.expected(), f" ({exc.strerror or exc})")
+        if not found:
             fail(path, value, self.expected(), f" (no file at {p})")
         return p.resolve()
 

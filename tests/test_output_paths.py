@@ -1,0 +1,109 @@
+"""Output paths a hostile user gives: every one gets one clear message before anything is
+computed (exit 2, no traceback), and no run ever writes outside its output folder.
+
+Reference: the rules of the command line (docs: README "Using it"): an output folder that
+cannot be written is refused before the run starts; names that become file names are made
+safe (fretwear.files.safe_name).
+"""
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from fretwear.files import inside, safe_name
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLE = ROOT / "src" / "fretwear" / "examples" / "beam-linear-frf.toml"
+
+
+def fretwear(*args, cwd=None) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "fretwear", *args], capture_output=True,
+                          text=True, cwd=cwd, timeout=120)
+
+
+def small_case(folder: Path, point: str = "Pe") -> Path:
+    """The shipped linear FRF example with 3 frequencies and its observed point renamed."""
+    text = EXAMPLE.read_text().replace("n_points = 600", "n_points = 3")
+    text = text.replace("\nPe = ", f"\n{point!r} = ".replace("'", '"'), 1)
+    path = folder / "case.toml"
+    path.write_text(text)
+    return path
+
+
+def refused(r: subprocess.CompletedProcess, *words: str) -> None:
+    assert r.returncode == 2, r.stderr
+    assert "Traceback" not in r.stderr
+    line = r.stderr.strip()
+    assert line.startswith("error:") and "\n" not in line, line
+    for w in words:
+        assert w in line, line
+
+
+def test_output_folder_that_is_a_file(tmp_path):
+    case = small_case(tmp_path)
+    (tmp_path / "taken").write_text("mine")
+    refused(fretwear("run", str(case), "-o", str(tmp_path / "taken")), "is a file")
+    assert (tmp_path / "taken").read_text() == "mine"
+
+
+def test_output_folder_under_a_file(tmp_path):
+    case = small_case(tmp_path)
+    (tmp_path / "taken").write_text("mine")
+    refused(fretwear("run", str(case), "-o", str(tmp_path / "taken" / "sub")),
+            "a part of the path is a file")
+
+
+def test_output_folder_name_too_long(tmp_path):
+    case = small_case(tmp_path)
+    refused(fretwear("run", str(case), "-o", str(tmp_path / ("x" * 300))), "too long")
+
+
+def test_output_to_dev_null(tmp_path):
+    refused(fretwear("run", str(small_case(tmp_path)), "-o", os.devnull), "is a file")
+
+
+def test_output_folder_without_write_permission(tmp_path):
+    """/proc refuses new folders even to root (a permission test with chmod would not hold
+    for root, which CI may be)."""
+    refused(fretwear("run", str(small_case(tmp_path)), "-o", "/proc/fretwear-out"),
+            "cannot write in the output folder")
+
+
+def test_a_failed_run_leaves_no_empty_output_folder(tmp_path):
+    text = small_case(tmp_path).read_text().replace('boundary = "bottom"', 'boundary = "nope"')
+    (tmp_path / "case.toml").write_text(text)
+    r = fretwear("run", str(tmp_path / "case.toml"), "-o", str(tmp_path / "out"))
+    refused(r, "nope")
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("point", ["../../../escape", "a/b", "x" * 400])
+def test_point_names_never_write_outside_the_output_folder(tmp_path, point):
+    work = tmp_path / "work"
+    work.mkdir()
+    case = small_case(work, point)
+    before = {p for p in tmp_path.rglob("*")}
+    r = fretwear("run", str(case), "-o", str(work / "out"))
+    assert r.returncode == 0, r.stderr
+    new = {p for p in tmp_path.rglob("*")} - before
+    assert new and all(work / "out" in p.parents or p == work / "out" for p in new), new
+    figures = [p for p in (work / "out").iterdir() if p.suffix == ".png"]
+    assert figures and all(len(p.name) <= 120 for p in figures)
+
+
+def test_safe_name_rules():
+    assert safe_name("Pe") == "Pe"
+    assert safe_name("../../x") == "_.._x"
+    assert "/" not in safe_name("a/b") and safe_name("a/b") == "a_b"
+    long_a, long_b = safe_name("y" * 300 + "a"), safe_name("y" * 300 + "b")
+    assert len(long_a) == 100 and long_a != long_b
+    assert safe_name("") == "_" and safe_name("...") == "_"
+
+
+def test_inside_guard(tmp_path):
+    assert inside(tmp_path, tmp_path / "a" / "b.png") == (tmp_path / "a" / "b.png").resolve()
+    with pytest.raises(ValueError, match="outside the output folder"):
+        inside(tmp_path / "out", tmp_path / "out" / ".." / "escape.png")
