@@ -289,3 +289,13 @@ def test_nodal_force():
     assert nodal_force(9, 1, (0.0, 0.0, 4.0)).tolist() == [0, 0, 0, 0, 0, 4.0, 0, 0, 0]
     with pytest.raises(InputError, match="node number"):
         nodal_force(m, 4, (1.0, 0.0))
+
+
+@pytest.mark.parametrize("E", [1e308, 1e-300, 0.5, 2e13])
+def test_youngs_modulus_outside_the_documented_range_is_refused(E):
+    """Reference: fretwear.limits.RANGES["modulus"] = [1, 1e13] Pa."""
+    from fretwear.model.fem import check_material
+
+    with pytest.raises(InputError, match=r"Young's modulus E = .* Pa: expected a magnitude in "
+                                         r"\[1, 1e\+13\] Pa"):
+        check_material(E, 0.3, 7800.0)

@@ -323,3 +323,22 @@ def test_user_mesh_with_non_finite_coordinates_is_refused():
     m.points[4, 1] = np.nan
     with pytest.raises(InputError, match=r"node 4 has coordinates .*expected finite"):
         check_cells(Mesh(m.points, m.cells, m.cell_type))
+
+
+# --- magnitudes and sizes (reference: the documented ranges of fretwear.limits) ------------
+@pytest.mark.parametrize("length", [1e-300, 1e300, 1e-10, 2e5])
+def test_lengths_outside_the_documented_range_are_refused(length):
+    with pytest.raises(InputError, match=r"length = .* m: expected a magnitude in \[1e-09, "
+                                         r"100000\] m"):
+        rectangle(length, 1.0, 2, 2)
+
+
+def test_lengths_at_the_ends_of_the_range_are_accepted():
+    rectangle(1e-9, 1e-9, 1, 1)
+    rectangle(1e5, 1e5, 1, 1)
+
+
+def test_a_mesh_too_large_for_the_machine_is_refused_before_it_is_made():
+    with pytest.raises(InputError, match=r"a mesh of 1e\+09 hexahedra needs about .* GiB of "
+                                         r"memory; this machine has"):
+        box(1.0, 1.0, 1.0, 1000, 1000, 1000)

@@ -11,6 +11,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from fretwear.errors import InputError
+from fretwear.limits import check_range
 from fretwear.model.core import Mesh
 
 # meshio/VTK hexahedron node k is scikit-fem's local node _HEX_TO_SKFEM.index(k): scikit-fem
@@ -39,6 +40,7 @@ def check_material(E, nu, rho) -> tuple[float, float, float]:
     E, nu, rho = vals
     if E <= 0.0:
         raise InputError(f"Young's modulus E = {E:g} Pa; expected E > 0")
+    check_range(E, "modulus", "Young's modulus E")
     if not -1.0 < nu < 0.5:
         raise InputError(
             f"Poisson's ratio nu = {nu:g}; expected -1 < nu < 0.5 (nu = 0.5 is incompressible, "
@@ -46,6 +48,7 @@ def check_material(E, nu, rho) -> tuple[float, float, float]:
         )
     if rho < 0.0:
         raise InputError(f"density rho = {rho:g} kg/m^3; expected rho >= 0")
+    check_range(rho, "density", "density rho")
     return E, nu, rho
 
 

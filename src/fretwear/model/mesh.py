@@ -19,7 +19,9 @@ from pathlib import Path
 import numpy as np
 
 from fretwear.errors import InputError
+from fretwear.limits import RANGES, check_range
 from fretwear.model.core import Mesh
+from fretwear.resources import require_memory
 
 CELL_DIM = {"quad": 2, "triangle": 2, "hexahedron": 3, "tetra": 3}
 FACET_TYPE = {"quad": "line", "triangle": "line", "hexahedron": "quad", "tetra": "triangle"}
@@ -46,7 +48,13 @@ def _positive(value, what: str) -> float:
         raise InputError(f"{what} = {value!r} is not a number; expected a length > 0 [m]") from None
     if not np.isfinite(v) or v <= 0.0:
         raise InputError(f"{what} = {value!r}; expected a finite length > 0 [m]")
-    return v
+    return check_range(v, "length", what)
+
+
+def _fits(n_cells: int, dofs_per_cell: int, what: str) -> None:
+    """Refuse a mesh whose assembly cannot fit in memory: scikit-fem assembles each of K and
+    M from ``n_cells * dofs_per_cell^2`` (row, column, value) triplets (24 bytes each)."""
+    require_memory(2 * 24.0 * n_cells * dofs_per_cell**2, f"a mesh of {n_cells:.3g} {what}")
 
 
 def _count(value, what: str) -> int:
@@ -57,8 +65,9 @@ def _count(value, what: str) -> int:
 
 def _origin(origin, d: int) -> np.ndarray:
     o = np.asarray(origin, dtype=float).reshape(-1)
-    if o.size != d or not np.all(np.isfinite(o)):
-        raise InputError(f"origin = {origin!r}; expected {d} finite coordinates [m]")
+    if o.size != d or not np.all(np.isfinite(o)) or np.any(np.abs(o) > RANGES["length"][1]):
+        raise InputError(f"origin = {origin!r}; expected {d} finite coordinates [m] of "
+                         f"magnitude up to {RANGES['length'][1]:g} m")
     return o
 
 
@@ -87,6 +96,7 @@ def rectangle(length, height, nx, ny, origin=(0.0, 0.0)) -> Mesh:
     """
     length, height = _positive(length, "length"), _positive(height, "height")
     nx, ny = _count(nx, "nx"), _count(ny, "ny")
+    _fits(nx * ny, 8, "quadrilaterals")
     x0, y0 = _origin(origin, 2)
     x = x0 + np.linspace(0.0, length, nx + 1)
     y = y0 + np.linspace(0.0, height, ny + 1)
@@ -142,6 +152,7 @@ def box(lx, ly, lz, nx, ny, nz, origin=(0.0, 0.0, 0.0)) -> Mesh:
     """
     lx, ly, lz = (_positive(v, w) for v, w in ((lx, "lx"), (ly, "ly"), (lz, "lz")))
     nx, ny, nz = (_count(v, w) for v, w in ((nx, "nx"), (ny, "ny"), (nz, "nz")))
+    _fits(nx * ny * nz, 24, "hexahedra")
     o = _origin(origin, 3)
     axes = [o[0] + np.linspace(0, lx, nx + 1), o[1] + np.linspace(0, ly, ny + 1),
             o[2] + np.linspace(0, lz, nz + 1)]

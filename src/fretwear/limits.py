@@ -1,0 +1,38 @@
+"""The ranges of input values that make physical and numerical sense, in one place.
+
+Physical: the structures fretwear is for (blade roots, joints, dampers, test rigs) have sizes
+from micrometres (a contact zone) to tens of metres, materials from soft polymers to diamond,
+and vibrate below a few hundred kHz. Numerical: with these bounds the entries of the stiffness
+and mass matrices and the dynamic stiffness ``K - (n w)^2 M`` stay between about 1e-60 and
+1e60, far inside the range of double precision (1e-308 to 1e308), so no product or
+factorisation overflows or underflows. A value outside gets one message naming it, the range
+and why; there is no case outside these ranges that fretwear could compute meaningfully.
+"""
+
+from __future__ import annotations
+
+import math
+
+from fretwear.errors import InputError
+
+#: kind -> (lowest, highest, unit, what it covers)
+RANGES = {
+    "length": (1e-9, 1e5, "m", "from a nanometre to 100 km"),
+    "modulus": (1.0, 1e13, "Pa", "from the softest gels to ten times diamond"),
+    "density": (0.0, 1e5, "kg/m^3", "from massless to five times osmium"),
+    "frequency": (0.0, 1e10, "Hz", "up to 10 GHz"),
+}
+
+
+def check_range(value: float, kind: str, what: str) -> float:
+    """``value`` as a float, after checking it is finite and within ``RANGES[kind]``."""
+    lo, hi, unit, why = RANGES[kind]
+    try:
+        v = float(value)
+    except (TypeError, ValueError, OverflowError):
+        raise InputError(f"{what} = {value!r} is not a number [{unit}]") from None
+    if not math.isfinite(v) or not lo <= abs(v) <= hi and not (v == 0.0 and lo == 0.0):
+        raise InputError(f"{what} = {value!r} {unit}: expected a magnitude in [{lo:g}, {hi:g}] "
+                         f"{unit} ({why}; outside it the matrices would overflow or lose all "
+                         "precision)")
+    return v
