@@ -79,7 +79,7 @@ def _sweep(lu, mu, xprev, lx, state):
                     lx[1 + c, n] = xprev[c]
                 state[n] = STICK
             else:
-                f = 1.0 - cap / nrm
+                f = 1.0 - cap / nrm if nrm > 0.0 else 1.0  # no cone (mu = 0): free
                 for c in range(dt):
                     lx[1 + c, n] = xprev[c] + pre[c] * f
                 state[n] = SLIP
