@@ -51,10 +51,28 @@ def new_figure(nrows: int = 1, ncols: int = 1, *, title: str | None = None,
     return fig, axes
 
 
+def _guard_log_axes(fig) -> None:
+    """A log axis with nothing positive to show (every solve of a sweep failed, a response
+    that is exactly zero) cannot be drawn: make it linear and say so on the panel."""
+    for ax in fig.axes:
+        for which in ("x", "y"):
+            if getattr(ax, f"get_{which}scale")() != "log":
+                continue
+            data = [np.asarray(getattr(ln, f"get_{which}data")(), float).ravel()
+                    for ln in ax.get_lines()
+                    if ln.get_transform() == ax.transData]  # not markers in axes units
+            values = np.concatenate(data) if data else np.zeros(0)
+            if not np.any(np.isfinite(values) & (values > 0)):
+                getattr(ax, f"set_{which}scale")("linear")
+                ax.text(0.5, 0.5, "nothing to draw (no positive value)", ha="center",
+                        va="center", transform=ax.transAxes, color="0.4")
+
+
 def save(fig, path: Path | str, dpi: int = 150) -> Path:
     """Lay out and write ``fig``; the format follows the file extension."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
+    _guard_log_axes(fig)
     fig.tight_layout()
     fig.savefig(path, dpi=dpi)
     return path

@@ -60,6 +60,8 @@ def check_thickness(thickness, dim: int) -> float:
         raise InputError(f"thickness = {thickness!r} is not a number") from None
     if not np.isfinite(t) or t <= 0.0:
         raise InputError(f"thickness = {thickness!r}; expected an out-of-plane width > 0 [m]")
+    if dim == 2:
+        check_range(t, "length", "thickness")
     if dim == 3 and t != 1.0:
         raise InputError(
             f"thickness = {thickness!r} given for a 3D mesh; the thickness (out-of-plane "
