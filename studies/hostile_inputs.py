@@ -21,9 +21,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-from hypothesis import HealthCheck, given, settings  # noqa: E402
-
 import hostile  # noqa: E402
+from hypothesis import HealthCheck, given, settings  # noqa: E402
 
 
 def main() -> None:

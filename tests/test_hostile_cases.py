@@ -11,10 +11,9 @@ over more cases and counts the outcomes.
 import tempfile
 from pathlib import Path
 
+import hostile
 import pytest
 from hypothesis import HealthCheck, Phase, given, settings
-
-import hostile
 
 
 def check(generated) -> None:
