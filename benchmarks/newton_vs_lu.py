@@ -76,10 +76,11 @@ def main():
     # the periodic solve at 79 kHz from the default start (paper's eps: spectral radius of Z_r)
     sol = None
     for solver in ("powell", "newton"):
-        s_, st = solve_periodic(model, basis, omega=w, reduced=red, solver=solver, max_iter=400)
+        s_ = solve_periodic(model, basis, omega=w, reduced=red, solver=solver, max_iter=400)
+        st = s_.stats
         print(f"periodic_79khz_{solver}_s={st.wall_time:.3f} iterations={st.iterations} "
-              f"converged={st.converged} residual={st.residual:.2e}")
-        sol = sol or s_
+              f"converged={st.success} residual={st.residual:.2e}")
+        sol = sol or (s_ if s_.success else None)
     if sol is not None:
         prob = DLFTProblem(red, model.contact, basis, anchor=sol.anchor)
         U = sol.U.reshape(prob.m, prob.H)

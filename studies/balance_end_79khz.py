@@ -67,7 +67,7 @@ def continue_in_wear(sp, W0, dW, anchor, U0, *, tol, max_iter=60, ds_min=1e-7):
         Ux, st = sp.solve_balance(W0 + s1 * dW, anchor, sp.shift_guess(U, (s1 - s) * dW),
                                   solver="powell", tol=tol, max_iter=max_iter)
         its += st.iterations
-        if st.converged:
+        if st.success:
             s, U = s1, Ux
             if st.iterations <= 3:
                 ds *= 1.5
@@ -144,7 +144,7 @@ def main(argv=None) -> int:
             if spx is not sp:  # the balance with the finer sampling at N0 first
                 Ustart, st = spx.solve_balance(W0, anchor, U0, solver="powell", tol=tolx,
                                                max_iter=400)
-                if not st.converged:
+                if not st.success:
                     print(f"  {label}: no balance at N0 ({st.message})")
                     continue
             s, Us, its, fails, wall = continue_in_wear(spx, W0, dW, anchor, Ustart, tol=tolx)

@@ -267,14 +267,17 @@ class Study:
         sol = None
         for name, start, solver, max_iter in attempts:
             U0 = None if start is None else self.embedded_base(basis, model)
-            sol, st = solve_periodic(model, basis, omega=2 * np.pi * FREQ, reduced=red,
-                                     eps=eps, anchor=anchor, U0=U0, solver=solver, tol=1e-9,
-                                     max_iter=max_iter)
-            tried.append({"start": name, "converged": bool(st.converged),
+            sol = solve_periodic(model, basis, omega=2 * np.pi * FREQ, reduced=red,
+                                 eps=eps, anchor=anchor, U0=U0, solver=solver, tol=1e-9,
+                                 max_iter=max_iter)
+            st = sol.stats
+            tried.append({"start": name, "converged": bool(st.success),
                           "message": st.message, "residual": float(st.residual),
                           "iterations": int(st.iterations), "wall_s": float(st.wall_time)})
-            if sol is not None:
+            if sol.success:
                 break
+        if not sol.success:
+            sol = None  # the last iterate of a failed solve is no result
         rec = {"modes_near_79khz": self.modes_near(v["nx"]), "eps": float(eps),
                "rho_orders": [float(np.abs(np.linalg.eigvals(z)).max())
                                                  for z in red.Z],

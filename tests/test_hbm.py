@@ -69,8 +69,9 @@ def solve_sequence(model, nhs, per=16, **kw):
     for nh in nhs:
         b = basis_for(nh, per)
         U0 = None if prev is None else embed(prev.U, prev.basis, b)
-        sol, st = solve_periodic(model, b, U0=U0, **kw)
-        assert sol is not None, f"Nh = {nh}: {st.message} (residual {st.residual:.3g})"
+        sol = solve_periodic(model, b, U0=U0, **kw)
+        st = sol.stats
+        assert sol.success, f"Nh = {nh}: {st.message} (residual {st.residual:.3g})"
         sols[nh] = prev = sol
     return sols
 
@@ -195,8 +196,9 @@ def test_den_hartog_from_default_initial_guess():
     """Same problem as test_den_hartog_oscillator (zeta = 2 %) solved directly with
     Nh = 15 from solve_periodic's default initial guess."""
     model, w, ref = den_hartog_case(0.02)
-    sol, st = solve_periodic(model, basis_for(15), omega=w, tol=1e-10)
-    assert st.converged, st.message
+    sol = solve_periodic(model, basis_for(15), omega=w, tol=1e-10)
+    st = sol.stats
+    assert st.success, st.message
 
 
 # --------------------------------------------------------------------------------------------
@@ -262,8 +264,9 @@ def test_jenkins_quasi_static_hysteresis(F0, phase, condensed):
     closed = 4 * R * (F - R) / k
     for nh in (1, 7, 31):
         b = basis_for(nh)
-        sol, st = solve_periodic(model, b, quasi_static=True, tol=1e-10)
-        assert sol is not None, st.message
+        sol = solve_periodic(model, b, quasi_static=True, tol=1e-10)
+        st = sol.stats
+        assert sol.success, st.message
         Fn = F * np.cos(b.tau + phase)
         sampled = 2 * R * (Fn.max() - Fn.min() - 2 * R) / k
         E = sol.friction_energy().sum()
@@ -290,9 +293,10 @@ def test_jenkins_full_stick(condensed):
     model, k, F = jenkins_model(F0, 0.3, condensed)
     for anchor in (None, 4e-6):  # k a = 8 N: 8 + 20 < 30
         b = basis_for(7)
-        sol, st = solve_periodic(model, b, quasi_static=True, tol=1e-10,
-                                 anchor=None if anchor is None else np.array([[anchor]]))
-        assert sol is not None, st.message
+        sol = solve_periodic(model, b, quasi_static=True, tol=1e-10,
+                             anchor=None if anchor is None else np.array([[anchor]]))
+        st = sol.stats
+        assert sol.success, st.message
         assert np.all(sol.state == law.STICK)
         assert sol.friction_energy().sum() == 0.0
         a = 0.0 if anchor is None else anchor
@@ -434,9 +438,10 @@ def test_fe_eps_independence(block_sequence, nh, bound):
         rho = red.spectral_radius()
         res = []
         for fac in (0.1, 1.0, 10.0):
-            sol, st = solve_periodic(model, b, omega=w, reduced=red, eps=fac * rho,
-                                     U0=base.U, tol=1e-11)
-            assert sol is not None, st.message
+            sol = solve_periodic(model, b, omega=w, reduced=red, eps=fac * rho,
+                                 U0=base.U, tol=1e-11)
+            st = sol.stats
+            assert sol.success, st.message
             res.append((sol.U[:, :, [0, 1, 1 + b.k]], sol.friction_energy().sum()))
         u_ref, e_ref = res[1]
         du = max(np.abs(u - u_ref).max() for u, _ in res) / np.abs(u_ref[:, :, 1:]).max()
@@ -457,8 +462,9 @@ def test_solvers_agree(block_sequence):
     red = condense(model, w, [0, *b.harmonics])
     U = {}
     for solver in ("powell", "newton", "hybr"):
-        sol, st = solve_periodic(model, b, omega=w, reduced=red, solver=solver, tol=1e-11)
-        assert sol is not None and st.converged and st.solver == solver, st.message
+        sol = solve_periodic(model, b, omega=w, reduced=red, solver=solver, tol=1e-11)
+        st = sol.stats
+        assert sol.success and st.success and st.solver == solver, st.message
         assert st.residual <= 1e-11
         U[solver] = sol.U
     scale = np.abs(U["powell"]).max()
@@ -467,15 +473,16 @@ def test_solvers_agree(block_sequence):
 
 
 @pytest.mark.parametrize("solver", ["powell", "newton", "hybr"])
-def test_failed_solve_returns_none(block_sequence, solver):
-    """One iteration is not enough: solve_periodic returns (None, stats) with
-    converged=False, a residual above the tolerance and a message saying why; with
+def test_failed_solve_says_so(block_sequence, solver):
+    """One iteration is not enough: solve_periodic returns the last iterate with
+    success=False, a residual above the tolerance and a message saying why; with
     raise_on_failure it raises ConvergenceError instead."""
     model, w, _ = block_sequence
     b = basis_for(7, per=8)
-    sol, st = solve_periodic(model, b, omega=w, solver=solver, tol=1e-11, max_iter=1)
-    assert sol is None
-    assert st.converged is False
+    sol = solve_periodic(model, b, omega=w, solver=solver, tol=1e-11, max_iter=1)
+    st = sol.stats
+    assert sol.success is False and sol.message == st.message
+    assert st.success is False
     assert st.residual > 1e-11
     assert isinstance(st.message, str) and st.message and st.message != "converged"
     with pytest.raises(ConvergenceError):
@@ -527,8 +534,9 @@ def global_friction(sol, model):
 @pytest.fixture(scope="module")
 def block_3d_45():
     model = block_3d(45.0)
-    sol, st = solve_periodic(model, basis_for(7, per=8), quasi_static=True, tol=1e-11)
-    assert sol is not None, st.message
+    sol = solve_periodic(model, basis_for(7, per=8), quasi_static=True, tol=1e-11)
+    st = sol.stats
+    assert sol.success, st.message
     return model, sol
 
 
@@ -578,8 +586,9 @@ def test_3d_gross_slip_follows_load_direction():
     magnitude is mu sum(lambda_N) within 1e-3. A friction law that is not isotropic would
     pull the force towards its preferred directions (45 deg for a square law: 15 deg off)."""
     model = block_3d(30.0)
-    sol, st = solve_periodic(model, basis_for(7, per=8), quasi_static=True, tol=1e-11)
-    assert sol is not None, st.message
+    sol = solve_periodic(model, basis_for(7, per=8), quasi_static=True, tol=1e-11)
+    st = sol.stats
+    assert sol.success, st.message
     lam = check_cone(sol, MU_B)
     full = np.all(sol.state == law.SLIP, axis=0)
     assert full.sum() >= 8
@@ -595,6 +604,7 @@ def test_3d_poisson_preload():
     outwards, beyond the cone of their zero anchor. Expected: a converged, symmetric
     solution whose forces lie in the cone (as with nu = 0)."""
     model = block_3d(45.0, nu=0.3)
-    sol, st = solve_periodic(model, basis_for(3, per=8), quasi_static=True, tol=1e-10)
-    assert sol is not None, st.message
+    sol = solve_periodic(model, basis_for(3, per=8), quasi_static=True, tol=1e-10)
+    st = sol.stats
+    assert sol.success, st.message
     check_cone(sol, MU_B)

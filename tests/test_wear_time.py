@@ -58,8 +58,9 @@ def periodic():
     order in the step; with 256 steps the worn volume differs by 5.4 %, with 1024 by 0.8 %)."""
     m = damped_block()
     basis = FourierBasis.up_to(15, 256)
-    sol, st = solve_periodic(m, basis, omega=OMEGA, tol=1e-10)
-    assert st.converged
+    sol = solve_periodic(m, basis, omega=OMEGA, tol=1e-10)
+    st = sol.stats
+    assert st.success
     coef = wear_coefficients(m)
     U0, V0 = initial_state(m, sol)
     tr = time_averaged_rate(m, OMEGA, basis, coef, np.zeros(len(coef)), U0=U0, V0=V0,
@@ -154,7 +155,7 @@ def _forced_failures(monkeypatch, balance_fails: bool, first_ok: bool = True):
         def solve_balance(self, W, anchor, U0, **kw):
             U, stats = real_solve(self, W, anchor, U0, **kw)
             if calls["n"] > 1:
-                stats.converged = False
+                stats.success = False
             return U, stats
 
         monkeypatch.setattr(SlowProblem, "solve_balance", solve_balance)
@@ -173,7 +174,7 @@ def test_time_domain_steps_return_to_balanced_solutions(monkeypatch):
     _forced_failures(monkeypatch, balance_fails=False)
     r = simulate_wear(m, BASIS, omega=OMEGA, options=WearOptions(**OPTS))
     h = r.history
-    assert r.converged and h.n_steps == 5
+    assert r.success and h.n_steps == 5
     np.testing.assert_array_equal(h.rescued[:2], [0, 0])
     assert np.all(h.rescued[2:] == 1)
     assert np.all(h.response[2:] == RESPONSE_KINDS.index("periodic"))
@@ -199,7 +200,7 @@ def test_time_averaged_steps_follow_the_time_integration(monkeypatch, tmp_path, 
     opts = WearOptions(scheme=scheme, **OPTS)
     full = simulate_wear(m, BASIS, omega=OMEGA, options=opts)
     h = full.history
-    assert full.converged and h.n_steps == 5
+    assert full.success and h.n_steps == 5
     assert np.all(h.rescued[2:] == 2)
     # the uncertainty of the averaged rates is recorded; balanced rates are exact (NaN)
     assert np.all(np.isnan(h.rate_scatter[:2]))
@@ -247,15 +248,15 @@ def test_run_starts_from_a_time_integration_when_the_unworn_balance_fails(monkey
     real = wear_schemes.solve_periodic
 
     def failing(*args, **kwargs):
-        sol, st = real(*args, **kwargs)
-        st.converged = False
-        return sol, st
+        sol = real(*args, **kwargs)
+        sol.stats.success = False
+        return sol
 
     monkeypatch.setattr(wear_schemes, "solve_periodic", failing)
     opts = WearOptions(**OPTS)
     r = simulate_wear(m, BASIS, omega=OMEGA, options=opts)
     h = r.history
-    assert r.converged and h.n_steps == 5 and h.rescued[0] == 2
+    assert r.success and h.n_steps == 5 and h.rescued[0] == 2
     ref = time_averaged_rate(m, OMEGA, BASIS, wear_coefficients(m), np.zeros(h.wear_depth.shape[1]),
                              U0=None, V0=None, settle=START_SETTLE, average=64,
                              steps_per_period=512)

@@ -8,7 +8,7 @@ The public API, stage by stage (data flows one way; each stage returns a plain d
 
     model = fretwear.rectangle(...) / fretwear.from_mesh(...) / fretwear.from_matrices(...)
     red   = fretwear.condense(model, omega, basis.orders)      # Reduced: Z_r per harmonic
-    sol, stats = fretwear.solve_periodic(model, basis, omega=...)   # PeriodicSolution
+    sol   = fretwear.solve_periodic(model, basis, omega=...)   # PeriodicSolution
     frf   = fretwear.sweep(model, basis, f_min, f_max, n)      # SweepResult
     wear  = fretwear.simulate_wear(model, basis, omega=...)    # WearResult
     run   = fretwear.integrate(model, omega, n_periods=...)    # TransientResult

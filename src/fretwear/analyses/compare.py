@@ -189,9 +189,12 @@ def compare_periodic(model, analysis: dict, outdir: Path | None, *, steps_per_pe
     omega = 2 * np.pi * float(analysis["frequency"])
     t0 = time.perf_counter()
     reduced = condense(model, omega, basis.orders)
-    sol, stats = solve_periodic(model, basis, omega=omega, reduced=reduced, eps=analysis["eps"],
-                                solver=analysis["solver"], tol=analysis["tol"],
-                                max_iter=analysis["max_iter"])
+    sol = solve_periodic(model, basis, omega=omega, reduced=reduced, eps=analysis["eps"],
+                         solver=analysis["solver"], tol=analysis["tol"],
+                         max_iter=analysis["max_iter"])
+    stats = sol.stats
+    if not sol.success:  # a failed solve is never compared (its last iterate is no result)
+        sol = None
     t_dlft = time.perf_counter() - t0
     ss = steady_state(model, omega, max_periods=max_periods, steps_per_period=steps_per_period,
                       harmonics=max(basis.harmonics))
@@ -239,7 +242,7 @@ def compare_wear(model, analysis: dict, outdir: Path | None, *, steps_per_cycle:
             ("worn volume [m^3]", w_d @ area, w_t @ area, relative(w_d @ area, w_t @ area)),
             ("profile: max |dW| / max W [-]", 0.0, float(np.abs(w_t - w_d).max() / w_t.max()),
              math.nan)]
-    out = Comparison(rows, "", res.converged, {"DLFT wear": res.wall_time,
+    out = Comparison(rows, "", res.success, {"DLFT wear": res.wall_time,
                                                "incremental wear": inc.wall_time})
     out.notes.append(f"{n} cycles; DLFT {res.history.n_steps} slow steps ({res.stop_reason}); "
                      f"incremental {inc.computed_cycles} computed cycles x {steps_per_cycle} "

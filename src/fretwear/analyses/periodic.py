@@ -186,7 +186,7 @@ def run_periodic(model, analysis: dict, case, outdir: Path, progress: bool) -> R
 
     Returns
     -------
-    RunOutput; ``converged`` False (and no solution variables) when the solve failed.
+    RunOutput; ``success`` False (and no solution variables) when the solve failed.
     """
     basis = basis_of(analysis)
     qs = analysis["quasi_static"]
@@ -194,13 +194,14 @@ def run_periodic(model, analysis: dict, case, outdir: Path, progress: bool) -> R
     omega = 2 * np.pi * f_hz
     reduced = condense(model, omega, basis.orders, quasi_static=qs)
     eps = penalty(analysis["eps"], model=model, reduced=reduced)
-    sol, stats = solve_periodic(model, basis, omega=omega, quasi_static=qs, reduced=reduced,
-                                eps=eps, solver=analysis["solver"], tol=analysis["tol"],
-                                max_iter=analysis["max_iter"])
+    sol = solve_periodic(model, basis, omega=omega, quasi_static=qs, reduced=reduced,
+                         eps=eps, solver=analysis["solver"], tol=analysis["tol"],
+                         max_iter=analysis["max_iter"])
+    stats = sol.stats
     attrs = {**solver_attributes(stats, analysis, eps), "excitation_frequency": f_hz,
              "quasi_static": int(qs)}
     where = _frequency_text(f_hz, qs)
-    if sol is None:
+    if not sol.success:  # never saved as a result: the diagnostics only
         return RunOutput(xr.Dataset(attrs=attrs), [], _failure_summary(stats, analysis, where),
                          False)
     points = [p.name for p in model.observed]

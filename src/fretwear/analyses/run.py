@@ -142,14 +142,14 @@ def run_case(path: Path | str, outdir: Path | str | None = None, progress: bool 
         out = analysis.run(model, case.analysis, case, out_dir, progress)
         out.results = write_results(
             results_path, out.dataset, title=case.title, analysis_type=analysis.name,
-            converged=out.converged, case_text=case.text, case_path=str(case.path),
+            converged=out.success, case_text=case.text, case_path=str(case.path),
             analysis=case.analysis,
         )
     except KeyboardInterrupt:
         raise RunInterrupted(_interrupted_message(out_dir, start)) from None
     if out.summary:
         say(out.summary)
-    if not out.converged:
+    if not out.success:
         say("warning: some solves did not converge (results.nc has converged = 0)")
     say(f"results: {out.results}  ({time.time() - start:.1f} s)")
     for p in out.figures:

@@ -42,7 +42,7 @@ from fretwear.timedomain.stability import sweep_check
 # --- dataset -------------------------------------------------------------------------------
 def _per_point(result: SweepResult, value, fill=np.nan, dtype=float) -> np.ndarray:
     """``value(point)`` for each converged sweep point (``fill`` elsewhere)."""
-    return np.array([value(p) if p.converged else fill for p in result.points], dtype=dtype)
+    return np.array([value(p) if p.success else fill for p in result.points], dtype=dtype)
 
 
 def _state_fractions(sol: PeriodicSolution) -> np.ndarray:
@@ -72,11 +72,11 @@ def _response_variables(result: SweepResult, basis: FourierBasis, model, points:
 
 
 def _sweep_point_variables(result: SweepResult) -> dict:
-    fr = np.array([_state_fractions(p.solution) if p.converged else np.full(3, np.nan)
+    fr = np.array([_state_fractions(p.solution) if p.success else np.full(3, np.nan)
                    for p in result.points]).reshape(-1, 3)
     f = "frequency"
     data = {
-        "converged": variable(f, result.converged.astype(np.int8), "1",
+        "converged": variable(f, result.point_success.astype(np.int8), "1",
                               "the periodic solve converged", flag_values=np.array(
                                   [0, 1], dtype=np.int8), flag_meanings="no yes"),
         "how": variable(f, np.array([p.how for p in result.points], dtype=str), "1",
@@ -160,7 +160,7 @@ def run_sweep(model, analysis: dict, case, outdir: Path, progress: bool) -> RunO
 
     Returns
     -------
-    RunOutput; ``converged`` False when some point did not converge.
+    RunOutput; ``success`` False when some point did not converge.
     """
     points = check_points(model, analysis.get("points"))
     basis = basis_of(analysis)
@@ -169,7 +169,7 @@ def run_sweep(model, analysis: dict, case, outdir: Path, progress: bool) -> RunO
         def tick(i, total, pt):
             bar.update(1)
             bar.set_postfix_str(f"{plots.format_frequency(pt.frequency_hz)}"
-                                f"{'' if pt.converged else ' (not converged)'}")
+                                f"{'' if pt.success else ' (not converged)'}")
 
         result = sweep(model, basis, analysis["f_min"], analysis["f_max"], n,
                        spacing=analysis["spacing"], eps=analysis["eps"],
@@ -202,7 +202,7 @@ def run_sweep(model, analysis: dict, case, outdir: Path, progress: bool) -> RunO
     if p is not None:
         figures.append(plot_sweep_interface(ds, p, title=titled(case.title,
                                                                   "contact interface")))
-    grid_ok = all(p.converged for p in result.points if p.on_grid)
+    grid_ok = all(p.success for p in result.points if p.on_grid)
     return RunOutput(ds, figures, _sweep_summary(result, ds), grid_ok)
 
 

@@ -337,7 +337,7 @@ def run_transient(model, analysis: dict, case, outdir: Path, progress: bool) -> 
 
     Returns
     -------
-    RunOutput; ``converged`` False when a steady-state run ends ``"transient"`` (undecided at
+    RunOutput; ``success`` False when a steady-state run ends ``"transient"`` (undecided at
     ``max_periods``).
     """
     f_hz = float(analysis["frequency"])

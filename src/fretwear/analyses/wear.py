@@ -187,7 +187,7 @@ def _frf_data(model, sweeps: dict, freqs: np.ndarray) -> dict:
         res = sweeps[name]
         f = res.frequency_hz
         idx = [int(np.argmin(np.abs(f - x))) for x in freqs]
-        conv[i] = res.converged[idx]
+        conv[i] = res.point_success[idx]
         for j, pt in enumerate(points):
             for k in range(len(model.observed_point(pt).dofs)):
                 amp[i, :, j, k] = res.amplitude(pt, k, harmonic=1)[idx]
@@ -345,7 +345,7 @@ def run_wear(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOu
                                  time_domain=FALLBACK if fb["time_domain"] else None)
                   for name, w in (("unworn", 0.0), ("worn", result.final_wear))}
         frf = _frf_data(model, sweeps, frequency_grid(*grid, fb["spacing"]))
-        frf_note = "\n".join(f"FRF {k}: {int(v.converged.sum())}/{len(v.points)} converged"
+        frf_note = "\n".join(f"FRF {k}: {int(v.point_success.sum())}/{len(v.points)} converged"
                              for k, v in sweeps.items())
     elif fb is not None:
         frf_note = "FRF before/after skipped: the model has no observed point"
@@ -366,7 +366,7 @@ def run_wear(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOu
     ]
     if frf_note:
         lines.append(frf_note)
-    return RunOutput(ds, figures, "\n".join(lines), result.converged,
+    return RunOutput(ds, figures, "\n".join(lines), result.success,
                      [outdir / CHECKPOINT_FILE])
 
 

@@ -125,13 +125,19 @@ class DLFTProblem:
 
 @dataclass
 class PeriodicSolution:
-    """A converged periodic solution of the DLFT balance at one frequency.
+    """A periodic solution of the DLFT balance at one frequency (the result of
+    :func:`solve_periodic`).
 
+    ``success`` says whether the balance converged and ``message`` why the solver stopped (as
+    :class:`scipy.optimize.OptimizeResult`); a solution with ``success`` False is the last
+    iterate of a failed solve, assembled so that it can be inspected, and is never a result.
     All contact quantities are in contact-local frames ``[N, T1, (T2)]``; forces are those the
     structure exerts on the obstacle (``N`` >= 0 in compression).
 
     Attributes
     ----------
+    success : the convergence test ``|f| <= tol |Z_r U|`` was met (``stats.success``).
+    message : why the solver stopped (``stats.message``).
     omega : circular frequency [rad/s] (0 for quasi-static).
     quasi_static : inertia and damping dropped.
     basis : the Fourier basis.
@@ -146,7 +152,8 @@ class PeriodicSolution:
     eps : DLFT penalty [N/m].
     observed : name -> (d, H) displacement harmonics of observed points [m].
     area : (nc,) tributary areas [m^2].
-    stats : solver statistics.
+    stats : solver statistics (:class:`~fretwear.hb.solvers.SolveStats`).
+    flags : reasons for caution (e.g. time-domain findings of a sweep's stability check).
     """
 
     omega: float
@@ -166,6 +173,16 @@ class PeriodicSolution:
     coords: np.ndarray
     stats: SolveStats
     flags: list = field(default_factory=list)
+
+    @property
+    def success(self) -> bool:
+        """The balance converged (``stats.success``)."""
+        return bool(self.stats.success)
+
+    @property
+    def message(self) -> str:
+        """Why the solver stopped (``stats.message``)."""
+        return self.stats.message
 
     @property
     def frequency_hz(self) -> float:
@@ -278,7 +295,7 @@ def static_anchor(model: Model, *, quasi: Reduced | None = None) -> np.ndarray:
 
     x, _, st = solve(fun, U0.reshape(-1), lambda x: prob.scale(x.reshape(prob.m, prob.H)),
                      method="powell", tol=1e-10, max_iter=100)
-    if not st.converged:
+    if not st.success:
         return np.zeros((prob.nc, prob.d - 1))
     U = x.reshape(prob.nc, prob.d, 1)
     return U[:, 1:, 0].copy()
@@ -287,7 +304,7 @@ def static_anchor(model: Model, *, quasi: Reduced | None = None) -> np.ndarray:
 def solve_periodic(model: Model, basis: FourierBasis, *, omega: float = 0.0,
                    quasi_static: bool = False, reduced: Reduced | None = None, gap=None,
                    eps="auto", anchor=None, U0=None, solver="powell", tol=1e-8, max_iter=200,
-                   raise_on_failure=False) -> tuple[PeriodicSolution | None, SolveStats]:
+                   raise_on_failure=False) -> PeriodicSolution:
     """Periodic response of ``model`` at ``omega`` [rad/s] with the DLFT (section 3.1-3.2).
 
     Parameters
@@ -305,10 +322,14 @@ def solve_periodic(model: Model, basis: FourierBasis, *, omega: float = 0.0,
     solver : ``"powell"`` (dog-leg at LAPACK speed), ``"newton"`` or ``"hybr"`` (MINPACK).
     tol : relative residual ``eps_r`` of the test ``|f| <= eps_r |Z_r U|``.
 
+    raise_on_failure : raise :class:`~fretwear.errors.ConvergenceError` when the solve does
+        not converge instead of returning a solution with ``success`` False.
+
     Returns
     -------
-    (solution, stats): ``solution`` is None when the solve did not converge (then
-    ``stats.converged`` is False and ``stats.message`` says why), unless ``raise_on_failure``.
+    :class:`PeriodicSolution`: ``success`` True when the balance converged; otherwise
+    ``success`` False, ``message`` says why (``stats`` has the residual and counts) and the
+    fields hold the last iterate (for inspection, never a result).
     """
     if reduced is None:
         reduced = condense(model, omega, _orders(basis), quasi_static=quasi_static)
@@ -327,16 +348,14 @@ def solve_periodic(model: Model, basis: FourierBasis, *, omega: float = 0.0,
     x, _, st = solve(fun, x0.reshape(-1), lambda x: prob.scale(x.reshape(prob.m, prob.H)),
                      method=solver, tol=tol, max_iter=max_iter)
     st.wall_time = time.perf_counter() - t0
-    if not st.converged:
-        if raise_on_failure:
-            from fretwear.errors import ConvergenceError
+    if not st.success and raise_on_failure:
+        from fretwear.errors import ConvergenceError
 
-            raise ConvergenceError(
-                f"periodic solve at f = {omega / 2 / np.pi:.6g} Hz did not converge: "
-                f"{st.message} (relative residual {st.residual:.3g} > {tol:g})"
-            )
-        return None, st
-    return assemble_solution(prob, x.reshape(prob.m, prob.H), model, st), st
+        raise ConvergenceError(
+            f"periodic solve at f = {omega / 2 / np.pi:.6g} Hz did not converge: "
+            f"{st.message} (relative residual {st.residual:.3g} > {tol:g})"
+        )
+    return assemble_solution(prob, x.reshape(prob.m, prob.H), model, st)
 
 
 def _harmonic_continuation_start(model, basis, reduced, prob, solver, tol, max_iter):
@@ -355,7 +374,7 @@ def _harmonic_continuation_start(model, basis, reduced, prob, solver, tol, max_i
     x, _, st = solve(fun, p1.initial_guess().reshape(-1),
                      lambda x: p1.scale(x.reshape(p1.m, p1.H)), method=solver, tol=tol,
                      max_iter=max_iter)
-    if not st.converged:
+    if not st.success:
         return None
     U = np.zeros((prob.m, prob.H))
     x = x.reshape(p1.m, p1.H)
@@ -366,7 +385,8 @@ def _harmonic_continuation_start(model, basis, reduced, prob, solver, tol, max_i
 
 
 def assemble_solution(prob: DLFTProblem, U, model: Model, stats: SolveStats) -> PeriodicSolution:
-    """Post-process a converged ``U`` (m, H) into a :class:`PeriodicSolution`."""
+    """Post-process ``U`` (m, H) into a :class:`PeriodicSolution` (converged or not: its
+    ``success`` is ``stats.success``)."""
     lu, lx, state, _ = prob.time_law(U)
     lam_t = lu - lx
     x_t = lx / prob.eps

@@ -93,8 +93,11 @@ HF_GAMMA = 1.0  # ... are integrated with this Newmark gamma (spectral radius 1/
 class TransientResult:
     """Output of :func:`integrate`.
 
-    Samples are taken at ``t_n = n h`` (``h = T / steps_per_period``) for every step of the
-    recorded periods (the last ``record`` periods), ``t`` counted from the start of the run.
+    ``success`` is True when the integration completed with every contact solve settled;
+    ``message`` says what happened (e.g. ``"integrated 100 periods"``, ``"12 contact solves
+    did not settle (first at t = 0.0123 s)"``). Samples are taken at ``t_n = n h``
+    (``h = T / steps_per_period``) for every step of the recorded periods (the last
+    ``record`` periods), ``t`` counted from the start of the run.
 
     Attributes
     ----------
@@ -117,6 +120,7 @@ class TransientResult:
     poincare : name -> (np, d) observed displacement at the start of each kept period [m].
     period_mean : name -> (np, d) mean over each kept period [m].
     info : reduction and solver statistics.
+    success : every contact solve settled; message : what happened.
     """
 
     t: np.ndarray
@@ -135,6 +139,8 @@ class TransientResult:
     poincare: dict = field(default_factory=dict)
     period_mean: dict = field(default_factory=dict)
     info: dict = field(default_factory=dict)
+    success: bool = True
+    message: str = ""
 
     def energy_residual(self) -> float:
         """Largest ``|dE - (W_ext - D_fric - D_normal - D_damp - D_num)|`` over the record [J]."""
@@ -186,9 +192,13 @@ class SteadyStateResult:
 
     Attributes
     ----------
+    success : the response was classified (not ``"transient"`` at ``max_periods``) and every
+        contact solve settled.
+    message : what happened, e.g. ``"periodic after 412 periods"``, ``"still transient after
+        20000 periods"``, ``"...; 12 contact solves did not settle"``.
     classification : see :class:`Classification` (``kind``).
     n_periods : periods integrated (including the recorded last one).
-    converged : True for ``"periodic"`` (and ``"subharmonic"``).
+    periodic : True for ``"periodic"`` (and ``"subharmonic"``).
     last : :class:`TransientResult` of the last period (every step recorded).
     harmonics : name -> (2 nh + 1, d) real Fourier coefficients of the observed displacement
         over the last period [m], basis ``[a0, a1..a_nh, b1..b_nh]``
@@ -200,9 +210,11 @@ class SteadyStateResult:
     U, V : final state [m], [m/s]. wall_time : [s]. info : solver statistics.
     """
 
+    success: bool
+    message: str
     classification: str
     n_periods: int
-    converged: bool
+    periodic: bool
     last: TransientResult
     harmonics: dict
     contact_harmonics: dict
@@ -218,6 +230,9 @@ class SteadyStateResult:
 class IncrementalWearResult:
     """Output of :func:`incremental_wear` (one row per recorded computed cycle).
 
+    success : every load step's contact problem settled; message : what happened (e.g.
+    ``"100 cycles (100 computed, 6400 load steps)"``, or how many load steps did not settle).
+
     cycles : (nrec,) number of load cycles done (computed cycles times their jumps).
     wear : (nrec, nc) wear depth [m] at the end of the cycle.
     pressure : (nrec, nc) contact pressure ``lam_N / area`` averaged over the cycle [Pa].
@@ -229,6 +244,8 @@ class IncrementalWearResult:
     lam : (nc, d) final contact forces [N]. info : solver statistics.
     """
 
+    success: bool
+    message: str
     cycles: np.ndarray
     wear: np.ndarray
     pressure: np.ndarray
@@ -807,16 +824,18 @@ class _Integrator:
                     hf_damped_modes=int(np.sum(self.g_modes > self.gamma)),
                     failed_steps=self.n_fail, max_active_set_iterations=self.max_it,
                     first_failure_time=self.first_fail_time, periods_total=self.periods_done)
+        message = f"integrated {n_periods} periods"
         if self.n_fail:
-            warnings.warn(f"{self.n_fail} contact solves did not settle (first at t = "
-                          f"{self.first_fail_time:.6g} s); results there are approximate",
-                          RuntimeWarning, stacklevel=3)
+            message = (f"{self.n_fail} contact solves did not settle (first at t = "
+                       f"{self.first_fail_time:.6g} s)")
+            warnings.warn(f"{message}; results there are approximate", RuntimeWarning,
+                          stacklevel=3)
         return TransientResult(
             t=t, observed=observed, velocities=velocities,
             u_loc=raw["x"].reshape(ns, nc, d), lam=raw["lam"].reshape(ns, nc, d),
             state=raw["state"], energy=energy, n_periods=n_periods, steps_per_period=N,
             omega=self.omega, wall_time=wall, U=U, V=V, poincare=poinc, period_mean=pmean,
-            info=info)
+            info=info, success=not self.n_fail, message=message)
 
 
 def integrate(model: Model, omega: float, *, n_periods: int, steps_per_period: int = DEFAULT_STEPS,
@@ -1060,9 +1079,16 @@ def steady_state(model: Model, omega: float, *, max_periods: int = 20_000, tol: 
              "u_loc": fourier_coefficients(last.u_loc, harmonics)}
     info = dict(last.info)
     info["history"] = history
+    n = done + 1
+    classified = cls.kind != "transient"
+    message = (f"{cls.kind} after {n} periods" if classified
+               else f"still transient after {n} periods")
+    if integ.n_fail:
+        message += f"; {integ.n_fail} contact solves did not settle"
     return SteadyStateResult(
-        classification=cls.kind, n_periods=done + 1,
-        converged=cls.kind in ("periodic", "subharmonic"), last=last, harmonics=harm,
+        success=classified and not integ.n_fail, message=message,
+        classification=cls.kind, n_periods=n,
+        periodic=cls.kind in ("periodic", "subharmonic"), last=last, harmonics=harm,
         contact_harmonics=charm, diagnostics=cls, poincare=P, U=last.U, V=last.V,
         wall_time=time.perf_counter() - t_start, info=info)
 
@@ -1072,8 +1098,8 @@ def steady_state(model: Model, omega: float, *, max_periods: int = 20_000, tol: 
 # --------------------------------------------------------------------------------------------
 def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int = 100,
                      cycle_jump: int = 1, k_w: float | None = None, record_every: int = 1,
-                     wear0=None, tol: float = 1e-10,
-                     progress: bool = False) -> IncrementalWearResult:
+                     wear0=None, tol: float = 1e-10, progress: bool = False,
+                     raise_on_failure: bool = True) -> IncrementalWearResult:
     """Quasi-static fretting wear by load steps (in the spirit of Stromberg 1997).
 
     At every load step ``tau_k = 2 pi k / steps_per_cycle`` the static equilibrium
@@ -1100,6 +1126,9 @@ def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int =
     record_every : record every this many computed cycles (and the last).
     wear0 : (nc,) initial wear [m].
     tol : relative tolerance of the contact solver.
+    raise_on_failure : raise :class:`~fretwear.errors.ConvergenceError` when the contact
+        problem of some load step does not settle (default); False: return the result with
+        ``success`` False and the count in ``message``.
 
     Returns
     -------
@@ -1146,15 +1175,18 @@ def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int =
         Contact(A, gap, float(c.mu), int(d)), LoadCycle(btab, _c_float(area), kw, jumps),
         Settings(float(tol), fscale, 60 + 4 * nc), WearState(x, wear, ContactState(status, tdir)),
         rec)
-    if nfail:
+    if nfail and raise_on_failure:
         raise ConvergenceError(f"incremental_wear: {nfail} load steps where the contact active "
                                "set did not settle (singular or cycling); check that the "
                                "contact holds the structure (rigid motions) and the loads")
+    message = (f"{n_cycles} cycles ({ncomp} computed, {ncomp * N} load steps)" if not nfail
+               else f"{nfail} load steps where the contact active set did not settle")
     lam = np.asarray(A @ (-x) + btab[0]).reshape(nc, d)
     U = cond.recover(x, model.load_time(np.zeros(1))[0] if model.loads
                      else np.zeros(model.ndof))
     return IncrementalWearResult(
-        cycles=rec.cycle, wear=rec.wear, pressure=rec.press, slip=rec.slip,
+        success=not nfail, message=message, cycles=rec.cycle, wear=rec.wear, pressure=rec.press,
+        slip=rec.slip,
         worn_volume=rec.wear @ area, dissipation=rec.diss, computed_cycles=ncomp, cycle_jump=J,
         steps_per_cycle=N, k_w=kw, wall_time=time.perf_counter() - t0, U=U, lam=lam,
         info={"max_active_set_iterations": int(maxit), "records": int(nr)})

@@ -162,7 +162,7 @@ class SlowProblem:
         its = 0
         if fast:
             x, st = newton(fun, x0, scale, tol=tol, max_iter=min(max_iter, 15))
-            if st.converged:
+            if st.success:
                 return x.reshape(self.m, self.H), st
             its = st.iterations
         x, _, st = solve(fun, x0, scale, method=solver, tol=tol, max_iter=max_iter)

@@ -130,7 +130,7 @@ def time_domain_step(sp: SlowProblem, st: dict, opts: WearOptions):
                                      solver=opts.solver, tol=opts.tol,
                                      max_iter=max(opts.max_iter, RESCUE_MAX_ITER))
         iters += stats.iterations
-        if stats.converged:
+        if stats.success:
             sp.set_state(W1, tr.anchor)
             g1 = sp.rate(U1)
             err_b = local_error(dN, W1, W_k, g1, g_k)
