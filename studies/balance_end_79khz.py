@@ -114,8 +114,8 @@ def main(argv=None) -> int:
         model = build_model(case)
         a = case.analysis
         basis = FourierBasis.up_to(int(a["harmonics"]), int(a["n_samples"]))
-        omega = 2.0 * np.pi * float(a["frequency"])
-        reduced = condense(model, omega, basis.orders)
+        f_hz = float(a["frequency"])
+        reduced = condense(model, f_hz, basis.orders)
         coef = wear_coefficients(model)
         sp = SlowProblem(model, reduced, basis, coef, eps=a.get("eps"))
         U0 = np.asarray(h.U[k - 1], float).reshape(sp.m, sp.H)
@@ -160,12 +160,12 @@ def main(argv=None) -> int:
             sp.set_state(W, anchor)
             g = sp.rate(Ub)
             Ut, Vt = initial_state(model, sp.solution(Ub, W, anchor, ok))
-            tr = time_averaged_rate(model, omega, basis, coef, W, U0=Ut, V0=Vt, settle=600,
+            tr = time_averaged_rate(model, f_hz, basis, coef, W, U0=Ut, V0=Vt, settle=600,
                                     average=200)
             print(f"  {label} = {N0 + s * (N1 - N0):.5g}: {tr.kind}; its wear rate differs from "
                   f"the balance's by {np.abs(tr.g - g).max() / g.max():.3f} of the largest rate")
             if label == "N*":  # and on to N1 from there
-                tr1 = time_averaged_rate(model, omega, basis, coef, W0 + dW, U0=tr.U_end,
+                tr1 = time_averaged_rate(model, f_hz, basis, coef, W0 + dW, U0=tr.U_end,
                                          V0=tr.V_end, settle=600, average=200)
                 print(f"  N1 = {N1:.5g} (continuing from N*): {tr1.kind}")
     return 0

@@ -176,7 +176,7 @@ def test_den_hartog_oscillator(zeta):
     1.5 %, 0.75 % for zeta = 2 %). Asserted: strictly decreasing errors, first-order rate
     0.15 <= err (Nh + 1) <= 0.45 for Nh >= 3, and < 1 % at Nh = 31."""
     model, w, ref = den_hartog_case(zeta)
-    sols = solve_sequence(model, NH_SEQ, omega=w, tol=1e-10)
+    sols = solve_sequence(model, NH_SEQ, frequency=w / (2 * np.pi), tol=1e-10)
     err_a, err_e = [], []
     for sol in sols.values():
         k = sol.basis.k
@@ -196,7 +196,7 @@ def test_den_hartog_from_default_initial_guess():
     """Same problem as test_den_hartog_oscillator (zeta = 2 %) solved directly with
     Nh = 15 from solve_periodic's default initial guess."""
     model, w, ref = den_hartog_case(0.02)
-    sol = solve_periodic(model, basis_for(15), omega=w, tol=1e-10)
+    sol = solve_periodic(model, basis_for(15), frequency=w / (2 * np.pi), tol=1e-10)
     st = sol.stats
     assert st.success, st.message
 
@@ -331,9 +331,8 @@ def fe_block(q_ratio=0.8):
 @pytest.fixture(scope="module")
 def block_sequence():
     model = fe_block()
-    w = 2 * np.pi * F_B
-    sols = solve_sequence(model, NH_SEQ, per=8, omega=w, tol=1e-11)
-    return model, w, sols
+    sols = solve_sequence(model, NH_SEQ, per=8, frequency=F_B, tol=1e-11)
+    return model, F_B, sols
 
 
 def energies(model, sol):
@@ -349,7 +348,7 @@ def energies(model, sol):
     T = 2 * np.pi / w
     orders = np.array([0, *b.harmonics])
     uloc = b.to_complex(sol.U.reshape(-1, b.size))  # (k+1, m)
-    U = recover(model, w, orders, uloc)  # (k+1, ndof)
+    U = recover(model, sol.frequency, orders, uloc)  # (k+1, ndof)
     V = 1j * (orders * w)[:, None] * U
     F = model.load_harmonics(int(orders.max()))[orders]
     w_ext = T / 2 * np.sum((F * V.conj()).real)
@@ -376,13 +375,13 @@ def test_fe_energy_balance(block_sequence):
         matters.
     The observed point's harmonics (PeriodicSolution.observed, from the condensation's
     recovery rows) are checked against the recovered full field on the way (1e-10)."""
-    model, w, sols = block_sequence
+    model, f, sols = block_sequence
     errs = []
     pe_dofs = model.observed_point("Pe").dofs
     for sol in sols.values():
         # the observed point's harmonics (condensation's recovery rows) = the full field
         b = sol.basis
-        U = recover(model, w, [0, *b.harmonics], b.to_complex(sol.U.reshape(-1, b.size)))
+        U = recover(model, f, [0, *b.harmonics], b.to_complex(sol.U.reshape(-1, b.size)))
         np.testing.assert_allclose(b.to_complex(sol.observed["Pe"]), U[:, pe_dofs], rtol=0,
                                    atol=1e-10 * np.abs(U[:, pe_dofs]).max())
         w_ext, w_visc, w_fric, w_contact = energies(model, sol)
@@ -403,7 +402,7 @@ def test_fe_convergence_in_harmonics(block_sequence):
     monotone, last < 4e-3 and first / last > 20. The convergence is slow and not geometric
     (the slip zone edge moves between samples); docs/verification.md gives the errors
     against an Nh = 63 solution."""
-    model, w, sols = block_sequence
+    model, f, sols = block_sequence
     E = np.array([s.friction_energy().sum() for s in sols.values()])
     dE = np.abs(np.diff(E)) / E[-1]
     assert np.all(np.diff(dE) < 0), dE
@@ -429,16 +428,16 @@ def test_fe_eps_independence(block_sequence, nh, bound):
     the docs, asserted > 2 %): the dependence on eps is a truncation effect that fades as
     the harmonics converge (section 3 of the method notes). The solution does not depend on
     the starting point (checked while writing this test: three starts agree to 1e-13)."""
-    model, w, sols = block_sequence
+    model, f, sols = block_sequence
     out = {}
     for n in (1, nh):
         base = sols[n]
         b = base.basis
-        red = condense(model, w, [0, *b.harmonics])
+        red = condense(model, f, [0, *b.harmonics])
         rho = red.spectral_radius()
         res = []
         for fac in (0.1, 1.0, 10.0):
-            sol = solve_periodic(model, b, omega=w, reduced=red, eps=fac * rho,
+            sol = solve_periodic(model, b, frequency=f, reduced=red, eps=fac * rho,
                                  U0=base.U, tol=1e-11)
             st = sol.stats
             assert sol.success, st.message
@@ -457,12 +456,12 @@ def test_solvers_agree(block_sequence):
     balance to |f| <= 1e-11 |Z U|, so two solutions may differ by ~cond(J) x 1e-11 (cond(J)
     < 1e4 here): asserted 1e-7 of max |U|; measured 1e-15 (powell 7, newton 5, hybr 53
     iterations)."""
-    model, w, _ = block_sequence
+    model, f, _ = block_sequence
     b = basis_for(7, per=8)
-    red = condense(model, w, [0, *b.harmonics])
+    red = condense(model, f, [0, *b.harmonics])
     U = {}
     for solver in ("powell", "newton", "hybr"):
-        sol = solve_periodic(model, b, omega=w, reduced=red, solver=solver, tol=1e-11)
+        sol = solve_periodic(model, b, frequency=f, reduced=red, solver=solver, tol=1e-11)
         st = sol.stats
         assert sol.success and st.success and st.solver == solver, st.message
         assert st.residual <= 1e-11
@@ -477,16 +476,16 @@ def test_failed_solve_says_so(block_sequence, solver):
     """One iteration is not enough: solve_periodic returns the last iterate with
     success=False, a residual above the tolerance and a message saying why; with
     raise_on_failure it raises ConvergenceError instead."""
-    model, w, _ = block_sequence
+    model, f, _ = block_sequence
     b = basis_for(7, per=8)
-    sol = solve_periodic(model, b, omega=w, solver=solver, tol=1e-11, max_iter=1)
+    sol = solve_periodic(model, b, frequency=f, solver=solver, tol=1e-11, max_iter=1)
     st = sol.stats
     assert sol.success is False and sol.message == st.message
     assert st.success is False
     assert st.residual > 1e-11
     assert isinstance(st.message, str) and st.message and st.message != "converged"
     with pytest.raises(ConvergenceError):
-        solve_periodic(model, b, omega=w, solver=solver, tol=1e-11, max_iter=1,
+        solve_periodic(model, b, frequency=f, solver=solver, tol=1e-11, max_iter=1,
                        raise_on_failure=True)
 
 

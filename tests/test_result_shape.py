@@ -13,18 +13,17 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from test_stability import K_, M_, oscillator
+from test_wear import sliders
 
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.sweep import sweep
 from fretwear.timedomain.integrate import incremental_wear, integrate, steady_state
 from fretwear.wear import SlowProblem, WearOptions, simulate_wear
-from test_stability import K_, M_, oscillator
-from test_wear import sliders
 
 BASIS = FourierBasis.up_to(3, 32)
-OMEGA = 0.7 * np.sqrt(K_ / M_)  # continuous slip, well below the resonance
-F_HZ = OMEGA / (2 * np.pi)
+F_HZ = 0.7 * np.sqrt(K_ / M_) / (2 * np.pi)  # [Hz] continuous slip, below the resonance
 
 
 def check_shape(result, success: bool):
@@ -34,10 +33,10 @@ def check_shape(result, success: bool):
 
 def test_solve_periodic():
     model = oscillator()
-    sol = solve_periodic(model, BASIS, omega=OMEGA)
+    sol = solve_periodic(model, BASIS, frequency=F_HZ)
     check_shape(sol, True)
     assert sol.message == sol.stats.message
-    bad = solve_periodic(model, BASIS, omega=OMEGA, max_iter=1, tol=1e-14)
+    bad = solve_periodic(model, BASIS, frequency=F_HZ, max_iter=1, tol=1e-14)
     check_shape(bad, False)
     assert bad.stats.success is False and bad.U.shape == sol.U.shape  # the last iterate
 
@@ -81,16 +80,16 @@ def test_simulate_wear(monkeypatch):
 
 
 def test_integrate():
-    res = integrate(oscillator(), OMEGA, n_periods=2, steps_per_period=64)
+    res = integrate(oscillator(), F_HZ, n_periods=2, steps_per_period=64)
     check_shape(res, True)
 
 
 def test_steady_state():
     model = oscillator()
-    res = steady_state(model, OMEGA, steps_per_period=64)
+    res = steady_state(model, F_HZ, steps_per_period=64)
     check_shape(res, True)
     assert res.classification == "periodic" and res.periodic
-    short = steady_state(model, OMEGA, steps_per_period=64, max_periods=2)
+    short = steady_state(model, F_HZ, steps_per_period=64, max_periods=2)
     check_shape(short, False)
     assert short.classification == "transient" and not short.periodic
 

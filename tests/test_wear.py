@@ -615,7 +615,7 @@ def test_mean_normal_force_balances_the_preload_on_the_paper_beam():
 
     m = paper_beam()
     basis = FourierBasis.up_to(3, 32)
-    r = simulate_wear(m, basis, omega=2 * np.pi * 10e3,
+    r = simulate_wear(m, basis, frequency=10e3,
                       options=WearOptions(max_steps=3, time_domain_rescue=False))
     h = r.history
     area = np.asarray(m.contact.area, float)

@@ -438,7 +438,7 @@ def _frf_condensed(model: Model, freqs: np.ndarray, interface: str):
     keep = np.flatnonzero(~held)
     obs, con, rea = [], [], []
     for f in freqs:
-        red = condense(model, 2.0 * np.pi * f, [1])
+        red = condense(model, f, [1])
         Z, Fr = red.Z[0], red.F[0]
         u = np.zeros(nc * d, dtype=complex)
         if keep.size:

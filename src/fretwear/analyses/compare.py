@@ -186,17 +186,17 @@ def compare_periodic(model, analysis: dict, outdir: Path | None, *, steps_per_pe
         raise InputError("compare: a quasi-static periodic case has no time-domain dynamic "
                          "counterpart; give a frequency (or a quasi-static wear case)")
     basis = basis_of(analysis)
-    omega = 2 * np.pi * float(analysis["frequency"])
+    f_hz = float(analysis["frequency"])
     t0 = time.perf_counter()
-    reduced = condense(model, omega, basis.orders)
-    sol = solve_periodic(model, basis, omega=omega, reduced=reduced, eps=analysis["eps"],
+    reduced = condense(model, f_hz, basis.orders)
+    sol = solve_periodic(model, basis, frequency=f_hz, reduced=reduced, eps=analysis["eps"],
                          solver=analysis["solver"], tol=analysis["tol"],
                          max_iter=analysis["max_iter"])
     stats = sol.stats
     if not sol.success:  # a failed solve is never compared (its last iterate is no result)
         sol = None
     t_dlft = time.perf_counter() - t0
-    ss = steady_state(model, omega, max_periods=max_periods, steps_per_period=steps_per_period,
+    ss = steady_state(model, f_hz, max_periods=max_periods, steps_per_period=steps_per_period,
                       harmonics=max(basis.harmonics))
     out = Comparison(periodic_rows(model, sol, ss), ss.classification, sol is not None,
                      {"DLFT": t_dlft, "time domain": ss.wall_time})

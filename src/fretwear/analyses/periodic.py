@@ -191,10 +191,9 @@ def run_periodic(model, analysis: dict, case, outdir: Path, progress: bool) -> R
     basis = basis_of(analysis)
     qs = analysis["quasi_static"]
     f_hz = float(analysis.get("frequency", 1.0))
-    omega = 2 * np.pi * f_hz
-    reduced = condense(model, omega, basis.orders, quasi_static=qs)
+    reduced = condense(model, f_hz, basis.orders, quasi_static=qs)
     eps = penalty(analysis["eps"], model=model, reduced=reduced)
-    sol = solve_periodic(model, basis, omega=omega, quasi_static=qs, reduced=reduced,
+    sol = solve_periodic(model, basis, frequency=f_hz, quasi_static=qs, reduced=reduced,
                          eps=eps, solver=analysis["solver"], tol=analysis["tol"],
                          max_iter=analysis["max_iter"])
     stats = sol.stats
@@ -244,7 +243,7 @@ def write_period_fields(model, sol: PeriodicSolution, pvd: Path) -> Path:
     b = sol.basis
     nc, d, H = sol.U.shape
     u_loc = b.to_complex(sol.U.reshape(nc * d, H))  # (k+1, m), orders [0, h1, ..]
-    full = recover(model, sol.omega, b.orders, u_loc, quasi_static=sol.quasi_static)
+    full = recover(model, sol.frequency, b.orders, u_loc, quasi_static=sol.quasi_static)
     samples = b.to_time(b.from_complex(full))  # (ndof, N)
     mesh = model.mesh
     nn = mesh.points.shape[0]

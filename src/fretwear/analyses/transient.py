@@ -62,9 +62,10 @@ ENERGY_TERMS = {
 
 
 # --- transient: computation ------------------------------------------------------------------
-def _continue(model, omega: float, U, V, n_periods: int, steps: int) -> TransientResult:
-    """``n_periods`` more periods from the state ``(U, V)``, the last one recorded."""
-    return integrate(model, omega, n_periods=n_periods, steps_per_period=steps, record=1,
+def _continue(model, frequency: float, U, V, n_periods: int, steps: int) -> TransientResult:
+    """``n_periods`` more periods at ``frequency`` [Hz] from the state ``(U, V)``, the last
+    one recorded."""
+    return integrate(model, frequency, n_periods=n_periods, steps_per_period=steps, record=1,
                      U0=U, V0=V, keep_poincare=n_periods)
 
 
@@ -77,8 +78,8 @@ def _classify_record(run: TransientResult, tol: float):
     return classify_sequence(P, means, tol=tol, scale=scale, min_window=min(128, len(P)))
 
 
-def time_run(model, analysis: dict, omega: float, progress: bool):
-    """Integrate as ``analysis`` asks.
+def time_run(model, analysis: dict, frequency: float, progress: bool):
+    """Integrate at ``frequency`` [Hz] as ``analysis`` asks.
 
     Returns
     -------
@@ -93,13 +94,14 @@ def time_run(model, analysis: dict, omega: float, progress: bool):
     steps = analysis["steps_per_period"]
     if analysis["mode"] == "fixed":
         n = analysis["n_periods"]
-        last = integrate(model, omega, n_periods=n, steps_per_period=steps, record=1,
+        last = integrate(model, frequency, n_periods=n, steps_per_period=steps, record=1,
                          keep_poincare=n, progress=progress)
         cls = _classify_record(last, analysis["tol"])
         return last, cls, 0, {"periods": n, "time_wall_time": last.wall_time}
-    ss = steady_state(model, omega, max_periods=analysis["max_periods"], tol=analysis["tol"],
-                      steps_per_period=steps, harmonics=analysis["harmonics"])
-    last = _continue(model, omega, ss.U, ss.V, POINCARE_PERIODS, steps)
+    ss = steady_state(model, frequency, max_periods=analysis["max_periods"],
+                      tol=analysis["tol"], steps_per_period=steps,
+                      harmonics=analysis["harmonics"])
+    last = _continue(model, frequency, ss.U, ss.V, POINCARE_PERIODS, steps)
     info = {"periods": ss.n_periods + POINCARE_PERIODS,
             "time_wall_time": ss.wall_time + last.wall_time}
     return last, ss.diagnostics, ss.n_periods, info
@@ -341,8 +343,7 @@ def run_transient(model, analysis: dict, case, outdir: Path, progress: bool) -> 
     ``max_periods``).
     """
     f_hz = float(analysis["frequency"])
-    omega = 2 * np.pi * f_hz
-    last, cls, before, info = time_run(model, analysis, omega, progress)
+    last, cls, before, info = time_run(model, analysis, f_hz, progress)
     points = [p.name for p in model.observed]
     ds = transient_dataset(model, last, points, analysis["harmonics"], before)
     ds.attrs.update(_transient_attributes(ds, cls, info, f_hz, analysis, last))

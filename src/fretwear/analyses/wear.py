@@ -333,7 +333,7 @@ def run_wear(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOu
     nodes = a.get("plot_nodes")
     if nodes is not None and any(p >= nc for p in nodes):
         fail("analysis.plot_nodes", nodes, f"contact node numbers from 0 to {nc - 1}")
-    result = simulate_wear(model, basis, omega=2 * np.pi * f_hz, quasi_static=quasi,
+    result = simulate_wear(model, basis, frequency=f_hz, quasi_static=quasi,
                            options=opts, eps=a.get("eps"), checkpoint=outdir / CHECKPOINT_FILE,
                            resume=bool(case.resume), progress=progress, time_domain=FALLBACK)
     frf, frf_note = None, ""

@@ -23,7 +23,7 @@ from fretwear.errors import InputError
 from fretwear.hb import contact as law
 from fretwear.hb.fourier import FourierBasis, amplitude
 from fretwear.hb.penalty import penalty
-from fretwear.hb.reduce import Reduced, condense, loads_to_real, recover, to_real_blocks
+from fretwear.hb.reduce import Reduced, _recover, condense, loads_to_real, to_real_blocks
 from fretwear.hb.solvers import SolveStats, solve
 from fretwear.model.core import ContactInterface, Model
 
@@ -138,7 +138,8 @@ class PeriodicSolution:
     ----------
     success : the convergence test ``|f| <= tol |Z_r U|`` was met (``stats.success``).
     message : why the solver stopped (``stats.message``).
-    omega : circular frequency [rad/s] (0 for quasi-static).
+    frequency : excitation frequency [Hz] (as given to :func:`solve_periodic`).
+    omega : circular frequency ``2 pi frequency`` [rad/s] (0 for quasi-static).
     quasi_static : inertia and damping dropped.
     basis : the Fourier basis.
     U : (nc, d, H) displacement harmonics of the contact nodes [m].
@@ -156,6 +157,7 @@ class PeriodicSolution:
     flags : reasons for caution (e.g. time-domain findings of a sweep's stability check).
     """
 
+    frequency: float
     omega: float
     quasi_static: bool
     basis: FourierBasis
@@ -183,10 +185,6 @@ class PeriodicSolution:
     def message(self) -> str:
         """Why the solver stopped (``stats.message``)."""
         return self.stats.message
-
-    @property
-    def frequency_hz(self) -> float:
-        return self.omega / (2 * np.pi)
 
     @property
     def tau(self):
@@ -301,16 +299,19 @@ def static_anchor(model: Model, *, quasi: Reduced | None = None) -> np.ndarray:
     return U[:, 1:, 0].copy()
 
 
-def solve_periodic(model: Model, basis: FourierBasis, *, omega: float = 0.0,
+def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float = 0.0,
                    quasi_static: bool = False, reduced: Reduced | None = None, gap=None,
                    eps="auto", anchor=None, U0=None, solver="powell", tol=1e-8, max_iter=200,
                    raise_on_failure=False) -> PeriodicSolution:
-    """Periodic response of ``model`` at ``omega`` [rad/s] with the DLFT (section 3.1-3.2).
+    """Periodic response of ``model`` at the excitation ``frequency`` [Hz] with the DLFT
+    (section 3.1-3.2).
 
     Parameters
     ----------
     basis : kept harmonics and samples per period.
-    quasi_static : drop inertia and damping (slow cyclic loading; ``omega`` only scales time).
+    frequency : excitation frequency [Hz] (0, the default, only with ``quasi_static``).
+    quasi_static : drop inertia and damping (slow cyclic loading; ``frequency`` only scales
+        time).
     reduced : a precomputed condensation on ``[0] + basis.harmonics`` (else computed here).
     gap : (nc,) gap + wear [m] (default: the model's initial gap).
     eps : DLFT penalty: ``"auto"`` (default) the spectral radius of ``Z_r`` over the kept
@@ -332,7 +333,7 @@ def solve_periodic(model: Model, basis: FourierBasis, *, omega: float = 0.0,
     fields hold the last iterate (for inspection, never a result).
     """
     if reduced is None:
-        reduced = condense(model, omega, _orders(basis), quasi_static=quasi_static)
+        reduced = condense(model, frequency, _orders(basis), quasi_static=quasi_static)
     eps = penalty("auto" if eps is None else eps, model=model, reduced=reduced)
     if anchor is None:
         anchor = static_anchor(model)
@@ -352,7 +353,7 @@ def solve_periodic(model: Model, basis: FourierBasis, *, omega: float = 0.0,
         from fretwear.errors import ConvergenceError
 
         raise ConvergenceError(
-            f"periodic solve at f = {omega / 2 / np.pi:.6g} Hz did not converge: "
+            f"periodic solve at f = {reduced.frequency:.6g} Hz did not converge: "
             f"{st.message} (relative residual {st.residual:.3g} > {tol:g})"
         )
     return assemble_solution(prob, x.reshape(prob.m, prob.H), model, st)
@@ -365,7 +366,8 @@ def _harmonic_continuation_start(model, basis, reduced, prob, solver, tol, max_i
     starts the full one within a few iterations (docs/verification.md)."""
     sub = FourierBasis(basis.harmonics[:1], basis.n_samples)
     red = Reduced(reduced.omega, reduced.orders[:2], reduced.Z[:2], reduced.F[:2],
-                  reduced.obs_A[:2], reduced.obs_b[:2], reduced.obs_dofs, reduced.quasi_static)
+                  reduced.obs_A[:2], reduced.obs_b[:2], reduced.obs_dofs, reduced.quasi_static,
+                  reduced.frequency)
     p1 = DLFTProblem(red, model.contact, sub, gap=prob.gap, eps=prob.eps, anchor=prob.anchor)
 
     def fun(x, jac=True):
@@ -409,7 +411,8 @@ def assemble_solution(prob: DLFTProblem, U, model: Model, stats: SolveStats) -> 
             observed[p.name] = real[i : i + nd]
             i += nd
     return PeriodicSolution(
-        omega=red.omega, quasi_static=red.quasi_static, basis=b, U=U.reshape(nc, d, H).copy(),
+        frequency=red.frequency, omega=red.omega, quasi_static=red.quasi_static, basis=b,
+        U=U.reshape(nc, d, H).copy(),
         lam=lam, X=X, lam_t=lam_t, x_t=x_t, state=state, gap=prob.gap.copy(),
         anchor=prob.anchor.copy(), eps=prob.eps, observed=observed,
         area=np.asarray(model.contact.area, float), coords=np.asarray(model.contact.coords),
@@ -423,7 +426,7 @@ def initial_state(model: Model, sol: PeriodicSolution):
     m = sol.U.shape[0] * sol.U.shape[1]
     Uc = b.to_complex(sol.U.reshape(m, -1))  # (k+1, m) complex amplitudes
     orders = np.array([0, *b.harmonics])
-    Ufull = recover(model, sol.omega, orders, Uc, quasi_static=sol.quasi_static)
+    Ufull = _recover(model, sol.omega, orders, Uc, quasi_static=sol.quasi_static)
     U0 = Ufull.real.sum(axis=0)
     V0 = -(orders[:, None] * sol.omega * Ufull.imag).sum(axis=0)
     return U0, V0

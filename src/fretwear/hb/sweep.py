@@ -25,7 +25,7 @@ from fretwear.hb.fallback import TimeDomainFallback
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.penalty import check_rule, penalty
 from fretwear.hb.periodic import DLFTProblem, PeriodicSolution, assemble_solution, static_anchor
-from fretwear.hb.reduce import condense
+from fretwear.hb.reduce import _condense
 from fretwear.hb.solvers import SolveStats, solve
 from fretwear.model.core import Model
 
@@ -147,10 +147,12 @@ class _Problems:
         self.size = cache_size
 
     def get(self, omega: float, anchor) -> DLFTProblem:
+        """The problem at the circular frequency ``omega`` [rad/s] (the continuation
+        variable of the sweep) with the stick anchors ``anchor``."""
         key = float(omega)
         red = self.cache.get(key)
         if red is None:
-            red = condense(self.model, omega, self.orders)
+            red = _condense(self.model, omega, self.orders)
             if len(self.cache) >= self.size:
                 self.cache.pop(next(iter(self.cache)))
             self.cache[key] = red
@@ -379,7 +381,7 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
                 prob, U, st, how = pb, Ub, stb, "eps-x10"
         td_msg = None
         if not st.success and time_domain is not None:
-            td_msg, Ut, anc_t = time_domain.start(model, omega, basis, last_solution[0],
+            td_msg, Ut, anc_t = time_domain.start(model, f, basis, last_solution[0],
                                                   max_periods=time_domain_periods)
             if Ut is not None:
                 prob, U, st = _solve_at(probs, omega, anc_t, Ut.reshape(-1, basis.size),

@@ -36,6 +36,7 @@ is replaced by the equivalent viscous damping at the forcing frequency, ``C_eq =
 
 from __future__ import annotations
 
+import inspect
 import math
 import time
 import warnings
@@ -114,7 +115,8 @@ class TransientResult:
         round-off for ``gamma = 1/2``). Balance:
         ``mechanical[j] - mechanical[0] = external - friction - normal - damping - numerical``.
     n_periods : forcing periods simulated. steps_per_period : steps per period.
-    omega : forcing angular frequency [rad/s]. wall_time : [s].
+    omega : forcing circular frequency ``2 pi frequency`` [rad/s] (``frequency``: [Hz]).
+    wall_time : [s].
     U, V : (ndof,) final displacement [m] and velocity [m/s] (pass them as ``U0, V0`` to
         continue the run exactly).
     poincare : name -> (np, d) observed displacement at the start of each kept period [m].
@@ -141,6 +143,11 @@ class TransientResult:
     info: dict = field(default_factory=dict)
     success: bool = True
     message: str = ""
+
+    @property
+    def frequency(self) -> float:
+        """Forcing frequency [Hz]."""
+        return self.omega / (2 * np.pi)
 
     def energy_residual(self) -> float:
         """Largest ``|dE - (W_ext - D_fric - D_normal - D_damp - D_num)|`` over the record [J]."""
@@ -838,18 +845,18 @@ class _Integrator:
             info=info, success=not self.n_fail, message=message)
 
 
-def integrate(model: Model, omega: float, *, n_periods: int, steps_per_period: int = DEFAULT_STEPS,
-              record="last", U0=None, V0=None, wear=None, stick_anchor=None, modal_cutoff=None,
-              n_modes=None, gamma: float = 0.5, hf_damping: bool = False,
-              keep_poincare: int = 10_000, tol: float = 1e-10,
-              progress: bool = False) -> TransientResult:
+def integrate(model: Model, frequency: float, *, n_periods: int,
+              steps_per_period: int = DEFAULT_STEPS, record="last", U0=None, V0=None,
+              wear=None, stick_anchor=None, modal_cutoff=None, n_modes=None,
+              gamma: float = 0.5, hf_damping: bool = False, keep_poincare: int = 10_000,
+              tol: float = 1e-10, progress: bool = False) -> TransientResult:
     """Integrate the forced response in time with exact contact and friction.
 
     Parameters
     ----------
     model : the structure (:class:`~fretwear.model.core.Model`).
-    omega : forcing angular frequency [rad/s]; the loads are ``F(omega t)``.
-    n_periods : number of forcing periods ``T = 2 pi / omega`` to simulate.
+    frequency : forcing frequency ``f`` [Hz]; the loads are ``F(omega t)``, ``omega = 2 pi f``.
+    n_periods : number of forcing periods ``T = 1 / f`` to simulate.
     steps_per_period : fixed steps per period (``h = T / steps_per_period``). Guidance: >= 20
         steps per period of the highest harmonic you want accurate (phase error of the
         trapezoidal rule ``(omega h)^2 / 12``); stick-slip events are first order in ``h``.
@@ -889,6 +896,7 @@ def integrate(model: Model, omega: float, *, n_periods: int, steps_per_period: i
         if n_rec > n_periods:
             raise InputError(f"record = {record} periods but n_periods = {n_periods}")
     n_keep = min(_count(keep_poincare, "keep_poincare", 0), n_periods)
+    omega = 2 * np.pi * _positive(frequency, "frequency")
     integ = _Integrator(model, omega, steps_per_period=steps_per_period,
                         modal_cutoff=modal_cutoff, n_modes=n_modes, gamma=gamma, tol=tol,
                         wear=wear, U0=U0, V0=V0, stick_anchor=stick_anchor,
@@ -1008,7 +1016,7 @@ def classify_sequence(poincare, means=None, *, tol: float = 1e-6, scale: float |
     return out
 
 
-def steady_state(model: Model, omega: float, *, max_periods: int = 20_000, tol: float = 1e-6,
+def steady_state(model: Model, frequency: float, *, max_periods: int = 20_000, tol: float = 1e-6,
                  steps_per_period: int = DEFAULT_STEPS, harmonics: int = 7,
                  check_every: int = 16, window: int = 512, min_periods: int = 128, U0=None,
                  V0=None, wear=None, stick_anchor=None, modal_cutoff=None, n_modes=None,
@@ -1027,7 +1035,7 @@ def steady_state(model: Model, omega: float, *, max_periods: int = 20_000, tol: 
 
     Parameters
     ----------
-    model, omega : as :func:`integrate`.
+    model, frequency : as :func:`integrate` (``frequency`` [Hz]).
     max_periods : give up after this many periods (classification then as found).
     tol : relative periodicity tolerance (see :func:`classify_sequence`).
     harmonics : highest harmonic of the last period reported (1 .. harmonics).
@@ -1035,8 +1043,33 @@ def steady_state(model: Model, omega: float, *, max_periods: int = 20_000, tol: 
 
     Returns
     -------
-    :class:`SteadyStateResult`.
+    :class:`SteadyStateResult`: ``success`` when the response was classified with every
+    contact solve settled; ``classification`` and ``message`` say what it is.
     """
+    return _steady_state(model, 2 * np.pi * _positive(frequency, "frequency"),
+                         max_periods=max_periods, tol=tol, steps_per_period=steps_per_period,
+                         harmonics=harmonics, check_every=check_every, window=window,
+                         min_periods=min_periods, U0=U0, V0=V0, wear=wear,
+                         stick_anchor=stick_anchor, modal_cutoff=modal_cutoff, n_modes=n_modes,
+                         gamma=gamma, hf_damping=hf_damping, contact_tol=contact_tol,
+                         progress=progress)
+
+
+def _steady_state_at_omega(model: Model, omega: float, **kwargs) -> SteadyStateResult:
+    """:func:`steady_state` at the circular frequency ``omega`` [rad/s] of a periodic solution
+    (no conversion to Hz and back), with its keywords and defaults."""
+    bound = inspect.signature(steady_state).bind(model, 0.0, **kwargs)
+    bound.apply_defaults()
+    args = dict(bound.arguments)
+    del args["model"], args["frequency"]
+    return _steady_state(model, omega, **args)
+
+
+def _steady_state(model: Model, omega: float, *, max_periods, tol, steps_per_period, harmonics,
+                  check_every, window, min_periods, U0, V0, wear, stick_anchor, modal_cutoff,
+                  n_modes, gamma, hf_damping, contact_tol, progress) -> SteadyStateResult:
+    """:func:`steady_state` at the circular frequency ``omega`` [rad/s] (every argument
+    given)."""
     max_periods = _count(max_periods, "max_periods", 1)
     check_every = _count(check_every, "check_every", 1)
     window = _count(window, "window", 8)

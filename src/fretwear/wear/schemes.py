@@ -45,7 +45,7 @@ def first_state(sp: SlowProblem, W0, anchor, U0, opts: WearOptions) -> tuple[dic
     t0 = time.perf_counter()
     sp.set_state(W0, anchor)
     # the first balance goes through solve_periodic (its start strategies for a cold start)
-    sol0 = solve_periodic(sp.model, sp.prob.basis, omega=sp.prob.reduced.omega,
+    sol0 = solve_periodic(sp.model, sp.prob.basis, frequency=sp.prob.reduced.frequency,
                           quasi_static=sp.prob.reduced.quasi_static,
                           reduced=sp.prob.reduced, gap=sp.gap0 + W0, eps=sp.eps,
                           anchor=anchor, U0=U0, solver=opts.solver, tol=opts.tol,

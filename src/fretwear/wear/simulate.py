@@ -44,7 +44,7 @@ from fretwear.wear.slow_problem import SlowProblem
 from fretwear.wear.time_steps import time_domain_step
 
 
-def simulate_wear(model: Model, basis: FourierBasis, *, omega: float = 2 * np.pi,
+def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
                   quasi_static: bool = False, options: WearOptions | None = None,
                   reduced: Reduced | None = None, eps: float | None = None, anchor=None,
                   W0=None, U0=None, checkpoint: Path | str | None = None, resume: bool = False,
@@ -56,7 +56,7 @@ def simulate_wear(model: Model, basis: FourierBasis, *, omega: float = 2 * np.pi
     ----------
     model : the structure (``contact.wear_coefficient`` k_w [1/Pa] for Archard's law).
     basis : Fourier basis of the periodic solutions.
-    omega : excitation circular frequency [rad/s] (only scales time when ``quasi_static``).
+    frequency : excitation frequency [Hz] (only scales time when ``quasi_static``).
     quasi_static : drop inertia and damping.
     options : :class:`WearOptions` (defaults: adaptive linearly implicit, tolerance 1e-2).
     reduced : precomputed condensation on ``[0] + basis.harmonics``.
@@ -94,7 +94,7 @@ def simulate_wear(model: Model, basis: FourierBasis, *, omega: float = 2 * np.pi
     t_start = time.perf_counter()
     nc, d = model.contact.dofs.shape
     if reduced is None:
-        reduced = condense(model, omega, basis.orders, quasi_static=quasi_static)
+        reduced = condense(model, frequency, basis.orders, quasi_static=quasi_static)
     coef = wear_coefficients(model, opts.law, opts.energy_coefficient)
     W0 = np.zeros(nc) if W0 is None else np.broadcast_to(np.asarray(W0, float), (nc,)).copy()
     if anchor is None:
