@@ -117,7 +117,7 @@ def main(argv=None) -> int:
         f_hz = float(a["frequency"])
         reduced = condense(model, f_hz, basis.orders)
         coef = wear_coefficients(model)
-        sp = SlowProblem(model, reduced, basis, coef, eps=a.get("eps"))
+        sp = SlowProblem(model, reduced, basis, coef, eps=a.get("eps", "auto"))
         U0 = np.asarray(h.U[k - 1], float).reshape(sp.m, sp.H)
         anchor = np.asarray(h.anchor[k - 1], float)
         W0 = np.asarray(h.wear_depth[k - 1], float)
@@ -139,7 +139,7 @@ def main(argv=None) -> int:
                 (f"{basis.n_samples} samples, tol {10 * tol:.0e}", sp, 10 * tol),
                 (f"{2 * basis.n_samples} samples, tol {tol:.0e}",
                  SlowProblem(model, reduced, FourierBasis(basis.harmonics, 2 * basis.n_samples),
-                             coef, eps=a.get("eps")), tol)):
+                             coef, eps=a.get("eps", "auto")), tol)):
             Ustart = U0
             if spx is not sp:  # the balance with the finer sampling at N0 first
                 Ustart, st = spx.solve_balance(W0, anchor, U0, solver="powell", tol=tolx,

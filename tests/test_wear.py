@@ -159,7 +159,7 @@ def test_uniform_sliding_analytic_rate():
     m = sliders(P=P, A=A, kt=kt, ratio=ratio)
     exact_path = 4 * (ratio - 1) * MU * P * A / kt
     errors = []
-    for nh, eps in ((3, None), (3, 10 * kt), (7, 10 * kt), (31, 10 * kt)):
+    for nh, eps in ((3, "auto"), (3, 10 * kt), (7, 10 * kt), (31, 10 * kt)):
         b = FourierBasis.up_to(nh, 16 * nh + 16)
         sol = solve_periodic(m, b, quasi_static=True, tol=1e-12, eps=eps)
         st = sol.stats

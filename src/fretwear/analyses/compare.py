@@ -223,7 +223,7 @@ def _reference_jump(n_cycles: int, stability_jump: float) -> int:
 def compare_wear(model, analysis: dict, outdir: Path | None, *, steps_per_cycle: int = 128,
                  title: str | None = None) -> Comparison:
     """DLFT wear against incremental wear at the DLFT run's final cycle count."""
-    from fretwear.analyses.wear import options_from_table
+    from fretwear.analyses.wear import options_from_table, penalty_of
     from fretwear.wear import simulate_wear
 
     if not analysis.get("quasi_static"):
@@ -231,7 +231,7 @@ def compare_wear(model, analysis: dict, outdir: Path | None, *, steps_per_cycle:
                          "quasi_static = true in the wear case")
     basis = basis_of(analysis)
     res = simulate_wear(model, basis, quasi_static=True, options=options_from_table(analysis),
-                        eps=analysis.get("eps"))
+                        **penalty_of(analysis))
     n = int(round(float(res.history.cycles[-1])))
     jump = _reference_jump(n, res.stability_jump)
     inc = incremental_wear(model, steps_per_cycle=steps_per_cycle, n_cycles=max(n, 1),

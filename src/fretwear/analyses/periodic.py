@@ -21,6 +21,7 @@ from fretwear.analyses.common import (
     STOP_TOL,
     basis_of,
     check_sampling,
+    default_of,
     figure_path,
     geometry,
     harmonic_balance_fields,
@@ -190,7 +191,7 @@ def run_periodic(model, analysis: dict, case, outdir: Path, progress: bool) -> R
     """
     basis = basis_of(analysis)
     qs = analysis["quasi_static"]
-    f_hz = float(analysis.get("frequency", 1.0))
+    f_hz = float(analysis.get("frequency", default_of(solve_periodic, "frequency")))
     reduced = condense(model, f_hz, basis.orders, quasi_static=qs)
     eps = penalty(analysis["eps"], model=model, reduced=reduced)
     sol = solve_periodic(model, basis, frequency=f_hz, quasi_static=qs, reduced=reduced,
@@ -407,8 +408,8 @@ register(
                            "quasi_static; then it only scales time, default 1 Hz)", unit="Hz"),
         "quasi_static": Field(Flag(), "drop inertia and damping (slow cyclic loading); the "
                               "friction law stays path dependent over the period",
-                              default=False),
-        **harmonic_balance_fields("auto", "DLFT penalty: " + _EPS_RULES, 200),
+                              default=default_of(solve_periodic, "quasi_static")),
+        **harmonic_balance_fields(solve_periodic, "DLFT penalty: " + _EPS_RULES),
     },
     run_periodic,
     checks=(_frequency_needed, check_sampling),

@@ -15,12 +15,13 @@ import numpy as np
 import xarray as xr
 from tqdm import tqdm
 
-from fretwear import linear
+from fretwear import api, linear
 from fretwear.analyses import figures as plots
 from fretwear.analyses.common import (
     basis_of,
     check_points,
     check_sampling,
+    default_of,
     figure_path,
     geometry,
     harmonic_balance_fields,
@@ -289,16 +290,18 @@ register(
         "f_max": Field(Number(lo=0, lo_open=True), "highest frequency", required=True, unit="Hz"),
         "n_points": Field(Integer(lo=2), "number of grid frequencies (the sweep may add "
                           "intermediate points where a step fails)", default=200),
-        "spacing": Field(Text(("log", "linear")), "frequency spacing", default="log"),
+        "spacing": Field(Text(("log", "linear")), "frequency spacing",
+                         default=default_of(sweep, "spacing")),
         "continuation": Field(Flag(), "pseudo-arclength continuation when a frequency step "
-                              "fails (passes folds of the response curve)", default=True),
+                              "fails (passes folds of the response curve)",
+                              default=default_of(sweep, "continuation")),
         "time_domain": Field(Flag(), "where a point still fails, integrate in time from the "
                              "neighbour: a periodic steady state starts one more solve, any "
                              "other response (drifting, quasi-periodic) is reported as the "
-                             "reason", default=True),
+                             "reason", default=default_of(api.sweep, "time_domain")),
         "time_domain_periods": Field(Integer(lo=10), "forcing periods allowed to each time "
                                      "integration (time_domain, check_stability)",
-                                     default=3000),
+                                     default=default_of(sweep, "time_domain_periods")),
         "check_stability": Field(Flag(), "check every converged point in time (does the "
                                  "structure settle to it?); slow", default=False),
         "points": Field(ListOf(Text(), non_empty=True, unique=True),
@@ -308,10 +311,10 @@ register(
             'linear FRFs drawn with the nonlinear one: "sliding" (frictionless), "stuck", '
             '"free"', default=[]),
         **harmonic_balance_fields(
-            "static",
+            sweep,
             'DLFT penalty: "static": the spectral radius of the static reduced stiffness K_r, '
             'the same at every frequency (a smooth FRF); "auto": the paper\'s rule (spectral '
-            "radius of Z_r) at each frequency; or a value", 40),
+            "radius of Z_r) at each frequency; or a value"),
     },
     run_sweep,
     checks=(increasing("f_min", "f_max", "Hz"), check_sampling),

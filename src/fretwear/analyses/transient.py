@@ -22,6 +22,7 @@ import xarray as xr
 
 from fretwear.analyses import figures as plots
 from fretwear.analyses.common import (
+    default_of,
     figure_path,
     geometry,
     interface_abscissa,
@@ -370,14 +371,15 @@ register(
                       'quasi-periodic, irregular) or max_periods; "fixed": exactly n_periods',
                       default="steady-state"),
         "steps_per_period": Field(Integer(lo=8), "fixed time steps per forcing period",
-                                  default=256),
+                                  default=default_of(integrate, "steps_per_period")),
         "max_periods": Field(Integer(lo=1), "steady-state: give up after this many periods",
-                             default=20000),
+                             default=default_of(steady_state, "max_periods")),
         "n_periods": Field(Integer(lo=1), "fixed: periods integrated from rest", default=200),
         "tol": Field(Number(lo=0, lo_open=True), "relative periodicity tolerance of the "
-                     "classification", default=1e-6, unit="-"),
+                     "classification", default=default_of(steady_state, "tol"), unit="-"),
         "harmonics": Field(Integer(lo=1), "highest harmonic of the last period reported: "
-                           "Nh reports 1, 2, .., Nh", default=7),
+                           "Nh reports 1, 2, .., Nh",
+                           default=default_of(steady_state, "harmonics")),
     },
     run_transient,
     checks=(_check_harmonics,),
@@ -457,13 +459,14 @@ register(
     "incremental-wear",
     {
         "steps_per_cycle": Field(Integer(lo=2), "quasi-static load steps per cycle",
-                                 default=64),
+                                 default=default_of(incremental_wear, "steps_per_cycle")),
         "n_cycles": Field(Integer(lo=1), "load cycles (physical, counting the jumps)",
-                          default=100),
+                          default=default_of(incremental_wear, "n_cycles")),
         "cycle_jump": Field(Integer(lo=1), "cycles represented by each computed cycle "
-                            "(explicit Euler on the slow scale)", default=1),
+                            "(explicit Euler on the slow scale)",
+                            default=default_of(incremental_wear, "cycle_jump")),
         "record_every": Field(Integer(lo=1), "record every this many computed cycles (and "
-                              "the last)", default=1),
+                              "the last)", default=default_of(incremental_wear, "record_every")),
     },
     run_incremental_wear,
     doc="Quasi-static fretting wear by load steps "

@@ -39,7 +39,7 @@ class DLFTProblem:
     gap : (nc,) normal gap + wear ``W`` [m].
     eps : DLFT penalty: ``"auto"`` (default) the spectral radius of ``Z_r`` (paper, section
         3.2), ``"static"`` that of the static ``K_r``, or a positive number [N/m]
-        (:func:`fretwear.hb.penalty.penalty`; ``None`` is the default, ``"auto"``).
+        (:func:`fretwear.hb.penalty.penalty`).
     anchor : (nc, d-1) stick anchors: where a node that sticks all period sticks [m]
         (tangential, contact-local). Default 0.
     """
@@ -56,7 +56,7 @@ class DLFTProblem:
         self.reduced = reduced
         self.Z = to_real_blocks(reduced.Z, reduced.orders)
         self.F = loads_to_real(reduced.F)
-        self.eps = penalty("auto" if eps is None else eps, reduced=reduced)
+        self.eps = penalty(eps, reduced=reduced)
         self.mu = np.full(nc, float(contact.mu))
         self.set_gap(contact.gap if gap is None else gap)
         self.anchor = np.zeros((nc, d - 1)) if anchor is None else np.array(anchor, float)
@@ -299,7 +299,7 @@ def static_anchor(model: Model, *, quasi: Reduced | None = None) -> np.ndarray:
     return U[:, 1:, 0].copy()
 
 
-def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float = 0.0,
+def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
                    quasi_static: bool = False, reduced: Reduced | None = None, gap=None,
                    eps="auto", anchor=None, U0=None, solver="powell", tol=1e-8, max_iter=200,
                    raise_on_failure=False) -> PeriodicSolution:
@@ -309,14 +309,14 @@ def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float = 0.0,
     Parameters
     ----------
     basis : kept harmonics and samples per period.
-    frequency : excitation frequency [Hz] (0, the default, only with ``quasi_static``).
-    quasi_static : drop inertia and damping (slow cyclic loading; ``frequency`` only scales
-        time).
+    frequency : excitation frequency [Hz] (default 1 Hz, as case files: with
+        ``quasi_static`` it only scales time, a 1 s cycle).
+    quasi_static : drop inertia and damping (slow cyclic loading).
     reduced : a precomputed condensation on ``[0] + basis.harmonics`` (else computed here).
     gap : (nc,) gap + wear [m] (default: the model's initial gap).
     eps : DLFT penalty: ``"auto"`` (default) the spectral radius of ``Z_r`` over the kept
         harmonics (the paper), ``"static"`` that of the static ``K_r``, or a positive number
-        [N/m] (:func:`fretwear.hb.penalty.penalty`; ``None`` is the default, ``"auto"``).
+        [N/m] (:func:`fretwear.hb.penalty.penalty`).
     anchor : (nc, d-1) stick anchors [m]; default: the static preload state
         (:func:`static_anchor`), the documented rule for the mean tangential position.
     U0 : (nc, d, H) starting point (e.g. a neighbouring solution).
@@ -334,7 +334,7 @@ def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float = 0.0,
     """
     if reduced is None:
         reduced = condense(model, frequency, _orders(basis), quasi_static=quasi_static)
-    eps = penalty("auto" if eps is None else eps, model=model, reduced=reduced)
+    eps = penalty(eps, model=model, reduced=reduced)
     if anchor is None:
         anchor = static_anchor(model)
     prob = DLFTProblem(reduced, model.contact, basis, gap=gap, eps=eps, anchor=anchor)

@@ -261,7 +261,7 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
     gap : (nc,) gap + wear [m] (a worn interface); default the model's initial gap.
     eps : DLFT penalty (:func:`fretwear.hb.penalty.penalty`). Default ``"static"``: the
         spectral radius of the static reduced stiffness ``Z_r(0) = K_r``, the same at every
-        frequency (``None`` is the default too). ``"auto"``: the spectral radius of ``Z_r``
+        frequency. ``"auto"``: the spectral radius of ``Z_r``
         over the kept harmonics at each frequency (the paper's rule applied point by point).
         A positive number [N/m]: that penalty everywhere. Why the default differs: the
         harmonics of ``Z_r(n w)`` have poles at the clamped-interface resonances, so its
@@ -288,7 +288,7 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
     """
     t_start = time.perf_counter()
     grid = frequency_grid(f_min, f_max, n_points, spacing)
-    eps = check_rule("static" if eps is None else eps)
+    eps = check_rule(eps)
     if eps != "auto":
         eps = penalty(eps, model=model)
     probs = _Problems(model, basis, gap, eps)

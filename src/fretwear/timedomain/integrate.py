@@ -79,7 +79,7 @@ __all__ = [
     "steady_state",
 ]
 
-DEFAULT_STEPS = 128
+DEFAULT_STEPS = 256  # time steps per forcing period (case files take it too)
 CUTOFF_STEPS = 8  # default cutoff: modes whose period spans at least this many steps
 DENSE_EIG_LIMIT = 3000  # interior DOFs up to which the fixed-interface modes are found densely
 CHUNK_STEPS = 2_000_000  # steps per kernel call (progress, interruption)

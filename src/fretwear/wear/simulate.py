@@ -46,7 +46,7 @@ from fretwear.wear.time_steps import time_domain_step
 
 def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
                   quasi_static: bool = False, options: WearOptions | None = None,
-                  reduced: Reduced | None = None, eps: float | None = None, anchor=None,
+                  reduced: Reduced | None = None, eps: str | float = "auto", anchor=None,
                   W0=None, U0=None, checkpoint: Path | str | None = None, resume: bool = False,
                   progress: bool = False, callback: Callable | None = None,
                   time_domain: TimeDomainFallback | None = None) -> WearResult:
@@ -60,7 +60,9 @@ def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
     quasi_static : drop inertia and damping.
     options : :class:`WearOptions` (defaults: adaptive linearly implicit, tolerance 1e-2).
     reduced : precomputed condensation on ``[0] + basis.harmonics``.
-    eps : DLFT penalty [N/m] (default: spectral radius of ``Z_r``).
+    eps : DLFT penalty: ``"auto"`` (default) the spectral radius of ``Z_r`` (the paper),
+        ``"static"`` that of the static ``K_r``, or a positive number [N/m]
+        (:func:`fretwear.hb.penalty.penalty`).
     anchor : (nc, d-1) stick anchors of the first solve [m] (default: static preload state).
     W0 : (nc,) initial wear [m] (default 0).
     U0 : (nc, d, H) or (m, H) start of the first periodic solve.
