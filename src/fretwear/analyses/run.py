@@ -27,7 +27,14 @@ RESULTS_FILE = "results.nc"
 
 def load_case(path: Path | str) -> Case:
     """Read and validate a case file against the registered analyses
-    (:func:`fretwear.io.case.load_case`); every mistake is one InputError naming the key."""
+    (:func:`fretwear.io.case.load_case`); every mistake is one InputError naming the key.
+
+    Returns
+    -------
+    :class:`fretwear.io.case.Case`: the validated tables with every default filled in
+    (``case.analysis``, ``case.output``, ...), the case text and its path; SI units
+    (frequencies in Hz) as in ``docs/case-files.md``.
+    """
     return case_files.load_case(path, analysis_tables())
 
 
@@ -109,7 +116,9 @@ def run_case(path: Path | str, outdir: Path | str | None = None, progress: bool 
 
     Returns
     -------
-    RunOutput, with ``results`` the NetCDF file written.
+    :class:`~fretwear.analyses.registry.RunOutput`: ``success`` (False when some solve did not
+    converge; the file's ``converged`` attribute), ``message`` (the summary printed),
+    ``dataset``, ``figures``, ``files`` and ``results`` (the NetCDF file written).
 
     Raises
     ------

@@ -285,6 +285,12 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
         quasi-periodic...).
     time_domain_periods : periods allowed to the time integration.
     progress : optional callable ``(i, n, point)`` called after each grid point.
+
+    Returns
+    -------
+    :class:`SweepResult`: ``success`` (every point converged), ``message`` (how many did),
+    the points in increasing frequency (a point that did not converge has no solution and
+    says why in ``flags``).
     """
     t_start = time.perf_counter()
     grid = frequency_grid(f_min, f_max, n_points, spacing)

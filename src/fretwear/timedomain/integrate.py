@@ -886,7 +886,9 @@ def integrate(model: Model, frequency: float, *, n_periods: int,
 
     Returns
     -------
-    :class:`TransientResult`.
+    :class:`TransientResult`: ``success`` (every contact solve settled), ``message``, the
+    recorded samples (times [s], displacements [m], forces [N], energies [J]) and the final
+    state ``U, V`` to continue the run.
     """
     n_periods = _count(n_periods, "n_periods", 1)
     if record == "last":
@@ -1165,7 +1167,8 @@ def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int =
 
     Returns
     -------
-    :class:`IncrementalWearResult`.
+    :class:`IncrementalWearResult`: ``success``, ``message``, and per recorded cycle the
+    wear [m], pressure [Pa], slip [m], worn volume [m^3] and dissipation [J].
     """
     N = _count(steps_per_cycle, "steps_per_cycle", 2)
     n_cycles = _count(n_cycles, "n_cycles", 1)

@@ -72,6 +72,15 @@ def check_periodic(model: Model, sol: PeriodicSolution, *, max_periods: int = 30
         periodic state". The harmonic balance truncates a non-smooth response, so the two
         methods differ by the truncation error even for a stable orbit; 0.2 is well above the
         truncation error measured on the paper's beam with 7 harmonics (docs/verification.md).
+    periodicity_tol : relative periodicity tolerance of the time integration's classification.
+    seed : of the random perturbation.
+
+    Returns
+    -------
+    :class:`StabilityCheck`: ``verdict`` (``"stable"`` when the structure settles back to the
+    solution), ``distance`` [-], ``periods`` integrated, ``wall_time`` [s], ``message`` (one
+    line), ``flags()`` for a sweep point. The integration runs at the solution's own circular
+    frequency ``sol.omega`` [rad/s] (``sol.frequency`` [Hz]).
     """
     from fretwear.timedomain.integrate import _steady_state_at_omega
 

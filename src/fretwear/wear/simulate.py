@@ -79,7 +79,8 @@ def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
 
     Returns
     -------
-    :class:`WearResult`.
+    :class:`WearResult`: ``success`` False when it stopped on a failed solve, ``message`` why
+    and when it stopped (``stop_reason``), the ``history`` of every slow step.
 
     Raises
     ------
