@@ -4,21 +4,25 @@ str), plus its details.
 
 Tiny models (a one-node friction oscillator, three independent sliders) so that each call is
 cheap; where a failure can be provoked cheaply (one solver iteration, a time integration too
-short to classify the response, a forced failure of the slow steps) it is checked too. The
-time integration has no cheap way to make its contact solves fail: only its success is
-checked.
+short to classify the response, a forced failure of the slow steps, a coarse time step
+where a contact solve does not settle) it is checked too; the incremental wear has no cheap
+failure to provoke.
 """
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
+from test_run_dlft import small_case
+from test_run_transient import FIXED
 from test_stability import K_, M_, oscillator
 from test_wear import sliders
 
+from fretwear.analyses.run import load_case
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.sweep import sweep
+from fretwear.io.case import build_model
 from fretwear.timedomain.integrate import incremental_wear, integrate, steady_state
 from fretwear.wear import SlowProblem, WearOptions, simulate_wear
 
@@ -79,9 +83,16 @@ def test_simulate_wear(monkeypatch):
     assert bad.stop_reason == "solver_failed" and "forced failure" in bad.message
 
 
-def test_integrate():
+def test_integrate(tmp_path):
     res = integrate(oscillator(), F_HZ, n_periods=2, steps_per_period=64)
     check_shape(res, True)
+    # the 10 x 2 beam of test_run_transient at 1 kHz with a coarse step: one contact solve of
+    # its third period does not settle (measured; the run warns and says so)
+    model = build_model(load_case(small_case(tmp_path, FIXED)))
+    with pytest.warns(RuntimeWarning, match="did not settle"):
+        bad = integrate(model, 1e3, n_periods=3, steps_per_period=64)
+    check_shape(bad, False)
+    assert "did not settle" in bad.message
 
 
 def test_steady_state():
