@@ -55,14 +55,14 @@ def beam():
     return paper_beam()
 
 
-def run_case(name, model, basis, *, omega, quasi_static, options):
+def run_case(name, model, basis, *, frequency, quasi_static, options):
     """Run one case; returns (result or None, wall [s], message)."""
     from fretwear.errors import ConvergenceError
     from fretwear.wear import simulate_wear
 
     t0 = time.perf_counter()
     try:
-        r = simulate_wear(model, basis, omega=omega, quasi_static=quasi_static,
+        r = simulate_wear(model, basis, frequency=frequency, quasi_static=quasi_static,
                           options=options, progress=sys.stderr.isatty())
     except ConvergenceError as exc:
         return None, time.perf_counter() - t0, f"{name}: {exc}"
@@ -122,7 +122,7 @@ def main(argv=None) -> int:
 
     # quasi-static, to N = 3e9 (plateau)
     opts = WearOptions(tolerance=args.tolerance, max_cycles=N_QS, plateau_rate=0.0)
-    r, wall, msg = run_case("quasi-static", model, basis, omega=2 * np.pi, quasi_static=True,
+    r, wall, msg = run_case("quasi-static", model, basis, frequency=1.0, quasi_static=True,
                             options=opts)
     if r is not None and r.stop_reason == "max_cycles":
         report("quasi-static", r, wall)
@@ -145,7 +145,7 @@ def main(argv=None) -> int:
     else:
         opts = WearOptions(tolerance=args.tolerance, plateau_rate=1e-3,
                            max_cycles=args.max_cycles_79khz)
-        r, wall, msg = run_case("79 kHz", model, basis, omega=2 * np.pi * 79e3,
+        r, wall, msg = run_case("79 kHz", model, basis, frequency=79e3,
                                 quasi_static=False, options=opts)
         if r is not None and r.stop_reason == "plateau":
             report("79 kHz", r, wall)
@@ -170,7 +170,7 @@ def reference_profile(model, basis):
     from fretwear.wear import WearOptions, simulate_wear
 
     t0 = time.perf_counter()
-    r = simulate_wear(model, basis, omega=2 * np.pi, quasi_static=True,
+    r = simulate_wear(model, basis, frequency=1.0, quasi_static=True,
                       options=WearOptions(scheme="explicit", adaptive=False,
                                           initial_jump=REFERENCE_JUMP, max_cycles=N_QS,
                                           plateau_rate=0.0, max_steps=10**6),

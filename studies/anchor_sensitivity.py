@@ -38,15 +38,16 @@ def main():
              "preload + 1 um": a0 + 1e-6, "preload - 1 um": a0 - 1e-6,
              "preload + 5 um": a0 + 5e-6, "preload - 5 um": a0 - 5e-6}
     for f in freqs:
-        red = condense(model, 2 * np.pi * f, [0, *basis.harmonics])
+        red = condense(model, f, [0, *basis.harmonics])
         ref = None
         print(f"\nf = {f:g} Hz")
         print(f"{'anchors':20s} {'conv':>5s} {'|u_x1(Pe)| [m]':>15s} {'E_fric [J]':>11s} "
               f"{'mean x(Pe) [m]':>15s} {'stuck':>6s} {'d_amp':>8s} {'d_E':>8s}")
         for name, anc in rules.items():
-            sol, st = solve_periodic(model, basis, omega=2 * np.pi * f, reduced=red,
-                                     anchor=anc, solver="newton", max_iter=300)
-            if sol is None:
+            sol = solve_periodic(model, basis, frequency=f, reduced=red,
+                                 anchor=anc, solver="newton", max_iter=300)
+            st = sol.stats
+            if not sol.success:
                 print(f"{name:20s} {'no':>5s}   ({st.message}, residual {st.residual:.1e})")
                 continue
             amp, e, mean, stuck = describe(sol)

@@ -67,7 +67,7 @@ def continue_in_wear(sp, W0, dW, anchor, U0, *, tol, max_iter=60, ds_min=1e-7):
         Ux, st = sp.solve_balance(W0 + s1 * dW, anchor, sp.shift_guess(U, (s1 - s) * dW),
                                   solver="powell", tol=tol, max_iter=max_iter)
         its += st.iterations
-        if st.converged:
+        if st.success:
             s, U = s1, Ux
             if st.iterations <= 3:
                 ds *= 1.5
@@ -114,10 +114,10 @@ def main(argv=None) -> int:
         model = build_model(case)
         a = case.analysis
         basis = FourierBasis.up_to(int(a["harmonics"]), int(a["n_samples"]))
-        omega = 2.0 * np.pi * float(a["frequency"])
-        reduced = condense(model, omega, basis.orders)
+        f_hz = float(a["frequency"])
+        reduced = condense(model, f_hz, basis.orders)
         coef = wear_coefficients(model)
-        sp = SlowProblem(model, reduced, basis, coef, eps=a.get("eps"))
+        sp = SlowProblem(model, reduced, basis, coef, eps=a.get("eps", "auto"))
         U0 = np.asarray(h.U[k - 1], float).reshape(sp.m, sp.H)
         anchor = np.asarray(h.anchor[k - 1], float)
         W0 = np.asarray(h.wear_depth[k - 1], float)
@@ -139,12 +139,12 @@ def main(argv=None) -> int:
                 (f"{basis.n_samples} samples, tol {10 * tol:.0e}", sp, 10 * tol),
                 (f"{2 * basis.n_samples} samples, tol {tol:.0e}",
                  SlowProblem(model, reduced, FourierBasis(basis.harmonics, 2 * basis.n_samples),
-                             coef, eps=a.get("eps")), tol)):
+                             coef, eps=a.get("eps", "auto")), tol)):
             Ustart = U0
             if spx is not sp:  # the balance with the finer sampling at N0 first
                 Ustart, st = spx.solve_balance(W0, anchor, U0, solver="powell", tol=tolx,
                                                max_iter=400)
-                if not st.converged:
+                if not st.success:
                     print(f"  {label}: no balance at N0 ({st.message})")
                     continue
             s, Us, its, fails, wall = continue_in_wear(spx, W0, dW, anchor, Ustart, tol=tolx)
@@ -160,12 +160,12 @@ def main(argv=None) -> int:
             sp.set_state(W, anchor)
             g = sp.rate(Ub)
             Ut, Vt = initial_state(model, sp.solution(Ub, W, anchor, ok))
-            tr = time_averaged_rate(model, omega, basis, coef, W, U0=Ut, V0=Vt, settle=600,
+            tr = time_averaged_rate(model, f_hz, basis, coef, W, U0=Ut, V0=Vt, settle=600,
                                     average=200)
             print(f"  {label} = {N0 + s * (N1 - N0):.5g}: {tr.kind}; its wear rate differs from "
                   f"the balance's by {np.abs(tr.g - g).max() / g.max():.3f} of the largest rate")
             if label == "N*":  # and on to N1 from there
-                tr1 = time_averaged_rate(model, omega, basis, coef, W0 + dW, U0=tr.U_end,
+                tr1 = time_averaged_rate(model, f_hz, basis, coef, W0 + dW, U0=tr.U_end,
                                          V0=tr.V_end, settle=600, average=200)
                 print(f"  N1 = {N1:.5g} (continuing from N*): {tr1.kind}")
     return 0

@@ -192,7 +192,7 @@ class Study:
         key = (nx, tuple(basis.orders))
         if key not in self.reduced:
             model, _ = self.model(nx)
-            self.reduced = {key: condense(model, 2 * np.pi * FREQ, basis.orders)}
+            self.reduced = {key: condense(model, FREQ, basis.orders)}
         return self.reduced[key]
 
     def baseline_eps(self):
@@ -267,14 +267,17 @@ class Study:
         sol = None
         for name, start, solver, max_iter in attempts:
             U0 = None if start is None else self.embedded_base(basis, model)
-            sol, st = solve_periodic(model, basis, omega=2 * np.pi * FREQ, reduced=red,
-                                     eps=eps, anchor=anchor, U0=U0, solver=solver, tol=1e-9,
-                                     max_iter=max_iter)
-            tried.append({"start": name, "converged": bool(st.converged),
+            sol = solve_periodic(model, basis, frequency=FREQ, reduced=red,
+                                 eps=eps, anchor=anchor, U0=U0, solver=solver, tol=1e-9,
+                                 max_iter=max_iter)
+            st = sol.stats
+            tried.append({"start": name, "converged": bool(st.success),
                           "message": st.message, "residual": float(st.residual),
                           "iterations": int(st.iterations), "wall_s": float(st.wall_time)})
-            if sol is not None:
+            if sol.success:
                 break
+        if not sol.success:
+            sol = None  # the last iterate of a failed solve is no result
         rec = {"modes_near_79khz": self.modes_near(v["nx"]), "eps": float(eps),
                "rho_orders": [float(np.abs(np.linalg.eigvals(z)).max())
                                                  for z in red.Z],
@@ -317,7 +320,7 @@ class Study:
         alarm = _Alarm(cap_s)
         try:
             with alarm:
-                r = simulate_wear(model, basis, omega=2 * np.pi * FREQ, reduced=red, eps=eps,
+                r = simulate_wear(model, basis, frequency=FREQ, reduced=red, eps=eps,
                                   anchor=anchor, U0=sol.U, options=opts, checkpoint=ckpt,
                                   resume=True)
         except KeyboardInterrupt:

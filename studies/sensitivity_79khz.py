@@ -54,7 +54,7 @@ PERTURBATION = 1e-12
 CHUNK = 50  # periods per integration call of the fast twins (recorded in full, then thinned)
 
 
-def period_starts(model, omega, U0, V0, wear, periods, steps):
+def period_starts(model, frequency, U0, V0, wear, periods, steps):
     """Contact displacements at the start of every period (periods, nc * d) and the peak-to-peak
     contact motion over the last chunk [m]."""
     import numpy as np
@@ -65,7 +65,7 @@ def period_starts(model, omega, U0, V0, wear, periods, steps):
     done = 0
     while done < periods:
         n = min(CHUNK, periods - done)
-        r = integrate(model, omega, n_periods=n, steps_per_period=steps, record=n, U0=U, V0=V,
+        r = integrate(model, frequency, n_periods=n, steps_per_period=steps, record=n, U0=U, V0=V,
                       wear=wear)
         x = r.u_loc.reshape(r.u_loc.shape[0], -1)
         out.append(x[::steps])
@@ -107,12 +107,12 @@ def fast_twins(folder: Path, periods: int) -> None:
     case = load_case(folder / "case.toml")
     model = build_model(case)
     a = case.analysis
-    omega = 2.0 * np.pi * float(a["frequency"])
+    f_hz = float(a["frequency"])
     basis = FourierBasis.up_to(int(a["harmonics"]), int(a["n_samples"]))
     steps = default_steps(basis, a.get("time_domain_steps"))
     t0 = time.perf_counter()
-    xa, ptp = period_starts(model, omega, U0, V0, W, periods, steps)
-    xb, _ = period_starts(model, omega, U0, V0 * (1 + PERTURBATION), W, periods, steps)
+    xa, ptp = period_starts(model, f_hz, U0, V0, W, periods, steps)
+    xb, _ = period_starts(model, f_hz, U0, V0 * (1 + PERTURBATION), W, periods, steps)
     d = np.abs(xa - xb).max(axis=1) / ptp
     print(f"fast twins ({periods} periods each, {time.perf_counter() - t0:.1f} s): distance / "
           f"peak-to-peak contact motion ({ptp:.3g} m) after n periods")
@@ -126,9 +126,9 @@ def fast_twins(folder: Path, periods: int) -> None:
               f" periods): largest Lyapunov exponent > 0")
     coef = wear_coefficients(model)
     area = np.asarray(model.contact.area, float)
-    ga = time_averaged_rate(model, omega, basis, coef, W, U0=U0, V0=V0)
-    gb = time_averaged_rate(model, omega, basis, coef, W, U0=U0, V0=V0 * (1 + PERTURBATION))
-    ga2 = time_averaged_rate(model, omega, basis, coef, W, U0=ga.U_end, V0=ga.V_end, settle=0)
+    ga = time_averaged_rate(model, f_hz, basis, coef, W, U0=U0, V0=V0)
+    gb = time_averaged_rate(model, f_hz, basis, coef, W, U0=U0, V0=V0 * (1 + PERTURBATION))
+    ga2 = time_averaged_rate(model, f_hz, basis, coef, W, U0=ga.U_end, V0=ga.V_end, settle=0)
 
     def diff(g1, g2):
         return (f"{np.abs(g1.g - g2.g).max() / g1.g.max():.3f} of the largest node rate, "

@@ -140,9 +140,12 @@ def unworn(model, basis) -> tuple[dict, object]:
     from fretwear.hb.periodic import solve_periodic
 
     t0 = time.perf_counter()
-    sol, st = solve_periodic(model, basis, omega=2 * np.pi * F_HZ)
-    d = {"converged": bool(st.converged), "iterations": int(st.iterations),
+    sol = solve_periodic(model, basis, frequency=F_HZ)
+    st = sol.stats
+    d = {"converged": bool(st.success), "iterations": int(st.iterations),
          "wall_s": time.perf_counter() - t0, "message": st.message}
+    if not sol.success:
+        sol = None  # the last iterate of a failed solve is no result
     if sol is not None:
         c = sol.observed["Pe"][0]
         d.update(amp_ux=float(np.hypot(c[1], c[1 + basis.k])),
@@ -192,7 +195,7 @@ def wear_run(name, model, basis, max_cycles, wall_budget, work: Path, fresh: boo
 
     stop = ""
     try:
-        r = simulate_wear(model, basis, omega=2 * np.pi * F_HZ, options=opts,
+        r = simulate_wear(model, basis, frequency=F_HZ, options=opts,
                           checkpoint=ckpt, resume=True, callback=log)
         hist, stop, msg = r.history, r.stop_reason, r.message
     except ConvergenceError as exc:

@@ -515,14 +515,14 @@ def real_blocks(Zc, k):
     return out.reshape(m * H, m * H)
 
 
-def problem_at(d, keys, omega=3.0):
+def problem_at(d, keys, frequency=3.0 / (2 * np.pi)):
     """A DLFTProblem on ``chain_model`` and a point U at which lambda_u of node p equals the
     test signal ``keys[p]`` (U from (eps I - Z) U = lambda_u - F + eps W, eps = 2 x spectral
     radius so that eps I - Z is invertible)."""
     nc = len(keys)
     model = chain_model(d, nc)
     basis = FourierBasis(HARM, NS)
-    red = condense(model, omega, [0, *HARM])
+    red = condense(model, frequency, [0, *HARM])
     eps = 2.0 * red.spectral_radius()
     scale = 1e3  # forces of order 1e3 N
     anchors = np.array([case(k)[2][0] for k in keys]) * scale / eps  # eps X_a = x_start

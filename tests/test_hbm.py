@@ -69,8 +69,9 @@ def solve_sequence(model, nhs, per=16, **kw):
     for nh in nhs:
         b = basis_for(nh, per)
         U0 = None if prev is None else embed(prev.U, prev.basis, b)
-        sol, st = solve_periodic(model, b, U0=U0, **kw)
-        assert sol is not None, f"Nh = {nh}: {st.message} (residual {st.residual:.3g})"
+        sol = solve_periodic(model, b, U0=U0, **kw)
+        st = sol.stats
+        assert sol.success, f"Nh = {nh}: {st.message} (residual {st.residual:.3g})"
         sols[nh] = prev = sol
     return sols
 
@@ -175,7 +176,7 @@ def test_den_hartog_oscillator(zeta):
     1.5 %, 0.75 % for zeta = 2 %). Asserted: strictly decreasing errors, first-order rate
     0.15 <= err (Nh + 1) <= 0.45 for Nh >= 3, and < 1 % at Nh = 31."""
     model, w, ref = den_hartog_case(zeta)
-    sols = solve_sequence(model, NH_SEQ, omega=w, tol=1e-10)
+    sols = solve_sequence(model, NH_SEQ, frequency=w / (2 * np.pi), tol=1e-10)
     err_a, err_e = [], []
     for sol in sols.values():
         k = sol.basis.k
@@ -195,8 +196,9 @@ def test_den_hartog_from_default_initial_guess():
     """Same problem as test_den_hartog_oscillator (zeta = 2 %) solved directly with
     Nh = 15 from solve_periodic's default initial guess."""
     model, w, ref = den_hartog_case(0.02)
-    sol, st = solve_periodic(model, basis_for(15), omega=w, tol=1e-10)
-    assert st.converged, st.message
+    sol = solve_periodic(model, basis_for(15), frequency=w / (2 * np.pi), tol=1e-10)
+    st = sol.stats
+    assert st.success, st.message
 
 
 # --------------------------------------------------------------------------------------------
@@ -262,8 +264,9 @@ def test_jenkins_quasi_static_hysteresis(F0, phase, condensed):
     closed = 4 * R * (F - R) / k
     for nh in (1, 7, 31):
         b = basis_for(nh)
-        sol, st = solve_periodic(model, b, quasi_static=True, tol=1e-10)
-        assert sol is not None, st.message
+        sol = solve_periodic(model, b, quasi_static=True, tol=1e-10)
+        st = sol.stats
+        assert sol.success, st.message
         Fn = F * np.cos(b.tau + phase)
         sampled = 2 * R * (Fn.max() - Fn.min() - 2 * R) / k
         E = sol.friction_energy().sum()
@@ -290,9 +293,10 @@ def test_jenkins_full_stick(condensed):
     model, k, F = jenkins_model(F0, 0.3, condensed)
     for anchor in (None, 4e-6):  # k a = 8 N: 8 + 20 < 30
         b = basis_for(7)
-        sol, st = solve_periodic(model, b, quasi_static=True, tol=1e-10,
-                                 anchor=None if anchor is None else np.array([[anchor]]))
-        assert sol is not None, st.message
+        sol = solve_periodic(model, b, quasi_static=True, tol=1e-10,
+                             anchor=None if anchor is None else np.array([[anchor]]))
+        st = sol.stats
+        assert sol.success, st.message
         assert np.all(sol.state == law.STICK)
         assert sol.friction_energy().sum() == 0.0
         a = 0.0 if anchor is None else anchor
@@ -327,9 +331,8 @@ def fe_block(q_ratio=0.8):
 @pytest.fixture(scope="module")
 def block_sequence():
     model = fe_block()
-    w = 2 * np.pi * F_B
-    sols = solve_sequence(model, NH_SEQ, per=8, omega=w, tol=1e-11)
-    return model, w, sols
+    sols = solve_sequence(model, NH_SEQ, per=8, frequency=F_B, tol=1e-11)
+    return model, F_B, sols
 
 
 def energies(model, sol):
@@ -345,7 +348,7 @@ def energies(model, sol):
     T = 2 * np.pi / w
     orders = np.array([0, *b.harmonics])
     uloc = b.to_complex(sol.U.reshape(-1, b.size))  # (k+1, m)
-    U = recover(model, w, orders, uloc)  # (k+1, ndof)
+    U = recover(model, sol.frequency, orders, uloc)  # (k+1, ndof)
     V = 1j * (orders * w)[:, None] * U
     F = model.load_harmonics(int(orders.max()))[orders]
     w_ext = T / 2 * np.sum((F * V.conj()).real)
@@ -372,13 +375,13 @@ def test_fe_energy_balance(block_sequence):
         matters.
     The observed point's harmonics (PeriodicSolution.observed, from the condensation's
     recovery rows) are checked against the recovered full field on the way (1e-10)."""
-    model, w, sols = block_sequence
+    model, f, sols = block_sequence
     errs = []
     pe_dofs = model.observed_point("Pe").dofs
     for sol in sols.values():
         # the observed point's harmonics (condensation's recovery rows) = the full field
         b = sol.basis
-        U = recover(model, w, [0, *b.harmonics], b.to_complex(sol.U.reshape(-1, b.size)))
+        U = recover(model, f, [0, *b.harmonics], b.to_complex(sol.U.reshape(-1, b.size)))
         np.testing.assert_allclose(b.to_complex(sol.observed["Pe"]), U[:, pe_dofs], rtol=0,
                                    atol=1e-10 * np.abs(U[:, pe_dofs]).max())
         w_ext, w_visc, w_fric, w_contact = energies(model, sol)
@@ -399,7 +402,7 @@ def test_fe_convergence_in_harmonics(block_sequence):
     monotone, last < 4e-3 and first / last > 20. The convergence is slow and not geometric
     (the slip zone edge moves between samples); docs/verification.md gives the errors
     against an Nh = 63 solution."""
-    model, w, sols = block_sequence
+    model, f, sols = block_sequence
     E = np.array([s.friction_energy().sum() for s in sols.values()])
     dE = np.abs(np.diff(E)) / E[-1]
     assert np.all(np.diff(dE) < 0), dE
@@ -425,18 +428,19 @@ def test_fe_eps_independence(block_sequence, nh, bound):
     the docs, asserted > 2 %): the dependence on eps is a truncation effect that fades as
     the harmonics converge (section 3 of the method notes). The solution does not depend on
     the starting point (checked while writing this test: three starts agree to 1e-13)."""
-    model, w, sols = block_sequence
+    model, f, sols = block_sequence
     out = {}
     for n in (1, nh):
         base = sols[n]
         b = base.basis
-        red = condense(model, w, [0, *b.harmonics])
+        red = condense(model, f, [0, *b.harmonics])
         rho = red.spectral_radius()
         res = []
         for fac in (0.1, 1.0, 10.0):
-            sol, st = solve_periodic(model, b, omega=w, reduced=red, eps=fac * rho,
-                                     U0=base.U, tol=1e-11)
-            assert sol is not None, st.message
+            sol = solve_periodic(model, b, frequency=f, reduced=red, eps=fac * rho,
+                                 U0=base.U, tol=1e-11)
+            st = sol.stats
+            assert sol.success, st.message
             res.append((sol.U[:, :, [0, 1, 1 + b.k]], sol.friction_energy().sum()))
         u_ref, e_ref = res[1]
         du = max(np.abs(u - u_ref).max() for u, _ in res) / np.abs(u_ref[:, :, 1:]).max()
@@ -452,13 +456,14 @@ def test_solvers_agree(block_sequence):
     balance to |f| <= 1e-11 |Z U|, so two solutions may differ by ~cond(J) x 1e-11 (cond(J)
     < 1e4 here): asserted 1e-7 of max |U|; measured 1e-15 (powell 7, newton 5, hybr 53
     iterations)."""
-    model, w, _ = block_sequence
+    model, f, _ = block_sequence
     b = basis_for(7, per=8)
-    red = condense(model, w, [0, *b.harmonics])
+    red = condense(model, f, [0, *b.harmonics])
     U = {}
     for solver in ("powell", "newton", "hybr"):
-        sol, st = solve_periodic(model, b, omega=w, reduced=red, solver=solver, tol=1e-11)
-        assert sol is not None and st.converged and st.solver == solver, st.message
+        sol = solve_periodic(model, b, frequency=f, reduced=red, solver=solver, tol=1e-11)
+        st = sol.stats
+        assert sol.success and st.success and st.solver == solver, st.message
         assert st.residual <= 1e-11
         U[solver] = sol.U
     scale = np.abs(U["powell"]).max()
@@ -467,19 +472,20 @@ def test_solvers_agree(block_sequence):
 
 
 @pytest.mark.parametrize("solver", ["powell", "newton", "hybr"])
-def test_failed_solve_returns_none(block_sequence, solver):
-    """One iteration is not enough: solve_periodic returns (None, stats) with
-    converged=False, a residual above the tolerance and a message saying why; with
+def test_failed_solve_says_so(block_sequence, solver):
+    """One iteration is not enough: solve_periodic returns the last iterate with
+    success=False, a residual above the tolerance and a message saying why; with
     raise_on_failure it raises ConvergenceError instead."""
-    model, w, _ = block_sequence
+    model, f, _ = block_sequence
     b = basis_for(7, per=8)
-    sol, st = solve_periodic(model, b, omega=w, solver=solver, tol=1e-11, max_iter=1)
-    assert sol is None
-    assert st.converged is False
+    sol = solve_periodic(model, b, frequency=f, solver=solver, tol=1e-11, max_iter=1)
+    st = sol.stats
+    assert sol.success is False and sol.message == st.message
+    assert st.success is False
     assert st.residual > 1e-11
     assert isinstance(st.message, str) and st.message and st.message != "converged"
     with pytest.raises(ConvergenceError):
-        solve_periodic(model, b, omega=w, solver=solver, tol=1e-11, max_iter=1,
+        solve_periodic(model, b, frequency=f, solver=solver, tol=1e-11, max_iter=1,
                        raise_on_failure=True)
 
 
@@ -527,8 +533,9 @@ def global_friction(sol, model):
 @pytest.fixture(scope="module")
 def block_3d_45():
     model = block_3d(45.0)
-    sol, st = solve_periodic(model, basis_for(7, per=8), quasi_static=True, tol=1e-11)
-    assert sol is not None, st.message
+    sol = solve_periodic(model, basis_for(7, per=8), quasi_static=True, tol=1e-11)
+    st = sol.stats
+    assert sol.success, st.message
     return model, sol
 
 
@@ -578,8 +585,9 @@ def test_3d_gross_slip_follows_load_direction():
     magnitude is mu sum(lambda_N) within 1e-3. A friction law that is not isotropic would
     pull the force towards its preferred directions (45 deg for a square law: 15 deg off)."""
     model = block_3d(30.0)
-    sol, st = solve_periodic(model, basis_for(7, per=8), quasi_static=True, tol=1e-11)
-    assert sol is not None, st.message
+    sol = solve_periodic(model, basis_for(7, per=8), quasi_static=True, tol=1e-11)
+    st = sol.stats
+    assert sol.success, st.message
     lam = check_cone(sol, MU_B)
     full = np.all(sol.state == law.SLIP, axis=0)
     assert full.sum() >= 8
@@ -595,6 +603,7 @@ def test_3d_poisson_preload():
     outwards, beyond the cone of their zero anchor. Expected: a converged, symmetric
     solution whose forces lie in the cone (as with nu = 0)."""
     model = block_3d(45.0, nu=0.3)
-    sol, st = solve_periodic(model, basis_for(3, per=8), quasi_static=True, tol=1e-10)
-    assert sol is not None, st.message
+    sol = solve_periodic(model, basis_for(3, per=8), quasi_static=True, tol=1e-10)
+    st = sol.stats
+    assert sol.success, st.message
     check_cone(sol, MU_B)

@@ -17,6 +17,7 @@ from fretwear.timedomain.stability import check_periodic, time_domain_start
 
 M_, K_, KN, N0, F0, ZETA = 1.0, 1e4, 1e6, 10.0, 20.0, 0.05
 MU = 0.3  # mu N0 / F0 = 0.15: continuous slip
+F_HZ = 0.7 * np.sqrt(K_ / M_) / (2 * np.pi)  # forcing frequency [Hz], below the resonance
 
 
 def oscillator() -> Model:
@@ -38,8 +39,9 @@ def test_initial_state_reproduces_the_periodic_solution():
     operator for the velocity): exact up to rounding."""
     model = oscillator()
     basis = FourierBasis.up_to(7, 64)
-    sol, st = solve_periodic(model, basis, omega=0.7 * np.sqrt(K_ / M_))
-    assert st.converged
+    sol = solve_periodic(model, basis, frequency=F_HZ)
+    st = sol.stats
+    assert st.success
     U0, V0 = initial_state(model, sol)
     u, v = sol.observed_time("x")
     assert abs(U0[1] - u[0, 0]) <= 1e-12 * np.abs(u).max()
@@ -53,8 +55,9 @@ def test_attracting_steady_state_is_reported_stable():
     Den Hartog table), and far below what another state would give."""
     model = oscillator()
     basis = FourierBasis.up_to(7, 64)
-    sol, st = solve_periodic(model, basis, omega=0.7 * np.sqrt(K_ / M_))
-    assert st.converged
+    sol = solve_periodic(model, basis, frequency=F_HZ)
+    st = sol.stats
+    assert st.success
     chk = check_periodic(model, sol, max_periods=2000, steps_per_period=512)
     assert chk.verdict == "stable", chk
     assert chk.distance < 0.1
@@ -67,8 +70,8 @@ def test_time_domain_start_gives_a_converging_start():
     error, ~3 %, which Newton removes in one step on this smooth-in-slip problem)."""
     model = oscillator()
     basis = FourierBasis.up_to(7, 64)
-    omega = 0.7 * np.sqrt(K_ / M_)
-    msg, U0, anchor = time_domain_start(model, omega, basis, max_periods=2000)
+    msg, U0, anchor = time_domain_start(model, F_HZ, basis, max_periods=2000)
     assert msg.startswith("time integration: periodic"), msg
-    sol, st = solve_periodic(model, basis, omega=omega, U0=U0, anchor=anchor)
-    assert st.converged and st.iterations <= 3
+    sol = solve_periodic(model, basis, frequency=F_HZ, U0=U0, anchor=anchor)
+    st = sol.stats
+    assert st.success and st.iterations <= 3

@@ -21,6 +21,12 @@ from fretwear.model.core import ContactInterface, Load, Model, ObservedPoint
 from fretwear.timedomain import integrate as tr
 
 
+def hz(w: float) -> float:
+    """The frequency [Hz] of the circular frequency ``w`` [rad/s] (the references of this file
+    are written in ``w``; the solvers take Hz)."""
+    return w / (2 * np.pi)
+
+
 # --------------------------------------------------------------------------------------------
 # models
 # --------------------------------------------------------------------------------------------
@@ -194,7 +200,7 @@ def test_den_hartog_continuous_slip(r):
     w = r
     N = 1024
     model = slider(mu=Ff, N=1.0)
-    res = tr.integrate(model, w, n_periods=200, steps_per_period=N)
+    res = tr.integrate(model, hz(w), n_periods=200, steps_per_period=N)
     xa, va, X = den_hartog(res.t, m=m, k=k, Ff=Ff, F0=F0, w=w)
     # the analytic solution has no stops: the velocity changes sign twice per period only
     tt = np.linspace(0, 2 * np.pi / w, 4001)[:-1]
@@ -226,7 +232,7 @@ def test_stick_slip_with_stops_vs_event_driven(Ff):
     n = 25
     T = 2 * np.pi / w
     h = T / N
-    res = tr.integrate(slider(mu=Ff), w, n_periods=n, steps_per_period=N)
+    res = tr.integrate(slider(mu=Ff), hz(w), n_periods=n, steps_per_period=N)
     ref, sticks = event_driven(m=m, k=k, Ff=Ff, F0=F0, w=w, t_end=n * T + 1e-9, t_eval=res.t)
     last = [s for s in sticks if s[0] > (n - 1) * T]
     assert len(last) == 2  # two stops per period: a genuine stick-slip case
@@ -255,7 +261,7 @@ def test_3d_rotating_force_circular_slip():
     X = np.sqrt(F0**2 - (mu * N) ** 2) / abs(k - m * w * w)
     errs = []
     for steps in (128, 256):
-        res = tr.integrate(slider3d(mu=mu), w, n_periods=150, steps_per_period=steps)
+        res = tr.integrate(slider3d(mu=mu), hz(w), n_periods=150, steps_per_period=steps)
         rad = np.hypot(*res.observed["x"].T)
         err = np.max(np.abs(rad / X - 1))
         lag = mu * N * (w * 2 * np.pi / (w * steps) / 2) / np.sqrt(F0**2 - (mu * N) ** 2)
@@ -284,7 +290,7 @@ def test_energy_conserved_without_friction_and_damping():
         model = chain(mu=0.0, gap=1.0, N=0.0, F=0.0)
         V0 = np.zeros(model.ndof)
         V0[5] = 1e-3
-        res = tr.integrate(model, 1.0, n_periods=200, steps_per_period=64, V0=V0, record=200,
+        res = tr.integrate(model, hz(1.0), n_periods=200, steps_per_period=64, V0=V0, record=200,
                            modal_cutoff=cut)
         E = res.energy["mechanical"]
         assert np.all(res.state == 0)
@@ -293,7 +299,7 @@ def test_energy_conserved_without_friction_and_damping():
     V0 = np.zeros(model.ndof)
     V0[1:4] = 1e-3
     V0[0] = 1e-3  # the contact node moves towards the obstacle
-    res = tr.integrate(model, 1.0, n_periods=50, steps_per_period=64, V0=V0, record=50)
+    res = tr.integrate(model, hz(1.0), n_periods=50, steps_per_period=64, V0=V0, record=50)
     E = res.energy["mechanical"]
     wn = np.diff(res.energy["normal"])
     assert np.any(res.state > 0)  # it hits
@@ -319,7 +325,7 @@ def test_energy_balance_with_friction_and_damping():
     """
     model = chain(mu=0.3, N=1.0, F=1.5, c_a=1e-2, c_b=2e-2)
     steps = 256
-    res = tr.integrate(model, 0.5, n_periods=300, steps_per_period=steps, record=2)
+    res = tr.integrate(model, hz(0.5), n_periods=300, steps_per_period=steps, record=2)
     assert res.info["diagonal"] and res.info["damping"]["low_rank"] == 1
     assert np.any(res.state[:, 0] == 1) and np.any(res.state[:, 0] == 2)  # stick and slip
     e = {key: val[steps] - val[0] for key, val in res.energy.items()}  # over one period
@@ -400,7 +406,7 @@ def _check_linear_limit(model):
     f[-1] = 1.0
     u = np.linalg.solve(Z[np.ix_(keep, keep)], f[keep])[-1]
     for cut, tol in (("all", 1e-9), (None, 1.0 / 64)):
-        res = tr.integrate(model, w, n_periods=400, steps_per_period=steps, modal_cutoff=cut)
+        res = tr.integrate(model, hz(w), n_periods=400, steps_per_period=steps, modal_cutoff=cut)
         c = tr.fourier_coefficients(res.observed["end"][:, 0], 3)
         assert abs((c[1] - 1j * c[4]) / u - 1) < tol
     assert res.info["r"] < model.ndof  # the default did truncate
@@ -411,9 +417,9 @@ def test_restart_is_exact():
     """Two runs of 15 periods chained through ``U, V`` equal one run of 30 periods to
     round-off (the final state encodes the two-step history exactly)."""
     model = chain(mu=0.3, N=2.0, F=1.5, c_a=2e-3)
-    a = tr.integrate(model, 1.2, n_periods=30, steps_per_period=64)
-    b = tr.integrate(model, 1.2, n_periods=15, steps_per_period=64)
-    b = tr.integrate(model, 1.2, n_periods=15, steps_per_period=64, U0=b.U, V0=b.V)
+    a = tr.integrate(model, hz(1.2), n_periods=30, steps_per_period=64)
+    b = tr.integrate(model, hz(1.2), n_periods=15, steps_per_period=64)
+    b = tr.integrate(model, hz(1.2), n_periods=15, steps_per_period=64, U0=b.U, V0=b.V)
     scale = np.abs(a.U).max()
     np.testing.assert_allclose(b.U, a.U, atol=1e-9 * scale)
     np.testing.assert_allclose(b.observed["end"], a.observed["end"], atol=1e-9 * scale)
@@ -547,8 +553,8 @@ def test_steady_state_classifies_real_responses():
     """
     m = k = F0 = 1.0
     Ff, w = 0.5, 0.5
-    ss = tr.steady_state(slider(mu=Ff), w, steps_per_period=512, tol=1e-8)
-    assert ss.classification == "periodic" and ss.converged
+    ss = tr.steady_state(slider(mu=Ff), hz(w), steps_per_period=512, tol=1e-8)
+    assert ss.classification == "periodic" and ss.periodic and ss.success, ss.message
     T = 2 * np.pi / w
     n = ss.n_periods
     ref, _ = event_driven(m=m, k=k, Ff=Ff, F0=F0, w=w, t_end=n * T + 1e-9, t_eval=ss.last.t)
@@ -564,7 +570,7 @@ def test_steady_state_classifies_real_responses():
     loads = [Load(np.array([1.0, 0.3]), "constant"), Load(np.array([0.6, 0.0]), "cos")]
     rat = Model(K=Kd, M=sp.identity(2, format="csr"), contact=contact, loads=loads,
                 observed=[ObservedPoint("x", np.array([1]), np.zeros(1))])
-    ss = tr.steady_state(rat, 1.0, steps_per_period=64, min_periods=64, check_every=32)
+    ss = tr.steady_state(rat, hz(1.0), steps_per_period=64, min_periods=64, check_every=32)
     assert ss.classification == "drifting"
     assert ss.diagnostics.drift_rate > 0
 
@@ -573,7 +579,7 @@ def test_steady_state_classifies_real_responses():
     model = chain(n=1, k=1.0, kg=0.0, mu=10.0, N=1.0, F=0.5)
     V0 = np.zeros(model.ndof)
     V0[2] = 0.2
-    ss = tr.steady_state(model, wq, steps_per_period=64, V0=V0, min_periods=64, max_periods=600)
+    ss = tr.steady_state(model, hz(wq), steps_per_period=64, V0=V0, min_periods=64, max_periods=600)
     assert ss.classification == "quasi-periodic"
     assert np.all(ss.last.state == 1)
     nu = np.mod(1.0 / wq, 1.0)
@@ -590,7 +596,7 @@ def test_bad_inputs_are_reported():
         tr.integrate(model, 1.0, n_periods=2, record=3)
     with pytest.raises(InputError, match="modal_cutoff"):
         tr.integrate(model, 1.0, n_periods=1, modal_cutoff="some")
-    with pytest.raises(InputError, match="omega"):
+    with pytest.raises(InputError, match="frequency"):
         tr.integrate(model, -1.0, n_periods=1)
     with pytest.raises(InputError, match="wear"):
         tr.integrate(model, 1.0, n_periods=1, wear=[0.0, 1.0])

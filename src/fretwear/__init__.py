@@ -7,13 +7,17 @@ slow-time steps, time-domain reference solvers).
 The public API, stage by stage (data flows one way; each stage returns a plain data object)::
 
     model = fretwear.rectangle(...) / fretwear.from_mesh(...) / fretwear.from_matrices(...)
-    red   = fretwear.condense(model, omega, basis.orders)      # Reduced: Z_r per harmonic
-    sol, stats = fretwear.solve_periodic(model, basis, omega=...)   # PeriodicSolution
-    frf   = fretwear.sweep(model, basis, f_min, f_max, n)      # SweepResult
-    wear  = fretwear.simulate_wear(model, basis, omega=...)    # WearResult
-    run   = fretwear.integrate(model, omega, n_periods=...)    # TransientResult
-    out   = fretwear.run_case("case.toml", "out/")             # a case file end to end
-    ds    = fretwear.read_results("out/results.nc")            # an xarray Dataset
+    red   = fretwear.condense(model, frequency, basis.orders)     # Reduced: Z_r per harmonic
+    sol   = fretwear.solve_periodic(model, basis, frequency=...)  # PeriodicSolution
+    frf   = fretwear.sweep(model, basis, f_min, f_max, n)         # SweepResult
+    wear  = fretwear.simulate_wear(model, basis, frequency=...)   # WearResult
+    run   = fretwear.integrate(model, frequency, n_periods=...)   # TransientResult
+    out   = fretwear.run_case("case.toml", "out/")                # a case file end to end
+    ds    = fretwear.read_results("out/results.nc")               # an xarray Dataset
+
+Every frequency argument is in Hz (``frequency``, ``f_min``, ``f_max``); objects also keep
+the circular frequency ``omega = 2 pi frequency`` [rad/s] where the equations use it. Every
+result has ``success`` (bool) and ``message`` (str), as :class:`scipy.optimize.OptimizeResult`.
 
 Names are loaded on first use, so ``import fretwear`` stays light (the command line sets its
 BLAS threads before numpy loads). ``docs/api.md`` has runnable examples.

@@ -22,22 +22,54 @@ def _fallback(time_domain: bool):
 
 def sweep(model, basis, f_min: float, f_max: float, n_points: int, *, time_domain: bool = True,
           **kwargs) -> _sweep.SweepResult:
-    """Nonlinear FRF from ``f_min`` to ``f_max`` [Hz]: :func:`fretwear.hb.sweep.sweep` with the
-    time-domain fallback at points whose balance fails (``time_domain=True``, as the case-file
-    key ``time_domain`` of a sweep)."""
+    """Nonlinear FRF: periodic solutions of the DLFT from ``f_min`` to ``f_max`` [Hz] on
+    ``n_points`` grid frequencies, each starting from its neighbours (continuation).
+
+    :func:`fretwear.hb.sweep.sweep` (every other keyword: ``spacing``, ``gap`` [m], ``eps``
+    [N/m or "static"/"auto"], ``solver``, ``tol``, ``max_iter``, ``continuation``, ``check``,
+    ``time_domain_periods``, ...) with the time-domain fallback at points whose balance fails
+    (``time_domain=True``, as the case-file key ``time_domain`` of a sweep).
+
+    Returns
+    -------
+    :class:`~fretwear.hb.sweep.SweepResult`: ``success`` (every point converged),
+    ``message`` (how many did), ``points`` (each a :class:`~fretwear.hb.sweep.SweepPoint`
+    with ``frequency_hz`` [Hz], ``solution`` or None, ``success``, ``message``, ``flags``),
+    ``frequency_hz`` [Hz], ``point_success``, ``amplitude(point, axis)`` [m].
+    """
     return _sweep.sweep(model, basis, f_min, f_max, n_points,
                         time_domain=_fallback(time_domain), **kwargs)
 
 
 def simulate_wear(model, basis, *, time_domain: bool = True, **kwargs) -> _wear.WearResult:
-    """Fretting wear on the slow time scale: :func:`fretwear.wear.simulate.simulate_wear` with
-    the time-domain fallback of steps whose balance fails (``time_domain=True``; whether it
-    is used is ``options.time_domain_rescue``, default true, as in case files)."""
+    """Fretting wear on the slow time scale (paper section 3.3, eq. 29-30) at the excitation
+    ``frequency`` [Hz] (keyword, default 1 Hz) or ``quasi_static=True``.
+
+    :func:`fretwear.wear.simulate.simulate_wear` (every other keyword: ``frequency``,
+    ``quasi_static``, ``options`` (:class:`~fretwear.wear.options.WearOptions`), ``eps``,
+    ``W0`` [m], ``checkpoint``, ``resume``, ...) with the time-domain fallback of steps whose
+    balance fails (``time_domain=True``; whether it is used is
+    ``options.time_domain_rescue``, default true, as in case files).
+
+    Returns
+    -------
+    :class:`~fretwear.wear.history.WearResult`: ``success`` (False when a solve failed even
+    with smaller jumps), ``message`` (why and when it stopped), ``stop_reason``, ``history``
+    (one row per slow step: cycles, wear depth [m], pressure [Pa], slip [m], ...),
+    ``final_wear`` [m], ``initial`` and ``final`` periodic solutions (None where the rate came
+    from a time integration).
+    """
     return _wear.simulate_wear(model, basis, time_domain=_fallback(time_domain), **kwargs)
 
 
 def frf_worn(model, wear, frequencies_hz, basis, *, time_domain: bool = True, **kwargs):
-    """Nonlinear FRF with the worn gap (paper Fig. 24): :func:`fretwear.wear.worn_frf.frf_worn`
-    with the time-domain fallback (``time_domain=True``)."""
+    """Nonlinear FRF with the worn gap ``gap + wear`` (paper Fig. 24), ``wear`` (nc,) [m],
+    ``frequencies_hz = (f_min, f_max, n_points)`` [Hz]: :func:`fretwear.wear.worn_frf.frf_worn`
+    with the time-domain fallback (``time_domain=True``).
+
+    Returns
+    -------
+    :class:`~fretwear.hb.sweep.SweepResult` (``success``, ``message``, as :func:`sweep`).
+    """
     return _wear.frf_worn(model, wear, frequencies_hz, basis,
                           time_domain=_fallback(time_domain), **kwargs)

@@ -59,7 +59,7 @@ def _run(case: Path, outdir, resume: bool, progress: bool) -> int:
     from fretwear.analyses.run import run_case
 
     out = run_case(case, outdir=outdir, progress=progress, resume=resume)
-    return 0 if out.converged else 1
+    return 0 if out.success else 1
 
 
 def cmd_run(args) -> int:

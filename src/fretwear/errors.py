@@ -10,4 +10,6 @@ class InputError(FretwearError, ValueError):
 
 
 class ConvergenceError(FretwearError, RuntimeError):
-    """A solve that did not converge (never returned or saved as a result)."""
+    """A solve that did not converge where nothing can go on without it (or where the caller
+    asked for an exception, ``raise_on_failure``); results otherwise say so themselves
+    (``success`` False, ``message``) and a failed solve is never saved as a result."""

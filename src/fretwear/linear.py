@@ -257,7 +257,8 @@ def modes(model: Model, n_modes: int = 10, *, interface: str = "sliding",
 
     Returns
     -------
-    ModesResult
+    ModesResult: ``interface``, ``frequency_hz`` (nm,) natural frequencies [Hz], ``shapes``
+    (nm, ndof) mass-normalised mode shapes (a linear computation: no ``success`` to report).
     """
     _check_interface(interface)
     if f_max is None and n_modes < 1:
@@ -438,7 +439,7 @@ def _frf_condensed(model: Model, freqs: np.ndarray, interface: str):
     keep = np.flatnonzero(~held)
     obs, con, rea = [], [], []
     for f in freqs:
-        red = condense(model, 2.0 * np.pi * f, [1])
+        red = condense(model, f, [1])
         Z, Fr = red.Z[0], red.F[0]
         u = np.zeros(nc * d, dtype=complex)
         if keep.size:
@@ -467,7 +468,8 @@ def frf(model: Model, frequencies_hz, *, interface: str = "sliding",
 
     Returns
     -------
-    FRFResult
+    FRFResult: ``interface``, ``frequency_hz`` (nf,) [Hz], ``observed``: name -> (nf, d)
+    complex displacement amplitudes [m], contact displacements [m] and reactions [N].
     """
     _check_interface(interface)
     if method not in FRF_METHODS:

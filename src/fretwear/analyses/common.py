@@ -7,6 +7,8 @@ Figure functions shared by several analyses are in :mod:`fretwear.analyses.figur
 
 from __future__ import annotations
 
+import inspect
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -106,6 +108,17 @@ def period_coordinates(basis: FourierBasis) -> dict:
     }
 
 
+# --- defaults ------------------------------------------------------------------------------
+def default_of(func: Callable, name: str):
+    """The default of the keyword ``name`` of ``func``: the signature of the function an
+    analysis calls is the one definition of a case-file key's default (e.g.
+    ``default_of(solve_periodic, "tol")``)."""
+    param = inspect.signature(func).parameters[name]
+    if param.default is inspect.Parameter.empty:
+        raise ValueError(f"{func.__qualname__}() has no default for {name!r}")
+    return param.default
+
+
 # --- harmonic-balance keys of [analysis] tables --------------------------------------------
 def harmonic_list(value) -> list[int]:
     """Kept harmonics from the ``harmonics`` key: ``Nh`` -> ``[1..Nh]``, a list -> sorted."""
@@ -129,25 +142,38 @@ def check_sampling(out: dict, path: str) -> None:
              f"more than {2 * top} samples per period (twice the highest harmonic, {top})")
 
 
-def harmonic_balance_fields(eps_default: str, eps_doc: str, max_iter: int) -> dict:
-    """The keys of the DLFT analyses' tables (``harmonics``, ``n_samples``, ``eps``,
-    ``solver``, ``tol``, ``max_iter``) with the given ``eps`` default and description and
-    ``max_iter`` default."""
+def basis_fields() -> dict:
+    """The keys ``harmonics`` and ``n_samples`` of the Fourier basis, with the defaults of
+    :meth:`fretwear.hb.fourier.FourierBasis.up_to`."""
     return {
         "harmonics": Field(
             AnyOf((Integer(lo=1), ListOf(Integer(lo=1), non_empty=True, unique=True))),
             "kept harmonics: Nh keeps 1, 2, .., Nh; a list keeps those listed (e.g. [1, 3, 5])",
-            default=7),
+            default=default_of(FourierBasis.up_to, "nh")),
         "n_samples": Field(Integer(lo=3), "time samples per period N of the contact law "
-                           "(more than twice the highest harmonic)", default=128),
+                           "(more than twice the highest harmonic)",
+                           default=default_of(FourierBasis.up_to, "n_samples")),
+    }
+
+
+def harmonic_balance_fields(func: Callable, eps_doc: str) -> dict:
+    """The keys of the DLFT analyses' tables (``harmonics``, ``n_samples``, ``eps``,
+    ``solver``, ``tol``, ``max_iter``) with the ``eps`` description ``eps_doc``; the defaults
+    are those of the keywords of ``func``, the function the analysis calls
+    (:func:`fretwear.hb.periodic.solve_periodic`, :func:`fretwear.hb.sweep.sweep`), and of
+    :meth:`~fretwear.hb.fourier.FourierBasis.up_to`."""
+    return {
+        **basis_fields(),
         "eps": Field(AnyOf((Text(RULES), Number(lo=0, lo_open=True))), eps_doc,
-                     default=eps_default, unit="N/m"),
+                     default=default_of(func, "eps"), unit="N/m"),
         "solver": Field(Text(SOLVERS), '"powell" (hybrid dog-leg, LAPACK), "newton" (damped '
-                        'Newton) or "hybr" (MINPACK hybrj, as in the paper)', default="powell"),
+                        'Newton) or "hybr" (MINPACK hybrj, as in the paper)',
+                        default=default_of(func, "solver")),
         "tol": Field(Number(lo=0, lo_open=True), "relative residual of the convergence test "
-                     "|f(U)| <= tol |Z_r U| (paper section 3.2)", default=1e-8, unit="-"),
+                     "|f(U)| <= tol |Z_r U| (paper section 3.2)", default=default_of(func, "tol"),
+                     unit="-"),
         "max_iter": Field(Integer(lo=1), "maximum solver iterations per frequency",
-                          default=max_iter),
+                          default=default_of(func, "max_iter")),
     }
 
 

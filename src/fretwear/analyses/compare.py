@@ -186,14 +186,17 @@ def compare_periodic(model, analysis: dict, outdir: Path | None, *, steps_per_pe
         raise InputError("compare: a quasi-static periodic case has no time-domain dynamic "
                          "counterpart; give a frequency (or a quasi-static wear case)")
     basis = basis_of(analysis)
-    omega = 2 * np.pi * float(analysis["frequency"])
+    f_hz = float(analysis["frequency"])
     t0 = time.perf_counter()
-    reduced = condense(model, omega, basis.orders)
-    sol, stats = solve_periodic(model, basis, omega=omega, reduced=reduced, eps=analysis["eps"],
-                                solver=analysis["solver"], tol=analysis["tol"],
-                                max_iter=analysis["max_iter"])
+    reduced = condense(model, f_hz, basis.orders)
+    sol = solve_periodic(model, basis, frequency=f_hz, reduced=reduced, eps=analysis["eps"],
+                         solver=analysis["solver"], tol=analysis["tol"],
+                         max_iter=analysis["max_iter"])
+    stats = sol.stats
+    if not sol.success:  # a failed solve is never compared (its last iterate is no result)
+        sol = None
     t_dlft = time.perf_counter() - t0
-    ss = steady_state(model, omega, max_periods=max_periods, steps_per_period=steps_per_period,
+    ss = steady_state(model, f_hz, max_periods=max_periods, steps_per_period=steps_per_period,
                       harmonics=max(basis.harmonics))
     out = Comparison(periodic_rows(model, sol, ss), ss.classification, sol is not None,
                      {"DLFT": t_dlft, "time domain": ss.wall_time})
@@ -220,7 +223,7 @@ def _reference_jump(n_cycles: int, stability_jump: float) -> int:
 def compare_wear(model, analysis: dict, outdir: Path | None, *, steps_per_cycle: int = 128,
                  title: str | None = None) -> Comparison:
     """DLFT wear against incremental wear at the DLFT run's final cycle count."""
-    from fretwear.analyses.wear import options_from_table
+    from fretwear.analyses.wear import options_from_table, penalty_of
     from fretwear.wear import simulate_wear
 
     if not analysis.get("quasi_static"):
@@ -228,7 +231,7 @@ def compare_wear(model, analysis: dict, outdir: Path | None, *, steps_per_cycle:
                          "quasi_static = true in the wear case")
     basis = basis_of(analysis)
     res = simulate_wear(model, basis, quasi_static=True, options=options_from_table(analysis),
-                        eps=analysis.get("eps"))
+                        **penalty_of(analysis))
     n = int(round(float(res.history.cycles[-1])))
     jump = _reference_jump(n, res.stability_jump)
     inc = incremental_wear(model, steps_per_cycle=steps_per_cycle, n_cycles=max(n, 1),
@@ -239,7 +242,7 @@ def compare_wear(model, analysis: dict, outdir: Path | None, *, steps_per_cycle:
             ("worn volume [m^3]", w_d @ area, w_t @ area, relative(w_d @ area, w_t @ area)),
             ("profile: max |dW| / max W [-]", 0.0, float(np.abs(w_t - w_d).max() / w_t.max()),
              math.nan)]
-    out = Comparison(rows, "", res.converged, {"DLFT wear": res.wall_time,
+    out = Comparison(rows, "", res.success, {"DLFT wear": res.wall_time,
                                                "incremental wear": inc.wall_time})
     out.notes.append(f"{n} cycles; DLFT {res.history.n_steps} slow steps ({res.stop_reason}); "
                      f"incremental {inc.computed_cycles} computed cycles x {steps_per_cycle} "

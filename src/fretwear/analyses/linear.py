@@ -15,7 +15,7 @@ from tqdm import tqdm
 
 from fretwear import linear
 from fretwear.analyses import figures as plots
-from fretwear.analyses.common import AXES, check_points, figure_path, geometry
+from fretwear.analyses.common import AXES, check_points, default_of, figure_path, geometry
 from fretwear.analyses.registry import RunOutput, register
 from fretwear.errors import InputError
 from fretwear.io.results import (
@@ -133,7 +133,8 @@ def _write_mode_files(mesh, r, outdir: Path, interface: str) -> Path:
 register(
     "modes",
     {
-        "n_modes": Field(Integer(lo=1), "number of lowest modes per interface", default=10),
+        "n_modes": Field(Integer(lo=1), "number of lowest modes per interface",
+                         default=default_of(linear.modes, "n_modes")),
         "f_max": Field(Number(lo=0, lo_open=True), "if given: every mode up to this frequency "
                        "(n_modes is then ignored)", unit="Hz"),
         "interfaces": _INTERFACES,
@@ -224,12 +225,14 @@ register(
         "f_min": Field(Number(lo=0, lo_open=True), "lowest frequency", required=True, unit="Hz"),
         "f_max": Field(Number(lo=0, lo_open=True), "highest frequency", required=True, unit="Hz"),
         "n_points": Field(Integer(lo=2), "number of frequencies", default=200),
-        "spacing": Field(Text(("log", "linear")), "frequency spacing", default="log"),
+        "spacing": Field(Text(("log", "linear")), "frequency spacing",
+                         default=default_of(linear.frequency_grid, "spacing")),
         "interfaces": _INTERFACES,
         "points": Field(ListOf(Text(), non_empty=True, unique=True),
                         "observed points to report (default: all)"),
         "method": Field(Text(linear.FRF_METHODS), '"direct" (sparse solve of the whole model) '
-                        'or "condensed" (on the contact DOFs); both exact', default="direct"),
+                        'or "condensed" (on the contact DOFs); both exact',
+                        default=default_of(linear.frf, "method")),
     },
     run_frf,
     checks=(increasing("f_min", "f_max", "Hz"),),

@@ -21,6 +21,7 @@ from fretwear.analyses.common import (
     STOP_TOL,
     basis_of,
     check_sampling,
+    default_of,
     figure_path,
     geometry,
     harmonic_balance_fields,
@@ -186,21 +187,21 @@ def run_periodic(model, analysis: dict, case, outdir: Path, progress: bool) -> R
 
     Returns
     -------
-    RunOutput; ``converged`` False (and no solution variables) when the solve failed.
+    RunOutput; ``success`` False (and no solution variables) when the solve failed.
     """
     basis = basis_of(analysis)
     qs = analysis["quasi_static"]
-    f_hz = float(analysis.get("frequency", 1.0))
-    omega = 2 * np.pi * f_hz
-    reduced = condense(model, omega, basis.orders, quasi_static=qs)
+    f_hz = float(analysis.get("frequency", default_of(solve_periodic, "frequency")))
+    reduced = condense(model, f_hz, basis.orders, quasi_static=qs)
     eps = penalty(analysis["eps"], model=model, reduced=reduced)
-    sol, stats = solve_periodic(model, basis, omega=omega, quasi_static=qs, reduced=reduced,
-                                eps=eps, solver=analysis["solver"], tol=analysis["tol"],
-                                max_iter=analysis["max_iter"])
+    sol = solve_periodic(model, basis, frequency=f_hz, quasi_static=qs, reduced=reduced,
+                         eps=eps, solver=analysis["solver"], tol=analysis["tol"],
+                         max_iter=analysis["max_iter"])
+    stats = sol.stats
     attrs = {**solver_attributes(stats, analysis, eps), "excitation_frequency": f_hz,
              "quasi_static": int(qs)}
     where = _frequency_text(f_hz, qs)
-    if sol is None:
+    if not sol.success:  # never saved as a result: the diagnostics only
         return RunOutput(xr.Dataset(attrs=attrs), [], _failure_summary(stats, analysis, where),
                          False)
     points = [p.name for p in model.observed]
@@ -243,7 +244,7 @@ def write_period_fields(model, sol: PeriodicSolution, pvd: Path) -> Path:
     b = sol.basis
     nc, d, H = sol.U.shape
     u_loc = b.to_complex(sol.U.reshape(nc * d, H))  # (k+1, m), orders [0, h1, ..]
-    full = recover(model, sol.omega, b.orders, u_loc, quasi_static=sol.quasi_static)
+    full = recover(model, sol.frequency, b.orders, u_loc, quasi_static=sol.quasi_static)
     samples = b.to_time(b.from_complex(full))  # (ndof, N)
     mesh = model.mesh
     nn = mesh.points.shape[0]
@@ -407,8 +408,8 @@ register(
                            "quasi_static; then it only scales time, default 1 Hz)", unit="Hz"),
         "quasi_static": Field(Flag(), "drop inertia and damping (slow cyclic loading); the "
                               "friction law stays path dependent over the period",
-                              default=False),
-        **harmonic_balance_fields("auto", "DLFT penalty: " + _EPS_RULES, 200),
+                              default=default_of(solve_periodic, "quasi_static")),
+        **harmonic_balance_fields(solve_periodic, "DLFT penalty: " + _EPS_RULES),
     },
     run_periodic,
     checks=(_frequency_needed, check_sampling),

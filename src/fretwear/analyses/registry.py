@@ -7,7 +7,7 @@ An analysis module registers itself when imported::
 
     def run(model, analysis, case, outdir, progress):
         ...                         # compute, write figures into outdir
-        return RunOutput(dataset, figures, summary, converged)
+        return RunOutput(dataset, figures, summary, success)
 
     register("periodic", {"n_harmonics": Field(Integer(lo=1), "kept harmonics", default=7)},
              run, doc="One paragraph for docs/case-files.md.")
@@ -50,8 +50,9 @@ class RunOutput:
     dataset : the results (``docs/results.md``: every variable with ``units`` and
         ``long_name``, no complex values); :func:`run_case` adds the global attributes.
     figures : figure files written (in ``outdir``).
-    summary : a few lines for the terminal.
-    converged : False if some solve did not converge (the file records it).
+    summary : a few lines for the terminal (also ``message``).
+    success : False if some solve did not converge (the results file records it as its
+        ``converged`` attribute).
     files : other files written (e.g. ParaView ``.vtu``/``.pvd``).
     results : the results file, set by :func:`run_case`.
     """
@@ -59,9 +60,14 @@ class RunOutput:
     dataset: xr.Dataset
     figures: list[Path] = field(default_factory=list)
     summary: str = ""
-    converged: bool = True
+    success: bool = True
     files: list[Path] = field(default_factory=list)
     results: Path | None = None
+
+    @property
+    def message(self) -> str:
+        """What the run found (``summary``)."""
+        return self.summary
 
 
 RunFunction = Callable[..., RunOutput]

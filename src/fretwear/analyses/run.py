@@ -28,7 +28,14 @@ RESULTS_FILE = "results.nc"
 
 def load_case(path: Path | str) -> Case:
     """Read and validate a case file against the registered analyses
-    (:func:`fretwear.io.case.load_case`); every mistake is one InputError naming the key."""
+    (:func:`fretwear.io.case.load_case`); every mistake is one InputError naming the key.
+
+    Returns
+    -------
+    :class:`fretwear.io.case.Case`: the validated tables with every default filled in
+    (``case.analysis``, ``case.output``, ...), the case text and its path; SI units
+    (frequencies in Hz) as in ``docs/case-files.md``.
+    """
     return case_files.load_case(path, analysis_tables())
 
 
@@ -126,7 +133,9 @@ def run_case(path: Path | str, outdir: Path | str | None = None, progress: bool 
 
     Returns
     -------
-    RunOutput, with ``results`` the NetCDF file written.
+    :class:`~fretwear.analyses.registry.RunOutput`: ``success`` (False when some solve did not
+    converge; the file's ``converged`` attribute), ``message`` (the summary printed),
+    ``dataset``, ``figures``, ``files`` and ``results`` (the NetCDF file written).
 
     Raises
     ------
@@ -158,7 +167,7 @@ def run_case(path: Path | str, outdir: Path | str | None = None, progress: bool 
         out = analysis.run(model, case.analysis, case, out_dir, progress)
         out.results = write_results(
             results_path, out.dataset, title=case.title, analysis_type=analysis.name,
-            converged=out.converged, case_text=case.text, case_path=str(case.path),
+            converged=out.success, case_text=case.text, case_path=str(case.path),
             analysis=case.analysis,
         )
     except KeyboardInterrupt:
@@ -169,7 +178,7 @@ def run_case(path: Path | str, outdir: Path | str | None = None, progress: bool 
         raise
     if out.summary:
         say(out.summary)
-    if not out.converged:
+    if not out.success:
         say("warning: some solves did not converge (results.nc has converged = 0)")
     say(f"results: {out.results}  ({time.time() - start:.1f} s)")
     for p in out.figures:

@@ -15,12 +15,13 @@ import numpy as np
 import xarray as xr
 from tqdm import tqdm
 
-from fretwear import linear
+from fretwear import api, linear
 from fretwear.analyses import figures as plots
 from fretwear.analyses.common import (
     basis_of,
     check_points,
     check_sampling,
+    default_of,
     figure_path,
     geometry,
     harmonic_balance_fields,
@@ -42,7 +43,7 @@ from fretwear.timedomain.stability import sweep_check
 # --- dataset -------------------------------------------------------------------------------
 def _per_point(result: SweepResult, value, fill=np.nan, dtype=float) -> np.ndarray:
     """``value(point)`` for each converged sweep point (``fill`` elsewhere)."""
-    return np.array([value(p) if p.converged else fill for p in result.points], dtype=dtype)
+    return np.array([value(p) if p.success else fill for p in result.points], dtype=dtype)
 
 
 def _state_fractions(sol: PeriodicSolution) -> np.ndarray:
@@ -72,11 +73,11 @@ def _response_variables(result: SweepResult, basis: FourierBasis, model, points:
 
 
 def _sweep_point_variables(result: SweepResult) -> dict:
-    fr = np.array([_state_fractions(p.solution) if p.converged else np.full(3, np.nan)
+    fr = np.array([_state_fractions(p.solution) if p.success else np.full(3, np.nan)
                    for p in result.points]).reshape(-1, 3)
     f = "frequency"
     data = {
-        "converged": variable(f, result.converged.astype(np.int8), "1",
+        "converged": variable(f, result.point_success.astype(np.int8), "1",
                               "the periodic solve converged", flag_values=np.array(
                                   [0, 1], dtype=np.int8), flag_meanings="no yes"),
         "how": variable(f, np.array([p.how for p in result.points], dtype=str), "1",
@@ -160,7 +161,7 @@ def run_sweep(model, analysis: dict, case, outdir: Path, progress: bool) -> RunO
 
     Returns
     -------
-    RunOutput; ``converged`` False when some point did not converge.
+    RunOutput; ``success`` False when some point did not converge.
     """
     points = check_points(model, analysis.get("points"))
     basis = basis_of(analysis)
@@ -169,7 +170,7 @@ def run_sweep(model, analysis: dict, case, outdir: Path, progress: bool) -> RunO
         def tick(i, total, pt):
             bar.update(1)
             bar.set_postfix_str(f"{plots.format_frequency(pt.frequency_hz)}"
-                                f"{'' if pt.converged else ' (not converged)'}")
+                                f"{'' if pt.success else ' (not converged)'}")
 
         result = sweep(model, basis, analysis["f_min"], analysis["f_max"], n,
                        spacing=analysis["spacing"], eps=analysis["eps"],
@@ -202,7 +203,7 @@ def run_sweep(model, analysis: dict, case, outdir: Path, progress: bool) -> RunO
     if p is not None:
         figures.append(plot_sweep_interface(ds, p, title=titled(case.title,
                                                                   "contact interface")))
-    grid_ok = all(p.converged for p in result.points if p.on_grid)
+    grid_ok = all(p.success for p in result.points if p.on_grid)
     return RunOutput(ds, figures, _sweep_summary(result, ds), grid_ok)
 
 
@@ -289,16 +290,18 @@ register(
         "f_max": Field(Number(lo=0, lo_open=True), "highest frequency", required=True, unit="Hz"),
         "n_points": Field(Integer(lo=2), "number of grid frequencies (the sweep may add "
                           "intermediate points where a step fails)", default=200),
-        "spacing": Field(Text(("log", "linear")), "frequency spacing", default="log"),
+        "spacing": Field(Text(("log", "linear")), "frequency spacing",
+                         default=default_of(sweep, "spacing")),
         "continuation": Field(Flag(), "pseudo-arclength continuation when a frequency step "
-                              "fails (passes folds of the response curve)", default=True),
+                              "fails (passes folds of the response curve)",
+                              default=default_of(sweep, "continuation")),
         "time_domain": Field(Flag(), "where a point still fails, integrate in time from the "
                              "neighbour: a periodic steady state starts one more solve, any "
                              "other response (drifting, quasi-periodic) is reported as the "
-                             "reason", default=True),
+                             "reason", default=default_of(api.sweep, "time_domain")),
         "time_domain_periods": Field(Integer(lo=10), "forcing periods allowed to each time "
                                      "integration (time_domain, check_stability)",
-                                     default=3000),
+                                     default=default_of(sweep, "time_domain_periods")),
         "check_stability": Field(Flag(), "check every converged point in time (does the "
                                  "structure settle to it?); slow", default=False),
         "points": Field(ListOf(Text(), non_empty=True, unique=True),
@@ -308,10 +311,10 @@ register(
             'linear FRFs drawn with the nonlinear one: "sliding" (frictionless), "stuck", '
             '"free"', default=[]),
         **harmonic_balance_fields(
-            "static",
+            sweep,
             'DLFT penalty: "static": the spectral radius of the static reduced stiffness K_r, '
             'the same at every frequency (a smooth FRF); "auto": the paper\'s rule (spectral '
-            "radius of Z_r) at each frequency; or a value", 40),
+            "radius of Z_r) at each frequency; or a value"),
     },
     run_sweep,
     checks=(increasing("f_min", "f_max", "Hz"), check_sampling),

@@ -22,6 +22,7 @@ import xarray as xr
 
 from fretwear.analyses import figures as plots
 from fretwear.analyses.common import (
+    default_of,
     figure_path,
     geometry,
     interface_abscissa,
@@ -62,9 +63,10 @@ ENERGY_TERMS = {
 
 
 # --- transient: computation ------------------------------------------------------------------
-def _continue(model, omega: float, U, V, n_periods: int, steps: int) -> TransientResult:
-    """``n_periods`` more periods from the state ``(U, V)``, the last one recorded."""
-    return integrate(model, omega, n_periods=n_periods, steps_per_period=steps, record=1,
+def _continue(model, frequency: float, U, V, n_periods: int, steps: int) -> TransientResult:
+    """``n_periods`` more periods at ``frequency`` [Hz] from the state ``(U, V)``, the last
+    one recorded."""
+    return integrate(model, frequency, n_periods=n_periods, steps_per_period=steps, record=1,
                      U0=U, V0=V, keep_poincare=n_periods)
 
 
@@ -77,8 +79,8 @@ def _classify_record(run: TransientResult, tol: float):
     return classify_sequence(P, means, tol=tol, scale=scale, min_window=min(128, len(P)))
 
 
-def time_run(model, analysis: dict, omega: float, progress: bool):
-    """Integrate as ``analysis`` asks.
+def time_run(model, analysis: dict, frequency: float, progress: bool):
+    """Integrate at ``frequency`` [Hz] as ``analysis`` asks.
 
     Returns
     -------
@@ -93,13 +95,14 @@ def time_run(model, analysis: dict, omega: float, progress: bool):
     steps = analysis["steps_per_period"]
     if analysis["mode"] == "fixed":
         n = analysis["n_periods"]
-        last = integrate(model, omega, n_periods=n, steps_per_period=steps, record=1,
+        last = integrate(model, frequency, n_periods=n, steps_per_period=steps, record=1,
                          keep_poincare=n, progress=progress)
         cls = _classify_record(last, analysis["tol"])
         return last, cls, 0, {"periods": n, "time_wall_time": last.wall_time}
-    ss = steady_state(model, omega, max_periods=analysis["max_periods"], tol=analysis["tol"],
-                      steps_per_period=steps, harmonics=analysis["harmonics"])
-    last = _continue(model, omega, ss.U, ss.V, POINCARE_PERIODS, steps)
+    ss = steady_state(model, frequency, max_periods=analysis["max_periods"],
+                      tol=analysis["tol"], steps_per_period=steps,
+                      harmonics=analysis["harmonics"])
+    last = _continue(model, frequency, ss.U, ss.V, POINCARE_PERIODS, steps)
     info = {"periods": ss.n_periods + POINCARE_PERIODS,
             "time_wall_time": ss.wall_time + last.wall_time}
     return last, ss.diagnostics, ss.n_periods, info
@@ -337,12 +340,11 @@ def run_transient(model, analysis: dict, case, outdir: Path, progress: bool) -> 
 
     Returns
     -------
-    RunOutput; ``converged`` False when a steady-state run ends ``"transient"`` (undecided at
+    RunOutput; ``success`` False when a steady-state run ends ``"transient"`` (undecided at
     ``max_periods``).
     """
     f_hz = float(analysis["frequency"])
-    omega = 2 * np.pi * f_hz
-    last, cls, before, info = time_run(model, analysis, omega, progress)
+    last, cls, before, info = time_run(model, analysis, f_hz, progress)
     points = [p.name for p in model.observed]
     ds = transient_dataset(model, last, points, analysis["harmonics"], before)
     ds.attrs.update(_transient_attributes(ds, cls, info, f_hz, analysis, last))
@@ -369,14 +371,15 @@ register(
                       'quasi-periodic, irregular) or max_periods; "fixed": exactly n_periods',
                       default="steady-state"),
         "steps_per_period": Field(Integer(lo=8), "fixed time steps per forcing period",
-                                  default=256),
+                                  default=default_of(integrate, "steps_per_period")),
         "max_periods": Field(Integer(lo=1), "steady-state: give up after this many periods",
-                             default=20000),
+                             default=default_of(steady_state, "max_periods")),
         "n_periods": Field(Integer(lo=1), "fixed: periods integrated from rest", default=200),
         "tol": Field(Number(lo=0, lo_open=True), "relative periodicity tolerance of the "
-                     "classification", default=1e-6, unit="-"),
+                     "classification", default=default_of(steady_state, "tol"), unit="-"),
         "harmonics": Field(Integer(lo=1), "highest harmonic of the last period reported: "
-                           "Nh reports 1, 2, .., Nh", default=7),
+                           "Nh reports 1, 2, .., Nh",
+                           default=default_of(steady_state, "harmonics")),
     },
     run_transient,
     checks=(_check_harmonics,),
@@ -456,13 +459,14 @@ register(
     "incremental-wear",
     {
         "steps_per_cycle": Field(Integer(lo=2), "quasi-static load steps per cycle",
-                                 default=64),
+                                 default=default_of(incremental_wear, "steps_per_cycle")),
         "n_cycles": Field(Integer(lo=1), "load cycles (physical, counting the jumps)",
-                          default=100),
+                          default=default_of(incremental_wear, "n_cycles")),
         "cycle_jump": Field(Integer(lo=1), "cycles represented by each computed cycle "
-                            "(explicit Euler on the slow scale)", default=1),
+                            "(explicit Euler on the slow scale)",
+                            default=default_of(incremental_wear, "cycle_jump")),
         "record_every": Field(Integer(lo=1), "record every this many computed cycles (and "
-                              "the last)", default=1),
+                              "the last)", default=default_of(incremental_wear, "record_every")),
     },
     run_incremental_wear,
     doc="Quasi-static fretting wear by load steps "

@@ -17,16 +17,20 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from fretwear import api
 from fretwear.analyses import figures as plots
+from fretwear.analyses.common import default_of
 from fretwear.analyses.registry import RunOutput, register
 from fretwear.files import safe_name
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.penalty import RULES
 from fretwear.hb.solvers import SOLVERS
 from fretwear.hb.sweep import frequency_grid
 from fretwear.io.results import label_coordinate, variable
 from fretwear.io.schema import (
     MISSING,
+    AnyOf,
     Field,
     Flag,
     Integer,
@@ -67,6 +71,13 @@ def options_from_table(a: dict) -> WearOptions:
     """:class:`~fretwear.wear.options.WearOptions` from the validated ``[analysis]`` table: its
     wear options (:data:`OPTION_KEYS`) that are there; the others keep their defaults."""
     return WearOptions(**{k: a[k] for k in OPTION_KEYS if k in a})
+
+
+def penalty_of(a: dict) -> dict:
+    """The keyword ``eps`` of the wear run and of its FRFs when the table gives it, else none:
+    each function then takes its own default (:func:`~fretwear.wear.simulate.simulate_wear`:
+    ``"auto"``, the paper's rule; :func:`~fretwear.hb.sweep.sweep`: ``"static"``)."""
+    return {"eps": a["eps"]} if "eps" in a else {}
 
 
 def _check_table(out: dict, path: str) -> None:
@@ -188,7 +199,7 @@ def _frf_data(model, sweeps: dict, freqs: np.ndarray) -> dict:
         res = sweeps[name]
         f = res.frequency_hz
         idx = [int(np.argmin(np.abs(f - x))) for x in freqs]
-        conv[i] = res.converged[idx]
+        conv[i] = res.point_success[idx]
         for j, pt in enumerate(points):
             for k in range(len(model.observed_point(pt).dofs)):
                 amp[i, :, j, k] = res.amplitude(pt, k, harmonic=1)[idx]
@@ -328,25 +339,25 @@ def run_wear(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOu
     a = analysis
     opts = options_from_table(a)
     quasi = bool(a["quasi_static"])
-    f_hz = float(a.get("frequency", 1.0))
+    f_hz = float(a.get("frequency", default_of(simulate_wear, "frequency")))
     basis = FourierBasis.up_to(a["harmonics"], a["n_samples"])
     nc = model.contact.n_nodes
     nodes = a.get("plot_nodes")
     if nodes is not None and any(p >= nc for p in nodes):
         fail("analysis.plot_nodes", nodes, f"contact node numbers from 0 to {nc - 1}")
-    result = simulate_wear(model, basis, omega=2 * np.pi * f_hz, quasi_static=quasi,
-                           options=opts, eps=a.get("eps"), checkpoint=outdir / CHECKPOINT_FILE,
+    result = simulate_wear(model, basis, frequency=f_hz, quasi_static=quasi,
+                           options=opts, checkpoint=outdir / CHECKPOINT_FILE, **penalty_of(a),
                            resume=bool(case.resume), progress=progress, time_domain=FALLBACK)
     frf, frf_note = None, ""
     fb = a.get("frf_before_after")
     if fb is not None and model.observed:
         grid = (fb["f_min"], fb["f_max"], fb["n_points"])
-        sweeps = {name: frf_worn(model, w, grid, basis, solver=a["solver"], eps=a.get("eps"),
+        sweeps = {name: frf_worn(model, w, grid, basis, solver=a["solver"], **penalty_of(a),
                                  spacing=fb["spacing"],
                                  time_domain=FALLBACK if fb["time_domain"] else None)
                   for name, w in (("unworn", 0.0), ("worn", result.final_wear))}
         frf = _frf_data(model, sweeps, frequency_grid(*grid, fb["spacing"]))
-        frf_note = "\n".join(f"FRF {k}: {int(v.converged.sum())}/{len(v.points)} converged"
+        frf_note = "\n".join(f"FRF {k}: {int(v.point_success.sum())}/{len(v.points)} converged"
                              for k, v in sweeps.items())
     elif fb is not None:
         frf_note = "FRF before/after skipped: the model has no observed point"
@@ -367,7 +378,7 @@ def run_wear(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOu
     ]
     if frf_note:
         lines.append(frf_note)
-    return RunOutput(ds, figures, "\n".join(lines), result.converged,
+    return RunOutput(ds, figures, "\n".join(lines), result.success,
                      [outdir / CHECKPOINT_FILE])
 
 
@@ -399,9 +410,11 @@ _FRF = Table(
         "f_min": Field(_POS, "lowest frequency", required=True, unit="Hz"),
         "f_max": Field(_POS, "highest frequency", required=True, unit="Hz"),
         "n_points": Field(Integer(lo=2), "number of frequencies", default=100),
-        "spacing": Field(Text(("linear", "log")), "frequency spacing", default="linear"),
+        "spacing": Field(Text(("linear", "log")), "frequency spacing",
+                         default=default_of(frf_worn, "spacing")),
         "time_domain": Field(Flag(), "where a point's balance fails, integrate in time from "
-                             "the neighbour (as in `frf` sweeps)", default=True),
+                             "the neighbour (as in `frf` sweeps)",
+                             default=default_of(api.frf_worn, "time_domain")),
     },
     checks=(increasing("f_min", "f_max", "Hz"),),
     doc="Nonlinear FRFs (fretwear.hb.sweep) of the unworn and the worn interface.",
@@ -412,11 +425,15 @@ SCHEMA = {
     "frequency": Field(_POS, "excitation frequency (with quasi_static: only the time "
                        "scale; default 1 Hz)", unit="Hz"),
     "quasi_static": Field(Flag(), "drop inertia and damping (slow cyclic loading)",
-                          default=False),
-    "harmonics": Field(Integer(lo=1), "kept harmonics 1..harmonics", default=7),
-    "n_samples": Field(Integer(lo=3), "time samples per period", default=128),
-    "eps": Field(_POS, "DLFT penalty (default: spectral radius of the reduced dynamic "
-                 "stiffness)", unit="N/m"),
+                          default=default_of(simulate_wear, "quasi_static")),
+    "harmonics": Field(Integer(lo=1), "kept harmonics 1..harmonics",
+                       default=default_of(FourierBasis.up_to, "nh")),
+    "n_samples": Field(Integer(lo=3), "time samples per period",
+                       default=default_of(FourierBasis.up_to, "n_samples")),
+    "eps": Field(AnyOf((Text(RULES), _POS)), 'DLFT penalty: "auto" (the spectral radius of '
+                 'Z_r over the kept harmonics, the paper), "static" (that of the static K_r) '
+                 "or a value; default: \"auto\" for the wear run (simulate_wear), \"static\" "
+                 "for the FRFs of frf_before_after (as sweeps)", unit="N/m"),
     # wear options: option() takes the default of WearOptions
     "solver": option("solver", Text(SOLVERS), "nonlinear solver of the first periodic solve "
                      "and the fallback of the slow steps"),

@@ -22,13 +22,13 @@ class TimeDomainFallback:
 
     Attributes
     ----------
-    start : ``start(model, omega, basis, solution | None, *, max_periods) ->
-        (message, U0 | None, anchor | None)``: integrate at ``omega`` [rad/s] (from a
+    start : ``start(model, frequency, basis, solution | None, *, max_periods) ->
+        (message, U0 | None, anchor | None)``: integrate at ``frequency`` [Hz] (from a
         neighbouring :class:`~fretwear.hb.periodic.PeriodicSolution` when given) until the
         response is classified; if it settles to a periodic state, its contact harmonics
         ``U0`` (nc, d, H) [m] and mean tangential positions ``anchor`` (nc, d-1) [m] start a
         balance; ``message`` says what the structure does.
-    averaged_rate : ``averaged_rate(model, omega, basis, coef, wear, *, U0, V0, settle,
+    averaged_rate : ``averaged_rate(model, frequency, basis, coef, wear, *, U0, V0, settle,
         average, steps_per_period)``: the wear rate averaged over a time integration at wear
         ``wear`` (nc,) [m] from the full-field state ``U0``, ``V0``; returns an object with the
         attributes of :class:`fretwear.timedomain.averaged_rate.TimeAveragedRate`.

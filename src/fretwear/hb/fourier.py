@@ -48,8 +48,9 @@ class FourierBasis:
             )
 
     @classmethod
-    def up_to(cls, nh: int, n_samples: int) -> FourierBasis:
-        """All harmonics ``1..nh``."""
+    def up_to(cls, nh: int = 7, n_samples: int = 128) -> FourierBasis:
+        """All harmonics ``1..nh`` with ``n_samples`` samples per period (default: the
+        paper's 7 harmonics and 128 samples, section 4.2)."""
         return cls(tuple(range(1, nh + 1)), n_samples)
 
     @property

@@ -40,15 +40,15 @@ def check_rule(rule) -> str | float:
                      "number [N/m]")
 
 
-def penalty(rule, *, model: Model | None = None, omega: float = 0.0, orders=None,
+def penalty(rule, *, model: Model | None = None, frequency: float = 0.0, orders=None,
             quasi_static: bool = False, reduced: Reduced | None = None) -> float:
-    """The DLFT penalty [N/m] of ``rule`` (module docstring) at circular frequency ``omega``.
+    """The DLFT penalty [N/m] of ``rule`` (module docstring) at the excitation ``frequency``.
 
     Parameters
     ----------
     rule : ``"auto"``, ``"static"`` or a positive number [N/m].
     model : the structure (needed unless ``reduced`` is given).
-    omega, orders, quasi_static : the frequency [rad/s], harmonic orders ``[0, h1, .., hk]``
+    frequency, orders, quasi_static : the frequency [Hz], harmonic orders ``[0, h1, .., hk]``
         and inertia setting of the solve (``"auto"`` only, when ``reduced`` is not given).
     reduced : the condensation of the solve (:func:`fretwear.hb.reduce.condense`) if already
         computed: ``"auto"`` then takes its blocks; ``"static"`` without a ``model`` takes its
@@ -65,7 +65,7 @@ def penalty(rule, *, model: Model | None = None, omega: float = 0.0, orders=None
         if reduced is None:
             if model is None or orders is None:
                 raise ValueError('eps = "auto" needs the reduced model or the model and orders')
-            reduced = condense(model, omega, orders, quasi_static=quasi_static)
+            reduced = condense(model, frequency, orders, quasi_static=quasi_static)
         return reduced.spectral_radius()
     if model is not None:
         return condense(model, 0.0, [0], quasi_static=True).spectral_radius()

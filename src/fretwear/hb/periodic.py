@@ -23,7 +23,7 @@ from fretwear.errors import InputError
 from fretwear.hb import contact as law
 from fretwear.hb.fourier import FourierBasis, amplitude
 from fretwear.hb.penalty import penalty
-from fretwear.hb.reduce import Reduced, condense, loads_to_real, recover, to_real_blocks
+from fretwear.hb.reduce import Reduced, _recover, condense, loads_to_real, to_real_blocks
 from fretwear.hb.solvers import SolveStats, solve
 from fretwear.model.core import ContactInterface, Model
 
@@ -39,7 +39,7 @@ class DLFTProblem:
     gap : (nc,) normal gap + wear ``W`` [m].
     eps : DLFT penalty: ``"auto"`` (default) the spectral radius of ``Z_r`` (paper, section
         3.2), ``"static"`` that of the static ``K_r``, or a positive number [N/m]
-        (:func:`fretwear.hb.penalty.penalty`; ``None`` is the default, ``"auto"``).
+        (:func:`fretwear.hb.penalty.penalty`).
     anchor : (nc, d-1) stick anchors: where a node that sticks all period sticks [m]
         (tangential, contact-local). Default 0.
     """
@@ -56,7 +56,7 @@ class DLFTProblem:
         self.reduced = reduced
         self.Z = to_real_blocks(reduced.Z, reduced.orders)
         self.F = loads_to_real(reduced.F)
-        self.eps = penalty("auto" if eps is None else eps, reduced=reduced)
+        self.eps = penalty(eps, reduced=reduced)
         self.mu = np.full(nc, float(contact.mu))
         self.set_gap(contact.gap if gap is None else gap)
         self.anchor = np.zeros((nc, d - 1)) if anchor is None else np.array(anchor, float)
@@ -125,14 +125,21 @@ class DLFTProblem:
 
 @dataclass
 class PeriodicSolution:
-    """A converged periodic solution of the DLFT balance at one frequency.
+    """A periodic solution of the DLFT balance at one frequency (the result of
+    :func:`solve_periodic`).
 
+    ``success`` says whether the balance converged and ``message`` why the solver stopped (as
+    :class:`scipy.optimize.OptimizeResult`); a solution with ``success`` False is the last
+    iterate of a failed solve, assembled so that it can be inspected, and is never a result.
     All contact quantities are in contact-local frames ``[N, T1, (T2)]``; forces are those the
     structure exerts on the obstacle (``N`` >= 0 in compression).
 
     Attributes
     ----------
-    omega : circular frequency [rad/s] (0 for quasi-static).
+    success : the convergence test ``|f| <= tol |Z_r U|`` was met (``stats.success``).
+    message : why the solver stopped (``stats.message``).
+    frequency : excitation frequency [Hz] (as given to :func:`solve_periodic`).
+    omega : circular frequency ``2 pi frequency`` [rad/s] (0 for quasi-static).
     quasi_static : inertia and damping dropped.
     basis : the Fourier basis.
     U : (nc, d, H) displacement harmonics of the contact nodes [m].
@@ -146,9 +153,11 @@ class PeriodicSolution:
     eps : DLFT penalty [N/m].
     observed : name -> (d, H) displacement harmonics of observed points [m].
     area : (nc,) tributary areas [m^2].
-    stats : solver statistics.
+    stats : solver statistics (:class:`~fretwear.hb.solvers.SolveStats`).
+    flags : reasons for caution (e.g. time-domain findings of a sweep's stability check).
     """
 
+    frequency: float
     omega: float
     quasi_static: bool
     basis: FourierBasis
@@ -168,8 +177,14 @@ class PeriodicSolution:
     flags: list = field(default_factory=list)
 
     @property
-    def frequency_hz(self) -> float:
-        return self.omega / (2 * np.pi)
+    def success(self) -> bool:
+        """The balance converged (``stats.success``)."""
+        return bool(self.stats.success)
+
+    @property
+    def message(self) -> str:
+        """Why the solver stopped (``stats.message``)."""
+        return self.stats.message
 
     @property
     def tau(self):
@@ -278,41 +293,48 @@ def static_anchor(model: Model, *, quasi: Reduced | None = None) -> np.ndarray:
 
     x, _, st = solve(fun, U0.reshape(-1), lambda x: prob.scale(x.reshape(prob.m, prob.H)),
                      method="powell", tol=1e-10, max_iter=100)
-    if not st.converged:
+    if not st.success:
         return np.zeros((prob.nc, prob.d - 1))
     U = x.reshape(prob.nc, prob.d, 1)
     return U[:, 1:, 0].copy()
 
 
-def solve_periodic(model: Model, basis: FourierBasis, *, omega: float = 0.0,
+def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
                    quasi_static: bool = False, reduced: Reduced | None = None, gap=None,
                    eps="auto", anchor=None, U0=None, solver="powell", tol=1e-8, max_iter=200,
-                   raise_on_failure=False) -> tuple[PeriodicSolution | None, SolveStats]:
-    """Periodic response of ``model`` at ``omega`` [rad/s] with the DLFT (section 3.1-3.2).
+                   raise_on_failure=False) -> PeriodicSolution:
+    """Periodic response of ``model`` at the excitation ``frequency`` [Hz] with the DLFT
+    (section 3.1-3.2).
 
     Parameters
     ----------
     basis : kept harmonics and samples per period.
-    quasi_static : drop inertia and damping (slow cyclic loading; ``omega`` only scales time).
+    frequency : excitation frequency [Hz] (default 1 Hz, as case files: with
+        ``quasi_static`` it only scales time, a 1 s cycle).
+    quasi_static : drop inertia and damping (slow cyclic loading).
     reduced : a precomputed condensation on ``[0] + basis.harmonics`` (else computed here).
     gap : (nc,) gap + wear [m] (default: the model's initial gap).
     eps : DLFT penalty: ``"auto"`` (default) the spectral radius of ``Z_r`` over the kept
         harmonics (the paper), ``"static"`` that of the static ``K_r``, or a positive number
-        [N/m] (:func:`fretwear.hb.penalty.penalty`; ``None`` is the default, ``"auto"``).
+        [N/m] (:func:`fretwear.hb.penalty.penalty`).
     anchor : (nc, d-1) stick anchors [m]; default: the static preload state
         (:func:`static_anchor`), the documented rule for the mean tangential position.
     U0 : (nc, d, H) starting point (e.g. a neighbouring solution).
     solver : ``"powell"`` (dog-leg at LAPACK speed), ``"newton"`` or ``"hybr"`` (MINPACK).
     tol : relative residual ``eps_r`` of the test ``|f| <= eps_r |Z_r U|``.
 
+    raise_on_failure : raise :class:`~fretwear.errors.ConvergenceError` when the solve does
+        not converge instead of returning a solution with ``success`` False.
+
     Returns
     -------
-    (solution, stats): ``solution`` is None when the solve did not converge (then
-    ``stats.converged`` is False and ``stats.message`` says why), unless ``raise_on_failure``.
+    :class:`PeriodicSolution`: ``success`` True when the balance converged; otherwise
+    ``success`` False, ``message`` says why (``stats`` has the residual and counts) and the
+    fields hold the last iterate (for inspection, never a result).
     """
     if reduced is None:
-        reduced = condense(model, omega, _orders(basis), quasi_static=quasi_static)
-    eps = penalty("auto" if eps is None else eps, model=model, reduced=reduced)
+        reduced = condense(model, frequency, _orders(basis), quasi_static=quasi_static)
+    eps = penalty(eps, model=model, reduced=reduced)
     if anchor is None:
         anchor = static_anchor(model)
     prob = DLFTProblem(reduced, model.contact, basis, gap=gap, eps=eps, anchor=anchor)
@@ -327,16 +349,14 @@ def solve_periodic(model: Model, basis: FourierBasis, *, omega: float = 0.0,
     x, _, st = solve(fun, x0.reshape(-1), lambda x: prob.scale(x.reshape(prob.m, prob.H)),
                      method=solver, tol=tol, max_iter=max_iter)
     st.wall_time = time.perf_counter() - t0
-    if not st.converged:
-        if raise_on_failure:
-            from fretwear.errors import ConvergenceError
+    if not st.success and raise_on_failure:
+        from fretwear.errors import ConvergenceError
 
-            raise ConvergenceError(
-                f"periodic solve at f = {omega / 2 / np.pi:.6g} Hz did not converge: "
-                f"{st.message} (relative residual {st.residual:.3g} > {tol:g})"
-            )
-        return None, st
-    return assemble_solution(prob, x.reshape(prob.m, prob.H), model, st), st
+        raise ConvergenceError(
+            f"periodic solve at f = {reduced.frequency:.6g} Hz did not converge: "
+            f"{st.message} (relative residual {st.residual:.3g} > {tol:g})"
+        )
+    return assemble_solution(prob, x.reshape(prob.m, prob.H), model, st)
 
 
 def _harmonic_continuation_start(model, basis, reduced, prob, solver, tol, max_iter):
@@ -346,7 +366,8 @@ def _harmonic_continuation_start(model, basis, reduced, prob, solver, tol, max_i
     starts the full one within a few iterations (docs/verification.md)."""
     sub = FourierBasis(basis.harmonics[:1], basis.n_samples)
     red = Reduced(reduced.omega, reduced.orders[:2], reduced.Z[:2], reduced.F[:2],
-                  reduced.obs_A[:2], reduced.obs_b[:2], reduced.obs_dofs, reduced.quasi_static)
+                  reduced.obs_A[:2], reduced.obs_b[:2], reduced.obs_dofs, reduced.quasi_static,
+                  reduced.frequency)
     p1 = DLFTProblem(red, model.contact, sub, gap=prob.gap, eps=prob.eps, anchor=prob.anchor)
 
     def fun(x, jac=True):
@@ -355,7 +376,7 @@ def _harmonic_continuation_start(model, basis, reduced, prob, solver, tol, max_i
     x, _, st = solve(fun, p1.initial_guess().reshape(-1),
                      lambda x: p1.scale(x.reshape(p1.m, p1.H)), method=solver, tol=tol,
                      max_iter=max_iter)
-    if not st.converged:
+    if not st.success:
         return None
     U = np.zeros((prob.m, prob.H))
     x = x.reshape(p1.m, p1.H)
@@ -366,7 +387,8 @@ def _harmonic_continuation_start(model, basis, reduced, prob, solver, tol, max_i
 
 
 def assemble_solution(prob: DLFTProblem, U, model: Model, stats: SolveStats) -> PeriodicSolution:
-    """Post-process a converged ``U`` (m, H) into a :class:`PeriodicSolution`."""
+    """Post-process ``U`` (m, H) into a :class:`PeriodicSolution` (converged or not: its
+    ``success`` is ``stats.success``)."""
     lu, lx, state, _ = prob.time_law(U)
     lam_t = lu - lx
     x_t = lx / prob.eps
@@ -389,7 +411,8 @@ def assemble_solution(prob: DLFTProblem, U, model: Model, stats: SolveStats) -> 
             observed[p.name] = real[i : i + nd]
             i += nd
     return PeriodicSolution(
-        omega=red.omega, quasi_static=red.quasi_static, basis=b, U=U.reshape(nc, d, H).copy(),
+        frequency=red.frequency, omega=red.omega, quasi_static=red.quasi_static, basis=b,
+        U=U.reshape(nc, d, H).copy(),
         lam=lam, X=X, lam_t=lam_t, x_t=x_t, state=state, gap=prob.gap.copy(),
         anchor=prob.anchor.copy(), eps=prob.eps, observed=observed,
         area=np.asarray(model.contact.area, float), coords=np.asarray(model.contact.coords),
@@ -403,7 +426,7 @@ def initial_state(model: Model, sol: PeriodicSolution):
     m = sol.U.shape[0] * sol.U.shape[1]
     Uc = b.to_complex(sol.U.reshape(m, -1))  # (k+1, m) complex amplitudes
     orders = np.array([0, *b.harmonics])
-    Ufull = recover(model, sol.omega, orders, Uc, quasi_static=sol.quasi_static)
+    Ufull = _recover(model, sol.omega, orders, Uc, quasi_static=sol.quasi_static)
     U0 = Ufull.real.sum(axis=0)
     V0 = -(orders[:, None] * sol.omega * Ufull.imag).sum(axis=0)
     return U0, V0

@@ -22,6 +22,7 @@ of eq. 19 (:func:`_schur`).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -37,7 +38,8 @@ class Reduced:
 
     Attributes
     ----------
-    omega : excitation circular frequency [rad/s] (0 allowed when ``quasi_static``).
+    omega : excitation circular frequency ``2 pi frequency`` [rad/s] (0 allowed when
+        ``quasi_static``).
     orders : (nb,) harmonic orders ``[0, h1, .., hk]``.
     Z : (nb, m, m) complex reduced dynamic stiffness [N/m] in contact-local coordinates,
         ``m = n_contact * d``, rows/columns node-major ``[N, T1, (T2)]``.
@@ -45,6 +47,7 @@ class Reduced:
     obs_A, obs_b : (nb, no, m), (nb, no) complex: observed DOFs ``U_o = obs_A @ u_loc + obs_b``.
     obs_dofs : (no,) global DOFs of the observed points, in the order of ``model.observed``.
     quasi_static : True when inertia and damping were dropped.
+    frequency : excitation frequency [Hz], as given to :func:`condense`.
     """
 
     omega: float
@@ -55,6 +58,11 @@ class Reduced:
     obs_b: np.ndarray
     obs_dofs: np.ndarray
     quasi_static: bool = False
+    frequency: float = math.nan
+
+    def __post_init__(self):
+        if math.isnan(self.frequency):
+            self.frequency = self.omega / (2 * np.pi)
 
     @property
     def m(self) -> int:
@@ -66,8 +74,14 @@ class Reduced:
         return float(max(np.max(np.abs(np.linalg.eigvals(z))) for z in self.Z))
 
 
-def dynamic_stiffness(model: Model, omega: float, n: int, quasi_static: bool = False):
-    """Sparse complex ``Z_n`` on all DOFs (eq. 18 in complex form)."""
+def dynamic_stiffness(model: Model, frequency: float, n: int, quasi_static: bool = False):
+    """Sparse complex ``Z_n`` [N/m] on all DOFs (eq. 18 in complex form) at the excitation
+    ``frequency`` [Hz] (harmonic ``n`` of it)."""
+    return _dynamic_stiffness(model, 2 * np.pi * frequency, n, quasi_static)
+
+
+def _dynamic_stiffness(model: Model, omega: float, n: int, quasi_static: bool = False):
+    """:func:`dynamic_stiffness` at the circular frequency ``omega`` [rad/s]."""
     K = model.K.tocsc()
     if n == 0 or quasi_static:
         return K.astype(complex)
@@ -108,9 +122,9 @@ def _factor(Zii, n: int, omega: float):
     except RuntimeError as exc:
         raise InputError(
             f"the structure with its contact DOFs held is singular at harmonic {n} "
-            f"(omega = {omega:.6g} rad/s): part of the model can move with nothing to hold it "
-            "(add springs or fixed DOFs), or the frequency is an eigenfrequency of the "
-            "undamped structure with a clamped interface"
+            f"(excitation {omega / (2 * np.pi):.6g} Hz): part of the model can move with "
+            "nothing to hold it (add springs or fixed DOFs), or the frequency is an "
+            "eigenfrequency of the undamped structure with a clamped interface"
         ) from exc
     diag = np.abs(lu.U.diagonal())
     if diag.size and diag.min() <= 1e-13 * diag.max():
@@ -206,12 +220,22 @@ def condense_static(model: Model) -> StaticCondensation:
                               lu, Kci)
 
 
-def condense(model: Model, omega: float, orders, *, quasi_static: bool = False) -> Reduced:
-    """Condense ``model`` onto its contact DOFs for harmonic ``orders`` at ``omega`` [rad/s].
+def condense(model: Model, frequency: float, orders, *, quasi_static: bool = False) -> Reduced:
+    """Condense ``model`` onto its contact DOFs for harmonic ``orders`` (``[0, h1, .., hk]``)
+    at the excitation ``frequency`` [Hz] (0 allowed when ``quasi_static``).
 
     Implements eq. (17)-(19) with sparse LU of ``Z_ii`` per harmonic. Returns a
-    :class:`Reduced` in contact-local coordinates with the observed-DOF recovery rows.
+    :class:`Reduced` in contact-local coordinates with the observed-DOF recovery rows
+    (``Reduced.omega = 2 pi frequency`` [rad/s], ``Reduced.frequency`` as given).
     """
+    return _condense(model, 2 * np.pi * frequency, orders, quasi_static=quasi_static,
+                     frequency=frequency)
+
+
+def _condense(model: Model, omega: float, orders, *, quasi_static: bool = False,
+              frequency: float | None = None) -> Reduced:
+    """:func:`condense` at the circular frequency ``omega`` [rad/s] (``frequency`` [Hz]:
+    recorded in the result, default ``omega / 2 pi``)."""
     orders = np.asarray(orders, dtype=np.int64)
     cdofs, idofs = _partition(model)
     R = _frame_matrix(model)
@@ -234,7 +258,7 @@ def condense(model: Model, omega: float, orders, *, quasi_static: bool = False) 
     for b, n in enumerate(orders):
         key = 0 if (n == 0 or quasi_static) else int(n)
         if key not in cache:
-            Z = dynamic_stiffness(model, omega, int(n), quasi_static)
+            Z = _dynamic_stiffness(model, omega, int(n), quasi_static)
             Zr_n, lu, X, Zci = _schur(Z, cdofs, idofs, R, int(n), omega)
             A = np.zeros((obs.size, m), dtype=complex)
             for j, g in enumerate(obs):
@@ -250,16 +274,24 @@ def condense(model: Model, omega: float, orders, *, quasi_static: bool = False) 
             for j, g in enumerate(obs):
                 if int(g) in pos_i:
                     ob[b, j] = xf[pos_i[int(g)]]
-    return Reduced(float(omega), orders, Zr, Fr, oA, ob, obs, bool(quasi_static))
+    return Reduced(float(omega), orders, Zr, Fr, oA, ob, obs, bool(quasi_static),
+                   math.nan if frequency is None else float(frequency))
 
 
-def recover(model: Model, omega: float, orders, u_loc: np.ndarray, *,
+def recover(model: Model, frequency: float, orders, u_loc: np.ndarray, *,
             quasi_static: bool = False) -> np.ndarray:
-    """All DOFs ``U_n`` (nb, ndof) complex from the contact-local amplitudes ``u_loc`` (nb, m).
+    """All DOFs ``U_n`` (nb, ndof) complex [m] from the contact-local amplitudes ``u_loc``
+    (nb, m) [m] of the harmonic ``orders`` at the excitation ``frequency`` [Hz].
 
     ``U_i = Z_ii^-1 (F_i - Z_ic U_c)`` per harmonic (exact recovery of the condensation);
     fixed DOFs are zero.
     """
+    return _recover(model, 2 * np.pi * frequency, orders, u_loc, quasi_static=quasi_static)
+
+
+def _recover(model: Model, omega: float, orders, u_loc: np.ndarray, *,
+             quasi_static: bool = False) -> np.ndarray:
+    """:func:`recover` at the circular frequency ``omega`` [rad/s]."""
     orders = np.asarray(orders, dtype=np.int64)
     cdofs, idofs = _partition(model)
     R = _frame_matrix(model)
@@ -269,7 +301,7 @@ def recover(model: Model, omega: float, orders, u_loc: np.ndarray, *,
         Uc = R.T @ np.asarray(u_loc[b], dtype=complex)
         out[b, cdofs] = Uc
         if idofs.size:
-            Z = dynamic_stiffness(model, omega, int(n), quasi_static)
+            Z = _dynamic_stiffness(model, omega, int(n), quasi_static)
             lu = _factor(Z[idofs][:, idofs], int(n), omega)
             out[b, idofs] = lu.solve(F_all[n][idofs] - Z[idofs][:, cdofs] @ Uc)
     return out

@@ -29,7 +29,7 @@ SOLVERS = ("powell", "newton", "hybr")
 class SolveStats:
     """What a nonlinear solve did (in the spirit of :class:`scipy.optimize.OptimizeResult`).
 
-    converged : whether the convergence test was met.
+    success : whether the convergence test was met.
     residual : final ``|f| / scale`` (the relative residual of the paper's test).
     iterations, nfev, njev : iterations, residual and Jacobian evaluations.
     wall_time : seconds.
@@ -37,7 +37,7 @@ class SolveStats:
     solver : the method used.
     """
 
-    converged: bool
+    success: bool
     residual: float
     iterations: int
     nfev: int

@@ -25,7 +25,7 @@ from fretwear.hb.fallback import TimeDomainFallback
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.penalty import check_rule, penalty
 from fretwear.hb.periodic import DLFTProblem, PeriodicSolution, assemble_solution, static_anchor
-from fretwear.hb.reduce import condense
+from fretwear.hb.reduce import _condense
 from fretwear.hb.solvers import SolveStats, solve
 from fretwear.model.core import Model
 
@@ -34,11 +34,13 @@ from fretwear.model.core import Model
 class SweepPoint:
     """One frequency of a sweep.
 
-    frequency_hz : the frequency [Hz]; solution : the periodic solution or None when the solve
-    did not converge; stats : solver statistics; how : ``"grid"``, ``"substep"``, ``"retry"``,
+    frequency_hz : the frequency [Hz]; solution : the converged periodic solution, or None
+    when the solve did not converge (a failed solve is never kept as a solution); stats :
+    solver statistics of the last solve; how : ``"grid"``, ``"substep"``, ``"retry"``,
     ``"arclength"``, ``"eps-x10"`` or ``"time-start"``; flags : reasons for caution
     (``"not converged: ..."``, time-domain findings); on_grid : a requested grid frequency
-    (False for the intermediate points the sweep added).
+    (False for the intermediate points the sweep added); time_domain : what the time
+    integration found at a point whose balance failed (``""`` when none ran).
     """
 
     frequency_hz: float
@@ -47,15 +49,26 @@ class SweepPoint:
     how: str = "grid"
     flags: list = field(default_factory=list)
     on_grid: bool = False
+    time_domain: str = ""
 
     @property
-    def converged(self) -> bool:
+    def success(self) -> bool:
+        """The periodic solve converged (``solution`` is not None)."""
         return self.solution is not None
+
+    @property
+    def message(self) -> str:
+        """Why the last solve stopped (``stats.message``)."""
+        return self.stats.message
 
 
 @dataclass
 class SweepResult:
-    """The points of a sweep, in the order computed (increasing frequency)."""
+    """The points of a sweep, in the order computed (increasing frequency).
+
+    ``success`` is True when every point converged; ``message`` counts the converged and
+    failed grid frequencies; ``point_success`` is the per-point array.
+    """
 
     points: list
     wall_time: float = 0.0
@@ -65,8 +78,28 @@ class SweepResult:
         return np.array([p.frequency_hz for p in self.points])
 
     @property
-    def converged(self) -> np.ndarray:
-        return np.array([p.converged for p in self.points], dtype=bool)
+    def point_success(self) -> np.ndarray:
+        """(n,) bool: whether each point converged."""
+        return np.array([p.success for p in self.points], dtype=bool)
+
+    @property
+    def success(self) -> bool:
+        """Every point converged."""
+        return bool(all(p.success for p in self.points))
+
+    @property
+    def message(self) -> str:
+        """E.g. ``"187 of 200 points converged; 13 not converged (12 flagged by the time
+        integration)"``, over the requested grid frequencies."""
+        grid = [p for p in self.points if p.on_grid]
+        failed = [p for p in grid if not p.success]
+        text = f"{len(grid) - len(failed)} of {len(grid)} points converged"
+        if failed:
+            timed = sum(1 for p in failed if p.time_domain)
+            text += f"; {len(failed)} not converged"
+            if timed:
+                text += f" ({timed} flagged by the time integration)"
+        return text
 
     def amplitude(self, point: str, axis: int = 0, harmonic: int | None = 1) -> np.ndarray:
         """Amplitude of an observed point [m] per sweep point (nan where not converged):
@@ -88,7 +121,7 @@ class SweepResult:
     def summary(self) -> str:
         """``sweep_converged=k/n`` over the grid frequencies, then every flagged point."""
         grid = [p for p in self.points if p.on_grid]
-        k = sum(p.converged for p in grid)
+        k = sum(p.success for p in grid)
         lines = [f"sweep_converged={k}/{len(grid)}"]
         for p in self.points:
             if p.flags:
@@ -114,10 +147,12 @@ class _Problems:
         self.size = cache_size
 
     def get(self, omega: float, anchor) -> DLFTProblem:
+        """The problem at the circular frequency ``omega`` [rad/s] (the continuation
+        variable of the sweep) with the stick anchors ``anchor``."""
         key = float(omega)
         red = self.cache.get(key)
         if red is None:
-            red = condense(self.model, omega, self.orders)
+            red = _condense(self.model, omega, self.orders)
             if len(self.cache) >= self.size:
                 self.cache.pop(next(iter(self.cache)))
             self.cache[key] = red
@@ -226,7 +261,7 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
     gap : (nc,) gap + wear [m] (a worn interface); default the model's initial gap.
     eps : DLFT penalty (:func:`fretwear.hb.penalty.penalty`). Default ``"static"``: the
         spectral radius of the static reduced stiffness ``Z_r(0) = K_r``, the same at every
-        frequency (``None`` is the default too). ``"auto"``: the spectral radius of ``Z_r``
+        frequency. ``"auto"``: the spectral radius of ``Z_r``
         over the kept harmonics at each frequency (the paper's rule applied point by point).
         A positive number [N/m]: that penalty everywhere. Why the default differs: the
         harmonics of ``Z_r(n w)`` have poles at the clamped-interface resonances, so its
@@ -250,10 +285,16 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
         quasi-periodic...).
     time_domain_periods : periods allowed to the time integration.
     progress : optional callable ``(i, n, point)`` called after each grid point.
+
+    Returns
+    -------
+    :class:`SweepResult`: ``success`` (every point converged), ``message`` (how many did),
+    the points in increasing frequency (a point that did not converge has no solution and
+    says why in ``flags``).
     """
     t_start = time.perf_counter()
     grid = frequency_grid(f_min, f_max, n_points, spacing)
-    eps = check_rule("static" if eps is None else eps)
+    eps = check_rule(eps)
     if eps != "auto":
         eps = penalty(eps, model=model)
     probs = _Problems(model, basis, gap, eps)
@@ -294,7 +335,7 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
         prob, U, st = _solve_at(probs, omega, current_anchor(), predict(omega), solver, tol,
                                 max_iter)
         how = "grid"
-        if not st.converged and history:
+        if not st.success and history:
             # adaptive step from the last converged point: halve on failure, grow on success
             w_cur = history[-1][0]
             step = 0.5 * (omega - w_cur)
@@ -308,7 +349,7 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
                     w_try = omega
                 pb, Ub, stb = _solve_at(probs, w_try, current_anchor(), predict(w_try), solver,
                                         tol, max_iter)
-                if not stb.converged:
+                if not stb.success:
                     step *= 0.5
                     continue
                 if last:
@@ -319,11 +360,11 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
                 step = step * 1.5
                 if abs(step) > abs(omega - w_cur):
                     step = omega - w_cur
-        if not st.converged and history:
+        if not st.success and history:
             prob, U, st = _solve_at(probs, omega, current_anchor(), history[-1][1], other, tol,
                                     max_iter)
             how = "retry"
-        if not st.converged and continuation and len(history) >= 2:
+        if not st.success and continuation and len(history) >= 2:
             anc = current_anchor()
             branch = _arclength(probs, model, anc, (history[-2][1].reshape(-1), history[-2][0]),
                                 (history[-1][1].reshape(-1), history[-1][0]), omega, tol)
@@ -334,7 +375,7 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
                 prob, U, st = _solve_at(probs, omega, current_anchor(), history[-1][1], solver,
                                         tol, max_iter)
                 how = "arclength"
-        if not st.converged and probs.eps != "auto":
+        if not st.success and probs.eps != "auto":
             # a larger penalty often converges where the default stalls (measured at 79 kHz
             # on the paper's beam); the solution differs by the eps-dependence of the
             # truncated balance, which the point records (its DLFTProblem's eps)
@@ -342,17 +383,17 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
             start = history[-1][1] if history else None
             pb, Ub, stb = _solve_at(big, omega, current_anchor(), start, "newton", tol,
                                     2 * max_iter)
-            if stb.converged:
+            if stb.success:
                 prob, U, st, how = pb, Ub, stb, "eps-x10"
         td_msg = None
-        if not st.converged and time_domain is not None:
-            td_msg, Ut, anc_t = time_domain.start(model, omega, basis, last_solution[0],
+        if not st.success and time_domain is not None:
+            td_msg, Ut, anc_t = time_domain.start(model, f, basis, last_solution[0],
                                                   max_periods=time_domain_periods)
             if Ut is not None:
                 prob, U, st = _solve_at(probs, omega, anc_t, Ut.reshape(-1, basis.size),
                                         solver, tol, 2 * max_iter)
                 how = "time-start"
-        if st.converged:
+        if st.success:
             pt = record(omega, prob, U, st, how)
             pt.on_grid = True
         else:
@@ -361,6 +402,7 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
             pt.on_grid = True
             if td_msg is not None:
                 pt.flags.append(td_msg)
+                pt.time_domain = td_msg
         points.append(pt)
         if progress is not None:
             progress(i, len(grid), pt)

@@ -155,6 +155,12 @@ def write_results(path: Path | str, ds: xr.Dataset, **attrs) -> Path:
 def read_results(path: Path | str) -> xr.Dataset:
     """Load a results file fully into memory (the file is closed on return).
 
+    Returns
+    -------
+    :class:`xarray.Dataset`: every variable with ``units`` (SI, frequencies in Hz) and
+    ``long_name`` attributes; the run's global attributes (``converged``, the case text,
+    solver settings); schema in ``docs/results.md``.
+
     Raises
     ------
     InputError

@@ -94,7 +94,7 @@ def run_one(key: str, workdir: Path | str, quick: bool = False,
                 path.write_text(text, encoding="utf-8")
             out = run_case(path, folder, progress=progress, resume=True, echo=False)
             status = ("up to date" if out.summary == "up to date"
-                      else "done" if out.converged else "not converged")
+                      else "done" if out.success else "not converged")
     except FretwearError as exc:
         return Outcome(key, "failed", " ".join(str(exc).split()), time.perf_counter() - t0)
     return Outcome(key, status, "", time.perf_counter() - t0)
@@ -151,7 +151,7 @@ def _frf_worn(folder: Path, wear_dir: Path, quick: bool) -> str:
         out[f"{name}_summary"] = r.summary()
         out[f"{name}_frequency"] = r.frequency_hz
         out[f"{name}_amplitude"] = r.amplitude("Pe", 0, 1)
-        out[f"{name}_converged"] = r.converged
+        out[f"{name}_converged"] = r.point_success
     _save_npz(path, settings=settings, wear=wear, **out)
     bad = sum(int((~out[f"{k}_converged"]).sum()) for k in ("unworn", "worn"))
     return "done" if bad == 0 else "not converged"

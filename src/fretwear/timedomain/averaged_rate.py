@@ -118,7 +118,7 @@ def window_samples(u_loc, lam, state):
     return x, f, s
 
 
-def time_averaged_rate(model: Model, omega: float, basis: FourierBasis, coef, wear, *, U0, V0,
+def time_averaged_rate(model: Model, frequency: float, basis: FourierBasis, coef, wear, *, U0, V0,
                        settle: int = 300, average: int = 500,
                        steps_per_period: int | None = None,
                        classify_tol: float = 1e-4) -> TimeAveragedRate:
@@ -126,7 +126,7 @@ def time_averaged_rate(model: Model, omega: float, basis: FourierBasis, coef, we
 
     Parameters
     ----------
-    model : the structure; omega : excitation circular frequency [rad/s] (dynamic only).
+    model : the structure; frequency : excitation frequency [Hz] (dynamic only).
     basis : Fourier basis on which the last period's harmonics are returned.
     coef : (nc,) factor ``c_p`` of the wear law [1/N] (``dW1 = c S``).
     wear : (nc,) wear depth [m] (opens the normal gap).
@@ -141,7 +141,7 @@ def time_averaged_rate(model: Model, omega: float, basis: FourierBasis, coef, we
     hmax = max(basis.harmonics) if basis.harmonics else 1
     nsteps = default_steps(basis, steps_per_period)
     average = max(int(average), 2)
-    r = integrate(model, omega, n_periods=int(settle) + average, steps_per_period=nsteps,
+    r = integrate(model, frequency, n_periods=int(settle) + average, steps_per_period=nsteps,
                   record=average, U0=U0, V0=V0, wear=wear)
     x, f, s = window_samples(r.u_loc, r.lam, r.state)
     nc, d, ns = x.shape

@@ -36,6 +36,7 @@ is replaced by the equivalent viscous damping at the forcing frequency, ``C_eq =
 
 from __future__ import annotations
 
+import inspect
 import math
 import time
 import warnings
@@ -78,7 +79,7 @@ __all__ = [
     "steady_state",
 ]
 
-DEFAULT_STEPS = 128
+DEFAULT_STEPS = 256  # time steps per forcing period (case files take it too)
 CUTOFF_STEPS = 8  # default cutoff: modes whose period spans at least this many steps
 DENSE_EIG_LIMIT = 3000  # interior DOFs up to which the fixed-interface modes are found densely
 CHUNK_STEPS = 2_000_000  # steps per kernel call (progress, interruption)
@@ -93,8 +94,11 @@ HF_GAMMA = 1.0  # ... are integrated with this Newmark gamma (spectral radius 1/
 class TransientResult:
     """Output of :func:`integrate`.
 
-    Samples are taken at ``t_n = n h`` (``h = T / steps_per_period``) for every step of the
-    recorded periods (the last ``record`` periods), ``t`` counted from the start of the run.
+    ``success`` is True when the integration completed with every contact solve settled;
+    ``message`` says what happened (e.g. ``"integrated 100 periods"``, ``"12 contact solves
+    did not settle (first at t = 0.0123 s)"``). Samples are taken at ``t_n = n h``
+    (``h = T / steps_per_period``) for every step of the recorded periods (the last
+    ``record`` periods), ``t`` counted from the start of the run.
 
     Attributes
     ----------
@@ -111,12 +115,14 @@ class TransientResult:
         round-off for ``gamma = 1/2``). Balance:
         ``mechanical[j] - mechanical[0] = external - friction - normal - damping - numerical``.
     n_periods : forcing periods simulated. steps_per_period : steps per period.
-    omega : forcing angular frequency [rad/s]. wall_time : [s].
+    omega : forcing circular frequency ``2 pi frequency`` [rad/s] (``frequency``: [Hz]).
+    wall_time : [s].
     U, V : (ndof,) final displacement [m] and velocity [m/s] (pass them as ``U0, V0`` to
         continue the run exactly).
     poincare : name -> (np, d) observed displacement at the start of each kept period [m].
     period_mean : name -> (np, d) mean over each kept period [m].
     info : reduction and solver statistics.
+    success : every contact solve settled; message : what happened.
     """
 
     t: np.ndarray
@@ -135,6 +141,13 @@ class TransientResult:
     poincare: dict = field(default_factory=dict)
     period_mean: dict = field(default_factory=dict)
     info: dict = field(default_factory=dict)
+    success: bool = True
+    message: str = ""
+
+    @property
+    def frequency(self) -> float:
+        """Forcing frequency [Hz]."""
+        return self.omega / (2 * np.pi)
 
     def energy_residual(self) -> float:
         """Largest ``|dE - (W_ext - D_fric - D_normal - D_damp - D_num)|`` over the record [J]."""
@@ -186,9 +199,13 @@ class SteadyStateResult:
 
     Attributes
     ----------
+    success : the response was classified (not ``"transient"`` at ``max_periods``) and every
+        contact solve settled.
+    message : what happened, e.g. ``"periodic after 412 periods"``, ``"still transient after
+        20000 periods"``, ``"...; 12 contact solves did not settle"``.
     classification : see :class:`Classification` (``kind``).
     n_periods : periods integrated (including the recorded last one).
-    converged : True for ``"periodic"`` (and ``"subharmonic"``).
+    periodic : True for ``"periodic"`` (and ``"subharmonic"``).
     last : :class:`TransientResult` of the last period (every step recorded).
     harmonics : name -> (2 nh + 1, d) real Fourier coefficients of the observed displacement
         over the last period [m], basis ``[a0, a1..a_nh, b1..b_nh]``
@@ -200,9 +217,11 @@ class SteadyStateResult:
     U, V : final state [m], [m/s]. wall_time : [s]. info : solver statistics.
     """
 
+    success: bool
+    message: str
     classification: str
     n_periods: int
-    converged: bool
+    periodic: bool
     last: TransientResult
     harmonics: dict
     contact_harmonics: dict
@@ -218,6 +237,9 @@ class SteadyStateResult:
 class IncrementalWearResult:
     """Output of :func:`incremental_wear` (one row per recorded computed cycle).
 
+    success : every load step's contact problem settled; message : what happened (e.g.
+    ``"100 cycles (100 computed, 6400 load steps)"``, or how many load steps did not settle).
+
     cycles : (nrec,) number of load cycles done (computed cycles times their jumps).
     wear : (nrec, nc) wear depth [m] at the end of the cycle.
     pressure : (nrec, nc) contact pressure ``lam_N / area`` averaged over the cycle [Pa].
@@ -229,6 +251,8 @@ class IncrementalWearResult:
     lam : (nc, d) final contact forces [N]. info : solver statistics.
     """
 
+    success: bool
+    message: str
     cycles: np.ndarray
     wear: np.ndarray
     pressure: np.ndarray
@@ -807,30 +831,32 @@ class _Integrator:
                     hf_damped_modes=int(np.sum(self.g_modes > self.gamma)),
                     failed_steps=self.n_fail, max_active_set_iterations=self.max_it,
                     first_failure_time=self.first_fail_time, periods_total=self.periods_done)
+        message = f"integrated {n_periods} periods"
         if self.n_fail:
-            warnings.warn(f"{self.n_fail} contact solves did not settle (first at t = "
-                          f"{self.first_fail_time:.6g} s); results there are approximate",
-                          RuntimeWarning, stacklevel=3)
+            message = (f"{self.n_fail} contact solves did not settle (first at t = "
+                       f"{self.first_fail_time:.6g} s)")
+            warnings.warn(f"{message}; results there are approximate", RuntimeWarning,
+                          stacklevel=3)
         return TransientResult(
             t=t, observed=observed, velocities=velocities,
             u_loc=raw["x"].reshape(ns, nc, d), lam=raw["lam"].reshape(ns, nc, d),
             state=raw["state"], energy=energy, n_periods=n_periods, steps_per_period=N,
             omega=self.omega, wall_time=wall, U=U, V=V, poincare=poinc, period_mean=pmean,
-            info=info)
+            info=info, success=not self.n_fail, message=message)
 
 
-def integrate(model: Model, omega: float, *, n_periods: int, steps_per_period: int = DEFAULT_STEPS,
-              record="last", U0=None, V0=None, wear=None, stick_anchor=None, modal_cutoff=None,
-              n_modes=None, gamma: float = 0.5, hf_damping: bool = False,
-              keep_poincare: int = 10_000, tol: float = 1e-10,
-              progress: bool = False) -> TransientResult:
+def integrate(model: Model, frequency: float, *, n_periods: int,
+              steps_per_period: int = DEFAULT_STEPS, record="last", U0=None, V0=None,
+              wear=None, stick_anchor=None, modal_cutoff=None, n_modes=None,
+              gamma: float = 0.5, hf_damping: bool = False, keep_poincare: int = 10_000,
+              tol: float = 1e-10, progress: bool = False) -> TransientResult:
     """Integrate the forced response in time with exact contact and friction.
 
     Parameters
     ----------
     model : the structure (:class:`~fretwear.model.core.Model`).
-    omega : forcing angular frequency [rad/s]; the loads are ``F(omega t)``.
-    n_periods : number of forcing periods ``T = 2 pi / omega`` to simulate.
+    frequency : forcing frequency ``f`` [Hz]; the loads are ``F(omega t)``, ``omega = 2 pi f``.
+    n_periods : number of forcing periods ``T = 1 / f`` to simulate.
     steps_per_period : fixed steps per period (``h = T / steps_per_period``). Guidance: >= 20
         steps per period of the highest harmonic you want accurate (phase error of the
         trapezoidal rule ``(omega h)^2 / 12``); stick-slip events are first order in ``h``.
@@ -860,7 +886,9 @@ def integrate(model: Model, omega: float, *, n_periods: int, steps_per_period: i
 
     Returns
     -------
-    :class:`TransientResult`.
+    :class:`TransientResult`: ``success`` (every contact solve settled), ``message``, the
+    recorded samples (times [s], displacements [m], forces [N], energies [J]) and the final
+    state ``U, V`` to continue the run.
     """
     n_periods = _count(n_periods, "n_periods", 1)
     if record == "last":
@@ -870,6 +898,7 @@ def integrate(model: Model, omega: float, *, n_periods: int, steps_per_period: i
         if n_rec > n_periods:
             raise InputError(f"record = {record} periods but n_periods = {n_periods}")
     n_keep = min(_count(keep_poincare, "keep_poincare", 0), n_periods)
+    omega = 2 * np.pi * _positive(frequency, "frequency")
     integ = _Integrator(model, omega, steps_per_period=steps_per_period,
                         modal_cutoff=modal_cutoff, n_modes=n_modes, gamma=gamma, tol=tol,
                         wear=wear, U0=U0, V0=V0, stick_anchor=stick_anchor,
@@ -989,7 +1018,7 @@ def classify_sequence(poincare, means=None, *, tol: float = 1e-6, scale: float |
     return out
 
 
-def steady_state(model: Model, omega: float, *, max_periods: int = 20_000, tol: float = 1e-6,
+def steady_state(model: Model, frequency: float, *, max_periods: int = 20_000, tol: float = 1e-6,
                  steps_per_period: int = DEFAULT_STEPS, harmonics: int = 7,
                  check_every: int = 16, window: int = 512, min_periods: int = 128, U0=None,
                  V0=None, wear=None, stick_anchor=None, modal_cutoff=None, n_modes=None,
@@ -1008,7 +1037,7 @@ def steady_state(model: Model, omega: float, *, max_periods: int = 20_000, tol: 
 
     Parameters
     ----------
-    model, omega : as :func:`integrate`.
+    model, frequency : as :func:`integrate` (``frequency`` [Hz]).
     max_periods : give up after this many periods (classification then as found).
     tol : relative periodicity tolerance (see :func:`classify_sequence`).
     harmonics : highest harmonic of the last period reported (1 .. harmonics).
@@ -1016,8 +1045,33 @@ def steady_state(model: Model, omega: float, *, max_periods: int = 20_000, tol: 
 
     Returns
     -------
-    :class:`SteadyStateResult`.
+    :class:`SteadyStateResult`: ``success`` when the response was classified with every
+    contact solve settled; ``classification`` and ``message`` say what it is.
     """
+    return _steady_state(model, 2 * np.pi * _positive(frequency, "frequency"),
+                         max_periods=max_periods, tol=tol, steps_per_period=steps_per_period,
+                         harmonics=harmonics, check_every=check_every, window=window,
+                         min_periods=min_periods, U0=U0, V0=V0, wear=wear,
+                         stick_anchor=stick_anchor, modal_cutoff=modal_cutoff, n_modes=n_modes,
+                         gamma=gamma, hf_damping=hf_damping, contact_tol=contact_tol,
+                         progress=progress)
+
+
+def _steady_state_at_omega(model: Model, omega: float, **kwargs) -> SteadyStateResult:
+    """:func:`steady_state` at the circular frequency ``omega`` [rad/s] of a periodic solution
+    (no conversion to Hz and back), with its keywords and defaults."""
+    bound = inspect.signature(steady_state).bind(model, 0.0, **kwargs)
+    bound.apply_defaults()
+    args = dict(bound.arguments)
+    del args["model"], args["frequency"]
+    return _steady_state(model, omega, **args)
+
+
+def _steady_state(model: Model, omega: float, *, max_periods, tol, steps_per_period, harmonics,
+                  check_every, window, min_periods, U0, V0, wear, stick_anchor, modal_cutoff,
+                  n_modes, gamma, hf_damping, contact_tol, progress) -> SteadyStateResult:
+    """:func:`steady_state` at the circular frequency ``omega`` [rad/s] (every argument
+    given)."""
     max_periods = _count(max_periods, "max_periods", 1)
     check_every = _count(check_every, "check_every", 1)
     window = _count(window, "window", 8)
@@ -1060,9 +1114,16 @@ def steady_state(model: Model, omega: float, *, max_periods: int = 20_000, tol: 
              "u_loc": fourier_coefficients(last.u_loc, harmonics)}
     info = dict(last.info)
     info["history"] = history
+    n = done + 1
+    classified = cls.kind != "transient"
+    message = (f"{cls.kind} after {n} periods" if classified
+               else f"still transient after {n} periods")
+    if integ.n_fail:
+        message += f"; {integ.n_fail} contact solves did not settle"
     return SteadyStateResult(
-        classification=cls.kind, n_periods=done + 1,
-        converged=cls.kind in ("periodic", "subharmonic"), last=last, harmonics=harm,
+        success=classified and not integ.n_fail, message=message,
+        classification=cls.kind, n_periods=n,
+        periodic=cls.kind in ("periodic", "subharmonic"), last=last, harmonics=harm,
         contact_harmonics=charm, diagnostics=cls, poincare=P, U=last.U, V=last.V,
         wall_time=time.perf_counter() - t_start, info=info)
 
@@ -1072,8 +1133,8 @@ def steady_state(model: Model, omega: float, *, max_periods: int = 20_000, tol: 
 # --------------------------------------------------------------------------------------------
 def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int = 100,
                      cycle_jump: int = 1, k_w: float | None = None, record_every: int = 1,
-                     wear0=None, tol: float = 1e-10,
-                     progress: bool = False) -> IncrementalWearResult:
+                     wear0=None, tol: float = 1e-10, progress: bool = False,
+                     raise_on_failure: bool = True) -> IncrementalWearResult:
     """Quasi-static fretting wear by load steps (in the spirit of Stromberg 1997).
 
     At every load step ``tau_k = 2 pi k / steps_per_cycle`` the static equilibrium
@@ -1100,10 +1161,14 @@ def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int =
     record_every : record every this many computed cycles (and the last).
     wear0 : (nc,) initial wear [m].
     tol : relative tolerance of the contact solver.
+    raise_on_failure : raise :class:`~fretwear.errors.ConvergenceError` when the contact
+        problem of some load step does not settle (default); False: return the result with
+        ``success`` False and the count in ``message``.
 
     Returns
     -------
-    :class:`IncrementalWearResult`.
+    :class:`IncrementalWearResult`: ``success``, ``message``, and per recorded cycle the
+    wear [m], pressure [Pa], slip [m], worn volume [m^3] and dissipation [J].
     """
     N = _count(steps_per_cycle, "steps_per_cycle", 2)
     n_cycles = _count(n_cycles, "n_cycles", 1)
@@ -1146,15 +1211,18 @@ def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int =
         Contact(A, gap, float(c.mu), int(d)), LoadCycle(btab, _c_float(area), kw, jumps),
         Settings(float(tol), fscale, 60 + 4 * nc), WearState(x, wear, ContactState(status, tdir)),
         rec)
-    if nfail:
+    if nfail and raise_on_failure:
         raise ConvergenceError(f"incremental_wear: {nfail} load steps where the contact active "
                                "set did not settle (singular or cycling); check that the "
                                "contact holds the structure (rigid motions) and the loads")
+    message = (f"{n_cycles} cycles ({ncomp} computed, {ncomp * N} load steps)" if not nfail
+               else f"{nfail} load steps where the contact active set did not settle")
     lam = np.asarray(A @ (-x) + btab[0]).reshape(nc, d)
     U = cond.recover(x, model.load_time(np.zeros(1))[0] if model.loads
                      else np.zeros(model.ndof))
     return IncrementalWearResult(
-        cycles=rec.cycle, wear=rec.wear, pressure=rec.press, slip=rec.slip,
+        success=not nfail, message=message, cycles=rec.cycle, wear=rec.wear, pressure=rec.press,
+        slip=rec.slip,
         worn_volume=rec.wear @ area, dissipation=rec.diss, computed_cycles=ncomp, cycle_jump=J,
         steps_per_cycle=N, k_w=kw, wall_time=time.perf_counter() - t0, U=U, lam=lam,
         info={"max_active_set_iterations": int(maxit), "records": int(nr)})

@@ -72,8 +72,17 @@ def check_periodic(model: Model, sol: PeriodicSolution, *, max_periods: int = 30
         periodic state". The harmonic balance truncates a non-smooth response, so the two
         methods differ by the truncation error even for a stable orbit; 0.2 is well above the
         truncation error measured on the paper's beam with 7 harmonics (docs/verification.md).
+    periodicity_tol : relative periodicity tolerance of the time integration's classification.
+    seed : of the random perturbation.
+
+    Returns
+    -------
+    :class:`StabilityCheck`: ``verdict`` (``"stable"`` when the structure settles back to the
+    solution), ``distance`` [-], ``periods`` integrated, ``wall_time`` [s], ``message`` (one
+    line), ``flags()`` for a sweep point. The integration runs at the solution's own circular
+    frequency ``sol.omega`` [rad/s] (``sol.frequency`` [Hz]).
     """
-    from fretwear.timedomain.integrate import steady_state
+    from fretwear.timedomain.integrate import _steady_state_at_omega
 
     t0 = time.perf_counter()
     if sol.quasi_static or sol.omega <= 0:
@@ -83,9 +92,10 @@ def check_periodic(model: Model, sol: PeriodicSolution, *, max_periods: int = 30
     vmax = np.abs(V0).max()
     V0 = V0 + perturbation * vmax * rng.standard_normal(V0.shape)
     nsteps = steps_per_period or max(128, 8 * max(sol.basis.harmonics))
-    res = steady_state(model, sol.omega, max_periods=max_periods, tol=periodicity_tol,
-                       steps_per_period=nsteps, harmonics=max(sol.basis.harmonics),
-                       U0=U0, V0=V0, wear=sol.gap - np.asarray(model.contact.gap, float))
+    res = _steady_state_at_omega(model, sol.omega, max_periods=max_periods,
+                                tol=periodicity_tol, steps_per_period=nsteps,
+                                harmonics=max(sol.basis.harmonics), U0=U0, V0=V0,
+                                wear=sol.gap - np.asarray(model.contact.gap, float))
     kind = res.classification
     # distance between the settled period and the periodic solution, on the observed points
     dist = 0.0
@@ -140,11 +150,11 @@ def sweep_check(model: Model, **kwargs):
     return check
 
 
-def time_domain_start(model: Model, omega: float, basis, start: PeriodicSolution | None = None,
-                      *, max_periods: int = 3000, steps_per_period: int | None = None,
-                      periodicity_tol: float = 1e-4):
-    """Integrate in time at ``omega`` until the response is classified; return what the
-    structure does there and, if it settles to a periodic state, a starting point for the
+def time_domain_start(model: Model, frequency: float, basis,
+                      start: PeriodicSolution | None = None, *, max_periods: int = 3000,
+                      steps_per_period: int | None = None, periodicity_tol: float = 1e-4):
+    """Integrate in time at ``frequency`` [Hz] until the response is classified; return what
+    the structure does there and, if it settles to a periodic state, a starting point for the
     harmonic balance taken from it.
 
     This is what a careful analyst does when a periodic solve fails: the time integration (from
@@ -164,7 +174,7 @@ def time_domain_start(model: Model, omega: float, basis, start: PeriodicSolution
         wear = start.gap - np.asarray(model.contact.gap, float)
     hmax = max(basis.harmonics) if basis.harmonics else 1
     nsteps = steps_per_period or max(128, 8 * hmax)
-    res = steady_state(model, omega, max_periods=max_periods, tol=periodicity_tol,
+    res = steady_state(model, frequency, max_periods=max_periods, tol=periodicity_tol,
                        steps_per_period=nsteps, harmonics=hmax, U0=U0, V0=V0, wear=wear)
     kind = res.classification
     n = res.n_periods

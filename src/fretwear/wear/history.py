@@ -102,21 +102,24 @@ class WearHistory:
 class WearResult:
     """Outcome of :func:`~fretwear.wear.simulate.simulate_wear`.
 
-    history : :class:`WearHistory`; initial, final : periodic solutions at the first and last
-    balanced steps (steps whose rate was averaged over a time integration, ``rescued = 2``,
-    have no periodic solution; None when no step was balanced); penalty : the DLFT eps [N/m];
-    stop_reason : why it stopped; message : one line for the user;
-    converged : False when it stopped on a failed solve (every recorded step converged);
-    wall_time : [s]; stability_jump : explicit Euler's stability limit ``2/rho`` estimated
-    from the slow Jacobian at the start [cycles] (nan if not computed).
+    success : False when the run stopped on a failed solve (``stop_reason`` ``"solver_failed"``;
+    every recorded step converged all the same); message : one line for the user (why it
+    stopped, after how many steps and cycles); stop_reason : why it stopped (one of
+    :data:`~fretwear.wear.options.STOP_REASONS`); history : :class:`WearHistory`;
+    initial, final : periodic solutions at the first and last balanced steps, or None: steps
+    whose rate was averaged over a time integration (``rescued = 2``) have no periodic
+    solution, so ``initial`` is None when the run started from a time integration (the unworn
+    interface had no balance) and both are None when no step was balanced; penalty : the
+    DLFT eps [N/m]; wall_time : [s]; stability_jump : explicit Euler's stability limit
+    ``2/rho`` estimated from the slow Jacobian at the start [cycles] (nan if not computed).
     """
 
     history: WearHistory
-    initial: PeriodicSolution
-    final: PeriodicSolution
+    initial: PeriodicSolution | None
+    final: PeriodicSolution | None
     stop_reason: str
     message: str
-    converged: bool
+    success: bool
     wall_time: float
     stability_jump: float = math.nan
     resumed_from: int = -1

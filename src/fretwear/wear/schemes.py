@@ -45,12 +45,13 @@ def first_state(sp: SlowProblem, W0, anchor, U0, opts: WearOptions) -> tuple[dic
     t0 = time.perf_counter()
     sp.set_state(W0, anchor)
     # the first balance goes through solve_periodic (its start strategies for a cold start)
-    sol0, st = solve_periodic(sp.model, sp.prob.basis, omega=sp.prob.reduced.omega,
-                              quasi_static=sp.prob.reduced.quasi_static,
-                              reduced=sp.prob.reduced, gap=sp.gap0 + W0, eps=sp.eps,
-                              anchor=anchor, U0=U0, solver=opts.solver, tol=opts.tol,
-                              max_iter=max(opts.max_iter, 200))
-    if sol0 is None or not st.converged:
+    sol0 = solve_periodic(sp.model, sp.prob.basis, frequency=sp.prob.reduced.frequency,
+                          quasi_static=sp.prob.reduced.quasi_static,
+                          reduced=sp.prob.reduced, gap=sp.gap0 + W0, eps=sp.eps,
+                          anchor=anchor, U0=U0, solver=opts.solver, tol=opts.tol,
+                          max_iter=max(opts.max_iter, 200))
+    st = sol0.stats
+    if not sol0.success:
         if sp.time_domain is not None:
             return time_domain_start(sp, W0, opts, st, t0)
         raise ConvergenceError(
@@ -111,7 +112,7 @@ def advance(sp: SlowProblem, st: dict, opts: WearOptions):
     while True:
         W1, U1, stats = _attempt(sp, opts, W_k, U_k, g_k, anchor, dN, lin)
         iters += stats.iterations
-        if not stats.converged:
+        if not stats.success:
             failures += 1
             rejected += 1
             if failures > opts.max_retries or dN <= fail_floor:
@@ -159,7 +160,7 @@ def _attempt(sp: SlowProblem, opts: WearOptions, W_k, U_k, g_k, anchor, dN, lin)
     Up = U_k + (dUdW @ dW).reshape(sp.m, sp.H)
     if opts.scheme == "rosenbrock":
         U1, stats = sp.solve_balance(Wp, anchor, Up, **kw)
-        if not stats.converged:
+        if not stats.success:
             its = stats.iterations
             U1, stats = sp.solve_balance(Wp, anchor, sp.shift_guess(U_k, dW), **kw)
             stats.iterations += its
@@ -186,7 +187,7 @@ def _backward_euler(sp: SlowProblem, opts: WearOptions, W_k, U_start, dN, anchor
     ``max|r| <= 0.5 tolerance max W``. The step's error estimate (:func:`local_error`) contains
     ``r``, so the error test judges such a step.
 
-    Returns ``(W1, U1, stats)``; ``stats.converged`` is False when the balance or the
+    Returns ``(W1, U1, stats)``; ``stats.success`` is False when the balance or the
     iteration fails.
     """
     t0 = time.perf_counter()
@@ -198,10 +199,10 @@ def _backward_euler(sp: SlowProblem, opts: WearOptions, W_k, U_start, dN, anchor
         nonlocal its
         U1, st = sp.solve_balance(W, anchor, U, **kw)
         its += st.iterations
-        if not st.converged:  # retry from the previous balance, shifted by the wear change
+        if not st.success:  # retry from the previous balance, shifted by the wear change
             U1, st = sp.solve_balance(W, anchor, sp.shift_guess(U_start, W - W_k), **kw)
             its += st.iterations
-        if not st.converged:
+        if not st.success:
             return None
         U = U1
         r = W - W_k - dN * sp.rate(U)

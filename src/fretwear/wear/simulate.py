@@ -44,9 +44,9 @@ from fretwear.wear.slow_problem import SlowProblem
 from fretwear.wear.time_steps import time_domain_step
 
 
-def simulate_wear(model: Model, basis: FourierBasis, *, omega: float = 2 * np.pi,
+def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
                   quasi_static: bool = False, options: WearOptions | None = None,
-                  reduced: Reduced | None = None, eps: float | None = None, anchor=None,
+                  reduced: Reduced | None = None, eps: str | float = "auto", anchor=None,
                   W0=None, U0=None, checkpoint: Path | str | None = None, resume: bool = False,
                   progress: bool = False, callback: Callable | None = None,
                   time_domain: TimeDomainFallback | None = None) -> WearResult:
@@ -56,11 +56,13 @@ def simulate_wear(model: Model, basis: FourierBasis, *, omega: float = 2 * np.pi
     ----------
     model : the structure (``contact.wear_coefficient`` k_w [1/Pa] for Archard's law).
     basis : Fourier basis of the periodic solutions.
-    omega : excitation circular frequency [rad/s] (only scales time when ``quasi_static``).
+    frequency : excitation frequency [Hz] (only scales time when ``quasi_static``).
     quasi_static : drop inertia and damping.
     options : :class:`WearOptions` (defaults: adaptive linearly implicit, tolerance 1e-2).
     reduced : precomputed condensation on ``[0] + basis.harmonics``.
-    eps : DLFT penalty [N/m] (default: spectral radius of ``Z_r``).
+    eps : DLFT penalty: ``"auto"`` (default) the spectral radius of ``Z_r`` (the paper),
+        ``"static"`` that of the static ``K_r``, or a positive number [N/m]
+        (:func:`fretwear.hb.penalty.penalty`).
     anchor : (nc, d-1) stick anchors of the first solve [m] (default: static preload state).
     W0 : (nc,) initial wear [m] (default 0).
     U0 : (nc, d, H) or (m, H) start of the first periodic solve.
@@ -77,7 +79,8 @@ def simulate_wear(model: Model, basis: FourierBasis, *, omega: float = 2 * np.pi
 
     Returns
     -------
-    :class:`WearResult`.
+    :class:`WearResult`: ``success`` False when it stopped on a failed solve, ``message`` why
+    and when it stopped (``stop_reason``), the ``history`` of every slow step.
 
     Raises
     ------
@@ -94,7 +97,7 @@ def simulate_wear(model: Model, basis: FourierBasis, *, omega: float = 2 * np.pi
     t_start = time.perf_counter()
     nc, d = model.contact.dofs.shape
     if reduced is None:
-        reduced = condense(model, omega, basis.orders, quasi_static=quasi_static)
+        reduced = condense(model, frequency, basis.orders, quasi_static=quasi_static)
     coef = wear_coefficients(model, opts.law, opts.energy_coefficient)
     W0 = np.zeros(nc) if W0 is None else np.broadcast_to(np.asarray(W0, float), (nc,)).copy()
     if anchor is None:

@@ -34,14 +34,15 @@ class SlowProblem:
     model : the model; reduced : its condensation on ``[0] + basis.harmonics``.
     basis : Fourier basis.
     coef : (nc,) wear factors ``c_p`` [1/N] (:func:`~fretwear.wear.laws.wear_coefficients`).
-    eps : DLFT penalty [N/m] (None: spectral radius of ``Z_r``).
+    eps : DLFT penalty: ``"auto"`` (default, spectral radius of ``Z_r``), ``"static"`` or a
+        positive number [N/m] (:func:`fretwear.hb.penalty.penalty`).
     anchor : (nc, d-1) stick anchors [m].
 
     The wear depths ``W`` (nc,) [m] enter the DLFT as the normal gap ``gap0 + W``; ``E_W`` puts
     ``W_p`` into the static coefficient of the normal DOF of node ``p``.
     """
 
-    def __init__(self, model: Model, reduced: Reduced, basis: FourierBasis, coef, *, eps=None,
+    def __init__(self, model: Model, reduced: Reduced, basis: FourierBasis, coef, *, eps="auto",
                  anchor=None, time_domain: TimeDomainFallback | None = None):
         self.model = model
         self.time_domain = time_domain  # fallback of failed balances (None: none)
@@ -162,7 +163,7 @@ class SlowProblem:
         its = 0
         if fast:
             x, st = newton(fun, x0, scale, tol=tol, max_iter=min(max_iter, 15))
-            if st.converged:
+            if st.success:
                 return x.reshape(self.m, self.H), st
             its = st.iterations
         x, _, st = solve(fun, x0, scale, method=solver, tol=tol, max_iter=max_iter)

@@ -37,8 +37,8 @@ def time_domain_start(sp: SlowProblem, W0, opts: WearOptions, st: SolveStats, t0
     :func:`time_domain_step`, and the run goes on with time-domain steps (which go back to the
     DLFT as soon as a balance converges). The first jump is ``initial_jump``, default
     ``START_JUMP`` cycles (no slow Jacobian without a balance; the error control adapts it)."""
-    tr = sp.time_domain.averaged_rate(sp.model, sp.prob.reduced.omega, sp.prob.basis, sp.coef,
-                                      W0, U0=None, V0=None,
+    tr = sp.time_domain.averaged_rate(sp.model, sp.prob.reduced.frequency, sp.prob.basis,
+                                      sp.coef, W0, U0=None, V0=None,
                                       settle=max(opts.time_domain_settle, START_SETTLE),
                                       average=opts.time_domain_average,
                                       steps_per_period=opts.time_domain_steps)
@@ -109,7 +109,7 @@ def time_domain_step(sp: SlowProblem, st: dict, opts: WearOptions):
         else:
             W1 = W_k + dN * g_k
         try:
-            tr = sp.time_domain.averaged_rate(sp.model, sp.prob.reduced.omega, sp.prob.basis,
+            tr = sp.time_domain.averaged_rate(sp.model, sp.prob.reduced.frequency, sp.prob.basis,
                                               sp.coef, W1, U0=U0, V0=V0,
                                               settle=opts.time_domain_settle,
                                               average=opts.time_domain_average,
@@ -130,7 +130,7 @@ def time_domain_step(sp: SlowProblem, st: dict, opts: WearOptions):
                                      solver=opts.solver, tol=opts.tol,
                                      max_iter=max(opts.max_iter, RESCUE_MAX_ITER))
         iters += stats.iterations
-        if stats.converged:
+        if stats.success:
             sp.set_state(W1, tr.anchor)
             g1 = sp.rate(U1)
             err_b = local_error(dN, W1, W_k, g1, g_k)

@@ -25,7 +25,7 @@ def frf_worn(model: Model, wear, frequencies_hz, basis: FourierBasis, *, anchor=
 
     Returns
     -------
-    :class:`fretwear.hb.sweep.SweepResult`.
+    :class:`fretwear.hb.sweep.SweepResult` (``success``, ``message``).
     """
     from fretwear.hb.sweep import sweep
 

@@ -1,0 +1,102 @@
+"""One definition per option: the default of every case-file key that is a keyword of the
+Python function its analysis calls is that keyword's default (the schema takes it from the
+signature, :func:`fretwear.analyses.common.default_of`).
+
+The table below restates, independently of the schemas, which function and keyword each key
+maps to; the test validates minimal case files and compares the filled-in defaults with the
+signatures, so it fails when either side is changed alone.
+"""
+
+from __future__ import annotations
+
+import inspect
+from dataclasses import fields
+
+import pytest
+
+from fretwear import api, linear
+from fretwear.analyses.registry import analysis_tables
+from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.periodic import solve_periodic
+from fretwear.hb.sweep import sweep
+from fretwear.io.case import validate
+from fretwear.timedomain.integrate import incremental_wear, integrate, steady_state
+from fretwear.wear import WearOptions, frf_worn, simulate_wear
+
+MODEL = {"model": {"type": "box", "lx": 1.0, "ly": 1.0, "lz": 1.0, "nx": 1, "ny": 1, "nz": 1},
+         "material": {"E": 1.0, "nu": 0.0}, "contact": {"boundary": "zmin", "mu": 0.1}}
+BASIS = {"harmonics": (FourierBasis.up_to, "nh"), "n_samples": (FourierBasis.up_to, "n_samples")}
+WEAR_OPTIONS = {f.name: f.default for f in fields(WearOptions)}
+
+#: analysis type -> (required keys, {key: (function, keyword)})
+CASES = {
+    "modes": ({}, {"n_modes": (linear.modes, "n_modes")}),
+    "frf": ({"f_min": 1.0, "f_max": 10.0},
+            {"spacing": (linear.frequency_grid, "spacing"), "method": (linear.frf, "method")}),
+    "periodic": ({"frequency": 10.0}, {
+        **BASIS, **{k: (solve_periodic, k) for k in ("quasi_static", "eps", "solver", "tol",
+                                                     "max_iter")}}),
+    "sweep": ({"f_min": 1.0, "f_max": 10.0}, {
+        **BASIS, **{k: (sweep, k) for k in ("spacing", "continuation", "time_domain_periods",
+                                            "eps", "solver", "tol", "max_iter")},
+        "time_domain": (api.sweep, "time_domain")}),
+    "transient": ({"frequency": 10.0}, {
+        "steps_per_period": (steady_state, "steps_per_period"),
+        **{k: (steady_state, k) for k in ("max_periods", "tol", "harmonics")}}),
+    "incremental-wear": ({}, {k: (incremental_wear, k) for k in (
+        "steps_per_cycle", "n_cycles", "cycle_jump", "record_every")}),
+    "wear": ({"frequency": 10.0, "frf_before_after": {"f_min": 1.0, "f_max": 10.0}}, {
+        **BASIS, "quasi_static": (simulate_wear, "quasi_static"),
+        "frf_before_after.spacing": (frf_worn, "spacing"),
+        "frf_before_after.time_domain": (api.frf_worn, "time_domain")}),
+}
+
+
+def python_default(func, name):
+    return inspect.signature(func).parameters[name].default
+
+
+def validated(kind: str, required: dict) -> dict:
+    return validate({**MODEL, "analysis": {"type": kind, **required}},
+                    analysis_tables())["analysis"]
+
+
+@pytest.mark.parametrize("kind", list(CASES))
+def test_case_file_defaults_are_the_python_defaults(kind):
+    required, keys = CASES[kind]
+    table = validated(kind, required)
+    for key, (func, name) in keys.items():
+        value = table
+        for part in key.split("."):
+            value = value[part]
+        expected = python_default(func, name)
+        assert value == expected and type(value) is type(expected), (
+            f"[analysis] {kind}.{key} = {value!r}, {func.__qualname__}({name}={expected!r})")
+
+
+def test_wear_options_defaults():
+    """Every wear option the table fills in has the default of WearOptions (None: not set, the
+    key is then absent)."""
+    table = validated("wear", {"frequency": 10.0})
+    keys = analysis_tables()["wear"].fields
+    for name, default in WEAR_OPTIONS.items():
+        if name in table:
+            assert table[name] == default, (name, table[name], default)
+        elif name in keys:  # not written into the table: the option keeps its default
+            assert default is None or name == "max_depth", name
+
+
+def test_integrate_and_steady_state_share_their_step_and_frequency_defaults():
+    """The transient analysis calls integrate (fixed) or steady_state: one default for the
+    steps per period; and the frequency of a quasi-static solve (case files: 1 Hz) is the
+    same for the periodic solve and the wear run."""
+    assert (python_default(integrate, "steps_per_period")
+            == python_default(steady_state, "steps_per_period"))
+    assert (python_default(solve_periodic, "frequency")
+            == python_default(simulate_wear, "frequency") == 1.0)
+
+
+def test_eps_words_not_none():
+    """The penalty is spelt with the same words in Python and case files: no None default."""
+    for func in (solve_periodic, sweep, simulate_wear):
+        assert python_default(func, "eps") in ("auto", "static"), func
