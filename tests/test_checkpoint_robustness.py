@@ -347,3 +347,26 @@ def test_next_run_removes_a_stale_temporary(case, reference, tmp_path, capsys):
     assert not stale.exists()
     for name, (data, mtime) in kept.items():
         assert (out / name).read_bytes() == data and (out / name).stat().st_mtime_ns == mtime
+
+
+def test_an_interruption_inside_compiled_code_is_an_interruption():
+    """Ctrl-C or SIGTERM that arrives while a numba function runs surfaces as SystemError
+    ("returned a result with an exception set") caused, through one or more such
+    SystemErrors, by the KeyboardInterrupt (seen on a killed wear run): the run must treat it
+    as the interruption (save, exit 130/143), and anything else as an error."""
+    from fretwear.errors import interrupted
+
+    def nested(depth):
+        exc = KeyboardInterrupt()
+        for _ in range(depth):
+            outer = SystemError("returned a result with an exception set")
+            outer.__cause__ = exc
+            exc = outer
+        return exc
+
+    assert interrupted(KeyboardInterrupt())
+    assert interrupted(nested(1)) and interrupted(nested(2))
+    assert not interrupted(SystemError("something else"))
+    other = SystemError("x")
+    other.__cause__ = ValueError("y")
+    assert not interrupted(other)

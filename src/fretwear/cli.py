@@ -25,7 +25,7 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
 from fretwear import __version__  # noqa: E402 (after the BLAS thread setting)
-from fretwear.errors import FretwearError, InputError  # noqa: E402 (after the BLAS thread setting)
+from fretwear.errors import FretwearError, InputError, interrupted  # noqa: E402 (after the BLAS thread setting)
 from fretwear.io.schema import suggest  # noqa: E402 (after the BLAS thread setting)
 
 
@@ -223,7 +223,9 @@ def main(argv: list[str] | None = None) -> int:
     except FretwearError as exc:
         print(f"error: {' '.join(str(exc).split())}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt as exc:
+    except (KeyboardInterrupt, SystemError) as exc:
+        if not interrupted(exc):
+            raise
         message = getattr(exc, "message", "interrupted: nothing was saved")
         if term.received:
             message = message.replace("interrupted", "terminated (SIGTERM)", 1)

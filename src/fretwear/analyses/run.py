@@ -17,7 +17,7 @@ from pathlib import Path
 
 from fretwear import __version__
 from fretwear.analyses.registry import RunOutput, analysis_tables, get
-from fretwear.errors import InputError
+from fretwear.errors import InputError, interrupted
 from fretwear.files import remove_stale_temporaries
 from fretwear.io import case as case_files
 from fretwear.io.case import Case, build_model, observed_notes
@@ -170,7 +170,9 @@ def run_case(path: Path | str, outdir: Path | str | None = None, progress: bool 
             converged=out.success, case_text=case.text, case_path=str(case.path),
             analysis=case.analysis,
         )
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, SystemError) as exc:
+        if not interrupted(exc):
+            raise
         raise RunInterrupted(_interrupted_message(out_dir, start)) from None
     except Exception:
         if made and not any(out_dir.iterdir()):  # nothing was written: leave no empty folder

@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from fretwear.errors import interrupted
 from fretwear.hb.fallback import TimeDomainFallback
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import PeriodicSolution, static_anchor
@@ -143,11 +144,13 @@ def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
             if callback is not None:
                 callback(int(state["step"]), row)
             reason = _stop_reason(state, opts)
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, SystemError) as exc:
+        if not interrupted(exc):
+            raise
         if ckpt is not None:
             save_checkpoint(ckpt, state, rows, key)
         bar.close()
-        raise
+        raise KeyboardInterrupt from None
     bar.close()
     state["stop_reason"] = np.asarray(reason)
     if ckpt is not None:
