@@ -541,7 +541,6 @@ def run_dynamic(op, en, con, opt, st, rec, n_periods, step0):
     n_fail = 0
     first_fail = -1
     max_it = 0
-    cum = np.zeros(6)
     step = step0
     for _ in range(n_periods):
         gp = step // N
@@ -697,18 +696,16 @@ def run_dynamic(op, en, con, opt, st, rec, n_periods, step0):
                         wn += 0.5 * lam[i0] * (x[i0] - xprev2[i0])
                         for c in range(1, d):
                             wt += 0.5 * lam[i0 + c] * (x[i0 + c] - xprev2[i0 + c])
-                    cum[0] += wext
-                    cum[1] += wt
-                    cum[2] += wn
-                    cum[3] += wdmp
+                    # cumulative from the first recorded sample: added to the previous
+                    # recorded row (not a local sum, which would restart at every call of
+                    # this kernel, i.e. at every chunk of CHUNK_STEPS steps)
                     de_ = emech - r_energy[js - 1, 4]
-                    cum[5] += wext - wt - wn - wdmp - de_
-                r_energy[js, 0] = cum[0]
-                r_energy[js, 1] = cum[1]
-                r_energy[js, 2] = cum[2]
-                r_energy[js, 3] = cum[3]
+                    r_energy[js, 0] = r_energy[js - 1, 0] + wext
+                    r_energy[js, 1] = r_energy[js - 1, 1] + wt
+                    r_energy[js, 2] = r_energy[js - 1, 2] + wn
+                    r_energy[js, 3] = r_energy[js - 1, 3] + wdmp
+                    r_energy[js, 5] = r_energy[js - 1, 5] + (wext - wt - wn - wdmp - de_)
                 r_energy[js, 4] = emech
-                r_energy[js, 5] = cum[5]
             # advance
             for j in range(r):
                 q[j] += dqf[j]
