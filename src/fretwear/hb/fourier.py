@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fretwear.errors import InputError
+from fretwear.resources import require_memory
 
 
 @dataclass(frozen=True)
@@ -34,8 +35,19 @@ class FourierBasis:
     n_samples: int
 
     def __post_init__(self):
-        h = tuple(int(x) for x in self.harmonics)
+        try:
+            h = tuple(self.harmonics)
+        except TypeError:
+            raise InputError(f"harmonics = {self.harmonics!r}: expected a sequence of "
+                             "integers >= 1") from None
+        if any(isinstance(x, bool) or int(x) != x for x in h):
+            raise InputError(f"harmonics = {list(h)}: expected integers >= 1")
+        h = tuple(int(x) for x in h)
         object.__setattr__(self, "harmonics", h)
+        n = self.n_samples
+        if isinstance(n, bool) or not isinstance(n, int | np.integer):
+            raise InputError(f"n_samples = {n!r}: expected an integer number of samples")
+        object.__setattr__(self, "n_samples", int(n))
         if any(x < 1 for x in h) or any(b <= a for a, b in zip(h, h[1:], strict=False)):
             raise InputError(
                 f"harmonics must be strictly increasing integers >= 1, got {list(h)}"
@@ -46,6 +58,9 @@ class FourierBasis:
                 f"n_samples = {self.n_samples} is too small for harmonic {hmax}: "
                 f"expected more than {2 * hmax} samples per period"
             )
+        # the basis matrices (N x (2 k + 1)) and the DLFT's per-node sample arrays
+        require_memory(8.0 * self.n_samples * (2 * len(h) + 1) * 4,
+                       f"a Fourier basis of {len(h)} harmonics and {self.n_samples} samples")
 
     @classmethod
     def up_to(cls, nh: int = 7, n_samples: int = 128) -> FourierBasis:

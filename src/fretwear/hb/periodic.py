@@ -25,6 +25,7 @@ from fretwear.hb.fourier import FourierBasis, amplitude
 from fretwear.hb.penalty import penalty
 from fretwear.hb.reduce import Reduced, _recover, condense, loads_to_real, to_real_blocks
 from fretwear.hb.solvers import SolveStats, solve
+from fretwear.limits import check_range
 from fretwear.model.core import ContactInterface, Model
 
 
@@ -276,6 +277,54 @@ def _orders(basis):
     return np.array([0, *basis.harmonics], dtype=np.int64)
 
 
+#: highest harmonic inspected when checking that the loads act on the kept harmonics
+LOAD_CHECK_HARMONICS = 64
+
+
+def check_inputs(model, basis, frequency, *, quasi_static: bool = False, anchor=None,
+                 U0=None) -> float:
+    """Check the arguments of a periodic solve (and of the drivers built on it); return the
+    frequency as a float [Hz].
+
+    Raises TypeError for a model or basis of the wrong kind and InputError (a ValueError)
+    naming the argument for: a basis with no harmonic; a frequency outside
+    :data:`fretwear.limits.RANGES` or not > 0 for a dynamic solve; an ``anchor`` or ``U0`` of
+    the wrong shape or not finite; loads whose periodic part acts only on harmonics the basis
+    does not keep (the response would be static, reported as a converged solution).
+    """
+    if not isinstance(model, Model):
+        raise TypeError(f"model = {model!r}: expected a fretwear Model (fretwear.from_mesh, "
+                        "fretwear.from_matrices)")
+    if not isinstance(basis, FourierBasis):
+        raise TypeError(f"basis = {basis!r}: expected a fretwear FourierBasis")
+    if not basis.harmonics:
+        raise InputError("basis keeps no harmonic: expected at least one (e.g. "
+                         "FourierBasis.up_to(7, 128))")
+    f = check_range(frequency, "frequency", "frequency")
+    if not quasi_static and f <= 0.0:
+        raise InputError(f"frequency = {frequency!r} Hz: expected > 0 for a dynamic solve "
+                         "(quasi_static=True drops inertia and damping)")
+    nc, d = model.contact.n_nodes, model.contact.dim
+    for name, value, shapes in (("anchor", anchor, [(nc, d - 1)]),
+                                ("U0", U0, [(nc, d, basis.size), (nc * d, basis.size)])):
+        if value is None:
+            continue
+        a = np.asarray(value)
+        if a.dtype.kind not in "fiu" or a.shape not in shapes or not np.all(np.isfinite(a)):
+            raise InputError(f"{name} has shape {a.shape} (dtype {a.dtype}): expected finite "
+                             f"real values of shape {' or '.join(map(str, shapes))}")
+    F = np.abs(model.load_harmonics(max(LOAD_CHECK_HARMONICS, max(basis.harmonics))))
+    if not np.all(np.isfinite(F)):
+        raise InputError("the loads hold non-finite values (nan or inf)")
+    periodic = F[1:].max(axis=1)
+    acting = [n for n in range(1, F.shape[0]) if periodic[n - 1] > 0]
+    if acting and not set(acting) & set(basis.harmonics):
+        raise InputError(f"the periodic loads act on harmonics {acting[:8]} but the basis "
+                         f"keeps {list(basis.harmonics)}: the response would be static; keep "
+                         "the harmonics of the loads")
+    return f
+
+
 def static_anchor(model: Model, *, quasi: Reduced | None = None) -> np.ndarray:
     """Tangential positions of the contact nodes after the static loads are applied from rest.
 
@@ -332,6 +381,8 @@ def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
     ``success`` False, ``message`` says why (``stats`` has the residual and counts) and the
     fields hold the last iterate (for inspection, never a result).
     """
+    frequency = check_inputs(model, basis, frequency, quasi_static=quasi_static,
+                             anchor=anchor, U0=U0)
     if reduced is None:
         reduced = condense(model, frequency, _orders(basis), quasi_static=quasi_static)
     eps = penalty(eps, model=model, reduced=reduced)

@@ -21,13 +21,22 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from fretwear.errors import InputError
 from fretwear.hb.fallback import TimeDomainFallback
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.penalty import check_rule, penalty
-from fretwear.hb.periodic import DLFTProblem, PeriodicSolution, assemble_solution, static_anchor
+from fretwear.hb.periodic import (
+    DLFTProblem,
+    PeriodicSolution,
+    assemble_solution,
+    check_inputs,
+    static_anchor,
+)
 from fretwear.hb.reduce import _condense
 from fretwear.hb.solvers import SolveStats, solve
+from fretwear.limits import check_range
 from fretwear.model.core import Model
+from fretwear.resources import require_memory
 
 
 @dataclass
@@ -130,7 +139,21 @@ class SweepResult:
 
 
 def frequency_grid(f_min: float, f_max: float, n: int, spacing: str = "log") -> np.ndarray:
-    """``n`` frequencies [Hz] from ``f_min`` to ``f_max``, log or linear spacing."""
+    """``n`` frequencies [Hz] from ``f_min`` to ``f_max``, log or linear spacing.
+
+    Raises InputError unless ``0 < f_min < f_max`` (finite, within
+    :data:`fretwear.limits.RANGES`), ``n >= 2`` an integer that fits in memory, and
+    ``spacing`` is ``"log"`` or ``"linear"``."""
+    f_min = check_range(f_min, "frequency", "f_min")
+    f_max = check_range(f_max, "frequency", "f_max")
+    if not 0.0 < f_min < f_max:
+        raise InputError(f"frequency band f_min = {f_min:g} Hz, f_max = {f_max:g} Hz: expected "
+                         "0 < f_min < f_max")
+    if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 2:
+        raise InputError(f"n_points = {n!r}: expected an integer >= 2")
+    if spacing not in ("log", "linear"):
+        raise InputError(f"spacing = {spacing!r}: expected \"log\" or \"linear\"")
+    require_memory(2000.0 * n, f"a sweep of {n} frequencies")  # per point: grid, results
     if spacing == "log":
         return np.geomspace(f_min, f_max, n)
     return np.linspace(f_min, f_max, n)
@@ -294,6 +317,7 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
     """
     t_start = time.perf_counter()
     grid = frequency_grid(f_min, f_max, n_points, spacing)
+    check_inputs(model, basis, f_min, anchor=anchor)
     eps = check_rule(eps)
     if eps != "auto":
         eps = penalty(eps, model=model)

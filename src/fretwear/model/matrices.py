@@ -23,6 +23,12 @@ SYMMETRY_TOL = 1e-9  # max |A - A^T| relative to max |A|
 
 
 def _matrix(A, what: str, n: int | None = None) -> sp.csr_matrix:
+    if A is None:
+        raise InputError(f"{what} is None; expected a square real matrix")
+    values = A.data if sp.issparse(A) else np.asarray(A)
+    if np.iscomplexobj(values):
+        raise InputError(f"{what} holds complex values; expected a real matrix (hysteretic "
+                         "damping goes in D or loss_factor, not in an imaginary part of K)")
     try:
         A = sp.csr_matrix(A, dtype=float)
     except (TypeError, ValueError) as exc:

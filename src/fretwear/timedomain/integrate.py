@@ -49,6 +49,7 @@ import scipy.sparse.linalg as spla
 
 from fretwear.errors import ConvergenceError, InputError
 from fretwear.hb.reduce import condense_static
+from fretwear.limits import check_range
 from fretwear.model.core import Model
 from fretwear.timedomain.kernels import (
     OPEN,
@@ -898,7 +899,7 @@ def integrate(model: Model, frequency: float, *, n_periods: int,
         if n_rec > n_periods:
             raise InputError(f"record = {record} periods but n_periods = {n_periods}")
     n_keep = min(_count(keep_poincare, "keep_poincare", 0), n_periods)
-    omega = 2 * np.pi * _positive(frequency, "frequency")
+    omega = 2 * np.pi * check_range(_positive(frequency, "frequency"), "frequency", "frequency")
     integ = _Integrator(model, omega, steps_per_period=steps_per_period,
                         modal_cutoff=modal_cutoff, n_modes=n_modes, gamma=gamma, tol=tol,
                         wear=wear, U0=U0, V0=V0, stick_anchor=stick_anchor,
@@ -1048,7 +1049,8 @@ def steady_state(model: Model, frequency: float, *, max_periods: int = 20_000, t
     :class:`SteadyStateResult`: ``success`` when the response was classified with every
     contact solve settled; ``classification`` and ``message`` say what it is.
     """
-    return _steady_state(model, 2 * np.pi * _positive(frequency, "frequency"),
+    return _steady_state(model, 2 * np.pi * check_range(_positive(frequency, "frequency"),
+                                                         "frequency", "frequency"),
                          max_periods=max_periods, tol=tol, steps_per_period=steps_per_period,
                          harmonics=harmonics, check_every=check_every, window=window,
                          min_periods=min_periods, U0=U0, V0=V0, wear=wear,

@@ -27,7 +27,7 @@ import numpy as np
 from fretwear.errors import interrupted
 from fretwear.hb.fallback import TimeDomainFallback
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import PeriodicSolution, static_anchor
+from fretwear.hb.periodic import PeriodicSolution, check_inputs, static_anchor
 from fretwear.hb.reduce import Reduced, condense
 from fretwear.hb.solvers import SolveStats
 from fretwear.model.core import Model
@@ -91,6 +91,10 @@ def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
     KeyboardInterrupt
         On Ctrl-C (the last accepted state is in the checkpoint first).
     """
+    frequency = check_inputs(model, basis, frequency, quasi_static=quasi_static,
+                             anchor=anchor, U0=U0)
+    if options is not None and not isinstance(options, WearOptions):
+        raise TypeError(f"options = {options!r}: expected a WearOptions")
     opts = (options or WearOptions()).check()
     ckpt = Path(checkpoint) if checkpoint is not None else None
     if ckpt is not None:
