@@ -20,7 +20,9 @@ from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.sweep import sweep
 from fretwear.io.case import validate
-from fretwear.timedomain.integrate import incremental_wear, integrate, steady_state
+from fretwear.timedomain.integrate import integrate
+from fretwear.timedomain.quasistatic import incremental_wear
+from fretwear.timedomain.steady import steady_state
 from fretwear.wear import WearOptions, frf_worn, simulate_wear
 
 MODEL = {"model": {"type": "box", "lx": 1.0, "ly": 1.0, "lz": 1.0, "nx": 1, "ny": 1, "nz": 1},

@@ -23,7 +23,7 @@ from fretwear.examples.builders import stromberg_beam
 from fretwear.io.case import build_model
 from fretwear.io.results import read_results
 from fretwear.paper.catalogue import edit_case_text
-from fretwear.timedomain.integrate import incremental_wear
+from fretwear.timedomain.quasistatic import incremental_wear
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
@@ -192,7 +192,8 @@ def test_quasi_static_periodic_example_agrees_with_load_stepping(tmp_path):
     """The quasi-static periodic state of the paper's beam (section 4.2, Q / (mu P) = 1/3):
     partial slip, the nodes next to the spring stick, the slip grows towards x = L. Compared
     with an independent method: load stepping with exact contact and incremental Coulomb
-    friction (fretwear.timedomain.integrate.incremental_wear without wear, 128 steps per cycle; the
+    friction (fretwear.timedomain.quasistatic.incremental_wear without wear, 128 steps per cycle;
+    the
     third cycle, once the initial loading is over). The shipped settings (7 harmonics, 128
     samples) take ~1 s, so the file is run as is. The slip path per cycle agrees within 5e-3
     of the largest: the difference is the harmonic truncation (measured 3.3e-3 with 5
@@ -332,7 +333,7 @@ def dlft_wear(tmp_path, name: str, harmonics: int, n_samples: int) -> np.ndarray
 
 
 def load_stepping_wear(waveform: str) -> np.ndarray:
-    """Independent reference: fretwear.timedomain.integrate.incremental_wear (exact contact and
+    """Independent reference: fretwear.timedomain.quasistatic.incremental_wear (exact contact and
     incremental Coulomb at 64 load steps per cycle, Archard after each step; Stromberg's kind
     of method) on the same beam, STROMBERG_CYCLES cycles with jumps of 10. Its own error,
     measured: 1.5e-3 of the deepest wear (jumps of 10 against 2), 5e-4 (64 against 256 steps).

@@ -23,7 +23,9 @@ from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.sweep import sweep
 from fretwear.io.case import build_model
-from fretwear.timedomain.integrate import incremental_wear, integrate, steady_state
+from fretwear.timedomain.integrate import integrate
+from fretwear.timedomain.quasistatic import incremental_wear
+from fretwear.timedomain.steady import steady_state
 from fretwear.wear import SlowProblem, WearOptions, simulate_wear
 
 BASIS = FourierBasis.up_to(3, 32)

@@ -19,6 +19,7 @@ from scipy.integrate import solve_ivp
 from fretwear.errors import InputError
 from fretwear.model.core import ContactInterface, Load, Model, ObservedPoint
 from fretwear.timedomain import integrate as tr
+from fretwear.timedomain import quasistatic, reduction, steady
 
 
 def hz(w: float) -> float:
@@ -346,7 +347,7 @@ def test_low_rank_damping_step_matches_dense():
     """The Woodbury form of the step (modal damping ``diag + U R U^T``) against a dense solve
     of ``S = M + gamma h C + beta h^2 K`` in the same coordinates (round-off)."""
     model = chain(mu=0.3, c_a=2e-3, c_b=1e-3)
-    integ = tr._Integrator(model, 1.2, steps_per_period=64, modal_cutoff=None, n_modes=None,
+    integ = tr.Integrator(model, 1.2, steps_per_period=64, modal_cutoff=None, n_modes=None,
                            gamma=0.5, tol=1e-10, wear=None, U0=None, V0=None,
                            stick_anchor=None)
     red, h = integ.red, integ.h
@@ -364,7 +365,8 @@ def test_reduction_is_exact_in_statics():
     response to any contact force and to the loads is exact. Compared with a direct sparse
     solve of the full model (round-off, 1e-9), with no fixed-interface mode kept."""
     model = chain(ks_normal=50.0)
-    red = tr._reduce(model, 1.0, modal_cutoff=None, n_modes=0, steps_per_period=64)
+    red = reduction.reduce_dynamics(model, 1.0, modal_cutoff=None, n_modes=0,
+                                    steps_per_period=64)
     assert red.basis.shape[1] < model.ndof
     rng = np.random.default_rng(1)
     lam = rng.normal(size=2)
@@ -407,7 +409,7 @@ def _check_linear_limit(model):
     u = np.linalg.solve(Z[np.ix_(keep, keep)], f[keep])[-1]
     for cut, tol in (("all", 1e-9), (None, 1.0 / 64)):
         res = tr.integrate(model, hz(w), n_periods=400, steps_per_period=steps, modal_cutoff=cut)
-        c = tr.fourier_coefficients(res.observed["end"][:, 0], 3)
+        c = steady.fourier_coefficients(res.observed["end"][:, 0], 3)
         assert abs((c[1] - 1j * c[4]) / u - 1) < tol
     assert res.info["r"] < model.ndof  # the default did truncate
     return res.info["diagonal"]
@@ -462,7 +464,7 @@ def test_incremental_wear_flat_punch():
     model = punch(p=p)
     c = model.contact
     k, mu, Q0, kw = 1e6, c.mu, 120.0, c.wear_coefficient
-    res = tr.incremental_wear(model, steps_per_cycle=16, n_cycles=10)
+    res = quasistatic.incremental_wear(model, steps_per_cycle=16, n_cycles=10)
     X = (Q0 - mu * p * c.area) / k
     rate = np.diff(res.wear, axis=0)[1:]
     expected = np.broadcast_to(kw * p[:3] * 4 * X[:3], rate[:, :3].shape)
@@ -472,7 +474,7 @@ def test_incremental_wear_flat_punch():
     np.testing.assert_allclose(res.pressure[-1], p, rtol=1e-10)
     np.testing.assert_allclose(np.diff(res.worn_volume)[1:], kw / mu * res.dissipation[2:],
                                rtol=1e-10)
-    jumped = tr.incremental_wear(model, steps_per_cycle=16, n_cycles=10, cycle_jump=3)
+    jumped = quasistatic.incremental_wear(model, steps_per_cycle=16, n_cycles=10, cycle_jump=3)
     assert jumped.computed_cycles == 4 and jumped.cycles[-1] == 10
     np.testing.assert_allclose(jumped.wear[-1], res.wear[-1], rtol=1e-10, atol=1e-20)
 
@@ -482,7 +484,7 @@ def test_incremental_wear_gap_grows_with_wear():
     constant load) sits exactly at the wear of the step before the last (the last step's
     wear is added after its solve), and the normal force stays the applied load."""
     steps = 8
-    res = tr.incremental_wear(punch(p=[1e6]), steps_per_cycle=steps, n_cycles=5)
+    res = quasistatic.incremental_wear(punch(p=[1e6]), steps_per_cycle=steps, n_cycles=5)
     w_last, w_prev = res.wear[-1, 0], res.wear[-2, 0]
     assert w_prev < res.U[0] < w_last
     # one step's wear at most: the slip per step is at most the cycle's slip over 2
@@ -499,35 +501,35 @@ def test_classifier_on_synthetic_sequences():
     base = np.array([[0.3, -0.2]])
     # geometric convergence, well converged
     conv = base + 1e-3 * 0.5**k
-    c = tr.classify_sequence(conv, tol=1e-6, scale=1.0)
+    c = steady.classify_sequence(conv, tol=1e-6, scale=1.0)
     assert c.kind == "periodic"
     # slower geometric convergence (ratio 0.97): after 100 periods the last difference is
     # 1.5e-6 but the distance to the limit is 5e-5: not yet periodic at tol 1e-5
     slow = base + 1e-3 * 0.97**k
-    c = tr.classify_sequence(slow[:100], tol=1e-5, scale=1.0)
+    c = steady.classify_sequence(slow[:100], tol=1e-5, scale=1.0)
     assert np.abs(np.diff(slow[:100], axis=0)).max(axis=1)[-1] < 1e-5
     assert c.kind == "transient" and c.periodicity_error > 1e-5
     # repeats every 3 periods
     sub = base + 1e-2 * np.cos(2 * np.pi * k / 3)
-    c = tr.classify_sequence(sub, tol=1e-6, scale=1.0)
+    c = steady.classify_sequence(sub, tol=1e-6, scale=1.0)
     assert c.kind == "subharmonic" and c.order == 3
     # steady drift (ratcheting) with an oscillation on top
     rng = np.random.default_rng(0)
     drift = base + 1e-4 * k + 1e-6 * rng.normal(size=(512, 2))
-    c = tr.classify_sequence(drift, tol=1e-6, scale=1.0)
+    c = steady.classify_sequence(drift, tol=1e-6, scale=1.0)
     assert c.kind == "drifting" and c.drift_rate == pytest.approx(1e-4, rel=1e-3)
     # incommensurate oscillation: bounded, sustained, a spectral peak at the rotation number
     nu = (np.sqrt(5) - 1) / 4  # 0.309...
     qp = base + 1e-2 * np.cos(2 * np.pi * nu * k + np.array([[0.0, 1.0]]))
-    c = tr.classify_sequence(qp, tol=1e-6, scale=1.0)
+    c = steady.classify_sequence(qp, tol=1e-6, scale=1.0)
     assert c.kind == "quasi-periodic"
     assert abs(c.rotation - nu) < 1.0 / 512
     # the same but decaying (a transient still dying out): not quasi-periodic
-    c = tr.classify_sequence(base + 1e-2 * 0.995**k * np.cos(2 * np.pi * nu * k), tol=1e-6,
+    c = steady.classify_sequence(base + 1e-2 * 0.995**k * np.cos(2 * np.pi * nu * k), tol=1e-6,
                              scale=1.0)
     assert c.kind == "transient" and c.decay < 0.5
     # too few samples to say anything but periodic
-    assert tr.classify_sequence(qp[:20], tol=1e-6, scale=1.0).kind == "transient"
+    assert steady.classify_sequence(qp[:20], tol=1e-6, scale=1.0).kind == "transient"
 
 
 def test_fourier_coefficients_convention():
@@ -535,7 +537,7 @@ def test_fourier_coefficients_convention():
     N = 64
     t = 2 * np.pi * np.arange(N) / N
     x = 0.5 + 2.0 * np.cos(t) - 3.0 * np.sin(t) + 0.25 * np.sin(3 * t)
-    c = tr.fourier_coefficients(x, 3)
+    c = steady.fourier_coefficients(x, 3)
     np.testing.assert_allclose(c, [0.5, 2.0, 0.0, 0.0, -3.0, 0.0, 0.25], atol=1e-13)
 
 
@@ -553,12 +555,12 @@ def test_steady_state_classifies_real_responses():
     """
     m = k = F0 = 1.0
     Ff, w = 0.5, 0.5
-    ss = tr.steady_state(slider(mu=Ff), hz(w), steps_per_period=512, tol=1e-8)
+    ss = steady.steady_state(slider(mu=Ff), hz(w), steps_per_period=512, tol=1e-8)
     assert ss.classification == "periodic" and ss.periodic and ss.success, ss.message
     T = 2 * np.pi / w
     n = ss.n_periods
     ref, _ = event_driven(m=m, k=k, Ff=Ff, F0=F0, w=w, t_end=n * T + 1e-9, t_eval=ss.last.t)
-    cref = tr.fourier_coefficients(ref, 7)
+    cref = steady.fourier_coefficients(ref, 7)
     c = ss.harmonics["x"][:, 0]
     assert np.max(np.abs(c - cref)) < 1e-3 * np.abs(cref).max()
     assert ss.contact_harmonics["lam"].shape == (15, 1, 2)
@@ -570,7 +572,7 @@ def test_steady_state_classifies_real_responses():
     loads = [Load(np.array([1.0, 0.3]), "constant"), Load(np.array([0.6, 0.0]), "cos")]
     rat = Model(K=Kd, M=sp.identity(2, format="csr"), contact=contact, loads=loads,
                 observed=[ObservedPoint("x", np.array([1]), np.zeros(1))])
-    ss = tr.steady_state(rat, hz(1.0), steps_per_period=64, min_periods=64, check_every=32)
+    ss = steady.steady_state(rat, hz(1.0), steps_per_period=64, min_periods=64, check_every=32)
     assert ss.classification == "drifting"
     assert ss.diagnostics.drift_rate > 0
 
@@ -579,7 +581,8 @@ def test_steady_state_classifies_real_responses():
     model = chain(n=1, k=1.0, kg=0.0, mu=10.0, N=1.0, F=0.5)
     V0 = np.zeros(model.ndof)
     V0[2] = 0.2
-    ss = tr.steady_state(model, hz(wq), steps_per_period=64, V0=V0, min_periods=64, max_periods=600)
+    ss = steady.steady_state(model, hz(wq), steps_per_period=64, V0=V0, min_periods=64,
+                             max_periods=600)
     assert ss.classification == "quasi-periodic"
     assert np.all(ss.last.state == 1)
     nu = np.mod(1.0 / wq, 1.0)

@@ -52,8 +52,8 @@ _API = {
     "simulate_wear": "fretwear.api", "frf_worn": "fretwear.api",
     "WearOptions": "fretwear.wear", "WearResult": "fretwear.wear",
     # time domain
-    "integrate": "fretwear.timedomain.integrate", "steady_state": "fretwear.timedomain.integrate",
-    "incremental_wear": "fretwear.timedomain.integrate",
+    "integrate": "fretwear.timedomain.integrate", "steady_state": "fretwear.timedomain.steady",
+    "incremental_wear": "fretwear.timedomain.quasistatic",
     "check_periodic": "fretwear.timedomain.stability",
     # case files and results
     "run_case": "fretwear.analyses.run", "load_case": "fretwear.analyses.run",

@@ -3,7 +3,7 @@
 * A ``periodic`` case at a frequency: the DLFT periodic solve
 (:func:`fretwear.hb.periodic.solve_periodic`,
   the case's harmonics, samples, penalty and solver) and the time-domain steady state of the
-  same model (:func:`fretwear.timedomain.integrate.steady_state`). One figure ``compare.png``
+  same model (:func:`fretwear.timedomain.steady.steady_state`). One figure ``compare.png``
   (observed
   displacement over one period by both methods, contact-state maps side by side, harmonic
   amplitudes), and a table of relative differences: harmonic-1 amplitude at the observed
@@ -11,7 +11,7 @@
   time-domain response and the wall times.
 * A quasi-static ``wear`` case: the DLFT wear (:func:`fretwear.wear.simulate.simulate_wear`, the
 case's
-  options) and :func:`fretwear.timedomain.integrate.incremental_wear` to the same cycle count; one
+  options) and :func:`fretwear.timedomain.quasistatic.incremental_wear` to the same cycle count; one
   figure
   ``compare-wear.png`` overlays the worn profiles.
 
@@ -36,7 +36,9 @@ from fretwear.errors import InputError
 from fretwear.hb.periodic import PeriodicSolution, solve_periodic
 from fretwear.hb.reduce import condense
 from fretwear.io.case import build_model
-from fretwear.timedomain.integrate import SteadyStateResult, incremental_wear, steady_state
+from fretwear.timedomain.quasistatic import incremental_wear
+from fretwear.timedomain.results import SteadyStateResult
+from fretwear.timedomain.steady import steady_state
 
 #: cycles computed by the incremental wear reference (at most; the jump sets the rest)
 WEAR_COMPUTED_CYCLES = 200

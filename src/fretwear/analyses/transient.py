@@ -1,12 +1,12 @@
 """The time-domain analyses of case files: ``"transient"`` and ``"incremental-wear"``.
 
 ``"transient"`` integrates the forced response in time with exact contact and friction
-(:func:`fretwear.timedomain.integrate.steady_state` or
+(:func:`fretwear.timedomain.steady.steady_state` or
 :func:`fretwear.timedomain.integrate.integrate`) and writes
 the last forcing period (observed points, contact nodes, harmonics, contact states, energy
 terms), the once-per-period (Poincare) samples and the classification of the response.
 ``"incremental-wear"`` runs quasi-static load steps with Archard wear applied as it goes
-(:func:`fretwear.timedomain.integrate.incremental_wear`) and writes the wear history.
+(:func:`fretwear.timedomain.quasistatic.incremental_wear`) and writes the wear history.
 
 Variable names follow ``docs/results.md``: the names of the ``periodic`` analysis where the
 meaning is the same (the last period is sampled at ``tau_j = 2 pi j / steps_per_period``),
@@ -35,15 +35,10 @@ from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.fourier import FourierBasis, amplitude
 from fretwear.io.results import label_coordinate, variable
 from fretwear.io.schema import Field, Integer, Number, Text, fail, join
-from fretwear.timedomain.integrate import (
-    IncrementalWearResult,
-    TransientResult,
-    classify_sequence,
-    fourier_coefficients,
-    incremental_wear,
-    integrate,
-    steady_state,
-)
+from fretwear.timedomain.integrate import integrate
+from fretwear.timedomain.quasistatic import incremental_wear
+from fretwear.timedomain.results import IncrementalWearResult, TransientResult
+from fretwear.timedomain.steady import classify_sequence, fourier_coefficients, steady_state
 
 #: forcing periods integrated after a steady-state run for the Poincare / drift figure
 POINCARE_PERIODS = 128
@@ -436,7 +431,7 @@ def plot_incremental_profiles(ds: xr.Dataset, path: Path, *, title: str | None =
 
 def run_incremental_wear(model, analysis: dict, case, outdir: Path, progress: bool
                          ) -> RunOutput:
-    """Quasi-static incremental wear (:func:`fretwear.timedomain.integrate.incremental_wear`)."""
+    """Quasi-static incremental wear (:func:`fretwear.timedomain.quasistatic.incremental_wear`)."""
     r = incremental_wear(model, steps_per_cycle=analysis["steps_per_cycle"],
                          n_cycles=analysis["n_cycles"], cycle_jump=analysis["cycle_jump"],
                          record_every=analysis["record_every"], progress=progress)
@@ -470,7 +465,7 @@ register(
     },
     run_incremental_wear,
     doc="Quasi-static fretting wear by load steps "
-    "(`fretwear.timedomain.integrate.incremental_wear`, in "
+    "(`fretwear.timedomain.quasistatic.incremental_wear`, in "
     "the spirit of Stromberg 1997): exact contact and incremental Coulomb friction at every "
     "load step, Archard wear (k_w = contact.wear_coefficient) applied after each step; "
     "inertia and damping are ignored. Writes `wear-profile.png` (wear depth along the "

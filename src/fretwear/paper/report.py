@@ -421,7 +421,7 @@ def _runs_table(runs, out: dict) -> str:
         return f"{st} | {w}"
 
     what = {"stromberg-load-stepping": "load stepping with exact contact and incremental "
-            "Coulomb friction (`fretwear.timedomain.integrate.incremental_wear`), the kind of "
+            "Coulomb friction (`fretwear.timedomain.quasistatic.incremental_wear`), the kind of "
             "method "
             "of Stromberg (1997)",
             "frf-worn-79khz": "nonlinear FRF (7 harmonics, 128 samples) with the unworn and "

@@ -104,7 +104,7 @@ def _load_stepping(folder: Path, quick: bool) -> str:
     """Stromberg's kind of method on the section 4.1 beam: load stepping with exact contact,
     incremental Coulomb friction and Archard after every step (fretwear.timedomain.integrate)."""
     from fretwear.examples.builders import stromberg_beam
-    from fretwear.timedomain.integrate import incremental_wear
+    from fretwear.timedomain.quasistatic import incremental_wear
 
     cycles = 200 if quick else STROMBERG_CYCLES
     steps = 32 if quick else 64

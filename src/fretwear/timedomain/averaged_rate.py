@@ -35,7 +35,7 @@ from fretwear.hb.fourier import FourierBasis
 from fretwear.model.core import Model
 from fretwear.wear.kernels import slip_work_samples
 
-#: response kinds of :func:`fretwear.timedomain.integrate.classify_sequence`, coded in wear
+#: response kinds of :func:`fretwear.timedomain.steady.classify_sequence`, coded in wear
 # histories
 RESPONSE_KINDS = ("periodic", "subharmonic", "drifting", "quasi-periodic", "irregular",
                   "transient")
@@ -135,7 +135,8 @@ def time_averaged_rate(model: Model, frequency: float, basis: FourierBasis, coef
     steps_per_period : time steps per period (default: :func:`default_steps`).
     classify_tol : relative periodicity tolerance of the response classification.
     """
-    from fretwear.timedomain.integrate import classify_sequence, fourier_coefficients, integrate
+    from fretwear.timedomain.integrate import integrate
+    from fretwear.timedomain.steady import classify_sequence, fourier_coefficients
 
     t0 = time.perf_counter()
     hmax = max(basis.harmonics) if basis.harmonics else 1

@@ -82,7 +82,7 @@ def check_periodic(model: Model, sol: PeriodicSolution, *, max_periods: int = 30
     line), ``flags()`` for a sweep point. The integration runs at the solution's own circular
     frequency ``sol.omega`` [rad/s] (``sol.frequency`` [Hz]).
     """
-    from fretwear.timedomain.integrate import _steady_state_at_omega
+    from fretwear.timedomain.steady import steady_state_at_omega
 
     t0 = time.perf_counter()
     if sol.quasi_static or sol.omega <= 0:
@@ -92,7 +92,7 @@ def check_periodic(model: Model, sol: PeriodicSolution, *, max_periods: int = 30
     vmax = np.abs(V0).max()
     V0 = V0 + perturbation * vmax * rng.standard_normal(V0.shape)
     nsteps = steps_per_period or max(128, 8 * max(sol.basis.harmonics))
-    res = _steady_state_at_omega(model, sol.omega, max_periods=max_periods,
+    res = steady_state_at_omega(model, sol.omega, max_periods=max_periods,
                                 tol=periodicity_tol, steps_per_period=nsteps,
                                 harmonics=max(sol.basis.harmonics), U0=U0, V0=V0,
                                 wear=sol.gap - np.asarray(model.contact.gap, float))
@@ -165,7 +165,7 @@ def time_domain_start(model: Model, frequency: float, basis,
 
     Returns ``(message, U0 (nc, d, H) or None, anchor (nc, d-1) or None)``.
     """
-    from fretwear.timedomain.integrate import steady_state
+    from fretwear.timedomain.steady import steady_state
 
     U0 = V0 = None
     wear = None
