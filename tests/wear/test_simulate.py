@@ -28,7 +28,7 @@ import math
 
 import numpy as np
 import pytest
-import scipy.sparse as sp
+from helpers.models import sliders
 
 from fretwear.hb import contact as law
 from fretwear.hb.fourier import FourierBasis
@@ -36,7 +36,6 @@ from fretwear.hb.periodic import solve_periodic, static_anchor
 from fretwear.hb.reduce import condense
 from fretwear.hb.solvers import solve_identity_rows
 from fretwear.model.build import ContactSpec, Material, Spring, Traction, from_mesh
-from fretwear.model.core import ContactInterface, Load, Model
 from fretwear.model.mesh import rectangle
 from fretwear.wear import (
     SlowProblem,
@@ -65,23 +64,6 @@ def block(q_ratio=0.5):
                             Traction("right", pressure=q, waveform="sin")],
                      contact=ContactSpec("bottom", mu=MU, normal=(0, -1), wear_coefficient=KW),
                      observed={"Pe": (0.02, 0.002)})
-
-
-def sliders(nc=3, P=1e6, A=1e-4, kn=1.0, kt=1e8, ratio=3.0):
-    """``nc`` independent contact nodes: normal DOF on a (soft) spring kn under the constant
-    load P A, tangential DOF on a spring kt under ``ratio`` x mu P A sin(tau). Every node slides
-    except near the load reversals; the normal force is exactly P A."""
-    n = 2 * nc
-    K = sp.diags(np.tile([kn, kt], nc)).tocsr()
-    fn = np.zeros(n)
-    fn[0::2] = P * A
-    ft = np.zeros(n)
-    ft[1::2] = ratio * MU * P * A
-    c = ContactInterface(dofs=np.arange(n).reshape(nc, 2), frame=np.tile(np.eye(2), (nc, 1, 1)),
-                         gap=np.zeros(nc), area=np.full(nc, A), mu=MU,
-                         coords=np.c_[np.arange(nc) * 1e-3, np.zeros(nc)], wear_coefficient=KW)
-    return Model(K=K, M=sp.csr_matrix((n, n)), contact=c,
-                 loads=[Load(fn, "constant"), Load(ft, "sin")], dim=2)
 
 
 @pytest.fixture(scope="module")

@@ -1,7 +1,7 @@
 """``fretwear reproduce``: case-file edits, resumable runs and the comparison report.
 
 The reproduction's numbers come from the shipped examples (their physics is tested in
-test_examples.py); here the driver is checked: the edited case files are what a TOML parser
+tests/test_examples.py); here the driver is checked: the edited case files are what a TOML parser
 reads back, a second call reads finished runs back instead of running them again, a missing
 run is reported as missing, and the report's figures agree with the results files it was
 measured on.

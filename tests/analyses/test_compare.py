@@ -21,7 +21,7 @@ without pretending to an agreement the models do not have.
 """
 
 import pytest
-from test_run_dlft import small_case
+from helpers.cases import small_case
 
 from fretwear import cli
 from fretwear.analyses.compare import compare_periodic
