@@ -9,7 +9,6 @@ residual test is 1e-10 relative to |Z U| and the kept harmonics are exact for a 
 """
 
 import numpy as np
-import pytest
 
 from fretwear.hb.contact import SEPARATION
 from fretwear.hb.fourier import FourierBasis
