@@ -151,7 +151,7 @@ def test_ctrl_c_says_what_was_saved(tmp_path, monkeypatch, capsys):
 def test_sigterm_is_handled_as_ctrl_c(tmp_path, monkeypatch, capsys):
     """SIGTERM (a batch scheduler's notice) stops a run as Ctrl-C does, with the exit status
     128 + 15; the previous handler is back afterwards (wear runs: the checkpoint is saved,
-    tests/test_checkpoint_robustness.py)."""
+    tests/wear/test_checkpoint.py)."""
     import os
     import signal
 

@@ -172,7 +172,7 @@ def test_nonlinear_frf_example_has_a_damped_resonance_near_30_khz(tmp_path):
 
 @pytest.mark.parametrize("khz, stops, numerics", [
     (10, 2, {"harmonics": 3, "n_samples": 32}),
-    (79, 4, {}),
+    pytest.param(79, 4, {}, marks=pytest.mark.slow),
 ])
 def test_periodic_example_stops_per_period(tmp_path, khz, stops, numerics):
     """Paper section 4.2 (Fig. 16): P_e stops twice per period at 10 kHz and four times at
@@ -269,7 +269,7 @@ def test_dynamic_wear_example_first_steps(tmp_path, khz):
     assert np.all(near_spring(ds) <= 1e-12 * ds["wear_depth"].values[-1].max())
 
 
-@pytest.mark.parametrize("khz", [70, 79])
+@pytest.mark.parametrize("khz", [pytest.param(70, marks=pytest.mark.slow), 79])
 def test_dynamic_wear_example_near_resonance_first_steps(tmp_path, khz):
     """Paper section 4.2, wear at 70 and 79 kHz, reduced as at 30 and 35 kHz. With 3
     harmonics and 32 samples the unworn interface has no periodic balance there (residual
@@ -382,6 +382,7 @@ def test_stromberg_triangle_and_sinusoid(tmp_path):
     assert x[np.argmax(np.abs(sin7 - tri7))] == pytest.approx(x.max())
 
 
+@pytest.mark.slow
 def test_frf_before_and_after_wear_example(tmp_path):
     """Paper Fig. 24 (salles2011-79khz-frf-worn): the wear run of salles2011-79khz, then the
     nonlinear FRF with the unworn and with the worn gap. Reduced: 3 harmonics, 32 samples,

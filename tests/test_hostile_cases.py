@@ -1,5 +1,5 @@
 """Property-based: every case file generated from the schema gets a results file or one
-clear message (tests/hostile.py says how cases are generated).
+clear message (tests/helpers/hostile.py says how cases are generated).
 
 Reference: the command line's contract (README, "Using it"): exit 0 (1 when some solve did
 not converge) with results.nc, or exit 2 with one line naming what is wrong; never a
@@ -11,8 +11,8 @@ over more cases and counts the outcomes.
 import tempfile
 from pathlib import Path
 
-import hostile
 import pytest
+from helpers import hostile
 from hypothesis import HealthCheck, Phase, given, settings
 
 
@@ -44,6 +44,7 @@ def test_generated_cases_fast_analyses(generated):
     check(generated)
 
 
+@pytest.mark.slow
 @pytest.mark.slow
 @settings(max_examples=200, deadline=None, derandomize=True, database=None,
           suppress_health_check=list(HealthCheck),

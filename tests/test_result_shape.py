@@ -13,10 +13,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from test_run_dlft import small_case
-from test_run_transient import FIXED
-from test_stability import K_, M_, oscillator
-from test_wear import sliders
+from helpers.cases import FIXED, small_case
+from helpers.models import K_, M_, oscillator, sliders
 
 from fretwear.analyses.run import load_case
 from fretwear.hb.fourier import FourierBasis
@@ -88,8 +86,8 @@ def test_simulate_wear(monkeypatch):
 def test_integrate(tmp_path):
     res = integrate(oscillator(), F_HZ, n_periods=2, steps_per_period=64)
     check_shape(res, True)
-    # the 10 x 2 beam of test_run_transient at 1 kHz with a coarse step: one contact solve of
-    # its third period does not settle (measured; the run warns and says so)
+    # the 10 x 2 beam of tests/analyses/test_transient.py at 1 kHz with a coarse step: one
+    # contact solve of its third period does not settle (measured; the run warns and says so)
     model = build_model(load_case(small_case(tmp_path, FIXED)))
     with pytest.warns(RuntimeWarning, match="did not settle"):
         bad = integrate(model, 1e3, n_periods=3, steps_per_period=64)

@@ -8,30 +8,13 @@ time-domain start must hand back harmonics that make the DLFT converge at once.
 """
 
 import numpy as np
-import scipy.sparse as sp
+from helpers.models import K_, M_, oscillator
 
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import initial_state, solve_periodic
-from fretwear.model.core import ContactInterface, Load, Model, ObservedPoint
 from fretwear.timedomain.stability import check_periodic, time_domain_start
 
-M_, K_, KN, N0, F0, ZETA = 1.0, 1e4, 1e6, 10.0, 20.0, 0.05
-MU = 0.3  # mu N0 / F0 = 0.15: continuous slip
 F_HZ = 0.7 * np.sqrt(K_ / M_) / (2 * np.pi)  # forcing frequency [Hz], below the resonance
-
-
-def oscillator() -> Model:
-    """DOF 0 normal (stiff spring, static load pressing it on the obstacle), DOF 1 tangential
-    (mass, spring, viscous damping, harmonic force)."""
-    K = sp.csr_matrix(np.diag([KN, K_]))
-    M = sp.csr_matrix(np.diag([M_, M_]))
-    C = sp.csr_matrix(np.diag([0.0, 2 * ZETA * np.sqrt(K_ * M_)]))
-    contact = ContactInterface(dofs=np.array([[0, 1]]), frame=np.eye(2)[None],
-                               gap=np.zeros(1), area=np.ones(1), mu=MU,
-                               coords=np.zeros((1, 2)))
-    loads = [Load(np.array([N0, 0.0]), "constant"), Load(np.array([0.0, F0]), "cos")]
-    return Model(K=K, M=M, C=C, contact=contact, loads=loads,
-                 observed=[ObservedPoint("x", np.array([1]), np.zeros(1))])
 
 
 def test_initial_state_reproduces_the_periodic_solution():

@@ -125,6 +125,7 @@ def wait_for(path: Path, proc: subprocess.Popen, timeout: float = 240.0) -> None
 
 
 # --- killed runs resume to the uninterrupted result ------------------------------------------
+@pytest.mark.slow
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGKILL], ids=["SIGTERM", "SIGKILL"])
 def test_killed_run_resumes_to_the_uninterrupted_results(case, reference, tmp_path, sig):
     out = tmp_path / "out"

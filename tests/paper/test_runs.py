@@ -1,7 +1,7 @@
 """``fretwear reproduce``: case-file edits, resumable runs and the comparison report.
 
 The reproduction's numbers come from the shipped examples (their physics is tested in
-test_examples.py); here the driver is checked: the edited case files are what a TOML parser
+tests/test_examples.py); here the driver is checked: the edited case files are what a TOML parser
 reads back, a second call reads finished runs back instead of running them again, a missing
 run is reported as missing, and the report's figures agree with the results files it was
 measured on.
@@ -73,6 +73,7 @@ def test_empty_work_folder_gives_a_report_of_missing_runs(tmp_path):
     assert text.count("no result") >= 10
 
 
+@pytest.mark.slow
 def test_quick_runs_resume_and_the_report_matches_the_results(tmp_path):
     """Two quick runs (~10 s): the report states the facts measured on their results files
     (P_e stops 4 times per period at 79 kHz with the shipped numerics, docs/examples.md; no
@@ -102,6 +103,7 @@ def test_quick_runs_resume_and_the_report_matches_the_results(tmp_path):
     assert [ln.split()[1] for ln in lines[:2]] == ["up", "up"]  # "up to date"
 
 
+@pytest.mark.slow
 def test_two_jobs_give_the_same_results_as_one(tmp_path):
     """The process pool runs the same case files: same results as a sequential run."""
     only = ["periodic-10khz"]

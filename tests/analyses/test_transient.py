@@ -8,7 +8,7 @@ analysis' section with the same units and dimensions).
 
 import numpy as np
 import pytest
-from test_run_dlft import check_documented, run, small_case
+from helpers.cases import FIXED, check_documented, run, small_case
 
 from fretwear.io.results import read_results
 
@@ -17,14 +17,6 @@ type = "transient"
 frequency = 1e3
 steps_per_period = 256
 harmonics = 7
-"""
-FIXED = """[analysis]
-type = "transient"
-frequency = 1e3
-mode = "fixed"
-n_periods = 20
-steps_per_period = 64
-harmonics = 3
 """
 WEAR = """[analysis]
 type = "incremental-wear"

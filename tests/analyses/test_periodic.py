@@ -1,4 +1,4 @@
-"""The DLFT analyses ``periodic`` and ``sweep`` run from case files through the command line.
+"""The DLFT analysis ``periodic`` run from case files through the command line.
 
 A small variant of the paper's beam (10 x 2 elements, 3 harmonics, 32 samples per period) keeps
 each run to a few seconds. The results files are checked against the tables of
@@ -7,19 +7,16 @@ units and dimensions); a solve that did not converge must leave no solution in t
 """
 
 import re
-from pathlib import Path
 
 import meshio
 import numpy as np
 import pytest
+from helpers.cases import LINEAR_EXAMPLE, ROOT, check_documented, run, small_case, with_key
 
 from fretwear import cli
 from fretwear.analyses.run import load_case
 from fretwear.io.results import read_results
 
-ROOT = Path(__file__).resolve().parents[1]
-EXAMPLES = ROOT / "src" / "fretwear" / "examples"
-LINEAR_EXAMPLE = EXAMPLES / "beam-linear-frf.toml"
 DLFT_EXAMPLES = ("salles2011-79khz-periodic", "salles2011-frf", "beam-quasistatic-periodic")
 
 PERIODIC = """[analysis]
@@ -28,66 +25,6 @@ frequency = 1e4
 harmonics = 3
 n_samples = 32
 """
-SWEEP = """[analysis]
-type = "sweep"
-f_min = 1e3
-f_max = 2e4
-n_points = 4
-harmonics = 3
-n_samples = 32
-linear_references = ["sliding", "stuck"]
-"""
-
-
-def small_case(tmp_path: Path, analysis: str, name: str = "beam.toml") -> Path:
-    """The shipped beam on a 10 x 2 mesh with another ``[analysis]`` table."""
-    text = LINEAR_EXAMPLE.read_text()
-    for old, new in {"nx = 30": "nx = 10", "ny = 4 ": "ny = 2 "}.items():
-        assert old in text
-        text = text.replace(old, new)
-    path = tmp_path / name
-    path.write_text(text[: text.index("[analysis]")] + analysis)
-    return path
-
-
-def with_key(analysis: str, line: str) -> str:
-    """``analysis`` with the key of ``line`` set by ``line`` (replaced or added)."""
-    key = line.split("=")[0].strip()
-    kept = [x for x in analysis.splitlines() if x.split("=")[0].strip() != key]
-    return "\n".join(kept + [line]) + "\n"
-
-
-def run(path: Path, capsys) -> tuple[int, str, str]:
-    status = cli.main(["run", str(path), "--no-progress"])
-    out = capsys.readouterr()
-    return status, out.out, out.err
-
-
-# --- the documented schema ------------------------------------------------------------------
-def doc_rows(section: str | None = None) -> dict[str, tuple[str, str]]:
-    """name -> (dimensions, units) from the tables of docs/results.md: the shared sections
-    (dimensions, geometry) and, if given, the section ``## `section```."""
-    rows, current = {}, None
-    for line in (ROOT / "docs" / "results.md").read_text().splitlines():
-        if line.startswith("## "):
-            current = line[3:].strip()
-        shared = current in ("Rules for every analysis",)
-        if not (shared or current == f"`{section}`"):
-            continue
-        m = re.match(r"\| `(\w+)` \| ([^|]*) \| ([^|]*) \|", line)
-        if m:
-            rows[m.group(1)] = (m.group(2).strip(), m.group(3).strip())
-    return rows
-
-
-def check_documented(ds, section: str) -> None:
-    docs = doc_rows(section)
-    for name, var in list(ds.coords.items()) + list(ds.data_vars.items()):
-        assert name in docs, f"{name} is not documented in docs/results.md ({section})"
-        assert var.attrs["units"] == docs[name][1], name
-        assert var.attrs["long_name"], name
-    for name, var in ds.data_vars.items():
-        assert ", ".join(var.dims) == docs[name][0], name
 
 
 def test_variable_names_mean_one_thing_across_docs():
@@ -171,45 +108,6 @@ def test_a_periodic_solve_that_fails_saves_no_solution(tmp_path, capsys):
     assert not list(res.glob("*.png")) and not (res / "periodic.pvd").exists()
 
 
-# --- sweep ----------------------------------------------------------------------------------
-def test_sweep_writes_documented_results_and_figures(tmp_path, capsys):
-    status, out, err = run(small_case(tmp_path, SWEEP), capsys)
-    res = tmp_path / "beam-results"
-    ds = read_results(res / "results.nc")
-    conv = ds["converged"].values
-    assert status == (0 if conv.all() else 1), err
-    n = ds.sizes["frequency"]
-    assert n >= 4 and conv.any()
-    assert ds.attrs["sweep_converged"] == f"{int(conv.sum())}/{n}"
-    assert out.splitlines()[1] == f"sweep_converged={int(conv.sum())}/{n}"
-    check_documented(ds, "sweep")
-    assert ds["frequency"].values[[0, -1]].tolist() == pytest.approx([1e3, 2e4])
-    assert ds.sizes["interface"] == 2 and ds.sizes["harmonic"] == 3
-    amp = ds["response_amplitude"].sel(point="Pe", axis="x", harmonic=1).values
-    assert np.all(np.isfinite(amp[conv == 1])) and np.all(amp[conv == 1] > 0)
-    # with friction the response lies between the stuck and the frictionless limits
-    lin = ds["linear_response_amplitude"].sel(point="Pe", axis="x")
-    assert np.all(amp[conv == 1] > lin.sel(interface="stuck").values[conv == 1])
-    frac = ds[["separation_fraction", "stick_fraction", "slip_fraction"]].to_array().sum("variable")
-    np.testing.assert_allclose(frac.values[conv == 1], 1.0)
-    for stem in ("sweep-Pe", "sweep-interface"):
-        assert (res / f"{stem}.png").stat().st_size > 10_000, stem
-
-
-def test_sweep_points_that_fail_are_kept_as_nan_with_the_reason(tmp_path, capsys):
-    path = small_case(tmp_path, with_key(with_key(SWEEP, "max_iter = 1"),
-                                         "continuation = false"))
-    status, out, _ = run(path, capsys)
-    assert status == 1
-    ds = read_results(tmp_path / "beam-results" / "results.nc")
-    bad = ds["converged"].values == 0
-    assert bad.any() and ds.attrs["converged"] == 0
-    assert np.all(np.isnan(ds["response_amplitude"].values[bad]))
-    assert all(f.startswith("not converged: ") for f in ds["flags"].values[bad])
-    assert "not converged: maximum number of iterations reached" in out
-    assert ds.attrs["flagged_points"].count("\n") == int(bad.sum()) - 1
-
-
 # --- input errors ---------------------------------------------------------------------------
 @pytest.mark.parametrize("line, message", [
     ("n_samples = 6", "analysis.n_samples = 6: expected more than 6 samples per period "
@@ -235,16 +133,6 @@ def test_frequency_is_required_unless_quasi_static(tmp_path, capsys):
     assert err.startswith("error: missing required key 'analysis.frequency' (excitation "
                           "frequency [Hz]")
     assert len(err.splitlines()) == 1
-
-
-def test_sweep_rejects_a_reversed_band_and_aliasing(tmp_path, capsys):
-    bad = SWEEP.replace("f_max = 2e4", "f_max = 100.0")
-    assert run(small_case(tmp_path, bad), capsys)[2] == (
-        "error: analysis.f_max = 100.0: expected a value above f_min = 1000.0 Hz\n")
-    bad = SWEEP.replace("harmonics = 3", "harmonics = [1, 3, 16]")
-    assert run(small_case(tmp_path, bad), capsys)[2] == (
-        "error: analysis.n_samples = 32: expected more than 32 samples per period "
-        "(twice the highest harmonic, 16)\n")
 
 
 # --- shipped examples -----------------------------------------------------------------------

@@ -286,7 +286,7 @@ def test_validate_a_dict():
 def test_case_files_doc_is_up_to_date():
     """The committed docs/case-files.md equals what the schemas generate (the repository's
     file, found from this test file: the package may be installed elsewhere)."""
-    committed = (Path(__file__).resolve().parents[1] / "docs" / "case-files.md").read_text(
+    committed = (Path(__file__).resolve().parents[2] / "docs" / "case-files.md").read_text(
         encoding="utf-8")
     assert committed == case_docs(), (
         "docs/case-files.md is out of date; regenerate it with\n"

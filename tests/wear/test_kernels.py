@@ -8,7 +8,7 @@
 * The exact static condensation onto the contact DOFs (:func:`fretwear.hb.reduce.condense_static`,
   the same code as the per-harmonic :func:`fretwear.hb.reduce.condense`): compared with a dense
   Schur complement written here with numpy (``numpy.linalg.solve``, not the sparse LU of the
-  code) on the hand-assembled truss of test_reduce.py (tilted contact frames, fixed DOFs).
+  code) on the hand-assembled truss of tests/helpers/models.py (tilted contact frames, fixed DOFs).
   Relative errors of a dense solve are ~ cond * 1e-16; the truss' interior stiffness has a
   condition number of about 20 (measured 2e-16 between the two), so 1e-9 relative leaves a
   wide margin while a missing term, a wrong sign or a wrong frame gives O(1) errors.
@@ -16,7 +16,7 @@
 
 import numpy as np
 import pytest
-from test_reduce import truss
+from helpers.models import truss
 
 from fretwear.hb.contact import SEPARATION, SLIP, STICK
 from fretwear.hb.reduce import condense, condense_static

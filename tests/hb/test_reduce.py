@@ -15,79 +15,13 @@ formula error (a missing term, a wrong sign or frame) gives O(1) errors.
 import numpy as np
 import pytest
 import scipy.linalg as sla
-import scipy.sparse as sp
+from helpers.models import RNG, truss
 
 from fretwear.errors import InputError
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.reduce import condense, loads_to_real, recover, to_real_blocks
-from fretwear.model.core import ContactInterface, Load, Model, ObservedPoint
 
 RTOL = 1e-9
-RNG = np.random.default_rng(7)
-THETA = 0.3  # tilt of the contact frames [rad]: normal not along an axis
-
-
-def truss(nx=6, ny=3, a=0.01, k=1e7, m=0.01, damping="hysteretic", theta=THETA,
-          dangling=False):
-    """Braced 2D truss on an nx x ny grid (spacing a [m]), bar stiffness k*a/L [N/m], lumped
-    mass m [kg] per node; bottom row = contact nodes with frames tilted by theta; statically
-    supported by three fixed DOFs on the top row. ``dangling`` adds a node hanging on a single
-    bar from a contact node (a mechanism that the contact does not hold)."""
-    xs, ys = np.meshgrid(np.arange(nx) * a, np.arange(ny) * a)
-    pts = np.column_stack([xs.ravel(), ys.ravel()])
-    nid = lambda i, j: j * nx + i
-    bars = []
-    for j in range(ny):
-        for i in range(nx):
-            if i + 1 < nx:
-                bars.append((nid(i, j), nid(i + 1, j)))
-            if j + 1 < ny:
-                bars.append((nid(i, j), nid(i, j + 1)))
-            if i + 1 < nx and j + 1 < ny:
-                bars += [(nid(i, j), nid(i + 1, j + 1)), (nid(i + 1, j), nid(i, j + 1))]
-    if dangling:
-        pts = np.vstack([pts, [[-a, 0.0]]])
-        bars.append((nid(0, 0), len(pts) - 1))
-    nd = 2 * len(pts)
-    K = np.zeros((nd, nd))
-    for p, q in bars:
-        e = pts[q] - pts[p]
-        L = np.linalg.norm(e)
-        c = e / L
-        kb = k * a / L * np.outer(c, c)
-        idx = np.r_[2 * p : 2 * p + 2, 2 * q : 2 * q + 2]
-        K[np.ix_(idx, idx)] += np.block([[kb, -kb], [-kb, kb]])
-    M = m * (1.0 + 0.1 * np.arange(nd) / nd)  # slightly non-uniform: no degenerate modes
-    bottom = np.arange(nx)
-    n = np.array([np.sin(theta), -np.cos(theta)])
-    t = np.array([np.cos(theta), np.sin(theta)])
-    contact = ContactInterface(
-        dofs=np.column_stack([2 * bottom, 2 * bottom + 1]),
-        frame=np.tile(np.array([n, t]), (nx, 1, 1)),
-        gap=np.zeros(nx), area=np.full(nx, a), mu=0.3, coords=pts[bottom])
-    top_left, top_right = nid(0, ny - 1), nid(nx - 1, ny - 1)
-    fixed = np.array([2 * top_left, 2 * top_left + 1, 2 * top_right + 1])
-    loads = [Load(RNG.standard_normal(nd), "constant", name="static"),
-             Load(RNG.standard_normal(nd), "cos", name="c"),
-             Load(RNG.standard_normal(nd), "sin", name="s"),
-             Load(RNG.standard_normal(nd), "fourier", {2: (0.5, -0.2), 3: (0.0, 1.0)}, "f")]
-    for ld in loads:
-        ld.vector[fixed] = 0.0
-    Ks = sp.csr_matrix(K)
-    kw = {}
-    if damping == "hysteretic":
-        kw["D"] = 2e-3 * Ks
-    elif damping == "rayleigh":
-        kw["C"] = sp.csr_matrix(30.0 * np.diag(M) + 2e-7 * K)
-    elif damping == "both":
-        kw["D"] = 1e-3 * Ks
-        kw["C"] = sp.csr_matrix(1e-7 * K)
-    mid = nid(nx // 2, ny - 1)
-    observed = [ObservedPoint("top", np.array([2 * mid, 2 * mid + 1]), pts[mid]),
-                ObservedPoint("contact1", np.array([2, 3]), pts[1]),
-                ObservedPoint("fixed", fixed[:2], pts[top_left])]
-    return Model(K=Ks, M=sp.diags(M).tocsr(), contact=contact, loads=loads,
-                 observed=observed, fixed_dofs=fixed, **kw)
 
 
 def dense_Z(model, omega, n):

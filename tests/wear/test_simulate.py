@@ -28,7 +28,7 @@ import math
 
 import numpy as np
 import pytest
-import scipy.sparse as sp
+from helpers.models import sliders
 
 from fretwear.hb import contact as law
 from fretwear.hb.fourier import FourierBasis
@@ -36,7 +36,6 @@ from fretwear.hb.periodic import solve_periodic, static_anchor
 from fretwear.hb.reduce import condense
 from fretwear.hb.solvers import solve_identity_rows
 from fretwear.model.build import ContactSpec, Material, Spring, Traction, from_mesh
-from fretwear.model.core import ContactInterface, Load, Model
 from fretwear.model.mesh import rectangle
 from fretwear.wear import (
     SlowProblem,
@@ -65,23 +64,6 @@ def block(q_ratio=0.5):
                             Traction("right", pressure=q, waveform="sin")],
                      contact=ContactSpec("bottom", mu=MU, normal=(0, -1), wear_coefficient=KW),
                      observed={"Pe": (0.02, 0.002)})
-
-
-def sliders(nc=3, P=1e6, A=1e-4, kn=1.0, kt=1e8, ratio=3.0):
-    """``nc`` independent contact nodes: normal DOF on a (soft) spring kn under the constant
-    load P A, tangential DOF on a spring kt under ``ratio`` x mu P A sin(tau). Every node slides
-    except near the load reversals; the normal force is exactly P A."""
-    n = 2 * nc
-    K = sp.diags(np.tile([kn, kt], nc)).tocsr()
-    fn = np.zeros(n)
-    fn[0::2] = P * A
-    ft = np.zeros(n)
-    ft[1::2] = ratio * MU * P * A
-    c = ContactInterface(dofs=np.arange(n).reshape(nc, 2), frame=np.tile(np.eye(2), (nc, 1, 1)),
-                         gap=np.zeros(nc), area=np.full(nc, A), mu=MU,
-                         coords=np.c_[np.arange(nc) * 1e-3, np.zeros(nc)], wear_coefficient=KW)
-    return Model(K=K, M=sp.csr_matrix((n, n)), contact=c,
-                 loads=[Load(fn, "constant"), Load(ft, "sin")], dim=2)
 
 
 @pytest.fixture(scope="module")
@@ -458,105 +440,6 @@ def test_resume_refuses_other_settings(blk, tmp_path):
 
 
 # --- the case-file analysis -------------------------------------------------------------------
-CASE = """
-title = "wear test block"
-[model]
-type = "rectangle"
-length = 0.02
-height = 0.004
-nx = 10
-ny = 2
-thickness = 0.01
-[material]
-E = 210e9
-nu = 0.3
-rho = 7800.0
-[[springs]]
-at = "bottom_left"
-direction = "x"
-stiffness = 1e5
-[[loads]]
-boundary = "top"
-pressure = 1e6
-[[loads]]
-boundary = "right"
-pressure = 7.5e5
-waveform = "sin"
-[contact]
-boundary = "bottom"
-normal = [0.0, -1.0]
-mu = 0.3
-wear_coefficient = 1e-11
-[observed]
-Pe = [0.02, 0.002]
-[analysis]
-type = "wear"
-quasi_static = true
-harmonics = 3
-n_samples = 32
-tolerance = 0.05
-max_cycles = 3e5
-checkpoint_every_s = 0.0
-[analysis.frf_before_after]
-f_min = 2e3
-f_max = 3e3
-n_points = 3
-"""
-
-
-@pytest.fixture
-def wear_registered():
-    """Import the analysis for this test only (the registry line in runner.ANALYSIS_MODULES
-    and the regenerated docs/case-files.md come with the merge)."""
-    from fretwear.analyses import registry as runner
-
-    before = "wear" in runner._REGISTRY
-    import fretwear.analyses.wear  # noqa: F401
-
-    if "wear" not in runner._REGISTRY:  # imported earlier, then removed by this fixture
-        rw = fretwear.analyses.wear
-        runner.register("wear", rw.SCHEMA, rw.run_wear, checks=rw.CHECKS, doc=rw.DOC,
-                        files=(rw.CHECKPOINT_FILE,))
-    yield
-    if not before:
-        runner._REGISTRY.pop("wear", None)
-
-
-def test_case_file_run_and_resume(tmp_path, wear_registered):
-    """`analysis = "wear"` end to end: results.nc follows the schema (units on every variable,
-    dims step/contact_node), figures exist, the checkpoint is there, and --resume of a finished
-    run reports it up to date."""
-    from fretwear.analyses.run import run_case
-    from fretwear.io.results import read_results
-
-    case = tmp_path / "w.toml"
-    case.write_text(CASE)
-    out = run_case(case, progress=False, echo=False)
-    ds = read_results(out.results)
-    assert ds.attrs["analysis_type"] == "wear" and ds.attrs["stop_reason"] == "max_cycles"
-    for name in ("cycles", "wear_depth", "worn_volume", "pressure_max",
-                 "slip_amplitude", "state_fraction", "newton_iterations"):
-        assert "units" in ds[name].attrs, name
-    assert ds["wear_depth"].dims == ("step", "contact_node")
-    assert float(ds["cycles"][-1]) == pytest.approx(3e5)
-    assert all(p.is_file() for p in out.figures) and len(out.figures) == 5
-    assert ds["frf_amplitude"].dims == ("wear_state", "frequency", "point", "axis")
-    assert int(ds["frf_converged"].sum()) == 6
-    assert (case.parent / "w-results" / "wear-checkpoint.npz").is_file()
-    again = run_case(case, progress=False, echo=False, resume=True)
-    assert again.summary == "up to date"
-
-
-def test_case_file_needs_frequency(tmp_path, wear_registered):
-    from fretwear.analyses.run import load_case
-    from fretwear.errors import InputError
-
-    case = tmp_path / "w.toml"
-    case.write_text(CASE.replace("quasi_static = true", ""))
-    with pytest.raises(InputError, match="frequency"):
-        load_case(case)
-
-
 def test_frf_worn_uniform_wear_is_a_rigid_shift(blk):
     """The block is held vertically by the contact only: a uniform wear depth translates it
     without changing any force, so the nonlinear FRF (fretwear.hb.sweep with the worn gap) is

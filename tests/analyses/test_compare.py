@@ -21,7 +21,7 @@ without pretending to an agreement the models do not have.
 """
 
 import pytest
-from test_run_dlft import small_case
+from helpers.cases import small_case
 
 from fretwear import cli
 from fretwear.analyses.compare import compare_periodic
@@ -37,6 +37,7 @@ n_samples = 256
 TOLERANCE = {"harmonic 1": 5e-3, "friction energy": 2.5e-2, "stick fraction": 2.2e-2}
 
 
+@pytest.mark.slow
 def test_compare_command_writes_the_figure_and_the_table(tmp_path, capsys):
     case = small_case(tmp_path, PERIODIC)
     status = cli.main(["compare", str(case), "-o", str(tmp_path / "cmp"), "--steps", "256"])

@@ -16,7 +16,7 @@ import pytest
 from fretwear.errors import InputError
 from fretwear.model.mesh import box, facet_normals, read, rectangle
 
-DATA = Path(__file__).parent / "data"
+DATA = Path(__file__).parents[1] / "data"
 
 
 def facet_set(facets):

@@ -1,0 +1,73 @@
+"""The DLFT analysis ``sweep`` run from case files through the command line.
+
+The small variant of the paper's beam of tests/helpers/cases.py (10 x 2 elements, 3 harmonics, 32
+samples per period, 4 frequencies) keeps each run to a few seconds. The results file is checked
+against the tables of docs/results.md; points that did not converge are kept as NaN with the
+reason.
+"""
+
+import numpy as np
+import pytest
+from helpers.cases import check_documented, run, small_case, with_key
+
+from fretwear.io.results import read_results
+
+SWEEP = """[analysis]
+type = "sweep"
+f_min = 1e3
+f_max = 2e4
+n_points = 4
+harmonics = 3
+n_samples = 32
+linear_references = ["sliding", "stuck"]
+"""
+
+
+
+# --- sweep ----------------------------------------------------------------------------------
+def test_sweep_writes_documented_results_and_figures(tmp_path, capsys):
+    status, out, err = run(small_case(tmp_path, SWEEP), capsys)
+    res = tmp_path / "beam-results"
+    ds = read_results(res / "results.nc")
+    conv = ds["converged"].values
+    assert status == (0 if conv.all() else 1), err
+    n = ds.sizes["frequency"]
+    assert n >= 4 and conv.any()
+    assert ds.attrs["sweep_converged"] == f"{int(conv.sum())}/{n}"
+    assert out.splitlines()[1] == f"sweep_converged={int(conv.sum())}/{n}"
+    check_documented(ds, "sweep")
+    assert ds["frequency"].values[[0, -1]].tolist() == pytest.approx([1e3, 2e4])
+    assert ds.sizes["interface"] == 2 and ds.sizes["harmonic"] == 3
+    amp = ds["response_amplitude"].sel(point="Pe", axis="x", harmonic=1).values
+    assert np.all(np.isfinite(amp[conv == 1])) and np.all(amp[conv == 1] > 0)
+    # with friction the response lies between the stuck and the frictionless limits
+    lin = ds["linear_response_amplitude"].sel(point="Pe", axis="x")
+    assert np.all(amp[conv == 1] > lin.sel(interface="stuck").values[conv == 1])
+    frac = ds[["separation_fraction", "stick_fraction", "slip_fraction"]].to_array().sum("variable")
+    np.testing.assert_allclose(frac.values[conv == 1], 1.0)
+    for stem in ("sweep-Pe", "sweep-interface"):
+        assert (res / f"{stem}.png").stat().st_size > 10_000, stem
+
+
+def test_sweep_points_that_fail_are_kept_as_nan_with_the_reason(tmp_path, capsys):
+    path = small_case(tmp_path, with_key(with_key(SWEEP, "max_iter = 1"),
+                                         "continuation = false"))
+    status, out, _ = run(path, capsys)
+    assert status == 1
+    ds = read_results(tmp_path / "beam-results" / "results.nc")
+    bad = ds["converged"].values == 0
+    assert bad.any() and ds.attrs["converged"] == 0
+    assert np.all(np.isnan(ds["response_amplitude"].values[bad]))
+    assert all(f.startswith("not converged: ") for f in ds["flags"].values[bad])
+    assert "not converged: maximum number of iterations reached" in out
+    assert ds.attrs["flagged_points"].count("\n") == int(bad.sum()) - 1
+
+
+def test_sweep_rejects_a_reversed_band_and_aliasing(tmp_path, capsys):
+    bad = SWEEP.replace("f_max = 2e4", "f_max = 100.0")
+    assert run(small_case(tmp_path, bad), capsys)[2] == (
+        "error: analysis.f_max = 100.0: expected a value above f_min = 1000.0 Hz\n")
+    bad = SWEEP.replace("harmonics = 3", "harmonics = [1, 3, 16]")
+    assert run(small_case(tmp_path, bad), capsys)[2] == (
+        "error: analysis.n_samples = 32: expected more than 32 samples per period "
+        "(twice the highest harmonic, 16)\n")

@@ -1,0 +1,93 @@
+"""The nonlinear solvers of the DLFT (fretwear.hb.solvers) on small systems with known roots.
+
+References independent of the code under test:
+
+* a 2 x 2 analytic system, ``x^2 + y^2 = 4``, ``x - y = 0``, whose root in the positive
+  quadrant is ``(sqrt 2, sqrt 2)`` (closed form);
+* a smooth n-dimensional problem ``A x + 0.1 x^3 = A x* + 0.1 x*^3`` with ``A`` symmetric
+  positive definite (a strictly monotone map: its only root is the ``x*`` it was built from);
+* ``numpy.linalg.solve`` of the dense system for :func:`solve_identity_rows`.
+
+The solvers stop at ``|f| <= tol * scale``; with tol = 1e-12 and Jacobians of condition < 10 the
+error of the root is below 1e-10 relative (the residual divided by the smallest singular
+value), so the roots are compared to 1e-9 relative.
+"""
+
+import numpy as np
+import pytest
+
+from fretwear.errors import InputError
+from fretwear.hb.solvers import SOLVERS, SolveStats, solve, solve_identity_rows
+
+RNG = np.random.default_rng(3)
+
+
+def circle_line(x, need_jacobian):
+    f = np.array([x[0] ** 2 + x[1] ** 2 - 4.0, x[0] - x[1]])
+    J = np.array([[2 * x[0], 2 * x[1]], [1.0, -1.0]]) if need_jacobian else None
+    return f, J
+
+
+def monotone(n=12):
+    B = RNG.standard_normal((n, n))
+    A = B @ B.T / n + np.eye(n)
+    x_star = RNG.standard_normal(n)
+    rhs = A @ x_star + 0.1 * x_star**3
+
+    def fun(x, need_jacobian):
+        f = A @ x + 0.1 * x**3 - rhs
+        return f, (A + np.diag(0.3 * x**2)) if need_jacobian else None
+
+    return fun, x_star, np.abs(rhs).max()
+
+
+@pytest.mark.parametrize("method", SOLVERS)
+def test_two_by_two_analytic_root(method):
+    x, f, st = solve(circle_line, [1.0, 0.5], lambda x: 4.0, method=method, tol=1e-12)
+    assert isinstance(st, SolveStats) and st.success, st.message
+    assert st.solver == method and st.message
+    np.testing.assert_allclose(x, [np.sqrt(2), np.sqrt(2)], rtol=1e-9)
+    assert np.linalg.norm(f) <= 1e-12 * 4.0 and st.residual <= 1e-12
+
+
+@pytest.mark.parametrize("method", SOLVERS)
+def test_smooth_n_dimensional_root(method):
+    fun, x_star, scale = monotone()
+    x, _, st = solve(fun, np.zeros_like(x_star), lambda x: scale, method=method, tol=1e-12)
+    assert st.success, st.message
+    np.testing.assert_allclose(x, x_star, rtol=1e-9, atol=1e-9 * np.abs(x_star).max())
+
+
+@pytest.mark.parametrize("method", SOLVERS)
+def test_a_failed_solve_says_so(method):
+    """No real root (``x^2 + 1 = 0``): the solve fails and says why, within its iterations."""
+    def fun(x, need_jacobian):
+        return np.array([x[0] ** 2 + 1.0]), (np.array([[2 * x[0]]]) if need_jacobian else None)
+
+    x, f, st = solve(fun, [0.3], lambda x: 1.0, method=method, tol=1e-12, max_iter=20)
+    assert st.success is False or st.success == 0
+    assert isinstance(st.message, str) and st.message and st.message != "converged"
+    assert st.residual >= 1.0 - 1e-12  # |x^2 + 1| >= 1 everywhere
+
+
+def test_unknown_method_is_refused():
+    with pytest.raises(InputError, match="solver = 'broyden'"):
+        solve(circle_line, [1.0, 0.5], lambda x: 4.0, method="broyden")
+
+
+@pytest.mark.parametrize("k", [1, 3])
+def test_identity_rows_against_a_dense_solve(k):
+    """Rows holding only their diagonal (a sticking node's ``eps I``) mixed with a full block:
+    the same X as numpy's dense solve to 1e-12 relative (condition < 100)."""
+    n = 9
+    J = RNG.standard_normal((n, n)) + 5 * np.eye(n)
+    ident = [0, 4, 7]
+    J[ident] = 0.0
+    J[ident, ident] = [2.0, 3.0, 0.5]
+    B = RNG.standard_normal((n, k)) if k > 1 else RNG.standard_normal(n)
+    np.testing.assert_allclose(solve_identity_rows(J, B), np.linalg.solve(J, B), rtol=1e-12,
+                               atol=1e-12)
+    full = RNG.standard_normal((4, 4)) + 4 * np.eye(4)  # no identity rows: plain dense solve
+    b = RNG.standard_normal(4)
+    np.testing.assert_allclose(solve_identity_rows(full, b), np.linalg.solve(full, b),
+                               rtol=1e-12)

@@ -1,0 +1,1 @@
+"""Helpers shared by the test files (importable as ``helpers``: tests/ is on the path)."""

@@ -1,0 +1,73 @@
+"""Small case files and the check of results files against docs/results.md, shared by the tests
+of the analyses run from case files."""
+
+import re
+from pathlib import Path
+
+from fretwear import cli
+
+ROOT = Path(__file__).resolve().parents[2]
+EXAMPLES = ROOT / "src" / "fretwear" / "examples"
+LINEAR_EXAMPLE = EXAMPLES / "beam-linear-frf.toml"
+
+
+def small_case(tmp_path: Path, analysis: str, name: str = "beam.toml") -> Path:
+    """The shipped beam on a 10 x 2 mesh with another ``[analysis]`` table."""
+    text = LINEAR_EXAMPLE.read_text()
+    for old, new in {"nx = 30": "nx = 10", "ny = 4 ": "ny = 2 "}.items():
+        assert old in text
+        text = text.replace(old, new)
+    path = tmp_path / name
+    path.write_text(text[: text.index("[analysis]")] + analysis)
+    return path
+
+
+def with_key(analysis: str, line: str) -> str:
+    """``analysis`` with the key of ``line`` set by ``line`` (replaced or added)."""
+    key = line.split("=")[0].strip()
+    kept = [x for x in analysis.splitlines() if x.split("=")[0].strip() != key]
+    return "\n".join(kept + [line]) + "\n"
+
+
+def run(path: Path, capsys) -> tuple[int, str, str]:
+    status = cli.main(["run", str(path), "--no-progress"])
+    out = capsys.readouterr()
+    return status, out.out, out.err
+
+
+# --- the documented schema ------------------------------------------------------------------
+def doc_rows(section: str | None = None) -> dict[str, tuple[str, str]]:
+    """name -> (dimensions, units) from the tables of docs/results.md: the shared sections
+    (dimensions, geometry) and, if given, the section ``## `section```."""
+    rows, current = {}, None
+    for line in (ROOT / "docs" / "results.md").read_text().splitlines():
+        if line.startswith("## "):
+            current = line[3:].strip()
+        shared = current in ("Rules for every analysis",)
+        if not (shared or current == f"`{section}`"):
+            continue
+        m = re.match(r"\| `(\w+)` \| ([^|]*) \| ([^|]*) \|", line)
+        if m:
+            rows[m.group(1)] = (m.group(2).strip(), m.group(3).strip())
+    return rows
+
+
+def check_documented(ds, section: str) -> None:
+    docs = doc_rows(section)
+    for name, var in list(ds.coords.items()) + list(ds.data_vars.items()):
+        assert name in docs, f"{name} is not documented in docs/results.md ({section})"
+        assert var.attrs["units"] == docs[name][1], name
+        assert var.attrs["long_name"], name
+    for name, var in ds.data_vars.items():
+        assert ", ".join(var.dims) == docs[name][0], name
+
+
+# the transient analysis in its "fixed" mode: 20 periods of 64 steps at 1 kHz
+FIXED = """[analysis]
+type = "transient"
+frequency = 1e3
+mode = "fixed"
+n_periods = 20
+steps_per_period = 64
+harmonics = 3
+"""

@@ -1,0 +1,116 @@
+"""Small hand-written models shared by several test files (independent of the FE layer)."""
+
+import numpy as np
+import scipy.sparse as sp
+
+from fretwear.model.core import ContactInterface, Load, Model, ObservedPoint
+
+# --- a braced 2D truss with tilted contact frames (the condensation tests) ------------------
+RNG = np.random.default_rng(7)
+
+
+def truss(nx=6, ny=3, a=0.01, k=1e7, m=0.01, damping="hysteretic", theta=0.3,
+          dangling=False):
+    """Braced 2D truss on an nx x ny grid (spacing a [m]), bar stiffness k*a/L [N/m], lumped
+    mass m [kg] per node; bottom row = contact nodes with frames tilted by theta [rad]; statically
+    supported by three fixed DOFs on the top row. ``dangling`` adds a node hanging on a single
+    bar from a contact node (a mechanism that the contact does not hold)."""
+    xs, ys = np.meshgrid(np.arange(nx) * a, np.arange(ny) * a)
+    pts = np.column_stack([xs.ravel(), ys.ravel()])
+    nid = lambda i, j: j * nx + i
+    bars = []
+    for j in range(ny):
+        for i in range(nx):
+            if i + 1 < nx:
+                bars.append((nid(i, j), nid(i + 1, j)))
+            if j + 1 < ny:
+                bars.append((nid(i, j), nid(i, j + 1)))
+            if i + 1 < nx and j + 1 < ny:
+                bars += [(nid(i, j), nid(i + 1, j + 1)), (nid(i + 1, j), nid(i, j + 1))]
+    if dangling:
+        pts = np.vstack([pts, [[-a, 0.0]]])
+        bars.append((nid(0, 0), len(pts) - 1))
+    nd = 2 * len(pts)
+    K = np.zeros((nd, nd))
+    for p, q in bars:
+        e = pts[q] - pts[p]
+        L = np.linalg.norm(e)
+        c = e / L
+        kb = k * a / L * np.outer(c, c)
+        idx = np.r_[2 * p : 2 * p + 2, 2 * q : 2 * q + 2]
+        K[np.ix_(idx, idx)] += np.block([[kb, -kb], [-kb, kb]])
+    M = m * (1.0 + 0.1 * np.arange(nd) / nd)  # slightly non-uniform: no degenerate modes
+    bottom = np.arange(nx)
+    n = np.array([np.sin(theta), -np.cos(theta)])
+    t = np.array([np.cos(theta), np.sin(theta)])
+    contact = ContactInterface(
+        dofs=np.column_stack([2 * bottom, 2 * bottom + 1]),
+        frame=np.tile(np.array([n, t]), (nx, 1, 1)),
+        gap=np.zeros(nx), area=np.full(nx, a), mu=0.3, coords=pts[bottom])
+    top_left, top_right = nid(0, ny - 1), nid(nx - 1, ny - 1)
+    fixed = np.array([2 * top_left, 2 * top_left + 1, 2 * top_right + 1])
+    loads = [Load(RNG.standard_normal(nd), "constant", name="static"),
+             Load(RNG.standard_normal(nd), "cos", name="c"),
+             Load(RNG.standard_normal(nd), "sin", name="s"),
+             Load(RNG.standard_normal(nd), "fourier", {2: (0.5, -0.2), 3: (0.0, 1.0)}, "f")]
+    for ld in loads:
+        ld.vector[fixed] = 0.0
+    Ks = sp.csr_matrix(K)
+    kw = {}
+    if damping == "hysteretic":
+        kw["D"] = 2e-3 * Ks
+    elif damping == "rayleigh":
+        kw["C"] = sp.csr_matrix(30.0 * np.diag(M) + 2e-7 * K)
+    elif damping == "both":
+        kw["D"] = 1e-3 * Ks
+        kw["C"] = sp.csr_matrix(1e-7 * K)
+    mid = nid(nx // 2, ny - 1)
+    observed = [ObservedPoint("top", np.array([2 * mid, 2 * mid + 1]), pts[mid]),
+                ObservedPoint("contact1", np.array([2, 3]), pts[1]),
+                ObservedPoint("fixed", fixed[:2], pts[top_left])]
+    return Model(K=Ks, M=sp.diags(M).tocsr(), contact=contact, loads=loads,
+                 observed=observed, fixed_dofs=fixed, **kw)
+
+
+
+# --- a one-node friction oscillator (Den Hartog's regime) ---------------------------------
+M_, K_, KN, N0, F0, ZETA = 1.0, 1e4, 1e6, 10.0, 20.0, 0.05
+MU = 0.3  # mu N0 / F0 = 0.15: continuous slip
+
+
+def oscillator() -> Model:
+    """DOF 0 normal (stiff spring, static load pressing it on the obstacle), DOF 1 tangential
+    (mass, spring, viscous damping, harmonic force)."""
+    K = sp.csr_matrix(np.diag([KN, K_]))
+    M = sp.csr_matrix(np.diag([M_, M_]))
+    C = sp.csr_matrix(np.diag([0.0, 2 * ZETA * np.sqrt(K_ * M_)]))
+    contact = ContactInterface(dofs=np.array([[0, 1]]), frame=np.eye(2)[None],
+                               gap=np.zeros(1), area=np.ones(1), mu=MU,
+                               coords=np.zeros((1, 2)))
+    loads = [Load(np.array([N0, 0.0]), "constant"), Load(np.array([0.0, F0]), "cos")]
+    return Model(K=K, M=M, C=C, contact=contact, loads=loads,
+                 observed=[ObservedPoint("x", np.array([1]), np.zeros(1))])
+
+
+
+# --- independent sliders under a constant normal load (the wear tests) --------------------
+KW = 1e-11  # Archard coefficient [1/Pa] (paper section 4)
+MU_SLIDERS = 0.3
+
+
+def sliders(nc=3, P=1e6, A=1e-4, kn=1.0, kt=1e8, ratio=3.0):
+    """``nc`` independent contact nodes: normal DOF on a (soft) spring kn under the constant
+    load P A, tangential DOF on a spring kt under ``ratio`` x mu P A sin(tau). Every node slides
+    except near the load reversals; the normal force is exactly P A."""
+    n = 2 * nc
+    K = sp.diags(np.tile([kn, kt], nc)).tocsr()
+    fn = np.zeros(n)
+    fn[0::2] = P * A
+    ft = np.zeros(n)
+    ft[1::2] = ratio * MU_SLIDERS * P * A
+    c = ContactInterface(dofs=np.arange(n).reshape(nc, 2), frame=np.tile(np.eye(2), (nc, 1, 1)),
+                         gap=np.zeros(nc), area=np.full(nc, A), mu=MU_SLIDERS,
+                         coords=np.c_[np.arange(nc) * 1e-3, np.zeros(nc)], wear_coefficient=KW)
+    return Model(K=K, M=sp.csr_matrix((n, n)), contact=c,
+                 loads=[Load(fn, "constant"), Load(ft, "sin")], dim=2)
+
