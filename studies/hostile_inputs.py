@@ -1,7 +1,7 @@
 """Survey: how fretwear answers case files a hostile user writes.
 
-Generates N case files from the schema (tests/helpers/hostile.py: one to three keys of a small valid
-case replaced by valid or invalid values for their specification) and runs each with
+Generates N case files from the schema (tests/helpers/hostile.py: one to three keys of a
+small valid case replaced by valid or invalid values for their specification) and runs each with
 ``fretwear run`` in this process. Prints the count of each outcome: ran (exit 0/1 with a
 results file), clean message (exit 2, one line), traceback (an exception escaped), hang
 (longer than the time limit), files written outside the output folder, and the first
@@ -21,7 +21,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "helpers"))
 
-import hostile  # noqa: E402
+from helpers import hostile  # noqa: E402
 from hypothesis import HealthCheck, given, settings  # noqa: E402
 
 
