@@ -11,7 +11,7 @@ import functools
 
 import numpy as np
 import pytest
-from helpers.cases import doc_rows
+from helpers.cases import check_documented
 
 import fretwear.analyses.wear as wear_analysis
 from fretwear.analyses.run import run_case
@@ -135,11 +135,7 @@ def test_dataset_is_the_wear_result_it_came_from(tmp_path, monkeypatch):
     h = result.history
     assert ds.attrs["stop_reason"] == result.stop_reason == "max_cycles"
     assert bool(ds.attrs["converged"]) == result.success
-    docs = doc_rows("wear")
-    for name in ("cycles", "wear_depth", "worn_volume", "pressure_max", "slip_amplitude",
-                 "dissipated_energy"):
-        assert ds[name].attrs["units"] == docs[name][1], name
-        assert ", ".join(ds[name].dims) == docs[name][0], name
+    check_documented(ds, "wear")  # every variable, coordinate and scalar in docs/results.md
     assert ds.sizes["step"] == h.n_steps  # record_every = 1: every step kept
     for name, field in [("cycles", "cycles"), ("wear_depth", "wear_depth"),
                         ("worn_volume", "worn_volume"), ("pressure_max", "pressure_max"),

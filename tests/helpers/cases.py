@@ -46,7 +46,7 @@ def doc_rows(section: str | None = None) -> dict[str, tuple[str, str]]:
         shared = current in ("Rules for every analysis",)
         if not (shared or current == f"`{section}`"):
             continue
-        m = re.match(r"\| `(\w+)` \| ([^|]*) \| ([^|]*) \|", line)
+        m = re.match(r"\| `(\w+)` \|([^|]*)\|([^|]*)\|", line)  # a scalar: empty dimensions
         if m:
             rows[m.group(1)] = (m.group(2).strip(), m.group(3).strip())
     return rows
