@@ -125,3 +125,10 @@ def test_time_integration_frequency(block):
         fw.integrate(block, 1e30, n_periods=1)
     with pytest.raises(InputError, match="frequency"):
         fw.integrate(block, -1.0, n_periods=1)
+
+
+def test_time_steps_that_cannot_be_recorded_are_refused(block):
+    """1e9 steps per period recorded: refused with the memory estimate, before allocating."""
+    with pytest.raises(InputError, match=r"recording 1 periods of 1000000000 time steps needs "
+                                         r"about .* GiB"):
+        fw.integrate(block, 1500.0, n_periods=1, steps_per_period=10**9)

@@ -49,6 +49,7 @@ import scipy.linalg as sla
 from fretwear.errors import InputError
 from fretwear.limits import check_range
 from fretwear.model.core import Model
+from fretwear.resources import require_memory
 from fretwear.timedomain.checks import c_float, count, node_wear, positive
 from fretwear.timedomain.kernels import (
     OPEN,
@@ -411,6 +412,12 @@ def integrate(model: Model, frequency: float, *, n_periods: int,
             raise InputError(f"record = {record} periods but n_periods = {n_periods}")
     n_keep = min(count(keep_poincare, "keep_poincare", 0), n_periods)
     omega = 2 * np.pi * check_range(positive(frequency, "frequency"), "frequency", "frequency")
+    steps = count(steps_per_period, "steps_per_period", 4)
+    # recorded samples: observed displacements and velocities, contact positions and forces,
+    # states and six energy terms per step [8 bytes each]
+    width = 2 * model.ndof + 2 * model.contact.dofs.size + model.contact.n_nodes + 6
+    require_memory(8.0 * n_rec * steps * width,
+                   f"recording {n_rec} periods of {steps} time steps")
     integ = Integrator(model, omega, steps_per_period=steps_per_period,
                         modal_cutoff=modal_cutoff, n_modes=n_modes, gamma=gamma, tol=tol,
                         wear=wear, U0=U0, V0=V0, stick_anchor=stick_anchor,
