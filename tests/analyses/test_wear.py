@@ -11,44 +11,15 @@ import functools
 
 import numpy as np
 import pytest
-from helpers.cases import check_documented
+from helpers.cases import WEAR_BLOCK, check_documented
 
 import fretwear.analyses.wear as wear_analysis
 from fretwear.analyses.run import run_case
 from fretwear.io.results import read_results
 
-CASE = """
+CASE = f"""
 title = "wear test block"
-[model]
-type = "rectangle"
-length = 0.02
-height = 0.004
-nx = 10
-ny = 2
-thickness = 0.01
-[material]
-E = 210e9
-nu = 0.3
-rho = 7800.0
-[[springs]]
-at = "bottom_left"
-direction = "x"
-stiffness = 1e5
-[[loads]]
-boundary = "top"
-pressure = 1e6
-[[loads]]
-boundary = "right"
-pressure = 7.5e5
-waveform = "sin"
-[contact]
-boundary = "bottom"
-normal = [0.0, -1.0]
-mu = 0.3
-wear_coefficient = 1e-11
-[observed]
-Pe = [0.02, 0.002]
-[analysis]
+{WEAR_BLOCK}[analysis]
 type = "wear"
 quasi_static = true
 harmonics = 3

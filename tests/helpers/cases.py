@@ -71,3 +71,38 @@ n_periods = 20
 steps_per_period = 64
 harmonics = 3
 """
+
+
+#: a small steel block (10 x 2 Q4) pressed on a flat and pushed back and forth: the model of
+#: the wear tests (quasi-static partial slip; a run of a few hundred steps takes seconds)
+WEAR_BLOCK = """
+[model]
+type = "rectangle"
+length = 0.02
+height = 0.004
+nx = 10
+ny = 2
+thickness = 0.01
+[material]
+E = 210e9
+nu = 0.3
+rho = 7800.0
+[[springs]]
+at = "bottom_left"
+direction = "x"
+stiffness = 1e5
+[[loads]]
+boundary = "top"
+pressure = 1e6
+[[loads]]
+boundary = "right"
+pressure = 7.5e5
+waveform = "sin"
+[contact]
+boundary = "bottom"
+normal = [0.0, -1.0]
+mu = 0.3
+wear_coefficient = 1e-11
+[observed]
+Pe = [0.02, 0.002]
+"""

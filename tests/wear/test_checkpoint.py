@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers.cases import WEAR_BLOCK
 
 from fretwear import cli
 from fretwear.errors import InputError
@@ -30,38 +31,9 @@ from fretwear.wear.checkpoint import load_checkpoint, read_history
 # seconds). Its first checkpoint is written after step 1, the next one only on an interrupt or
 # at the end (checkpoint_every_s = 1e9): a checkpoint at a later step than 1 before the end was
 # written by the interrupt.
-CASE = """
+CASE = f"""
 title = "checkpoint robustness: small quasi-static wear"
-[model]
-type = "rectangle"
-length = 0.02
-height = 0.004
-nx = 10
-ny = 2
-thickness = 0.01
-[material]
-E = 210e9
-nu = 0.3
-rho = 7800.0
-[[springs]]
-at = "bottom_left"
-direction = "x"
-stiffness = 1e5
-[[loads]]
-boundary = "top"
-pressure = 1e6
-[[loads]]
-boundary = "right"
-pressure = 7.5e5
-waveform = "sin"
-[contact]
-boundary = "bottom"
-normal = [0.0, -1.0]
-mu = 0.3
-wear_coefficient = 1e-11
-[observed]
-Pe = [0.02, 0.002]
-[analysis]
+{WEAR_BLOCK}[analysis]
 type = "wear"
 quasi_static = true
 harmonics = 3
