@@ -17,8 +17,17 @@ from pathlib import Path
 
 import numpy as np
 
-from fretwear import __version__
+from fretwear import __version__, linear
 from fretwear.analyses import figures as plots
+from fretwear.analyses.run import load_case
+from fretwear.analyses.wear import default_nodes, selected_steps
+from fretwear.errors import InputError
+from fretwear.files import atomic_write
+from fretwear.io.case import build_model
+from fretwear.io.results import read_results
+from fretwear.paper.catalogue import EXTRA_KEYS, RUNS
+from fretwear.timedomain.averaged_rate import RESPONSE_KINDS
+from fretwear.wear import zero_wear_zones
 
 #: what the paper states, by figure (Salles et al. 2011, section 4)
 PAPER = {
@@ -58,8 +67,6 @@ WEAR_FREQS = (("wear-quasistatic", "quasi-static"), ("wear-30khz", "30 kHz"),
 # --- reading ----------------------------------------------------------------------------------
 def load(workdir: Path, key: str):
     """The results dataset of run ``key``, or None when it is missing or did not converge."""
-    from fretwear.errors import InputError
-    from fretwear.io.results import read_results
 
     path = workdir / key / "results.nc"
     if not path.is_file():
@@ -110,7 +117,6 @@ def sweep_amplitude(ds, harmonic: int = 1):
 def linear_facts(model, f_max: float = 1e5) -> dict:
     """Natural frequencies below ``f_max`` with a sliding and a stuck interface, and the
     resonance peaks of the linear FRF of u_x(P_e) on a fine grid (10 Hz to ``f_max``)."""
-    from fretwear import linear
 
     out = {}
     grid = np.geomspace(10.0, f_max, 4000)
@@ -125,8 +131,6 @@ def linear_facts(model, f_max: float = 1e5) -> dict:
 
 def wear_facts(ds) -> dict:
     """What the paper reads off a wear run (section 4.2)."""
-    from fretwear.timedomain.averaged_rate import RESPONSE_KINDS
-    from fretwear.wear import zero_wear_zones
 
     x = ds["contact_position"].values[:, 0]
     w = ds["wear_depth"].values[-1]
@@ -234,7 +238,6 @@ def fig_stromberg(figdir, sin, tri, short, ls) -> str | None:
 
 def fig_wear_run(figdir, ds, name: str, label: str, figs: str) -> str:
     """Four panels as the paper's figure groups: profiles, kinetics, pressure, slip."""
-    from fretwear.analyses.wear import default_nodes, selected_steps
 
     fig, ax = plots.new_figure(2, 2, title=f"Paper Fig. {figs}: wear, {label}")
     x = ds["contact_position"].values[:, 0] * 1e3
@@ -365,8 +368,6 @@ def fig_frf_worn(figdir, fw) -> str | None:
 def write_report(workdir: Path, doc: Path, outcomes, *, quick: bool, wall: float,
                  jobs: int) -> Path:
     """Measure, draw and write the report ``doc``; figures in ``doc.parent/doc.stem``."""
-    from fretwear.files import atomic_write
-    from fretwear.paper.catalogue import RUNS
 
     workdir = Path(workdir)
     doc = Path(doc)
@@ -412,7 +413,6 @@ going on at the same time; `benchmarks/paper_table1.py` times the Table 1 runs a
 
 
 def _runs_table(runs, out: dict) -> str:
-    from fretwear.paper.catalogue import EXTRA_KEYS
 
     def status(key: str) -> str:
         o = out.get(key)
@@ -567,8 +567,6 @@ class _Report:
 
     # Fig. 14, 15, 22
     def frf(self) -> str:
-        from fretwear.analyses.run import load_case
-        from fretwear.io.case import build_model
 
         frf = self.ds["frf"]
         s = ["## Fig. 14, 15, 22: FRFs of the unworn beam", "", f"Paper: {PAPER['14']} "

@@ -24,7 +24,12 @@ from pathlib import Path
 
 import numpy as np
 
+from fretwear.analyses.run import RunInterrupted, load_case, run_case
 from fretwear.errors import FretwearError, InputError
+from fretwear.examples.builders import stromberg_beam
+from fretwear.files import atomic_write
+from fretwear.hb.fourier import FourierBasis
+from fretwear.io.case import build_model
 from fretwear.paper.catalogue import (
     EXTRA_KEYS,
     FRF_WORN_BAND,
@@ -37,6 +42,10 @@ from fretwear.paper.catalogue import (
     run_case_text,
     toml_value,
 )
+from fretwear.paper.report import load, write_report
+from fretwear.timedomain.fallback import FALLBACK
+from fretwear.timedomain.quasistatic import incremental_wear
+from fretwear.wear import frf_worn
 
 
 # --- running ----------------------------------------------------------------------------------
@@ -54,7 +63,6 @@ class Outcome:
 def _save_npz(path: Path, **arrays) -> None:
     """Write ``path`` (``.npz``) complete or not at all
     (:func:`fretwear.io.results.atomic_write`)."""
-    from fretwear.files import atomic_write
 
     def write(tmp: Path) -> None:
         with open(tmp, "wb") as fh:
@@ -75,7 +83,6 @@ def run_one(key: str, workdir: Path | str, quick: bool = False,
     """Run the case file of run ``key`` (or the extra computation ``key``) into
     ``workdir/key``; an up-to-date result is kept. Never raises for a failed solve: the
     outcome says what happened."""
-    from fretwear.analyses.run import run_case
 
     workdir = Path(workdir)
     folder = workdir / key
@@ -103,8 +110,6 @@ def run_one(key: str, workdir: Path | str, quick: bool = False,
 def _load_stepping(folder: Path, quick: bool) -> str:
     """Stromberg's kind of method on the section 4.1 beam: load stepping with exact contact,
     incremental Coulomb friction and Archard after every step (fretwear.timedomain.integrate)."""
-    from fretwear.examples.builders import stromberg_beam
-    from fretwear.timedomain.quasistatic import incremental_wear
 
     cycles = 200 if quick else STROMBERG_CYCLES
     steps = 32 if quick else 64
@@ -123,12 +128,6 @@ def _load_stepping(folder: Path, quick: bool) -> str:
 
 def _frf_worn(folder: Path, wear_dir: Path, quick: bool) -> str:
     """The nonlinear FRF of the paper's beam before and after the 79 kHz wear (Fig. 24)."""
-    from fretwear.analyses.run import load_case
-    from fretwear.hb.fourier import FourierBasis
-    from fretwear.io.case import build_model
-    from fretwear.paper.report import load
-    from fretwear.timedomain.fallback import FALLBACK
-    from fretwear.wear import frf_worn
 
     ds = load(wear_dir.parent, wear_dir.name)
     if ds is None:
@@ -181,7 +180,6 @@ def run_all(workdir: Path | str, *, quick: bool = False, jobs: int = 1,
     from concurrent.futures import ProcessPoolExecutor, as_completed
     from multiprocessing import get_context
 
-    from fretwear.analyses.run import RunInterrupted
 
     if jobs < 1:
         raise InputError(f"jobs = {jobs}: expected a number of processes >= 1")
@@ -221,7 +219,6 @@ def reproduce(workdir: Path | str, doc: Path | str | None = None, *, quick: bool
     """Run the reproduction into ``workdir`` and write the report ``doc`` (default
     ``workdir/reproduction.md``, figures in the folder ``<doc stem>/`` beside it).
     Returns the report's path."""
-    from fretwear.paper.report import write_report
 
     workdir = Path(workdir).expanduser().resolve()
     t0 = time.perf_counter()

@@ -33,6 +33,8 @@ import numpy as np
 from fretwear.hb import contact as law
 from fretwear.hb.fourier import FourierBasis
 from fretwear.model.core import Model
+from fretwear.timedomain.integrate import integrate
+from fretwear.timedomain.steady import classify_sequence, fourier_coefficients
 from fretwear.wear.kernels import slip_work_samples
 
 #: response kinds of :func:`fretwear.timedomain.steady.classify_sequence`, coded in wear
@@ -135,8 +137,6 @@ def time_averaged_rate(model: Model, frequency: float, basis: FourierBasis, coef
     steps_per_period : time steps per period (default: :func:`default_steps`).
     classify_tol : relative periodicity tolerance of the response classification.
     """
-    from fretwear.timedomain.integrate import integrate
-    from fretwear.timedomain.steady import classify_sequence, fourier_coefficients
 
     t0 = time.perf_counter()
     hmax = max(basis.harmonics) if basis.harmonics else 1

@@ -22,8 +22,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import PeriodicSolution, initial_state
 from fretwear.model.core import Model
+from fretwear.timedomain.steady import steady_state, steady_state_at_omega
 
 VERDICTS = ("stable", "settles elsewhere", "drifting", "quasi-periodic", "irregular",
             "undecided")
@@ -82,7 +84,6 @@ def check_periodic(model: Model, sol: PeriodicSolution, *, max_periods: int = 30
     line), ``flags()`` for a sweep point. The integration runs at the solution's own circular
     frequency ``sol.omega`` [rad/s] (``sol.frequency`` [Hz]).
     """
-    from fretwear.timedomain.steady import steady_state_at_omega
 
     t0 = time.perf_counter()
     if sol.quasi_static or sol.omega <= 0:
@@ -100,7 +101,6 @@ def check_periodic(model: Model, sol: PeriodicSolution, *, max_periods: int = 30
     # distance between the settled period and the periodic solution, on the observed points
     dist = 0.0
     tau = 2 * np.pi * np.arange(nsteps) / nsteps
-    from fretwear.hb.fourier import FourierBasis
 
     bt = FourierBasis.up_to(max(sol.basis.harmonics), nsteps)
     for name, c_hb in sol.observed.items():
@@ -165,7 +165,6 @@ def time_domain_start(model: Model, frequency: float, basis,
 
     Returns ``(message, U0 (nc, d, H) or None, anchor (nc, d-1) or None)``.
     """
-    from fretwear.timedomain.steady import steady_state
 
     U0 = V0 = None
     wear = None
