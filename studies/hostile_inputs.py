@@ -19,7 +19,7 @@ import tempfile
 from collections import Counter
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "helpers"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 from helpers import hostile  # noqa: E402
 from hypothesis import HealthCheck, given, settings  # noqa: E402
