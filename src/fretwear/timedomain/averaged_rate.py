@@ -120,6 +120,15 @@ def window_samples(u_loc, lam, state):
     return x, f, s
 
 
+def _sum_in_time(a: np.ndarray) -> np.ndarray:
+    """Row sums of ``a`` (nc, ns) accumulated in time order, one step after the other: the
+    same additions in the same order whatever the memory layout of ``a`` (numpy's ``sum``
+    pairs terms differently for contiguous and strided rows, which moves the last bits)."""
+    if a.shape[1] == 0:
+        return np.zeros(a.shape[0])
+    return np.cumsum(a, axis=1)[:, -1]
+
+
 def time_averaged_rate(model: Model, frequency: float, basis: FourierBasis, coef, wear, *, U0, V0,
                        settle: int = 300, average: int = 500,
                        steps_per_period: int | None = None,
@@ -151,11 +160,11 @@ def time_averaged_rate(model: Model, frequency: float, basis: FourierBasis, coef
     # slip; column 0 is marked stick
     inc, work = slip_work_samples(np.ascontiguousarray(f[:, 0, :]), np.ascontiguousarray(x),
                                   np.ascontiguousarray(s))
-    S = work.sum(axis=1) / cycles
+    S = _sum_in_time(work) / cycles
     area = np.asarray(model.contact.area, float)
     c_area = area * np.asarray(coef, float)  # worn volume per unit slip work
     mid = ns // 2  # columns 1..mid-1 and mid..ns-1: the steps of each half of the window
-    v = [float(c_area @ work[:, cols].sum(axis=1)) * nsteps / n
+    v = [float(c_area @ _sum_in_time(work[:, cols])) * nsteps / n
          for cols, n in ((slice(1, mid), mid - 1), (slice(mid, ns), ns - mid))]
     scatter = abs(v[0] - v[1]) / (v[0] + v[1]) if v[0] + v[1] > 0 else 0.0
     p = f[:, 0, :] / area[:, None]
