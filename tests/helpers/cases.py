@@ -52,9 +52,22 @@ def doc_rows(section: str | None = None) -> dict[str, tuple[str, str]]:
     return rows
 
 
+def section_dimensions(section: str) -> set[str]:
+    """The names in backquotes of the ``Dimensions:`` paragraph of a section of
+    docs/results.md (label coordinates described in prose, e.g. the wear ``contact_state``)."""
+    text = (ROOT / "docs" / "results.md").read_text()
+    part = text.split(f"## `{section}`", 1)[1].split("\n## ", 1)[0]
+    para = part.split("Dimensions:", 1)[1].split("\n\n", 1)[0] if "Dimensions:" in part else ""
+    return set(re.findall(r"`(\w+)`", para))
+
+
 def check_documented(ds, section: str) -> None:
     docs = doc_rows(section)
+    prose = section_dimensions(section)
     for name, var in list(ds.coords.items()) + list(ds.data_vars.items()):
+        if name in ds.dims and name in prose and name not in docs:
+            assert var.attrs["units"] == "1" and var.attrs["long_name"], name
+            continue  # a label coordinate described in the section's Dimensions paragraph
         assert name in docs, f"{name} is not documented in docs/results.md ({section})"
         assert var.attrs["units"] == docs[name][1], name
         assert var.attrs["long_name"], name

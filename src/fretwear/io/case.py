@@ -166,8 +166,9 @@ MATERIAL = Table(
 )
 DAMPING = Table(
     {
-        "loss_factor": Field(_NON_NEG, "hysteretic loss factor eta: D = eta K on harmonics "
-                             "n >= 1 (no static part)", default=0.0, unit="-"),
+        "loss_factor": Field(Number(lo=0, hi=10), "hysteretic loss factor eta: D = eta K on "
+                             "harmonics n >= 1 (no static part; real materials stay below 2)",
+                             default=0.0, unit="-"),
         "rayleigh_mass": Field(_NON_NEG, "viscous Rayleigh coefficient a in C = a M + b K",
                                default=0.0, unit="1/s"),
         "rayleigh_stiffness": Field(_NON_NEG, "viscous Rayleigh coefficient b in C = a M + b K",

@@ -107,6 +107,9 @@ class Damping:
 
     def __post_init__(self):
         self.loss_factor = _finite(self.loss_factor, "damping loss_factor", minimum=0.0)
+        if self.loss_factor > 10.0:  # the same bound as the case files (io.case.DAMPING)
+            raise InputError(f"damping loss_factor = {self.loss_factor:g}; expected a value in "
+                             "[0, 10] (real materials stay below 2)")
         self.rayleigh_mass = _finite(self.rayleigh_mass, "damping rayleigh_mass", minimum=0.0)
         self.rayleigh_stiffness = _finite(self.rayleigh_stiffness,
                                           "damping rayleigh_stiffness", minimum=0.0)
