@@ -313,11 +313,17 @@ def check_inputs(model, basis, frequency, *, quasi_static: bool = False, anchor=
         if a.dtype.kind not in "fiu" or a.shape not in shapes or not np.all(np.isfinite(a)):
             raise InputError(f"{name} has shape {a.shape} (dtype {a.dtype}): expected finite "
                              f"real values of shape {' or '.join(map(str, shapes))}")
-    F = np.abs(model.load_harmonics(max(LOAD_CHECK_HARMONICS, max(basis.harmonics))))
-    if not np.all(np.isfinite(F)):
-        raise InputError("the loads hold non-finite values (nan or inf)")
-    periodic = F[1:].max(axis=1)
-    acting = [n for n in range(1, F.shape[0]) if periodic[n - 1] > 0]
+    nmax = max(LOAD_CHECK_HARMONICS, max(basis.harmonics))
+    acting = set()
+    for load in model.loads:  # the waveforms' coefficients: no (harmonics x DOFs) array
+        a, b = load.fourier_coefficients(nmax)
+        vec = np.asarray(load.vector)
+        if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))
+                and np.all(np.isfinite(vec))):
+            raise InputError(f"load {load.name!r} holds non-finite values (nan or inf)")
+        if np.any(vec != 0):
+            acting |= {n for n in range(1, nmax + 1) if a[n] != 0 or b[n] != 0}
+    acting = sorted(acting)
     if acting and not set(acting) & set(basis.harmonics):
         raise InputError(f"the periodic loads act on harmonics {acting[:8]} but the basis "
                          f"keeps {list(basis.harmonics)}: the response would be static; keep "
