@@ -169,9 +169,11 @@ DAMPING = Table(
         "loss_factor": Field(Number(lo=0, hi=10), "hysteretic loss factor eta: D = eta K on "
                              "harmonics n >= 1 (no static part; real materials stay below 2)",
                              default=0.0, unit="-"),
-        "rayleigh_mass": Field(_NON_NEG, "viscous Rayleigh coefficient a in C = a M + b K",
+        "rayleigh_mass": Field(Number(lo=0, hi=1e9), "viscous Rayleigh coefficient a in "
+                               "C = a M + b K (up to 1e9: beyond, the damping swamps everything)",
                                default=0.0, unit="1/s"),
-        "rayleigh_stiffness": Field(_NON_NEG, "viscous Rayleigh coefficient b in C = a M + b K",
+        "rayleigh_stiffness": Field(Number(lo=0, hi=1.0), "viscous Rayleigh coefficient b in "
+                                    "C = a M + b K (up to 1 s: real structures are below 1e-3)",
                                     default=0.0, unit="s"),
     },
     doc="Structural damping (optional; all zero by default). For a `matrices` model the "
@@ -184,9 +186,10 @@ SPRING = Table(
                     required=True, unit="m"),
         "direction": Field(AnyOf((Text(AXES), Vector())), '"x", "y", "z" or a vector',
                            required=True),
-        "stiffness": Field(Number(lo=0, lo_open=True, allow_inf=True),
+        "stiffness": Field(Number(lo=0, lo_open=True, hi=1e20, allow_inf=True),
                            "total stiffness to the ground, shared equally by the nodes of `at`; "
-                           "inf holds them (Dirichlet; axis directions only)",
+                           "inf holds them (Dirichlet; axis directions only); finite values up "
+                           "to 1e20 (beyond, use inf: the matrices would lose all precision)",
                            required=True, unit="N/m"),
     },
     checks=(non_zero("direction"),),

@@ -156,7 +156,8 @@ class Number(Spec):
             fail(path, value, self.expected())
         if self.lo is not None and (value < self.lo or (self.lo_open and value == self.lo)):
             fail(path, value, self.expected())
-        if self.hi is not None and (value > self.hi or (self.hi_open and value == self.hi)):
+        if self.hi is not None and not (self.allow_inf and value == math.inf) and (
+                value > self.hi or (self.hi_open and value == self.hi)):
             fail(path, value, self.expected())
         return value
 
