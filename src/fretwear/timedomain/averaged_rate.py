@@ -184,7 +184,7 @@ def time_averaged_rate(model: Model, frequency: float, basis: FourierBasis, coef
     return TimeAveragedRate(
         g=np.asarray(coef, float) * S, slip_work=S, pressure_mean=p[:, 1:].mean(axis=1),
         pressure_max=p.max(axis=1), slip_amplitude=np.sqrt((half**2).sum(axis=1)),
-        slip_path=inc.sum(axis=1) / cycles,
+        slip_path=_sum_in_time(inc) / cycles,
         state_fraction=np.stack([(s[:, 1:] == k).mean(axis=1) for k in range(3)], axis=1),
         friction_energy=law.friction_work(f, x, s) / cycles, U=U, lam=lam_h,
         anchor=U[:, 1:, 0].copy(), kind=c.kind, rotation=float(c.rotation), order=int(c.order),
