@@ -64,7 +64,8 @@ def _symmetric(A: sp.csr_matrix, what: str) -> sp.csr_matrix:
     return S
 
 
-DENSE_INERTIA_LIMIT = 2000  # matrices up to this size get their eigenvalues densely
+DENSE_INERTIA_LIMIT = 400  # up to this size, dense eigenvalues; above, the sparse LDL^T pivots
+# (every from_matrices call checks K, M, C and D: a dense eigvalsh of 2000 DOFs costs seconds)
 
 
 def _most_negative_eigenvalue(S: sp.csr_matrix) -> float:
