@@ -27,8 +27,9 @@ def sweep(model, basis, f_min: float, f_max: float, n_points: int, *, time_domai
 
     :func:`fretwear.hb.sweep.sweep` (every other keyword: ``spacing``, ``gap`` [m], ``eps``
     [N/m or "static"/"auto"], ``solver``, ``tol``, ``max_iter``, ``continuation``, ``check``,
-    ``time_domain_periods``, ...) with the time-domain fallback at points whose balance fails
-    (``time_domain=True``, as the case-file key ``time_domain`` of a sweep).
+    ``time_domain_periods``, ``checkpoint``, ``resume``, ...) with the time-domain fallback at
+    points whose balance fails (``time_domain=True``, as the case-file key ``time_domain`` of a
+    sweep).
 
     Returns
     -------

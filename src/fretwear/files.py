@@ -13,8 +13,13 @@ import re
 import stat
 import tempfile
 import time
+import zipfile
 from collections.abc import Callable
 from pathlib import Path
+
+import numpy as np
+
+from fretwear.errors import InputError
 
 #: the temporary files of :func:`atomic_write`: ``.<name>.<random>.tmp`` beside the target
 #: (``tempfile.mkstemp`` draws ``<random>`` from lowercase letters, digits and ``_``)
@@ -127,3 +132,52 @@ def inside(folder: Path | str, path: Path | str) -> Path:
     if folder != path and folder not in path.parents:
         raise ValueError(f"{path} is outside the output folder {folder}")
     return path
+
+
+def check_state_file(path: Path | str, what: str) -> None:
+    """Refuse a state file path (``what``, e.g. ``"wear checkpoint"``) that is a folder or
+    another non-file: it could be neither read nor written, and the run would fail at its
+    first save."""
+    path = Path(path)
+    if path.exists() and not path.is_file():
+        kind = "a folder, not a file" if path.is_dir() else "not a regular file"
+        raise InputError(f"the {what} {str(path)!r} is {kind}: move or delete it (the run writes "
+                         f"its {what.split()[-1]} there)")
+
+
+def damaged(path: Path | str, what: str, why: str) -> InputError:
+    """The one error of a state file (``what``) that cannot be used: it names the file, says
+    why and what to do."""
+    return InputError(f"the {what} {str(path)!r} is damaged ({why}); delete it to start the run "
+                      "over (a run without --resume also starts over and replaces it)")
+
+
+def read_archive(path: Path | str, what: str) -> dict:
+    """Every array of a ``.npz`` state file (``what``, e.g. ``"wear checkpoint"``), read whole
+    so that every member's CRC is checked, with no pickled objects.
+
+    Raises
+    ------
+    InputError
+        One message naming the file: missing, a folder, unreadable, or damaged (truncated,
+        empty, altered, another kind of file: :func:`damaged`).
+    """
+    path = Path(path)
+    check_state_file(path, what)
+    if not path.is_file():
+        raise InputError(f"{what} {str(path)!r} does not exist")
+    try:
+        with open(path, "rb") as fh:
+            complete = zipfile.is_zipfile(fh)  # its end record is there
+    except OSError as exc:  # e.g. no permission: not damaged
+        raise InputError(f"cannot read the {what} {str(path)!r}: {exc.strerror}") from None
+    if not complete:
+        raise damaged(path, what, "not a complete .npz archive: truncated, empty or another kind "
+                      "of file")
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            return {k: z[k] for k in z.files}  # reads every member: checks every CRC
+    except Exception as exc:  # zip, npy header, EOF, CRC, memory errors: all say "damaged"
+        text = " ".join(str(exc).split())
+        raise damaged(path, what, f"{type(exc).__name__}: {text}" if text
+                      else type(exc).__name__) from None

@@ -39,6 +39,9 @@ from fretwear.io.schema import Field, Flag, Integer, ListOf, Number, Text, incre
 from fretwear.timedomain.fallback import FALLBACK
 from fretwear.timedomain.stability import sweep_check
 
+#: the points computed so far, saved after every grid frequency (``--resume`` continues)
+CHECKPOINT_FILE = "sweep-checkpoint.npz"
+
 
 # --- dataset -------------------------------------------------------------------------------
 def _per_point(result: SweepResult, value, fill=np.nan, dtype=float) -> np.ndarray:
@@ -137,6 +140,8 @@ def sweep_dataset(model, result: SweepResult, basis: FourierBasis, points: list[
 # --- run -----------------------------------------------------------------------------------
 def _sweep_summary(result: SweepResult, ds: xr.Dataset) -> str:
     lines = [result.summary()]
+    if result.resumed_from > 0:
+        lines[0] += f" (resumed after {result.resumed_from} grid frequencies)"
     h = int(ds["harmonic"].values[0])
     amp = ds["response_amplitude"].sel(harmonic=h)
     f = ds["frequency"].values
@@ -181,7 +186,8 @@ def run_sweep(model, analysis: dict, case, outdir: Path, progress: bool) -> RunO
                        time_domain_periods=analysis["time_domain_periods"],
                        check=(sweep_check(model, max_periods=analysis["time_domain_periods"])
                               if analysis["check_stability"] else None),
-                       progress=tick)
+                       progress=tick, checkpoint=outdir / CHECKPOINT_FILE,
+                       resume=bool(case.resume))
     ds = sweep_dataset(model, result, basis, points, analysis["linear_references"])
     flagged = [f"{p.frequency_hz:.6g} Hz: " + "; ".join(p.flags)
                for p in result.points if p.flags]
@@ -318,9 +324,12 @@ register(
     },
     run_sweep,
     checks=(increasing("f_min", "f_max", "Hz"), check_sampling),
+    files=(CHECKPOINT_FILE,),
     doc="Nonlinear FRF: periodic responses with the frictional interface over a frequency "
     "band, each point starting from its neighbours (continuation). Points that do not "
     "converge are kept as NaN with `converged = 0` and the reason in `flags`; the run then "
-    "exits with status 1. Writes `sweep-<point>.png` (amplitude against frequency, with the "
+    "exits with status 1. The points computed so far are saved in `sweep-checkpoint.npz` after "
+    "every grid frequency: `fretwear run CASE.toml --resume` continues a killed sweep to the "
+    "same result. Writes `sweep-<point>.png` (amplitude against frequency, with the "
     "linear references) and `sweep-interface.png` (friction energy and contact states).",
 )

@@ -18,10 +18,12 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
 from fretwear.errors import InputError
+from fretwear.files import check_state_file
 from fretwear.hb.fallback import TimeDomainFallback
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.penalty import check_rule, penalty
@@ -34,6 +36,12 @@ from fretwear.hb.periodic import (
 )
 from fretwear.hb.reduce import _condense
 from fretwear.hb.solvers import SolveStats, solve
+from fretwear.hb.sweep_checkpoint import (
+    WHAT,
+    fingerprint,
+    load_sweep_checkpoint,
+    save_sweep_checkpoint,
+)
 from fretwear.limits import check_range
 from fretwear.model.core import Model
 from fretwear.resources import require_memory
@@ -76,11 +84,13 @@ class SweepResult:
     """The points of a sweep, in the order computed (increasing frequency).
 
     ``success`` is True when every point converged; ``message`` counts the converged and
-    failed grid frequencies; ``point_success`` is the per-point array.
+    failed grid frequencies; ``point_success`` is the per-point array; ``resumed_from`` is the
+    number of grid frequencies read from a checkpoint (-1: none was read).
     """
 
     points: list
     wall_time: float = 0.0
+    resumed_from: int = -1
 
     @property
     def frequency_hz(self) -> np.ndarray:
@@ -183,6 +193,23 @@ class _Problems:
                            anchor=anchor)
 
 
+def rebuild_point(model: Model, basis: FourierBasis, gap, entry: dict) -> SweepPoint:
+    """A sweep point from a checkpoint entry
+    (:func:`fretwear.hb.sweep_checkpoint.load_sweep_checkpoint`): its solution re-assembled
+    from its harmonics, anchors and penalty by the code that assembled it first, so it equals
+    the original bit for bit."""
+    rec = entry["record"]
+    stats = SolveStats(**rec["stats"])
+    sol = None
+    if "U" in entry:
+        orders = np.array([0, *basis.harmonics])
+        prob = DLFTProblem(_condense(model, entry["omega"], orders), model.contact, basis,
+                           gap=gap, eps=entry["eps"], anchor=entry["anchor"])
+        sol = assemble_solution(prob, np.array(entry["U"], float), model, stats)
+    return SweepPoint(rec["frequency_hz"], sol, stats, rec["how"], list(rec["flags"]),
+                      bool(rec["on_grid"]), rec["time_domain"])
+
+
 def _solve_at(probs, omega, anchor, U0, solver, tol, max_iter):
     prob = probs.get(omega, anchor)
     x0 = prob.initial_guess() if U0 is None else np.asarray(U0, float).reshape(prob.m, prob.H)
@@ -274,7 +301,8 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
           tol: float = 1e-8, max_iter: int = 40, continuation: bool = True,
           max_bisections: int = 4, check=None,
           time_domain: TimeDomainFallback | None = None,
-          time_domain_periods: int = 3000, progress=None) -> SweepResult:
+          time_domain_periods: int = 3000, progress=None, checkpoint=None,
+          resume: bool = False) -> SweepResult:
     """Nonlinear FRF: periodic solutions from ``f_min`` to ``f_max`` [Hz].
 
     Parameters
@@ -308,6 +336,12 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
         quasi-periodic...).
     time_domain_periods : periods allowed to the time integration.
     progress : optional callable ``(i, n, point)`` called after each grid point.
+    checkpoint : path of a ``.npz`` file where the points computed so far are saved after
+        every grid frequency (:mod:`fretwear.hb.sweep_checkpoint`); ``None``: no checkpoint.
+    resume : continue from ``checkpoint`` when it exists (it must have been written by the
+        same sweep: same model, grid and settings); the result equals the uninterrupted
+        sweep's bit for bit. A damaged or foreign checkpoint is an
+        :class:`~fretwear.errors.InputError`, never silently replaced.
 
     Returns
     -------
@@ -327,6 +361,25 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
     history: list = []  # converged (omega, U (m, H)) in order
     last_solution: list = [None]
     points: list = []
+    shape = (model.contact.n_nodes, model.contact.dim, basis.size)
+    key = None
+    first = 0
+    if checkpoint is not None:
+        check_state_file(checkpoint, WHAT)
+        settings = {"eps": probs.eps, "gap": gap, "anchor": anchor, "solver": solver,
+                    "tol": tol, "max_iter": max_iter, "continuation": continuation,
+                    "max_bisections": max_bisections, "check": check is not None,
+                    "time_domain": time_domain is not None,
+                    "time_domain_periods": time_domain_periods}
+        key = fingerprint(model, basis, grid, settings)
+        if resume and Path(checkpoint).exists():
+            first, entries = load_sweep_checkpoint(checkpoint, key, shape)
+            for e in entries:
+                pt = rebuild_point(model, basis, gap, e)
+                points.append(pt)
+                if pt.solution is not None:
+                    history.append((e["omega"], e["U"]))
+                    last_solution[0] = pt.solution
     other = {"powell": "newton", "newton": "powell", "hybr": "powell"}[solver]
 
     def record(omega, prob, U, st, how, flags=()):
@@ -355,6 +408,8 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
         return U[:, 1:, 0].copy()
 
     for i, f in enumerate(grid):
+        if i < first:
+            continue
         omega = 2 * np.pi * f
         prob, U, st = _solve_at(probs, omega, current_anchor(), predict(omega), solver, tol,
                                 max_iter)
@@ -428,7 +483,10 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
                 pt.flags.append(td_msg)
                 pt.time_domain = td_msg
         points.append(pt)
+        if key is not None:
+            save_sweep_checkpoint(checkpoint, key, i + 1, points, shape)
         if progress is not None:
             progress(i, len(grid), pt)
     points.sort(key=lambda p: p.frequency_hz)
-    return SweepResult(points, time.perf_counter() - t_start)
+    return SweepResult(points, time.perf_counter() - t_start,
+                       first if key is not None and resume and first else -1)

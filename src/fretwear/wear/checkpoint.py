@@ -15,13 +15,12 @@ from __future__ import annotations
 
 import hashlib
 import json
-import zipfile
 from pathlib import Path
 
 import numpy as np
 
 from fretwear.errors import InputError
-from fretwear.files import atomic_write
+from fretwear.files import atomic_write, check_state_file, damaged, read_archive
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.reduce import Reduced
 from fretwear.model.core import Model
@@ -80,21 +79,18 @@ HISTORY_SHAPES = {
 _TEXT = ("fingerprint", "state_stop_reason")
 
 
+WHAT = "wear checkpoint"
+
+
 def _damaged(path: Path | str, why: str) -> InputError:
-    """The one error of a checkpoint that cannot be used: it names the file, says why and
-    what to do."""
-    return InputError(f"the wear checkpoint {str(path)!r} is damaged ({why}); delete it to start "
-                      "the run over (a run without --resume also starts over and replaces it)")
+    """The one error of a checkpoint that cannot be used (:func:`fretwear.files.damaged`)."""
+    return damaged(path, WHAT, why)
 
 
 def check_checkpoint_path(path: Path | str) -> None:
     """Refuse a checkpoint path that is a folder (or other non-file): it could be neither
     read nor written, and the run would fail at its first save."""
-    path = Path(path)
-    if path.exists() and not path.is_file():
-        what = "a folder, not a file" if path.is_dir() else "not a regular file"
-        raise InputError(f"the wear checkpoint {str(path)!r} is {what}: move or delete it (the "
-                         "run writes its checkpoint there)")
+    check_state_file(path, WHAT)
 
 
 def _read_checkpoint(path: Path | str) -> dict:
@@ -106,23 +102,7 @@ def _read_checkpoint(path: Path | str) -> dict:
     InputError
         One message naming the file, whatever is wrong with it (:func:`_damaged`).
     """
-    path = Path(path)
-    check_checkpoint_path(path)
-    if not path.is_file():
-        raise InputError(f"wear checkpoint {str(path)!r} does not exist")
-    try:
-        with open(path, "rb") as fh:
-            complete = zipfile.is_zipfile(fh)  # its end record is there
-    except OSError as exc:  # e.g. no permission: not damaged
-        raise InputError(f"cannot read the wear checkpoint {str(path)!r}: {exc.strerror}") from None
-    if not complete:
-        raise _damaged(path, "not a complete .npz archive: truncated, empty or another kind of "
-                       "file")
-    try:
-        with np.load(path, allow_pickle=False) as z:
-            data = {k: z[k] for k in z.files}  # reads every member: checks every CRC
-    except Exception as exc:  # zip, npy header, EOF, CRC, memory errors: all say "damaged"
-        raise _damaged(path, _why(exc)) from None
+    data = read_archive(path, WHAT)
     version = data.get("version")
     if version is None or version.shape != () or version.dtype.kind not in "iu":
         raise _damaged(path, "no format version")
@@ -133,11 +113,6 @@ def _read_checkpoint(path: Path | str) -> dict:
     if why:
         raise _damaged(path, why)
     return data
-
-
-def _why(exc: Exception) -> str:
-    text = " ".join(str(exc).split())
-    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
 
 
 def _dims(data: dict) -> dict:
