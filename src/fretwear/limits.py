@@ -23,6 +23,23 @@ RANGES = {
     "frequency": (0.0, 1e10, "Hz", "up to 10 GHz"),
 }
 
+#: the highest hysteretic loss factor eta accepted (``D = eta K``): real materials and joints stay
+#: below 2; 10 leaves room for a deliberately over-damped model
+LOSS_FACTOR_MAX = 10.0
+
+
+def check_loss_factor(value, what: str = "loss_factor") -> float:
+    """The loss factor ``value`` as a float, after checking it is a number in
+    ``[0, LOSS_FACTOR_MAX]``."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError, OverflowError):
+        raise InputError(f"{what} = {value!r} is not a number") from None
+    if not 0.0 <= v <= LOSS_FACTOR_MAX:  # (NaN fails too)
+        raise InputError(f"{what} = {value!r}; expected a value in [0, {LOSS_FACTOR_MAX:g}] "
+                         "(real materials stay below 2)")
+    return v
+
 
 def check_range(value: float, kind: str, what: str) -> float:
     """``value`` as a float, after checking it is finite and within ``RANGES[kind]``."""

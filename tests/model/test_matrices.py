@@ -131,6 +131,9 @@ def test_other_bad_inputs():
         build(contact_tangential_dofs=[[0, 2, 2]])
     with pytest.raises(InputError, match="either D or loss_factor"):
         build(D=np.eye(3), loss_factor=0.1)
+    for eta in (1e300, -0.1, float("nan")):  # the bound of case files and Damping: [0, 10]
+        with pytest.raises(InputError, match=r"loss_factor = .*; expected a value in \[0, 10\]"):
+            build(loss_factor=eta)
     with pytest.raises(InputError, match="normal_sign"):
         build(normal_sign=2)
     with pytest.raises(InputError, match="area: 0; expected values > 0"):

@@ -49,6 +49,7 @@ from fretwear.io.schema import (
     suggest,
     table_label,
 )
+from fretwear.limits import LOSS_FACTOR_MAX
 from fretwear.model.core import WAVEFORMS
 
 AXES = ("x", "y", "z")
@@ -166,8 +167,9 @@ MATERIAL = Table(
 )
 DAMPING = Table(
     {
-        "loss_factor": Field(Number(lo=0, hi=10), "hysteretic loss factor eta: D = eta K on "
-                             "harmonics n >= 1 (no static part; real materials stay below 2)",
+        "loss_factor": Field(Number(lo=0, hi=LOSS_FACTOR_MAX), "hysteretic loss factor eta: "
+                             "D = eta K on harmonics n >= 1 (no static part; real materials "
+                             "stay below 2)",
                              default=0.0, unit="-"),
         "rayleigh_mass": Field(Number(lo=0, hi=1e9), "viscous Rayleigh coefficient a in "
                                "C = a M + b K (up to 1e9: beyond, the damping swamps everything)",

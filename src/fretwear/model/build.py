@@ -26,6 +26,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from fretwear.errors import InputError
+from fretwear.limits import check_loss_factor
 from fretwear.model.core import WAVEFORMS, ContactInterface, Load, Mesh, Model, ObservedPoint
 from fretwear.model.fem import assemble, check_material, check_thickness
 from fretwear.model.loads import boundary_load, nodal_areas
@@ -106,10 +107,7 @@ class Damping:
     rayleigh_stiffness: float = 0.0
 
     def __post_init__(self):
-        self.loss_factor = _finite(self.loss_factor, "damping loss_factor", minimum=0.0)
-        if self.loss_factor > 10.0:  # the same bound as the case files (io.case.DAMPING)
-            raise InputError(f"damping loss_factor = {self.loss_factor:g}; expected a value in "
-                             "[0, 10] (real materials stay below 2)")
+        self.loss_factor = check_loss_factor(self.loss_factor, "damping loss_factor")
         self.rayleigh_mass = _finite(self.rayleigh_mass, "damping rayleigh_mass", minimum=0.0)
         self.rayleigh_stiffness = _finite(self.rayleigh_stiffness,
                                           "damping rayleigh_stiffness", minimum=0.0)

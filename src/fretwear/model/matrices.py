@@ -15,6 +15,7 @@ import scipy.io
 import scipy.sparse as sp
 
 from fretwear.errors import InputError
+from fretwear.limits import check_loss_factor
 from fretwear.model.build import rigid_motion_check
 from fretwear.model.core import WAVEFORMS, ContactInterface, Load, Model, ObservedPoint
 from fretwear.resources import require_memory
@@ -278,7 +279,7 @@ def from_matrices(K, M, *, contact_normal_dofs, contact_tangential_dofs, gap=0.0
     if D is not None:
         D = _matrix(D, "D", n)
         check_semidefinite(D, "D")
-    elif loss_factor is not None and _nonnegative(loss_factor, "loss_factor") > 0.0:
+    elif loss_factor is not None and check_loss_factor(loss_factor) > 0.0:
         D = (float(loss_factor) * K).tocsr()
 
     model = Model(
