@@ -217,6 +217,247 @@ def _gauss_solve(a, rhs, n):
 
 
 @njit(cache=True, fastmath=_FAST)
+def _cone_residual(A, x, lam, gap, xprev, mu, rn, rt, F, st):
+    """Alart-Curnier residual of the 3D contact problem at ``x`` (``lam`` the matching forces).
+
+    Per node, with ``sN = lam_N + rn (x_N - g)`` and ``sT = lam_T + rt xi``
+    (``xi = x_T - xprev_T``): open (``sN <= 0``) ``F = lam``; else ``F_N = -rn (x_N - g)`` and
+    stick (``|sT| <= mu sN``) ``F_T = -rt xi`` or slip ``F_T = lam_T - mu sN sT / |sT|``. The
+    roots of ``F`` are exactly the solutions of Signorini and incremental Coulomb on the
+    isotropic cone, whatever ``rn, rt > 0``. ``st`` receives the statuses. Returns
+    ``(0.5 |F|^2, max |F|)``.
+    """
+    nc = gap.shape[0]
+    phi = 0.0
+    fmax = 0.0
+    for i in range(nc):
+        i0 = 3 * i
+        sn = lam[i0] + rn[i] * (x[i0] - gap[i])
+        s1 = lam[i0 + 1] + rt[i] * (x[i0 + 1] - xprev[i0 + 1])
+        s2 = lam[i0 + 2] + rt[i] * (x[i0 + 2] - xprev[i0 + 2])
+        if sn <= 0.0:
+            st[i] = OPEN
+            F[i0] = lam[i0]
+            F[i0 + 1] = lam[i0 + 1]
+            F[i0 + 2] = lam[i0 + 2]
+        else:
+            F[i0] = -rn[i] * (x[i0] - gap[i])
+            ns = np.sqrt(s1 * s1 + s2 * s2)
+            rad = mu * sn
+            if ns <= rad:
+                st[i] = STICK
+                F[i0 + 1] = -rt[i] * (x[i0 + 1] - xprev[i0 + 1])
+                F[i0 + 2] = -rt[i] * (x[i0 + 2] - xprev[i0 + 2])
+            else:
+                st[i] = SLIP
+                F[i0 + 1] = lam[i0 + 1] - rad * s1 / ns
+                F[i0 + 2] = lam[i0 + 2] - rad * s2 / ns
+        for c in range(3):
+            v = F[i0 + c]
+            phi += 0.5 * v * v
+            if abs(v) > fmax:
+                fmax = abs(v)
+    return phi, fmax
+
+
+@njit(cache=True, fastmath=_FAST)
+def _solve_contact_cone(A, b, xref, gap, xprev, mu, status, tdir, x, lam, tol, fscale, maxit,
+                        cols, J, rhs):
+    """The 3D contact problem on the exact isotropic Coulomb cone (see :func:`solve_contact`).
+
+    Semismooth Newton method on the Alart-Curnier equations (:func:`_cone_residual`, with
+    ``rn, rt`` the diagonal of ``A``: stiffness-scaled augmentation, no regularisation),
+    globalised by a backtracking (Armijo) line search on ``0.5 |F|^2``. The rows of closed
+    normals and sticking tangents are ``x_c = target``: their Newton increments are known and
+    only the other components (open nodes, slipping tangents) are solved for. Converged when
+    ``max |F| <= tol * max(fscale, max |lam|)``; the prescribed components are then set
+    exactly (a sticking node does not move by one rounding unit) and the test repeated with
+    the forces recomputed in full.
+    """
+    nc = gap.shape[0]
+    m = 3 * nc
+    rn = np.empty(nc)
+    rt = np.empty(nc)
+    dmax = 0.0
+    for i in range(nc):
+        rn[i] = A[3 * i, 3 * i]
+        rt[i] = 0.5 * (A[3 * i + 1, 3 * i + 1] + A[3 * i + 2, 3 * i + 2])
+        if rn[i] > dmax:
+            dmax = rn[i]
+    if dmax <= 0.0:
+        dmax = 1.0
+    for i in range(nc):
+        if not rn[i] > 0.0:
+            rn[i] = dmax
+        if not rt[i] > 0.0:
+            rt[i] = dmax
+    # start from the warm-start statuses: closed normals at the gap, sticking and slipping
+    # tangents where they were, open nodes at their free position
+    for i in range(nc):
+        i0 = 3 * i
+        if status[i] == OPEN:
+            for c in range(3):
+                x[i0 + c] = xref[i0 + c]
+        else:
+            x[i0] = gap[i]
+            x[i0 + 1] = xprev[i0 + 1]
+            x[i0 + 2] = xprev[i0 + 2]
+    for r in range(m):
+        s = b[r]
+        for c in range(m):
+            s -= A[r, c] * (x[c] - xref[c])
+        lam[r] = s
+    F = np.empty(m)
+    dx = np.empty(m)
+    adx = np.empty(m)
+    xt = np.empty(m)
+    lt = np.empty(m)
+    Ft = np.empty(m)
+    st = np.empty(nc, dtype=np.int8)
+    stt = np.empty(nc, dtype=np.int8)
+    phi, fmax = _cone_residual(A, x, lam, gap, xprev, mu, rn, rt, F, st)
+    it = 0
+    while it < maxit:
+        it += 1
+        fs = fscale
+        for r in range(m):
+            if abs(lam[r]) > fs:
+                fs = abs(lam[r])
+        if fs == 0.0:
+            for r in range(m):
+                v = dmax * max(abs(xref[r]), abs(x[r]))
+                if v > fs:
+                    fs = v
+            if fs == 0.0:
+                fs = 1e-300
+        eps_f = tol * fs
+        if fmax <= eps_f:
+            # set the prescribed components exactly, recompute the forces in full, retest
+            for i in range(nc):
+                i0 = 3 * i
+                if st[i] != OPEN:
+                    x[i0] = gap[i]
+                if st[i] == STICK:
+                    x[i0 + 1] = xprev[i0 + 1]
+                    x[i0 + 2] = xprev[i0 + 2]
+            for r in range(m):
+                s = b[r]
+                for c in range(m):
+                    s -= A[r, c] * (x[c] - xref[c])
+                lam[r] = s
+            phi, fmax = _cone_residual(A, x, lam, gap, xprev, mu, rn, rt, F, st)
+            if fmax <= eps_f:
+                for i in range(nc):
+                    status[i] = st[i]
+                    if st[i] == SLIP:
+                        i0 = 3 * i
+                        t1 = x[i0 + 1] - xprev[i0 + 1]
+                        t2 = x[i0 + 2] - xprev[i0 + 2]
+                        nt = np.sqrt(t1 * t1 + t2 * t2)
+                        if nt == 0.0:  # slipping by less than a rounding unit: the force
+                            t1 = lam[i0 + 1]
+                            t2 = lam[i0 + 2]
+                            nt = np.sqrt(t1 * t1 + t2 * t2)
+                        if nt > 0.0:
+                            tdir[i, 0] = t1 / nt
+                            tdir[i, 1] = t2 / nt
+                return it
+        # Newton step: increments of the prescribed components, then the free ones
+        nf = 0
+        for i in range(nc):
+            i0 = 3 * i
+            if st[i] == OPEN:
+                for c in range(3):
+                    cols[nf] = i0 + c
+                    nf += 1
+            else:
+                dx[i0] = gap[i] - x[i0]
+                if st[i] == STICK:
+                    dx[i0 + 1] = xprev[i0 + 1] - x[i0 + 1]
+                    dx[i0 + 2] = xprev[i0 + 2] - x[i0 + 2]
+                else:
+                    cols[nf] = i0 + 1
+                    cols[nf + 1] = i0 + 2
+                    nf += 2
+        for k in range(nf):
+            dx[cols[k]] = 0.0
+        for k in range(nf):
+            row = cols[k]
+            i = row // 3
+            i0 = 3 * i
+            # full row of the Jacobian into rhs-free storage: J[k, :] over the free columns,
+            # and the prescribed columns' contribution to the right-hand side
+            if st[i] == OPEN:
+                s = -F[row]
+                for c in range(m):
+                    s += A[row, c] * dx[c]  # dx is zero on the free columns
+                rhs[k] = s
+                for j in range(nf):
+                    J[k, j] = -A[row, cols[j]]
+            else:
+                a = row - i0 - 1  # 0 or 1
+                sn = lam[i0] + rn[i] * (x[i0] - gap[i])
+                s1 = lam[i0 + 1] + rt[i] * (x[i0 + 1] - xprev[i0 + 1])
+                s2 = lam[i0 + 2] + rt[i] * (x[i0 + 2] - xprev[i0 + 2])
+                ns = np.sqrt(s1 * s1 + s2 * s2)
+                n0 = s1 / ns
+                n1 = s2 / ns
+                na = n0 if a == 0 else n1
+                g = mu * sn / ns
+                # dF_Ta = dlam_Ta - mu n_a dsN - g sum_b (delta_ab - n_a n_b) dsT_b
+                # dsN = -A[N,:] dx + rn dx_N;  dsT_b = -A[T_b,:] dx + rt dx_Tb
+                p0 = g * ((1.0 if a == 0 else 0.0) - na * n0)
+                p1 = g * ((1.0 if a == 1 else 0.0) - na * n1)
+                s = -F[row]
+                for c in range(m):
+                    v = (-A[row, c] + mu * na * A[i0, c] + p0 * A[i0 + 1, c]
+                         + p1 * A[i0 + 2, c])
+                    if c == i0:
+                        v -= mu * na * rn[i]
+                    elif c == i0 + 1:
+                        v -= p0 * rt[i]
+                    elif c == i0 + 2:
+                        v -= p1 * rt[i]
+                    Ft[c] = v
+                    s -= v * dx[c]
+                rhs[k] = s
+                for j in range(nf):
+                    J[k, j] = Ft[cols[j]]
+        if nf > 0:
+            if not _gauss_solve(J, rhs, nf):
+                return -1
+            for k in range(nf):
+                dx[cols[k]] = rhs[k]
+        for r in range(m):
+            s = 0.0
+            for c in range(m):
+                s += A[r, c] * dx[c]
+            adx[r] = s
+        # backtracking line search on 0.5 |F|^2 (Armijo, sigma = 1e-4)
+        alpha = 1.0
+        accepted = False
+        for _ls in range(30):
+            for r in range(m):
+                xt[r] = x[r] + alpha * dx[r]
+                lt[r] = lam[r] - alpha * adx[r]
+            phit, fmt = _cone_residual(A, xt, lt, gap, xprev, mu, rn, rt, Ft, stt)
+            if phit <= (1.0 - 2e-4 * alpha) * phi:
+                accepted = True
+                break
+            alpha *= 0.5
+        if not accepted:
+            return -1
+        for r in range(m):
+            x[r] = xt[r]
+            lam[r] = lt[r]
+            F[r] = Ft[r]
+        for i in range(nc):
+            st[i] = stt[i]
+        phi, fmax = phit, fmt
+    return -1
+
+
+@njit(cache=True, fastmath=_FAST)
 def solve_contact(A, b, xref, gap, xprev, mu, d, status, tdir, x, lam, tol, fscale, maxit,
                   cols, rows_node, rows_comp, J, rhs):
     """Solve one frictional contact problem exactly (see module docstring).
@@ -239,6 +480,9 @@ def solve_contact(A, b, xref, gap, xprev, mu, d, status, tdir, x, lam, tol, fsca
     -------
     Number of iterations, or ``-1`` if the active set did not settle within ``maxit``.
     """
+    if d == 3:
+        return _solve_contact_cone(A, b, xref, gap, xprev, mu, status, tdir, x, lam, tol,
+                                   fscale, maxit, cols, J, rhs)
     nc = gap.shape[0]
     m = nc * d
     dmax = 0.0
