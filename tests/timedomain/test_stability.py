@@ -4,15 +4,19 @@ Compared with: an independent method, the exact time integration of fretwear.tim
 on
 a single friction oscillator whose steady state is known to be unique and attracting (viscous
 damping, continuous slip: Den Hartog's regime), so the check must answer "stable"; and the
-time-domain start must hand back harmonics that make the DLFT converge at once.
+time-domain start must hand back harmonics that make the DLFT converge at once; and on the
+16-node 3D pad (tests/helpers/pads.py), whose partial-slip periodic state the time integration
+reproduces (test_integrate.py), the check must answer "stable" when its step resolves the
+contact's dynamics and say that the step is too coarse when it does not.
 """
 
 import numpy as np
 from helpers.models import K_, M_, oscillator
+from helpers.pads import F_PAD, pad_3d
 
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import initial_state, solve_periodic
-from fretwear.timedomain.stability import check_periodic, time_domain_start
+from fretwear.timedomain.stability import RESOLVED_STEPS, check_periodic, time_domain_start
 
 F_HZ = 0.7 * np.sqrt(K_ / M_) / (2 * np.pi)  # forcing frequency [Hz], below the resonance
 
@@ -58,3 +62,24 @@ def test_time_domain_start_gives_a_converging_start():
     sol = solve_periodic(model, basis, frequency=F_HZ, U0=U0, anchor=anchor)
     st = sol.stats
     assert st.success and st.iterations <= 3
+
+
+def test_3d_pad_is_reported_stable_when_the_step_resolves_the_contact():
+    """The 16-node pad (partial slip) from its 6-harmonic DLFT solution: with 4096 steps per
+    period (3.4 per period of the reduced model's highest mode, 1.2 MHz) the time integration
+    settles back to it (measured distance 0.08 of the peak-to-peak: the 6-harmonic truncation
+    and the step; the default bound 0.2). With 1024 steps (0.88 per highest period) the
+    contact nodes' dynamics are not resolved, the pad settles at another stuck position
+    (distance 9.7: it slid by ~3 um during the start), and the message gives the step that
+    resolves them: more than 1024 x 3 (fewer than one step per highest period at 1024) and
+    fewer than 4096 (3.4 steps at 4096); measured 3489."""
+    model = pad_3d()
+    sol = solve_periodic(model, FourierBasis.up_to(6, 96), frequency=F_PAD, tol=1e-10)
+    assert sol.success
+    chk = check_periodic(model, sol, max_periods=200, steps_per_period=4096)
+    assert chk.verdict == "stable", chk
+    assert chk.distance < 0.15
+    coarse = check_periodic(model, sol, max_periods=200, steps_per_period=1024)
+    assert coarse.verdict != "stable"
+    need = int(coarse.message.rsplit(">= ", 1)[1])
+    assert 1024 * RESOLVED_STEPS < need < 4096
