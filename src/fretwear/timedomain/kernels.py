@@ -7,11 +7,14 @@ Three pieces, on plain arrays:
   contact forces [N], ``A`` a dense condensed stiffness [N/m]): Signorini
   ``x_N <= g, lam_N >= 0, lam_N (x_N - g) = 0`` and incremental Coulomb on the slip increment
   ``xi = x_T - xprev_T`` (stick ``xi = 0``, ``|lam_T| <= mu lam_N``; slip
-  ``lam_T = mu lam_N xi / |xi|``). Solved by a primal-dual active set / semismooth Newton
-  method: statuses (open, stick, slip) are guessed, the (small) system for the free components
-  is solved, statuses are corrected, until nothing changes. The unknowns are only the free
-  components (open nodes, tangential components of slipping nodes), so a step where most
-  nodes stick costs a few small solves. Warm-started from the previous step's statuses.
+  ``lam_T = mu lam_N xi / |xi|``, the isotropic cone in 3D). In 2D, a primal-dual active set
+  method: statuses (open, stick, slip) are guessed, the (small) system for the free
+  components is solved, statuses are corrected, until nothing changes. In 3D
+  (:func:`_solve_contact_cone`), a semismooth Newton method on the Alart-Curnier equations
+  with a backtracking line search (the active set cycled there: the slip direction is an
+  unknown). Both solve only for the free components (open nodes, tangential components of
+  slipping nodes), so a step where most nodes stick costs a few small solves, and both are
+  warm-started from the previous step's statuses.
 * :func:`run_dynamic` -- the fixed-step time loop of the dynamic solver (two-step form of the
   trapezoidal / Newmark rule with the contact problem solved at every step).
 * :func:`run_quasistatic` -- load steps through cycles with Archard wear applied as it goes
@@ -272,7 +275,13 @@ def _solve_contact_cone(A, b, xref, gap, xprev, mu, status, tdir, x, lam, tol, f
     only the other components (open nodes, slipping tangents) are solved for. Converged when
     ``max |F| <= tol * max(fscale, max |lam|)``; the prescribed components are then set
     exactly (a sticking node does not move by one rounding unit) and the test repeated with
-    the forces recomputed in full.
+    the forces recomputed in full. The state is then within ``tol * fscale`` (in force) of an
+    exact solution; the direction of a slip ``xi`` is fixed to about
+    ``tol * fscale / (rt |xi|)`` rad (docs/transient.md, section 2).
+
+    Returns the number of Newton iterations, or ``-1`` when ``maxit`` iterations did not
+    converge, a Newton system was singular or the line search found no decrease (a problem
+    without a solution, e.g. a structure that the contact does not hold).
     """
     nc = gap.shape[0]
     m = 3 * nc
@@ -473,12 +482,13 @@ def solve_contact(A, b, xref, gap, xprev, mu, d, status, tdir, x, lam, tol, fsca
     tdir : (nc, d-1), in/out: unit slip direction (2D: +1 or -1).
     x, lam : (m,) out: local displacements [m] and contact forces [N].
     tol : relative tolerance; fscale : force scale [N] (forces below ``tol*fscale`` are zero).
-    maxit : maximum active-set iterations.
+    maxit : maximum iterations (active-set in 2D, Newton in 3D).
     cols, rows_node, rows_comp, J, rhs : work arrays (m,), (m,), (m,), (m, m), (m,).
 
     Returns
     -------
-    Number of iterations, or ``-1`` if the active set did not settle within ``maxit``.
+    Number of iterations, or ``-1`` if the solve did not settle within ``maxit`` (2D: the
+    active set; 3D: see :func:`_solve_contact_cone`).
     """
     if d == 3:
         return _solve_contact_cone(A, b, xref, gap, xprev, mu, status, tdir, x, lam, tol,
