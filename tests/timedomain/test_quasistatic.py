@@ -4,19 +4,22 @@ with many contact nodes.
 Compared with: the quasi-static DLFT wear rate (eq. 29 on the converged harmonic balance of
 the same model, :mod:`fretwear.wear`), a different method (frequency domain, truncated to a few
 harmonics) for the same cyclic load; and Archard's law with Coulomb slip (worn volume per
-cycle = k_w / mu x friction energy per cycle), which holds exactly for the load steps.
-The one- and four-node analytic cases (flat punch) are in test_integrate.py.
+cycle = k_w / mu x friction energy per cycle), which holds exactly for the load steps; and
+a closed form for one 3D node under a rotating tangential load. The 2D flat punch is in
+test_integrate.py.
 """
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 from helpers.pads import MU_PAD, dlft_friction_energy, pad_3d
 
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.reduce import condense
+from fretwear.model.core import ContactInterface, Load, Model
 from fretwear.timedomain.quasistatic import incremental_wear
 from fretwear.wear import SlowProblem, wear_coefficients
 
@@ -35,6 +38,37 @@ def dlft_wear_rate(model, H):
     sp.set_state(np.zeros(len(coef)), sol.anchor)
     g = sp.rate(sol.U.reshape(sp.m, sp.H))
     return float(model.contact.area @ g), dlft_friction_energy(sol)
+
+
+@pytest.mark.parametrize("steps", [8, 64])
+def test_3d_node_under_a_rotating_load_slides_on_the_discrete_circle(steps):
+    """One 3D node pressed by N, held tangentially by an isotropic spring k, under a rotating
+    tangential force F0 (cos tau, sin tau) > mu N: it slides on a circle. With N_s load steps
+    per cycle the slip of each step is a chord of the circle and the friction force lies along
+    it (the incremental law); equilibrium at step k+1 in axes turned with the load gives, with
+    s = pi / N_s and the lag phi of the position behind the load,
+    ``sin phi = mu N cos s / F0``, ``k X = F0 cos(s + phi) / cos s`` (``X ->
+    sqrt(F0^2 - mu^2 N^2) / k`` as s -> 0). Per cycle: slip ``2 N_s X sin s``, friction
+    energy mu N times it, wear ``k_w N / area`` times it: exact for the load steps, so
+    round-off (1e-12) from the seventh cycle on (the start from rest dies out geometrically:
+    2.7e-11 in the fourth cycle with 8 steps)."""
+    k, n0, f0, mu, kw, area = 1e6, 100.0, 50.0, 0.3, 1e-12, 1e-4
+    c = ContactInterface(dofs=np.array([[0, 1, 2]]), frame=np.eye(3)[None], gap=np.zeros(1),
+                         area=np.full(1, area), mu=mu, coords=np.zeros((1, 3)),
+                         wear_coefficient=kw)
+    model = Model(K=sp.csr_matrix(np.diag([0.0, k, k])), M=sp.csr_matrix((3, 3)), contact=c,
+                  loads=[Load(np.array([n0, 0.0, 0.0]), "constant"),
+                         Load(np.array([0.0, f0, 0.0]), "cos"),
+                         Load(np.array([0.0, 0.0, f0]), "sin")], dim=3)
+    res = incremental_wear(model, steps_per_cycle=steps, n_cycles=10)
+    assert res.success, res.message
+    s = np.pi / steps
+    phi = np.arcsin(mu * n0 * np.cos(s) / f0)
+    X = f0 * np.cos(s + phi) / np.cos(s) / k
+    slip = 2 * steps * X * np.sin(s)
+    np.testing.assert_allclose(res.slip[6:, 0], slip, rtol=1e-12)
+    np.testing.assert_allclose(res.dissipation[6:], mu * n0 * slip, rtol=1e-12)
+    np.testing.assert_allclose(np.diff(res.wear[:, 0])[5:], kw * n0 * slip / area, rtol=1e-12)
 
 
 def test_3d_pad_wear_per_cycle_agrees_with_the_dlft():

@@ -111,11 +111,11 @@ def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int =
         Settings(float(tol), fscale, 60 + 4 * nc), WearState(x, wear, ContactState(status, tdir)),
         rec)
     if nfail and raise_on_failure:
-        raise ConvergenceError(f"incremental_wear: {nfail} load steps where the contact active "
-                               "set did not settle (singular or cycling); check that the "
-                               "contact holds the structure (rigid motions) and the loads")
+        raise ConvergenceError(f"incremental_wear: {nfail} load steps where the contact solve "
+                               "did not settle (singular or cycling); check that the contact "
+                               "holds the structure (rigid motions) and the loads")
     message = (f"{n_cycles} cycles ({ncomp} computed, {ncomp * N} load steps)" if not nfail
-               else f"{nfail} load steps where the contact active set did not settle")
+               else f"{nfail} load steps where the contact solve did not settle")
     lam = np.asarray(A @ (-x) + btab[0]).reshape(nc, d)
     U = cond.recover(x, model.load_time(np.zeros(1))[0] if model.loads
                      else np.zeros(model.ndof))
