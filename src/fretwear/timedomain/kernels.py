@@ -275,8 +275,8 @@ def _solve_contact_cone(A, b, xref, gap, xprev, mu, status, tdir, x, lam, tol, f
     only the other components (open nodes, slipping tangents) are solved for. Converged when
     ``max |F| <= tol * max(fscale, max |lam|)``; the prescribed components are then set
     exactly (a sticking node does not move by one rounding unit) and the test repeated with
-    the forces recomputed in full. The state is then within ``tol * fscale`` (in force) of an
-    exact solution; the direction of a slip ``xi`` is fixed to about
+    the forces recomputed in full. The Alart-Curnier residual is then below
+    ``tol * fscale`` (a force); the direction of a slip ``xi`` is fixed to about
     ``tol * fscale / (rt |xi|)`` rad (docs/transient.md, section 2).
 
     Returns the number of Newton iterations, or ``-1`` when ``maxit`` iterations did not
