@@ -34,6 +34,7 @@ import scipy.sparse.linalg as spla
 from fretwear.errors import InputError
 from fretwear.hb.reduce import condense
 from fretwear.model.core import Model
+from fretwear.model.interfaces import pair_transform
 
 INTERFACES = ("free", "sliding", "stuck")
 FRF_METHODS = ("direct", "condensed")
@@ -85,12 +86,15 @@ def local_positions(model: Model) -> np.ndarray:
 
 
 def local_transform(model: Model) -> sp.csr_matrix:
-    """Orthogonal ``T`` (ndof, ndof) with ``U = T q`` (see module docstring).
+    """``T`` (ndof, ndof) with ``U = T q`` (see module docstring).
 
     Returns
     -------
-    T : sparse (ndof, ndof); ``q = T.T @ U`` holds the contact-local components at the
-        positions of the contact nodes' global DOFs and the global components elsewhere.
+    T : sparse (ndof, ndof); ``q`` holds the contact-local components at the positions of
+        the contact nodes' global DOFs and the global components elsewhere. Without
+        node-to-node pairs ``T`` is orthogonal (``q = T.T @ U``); a pair's local components
+        are those of the relative displacement ``U_a - U_b``, and ``T = P T_frame`` with the
+        pair transform ``P`` of :func:`fretwear.model.interfaces.pair_transform`.
     """
     _check_contact(model)
     c = model.contact
@@ -104,7 +108,9 @@ def local_transform(model: Model) -> sp.csr_matrix:
     rows = np.concatenate([rows, other])
     cols = np.concatenate([cols, other])
     vals = np.concatenate([vals, np.ones(other.size)])
-    return sp.csr_matrix((vals, (rows, cols)), shape=(model.ndof, model.ndof))
+    T = sp.csr_matrix((vals, (rows, cols)), shape=(model.ndof, model.ndof))
+    P = pair_transform(c, model.ndof)  # node-to-node pairs: U = P U', U'_a = U_a - U_b
+    return T if P is None else (P @ T).tocsr()
 
 
 def _held_local(model: Model, interface: str) -> np.ndarray:

@@ -297,12 +297,36 @@ def test_other_bad_inputs():
                   contact=ContactSpec("zmin", mu=0.1))
 
 
-def test_non_flat_contact_needs_a_normal():
-    """A contact boundary made of the bottom and right faces is not flat."""
+def test_two_flank_contact_gets_per_node_normals():
+    """A contact boundary made of the bottom and right faces (two flanks at a right angle):
+    every node gets the outward normal of its flank, the corner node the average of its two
+    facets' normals weighted by their lengths (0.025 m along x, 0.005 m along y), each frame
+    orthonormal; exact geometry, to rounding."""
     mesh = rectangle(0.1, 0.01, 4, 2)
     mesh.boundaries["corner"] = np.vstack([mesh.boundaries["bottom"], mesh.boundaries["right"]])
-    with pytest.raises(InputError, match="'corner' is not flat .* give the obstacle's normal"):
-        from_mesh(mesh, STEEL, contact=ContactSpec("corner", mu=0.1))
+    c = from_mesh(mesh, STEEL, contact=ContactSpec("corner", mu=0.1),
+                  springs=[Spring((0.0, 0.005), "x", 1e4)]).contact
+    x = c.coords
+    corner = np.isclose(x[:, 0], 0.1) & np.isclose(x[:, 1], 0.0)
+    bottom = np.isclose(x[:, 1], 0.0) & ~corner
+    right = np.isclose(x[:, 0], 0.1) & ~corner
+    np.testing.assert_allclose(c.frame[bottom, 0], [[0.0, -1.0]] * bottom.sum(), atol=1e-15)
+    np.testing.assert_allclose(c.frame[right, 0], [[1.0, 0.0]] * right.sum(), atol=1e-15)
+    expected = np.array([0.005, -0.025]) / math.hypot(0.005, 0.025)
+    np.testing.assert_allclose(c.frame[corner, 0], [expected], atol=1e-15)
+    gram = c.frame @ np.swapaxes(c.frame, 1, 2)
+    np.testing.assert_allclose(gram, np.broadcast_to(np.eye(2), gram.shape), atol=1e-14)
+
+
+def test_folded_contact_boundary_is_refused():
+    """A triangle's two sides meeting at an 11 degree tip: their outward normals are 169
+    degrees apart at the tip node: one message naming the node."""
+    from fretwear.model.core import Mesh
+
+    mesh = Mesh(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 0.2]]), np.array([[0, 1, 2]]),
+                "triangle", boundaries={"tip": np.array([[0, 1], [2, 0]])})
+    with pytest.raises(InputError, match="normals flip between neighbouring facets at node 0"):
+        from_mesh(mesh, STEEL, contact=ContactSpec("tip", mu=0.1))
 
 
 def test_generic_rigid_motion_check():

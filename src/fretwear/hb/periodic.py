@@ -35,7 +35,7 @@ class DLFTProblem:
     Parameters
     ----------
     reduced : :class:`~fretwear.hb.reduce.Reduced` on the orders ``[0] + basis.harmonics``.
-    contact : the interface (friction coefficient per node is ``contact.mu``).
+    contact : the contact record (friction coefficient per node: ``contact.mu_nodes()``).
     basis : Fourier basis.
     gap : (nc,) normal gap + wear ``W`` [m].
     eps : DLFT penalty: ``"auto"`` (default) the spectral radius of ``Z_r`` (paper, section
@@ -58,7 +58,7 @@ class DLFTProblem:
         self.Z = to_real_blocks(reduced.Z, reduced.orders)
         self.F = loads_to_real(reduced.F)
         self.eps = penalty(eps, reduced=reduced)
-        self.mu = np.full(nc, float(contact.mu))
+        self.mu = contact.mu_nodes()
         self.set_gap(contact.gap if gap is None else gap)
         self.anchor = np.zeros((nc, d - 1)) if anchor is None else np.array(anchor, float)
         self.P = basis.forward_matrix()

@@ -30,6 +30,7 @@ import scipy.sparse.linalg as spla
 
 from fretwear.errors import InputError
 from fretwear.model.core import Model
+from fretwear.model.interfaces import observed_map, relative_model
 
 
 @dataclass
@@ -121,7 +122,8 @@ def _factor(Zii, n: int, omega: float):
         lu = spla.splu(Zii.tocsc())
     except RuntimeError as exc:
         raise InputError(
-            f"the structure with its contact DOFs held is singular at harmonic {n} "
+            f"the structure with its contact DOFs held (node-to-node pairs glued) is singular "
+            f"at harmonic {n} "
             f"(excitation {omega / (2 * np.pi):.6g} Hz): part of the model can move with "
             "nothing to hold it (add springs or fixed DOFs), or the frequency is an "
             "eigenfrequency of the undamped structure with a clamped interface"
@@ -129,7 +131,8 @@ def _factor(Zii, n: int, omega: float):
     diag = np.abs(lu.U.diagonal())
     if diag.size and diag.min() <= 1e-13 * diag.max():
         raise InputError(
-            f"the structure with its contact DOFs held is (nearly) singular at harmonic {n}: "
+            f"the structure with its contact DOFs held (node-to-node pairs glued) is (nearly) "
+            f"singular at harmonic {n}: "
             "part of the model can move with nothing to hold it (add springs or fixed DOFs)"
         )
     return lu
@@ -185,10 +188,13 @@ class StaticCondensation:
     _R: np.ndarray
     _lu: object
     _Kci: object
+    _P: object = None  # U = P U' for node-to-node pairs (model.interfaces), None without
 
     def loads(self, F) -> np.ndarray:
         """Condensed loads ``F_r`` (..., m) [N] of load vectors ``F`` (..., ndof) [N]."""
         F = np.asarray(F, dtype=float)
+        if self._P is not None:
+            F = (self._P.T @ F.reshape(-1, F.shape[-1]).T).T.reshape(F.shape)
         cols = F.reshape(-1, F.shape[-1]).T  # one load per column
         Fr, _ = _condensed_load(cols, self._cdofs, self._idofs, self._R, self._lu, self._Kci)
         return Fr.T.reshape(F.shape[:-1] + (self._R.shape[0],))
@@ -199,11 +205,14 @@ class StaticCondensation:
         U = np.zeros(self._model.ndof)
         Uc = self._R.T @ np.asarray(u_loc, dtype=float)
         U[self._cdofs] = Uc
+        F = np.asarray(F, float)
+        if self._P is not None:
+            F = self._P.T @ F
         if self._lu is not None:
             K = self._model.K.tocsr()
-            U[self._idofs] = self._lu.solve(np.asarray(F, float)[self._idofs]
+            U[self._idofs] = self._lu.solve(F[self._idofs]
                                             - K[self._idofs][:, self._cdofs] @ Uc)
-        return U
+        return U if self._P is None else self._P @ U
 
 
 def condense_static(model: Model) -> StaticCondensation:
@@ -213,11 +222,12 @@ def condense_static(model: Model) -> StaticCondensation:
     condensed loads of any load vectors (e.g. the loads at the phases of a quasi-static
     cycle) and the exact recovery of every DOF.
     """
+    model, P = relative_model(model)
     cdofs, idofs = _partition(model)
     R = _frame_matrix(model)
     Kr, lu, _, Kci = _schur(model.K.tocsc().astype(float), cdofs, idofs, R, 0, 0.0)
     return StaticCondensation(np.ascontiguousarray(0.5 * (Kr + Kr.T)), model, cdofs, idofs, R,
-                              lu, Kci)
+                              lu, Kci, P)
 
 
 def condense(model: Model, frequency: float, orders, *, quasi_static: bool = False) -> Reduced:
@@ -237,14 +247,11 @@ def _condense(model: Model, omega: float, orders, *, quasi_static: bool = False,
     """:func:`condense` at the circular frequency ``omega`` [rad/s] (``frequency`` [Hz]:
     recorded in the result, default ``omega / 2 pi``)."""
     orders = np.asarray(orders, dtype=np.int64)
+    model, P = relative_model(model)  # node-to-node pairs: relative coordinates U = P U'
     cdofs, idofs = _partition(model)
     R = _frame_matrix(model)
     m = cdofs.size
-    obs = (
-        np.concatenate([np.asarray(p.dofs, dtype=np.int64) for p in model.observed])
-        if model.observed
-        else np.zeros(0, dtype=np.int64)
-    )
+    obs_out, obs, S = observed_map(model, P)  # U[obs_out] = S @ U'[obs]
     F_all = model.load_harmonics(int(orders.max()) if orders.size else 0)
     # where each observed DOF lives: contact (index in cdofs), interior (index in idofs), fixed
     pos_c = {int(g): j for j, g in enumerate(cdofs)}
@@ -274,7 +281,10 @@ def _condense(model: Model, omega: float, orders, *, quasi_static: bool = False,
             for j, g in enumerate(obs):
                 if int(g) in pos_i:
                     ob[b, j] = xf[pos_i[int(g)]]
-    return Reduced(float(omega), orders, Zr, Fr, oA, ob, obs, bool(quasi_static),
+    if S is not None:
+        oA = np.einsum("oj,bjm->bom", S.toarray(), oA)
+        ob = ob @ S.toarray().T
+    return Reduced(float(omega), orders, Zr, Fr, oA, ob, obs_out, bool(quasi_static),
                    math.nan if frequency is None else float(frequency))
 
 
@@ -293,6 +303,7 @@ def _recover(model: Model, omega: float, orders, u_loc: np.ndarray, *,
              quasi_static: bool = False) -> np.ndarray:
     """:func:`recover` at the circular frequency ``omega`` [rad/s]."""
     orders = np.asarray(orders, dtype=np.int64)
+    model, P = relative_model(model)  # node-to-node pairs: U = P U'
     cdofs, idofs = _partition(model)
     R = _frame_matrix(model)
     F_all = model.load_harmonics(int(orders.max()) if orders.size else 0)
@@ -304,7 +315,7 @@ def _recover(model: Model, omega: float, orders, u_loc: np.ndarray, *,
             Z = _dynamic_stiffness(model, omega, int(n), quasi_static)
             lu = _factor(Z[idofs][:, idofs], int(n), omega)
             out[b, idofs] = lu.solve(F_all[n][idofs] - Z[idofs][:, cdofs] @ Uc)
-    return out
+    return out if P is None else (P @ out.T).T
 
 
 def to_real_blocks(Zc: np.ndarray, orders: np.ndarray) -> np.ndarray:

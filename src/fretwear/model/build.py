@@ -29,6 +29,7 @@ from fretwear.errors import InputError
 from fretwear.limits import check_loss_factor
 from fretwear.model.core import WAVEFORMS, ContactInterface, Load, Mesh, Model, ObservedPoint
 from fretwear.model.fem import assemble, check_material, check_thickness
+from fretwear.model.interfaces import combine, relative_model
 from fretwear.model.loads import boundary_load, nodal_areas
 from fretwear.model.mesh import boundary as _boundary
 from fretwear.model.mesh import check_cells, facet_normals, model_size, orient_facets
@@ -185,12 +186,16 @@ class NodalForce:
 
 @dataclass
 class ContactSpec:
-    """A frictional contact of a boundary against a rigid flat obstacle.
+    """A frictional contact interface: a boundary against a rigid obstacle (node-to-rigid),
+    or against a second elastic body (node-to-node, ``partner``).
 
     boundary : boundary name (its nodes are the contact nodes).
     mu : Coulomb friction coefficient [-], >= 0.
-    normal : unit vector from the structure into the obstacle. Default: the outward normal of
-        the boundary, which must then be flat.
+    normal : unit vector from the structure into the obstacle (one for every node). Default:
+        the outward normal of the boundary: the same for every node on a flat boundary; on a
+        curved or multi-flank boundary each node's normal is the area-weighted average of the
+        outward normals of the facets around it (two neighbouring facets whose normals turn
+        by more than 90 degrees are refused).
     tangent : 2D: the tangent (must be orthogonal to the normal); default
         ``t = (-n_y, n_x)`` or its opposite, whichever has ``t_x > 0`` (``t_y > 0`` if
         ``t_x = 0``), so the bottom face (``n = (0, -1)``) gets ``t = (1, 0)``.
@@ -199,12 +204,21 @@ class ContactSpec:
         ``t2 = n x t1``.
     gap : initial normal gap [m] (>= 0 open, < 0 an initial interference), a number or a
         function of the contact node coordinates (nc, d) -> (nc,).
-    wear_coefficient : Archard coefficient k_w [1/Pa], >= 0.
-    name : label.
+    wear_coefficient : Archard coefficient k_w [1/Pa], >= 0, of the boundary's surface.
+    name : label (interfaces of one model have distinct names).
+    partner : the boundary of the second body (node-to-node): every contact node is paired
+        with the partner node at the same position (within ``tolerance``); the contact law
+        acts on their relative displacement, with equal and opposite forces. None:
+        node-to-rigid.
+    tolerance : largest distance [m] between paired nodes; default ``1e-6`` times the model
+        size.
+    partner_wear_coefficient : Archard coefficient k_w [1/Pa], >= 0, of the partner's
+        surface; the gap opens by the sum of the two worn depths.
 
     Contact nodes are ordered by increasing coordinate along the tangent (2D) or along
-    ``t2`` then ``t1`` (3D), so that profiles come out ordered. Each node's area is its
-    consistent nodal area (see :func:`fretwear.model.loads.nodal_areas`).
+    ``t2`` then ``t1`` (3D) of the boundary's mean frame, so that profiles come out ordered.
+    Each node's area is its consistent nodal area (see
+    :func:`fretwear.model.loads.nodal_areas`).
     """
 
     boundary: str
@@ -214,12 +228,23 @@ class ContactSpec:
     gap: float | Callable = 0.0
     wear_coefficient: float = 0.0
     name: str = "contact"
+    partner: str | None = None
+    tolerance: float | None = None
+    partner_wear_coefficient: float = 0.0
 
     def __post_init__(self):
         what = f"contact {self.name!r}"
         self.mu = _finite(self.mu, f"{what}: friction coefficient mu", minimum=0.0)
         self.wear_coefficient = _finite(self.wear_coefficient, f"{what}: wear_coefficient",
                                         minimum=0.0)
+        self.partner_wear_coefficient = _finite(
+            self.partner_wear_coefficient, f"{what}: partner_wear_coefficient", minimum=0.0)
+        if self.partner is None and self.partner_wear_coefficient > 0.0:
+            raise InputError(f"{what}: partner_wear_coefficient = "
+                             f"{self.partner_wear_coefficient!r} without a partner boundary: a "
+                             "rigid obstacle does not wear")
+        if self.tolerance is not None:
+            self.tolerance = _finite(self.tolerance, f"{what}: tolerance", minimum=0.0)
         if not callable(self.gap):
             self.gap = _finite(self.gap, f"{what}: gap")
 
@@ -412,6 +437,93 @@ def _frame(n: np.ndarray, tangent, what: str) -> np.ndarray:
     return F
 
 
+def nodal_normals(mesh: Mesh, facets: np.ndarray, nodes: np.ndarray,
+                  what: str = "boundary") -> np.ndarray:
+    """Outward unit normals (n, d) at ``nodes``: the area-weighted average of the outward
+    normals of the (outward-oriented) ``facets`` around each node.
+
+    Raises InputError for a node without facets or with a vanishing average, and where two
+    facets around one node have normals more than 90 degrees apart (a boundary that folds
+    back: its normal flips between neighbours).
+    """
+    v = np.asarray(mesh_facet_vectors(mesh, facets), dtype=float)  # |v| ~ facet measure
+    unit = v / np.linalg.norm(v, axis=1, keepdims=True)
+    pos = np.full(mesh.points.shape[0], -1, dtype=np.int64)
+    pos[nodes] = np.arange(nodes.size)
+    total = np.zeros((nodes.size, mesh.dim))
+    k = facets.shape[1]
+    for j in range(k):
+        np.add.at(total, pos[facets[:, j]], v)
+    # the most opposed pair of facets around each node
+    for j in range(k):
+        p = pos[facets[:, j]]
+        mean = total[p] / np.linalg.norm(total[p], axis=1, keepdims=True)
+        cos = np.einsum("ij,ij->i", unit, mean)
+        bad = np.flatnonzero(~(cos > 0.0))
+        if bad.size:
+            node = int(facets[bad[0], j])
+            raise InputError(
+                f"{what}: the outward normals flip between neighbouring facets at node {node} "
+                f"{tuple(np.round(mesh.points[node], 12).tolist())} (more than 90 degrees "
+                "apart): split the boundary into flanks, one interface each"
+            )
+    norm = np.linalg.norm(total, axis=1)
+    return total / norm[:, None]
+
+
+def mesh_facet_vectors(mesh: Mesh, facets: np.ndarray) -> np.ndarray:
+    """Outward normals of oriented facets scaled by the facet's length or area (nf, d)."""
+    n = facet_normals(mesh, facets)
+    p = mesh.points[facets]
+    if facets.shape[1] == 2:
+        size = np.linalg.norm(p[:, 1] - p[:, 0], axis=1)
+    elif facets.shape[1] == 3:
+        size = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+    else:
+        size = 0.5 * np.linalg.norm(np.cross(p[:, 2] - p[:, 0], p[:, 3] - p[:, 1]), axis=1)
+    return n * size[:, None]
+
+
+def match_nodes(mesh: Mesh, nodes: np.ndarray, partner: str, tolerance: float | None,
+                what: str) -> np.ndarray:
+    """The node of boundary ``partner`` at the position of each of ``nodes`` (n,).
+
+    Raises InputError naming the first node without a partner within ``tolerance`` [m]
+    (default ``1e-6`` times the model size), its position and the distance to the nearest
+    partner node, and a partner node matched twice.
+    """
+    from scipy.spatial import cKDTree  # lazy: scipy.spatial is slow to import
+
+    if partner not in mesh.boundaries:
+        raise InputError(f"{what}: unknown partner boundary {partner!r}; the mesh has "
+                         f"boundaries {sorted(mesh.boundaries)}")
+    cand = np.unique(_boundary(mesh, partner))
+    if cand.size == 0:
+        raise InputError(f"{what}: partner boundary {partner!r} is empty")
+    tol = 1e-6 * model_size(mesh) if tolerance is None else tolerance
+    dist, idx = cKDTree(mesh.points[cand]).query(mesh.points[nodes])
+    far = np.flatnonzero(dist > tol)
+    if far.size:
+        i = int(far[np.argmax(dist[far])])
+        raise InputError(
+            f"{what}: node {int(nodes[i])} at {tuple(np.round(mesh.points[nodes[i]], 12).tolist())}"
+            f" has no node of boundary {partner!r} within {tol:.3g} m (nearest: node "
+            f"{int(cand[idx[i]])}, {dist[i]:.3g} m away; {far.size} such nodes): the two "
+            "boundaries need matching nodes (or a larger tolerance)"
+        )
+    out = cand[idx]
+    same = np.intersect1d(out, nodes)
+    if same.size:
+        raise InputError(f"{what}: node {int(same[0])} is on both boundaries of the pair; the "
+                         "two bodies need their own nodes at the interface")
+    values, counts = np.unique(out, return_counts=True)
+    if np.any(counts > 1):
+        j = int(values[counts > 1][0])
+        raise InputError(f"{what}: node {j} of boundary {partner!r} is the partner of "
+                         f"{int(counts.max())} contact nodes; expected one-to-one pairs")
+    return out
+
+
 def _contact(mesh: Mesh, spec: ContactSpec, thickness: float) -> ContactInterface:
     if not isinstance(spec, ContactSpec):
         raise InputError(f"contact: {spec!r} is not a ContactSpec")
@@ -428,14 +540,19 @@ def _contact(mesh: Mesh, spec: ContactSpec, thickness: float) -> ContactInterfac
     outward = facet_normals(mesh, facets)
     mean = outward.mean(axis=0)
     mean /= np.linalg.norm(mean)
+    nodes, area = nodal_areas(mesh, spec.boundary, thickness)
+    if np.any(~(area > 0.0)):
+        i = int(np.flatnonzero(~(area > 0.0))[0])
+        raise InputError(f"{what}: node {int(nodes[i])} at "
+                         f"{tuple(np.round(mesh.points[nodes[i]], 12).tolist())} has a zero "
+                         f"contact area ({area[i]:.3g} m^2): degenerate facets on boundary "
+                         f"{spec.boundary!r}")
+    per_node = None
     if spec.normal is None:
         dev = np.linalg.norm(outward - mean, axis=1).max()
-        if dev > 1e-6:
-            raise InputError(
-                f"{what}: boundary {spec.boundary!r} is not flat (outward normals differ by "
-                f"up to {dev:.3g}); give the obstacle's normal explicitly (normal = ...)"
-            )
         n = mean
+        if dev > 1e-6:  # curved or multi-flank: one normal per node
+            per_node = nodal_normals(mesh, facets, nodes, f"{what}: boundary {spec.boundary!r}")
     else:
         n = unit_direction(spec.normal, mesh.dim, f"{what}: normal")
         if n @ mean <= 0.0:
@@ -446,7 +563,6 @@ def _contact(mesh: Mesh, spec: ContactSpec, thickness: float) -> ContactInterfac
             )
     frame = _tangents(n, spec.tangent, what)
 
-    nodes, area = nodal_areas(mesh, spec.boundary, thickness)
     coords = mesh.points[nodes]
     if mesh.dim == 2:
         order = np.argsort(coords @ frame[1], kind="stable")
@@ -454,6 +570,11 @@ def _contact(mesh: Mesh, spec: ContactSpec, thickness: float) -> ContactInterfac
         order = np.lexsort((coords @ frame[1], coords @ frame[2]))
     nodes, area, coords = nodes[order], area[order], coords[order]
     nc, d = nodes.size, mesh.dim
+    if per_node is None:
+        frames = np.broadcast_to(frame, (nc, d, d)).copy()
+    else:
+        frames = np.array([_node_frame(v, frame, spec.tangent, what)
+                           for v in per_node[order]])
 
     if callable(spec.gap):
         gap = np.asarray(spec.gap(coords.copy()), dtype=float)
@@ -462,9 +583,13 @@ def _contact(mesh: Mesh, spec: ContactSpec, thickness: float) -> ContactInterfac
                              f"({nc},) finite values [m] for the {nc} contact nodes")
     else:
         gap = np.full(nc, float(spec.gap))
+    partner = dict(partner_dofs=None, partner_ids=None)
+    if spec.partner is not None:
+        other = match_nodes(mesh, nodes, spec.partner, spec.tolerance, what)
+        partner = dict(partner_dofs=d * other[:, None] + np.arange(d), partner_ids=other)
     return ContactInterface(
         dofs=d * nodes[:, None] + np.arange(d),
-        frame=np.broadcast_to(frame, (nc, d, d)).copy(),
+        frame=frames,
         gap=gap,
         area=area,
         mu=spec.mu,
@@ -472,7 +597,25 @@ def _contact(mesh: Mesh, spec: ContactSpec, thickness: float) -> ContactInterfac
         node_ids=nodes,
         wear_coefficient=spec.wear_coefficient,
         name=spec.name,
+        partner_wear_coefficient=spec.partner_wear_coefficient,
+        **partner,
     )
+
+
+def _node_frame(n: np.ndarray, mean_frame: np.ndarray, tangent, what: str) -> np.ndarray:
+    """The frame of one node of a curved boundary: its normal ``n``; 2D: the tangent turned
+    from the normal, signed like the mean frame's; 3D: ``t1`` the projection of the mean
+    frame's ``t1`` on the node's tangent plane (continuous along the boundary)."""
+    if n.size == 2:
+        t = np.array([-n[1], n[0]])
+        if t @ mean_frame[1] < 0.0:
+            t = -t
+        return np.vstack([n, t]) + 0.0
+    t1 = mean_frame[1] - (mean_frame[1] @ n) * n
+    if np.linalg.norm(t1) < 1e-6:
+        t1 = mean_frame[2] - (mean_frame[2] @ n) * n
+    t1 /= np.linalg.norm(t1)
+    return np.vstack([n, t1, np.cross(n, t1)]) + 0.0
 
 
 def _observed(mesh: Mesh, observed) -> list[ObservedPoint]:
@@ -499,9 +642,9 @@ def _observed(mesh: Mesh, observed) -> list[ObservedPoint]:
 # the model
 # --------------------------------------------------------------------------------------------
 def from_mesh(mesh: Mesh, material: Material, *, thickness=1.0, damping: Damping | None = None,
-              springs=(), fixed=(), loads=(), contact: ContactSpec, observed=None,
+              springs=(), fixed=(), loads=(), contact, observed=None,
               name: str = "model") -> Model:
-    """A linear elastic model of a mesh with one contact interface.
+    """A linear elastic model of a mesh with one or several contact interfaces.
 
     Parameters
     ----------
@@ -516,7 +659,9 @@ def from_mesh(mesh: Mesh, material: Material, *, thickness=1.0, damping: Damping
     fixed : sequence of (at, direction)
         DOFs held at zero; ``direction`` is an axis name or ``"all"``.
     loads : sequence of Traction, NodalForce or core.Load
-    contact : ContactSpec
+    contact : ContactSpec or sequence of ContactSpec
+        The interfaces (node-to-rigid, or node-to-node with ``partner``), one record for
+        all (:func:`fretwear.model.interfaces.combine`: a node belongs to one interface).
     observed : dict, optional
         name -> coordinates [m] (the nearest node, reported with its exact coordinates) or
         the name of a one-node node set.
@@ -543,12 +688,16 @@ def from_mesh(mesh: Mesh, material: Material, *, thickness=1.0, damping: Damping
     thickness = check_thickness(thickness, mesh.dim)
     K0, M = assemble(mesh, material.E, material.nu, material.rho, thickness)
     Ks, fixed_dofs = _springs_and_fixed(mesh, springs, fixed)
-    interface = _contact(mesh, contact, thickness)
+    specs = [contact] if isinstance(contact, ContactSpec) else list(contact) \
+        if isinstance(contact, Sequence) and not isinstance(contact, str) else [contact]
+    interface = combine([_contact(mesh, spec, thickness) for spec in specs])
     clash = np.intersect1d(interface.dofs.ravel(), fixed_dofs)
     if clash.size:
         node = int(clash[0]) // mesh.dim
+        which = interface.names()[int(interface.interface_index()[
+            np.flatnonzero(np.any(interface.dofs == clash[0], axis=1))[0]])]
         raise InputError(
-            f"contact {interface.name!r}: node {node} at {tuple(mesh.points[node].tolist())} "
+            f"contact {which!r}: node {node} at {tuple(mesh.points[node].tolist())} "
             f"is a contact node with a fixed DOF ({AXES[int(clash[0]) % mesh.dim]}); contact "
             "DOFs cannot be fixed: hold the structure at nodes off the contact boundary, or "
             "use a stiff finite spring"
@@ -666,7 +815,9 @@ def check_supported(model: Model) -> None:
     if model.mesh is None:
         c = model.contact
         normal_dofs = c.dofs[np.arange(c.n_nodes), np.argmax(np.abs(c.frame[:, 0, :]), axis=1)]
-        rigid_motion_check(model.K, np.union1d(normal_dofs, model.fixed_dofs))
+        # pairs: in the relative coordinates the normal DOF of node a holds n . (U_a - U_b)
+        rigid_motion_check(relative_model(model)[0].K, np.union1d(normal_dofs,
+                                                                  model.fixed_dofs))
         return
     d = model.dim
     R, centre, size = rigid_body_modes(model.mesh.points)
@@ -678,8 +829,12 @@ def check_supported(model: Model) -> None:
     KR[np.abs(KR) <= 64 * np.finfo(float).eps * (abs(model.K) @ np.abs(R))] = 0.0
     springs = KR[np.any(KR != 0.0, axis=1)]
     springs = springs / np.linalg.norm(springs, axis=1, keepdims=True)
+    Rrel = R[c.dofs]
+    if c.has_pairs:  # a pair holds the relative normal displacement n . (U_a - U_b)
+        pd = np.asarray(c.partner_dofs)
+        Rrel = Rrel - np.where(pd[..., None] >= 0, R[np.maximum(pd, 0)], 0.0)
     A = np.vstack([
-        np.einsum("nd,ndr->nr", c.frame[:, 0, :], R[c.dofs]),
+        np.einsum("nd,ndr->nr", c.frame[:, 0, :], Rrel),
         R[np.asarray(model.fixed_dofs, dtype=np.int64)],
         springs,
     ])

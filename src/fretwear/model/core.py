@@ -109,30 +109,55 @@ class Load:
 
 @dataclass
 class ContactInterface:
-    """Contact nodes against a rigid obstacle (node-to-rigid-surface).
+    """The contact nodes of a model: one per-node record for all its interfaces.
+
+    A node is either *node-to-rigid* (it touches a rigid obstacle) or one node ``a`` of a
+    *node-to-node pair* ``(a, b)`` between two elastic bodies (or two parts of one body). The
+    contact law acts on the displacement of ``a`` relative to the obstacle, or relative to
+    its partner ``b``: ``u_loc = frame @ (U[dofs] - U[partner_dofs])`` (paper subscript r,
+    eq. 19-23); the pair's contact forces are equal and opposite on ``a`` and ``b``. Several
+    named interfaces share this one record (``interface`` holds each node's interface index
+    into ``interface_names``), so the harmonic balance and the wear integration run on plain
+    per-node arrays whatever the number of interfaces.
 
     Attributes
     ----------
-    dofs : (nc, d) int array, global DOFs of each contact node in the structure's axes.
-    frame : (nc, d, d) float array, rows ``[n, t1(, t2)]`` (see module docstring).
+    dofs : (nc, d) int array, global DOFs of each contact node (node ``a`` of a pair).
+    frame : (nc, d, d) float array, rows ``[n, t1(, t2)]`` (see module docstring); for a pair
+        ``n`` points from node ``a`` into the body of node ``b``.
     gap : (nc,) initial normal gap [m] (>= 0 means open).
     area : (nc,) tributary area [m^2] (2D plane strain: tributary length x width).
-    mu : Coulomb friction coefficient [-].
+    mu : Coulomb friction coefficient [-]: one number, or (nc,) per node.
     coords : (nc, d) node positions [m] (for output; zeros for user matrices if unknown).
     node_ids : (nc,) mesh node numbers, or -1 when built from matrices.
-    wear_coefficient : Archard coefficient k_w [1/Pa] (eq. 29), used by wear analyses.
-    name : label.
+    wear_coefficient : Archard coefficient k_w [1/Pa] (eq. 29) of the surface of node ``a``
+        (the structure's side against a rigid obstacle): one number or (nc,) per node.
+    name : label (of the first interface when there are several).
+    partner_dofs : (nc, d) int array, the DOFs of each node's partner ``b`` (same axes as
+        ``dofs``), ``-1`` for a node-to-rigid node; None: every node is node-to-rigid.
+    partner_ids : (nc,) mesh node numbers of the partners (-1 where none), for output.
+    partner_wear_coefficient : Archard coefficient [1/Pa] of the partner's surface: one
+        number or (nc,) per node (0 for node-to-rigid nodes: a rigid obstacle does not wear).
+        The gap of a pair opens by the sum of both worn depths.
+    interface : (nc,) int, each node's interface (index into ``interface_names``); None: one
+        interface, named ``name``.
+    interface_names : the interfaces' names, in the order of their indices.
     """
 
     dofs: np.ndarray
     frame: np.ndarray
     gap: np.ndarray
     area: np.ndarray
-    mu: float
+    mu: float | np.ndarray
     coords: np.ndarray
     node_ids: np.ndarray | None = None
-    wear_coefficient: float = 0.0
+    wear_coefficient: float | np.ndarray = 0.0
     name: str = "contact"
+    partner_dofs: np.ndarray | None = None
+    partner_ids: np.ndarray | None = None
+    partner_wear_coefficient: float | np.ndarray = 0.0
+    interface: np.ndarray | None = None
+    interface_names: tuple = ()
 
     @property
     def n_nodes(self) -> int:
@@ -142,13 +167,55 @@ class ContactInterface:
     def dim(self) -> int:
         return int(self.dofs.shape[1])
 
+    def _per_node(self, value) -> np.ndarray:
+        return np.broadcast_to(np.asarray(value, dtype=float), (self.n_nodes,)).copy()
+
+    def mu_nodes(self) -> np.ndarray:
+        """Friction coefficient of every node (nc,) [-]."""
+        return self._per_node(self.mu)
+
+    def wear_nodes(self) -> np.ndarray:
+        """Archard coefficient of the surface of every node ``a`` (nc,) [1/Pa]."""
+        return self._per_node(self.wear_coefficient)
+
+    def partner_wear_nodes(self) -> np.ndarray:
+        """Archard coefficient of every partner's surface (nc,) [1/Pa] (0 without partner)."""
+        return np.where(self.paired(), self._per_node(self.partner_wear_coefficient), 0.0)
+
+    def paired(self) -> np.ndarray:
+        """(nc,) bool: which nodes are node ``a`` of a node-to-node pair."""
+        if self.partner_dofs is None:
+            return np.zeros(self.n_nodes, dtype=bool)
+        return np.asarray(self.partner_dofs)[:, 0] >= 0
+
+    @property
+    def has_pairs(self) -> bool:
+        return bool(np.any(self.paired()))
+
+    def interface_index(self) -> np.ndarray:
+        """(nc,) int: the interface of every node (all 0 for one interface)."""
+        if self.interface is None:
+            return np.zeros(self.n_nodes, dtype=np.int64)
+        return np.asarray(self.interface, dtype=np.int64)
+
+    def names(self) -> list[str]:
+        """The interfaces' names, in the order of :meth:`interface_index`."""
+        return list(self.interface_names) if self.interface_names else [self.name]
+
     def local_transform(self, ndof: int) -> sp.csr_matrix:
-        """Sparse ``T`` (nc*d x ndof) with ``u_loc = T @ U``; rows node-major ``[N, T1, (T2)]``."""
+        """Sparse ``T`` (nc*d x ndof) with ``u_loc = T @ U`` (relative to the partner for a
+        pair); rows node-major ``[N, T1, (T2)]``."""
         nc, d = self.dofs.shape
         rows = np.repeat(np.arange(nc * d), d)
         cols = np.broadcast_to(self.dofs[:, None, :], (nc, d, d)).reshape(-1)
         vals = self.frame.reshape(-1)
-        return sp.csr_matrix((vals, (rows, cols)), shape=(nc * d, ndof))
+        T = sp.csr_matrix((vals, (rows, cols)), shape=(nc * d, ndof))
+        if self.has_pairs:
+            pd = np.asarray(self.partner_dofs)
+            keep = np.broadcast_to(pd[:, None, :] >= 0, (nc, d, d)).reshape(-1)
+            pcols = np.broadcast_to(pd[:, None, :], (nc, d, d)).reshape(-1)
+            T = T - sp.csr_matrix((vals[keep], (rows[keep], pcols[keep])), shape=(nc * d, ndof))
+        return T.tocsr()
 
 
 @dataclass
@@ -182,7 +249,7 @@ class Mesh:
 
 @dataclass
 class Model:
-    """A linear structure with one frictional contact interface (paper eq. 11).
+    """A linear structure with frictional contact interfaces (paper eq. 11).
 
     K, M : (ndof, ndof) sparse stiffness [N/m] and mass [kg] (M may be singular).
     C : viscous damping [N s/m] or None.
@@ -190,7 +257,7 @@ class Model:
         is ``K + i D - (n w)^2 M + i n w C`` (a loss factor eta gives ``D = eta K``); it
         has no static part.
     loads : list of :class:`Load`.
-    contact : the interface.
+    contact : the contact nodes of every interface (one per-node record).
     observed : points whose motion is reported.
     fixed_dofs : DOFs held at zero (Dirichlet), removed before any solve.
     dim : 2 (plane strain) or 3.

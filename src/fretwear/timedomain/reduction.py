@@ -14,6 +14,7 @@ import scipy.sparse.linalg as spla
 
 from fretwear.errors import InputError
 from fretwear.model.core import Model
+from fretwear.model.interfaces import relative_model
 from fretwear.timedomain.checks import check_contact, count, positive
 
 CUTOFF_STEPS = 8  # default cutoff: modes whose period spans at least this many steps
@@ -136,8 +137,14 @@ def damping_split(K, M, C):
 
 def reduce_dynamics(model: Model, omega: float, *, modal_cutoff, n_modes,
                     steps_per_period) -> ReducedDynamics:
-    """Reduce the free structure onto the contact DOFs (see module docstring)."""
+    """Reduce the free structure onto the contact DOFs (see module docstring).
+
+    Node-to-node pairs are reduced in their relative coordinates ``U = P U'``
+    (:func:`fretwear.model.interfaces.relative_model`); the returned basis maps the reduced
+    coordinates to the physical free DOFs (``P`` applied), so loads, initial states and
+    observed points need nothing else."""
     check_contact(model)
+    model, P = relative_model(model)
     n = model.ndof
     free = model.free_dofs()
     nf = free.size
@@ -250,7 +257,9 @@ def reduce_dynamics(model: Model, omega: float, *, modal_cutoff, n_modes,
         basis, Kred, Mred, Cred = Phi, Kr, Mr, Cr
     info["r"] = int(basis.shape[1])
     info["diagonal"] = diag
-    Tx = np.asarray(T @ basis)
+    Tx = np.asarray(T @ basis)  # the contact-local (relative) displacements
+    if P is not None:  # back to the physical free DOFs: U_free = P_ff U'_free
+        basis = np.asarray(P.tocsr()[free][:, free] @ basis)
     names, slices, rows = [], [], []
     start = 0
     for p in model.observed:

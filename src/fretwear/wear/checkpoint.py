@@ -30,6 +30,12 @@ from fretwear.wear.options import WearOptions
 CHECKPOINT_VERSION = 2
 
 
+def _mu_key(mu):
+    """One number for one coefficient (the key of earlier checkpoints), else the list."""
+    mu = np.asarray(mu, dtype=float)
+    return float(mu) if mu.ndim == 0 else mu.tolist()
+
+
 def fingerprint(model: Model, reduced: Reduced, basis: FourierBasis, eps: float, coef,
                 options: WearOptions, W0, anchor0) -> str:
     """SHA-256 of everything that determines the trajectory (model data after condensation,
@@ -40,7 +46,7 @@ def fingerprint(model: Model, reduced: Reduced, basis: FourierBasis, eps: float,
               np.asarray(W0, float), np.asarray(anchor0, float)):
         h.update(np.ascontiguousarray(a).tobytes())
     meta = {"basis": [list(basis.harmonics), basis.n_samples], "eps": float(eps),
-            "mu": float(model.contact.mu), "omega": float(reduced.omega),
+            "mu": _mu_key(model.contact.mu), "omega": float(reduced.omega),
             "quasi_static": bool(reduced.quasi_static), "options": options.trajectory_key()}
     h.update(json.dumps(meta, sort_keys=True, default=str).encode())
     return h.hexdigest()

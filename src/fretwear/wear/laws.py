@@ -39,15 +39,16 @@ def wear_coefficients(model: Model, law_name: str = "archard",
     c = model.contact
     area = np.asarray(c.area, dtype=float)
     if law_name == "archard":
-        k = float(c.wear_coefficient)
-        if not k >= 0:
-            raise InputError(f"wear_coefficient = {k!r}: expected k_w >= 0 [1/Pa]")
+        k = c.wear_nodes() + c.partner_wear_nodes()  # both surfaces of a pair wear
+        if not np.all(k >= 0):
+            raise InputError(f"wear_coefficient = {c.wear_coefficient!r}: expected k_w >= 0 "
+                             "[1/Pa]")
         return k / area
     if law_name == "energy":
         if energy_coefficient is None or not float(energy_coefficient) >= 0:
             raise InputError(f"energy_coefficient = {energy_coefficient!r}: the energy law needs "
                              "k_e >= 0 [m^3/J]")
-        return float(energy_coefficient) * float(c.mu) / area
+        return float(energy_coefficient) * c.mu_nodes() / area
     raise InputError(f"law = {law_name!r}: expected one of {LAWS}")
 
 

@@ -1,0 +1,188 @@
+"""Several contact interfaces in one model, node-to-node pairs and their exact change of
+variables.
+
+A model holds one per-node contact record (:class:`~fretwear.model.core.ContactInterface`)
+for all its interfaces: :func:`combine` concatenates the interfaces, records each node's
+interface and refuses a node that belongs to two of them.
+
+Node-to-node pairs ``(a, b)`` are taken to the relative coordinates the paper writes its
+method in (subscript r) by an exact change of variables: ``U = P U'``, where ``U'`` equals
+``U`` except at the DOFs of every node ``a``, which hold the relative displacement
+``r = U_a - U_b``; ``P`` is the identity plus one identity block per pair (``U_a = r + U_b``).
+Then ``P^T Z P U' = P^T F - [frame^T lambda on r; 0]``: the contact forces act on ``r``
+only, equal and opposite on ``a`` and ``b`` by construction, and the model in the primed
+coordinates (:func:`relative_model`) has node-to-rigid contact on the ``r`` DOFs. The
+condensation, the DLFT law, its Jacobian, the sweeps and the wear integration see it
+unchanged. The condensation holds ``r = 0`` (the pairs glued) and needs the glued assembly
+to be held; a displacement field is recovered as ``U = P U'``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import scipy.sparse as sp
+
+from fretwear.errors import InputError
+from fretwear.model.core import ContactInterface, Model, ObservedPoint
+
+
+def combine(interfaces) -> ContactInterface:
+    """One per-node record of several interfaces (each a :class:`ContactInterface`).
+
+    The nodes keep their order, interface after interface; ``interface`` holds each node's
+    interface index and ``interface_names`` the names (which must differ). Per-interface
+    numbers (``mu``, wear coefficients) become per-node arrays.
+
+    Raises
+    ------
+    InputError
+        Two interfaces with one name, mixed dimensions, or a DOF that belongs to two contact
+        nodes (a node in two interfaces, or a node that is both a contact node and another
+        pair's partner).
+    """
+    items = list(interfaces)
+    if not items:
+        raise InputError("contact: expected at least one interface")
+    if len(items) == 1 and items[0].interface is None:
+        return items[0]
+    names = []
+    for c in items:
+        names.extend(c.names())
+    if len(set(names)) != len(names):
+        dup = next(n for n in names if names.count(n) > 1)
+        raise InputError(f"contact: two interfaces are named {dup!r}; expected distinct names")
+    dims = {c.dim for c in items}
+    if len(dims) != 1:
+        raise InputError(f"contact: interfaces of dimensions {sorted(dims)}; expected one")
+    d = dims.pop()
+    offset = 0
+    index = []
+    for c in items:
+        index.append(c.interface_index() + offset)
+        offset += len(c.names())
+
+    def cat(get):
+        return np.concatenate([np.asarray(get(c)) for c in items])
+
+    def partner(c):
+        if c.partner_dofs is None:
+            return np.full((c.n_nodes, d), -1, dtype=np.int64)
+        return np.asarray(c.partner_dofs, dtype=np.int64)
+
+    def ids(c, field):
+        v = getattr(c, field)
+        return np.full(c.n_nodes, -1, dtype=np.int64) if v is None else np.asarray(v, np.int64)
+
+    out = ContactInterface(
+        dofs=cat(lambda c: np.asarray(c.dofs, dtype=np.int64)),
+        frame=cat(lambda c: np.asarray(c.frame, dtype=float)),
+        gap=cat(lambda c: c._per_node(c.gap)),
+        area=cat(lambda c: c._per_node(c.area)),
+        mu=cat(lambda c: c.mu_nodes()),
+        coords=cat(lambda c: np.asarray(c.coords, dtype=float).reshape(c.n_nodes, d)),
+        node_ids=cat(lambda c: ids(c, "node_ids")),
+        wear_coefficient=cat(lambda c: c.wear_nodes()),
+        name=names[0],
+        partner_dofs=cat(partner),
+        partner_ids=cat(lambda c: ids(c, "partner_ids")),
+        partner_wear_coefficient=cat(lambda c: c.partner_wear_nodes()),
+        interface=np.concatenate(index),
+        interface_names=tuple(names),
+    )
+    check_distinct(out)
+    if not out.has_pairs:
+        out.partner_dofs = out.partner_ids = None
+    return out
+
+
+def check_distinct(c: ContactInterface) -> None:
+    """A DOF belongs to at most one contact node, and a pair's partner is not a node ``a``.
+
+    Raises InputError naming the node, its interfaces and position.
+    """
+    dofs = np.asarray(c.dofs, dtype=np.int64)
+    where = c.interface_index()
+    names = c.names()
+    flat = dofs.reshape(-1)
+    values, first, counts = np.unique(flat, return_index=True, return_counts=True)
+    if np.any(counts > 1):
+        g = int(values[counts > 1][0])
+        nodes = np.flatnonzero(np.any(dofs == g, axis=1))
+        ifs = sorted({names[where[p]] for p in nodes})
+        raise InputError(
+            f"contact: the node at {tuple(np.round(c.coords[nodes[0]], 12).tolist())} (DOF {g}) "
+            f"is in {len(nodes)} contact places (interfaces {ifs}); a node belongs to one "
+            "interface only"
+        )
+    if c.partner_dofs is not None:
+        pd = np.asarray(c.partner_dofs, dtype=np.int64)
+        clash = np.intersect1d(pd[pd >= 0], flat)
+        if clash.size:
+            p = int(np.flatnonzero(np.any(pd == clash[0], axis=1))[0])
+            raise InputError(
+                f"contact: the partner (DOF {int(clash[0])}) of the pair at "
+                f"{tuple(np.round(c.coords[p], 12).tolist())} (interface "
+                f"{names[where[p]]!r}) is itself a contact node; a node belongs to one "
+                "interface only"
+            )
+
+
+def pair_transform(contact: ContactInterface, ndof: int) -> sp.csr_matrix | None:
+    """``P`` (ndof, ndof) with ``U = P U'`` (module docstring), or None without pairs."""
+    if not contact.has_pairs:
+        return None
+    pd = np.asarray(contact.partner_dofs, dtype=np.int64)
+    keep = pd >= 0
+    rows = np.asarray(contact.dofs, dtype=np.int64)[keep]
+    cols = pd[keep]
+    eye = np.arange(ndof)
+    return sp.csr_matrix(
+        (np.ones(ndof + rows.size), (np.concatenate([eye, rows]), np.concatenate([eye, cols]))),
+        shape=(ndof, ndof),
+    )
+
+
+def relative_model(model: Model) -> tuple[Model, sp.csr_matrix | None]:
+    """The model in the relative coordinates ``U'`` of its pairs, and ``P`` (``U = P U'``).
+
+    ``K' = P^T K P`` (the same for ``M``, ``C``, ``D``), loads ``P^T F``; the contact record
+    keeps its nodes with the partners dropped (node-to-rigid on the ``r`` DOFs); the
+    observed points keep their DOFs, whose displacement is ``(P U')[dofs]``. A model without
+    pairs is returned as it is, with ``P = None``.
+    """
+    P = pair_transform(model.contact, model.ndof)
+    if P is None:
+        return model, None
+    fixed = np.asarray(model.fixed_dofs, dtype=np.int64)
+    if np.intersect1d(fixed, np.asarray(model.contact.dofs).reshape(-1)).size:
+        raise InputError("contact DOFs cannot also be fixed (Dirichlet) DOFs")
+    Pt = P.T.tocsr()
+
+    def tr(A):
+        return None if A is None else (Pt @ A @ P).tocsr()
+
+    loads = [dataclasses.replace(ld, vector=Pt @ np.asarray(ld.vector, dtype=float))
+             for ld in model.loads]
+    contact = dataclasses.replace(model.contact, partner_dofs=None)
+    rel = dataclasses.replace(model, K=tr(model.K), M=tr(model.M), C=tr(model.C), D=tr(model.D),
+                              loads=loads, contact=contact,
+                              observed=[ObservedPoint(p.name, p.dofs, p.coords)
+                                        for p in model.observed])
+    return rel, P
+
+
+def observed_map(model: Model, P) -> tuple[np.ndarray, np.ndarray, sp.csr_matrix | None]:
+    """Observed DOFs, the primed DOFs they depend on and the map between them.
+
+    Returns ``(obs, cols, S)``: ``U[obs] = S @ U'[cols]`` (``S = None`` and ``cols = obs``
+    without pairs).
+    """
+    obs = (np.concatenate([np.asarray(p.dofs, dtype=np.int64) for p in model.observed])
+           if model.observed else np.zeros(0, dtype=np.int64))
+    if P is None:
+        return obs, obs, None
+    rows = P[obs]
+    cols = np.unique(rows.indices).astype(np.int64)
+    return obs, cols, rows[:, cols].tocsr()
