@@ -1,4 +1,4 @@
-"""Linear models: FE meshes (scikit-fem) or user matrices, loads, springs, contact interface."""
+"""Linear models: FE meshes (scikit-fem) or user matrices, loads, springs, contact interfaces."""
 
 from fretwear.model.build import (
     ContactSpec,
@@ -13,6 +13,7 @@ from fretwear.model.build import (
 )
 from fretwear.model.core import ContactInterface, Load, Mesh, Model, ObservedPoint
 from fretwear.model.fem import assemble
+from fretwear.model.interfaces import combine, relative_model
 from fretwear.model.loads import (
     boundary_load,
     boundary_measure,
@@ -21,7 +22,7 @@ from fretwear.model.loads import (
     resultant,
 )
 from fretwear.model.matrices import from_matrices, read_matrix_market
-from fretwear.model.mesh import box, rectangle
+from fretwear.model.mesh import box, join, rectangle, transformed
 from fretwear.model.mesh import read as read_mesh
 
 __all__ = [
@@ -41,13 +42,17 @@ __all__ = [
     "boundary_measure",
     "box",
     "check_supported",
+    "combine",
     "from_matrices",
     "from_mesh",
+    "join",
     "nodal_areas",
     "nodal_force",
     "read_matrix_market",
     "read_mesh",
     "rectangle",
+    "relative_model",
     "resultant",
     "rigid_motion_check",
+    "transformed",
 ]

@@ -650,7 +650,10 @@ def from_mesh(mesh: Mesh, material: Material, *, thickness=1.0, damping: Damping
     ----------
     mesh : Mesh
         2D (plane strain) or 3D mesh (:mod:`fretwear.model.mesh`).
-    material : Material
+    material : Material, or dict body -> Material
+        One material, or one per body: ``body`` names a node set (e.g. the body names of
+        :func:`fretwear.model.mesh.join`); a cell belongs to the body that holds all its
+        nodes, and every cell must belong to exactly one body.
     thickness : float
         Out-of-plane width [m] of a 2D mesh; 1 in 3D.
     damping : Damping, optional
@@ -681,12 +684,16 @@ def from_mesh(mesh: Mesh, material: Material, *, thickness=1.0, damping: Damping
     if not isinstance(mesh, Mesh):
         raise InputError(f"mesh = {mesh!r} is not a fretwear Mesh")
     check_cells(mesh)
-    if not isinstance(material, Material):
-        raise InputError(f"material = {material!r} is not a Material(E, nu, rho)")
     if damping is not None and not isinstance(damping, Damping):
         raise InputError(f"damping = {damping!r} is not a Damping(...)")
     thickness = check_thickness(thickness, mesh.dim)
-    K0, M = assemble(mesh, material.E, material.nu, material.rho, thickness)
+    if isinstance(material, dict):
+        K0, M = _assemble_bodies(mesh, material, thickness)
+        material = next(iter(material.values()))
+    elif not isinstance(material, Material):
+        raise InputError(f"material = {material!r} is not a Material(E, nu, rho)")
+    else:
+        K0, M = assemble(mesh, material.E, material.nu, material.rho, thickness)
     Ks, fixed_dofs = _springs_and_fixed(mesh, springs, fixed)
     specs = [contact] if isinstance(contact, ContactSpec) else list(contact) \
         if isinstance(contact, Sequence) and not isinstance(contact, str) else [contact]
@@ -726,6 +733,44 @@ def from_mesh(mesh: Mesh, material: Material, *, thickness=1.0, damping: Damping
     )
     check_supported(model)
     return model
+
+
+def _assemble_bodies(mesh: Mesh, materials: dict, thickness: float):
+    """``K, M`` of a mesh whose bodies (node sets) have their own materials."""
+    nn, d = mesh.points.shape
+    cells = np.asarray(mesh.cells, dtype=np.int64)
+    owner = np.full(cells.shape[0], -1, dtype=np.int64)
+    K = sp.csr_matrix((d * nn, d * nn))
+    M = sp.csr_matrix((d * nn, d * nn))
+    for b, (body, mat) in enumerate(materials.items()):
+        if not isinstance(mat, Material):
+            raise InputError(f"material[{body!r}] = {mat!r} is not a Material(E, nu, rho)")
+        if body not in mesh.node_sets:
+            raise InputError(f"material: no body (node set) named {body!r}; the mesh has node "
+                             f"sets {sorted(mesh.node_sets)}")
+        inside = np.zeros(nn, dtype=bool)
+        inside[np.asarray(mesh.node_sets[body], dtype=np.int64)] = True
+        mine = np.flatnonzero(np.all(inside[cells], axis=1))
+        twice = mine[owner[mine] >= 0]
+        if twice.size:
+            raise InputError(f"material: cell {int(twice[0])} belongs to two bodies "
+                             f"({list(materials)[owner[twice[0]]]!r} and {body!r})")
+        owner[mine] = b
+        nodes = np.unique(cells[mine])
+        local = np.full(nn, -1, dtype=np.int64)
+        local[nodes] = np.arange(nodes.size)
+        part = Mesh(mesh.points[nodes], local[cells[mine]], mesh.cell_type)
+        Kb, Mb = assemble(part, mat.E, mat.nu, mat.rho, thickness)
+        dofs = (d * nodes[:, None] + np.arange(d)).ravel()
+        S = sp.csr_matrix((np.ones(dofs.size), (dofs, np.arange(dofs.size))),
+                          shape=(d * nn, dofs.size))
+        K = K + S @ Kb @ S.T
+        M = M + S @ Mb @ S.T
+    if np.any(owner < 0):
+        c = int(np.flatnonzero(owner < 0)[0])
+        raise InputError(f"material: cell {c} (nodes {cells[c].tolist()}) belongs to none of the "
+                         f"bodies {list(materials)}")
+    return K.tocsr(), M.tocsr()
 
 
 # --------------------------------------------------------------------------------------------
@@ -820,7 +865,19 @@ def check_supported(model: Model) -> None:
                                                                   model.fixed_dofs))
         return
     d = model.dim
-    R, centre, size = rigid_body_modes(model.mesh.points)
+    points = model.mesh.points
+    body = bodies(model.mesh)
+    nb = int(body.max()) + 1
+    # the rigid-body modes of every body (a mesh of several bodies: join, node-to-node pairs)
+    parts = []
+    for k in range(nb):
+        nodes = np.flatnonzero(body == k)
+        Rk, centre_k, size_k = rigid_body_modes(points[nodes])
+        dofs = (d * nodes[:, None] + np.arange(d)).ravel()
+        Rfull = np.zeros((model.ndof, Rk.shape[1]))
+        Rfull[dofs] = Rk
+        parts.append((Rfull, centre_k, size_k, int(nodes[0])))
+    R = np.hstack([p[0] for p in parts])
     c = model.contact
     # K R vanishes for the elastic structure (up to rounding); what remains is the springs'
     # reaction to each rigid mode. Entries within a rounding bound are cleared, and each
@@ -843,14 +900,39 @@ def check_supported(model: Model) -> None:
     free = Vt[rank:].T  # rigid motions that move no held direction and strain no spring
     if free.shape[1] == 0:
         return
-    motions = [_describe(a, d, centre, size) for a in _rref(free.T)]
+    nr = parts[0][0].shape[1]
+    motions = []
+    for a in _rref(free.T):
+        k = int(np.argmax([np.abs(a[j * nr:(j + 1) * nr]).max() for j in range(nb)]))
+        _, centre_k, size_k, first = parts[k]
+        words = _describe(a[k * nr:(k + 1) * nr], d, centre_k, size_k)
+        if nb > 1:
+            others = [j for j in range(nb) if j != k and np.abs(a[j * nr:(j + 1) * nr]).max()
+                      > 1e-8]
+            who = f"the body of node {first}" + (" (with others)" if others else "")
+            words = f"{who} can {words}"
+        motions.append(words)
     hint = ", ".join(f"Spring(at, {AXES[i]!r}, stiffness)" for i in range(d))
+    lead = "the structure can " if nb == 1 else ""
     raise InputError(
-        "with the contact held only along its normal (frictionless), the structure can "
+        "with the contact held only along its normal (frictionless), " + lead
         + (", ".join(motions[:-1]) + " and " if len(motions) > 1 else "") + motions[-1]
         + " with nothing to hold it but friction: add a spring or a fixed DOF (springs = ["
         + hint + "] or fixed = [(at, direction)]) at a node off the contact boundary"
     )
+
+
+def bodies(mesh: Mesh) -> np.ndarray:
+    """The body of every node (nn,) int: the connected components of the mesh's cells."""
+    from scipy.sparse.csgraph import connected_components
+
+    cells = np.asarray(mesh.cells, dtype=np.int64)
+    nn = mesh.points.shape[0]
+    k = cells.shape[1]
+    rows = np.repeat(cells, k, axis=1).ravel()
+    cols = np.tile(cells, (1, k)).ravel()
+    graph = sp.csr_matrix((np.ones(rows.size), (rows, cols)), shape=(nn, nn))
+    return connected_components(graph, directed=False)[1]
 
 
 def rigid_motion_check(K, held_dofs, *, dense_limit: int = 600) -> None:

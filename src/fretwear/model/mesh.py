@@ -184,6 +184,55 @@ def box(lx, ly, lz, nx, ny, nz, origin=(0.0, 0.0, 0.0)) -> Mesh:
     return mesh
 
 
+def join(*parts: tuple[str, Mesh]) -> Mesh:
+    """One mesh of several bodies that share no node: ``join(("blade", m1), ("disc", m2))``.
+
+    The bodies keep their nodes (coincident nodes of two bodies stay distinct: a node-to-node
+    interface pairs them, :class:`fretwear.model.build.ContactSpec` ``partner``); node
+    numbers of later bodies are offset by the earlier bodies' node counts. Every boundary and
+    node set is renamed ``"<body>.<name>"``, and each body's nodes form a node set named after
+    the body.
+
+    Raises InputError for meshes of different dimension or cell type, or repeated names.
+    """
+    if not parts:
+        raise InputError("join: expected at least one (name, mesh) pair")
+    names = [str(n) for n, _ in parts]
+    if len(set(names)) != len(names):
+        raise InputError(f"join: body names {names} repeat; expected distinct names")
+    kinds = {(m.dim, m.cell_type) for _, m in parts}
+    if len(kinds) != 1:
+        raise InputError(f"join: the meshes have (dimension, cell type) {sorted(kinds)}; "
+                         "expected one kind")
+    points, cells, boundaries, node_sets = [], [], {}, {}
+    offset = 0
+    for name, m in parts:
+        points.append(np.asarray(m.points, dtype=float))
+        cells.append(np.asarray(m.cells, dtype=np.int64) + offset)
+        for key, f in m.boundaries.items():
+            boundaries[f"{name}.{key}"] = np.asarray(f, dtype=np.int64) + offset
+        for key, s in m.node_sets.items():
+            node_sets[f"{name}.{key}"] = np.asarray(s, dtype=np.int64) + offset
+        node_sets[name] = offset + np.arange(m.points.shape[0])
+        offset += m.points.shape[0]
+    cell_type = parts[0][1].cell_type
+    return Mesh(np.vstack(points), np.vstack(cells), cell_type, boundaries, node_sets)
+
+
+def transformed(mesh: Mesh, rotation, shift=None) -> Mesh:
+    """The mesh moved rigidly: ``x -> rotation @ x + shift`` (``rotation`` (d, d)
+    orthogonal with determinant 1, ``shift`` (d,) [m])."""
+    R = np.asarray(rotation, dtype=float)
+    d = mesh.dim
+    if R.shape != (d, d) or not np.allclose(R @ R.T, np.eye(d), atol=1e-12) \
+            or np.linalg.det(R) <= 0:
+        raise InputError(f"rotation has shape {R.shape}; expected a ({d}, {d}) rotation matrix")
+    t = np.zeros(d) if shift is None else np.asarray(shift, dtype=float).reshape(d)
+    return Mesh(mesh.points @ R.T + t, mesh.cells.copy(), mesh.cell_type,
+                {k: v.copy() for k, v in mesh.boundaries.items()},
+                {k: v.copy() for k, v in mesh.node_sets.items()})
+
+
 # --------------------------------------------------------------------------------------------
 # facet geometry
 # --------------------------------------------------------------------------------------------

@@ -4,6 +4,8 @@ Per node, per cycle, evaluated on the converged DLFT samples with the *corrected
 ``X_T(n) - X_T(n-1)``, which is exactly zero in stick:
 
 * Archard (eq. 29): ``dW1_p = k_w sum_n p_N(n) |X_T(n) - X_T(n-1)|``, ``p_N = lambda_N/area``;
+  at a node-to-node pair both surfaces wear, each at its own coefficient, and the gap opens
+  by the sum (``k_w = k_w(a) + k_w(b)``; :func:`side_depths` splits it);
 * energy (Fouvry et al. 2003): worn volume = ``k_e`` x friction energy, so
   ``dW1_p = k_e E_p / area_p`` with ``E_p = sum_n lambda_T(n).(X_T(n) - X_T(n-1))``.
 
@@ -73,6 +75,26 @@ def wear_per_cycle(sol: PeriodicSolution, *, law_name: str = "archard",
             raise InputError("the energy law needs energy_coefficient k_e [m^3/J]")
         return float(energy_coefficient) * sol.friction_energy() / sol.area
     raise InputError(f"law = {law_name!r}: expected one of {LAWS}")
+
+
+def side_depths(model: Model, wear, law_name: str = "archard") -> tuple[np.ndarray, np.ndarray]:
+    """Worn depths ``(W_a, W_b)`` [m] of the two surfaces of every contact node from the
+    total ``wear`` (..., nc) [m] by which the gap opened.
+
+    Archard's law wears each surface at its own coefficient under the same pressure and slip
+    (eq. 29), so ``W_side = k_w(side) / (k_w(a) + k_w(b)) W``; a node-to-rigid node, a pair
+    whose partner's coefficient is 0 and the energy law (one coefficient ``k_e``) put all of
+    ``W`` on the surface of node ``a``.
+    """
+    c = model.contact
+    W = np.asarray(wear, dtype=float)
+    ka, kb = c.wear_nodes(), c.partner_wear_nodes()
+    if law_name != "archard":
+        kb = np.zeros_like(kb)
+    tot = ka + kb
+    share_b = np.divide(kb, tot, out=np.zeros_like(tot), where=tot > 0)
+    Wb = W * share_b
+    return W - Wb, Wb
 
 
 def worn_volume(wear: np.ndarray, area: np.ndarray) -> float:
