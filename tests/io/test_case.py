@@ -92,7 +92,7 @@ def test_valid_case_loads_with_defaults_and_builds(tmp_path):
     }
     assert case.output == {"figures": True, "figure_format": "png", "vtu": True}
     assert case.model["loads"][0]["waveform"] == "constant"
-    assert case.model["contact"]["gap"] == 0.0
+    assert case.model["contact"][0]["gap"] == 0.0  # [contact]: a list of one interface
     assert case.output_dir() == tmp_path / "case-results"
     model = build_model(case)
     assert model.contact.n_nodes == 7  # nx + 1 nodes on the bottom face
@@ -358,3 +358,37 @@ def test_note_when_an_observed_point_is_not_a_node(tmp_path):
         "note: observed.Pe = [0.1, 0.005] is not a mesh node; reporting the nearest node, "
         "at (0.1, 0.00333333)"
     ]
+
+
+def test_two_interfaces_in_one_case(tmp_path):
+    """Two [[contact]] blocks (the bottom on a rigid flat, the top under a rigid plate) build
+    one contact record with each node's interface and friction coefficient; a repeated name
+    and a key of node-to-node contact without a partner are refused with one line."""
+    two = BASE.replace('''[contact]
+boundary = "bottom"
+normal = [0.0, -1.0]
+mu = 0.3
+wear_coefficient = 1e-11
+''', '''[[contact]]
+boundary = "bottom"
+mu = 0.3
+name = "flat"
+
+[[contact]]
+boundary = "top"
+mu = 0.5
+name = "plate"
+''').replace('''[[loads]]
+boundary = "top"
+pressure = 1e4
+''', "")
+    model = build_model(load_case(write(tmp_path, two)))
+    c = model.contact
+    assert c.names() == ["flat", "plate"]
+    np.testing.assert_array_equal(c.mu_nodes(), [0.3] * 7 + [0.5] * 7)
+    np.testing.assert_array_equal(c.frame[c.interface_index() == 1, 0],
+                                  [[0.0, 1.0]] * 7)  # the top's outward normal
+    msg = error_of(tmp_path, two.replace('name = "plate"', 'name = "flat"'), build=True)
+    assert msg == "contact: two interfaces are named 'flat'; expected distinct names"
+    msg = error_of(tmp_path, two.replace('name = "plate"', 'name = "plate"\ntolerance = 1e-6'))
+    assert msg == "[contact[2]]: 'tolerance' needs 'partner'"

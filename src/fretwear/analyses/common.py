@@ -79,8 +79,16 @@ def geometry(model, points: list[str]) -> tuple[dict, dict]:
                                      "position of the contact node"),
         "contact_area": variable("contact_node", np.asarray(c.area, dtype=float), "m^2",
                                  "tributary area of the contact node"),
+        "contact_interface": interface_labels(model),
     }
     return coords, data
+
+
+def interface_labels(model):
+    """The interface name of every contact node (contact_node), a label variable."""
+    c = model.contact
+    names = np.asarray(c.names(), dtype=str)[c.interface_index()]
+    return variable("contact_node", names, "1", "interface of the contact node (its name)")
 
 
 def live_axes(ds: xr.Dataset, point: str) -> list[str]:

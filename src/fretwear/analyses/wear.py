@@ -19,7 +19,7 @@ import xarray as xr
 
 from fretwear import api
 from fretwear.analyses import figures as plots
-from fretwear.analyses.common import default_of
+from fretwear.analyses.common import default_of, interface_labels
 from fretwear.analyses.registry import RunOutput, register
 from fretwear.files import safe_name
 from fretwear.hb.contact import STATE_NAMES
@@ -45,6 +45,10 @@ from fretwear.io.schema import (
 from fretwear.timedomain.averaged_rate import RESPONSE_KINDS
 from fretwear.timedomain.fallback import FALLBACK
 from fretwear.wear import LAWS, SCHEMES, WearOptions, WearResult, frf_worn, simulate_wear
+from fretwear.wear.laws import side_depths
+
+#: the two worn surfaces of a contact node: its own, and its partner's (node-to-node pairs)
+SURFACES = ("contact", "partner")
 
 CHECKPOINT_FILE = "wear-checkpoint.npz"
 COMPONENTS = ("N", "T1", "T2")
@@ -100,8 +104,11 @@ def _steps_kept(n: int, every: int) -> np.ndarray:
 
 
 def wear_dataset(model, result: WearResult, basis: FourierBasis, *, frequency_hz: float,
-                 record_every: int = 1, frf=None) -> xr.Dataset:
-    """The results dataset of a wear run (``docs/results.md``, section ``wear``)."""
+                 record_every: int = 1, frf=None, law: str = "archard") -> xr.Dataset:
+    """The results dataset of a wear run (``docs/results.md``, section ``wear``); ``law``
+    splits the wear depth between the two surfaces of a pair
+    (:func:`fretwear.wear.laws.side_depths`)."""
+    opts_law = law
     h = result.history
     keep = _steps_kept(h.n_steps, record_every)
     c = model.contact
@@ -114,6 +121,8 @@ def wear_dataset(model, result: WearResult, basis: FourierBasis, *, frequency_hz
         "contact_state": label_coordinate("contact_state", STATE_NAMES,
                                           "contact state: separation, stick, slip"),
         "axis": label_coordinate("axis", AXES[:d]),
+        "surface": label_coordinate("surface", SURFACES,
+                                    "worn surface: the contact node's, its partner's"),
     }
     sn, sc = ("step", "contact_node"), ("step",)
     hist = {k: np.asarray(getattr(h, k))[keep] for k in (
@@ -127,6 +136,11 @@ def wear_dataset(model, result: WearResult, basis: FourierBasis, *, frequency_hz
                                      "position of the contact node"),
         "contact_area": variable("contact_node", np.asarray(c.area, float), "m^2",
                                  "tributary area of the contact node"),
+        "contact_interface": interface_labels(model),
+        "worn_depth_surface": variable(
+            ("step", "contact_node", "surface"),
+            np.stack(side_depths(model, hist["wear_depth"], opts_law), axis=-1), "m",
+            "worn depth of each surface (the contact node's, its partner's); their sum is W"),
         "excitation_frequency": variable((), frequency_hz, "Hz",
                                          "excitation frequency (time scale only if quasi-static)"),
         "penalty": variable((), result.penalty, "N/m", "DLFT penalty eps"),
@@ -362,7 +376,7 @@ def run_wear(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOu
     elif fb is not None:
         frf_note = "FRF before/after skipped: the model has no observed point"
     ds = wear_dataset(model, result, basis, frequency_hz=f_hz, record_every=a["record_every"],
-                      frf=frf)
+                      frf=frf, law=opts.law)
     figures = _figures(ds, case, outdir, nodes)
     h = result.history
     area = np.asarray(model.contact.area, float)

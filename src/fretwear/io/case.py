@@ -230,19 +230,34 @@ LOAD_MESH = Table(
 )
 CONTACT_MESH = Table(
     {
-        "boundary": Field(Text(), "boundary in contact with the rigid obstacle", required=True),
+        "boundary": Field(Text(), "boundary in contact with the rigid obstacle, or with the "
+                          "`partner` boundary of a second body", required=True),
         "mu": _MU,
-        "normal": Field(Vector(), "normal pointing from the structure into the obstacle "
-                        "(default: the outward normal of the boundary, which must then be flat)"),
+        "normal": Field(Vector(), "one normal for every node, pointing from the structure into "
+                        "the obstacle (default: the outward normal of the boundary; on a "
+                        "curved or multi-flank boundary each node's own, averaged from the "
+                        "facets around it)"),
         "tangent": Field(Vector(), "3D: first tangential direction (default: chosen from the "
                          "normal)"),
         "gap": Field(Number(), "initial normal gap (>= 0 open, < 0 interference)", default=0.0,
                      unit="m"),
         "wear_coefficient": _WEAR,
         "name": _CONTACT_NAME,
+        "partner": Field(Text(), "node-to-node contact: the boundary of the second body whose "
+                         "nodes face those of `boundary` (same positions, within `tolerance`); "
+                         "the contact law acts on their relative displacement"),
+        "tolerance": Field(_NON_NEG, "largest distance between paired nodes (default 1e-6 "
+                           "times the model size)", unit="m"),
+        "partner_wear_coefficient": Field(_NON_NEG, "Archard wear coefficient of the "
+                                          "partner's surface (the gap opens by the sum of both "
+                                          "worn depths; default 0)", unit="1/Pa"),
     },
-    checks=(non_zero("normal", "tangent"),),
-    doc="The frictional interface: the nodes of one boundary against a rigid flat.",
+    checks=(non_zero("normal", "tangent"),
+            requires("partner_wear_coefficient", "partner"),
+            requires("tolerance", "partner")),
+    doc="A frictional interface: the nodes of one boundary against a rigid obstacle, or "
+    "against the matching nodes of a second body (`partner`). Several interfaces: one "
+    "`[[contact]]` block each, with distinct names (a node belongs to one interface).",
 )
 OBSERVED_MESH = Dict(AnyOf((Vector(), Text())), key_doc="point names")
 
@@ -320,7 +335,7 @@ def _case_table(model_kind: str, analyses: Mapping[str, Table]) -> Table:
             "springs": Field(TableList(SPRING), "grounded springs", default=[]),
             "fixed": Field(TableList(FIXED), "held displacement components", default=[]),
             "loads": Field(TableList(LOAD_MESH), "loads", default=[]),
-            "contact": Field(CONTACT_MESH, "the frictional interface", required=True),
+            "contact": Field(TableList(CONTACT_MESH), "the frictional interfaces", required=True),
             "observed": Field(OBSERVED_MESH, "points whose motion is reported", default={}),
         }
     fields["analysis"] = Field(Variant(dict(analyses), key_doc="analysis type"),
@@ -532,12 +547,17 @@ def _check_against_mesh(m: dict, mesh, given: Mapping) -> None:
             _check_name(load["at"], f"{path}.at", anywhere)
         for key in ("at", "traction", "force"):
             _check_vector(load.get(key), f"{path}.{key}", dim)
-    contact = m["contact"]
-    _check_name(contact["boundary"], "contact.boundary", bnames)
-    if len(mesh.boundaries[contact["boundary"]]) == 0:
-        fail("contact.boundary", contact["boundary"], "a boundary with at least one facet")
-    for key in ("normal", "tangent"):
-        _check_vector(contact.get(key), f"contact.{key}", dim)
+    many = len(m["contact"]) > 1
+    for i, contact in enumerate(m["contact"]):
+        path = f"contact[{i + 1}]" if many else "contact"
+        for key in ("boundary", "partner"):
+            if key not in contact:
+                continue
+            _check_name(contact[key], f"{path}.{key}", bnames)
+            if len(mesh.boundaries[contact[key]]) == 0:
+                fail(f"{path}.{key}", contact[key], "a boundary with at least one facet")
+        for key in ("normal", "tangent"):
+            _check_vector(contact.get(key), f"{path}.{key}", dim)
     for name, where in m.get("observed", {}).items():
         if isinstance(where, str):
             _check_name(where, f"observed.{name}", mesh.node_sets)
@@ -568,10 +588,13 @@ def _build_from_mesh(m: dict, title: str, given: Mapping):
             loads.append(build.Traction(ld["boundary"], pressure=ld.get("pressure"),
                                         traction=ld.get("traction"), waveform=ld["waveform"],
                                         name=name, **coefficients))
-    c = m["contact"]
-    contact = build.ContactSpec(c["boundary"], c["mu"], normal=c.get("normal"),
-                                tangent=c.get("tangent"), gap=c["gap"],
-                                wear_coefficient=c["wear_coefficient"], name=c["name"])
+    contact = [build.ContactSpec(c["boundary"], c["mu"], normal=c.get("normal"),
+                                 tangent=c.get("tangent"), gap=c["gap"],
+                                 wear_coefficient=c["wear_coefficient"],
+                                 name=c["name"], partner=c.get("partner"),
+                                 tolerance=c.get("tolerance"),
+                                 partner_wear_coefficient=c.get("partner_wear_coefficient", 0.0))
+               for c in m["contact"]]
     observed = {k: _at(v) for k, v in m.get("observed", {}).items()} or None
     thickness = m["model"].get("thickness", 1.0) if mesh.dim == 2 else 1.0
     return build.from_mesh(

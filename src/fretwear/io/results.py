@@ -52,6 +52,7 @@ DIMENSIONS = {
     "dof": ("degree of freedom of the model, from 0", "1"),
     "contact_state": ("contact state: separation, stick, slip", "1"),
     "wear_state": ("interface before and after wear: unworn, worn", "1"),
+    "surface": ("worn surface: the contact node's, its partner's", "1"),
 }
 
 

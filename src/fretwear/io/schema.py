@@ -408,8 +408,8 @@ class TableList(Spec):
         return isinstance(value, list | tuple)
 
     def check(self, value, path, ctx):
-        if isinstance(value, Mapping):  # [name] written instead of [[name]]
-            value = [value]
+        if isinstance(value, Mapping):  # [name] written instead of [[name]]: one item,
+            return [self.table.check(value, path, ctx)]  # named as written
         if not isinstance(value, list | tuple):
             self._type_error(value, path)
         return [self.table.check(v, f"{path}[{i + 1}]", ctx) for i, v in enumerate(value)]

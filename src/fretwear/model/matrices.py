@@ -18,6 +18,7 @@ from fretwear.errors import InputError
 from fretwear.limits import check_loss_factor
 from fretwear.model.build import rigid_motion_check
 from fretwear.model.core import WAVEFORMS, ContactInterface, Load, Model, ObservedPoint
+from fretwear.model.interfaces import relative_model
 from fretwear.resources import require_memory
 
 SYMMETRY_TOL = 1e-9  # max |A - A^T| relative to max |A|
@@ -164,7 +165,9 @@ def _nonnegative(value, what: str) -> float:
 def from_matrices(K, M, *, contact_normal_dofs, contact_tangential_dofs, gap=0.0, area=1.0,
                   mu, normal_sign=1, C=None, D=None, loss_factor=None, loads=(),
                   fixed_dofs=(), observed=None, wear_coefficient=0.0, coords=None,
-                  name: str = "matrices", contact_name: str = "contact") -> Model:
+                  name: str = "matrices", contact_name: str = "contact",
+                  contact_partner_dofs=None, contact_frames=None,
+                  partner_wear_coefficient=0.0) -> Model:
     """A model from stiffness and mass matrices and a list of contact DOFs.
 
     Parameters
@@ -201,6 +204,16 @@ def from_matrices(K, M, *, contact_normal_dofs, contact_tangential_dofs, gap=0.0
         Label of the model.
     contact_name : str
         Label of the contact interface.
+    contact_partner_dofs : (nc, d) int, optional
+        Node-to-node contact: the DOFs of each contact node's partner on the second body, in
+        the order of the node's own DOFs ``[normal, tangential..]`` (the same axes); the law
+        acts on the relative displacement, with equal and opposite forces.
+    contact_frames : (nc, d, d), optional
+        Orthonormal rows ``[n, t1(, t2)]`` of each node's frame in the axes of its DOFs
+        ``[normal, tangential..]`` (e.g. DOF triplets x, y, z of a node on an inclined
+        flank); default: the identity, with ``normal_sign`` on the normal.
+    partner_wear_coefficient : float
+        Archard coefficient k_w [1/Pa] of the partners' surface (pairs only).
 
     Returns
     -------
@@ -252,6 +265,27 @@ def from_matrices(K, M, *, contact_normal_dofs, contact_tangential_dofs, gap=0.0
     sign = _per_node(normal_sign, nc, "normal_sign", signs=True)
     frame = np.broadcast_to(np.eye(dim), (nc, dim, dim)).copy()
     frame[:, 0, 0] = sign
+    if contact_frames is not None:
+        frame = np.asarray(contact_frames, dtype=float)
+        if frame.shape != (nc, dim, dim) or not np.all(np.isfinite(frame)):
+            raise InputError(f"contact_frames has shape {frame.shape}; expected ({nc}, {dim}, "
+                             f"{dim}) finite frames [n, t1(, t2)] of the {nc} contact nodes")
+        err = np.abs(frame @ np.swapaxes(frame, 1, 2) - np.eye(dim)).max(axis=(1, 2))
+        if np.any(err > 1e-9):
+            p = int(np.argmax(err))
+            raise InputError(f"contact_frames[{p}] is not orthonormal (rows [n, t1(, t2)] "
+                             f"off by {err[p]:.3g})")
+    partner = None
+    if contact_partner_dofs is not None:
+        partner = _dofs(contact_partner_dofs, n, "contact_partner_dofs")
+        if partner.shape != (nc, dim):
+            raise InputError(f"contact_partner_dofs has shape {partner.shape}; expected "
+                             f"({nc}, {dim}): the DOFs of each node's partner, ordered like "
+                             "its own [normal, tangential..]")
+        clash = np.intersect1d(partner, dofs)
+        if clash.size or np.unique(partner).size != partner.size:
+            raise InputError("contact_partner_dofs: a partner DOF is also a contact DOF or "
+                             "is listed twice; each pair has its own two nodes")
     if coords is None:
         xyz = np.zeros((nc, dim))
     else:
@@ -269,6 +303,10 @@ def from_matrices(K, M, *, contact_normal_dofs, contact_tangential_dofs, gap=0.0
         node_ids=np.full(nc, -1, dtype=np.int64),
         wear_coefficient=_nonnegative(wear_coefficient, "wear_coefficient"),
         name=str(contact_name),
+        partner_dofs=partner,
+        partner_ids=None if partner is None else np.full(nc, -1, dtype=np.int64),
+        partner_wear_coefficient=_nonnegative(partner_wear_coefficient,
+                                              "partner_wear_coefficient"),
     )
 
     if C is not None:
@@ -297,7 +335,10 @@ def from_matrices(K, M, *, contact_normal_dofs, contact_tangential_dofs, gap=0.0
         name=str(name),
         meta={"source": "matrices"},
     )
-    rigid_motion_check(K, np.union1d(normal, fixed))
+    # the DOF nearest to each normal is held; for pairs in the relative coordinates, where
+    # it holds n . (U_a - U_b)
+    held = np.union1d(dofs[np.arange(nc), np.argmax(np.abs(frame[:, 0, :]), axis=1)], fixed)
+    rigid_motion_check(relative_model(model)[0].K, held)
     return model
 
 
