@@ -435,3 +435,61 @@ def test_explicit_pairs_from_matrices_match_the_mesh_model():
                       contact_tangential_dofs=c.dofs[:, 1], mu=MU,
                       contact_partner_dofs=c.partner_dofs, contact_frames=2 * c.frame,
                       fixed_dofs=mesh_model.fixed_dofs)
+
+
+def test_wear_of_a_pair_on_a_stiff_held_body_is_the_rigid_obstacle_wear(tmp_path):
+    """A wear run (adaptive scheme, checkpoint written and resumed) on the soft block over a
+    1e6 times stiffer held base = the same run on a rigid flat: wear depths and step cycles
+    agree to 5 x the stiffness ratio (measured 1.3 x the ratio at ratios 1e-5 and 1e-6:
+    linear in the ratio). Resuming from the checkpoint after the run gives the same final
+    wear (the fingerprint takes the pair model)."""
+    from fretwear.wear import WearOptions, simulate_wear
+
+    scale = 1e7 / STEEL.E
+    soft = Material(1e7, 0.3, 7800.0 * scale)
+    models = {"pair": block_on_base(E_base=1e7 / 1e-6, block=soft, scale=scale,
+                                    kw=(1e-9, 3e-9)),
+              "rigid": block_on_rigid(block=soft, scale=scale)}
+    models["rigid"].contact.wear_coefficient = 4e-9  # the sum of both surfaces'
+    opts = WearOptions(max_steps=4, tolerance=0.1)
+    out = {k: simulate_wear(m, BASIS, frequency=F_HZ, options=opts,
+                            checkpoint=tmp_path / f"{k}.npz")
+           for k, m in models.items()}
+    wa, wb = out["pair"].history.wear_depth, out["rigid"].history.wear_depth
+    assert out["pair"].success and wb[-1].max() > 0
+    np.testing.assert_allclose(out["pair"].history.cycles, out["rigid"].history.cycles,
+                               rtol=5e-6)
+    np.testing.assert_allclose(wa, wb, rtol=0, atol=5e-6 * wb[-1].max())
+    again = simulate_wear(models["pair"], BASIS, frequency=F_HZ, options=opts,
+                          checkpoint=tmp_path / "pair.npz", resume=True)
+    assert again.resumed_from >= 0
+    np.testing.assert_array_equal(again.final_wear, out["pair"].final_wear)
+
+
+def test_time_integration_of_a_pair_on_a_stiff_held_body_is_the_rigid_obstacle_one():
+    """The time-domain reference takes pairs through the same change of variables in its
+    reduced model: 10 periods of the soft block on a 1e6 times stiffer held base = the block
+    on a rigid flat (contact forces and tip motion over the last period, to 20 x the
+    stiffness ratio: an O(ratio) perturbation carried through stick-slip transitions). Each
+    starts from its own periodic balance's state at t = 0 (the preload applied at once from
+    rest is a shock the contact solve of the first step does not settle); 256 steps per
+    period, because at 64 a few contact solves of either model, the rigid one included, do
+    not settle."""
+    from fretwear.hb.periodic import initial_state
+    from fretwear.timedomain.integrate import integrate
+
+    ratio = 1e-6
+    scale = 1e7 / STEEL.E
+    soft = Material(1e7, 0.3, 7800.0 * scale)
+    pair = block_on_base(E_base=1e7 / ratio, block=soft, scale=scale)
+    rigid = block_on_rigid(block=soft, scale=scale)
+    run = {}
+    for key, model in (("pair", pair), ("rigid", rigid)):
+        U0, V0 = initial_state(model, solve_periodic(model, BASIS, frequency=F_HZ, tol=1e-12))
+        run[key] = integrate(model, F_HZ, n_periods=10, steps_per_period=256, record="last",
+                             U0=U0, V0=V0)
+    a, b = run["pair"], run["rigid"]
+    assert a.success and b.success and np.any(b.state == 2)
+    np.testing.assert_allclose(a.lam, b.lam, rtol=0, atol=20 * ratio * np.abs(b.lam).max())
+    tip_a, tip_b = a.observed["tip"], b.observed["tip"]
+    np.testing.assert_allclose(tip_a, tip_b, rtol=0, atol=20 * ratio * np.abs(tip_b).max())
