@@ -10,7 +10,9 @@ analysis, load stepping, a conservation identity); the figures quoted in the doc
 measured (docs/examples.md).
 """
 
+import json
 import os
+import shutil
 import tomllib
 from pathlib import Path
 
@@ -74,14 +76,24 @@ def test_the_paper_examples_are_shipped():
         assert name in names, name
 
 
+_BUILT = {}  # model section (as JSON) -> model: examples sharing a model build it once
+
+
 @pytest.mark.parametrize("path", ALL_EXAMPLES, ids=lambda p: p.stem)
 def test_example_loads_validates_and_builds(path):
     case = load_case(path)
     assert case.title
     assert case.analysis["type"] == tomllib.loads(path.read_text())["analysis"]["type"]
-    model = build_model(case)
+    key = json.dumps(case.model, sort_keys=True, default=str)
+    if key not in _BUILT:
+        _BUILT[key] = build_model(case)
+    model = _BUILT[key]
     assert model.contact is not None
-    assert [p.name for p in model.observed] == ["Pe"]
+    names = [p.name for p in model.observed]
+    if path.stem.startswith(("salles2011", "stromberg1997", "beam-")):
+        assert names == ["Pe"]  # the paper's point
+    else:
+        assert names
 
 
 @pytest.mark.parametrize("khz", [30, 35, 70, 79])
@@ -412,3 +424,21 @@ def test_frf_before_and_after_wear_example(tmp_path):
     on_grid = [int(np.argmin(np.abs(ref.frequency_hz - f))) for f in ds["frequency"].values]
     np.testing.assert_allclose(amp[0], ref.amplitude("Pe", 0, 1)[on_grid], rtol=1e-12)
     assert np.abs(amp[1] / amp[0] - 1.0).max() > 1e-3
+
+
+def test_platform_damper_example_damps_the_stuck_resonance(tmp_path):
+    """The under-platform damper (three bodies, two node-to-node interfaces), reduced to
+    three frequencies around the stuck resonance (39.7 kHz) with one harmonic: every point
+    converges, the damper slips and dissipates (friction energy > 0; both interfaces named
+    per node), and its response stays below the linear one with a stuck damper, whose
+    resonance it damps (measured: 13 times below at 39.7 kHz)."""
+    shutil.copy(EXAMPLES / "platform-damper.msh", tmp_path)  # the case's mesh file
+    ds = run_reduced("platform-damper-frf.toml", tmp_path,
+                     numerics={"harmonics": 1, "n_samples": 16, "n_points": 3,
+                               "f_min": 38.5e3, "f_max": 41e3, "spacing": "linear"})
+    assert set(ds["contact_interface"].values.tolist()) == {"left", "right"}
+    assert ds["converged"].values.all() and ds["friction_energy"].values.min() > 0
+    nonlinear = ds["response_amplitude"].sel(point="left_tip", axis="y", harmonic=1).values
+    stuck = ds["linear_response_amplitude"].sel(interface="stuck", point="left_tip",
+                                                axis="y").values
+    assert nonlinear.max() < stuck.max()

@@ -493,3 +493,66 @@ def test_time_integration_of_a_pair_on_a_stiff_held_body_is_the_rigid_obstacle_o
     np.testing.assert_allclose(a.lam, b.lam, rtol=0, atol=20 * ratio * np.abs(b.lam).max())
     tip_a, tip_b = a.observed["tip"], b.observed["tip"]
     np.testing.assert_allclose(tip_a, tip_b, rtol=0, atol=20 * ratio * np.abs(tip_b).max())
+
+
+def mapped(nx, ny, x_of, height):
+    """A structured Q4 mesh of the region ``x_of(u, y)`` (u in [0, 1], y in [0, height])."""
+    m = rectangle(1.0, height, nx, ny)
+    u, y = m.points[:, 0].copy(), m.points[:, 1].copy()
+    m.points[:, 0] = x_of(u, y)
+    return m
+
+
+def dovetail_2d():
+    """A 2D dovetail root (20 mm wide at the bottom, 8 mm at the top, 6 mm high: 45 degree
+    flanks) between two disc blocks held at their bottoms, mirror-symmetric about x = 0 node
+    by node; node-to-node on both flanks; a radial static pull and a radial harmonic load on
+    the root's top."""
+    wb, wt, h, W = 0.02, 0.008, 0.006, 0.04
+
+    def flank(y):
+        return 0.5 * (wb - (wb - wt) * y / h)
+
+    root = mapped(6, 4, lambda u, y: (2 * u - 1) * flank(y), h)
+    right = mapped(4, 4, lambda u, y: flank(y) + u * (W / 2 - flank(y)), h)
+    left = mapped(4, 4, lambda u, y: -(flank(y) + (1 - u) * (W / 2 - flank(y))), h)
+    mesh = join(("root", root), ("left", left), ("right", right))
+    return from_mesh(
+        mesh, STEEL, thickness=0.01, damping=Damping(loss_factor=0.01),
+        fixed=[("left.bottom", "all"), ("right.bottom", "all")],
+        loads=[Traction("root.top", traction=(0.0, 200e6), waveform="constant"),
+               Traction("root.top", traction=(0.0, 150e6), waveform="cos")],
+        contact=[ContactSpec("root.left", mu=MU, partner="left.right", name="west",
+                             wear_coefficient=1e-13, partner_wear_coefficient=2e-13),
+                 ContactSpec("root.right", mu=MU, partner="right.left", name="east",
+                             wear_coefficient=1e-13, partner_wear_coefficient=2e-13)],
+    )
+
+
+def test_symmetric_dovetail_gives_symmetric_forces_and_wear():
+    """Mirror-symmetric model and loads: the contact forces and wear per cycle of the two
+    flanks are mirror images (normal forces and wear equal, tangential forces opposite: the
+    default tangents of mirrored normals point the same way along x), to rounding (1e-9 of
+    the largest: the balance's 1e-12 convergence test, conditioning ~1e3)."""
+    model = dovetail_2d()
+    c = model.contact
+    west, east = c.interface_index() == 0, c.interface_index() == 1
+    x = c.coords
+    mirror = np.array([int(np.flatnonzero(east & np.all(np.isclose(x, [-p[0], p[1]]), axis=1))[0])
+                       for p in x[west]])
+    np.testing.assert_allclose(c.frame[west][:, 0], c.frame[mirror][:, 0] * [-1, 1], atol=1e-15)
+    f = 3000.0
+    sol = solve_periodic(model, BASIS, frequency=f, tol=1e-12, raise_on_failure=True)
+    assert np.any(sol.state == 2) and np.any(sol.state == 1)
+    lam = sol.lam
+    scale = np.abs(lam).max()
+    np.testing.assert_allclose(lam[west][:, 0], lam[mirror][:, 0], rtol=0, atol=1e-9 * scale)
+    np.testing.assert_allclose(lam[west][:, 1], -lam[mirror][:, 1], rtol=0, atol=1e-9 * scale)
+    from fretwear.wear.kernels import slip_work
+
+    prob = DLFTProblem(condense(model, f, [0, *BASIS.harmonics]), c, BASIS, eps=sol.eps,
+                       anchor=sol.anchor)
+    lu, lx, state, _ = prob.time_law(sol.U.reshape(prob.m, -1))
+    dW = wear_coefficients(model) * slip_work(lu, lx, state, sol.eps)
+    assert dW.max() > 0
+    np.testing.assert_allclose(dW[west], dW[mirror], rtol=0, atol=1e-9 * dW.max())

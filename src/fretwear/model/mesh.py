@@ -343,8 +343,9 @@ def read(path) -> Mesh:
         nodes (merged with a vertex group of the same name, if any). Nodes used by no cell
         are removed and the remaining ones renumbered in their original order; duplicate
         cells (as Gmsh writes for an entity in several physical groups) are kept once; 2D
-        cells are made counter-clockwise. Groups of body cells (e.g. a physical surface in
-        2D; the model has one material) and groups of edges in 3D are ignored.
+        cells are made counter-clockwise. A named group of body cells (a physical volume in
+        3D, a physical surface in 2D: a body, e.g. for its material) becomes a node set of
+        its cells' nodes; groups of edges in 3D are ignored.
 
     Raises
     ------
@@ -416,6 +417,7 @@ def read(path) -> Mesh:
     for name, blocks in groups.items():
         facet_blocks = [a for t, a in blocks if t == facet_type]
         vertex_blocks = [a for t, a in blocks if t in _VERTEX_TYPES]
+        vertex_blocks += [a for t, a in blocks if t == cell_type]  # a body: its nodes
         wrong = sorted({t for t, _ in blocks if meshio_dim(t) == body_dim - 1} - {facet_type})
         if wrong:
             raise InputError(

@@ -56,7 +56,8 @@ def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int =
     steps_per_cycle : load steps per cycle.
     n_cycles : number of load cycles (physical, counting the jumps).
     cycle_jump : cycles represented by each computed cycle.
-    k_w : Archard coefficient [1/Pa]; default ``model.contact.wear_coefficient``.
+    k_w : Archard coefficient [1/Pa]; default ``model.contact.wear_coefficient`` (plus the
+        partners' coefficient at node-to-node pairs: the gap opens by both worn depths).
     record_every : record every this many computed cycles (and the last).
     wear0 : (nc,) initial wear [m].
     tol : relative tolerance of the contact solver.
@@ -73,7 +74,15 @@ def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int =
     n_cycles = count(n_cycles, "n_cycles", 1)
     J = count(cycle_jump, "cycle_jump", 1)
     rec_every = count(record_every, "record_every", 1)
-    kw = model.contact.wear_coefficient if k_w is None else k_w
+    if k_w is None:  # both surfaces of a pair wear: the gap opens at their summed rate
+        both = model.contact.wear_nodes() + model.contact.partner_wear_nodes()
+        if np.ptp(both) > 0.0:
+            raise InputError(f"contact: the Archard coefficients (both surfaces summed) differ "
+                             f"between nodes ({sorted(set(both.tolist()))[:4]} 1/Pa); "
+                             "incremental_wear takes one coefficient k_w")
+        kw = both[0]
+    else:
+        kw = k_w
     kw = float(kw)
     if not (math.isfinite(kw) and kw >= 0.0):
         raise InputError(f"k_w = {k_w!r}; expected an Archard coefficient >= 0 [1/Pa]")
