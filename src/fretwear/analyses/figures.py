@@ -245,3 +245,63 @@ def plot_state_map(ds, path: Path | str, *, title: str | None = None) -> Path:
     ax.legend(handles=handles, title="contact state", loc="upper left",
               bbox_to_anchor=(1.01, 1.0), fontsize="small")
     return save(fig, path)
+
+
+def surface_coordinates(position: np.ndarray) -> tuple[np.ndarray, list[str]]:
+    """In-surface coordinates (n, 2) [m] of the contact nodes of one interface (n, d), and
+    the axis labels: the two principal directions of the node cloud (a flank of a 3D
+    interface drawn flat, whatever its inclination); in 2D the abscissa along the boundary
+    and zero."""
+    p = np.asarray(position, dtype=float)
+    c = p - p.mean(axis=0)
+    _, _, Vt = np.linalg.svd(c, full_matrices=False)
+    uv = c @ Vt[:2].T if p.shape[1] == 3 else np.column_stack([c @ Vt[0], np.zeros(len(p))])
+    names = ["".join(f"{v:+.2f}{a}" for v, a in zip(row, AXIS_NAMES, strict=False)
+                     if abs(v) > 0.005) for row in Vt[:2]]
+    return uv, [f"along ({n}) [m]" for n in names]
+
+
+def wants_interface_maps(ds) -> bool:
+    """Maps per interface are drawn for 3D interfaces and for several interfaces (a single
+    2D interface has its profiles)."""
+    pos = np.asarray(ds["contact_position"].values, dtype=float)
+    three_d = pos.shape[1] == 3 and bool(np.all(np.isfinite(pos)))
+    return "contact_interface" in ds and (
+        three_d or len(set(np.asarray(ds["contact_interface"].values).tolist())) > 1)
+
+
+def plot_interface_maps(ds, fields, path: Path | str, *, title: str | None = None) -> Path:
+    """Maps of nodal quantities over each interface's surface: one row per interface (named by
+    ``contact_interface``), one panel per field. 3D interfaces are drawn flat in their own
+    principal directions (:func:`surface_coordinates`), each node a dot coloured by its
+    value; 2D interfaces as curves along the boundary.
+
+    Parameters
+    ----------
+    ds : a results dataset with ``contact_position`` and ``contact_interface``.
+    fields : list of ``(label, values (nc,), unit)``.
+    """
+    pos = np.asarray(ds["contact_position"].values, dtype=float)
+    pos = pos[:, np.all(np.isfinite(pos), axis=0)]
+    names = np.asarray(ds["contact_interface"].values).astype(str)
+    order = list(dict.fromkeys(names.tolist()))
+    fig, axes = new_figure(len(order), len(fields), title=title, panel_size=(4.4, 3.4))
+    for i, name in enumerate(order):
+        sel = names == name
+        uv, labels = surface_coordinates(pos[sel])
+        for j, (label, values, unit) in enumerate(fields):
+            ax = axes[i, j]
+            v = np.asarray(values, dtype=float)[sel]
+            if pos.shape[1] == 3:
+                sc = ax.scatter(uv[:, 0], uv[:, 1], c=v, s=28, cmap="viridis")
+                fig.colorbar(sc, ax=ax, label=f"{label} [{unit}]")
+                ax.set_ylabel(labels[1])
+                ax.set_aspect("equal", adjustable="datalim")
+            else:
+                o = np.argsort(uv[:, 0])
+                ax.plot(uv[o, 0], v[o], marker=".")
+                ax.set_ylabel(f"{label} [{unit}]")
+            ax.set_xlabel(labels[0])
+            ax.set_title(f"{name}: {label}", fontsize="small")
+            ax.grid(True, alpha=0.3)
+    return save(fig, path)

@@ -225,6 +225,14 @@ def _periodic_figures(ds: xr.Dataset, case, outdir: Path, title: str) -> list[Pa
         p = figure_path(case, outdir, stem)
         if p is not None:
             figures.append(plot(ds, p, title=title))
+    p = figure_path(case, outdir, "interface-maps")
+    if p is not None and plots.wants_interface_maps(ds):
+        state = ds["contact_state"].values
+        fields = [("mean pressure", ds["pressure_mean"].values, "Pa"),
+                  ("max pressure", ds["pressure_max"].values, "Pa"),
+                  ("stick fraction", np.mean(state == 1, axis=1), "-"),
+                  ("slip path", ds["slip_path"].values, "m")]
+        figures.append(plots.plot_interface_maps(ds, fields, p, title=title))
     return figures
 
 
@@ -234,7 +242,8 @@ def write_period_fields(model, sol: PeriodicSolution, pvd: Path) -> Path:
     Every DOF is recovered from the contact solution (:func:`fretwear.hb.reduce.recover`, exact)
     and sampled at the ``N`` instants of the period: one ``.vtu`` per instant in the folder
     ``pvd.stem`` (point arrays ``displacement`` [m], ``contact_state`` and
-    ``contact_pressure`` [Pa], NaN off the interface), stepped through by the ``.pvd`` with
+    ``contact_pressure`` [Pa] on both surfaces of node-to-node pairs, NaN off the
+    interfaces), stepped through by the ``.pvd`` with
     the time [s] as time step.
 
     Returns
@@ -253,6 +262,11 @@ def write_period_fields(model, sol: PeriodicSolution, pvd: Path) -> Path:
     pressure = np.full((nn, b.n_samples), np.nan)
     state[nodes] = sol.state
     pressure[nodes] = sol.pressure_t()
+    c = model.contact
+    if c.has_pairs:  # both surfaces of a pair: its partner node shows the same contact
+        pair = c.paired()
+        state[np.asarray(c.partner_ids)[pair]] = sol.state[pair]
+        pressure[np.asarray(c.partner_ids)[pair]] = sol.pressure_t()[pair]
     folder = pvd.parent / pvd.stem
     entries = []
     for j, t in enumerate(sol.time):

@@ -27,7 +27,7 @@ from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.penalty import RULES
 from fretwear.hb.solvers import SOLVERS
 from fretwear.hb.sweep import frequency_grid
-from fretwear.io.results import label_coordinate, variable
+from fretwear.io.results import label_coordinate, variable, write_pvd, write_vtu
 from fretwear.io.schema import (
     MISSING,
     AnyOf,
@@ -378,6 +378,9 @@ def run_wear(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOu
     ds = wear_dataset(model, result, basis, frequency_hz=f_hz, record_every=a["record_every"],
                       frf=frf, law=opts.law)
     figures = _figures(ds, case, outdir, nodes)
+    files = [outdir / CHECKPOINT_FILE]
+    if model.mesh is not None and case.output["vtu"]:
+        files.append(write_wear_fields(model, ds, outdir / "wear.pvd"))
     h = result.history
     area = np.asarray(model.contact.area, float)
     w = h.wear_depth[-1]
@@ -392,8 +395,31 @@ def run_wear(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOu
     ]
     if frf_note:
         lines.append(frf_note)
-    return RunOutput(ds, figures, "\n".join(lines), result.success,
-                     [outdir / CHECKPOINT_FILE])
+    return RunOutput(ds, figures, "\n".join(lines), result.success, files)
+
+
+def write_wear_fields(model, ds, pvd: Path) -> Path:
+    """ParaView series of the worn surfaces: one ``.vtu`` per recorded step in the folder
+    ``pvd.stem`` with the point array ``worn_depth`` [m] (each surface's own depth on its
+    own nodes: the contact nodes and, at node-to-node pairs, their partners; NaN off the
+    interfaces), stepped through by the ``.pvd`` with the cycle count as time."""
+    mesh = model.mesh
+    c = model.contact
+    nn = mesh.points.shape[0]
+    ids = np.asarray(c.node_ids)
+    pair = c.paired()
+    partner = np.asarray(c.partner_ids)[pair] if c.has_pairs else np.zeros(0, dtype=int)
+    worn = ds["worn_depth_surface"].values
+    folder = pvd.parent / pvd.stem
+    entries = []
+    for k, cycles in enumerate(ds["cycles"].values):
+        w = np.full(nn, np.nan)
+        w[ids] = worn[k, :, 0]
+        w[partner] = worn[k, pair, 1]
+        path = write_vtu(folder / f"step-{k:04d}.vtu", mesh, {"worn_depth": w},
+                         {"cycles": float(cycles)})
+        entries.append((float(cycles), path))
+    return write_pvd(pvd, entries)
 
 
 def _figures(ds, case, outdir: Path, nodes) -> list[Path]:
@@ -410,6 +436,14 @@ def _figures(ds, case, outdir: Path, nodes) -> list[Path]:
                            title=f"{t}: pressure and slip"),
         plot_worn_volume(ds, outdir / f"worn-volume.{fmt}", title=f"{t}: worn volume"),
     ]
+    if plots.wants_interface_maps(ds):
+        last = ds["worn_depth_surface"].values[-1]
+        fields = [("worn depth, contact surface", last[:, 0], "m")]
+        if np.any(last[:, 1] > 0):
+            fields.append(("worn depth, partner surface", last[:, 1], "m"))
+        fields.append(("mean pressure (last step)", ds["pressure_mean"].values[-1], "Pa"))
+        figs.append(plots.plot_interface_maps(ds, fields, outdir / f"wear-maps.{fmt}",
+                                              title=f"{t}: worn surfaces"))
     if "frf_amplitude" in ds:
         for p in ds["point"].values:
             path = outdir / f"frf-worn-{safe_name(str(p))}.{fmt}"
@@ -503,7 +537,9 @@ DOC = (
     "volume, a depth or a cycle count. A checkpoint `wear-checkpoint.npz` in the results "
     "folder lets `fretwear run CASE.toml --resume` continue an interrupted run to the same "
     "result. Writes `wear-profile.png`, `wear-kinetics.png`, `pressure-slip.png`, "
-    "`worn-volume.png` and, with `frf_before_after`, `frf-worn-<point>.png`."
+    "`worn-volume.png`, with several or 3D interfaces `wear-maps.png` (worn depth of each "
+    "surface over each interface), with `frf_before_after` `frf-worn-<point>.png`, and for "
+    "mesh models the ParaView series `wear.pvd` of the worn surfaces."
 )
 
 register("wear", SCHEMA, run_wear, checks=CHECKS, doc=DOC, files=(CHECKPOINT_FILE,))

@@ -33,7 +33,8 @@ def combine(interfaces) -> ContactInterface:
 
     The nodes keep their order, interface after interface; ``interface`` holds each node's
     interface index and ``interface_names`` the names (which must differ). Per-interface
-    numbers (``mu``, wear coefficients) become per-node arrays.
+    numbers (``mu``, wear coefficients) become per-node arrays, or stay one number when all
+    interfaces have the same.
 
     Raises
     ------
@@ -92,6 +93,10 @@ def combine(interfaces) -> ContactInterface:
         interface_names=tuple(names),
     )
     check_distinct(out)
+    for key in ("mu", "wear_coefficient", "partner_wear_coefficient"):
+        v = np.asarray(getattr(out, key))
+        if v.size and np.all(v == v[0]):  # one number for every node stays one number
+            setattr(out, key, float(v[0]))
     if not out.has_pairs:
         out.partner_dofs = out.partner_ids = None
     return out

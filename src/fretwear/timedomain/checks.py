@@ -45,8 +45,9 @@ def check_contact(model: Model) -> None:
         raise InputError(f"contact DOF {int(fixed[0])} is also a fixed DOF; a contact node must "
                          "be free to move in all its directions for the time-domain solver")
     if np.ndim(c.mu) != 0:
-        raise InputError(f"contact.mu differs between interfaces ({sorted(set(c.mu_nodes()))}); "
-                         "the time-domain solver takes one friction coefficient")
+        raise InputError(f"contact.mu differs between interfaces "
+                         f"({sorted(set(c.mu_nodes().tolist()))}); the time-domain solver "
+                         "takes one friction coefficient")
     if not (np.isfinite(c.mu) and c.mu >= 0.0):
         raise InputError(f"contact.mu = {c.mu!r}; expected a friction coefficient >= 0")
 

@@ -1,0 +1,94 @@
+"""Cost of the two-body dovetail example (a 3D blade root in a disc slot, two node-to-node
+flanks; src/fretwear/examples/dovetail-frf.toml and dovetail-wear.toml).
+
+Prints, on this machine and in this run, with the number of unknowns of each stage:
+- the model: DOFs, contact pairs, reduced DOFs (3 per pair, relative displacements);
+- the condensation on the pairs' relative DOFs for harmonics [0, 1] and [0, 1, 2, 3];
+- one periodic solve at 2.4 kHz with 1 and with 3 harmonics (unknowns = reduced DOFs x
+  coefficients), and as a machine reference the time of one dense LU factorisation of the
+  Jacobian's size, timed in the same run (``solve_over_lu``);
+- one slow wear step of the wear example (its first step after the unworn balance);
+- a nonlinear FRF of ``--points`` (default 50) points from 1.9 to 2.8 kHz with the example's
+  settings (1 harmonic), and how many converged.
+
+Run: ``python benchmarks/dovetail.py [--points 50] [--quick]`` (``--quick`` skips the FRF).
+Quote the figures with the machine load (``uptime``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+import scipy.linalg as sla
+
+from fretwear.analyses.run import load_case
+from fretwear.examples import example_path
+from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.periodic import solve_periodic
+from fretwear.hb.reduce import condense
+from fretwear.hb.sweep import sweep
+from fretwear.io.case import build_model
+from fretwear.wear import WearOptions, simulate_wear
+
+
+def _timed(fn):
+    t0 = time.perf_counter()
+    out = fn()
+    return out, time.perf_counter() - t0
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--points", type=int, default=50, help="points of the FRF sweep")
+    ap.add_argument("--quick", action="store_true", help="skip the FRF sweep")
+    args = ap.parse_args()
+
+    model, t_build = _timed(lambda: build_model(load_case(example_path("dovetail-frf"))))
+    c = model.contact
+    m = c.n_nodes * c.dim
+    print(f"model: {model.ndof} DOFs, {c.n_nodes} node-to-node pairs on "
+          f"{len(c.names())} flanks, {m} reduced DOFs; built in {t_build:.2f} s")
+
+    f = 2400.0
+    for orders in ([0, 1], [0, 1, 2, 3]):
+        _, t = _timed(lambda o=orders: condense(model, f, o))
+        print(f"condensation, harmonics {orders}: {t:.2f} s")
+
+    for nh in (1, 3):
+        basis = FourierBasis.up_to(nh, 16 * nh)
+        red = condense(model, f, [0, *basis.harmonics])
+        sol, t = _timed(lambda b=basis, r=red: solve_periodic(model, b, frequency=f,
+                                                              reduced=r, eps="static"))
+        n = m * basis.size
+        A = np.random.default_rng(0).standard_normal((n, n))
+        _, t_lu = _timed(lambda a=A: sla.lu_factor(a))
+        st = sol.stats
+        print(f"periodic solve, {nh} harmonic(s): {n} unknowns, {t:.2f} s "
+              f"({st.iterations} iterations, success={sol.success}); dense LU of {n}: "
+              f"{t_lu:.3f} s; solve_over_lu={t / t_lu:.1f}")
+
+    wear_model = build_model(load_case(example_path("dovetail-wear")))
+    wcase = load_case(example_path("dovetail-wear"))
+    wb = FourierBasis.up_to(wcase.analysis["harmonics"], wcase.analysis["n_samples"])
+    res, t = _timed(lambda: simulate_wear(wear_model, wb, frequency=wcase.analysis["frequency"],
+                                          eps="static", options=WearOptions(max_steps=1)))
+    h = res.history
+    print(f"wear: first slow step {h.wall_time[-1]:.2f} s (run with the unworn balance "
+          f"{t:.2f} s, {m * wb.size} unknowns, jump {h.jump[-1]:.3g} cycles, "
+          f"success={res.success})")
+
+    if not args.quick:
+        case = load_case(example_path("dovetail-frf"))
+        a = case.analysis
+        basis = FourierBasis.up_to(a["harmonics"], a["n_samples"])
+        res, t = _timed(lambda: sweep(model, basis, a["f_min"], a["f_max"], args.points,
+                                      spacing="linear", eps="static", progress=False))
+        ok = int(np.sum(res.point_success))
+        print(f"FRF: {args.points} points, {m * basis.size} unknowns each, {t:.1f} s "
+              f"({t / args.points:.2f} s per point); sweep_converged={ok}/{len(res.points)}")
+
+
+if __name__ == "__main__":
+    main()
