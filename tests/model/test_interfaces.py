@@ -556,3 +556,4 @@ def test_symmetric_dovetail_gives_symmetric_forces_and_wear():
     dW = wear_coefficients(model) * slip_work(lu, lx, state, sol.eps)
     assert dW.max() > 0
     np.testing.assert_allclose(dW[west], dW[mirror], rtol=0, atol=1e-9 * dW.max())
+
