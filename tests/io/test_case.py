@@ -392,3 +392,30 @@ pressure = 1e4
     assert msg == "contact: two interfaces are named 'flat'; expected distinct names"
     msg = error_of(tmp_path, two.replace('name = "plate"', 'name = "plate"\ntolerance = 1e-6'))
     assert msg == "[contact[2]]: 'tolerance' needs 'partner'"
+
+
+def test_materials_of_bodies(tmp_path):
+    """[materials.<body>] on the damper example's mesh (three bodies): the damper in steel
+    gives the stiffness of the one-material model (the same elements assembled body by
+    body, to rounding); the damper in a material twice as stiff changes only the damper's
+    rows; an unknown body is named."""
+    import shutil
+
+    from fretwear.examples import EXAMPLES_DIR
+
+    shutil.copy(EXAMPLES_DIR / "platform-damper.msh", tmp_path)
+    text = (EXAMPLES_DIR / "platform-damper-frf.toml").read_text()
+    one = build_model(load_case(write(tmp_path, text)))
+    steel = "\n[materials.damper]\nE = 210e9\nnu = 0.3\nrho = 7800.0\n"
+    head, tail = text.split("[damping]", 1)
+    same = build_model(load_case(write(tmp_path, head + steel + "\n[damping]" + tail)))
+    scale = abs(one.K).max()
+    assert abs(same.K - one.K).max() <= 1e-12 * scale
+    stiff = build_model(load_case(write(tmp_path, head + steel.replace("210e9", "420e9")
+                                        + "\n[damping]" + tail)))
+    changed = np.unique((abs(stiff.K - one.K) > 1e-9 * scale).nonzero()[0]) // 2
+    damper = one.mesh.node_sets["damper"]
+    assert changed.size and np.all(np.isin(changed, damper))
+    msg = error_of(tmp_path, head + steel.replace("damper]", "dampr]") + "\n[damping]" + tail,
+                   build=True)
+    assert msg.startswith('materials.dampr = "dampr": expected one of')

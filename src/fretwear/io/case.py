@@ -337,6 +337,11 @@ def _case_table(model_kind: str, analyses: Mapping[str, Table]) -> Table:
             "loads": Field(TableList(LOAD_MESH), "loads", default=[]),
             "contact": Field(TableList(CONTACT_MESH), "the frictional interfaces", required=True),
             "observed": Field(OBSERVED_MESH, "points whose motion is reported", default={}),
+            "materials": Field(Dict(MATERIAL, key_doc="body (node set) names"),
+                               "materials of some bodies, by the name of the node set that "
+                               "holds a body (e.g. a Gmsh physical volume); a cell with all "
+                               "its nodes in such a set takes its material, the others take "
+                               "[material]", default={}),
         }
     fields["analysis"] = Field(Variant(dict(analyses), key_doc="analysis type"),
                                "what to compute", required=True)
@@ -366,7 +371,7 @@ def validate(raw: Mapping, analyses: Mapping[str, Table], base_dir: Path | str =
 
 # --- loading ----------------------------------------------------------------------------
 _MODEL_SECTIONS = ("model", "material", "damping", "springs", "fixed", "loads", "contact",
-                   "observed")
+                   "observed", "materials")
 
 
 @dataclass
@@ -573,6 +578,12 @@ def _build_from_mesh(m: dict, title: str, given: Mapping):
     mesh = _make_mesh(m["model"])
     _check_against_mesh(m, mesh, given)
     mat = m["material"]
+    material = build.Material(mat["E"], mat["nu"], mat["rho"])
+    if m.get("materials"):
+        for body in m["materials"]:
+            _check_name(body, f"materials.{body}", mesh.node_sets)
+        material = {**{body: build.Material(v["E"], v["nu"], v["rho"])
+                       for body, v in m["materials"].items()}, None: material}
     damp = m["damping"]
     springs = [build.Spring(_at(s["at"]), s["direction"], s["stiffness"])
                for s in m.get("springs", [])]
@@ -599,7 +610,7 @@ def _build_from_mesh(m: dict, title: str, given: Mapping):
     thickness = m["model"].get("thickness", 1.0) if mesh.dim == 2 else 1.0
     return build.from_mesh(
         mesh,
-        build.Material(mat["E"], mat["nu"], mat["rho"]),
+        material,
         thickness=thickness,
         damping=build.Damping(damp["loss_factor"], damp["rayleigh_mass"],
                               damp["rayleigh_stiffness"]),
@@ -749,8 +760,9 @@ differ between the two; `[material]`, `[[springs]]` and `[[fixed]]` exist for me
 | `[[springs]]` | grounded springs (meshes, optional) |
 | `[[fixed]]` | held displacement components (meshes, optional) |
 | `[[loads]]` | loads (optional) |
-| `[contact]` | the frictional interface (required) |
+| `[contact]` | the frictional interface, or `[[contact]]` blocks for several (required) |
 | `[observed]` | points (meshes) or DOFs (matrices) whose motion is reported (optional) |
+| `[materials.<body>]` | material of the cells of node set `<body>` (meshes, optional) |
 | `[analysis]` | what to compute (required) |
 | `[output]` | where and what to write (optional) |
 """

@@ -653,7 +653,8 @@ def from_mesh(mesh: Mesh, material: Material, *, thickness=1.0, damping: Damping
     material : Material, or dict body -> Material
         One material, or one per body: ``body`` names a node set (e.g. the body names of
         :func:`fretwear.model.mesh.join`); a cell belongs to the body that holds all its
-        nodes, and every cell must belong to exactly one body.
+        nodes, and every cell must belong to exactly one body, or to the key ``None``
+        (every cell of no listed body).
     thickness : float
         Out-of-plane width [m] of a 2D mesh; 1 in 3D.
     damping : Damping, optional
@@ -742,19 +743,27 @@ def _assemble_bodies(mesh: Mesh, materials: dict, thickness: float):
     owner = np.full(cells.shape[0], -1, dtype=np.int64)
     K = sp.csr_matrix((d * nn, d * nn))
     M = sp.csr_matrix((d * nn, d * nn))
-    for b, (body, mat) in enumerate(materials.items()):
+    named = [(b, m) for b, m in materials.items() if b is not None]
+    if None in materials:  # the cells of no listed body
+        named.append((None, materials[None]))
+    for b, (body, mat) in enumerate(named):
         if not isinstance(mat, Material):
             raise InputError(f"material[{body!r}] = {mat!r} is not a Material(E, nu, rho)")
-        if body not in mesh.node_sets:
+        if body is None:
+            mine = np.flatnonzero(owner < 0)
+            if mine.size == 0:
+                continue
+        elif body not in mesh.node_sets:
             raise InputError(f"material: no body (node set) named {body!r}; the mesh has node "
                              f"sets {sorted(mesh.node_sets)}")
-        inside = np.zeros(nn, dtype=bool)
-        inside[np.asarray(mesh.node_sets[body], dtype=np.int64)] = True
-        mine = np.flatnonzero(np.all(inside[cells], axis=1))
+        else:
+            inside = np.zeros(nn, dtype=bool)
+            inside[np.asarray(mesh.node_sets[body], dtype=np.int64)] = True
+            mine = np.flatnonzero(np.all(inside[cells], axis=1))
         twice = mine[owner[mine] >= 0]
         if twice.size:
             raise InputError(f"material: cell {int(twice[0])} belongs to two bodies "
-                             f"({list(materials)[owner[twice[0]]]!r} and {body!r})")
+                             f"({named[owner[twice[0]]][0]!r} and {body!r})")
         owner[mine] = b
         nodes = np.unique(cells[mine])
         local = np.full(nn, -1, dtype=np.int64)
