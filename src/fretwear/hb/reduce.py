@@ -23,9 +23,13 @@ of eq. 19 (:func:`_schur`).
 from __future__ import annotations
 
 import math
+import warnings
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from fretwear.errors import InputError
@@ -78,93 +82,358 @@ class Reduced:
 def dynamic_stiffness(model: Model, frequency: float, n: int, quasi_static: bool = False):
     """Sparse complex ``Z_n`` [N/m] on all DOFs (eq. 18 in complex form) at the excitation
     ``frequency`` [Hz] (harmonic ``n`` of it)."""
-    return _dynamic_stiffness(model, 2 * np.pi * frequency, n, quasi_static)
+    return _dynamic_stiffness(_structure(model), 2 * np.pi * frequency, n, quasi_static)
 
 
-def _dynamic_stiffness(model: Model, omega: float, n: int, quasi_static: bool = False):
-    """:func:`dynamic_stiffness` at the circular frequency ``omega`` [rad/s]."""
-    K = model.K.tocsc()
+@dataclass
+class Structure:
+    """What the condensation reads from a model, read in one place (:func:`_structure`).
+
+    K, M : (ndof, ndof) sparse CSR [N/m], [kg]; C, D : viscous [N s/m] and hysteretic [N/m]
+    damping or None; load_harmonics : ``nmax -> (nmax+1, ndof)`` complex load amplitudes [N]
+    (:meth:`fretwear.model.core.Model.load_harmonics`); fixed : held DOFs; cdofs : (m,)
+    contact DOFs node-major; frame : (nc, d, d) local frames; obs : global DOFs of the
+    observed points in the order of ``model.observed``.
+    """
+
+    K: sp.csr_matrix
+    M: sp.csr_matrix
+    C: sp.csr_matrix | None
+    D: sp.csr_matrix | None
+    load_harmonics: object
+    fixed: np.ndarray
+    cdofs: np.ndarray
+    frame: np.ndarray
+    obs: np.ndarray
+
+    @property
+    def ndof(self) -> int:
+        return int(self.K.shape[0])
+
+
+def _structure(model: Model) -> Structure:
+    """The structure's matrices, loads, contact DOFs and observed DOFs as the condensation
+    sees them: every read of ``model.K/M/C/D``, the loads and the observed DOFs in this module
+    goes through here (a change of coordinates of the model applies in one place)."""
+    obs = (np.concatenate([np.asarray(p.dofs, dtype=np.int64) for p in model.observed])
+           if model.observed else np.zeros(0, dtype=np.int64))
+    return Structure(
+        K=sp.csr_matrix(model.K), M=sp.csr_matrix(model.M),
+        C=None if model.C is None else sp.csr_matrix(model.C),
+        D=None if model.D is None else sp.csr_matrix(model.D),
+        load_harmonics=model.load_harmonics,
+        fixed=np.asarray(model.fixed_dofs, dtype=np.int64),
+        cdofs=np.asarray(model.contact.dofs, dtype=np.int64).reshape(-1),
+        frame=np.asarray(model.contact.frame, dtype=float), obs=obs)
+
+
+def _dynamic_stiffness(s: Structure, omega: float, n: int, quasi_static: bool = False):
+    """Sparse complex ``Z_n`` of the structure ``s`` at the circular frequency ``omega``."""
+    K = s.K.tocsc()
     if n == 0 or quasi_static:
         return K.astype(complex)
     w = n * omega
-    Z = K.astype(complex) - (w * w) * model.M.tocsc()
-    if model.D is not None:
-        Z = Z + 1j * model.D.tocsc()
-    if model.C is not None:
-        Z = Z + (1j * w) * model.C.tocsc()
+    Z = K.astype(complex) - (w * w) * s.M.tocsc()
+    if s.D is not None:
+        Z = Z + 1j * s.D.tocsc()
+    if s.C is not None:
+        Z = Z + (1j * w) * s.C.tocsc()
     return Z.tocsc()
 
 
-def _partition(model: Model):
-    free = model.free_dofs()
-    cdofs = model.contact.dofs.reshape(-1)
-    if np.intersect1d(cdofs, model.fixed_dofs).size:
+def _partition(s: Structure):
+    cdofs = s.cdofs
+    if np.intersect1d(cdofs, s.fixed).size:
         raise InputError("contact DOFs cannot also be fixed (Dirichlet) DOFs")
-    is_c = np.zeros(model.ndof, dtype=bool)
-    is_c[cdofs] = True
-    idofs = free[~is_c[free]]
-    return cdofs, idofs
+    keep = np.ones(s.ndof, dtype=bool)
+    keep[s.fixed] = False
+    keep[cdofs] = False
+    return cdofs, np.flatnonzero(keep)
 
 
-def _frame_matrix(model: Model) -> np.ndarray:
+def _frame_matrix(s: Structure) -> np.ndarray:
     """Block-diagonal R (m, m) with ``u_loc = R @ U[cdofs]``."""
-    frame = model.contact.frame
-    nc, d, _ = frame.shape
+    nc, d, _ = s.frame.shape
     R = np.zeros((nc * d, nc * d))
     for p in range(nc):
-        R[p * d : (p + 1) * d, p * d : (p + 1) * d] = frame[p]
+        R[p * d : (p + 1) * d, p * d : (p + 1) * d] = s.frame[p]
     return R
 
 
+def _singular(n: int, omega: float, near: bool) -> InputError:
+    if near:
+        return InputError(
+            f"the structure with its contact DOFs held is (nearly) singular at harmonic {n}: "
+            "part of the model can move with nothing to hold it (add springs or fixed DOFs)")
+    return InputError(
+        f"the structure with its contact DOFs held is singular at harmonic {n} "
+        f"(excitation {omega / (2 * np.pi):.6g} Hz): part of the model can move with "
+        "nothing to hold it (add springs or fixed DOFs), or the frequency is an "
+        "eigenfrequency of the undamped structure with a clamped interface")
+
+
+class _DenseLU:
+    """LAPACK LU of a small dense ``Z_ii`` with the interface of SuperLU's ``solve``."""
+
+    def __init__(self, A, n, omega):
+        try:
+            with warnings.catch_warnings():  # singular: the message below says why
+                warnings.simplefilter("ignore", sla.LinAlgWarning)
+                self.lu = sla.lu_factor(A, check_finite=False)
+        except (ValueError, sla.LinAlgError) as exc:
+            raise _singular(n, omega, False) from exc
+        diag = np.abs(np.diag(self.lu[0]))
+        if diag.size and (not np.all(np.isfinite(diag)) or diag.min() <= 1e-13 * diag.max()):
+            raise _singular(n, omega, diag.min() > 0)
+
+    def solve(self, b):
+        return sla.lu_solve(self.lu, b, check_finite=False)
+
+
 def _factor(Zii, n: int, omega: float):
-    """Sparse LU of ``Z_ii``; a singular matrix becomes an InputError naming the cause."""
+    """LU of ``Z_ii`` (sparse SuperLU, or LAPACK for a dense array); a singular matrix
+    becomes an InputError naming the cause."""
+    if isinstance(Zii, np.ndarray):
+        return _DenseLU(Zii, n, omega)
     try:
         lu = spla.splu(Zii.tocsc())
     except RuntimeError as exc:
-        raise InputError(
-            f"the structure with its contact DOFs held (node-to-node pairs glued) is singular "
-            f"at harmonic {n} "
-            f"(excitation {omega / (2 * np.pi):.6g} Hz): part of the model can move with "
-            "nothing to hold it (add springs or fixed DOFs), or the frequency is an "
-            "eigenfrequency of the undamped structure with a clamped interface"
-        ) from exc
+        raise _singular(n, omega, False) from exc
     diag = np.abs(lu.U.diagonal())
     if diag.size and diag.min() <= 1e-13 * diag.max():
-        raise InputError(
-            f"the structure with its contact DOFs held (node-to-node pairs glued) is (nearly) "
-            f"singular at harmonic {n}: "
-            "part of the model can move with nothing to hold it (add springs or fixed DOFs)"
-        )
+        raise _singular(n, omega, True)
     return lu
 
 
-def _schur(Z, cdofs, idofs, R, n: int, omega: float):
-    """Exact condensation of one (dynamic) stiffness ``Z`` onto the contact DOFs (eq. 19).
+#: at most this many interior DOFs: the condensation works on dense arrays (LAPACK). Below it
+#: the sparse machinery costs more than the arithmetic (docs/theory.md, "Cost of the
+#: condensation": measured crossover about 1000 DOFs, benchmarks/condense_small.py).
+DENSE_MAX = 600
+#: right-hand sides per block of the multi-RHS sparse solves: bounds the memory of
+#: ``Z_ii^-1 Z_ic`` to ``n_i x BLOCK`` complex values.
+BLOCK = 256
+#: bytes of factorisations a :class:`Condenser` keeps for reuse (static LU first).
+LU_BUDGET = 2**29
 
-    Returns ``(Z_r, lu, X, Z_ci)`` with ``Z_r = R (Z_cc - Z_ci Z_ii^-1 Z_ic) R^T`` in the
-    contact-local frame, ``lu`` the sparse LU of ``Z_ii`` (None without interior DOFs) and
-    ``X = Z_ii^-1 Z_ic``. ``Z`` real (statics) or complex (one harmonic).
+
+@dataclass
+class _Blocks:
+    """One matrix split into contact (c) and interior (i) blocks: ``cc`` dense, ``ci``
+    sparse CSR (or dense), ``ic`` sparse CSC (or dense), ``ii`` sparse CSC or dense."""
+
+    cc: np.ndarray
+    ci: object
+    ic: object
+    ii: object
+
+
+def _split(A, cdofs, idofs, dense: bool) -> _Blocks | None:
+    if A is None:
+        return None
+    A = A.tocsr()
+    rows_c, rows_i = A[cdofs], A[idofs]
+    ci, ic, ii = rows_c[:, idofs], rows_i[:, cdofs].tocsc(), rows_i[:, idofs].tocsc()
+    if dense:
+        ci, ic, ii = ci.toarray(), ic.toarray(), ii.toarray()
+    return _Blocks(rows_c[:, cdofs].toarray(), ci, ic, ii)
+
+
+class Condenser:
+    """The exact condensation (eq. 19) of one structure, prepared once and reused across
+    harmonics, frequencies, sweep points and wear steps.
+
+    The partition, the frame rotation and the contact/interior blocks of ``K, M, C, D`` are
+    extracted once; per harmonic only ``Z_ii`` is formed and factorised (the static LU of
+    ``K_ii`` is kept: harmonic 0 at every frequency, quasi-static solves, recovery). Small
+    models (``n_i <= DENSE_MAX``) work on dense arrays with LAPACK; large ones use SuperLU
+    with blocked multi-right-hand-side solves (``BLOCK`` columns at a time, so the dense
+    ``Z_ii^-1 Z_ic`` is never held whole). Made by :func:`condenser`.
     """
-    m = cdofs.size
-    Zc_rows = Z[cdofs]
-    Zcc = Zc_rows[:, cdofs].toarray()
-    Zci = Zc_rows[:, idofs]
-    if idofs.size:
-        lu = _factor(Z[idofs][:, idofs], n, omega)
-        X = lu.solve(Z[idofs][:, cdofs].toarray())  # Z_ii^-1 Z_ic
-        S = Zcc - Zci @ X
-    else:
-        lu, X, S = None, np.zeros((0, m), dtype=Z.dtype), Zcc
-    return R @ S @ R.T, lu, X, Zci
+
+    def __init__(self, structure: Structure, dense: bool | None = None):
+        s = self.structure = structure
+        self.cdofs, self.idofs = _partition(s)
+        self.R = _frame_matrix(s)
+        self.m, self.ni = self.cdofs.size, self.idofs.size
+        self.dense = self.ni <= DENSE_MAX if dense is None else bool(dense)
+        args = (self.cdofs, self.idofs, self.dense)
+        self.K, self.M = _split(s.K, *args), _split(s.M, *args)
+        self.C, self.D = _split(s.C, *args), _split(s.D, *args)
+        pos_c = {int(g): j for j, g in enumerate(self.cdofs)}
+        pos_i = {int(g): j for j, g in enumerate(self.idofs)}
+        # observed DOFs: on the contact (column of R), interior (row of Z_ii^-1), or fixed
+        self.obs_c = [(j, pos_c[int(g)]) for j, g in enumerate(s.obs) if int(g) in pos_c]
+        self.obs_i = [(j, pos_i[int(g)]) for j, g in enumerate(s.obs) if int(g) in pos_i]
+        self._lus: dict = {}
+
+    # -- the blocks of Z_n ------------------------------------------------------------------
+    def _z(self, part: str, omega: float, n: int, quasi_static: bool):
+        """Block ``part`` (``"cc"``, ``"ci"``, ``"ic"``, ``"ii"``) of ``Z_n`` (eq. 18)."""
+        K = getattr(self.K, part)
+        if n == 0 or quasi_static:
+            return K.astype(complex)
+        w = n * omega
+        Z = K.astype(complex) - (w * w) * getattr(self.M, part)
+        if self.D is not None:
+            Z = Z + 1j * getattr(self.D, part)
+        if self.C is not None:
+            Z = Z + (1j * w) * getattr(self.C, part)
+        return Z
+
+    @staticmethod
+    def _key(omega, n, quasi_static):
+        return ("static",) if (n == 0 or quasi_static) else (float(omega), int(n))
+
+    def factor(self, omega: float, n: int, quasi_static: bool = False):
+        """LU of ``Z_ii`` for harmonic ``n`` at ``omega`` [rad/s] (None without interior
+        DOFs); kept for reuse within :data:`LU_BUDGET` bytes."""
+        if not self.ni:
+            return None
+        key = self._key(omega, n, quasi_static)
+        lu = self._lus.get(key)
+        if lu is None:
+            Zii = self._z("ii", omega, n, quasi_static)
+            if key == ("static",):
+                Zii = Zii.real  # real arithmetic for the static LU
+            lu = _factor(Zii, n, omega)
+            size = (16 * self.ni**2 if self.dense
+                    else 16 * (lu.L.nnz + lu.U.nnz))
+            if size <= LU_BUDGET:
+                if key != ("static",):  # keep the static LU and the latest frequency only
+                    for k in [k for k in self._lus if k != ("static",) and k[0] != key[0]]:
+                        del self._lus[k]
+                self._lus[key] = lu
+        return lu
+
+    def schur(self, omega: float, n: int, quasi_static: bool = False):
+        """``(Z_r, lu, Zci, Xo)``: the condensed ``Z_r = R (Z_cc - Z_ci Z_ii^-1 Z_ic) R^T``
+        (eq. 19) in the contact-local frame, the LU of ``Z_ii``, ``Z_ci`` and the rows of
+        ``Z_ii^-1 Z_ic`` at the interior observed DOFs (``len(obs_i)``, m)."""
+        static = n == 0 or quasi_static
+        S = self._z("cc", omega, n, quasi_static)
+        if static:
+            S = S.real
+        lu = self.factor(omega, n, quasi_static)
+        if lu is None:
+            return self.R @ S @ self.R.T, None, None, np.zeros((0, self.m))
+        Zci = self._z("ci", omega, n, quasi_static)
+        Zic = self._z("ic", omega, n, quasi_static)
+        if static:
+            Zci, Zic = Zci.real, Zic.real
+        rows = np.array([i for _, i in self.obs_i], dtype=np.int64)
+        Xo = np.zeros((rows.size, self.m), dtype=S.dtype)
+        S = S.copy()
+        for j0 in range(0, self.m, BLOCK):  # blocked multi-RHS solves
+            cols = slice(j0, min(j0 + BLOCK, self.m))
+            B = Zic[:, cols]
+            X = lu.solve(B if isinstance(B, np.ndarray) else B.toarray())  # Z_ii^-1 Z_ic
+            S[:, cols] -= Zci @ X
+            Xo[:, cols] = X[rows]
+        return self.R @ S @ self.R.T, lu, Zci, Xo
+
+    def loads(self, F, lu, Zci):
+        """``F_r = R (F_c - Z_ci Z_ii^-1 F_i)`` (eq. 19) and ``Z_ii^-1 F_i`` (None without
+        interior DOFs) for a load vector ``F`` (ndof,) or one per column (ndof, k)."""
+        if lu is None:
+            return self.R @ F[self.cdofs], None
+        xf = _solve(lu, F[self.idofs])
+        return self.R @ (F[self.cdofs] - Zci @ xf), xf
+
+    # -- the reduced model --------------------------------------------------------------------
+    def reduced(self, omega: float, orders, quasi_static: bool = False,
+                frequency: float | None = None) -> Reduced:
+        """The :class:`Reduced` model on harmonic ``orders`` at ``omega`` [rad/s]."""
+        orders = np.asarray(orders, dtype=np.int64)
+        m, no, nb = self.m, self.structure.obs.size, orders.size
+        F_all = self.structure.load_harmonics(int(orders.max()) if orders.size else 0)
+        Zr = np.zeros((nb, m, m), dtype=complex)
+        Fr = np.zeros((nb, m), dtype=complex)
+        oA = np.zeros((nb, no, m), dtype=complex)
+        ob = np.zeros((nb, no), dtype=complex)
+        done = {}  # quasi-static: every harmonic shares Z_0 = K
+        for b, n in enumerate(orders):
+            key = self._key(omega, int(n), quasi_static)
+            if key not in done:
+                Zr_n, lu, Zci, Xo = self.schur(omega, int(n), quasi_static)
+                A = np.zeros((no, m), dtype=complex)
+                for j, c in self.obs_c:
+                    A[j] = self.R[:, c]  # U_c = R^T u_loc
+                for (j, _), x in zip(self.obs_i, Xo, strict=True):
+                    A[j] = -(x @ self.R.T)
+                done[key] = (Zr_n, A, lu, Zci)
+            Zr[b], oA[b], lu, Zci = done[key]
+            Fr[b], xf = self.loads(F_all[n], lu, Zci)
+            for j, i in self.obs_i:
+                ob[b, j] = xf[i]
+        return Reduced(float(omega), orders, Zr, Fr, oA, ob, self.structure.obs,
+                       bool(quasi_static), math.nan if frequency is None else float(frequency))
+
+    def recover(self, omega: float, orders, u_loc, quasi_static: bool = False) -> np.ndarray:
+        """All DOFs ``U_n`` (nb, ndof) complex [m] from ``u_loc`` (nb, m):
+        ``U_i = Z_ii^-1 (F_i - Z_ic U_c)``; fixed DOFs are zero."""
+        orders = np.asarray(orders, dtype=np.int64)
+        F_all = self.structure.load_harmonics(int(orders.max()) if orders.size else 0)
+        out = np.zeros((orders.size, self.structure.ndof), dtype=complex)
+        for b, n in enumerate(orders):
+            Uc = self.R.T @ np.asarray(u_loc[b], dtype=complex)
+            out[b, self.cdofs] = Uc
+            if self.ni:
+                lu = self.factor(omega, int(n), quasi_static)
+                rhs = F_all[n][self.idofs] - self._z("ic", omega, int(n), quasi_static) @ Uc
+                out[b, self.idofs] = _solve(lu, rhs)
+        return out
 
 
-def _condensed_load(F, cdofs, idofs, R, lu, Zci):
-    """``F_r = R (F_c - Z_ci Z_ii^-1 F_i)`` (eq. 19) and ``Z_ii^-1 F_i`` (None without interior
-    DOFs) for a load vector ``F`` (ndof,) or one per column (ndof, k)."""
-    if lu is None:
-        return R @ F[cdofs], None
-    xf = lu.solve(F[idofs])  # Z_ii^-1 F_i
-    return R @ (F[cdofs] - Zci @ xf), xf
+def _solve(lu, B):
+    """``Z_ii^-1 B`` with a factorisation of :func:`_factor`; a real LU (the static one)
+    solves a complex ``B`` by its real and imaginary parts."""
+    cplx = (lu.lu[0] if isinstance(lu, _DenseLU) else lu.U).dtype.kind == "c"
+    if cplx or B.dtype.kind != "c":
+        return lu.solve(B)
+    if not np.any(B.imag):
+        return lu.solve(np.ascontiguousarray(B.real)).astype(complex)
+    return lu.solve(np.ascontiguousarray(B.real)) + 1j * lu.solve(np.ascontiguousarray(B.imag))
+
+
+#: condensers of recently condensed models (a sweep, a wear run or an FRF condenses the same
+#: structure at many frequencies): model id -> (weak reference, fingerprint, Condenser)
+_CONDENSERS: dict = {}
+_CONDENSERS_KEEP = 4
+
+
+def _fingerprint(model: Model):
+    """What a :class:`Condenser` depends on: the matrices (identity, pattern size and a sum of
+    their entries, so an edit in place is seen), the fixed DOFs, contact DOFs and frames."""
+    def mat(A):
+        if A is None:
+            return None
+        data = A.data if sp.issparse(A) else np.asarray(A)
+        return (id(A), getattr(A, "nnz", data.size), float(np.sum(data)),
+                float(np.sum(np.abs(data))))
+
+    c = model.contact
+    return (mat(model.K), mat(model.M), mat(model.C), mat(model.D),
+            np.asarray(model.fixed_dofs).tobytes(), np.asarray(c.dofs).tobytes(),
+            np.asarray(c.frame, float).tobytes(),
+            tuple(tuple(np.asarray(p.dofs).tolist()) for p in model.observed))
+
+
+def condenser(model: Model) -> Condenser:
+    """The :class:`Condenser` of ``model``, reused while the model is unchanged (its matrices,
+    fixed DOFs, contact DOFs, frames and observed points; the loads are read at each call)."""
+    key = id(model)
+    fp = _fingerprint(model)
+    hit = _CONDENSERS.get(key)
+    if hit is not None and hit[0]() is model and hit[1] == fp:
+        cond = hit[2]
+        cond.structure.load_harmonics = model.load_harmonics
+        return cond
+    cond = Condenser(_structure(model))
+    _CONDENSERS.pop(key, None)
+    while len(_CONDENSERS) >= _CONDENSERS_KEEP:
+        _CONDENSERS.pop(next(iter(_CONDENSERS)))
+    _CONDENSERS[key] = (weakref.ref(model), fp, cond)
+    return cond
 
 
 @dataclass
@@ -182,10 +451,7 @@ class StaticCondensation:
     """
 
     K: np.ndarray
-    _model: Model
-    _cdofs: np.ndarray
-    _idofs: np.ndarray
-    _R: np.ndarray
+    _cond: Condenser
     _lu: object
     _Kci: object
     _P: object = None  # U = P U' for node-to-node pairs (model.interfaces), None without
@@ -196,47 +462,41 @@ class StaticCondensation:
         if self._P is not None:
             F = (self._P.T @ F.reshape(-1, F.shape[-1]).T).T.reshape(F.shape)
         cols = F.reshape(-1, F.shape[-1]).T  # one load per column
-        Fr, _ = _condensed_load(cols, self._cdofs, self._idofs, self._R, self._lu, self._Kci)
-        return Fr.T.reshape(F.shape[:-1] + (self._R.shape[0],))
+        Fr, _ = self._cond.loads(cols, self._lu, self._Kci)
+        return Fr.T.reshape(F.shape[:-1] + (self._cond.m,))
 
     def recover(self, u_loc, F) -> np.ndarray:
         """All DOFs ``U`` (ndof,) [m] from the local contact displacements ``u_loc`` (m,) under
         the load ``F`` (ndof,): ``U_i = K_ii^-1 (F_i - K_ic U_c)``; fixed DOFs are zero."""
-        U = np.zeros(self._model.ndof)
-        Uc = self._R.T @ np.asarray(u_loc, dtype=float)
-        U[self._cdofs] = Uc
-        F = np.asarray(F, float)
-        if self._P is not None:
-            F = self._P.T @ F
+        c = self._cond
+        U = np.zeros(c.structure.ndof)
+        Uc = c.R.T @ np.asarray(u_loc, dtype=float)
+        U[c.cdofs] = Uc
         if self._lu is not None:
-            K = self._model.K.tocsr()
-            U[self._idofs] = self._lu.solve(F[self._idofs]
-                                            - K[self._idofs][:, self._cdofs] @ Uc)
-        return U if self._P is None else self._P @ U
+            U[c.idofs] = self._lu.solve(np.asarray(F, float)[c.idofs] - c.K.ic @ Uc)
+        return U
 
 
 def condense_static(model: Model) -> StaticCondensation:
     """Exact static condensation of ``model`` onto its contact DOFs (eq. 19 with ``Z = K``).
 
-    The same computation as :func:`condense` (:func:`_schur`), in real arithmetic, with the
-    condensed loads of any load vectors (e.g. the loads at the phases of a quasi-static
-    cycle) and the exact recovery of every DOF.
+    The same computation as :func:`condense` (:meth:`Condenser.schur`), in real arithmetic,
+    with the condensed loads of any load vectors (e.g. the loads at the phases of a
+    quasi-static cycle) and the exact recovery of every DOF.
     """
-    model, P = relative_model(model)
-    cdofs, idofs = _partition(model)
-    R = _frame_matrix(model)
-    Kr, lu, _, Kci = _schur(model.K.tocsc().astype(float), cdofs, idofs, R, 0, 0.0)
-    return StaticCondensation(np.ascontiguousarray(0.5 * (Kr + Kr.T)), model, cdofs, idofs, R,
-                              lu, Kci, P)
+    cond = condenser(model)
+    Kr, lu, Kci, _ = cond.schur(0.0, 0, True)
+    return StaticCondensation(np.ascontiguousarray(0.5 * (Kr + Kr.T)), cond, lu, Kci)
 
 
 def condense(model: Model, frequency: float, orders, *, quasi_static: bool = False) -> Reduced:
     """Condense ``model`` onto its contact DOFs for harmonic ``orders`` (``[0, h1, .., hk]``)
     at the excitation ``frequency`` [Hz] (0 allowed when ``quasi_static``).
 
-    Implements eq. (17)-(19) with sparse LU of ``Z_ii`` per harmonic. Returns a
-    :class:`Reduced` in contact-local coordinates with the observed-DOF recovery rows
-    (``Reduced.omega = 2 pi frequency`` [rad/s], ``Reduced.frequency`` as given).
+    Implements eq. (17)-(19) with one LU of ``Z_ii`` per harmonic (:class:`Condenser`, reused
+    across calls on the same model). Returns a :class:`Reduced` in contact-local coordinates
+    with the observed-DOF recovery rows (``Reduced.omega = 2 pi frequency`` [rad/s],
+    ``Reduced.frequency`` as given).
     """
     return _condense(model, 2 * np.pi * frequency, orders, quasi_static=quasi_static,
                      frequency=frequency)
@@ -246,46 +506,7 @@ def _condense(model: Model, omega: float, orders, *, quasi_static: bool = False,
               frequency: float | None = None) -> Reduced:
     """:func:`condense` at the circular frequency ``omega`` [rad/s] (``frequency`` [Hz]:
     recorded in the result, default ``omega / 2 pi``)."""
-    orders = np.asarray(orders, dtype=np.int64)
-    model, P = relative_model(model)  # node-to-node pairs: relative coordinates U = P U'
-    cdofs, idofs = _partition(model)
-    R = _frame_matrix(model)
-    m = cdofs.size
-    obs_out, obs, S = observed_map(model, P)  # U[obs_out] = S @ U'[obs]
-    F_all = model.load_harmonics(int(orders.max()) if orders.size else 0)
-    # where each observed DOF lives: contact (index in cdofs), interior (index in idofs), fixed
-    pos_c = {int(g): j for j, g in enumerate(cdofs)}
-    pos_i = {int(g): j for j, g in enumerate(idofs)}
-    nb = orders.size
-    Zr = np.zeros((nb, m, m), dtype=complex)
-    Fr = np.zeros((nb, m), dtype=complex)
-    oA = np.zeros((nb, obs.size, m), dtype=complex)
-    ob = np.zeros((nb, obs.size), dtype=complex)
-    cache = {}  # quasi-static: every harmonic shares Z_0 = K
-    for b, n in enumerate(orders):
-        key = 0 if (n == 0 or quasi_static) else int(n)
-        if key not in cache:
-            Z = _dynamic_stiffness(model, omega, int(n), quasi_static)
-            Zr_n, lu, X, Zci = _schur(Z, cdofs, idofs, R, int(n), omega)
-            A = np.zeros((obs.size, m), dtype=complex)
-            for j, g in enumerate(obs):
-                g = int(g)
-                if g in pos_c:
-                    A[j] = R[:, pos_c[g]]  # U_c = R^T u_loc
-                elif g in pos_i:
-                    A[j] = -(X[pos_i[g]] @ R.T)
-            cache[key] = (Zr_n, A, lu, Zci)
-        Zr[b], oA[b], lu, Zci = cache[key]
-        Fr[b], xf = _condensed_load(F_all[n].astype(complex), cdofs, idofs, R, lu, Zci)
-        if xf is not None:
-            for j, g in enumerate(obs):
-                if int(g) in pos_i:
-                    ob[b, j] = xf[pos_i[int(g)]]
-    if S is not None:
-        oA = np.einsum("oj,bjm->bom", S.toarray(), oA)
-        ob = ob @ S.toarray().T
-    return Reduced(float(omega), orders, Zr, Fr, oA, ob, obs_out, bool(quasi_static),
-                   math.nan if frequency is None else float(frequency))
+    return condenser(model).reduced(omega, orders, quasi_static, frequency)
 
 
 def recover(model: Model, frequency: float, orders, u_loc: np.ndarray, *,
@@ -302,20 +523,7 @@ def recover(model: Model, frequency: float, orders, u_loc: np.ndarray, *,
 def _recover(model: Model, omega: float, orders, u_loc: np.ndarray, *,
              quasi_static: bool = False) -> np.ndarray:
     """:func:`recover` at the circular frequency ``omega`` [rad/s]."""
-    orders = np.asarray(orders, dtype=np.int64)
-    model, P = relative_model(model)  # node-to-node pairs: U = P U'
-    cdofs, idofs = _partition(model)
-    R = _frame_matrix(model)
-    F_all = model.load_harmonics(int(orders.max()) if orders.size else 0)
-    out = np.zeros((orders.size, model.ndof), dtype=complex)
-    for b, n in enumerate(orders):
-        Uc = R.T @ np.asarray(u_loc[b], dtype=complex)
-        out[b, cdofs] = Uc
-        if idofs.size:
-            Z = _dynamic_stiffness(model, omega, int(n), quasi_static)
-            lu = _factor(Z[idofs][:, idofs], int(n), omega)
-            out[b, idofs] = lu.solve(F_all[n][idofs] - Z[idofs][:, cdofs] @ Uc)
-    return out if P is None else (P @ out.T).T
+    return condenser(model).recover(omega, orders, u_loc, quasi_static)
 
 
 def to_real_blocks(Zc: np.ndarray, orders: np.ndarray) -> np.ndarray:
