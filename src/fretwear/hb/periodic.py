@@ -22,11 +22,19 @@ import numpy as np
 from fretwear.errors import InputError
 from fretwear.hb import contact as law
 from fretwear.hb.fourier import FourierBasis, amplitude
+from fretwear.hb.krylov import HarmonicBlocks, KrylovJacobian
 from fretwear.hb.penalty import penalty
 from fretwear.hb.reduce import Reduced, _recover, condense, loads_to_real, to_real_blocks
 from fretwear.hb.solvers import SolveStats, solve
 from fretwear.limits import check_range
 from fretwear.model.core import ContactInterface, Model
+
+#: how the Newton step is computed: ``"dense"`` (LAPACK LU of the formed Jacobian),
+#: ``"krylov"`` (GMRES on the Jacobian as an operator, :mod:`fretwear.hb.krylov`), ``"auto"``
+JACOBIANS = ("auto", "dense", "krylov")
+#: ``"auto"`` forms the Jacobian up to this many unknowns ``m H`` (docs/theory.md, "Large
+#: interfaces": measured crossover, benchmarks/scale_3d.py)
+DENSE_JACOBIAN_MAX = 3000
 
 
 class DLFTProblem:
@@ -43,10 +51,14 @@ class DLFTProblem:
         (:func:`fretwear.hb.penalty.penalty`).
     anchor : (nc, d-1) stick anchors: where a node that sticks all period sticks [m]
         (tangential, contact-local). Default 0.
+    jacobian : how the Newton step is computed (:data:`JACOBIANS`): ``"auto"`` (default)
+        forms the Jacobian up to :data:`DENSE_JACOBIAN_MAX` unknowns and uses it as an
+        operator (GMRES with per-harmonic factorisations) above.
     """
 
     def __init__(self, reduced: Reduced, contact: ContactInterface, basis: FourierBasis,
-                 gap=None, eps="auto", anchor=None, periodicity_tol=1e-12, max_sweeps=200):
+                 gap=None, eps="auto", anchor=None, periodicity_tol=1e-12, max_sweeps=200,
+                 jacobian="auto"):
         nc, d = contact.dofs.shape
         self.nc, self.d, self.basis = nc, d, basis
         self.H = basis.size
@@ -55,7 +67,13 @@ class DLFTProblem:
         if not np.array_equal(np.asarray(reduced.orders), exp):
             raise InputError(f"reduced model orders {list(reduced.orders)} != basis {list(exp)}")
         self.reduced = reduced
-        self.Z = to_real_blocks(reduced.Z, reduced.orders)
+        self.blocks = HarmonicBlocks(reduced.Z)
+        self._Z = None
+        if jacobian not in JACOBIANS:
+            raise InputError(f"jacobian = {jacobian!r}: expected one of {JACOBIANS}")
+        if jacobian == "auto":
+            jacobian = "dense" if self.m * self.H <= DENSE_JACOBIAN_MAX else "krylov"
+        self.jacobian = jacobian
         self.F = loads_to_real(reduced.F)
         self.eps = penalty(eps, reduced=reduced)
         self.mu = contact.mu_nodes()
@@ -74,11 +92,25 @@ class DLFTProblem:
         self.gap = np.array(gap)
         self.W = W
 
+    @property
+    def Z(self) -> np.ndarray:
+        """The real block operator ``Z~`` (m*H, m*H), DOF-major
+        (:func:`~fretwear.hb.reduce.to_real_blocks`), formed on first use."""
+        if self._Z is None:
+            self._Z = to_real_blocks(self.reduced.Z, self.reduced.orders)
+        return self._Z
+
+    def apply_Z(self, U) -> np.ndarray:
+        """``Z~ U~`` (m, H): with the dense ``Z~`` when it is formed, else by harmonic
+        blocks (:class:`~fretwear.hb.krylov.HarmonicBlocks`)."""
+        if self._Z is not None:
+            return (self._Z @ np.reshape(U, -1)).reshape(self.m, self.H)
+        return self.blocks.apply(U)
+
     # -- evaluation ---------------------------------------------------------------------
     def lambda_u(self, U):
         """``lambda_u~ = F~ - Z U~ + eps (U~ - W~)`` (m, H) (eq. 23)."""
-        ZU = (self.Z @ U.reshape(-1)).reshape(self.m, self.H)
-        return self.F - ZU + self.eps * (U - self.W)
+        return self.F - self.apply_Z(U) + self.eps * (U - self.W)
 
     def time_law(self, U):
         """Time-domain law: ``(lam_u, lam_x, state, sweeps)`` with samples (nc, d, N)."""
@@ -98,6 +130,8 @@ class DLFTProblem:
             return f, None
         G = law.dlft_jacobian(lu, lx, state, self.mu, self.P, self.Q, self.eps * self.anchor,
                               self.tol, self.max_sweeps)
+        if self.jacobian == "krylov":
+            return f, KrylovJacobian(G, self.blocks, self.eps, self.d, owner=self)
         n = self.m * self.H
         dH = self.d * self.H
         # J = eps I - G (eps I - Z) = eps (I - G) + G Z, G block-diagonal per node
@@ -112,7 +146,7 @@ class DLFTProblem:
     def scale(self, U):
         """Reference magnitude of the convergence test: ``|Z_r U~|`` (section 3.2), or |F~|
         when that vanishes."""
-        zu = np.linalg.norm(self.Z @ U.reshape(-1))
+        zu = np.linalg.norm(self.apply_Z(U))
         return max(zu, np.linalg.norm(self.F), 1e-300)
 
     def initial_guess(self):

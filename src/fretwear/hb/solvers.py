@@ -86,8 +86,17 @@ def _dense_solve(A, B):
 
 
 def _lu_step(J, f):
-    """The Newton step ``-J^-1 f``."""
-    return -solve_identity_rows(J, f)
+    """The Newton step ``-J^-1 f``: LAPACK LU of a formed Jacobian, or the operator's own
+    solve (:class:`fretwear.hb.krylov.KrylovJacobian`: GMRES)."""
+    if isinstance(J, np.ndarray):
+        return -solve_identity_rows(J, f)
+    return -J.solve(f)
+
+
+def _column_norms(J):
+    if isinstance(J, np.ndarray):
+        return np.linalg.norm(J, axis=0)
+    return J.column_norms()
 
 
 def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None):
@@ -102,7 +111,7 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None):
     f, J = fun(x, True)
     nfev = njev = 1
     fn = np.linalg.norm(f)
-    dscale = np.linalg.norm(J, axis=0)
+    dscale = _column_norms(J)
     dscale[dscale == 0] = 1.0
     delta = None  # first trial: the full Newton step
     it = 0
@@ -160,7 +169,7 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None):
             x, f, fn = xn, fnew, fnn
             _, J = fun(x, True)
             njev += 1
-            dscale = np.maximum(dscale, np.linalg.norm(J, axis=0))
+            dscale = np.maximum(dscale, _column_norms(J))
             stall = 0
         else:
             stall += 1
@@ -222,7 +231,8 @@ def hybr(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None):
 
     def fj(x):
         counts["f"] += 1
-        return fun(x, True)
+        f, J = fun(x, True)
+        return f, (J if isinstance(J, np.ndarray) else J.toarray())
 
     sol = so.root(fj, np.array(x0, dtype=float), jac=True, method="hybr",
                   options={"xtol": 1e-13, "maxfev": max_iter * 10})

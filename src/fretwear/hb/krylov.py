@@ -1,0 +1,289 @@
+"""The DLFT Jacobian as an operator, for interfaces with many contact nodes (docs/theory.md,
+"Large interfaces").
+
+After condensation the linear part of the balance is block-diagonal per harmonic (dense
+``m x m`` complex blocks ``Z_r(n w)``, eq. 19) and the contact part is block-diagonal per node
+(dense ``dH x dH`` blocks ``G_p = d lambda_x~_p / d lambda_u~_p``, eq. 23-28). The Jacobian
+``J = eps I - G (eps I - Z)`` (eq. 22) of ``n = m H`` unknowns is never formed: a product with
+it costs ``k m^2`` complex operations (the harmonic blocks) plus ``nc (dH)^2`` (the node
+blocks), against ``n^2`` memory and ``n^3 / 3`` operations for a dense LU.
+
+The Newton step ``J s = -f`` is solved by GMRES preconditioned with per-harmonic
+factorisations: replacing each node's time-varying gain by its mean over the period
+(``gbar_p``, the (0, 0) coefficient block of ``G_p``) makes the Jacobian block-diagonal per
+harmonic, ``P_n = eps I + gbar (Z_r(n w) - eps I)`` (``gbar`` block-diagonal per node), so the
+preconditioner is ``k + 1`` dense LUs of ``m x m``. It is exact for nodes whose gain does not
+vary over the period (stuck or separated all period) and for a linear interface; it is kept
+across Newton iterations and rebuilt when GMRES slows down. The contact law and the residual
+are those of the dense path: only the linear algebra of the step differs, so the converged
+answer is the same (tests/hb/test_krylov.py).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse.linalg as spla
+
+#: relative residual to which GMRES solves the Newton step (the dense LU is exact to rounding;
+#: an inexact step changes the iterates, not the converged answer, which the residual test of
+#: the nonlinear solver decides)
+GMRES_RTOL = 1e-10
+#: Krylov vectors kept before a restart, and restarts allowed
+GMRES_RESTART = 60
+GMRES_MAXITER = 4
+#: GMRES iterations above which the preconditioner is rebuilt from the current Jacobian
+REBUILD_AFTER = 25
+#: the step is solved by a LAPACK LU of the active block up to this many unknowns (slipping
+#: or separating nodes x d x H), by GMRES above (docs/theory.md, "Large interfaces")
+ACTIVE_DENSE_MAX = 6000
+
+
+class HarmonicBlocks:
+    """``Z~`` of the real Fourier basis held as its complex per-harmonic blocks (nb, m, m).
+
+    Products follow :func:`fretwear.hb.reduce.to_real_blocks` (harmonic ``n >= 1`` maps
+    ``[a; b]`` by ``[[Zr, Zi], [-Zi, Zr]]``) on DOF-major ``(m, H)`` arrays, without the
+    ``(mH)^2`` real matrix.
+    """
+
+    def __init__(self, Zc: np.ndarray):
+        self.Zc = np.ascontiguousarray(Zc)
+        self.nb, self.m, _ = Zc.shape
+        self.k = self.nb - 1
+        self.H = 1 + 2 * self.k
+        self.Z0 = np.ascontiguousarray(Zc[0].real)
+        self._ZcH = None
+
+    def _apply(self, Z0, Zc, U):
+        U = U.reshape(self.m, self.H)
+        k = self.k
+        out = np.empty((self.m, self.H))
+        out[:, 0] = Z0 @ U[:, 0]
+        if k:
+            c = (U[:, 1 : k + 1] - 1j * U[:, k + 1 :]).T  # (k, m): U_n = a_n - i b_n
+            y = np.matmul(Zc[1:], c[:, :, None])[:, :, 0]  # (k, m)
+            out[:, 1 : k + 1] = y.real.T
+            out[:, k + 1 :] = -y.imag.T
+        return out
+
+    def apply(self, U) -> np.ndarray:
+        """``Z~ U`` (m, H) for ``U`` (m, H) or (m*H,)."""
+        return self._apply(self.Z0, self.Zc, U)
+
+    def apply_T(self, U) -> np.ndarray:
+        """``Z~^T U`` (m, H): the real form of the conjugate transposes ``Z_n^H``."""
+        if self._ZcH is None:
+            self._ZcH = np.ascontiguousarray(np.conj(np.transpose(self.Zc, (0, 2, 1))))
+        return self._apply(np.ascontiguousarray(self.Z0.T), self._ZcH, U)
+
+    def columns(self, b: int, js: np.ndarray) -> tuple[np.ndarray, list[int]]:
+        """The non-zero rows of the real columns ``(j, c)`` of ``Z~`` for the DOFs ``js`` and
+        the coefficients ``c`` of harmonic block ``b`` (``[0]`` or ``[b, k+b]``): returns
+        ``(Zs, cs)`` with ``Zs`` (m, len(cs), len(js) * len(cs)), rows (DOF, coefficient in
+        ``cs``), columns (DOF in ``js``, coefficient in ``cs``)."""
+        if b == 0:
+            return self.Z0[:, js][:, None, :], [0]
+        zr, zi = self.Zc[b][:, js].real, self.Zc[b][:, js].imag
+        Zs = np.empty((self.m, 2, js.size, 2))
+        Zs[:, 0, :, 0], Zs[:, 0, :, 1] = zr, zi
+        Zs[:, 1, :, 0], Zs[:, 1, :, 1] = -zi, zr
+        return Zs.reshape(self.m, 2, 2 * js.size), [b, self.k + b]
+
+    def dense(self) -> np.ndarray:
+        """The real (mH, mH) matrix (:func:`fretwear.hb.reduce.to_real_blocks`)."""
+        from fretwear.hb.reduce import to_real_blocks
+
+        return to_real_blocks(self.Zc, np.arange(self.nb))
+
+
+class MeanGainPreconditioner:
+    """``P^-1`` with ``P_n = eps I + gbar (Z_n - eps I)`` per harmonic (module docstring).
+
+    gbar : (nc, d, d) mean gain of each node over the period; Z : :class:`HarmonicBlocks`.
+    """
+
+    def __init__(self, gbar: np.ndarray, Z: HarmonicBlocks, eps: float):
+        nc, d, _ = gbar.shape
+        m = Z.m
+        g = np.zeros((m, m))
+        for p in range(nc):
+            g[p * d : (p + 1) * d, p * d : (p + 1) * d] = gbar[p]
+        self.Z, self.k, self.m, self.H = Z, Z.k, m, Z.H
+        I = np.eye(m)
+        self.lu0 = sla.lu_factor(eps * I + g @ (Z.Z0 - eps * I), check_finite=False)
+        self.lus = [sla.lu_factor(eps * I + g @ (Z.Zc[b] - eps * I), check_finite=False)
+                    for b in range(1, Z.nb)]
+
+    def apply(self, r) -> np.ndarray:
+        r = np.asarray(r).reshape(self.m, self.H)
+        k = self.k
+        out = np.empty_like(r)
+        out[:, 0] = sla.lu_solve(self.lu0, r[:, 0], check_finite=False)
+        for b in range(1, k + 1):
+            y = sla.lu_solve(self.lus[b - 1], r[:, b] - 1j * r[:, k + b], check_finite=False)
+            out[:, b], out[:, k + b] = y.real, -y.imag
+        return out.reshape(-1)
+
+
+class KrylovJacobian:
+    """``J = eps I - G (eps I - Z~)`` (eq. 22) as an operator: ``J @ x``, ``J.T @ x``,
+    ``column_norms()`` (exact, from the block structure) and ``solve(b)`` (GMRES
+    preconditioned by :class:`MeanGainPreconditioner`).
+
+    G : (nc, dH, dH) node blocks (:func:`fretwear.hb.contact.dlft_jacobian`);
+    Z : :class:`HarmonicBlocks`; owner : the object that keeps the preconditioner across
+    Jacobians (its attribute ``_precond``).
+    """
+
+    def __init__(self, G: np.ndarray, Z: HarmonicBlocks, eps: float, d: int, owner=None):
+        self.G, self.Z, self.eps, self.d = G, Z, float(eps), d
+        self.nc, self.dH = G.shape[0], G.shape[1]
+        self.n = Z.m * Z.H
+        self.shape = (self.n, self.n)
+        self.owner = owner if owner is not None else self
+        self.gmres_iterations = 0
+
+    # -- products -----------------------------------------------------------------------------
+    def matvec(self, x) -> np.ndarray:
+        x = np.asarray(x, float).reshape(-1)
+        y = (self.Z.apply(x).reshape(-1) - self.eps * x).reshape(self.nc, self.dH)
+        return self.eps * x + np.matmul(self.G, y[:, :, None])[:, :, 0].reshape(-1)
+
+    def rmatvec(self, x) -> np.ndarray:
+        x = np.asarray(x, float).reshape(-1)
+        y = np.matmul(np.transpose(self.G, (0, 2, 1)),
+                      x.reshape(self.nc, self.dH, 1))[:, :, 0].reshape(-1)
+        return self.eps * x + self.Z.apply_T(y).reshape(-1) - self.eps * y
+
+    def __matmul__(self, x):
+        return self.matvec(x)
+
+    @property
+    def T(self):
+        return _Transposed(self)
+
+    def column_norms(self, chunk: int = 256) -> np.ndarray:
+        """Euclidean norm of every column of ``J`` (what MINPACK scales the variables by),
+        exact: column ``(j, c)`` of ``Z~`` has non-zeros in the coefficients of its harmonic
+        only, so ``G Z~`` is formed a block of columns at a time in ``nc dH 2d n`` operations.
+        """
+        Z, G, eps, d = self.Z, self.G, self.eps, self.d
+        H, nc, dH, m = Z.H, self.nc, self.dH, Z.m
+        Gr = G.reshape(nc, dH, d, H)
+        out = np.zeros((m, H))
+        for b in range(Z.nb):
+            for j0 in range(0, m, chunk):
+                js = np.arange(j0, min(j0 + chunk, m))
+                Zs, cs = Z.columns(b, js)  # (m, nl, ncol), rows (DOF, coef in cs)
+                nl = len(cs)
+                Gs = Gr[:, :, :, cs].reshape(nc, dH, d * nl)  # columns (DOF of node, coef)
+                cols = np.matmul(Gs, Zs.reshape(nc, d * nl, -1))  # (nc, dH, ncol): G Z~
+                # + eps (I - G) on the owner's block: column (j, c) -> node j // d, row j%d, c
+                jj = np.repeat(js, nl)
+                cc = np.tile(cs, js.size)
+                q, row = jj // d, (jj % d) * H + cc
+                ci = np.arange(jj.size)
+                cols[q, :, ci] -= eps * G[q, :, row]
+                cols[q, row, ci] += eps
+                out[js[:, None], np.array(cs)[None, :]] = np.sqrt(
+                    np.einsum("pij,pij->j", cols, cols)).reshape(js.size, nl)
+        return out.reshape(-1)
+
+    def toarray(self) -> np.ndarray:
+        """The formed (n, n) Jacobian (as the dense path forms it)."""
+        GZ = np.matmul(self.G, self.Z.dense().reshape(self.nc, self.dH, self.n))
+        J = GZ.reshape(self.n, self.n)
+        for p in range(self.nc):
+            sl = slice(p * self.dH, (p + 1) * self.dH)
+            J[sl, sl] -= self.eps * self.G[p]
+        J[np.diag_indices(self.n)] += self.eps
+        return J
+
+    # -- the Newton step ----------------------------------------------------------------------
+    def _preconditioner(self, rebuild=False):
+        owner = self.owner
+        pc = getattr(owner, "_precond", None)
+        if pc is None or rebuild:
+            H = self.Z.H
+            Gr = self.G.reshape(self.nc, self.d, H, self.d, H)
+            pc = MeanGainPreconditioner(np.ascontiguousarray(Gr[:, :, 0, :, 0]), self.Z,
+                                        self.eps)
+            owner._precond = pc
+        return pc
+
+    def active_nodes(self) -> np.ndarray:
+        """Nodes whose block ``G_p`` is not zero: those that slip or separate during the
+        period (a node that sticks all period has ``G_p = 0``, its rows of ``J`` are
+        ``eps I``)."""
+        return np.flatnonzero(np.any(self.G.reshape(self.nc, -1) != 0.0, axis=1))
+
+    def solve(self, b) -> np.ndarray:
+        """``J^-1 b``, exact on the stuck nodes and reduced to the active ones
+        (:meth:`active_nodes`): with ``s`` the stuck unknowns, ``x_s = b_s / eps`` and
+
+            (eps I + G_a (Z_aa - eps I)) x_a = b_a - G_a Z_as x_s,
+
+        solved by a LAPACK LU when it has at most :data:`ACTIVE_DENSE_MAX` unknowns, else by
+        right-preconditioned GMRES on the whole system to :data:`GMRES_RTOL` (the
+        preconditioner is rebuilt from this Jacobian when the kept one needs more than
+        :data:`REBUILD_AFTER` iterations or fails)."""
+        b = np.asarray(b, float).reshape(-1)
+        act = self.active_nodes()
+        if act.size * self.dH <= ACTIVE_DENSE_MAX:
+            return self._solve_active(b, act)
+        return self._gmres(b)
+
+    def _solve_active(self, b, act) -> np.ndarray:
+        from fretwear.hb.solvers import solve_identity_rows
+
+        eps, dH, d, Z = self.eps, self.dH, self.d, self.Z
+        x = (b / eps).reshape(self.nc, dH)
+        if not act.size:
+            return x.reshape(-1)
+        x[act] = 0.0
+        # G_a Z_as x_s: the product with the stuck part only
+        rhs = b.reshape(self.nc, dH)[act] - np.matmul(
+            self.G[act], Z.apply(x.reshape(-1)).reshape(self.nc, dH)[act][:, :, None])[:, :, 0]
+        dofs = (act[:, None] * d + np.arange(d)[None, :]).reshape(-1)
+        Za = HarmonicBlocks(Z.Zc[:, dofs][:, :, dofs]).dense()  # (na dH, na dH) DOF-major
+        na = act.size
+        Ja = np.matmul(self.G[act], Za.reshape(na, dH, na * dH)).reshape(na * dH, na * dH)
+        for i in range(na):
+            sl = slice(i * dH, (i + 1) * dH)
+            Ja[sl, sl] -= eps * self.G[act[i]]
+        Ja[np.diag_indices(na * dH)] += eps
+        x[act] = solve_identity_rows(Ja, rhs.reshape(-1)).reshape(na, dH)
+        return x.reshape(-1)
+
+    def _gmres(self, b) -> np.ndarray:
+        A = spla.LinearOperator(self.shape, matvec=self.matvec, dtype=float)
+        x = None
+        for attempt in range(2):
+            fresh = attempt > 0 or getattr(self.owner, "_precond", None) is None
+            pc = self._preconditioner(rebuild=attempt > 0)
+            M = spla.LinearOperator(self.shape, matvec=pc.apply, dtype=float)
+            count = [0]
+
+            def cb(_r, count=count):
+                count[0] += 1
+
+            x, info = spla.gmres(A, b, x0=x, rtol=GMRES_RTOL, atol=0.0,
+                                 restart=GMRES_RESTART, maxiter=GMRES_MAXITER, M=M,
+                                 callback=cb, callback_type="pr_norm")
+            self.gmres_iterations += count[0]
+            if info == 0:
+                if count[0] > REBUILD_AFTER and not fresh:
+                    self.owner._precond = None  # slow: rebuild at the next Jacobian
+                break
+            if fresh:
+                break  # the best preconditioner at hand: GMRES's last iterate
+        return x
+
+
+class _Transposed:
+    def __init__(self, J):
+        self.J = J
+
+    def __matmul__(self, x):
+        return self.J.rmatvec(x)
