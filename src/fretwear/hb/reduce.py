@@ -271,7 +271,7 @@ class Condenser:
         """Block ``part`` (``"cc"``, ``"ci"``, ``"ic"``, ``"ii"``) of ``Z_n`` (eq. 18)."""
         K = getattr(self.K, part)
         if n == 0 or quasi_static:
-            return K.astype(complex)
+            return K  # real: the static LU and products stay in real arithmetic
         w = n * omega
         Z = K.astype(complex) - (w * w) * getattr(self.M, part)
         if self.D is not None:
@@ -292,10 +292,7 @@ class Condenser:
         key = self._key(omega, n, quasi_static)
         lu = self._lus.get(key)
         if lu is None:
-            Zii = self._z("ii", omega, n, quasi_static)
-            if key == ("static",):
-                Zii = Zii.real  # real arithmetic for the static LU
-            lu = _factor(Zii, n, omega)
+            lu = _factor(self._z("ii", omega, n, quasi_static), n, omega)
             size = (16 * self.ni**2 if self.dense
                     else 16 * (lu.L.nnz + lu.U.nnz))
             if size <= LU_BUDGET:
@@ -309,17 +306,12 @@ class Condenser:
         """``(Z_r, lu, Zci, Xo)``: the condensed ``Z_r = R (Z_cc - Z_ci Z_ii^-1 Z_ic) R^T``
         (eq. 19) in the contact-local frame, the LU of ``Z_ii``, ``Z_ci`` and the rows of
         ``Z_ii^-1 Z_ic`` at the interior observed DOFs (``len(obs_i)``, m)."""
-        static = n == 0 or quasi_static
         S = self._z("cc", omega, n, quasi_static)
-        if static:
-            S = S.real
         lu = self.factor(omega, n, quasi_static)
         if lu is None:
             return self.R @ S @ self.R.T, None, None, np.zeros((0, self.m))
         Zci = self._z("ci", omega, n, quasi_static)
         Zic = self._z("ic", omega, n, quasi_static)
-        if static:
-            Zci, Zic = Zci.real, Zic.real
         rows = np.array([i for _, i in self.obs_i], dtype=np.int64)
         Xo = np.zeros((rows.size, self.m), dtype=S.dtype)
         S = S.copy()
@@ -429,11 +421,18 @@ def condenser(model: Model) -> Condenser:
         cond.structure.load_harmonics = model.load_harmonics
         return cond
     cond = Condenser(_structure(model))
+    install(model, cond)
+    return cond
+
+
+def install(model: Model, cond: Condenser) -> None:
+    """Make :func:`condenser` return ``cond`` for ``model`` while the model is unchanged (a
+    modal representation, :func:`fretwear.hb.modal.use_modal`)."""
+    key = id(model)
     _CONDENSERS.pop(key, None)
     while len(_CONDENSERS) >= _CONDENSERS_KEEP:
         _CONDENSERS.pop(next(iter(_CONDENSERS)))
-    _CONDENSERS[key] = (weakref.ref(model), fp, cond)
-    return cond
+    _CONDENSERS[key] = (weakref.ref(model), _fingerprint(model), cond)
 
 
 @dataclass

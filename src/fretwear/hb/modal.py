@@ -1,0 +1,241 @@
+"""Modal (Craig-Bampton) representation of the condensed dynamic stiffness ``Z_r(omega)``, with
+its error measured against the exact condensation (docs/theory.md, "Large interfaces").
+
+The exact condensation (eq. 19, :mod:`fretwear.hb.reduce`) factorises ``Z_ii(n w)`` and solves
+for every contact DOF, at every harmonic and every frequency. Craig and Bampton (1968) write
+the interior motion as
+
+    u_i = Psi u_c + V q,      Psi = -K_ii^-1 K_ic  (static constraint modes, exact),
+
+with ``V`` the fixed-interface modes of ``(K_ii, M_ii)`` up to a cutoff frequency, augmented
+by the static responses ``K_ii^-1 F_i`` of the load vectors (so that the static part of every
+load is exact). Projecting ``K, M, C, D`` gives small matrices that are assembled once; at
+any frequency and harmonic
+
+    Z_r = Z^cc - Z^cq (Z^qq)^-1 Z^qc          (dense, m x m and q x q),
+
+the same Schur complement on the reduced coordinates. At harmonic 0 and in the quasi-static
+case it is exact (``Z^cq = 0``, ``Z^cc = K_r``); above, the error is that of the omitted
+modes, which grows with frequency. :class:`ModalCondenser` therefore checks itself at the
+highest frequency it is built for: ``Z_r`` and ``F_r`` applied to random probe vectors
+against the exact condensation (one sparse LU of ``Z_ii`` there and a few solves); the
+relative error is stored (``error``) and an :class:`~fretwear.errors.InputError` is raised
+when it exceeds ``tol`` (keep more modes, or condense exactly).
+
+Cost: one real LU of ``K_ii`` and ``m`` real solves (``Psi``), a shift-invert Lanczos for the
+modes, and projections; then ``O(m^2 q)`` per harmonic and frequency, against one complex
+LU and ``m`` complex solves per harmonic and frequency for the exact condensation.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse.linalg as spla
+
+from fretwear.errors import InputError
+from fretwear.hb.reduce import BLOCK, Condenser, Reduced, _factor, _solve, _structure, install
+from fretwear.model.core import Model
+
+#: keep the fixed-interface modes up to this multiple of the highest harmonic frequency
+CUTOFF = 3.0
+#: default bound on the relative error of ``Z_r`` (and ``F_r``) at the highest frequency
+TOL = 1e-3
+#: random probe vectors of the error check
+PROBES = 4
+
+
+class ModalCondenser(Condenser):
+    """Craig-Bampton condensation of ``model`` for excitation frequencies up to ``f_max`` [Hz]
+    and harmonic orders up to ``max_order`` (module docstring), with the interface of
+    :class:`~fretwear.hb.reduce.Condenser` (``reduced``, ``recover``).
+
+    Parameters
+    ----------
+    model : the structure.
+    f_max : highest excitation frequency [Hz] it will be used at (> 0).
+    max_order : highest harmonic order (``basis.harmonics[-1]``).
+    modes : number of fixed-interface modes to keep; default: every mode below ``cutoff``
+        times ``max_order * f_max``.
+    cutoff : see ``modes``.
+    tol : largest relative error of ``Z_r``/``F_r`` accepted at ``max_order * f_max``.
+
+    Attributes
+    ----------
+    n_modes : fixed-interface modes kept; q : reduced interior coordinates (modes + load
+    responses); mode_frequencies : (n_modes,) [Hz]; error : relative error of the check.
+    """
+
+    def __init__(self, model: Model, f_max: float, max_order: int, *, modes: int | None = None,
+                 cutoff: float = CUTOFF, tol: float = TOL):
+        if not (isinstance(f_max, int | float) and math.isfinite(f_max) and f_max > 0):
+            raise InputError(f"f_max = {f_max!r}: expected a positive frequency [Hz]")
+        if modes is not None and (isinstance(modes, bool) or not isinstance(modes, int)
+                                  or modes < 0):
+            raise InputError(f"modes = {modes!r}: expected a number of modes >= 0")
+        super().__init__(_structure(model), dense=False)
+        if not self.ni:
+            raise InputError("the model has no interior DOFs: nothing to represent by modes")
+        self.f_max, self.max_order, self.tol = float(f_max), int(max_order), float(tol)
+        lu = self.factor(0.0, 0, True)  # real LU of K_ii, kept
+        # static constraint modes Psi = -K_ii^-1 K_ic (blocked multi-RHS solves)
+        Psi = np.empty((self.ni, self.m))
+        for j0 in range(0, self.m, BLOCK):
+            cols = slice(j0, min(j0 + BLOCK, self.m))
+            Psi[:, cols] = -lu.solve(self.K.ic[:, cols].toarray())
+        self.Psi = Psi
+        # fixed-interface modes up to the cutoff, by shift-invert Lanczos on the kept LU
+        f_cut = cutoff * self.max_order * self.f_max
+        self.mode_frequencies, Phi = self._modes(lu, modes, f_cut)
+        self.n_modes = Phi.shape[1]
+        # + static responses of the loads' interior parts, orthonormalised
+        Fl = np.column_stack([np.asarray(ld.vector, float)[self.idofs] for ld in model.loads]
+                             ) if model.loads else np.zeros((self.ni, 0))
+        Xl = lu.solve(Fl) if Fl.shape[1] else Fl
+        V = np.column_stack([Phi, Xl])
+        if V.shape[1]:
+            Q, r, _ = sla.qr(V, mode="economic", pivoting=True)
+            keep = np.abs(np.diag(r)) > 1e-10 * abs(r[0, 0])
+            V = Q[:, keep]
+        self.V, self.q = V, V.shape[1]
+        self._project()
+        self.error = self._check()
+        if self.error > self.tol:
+            raise InputError(
+                f"modal condensation with {self.n_modes} modes (up to "
+                f"{(self.mode_frequencies.max() if self.n_modes else 0.0):.6g} Hz): relative "
+                f"error {self.error:.3g} of Z_r at harmonic {self.max_order} of {f_max:.6g} Hz"
+                f" > tol = {tol:g}; keep more modes (modes=, cutoff=) or condense exactly")
+
+    # -- construction -------------------------------------------------------------------------
+    def _modes(self, lu, modes, f_cut):
+        Kii, Mii = self.K.ii, self.M.ii
+        n = self.ni
+        op = spla.LinearOperator((n, n), matvec=lambda x: lu.solve(np.asarray(x, float)),
+                                 dtype=float)
+        if modes == 0 or n < 3:
+            return np.zeros(0), np.zeros((n, 0))
+        k = min(modes if modes is not None else 20, n - 2)
+        while True:
+            lam, Phi = spla.eigsh(Kii, k=k, M=Mii, sigma=0.0, which="LM", OPinv=op)
+            order = np.argsort(lam)
+            lam, Phi = lam[order], Phi[:, order]
+            f = np.sqrt(np.maximum(lam, 0.0)) / (2 * np.pi)
+            if modes is not None:
+                return f, Phi
+            if f[-1] > f_cut or k >= n - 2:
+                keep = f <= f_cut
+                return f[keep], Phi[:, keep]
+            k = min(2 * k, n - 2)
+
+    def _project(self):
+        """The reduced matrices ``X^cc`` (m, m), ``X^cq`` (m, q), ``X^qc`` (q, m), ``X^qq``
+        (q, q) of ``K, M, C, D`` in the coordinates ``(u_c, q)``."""
+        Psi, V = self.Psi, self.V
+        self.proj = {}
+        for name in ("K", "M", "C", "D"):
+            B = getattr(self, name)
+            if B is None:
+                continue
+            XiiPsi = B.ii @ Psi
+            cc = B.cc + B.ci @ Psi + (B.ic.T @ Psi).T + Psi.T @ XiiPsi
+            cc = cc if name != "K" else B.cc + B.ci @ Psi  # K_ii Psi = -K_ic exactly
+            cq = (B.ci @ V) + Psi.T @ (B.ii @ V)
+            qc = (B.ic.T @ V).T + V.T @ XiiPsi
+            qq = V.T @ (B.ii @ V)
+            self.proj[name] = (cc, cq, qc, qq)
+
+    def _zr(self, omega, n, quasi_static):
+        """``(Z^cc, Z^cq, Z^qc, Z^qq)`` of harmonic ``n`` (eq. 18 on the reduced
+        coordinates)."""
+        out = list(self.proj["K"])
+        if n == 0 or quasi_static:
+            return out
+        w = n * omega
+        for name, c in (("M", -(w * w)), ("D", 1j), ("C", 1j * w)):
+            if name in self.proj:
+                for i, x in enumerate(self.proj[name]):
+                    out[i] = out[i] + c * x
+        return out
+
+    def _parts(self, omega, n, quasi_static, F):
+        """Condensed ``Z_r`` (global contact axes), ``Z^cq Z^qq^-1`` and the condensed load and
+        modal coordinates of ``F`` (ndof,) for harmonic ``n``."""
+        cc, cq, qc, qq = self._zr(omega, n, quasi_static)
+        Fi = F[self.idofs]
+        Fc = F[self.cdofs] + self.Psi.T @ Fi
+        Fq = self.V.T @ Fi
+        if self.q:
+            sol = np.linalg.solve(qq, np.column_stack([qc, Fq]))
+            S = cc - cq @ sol[:, :-1]
+            return S, sol[:, :-1], Fc - cq @ sol[:, -1], sol[:, -1]
+        return cc, np.zeros((0, self.m)), Fc, np.zeros(0)
+
+    def _check(self) -> float:
+        """Relative error of ``Z_r`` on :data:`PROBES` random vectors and of ``F_r`` at the
+        highest harmonic of ``f_max``, against the exact condensation (eq. 19)."""
+        n, omega = self.max_order, 2 * np.pi * self.f_max
+        rng = np.random.default_rng(0)
+        P = rng.standard_normal((self.m, PROBES))
+        F = self.structure.load_harmonics(n)[n]
+        S, _, Fr, _ = self._parts(omega, n, False, F)
+        Zii = self._z("ii", omega, n, False)
+        lu = _factor(Zii, n, omega)
+        Zci, Zic = self._z("ci", omega, n, False), self._z("ic", omega, n, False)
+        exact = self._z("cc", omega, n, False) @ P - Zci @ _solve(lu, Zic @ P)
+        err = np.linalg.norm(S @ P - exact, axis=0) / np.linalg.norm(exact, axis=0)
+        e = float(err.max())
+        if np.any(F):
+            Fe = F[self.cdofs] - Zci @ _solve(lu, F[self.idofs])
+            e = max(e, float(np.linalg.norm(Fr - Fe) / max(np.linalg.norm(Fe), 1e-300)))
+        return e
+
+    # -- the Condenser interface --------------------------------------------------------------
+    def reduced(self, omega: float, orders, quasi_static: bool = False,
+                frequency: float | None = None) -> Reduced:
+        """The :class:`~fretwear.hb.reduce.Reduced` model on ``orders`` at ``omega`` [rad/s]
+        from the modal representation."""
+        orders = np.asarray(orders, dtype=np.int64)
+        m, no, nb, R = self.m, self.structure.obs.size, orders.size, self.R
+        F_all = self.structure.load_harmonics(int(orders.max()) if orders.size else 0)
+        Zr = np.zeros((nb, m, m), dtype=complex)
+        Fr = np.zeros((nb, m), dtype=complex)
+        oA = np.zeros((nb, no, m), dtype=complex)
+        ob = np.zeros((nb, no), dtype=complex)
+        rows = np.array([i for _, i in self.obs_i], dtype=np.int64)
+        for b, n in enumerate(orders):
+            S, Y, Fc, qF = self._parts(omega, int(n), quasi_static, F_all[n])
+            Zr[b], Fr[b] = R @ S @ R.T, R @ Fc
+            for j, c in self.obs_c:
+                oA[b, j] = R[:, c]
+            if rows.size:
+                # u_i = Psi u_c + V q, q = qF - Y u_c: rows at the interior observed DOFs
+                A = (self.Psi[rows] - self.V[rows] @ Y) @ R.T
+                for (j, _), a, bo in zip(self.obs_i, A, self.V[rows] @ qF, strict=True):
+                    oA[b, j], ob[b, j] = a, bo
+        return Reduced(float(omega), orders, Zr, Fr, oA, ob, self.structure.obs,
+                       bool(quasi_static), math.nan if frequency is None else float(frequency))
+
+    def recover(self, omega: float, orders, u_loc, quasi_static: bool = False) -> np.ndarray:
+        """All DOFs (nb, ndof) from ``u_loc`` (nb, m) through the modal representation
+        (``u_i = Psi u_c + V q``)."""
+        orders = np.asarray(orders, dtype=np.int64)
+        F_all = self.structure.load_harmonics(int(orders.max()) if orders.size else 0)
+        out = np.zeros((orders.size, self.structure.ndof), dtype=complex)
+        for b, n in enumerate(orders):
+            Uc = self.R.T @ np.asarray(u_loc[b], dtype=complex)
+            _, Y, _, qF = self._parts(omega, int(n), quasi_static, F_all[n])
+            out[b, self.cdofs] = Uc
+            out[b, self.idofs] = self.Psi @ Uc + self.V @ (qF - Y @ Uc)
+        return out
+
+
+def use_modal(model: Model, f_max: float, max_order: int, **options) -> ModalCondenser:
+    """Build a :class:`ModalCondenser` of ``model`` (error-checked) and make every
+    condensation of this model object (:func:`~fretwear.hb.reduce.condense`, periodic solves,
+    sweeps, wear runs, recovery) use it until the model's matrices change."""
+    cond = ModalCondenser(model, f_max, max_order, **options)
+    install(model, cond)
+    return cond
