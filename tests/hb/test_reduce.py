@@ -18,10 +18,22 @@ import scipy.linalg as sla
 from helpers.models import RNG, truss
 
 from fretwear.errors import InputError
+from fretwear.hb import reduce
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.reduce import condense, loads_to_real, recover, to_real_blocks
 
 RTOL = 1e-9
+
+
+@pytest.fixture(autouse=True, params=["dense", "sparse"])
+def condensation_path(request, monkeypatch):
+    """Every test runs on both paths of the condensation: LAPACK on dense blocks (small
+    models, reduce.DENSE_MAX) and SuperLU with blocked multi-right-hand-side solves (BLOCK = 5
+    columns, so the 12 contact DOFs of the truss take three blocks)."""
+    monkeypatch.setattr(reduce, "DENSE_MAX", 10**9 if request.param == "dense" else -1)
+    monkeypatch.setattr(reduce, "BLOCK", 5)
+    monkeypatch.setattr(reduce, "_CONDENSERS", {})
+    return request.param
 
 
 def dense_Z(model, omega, n):
@@ -185,3 +197,23 @@ def test_real_blocks_match_time_domain_operator():
     F = model.load_harmonics(3)
     samples = model.load_time(basis.tau)  # exact load samples (N, ndof)
     np.testing.assert_allclose(loads_to_real(F), basis.to_freq(samples.T), rtol=0, atol=1e-12)
+
+
+def test_condenser_reused_until_the_model_changes():
+    """A second condensation of the same model reuses the prepared condenser (and its static
+    LU); replacing or editing a matrix in place gives a new one, whose result is that of a
+    fresh model (exact comparison with a condensation of a copy)."""
+    model = truss(damping="both")
+    c1 = reduce.condenser(model)
+    assert reduce.condenser(model) is c1
+    model.K = model.K.tocsr(copy=True)
+    model.K.data[0] *= 1.5
+    c2 = reduce.condenser(model)
+    assert c2 is not c1
+    model.K.data[0] *= 2.0  # in place: seen by the fingerprint
+    assert reduce.condenser(model) is not c2
+    red = condense(model, 10.0, [0, 1])
+    fresh = truss(damping="both")
+    fresh.K = model.K.copy()
+    ref = condense(fresh, 10.0, [0, 1])
+    np.testing.assert_array_equal(red.Z, ref.Z)

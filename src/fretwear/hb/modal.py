@@ -96,6 +96,7 @@ class ModalCondenser(Condenser):
         Xl = lu.solve(Fl) if Fl.shape[1] else Fl
         V = np.column_stack([Phi, Xl])
         if V.shape[1]:
+            V = V / np.maximum(np.linalg.norm(V, axis=0), 1e-300)  # modes ~ 1/sqrt(kg), loads ~ m
             Q, r, _ = sla.qr(V, mode="economic", pivoting=True)
             keep = np.abs(np.diag(r)) > 1e-10 * abs(r[0, 0])
             V = Q[:, keep]
@@ -174,19 +175,25 @@ class ModalCondenser(Condenser):
         return cc, np.zeros((0, self.m)), Fc, np.zeros(0)
 
     def _check(self) -> float:
-        """Relative error of ``Z_r`` on :data:`PROBES` random vectors and of ``F_r`` at the
-        highest harmonic of ``f_max``, against the exact condensation (eq. 19)."""
+        """Relative error of ``Z_r`` on :data:`PROBES` random vectors, of the observed
+        interior DOFs' response to them and of ``F_r``, at the highest harmonic of ``f_max``,
+        against the exact condensation (eq. 19)."""
         n, omega = self.max_order, 2 * np.pi * self.f_max
         rng = np.random.default_rng(0)
         P = rng.standard_normal((self.m, PROBES))
         F = self.structure.load_harmonics(n)[n]
-        S, _, Fr, _ = self._parts(omega, n, False, F)
+        S, Y, Fr, _ = self._parts(omega, n, False, F)
         Zii = self._z("ii", omega, n, False)
         lu = _factor(Zii, n, omega)
         Zci, Zic = self._z("ci", omega, n, False), self._z("ic", omega, n, False)
-        exact = self._z("cc", omega, n, False) @ P - Zci @ _solve(lu, Zic @ P)
+        X = _solve(lu, Zic @ P)  # Z_ii^-1 Z_ic P: the interior response to the probes
+        exact = self._z("cc", omega, n, False) @ P - Zci @ X
         err = np.linalg.norm(S @ P - exact, axis=0) / np.linalg.norm(exact, axis=0)
         e = float(err.max())
+        rows = np.array([i for _, i in self.obs_i], dtype=np.int64)
+        if rows.size:  # recovery of the observed interior DOFs: -(Psi - V Y) P vs -X
+            mod = (self.Psi[rows] - self.V[rows] @ Y) @ P
+            e = max(e, float(np.linalg.norm(mod + X[rows]) / np.linalg.norm(X[rows])))
         if np.any(F):
             Fe = F[self.cdofs] - Zci @ _solve(lu, F[self.idofs])
             e = max(e, float(np.linalg.norm(Fr - Fe) / max(np.linalg.norm(Fe), 1e-300)))

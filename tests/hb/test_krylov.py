@@ -1,0 +1,127 @@
+"""The large-interface Newton step (fretwear.hb.krylov) against the dense path of
+fretwear.hb.periodic.
+
+References: the formed Jacobian of the dense path (``J = eps (I - G) + G Z`` built by
+DLFTProblem.residual with jacobian="dense", LAPACK LU), which is independent of the operator
+products, the active-node reduction and GMRES tested here. Small 2D and 3D blocks are loaded
+so that separation, stick and slip all occur during the period (asserted).
+
+Tolerances: the operator products are the same sums in another order (1e-12 relative to the
+largest entry); the converged solutions are compared at a residual tolerance of 1e-12, where
+two exact-step solvers agree to ~1e-13 (measured 2e-13 to 5e-12 on these cases): 1e-8 is the
+acceptance of the issue and a wrong Jacobian product or step would not converge or would
+stop at a different point.
+"""
+
+import numpy as np
+import pytest
+
+from fretwear.hb import contact as law
+from fretwear.hb import krylov
+from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.krylov import KrylovJacobian
+from fretwear.hb.periodic import DLFTProblem, static_anchor
+from fretwear.hb.reduce import condense
+from fretwear.hb.solvers import solve
+from fretwear.model import ContactSpec, Material, Spring, Traction, box, from_mesh, rectangle
+
+P0, MU = 1e6, 0.5  # Pa, -
+
+
+def block(dim):
+    """A steel block on a rigid flat, pressed by P0, under a cyclic tangential traction (mu P0
+    in 3D, 0.5 mu P0 in 2D) and a cyclic normal traction growing along x to 1.3 P0 (in
+    quadrature), so that the edge at large x lifts off during part of the period while the
+    other edge sticks."""
+    a = 0.01
+    if dim == 2:
+        mesh, top, bottom = rectangle(a, 0.004, 6, 2), "top", "bottom"
+        cyc, lift = (0.5 * MU * P0, 0.0), (lambda x: np.column_stack([0 * x[:, 0],
+                                                                      1.3 * P0 * x[:, 0] / a]))
+        springs = [Spring(top, "x", 1e7)]
+    else:
+        mesh, top, bottom = box(a, a, 0.005, 4, 4, 1), "zmax", "zmin"
+        cyc = (MU * P0, 0.0, 0.0)
+        lift = (lambda x: np.column_stack([0 * x[:, 0], 0 * x[:, 0], 1.3 * P0 * x[:, 0] / a]))
+        springs = [Spring(top, "x", 1e7), Spring(top, "y", 1e7)]
+    return from_mesh(mesh, Material(210e9, 0.3, 7800.0), springs=springs,
+                     loads=[Traction(top, pressure=P0),
+                            Traction(top, traction=cyc, waveform="cos"),
+                            Traction(top, traction=lift, waveform="sin")],
+                     contact=ContactSpec(bottom, mu=MU))
+
+
+def problem(model, jacobian, nh=3):
+    basis = FourierBasis.up_to(nh, 32)
+    red = condense(model, 2000.0, basis.orders)
+    return DLFTProblem(red, model.contact, basis, eps="auto", anchor=static_anchor(model),
+                       jacobian=jacobian)
+
+
+def run(prob, tol=1e-12, x0=None):
+    def fun(x, jac=True):
+        return prob.residual(x.reshape(prob.m, prob.H), jac)
+
+    x0 = prob.initial_guess().reshape(-1) if x0 is None else x0
+    x, _, st = solve(fun, x0,
+                     lambda x: prob.scale(x.reshape(prob.m, prob.H)), tol=tol)
+    assert st.success, st.message
+    return x
+
+
+@pytest.fixture(scope="module", params=[2, 3])
+def case(request):
+    model = block(request.param)
+    dense = problem(model, "dense")
+    x = run(dense)
+    _, _, state, _ = dense.time_law(x.reshape(dense.m, dense.H))
+    for s in (law.SEPARATION, law.STICK, law.SLIP):
+        assert np.any(state == s), f"no {law.STATE_NAMES[s]} in the {request.param}D case"
+    return model, x
+
+
+def test_operator_products_equal_the_formed_jacobian(case):
+    """J @ x, J.T @ x and the column norms of the operator equal those of the dense path's
+    formed Jacobian at the solution (every contact state present in G)."""
+    model, x = case
+    dense = problem(model, "dense")
+    op = problem(model, "krylov")
+    _, J = dense.residual(x.reshape(dense.m, dense.H), True)
+    _, Jo = op.residual(x.reshape(op.m, op.H), True)
+    assert isinstance(Jo, KrylovJacobian)
+    v = np.random.default_rng(1).standard_normal(J.shape[0])
+    scale = np.abs(J).max() * np.abs(v).sum()
+    assert np.abs(Jo @ v - J @ v).max() < 1e-12 * scale
+    assert np.abs(Jo.T @ v - J.T @ v).max() < 1e-12 * scale
+    np.testing.assert_allclose(Jo.column_norms(chunk=5), np.linalg.norm(J, axis=0),
+                               rtol=1e-12)
+    np.testing.assert_allclose(Jo.toarray(), J, rtol=0, atol=1e-13 * np.abs(J).max())
+
+
+@pytest.mark.parametrize("step", ["active", "gmres"])
+def test_converged_answer_equals_dense_path(case, step, monkeypatch):
+    """The periodic solution with the operator Jacobian (step reduced to the active nodes and
+    solved by LU, or by preconditioned GMRES) equals the dense path's to 1e-8 relative. In 3D
+    the GMRES variant starts from 0.9 times the solution (from rest Powell takes ~50
+    iterations there, each with ~100 GMRES iterations: 35 s)."""
+    model, x_ref = case
+    x0 = None
+    if step == "gmres":
+        monkeypatch.setattr(krylov, "ACTIVE_DENSE_MAX", -1)
+        x0 = 0.9 * x_ref if model.dim == 3 else None
+    x = run(problem(model, "krylov"), x0=x0)
+    assert np.abs(x - x_ref).max() <= 1e-8 * np.abs(x_ref).max()
+
+
+def test_step_equals_lu_step(case):
+    """One Newton step: the active-node reduction and GMRES both give the LU solution of the
+    formed Jacobian (to 1e-9 relative: GMRES stops at 1e-10 of the residual; the LU is
+    exact to rounding)."""
+    model, x = case
+    dense, op = problem(model, "dense"), problem(model, "krylov")
+    x1 = 0.9 * x  # off the solution: a non-trivial step with every state present
+    f, J = dense.residual(x1.reshape(dense.m, dense.H), True)
+    _, Jo = op.residual(x1.reshape(op.m, op.H), True)
+    ref = np.linalg.solve(J, f)
+    for s in (Jo._solve_active(f, Jo.active_nodes()), Jo._gmres(f)):
+        assert np.abs(s - ref).max() <= 1e-9 * np.abs(ref).max()
