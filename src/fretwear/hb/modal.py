@@ -36,7 +36,16 @@ import scipy.linalg as sla
 import scipy.sparse.linalg as spla
 
 from fretwear.errors import InputError
-from fretwear.hb.reduce import BLOCK, Condenser, Reduced, _factor, _solve, _structure, install
+from fretwear.hb.reduce import (
+    BLOCK,
+    Condenser,
+    Reduced,
+    _column,
+    _factor,
+    _solve,
+    _structure,
+    install,
+)
 from fretwear.model.core import Model
 
 #: keep the fixed-interface modes up to this multiple of the highest harmonic frequency
@@ -216,7 +225,7 @@ class ModalCondenser(Condenser):
             S, Y, Fc, qF = self._parts(omega, int(n), quasi_static, F_all[n])
             Zr[b], Fr[b] = R @ S @ R.T, R @ Fc
             for j, c in self.obs_c:
-                oA[b, j] = R[:, c]
+                oA[b, j] = _column(R, c)
             if rows.size:
                 # u_i = Psi u_c + V q, q = qF - Y u_c: rows at the interior observed DOFs
                 A = (self.Psi[rows] - self.V[rows] @ Y) @ R.T

@@ -151,13 +151,22 @@ def _partition(s: Structure):
     return cdofs, np.flatnonzero(keep)
 
 
-def _frame_matrix(s: Structure) -> np.ndarray:
-    """Block-diagonal R (m, m) with ``u_loc = R @ U[cdofs]``."""
+def _frame_matrix(s: Structure) -> sp.csr_matrix:
+    """Block-diagonal R (m, m) with ``u_loc = R @ U[cdofs]``; sparse above ``DENSE_MAX``
+    contact DOFs (a dense R made the rotation ``R S R^T`` of a large interface cost
+    ``4 m^3``)."""
     nc, d, _ = s.frame.shape
+    if nc * d > DENSE_MAX:
+        return sp.block_diag(list(s.frame), format="csr")
     R = np.zeros((nc * d, nc * d))
     for p in range(nc):
         R[p * d : (p + 1) * d, p * d : (p + 1) * d] = s.frame[p]
     return R
+
+
+def _column(R, c: int) -> np.ndarray:
+    """Column ``c`` of the frame matrix (dense or sparse) as a 1-D array."""
+    return R[:, c] if isinstance(R, np.ndarray) else R[:, [c]].toarray()[:, 0]
 
 
 def _singular(n: int, omega: float, near: bool) -> InputError:
@@ -349,7 +358,7 @@ class Condenser:
                 Zr_n, lu, Zci, Xo = self.schur(omega, int(n), quasi_static)
                 A = np.zeros((no, m), dtype=complex)
                 for j, c in self.obs_c:
-                    A[j] = self.R[:, c]  # U_c = R^T u_loc
+                    A[j] = _column(self.R, c)  # U_c = R^T u_loc
                 for (j, _), x in zip(self.obs_i, Xo, strict=True):
                     A[j] = -(x @ self.R.T)
                 done[key] = (Zr_n, A, lu, Zci)
