@@ -125,3 +125,22 @@ def test_step_equals_lu_step(case):
     ref = np.linalg.solve(J, f)
     for s in (Jo._solve_active(f, Jo.active_nodes()), Jo._gmres(f)):
         assert np.abs(s - ref).max() <= 1e-9 * np.abs(ref).max()
+
+
+@pytest.mark.parametrize("symmetric", [True, False])
+def test_harmonic_blocks_products_equal_real_blocks(symmetric):
+    """Z~ U and Z~^T U by harmonic blocks equal the products with the formed real operator
+    (reduce.to_real_blocks, independent code) for complex symmetric blocks (the shortcut
+    Z^H = conj(Z)) and general ones (the transposed copy); rounding only: 1e-13."""
+    rng = np.random.default_rng(2)
+    Zc = rng.standard_normal((4, 6, 6)) + 1j * rng.standard_normal((4, 6, 6))
+    Zc[0] = Zc[0].real
+    if symmetric:
+        Zc = Zc + np.transpose(Zc, (0, 2, 1))
+    hb = krylov.HarmonicBlocks(Zc)
+    Zd = hb.dense()
+    U = rng.standard_normal((6, 7))
+    assert hb.symmetric() == symmetric
+    np.testing.assert_allclose(hb.apply(U).reshape(-1), Zd @ U.reshape(-1), rtol=0, atol=1e-13 * 50)
+    np.testing.assert_allclose(hb.apply_T(U).reshape(-1), Zd.T @ U.reshape(-1), rtol=0,
+                               atol=1e-13 * 50)

@@ -54,15 +54,19 @@ class HarmonicBlocks:
         self.H = 1 + 2 * self.k
         self.Z0 = np.ascontiguousarray(Zc[0].real)
         self._ZcH = None
+        self._symmetric = None
 
-    def _apply(self, Z0, Zc, U):
+    def _apply(self, Z0, Zc, U, conj=False):
         U = U.reshape(self.m, self.H)
         k = self.k
         out = np.empty((self.m, self.H))
         out[:, 0] = Z0 @ U[:, 0]
         if k:
             c = (U[:, 1 : k + 1] - 1j * U[:, k + 1 :]).T  # (k, m): U_n = a_n - i b_n
-            y = np.matmul(Zc[1:], c[:, :, None])[:, :, 0]  # (k, m)
+            if conj:  # conj(Z) c = conj(Z conj(c))
+                y = np.conj(np.matmul(Zc[1:], np.conj(c)[:, :, None])[:, :, 0])
+            else:
+                y = np.matmul(Zc[1:], c[:, :, None])[:, :, 0]  # (k, m)
             out[:, 1 : k + 1] = y.real.T
             out[:, k + 1 :] = -y.imag.T
         return out
@@ -71,8 +75,19 @@ class HarmonicBlocks:
         """``Z~ U`` (m, H) for ``U`` (m, H) or (m*H,)."""
         return self._apply(self.Z0, self.Zc, U)
 
+    def symmetric(self) -> bool:
+        """Whether every block is complex symmetric (symmetric ``K, M, C, D``): then
+        ``Z_n^H = conj(Z_n)`` and no transposed copy is needed."""
+        if self._symmetric is None:
+            self._symmetric = all(
+                np.allclose(z, z.T, rtol=0.0, atol=1e-13 * max(np.abs(z).max(), 1e-300))
+                for z in self.Zc)
+        return self._symmetric
+
     def apply_T(self, U) -> np.ndarray:
         """``Z~^T U`` (m, H): the real form of the conjugate transposes ``Z_n^H``."""
+        if self.symmetric():
+            return self._apply(self.Z0, self.Zc, U, conj=True)
         if self._ZcH is None:
             self._ZcH = np.ascontiguousarray(np.conj(np.transpose(self.Zc, (0, 2, 1))))
         return self._apply(np.ascontiguousarray(self.Z0.T), self._ZcH, U)

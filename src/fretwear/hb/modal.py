@@ -150,8 +150,10 @@ class ModalCondenser(Condenser):
             if B is None:
                 continue
             XiiPsi = B.ii @ Psi
-            cc = B.cc + B.ci @ Psi + (B.ic.T @ Psi).T + Psi.T @ XiiPsi
-            cc = cc if name != "K" else B.cc + B.ci @ Psi  # K_ii Psi = -K_ic exactly
+            if name == "K":  # K_ii Psi = -K_ic: the static condensation K_r
+                cc = B.cc + B.ci @ Psi
+            else:
+                cc = B.cc + B.ci @ Psi + (B.ic.T @ Psi).T + Psi.T @ XiiPsi
             cq = (B.ci @ V) + Psi.T @ (B.ii @ V)
             qc = (B.ic.T @ V).T + V.T @ XiiPsi
             qq = V.T @ (B.ii @ V)

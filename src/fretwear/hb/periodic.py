@@ -365,16 +365,17 @@ def check_inputs(model, basis, frequency, *, quasi_static: bool = False, anchor=
     return f
 
 
-def static_anchor(model: Model, *, quasi: Reduced | None = None) -> np.ndarray:
+def static_anchor(model: Model, *, quasi: Reduced | None = None, eps="auto") -> np.ndarray:
     """Tangential positions of the contact nodes after the static loads are applied from rest.
 
     Solves the static contact problem (one instant) starting from a stress-free state in which
     every node that touches sticks where it is (anchor 0): the loading history "preload first,
-    then vibrate". Returns (nc, d-1) [m].
+    then vibrate". ``eps``: the penalty of this static solve (the rule or a number, as for
+    :class:`DLFTProblem`). Returns (nc, d-1) [m].
     """
     basis = FourierBasis((), 1)
     red = quasi if quasi is not None else condense(model, 0.0, [0], quasi_static=True)
-    prob = DLFTProblem(red, model.contact, basis)
+    prob = DLFTProblem(red, model.contact, basis, eps=eps)
     U0 = prob.initial_guess()
 
     def fun(x, jac=True):

@@ -1,0 +1,200 @@
+"""Cost of the periodic solve, the condensation, sweeps and wear runs on large 3D interfaces.
+
+The model: a steel pad 10 x 10 x 1.25 mm (hexahedra of about 0.3 mm) pressed by 1 MPa on a
+rigid flat (mu = 0.5) with springs on its top face, under a harmonic tangential traction of
+0.8 mu P at 5 kHz; the contact face has n x n nodes (3 DOFs each), 7 harmonics, 128 samples
+per period. For each size, in a fresh process (so that the peak memory is that size's), it
+prints: unknowns ``3 n^2 (2 H + 1)``, the condensation (the modal representation of
+fretwear.hb.modal with its error check against the exact condensation, and the exact
+condensation itself where it runs in minutes), the periodic solve (fretwear's
+solve_periodic: static preload, harmonic continuation start, Powell with the Newton step of
+fretwear.hb.krylov), its iterations and contact states, the peak resident memory, and, where
+a dense matrix of the Jacobian's size fits in 4 GiB, one dense LU of that size timed in the
+same process (what the dense path pays per iteration). CPU seconds of the process are
+printed beside wall seconds: the machine is shared.
+
+eps: a number, the largest diagonal entry of the static ``K_r`` (``eps="auto"``/``"static"``
+take every eigenvalue of every block, minutes at 1024 nodes: see the report of the penalty
+rule).
+
+Optionally (``--sweep N`` / ``--wear N``) it times a sweep of N points from 4 to 6 kHz and a
+wear run of N slow steps at the largest size given to ``--extras-size``.
+
+The last lines read ``solve_1024_s=``, ``condense_1024_s=`` and ``peak_rss_1024_gib=`` (CPU
+seconds and GiB of the 32 x 32 size, when it was run).
+
+Run: ``python benchmarks/scale_3d.py [--sizes 8,16,32] [--sweep 50 --wear 20
+--extras-size 32]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+A, P0, MU, FREQ, H = 0.01, 1e6, 0.5, 5000.0, 7
+
+
+def pad(n: int):
+    """The pad with n x n contact nodes."""
+    from fretwear.model import ContactSpec, Material, Spring, Traction, box, from_mesh
+
+    ne = n - 1
+    nz = max(1, round(ne / 8))
+    return from_mesh(box(A, A, A / 8, ne, ne, nz), Material(210e9, 0.3, 7800.0),
+                     springs=[Spring("zmax", "x", 1e7), Spring("zmax", "y", 1e7)],
+                     loads=[Traction("zmax", pressure=P0),
+                            Traction("zmax", traction=(0.8 * MU * P0, 0.0, 0.0),
+                                     waveform="cos")],
+                     contact=ContactSpec("zmin", mu=MU, wear_coefficient=1e-15))
+
+
+class Clock:
+    def __enter__(self):
+        self.c, self.w = time.process_time(), time.perf_counter()
+        return self
+
+    def __exit__(self, *exc):
+        self.cpu, self.wall = time.process_time() - self.c, time.perf_counter() - self.w
+
+
+def peak_gib() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20
+
+
+def one(n: int, extras: dict) -> dict:
+    """Everything for one size (run in its own process)."""
+    import scipy.linalg as sla
+
+    from fretwear.hb.fourier import FourierBasis
+    from fretwear.hb.modal import use_modal
+    from fretwear.hb.periodic import solve_periodic, static_anchor
+    from fretwear.hb.reduce import Condenser, _structure
+
+    out = {"n": n, "nodes": n * n}
+    with Clock() as c:
+        model = pad(n)
+    out.update(ndof=model.ndof, build_cpu=c.cpu, build_wall=c.wall)
+    basis = FourierBasis.up_to(H, 128)
+    out["unknowns"] = 3 * n * n * basis.size
+    with Clock() as c:
+        mc = use_modal(model, FREQ * 1.2, H)
+        red = mc.reduced(2 * np.pi * FREQ, basis.orders, frequency=FREQ)
+    out.update(condense_cpu=c.cpu, condense_wall=c.wall, modes=mc.n_modes, q=mc.q,
+               modal_error=mc.error)
+    if n * n <= 256:  # the exact condensation, for comparison
+        with Clock() as c:
+            ex = Condenser(_structure(model)).reduced(2 * np.pi * FREQ, basis.orders)
+        out.update(exact_cpu=c.cpu, exact_wall=c.wall,
+                   modal_vs_exact=float(max(np.abs(red.Z[b] - ex.Z[b]).max()
+                                            / np.abs(ex.Z[b]).max() for b in range(H + 1))))
+        del ex
+    eps = float(np.abs(np.diag(red.Z[0].real)).max())
+    out["eps"] = eps
+    with Clock() as c:
+        anchor = static_anchor(model, eps=eps)  # the static preload state
+        sol = solve_periodic(model, basis, frequency=FREQ, reduced=red, eps=eps, anchor=anchor)
+    st = sol.stats
+    frac = sol.state_fractions().mean(axis=0)
+    out.update(solve_cpu=c.cpu, solve_wall=c.wall, success=sol.success, iterations=st.iterations,
+               residual=st.residual, sep=frac[0], stick=frac[1], slip=frac[2],
+               active_nodes=int(np.sum(np.any(sol.state != 1, axis=1))))
+    out["peak_gib"] = peak_gib()  # condensation + solve
+    if extras.get("sweep"):
+        from fretwear.hb.sweep import sweep
+
+        with Clock() as c:
+            res = sweep(model, basis, 4000.0, 6000.0, extras["sweep"], spacing="linear",
+                        eps=eps, anchor=sol.anchor)
+        out.update(sweep_points=extras["sweep"], sweep_cpu=c.cpu, sweep_wall=c.wall,
+                   sweep_converged=int(sum(p.success for p in res.points)))
+    if extras.get("wear"):
+        from fretwear.wear.options import WearOptions
+        from fretwear.wear.simulate import simulate_wear
+
+        with Clock() as c:
+            wr = simulate_wear(model, basis, frequency=FREQ, reduced=red, eps=eps,
+                               anchor=sol.anchor, U0=sol.U,
+                               options=WearOptions(max_steps=extras["wear"]))
+        out.update(wear_steps=len(wr.history.cycles) if hasattr(wr, "history") else None,
+                   wear_cpu=c.cpu, wear_wall=c.wall, wear_success=bool(wr.success))
+    out["peak_extras_gib"] = peak_gib()
+    nu = out["unknowns"]
+    if 8.0 * nu * nu <= 4 * 2**30:  # last: its memory is not the solve's
+        M = np.random.default_rng(0).standard_normal((nu, nu)) + nu * np.eye(nu)
+        with Clock() as c:
+            sla.lu_factor(M, overwrite_a=True, check_finite=False)
+        out.update(dense_lu_cpu=c.cpu, dense_lu_wall=c.wall)
+    return out
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--sizes", default="8,16,32", help="nodes per side of the contact face")
+    ap.add_argument("--sweep", type=int, default=0, help="points of the sweep (0: none)")
+    ap.add_argument("--wear", type=int, default=0, help="slow steps of the wear run (0: none)")
+    ap.add_argument("--extras-size", type=int, default=32, help="size of the sweep/wear run")
+    ap.add_argument("--one", type=int, help=argparse.SUPPRESS)
+    ap.add_argument("--extras", default="{}", help=argparse.SUPPRESS)
+    args = ap.parse_args()
+    if args.one:
+        print("RESULT " + json.dumps(one(args.one, json.loads(args.extras)), default=float))
+        return
+    print(f"load: {os.getloadavg()}; OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS')}")
+    rows = {}
+    for n in (int(s) for s in args.sizes.split(",")):
+        extras = ({"sweep": args.sweep, "wear": args.wear} if n == args.extras_size else {})
+        proc = subprocess.run([sys.executable, __file__, "--one", str(n), "--extras",
+                               json.dumps(extras)], capture_output=True, text=True)
+        line = [x for x in proc.stdout.splitlines() if x.startswith("RESULT ")]
+        if proc.returncode or not line:
+            print(f"n = {n}: failed\n{proc.stderr[-2000:]}")
+            continue
+        r = rows[n] = json.loads(line[0][7:])
+        print(f"\n{r['nodes']} contact nodes ({r['ndof']} DOFs), H = {H}: "
+              f"{r['unknowns']} unknowns (model built in {r['build_cpu']:.1f} s CPU)")
+        print(f"  condensation (modal, {r['modes']} modes + loads, checked error "
+              f"{r['modal_error']:.2g}): {r['condense_cpu']:.1f} s CPU, "
+              f"{r['condense_wall']:.1f} s wall")
+        if "exact_cpu" in r:
+            print(f"  exact condensation: {r['exact_cpu']:.1f} s CPU, {r['exact_wall']:.1f} s "
+                  f"wall; modal vs exact max rel. difference {r['modal_vs_exact']:.2g}")
+        print(f"  periodic solve: {r['solve_cpu']:.1f} s CPU, {r['solve_wall']:.1f} s wall, "
+              f"success {r['success']}, {r['iterations']} iterations (after the 1-harmonic "
+              f"start), residual {r['residual']:.2g}; states sep/stick/slip "
+              f"{r['sep']:.3f}/{r['stick']:.3f}/{r['slip']:.3f}, {r['active_nodes']} nodes "
+              "slip or separate")
+        if "dense_lu_cpu" in r:
+            print(f"  one dense LU of {r['unknowns']}: {r['dense_lu_cpu']:.1f} s CPU, "
+                  f"{r['dense_lu_wall']:.1f} s wall")
+        else:
+            print(f"  dense LU of {r['unknowns']}: does not fit in 4 GiB "
+                  f"({8 * r['unknowns'] ** 2 / 2**30:.0f} GiB)")
+        if "sweep_cpu" in r:
+            print(f"  sweep of {r['sweep_points']} points: {r['sweep_cpu']:.1f} s CPU, "
+                  f"{r['sweep_wall']:.1f} s wall, {r['sweep_converged']} converged")
+        if "wear_cpu" in r:
+            print(f"  wear run ({r['wear_steps']} slow steps): {r['wear_cpu']:.1f} s CPU, "
+                  f"{r['wear_wall']:.1f} s wall, success {r['wear_success']}")
+        print(f"  peak memory {r['peak_gib']:.2f} GiB (condensation + solve), "
+              f"{r['peak_extras_gib']:.2f} GiB with the sweep and wear run")
+    if 16 in rows and 32 in rows:
+        g = np.log(rows[32]["solve_cpu"] / rows[16]["solve_cpu"]) / np.log(
+            rows[32]["unknowns"] / rows[16]["unknowns"])
+        print(f"\nsolve time ~ unknowns^{g:.2f} from 256 to 1024 nodes")
+    print(f"load: {os.getloadavg()}")
+    r = rows.get(32, {})
+    print(f"solve_1024_s={r.get('solve_cpu', float('nan')):.1f}")
+    print(f"condense_1024_s={r.get('condense_cpu', float('nan')):.1f}")
+    print(f"peak_rss_1024_gib={r.get('peak_gib', float('nan')):.2f}")
+
+
+if __name__ == "__main__":
+    main()
