@@ -274,6 +274,7 @@ class Condenser:
         self.obs_c = [(j, pos_c[int(g)]) for j, g in enumerate(s.obs) if int(g) in pos_c]
         self.obs_i = [(j, pos_i[int(g)]) for j, g in enumerate(s.obs) if int(g) in pos_i]
         self._lus: dict = {}
+        self._static = None
 
     # -- the blocks of Z_n ------------------------------------------------------------------
     def _z(self, part: str, omega: float, n: int, quasi_static: bool):
@@ -314,7 +315,19 @@ class Condenser:
     def schur(self, omega: float, n: int, quasi_static: bool = False):
         """``(Z_r, lu, Zci, Xo)``: the condensed ``Z_r = R (Z_cc - Z_ci Z_ii^-1 Z_ic) R^T``
         (eq. 19) in the contact-local frame, the LU of ``Z_ii``, ``Z_ci`` and the rows of
-        ``Z_ii^-1 Z_ic`` at the interior observed DOFs (``len(obs_i)``, m)."""
+        ``Z_ii^-1 Z_ic`` at the interior observed DOFs (``len(obs_i)``, m). The static one
+        (harmonic 0, quasi-static) is computed once and kept (read-only arrays)."""
+        static = n == 0 or quasi_static
+        if static and self._static is not None:
+            return self._static
+        out = self._schur(omega, n, quasi_static)
+        if static:
+            for a in (out[0], out[3]):
+                a.flags.writeable = False
+            self._static = out
+        return out
+
+    def _schur(self, omega: float, n: int, quasi_static: bool):
         S = self._z("cc", omega, n, quasi_static)
         lu = self.factor(omega, n, quasi_static)
         if lu is None:
