@@ -101,10 +101,12 @@ class DLFTProblem:
         return self._Z
 
     def apply_Z(self, U) -> np.ndarray:
-        """``Z~ U~`` (m, H): with the dense ``Z~`` when it is formed, else by harmonic
-        blocks (:class:`~fretwear.hb.krylov.HarmonicBlocks`)."""
-        if self._Z is not None:
-            return (self._Z @ np.reshape(U, -1)).reshape(self.m, self.H)
+        """``Z~ U~`` (m, H): with the formed ``Z~`` on the dense path, by harmonic blocks
+        (:class:`~fretwear.hb.krylov.HarmonicBlocks`) on the operator path; always the same
+        way for one problem, so that a result re-assembled from saved harmonics is bitwise
+        the one of the solve."""
+        if self.jacobian == "dense":
+            return (self.Z @ np.reshape(U, -1)).reshape(self.m, self.H)
         return self.blocks.apply(U)
 
     # -- evaluation ---------------------------------------------------------------------

@@ -216,8 +216,8 @@ def _factor(Zii, n: int, omega: float):
 
 #: at most this many interior DOFs: the condensation works on dense arrays (LAPACK). Below it
 #: the sparse machinery costs more than the arithmetic (docs/theory.md, "Cost of the
-#: condensation": measured crossover about 1000 DOFs, benchmarks/condense_small.py).
-DENSE_MAX = 600
+#: condensation": measured crossover 100-180 interior DOFs, benchmarks/condense_small.py).
+DENSE_MAX = 150
 #: right-hand sides per block of the multi-RHS sparse solves: bounds the memory of
 #: ``Z_ii^-1 Z_ic`` to ``n_i x BLOCK`` complex values.
 BLOCK = 256
