@@ -249,23 +249,29 @@ class KrylovJacobian:
         right-preconditioned GMRES on the whole system to :data:`GMRES_RTOL` (the
         preconditioner is rebuilt from this Jacobian when the kept one needs more than
         :data:`REBUILD_AFTER` iterations or fails)."""
-        b = np.asarray(b, float).reshape(-1)
+        b = np.asarray(b, float)
         act = self.active_nodes()
         if act.size * self.dH <= ACTIVE_DENSE_MAX:
             return self._solve_active(b, act)
+        if b.ndim == 2:  # several right-hand sides (e.g. the wear rate's dU/dW)
+            return np.column_stack([self._gmres(c) for c in b.T])
         return self._gmres(b)
 
     def _solve_active(self, b, act) -> np.ndarray:
         from fretwear.hb.solvers import solve_identity_rows
 
         eps, dH, d, Z = self.eps, self.dH, self.d, self.Z
-        x = (b / eps).reshape(self.nc, dH)
+        shape = b.shape
+        B = b.reshape(self.n, -1)
+        k = B.shape[1]
+        x = (B / eps).reshape(self.nc, dH, k)
         if not act.size:
-            return x.reshape(-1)
+            return x.reshape(shape)
         x[act] = 0.0
         # G_a Z_as x_s: the product with the stuck part only
-        rhs = b.reshape(self.nc, dH)[act] - np.matmul(
-            self.G[act], Z.apply(x.reshape(-1)).reshape(self.nc, dH)[act][:, :, None])[:, :, 0]
+        ZX = np.column_stack([Z.apply(x[:, :, c].reshape(-1)).reshape(-1) for c in range(k)])
+        rhs = B.reshape(self.nc, dH, k)[act] - np.matmul(
+            self.G[act], ZX.reshape(self.nc, dH, k)[act])
         dofs = (act[:, None] * d + np.arange(d)[None, :]).reshape(-1)
         Za = HarmonicBlocks(Z.Zc[:, dofs][:, :, dofs]).dense()  # (na dH, na dH) DOF-major
         na = act.size
@@ -274,8 +280,8 @@ class KrylovJacobian:
             sl = slice(i * dH, (i + 1) * dH)
             Ja[sl, sl] -= eps * self.G[act[i]]
         Ja[np.diag_indices(na * dH)] += eps
-        x[act] = solve_identity_rows(Ja, rhs.reshape(-1)).reshape(na, dH)
-        return x.reshape(-1)
+        x[act] = solve_identity_rows(Ja, rhs.reshape(na * dH, k)).reshape(na, dH, k)
+        return x.reshape(shape)
 
     def _gmres(self, b) -> np.ndarray:
         A = spla.LinearOperator(self.shape, matvec=self.matvec, dtype=float)

@@ -57,8 +57,11 @@ def solve_identity_rows(J, B):
 
     Parameters
     ----------
-    J : (n, n); B : (n,) or (n, k).
+    J : (n, n), or the Jacobian as an operator (:class:`fretwear.hb.krylov.KrylovJacobian`,
+        which eliminates those rows itself); B : (n,) or (n, k).
     """
+    if not isinstance(J, np.ndarray):
+        return J.solve(B)
     n = J.shape[0]
     idx = np.arange(n)
     diag_only = (np.count_nonzero(J, axis=1) == 1) & (J[idx, idx] != 0.0)

@@ -126,7 +126,7 @@ class SlowProblem:
         R = np.concatenate([f, self.eps * (W - W_k - dN * g)])
         n, nc = self.n, self.nc
         JJ = np.empty((n + nc, n + nc))
-        JJ[:n, :n] = J
+        JJ[:n, :n] = J if isinstance(J, np.ndarray) else J.toarray()  # operator: large models
         JJ[:n, n:] = self.dfdW(lu, lx, state)
         JJ[n:, :n] = -self.eps * dN * gU
         JJ[n:, n:] = 0.0
