@@ -125,6 +125,10 @@ def test_step_equals_lu_step(case):
     ref = np.linalg.solve(J, f)
     for s in (Jo._solve_active(f, Jo.active_nodes()), Jo._gmres(f)):
         assert np.abs(s - ref).max() <= 1e-9 * np.abs(ref).max()
+    # several right-hand sides at once (the wear rate's dU/dW)
+    B = np.random.default_rng(3).standard_normal((f.size, 3))
+    ref = np.linalg.solve(J, B)
+    assert np.abs(Jo.solve(B) - ref).max() <= 1e-9 * np.abs(ref).max()
 
 
 @pytest.mark.parametrize("symmetric", [True, False])
