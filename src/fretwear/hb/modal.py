@@ -100,8 +100,9 @@ class ModalCondenser(Condenser):
         self.mode_frequencies, Phi = self._modes(lu, modes, f_cut)
         self.n_modes = Phi.shape[1]
         # + static responses of the loads' interior parts, orthonormalised
-        Fl = np.column_stack([np.asarray(ld.vector, float)[self.idofs] for ld in model.loads]
-                             ) if model.loads else np.zeros((self.ni, 0))
+        vecs = self.structure.load_vectors
+        Fl = (np.column_stack([v[self.idofs] for v in vecs]) if vecs
+              else np.zeros((self.ni, 0)))
         Xl = lu.solve(Fl) if Fl.shape[1] else Fl
         V = np.column_stack([Phi, Xl])
         if V.shape[1]:
@@ -233,8 +234,7 @@ class ModalCondenser(Condenser):
                 A = (self.Psi[rows] - self.V[rows] @ Y) @ R.T
                 for (j, _), a, bo in zip(self.obs_i, A, self.V[rows] @ qF, strict=True):
                     oA[b, j], ob[b, j] = a, bo
-        return Reduced(float(omega), orders, Zr, Fr, oA, ob, self.structure.obs,
-                       bool(quasi_static), math.nan if frequency is None else float(frequency))
+        return self._result(omega, orders, Zr, Fr, oA, ob, quasi_static, frequency)
 
     def recover(self, omega: float, orders, u_loc, quasi_static: bool = False) -> np.ndarray:
         """All DOFs (nb, ndof) from ``u_loc`` (nb, m) through the modal representation
@@ -247,7 +247,8 @@ class ModalCondenser(Condenser):
             _, Y, _, qF = self._parts(omega, int(n), quasi_static, F_all[n])
             out[b, self.cdofs] = Uc
             out[b, self.idofs] = self.Psi @ Uc + self.V @ (qF - Y @ Uc)
-        return out
+        P = self.structure.P
+        return out if P is None else (P @ out.T).T
 
 
 def use_modal(model: Model, f_max: float, max_order: int, **options) -> ModalCondenser:

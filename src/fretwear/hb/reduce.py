@@ -82,7 +82,8 @@ class Reduced:
 def dynamic_stiffness(model: Model, frequency: float, n: int, quasi_static: bool = False):
     """Sparse complex ``Z_n`` [N/m] on all DOFs (eq. 18 in complex form) at the excitation
     ``frequency`` [Hz] (harmonic ``n`` of it)."""
-    return _dynamic_stiffness(_structure(model), 2 * np.pi * frequency, n, quasi_static)
+    return _dynamic_stiffness(_structure(model, relative=False), 2 * np.pi * frequency, n,
+                              quasi_static)
 
 
 @dataclass
@@ -93,7 +94,11 @@ class Structure:
     damping or None; load_harmonics : ``nmax -> (nmax+1, ndof)`` complex load amplitudes [N]
     (:meth:`fretwear.model.core.Model.load_harmonics`); fixed : held DOFs; cdofs : (m,)
     contact DOFs node-major; frame : (nc, d, d) local frames; obs : global DOFs of the
-    observed points in the order of ``model.observed``.
+    observed points in the order of ``model.observed``; load_vectors : the loads' (ndof,)
+    vectors [N]. With node-to-node pairs every field is in the relative coordinates ``U'``
+    (``U = P U'``, :func:`fretwear.model.interfaces.relative_model`), ``obs`` holds the
+    primed DOFs the observed ones depend on and ``U[obs_out] = S @ U'[obs]``; ``P``, ``S``
+    are None without pairs (``obs_out = obs``).
     """
 
     K: sp.csr_matrix
@@ -105,18 +110,30 @@ class Structure:
     cdofs: np.ndarray
     frame: np.ndarray
     obs: np.ndarray
+    load_vectors: list
+    P: sp.csr_matrix | None = None
+    obs_out: np.ndarray | None = None
+    S: sp.csr_matrix | None = None
 
     @property
     def ndof(self) -> int:
         return int(self.K.shape[0])
 
 
-def _structure(model: Model) -> Structure:
+def _structure(model: Model, relative: bool = True) -> Structure:
     """The structure's matrices, loads, contact DOFs and observed DOFs as the condensation
     sees them: every read of ``model.K/M/C/D``, the loads and the observed DOFs in this module
-    goes through here (a change of coordinates of the model applies in one place)."""
-    obs = (np.concatenate([np.asarray(p.dofs, dtype=np.int64) for p in model.observed])
-           if model.observed else np.zeros(0, dtype=np.int64))
+    goes through here, and the change of coordinates of node-to-node pairs (``U = P U'``)
+    applies here (``relative=False``: the model's own coordinates)."""
+    P = None
+    if relative:
+        model, P = relative_model(model)  # node-to-node pairs: relative coordinates U = P U'
+        obs_out, obs, S = observed_map(model, P)  # U[obs_out] = S @ U'[obs]
+    else:
+        obs_out = obs = (np.concatenate([np.asarray(p.dofs, dtype=np.int64)
+                                         for p in model.observed])
+                         if model.observed else np.zeros(0, dtype=np.int64))
+        S = None
     return Structure(
         K=sp.csr_matrix(model.K), M=sp.csr_matrix(model.M),
         C=None if model.C is None else sp.csr_matrix(model.C),
@@ -124,7 +141,9 @@ def _structure(model: Model) -> Structure:
         load_harmonics=model.load_harmonics,
         fixed=np.asarray(model.fixed_dofs, dtype=np.int64),
         cdofs=np.asarray(model.contact.dofs, dtype=np.int64).reshape(-1),
-        frame=np.asarray(model.contact.frame, dtype=float), obs=obs)
+        frame=np.asarray(model.contact.frame, dtype=float), obs=np.asarray(obs, np.int64),
+        load_vectors=[np.asarray(ld.vector, dtype=float) for ld in model.loads],
+        P=P, obs_out=np.asarray(obs_out, np.int64), S=S)
 
 
 def _dynamic_stiffness(s: Structure, omega: float, n: int, quasi_static: bool = False):
@@ -172,10 +191,12 @@ def _column(R, c: int) -> np.ndarray:
 def _singular(n: int, omega: float, near: bool) -> InputError:
     if near:
         return InputError(
-            f"the structure with its contact DOFs held is (nearly) singular at harmonic {n}: "
+            f"the structure with its contact DOFs held (node-to-node pairs glued) is (nearly) "
+            f"singular at harmonic {n}: "
             "part of the model can move with nothing to hold it (add springs or fixed DOFs)")
     return InputError(
-        f"the structure with its contact DOFs held is singular at harmonic {n} "
+        f"the structure with its contact DOFs held (node-to-node pairs glued) is singular "
+        f"at harmonic {n} "
         f"(excitation {omega / (2 * np.pi):.6g} Hz): part of the model can move with "
         "nothing to hold it (add springs or fixed DOFs), or the frequency is an "
         "eigenfrequency of the undamped structure with a clamped interface")
@@ -379,7 +400,16 @@ class Condenser:
             Fr[b], xf = self.loads(F_all[n], lu, Zci)
             for j, i in self.obs_i:
                 ob[b, j] = xf[i]
-        return Reduced(float(omega), orders, Zr, Fr, oA, ob, self.structure.obs,
+        return self._result(omega, orders, Zr, Fr, oA, ob, quasi_static, frequency)
+
+    def _result(self, omega, orders, Zr, Fr, oA, ob, quasi_static, frequency) -> Reduced:
+        """The :class:`Reduced` model, its observed rows mapped back from the relative
+        coordinates of node-to-node pairs (``U[obs_out] = S U'[obs]``)."""
+        S = self.structure.S
+        if S is not None:
+            oA = np.einsum("oj,bjm->bom", S.toarray(), oA)
+            ob = ob @ S.toarray().T
+        return Reduced(float(omega), orders, Zr, Fr, oA, ob, self.structure.obs_out,
                        bool(quasi_static), math.nan if frequency is None else float(frequency))
 
     def recover(self, omega: float, orders, u_loc, quasi_static: bool = False) -> np.ndarray:
@@ -395,7 +425,8 @@ class Condenser:
                 lu = self.factor(omega, int(n), quasi_static)
                 rhs = F_all[n][self.idofs] - self._z("ic", omega, int(n), quasi_static) @ Uc
                 out[b, self.idofs] = _solve(lu, rhs)
-        return out
+        P = self.structure.P
+        return out if P is None else (P @ out.T).T
 
 
 def _solve(lu, B):
@@ -429,6 +460,8 @@ def _fingerprint(model: Model):
     return (mat(model.K), mat(model.M), mat(model.C), mat(model.D),
             np.asarray(model.fixed_dofs).tobytes(), np.asarray(c.dofs).tobytes(),
             np.asarray(c.frame, float).tobytes(),
+            None if getattr(c, "partner_dofs", None) is None
+            else np.asarray(c.partner_dofs).tobytes(),
             tuple(tuple(np.asarray(p.dofs).tolist()) for p in model.observed))
 
 
@@ -439,8 +472,15 @@ def condenser(model: Model) -> Condenser:
     fp = _fingerprint(model)
     hit = _CONDENSERS.get(key)
     if hit is not None and hit[0]() is model and hit[1] == fp:
-        cond = hit[2]
-        cond.structure.load_harmonics = model.load_harmonics
+        cond = hit[2]  # the loads are read anew (in relative coordinates with pairs)
+        s, P = cond.structure, cond.structure.P
+        if P is None:
+            s.load_harmonics = model.load_harmonics
+            s.load_vectors = [np.asarray(ld.vector, dtype=float) for ld in model.loads]
+        else:
+            Pt = P.T.tocsr()
+            s.load_harmonics = lambda nmax: (Pt @ model.load_harmonics(nmax).T).T
+            s.load_vectors = [Pt @ np.asarray(ld.vector, dtype=float) for ld in model.loads]
         return cond
     cond = Condenser(_structure(model))
     install(model, cond)
@@ -475,7 +515,11 @@ class StaticCondensation:
     _cond: Condenser
     _lu: object
     _Kci: object
-    _P: object = None  # U = P U' for node-to-node pairs (model.interfaces), None without
+
+    @property
+    def _P(self):
+        """``U = P U'`` for node-to-node pairs (model.interfaces), None without."""
+        return self._cond.structure.P
 
     def loads(self, F) -> np.ndarray:
         """Condensed loads ``F_r`` (..., m) [N] of load vectors ``F`` (..., ndof) [N]."""
@@ -493,9 +537,12 @@ class StaticCondensation:
         U = np.zeros(c.structure.ndof)
         Uc = c.R.T @ np.asarray(u_loc, dtype=float)
         U[c.cdofs] = Uc
+        F = np.asarray(F, float)
+        if self._P is not None:
+            F = self._P.T @ F
         if self._lu is not None:
-            U[c.idofs] = self._lu.solve(np.asarray(F, float)[c.idofs] - c.K.ic @ Uc)
-        return U
+            U[c.idofs] = self._lu.solve(F[c.idofs] - c.K.ic @ Uc)
+        return U if self._P is None else self._P @ U
 
 
 def condense_static(model: Model) -> StaticCondensation:
