@@ -128,7 +128,7 @@ def cmd_study(args) -> int:
         raise InputError(f"--workers {args.workers}: expected a positive number of worker "
                          "processes")
     res = run_study(args.study, args.output, scheduler=args.scheduler, workers=args.workers,
-                    progress=not args.no_progress)
+                    progress=not args.no_progress, collect=args.collect)
     return 0 if res.success else 1
 
 
@@ -218,6 +218,9 @@ def _parser() -> argparse.ArgumentParser:
                     "local cluster")
     st.add_argument("--workers", metavar="N", type=int, default=None,
                     help="worker processes of the local cluster (default: the number of cores)")
+    st.add_argument("--collect", action="store_true",
+                    help="run nothing: write study.nc and the figures of the members finished "
+                    "so far (e.g. while the study runs elsewhere)")
     st.add_argument("--list", action="store_true", help="list the shipped study files")
     st.add_argument("--no-progress", action="store_true", help="no progress bar")
     st.set_defaults(func=cmd_study)

@@ -203,7 +203,7 @@ def aggregate(study, members: list[Member], records: list[MemberRecord], outdir)
     coords = _member_coords(members)
     data = {
         "member_status": ("member", np.array([r.status for r in records]),
-                          {"long_name": "ok, not converged or failed"}),
+                          {"long_name": "ok, not converged, failed or not run"}),
         "member_message": ("member", np.array([r.message for r in records]),
                            {"long_name": "summary of the run or why it failed"}),
         "member_seconds": ("member", np.array([r.seconds for r in records], float),
@@ -227,5 +227,6 @@ def aggregate(study, members: list[Member], records: list[MemberRecord], outdir)
         "members_ok": sum(r.status == "ok" for r in records),
         "members_not_converged": sum(r.status == "not converged" for r in records),
         "members_failed": sum(r.status == "failed" for r in records),
+        "members_not_run": sum(r.status == "not run" for r in records),
     })
     return ds

@@ -68,13 +68,15 @@ def _write_dataset(path: Path, ds) -> Path:
 
 def _summary(study: Study, records, ds) -> tuple[bool, str]:
     n = len(records)
-    count = {s: sum(r.status == s for r in records) for s in ("ok", "not converged", "failed")}
+    count = {s: sum(r.status == s for r in records)
+             for s in ("ok", "not converged", "failed", "not run")}
     skipped = sum(r.skipped for r in records)
     lines = [f"{study.kind} study of {n} members: {count['ok']} ok, "
              f"{count['not converged']} not converged, {count['failed']} failed"
+             + (f", {count['not run']} not run" if count["not run"] else "")
              + (f" ({skipped} finished before)" if skipped else "")]
     for r in records:
-        if r.status != "ok":
+        if r.status not in ("ok", "not run"):
             lines.append(f"  member {r.index}: {r.status}: {r.message[:200]}")
     ok = count["ok"] == n
     if study.kind == "split" and "join_ok" in ds:
@@ -98,7 +100,7 @@ def _summary(study: Study, records, ds) -> tuple[bool, str]:
 
 
 def run_study(path, outdir=None, *, scheduler=None, workers: int | None = None,
-              progress: bool = True, echo: bool = True) -> StudyResult:
+              progress: bool = True, echo: bool = True, collect: bool = False) -> StudyResult:
     """Run a study file on Dask distributed.
 
     Parameters
@@ -114,6 +116,8 @@ def run_study(path, outdir=None, *, scheduler=None, workers: int | None = None,
         else the number of cores).
     progress : a progress bar over members, with the time left (stderr).
     echo : print the summary (stdout).
+    collect : run nothing: write ``study.nc`` and the figures of the members finished so
+        far, the others recorded as "not run" (e.g. while the study runs on a cluster).
 
     Returns
     -------
@@ -139,9 +143,12 @@ def run_study(path, outdir=None, *, scheduler=None, workers: int | None = None,
     for p in remove_stale_temporaries(out_dir):
         say(f"removed {p.name}: temporary file of a write that was killed")
     try:
-        with dask_client(scheduler if scheduler is not None else study.scheduler,
-                         workers if workers is not None else study.workers) as client:
-            report = run_members(members, out_dir, client, progress=progress)
+        if collect:
+            report = run_members(members, out_dir, None)
+        else:
+            with dask_client(scheduler if scheduler is not None else study.scheduler,
+                             workers if workers is not None else study.workers) as client:
+                report = run_members(members, out_dir, client, progress=progress)
     except (KeyboardInterrupt, SystemError) as exc:
         if not interrupted(exc):
             raise

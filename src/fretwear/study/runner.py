@@ -179,7 +179,7 @@ def dask_client(scheduler=None, workers: int | None = None):
         return
     n = workers or os.cpu_count() or 1
     cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                           dashboard_address=None, silence_logs=logging.ERROR)
+                           dashboard_address=":0", silence_logs=logging.ERROR)
     client = Client(cluster)
     try:
         yield client
@@ -199,7 +199,9 @@ class RunReport:
 def run_members(members: list[Member], outdir: Path, client, progress: bool = True,
                 on_record: Callable[[MemberRecord], None] | None = None) -> RunReport:
     """Run the members not finished yet on ``client`` (a ``distributed.Client``); members
-    already finished with the same case text are skipped. Returns every member's record."""
+    already finished with the same case text are skipped. Returns every member's record.
+    ``client = None`` runs nothing: the members not finished are recorded as "not run"
+    (a look at a study still running elsewhere)."""
     from distributed import as_completed
     from tqdm.auto import tqdm
 
@@ -215,6 +217,12 @@ def run_members(members: list[Member], outdir: Path, client, progress: bool = Tr
             records[m.index] = rec
         else:
             todo.append(m)
+    if client is None:
+        for m in todo:
+            rec = read_status(outdir / m.folder_name)
+            why = f" (last record: {rec.status}: {rec.message})" if rec is not None else ""
+            records[m.index] = MemberRecord(m.index, "not run", f"no finished result{why}")
+        return RunReport([records[m.index] for m in members], time.perf_counter() - start)
     futures = {}
     bar = tqdm(total=len(members), initial=len(members) - len(todo), unit="member",
                desc="study", disable=not progress, file=sys.stderr, smoothing=0.0)
