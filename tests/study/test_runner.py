@@ -12,7 +12,7 @@ import time
 
 import numpy as np
 import xarray as xr
-from helpers.studies import PERIODIC, WEAR, base_case, study_file
+from helpers.studies import WEAR, base_case, study_file
 
 from fretwear import cli
 from fretwear.study.run import run_study
@@ -103,33 +103,36 @@ def test_wear_ensemble_statistics_are_the_members_order_statistics(tmp_path, cli
     assert {p.name for p in res.figures} == {"study-worn-volume.png", "study-wear-profiles.png"}
 
 
-def test_killed_worker_member_is_run_again_to_the_same_result(tmp_path, client):
-    """SIGKILL the worker process running a member: the scheduler gives the member to a
-    worker again (the nanny restarts the killed one) and the study completes with results
-    equal bit for bit to the same member run undisturbed."""
-    base_case(tmp_path, PERIODIC.replace("harmonics = 3", "harmonics = 5")
-              .replace("n_samples = 32", "n_samples = 64"))
-    path = study_file(tmp_path, "[grid]\nanalysis.frequency = [6.5e3, 7e3, 7.5e3]\n")
+def test_killed_worker_member_continues_from_its_checkpoint_to_the_same_result(tmp_path,
+                                                                            client):
+    """SIGKILL the worker process running a wear member once the member has saved a
+    checkpoint: the scheduler gives the member to a worker again (the nanny restarts the
+    killed one), the member continues from its checkpoint (`fretwear run --resume`), and the
+    study completes with results equal bit for bit to the same member run undisturbed."""
+    base_case(tmp_path, WEAR.replace("max_cycles = 3e5", "max_cycles = 3e6"))
+    path = study_file(tmp_path, "[grid]\ncontact.wear_coefficient = [1e-11, 2e-11, 3e-11]\n")
     out = tmp_path / "out"
     box = {}
     thread = threading.Thread(target=lambda: box.setdefault(
         "res", run_study(path, out, scheduler=client, progress=False, echo=False)))
     thread.start()
     killed = None
-    deadline = time.time() + 60
+    deadline = time.time() + 120
     while killed is None and time.time() < deadline and thread.is_alive():
-        busy = {w: ks for w, ks in client.processing().items() if ks}
-        if busy:
-            worker, keys = next(iter(busy.items()))
-            pid = client.run(os.getpid, workers=[worker])[worker]
-            time.sleep(0.3)  # inside the member's run
-            os.kill(pid, signal.SIGKILL)
-            killed = str(next(iter(keys))).split("-member-")[1][:4]
-        time.sleep(0.05)
+        for worker, keys in client.processing().items():
+            names = [str(k).split("-member-")[1][:4] for k in keys]
+            saved = [n for n in names if (out / f"member-{n}" / "wear-checkpoint.npz").exists()]
+            if saved:
+                pid = client.run(os.getpid, workers=[worker])[worker]
+                os.kill(pid, signal.SIGKILL)
+                killed = saved[0]
+                break
+        time.sleep(0.02)
     thread.join(240)
-    assert killed is not None, "no member was seen running"
+    assert killed is not None, "no member was seen running with a checkpoint"
     res = box["res"]
     assert res.success and all(r.status == "ok" for r in res.records), res.message
+    assert "resumed from step" in res.records[int(killed)].message
     folder = out / f"member-{killed}"  # the member whose worker was killed, run undisturbed
     assert cli.main(["run", str(folder / "case.toml"), "-o", str(tmp_path / "d"),
                      "--no-progress"]) == 0
