@@ -12,7 +12,7 @@ import time
 
 import numpy as np
 import xarray as xr
-from helpers.studies import WEAR, base_case, study_file
+from helpers.studies import SWEEP, WEAR, base_case, study_file
 
 from fretwear import cli
 from fretwear.study.run import run_study
@@ -137,3 +137,41 @@ def test_killed_worker_member_continues_from_its_checkpoint_to_the_same_result(t
     assert cli.main(["run", str(folder / "case.toml"), "-o", str(tmp_path / "d"),
                      "--no-progress"]) == 0
     assert_same_results(folder / "results.nc", tmp_path / "d" / "results.nc")
+
+
+def test_split_sweep_joins_checked_and_equal_to_the_whole_sweep(tmp_path, client):
+    """A sweep cut into 2 chunks: the joined curve covers the base sweep's frequencies, the
+    join is within join_rtol, and every point equals the unsplit sweep run by `fretwear run`
+    to the solver's tolerance (the two started their continuations from different points, so
+    they agree as two converged solutions of one balance do, not bit for bit)."""
+    base = base_case(tmp_path, SWEEP)
+    path = study_file(tmp_path, "[split]\nchunks = 2\n")
+    out = tmp_path / "out"
+    res = run_study(path, out, scheduler=client, progress=False, echo=False)
+    assert res.success, res.message
+    ds = res.dataset
+    assert cli.main(["run", str(base), "-o", str(tmp_path / "whole"), "--no-progress"]) == 0
+    whole = xr.open_dataset(tmp_path / "whole" / "results.nc").load()
+    np.testing.assert_allclose(ds["frequency"].values, whole["frequency"].values, rtol=1e-14)
+    assert list(ds["join_ok"].values) == [1]
+    assert ds["join_frequency"].values[0] == ds["frequency"].values[3]  # 7 points: 0-3, 3-6
+    a, b = ds["response_amplitude"].values, whole["response_amplitude"].values
+    # 1e-6 of the largest amplitude: the join tolerance, far above the balance's residual
+    # tolerance and far below any difference between two different periodic solutions
+    assert np.max(np.abs(a - b)) <= 1e-6 * np.max(np.abs(b))
+
+
+def test_a_join_between_different_solutions_is_flagged():
+    """join_difference on two constructed chunks: the relative difference it reports is the
+    one computed by hand, and a frequency mismatch is NaN."""
+    from fretwear.study.sweep_split import join_difference
+
+    def chunk(freqs, amp_end, amp_start):
+        amp = np.ones((len(freqs), 1, 2, 1))
+        amp[-1, 0, 0, 0], amp[0, 0, 0, 0] = amp_end, amp_start
+        return xr.Dataset({"response_amplitude": (("frequency", "point", "axis", "harmonic"),
+                                                  amp)}, coords={"frequency": freqs})
+
+    f, d = join_difference(chunk([1.0, 2.0], 4.0, 1.0), chunk([2.0, 3.0], 1.0, 3.0))
+    assert f == 2.0 and d == abs(4.0 - 3.0) / 4.0
+    assert np.isnan(join_difference(chunk([1.0, 2.0], 1, 1), chunk([2.5, 3.0], 1, 1))[1])
