@@ -17,6 +17,7 @@ dropped.
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import json
 import os
 import socket
@@ -47,10 +48,18 @@ class MemberRecord:
     seconds: float = 0.0
     worker: str = ""
     skipped: bool = False
+    case_sha256: str = ""
 
     def to_json(self) -> str:
-        d = {k: getattr(self, k) for k in ("index", "status", "message", "seconds", "worker")}
+        d = {k: getattr(self, k)
+             for k in ("index", "status", "message", "seconds", "worker", "case_sha256")}
         return json.dumps(d, indent=1) + "\n"
+
+
+def case_hash(text: str) -> str:
+    """The SHA-256 of a member's case text: the status of a member is the status of this
+    exact case."""
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()
 
 
 @dataclass
@@ -89,7 +98,8 @@ def read_status(folder: Path) -> MemberRecord | None:
     try:
         d = json.loads((folder / STATUS_FILE).read_text(encoding="utf-8"))
         return MemberRecord(int(d["index"]), str(d["status"]), str(d.get("message", "")),
-                            float(d.get("seconds", 0.0)), str(d.get("worker", "")))
+                            float(d.get("seconds", 0.0)), str(d.get("worker", "")),
+                            case_sha256=str(d.get("case_sha256", "")))
     except (OSError, ValueError, KeyError, TypeError):
         return None
 
@@ -100,9 +110,13 @@ def finished(folder: Path, text: str) -> MemberRecord | None:
     rec = read_status(folder)
     if rec is None or rec.status not in FINISHED or not (folder / RESULTS_FILE).is_file():
         return None
-    case = folder / CASE_FILE
-    if not case.is_file() or case.read_text(encoding="utf-8") != text:
-        return None
+    if rec.case_sha256:
+        if rec.case_sha256 != case_hash(text):  # the study changed this member since
+            return None
+    else:  # a status without the hash: the member's case file must hold this text
+        case = folder / CASE_FILE
+        if not case.is_file() or case.read_text(encoding="utf-8") != text:
+            return None
     rec.skipped = True
     return rec
 
@@ -127,7 +141,8 @@ def run_member(index: int, text: str, folder: str) -> MemberPayload:
         status, message = "failed", " ".join(str(exc).split())
     except Exception as exc:  # recorded with its message, never dropped
         status, message = "failed", f"{type(exc).__name__}: {' '.join(str(exc).split())}"
-    rec = MemberRecord(index, status, message, time.perf_counter() - start, worker)
+    rec = MemberRecord(index, status, message, time.perf_counter() - start, worker,
+                       case_sha256=case_hash(text))
     with contextlib.suppress(OSError):
         _write_text(folder_path / STATUS_FILE, rec.to_json())
     return MemberPayload(rec, results)
@@ -211,8 +226,8 @@ def run_members(members: list[Member], outdir: Path, client, progress: bool = Tr
     for m in members:
         folder = outdir / m.folder_name
         folder.mkdir(parents=True, exist_ok=True)
-        write_case(folder, m.text)
         rec = finished(folder, m.text)
+        write_case(folder, m.text)
         if rec is not None:
             records[m.index] = rec
         else:
