@@ -160,9 +160,12 @@ def keep_payload(folder: Path, payload: MemberPayload) -> MemberRecord:
 
 
 def _lost(folder: Path, index: int, exc: BaseException | None) -> MemberRecord:
+    """The record of a member whose task gave no result (its worker died too often, or its
+    results could not be written on the client)."""
     what = f"{type(exc).__name__}: {exc}" if exc is not None else "no result"
     rec = MemberRecord(index, "failed", f"the task was lost ({' '.join(what.split())})")
-    _write_text(folder / STATUS_FILE, rec.to_json())
+    with contextlib.suppress(OSError):
+        _write_text(folder / STATUS_FILE, rec.to_json())
     return rec
 
 
@@ -251,7 +254,10 @@ def run_members(members: list[Member], outdir: Path, client, progress: bool = Tr
             m = futures[f]
             folder = outdir / m.folder_name
             if f.status == "finished":
-                rec = keep_payload(folder, f.result())
+                try:
+                    rec = keep_payload(folder, f.result())
+                except OSError as exc:
+                    rec = _lost(folder, m.index, exc)
             else:
                 rec = _lost(folder, m.index, f.exception() if f.status == "error" else None)
             records[m.index] = rec
