@@ -14,6 +14,7 @@ The public API, stage by stage (data flows one way; each stage returns a plain d
     run   = fretwear.integrate(model, frequency, n_periods=...)   # TransientResult
     out   = fretwear.run_case("case.toml", "out/")                # a case file end to end
     ds    = fretwear.read_results("out/results.nc")               # an xarray Dataset
+    st    = fretwear.run_study("study.toml", "out/")              # members on Dask (study.nc)
 
 Every frequency argument is in Hz (``frequency``, ``f_min``, ``f_max``); objects also keep
 the circular frequency ``omega = 2 pi frequency`` [rad/s] where the equations use it. Every
@@ -58,6 +59,7 @@ _API = {
     # case files and results
     "run_case": "fretwear.analyses.run", "load_case": "fretwear.analyses.run",
     "read_results": "fretwear.io.results",
+    "run_study": "fretwear.study.run", "read_study": "fretwear.study.spec",
     # errors
     "FretwearError": "fretwear.errors", "InputError": "fretwear.errors",
     "ConvergenceError": "fretwear.errors",

@@ -1,4 +1,4 @@
-"""The command line: ``fretwear run``, ``compare``, ``example``, ``reproduce``,
+"""The command line: ``fretwear run``, ``compare``, ``example``, ``reproduce``, ``study``,
 ``fretwear --version``.
 
 Exit status: 0 success; 1 the run finished but some solve did not converge (the results file
@@ -111,6 +111,27 @@ def cmd_reproduce(args) -> int:
                       not args.no_progress)
 
 
+def cmd_study(args) -> int:
+    from fretwear.study.run import run_study, shipped_studies
+
+    if args.list:
+        from fretwear.io.case import read_toml
+
+        found = shipped_studies()
+        width = max((len(n) for n in found), default=0)
+        for name, path in found.items():
+            print(f"{name:<{width}}  {read_toml(path)[1].get('title', '')}")
+        return 0
+    if args.study is None:
+        raise InputError("fretwear study: expected a study file STUDY.toml (or --list)")
+    if args.workers is not None and args.workers < 1:
+        raise InputError(f"--workers {args.workers}: expected a positive number of worker "
+                         "processes")
+    res = run_study(args.study, args.output, scheduler=args.scheduler, workers=args.workers,
+                    progress=not args.no_progress, collect=args.collect)
+    return 0 if res.success else 1
+
+
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="fretwear",
@@ -180,6 +201,29 @@ def _parser() -> argparse.ArgumentParser:
                     "the reproduction)")
     rp.add_argument("--no-progress", action="store_true", help="no progress bars")
     rp.set_defaults(func=cmd_reproduce)
+
+    st = sub.add_parser(
+        "study", help="run a study (grid, samples, ensemble, split sweep) on Dask",
+        description="Run the members of a study file (a base case file and what varies) on "
+        "Dask distributed: a local cluster on this machine's cores, or an existing cluster "
+        "with --scheduler. Each member writes its own results; a rerun skips the finished "
+        "ones. Writes study.nc (a member dimension) and the study's figures (docs/study.md).")
+    st.add_argument("study", metavar="STUDY.toml", nargs="?", default=None,
+                    help="the study file, or the name of a shipped study")
+    st.add_argument("-o", "--output", metavar="DIR", type=Path, default=None,
+                    help="results folder (default: [output] directory of the study file, "
+                    "else STUDY-results beside it)")
+    st.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                    help="address of a running Dask scheduler (tcp://host:8786); default: a "
+                    "local cluster")
+    st.add_argument("--workers", metavar="N", type=int, default=None,
+                    help="worker processes of the local cluster (default: the number of cores)")
+    st.add_argument("--collect", action="store_true",
+                    help="run nothing: write study.nc and the figures of the members finished "
+                    "so far (e.g. while the study runs elsewhere)")
+    st.add_argument("--list", action="store_true", help="list the shipped study files")
+    st.add_argument("--no-progress", action="store_true", help="no progress bar")
+    st.set_defaults(func=cmd_study)
     return p
 
 

@@ -1,0 +1,151 @@
+"""The figures of a study, drawn from ``study.nc`` alone (so they can be redrawn):
+
+* wear studies: a fan chart of the worn volume against cycles (the 5-95 % band, the median,
+  the mean and every member thin) and the band of worn profiles at the last cycle every
+  member reached;
+* sweep studies: the family of FRFs (one curve per member, labelled with its varied keys)
+  and their envelope; a split sweep: the joined FRF with the joins marked.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from fretwear.files import atomic_write
+
+
+def _save(fig, path: Path) -> Path:
+    import matplotlib.pyplot as plt
+
+    def write(tmp: Path) -> None:
+        fig.savefig(tmp, format=path.suffix.lstrip("."), dpi=130, bbox_inches="tight")
+
+    try:
+        return atomic_write(path, write)
+    finally:
+        plt.close(fig)
+
+
+def _figure(*args, **kwargs):
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    return plt.subplots(*args, **kwargs)
+
+
+def fan_chart(ds, path: Path) -> Path:
+    """Worn volume against cycles: members, 5-95 % band, median and mean."""
+    fig, ax = _figure(figsize=(7, 4.5))
+    n = ds["cycle"].values
+    for v in ds["worn_volume_on_cycles"].values:
+        ax.plot(n, v * 1e9, color="0.6", lw=0.6)
+    q = ds["worn_volume_quantile"].values * 1e9
+    ax.fill_between(n, q[0], q[2], color="C0", alpha=0.3, label="5-95 % of the members")
+    ax.plot(n, q[1], color="C0", lw=2, label="median")
+    ax.plot(n, ds["worn_volume_mean"].values * 1e9, color="C1", ls="--", label="mean")
+    ax.set_xlabel("cycles N")
+    ax.set_ylabel("worn volume [mm^3]")
+    ax.set_title(f"{ds.attrs.get('title', '')}: {int(ds.attrs.get('members_ok', 0))} members",
+                 fontsize=9)
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    return _save(fig, path)
+
+
+def profile_band(ds, path: Path) -> Path:
+    """Worn profiles at the last cycle every member reached: members, band and median."""
+    reached = ds["members_reached"].values
+    full = np.flatnonzero(reached == reached.max())
+    k = int(full[-1]) if full.size else ds.sizes["cycle"] - 1
+    x = ds["contact_position"].values[..., 0] if "contact_position" in ds else \
+        np.arange(ds.sizes["contact_node"])
+    x = np.nanmean(x, axis=0) if x.ndim == 2 else x
+    xs = x * 1e3 if "contact_position" in ds else x
+    fig, ax = _figure(figsize=(7, 4.5))
+    for w in ds["wear_depth_on_cycles"].values[:, k]:
+        ax.plot(xs, w * 1e6, color="0.6", lw=0.6)
+    q = ds["wear_depth_quantile"].values[:, k] * 1e6
+    ax.fill_between(xs, q[0], q[2], color="C0", alpha=0.3, label="5-95 % of the members")
+    ax.plot(xs, q[1], color="C0", lw=2, label="median")
+    ax.set_xlabel("x [mm]" if "contact_position" in ds else "contact node")
+    ax.set_ylabel("wear depth [um]")
+    ax.set_title(f"worn profiles at N = {float(ds['cycle'].values[k]):.3g}", fontsize=9)
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    return _save(fig, path)
+
+
+def _main_response(ds):
+    """Amplitude of harmonic 1 of the first observed point along its largest axis:
+    (member or none, frequency)."""
+    amp = ds["response_amplitude"]
+    sel = {}
+    if "point" in amp.dims:
+        sel["point"] = 0
+    if "harmonic" in amp.dims:
+        sel["harmonic"] = 0
+    amp = amp.isel(sel)
+    label = f"{str(ds['point'].values[0]) if 'point' in ds else ''}"
+    if "axis" in amp.dims:
+        axis = int(np.nanargmax(np.nanmax(amp.values.reshape(-1, amp.sizes["axis"]), axis=0)))
+        label += f" {str(ds['axis'].values[axis])}"
+        amp = amp.isel(axis=axis)
+    return amp, label.strip()
+
+
+def frf_family(ds, path: Path, varied: list[str]) -> Path:
+    """One FRF per member (amplitude of harmonic 1), labelled by its varied keys."""
+    amp, label = _main_response(ds)
+    f = ds["frequency"].values
+    fig, ax = _figure(figsize=(7, 4.5))
+    for i in range(ds.sizes["member"]):
+        text = ", ".join(f"{k} = {ds[k].values[i]:.3g}" if ds[k].dtype.kind == "f"
+                         else f"{k} = {ds[k].values[i]}" for k in varied if k in ds.coords
+                         and ds[k].dims == ("member",))
+        ax.plot(f, amp.values[i], lw=1, label=text or f"member {i}")
+    ax.set_yscale("log")
+    if f.min() > 0 and f.max() / f.min() > 20:
+        ax.set_xscale("log")
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel(f"amplitude {label} [m]")
+    ax.set_title(ds.attrs.get("title", ""), fontsize=9)
+    if ds.sizes["member"] <= 12:
+        ax.legend(fontsize=7)
+    ax.grid(alpha=0.3, which="both")
+    return _save(fig, path)
+
+
+def joined_frf(ds, path: Path) -> Path:
+    """The joined FRF of a split sweep, the joins marked (red where the check failed)."""
+    amp, label = _main_response(ds)
+    fig, ax = _figure(figsize=(7, 4.5))
+    f = ds["frequency"].values
+    ax.plot(f, amp.values, lw=1, marker=".", ms=3)
+    for fj, ok in zip(ds["join_frequency"].values, ds["join_ok"].values, strict=True):
+        if np.isfinite(fj):
+            ax.axvline(fj, color="0.5" if ok else "red", lw=0.8, ls=":")
+    ax.set_yscale("log")
+    if f.size and f.min() > 0 and f.max() / f.min() > 20:
+        ax.set_xscale("log")
+    ax.set_xlabel("frequency [Hz] (dotted: joins of chunks; red: join check failed)")
+    ax.set_ylabel(f"amplitude {label} [m]")
+    ax.set_title(ds.attrs.get("title", ""), fontsize=9)
+    ax.grid(alpha=0.3, which="both")
+    return _save(fig, path)
+
+
+def study_figures(ds, outdir: Path, varied: list[str], fmt: str = "png") -> list[Path]:
+    """Every figure that applies to the dataset; returns the files written."""
+    out = []
+    if "join_frequency" in ds and "response_amplitude" in ds:
+        out.append(joined_frf(ds, outdir / f"study-frf-joined.{fmt}"))
+    elif "worn_volume_on_cycles" in ds:
+        out.append(fan_chart(ds, outdir / f"study-worn-volume.{fmt}"))
+        out.append(profile_band(ds, outdir / f"study-wear-profiles.{fmt}"))
+    elif "response_amplitude" in ds and "member" in ds["response_amplitude"].dims:
+        out.append(frf_family(ds, outdir / f"study-frf-family.{fmt}", varied))
+    return out

@@ -1,0 +1,230 @@
+"""The members of a study: the base case with the varied keys set, as complete case files.
+
+:func:`expand` turns a :class:`~fretwear.study.spec.Study` into its list of :class:`Member`
+(a grid's combinations, seeded samples, seeded ensemble perturbations, chunks of a sweep);
+:func:`member_cases` applies each member's values to the base case, validates the result as a
+case file (the same validation as ``fretwear run``, so a bad key or value gets the same
+one-line message, prefixed with the study file and the member) and writes its case text. A
+member's case file is self-contained (file paths made absolute, no ``[output] directory``):
+``fretwear run member-0003/case.toml -o DIR`` reruns it by hand, bit for bit.
+"""
+
+from __future__ import annotations
+
+import copy
+import itertools
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import tomli_w
+
+from fretwear.analyses.registry import analysis_tables
+from fretwear.errors import InputError
+from fretwear.io.case import read_toml, validate
+from fretwear.io.schema import show
+from fretwear.study.spec import Study, split_key, value_label
+
+CASE_FILE = "case.toml"
+
+
+@dataclass
+class Member:
+    """One member: ``index`` (from 0), the values of the varied keys (key path -> value)
+    and, once built, its case text."""
+
+    index: int
+    values: dict
+    text: str = ""
+    analysis: dict = field(default_factory=dict)
+
+    @property
+    def folder_name(self) -> str:
+        return f"member-{self.index:04d}"
+
+    def describe(self) -> str:
+        return ", ".join(f"{k} = {value_label(v)}" for k, v in self.values.items()) or "base"
+
+
+# --- key paths in a case ------------------------------------------------------------------
+def _locate(raw: dict, parts: list[str], key: str):
+    """The table holding the last part of ``parts`` in ``raw`` (tables created as needed)."""
+    node, i = raw, 0
+    while i < len(parts) - 1:
+        part, here = parts[i], ".".join(parts[: i + 1])
+        child = node.get(part)
+        if isinstance(child, list):  # an array of tables: a block by name or number from 1
+            if i + 2 > len(parts) - 1:
+                raise InputError(f"{key}: {part} is an array of tables; name a block and a "
+                                 f"key ({part}.NAME.KEY or \"{part}[N].KEY\")")
+            sel = parts[i + 1]
+            names = [str(b.get("name")) for b in child if isinstance(b, Mapping)]
+            if sel.isdigit():
+                n = int(sel)
+                if not 1 <= n <= len(child):
+                    raise InputError(f"{key}: the base case has {len(child)} [[{part}]] "
+                                     f"blocks; expected a number from 1 to {len(child)}")
+                node = child[n - 1]
+            elif sel in names:
+                node = child[names.index(sel)]
+            else:
+                raise InputError(f"{key}: the base case has no [[{part}]] block named "
+                                 f"{sel!r} (names: {', '.join(names) or 'none'})")
+            i += 2
+            continue
+        if child is None:
+            child = node[part] = {}
+        elif not isinstance(child, Mapping):
+            raise InputError(f"{key}: {here} = {show(child)} is a value, not a table")
+        node, i = child, i + 1
+    return node, parts[-1]
+
+
+def get_key(raw: dict, key: str):
+    """The value of ``key`` (a dotted path) in the parsed case ``raw`` (None if absent)."""
+    table, last = _locate(copy.deepcopy(raw), split_key(key), key)
+    return table.get(last)
+
+
+def set_key(raw: dict, key: str, value) -> None:
+    """Set ``key`` (a dotted path) in the parsed case ``raw``."""
+    table, last = _locate(raw, split_key(key), key)
+    table[last] = value
+
+
+# --- expanding a study ------------------------------------------------------------------------
+def _grid(study: Study) -> list[dict]:
+    keys = list(study.grid)
+    return [dict(zip(keys, combo, strict=True))
+            for combo in itertools.product(*(study.grid[k] for k in keys))]
+
+
+def _uniform_draws(n: int, d: int, seed: int, method: str) -> np.ndarray:
+    if method == "latin_hypercube":
+        from scipy.stats import qmc
+
+        return qmc.LatinHypercube(d=d, seed=np.random.default_rng(seed)).random(n)
+    return np.random.default_rng(seed).random((n, d))
+
+
+def _samples(study: Study) -> list[dict]:
+    from scipy.stats import norm
+
+    vary = study.samples["vary"]
+    u = _uniform_draws(study.samples["n"], len(vary), study.samples["seed"],
+                       study.samples["method"])
+    out = [{} for _ in range(u.shape[0])]
+    for j, (key, d) in enumerate(vary.items()):
+        if d["distribution"] == "uniform":
+            x = d["low"] + u[:, j] * (d["high"] - d["low"])
+        elif d["distribution"] == "loguniform":
+            x = np.exp(np.log(d["low"]) + u[:, j] * (np.log(d["high"]) - np.log(d["low"])))
+        else:
+            x = d["mean"] + d["std"] * norm.ppf(u[:, j])
+        for i in range(u.shape[0]):
+            out[i][key] = float(x[i])
+    return out
+
+
+def _perturb(value, spec: dict, rng: np.random.Generator, key: str):
+    """``value`` (a number or a list of numbers, each perturbed independently)."""
+    if isinstance(value, list):
+        return [_perturb(v, spec, rng, key) for v in value]
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise InputError(f"ensemble.perturb.{key}: the base case value {show(value)} is not a "
+                         "number")
+    z = rng.standard_normal() if spec["distribution"] == "normal" else rng.uniform(-1.0, 1.0)
+    if "relative" in spec:
+        return float(value) * (1.0 + spec["relative"] * z)
+    return float(value) + spec["absolute"] * z
+
+
+def _ensemble(study: Study, base: dict) -> list[dict]:
+    e = study.ensemble
+    out = []
+    for i in range(e["members"]):
+        if i == 0 and e["include_base"]:
+            out.append({})
+            continue
+        rng = np.random.default_rng([e["seed"], i])  # member i's draws do not depend on n
+        values = {}
+        for key, spec in e["perturb"].items():
+            current = get_key(base, key)
+            if current is None:
+                raise InputError(f"ensemble.perturb.{key}: the base case has no value to "
+                                 "perturb (set it in the base case or in [set])")
+            values[key] = _perturb(current, spec, rng, key)
+        out.append(values)
+    return out
+
+
+def _chunks(study: Study, base: dict) -> list[dict]:
+    """The sweep band cut into chunks of the base's frequency grid; neighbours share their
+    end frequency (the join, checked after the run)."""
+    a = validate(base, analysis_tables(), study.base.parent)["analysis"]
+    if a["type"] != "sweep":
+        raise InputError(f"[split] needs a sweep as base case; {study.base.name} has "
+                         f"analysis.type = {show(a['type'])}")
+    n, chunks = a["n_points"], study.split["chunks"]
+    if n < 2 * chunks:
+        raise InputError(f"split.chunks = {chunks}: the base sweep has {n} points; expected at "
+                         f"most {n // 2} chunks (two points each at least)")
+    grid = (np.geomspace if a["spacing"] == "log" else np.linspace)(a["f_min"], a["f_max"], n)
+    edges = np.linspace(0, n - 1, chunks + 1).round().astype(int)
+    return [{"analysis.f_min": float(grid[i0]), "analysis.f_max": float(grid[i1]),
+             "analysis.n_points": int(i1 - i0 + 1)}
+            for i0, i1 in itertools.pairwise(edges)]
+
+
+def _absolute_paths(raw, checked):
+    """``raw`` with every file path replaced by the absolute path validation resolved."""
+    if isinstance(raw, Mapping) and isinstance(checked, Mapping):
+        return {k: _absolute_paths(v, checked.get(k)) for k, v in raw.items()}
+    if isinstance(raw, list) and isinstance(checked, list) and len(raw) == len(checked):
+        return [_absolute_paths(r, c) for r, c in zip(raw, checked, strict=True)]
+    if isinstance(raw, str) and isinstance(checked, Path):
+        return str(checked)
+    return raw
+
+
+def member_case(base: dict, values: dict, base_dir: Path):
+    """The parsed case of a member (``base`` with ``values`` set, file paths absolute, no
+    ``[output] directory``) and its validated tables."""
+    raw = copy.deepcopy(base)
+    for key, value in values.items():
+        set_key(raw, key, value)
+    if isinstance(raw.get("output"), dict):
+        raw["output"].pop("directory", None)
+    checked = validate(raw, analysis_tables(), base_dir)
+    return _absolute_paths(raw, checked), checked
+
+
+def expand(study: Study) -> list[Member]:
+    """The members of ``study``, each with its case text; every bad key or value is one
+    InputError naming the study file, the member and the key."""
+    _, base = read_toml(study.base)
+    name = study.path.name
+    try:
+        fixed, _ = member_case(base, study.set, study.base.parent)
+    except InputError as exc:
+        raise InputError(f"{name}: [set] on {study.base.name}: {exc}") from None
+    try:
+        values = {"grid": lambda: _grid(study), "samples": lambda: _samples(study),
+                  "ensemble": lambda: _ensemble(study, fixed),
+                  "split": lambda: _chunks(study, fixed)}[study.kind]()
+    except InputError as exc:
+        raise InputError(f"{name}: {exc}") from None
+    members = []
+    for i, v in enumerate(values):
+        m = Member(i, v)
+        try:
+            raw, checked = member_case(fixed, v, study.base.parent)
+        except InputError as exc:
+            raise InputError(f"{name}: member {i} ({m.describe()}): {exc}") from None
+        header = (f"# fretwear study {study.title!r}: member {i} of {len(values)} "
+                  f"({m.describe()})\n# base case: {study.base}\n")
+        m.text = header + tomli_w.dumps(raw)
+        m.analysis = checked["analysis"]
+        members.append(m)
+    return members

@@ -1,0 +1,275 @@
+"""Running the members of a study on Dask distributed, one task per member.
+
+Each member is one task (:func:`run_member`) that writes ``member-XXXX/case.toml``, runs it
+with :func:`fretwear.analyses.run.run_case` (``resume = True``: a wear member continues from
+its checkpoint, a finished one is read back) into ``member-XXXX/``, where ``results.nc`` is
+written atomically, and records ``member-XXXX/status.json`` (``ok``, ``not converged`` or
+``failed`` with the message). The task also returns the results file's bytes, so the client
+has every result even when the workers do not share its file system.
+
+So a killed worker loses only the members it was running (the scheduler gives them to another
+worker, which continues a wear member from its checkpoint), a killed client loses only the
+members in flight, and a rerun skips the finished members (:func:`finished`). A member whose
+worker died too often (Dask's ``KilledWorker``) is recorded as failed with that message, never
+dropped.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import json
+import os
+import socket
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from fretwear.errors import FretwearError, InputError
+from fretwear.files import atomic_write
+from fretwear.study.members import CASE_FILE, Member
+
+STATUS_FILE = "status.json"
+RESULTS_FILE = "results.nc"
+FINISHED = ("ok", "not converged")
+
+
+@dataclass
+class MemberRecord:
+    """What happened to one member: ``status`` ("ok", "not converged", "failed"), the
+    ``message`` (the run's summary or the error), ``seconds`` of wall time of the run, the
+    ``worker`` host and process, and whether it was ``skipped`` (finished before)."""
+
+    index: int
+    status: str
+    message: str = ""
+    seconds: float = 0.0
+    worker: str = ""
+    skipped: bool = False
+    case_sha256: str = ""
+
+    def to_json(self) -> str:
+        d = {k: getattr(self, k)
+             for k in ("index", "status", "message", "seconds", "worker", "case_sha256")}
+        return json.dumps(d, indent=1) + "\n"
+
+
+def case_hash(text: str) -> str:
+    """The SHA-256 of a member's case text: the status of a member is the status of this
+    exact case."""
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()
+
+
+@dataclass
+class MemberPayload:
+    """What a task sends back: its record and the bytes of its results file (None when
+    there is none)."""
+
+    record: MemberRecord
+    results: bytes | None = field(default=None, repr=False)
+
+
+def _write_text(path: Path, text: str) -> None:
+    def write(tmp: Path) -> None:
+        tmp.write_text(text, encoding="utf-8")
+
+    atomic_write(path, write)
+
+
+def _write_bytes(path: Path, data: bytes) -> None:
+    def write(tmp: Path) -> None:
+        tmp.write_bytes(data)
+
+    atomic_write(path, write)
+
+
+def write_case(folder: Path, text: str) -> Path:
+    """``folder/case.toml`` holding ``text`` (rewritten only when it differs)."""
+    path = folder / CASE_FILE
+    if not (path.is_file() and path.read_text(encoding="utf-8") == text):
+        _write_text(path, text)
+    return path
+
+
+def read_status(folder: Path) -> MemberRecord | None:
+    """The recorded status of the member in ``folder`` (None: none, or unreadable)."""
+    try:
+        d = json.loads((folder / STATUS_FILE).read_text(encoding="utf-8"))
+        return MemberRecord(int(d["index"]), str(d["status"]), str(d.get("message", "")),
+                            float(d.get("seconds", 0.0)), str(d.get("worker", "")),
+                            case_sha256=str(d.get("case_sha256", "")))
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+
+
+def finished(folder: Path, text: str) -> MemberRecord | None:
+    """The record of a member already run to the end with exactly this case text (ok or not
+    converged, with its results file), else None: it must run (again)."""
+    rec = read_status(folder)
+    if rec is None or rec.status not in FINISHED or not (folder / RESULTS_FILE).is_file():
+        return None
+    if rec.case_sha256:
+        if rec.case_sha256 != case_hash(text):  # the study changed this member since
+            return None
+    else:  # a status without the hash: the member's case file must hold this text
+        case = folder / CASE_FILE
+        if not case.is_file() or case.read_text(encoding="utf-8") != text:
+            return None
+    rec.skipped = True
+    return rec
+
+
+def run_member(index: int, text: str, folder: str) -> MemberPayload:
+    """Run one member (on a worker): write its case file, run it into ``folder`` with
+    ``resume = True``, record its status. Never raises for a failed run: the failure is the
+    member's record."""
+    from fretwear.analyses.run import run_case
+
+    folder_path = Path(folder)
+    start = time.perf_counter()
+    worker = f"{socket.gethostname()}:{os.getpid()}"
+    results = None
+    try:
+        case = write_case(folder_path, text)
+        out = run_case(case, folder_path, progress=False, resume=True, echo=False)
+        status = "ok" if out.success else "not converged"
+        message = " ".join(str(out.summary or "").split())
+        results = Path(out.results).read_bytes() if out.results else None
+    except FretwearError as exc:
+        status, message = "failed", " ".join(str(exc).split())
+    except Exception as exc:  # recorded with its message, never dropped
+        status, message = "failed", f"{type(exc).__name__}: {' '.join(str(exc).split())}"
+    rec = MemberRecord(index, status, message, time.perf_counter() - start, worker,
+                       case_sha256=case_hash(text))
+    with contextlib.suppress(OSError):
+        _write_text(folder_path / STATUS_FILE, rec.to_json())
+    return MemberPayload(rec, results)
+
+
+def keep_payload(folder: Path, payload: MemberPayload) -> MemberRecord:
+    """On the client: the results file and the status of a finished task, written in
+    ``folder`` (the worker may not share this file system)."""
+    if payload.results is not None:
+        path = folder / RESULTS_FILE
+        if not (path.is_file() and path.read_bytes() == payload.results):
+            _write_bytes(path, payload.results)
+    _write_text(folder / STATUS_FILE, payload.record.to_json())
+    return payload.record
+
+
+def _lost(folder: Path, index: int, exc: BaseException | None) -> MemberRecord:
+    """The record of a member whose task gave no result (its worker died too often, or its
+    results could not be written on the client)."""
+    what = f"{type(exc).__name__}: {exc}" if exc is not None else "no result"
+    rec = MemberRecord(index, "failed", f"the task was lost ({' '.join(what.split())})")
+    with contextlib.suppress(OSError):
+        _write_text(folder / STATUS_FILE, rec.to_json())
+    return rec
+
+
+# --- the cluster ------------------------------------------------------------------------------
+@contextlib.contextmanager
+def dask_client(scheduler=None, workers: int | None = None):
+    """A ``distributed.Client``: ``scheduler`` is a Client (used as is), an address
+    (``tcp://host:8786``: an existing cluster, e.g. ``dask scheduler`` / ``dask worker`` or
+    dask-jobqueue), or None: a LocalCluster of ``workers`` processes (default: the number of
+    cores) with one thread each. What is started here is closed on exit."""
+    import logging
+
+    from distributed import Client, LocalCluster
+
+    if scheduler is not None and not isinstance(scheduler, str):
+        yield scheduler
+        return
+    if scheduler is not None:
+        try:
+            client = Client(scheduler, timeout="30s")
+        except (OSError, TimeoutError) as exc:
+            raise InputError(f"cannot connect to the Dask scheduler {scheduler!r} ({exc}): "
+                             "expected the address of a running scheduler, e.g. "
+                             "tcp://host:8786") from None
+        try:
+            yield client
+        finally:
+            client.close()
+        return
+    n = workers or os.cpu_count() or 1
+    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                           dashboard_address=":0", silence_logs=logging.ERROR)
+    client = Client(cluster)
+    try:
+        yield client
+    finally:
+        client.close()
+        cluster.close()
+
+
+@dataclass
+class RunReport:
+    """The records of every member (in member order) and the wall time of the run."""
+
+    records: list
+    seconds: float
+
+
+def run_members(members: list[Member], outdir: Path, client, progress: bool = True,
+                on_record: Callable[[MemberRecord], None] | None = None) -> RunReport:
+    """Run the members not finished yet on ``client`` (a ``distributed.Client``); members
+    already finished with the same case text are skipped. Returns every member's record.
+    ``client = None`` runs nothing: the members not finished are recorded as "not run"
+    (a look at a study still running elsewhere)."""
+    from distributed import as_completed
+    from tqdm.auto import tqdm
+
+    start = time.perf_counter()
+    records: dict[int, MemberRecord] = {}
+    todo = []
+    for m in members:
+        folder = outdir / m.folder_name
+        folder.mkdir(parents=True, exist_ok=True)
+        rec = finished(folder, m.text)
+        write_case(folder, m.text)
+        if rec is not None:
+            records[m.index] = rec
+        else:
+            todo.append(m)
+    if client is None:
+        for m in todo:
+            rec = read_status(outdir / m.folder_name)
+            why = f" (last record: {rec.status}: {rec.message})" if rec is not None else ""
+            records[m.index] = MemberRecord(m.index, "not run", f"no finished result{why}")
+        return RunReport([records[m.index] for m in members], time.perf_counter() - start)
+    futures = {}
+    bar = tqdm(total=len(members), initial=len(members) - len(todo), unit="member",
+               desc="study", disable=not progress, file=sys.stderr, smoothing=0.0)
+    try:
+        for m in todo:
+            f = client.submit(run_member, m.index, m.text, str(outdir / m.folder_name),
+                              pure=False, key=f"fretwear-{outdir.name}-{m.folder_name}-"
+                              f"{time.time_ns()}")
+            futures[f] = m
+        for f in as_completed(list(futures)):
+            m = futures[f]
+            folder = outdir / m.folder_name
+            if f.status == "finished":
+                try:
+                    rec = keep_payload(folder, f.result())
+                except OSError as exc:
+                    rec = _lost(folder, m.index, exc)
+            else:
+                rec = _lost(folder, m.index, f.exception() if f.status == "error" else None)
+            records[m.index] = rec
+            if on_record is not None:
+                on_record(rec)
+            bar.update(1)
+            f.release()
+    except BaseException:
+        for f in futures:
+            with contextlib.suppress(Exception):
+                f.cancel()
+        raise
+    finally:
+        bar.close()
+    return RunReport([records[m.index] for m in members], time.perf_counter() - start)

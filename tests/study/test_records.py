@@ -1,0 +1,35 @@
+"""Which members a rerun skips: finished (ok or not converged) with a results file and a
+status recorded for exactly the same case text; anything else runs again."""
+
+from __future__ import annotations
+
+from fretwear.study.runner import MemberRecord, case_hash, finished, read_status
+
+
+def _member(folder, status, text="a = 1\n", results=True):
+    folder.mkdir()
+    (folder / "case.toml").write_text(text)
+    (folder / "status.json").write_text(MemberRecord(0, status, case_sha256=case_hash(text))
+                                        .to_json())
+    if results:
+        (folder / "results.nc").write_bytes(b"x")
+    return folder
+
+
+def test_finished_members_only_for_the_same_case_text(tmp_path):
+    ok = _member(tmp_path / "ok", "ok")
+    assert finished(ok, "a = 1\n").skipped
+    assert finished(ok, "a = 2\n") is None  # the study changed the member: run it again
+    assert finished(_member(tmp_path / "nc", "not converged"), "a = 1\n") is not None
+    assert finished(_member(tmp_path / "f", "failed"), "a = 1\n") is None
+    assert finished(_member(tmp_path / "nr", "ok", results=False), "a = 1\n") is None
+    bad = _member(tmp_path / "bad", "ok")
+    (bad / "status.json").write_text("{truncated")
+    assert read_status(bad) is None and finished(bad, "a = 1\n") is None
+
+
+def test_a_status_without_hash_is_checked_against_the_case_file(tmp_path):
+    ok = _member(tmp_path / "ok", "ok")
+    (ok / "status.json").write_text('{"index": 0, "status": "ok"}')
+    assert finished(ok, "a = 1\n") is not None
+    assert finished(ok, "a = 2\n") is None
