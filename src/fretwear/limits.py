@@ -15,13 +15,16 @@ import math
 
 from fretwear.errors import InputError
 
-#: kind -> (lowest, highest, unit, what it covers)
+#: kind -> (lowest, highest, unit, what it covers); the magnitude 0 is also accepted for the
+#: kinds of ZERO_ALLOWED (a massless model, a static load)
 RANGES = {
     "length": (1e-9, 1e5, "m", "from a nanometre to 100 km"),
     "modulus": (1.0, 1e13, "Pa", "from the softest gels to ten times diamond"),
-    "density": (0.0, 1e5, "kg/m^3", "from massless to five times osmium"),
+    "density": (1e-3, 1e5, "kg/m^3", "0 for massless, or from a thousandth of air to five "
+                "times osmium"),
     "frequency": (0.0, 1e10, "Hz", "up to 10 GHz"),
 }
+ZERO_ALLOWED = ("density", "frequency")
 
 #: the highest hysteretic loss factor eta accepted (``D = eta K``): real materials and joints stay
 #: below 2; 10 leaves room for a deliberately over-damped model
@@ -48,8 +51,10 @@ def check_range(value: float, kind: str, what: str) -> float:
         v = float(value)
     except (TypeError, ValueError, OverflowError):
         raise InputError(f"{what} = {value!r} is not a number [{unit}]") from None
-    if not math.isfinite(v) or not lo <= abs(v) <= hi and not (v == 0.0 and lo == 0.0):
-        raise InputError(f"{what} = {value!r} {unit}: expected a magnitude in [{lo:g}, {hi:g}] "
-                         f"{unit} ({why}; outside it the matrices would overflow or lose all "
-                         "precision)")
+    zero_ok = kind in ZERO_ALLOWED
+    if not math.isfinite(v) or not lo <= abs(v) <= hi and not (v == 0.0 and zero_ok):
+        zero = "0 or " if zero_ok and lo > 0 else ""
+        raise InputError(f"{what} = {value!r} {unit}: expected {zero}a magnitude in [{lo:g}, "
+                         f"{hi:g}] {unit} ({why}; outside it the matrices would overflow or lose "
+                         "all precision)")
     return v

@@ -299,3 +299,15 @@ def test_youngs_modulus_outside_the_documented_range_is_refused(E):
     with pytest.raises(InputError, match=r"Young's modulus E = .* Pa: expected a magnitude in "
                                          r"\[1, 1e\+13\] Pa"):
         check_material(E, 0.3, 7800.0)
+
+
+@pytest.mark.parametrize("rho", [1e-300, 1e-4, 2e5])
+def test_density_outside_the_documented_range_is_refused(rho):
+    """Reference: fretwear.limits.RANGES["density"] = 0, or [1e-3, 1e5] kg/m^3 (a density of
+    1e-300 made the mass matrix underflow and the solve fail deep inside LAPACK)."""
+    from fretwear.model.fem import check_material
+
+    with pytest.raises(InputError, match=r"density rho = .* kg/m\^3: expected 0 or a magnitude "
+                                         r"in \[0.001, 100000\] kg/m\^3"):
+        check_material(2e11, 0.3, rho)
+    assert check_material(2e11, 0.3, 0.0)[2] == 0.0  # massless stays legal
