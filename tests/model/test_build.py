@@ -344,3 +344,17 @@ def test_generic_rigid_motion_check():
     model.K = sp.csr_matrix(K0)
     with pytest.raises(InputError, match="nothing to hold them but friction"):
         check_supported(model)
+
+
+def test_direction_of_huge_or_tiny_components_is_its_unit_vector():
+    """Reference: the unit vector (1, 1)/sqrt(2) written by hand; a direction's magnitude does
+    not count, and [1e308, 1e308] overflowed the norm (a warning and a wrong message)."""
+    import warnings
+
+    from fretwear.model.build import unit_direction
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for scale in (1e308, 1e-320, 1.0):
+            np.testing.assert_allclose(unit_direction([scale, scale], 2), [0.5**0.5] * 2,
+                                       rtol=1e-15)

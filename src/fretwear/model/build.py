@@ -304,7 +304,10 @@ def unit_direction(direction, dim: int, what: str = "direction") -> np.ndarray:
         v = np.asarray(direction, dtype=float).reshape(-1)
     except (TypeError, ValueError):
         v = np.zeros(0)
-    n = np.linalg.norm(v) if v.size == dim and np.all(np.isfinite(v)) else 0.0
+    big = np.abs(v).max() if v.size == dim and np.all(np.isfinite(v)) else 0.0
+    if big > 0.0:  # only the direction counts: scale first so that the norm cannot overflow
+        v = v / big
+    n = np.linalg.norm(v) if big > 0.0 else 0.0
     if n == 0.0:
         raise InputError(
             f"{what} = {direction!r}; expected one of {list(AXES[:dim])} or a non-zero vector "
