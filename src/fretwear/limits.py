@@ -22,7 +22,7 @@ RANGES = {
     "modulus": (1.0, 1e13, "Pa", "from the softest gels to ten times diamond"),
     "density": (1e-3, 1e5, "kg/m^3", "0 for massless, or from a thousandth of air to five "
                 "times osmium"),
-    "frequency": (0.0, 1e10, "Hz", "up to 10 GHz"),
+    "frequency": (1e-6, 1e10, "Hz", "0 for static, or from a period of 11 days to 10 GHz"),
 }
 ZERO_ALLOWED = ("density", "frequency")
 
