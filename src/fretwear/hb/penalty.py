@@ -19,6 +19,7 @@ from numbers import Real
 import numpy as np
 
 from fretwear.errors import InputError
+from fretwear.hb.connectors import connect
 from fretwear.hb.reduce import Reduced, condense
 from fretwear.model.core import Model
 
@@ -65,10 +66,12 @@ def penalty(rule, *, model: Model | None = None, frequency: float = 0.0, orders=
         if reduced is None:
             if model is None or orders is None:
                 raise ValueError('eps = "auto" needs the reduced model or the model and orders')
-            reduced = condense(model, frequency, orders, quasi_static=quasi_static)
+            reduced = connect(condense(model, frequency, orders, quasi_static=quasi_static),
+                              model.contact)
         return reduced.spectral_radius()
     if model is not None:
-        return condense(model, 0.0, [0], quasi_static=True).spectral_radius()
+        return connect(condense(model, 0.0, [0], quasi_static=True),
+                       model.contact).spectral_radius()
     if reduced is None or int(reduced.orders[0]) != 0:
         raise ValueError('eps = "static" needs the model or a reduced model with order 0')
     return float(np.max(np.abs(np.linalg.eigvals(reduced.Z[0]))))

@@ -21,6 +21,7 @@ import numpy as np
 
 from fretwear.errors import InputError
 from fretwear.hb import contact as law
+from fretwear.hb.connectors import Connected, connect, node_displacements
 from fretwear.hb.fourier import FourierBasis, amplitude
 from fretwear.hb.penalty import penalty
 from fretwear.hb.reduce import Reduced, _recover, condense, loads_to_real, to_real_blocks
@@ -43,6 +44,11 @@ class DLFTProblem:
         (:func:`fretwear.hb.penalty.penalty`).
     anchor : (nc, d-1) stick anchors: where a node that sticks all period sticks [m]
         (tangential, contact-local). Default 0.
+
+    Contact springs of the interface (``contact.kn``, ``contact.kt``) are applied to
+    ``reduced`` here (:func:`fretwear.hb.connectors.connect`): the unknowns are then the
+    contact points in series with the springs. Nodes with a prescribed normal load
+    (``contact.normal_load``) take ``lambda_N = N(t)`` and the slip threshold ``mu N(t)``.
     """
 
     def __init__(self, reduced: Reduced, contact: ContactInterface, basis: FourierBasis,
@@ -54,11 +60,13 @@ class DLFTProblem:
         exp = np.array([0, *basis.harmonics])
         if not np.array_equal(np.asarray(reduced.orders), exp):
             raise InputError(f"reduced model orders {list(reduced.orders)} != basis {list(exp)}")
+        reduced = connect(reduced, contact)
         self.reduced = reduced
         self.Z = to_real_blocks(reduced.Z, reduced.orders)
         self.F = loads_to_real(reduced.F)
         self.eps = penalty(eps, reduced=reduced)
         self.mu = np.full(nc, float(contact.mu))
+        self.normal = contact.normal_force_samples(basis.tau)  # None: all unilateral
         self.set_gap(contact.gap if gap is None else gap)
         self.anchor = np.zeros((nc, d - 1)) if anchor is None else np.array(anchor, float)
         self.P = basis.forward_matrix()
@@ -85,7 +93,7 @@ class DLFTProblem:
         lu = self.basis.to_time(self.lambda_u(U)).reshape(self.nc, self.d, -1)
         lu = np.ascontiguousarray(lu)
         lx, state, sweeps = law.dlft_time(lu, self.mu, self.eps * self.anchor, self.tol,
-                                          self.max_sweeps)
+                                          self.max_sweeps, self.normal)
         return lu, lx, state, sweeps
 
     def residual(self, U, jacobian=True):
@@ -97,7 +105,7 @@ class DLFTProblem:
         if not jacobian:
             return f, None
         G = law.dlft_jacobian(lu, lx, state, self.mu, self.P, self.Q, self.eps * self.anchor,
-                              self.tol, self.max_sweeps)
+                              self.tol, self.max_sweeps, self.normal)
         n = self.m * self.H
         dH = self.d * self.H
         # J = eps I - G (eps I - Z) = eps (I - G) + G Z, G block-diagonal per node
@@ -156,6 +164,8 @@ class PeriodicSolution:
     area : (nc,) tributary areas [m^2].
     stats : solver statistics (:class:`~fretwear.hb.solvers.SolveStats`).
     flags : reasons for caution (e.g. time-domain findings of a sweep's stability check).
+    U_node : (nc, d, H) displacement harmonics of the structure's contact nodes [m] when the
+        interface has contact springs (``U`` is then the contact points'); None otherwise.
     """
 
     frequency: float
@@ -176,6 +186,7 @@ class PeriodicSolution:
     coords: np.ndarray
     stats: SolveStats
     flags: list = field(default_factory=list)
+    U_node: np.ndarray | None = None
 
     @property
     def success(self) -> bool:
@@ -391,6 +402,7 @@ def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
                              anchor=anchor, U0=U0)
     if reduced is None:
         reduced = condense(model, frequency, _orders(basis), quasi_static=quasi_static)
+    reduced = connect(reduced, model.contact)
     eps = penalty(eps, model=model, reduced=reduced)
     if anchor is None:
         anchor = static_anchor(model)
@@ -458,6 +470,9 @@ def assemble_solution(prob: DLFTProblem, U, model: Model, stats: SolveStats) -> 
     x_t[:, 0, :] += prob.gap[:, None]
     red = prob.reduced
     observed = {}
+    U_node = None
+    if isinstance(red, Connected):
+        U_node = b.from_complex(node_displacements(red, b.to_complex(U))).reshape(nc, d, H)
     if red.obs_dofs.size:
         Uc = b.to_complex(U)  # (k+1, m) complex
         Uo = np.einsum("bom,bm->bo", red.obs_A, Uc) + red.obs_b
@@ -473,7 +488,7 @@ def assemble_solution(prob: DLFTProblem, U, model: Model, stats: SolveStats) -> 
         lam=lam, X=X, lam_t=lam_t, x_t=x_t, state=state, gap=prob.gap.copy(),
         anchor=prob.anchor.copy(), eps=prob.eps, observed=observed,
         area=np.asarray(model.contact.area, float), coords=np.asarray(model.contact.coords),
-        stats=stats,
+        stats=stats, U_node=U_node,
     )
 
 
@@ -481,7 +496,8 @@ def initial_state(model: Model, sol: PeriodicSolution):
     """Full-field displacement [m] and velocity [m/s] at ``t = 0`` of a periodic solution."""
     b = sol.basis
     m = sol.U.shape[0] * sol.U.shape[1]
-    Uc = b.to_complex(sol.U.reshape(m, -1))  # (k+1, m) complex amplitudes
+    U = sol.U if sol.U_node is None else sol.U_node  # the structure's contact nodes
+    Uc = b.to_complex(U.reshape(m, -1))  # (k+1, m) complex amplitudes
     orders = np.array([0, *b.harmonics])
     Ufull = _recover(model, sol.omega, orders, Uc, quasi_static=sol.quasi_static)
     U0 = Ufull.real.sum(axis=0)

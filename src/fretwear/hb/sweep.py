@@ -329,8 +329,9 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
         time-domain stability check of :mod:`fretwear.timedomain.stability`).
     time_domain : a :class:`~fretwear.hb.fallback.TimeDomainFallback` (e.g.
         :data:`fretwear.timedomain.fallback.FALLBACK`; ``None``: none). At a point that still
-        did not converge, integrate in time from the neighbour: if the structure settles to a
-        periodic
+        did not converge, integrate in time from the neighbour (not with contact springs or
+        prescribed normal loads, which the time-domain solver does not model): if the
+        structure settles to a periodic
         state, its harmonics and mean positions start one more solve (``how = "time-start"``);
         otherwise the point is flagged with what the structure does there (drifting,
         quasi-periodic...).
@@ -352,6 +353,8 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
     t_start = time.perf_counter()
     grid = frequency_grid(f_min, f_max, n_points, spacing)
     check_inputs(model, basis, f_min, anchor=anchor)
+    if model.contact.has_connectors:  # the time-domain solver has rigid contacts only
+        time_domain = None
     eps = check_rule(eps)
     if eps != "auto":
         eps = penalty(eps, model=model)
