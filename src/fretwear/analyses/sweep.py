@@ -84,8 +84,8 @@ def _sweep_point_variables(result: SweepResult) -> dict:
                               "the periodic solve converged", flag_values=np.array(
                                   [0, 1], dtype=np.int8), flag_meanings="no yes"),
         "how": variable(f, np.array([p.how for p in result.points], dtype=str), "1",
-                        "how the point was reached: grid, substep, retry, arclength, eps-x10, "
-                        "time-start"),
+                        "how the point was reached: grid, substep, retry, arclength, "
+                        "eps-continuation, harmonic-continuation, time-start"),
         "flags": variable(f, np.array(["; ".join(p.flags) for p in result.points], dtype=str),
                           "1", "reasons for caution (empty: none)"),
         "friction_energy": variable(
@@ -318,9 +318,11 @@ register(
             '"free"', default=[]),
         **harmonic_balance_fields(
             sweep,
-            'DLFT penalty: "static": the spectral radius of the static reduced stiffness K_r, '
-            'the same at every frequency (a smooth FRF); "auto": the paper\'s rule (spectral '
-            "radius of Z_r) at each frequency; or a value"),
+            'DLFT penalty, one value for the whole sweep (a smooth FRF): "top": the spectral '
+            "radius of Z_r at the highest kept harmonic, its median over the band (chosen "
+            'from measurements, docs/studies/eps-rule.md); "static": that of the static '
+            'reduced stiffness K_r; or a value. "auto": the paper\'s rule (spectral radius of '
+            "Z_r over the kept harmonics) at each frequency"),
     },
     run_sweep,
     checks=(increasing("f_min", "f_max", "Hz"), check_sampling),

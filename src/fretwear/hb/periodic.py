@@ -14,6 +14,7 @@ block-diagonal per node.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass, field
 
@@ -62,9 +63,10 @@ class DLFTProblem:
             raise InputError(f"reduced model orders {list(reduced.orders)} != basis {list(exp)}")
         reduced = connect(reduced, contact)
         self.reduced = reduced
+        self.contact = contact
         self.Z = to_real_blocks(reduced.Z, reduced.orders)
         self.F = loads_to_real(reduced.F)
-        self.eps = penalty(eps, reduced=reduced)
+        self.eps = penalty(eps, reduced=reduced, contact=contact)
         self.mu = np.full(nc, float(contact.mu))
         self.normal = contact.normal_force_samples(basis.tau)  # None: all unilateral
         self.set_gap(contact.gap if gap is None else gap)
@@ -74,6 +76,12 @@ class DLFTProblem:
         self.tol = periodicity_tol
         self.max_sweeps = max_sweeps
         self.nfev = 0
+
+    def with_eps(self, eps: float) -> DLFTProblem:
+        """The same problem (reduced model, gap, anchors) with the penalty ``eps`` [N/m]."""
+        return DLFTProblem(self.reduced, self.contact, self.basis, gap=self.gap, eps=eps,
+                           anchor=self.anchor, periodicity_tol=self.tol,
+                           max_sweeps=self.max_sweeps)
 
     def set_gap(self, gap):
         gap = np.broadcast_to(np.asarray(gap, dtype=float), (self.nc,))
@@ -166,6 +174,8 @@ class PeriodicSolution:
     flags : reasons for caution (e.g. time-domain findings of a sweep's stability check).
     U_node : (nc, d, H) displacement harmonics of the structure's contact nodes [m] when the
         interface has contact springs (``U`` is then the contact points'); None otherwise.
+    attempts : the attempts of the solve strategy, in order (:class:`Attempt`; the last one
+        gave this solution).
     """
 
     frequency: float
@@ -187,6 +197,7 @@ class PeriodicSolution:
     stats: SolveStats
     flags: list = field(default_factory=list)
     U_node: np.ndarray | None = None
+    attempts: list = field(default_factory=list)
 
     @property
     def success(self) -> bool:
@@ -284,6 +295,137 @@ class PeriodicSolution:
         return stops
 
 
+@dataclass
+class Attempt:
+    """One attempt of a periodic solve (:func:`solve_strategy`, the sweeps).
+
+    method : what was tried: ``"start"`` (the solver from the given start), ``"best-point"``
+        (the other solver from the best iterate so far), ``"eps-continuation"`` (converged at
+        another penalty, then stepped back to the target one: the answer is at the target
+        eps), ``"harmonic-continuation"`` (the first harmonic alone, then all of them),
+        ``"time-start"`` (from a time integration), and for sweeps ``"grid"``, ``"substep"``,
+        ``"retry"``, ``"arclength"``.
+    solver : the nonlinear solver; eps : the penalty of the answer [N/m]; success, residual
+    (relative), iterations, wall_time [s], message : as :class:`~fretwear.hb.solvers.SolveStats`.
+    """
+
+    method: str
+    solver: str
+    eps: float
+    success: bool
+    residual: float
+    iterations: int
+    wall_time: float
+    message: str
+
+    @classmethod
+    def of(cls, method: str, eps: float, st: SolveStats, message: str | None = None):
+        return cls(method, st.solver, float(eps), bool(st.success), float(st.residual),
+                   int(st.iterations), float(st.wall_time),
+                   st.message if message is None else message)
+
+
+#: the attempts of :func:`solve_strategy`, in order
+STRATEGY = ("start", "best-point", "eps-continuation", "harmonic-continuation")
+#: penalties tried by the eps continuation, as factors of the target eps, and the number of
+#: geometric steps back to the target
+EPS_FACTORS = (10.0, 0.1)
+EPS_STEPS = 4
+
+
+def _run(prob: DLFTProblem, x0, solver, tol, max_iter):
+    """One solver run on ``prob`` from ``x0`` (m, H): ``(x (m, H), stats)``."""
+
+    def fun(x, jac=True):
+        return prob.residual(x.reshape(prob.m, prob.H), jac)
+
+    t0 = time.perf_counter()
+    x, _, st = solve(fun, np.asarray(x0, float).reshape(-1),
+                     lambda x: prob.scale(x.reshape(prob.m, prob.H)), method=solver, tol=tol,
+                     max_iter=max_iter)
+    st.wall_time = time.perf_counter() - t0
+    return x.reshape(prob.m, prob.H), st
+
+
+def solve_strategy(prob: DLFTProblem, x0, *, solver="powell", tol=1e-8, max_iter=200,
+                   attempts: list | None = None, steps=STRATEGY):
+    """Solve the balance of ``prob`` from ``x0`` (m, H), trying in order until one converges
+    (``steps``, a subset of :data:`STRATEGY`):
+
+    1. ``"start"``: ``solver`` from ``x0``;
+    2. ``"best-point"``: the other solver (Newton after Powell, Powell after Newton or hybr)
+       from the best iterate so far (Newton converges where Powell's trust region stalls, and
+       the reverse, on the paper's beam);
+    3. ``"eps-continuation"``: the balance at ``10 eps`` (then ``eps / 10``) from ``x0``, and
+       from there :data:`EPS_STEPS` geometric steps back to ``eps``, each starting from the
+       previous answer: the answer is that of the target eps (no eps jump);
+    4. ``"harmonic-continuation"``: the first harmonic alone from the contact-closed guess,
+       then all harmonics from it.
+
+    Every attempt is appended to ``attempts`` (:class:`Attempt`). Returns ``(x, stats)``: the
+    converged answer, or the iterate with the smallest residual when none converged.
+    """
+    attempts = [] if attempts is None else attempts
+    other = "newton" if solver != "newton" else "powell"
+    best = None
+
+    def keep(x, st):
+        nonlocal best
+        if best is None or st.success or st.residual < best[1].residual:
+            best = (x, st)
+        return st.success
+
+    x0 = np.asarray(x0, float).reshape(prob.m, prob.H)
+    if "start" in steps:
+        x, st = _run(prob, x0, solver, tol, max_iter)
+        attempts.append(Attempt.of("start", prob.eps, st))
+        if keep(x, st):
+            return best
+    if "best-point" in steps:
+        start = x0 if best is None else best[0]
+        x, st = _run(prob, start, other, tol, max_iter)
+        attempts.append(Attempt.of("best-point", prob.eps, st))
+        if keep(x, st):
+            return best
+    if "eps-continuation" in steps:
+        for factor in EPS_FACTORS:
+            t0 = time.perf_counter()
+            x, st = _run(prob.with_eps(factor * prob.eps), x0, "newton", tol, max_iter)
+            path = [factor * prob.eps]
+            if st.success:
+                for e in np.geomspace(factor * prob.eps, prob.eps, EPS_STEPS + 1)[1:]:
+                    x, st = _run(prob.with_eps(float(e)) if e != prob.eps else prob, x,
+                                 solver, tol, max_iter)
+                    path.append(float(e))
+                    if not st.success:
+                        break
+            st.wall_time = time.perf_counter() - t0
+            msg = (f"{st.message} (eps path {', '.join(f'{e:.3g}' for e in path)} N/m)")
+            attempts.append(Attempt.of("eps-continuation", prob.eps if st.success else
+                                       path[-1], st, msg))
+            if st.success and path[-1] == prob.eps:
+                keep(x, st)
+                return best
+    if "harmonic-continuation" in steps and prob.basis.k > 1:
+        t0 = time.perf_counter()
+        U1 = _first_harmonic_start(prob, solver, tol, max_iter)
+        if U1 is not None:
+            x, st = _run(prob, U1, solver, tol, max_iter)
+            st.wall_time = time.perf_counter() - t0
+            attempts.append(Attempt.of("harmonic-continuation", prob.eps, st))
+            if keep(x, st):
+                return best
+        else:
+            attempts.append(Attempt("harmonic-continuation", solver, prob.eps, False,
+                                    float("nan"), 0, time.perf_counter() - t0,
+                                    "the first harmonic alone did not converge"))
+    if best is None:  # nothing ran at the target eps: the start, unconverged
+        tried = ", ".join(a.method for a in attempts) or "none"
+        best = (x0, SolveStats(False, float("inf"), 0, 0, 0, 0.0,
+                               f"no attempt converged ({tried})", solver))
+    return best
+
+
 def _orders(basis):
     return np.array([0, *basis.harmonics], dtype=np.int64)
 
@@ -368,7 +510,7 @@ def static_anchor(model: Model, *, quasi: Reduced | None = None) -> np.ndarray:
 def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
                    quasi_static: bool = False, reduced: Reduced | None = None, gap=None,
                    eps="auto", anchor=None, U0=None, solver="powell", tol=1e-8, max_iter=200,
-                   raise_on_failure=False) -> PeriodicSolution:
+                   raise_on_failure=False, strategy=STRATEGY) -> PeriodicSolution:
     """Periodic response of ``model`` at the excitation ``frequency`` [Hz] with the DLFT
     (section 3.1-3.2).
 
@@ -391,6 +533,9 @@ def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
 
     raise_on_failure : raise :class:`~fretwear.errors.ConvergenceError` when the solve does
         not converge instead of returning a solution with ``success`` False.
+    strategy : the attempts made until one converges (:func:`solve_strategy`; default all of
+        :data:`STRATEGY`; ``("start",)``: the solver alone). Each is recorded in the result's
+        ``attempts``.
 
     Returns
     -------
@@ -410,22 +555,22 @@ def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
     if U0 is None and basis.k > 3:
         U0 = _harmonic_continuation_start(model, basis, reduced, prob, solver, tol, max_iter)
     x0 = (prob.initial_guess() if U0 is None else np.asarray(U0, float).reshape(prob.m, prob.H))
-
-    def fun(x, jac=True):
-        return prob.residual(x.reshape(prob.m, prob.H), jac)
-
+    attempts: list = []
     t0 = time.perf_counter()
-    x, _, st = solve(fun, x0.reshape(-1), lambda x: prob.scale(x.reshape(prob.m, prob.H)),
-                     method=solver, tol=tol, max_iter=max_iter)
+    x, st = solve_strategy(prob, x0, solver=solver, tol=tol, max_iter=max_iter,
+                           attempts=attempts, steps=strategy)
     st.wall_time = time.perf_counter() - t0
     if not st.success and raise_on_failure:
         from fretwear.errors import ConvergenceError
 
         raise ConvergenceError(
             f"periodic solve at f = {reduced.frequency:.6g} Hz did not converge: "
-            f"{st.message} (relative residual {st.residual:.3g} > {tol:g})"
+            f"{st.message} (relative residual {st.residual:.3g} > {tol:g}; "
+            f"{len(attempts)} attempts: {', '.join(a.method for a in attempts)})"
         )
-    return assemble_solution(prob, x.reshape(prob.m, prob.H), model, st)
+    sol = assemble_solution(prob, x.reshape(prob.m, prob.H), model, st)
+    sol.attempts = attempts
+    return sol
 
 
 def _harmonic_continuation_start(model, basis, reduced, prob, solver, tol, max_iter):
@@ -433,11 +578,18 @@ def _harmonic_continuation_start(model, basis, reduced, prob, solver, tol, max_i
     embedded in the full basis (None if that fails). From the contact-closed guess, the
     solvers can stall with 15+ harmonics where the one-harmonic problem converges and then
     starts the full one within a few iterations (docs/verification.md)."""
+    return _first_harmonic_start(prob, solver, tol, max_iter)
+
+
+def _first_harmonic_start(prob, solver, tol, max_iter):
+    """:func:`_harmonic_continuation_start` from the problem alone."""
+    basis, reduced = prob.basis, prob.reduced
     sub = FourierBasis(basis.harmonics[:1], basis.n_samples)
-    red = Reduced(reduced.omega, reduced.orders[:2], reduced.Z[:2], reduced.F[:2],
-                  reduced.obs_A[:2], reduced.obs_b[:2], reduced.obs_dofs, reduced.quasi_static,
-                  reduced.frequency)
-    p1 = DLFTProblem(red, model.contact, sub, gap=prob.gap, eps=prob.eps, anchor=prob.anchor)
+    cut = {k: getattr(reduced, k)[:2] for k in ("orders", "Z", "F", "obs_A", "obs_b")}
+    if isinstance(reduced, Connected):  # already seen through the contact springs
+        cut.update(node_A=reduced.node_A[:2], node_b=reduced.node_b[:2])
+    red = dataclasses.replace(reduced, **cut)
+    p1 = DLFTProblem(red, prob.contact, sub, gap=prob.gap, eps=prob.eps, anchor=prob.anchor)
 
     def fun(x, jac=True):
         return p1.residual(x.reshape(p1.m, p1.H), jac)
