@@ -24,7 +24,8 @@ References: event-driven integration with exact stick/slip switching plus Newton
 Each code runs in a fresh process of its own interpreter (``cold``: first run in that process,
 imports and just-in-time compilation included) and runs the same analysis again in that
 process (``warm``). fretwear: 121 (a) / 137 (b) linearly spaced frequencies (``fretwear.sweep``,
-default eps rule); pyHarm: its arclength continuation over the same band (step ``ds = 0.05``:
+default eps rule "top"; on (b) also with pyHarm's eps = 1000, row ``fretwear*``); pyHarm: its
+arclength continuation over the same band (step ``ds = 0.05``:
 its default continuation did not end on (b)). The peak of each curve is the largest A1 of its
 points refined by a parabola through the three points around it.
 
@@ -64,6 +65,7 @@ from fretwear.model.matrices import from_matrices
 
 prob, H, n, w0, w1 = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), float(sys.argv[4]), \
     float(sys.argv[5])
+eps = sys.argv[6] if sys.argv[6] in ("top", "auto", "static") else float(sys.argv[6])
 
 
 def model():
@@ -79,7 +81,7 @@ def model():
 
 def run():
     res = fretwear.sweep(model(), FourierBasis.up_to(H, 128), w0 / (2 * np.pi),
-                         w1 / (2 * np.pi), n, spacing="linear", time_domain=False)
+                         w1 / (2 * np.pi), n, spacing="linear", eps=eps, time_domain=False)
     pts = [p for p in res.points if p.on_grid]
     w = [2 * np.pi * p.frequency_hz for p in pts if p.success]
     a = [float(p.solution.observed_amplitude("x")[0][0]) for p in pts if p.success]
@@ -216,7 +218,10 @@ def main(argv=None):
         w_ref, a_ref = refs[prob]
         for H in args.harmonics:
             rows = {"fretwear": child(sys.executable, FRETWEAR_CHILD,
-                                      [prob, H, N_POINTS[prob], *BAND[prob]], env)}
+                                      [prob, H, N_POINTS[prob], *BAND[prob], "top"], env)}
+            if prob == "b":  # the penalty pyHarm is given, for a like-for-like accuracy
+                rows["fretwear*"] = child(sys.executable, FRETWEAR_CHILD,
+                                          [prob, H, N_POINTS[prob], *BAND[prob], 1000.0], env)
             if have_pyharm:
                 rows["pyHarm"] = child(args.pyharm, PYHARM_CHILD, [prob, H, *BAND[prob]],
                                        env)
