@@ -75,6 +75,12 @@ def _response_variables(result: SweepResult, basis: FourierBasis, model, points:
     }
 
 
+def _attempts(attempts) -> str:
+    """The attempts of a point as one line: ``grid/powell/no/5.3e-04; eps-continuation/...``."""
+    return "; ".join(f"{a.method}/{a.solver}/{'yes' if a.success else 'no'}/{a.residual:.1e}"
+                     for a in attempts)
+
+
 def _sweep_point_variables(result: SweepResult) -> dict:
     fr = np.array([_state_fractions(p.solution) if p.success else np.full(3, np.nan)
                    for p in result.points]).reshape(-1, 3)
@@ -88,6 +94,10 @@ def _sweep_point_variables(result: SweepResult) -> dict:
                         "eps-continuation, harmonic-continuation, time-start"),
         "flags": variable(f, np.array(["; ".join(p.flags) for p in result.points], dtype=str),
                           "1", "reasons for caution (empty: none)"),
+        "attempts": variable(f, np.array([_attempts(p.attempts) for p in result.points],
+                                         dtype=str), "1",
+                             "every attempt at this frequency, in order: method/solver/"
+                             "converged or not/relative residual"),
         "friction_energy": variable(
             f, _per_point(result, lambda p: p.solution.friction_energy().sum()), "J",
             "energy dissipated by friction per period over the interface"),
