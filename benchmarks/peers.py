@@ -85,8 +85,8 @@ def run():
     pts = [p for p in res.points if p.on_grid]
     w = [2 * np.pi * p.frequency_hz for p in pts if p.success]
     a = [float(p.solution.observed_amplitude("x")[0][0]) for p in pts if p.success]
-    eps = res.points[0].solution.eps if res.points[0].success else float("nan")
-    return {"points": len(pts), "converged": len(w), "w": w, "a": a, "eps": eps}
+    used = res.points[0].solution.eps if res.points[0].success else float("nan")
+    return {"points": len(pts), "converged": len(w), "w": w, "a": a, "eps": used}
 
 
 out = run()
