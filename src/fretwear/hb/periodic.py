@@ -390,7 +390,7 @@ def solve_strategy(prob: DLFTProblem, x0, *, solver="powell", tol=1e-8, max_iter
     if "eps-continuation" in steps:
         for factor in EPS_FACTORS:
             t0 = time.perf_counter()
-            x, st = _run(prob.with_eps(factor * prob.eps), x0, "newton", tol, max_iter)
+            x, st = _run(prob.with_eps(factor * prob.eps), x0, solver, tol, max_iter)
             path = [factor * prob.eps]
             if st.success:
                 for e in np.geomspace(factor * prob.eps, prob.eps, EPS_STEPS + 1)[1:]:
