@@ -356,7 +356,8 @@ def solve_strategy(prob: DLFTProblem, x0, *, solver="powell", tol=1e-8, max_iter
     2. ``"best-point"``: the other solver (Newton after Powell, Powell after Newton or hybr)
        from the best iterate so far (Newton converges where Powell's trust region stalls, and
        the reverse, on the paper's beam);
-    3. ``"eps-continuation"``: the balance at ``10 eps`` (then ``eps / 10``) from ``x0``, and
+    3. ``"eps-continuation"``: the balance at ``10 eps`` (then ``eps / 10``) from ``x0`` (the
+       solver, then the other one), and
        from there :data:`EPS_STEPS` geometric steps back to ``eps``, each starting from the
        previous answer: the answer is that of the target eps (no eps jump);
     4. ``"harmonic-continuation"``: the first harmonic alone from the contact-closed guess,
@@ -390,7 +391,10 @@ def solve_strategy(prob: DLFTProblem, x0, *, solver="powell", tol=1e-8, max_iter
     if "eps-continuation" in steps:
         for factor in EPS_FACTORS:
             t0 = time.perf_counter()
-            x, st = _run(prob.with_eps(factor * prob.eps), x0, solver, tol, max_iter)
+            shifted = prob.with_eps(factor * prob.eps)
+            x, st = _run(shifted, x0, solver, tol, max_iter)
+            if not st.success:  # the other solver at the shifted eps
+                x, st = _run(shifted, x0, other, tol, max_iter)
             path = [factor * prob.eps]
             if st.success:
                 for e in np.geomspace(factor * prob.eps, prob.eps, EPS_STEPS + 1)[1:]:
