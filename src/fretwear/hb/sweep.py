@@ -211,8 +211,12 @@ def rebuild_point(model: Model, basis: FourierBasis, gap, entry: dict) -> SweepP
         prob = DLFTProblem(_condense(model, entry["omega"], orders), model.contact, basis,
                            gap=gap, eps=entry["eps"], anchor=entry["anchor"])
         sol = assemble_solution(prob, np.array(entry["U"], float), model, stats)
-    return SweepPoint(rec["frequency_hz"], sol, stats, rec["how"], list(rec["flags"]),
-                      bool(rec["on_grid"]), rec["time_domain"])
+    pt = SweepPoint(rec["frequency_hz"], sol, stats, rec["how"], list(rec["flags"]),
+                    bool(rec["on_grid"]), rec["time_domain"],
+                    [Attempt(**a) for a in rec.get("attempts", [])])
+    if sol is not None:
+        sol.attempts = pt.attempts
+    return pt
 
 
 def _solve_at(probs, omega, anchor, U0, solver, tol, max_iter):
