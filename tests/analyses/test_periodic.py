@@ -115,7 +115,7 @@ def test_a_periodic_solve_that_fails_saves_no_solution(tmp_path, capsys):
     ("frequency = -50.0", "analysis.frequency = -50.0: expected a number > 0"),
     ('solver = "powel"', 'analysis.solver = "powel": expected one of "powell", "newton", '
                          '"hybr" (did you mean "powell"?)'),
-    ('eps = "paper"', 'analysis.eps = "paper": expected one of "auto", "static" or a number '
+    ('eps = "paper"', 'analysis.eps = "paper": expected one of "auto", "static", "top" or a number '
                       "> 0"),
     ("harmonics = 0", "analysis.harmonics = 0: expected an integer >= 1 or a non-empty list "
                       "of integers >= 1 (no repeats)"),

@@ -584,3 +584,92 @@ def test_residual_jacobian_matches_finite_differences(d, keys):
     np.testing.assert_allclose(J, J_fd, rtol=0, atol=FD_RTOL * prob.eps)
     # the nonlinear part is not negligible: the test would see an error in G
     assert np.abs(J - prob.eps * np.eye(n)).max() > 0.1 * prob.eps
+
+
+# --------------------------------------------------------------------------------------------
+# 3. friction under a prescribed normal load N(t) (no normal DOF in the law)
+# --------------------------------------------------------------------------------------------
+def ref_sweep_prescribed(lu, mu, xprev, nfix):
+    """One pass of the tangential law with the threshold ``mu N(n)`` of a prescribed normal
+    force ``nfix`` (N,), written independently of the kernel: ``lambda_N = N(n)`` always;
+    ``N(n) <= 0`` frees the tangential force (``lambda_T = 0``); otherwise stick/slip as eq.
+    27-28 with ``pre_N`` replaced by ``N(n)``. Returns (lx, state, end)."""
+    d, n_t = lu.shape
+    lx = np.zeros((d, n_t))
+    state = np.zeros(n_t, dtype=int)
+    xp = np.array(xprev, dtype=float)
+    for n in range(n_t):
+        lx[0, n] = lu[0, n] - nfix[n]
+        pre_t = lu[1:, n] - xp
+        if nfix[n] <= 0.0:
+            lx[1:, n] = lu[1:, n]
+            state[n] = law.SEPARATION
+        elif np.linalg.norm(pre_t) < mu * nfix[n]:
+            lx[1:, n] = xp
+            state[n] = law.STICK
+        else:
+            lx[1:, n] = xp + pre_t * (1.0 - mu * nfix[n] / np.linalg.norm(pre_t))
+            state[n] = law.SLIP
+        xp = lx[1:, n].copy()
+    return lx, state, xp
+
+
+TAU = 2.0 * np.pi * np.arange(NS) / NS
+# prescribed normal forces: constant, periodic and positive, periodic and lifting off
+NFIX = {"constant": np.full(NS, 1.0), "periodic": 1.0 + 0.5 * np.cos(TAU + 0.3),
+        "lift-off": 0.4 + np.cos(TAU + 0.3)}
+# tangential lambda_u that slips (amplitude > mu N) and sticks near its turning points; the
+# normal component of lambda_u is arbitrary (it does not enter the law)
+LU_T = {2: {(0, "0"): 0.7, (0, "s1"): 0.3, (1, "c1"): 0.9, (1, "s2"): 0.1},
+        3: {(0, "0"): 0.7, (0, "s1"): 0.3, (1, "c1"): 0.9, (1, "s2"): 0.1, (2, "c1"): 0.3,
+            (2, "s2"): 0.05}}
+
+
+@pytest.mark.parametrize("d", [2, 3])
+@pytest.mark.parametrize("load", list(NFIX))
+def test_prescribed_normal_law_and_jacobian(d, load):
+    """dlft_time with a prescribed normal force vs ``ref_sweep_prescribed`` (made periodic by
+    repeated passes): same corrections (tolerance ATOL_LAW: rounding only) and
+    ``lambda_N = N(t)`` exactly at every instant; then dlft_jacobian vs central differences of
+    the time law (tolerance FD_RTOL, see its comment; margins from the switches asserted
+    first). A Jacobian that kept the ``- mu t e_N`` term of the unilateral law, or dropped the
+    identity on the normal component, is off by O(mu) = 0.3."""
+    c = coeffs(d, LU_T[d])[None]
+    mu = np.array([0.3])
+    xs = np.zeros((1, d - 1))
+    nfix = NFIX[load][None]
+    lu = np.ascontiguousarray(c @ Q_REF.T)
+    lx, state, _ = law.dlft_time(lu, mu, xs, TOL_LAW, SWEEPS, nfix)
+    start = xs[0].copy()
+    for _ in range(SWEEPS):
+        lx_ref, st_ref, end = ref_sweep_prescribed(lu[0], 0.3, start, nfix[0])
+        done = np.abs(end - start).max() <= TOL_LAW * np.abs(lu).max()
+        start = end
+        if done:
+            break
+    scale = np.abs(lu).max()
+    np.testing.assert_array_equal(state[0], st_ref)
+    assert {law.STICK, law.SLIP} <= set(st_ref.tolist())  # both regimes visited
+    if load == "lift-off":
+        assert law.SEPARATION in st_ref
+    np.testing.assert_allclose(lx[0], lx_ref, rtol=0, atol=ATOL_LAW * scale)
+    np.testing.assert_allclose((lu - lx)[0, 0], nfix[0], rtol=0, atol=ATOL_LAW * scale)
+    # margins from the stick/slip threshold mu N and from N = 0
+    pre = lu[0, 1:] - np.roll(lx[0, 1:], 1, axis=1)
+    marg = np.where(nfix[0] <= 0, -nfix[0],
+                    np.abs(np.linalg.norm(pre, axis=0) - 0.3 * nfix[0]))
+    assert marg.min() / scale > MIN_MARGIN
+    G = law.dlft_jacobian(lu, lx, state, mu, P_REF, Q_REF, xs, TOL_LAW, SWEEPS, nfix)[0]
+    H = c.shape[2]
+    h = FD_STEP * scale
+    G_fd = np.zeros((d * H, d * H))
+    for j in range(d * H):
+        e = np.zeros(d * H)
+        e[j] = h
+        out = []
+        for s in (1.0, -1.0):
+            lu_s = np.ascontiguousarray((c + s * e.reshape(1, d, H)) @ Q_REF.T)
+            lx_s, _, _ = law.dlft_time(lu_s, mu, xs, TOL_LAW, SWEEPS, nfix)
+            out.append((lx_s[0] @ P_REF.T).reshape(-1))
+        G_fd[:, j] = (out[0] - out[1]) / (2 * h)
+    np.testing.assert_allclose(G, G_fd, rtol=0, atol=FD_RTOL * max(np.abs(G_fd).max(), 1.0))

@@ -138,17 +138,24 @@ def test_the_solvers_take_the_same_words():
             call()
 
 
-def test_sweep_static_is_one_penalty_and_auto_one_per_frequency():
+def test_sweep_static_and_top_are_one_penalty_and_auto_one_per_frequency():
+    """The default ``"top"`` of a sweep is one eps for every point: the median over 5
+    frequencies of the band of the spectral radius of Z_r at the highest kept harmonic,
+    compared with ``reference_radius`` (dense matrices, module docstring) to rounding."""
     model = tiny_model()
     basis = FourierBasis((1,), 16)
     # between the resonances of the interior node with the contact held (675 and 1031 Hz),
     # where Z_r(w) outweighs K_r
     f = np.array([700.0, 800.0])
-    static = sweep(model, basis, f[0], f[1], 2, spacing="linear", time_domain=None)
-    default = sweep(model, basis, f[0], f[1], 2, spacing="linear", time_domain=None,
-                    eps="static")
+    top = sweep(model, basis, f[0], f[1], 2, spacing="linear", time_domain=None)
+    ref_top = float(np.median([reference_radius(model, 2 * np.pi * x, [1])
+                               for x in np.linspace(f[0], f[1], 5)]))
+    assert [p.solution.eps for p in top.points] == pytest.approx([ref_top] * 2, rel=1e-12)
+    static = sweep(model, basis, f[0], f[1], 2, spacing="linear", time_domain=None,
+                   eps="static")
+    default = static
     auto = sweep(model, basis, f[0], f[1], 2, spacing="linear", time_domain=None, eps="auto")
-    for res in (static, default, auto):
+    for res in (static, top, auto):
         assert res.success, res.message
         np.testing.assert_allclose(res.frequency_hz, f, rtol=1e-15)
     k_r = penalty("static", model=model)
@@ -158,3 +165,31 @@ def test_sweep_static_is_one_penalty_and_auto_one_per_frequency():
                  for x in f]
     assert [p.solution.eps for p in auto.points] == per_point
     assert per_point[0] != pytest.approx(per_point[1])
+
+
+def test_top_is_the_spectral_radius_at_the_highest_kept_harmonic():
+    """``"top"`` vs ``reference_radius`` on the highest kept order alone (dense matrices)."""
+    model = tiny_model()
+    for f in (300.0, 2000.0):
+        ref = reference_radius(model, 2 * np.pi * f, [ORDERS[-1]])
+        assert penalty("top", model=model, frequency=f, orders=ORDERS) == pytest.approx(
+            ref, rel=1e-12)
+
+
+def test_radius_estimate_of_large_blocks():
+    """Above EXACT_SIZE rows the spectral radius is a power-iteration estimate of the largest
+    singular value: on a complex symmetric matrix with a known spectrum (Q diag(l) Q^T, Q
+    real orthogonal, so the matrix is normal and |l|max is both the spectral radius and the
+    2-norm, here 2.5 x the next one) it matches to 1e-3 (the iteration stops at a 1e-3 relative
+    change, and converges geometrically with ratio (2/5)^2 per step)."""
+    from fretwear.hb.penalty import EXACT_SIZE, radius
+
+    n = EXACT_SIZE + 44
+    rng = np.random.default_rng(1)
+    Q, _ = np.linalg.qr(rng.standard_normal((n, n)))
+    lam = rng.uniform(1.0, 2.0, n) * np.exp(1j * rng.uniform(0, 0.1, n))
+    lam[7] = 5.0 + 0.2j
+    Z = (Q * lam) @ Q.T
+    assert radius(Z) == pytest.approx(abs(lam[7]), rel=1e-3)
+    assert radius(Z[:40, :40]) == pytest.approx(np.abs(np.linalg.eigvals(Z[:40, :40])).max(),
+                                                rel=1e-12)

@@ -26,7 +26,7 @@ from scipy import integrate, optimize
 from fretwear.errors import ConvergenceError
 from fretwear.hb import contact as law
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import solve_periodic
+from fretwear.hb.periodic import DLFTProblem, solve_periodic
 from fretwear.hb.reduce import condense, recover
 from fretwear.model import (
     ContactSpec,
@@ -607,3 +607,34 @@ def test_3d_poisson_preload():
     st = sol.stats
     assert sol.success, st.message
     check_cone(sol, MU_B)
+
+
+def test_strategy_records_every_attempt_and_ends_at_the_target_eps():
+    """The issue's two-DOF chain (mass 2 rubbing on the ground under a prescribed normal
+    force) at 15 harmonics with eps = 1 N/m: Powell stalls from the contact-closed start,
+    Newton from its best iterate too, and the eps continuation (10 N/m, then back to 1 N/m)
+    converges. Checked independently of the solver's own test: a fresh problem at eps = 1
+    evaluates the residual of the returned harmonics below the tolerance, and the attempts
+    are recorded in order with only the last one successful."""
+    from fretwear.hb.fourier import FourierBasis as FB
+    from fretwear.model.matrices import from_matrices
+
+    model = from_matrices(np.array([[2.0, -1.0], [-1.0, 1.0]]), np.eye(2), C=0.02 * np.eye(2),
+                          contact_normal_dofs=None, contact_tangential_dofs=[1], mu=0.5,
+                          normal_load=1.0, loads=[Load(np.array([0.2, 0.0]), "cos")],
+                          observed={"x": 0})
+    basis = FB.up_to(15, 128)
+    sol = solve_periodic(model, basis, frequency=1.4905405 / (2 * np.pi), eps=1.0)
+    assert sol.success and sol.eps == 1.0
+    methods = [a.method for a in sol.attempts]
+    assert methods == ["start", "best-point", "eps-continuation"]
+    assert [a.success for a in sol.attempts] == [False, False, True]
+    assert sol.attempts[-1].eps == 1.0 and "eps path 10, " in sol.attempts[-1].message
+    red = condense(model, sol.frequency, basis.orders)
+    prob = DLFTProblem(red, model.contact, basis, eps=1.0, anchor=sol.anchor)
+    U = sol.U.reshape(prob.m, prob.H)
+    f, _ = prob.residual(U, jacobian=False)
+    assert np.linalg.norm(f) <= 1e-8 * prob.scale(U)
+    only = solve_periodic(model, basis, frequency=1.4905405 / (2 * np.pi), eps=1.0,
+                          strategy=("start",))
+    assert not only.success and [a.method for a in only.attempts] == ["start"]

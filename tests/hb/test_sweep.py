@@ -65,3 +65,34 @@ def test_failed_points_say_so():
     assert isinstance(res.message, str) and res.message
     for p, ok in zip(res.points, res.point_success, strict=True):
         assert p.success == ok and isinstance(p.message, str) and p.message
+
+
+def test_point_passed_by_eps_continuation_keeps_the_sweep_eps_and_its_attempts():
+    """The issue's two-DOF chain at 15 harmonics with eps = 1 N/m: the grid solve fails at
+    the first point (no neighbour to retry from), the eps continuation converges; the point
+    says so (``how``), keeps every attempt in order, and its answer is at the sweep's eps (no
+    eps jump). Independent check: the residual of a fresh problem at eps = 1 at the point's
+    harmonics is below the tolerance."""
+    from fretwear.hb.periodic import DLFTProblem
+    from fretwear.hb.reduce import condense
+    from fretwear.model.core import Load
+    from fretwear.model.matrices import from_matrices
+
+    model = from_matrices(np.array([[2.0, -1.0], [-1.0, 1.0]]), np.eye(2), C=0.02 * np.eye(2),
+                          contact_normal_dofs=None, contact_tangential_dofs=[1], mu=0.5,
+                          normal_load=1.0, loads=[Load(np.array([0.2, 0.0]), "cos")],
+                          observed={"x": 0})
+    basis = FourierBasis.up_to(15, 128)
+    f = 1.4905405 / (2 * np.pi)
+    res = sweep(model, basis, f, 1.01 * f, 2, eps=1.0, time_domain=None)
+    p = res.points[0]
+    assert p.success and p.how == "eps-continuation"
+    assert [a.method for a in p.attempts][0] == "grid" and not p.attempts[0].success
+    assert p.attempts[-1].method == "eps-continuation" and p.attempts[-1].success
+    assert p.solution.eps == 1.0 and p.solution.attempts is p.attempts
+    assert all(q.solution.eps == 1.0 for q in res.points if q.success)
+    red = condense(model, p.frequency_hz, basis.orders)
+    prob = DLFTProblem(red, model.contact, basis, eps=1.0, anchor=p.solution.anchor)
+    U = p.solution.U.reshape(prob.m, prob.H)
+    fres, _ = prob.residual(U, jacobian=False)
+    assert np.linalg.norm(fres) <= 1e-8 * prob.scale(U)

@@ -419,3 +419,47 @@ def test_materials_of_bodies(tmp_path):
     msg = error_of(tmp_path, head + steel.replace("damper]", "dampr]") + "\n[damping]" + tail,
                    build=True)
     assert msg.startswith('materials.dampr = "dampr": expected one of')
+# --- connectors: contact stiffness and prescribed normal loads ------------------------------
+def test_connector_keys_of_a_mesh_case(tmp_path):
+    """Stiffness per unit area becomes each node's stiffness times its area; a prescribed
+    pressure becomes each node's normal force times its area (the nodal areas are the
+    model's own, so the comparison is with the interface's area field)."""
+    text = BASE.replace("wear_coefficient = 1e-11", "wear_coefficient = 1e-11\n"
+                        "normal_stiffness = 1e12\ntangential_stiffness = 5e11\n"
+                        "normal_pressure = 2e6\nnormal_waveform = \"cos\"")
+    c = build_model(load_case(write(tmp_path, text))).contact
+    np.testing.assert_allclose(c.kn, 1e12 * c.area, rtol=1e-15)
+    np.testing.assert_allclose(c.kt, 5e11 * c.area, rtol=1e-15)
+    np.testing.assert_allclose(c.normal_load.vector, 2e6 * c.area, rtol=1e-15)
+    assert c.normal_load.waveform == "cos"
+    rigid = build_model(load_case(write(tmp_path, BASE))).contact
+    assert rigid.kn is None and rigid.kt is None and rigid.normal_load is None
+    assert not rigid.has_connectors
+
+
+def test_jenkins_oscillator_from_a_matrices_case(tmp_path):
+    """The issue's Jenkins oscillator (one DOF, no normal DOF, kt in series with the slider
+    under a prescribed normal force) from a case file equals the one built in Python."""
+    folder = tmp_path / "m"
+    folder.mkdir()
+    scipy.io.mmwrite(folder / "K.mtx", sp.coo_matrix(np.array([[1.0]])))
+    scipy.io.mmwrite(folder / "M.mtx", sp.coo_matrix(np.array([[1.0]])))
+    (folder / "f.txt").write_text("0.2\n")
+    text = ('[model]\ntype = "matrices"\nK = "K.mtx"\nM = "M.mtx"\n'
+            '[[loads]]\nfile = "f.txt"\nwaveform = "cos"\n'
+            '[contact]\ntangential_dofs = [0]\nmu = 0.5\nnormal_load = 1.0\nkt = 0.5\n'
+            '[analysis]\ntype = "modes"\n')
+    model = build_model(load_case(write(folder, text)))
+    c = model.contact
+    assert c.prescribed_nodes().tolist() == [True]
+    np.testing.assert_array_equal(c.kt, [0.5])
+    assert c.kn is None
+    assert model.ndof == 2  # the added normal DOF, held at zero by its load
+
+
+def test_matrices_contact_needs_normal_dofs_or_a_normal_load(tmp_path):
+    folder = matrices_folder(tmp_path)
+    msg = error_of(folder, MATRICES.replace("normal_dofs = [0, 2]\n", ""))
+    assert msg.startswith("[contact]: missing 'normal_dofs'")
+    msg = error_of(folder, MATRICES.replace("mu = 0.2", "mu = 0.2\nkt = 0.0"))
+    assert msg.startswith("contact.kt = 0.0: expected")

@@ -75,6 +75,12 @@ def _response_variables(result: SweepResult, basis: FourierBasis, model, points:
     }
 
 
+def _attempts(attempts) -> str:
+    """The attempts of a point as one line: ``grid/powell/no/5.3e-04; eps-continuation/...``."""
+    return "; ".join(f"{a.method}/{a.solver}/{'yes' if a.success else 'no'}/{a.residual:.1e}"
+                     for a in attempts)
+
+
 def _sweep_point_variables(result: SweepResult) -> dict:
     fr = np.array([_state_fractions(p.solution) if p.success else np.full(3, np.nan)
                    for p in result.points]).reshape(-1, 3)
@@ -84,10 +90,14 @@ def _sweep_point_variables(result: SweepResult) -> dict:
                               "the periodic solve converged", flag_values=np.array(
                                   [0, 1], dtype=np.int8), flag_meanings="no yes"),
         "how": variable(f, np.array([p.how for p in result.points], dtype=str), "1",
-                        "how the point was reached: grid, substep, retry, arclength, eps-x10, "
-                        "time-start"),
+                        "how the point was reached: grid, substep, retry, arclength, "
+                        "eps-continuation, harmonic-continuation, time-start"),
         "flags": variable(f, np.array(["; ".join(p.flags) for p in result.points], dtype=str),
                           "1", "reasons for caution (empty: none)"),
+        "attempts": variable(f, np.array([_attempts(p.attempts) for p in result.points],
+                                         dtype=str), "1",
+                             "every attempt at this frequency, in order: method/solver/"
+                             "converged or not/relative residual"),
         "friction_energy": variable(
             f, _per_point(result, lambda p: p.solution.friction_energy().sum()), "J",
             "energy dissipated by friction per period over the interface"),
@@ -318,9 +328,11 @@ register(
             '"free"', default=[]),
         **harmonic_balance_fields(
             sweep,
-            'DLFT penalty: "static": the spectral radius of the static reduced stiffness K_r, '
-            'the same at every frequency (a smooth FRF); "auto": the paper\'s rule (spectral '
-            "radius of Z_r) at each frequency; or a value"),
+            'DLFT penalty, one value for the whole sweep (a smooth FRF): "top": the spectral '
+            "radius of Z_r at the highest kept harmonic, its median over the band (chosen "
+            'from measurements, docs/studies/eps-rule.md); "static": that of the static '
+            'reduced stiffness K_r; or a value. "auto": the paper\'s rule (spectral radius of '
+            "Z_r over the kept harmonics) at each frequency"),
     },
     run_sweep,
     checks=(increasing("f_min", "f_max", "Hz"), check_sampling),

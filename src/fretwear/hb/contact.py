@@ -45,20 +45,24 @@ ROUND = 1e-13  # relative rounding margin of the stick test (see _sweep)
 
 
 @njit(cache=True)
-def _sweep(lu, mu, xprev, lx, state):
+def _sweep(lu, mu, xprev, lx, state, nfix):
     """One pass over the period for one node; returns the final tangential correction.
 
     lu : (d, N) lambda_u samples; xprev : (d-1,) lambda_x,T before n = 0 (overwritten);
-    lx : (d, N) output; state : (N,) output.
+    lx : (d, N) output; state : (N,) output; nfix : (N,) prescribed normal force samples, or
+    NaN in ``nfix[0]`` for a unilateral contact.
     """
     d, N = lu.shape
     dt = d - 1
     pre = np.empty(dt)
+    fixed = not np.isnan(nfix[0])
     for n in range(N):
-        pn = lu[0, n]
+        pn = nfix[n] if fixed else lu[0, n]
         if pn <= 0.0:
             for c in range(d):
                 lx[c, n] = lu[c, n]
+            if fixed:  # no normal force, hence no friction: lambda = (pn, 0)
+                lx[0, n] = lu[0, n] - pn
             state[n] = SEPARATION
         else:
             nrm2 = 0.0
@@ -66,7 +70,7 @@ def _sweep(lu, mu, xprev, lx, state):
                 pre[c] = lu[1 + c, n] - xprev[c]
                 nrm2 += pre[c] * pre[c]
             nrm = np.sqrt(nrm2)
-            lx[0, n] = 0.0
+            lx[0, n] = lu[0, n] - pn if fixed else 0.0
             cap = mu * pn
             # rounding margin: a periodic state set by a slip at this instant in an earlier
             # pass sits on the cone up to the rounding of lam_u,T - lam_x,T; it must stay
@@ -88,8 +92,23 @@ def _sweep(lu, mu, xprev, lx, state):
     return xprev
 
 
+def dlft_time(lam_u, mu, x_start, tol, max_sweeps, normal=None):
+    """Corrections ``lambda_x`` for all nodes over one period (eq. 24-28): see
+    :func:`_dlft_time`. ``normal`` (nc, N): prescribed normal force samples [N] per node, NaN
+    rows for unilateral contacts; None: every node unilateral."""
+    return _dlft_time(lam_u, mu, x_start, tol, max_sweeps, _normal(normal, lam_u))
+
+
+def _normal(normal, lam_u):
+    """The prescribed normal force samples (nc, N) [N] given to the kernels (NaN: unilateral)."""
+    nc, _, N = lam_u.shape
+    if normal is None:
+        return np.full((nc, N), np.nan)
+    return np.ascontiguousarray(np.broadcast_to(np.asarray(normal, float), (nc, N)))
+
+
 @njit(cache=True)
-def dlft_time(lam_u, mu, x_start, tol, max_sweeps):
+def _dlft_time(lam_u, mu, x_start, tol, max_sweeps, normal):
     """Corrections ``lambda_x`` for all nodes over one period, made periodic (eq. 24-28).
 
     Parameters
@@ -100,6 +119,9 @@ def dlft_time(lam_u, mu, x_start, tol, max_sweeps):
         first pass (kept by nodes that stick all period).
     tol : relative tolerance of the periodicity test (on ``max |lambda_u|`` of the node).
     max_sweeps : passes allowed per node.
+    normal : (nc, N) prescribed normal forces ``N(t)`` [N] (friction under a prescribed normal
+        load: ``lambda_N = N(t)``, the slip threshold is ``mu N(t)``), NaN rows for nodes in
+        unilateral contact (the normal force then comes from ``lambda_u,N``).
 
     Returns
     -------
@@ -126,7 +148,7 @@ def dlft_time(lam_u, mu, x_start, tol, max_sweeps):
         while True:
             k += 1
             xprev = start.copy()
-            end = _sweep(lam_u[p], mu[p], xprev, lam_x[p], state[p])
+            end = _sweep(lam_u[p], mu[p], xprev, lam_x[p], state[p], normal[p])
             diff = 0.0
             for c in range(dt):
                 diff = max(diff, abs(end[c] - start[c]))
@@ -142,7 +164,7 @@ def dlft_time(lam_u, mu, x_start, tol, max_sweeps):
 
 
 @njit(cache=True)
-def _propagate(lu, lx, state, mu, Q, xprev0, D):
+def _propagate(lu, lx, state, mu, Q, xprev0, D, nfix):
     """Derivative of one pass of :func:`_sweep`: on entry ``D`` (d-1, dH) is
     ``d lambda_x,T(-1) / d lambda_u~`` (the derivative of the pass's start state); on exit it is
     the derivative of ``lambda_x,T(N-1)`` (the pass's end state)."""
@@ -153,6 +175,8 @@ def _propagate(lu, lx, state, mu, Q, xprev0, D):
     that = np.zeros(dt)
     B = np.zeros((dt, dt))
     tmp = np.zeros((dt, dH))
+    fixed = not np.isnan(nfix[0])
+    dcap = 0.0 if fixed else mu  # d (mu pn) / d lambda_u,N
     for n in range(N):
         st = state[n]
         if st == SEPARATION:
@@ -161,7 +185,7 @@ def _propagate(lu, lx, state, mu, Q, xprev0, D):
                 for h in range(H):
                     D[c, (1 + c) * H + h] = Q[n, h]
         elif st == SLIP:
-            pn = lu[0, n]
+            pn = nfix[n] if fixed else lu[0, n]
             nrm2 = 0.0
             for c in range(dt):
                 that[c] = lu[1 + c, n] - lx[1 + c, n]
@@ -192,12 +216,12 @@ def _propagate(lu, lx, state, mu, Q, xprev0, D):
                     qh = Q[n, h]
                     for b in range(dt):
                         D[a, (1 + b) * H + h] += ((1.0 if a == b else 0.0) - B[a, b]) * qh
-                    D[a, h] += -mu * that[a] * qh
+                    D[a, h] += -dcap * that[a] * qh
         # STICK: D carried unchanged
 
 
 @njit(cache=True)
-def _start_derivative(lu, mu, Q, x_start, tol, max_sweeps):
+def _start_derivative(lu, mu, Q, x_start, tol, max_sweeps, nfix):
     """Derivative of the start state of the final pass of :func:`dlft_time`, obtained by
     differentiating the passes actually made from the fixed ``x_start`` (used when the
     periodic fixed point is not isolated, e.g. a 3D node that touches the cone without
@@ -220,32 +244,34 @@ def _start_derivative(lu, mu, Q, x_start, tol, max_sweeps):
     while True:
         k += 1
         xprev = start.copy()
-        end = _sweep(lu, mu, xprev, lxk, stk)
+        end = _sweep(lu, mu, xprev, lxk, stk, nfix)
         diff = 0.0
         for c in range(dt):
             diff = max(diff, abs(end[c] - start[c]))
         if diff <= thr or k > max_sweeps:
             return D
         Dn = D.copy()
-        _propagate(lu, lxk, stk, mu, Q, start, Dn)
+        _propagate(lu, lxk, stk, mu, Q, start, Dn, nfix)
         D = Dn
         for c in range(dt):
             start[c] = end[c]
 
 
-def dlft_jacobian(lam_u, lam_x, state, mu, P, Q, x_start=None, tol=1e-12, max_sweeps=200):
+def dlft_jacobian(lam_u, lam_x, state, mu, P, Q, x_start=None, tol=1e-12, max_sweeps=200,
+                  normal=None):
     """Derivative ``G = d lambda_x~ / d lambda_u~`` per node (nc, d*H, d*H); see
     :func:`_dlft_jacobian`. ``x_start`` (nc, d-1) are the stick anchors ``eps X_a`` given to
-    :func:`dlft_time` (default zero), ``tol`` and ``max_sweeps`` its periodicity settings."""
+    :func:`dlft_time` (default zero), ``tol``, ``max_sweeps`` and ``normal`` (prescribed
+    normal forces) its settings."""
     nc, d, _ = lam_u.shape
     if x_start is None:
         x_start = np.zeros((nc, d - 1))
     return _dlft_jacobian(lam_u, lam_x, state, mu, P, Q, np.ascontiguousarray(x_start, float),
-                          float(tol), int(max_sweeps))
+                          float(tol), int(max_sweeps), _normal(normal, lam_u))
 
 
 @njit(cache=True)
-def slip_derivative_step(lu, lx, n, m, mu, Q, A0, S, that, B, tmpA, tmpS):
+def slip_derivative_step(lu, lx, n, m, mu, Q, A0, S, that, B, tmpA, tmpS, pfix):
     """Advance the derivative of the recursion over a *slip* instant ``n`` (previous ``m``).
 
     ``A0`` (d, dH) holds ``d lambda_x(n-1) / d lambda_u~`` (seed-free part) and ``S`` (d, d-1)
@@ -254,13 +280,18 @@ def slip_derivative_step(lu, lx, n, m, mu, Q, A0, S, that, B, tmpA, tmpS):
     ``A0_T(n) = (I - B) e_T phi(n) - mu t e_N phi(n) + B A0_T(n-1)``, ``S_T(n) = B S_T(n-1)``,
     ``A0_N = S_N = 0``. ``lu``, ``lx`` are the node's (d, N) samples; ``that`` (d-1,),
     ``B`` (d-1, d-1), ``tmpA`` (d-1, dH), ``tmpS`` (d-1, d-1) are work arrays (``that`` is
-    left holding the slip direction).
+    left holding the slip direction). ``pfix``: the prescribed normal force at ``n`` [N], or
+    NaN for a unilateral contact; when prescribed the threshold ``mu pfix`` does not depend on
+    ``lambda_u`` (no ``- mu t e_N`` term) and ``lambda_x,N = lambda_u,N - pfix`` gives
+    ``A0_N = e_N phi(n)``.
     """
     d = lu.shape[0]
     dt = d - 1
     H = Q.shape[1]
     dH = d * H
-    pn = lu[0, n]
+    fixed = not np.isnan(pfix)
+    pn = pfix if fixed else lu[0, n]
+    dcap = 0.0 if fixed else mu
     # on the cone lam_T(n) = lam_u,T(n) - lam_x,T(n) = mu pn t^: gives the direction t^
     nrm2 = 0.0
     for c in range(dt):
@@ -296,15 +327,18 @@ def slip_derivative_step(lu, lx, n, m, mu, Q, A0, S, that, B, tmpA, tmpS):
             qh = Q[n, h]
             for b in range(dt):
                 A0[1 + a, (1 + b) * H + h] += ((1.0 if a == b else 0.0) - B[a, b]) * qh
-            A0[1 + a, h] += -mu * that[a] * qh
+            A0[1 + a, h] += -dcap * that[a] * qh
         for j in range(dt):
             S[1 + a, j] = tmpS[a, j]
     A0[0, :] = 0.0
     S[0, :] = 0.0
+    if fixed:
+        for h in range(H):
+            A0[0, h] = Q[n, h]
 
 
 @njit(cache=True)
-def _dlft_jacobian(lam_u, lam_x, state, mu, P, Q, x_start, tol, max_sweeps):
+def _dlft_jacobian(lam_u, lam_x, state, mu, P, Q, x_start, tol, max_sweeps, normal):
     """Derivative ``G = d lambda_x~ / d lambda_u~`` per node (nc, d*H, d*H).
 
     Rows and columns are ordered ``c*H + h`` (component ``c`` of the node, real Fourier
@@ -333,6 +367,7 @@ def _dlft_jacobian(lam_u, lam_x, state, mu, P, Q, x_start, tol, max_sweeps):
         PS[:, :] = 0.0
         all_stick = True
         Gp = G[p]
+        fixed = not np.isnan(normal[p, 0])
         for n in range(N):
             st = state[p, n]
             if st == SEPARATION:
@@ -345,10 +380,13 @@ def _dlft_jacobian(lam_u, lam_x, state, mu, P, Q, x_start, tol, max_sweeps):
             elif st == STICK:
                 A0[0, :] = 0.0
                 S[0, :] = 0.0
+                if fixed:  # lambda_x,N = lambda_u,N - N(t)
+                    for h in range(H):
+                        A0[0, h] = Q[n, h]
             else:
                 all_stick = False
                 slip_derivative_step(lam_u[p], lam_x[p], n, n - 1 if n > 0 else N - 1, mu[p],
-                                     Q, A0, S, that, B, tmpA, tmpS)
+                                     Q, A0, S, that, B, tmpA, tmpS, normal[p, n])
             # accumulate the DFT of the derivative
             for c in range(d):
                 for h in range(H):
@@ -370,7 +408,8 @@ def _dlft_jacobian(lam_u, lam_x, state, mu, P, Q, x_start, tol, max_sweeps):
         else:
             # not an isolated fixed point (all stick, or touching the cone without slipping):
             # the result depends on the passes made from x_start; differentiate them
-            seed = _start_derivative(lam_u[p], mu[p], Q, x_start[p].copy(), tol, max_sweeps)
+            seed = _start_derivative(lam_u[p], mu[p], Q, x_start[p].copy(), tol, max_sweeps,
+                                         normal[p])
         for row in range(dH):
             for j in range(dH):
                 acc = 0.0

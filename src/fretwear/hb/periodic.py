@@ -14,6 +14,7 @@ block-diagonal per node.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass, field
 
@@ -21,6 +22,7 @@ import numpy as np
 
 from fretwear.errors import InputError
 from fretwear.hb import contact as law
+from fretwear.hb.connectors import Connected, connect, node_displacements
 from fretwear.hb.fourier import FourierBasis, amplitude
 from fretwear.hb.krylov import HarmonicBlocks, KrylovJacobian
 from fretwear.hb.penalty import penalty
@@ -54,6 +56,11 @@ class DLFTProblem:
     jacobian : how the Newton step is computed (:data:`JACOBIANS`): ``"auto"`` (default)
         forms the Jacobian up to :data:`DENSE_JACOBIAN_MAX` unknowns and uses it as an
         operator (GMRES with per-harmonic factorisations) above.
+
+    Contact springs of the interface (``contact.kn``, ``contact.kt``) are applied to
+    ``reduced`` here (:func:`fretwear.hb.connectors.connect`): the unknowns are then the
+    contact points in series with the springs. Nodes with a prescribed normal load
+    (``contact.normal_load``) take ``lambda_N = N(t)`` and the slip threshold ``mu N(t)``.
     """
 
     def __init__(self, reduced: Reduced, contact: ContactInterface, basis: FourierBasis,
@@ -66,7 +73,9 @@ class DLFTProblem:
         exp = np.array([0, *basis.harmonics])
         if not np.array_equal(np.asarray(reduced.orders), exp):
             raise InputError(f"reduced model orders {list(reduced.orders)} != basis {list(exp)}")
+        reduced = connect(reduced, contact)
         self.reduced = reduced
+        self.contact = contact
         self.blocks = HarmonicBlocks(reduced.Z)
         self._Z = None
         if jacobian not in JACOBIANS:
@@ -75,8 +84,9 @@ class DLFTProblem:
             jacobian = "dense" if self.m * self.H <= DENSE_JACOBIAN_MAX else "krylov"
         self.jacobian = jacobian
         self.F = loads_to_real(reduced.F)
-        self.eps = penalty(eps, reduced=reduced)
+        self.eps = penalty(eps, reduced=reduced, contact=contact)
         self.mu = contact.mu_nodes()
+        self.normal = contact.normal_force_samples(basis.tau)  # None: all unilateral
         self.set_gap(contact.gap if gap is None else gap)
         self.anchor = np.zeros((nc, d - 1)) if anchor is None else np.array(anchor, float)
         self.P = basis.forward_matrix()
@@ -84,6 +94,12 @@ class DLFTProblem:
         self.tol = periodicity_tol
         self.max_sweeps = max_sweeps
         self.nfev = 0
+
+    def with_eps(self, eps: float) -> DLFTProblem:
+        """The same problem (reduced model, gap, anchors) with the penalty ``eps`` [N/m]."""
+        return DLFTProblem(self.reduced, self.contact, self.basis, gap=self.gap, eps=eps,
+                           anchor=self.anchor, periodicity_tol=self.tol,
+                           max_sweeps=self.max_sweeps, jacobian=self.jacobian)
 
     def set_gap(self, gap):
         gap = np.broadcast_to(np.asarray(gap, dtype=float), (self.nc,))
@@ -119,7 +135,7 @@ class DLFTProblem:
         lu = self.basis.to_time(self.lambda_u(U)).reshape(self.nc, self.d, -1)
         lu = np.ascontiguousarray(lu)
         lx, state, sweeps = law.dlft_time(lu, self.mu, self.eps * self.anchor, self.tol,
-                                          self.max_sweeps)
+                                          self.max_sweeps, self.normal)
         return lu, lx, state, sweeps
 
     def residual(self, U, jacobian=True):
@@ -131,7 +147,7 @@ class DLFTProblem:
         if not jacobian:
             return f, None
         G = law.dlft_jacobian(lu, lx, state, self.mu, self.P, self.Q, self.eps * self.anchor,
-                              self.tol, self.max_sweeps)
+                              self.tol, self.max_sweeps, self.normal)
         if self.jacobian == "krylov":
             return f, KrylovJacobian(G, self.blocks, self.eps, self.d, owner=self)
         n = self.m * self.H
@@ -192,6 +208,10 @@ class PeriodicSolution:
     area : (nc,) tributary areas [m^2].
     stats : solver statistics (:class:`~fretwear.hb.solvers.SolveStats`).
     flags : reasons for caution (e.g. time-domain findings of a sweep's stability check).
+    U_node : (nc, d, H) displacement harmonics of the structure's contact nodes [m] when the
+        interface has contact springs (``U`` is then the contact points'); None otherwise.
+    attempts : the attempts of the solve strategy, in order (:class:`Attempt`; the last one
+        gave this solution).
     """
 
     frequency: float
@@ -212,6 +232,8 @@ class PeriodicSolution:
     coords: np.ndarray
     stats: SolveStats
     flags: list = field(default_factory=list)
+    U_node: np.ndarray | None = None
+    attempts: list = field(default_factory=list)
 
     @property
     def success(self) -> bool:
@@ -309,6 +331,141 @@ class PeriodicSolution:
         return stops
 
 
+@dataclass
+class Attempt:
+    """One attempt of a periodic solve (:func:`solve_strategy`, the sweeps).
+
+    method : what was tried: ``"start"`` (the solver from the given start), ``"best-point"``
+        (the other solver from the best iterate so far), ``"eps-continuation"`` (converged at
+        another penalty, then stepped back to the target one: the answer is at the target
+        eps), ``"harmonic-continuation"`` (the first harmonic alone, then all of them),
+        ``"time-start"`` (from a time integration), and for sweeps ``"grid"``, ``"substep"``,
+        ``"retry"``, ``"arclength"``.
+    solver : the nonlinear solver; eps : the penalty of the answer [N/m]; success, residual
+    (relative), iterations, wall_time [s], message : as :class:`~fretwear.hb.solvers.SolveStats`.
+    """
+
+    method: str
+    solver: str
+    eps: float
+    success: bool
+    residual: float
+    iterations: int
+    wall_time: float
+    message: str
+
+    @classmethod
+    def of(cls, method: str, eps: float, st: SolveStats, message: str | None = None):
+        return cls(method, st.solver, float(eps), bool(st.success), float(st.residual),
+                   int(st.iterations), float(st.wall_time),
+                   st.message if message is None else message)
+
+
+#: the attempts of :func:`solve_strategy`, in order
+STRATEGY = ("start", "best-point", "eps-continuation", "harmonic-continuation")
+#: penalties tried by the eps continuation, as factors of the target eps, and the number of
+#: geometric steps back to the target
+EPS_FACTORS = (10.0, 0.1)
+EPS_STEPS = 4
+
+
+def _run(prob: DLFTProblem, x0, solver, tol, max_iter):
+    """One solver run on ``prob`` from ``x0`` (m, H): ``(x (m, H), stats)``."""
+
+    def fun(x, jac=True):
+        return prob.residual(x.reshape(prob.m, prob.H), jac)
+
+    t0 = time.perf_counter()
+    x, _, st = solve(fun, np.asarray(x0, float).reshape(-1),
+                     lambda x: prob.scale(x.reshape(prob.m, prob.H)), method=solver, tol=tol,
+                     max_iter=max_iter)
+    st.wall_time = time.perf_counter() - t0
+    return x.reshape(prob.m, prob.H), st
+
+
+def solve_strategy(prob: DLFTProblem, x0, *, solver="powell", tol=1e-8, max_iter=200,
+                   attempts: list | None = None, steps=STRATEGY):
+    """Solve the balance of ``prob`` from ``x0`` (m, H), trying in order until one converges
+    (``steps``, a subset of :data:`STRATEGY`):
+
+    1. ``"start"``: ``solver`` from ``x0``;
+    2. ``"best-point"``: the other solver (Newton after Powell, Powell after Newton or hybr)
+       from the best iterate so far (Newton converges where Powell's trust region stalls, and
+       the reverse, on the paper's beam);
+    3. ``"eps-continuation"``: the balance at ``10 eps`` (then ``eps / 10``) from ``x0`` (the
+       solver, then the other one), and
+       from there :data:`EPS_STEPS` geometric steps back to ``eps``, each starting from the
+       previous answer: the answer is that of the target eps (no eps jump);
+    4. ``"harmonic-continuation"``: the first harmonic alone from the contact-closed guess,
+       then all harmonics from it.
+
+    Every attempt is appended to ``attempts`` (:class:`Attempt`). Returns ``(x, stats)``: the
+    converged answer, or the iterate with the smallest residual when none converged.
+    """
+    attempts = [] if attempts is None else attempts
+    other = "newton" if solver != "newton" else "powell"
+    best = None
+
+    def keep(x, st):
+        nonlocal best
+        if best is None or st.success or st.residual < best[1].residual:
+            best = (x, st)
+        return st.success
+
+    x0 = np.asarray(x0, float).reshape(prob.m, prob.H)
+    if "start" in steps:
+        x, st = _run(prob, x0, solver, tol, max_iter)
+        attempts.append(Attempt.of("start", prob.eps, st))
+        if keep(x, st):
+            return best
+    if "best-point" in steps:
+        start = x0 if best is None else best[0]
+        x, st = _run(prob, start, other, tol, max_iter)
+        attempts.append(Attempt.of("best-point", prob.eps, st))
+        if keep(x, st):
+            return best
+    if "eps-continuation" in steps:
+        for factor in EPS_FACTORS:
+            t0 = time.perf_counter()
+            shifted = prob.with_eps(factor * prob.eps)
+            x, st = _run(shifted, x0, solver, tol, max_iter)
+            if not st.success:  # the other solver at the shifted eps
+                x, st = _run(shifted, x0, other, tol, max_iter)
+            path = [factor * prob.eps]
+            if st.success:
+                for e in np.geomspace(factor * prob.eps, prob.eps, EPS_STEPS + 1)[1:]:
+                    x, st = _run(prob.with_eps(float(e)) if e != prob.eps else prob, x,
+                                 solver, tol, max_iter)
+                    path.append(float(e))
+                    if not st.success:
+                        break
+            st.wall_time = time.perf_counter() - t0
+            msg = (f"{st.message} (eps path {', '.join(f'{e:.3g}' for e in path)} N/m)")
+            attempts.append(Attempt.of("eps-continuation", prob.eps if st.success else
+                                       path[-1], st, msg))
+            if st.success and path[-1] == prob.eps:
+                keep(x, st)
+                return best
+    if "harmonic-continuation" in steps and prob.basis.k > 1:
+        t0 = time.perf_counter()
+        U1 = _first_harmonic_start(prob, solver, tol, max_iter)
+        if U1 is not None:
+            x, st = _run(prob, U1, solver, tol, max_iter)
+            st.wall_time = time.perf_counter() - t0
+            attempts.append(Attempt.of("harmonic-continuation", prob.eps, st))
+            if keep(x, st):
+                return best
+        else:
+            attempts.append(Attempt("harmonic-continuation", solver, prob.eps, False,
+                                    float("nan"), 0, time.perf_counter() - t0,
+                                    "the first harmonic alone did not converge"))
+    if best is None:  # nothing ran at the target eps: the start, unconverged
+        tried = ", ".join(a.method for a in attempts) or "none"
+        best = (x0, SolveStats(False, float("inf"), 0, 0, 0, 0.0,
+                               f"no attempt converged ({tried})", solver))
+    return best
+
+
 def _orders(basis):
     return np.array([0, *basis.harmonics], dtype=np.int64)
 
@@ -394,7 +551,7 @@ def static_anchor(model: Model, *, quasi: Reduced | None = None, eps="auto") -> 
 def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
                    quasi_static: bool = False, reduced: Reduced | None = None, gap=None,
                    eps="auto", anchor=None, U0=None, solver="powell", tol=1e-8, max_iter=200,
-                   raise_on_failure=False) -> PeriodicSolution:
+                   raise_on_failure=False, strategy=STRATEGY) -> PeriodicSolution:
     """Periodic response of ``model`` at the excitation ``frequency`` [Hz] with the DLFT
     (section 3.1-3.2).
 
@@ -417,6 +574,9 @@ def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
 
     raise_on_failure : raise :class:`~fretwear.errors.ConvergenceError` when the solve does
         not converge instead of returning a solution with ``success`` False.
+    strategy : the attempts made until one converges (:func:`solve_strategy`; default all of
+        :data:`STRATEGY`; ``("start",)``: the solver alone). Each is recorded in the result's
+        ``attempts``.
 
     Returns
     -------
@@ -428,6 +588,7 @@ def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
                              anchor=anchor, U0=U0)
     if reduced is None:
         reduced = condense(model, frequency, _orders(basis), quasi_static=quasi_static)
+    reduced = connect(reduced, model.contact)
     eps = penalty(eps, model=model, reduced=reduced)
     if anchor is None:
         anchor = static_anchor(model)
@@ -435,22 +596,22 @@ def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
     if U0 is None and basis.k > 3:
         U0 = _harmonic_continuation_start(model, basis, reduced, prob, solver, tol, max_iter)
     x0 = (prob.initial_guess() if U0 is None else np.asarray(U0, float).reshape(prob.m, prob.H))
-
-    def fun(x, jac=True):
-        return prob.residual(x.reshape(prob.m, prob.H), jac)
-
+    attempts: list = []
     t0 = time.perf_counter()
-    x, _, st = solve(fun, x0.reshape(-1), lambda x: prob.scale(x.reshape(prob.m, prob.H)),
-                     method=solver, tol=tol, max_iter=max_iter)
+    x, st = solve_strategy(prob, x0, solver=solver, tol=tol, max_iter=max_iter,
+                           attempts=attempts, steps=strategy)
     st.wall_time = time.perf_counter() - t0
     if not st.success and raise_on_failure:
         from fretwear.errors import ConvergenceError
 
         raise ConvergenceError(
             f"periodic solve at f = {reduced.frequency:.6g} Hz did not converge: "
-            f"{st.message} (relative residual {st.residual:.3g} > {tol:g})"
+            f"{st.message} (relative residual {st.residual:.3g} > {tol:g}; "
+            f"{len(attempts)} attempts: {', '.join(a.method for a in attempts)})"
         )
-    return assemble_solution(prob, x.reshape(prob.m, prob.H), model, st)
+    sol = assemble_solution(prob, x.reshape(prob.m, prob.H), model, st)
+    sol.attempts = attempts
+    return sol
 
 
 def _harmonic_continuation_start(model, basis, reduced, prob, solver, tol, max_iter):
@@ -458,11 +619,18 @@ def _harmonic_continuation_start(model, basis, reduced, prob, solver, tol, max_i
     embedded in the full basis (None if that fails). From the contact-closed guess, the
     solvers can stall with 15+ harmonics where the one-harmonic problem converges and then
     starts the full one within a few iterations (docs/verification.md)."""
+    return _first_harmonic_start(prob, solver, tol, max_iter)
+
+
+def _first_harmonic_start(prob, solver, tol, max_iter):
+    """:func:`_harmonic_continuation_start` from the problem alone."""
+    basis, reduced = prob.basis, prob.reduced
     sub = FourierBasis(basis.harmonics[:1], basis.n_samples)
-    red = Reduced(reduced.omega, reduced.orders[:2], reduced.Z[:2], reduced.F[:2],
-                  reduced.obs_A[:2], reduced.obs_b[:2], reduced.obs_dofs, reduced.quasi_static,
-                  reduced.frequency)
-    p1 = DLFTProblem(red, model.contact, sub, gap=prob.gap, eps=prob.eps, anchor=prob.anchor)
+    cut = {k: getattr(reduced, k)[:2] for k in ("orders", "Z", "F", "obs_A", "obs_b")}
+    if isinstance(reduced, Connected):  # already seen through the contact springs
+        cut.update(node_A=reduced.node_A[:2], node_b=reduced.node_b[:2])
+    red = dataclasses.replace(reduced, **cut)
+    p1 = DLFTProblem(red, prob.contact, sub, gap=prob.gap, eps=prob.eps, anchor=prob.anchor)
 
     def fun(x, jac=True):
         return p1.residual(x.reshape(p1.m, p1.H), jac)
@@ -495,6 +663,9 @@ def assemble_solution(prob: DLFTProblem, U, model: Model, stats: SolveStats) -> 
     x_t[:, 0, :] += prob.gap[:, None]
     red = prob.reduced
     observed = {}
+    U_node = None
+    if isinstance(red, Connected):
+        U_node = b.from_complex(node_displacements(red, b.to_complex(U))).reshape(nc, d, H)
     if red.obs_dofs.size:
         Uc = b.to_complex(U)  # (k+1, m) complex
         Uo = np.einsum("bom,bm->bo", red.obs_A, Uc) + red.obs_b
@@ -510,7 +681,7 @@ def assemble_solution(prob: DLFTProblem, U, model: Model, stats: SolveStats) -> 
         lam=lam, X=X, lam_t=lam_t, x_t=x_t, state=state, gap=prob.gap.copy(),
         anchor=prob.anchor.copy(), eps=prob.eps, observed=observed,
         area=np.asarray(model.contact.area, float), coords=np.asarray(model.contact.coords),
-        stats=stats,
+        stats=stats, U_node=U_node,
     )
 
 
@@ -518,7 +689,8 @@ def initial_state(model: Model, sol: PeriodicSolution):
     """Full-field displacement [m] and velocity [m/s] at ``t = 0`` of a periodic solution."""
     b = sol.basis
     m = sol.U.shape[0] * sol.U.shape[1]
-    Uc = b.to_complex(sol.U.reshape(m, -1))  # (k+1, m) complex amplitudes
+    U = sol.U if sol.U_node is None else sol.U_node  # the structure's contact nodes
+    Uc = b.to_complex(U.reshape(m, -1))  # (k+1, m) complex amplitudes
     orders = np.array([0, *b.harmonics])
     Ufull = _recover(model, sol.omega, orders, Uc, quasi_static=sol.quasi_static)
     U0 = Ufull.real.sum(axis=0)

@@ -26,12 +26,14 @@ from fretwear.errors import InputError
 from fretwear.files import check_state_file
 from fretwear.hb.fallback import TimeDomainFallback
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.penalty import check_rule, penalty
+from fretwear.hb.penalty import sweep_penalty
 from fretwear.hb.periodic import (
+    Attempt,
     DLFTProblem,
     PeriodicSolution,
     assemble_solution,
     check_inputs,
+    solve_strategy,
     static_anchor,
 )
 from fretwear.hb.reduce import _condense
@@ -54,7 +56,9 @@ class SweepPoint:
     frequency_hz : the frequency [Hz]; solution : the converged periodic solution, or None
     when the solve did not converge (a failed solve is never kept as a solution); stats :
     solver statistics of the last solve; how : ``"grid"``, ``"substep"``, ``"retry"``,
-    ``"arclength"``, ``"eps-x10"`` or ``"time-start"``; flags : reasons for caution
+    ``"arclength"``, ``"eps-continuation"``, ``"harmonic-continuation"`` or
+    ``"time-start"``; attempts : every attempt made at this frequency, in order
+    (:class:`~fretwear.hb.periodic.Attempt`); flags : reasons for caution
     (``"not converged: ..."``, time-domain findings); on_grid : a requested grid frequency
     (False for the intermediate points the sweep added); time_domain : what the time
     integration found at a point whose balance failed (``""`` when none ran).
@@ -67,6 +71,7 @@ class SweepPoint:
     flags: list = field(default_factory=list)
     on_grid: bool = False
     time_domain: str = ""
+    attempts: list = field(default_factory=list)
 
     @property
     def success(self) -> bool:
@@ -206,8 +211,12 @@ def rebuild_point(model: Model, basis: FourierBasis, gap, entry: dict) -> SweepP
         prob = DLFTProblem(_condense(model, entry["omega"], orders), model.contact, basis,
                            gap=gap, eps=entry["eps"], anchor=entry["anchor"])
         sol = assemble_solution(prob, np.array(entry["U"], float), model, stats)
-    return SweepPoint(rec["frequency_hz"], sol, stats, rec["how"], list(rec["flags"]),
-                      bool(rec["on_grid"]), rec["time_domain"])
+    pt = SweepPoint(rec["frequency_hz"], sol, stats, rec["how"], list(rec["flags"]),
+                    bool(rec["on_grid"]), rec["time_domain"],
+                    [Attempt(**a) for a in rec.get("attempts", [])])
+    if sol is not None:
+        sol.attempts = pt.attempts
+    return pt
 
 
 def _solve_at(probs, omega, anchor, U0, solver, tol, max_iter):
@@ -297,7 +306,7 @@ def _arclength(probs, model, anchor, y_prev, y_last, omega_target, solver_tol, m
 
 
 def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_points: int, *,
-          spacing: str = "log", gap=None, eps="static", anchor=None, solver: str = "powell",
+          spacing: str = "log", gap=None, eps="top", anchor=None, solver: str = "powell",
           tol: float = 1e-8, max_iter: int = 40, continuation: bool = True,
           max_bisections: int = 4, check=None,
           time_domain: TimeDomainFallback | None = None,
@@ -310,16 +319,15 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
     model, basis : the structure and the Fourier basis.
     n_points, spacing : the frequency grid (``"log"`` or ``"linear"``).
     gap : (nc,) gap + wear [m] (a worn interface); default the model's initial gap.
-    eps : DLFT penalty (:func:`fretwear.hb.penalty.penalty`). Default ``"static"``: the
-        spectral radius of the static reduced stiffness ``Z_r(0) = K_r``, the same at every
-        frequency. ``"auto"``: the spectral radius of ``Z_r``
-        over the kept harmonics at each frequency (the paper's rule applied point by point).
-        A positive number [N/m]: that penalty everywhere. Why the default differs: the
-        harmonics of ``Z_r(n w)`` have poles at the clamped-interface resonances, so its
-        spectral radius jumps by orders of magnitude between neighbouring frequencies (x30
-        between 21.1 and 21.4 kHz on the paper's beam); with 7 harmonics the solution depends
-        measurably on eps, so a per-frequency eps makes the FRF jagged and the continuation
-        lose its way (docs/theory.md, "The penalty eps").
+    eps : DLFT penalty (:func:`fretwear.hb.penalty.sweep_penalty`), one value for every
+        point. Default ``"top"``: the spectral radius of ``Z_r`` at the highest kept harmonic,
+        its median over the band. ``"static"``: the spectral radius of the static reduced
+        stiffness ``Z_r(0) = K_r``. ``"auto"``: the spectral radius of ``Z_r`` over the kept
+        harmonics at each frequency (the paper's rule applied point by point; kept for
+        comparison: the harmonics of ``Z_r(n w)`` have poles at the clamped-interface
+        resonances, so it jumps by orders of magnitude between neighbouring frequencies, and
+        with 7 harmonics the solution depends measurably on eps, so the FRF is jagged).
+        A positive number [N/m]: that penalty everywhere (docs/theory.md, "The penalty eps").
     anchor : stick anchors of the first point (default: static preload state).
     solver, tol, max_iter : nonlinear solver settings (:func:`fretwear.hb.solvers.solve`).
     continuation : use pseudo-arclength continuation when a grid step fails.
@@ -329,8 +337,9 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
         time-domain stability check of :mod:`fretwear.timedomain.stability`).
     time_domain : a :class:`~fretwear.hb.fallback.TimeDomainFallback` (e.g.
         :data:`fretwear.timedomain.fallback.FALLBACK`; ``None``: none). At a point that still
-        did not converge, integrate in time from the neighbour: if the structure settles to a
-        periodic
+        did not converge, integrate in time from the neighbour (not with contact springs or
+        prescribed normal loads, which the time-domain solver does not model): if the
+        structure settles to a periodic
         state, its harmonics and mean positions start one more solve (``how = "time-start"``);
         otherwise the point is flagged with what the structure does there (drifting,
         quasi-periodic...).
@@ -352,9 +361,9 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
     t_start = time.perf_counter()
     grid = frequency_grid(f_min, f_max, n_points, spacing)
     check_inputs(model, basis, f_min, anchor=anchor)
-    eps = check_rule(eps)
-    if eps != "auto":
-        eps = penalty(eps, model=model)
+    if model.contact.has_connectors:  # the time-domain solver has rigid contacts only
+        time_domain = None
+    eps = sweep_penalty(eps, model, [0, *basis.harmonics], f_min, f_max, spacing=spacing)
     probs = _Problems(model, basis, gap, eps)
     if anchor is None:
         anchor = static_anchor(model)
@@ -414,6 +423,7 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
         prob, U, st = _solve_at(probs, omega, current_anchor(), predict(omega), solver, tol,
                                 max_iter)
         how = "grid"
+        tried = [Attempt.of("grid", prob.eps, st)]
         if not st.success and history:
             # adaptive step from the last converged point: halve on failure, grow on success
             w_cur = history[-1][0]
@@ -433,6 +443,7 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
                     continue
                 if last:
                     prob, U, st, how = pb, Ub, stb, "substep"
+                    tried.append(Attempt.of("substep", pb.eps, stb))
                     break
                 points.append(record(w_try, pb, Ub, stb, "substep"))
                 w_cur = w_try
@@ -443,6 +454,7 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
             prob, U, st = _solve_at(probs, omega, current_anchor(), history[-1][1], other, tol,
                                     max_iter)
             how = "retry"
+            tried.append(Attempt.of("retry", prob.eps, st))
         if not st.success and continuation and len(history) >= 2:
             anc = current_anchor()
             branch = _arclength(probs, model, anc, (history[-2][1].reshape(-1), history[-2][0]),
@@ -454,16 +466,19 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
                 prob, U, st = _solve_at(probs, omega, current_anchor(), history[-1][1], solver,
                                         tol, max_iter)
                 how = "arclength"
-        if not st.success and probs.eps != "auto":
-            # a larger penalty often converges where the default stalls (measured at 79 kHz
-            # on the paper's beam); the solution differs by the eps-dependence of the
-            # truncated balance, which the point records (its DLFTProblem's eps)
-            big = _Problems(model, basis, gap, 10.0 * probs.eps)
-            start = history[-1][1] if history else None
-            pb, Ub, stb = _solve_at(big, omega, current_anchor(), start, "newton", tol,
-                                    2 * max_iter)
+                tried.append(Attempt.of("arclength", prob.eps, st))
+        if not st.success:
+            # continuation in eps (ending at the sweep's eps: no jump), then in harmonics
+            pb = probs.get(omega, current_anchor())
+            start = history[-1][1] if history else pb.initial_guess()
+            n0 = len(tried)
+            Ub, stb = solve_strategy(pb, start, solver=solver, tol=tol, max_iter=max_iter,
+                                     attempts=tried,
+                                     steps=("eps-continuation", "harmonic-continuation"))
             if stb.success:
-                prob, U, st, how = pb, Ub, stb, "eps-x10"
+                prob, U, st, how = pb, Ub, stb, tried[-1].method
+            elif len(tried) > n0:
+                st = stb
         td_msg = None
         if not st.success and time_domain is not None:
             td_msg, Ut, anc_t = time_domain.start(model, f, basis, last_solution[0],
@@ -472,16 +487,20 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
                 prob, U, st = _solve_at(probs, omega, anc_t, Ut.reshape(-1, basis.size),
                                         solver, tol, 2 * max_iter)
                 how = "time-start"
+                tried.append(Attempt.of("time-start", prob.eps, st))
         if st.success:
             pt = record(omega, prob, U, st, how)
             pt.on_grid = True
+            pt.solution.attempts = tried
         else:
             pt = SweepPoint(f, None, st, how, [f"not converged: {st.message} "
-                                                f"(relative residual {st.residual:.2e})"])
+                                                f"(relative residual {st.residual:.2e}; "
+                                                f"{len(tried)} attempts)"])
             pt.on_grid = True
             if td_msg is not None:
                 pt.flags.append(td_msg)
                 pt.time_domain = td_msg
+        pt.attempts = tried
         points.append(pt)
         if key is not None:
             save_sweep_checkpoint(checkpoint, key, i + 1, points, shape)

@@ -97,7 +97,8 @@ def save_sweep_checkpoint(path: Path | str, key: str, next_index: int, points: l
             U[i], anchor[i], omega[i], eps[i] = s.U.reshape(nc * d, H), s.anchor, s.omega, s.eps
         records.append({"frequency_hz": pt.frequency_hz, "how": pt.how, "flags": pt.flags,
                         "on_grid": pt.on_grid, "time_domain": pt.time_domain,
-                        "stats": dataclasses.asdict(pt.stats)})
+                        "stats": dataclasses.asdict(pt.stats),
+                        "attempts": [dataclasses.asdict(a) for a in pt.attempts]})
     arrays = {"U": U, "anchor": anchor, "omega": omega, "eps": eps, "converged": conv,
               "next_index": np.asarray(int(next_index)), "fingerprint": np.asarray(key),
               "records": np.asarray(json.dumps(records)),

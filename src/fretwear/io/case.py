@@ -16,6 +16,7 @@ The documentation ``docs/case-files.md`` is generated from these schemas
 
 from __future__ import annotations
 
+import math
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -90,6 +91,11 @@ _LOAD_NAME = Field(Text(), "label used in output")
 _MU = Field(_NON_NEG, "Coulomb friction coefficient", required=True, unit="-")
 _WEAR = Field(_NON_NEG, "Archard wear coefficient k_w (paper eq. 29)", default=0.0, unit="1/Pa")
 _CONTACT_NAME = Field(Text(), "label of the interface in output", default="contact")
+_CONTACT_K = Number(lo=0, lo_open=True, hi=1e20, allow_inf=True)
+_NORMAL_WAVEFORM = Field(Text(tuple(w for w in WAVEFORMS if w != "fourier")),
+                         "time history g(omega t) of the prescribed normal load"
+                         ' (as loads\' `waveform`; "fourier" is not offered here)',
+                         default="constant")
 _THICKNESS = Field(
     _POSITIVE,
     "out-of-plane width of a 2D (plane strain) model; the default 1 m gives results per metre "
@@ -251,6 +257,18 @@ CONTACT_MESH = Table(
         "partner_wear_coefficient": Field(_NON_NEG, "Archard wear coefficient of the "
                                           "partner's surface (the gap opens by the sum of both "
                                           "worn depths; default 0)", unit="1/Pa"),
+        "normal_stiffness": Field(_CONTACT_K, "normal contact stiffness per unit area, in "
+                                  "series with the contact law (a property of the interface, "
+                                  "not a regularisation; inf: rigid)", default=math.inf,
+                                  unit="Pa/m"),
+        "tangential_stiffness": Field(_CONTACT_K, "tangential contact stiffness per unit area "
+                                      "(a finite value makes each node a Jenkins element; "
+                                      "inf: rigid)", default=math.inf, unit="Pa/m"),
+        "normal_pressure": Field(Number(), "friction under a prescribed normal load: the "
+                                 "normal pressure p (each node carries p x its area x "
+                                 "g(omega t), whatever its normal motion; slip threshold mu "
+                                 "times that); absent: unilateral contact", unit="Pa"),
+        "normal_waveform": _NORMAL_WAVEFORM,
     },
     checks=(non_zero("normal", "tangent"),
             requires("partner_wear_coefficient", "partner"),
@@ -262,6 +280,14 @@ CONTACT_MESH = Table(
 OBSERVED_MESH = Dict(AnyOf((Vector(), Text())), key_doc="point names")
 
 # --- matrices models ------------------------------------------------------------------
+def _normal_dofs_or_load(out: dict, path: str) -> None:
+    """Rule: ``normal_dofs`` is given unless ``normal_load`` is (friction under a known load)."""
+    if "normal_dofs" not in out and "normal_load" not in out:
+        raise InputError(f"{table_label(path)}: missing 'normal_dofs' (the normal DOF of each "
+                         "contact node; or give normal_load for nodes without one)")
+
+
+
 _DOFS_OR_FILE = AnyOf((ListOf(_DOF, non_empty=True, unique=True), FilePath()))
 LOAD_MATRICES = Table(
     {
@@ -277,7 +303,8 @@ LOAD_MATRICES = Table(
 CONTACT_MATRICES = Table(
     {
         "normal_dofs": Field(_DOFS_OR_FILE, "normal DOF of each contact node (or a text file "
-                             "of them)", required=True),
+                             "of them); required unless `normal_load` is given (nodes without "
+                             "a normal DOF rub under that load)"),
         "tangential_dofs": Field(
             AnyOf((ListOf(AnyOf((_DOF, ListOf(_DOF, sizes=(2,)))), non_empty=True), FilePath())),
             "tangential DOF of each contact node (2D), or [t1, t2] pairs (3D), or a text file "
@@ -294,7 +321,21 @@ CONTACT_MATRICES = Table(
                              "gap (moves into the obstacle), -1 otherwise", default=1),
         "wear_coefficient": _WEAR,
         "name": _CONTACT_NAME,
+        "kn": Field(AnyOf((_CONTACT_K, ListOf(_CONTACT_K, non_empty=True))),
+                    "normal contact stiffness, one value or one per node, in series with the "
+                    "contact law (inf: rigid)", default=math.inf, unit="N/m"),
+        "kt": Field(AnyOf((_CONTACT_K, ListOf(_CONTACT_K, non_empty=True))),
+                    "tangential contact stiffness, one value or one per node (a finite value "
+                    "makes each node a Jenkins element; inf: rigid)", default=math.inf,
+                    unit="N/m"),
+        "normal_load": Field(AnyOf((Number(), ListOf(Number(), non_empty=True))),
+                             "friction under a prescribed normal load: each node's normal force "
+                             "N, one value or one per node (N x g(omega t), whatever the normal "
+                             "motion; slip threshold mu N); absent: unilateral contact",
+                             unit="N"),
+        "normal_waveform": _NORMAL_WAVEFORM,
     },
+    checks=(_normal_dofs_or_load,),
     doc="The frictional interface: DOFs of the contact nodes against a rigid obstacle.",
 )
 OBSERVED_MATRICES = Dict(AnyOf((_DOF, ListOf(_DOF, non_empty=True))), key_doc="point names")
@@ -604,7 +645,11 @@ def _build_from_mesh(m: dict, title: str, given: Mapping):
                                  wear_coefficient=c["wear_coefficient"],
                                  name=c["name"], partner=c.get("partner"),
                                  tolerance=c.get("tolerance"),
-                                 partner_wear_coefficient=c.get("partner_wear_coefficient", 0.0))
+                                 partner_wear_coefficient=c.get("partner_wear_coefficient", 0.0),
+                                 normal_stiffness=c["normal_stiffness"],
+                                 tangential_stiffness=c["tangential_stiffness"],
+                                 normal_pressure=c.get("normal_pressure"),
+                                 normal_waveform=c["normal_waveform"])
                for c in m["contact"]]
     observed = {k: _at(v) for k, v in m.get("observed", {}).items()} or None
     thickness = m["model"].get("thickness", 1.0) if mesh.dim == 2 else 1.0
@@ -694,7 +739,8 @@ def _build_from_matrices(m: dict, title: str):
         loads.append(Load(vec, ld["waveform"], _coefficients(ld.get("coefficients")).get(
             "coefficients"), ld.get("name") or f"load{i + 1}"))
     c = m["contact"]
-    normal = _read_dofs(c["normal_dofs"], "contact.normal_dofs", base)
+    normal = (_read_dofs(c["normal_dofs"], "contact.normal_dofs", base)
+              if "normal_dofs" in c else None)
     tangential = _read_dofs(c["tangential_dofs"], "contact.tangential_dofs", base)
     observed = {name: _read_dofs(d if isinstance(d, list) else [d], f"observed.{name}",
                                  base).tolist()
@@ -716,7 +762,19 @@ def _build_from_matrices(m: dict, title: str):
         observed=observed or None,
         wear_coefficient=c["wear_coefficient"],
         name=title,
+        normal_load=(None if "normal_load" not in c else
+                     Load(np.broadcast_to(np.asarray(c["normal_load"], float),
+                                          (len(tangential),)).copy(), c["normal_waveform"],
+                          None, "normal load")),
+        kn=_per_node_or_none(c["kn"]),
+        kt=_per_node_or_none(c["kt"]),
     )
+
+
+def _per_node_or_none(value):
+    """A contact stiffness of a case file: None when rigid everywhere (inf), else the value(s)."""
+    a = np.asarray(value, dtype=float)
+    return None if np.all(np.isinf(a)) else a
 
 
 # --- documentation --------------------------------------------------------------------------

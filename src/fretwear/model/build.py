@@ -214,6 +214,12 @@ class ContactSpec:
         size.
     partner_wear_coefficient : Archard coefficient k_w [1/Pa], >= 0, of the partner's
         surface; the gap opens by the sum of the two worn depths.
+    normal_stiffness, tangential_stiffness : contact stiffness per unit area [Pa/m] in series
+        with the contact law (:mod:`fretwear.hb.connectors`); each node gets the value times
+        its area [N/m]. ``inf`` (default): rigid.
+    normal_pressure : friction under a prescribed normal load: the pressure [Pa]; each node
+        carries ``pressure x area x g(omega t)`` (``normal_waveform``) whatever its normal
+        motion. None (default): unilateral contact.
 
     Contact nodes are ordered by increasing coordinate along the tangent (2D) or along
     ``t2`` then ``t1`` (3D) of the boundary's mean frame, so that profiles come out ordered.
@@ -231,6 +237,10 @@ class ContactSpec:
     partner: str | None = None
     tolerance: float | None = None
     partner_wear_coefficient: float = 0.0
+    normal_stiffness: float = np.inf
+    tangential_stiffness: float = np.inf
+    normal_pressure: float | None = None
+    normal_waveform: str = "constant"
 
     def __post_init__(self):
         what = f"contact {self.name!r}"
@@ -601,6 +611,12 @@ def _contact(mesh: Mesh, spec: ContactSpec, thickness: float) -> ContactInterfac
         wear_coefficient=spec.wear_coefficient,
         name=spec.name,
         partner_wear_coefficient=spec.partner_wear_coefficient,
+        normal_load=(None if spec.normal_pressure is None else
+                     Load(float(spec.normal_pressure) * area, spec.normal_waveform, None,
+                          "normal load")),
+        kn=_contact_stiffness(spec.normal_stiffness, area, f"{what}: normal_stiffness"),
+        kt=_contact_stiffness(spec.tangential_stiffness, area,
+                              f"{what}: tangential_stiffness"),
         **partner,
     )
 
@@ -619,6 +635,15 @@ def _node_frame(n: np.ndarray, mean_frame: np.ndarray, tangent, what: str) -> np
         t1 = mean_frame[2] - (mean_frame[2] @ n) * n
     t1 /= np.linalg.norm(t1)
     return np.vstack([n, t1, np.cross(n, t1)]) + 0.0
+
+
+def _contact_stiffness(per_area, area, what: str):
+    """Per-node contact stiffness [N/m] from a stiffness per unit area [Pa/m]; None if rigid."""
+    k = float(per_area)
+    if not k > 0:
+        raise InputError(f"{what} = {per_area!r}: expected a stiffness per area > 0 [Pa/m] "
+                         "(inf: rigid)")
+    return None if math.isinf(k) else k * np.asarray(area, float)
 
 
 def _observed(mesh: Mesh, observed) -> list[ObservedPoint]:

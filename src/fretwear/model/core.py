@@ -142,6 +142,16 @@ class ContactInterface:
     interface : (nc,) int, each node's interface (index into ``interface_names``); None: one
         interface, named ``name``.
     interface_names : the interfaces' names, in the order of their indices.
+    normal_load : friction under a prescribed normal load: a :class:`Load` whose ``vector``
+        (nc,) holds each node's normal force [N] (NaN: that node is in unilateral contact) and
+        whose waveform gives its time history ``N(t) = vector * g(omega t)`` (``"constant"``,
+        ``"cos"``, ``"fourier"``...). On such a node the normal contact force is ``N(t)``
+        whatever the normal displacement, and the slip threshold is ``mu N(t)``
+        (:mod:`fretwear.hb.contact`). None: every node in unilateral contact (default).
+    kn, kt : (nc,) normal and tangential contact stiffness [N/m] per node, a physical property
+        of the interface in series with the contact law (:mod:`fretwear.hb.connectors`):
+        ``inf`` is a rigid contact (default), a finite ``kt`` with a rigid normal is a
+        Jenkins element. None: rigid everywhere.
     """
 
     dofs: np.ndarray
@@ -158,6 +168,9 @@ class ContactInterface:
     partner_wear_coefficient: float | np.ndarray = 0.0
     interface: np.ndarray | None = None
     interface_names: tuple = ()
+    normal_load: Load | None = None
+    kn: np.ndarray | None = None
+    kt: np.ndarray | None = None
 
     @property
     def n_nodes(self) -> int:
@@ -201,6 +214,31 @@ class ContactInterface:
     def names(self) -> list[str]:
         """The interfaces' names, in the order of :meth:`interface_index`."""
         return list(self.interface_names) if self.interface_names else [self.name]
+    @property
+    def has_springs(self) -> bool:
+        """A finite contact stiffness on some node (:mod:`fretwear.hb.connectors`)."""
+        return any(k is not None and not np.all(np.isinf(k)) for k in (self.kn, self.kt))
+
+    @property
+    def has_connectors(self) -> bool:
+        """Contact stiffness or a prescribed normal load on some node: the interface is more
+        than the rigid unilateral contact with Coulomb friction."""
+        return self.has_springs or self.prescribed_nodes().any()
+
+    def prescribed_nodes(self) -> np.ndarray:
+        """(nc,) bool: the nodes whose normal force is prescribed (``normal_load``)."""
+        if self.normal_load is None:
+            return np.zeros(self.n_nodes, dtype=bool)
+        return ~np.isnan(np.asarray(self.normal_load.vector, float))
+
+    def normal_force_samples(self, tau) -> np.ndarray:
+        """Prescribed normal forces ``N(tau)`` (nc, len(tau)) [N] at the angles ``tau =
+        omega t`` (exact samples of the waveform), NaN rows for unilateral nodes; None when no
+        node has a prescribed normal load."""
+        if not self.prescribed_nodes().any():
+            return None
+        vec = np.asarray(self.normal_load.vector, float)
+        return np.outer(vec, self.normal_load.waveform_samples(np.asarray(tau, float)))
 
     def local_transform(self, ndof: int) -> sp.csr_matrix:
         """Sparse ``T`` (nc*d x ndof) with ``u_loc = T @ U`` (relative to the partner for a

@@ -25,7 +25,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from fretwear.errors import InputError
-from fretwear.model.core import ContactInterface, Model, ObservedPoint
+from fretwear.model.core import ContactInterface, Load, Model, ObservedPoint
 
 
 def combine(interfaces) -> ContactInterface:
@@ -91,6 +91,9 @@ def combine(interfaces) -> ContactInterface:
         partner_wear_coefficient=cat(lambda c: c.partner_wear_nodes()),
         interface=np.concatenate(index),
         interface_names=tuple(names),
+        normal_load=_combined_normal_load(items),
+        kn=_combined_stiffness(items, "kn"),
+        kt=_combined_stiffness(items, "kt"),
     )
     check_distinct(out)
     for key in ("mu", "wear_coefficient", "partner_wear_coefficient"):
@@ -100,6 +103,33 @@ def combine(interfaces) -> ContactInterface:
     if not out.has_pairs:
         out.partner_dofs = out.partner_ids = None
     return out
+
+
+def _combined_stiffness(items, field: str):
+    """Per-node contact stiffness of several interfaces [N/m]: ``inf`` (rigid) where an
+    interface has none; None when every node is rigid."""
+    if all(getattr(c, field) is None for c in items):
+        return None
+    return np.concatenate([np.full(c.n_nodes, np.inf) if getattr(c, field) is None
+                           else np.asarray(getattr(c, field), float) for c in items])
+
+
+def _combined_normal_load(items) -> Load | None:
+    """The prescribed normal load of several interfaces: one waveform for all (the record
+    holds one ``N(t) = vector * g(omega t)``), NaN for the nodes in unilateral contact."""
+    loaded = [c.normal_load for c in items if c.normal_load is not None]
+    if not loaded:
+        return None
+    first = loaded[0]
+    for ld in loaded[1:]:
+        if ld.waveform != first.waveform or ld.coefficients != first.coefficients:
+            raise InputError(
+                f"contact: prescribed normal loads with waveforms {first.waveform!r} and "
+                f"{ld.waveform!r}; expected one normal_waveform for every interface with a "
+                "normal_pressure")
+    vec = np.concatenate([np.full(c.n_nodes, np.nan) if c.normal_load is None
+                          else np.asarray(c.normal_load.vector, float) for c in items])
+    return Load(vec, first.waveform, first.coefficients, first.name)
 
 
 def check_distinct(c: ContactInterface) -> None:

@@ -167,7 +167,7 @@ def from_matrices(K, M, *, contact_normal_dofs, contact_tangential_dofs, gap=0.0
                   fixed_dofs=(), observed=None, wear_coefficient=0.0, coords=None,
                   name: str = "matrices", contact_name: str = "contact",
                   contact_partner_dofs=None, contact_frames=None,
-                  partner_wear_coefficient=0.0) -> Model:
+                  partner_wear_coefficient=0.0, normal_load=None, kn=None, kt=None) -> Model:
     """A model from stiffness and mass matrices and a list of contact DOFs.
 
     Parameters
@@ -175,8 +175,12 @@ def from_matrices(K, M, *, contact_normal_dofs, contact_tangential_dofs, gap=0.0
     K, M : (n, n) array or scipy.sparse
         Symmetric stiffness [N/m] and mass [kg] (``M`` may be singular, e.g. massless contact
         DOFs). Symmetry is checked to ``1e-9`` relative and then enforced exactly.
-    contact_normal_dofs : (nc,) int
-        The normal DOF of each contact node.
+    contact_normal_dofs : (nc,) int, or None with ``normal_load``
+        The normal DOF of each contact node. None: the nodes have no normal DOF in the
+        matrices (e.g. a one-DOF oscillator rubbing under a known normal force); their normal
+        force is ``normal_load``. A normal DOF held at zero is then added per node (stiffness
+        ``max diag K``, no mass, loaded by ``N(t)`` so that it stays at 0), invisible to the
+        friction law, which takes ``lambda_N = N(t)``.
     contact_tangential_dofs : (nc,) int (2D) or (nc, 2) int (3D)
         Its tangential DOF(s).
     gap : float or (nc,)
@@ -214,6 +218,15 @@ def from_matrices(K, M, *, contact_normal_dofs, contact_tangential_dofs, gap=0.0
         flank); default: the identity, with ``normal_sign`` on the normal.
     partner_wear_coefficient : float
         Archard coefficient k_w [1/Pa] of the partners' surface (pairs only).
+    normal_load : float, (nc,) or Load, optional
+        Friction under a prescribed normal load: each node's normal force [N] (a constant, or a
+        :class:`~fretwear.model.core.Load` with a (nc,) ``vector`` and a waveform for
+        ``N(t)``; NaN entries: unilateral contact at that node). The slip threshold is then
+        ``mu N(t)`` and no normal DOF is needed.
+    kn, kt : float or (nc,), optional
+        Normal and tangential contact stiffness [N/m] (> 0, ``inf`` rigid; default rigid), in
+        series with the contact law (:mod:`fretwear.hb.connectors`): a finite ``kt`` is a
+        Jenkins element.
 
     Returns
     -------
@@ -234,8 +247,20 @@ def from_matrices(K, M, *, contact_normal_dofs, contact_tangential_dofs, gap=0.0
     check_semidefinite(K, "K")
     check_semidefinite(M, "M")
 
-    normal = _dofs(contact_normal_dofs, n, "contact_normal_dofs").reshape(-1)
     tang = _dofs(contact_tangential_dofs, n, "contact_tangential_dofs")
+    n_user = n
+    if contact_normal_dofs is None:
+        if normal_load is None:
+            raise InputError("contact_normal_dofs = None: expected a normal_load (the normal "
+                             "force of contact nodes without a normal DOF)")
+        nc = tang.shape[0]
+        k_pad = float(np.max(np.abs(K.diagonal()))) if K.nnz else 1.0
+        K = sp.block_diag([K, sp.identity(nc) * (k_pad or 1.0)], format="csr")
+        M = sp.block_diag([M, sp.csr_matrix((nc, nc))], format="csr")
+        n = n + nc
+        normal = np.arange(n_user, n, dtype=np.int64)
+    else:
+        normal = _dofs(contact_normal_dofs, n, "contact_normal_dofs").reshape(-1)
     nc = normal.size
     if nc == 0:
         raise InputError("contact_normal_dofs is empty; expected at least one contact node")
@@ -307,18 +332,37 @@ def from_matrices(K, M, *, contact_normal_dofs, contact_tangential_dofs, gap=0.0
         partner_ids=None if partner is None else np.full(nc, -1, dtype=np.int64),
         partner_wear_coefficient=_nonnegative(partner_wear_coefficient,
                                               "partner_wear_coefficient"),
+        normal_load=_normal_load(normal_load, nc),
+        kn=_stiffness(kn, nc, "kn"),
+        kt=_stiffness(kt, nc, "kt"),
     )
+    if contact_normal_dofs is None and np.isnan(interface.normal_load.vector).any():
+        raise InputError("normal_load has NaN entries (unilateral nodes) but the nodes have no "
+                         "normal DOF (contact_normal_dofs = None)")
 
+    pad = sp.csr_matrix((n - n_user, n - n_user))
     if C is not None:
-        C = _matrix(C, "C", n)
+        C = _matrix(C, "C", n_user)
         check_semidefinite(C, "C")
+        C = sp.block_diag([C, pad], format="csr")
     if D is not None and loss_factor is not None:
         raise InputError("give either D or loss_factor (D = loss_factor * K), not both")
     if D is not None:
-        D = _matrix(D, "D", n)
+        D = _matrix(D, "D", n_user)
         check_semidefinite(D, "D")
+        D = sp.block_diag([D, pad], format="csr")
     elif loss_factor is not None and check_loss_factor(loss_factor) > 0.0:
         D = (float(loss_factor) * K).tocsr()
+        if n > n_user:
+            D[n_user:, n_user:] = 0.0
+            D.eliminate_zeros()
+    loads = _loads(loads, n_user)
+    if n > n_user:  # the added normal DOFs: loaded by N(t) so that they stay at 0
+        loads = [Load(np.concatenate([ld.vector, np.zeros(n - n_user)]), ld.waveform,
+                      ld.coefficients, ld.name) for ld in loads]
+        nl = interface.normal_load
+        loads.append(Load(np.concatenate([np.zeros(n_user), sign * nl.vector]), nl.waveform,
+                          nl.coefficients, "normal load"))
 
     model = Model(
         K=K,
@@ -326,8 +370,8 @@ def from_matrices(K, M, *, contact_normal_dofs, contact_tangential_dofs, gap=0.0
         contact=interface,
         C=C,
         D=D,
-        loads=_loads(loads, n),
-        observed=_observed(observed, n),
+        loads=loads,
+        observed=_observed(observed, n_user),
         fixed_dofs=fixed,
         dim=dim,
         mesh=None,
@@ -340,6 +384,44 @@ def from_matrices(K, M, *, contact_normal_dofs, contact_tangential_dofs, gap=0.0
     held = np.union1d(dofs[np.arange(nc), np.argmax(np.abs(frame[:, 0, :]), axis=1)], fixed)
     rigid_motion_check(relative_model(model)[0].K, held)
     return model
+
+
+def _normal_load(value, nc: int) -> Load | None:
+    """The prescribed normal load of ``from_matrices``: a constant or (nc,) force [N], or a
+    :class:`Load` with a (nc,) vector (NaN entries: unilateral nodes)."""
+    if value is None:
+        return None
+    if isinstance(value, Load):
+        vec = np.asarray(value.vector, dtype=float)
+        if vec.shape != (nc,) or np.isinf(vec).any():
+            raise InputError(f"normal_load: vector of shape {vec.shape}; expected ({nc},) normal "
+                             "forces [N] (NaN: unilateral contact at that node)")
+        if value.waveform not in WAVEFORMS:
+            raise InputError(f"normal_load: waveform {value.waveform!r}; expected one of "
+                             f"{list(WAVEFORMS)}")
+        return Load(vec.copy(), value.waveform, value.coefficients, value.name)
+    try:
+        vec = np.broadcast_to(np.asarray(value, dtype=float), (nc,)).copy()
+    except (TypeError, ValueError):
+        raise InputError(f"normal_load = {value!r}; expected a force [N], {nc} forces or a "
+                         "Load") from None
+    if np.isinf(vec).any():
+        raise InputError(f"normal_load = {value!r}; expected finite forces [N]")
+    return Load(vec, "constant", None, "normal load")
+
+
+def _stiffness(value, nc: int, what: str) -> np.ndarray | None:
+    """A contact stiffness per node [N/m] (> 0, inf allowed), or None (rigid)."""
+    if value is None:
+        return None
+    try:
+        k = np.broadcast_to(np.asarray(value, dtype=float), (nc,)).copy()
+    except (TypeError, ValueError):
+        raise InputError(f"{what} = {value!r}; expected a stiffness [N/m] or {nc} of "
+                         "them") from None
+    if np.isnan(k).any() or np.any(k <= 0):
+        raise InputError(f"{what} = {value!r}; expected a stiffness > 0 [N/m] (inf: rigid)")
+    return k
 
 
 def _loads(loads, n: int) -> list[Load]:

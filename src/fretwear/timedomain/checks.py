@@ -50,6 +50,10 @@ def check_contact(model: Model) -> None:
                          "takes one friction coefficient")
     if not (np.isfinite(c.mu) and c.mu >= 0.0):
         raise InputError(f"contact.mu = {c.mu!r}; expected a friction coefficient >= 0")
+    if getattr(c, "has_connectors", False):
+        raise InputError("contact stiffness (kn, kt) and prescribed normal loads are modelled "
+                         "by the harmonic balance only; the time-domain solver takes rigid "
+                         "unilateral contacts (write the springs as massless DOFs instead)")
 
 
 def node_wear(wear, nc: int, what: str = "wear") -> np.ndarray:

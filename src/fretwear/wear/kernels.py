@@ -176,7 +176,7 @@ def slip_work_gradient(lam_u, lam_x, state, mu, Q, eps):
                 pn = lam_u[p, 0, n]
                 m = n - 1 if n > 0 else N - 1
                 slip_derivative_step(lam_u[p], lam_x[p], n, m, mu[p], Q, A0, Sd, that, B,
-                                     tmpA, tmpS)
+                                     tmpA, tmpS, np.nan)
                 # the wear integrand pn |dX| and its derivative
                 sl, w = archard_integrand(pn, lam_x[p, :, n], lam_x[p, :, m])
                 acc += w

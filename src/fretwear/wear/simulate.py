@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fretwear.errors import interrupted
+from fretwear.errors import InputError, interrupted
 from fretwear.hb.fallback import TimeDomainFallback
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import PeriodicSolution, check_inputs, static_anchor
@@ -93,6 +93,11 @@ def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
     """
     frequency = check_inputs(model, basis, frequency, quasi_static=quasi_static,
                              anchor=anchor, U0=U0)
+    if model.contact.prescribed_nodes().any():
+        raise InputError("contact normal_load: wear needs the normal contact to come from the "
+                         "structure (a prescribed normal load does not move with the worn gap)")
+    if model.contact.has_connectors:  # the time-domain solver has rigid contacts only
+        time_domain = None
     if options is not None and not isinstance(options, WearOptions):
         raise TypeError(f"options = {options!r}: expected a WearOptions")
     opts = (options or WearOptions()).check()

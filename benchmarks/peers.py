@@ -1,0 +1,246 @@
+"""fretwear against pyHarm-os 1.2.2 on two friction oscillators, with references from neither.
+
+pyHarm is installed in the benchmark's own environment, never as a fretwear dependency:
+
+    python3 -m venv /tmp/pyharm-venv && /tmp/pyharm-venv/bin/pip install pyharm-os==1.2.2
+
+then, from the repository root (with fretwear importable, e.g. ``PYTHONPATH=src``)::
+
+    python benchmarks/peers.py [--pyharm /tmp/pyharm-venv/bin/python] [--harmonics 7 15]
+
+Problems (benchmarks/reference_oscillators.py):
+
+* (a) one DOF m = 1, k = 1, c = 0.02 with a Jenkins element (kt = 0.5 in series with a Coulomb
+  slider, mu N = 0.5), forcing 0.2 cos(w t), w = 0.7-1.3 rad/s. fretwear: interface stiffness
+  kt under a prescribed normal load (no normal DOF). pyHarm: its ``Jenkins`` connector.
+* (b) two-DOF chain (m = 1, 1; k = 1, 1; c = 0.02, 0.02 to the ground), forcing on mass 1,
+  mass 2 on a rigid Coulomb contact (mu N = 0.5), w = 1.0-1.8 rad/s (its peak is at 1.49).
+  fretwear: prescribed normal load on a rigid contact. pyHarm: its ``DLFTFriction`` connector
+  (eps = 1000, the value the issue used).
+
+References: event-driven integration with exact stick/slip switching plus Newton shooting
+(periodic to 1e-10), peak of the first-harmonic amplitude A1 of mass 1 by golden section.
+
+Each code runs in a fresh process of its own interpreter (``cold``: first run in that process,
+imports and just-in-time compilation included) and runs the same analysis again in that
+process (``warm``). fretwear: 121 (a) / 137 (b) linearly spaced frequencies (``fretwear.sweep``,
+default eps rule "top"; on (b) also with pyHarm's eps = 1000, row ``fretwear*``); pyHarm: its
+arclength continuation over the same band (step ``ds = 0.05``:
+its default continuation did not end on (b)). The peak of each curve is the largest A1 of its
+points refined by a parabola through the three points around it.
+
+Prints per code, problem and H: points, converged, warm and cold wall time [s], peak amplitude
+and frequency errors (relative); then the machine load; the last line is
+``speedup_vs_pyharm_warm=<geometric mean over problems and H of pyHarm warm / fretwear warm>``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+
+import reference_oscillators as ref  # noqa: E402
+
+BAND = {"a": (0.7, 1.3), "b": (1.0, 1.8)}  # rad/s
+N_POINTS = {"a": 121, "b": 137}
+
+FRETWEAR_CHILD = r'''
+import json, sys, time
+t0 = time.perf_counter()
+import numpy as np
+import fretwear
+from fretwear.hb.fourier import FourierBasis
+from fretwear.model.core import Load
+from fretwear.model.matrices import from_matrices
+
+prob, H, n, w0, w1 = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), float(sys.argv[4]), \
+    float(sys.argv[5])
+eps = sys.argv[6] if sys.argv[6] in ("top", "auto", "static") else float(sys.argv[6])
+
+
+def model():
+    if prob == "a":
+        return from_matrices([[1.0]], [[1.0]], C=[[0.02]], contact_normal_dofs=None,
+                             contact_tangential_dofs=[0], mu=0.5, normal_load=1.0, kt=0.5,
+                             loads=[Load(np.array([0.2]), "cos")], observed={"x": 0})
+    return from_matrices(np.array([[2.0, -1.0], [-1.0, 1.0]]), np.eye(2), C=0.02 * np.eye(2),
+                         contact_normal_dofs=None, contact_tangential_dofs=[1], mu=0.5,
+                         normal_load=1.0, loads=[Load(np.array([0.2, 0.0]), "cos")],
+                         observed={"x": 0})
+
+
+def run():
+    res = fretwear.sweep(model(), FourierBasis.up_to(H, 128), w0 / (2 * np.pi),
+                         w1 / (2 * np.pi), n, spacing="linear", eps=eps, time_domain=False)
+    pts = [p for p in res.points if p.on_grid]
+    w = [2 * np.pi * p.frequency_hz for p in pts if p.success]
+    a = [float(p.solution.observed_amplitude("x")[0][0]) for p in pts if p.success]
+    used = res.points[0].solution.eps if res.points[0].success else float("nan")
+    return {"points": len(pts), "converged": len(w), "w": w, "a": a, "eps": used}
+
+
+out = run()
+out["cold"] = time.perf_counter() - t0
+t1 = time.perf_counter()
+run()
+out["warm"] = time.perf_counter() - t1
+print("RESULT " + json.dumps(out))
+'''
+
+PYHARM_CHILD = r'''
+import copy, json, logging, sys, time, warnings
+warnings.filterwarnings("ignore")
+t0 = time.perf_counter()
+import numpy as np
+from pyHarm.Maestro import Maestro
+
+prob, H, w0, w1 = sys.argv[1], int(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4])
+if prob == "a":
+    subs = {"m": {"type": "onlydofs", "ndofs": 1, "nnodes": 1}}
+    con = {"k": {"type": "LinearSpring", "connect": {"m": [0]}, "dirs": [0], "k": 1.0},
+           "c": {"type": "LinearDamper", "connect": {"m": [0]}, "dirs": [0], "k": 0.02},
+           "mass": {"type": "GOElement", "connect": {"m": [0]}, "dirs": [0], "dto": 2, "xo": 1,
+                    "k": 1.0},
+           "f": {"type": "CosinusForcing", "connect": {"m": [0]}, "dirs": [0], "amp": 0.2},
+           "jenkins": {"type": "Jenkins", "connect": {"m": [0]}, "dirs": [0], "mu": 0.5,
+                       "N0": 1.0, "k": 0.5}}
+else:
+    subs = {"m": {"type": "onlydofs", "ndofs": 1, "nnodes": 2}}
+    con = {"k1": {"type": "LinearSpring", "connect": {"m": [0]}, "dirs": [0], "k": 1.0},
+           "k2": {"type": "LinearSpring", "connect": [("m", [0]), ("m", [1])], "dirs": [0],
+                  "k": 1.0},
+           "c1": {"type": "LinearDamper", "connect": {"m": [0]}, "dirs": [0], "k": 0.02},
+           "c2": {"type": "LinearDamper", "connect": {"m": [1]}, "dirs": [0], "k": 0.02},
+           "m1": {"type": "GOElement", "connect": {"m": [0]}, "dirs": [0], "dto": 2, "xo": 1,
+                  "k": 1.0},
+           "m2": {"type": "GOElement", "connect": {"m": [1]}, "dirs": [0], "dto": 2, "xo": 1,
+                  "k": 1.0},
+           "f": {"type": "CosinusForcing", "connect": {"m": [0]}, "dirs": [0], "amp": 0.2},
+           "friction": {"type": "DLFTFriction", "connect": {"m": [1]}, "dirs": [0], "mu": 0.5,
+                        "N0": 1.0, "eps": 1000.0}}
+idata = {"system": {"type": "Base", "nh": H, "nti": 128}, "substructures": subs,
+         "connectors": con,
+         "analysis": {"frf": {"study": "frf", "puls_inf": w0, "puls_sup": w1, "ds0": 0.05,
+                              "ds_max": 0.05, "ds_min": 1e-6, "verbose": False}}}
+
+
+def run():
+    m = Maestro(copy.deepcopy(idata))
+    m.operate()
+    edf = m.system.expl_dofs
+    pick = lambda cs: int(edf[(edf["harm"] == 1) & (edf["cs"] == cs) & (edf["node_num"] == 0)
+                              & (edf["sub"] == "m")].index[0])
+    ic, js = pick("c"), pick("s")
+    sols = m.nls["frf"].SolList
+    ok = [s for s in sols if s.flag_accepted]
+    w = [float(s.x[-1]) for s in ok]
+    a = [float(np.hypot(s.x[ic], s.x[js])) for s in ok]
+    return {"points": len(sols), "converged": len(ok), "w": w, "a": a}
+
+
+logging.disable(logging.CRITICAL)
+out = run()
+out["cold"] = time.perf_counter() - t0
+t1 = time.perf_counter()
+run()
+out["warm"] = time.perf_counter() - t1
+print("RESULT " + json.dumps(out))
+'''
+
+
+def child(python: str, code: str, args, env=None) -> dict:
+    """Run ``code`` with ``python`` in a fresh process; its ``RESULT {json}`` line."""
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "child.py"
+        path.write_text(code)
+        proc = subprocess.run([python, str(path), *map(str, args)], capture_output=True,
+                              text=True, cwd=tmp, env=env, timeout=3600)
+    for line in proc.stdout.splitlines():
+        if line.startswith("RESULT "):
+            return json.loads(line[7:])
+    return {"error": (proc.stderr or proc.stdout).strip().splitlines()[-1:] or ["no output"]}
+
+
+def curve_peak(w, a):
+    """Peak (w, A1) of sampled points: the largest, refined by a parabola through its
+    neighbours (the sample itself at an end of the band)."""
+    pts = sorted(zip(w, a, strict=True))
+    if not pts:
+        return math.nan, math.nan
+    ws, As = zip(*pts, strict=True)
+    i = max(range(len(As)), key=As.__getitem__)
+    if 0 < i < len(As) - 1:
+        x0, x1, x2 = ws[i - 1 : i + 2]
+        y0, y1, y2 = As[i - 1 : i + 2]
+        den = (x0 - x1) * (x0 - x2) * (x1 - x2)
+        A = (x2 * (y1 - y0) + x1 * (y0 - y2) + x0 * (y2 - y1)) / den
+        B = (x2 * x2 * (y0 - y1) + x1 * x1 * (y2 - y0) + x0 * x0 * (y1 - y2)) / den
+        C = (x1 * x2 * (x1 - x2) * y0 + x2 * x0 * (x2 - x0) * y1
+             + x0 * x1 * (x0 - x1) * y2) / den
+        if A < 0:
+            xv = -B / (2 * A)
+            return xv, C - B * B / (4 * A)
+    return ws[i], As[i]
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--pyharm", default=os.environ.get("PYHARM_PYTHON",
+                                                       "/tmp/pyharm-venv/bin/python"),
+                    help="python of the environment where pyharm-os 1.2.2 is installed")
+    ap.add_argument("--harmonics", type=int, nargs="+", default=[7, 15])
+    args = ap.parse_args(argv)
+    have_pyharm = Path(args.pyharm).exists()
+    if not have_pyharm:
+        print(f"# no pyHarm interpreter at {args.pyharm}: install it with\n"
+              "#   python3 -m venv /tmp/pyharm-venv && /tmp/pyharm-venv/bin/pip install "
+              "pyharm-os==1.2.2")
+
+    t0 = time.perf_counter()
+    refs = {"a": ref.peak(ref.Jenkins(), 1.1, 1.3), "b": ref.peak(ref.Chain(), 1.4, 1.6)}
+    print(f"# references (event-driven + shooting, {time.perf_counter() - t0:.0f} s): "
+          + ", ".join(f"({k}) A1 = {v[1]:.7f} at w = {v[0]:.7f}" for k, v in refs.items()))
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1")
+    print(f"{'code':9s} {'prob':4s} {'H':>3s} {'points':>6s} {'conv':>5s} {'warm_s':>8s} "
+          f"{'cold_s':>8s} {'peak_err':>10s} {'freq_err':>10s}  notes")
+    ratios = []
+    for prob in ("a", "b"):
+        w_ref, a_ref = refs[prob]
+        for H in args.harmonics:
+            rows = {"fretwear": child(sys.executable, FRETWEAR_CHILD,
+                                      [prob, H, N_POINTS[prob], *BAND[prob], "top"], env)}
+            if prob == "b":  # the penalty pyHarm is given, for a like-for-like accuracy
+                rows["fretwear*"] = child(sys.executable, FRETWEAR_CHILD,
+                                          [prob, H, N_POINTS[prob], *BAND[prob], 1000.0], env)
+            if have_pyharm:
+                rows["pyHarm"] = child(args.pyharm, PYHARM_CHILD, [prob, H, *BAND[prob]],
+                                       env)
+            for code, r in rows.items():
+                if "error" in r:
+                    print(f"{code:9s} {prob:4s} {H:3d}  failed: {r['error']}")
+                    continue
+                wp, ap_ = curve_peak(r["w"], r["a"])
+                note = f"eps = {r['eps']:.3g} N/m" if "eps" in r else ""
+                print(f"{code:9s} {prob:4s} {H:3d} {r['points']:6d} {r['converged']:5d} "
+                      f"{r['warm']:8.2f} {r['cold']:8.2f} {ap_ / a_ref - 1:+10.2e} "
+                      f"{wp / w_ref - 1:+10.2e}  {note}")
+            if all(c in rows and "error" not in rows[c] for c in ("fretwear", "pyHarm")):
+                ratios.append(rows["pyHarm"]["warm"] / rows["fretwear"]["warm"])
+    print(f"# machine load (uptime): {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f} "
+          f"{os.getloadavg()[2]:.2f} on {os.cpu_count()} cores")
+    gm = math.exp(sum(map(math.log, ratios)) / len(ratios)) if ratios else math.nan
+    print(f"speedup_vs_pyharm_warm={gm:.3g}")
+
+
+if __name__ == "__main__":
+    main()
