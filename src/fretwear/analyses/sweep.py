@@ -189,8 +189,8 @@ def run_sweep(model, analysis: dict, case, outdir: Path, progress: bool) -> RunO
 
         result = sweep(model, basis, analysis["f_min"], analysis["f_max"], n,
                        spacing=analysis["spacing"], eps=analysis["eps"],
-                       solver=analysis["solver"], tol=analysis["tol"],
-                       max_iter=analysis["max_iter"],
+                       eps_band=analysis.get("eps_band"), solver=analysis["solver"],
+                       tol=analysis["tol"], max_iter=analysis["max_iter"],
                        continuation=analysis["continuation"],
                        time_domain=FALLBACK if analysis["time_domain"] else None,
                        time_domain_periods=analysis["time_domain_periods"],
@@ -322,6 +322,10 @@ register(
                                  "structure settle to it?); slow", default=False),
         "points": Field(ListOf(Text(), non_empty=True, unique=True),
                         "observed points to report (default: all)"),
+        "eps_band": Field(ListOf(Number(lo=0, lo_open=True), sizes=(2,)),
+                          'the band [f_min, f_max] over which eps = "top" takes its median '
+                          "(default: the sweep's band; the chunks of a split sweep give the "
+                          "whole band, so that they share the whole sweep's eps)", unit="Hz"),
         "linear_references": Field(
             ListOf(Text(linear.INTERFACES), unique=True),
             'linear FRFs drawn with the nonlinear one: "sliding" (frictionless), "stuck", '

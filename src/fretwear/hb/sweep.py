@@ -305,11 +305,21 @@ def _arclength(probs, model, anchor, y_prev, y_last, omega_target, solver_tol, m
     return out
 
 
+def _band(eps_band) -> tuple[float, float]:
+    try:
+        lo, hi = (float(v) for v in eps_band)
+    except (TypeError, ValueError):
+        raise InputError(f"eps_band = {eps_band!r}: expected (f_min, f_max) in Hz") from None
+    if not (0.0 < lo <= hi < np.inf):
+        raise InputError(f"eps_band = {eps_band!r}: expected 0 < f_min <= f_max [Hz]")
+    return lo, hi
+
+
 def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_points: int, *,
           spacing: str = "log", gap=None, eps="top", anchor=None, solver: str = "powell",
           tol: float = 1e-8, max_iter: int = 40, continuation: bool = True,
           max_bisections: int = 4, check=None,
-          time_domain: TimeDomainFallback | None = None,
+          time_domain: TimeDomainFallback | None = None, eps_band=None,
           time_domain_periods: int = 3000, progress=None, checkpoint=None,
           resume: bool = False) -> SweepResult:
     """Nonlinear FRF: periodic solutions from ``f_min`` to ``f_max`` [Hz].
@@ -328,6 +338,10 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
         resonances, so it jumps by orders of magnitude between neighbouring frequencies, and
         with 7 harmonics the solution depends measurably on eps, so the FRF is jagged).
         A positive number [N/m]: that penalty everywhere (docs/theory.md, "The penalty eps").
+    eps_band : ``(f_min, f_max)`` [Hz], the band over which the ``"top"`` rule takes its
+        median (default: the sweep's own band). The chunks of a sweep split across workers
+        (:mod:`fretwear.study`) give the whole band, so that they all use the whole sweep's eps
+        and join without an eps jump.
     anchor : stick anchors of the first point (default: static preload state).
     solver, tol, max_iter : nonlinear solver settings (:func:`fretwear.hb.solvers.solve`).
     continuation : use pseudo-arclength continuation when a grid step fails.
@@ -363,7 +377,8 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
     check_inputs(model, basis, f_min, anchor=anchor)
     if model.contact.has_connectors:  # the time-domain solver has rigid contacts only
         time_domain = None
-    eps = sweep_penalty(eps, model, [0, *basis.harmonics], f_min, f_max, spacing=spacing)
+    band = (f_min, f_max) if eps_band is None else _band(eps_band)
+    eps = sweep_penalty(eps, model, [0, *basis.harmonics], *band, spacing=spacing)
     probs = _Problems(model, basis, gap, eps)
     if anchor is None:
         anchor = static_anchor(model)

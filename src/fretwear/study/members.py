@@ -161,7 +161,9 @@ def _ensemble(study: Study, base: dict) -> list[dict]:
 
 def _chunks(study: Study, base: dict) -> list[dict]:
     """The sweep band cut into chunks of the base's frequency grid; neighbours share their
-    end frequency (the join, checked after the run)."""
+    end frequency (the join, checked after the run). Every chunk takes its eps from the whole
+    band (``eps_band``): the "top" rule's median over a chunk's own band would differ from
+    chunk to chunk, and the joins with it."""
     a = validate(base, analysis_tables(), study.base.parent)["analysis"]
     if a["type"] != "sweep":
         raise InputError(f"[split] needs a sweep as base case; {study.base.name} has "
@@ -172,8 +174,9 @@ def _chunks(study: Study, base: dict) -> list[dict]:
                          f"most {n // 2} chunks (two points each at least)")
     grid = (np.geomspace if a["spacing"] == "log" else np.linspace)(a["f_min"], a["f_max"], n)
     edges = np.linspace(0, n - 1, chunks + 1).round().astype(int)
+    band = a.get("eps_band") or [float(a["f_min"]), float(a["f_max"])]
     return [{"analysis.f_min": float(grid[i0]), "analysis.f_max": float(grid[i1]),
-             "analysis.n_points": int(i1 - i0 + 1)}
+             "analysis.n_points": int(i1 - i0 + 1), "analysis.eps_band": band}
             for i0, i1 in itertools.pairwise(edges)]
 
 
