@@ -3,8 +3,8 @@
 The study: the paper's beam (Salles et al. 2011, section 4.2) on its 30 x 4 mesh, a sweep of
 ``--points`` frequencies (7 harmonics, 128 samples, the paper's settings) around its first
 frictional resonance, over a grid of 8 friction coefficients (0.1 ... 0.45): members of 3-6 s
-each, so that the figures are about the solves rather than Dask's per-task costs. Prints, on this machine and in this
-run:
+each, so that the figures are about the solves rather than Dask's per-task costs. Prints, on
+this machine and in this run:
 
 - ``in-process``: the 8 members run one after another in this process with the same task
   function the workers run (:func:`fretwear.study.runner.run_member`), after one warm-up run
