@@ -44,7 +44,7 @@ _API = {
     "from_matrices": "fretwear.model.matrices", "read_matrix_market": "fretwear.model.matrices",
     # harmonic balance
     "FourierBasis": "fretwear.hb.fourier", "condense": "fretwear.hb.reduce",
-    "Reduced": "fretwear.hb.reduce", "solve_periodic": "fretwear.hb.periodic",
+    "Reduced": "fretwear.hb.reduce", "solve_periodic": "fretwear.api",
     "PeriodicSolution": "fretwear.hb.periodic", "SweepResult": "fretwear.hb.sweep",
     "sweep": "fretwear.api",
     # linear

@@ -10,6 +10,7 @@ passed through unchanged.
 from __future__ import annotations
 
 from fretwear import wear as _wear
+from fretwear.hb import periodic as _periodic
 from fretwear.hb import sweep as _sweep
 from fretwear.timedomain.fallback import FALLBACK
 
@@ -18,6 +19,26 @@ def _fallback(time_domain: bool):
     if not isinstance(time_domain, bool):
         raise TypeError(f"time_domain = {time_domain!r}: expected True or False")
     return FALLBACK if time_domain else None
+
+
+def solve_periodic(model, basis, *, time_domain: bool = True,
+                   **kwargs) -> _periodic.PeriodicSolution:
+    """Periodic response of ``model`` at the excitation ``frequency`` [Hz] (keyword, default
+    1 Hz) with the DLFT (paper section 3.1-3.2).
+
+    :func:`fretwear.hb.periodic.solve_periodic` (every other keyword: ``frequency``,
+    ``quasi_static``, ``gap`` [m], ``eps``, ``anchor``, ``U0``, ``solver``, ``tol``,
+    ``max_iter``, ``strategy``, ``time_domain_periods``, ...) with the time-domain fallback
+    when every attempt of the solve strategy failed (``time_domain=True``, as the case-file
+    key ``time_domain`` of a periodic analysis): a periodic steady state of a time integration
+    starts one more solve; any other response is reported (``solution.time_domain``).
+
+    Returns
+    -------
+    :class:`~fretwear.hb.periodic.PeriodicSolution`: ``success``, ``message``, ``attempts``,
+    the harmonics and time histories of the contact (see its docstring).
+    """
+    return _periodic.solve_periodic(model, basis, time_domain=_fallback(time_domain), **kwargs)
 
 
 def sweep(model, basis, f_min: float, f_max: float, n_points: int, *, time_domain: bool = True,

@@ -92,7 +92,8 @@ def test_quasi_static_needs_no_frequency_and_takes_a_list_of_harmonics(tmp_path,
 
 
 def test_a_periodic_solve_that_fails_saves_no_solution(tmp_path, capsys):
-    path = small_case(tmp_path, with_key(PERIODIC, "max_iter = 1"))
+    # without the time-domain start, which would rescue this solve (the next test)
+    path = small_case(tmp_path, with_key(PERIODIC, "max_iter = 1\ntime_domain = false"))
     status, out, err = run(path, capsys)
     assert status == 1
     assert err == ""
@@ -106,6 +107,23 @@ def test_a_periodic_solve_that_fails_saves_no_solution(tmp_path, capsys):
     assert len(ds.variables) == 0  # no solution, not even the coordinates
     assert ds.attrs["iterations"] == 1 and ds.attrs["residual"] > 1e-8
     assert not list(res.glob("*.png")) and not (res / "periodic.pvd").exists()
+
+
+def test_a_failed_solve_reports_its_attempts_and_the_time_integration(tmp_path, capsys):
+    """The same starved solve (max_iter = 1) with the default time_domain = true: every
+    attempt of the strategy fails, then the time integration settles to a periodic state whose
+    solve (2 x max_iter iterations) fails too; the diagnostics of results.nc and the summary
+    name every attempt and what the integration found, and no solution is saved."""
+    path = small_case(tmp_path, with_key(PERIODIC, "max_iter = 1"))
+    status, out, err = run(path, capsys)
+    assert status == 1
+    ds = read_results(tmp_path / "beam-results" / "results.nc")
+    assert ds.attrs["converged"] == 0 and len(ds.variables) == 0
+    methods = [a.split("/")[0] for a in ds.attrs["attempts"].split("; ")]
+    assert methods == ["start", "best-point", "eps-continuation", "eps-continuation",
+                       "harmonic-continuation", "time-start"]
+    assert ds.attrs["time_domain"].startswith("time integration: periodic steady state")
+    assert "attempts: start, best-point" in out and ds.attrs["time_domain"] in out
 
 
 # --- input errors ---------------------------------------------------------------------------

@@ -638,3 +638,66 @@ def test_strategy_records_every_attempt_and_ends_at_the_target_eps():
     only = solve_periodic(model, basis, frequency=1.4905405 / (2 * np.pi), eps=1.0,
                           strategy=("start",))
     assert not only.success and [a.method for a in only.attempts] == ["start"]
+
+
+# --- the time-domain start of solve_periodic ------------------------------------------------
+def test_time_start_reaches_the_balance_of_the_standard_solve():
+    """The attempt "time-start" alone (no other attempt) on the friction oscillator (continuous
+    slip: one periodic solution, no stick anchors to choose): the balance started from a time
+    integration's periodic steady state equals the one solved from the contact-closed guess.
+    Two independent paths to one solution of one balance: they agree to the conditioning of
+    the balance times its tolerance 1e-8 (1e-6 relative leaves that margin; measured 1e-13)."""
+    from fretwear.timedomain.fallback import FALLBACK
+    from tests.helpers.models import oscillator
+
+    model, basis = oscillator(), FourierBasis.up_to(5, 64)
+    ref = solve_periodic(model, basis, frequency=15.0)
+    ts = solve_periodic(model, basis, frequency=15.0, strategy=("time-start",),
+                        time_domain=FALLBACK)
+    assert ref.success and ts.success
+    assert [a.method for a in ts.attempts] == ["time-start"] and ts.attempts[0].success
+    assert ts.time_domain.startswith("time integration: periodic steady state")
+    assert not ts.flags
+    assert np.abs(ts.U - ref.U).max() <= 1e-6 * np.abs(ref.U).max()
+
+
+def test_time_start_reports_a_response_that_is_not_periodic():
+    """When the time integration finds no periodic state, the solve fails with what the
+    structure does: in ``time_domain``, in ``flags`` and as the last attempt's message; the
+    integration is asked for the given number of periods, from rest."""
+    from fretwear.hb.fallback import TimeDomainFallback
+    from tests.helpers.models import oscillator
+
+    calls = []
+    msg = "time integration: quasi-periodic over 300 periods: no periodic steady state"
+
+    def start(model, frequency, basis, solution, *, max_periods):
+        calls.append((frequency, solution, max_periods))
+        return msg, None, None
+
+    fake = TimeDomainFallback(start=start, averaged_rate=None)
+    sol = solve_periodic(oscillator(), FourierBasis.up_to(3, 32), frequency=15.0,
+                         strategy=("time-start",), time_domain=fake, time_domain_periods=300)
+    assert not sol.success
+    assert calls == [(15.0, None, 300)]
+    assert sol.time_domain == msg and msg in sol.flags
+    assert [a.method for a in sol.attempts] == ["time-start"]
+    assert sol.attempts[0].message == msg and not sol.attempts[0].success
+
+
+def test_time_start_is_skipped_where_the_time_domain_does_not_apply():
+    """Quasi-static solves, a worn gap and contact springs take no time-domain start (the
+    integration would answer another problem): the fallback is never called."""
+    from fretwear.hb.fallback import TimeDomainFallback
+    from tests.helpers.models import oscillator
+
+    def start(*args, **kwargs):
+        raise AssertionError("the time-domain start ran")
+
+    fake = TimeDomainFallback(start=start, averaged_rate=None)
+    basis = FourierBasis.up_to(3, 32)
+    model = oscillator()
+    for kw in ({"quasi_static": True}, {"gap": np.array([1e-9])}):
+        sol = solve_periodic(model, basis, frequency=15.0, strategy=("time-start",),
+                             time_domain=fake, **kw)
+        assert not sol.success and sol.time_domain == ""

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from fretwear import api
 from fretwear.analyses import figures as plots
 from fretwear.analyses.common import (
     STOP_TOL,
@@ -41,7 +42,8 @@ from fretwear.hb.periodic import PeriodicSolution, solve_periodic
 from fretwear.hb.reduce import condense, recover
 from fretwear.hb.solvers import SolveStats
 from fretwear.io.results import nodal_vectors, variable, write_pvd, write_vtu
-from fretwear.io.schema import Field, Flag, Number, join
+from fretwear.io.schema import Field, Flag, Integer, Number, join
+from fretwear.timedomain.fallback import FALLBACK
 
 
 # --- dataset -------------------------------------------------------------------------------
@@ -140,13 +142,19 @@ def _frequency_text(f_hz: float, quasi_static: bool) -> str:
     return "quasi-static loading" if quasi_static else plots.format_frequency(f_hz)
 
 
-def _failure_summary(stats: SolveStats, analysis: dict, where: str) -> str:
-    return (
+def _failure_summary(stats: SolveStats, analysis: dict, where: str,
+                     sol: PeriodicSolution | None = None) -> str:
+    tried = ""
+    if sol is not None and sol.attempts:
+        tried = f"; attempts: {', '.join(a.method for a in sol.attempts)}"
+    text = (
         f"periodic solve at {where} did not converge: {stats.message} (relative residual "
         f"{stats.residual:.3g} > tol {analysis['tol']:g} after {stats.iterations} iterations, "
-        f"solver {stats.solver or analysis['solver']}). No solution was saved. Try a larger "
-        "max_iter, another solver (powell, newton, hybr) or another eps."
+        f"solver {stats.solver or analysis['solver']}{tried}). No solution was saved."
     )
+    if sol is not None and sol.time_domain:
+        return f"{text}\n{sol.time_domain}"
+    return text + " Try a larger max_iter, another solver (powell, newton, hybr) or another eps."
 
 
 def _periodic_summary(sol: PeriodicSolution, ds: xr.Dataset, analysis: dict, where: str
@@ -196,14 +204,19 @@ def run_periodic(model, analysis: dict, case, outdir: Path, progress: bool) -> R
     eps = penalty(analysis["eps"], model=model, reduced=reduced)
     sol = solve_periodic(model, basis, frequency=f_hz, quasi_static=qs, reduced=reduced,
                          eps=eps, solver=analysis["solver"], tol=analysis["tol"],
-                         max_iter=analysis["max_iter"])
+                         max_iter=analysis["max_iter"],
+                         time_domain=FALLBACK if analysis["time_domain"] else None,
+                         time_domain_periods=analysis["time_domain_periods"])
     stats = sol.stats
     attrs = {**solver_attributes(stats, analysis, eps), "excitation_frequency": f_hz,
-             "quasi_static": int(qs)}
+             "quasi_static": int(qs),
+             "attempts": "; ".join(f"{a.method}/{a.solver}/{'yes' if a.success else 'no'}/"
+                                   f"{a.residual:.1e}" for a in sol.attempts),
+             "time_domain": sol.time_domain}
     where = _frequency_text(f_hz, qs)
     if not sol.success:  # never saved as a result: the diagnostics only
-        return RunOutput(xr.Dataset(attrs=attrs), [], _failure_summary(stats, analysis, where),
-                         False)
+        return RunOutput(xr.Dataset(attrs=attrs), [],
+                         _failure_summary(stats, analysis, where, sol), False)
     points = [p.name for p in model.observed]
     ds = periodic_dataset(model, sol, points)
     ds.attrs.update(attrs)
@@ -424,6 +437,14 @@ register(
         "quasi_static": Field(Flag(), "drop inertia and damping (slow cyclic loading); the "
                               "friction law stays path dependent over the period",
                               default=default_of(solve_periodic, "quasi_static")),
+        "time_domain": Field(Flag(), "where every attempt of the solve strategy fails, "
+                             "integrate in time from rest: a periodic steady state starts one "
+                             "more solve, any other response (drifting, quasi-periodic) is "
+                             "reported as the reason", default=default_of(api.solve_periodic,
+                                                                          "time_domain")),
+        "time_domain_periods": Field(Integer(lo=10), "forcing periods allowed to the time "
+                                     "integration (time_domain)",
+                                     default=default_of(solve_periodic, "time_domain_periods")),
         **harmonic_balance_fields(solve_periodic, "DLFT penalty: " + _EPS_RULES),
     },
     run_periodic,

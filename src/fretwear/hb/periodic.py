@@ -23,6 +23,7 @@ import numpy as np
 from fretwear.errors import InputError
 from fretwear.hb import contact as law
 from fretwear.hb.connectors import Connected, connect, node_displacements
+from fretwear.hb.fallback import TimeDomainFallback
 from fretwear.hb.fourier import FourierBasis, amplitude
 from fretwear.hb.krylov import HarmonicBlocks, KrylovJacobian
 from fretwear.hb.penalty import penalty
@@ -212,6 +213,9 @@ class PeriodicSolution:
         interface has contact springs (``U`` is then the contact points'); None otherwise.
     attempts : the attempts of the solve strategy, in order (:class:`Attempt`; the last one
         gave this solution).
+    time_domain : what a time integration found where the balance failed (``"time-start"``
+        of :func:`solve_periodic`; e.g. "quasi-periodic ...: no periodic steady state"), ``""``
+        when none ran.
     """
 
     frequency: float
@@ -234,6 +238,7 @@ class PeriodicSolution:
     flags: list = field(default_factory=list)
     U_node: np.ndarray | None = None
     attempts: list = field(default_factory=list)
+    time_domain: str = ""
 
     @property
     def success(self) -> bool:
@@ -361,8 +366,9 @@ class Attempt:
                    st.message if message is None else message)
 
 
-#: the attempts of :func:`solve_strategy`, in order
-STRATEGY = ("start", "best-point", "eps-continuation", "harmonic-continuation")
+#: the attempts of :func:`solve_strategy`, in order; :func:`solve_periodic` adds
+#: ``"time-start"`` when it is given a time-domain fallback
+STRATEGY = ("start", "best-point", "eps-continuation", "harmonic-continuation", "time-start")
 #: penalties tried by the eps continuation, as factors of the target eps, and the number of
 #: geometric steps back to the target
 EPS_FACTORS = (10.0, 0.1)
@@ -551,7 +557,9 @@ def static_anchor(model: Model, *, quasi: Reduced | None = None, eps="auto") -> 
 def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
                    quasi_static: bool = False, reduced: Reduced | None = None, gap=None,
                    eps="auto", anchor=None, U0=None, solver="powell", tol=1e-8, max_iter=200,
-                   raise_on_failure=False, strategy=STRATEGY) -> PeriodicSolution:
+                   raise_on_failure=False, strategy=STRATEGY,
+                   time_domain: TimeDomainFallback | None = None,
+                   time_domain_periods: int = 3000) -> PeriodicSolution:
     """Periodic response of ``model`` at the excitation ``frequency`` [Hz] with the DLFT
     (section 3.1-3.2).
 
@@ -577,6 +585,16 @@ def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
     strategy : the attempts made until one converges (:func:`solve_strategy`; default all of
         :data:`STRATEGY`; ``("start",)``: the solver alone). Each is recorded in the result's
         ``attempts``.
+    time_domain : a :class:`~fretwear.hb.fallback.TimeDomainFallback`
+        (:data:`fretwear.timedomain.fallback.FALLBACK`, which :func:`fretwear.solve_periodic`
+        passes by default; None: none). When every attempt of ``strategy`` failed, integrate
+        in time from rest for at most ``time_domain_periods`` periods: a periodic steady state
+        starts one more solve (attempt ``"time-start"``, its mean tangential positions as
+        anchors); any other response (drifting, quasi-periodic, subharmonic) is what the result
+        reports (``time_domain``, ``flags``): the solve then failed because there is no periodic
+        state to find, or none the integration reached. Not with ``quasi_static``, a ``gap``
+        other than the model's, contact springs or prescribed normal loads (the time-domain
+        solver models none of these).
 
     Returns
     -------
@@ -600,6 +618,17 @@ def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
     t0 = time.perf_counter()
     x, st = solve_strategy(prob, x0, solver=solver, tol=tol, max_iter=max_iter,
                            attempts=attempts, steps=strategy)
+    found = ""
+    if not st.success and _time_start_applies(model, time_domain, quasi_static, gap, strategy):
+        found, prob2, x2, st2 = _time_start(model, basis, frequency, reduced, prob, time_domain,
+                                            time_domain_periods, solver, tol, max_iter)
+        if st2 is not None:
+            attempts.append(Attempt.of("time-start", prob2.eps, st2))
+            if st2.success or st2.residual < st.residual:
+                prob, x, st = prob2, x2, st2
+        else:
+            attempts.append(Attempt("time-start", solver, prob.eps, False, float("nan"), 0,
+                                    0.0, found))
     st.wall_time = time.perf_counter() - t0
     if not st.success and raise_on_failure:
         from fretwear.errors import ConvergenceError
@@ -611,7 +640,37 @@ def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
         )
     sol = assemble_solution(prob, x.reshape(prob.m, prob.H), model, st)
     sol.attempts = attempts
+    if found:
+        sol.time_domain = found
+        if not sol.success:
+            sol.flags.append(found)
     return sol
+
+
+def _time_start_applies(model: Model, time_domain, quasi_static: bool, gap, strategy) -> bool:
+    if time_domain is None or quasi_static or "time-start" not in strategy:
+        return False
+    if model.contact.has_connectors:  # the time-domain solver has rigid contacts only
+        return False
+    return gap is None or np.array_equal(np.broadcast_to(np.asarray(gap, float),
+                                                         model.contact.gap.shape),
+                                         model.contact.gap)
+
+
+def _time_start(model, basis, frequency, reduced, prob, time_domain, periods, solver, tol,
+                max_iter):
+    """The ``"time-start"`` attempt: ``(message, problem, x, stats)``; ``stats`` None when
+    the integration did not settle to a periodic state (the message says what it does)."""
+    t0 = time.perf_counter()
+    msg, Ut, anchor = time_domain.start(model, frequency, basis, None, max_periods=periods)
+    if Ut is None:
+        return msg, prob, None, None
+    prob2 = DLFTProblem(reduced, model.contact, basis, gap=prob.gap, eps=prob.eps,
+                        anchor=anchor, jacobian=prob.jacobian)
+    x, st = _run(prob2, np.asarray(Ut, float).reshape(prob2.m, prob2.H), solver, tol,
+                 2 * max_iter)
+    st.wall_time = time.perf_counter() - t0
+    return msg, prob2, x, st
 
 
 def _harmonic_continuation_start(model, basis, reduced, prob, solver, tol, max_iter):
