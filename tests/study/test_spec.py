@@ -131,6 +131,27 @@ def test_malformed_study_gets_one_line_and_status_2(tmp_path, capsys, body, word
         assert w in err, (w, err)
 
 
+@pytest.mark.parametrize("address, words", [
+    ("foo", ["scheduler = 'foo'", "missing port", "tcp://host:8786"]),
+    ("tcp://host", ["scheduler = 'tcp://host'", "missing port"]),
+    ("http://host:8786", ["scheduler = 'http://host:8786'", "unknown protocol 'http'"]),
+])
+def test_malformed_scheduler_address_gets_one_line_and_writes_nothing(tmp_path, capsys,
+                                                                      address, words):
+    """A scheduler address Dask cannot parse is refused before any connection is tried (no
+    30 s timeout) and before the output folder is made."""
+    base_case(tmp_path)
+    path = study_file(tmp_path, "[grid]\ncontact.mu = [0.1]\n")
+    out = tmp_path / "out"
+    assert cli.main(["study", str(path), "-o", str(out), "--scheduler", address,
+                     "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("error: ") and "Traceback" not in err, err
+    for w in words:
+        assert w in err, (w, err)
+    assert not out.exists()
+
+
 def test_missing_base_and_missing_study(tmp_path, capsys):
     path = study_file(tmp_path, "[grid]\ncontact.mu = [0.1]\n", base="nowhere.toml")
     assert cli.main(["study", str(path)]) == 2

@@ -14,7 +14,7 @@ from fretwear.files import atomic_write, remove_stale_temporaries
 from fretwear.study.aggregate import aggregate
 from fretwear.study.figures import study_figures
 from fretwear.study.members import expand
-from fretwear.study.runner import dask_client, run_members
+from fretwear.study.runner import check_scheduler_address, dask_client, run_members
 from fretwear.study.spec import Study, read_study
 from fretwear.study.sweep_split import join_chunks
 
@@ -135,6 +135,9 @@ def run_study(path, outdir=None, *, scheduler=None, workers: int | None = None,
     """
     study = read_study(resolve_study(path))
     members = expand(study)
+    address = scheduler if scheduler is not None else study.scheduler
+    if isinstance(address, str) and not collect:
+        check_scheduler_address(address)  # before anything is written
     out_dir = study.output_dir(outdir)
     _check_output(out_dir)
     say = print if echo else (lambda *a, **k: None)

@@ -170,6 +170,24 @@ def _lost(folder: Path, index: int, exc: BaseException | None) -> MemberRecord:
 
 
 # --- the cluster ------------------------------------------------------------------------------
+def check_scheduler_address(address: str) -> None:
+    """A scheduler address Dask can connect to (``tcp://host:8786``, ``tls://...``,
+    ``host:port``...): InputError naming it otherwise, before any connection is tried."""
+    from distributed.comm import registry
+    from distributed.comm.addressing import parse_address, parse_host_port
+
+    expected = ("expected the address of a running scheduler, e.g. tcp://host:8786 "
+                f"(protocols: {', '.join(sorted(registry.backends))})")
+    try:
+        scheme, location = parse_address(str(address))
+        if scheme not in registry.backends:
+            raise ValueError(f"unknown protocol {scheme!r}")
+        if scheme in ("tcp", "tls", "ws", "wss", "ucx"):
+            parse_host_port(location)
+    except (ValueError, TypeError) as exc:
+        raise InputError(f"scheduler = {address!r}: {exc}; {expected}") from None
+
+
 @contextlib.contextmanager
 def dask_client(scheduler=None, workers: int | None = None):
     """A ``distributed.Client``: ``scheduler`` is a Client (used as is), an address
@@ -182,9 +200,10 @@ def dask_client(scheduler=None, workers: int | None = None):
         yield scheduler
         return
     if scheduler is not None:
+        check_scheduler_address(scheduler)
         try:
             client = Client(scheduler, timeout="30s")
-        except (OSError, TimeoutError) as exc:
+        except (OSError, TimeoutError, ValueError) as exc:
             raise InputError(f"cannot connect to the Dask scheduler {scheduler!r} ({exc}): "
                              "expected the address of a running scheduler, e.g. "
                              "tcp://host:8786") from None
