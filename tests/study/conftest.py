@@ -8,16 +8,10 @@ import pytest
 
 @pytest.fixture(scope="module")
 def client():
-    """A LocalCluster of 2 worker processes (1 thread each) shared by a test module."""
-    import logging
+    """The LocalCluster `fretwear study` starts by default
+    (:func:`fretwear.study.runner.dask_client` without a scheduler), with 2 worker processes
+    of 1 thread each, shared by a test module."""
+    from fretwear.study.runner import dask_client
 
-    from distributed import Client, LocalCluster
-
-    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                           dashboard_address=":0", silence_logs=logging.ERROR)
-    c = Client(cluster)
-    try:
+    with dask_client(None, workers=2) as c:
         yield c
-    finally:
-        c.close()
-        cluster.close()

@@ -33,3 +33,15 @@ def test_a_status_without_hash_is_checked_against_the_case_file(tmp_path):
     (ok / "status.json").write_text('{"index": 0, "status": "ok"}')
     assert finished(ok, "a = 1\n") is not None
     assert finished(ok, "a = 2\n") is None
+
+
+def test_default_workers_start_without_dask_memory_trimming(client):
+    """The workers of the default LocalCluster run without Dask's MALLOC_TRIM_THRESHOLD_
+    (it made fretwear's members 30-50 % slower, docs/study.md) and with one BLAS thread."""
+    import os
+
+    envs = client.run(lambda: {k: os.environ.get(k) for k in
+                               ("MALLOC_TRIM_THRESHOLD_", "OMP_NUM_THREADS")})
+    assert len(envs) == 2
+    for env in envs.values():
+        assert env["MALLOC_TRIM_THRESHOLD_"] is None and env["OMP_NUM_THREADS"] == "1"
