@@ -231,6 +231,11 @@ def _solve_at(probs, omega, anchor, U0, solver, tol, max_iter):
     return prob, x.reshape(prob.m, prob.H), st
 
 
+#: Newton iterations of an arclength corrector without halving its best residual after which
+#: the step is shortened (rather than spending the rest of ``max_iter`` on a diverging step)
+STALL_ITERATIONS = 5
+
+
 def _arclength(probs, model, anchor, y_prev, y_last, omega_target, solver_tol, max_steps=20,
                max_iter=20):
     """Pseudo-arclength continuation from ``y_last`` (secant from ``y_prev``) until the
@@ -260,18 +265,30 @@ def _arclength(probs, model, anchor, y_prev, y_last, omega_target, solver_tol, m
             y = yp.copy()
             t0 = time.perf_counter()
             nit = nf = 0
+            fw = None
+            best = []
             for _it in range(max_iter):
                 U, w = y[:-1] * sx, y[-1] * sw
                 prob = probs.get(w, anchor)
                 f, J = prob.residual(U.reshape(prob.m, prob.H))
                 nf += 1
-                dw = 1e-7 * w
-                f2, _ = probs.get(w + dw, anchor).residual(U.reshape(prob.m, prob.H), False)
-                fw = (f2 - f) / dw
+                if fw is None:
+                    # df/dw by a forward difference, once per corrector (a chord: each one
+                    # costs a condensation at w + dw; the residual itself is exact at every
+                    # iterate, so the converged point is the same)
+                    dw = 1e-7 * w
+                    f2, _ = probs.get(w + dw, anchor).residual(U.reshape(prob.m, prob.H),
+                                                               False)
+                    fw = (f2 - f) / dw
                 g = t @ (y - yp)
-                if np.linalg.norm(f) <= solver_tol * prob.scale(U.reshape(prob.m, prob.H)):
+                rel = np.linalg.norm(f) / prob.scale(U.reshape(prob.m, prob.H))
+                if rel <= solver_tol:
                     converged = True
                     break
+                best.append(rel)
+                if len(best) > STALL_ITERATIONS and min(best[-STALL_ITERATIONS:]) > \
+                        0.5 * min(best[:-STALL_ITERATIONS]):
+                    break  # no progress: a shorter step rather than more iterations
                 n = f.size
                 A = np.zeros((n + 1, n + 1))
                 A[:n, :n] = J * sx
@@ -472,6 +489,7 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
             tried.append(Attempt.of("retry", prob.eps, st))
         if not st.success and continuation and len(history) >= 2:
             anc = current_anchor()
+            t_arc = time.perf_counter()
             branch = _arclength(probs, model, anc, (history[-2][1].reshape(-1), history[-2][0]),
                                 (history[-1][1].reshape(-1), history[-1][0]), omega, tol)
             for Ub, wb, stb in branch:
@@ -482,6 +500,10 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
                                         tol, max_iter)
                 how = "arclength"
                 tried.append(Attempt.of("arclength", prob.eps, st))
+            else:
+                tried.append(Attempt("arclength", "arclength", probs.get(omega, anc).eps,
+                                     False, float("nan"), 0, time.perf_counter() - t_arc,
+                                     "the continuation did not reach this frequency"))
         if not st.success:
             # continuation in eps (ending at the sweep's eps: no jump), then in harmonics
             pb = probs.get(omega, current_anchor())
