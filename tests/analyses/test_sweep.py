@@ -59,7 +59,8 @@ def test_sweep_points_that_fail_are_kept_as_nan_with_the_reason(tmp_path, capsys
     assert bad.any() and ds.attrs["converged"] == 0
     assert np.all(np.isnan(ds["response_amplitude"].values[bad]))
     assert all(f.startswith("not converged: ") for f in ds["flags"].values[bad])
-    assert "not converged: maximum number of iterations reached" in out
+    # the reason of the last attempt and how many were made (max_iter = 1 starves them all)
+    assert "Hz: not converged: " in out and " attempts)" in out
     assert ds.attrs["flagged_points"].count("\n") == int(bad.sum()) - 1
 
 

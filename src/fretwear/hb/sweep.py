@@ -31,6 +31,7 @@ from fretwear.hb.periodic import (
     Attempt,
     DLFTProblem,
     PeriodicSolution,
+    _first_harmonic_start,
     assemble_solution,
     check_inputs,
     solve_strategy,
@@ -56,8 +57,8 @@ class SweepPoint:
     frequency_hz : the frequency [Hz]; solution : the converged periodic solution, or None
     when the solve did not converge (a failed solve is never kept as a solution); stats :
     solver statistics of the last solve; how : ``"grid"``, ``"substep"``, ``"retry"``,
-    ``"arclength"``, ``"eps-continuation"``, ``"harmonic-continuation"`` or
-    ``"time-start"``; attempts : every attempt made at this frequency, in order
+    ``"arclength"``, ``"eps-continuation"``, ``"harmonic-continuation"``, ``"fresh-start"``
+    or ``"time-start"``; attempts : every attempt made at this frequency, in order
     (:class:`~fretwear.hb.periodic.Attempt`); flags : reasons for caution
     (``"not converged: ..."``, time-domain findings); on_grid : a requested grid frequency
     (False for the intermediate points the sweep added); time_domain : what the time
@@ -231,6 +232,10 @@ def _solve_at(probs, omega, anchor, U0, solver, tol, max_iter):
     return prob, x.reshape(prob.m, prob.H), st
 
 
+#: iterations of the last attempt of a sweep point before the time integration (a fresh start
+#: as :func:`fretwear.hb.periodic.solve_periodic` makes it), as a multiple of the sweep's
+#: ``max_iter``: 5 x 40 is the single solve's default of 200
+FRESH_ITER_FACTOR = 5
 #: Newton iterations of an arclength corrector without halving its best residual after which
 #: the step is shortened (rather than spending the rest of ``max_iter`` on a diverging step)
 STALL_ITERATIONS = 5
@@ -516,6 +521,24 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
                 prob, U, st, how = pb, Ub, stb, tried[-1].method
             elif len(tried) > n0:
                 st = stb
+        if not st.success:
+            # as a single solve would: from the first harmonic alone with the static anchors,
+            # the solver and the eps continuation with the single solve's iterations (the
+            # neighbour's state can lie on the wrong side of a jump of the mean position)
+            pb = probs.get(omega, anchor)
+            U1 = _first_harmonic_start(pb, solver, tol, FRESH_ITER_FACTOR * max_iter)
+            tried.append(Attempt("fresh-start", solver, pb.eps, U1 is not None, float("nan"),
+                                 0, 0.0, "the first harmonic alone" + ("" if U1 is not None
+                                                                       else " did not converge")))
+            if U1 is not None:
+                n0 = len(tried)
+                Ub, stb = solve_strategy(pb, U1, solver=solver, tol=tol,
+                                         max_iter=FRESH_ITER_FACTOR * max_iter, attempts=tried,
+                                         steps=("start", "eps-continuation"))
+                if stb.success:
+                    prob, U, st, how = pb, Ub, stb, "fresh-start"
+                elif len(tried) > n0:
+                    st = stb
         td_msg = None
         if not st.success and time_domain is not None:
             td_msg, Ut, anc_t = time_domain.start(model, f, basis, last_solution[0],
