@@ -15,6 +15,7 @@ stop at a different point.
 
 import numpy as np
 import pytest
+from helpers.blocks import block
 
 from fretwear.hb import contact as law
 from fretwear.hb import krylov
@@ -23,32 +24,6 @@ from fretwear.hb.krylov import KrylovJacobian
 from fretwear.hb.periodic import DLFTProblem, static_anchor
 from fretwear.hb.reduce import condense
 from fretwear.hb.solvers import solve
-from fretwear.model import ContactSpec, Material, Spring, Traction, box, from_mesh, rectangle
-
-P0, MU = 1e6, 0.5  # Pa, -
-
-
-def block(dim):
-    """A steel block on a rigid flat, pressed by P0, under a cyclic tangential traction (mu P0
-    in 3D, 0.5 mu P0 in 2D) and a cyclic normal traction growing along x to 1.3 P0 (in
-    quadrature), so that the edge at large x lifts off during part of the period while the
-    other edge sticks."""
-    a = 0.01
-    if dim == 2:
-        mesh, top, bottom = rectangle(a, 0.004, 6, 2), "top", "bottom"
-        cyc, lift = (0.5 * MU * P0, 0.0), (lambda x: np.column_stack([0 * x[:, 0],
-                                                                      1.3 * P0 * x[:, 0] / a]))
-        springs = [Spring(top, "x", 1e7)]
-    else:
-        mesh, top, bottom = box(a, a, 0.005, 4, 4, 1), "zmax", "zmin"
-        cyc = (MU * P0, 0.0, 0.0)
-        lift = (lambda x: np.column_stack([0 * x[:, 0], 0 * x[:, 0], 1.3 * P0 * x[:, 0] / a]))
-        springs = [Spring(top, "x", 1e7), Spring(top, "y", 1e7)]
-    return from_mesh(mesh, Material(210e9, 0.3, 7800.0), springs=springs,
-                     loads=[Traction(top, pressure=P0),
-                            Traction(top, traction=cyc, waveform="cos"),
-                            Traction(top, traction=lift, waveform="sin")],
-                     contact=ContactSpec(bottom, mu=MU))
 
 
 def problem(model, jacobian, nh=3):
@@ -148,3 +123,21 @@ def test_harmonic_blocks_products_equal_real_blocks(symmetric):
     np.testing.assert_allclose(hb.apply(U).reshape(-1), Zd @ U.reshape(-1), rtol=0, atol=1e-13 * 50)
     np.testing.assert_allclose(hb.apply_T(U).reshape(-1), Zd.T @ U.reshape(-1), rtol=0,
                                atol=1e-13 * 50)
+
+
+def test_arclength_step_with_the_operator_equals_the_bordered_lu(case):
+    """The arclength Newton step of a sweep with the operator Jacobian (block elimination, two
+    solves) equals the LU of the formed bordered matrix (numpy.linalg.solve on the dense
+    path's Jacobian): 1e-9 relative, the accuracy of the step (test above)."""
+    from fretwear.hb.sweep import _bordered_step
+
+    model, x = case
+    dense, op = problem(model, "dense"), problem(model, "krylov")
+    x1 = 0.9 * x
+    f, J = dense.residual(x1.reshape(dense.m, dense.H), True)
+    _, Jo = op.residual(x1.reshape(op.m, op.H), True)
+    rng = np.random.default_rng(4)
+    fw, t = rng.standard_normal(f.size), rng.standard_normal(f.size + 1)
+    ref = _bordered_step(J, f, fw, 0.3, t, 2.0, 5.0)
+    got = _bordered_step(Jo, f, fw, 0.3, t, 2.0, 5.0)
+    assert np.abs(got - ref).max() <= 1e-9 * np.abs(ref).max()

@@ -96,3 +96,20 @@ def test_point_passed_by_eps_continuation_keeps_the_sweep_eps_and_its_attempts()
     U = p.solution.U.reshape(prob.m, prob.H)
     fres, _ = prob.residual(U, jacobian=False)
     assert np.linalg.norm(fres) <= 1e-8 * prob.scale(U)
+
+
+def test_reduced_models_kept_within_the_memory_budget(monkeypatch):
+    """The sweep's cache of reduced models keeps at most CACHE_SIZE of them and no more bytes
+    than CACHE_BYTES, always the newest (counted against the models' own sizes)."""
+    from fretwear.hb import sweep as sw
+
+    model = closed_block()
+    probs = sw._Problems(model, BASIS, None, 1e9)
+    one = probs.get(2 * np.pi * 1000.0, None).reduced.Z.nbytes
+    monkeypatch.setattr(sw, "CACHE_BYTES", int(2.5 * one))
+    for f in (1100.0, 1200.0, 1300.0):
+        probs.get(2 * np.pi * f, None)
+    assert list(probs.cache) == [2 * np.pi * 1200.0, 2 * np.pi * 1300.0]
+    monkeypatch.setattr(sw, "CACHE_BYTES", one // 2)  # smaller than one: the newest only
+    probs.get(2 * np.pi * 1400.0, None)
+    assert list(probs.cache) == [2 * np.pi * 1400.0]

@@ -84,6 +84,43 @@ class HarmonicBlocks:
                 for z in self.Zc)
         return self._symmetric
 
+    def apply_sub(self, rows: np.ndarray, cols: np.ndarray, U: np.ndarray) -> np.ndarray:
+        """``(Z~ U)`` on the DOFs ``rows`` for ``U`` (len(cols), H, r) non-zero on the DOFs
+        ``cols`` only (several right-hand sides): (len(rows), H, r). Harmonics on which ``U``
+        vanishes are skipped."""
+        k, r = self.k, U.shape[2]
+        out = np.zeros((rows.size, self.H, r))
+        if not (rows.size and cols.size):
+            return out
+        if np.any(U[:, 0]):
+            out[:, 0] = self.Z0[np.ix_(rows, cols)] @ U[:, 0]
+        for b in range(1, k + 1):
+            c = U[:, b] - 1j * U[:, k + b]
+            if np.any(c):
+                y = self.Zc[b][np.ix_(rows, cols)] @ c
+                out[:, b], out[:, k + b] = y.real, -y.imag
+        return out
+
+    def node_rows(self, V: np.ndarray) -> np.ndarray:
+        """``sum_i V[p, i] Z~[p dH + i, :]`` for every node ``p``: (nc, m H) from ``V``
+        (nc, d H) (node-major rows ``(DOF, coefficient)``; the node blocks of a row vector
+        times ``Z~``, e.g. the wear rate's gradient), ``(k + 1) m^2`` operations instead of
+        the ``(m H)^2`` real matrix."""
+        m, H, k = self.m, self.H, self.k
+        nc = V.shape[0]
+        d = m // nc
+        V = V.reshape(nc, d, H)
+        out = np.empty((nc, m, H))
+        out[:, :, 0] = np.einsum("pi,pij->pj", V[:, :, 0], self.Z0.reshape(nc, d, m))
+        for b in range(1, k + 1):
+            # row (r, a_n) of Z~ is [Re Z_n, Im Z_n], row (r, b_n) is [-Im Z_n, Re Z_n]:
+            # (V_a + i V_b) Z_n gives the a-columns in its real part, the b-columns in its
+            # imaginary part
+            w = V[:, :, b] + 1j * V[:, :, k + b]
+            y = np.einsum("pi,pij->pj", w, self.Zc[b].reshape(nc, d, m))
+            out[:, :, b], out[:, :, k + b] = y.real, y.imag
+        return out.reshape(nc, m * H)
+
     def apply_T(self, U) -> np.ndarray:
         """``Z~^T U`` (m, H): the real form of the conjugate transposes ``Z_n^H``."""
         if self.symmetric():
@@ -119,16 +156,23 @@ class MeanGainPreconditioner:
     """
 
     def __init__(self, gbar: np.ndarray, Z: HarmonicBlocks, eps: float):
+        self.Z, self.k, self.m, self.H = Z, Z.k, Z.m, Z.H
+        self.lu0 = sla.lu_factor(self._block(gbar, Z.Z0, eps), overwrite_a=True,
+                                 check_finite=False)
+        self.lus = [sla.lu_factor(self._block(gbar, Z.Zc[b], eps), overwrite_a=True,
+                                  check_finite=False) for b in range(1, Z.nb)]
+
+    @staticmethod
+    def _block(gbar, Zn, eps):
+        """``eps I + gbar (Z_n - eps I)`` with ``gbar`` applied node block by node block
+        (``d m^2`` operations, not the ``m^3`` of a dense product)."""
         nc, d, _ = gbar.shape
-        m = Z.m
-        g = np.zeros((m, m))
-        for p in range(nc):
-            g[p * d : (p + 1) * d, p * d : (p + 1) * d] = gbar[p]
-        self.Z, self.k, self.m, self.H = Z, Z.k, m, Z.H
-        I = np.eye(m)
-        self.lu0 = sla.lu_factor(eps * I + g @ (Z.Z0 - eps * I), check_finite=False)
-        self.lus = [sla.lu_factor(eps * I + g @ (Z.Zc[b] - eps * I), check_finite=False)
-                    for b in range(1, Z.nb)]
+        m = Zn.shape[0]
+        P = np.matmul(gbar, Zn.reshape(nc, d, m)).reshape(m, m)
+        idx = np.arange(nc)
+        P.reshape(nc, d, nc, d)[idx, :, idx, :] -= eps * gbar
+        P[np.diag_indices(m)] += eps
+        return P
 
     def apply(self, r) -> np.ndarray:
         r = np.asarray(r).reshape(self.m, self.H)
@@ -183,32 +227,53 @@ class KrylovJacobian:
         exact: column ``(j, c)`` of ``Z~`` has non-zeros in the coefficients ``cs`` of its
         harmonic only, so ``|G Z~ e|^2 = sum_p z_p^T (G_p,cs^T G_p,cs) z_p`` with the small
         Gram matrices of the node blocks, plus the ``eps (I - G)`` term of the column's own
-        node: ``4 d^2 nc n`` operations and no ``n x n`` intermediate."""
+        node: ``4 d^2 nc n`` operations and no ``n x n`` intermediate. The real columns of
+        harmonic ``n`` are read in place from ``Re Z_n``, ``Im Z_n`` (no copies)."""
         Z, G, eps, d = self.Z, self.G, self.eps, self.d
         H, nc, dH, m = Z.H, self.nc, self.dH, Z.m
         Gr = G.reshape(nc, dH, d, H)
         out = np.zeros((m, H))
+
+        def quad(M, x, y):  # sum_p x_p^T M_p y_p per column, x, y (nc, d, ncol)
+            return np.einsum("pic,pic->c", x, np.matmul(M, y))
+
         for b in range(Z.nb):
             cs = [0] if b == 0 else [b, Z.k + b]
             nl = len(cs)
             Gs = np.ascontiguousarray(Gr[:, :, :, cs].reshape(nc, dH, d * nl))
             gram = np.matmul(np.transpose(Gs, (0, 2, 1)), Gs)  # (nc, d nl, d nl)
             for j0 in range(0, m, chunk):
-                js = np.arange(j0, min(j0 + chunk, m))
-                Zs, _ = Z.columns(b, js)  # (m, nl, ncol), rows (DOF, coef in cs)
-                Zp = Zs.reshape(nc, d * nl, -1)
-                sq = np.einsum("pac,pac->c", np.matmul(gram, Zp), Zp)  # |G Z~ e|^2
+                sl = slice(j0, min(j0 + chunk, m))
+                js = np.arange(sl.start, sl.stop)
+                if b == 0:
+                    x = Z.Z0[:, sl].reshape(nc, d, -1)
+                    sq = quad(gram, x, x)[:, None]
+                else:
+                    zb = Z.Zc[b][:, sl]
+                    x, y = zb.real.reshape(nc, d, -1), zb.imag.reshape(nc, d, -1)
+                    A, B, D = gram[:, 0::2, 0::2], gram[:, 0::2, 1::2], gram[:, 1::2, 1::2]
+                    # column (j, a_n): entries (x, -y); column (j, b_n): entries (y, x)
+                    xAx, yAy, xDx, yDy = quad(A, x, x), quad(A, y, y), quad(D, x, x), \
+                        quad(D, y, y)
+                    xBy = quad(B, x, y)
+                    yBx = quad(B, y, x)
+                    sq = np.column_stack([xAx - 2.0 * xBy + yDy, yAy + 2.0 * yBx + xDx])
                 # + eps (I - G) on the owner's block: column (j, c) -> node j // d, row j%d, c
-                jj = np.repeat(js, nl)
-                cc = np.tile(cs, js.size)
-                q, row = jj // d, (jj % d) * H + cc
-                ci = np.arange(jj.size)
-                g = np.einsum("cij,cj->ci", Gs[q], Zp[q, :, ci])  # (ncol, dH): G_q z_q
-                e = -eps * G[q, :, row]
-                e[ci, row] += eps
-                sq += 2.0 * np.einsum("ci,ci->c", g, e) + np.einsum("ci,ci->c", e, e)
-                out[js[:, None], np.array(cs)[None, :]] = np.sqrt(
-                    np.maximum(sq, 0.0)).reshape(js.size, nl)
+                q = js // d
+                ci = np.arange(js.size)
+                if b == 0:
+                    zz = [x[q, :, ci]]  # (ncol, d nl): the column's entries at its node
+                else:
+                    xo, yo = x[q, :, ci], y[q, :, ci]
+                    zz = [np.stack([xo, -yo], axis=2).reshape(js.size, d * nl),
+                          np.stack([yo, xo], axis=2).reshape(js.size, d * nl)]
+                for t, c in enumerate(cs):
+                    row = (js % d) * H + c
+                    g = np.einsum("cij,cj->ci", Gs[q], zz[t])  # (ncol, dH): G_q z_q
+                    e = -eps * G[q, :, row]
+                    e[ci, row] += eps
+                    sq[:, t] += 2.0 * np.einsum("ci,ci->c", g, e) + np.einsum("ci,ci->c", e, e)
+                out[js, np.array(cs)[:, None]] = np.sqrt(np.maximum(sq, 0.0)).T
         return out.reshape(-1)
 
     def toarray(self) -> np.ndarray:
@@ -268,11 +333,14 @@ class KrylovJacobian:
         if not act.size:
             return x.reshape(shape)
         x[act] = 0.0
-        # G_a Z_as x_s: the product with the stuck part only
-        ZX = np.column_stack([Z.apply(x[:, :, c].reshape(-1)).reshape(-1) for c in range(k)])
-        rhs = B.reshape(self.nc, dH, k)[act] - np.matmul(
-            self.G[act], ZX.reshape(self.nc, dH, k)[act])
+        # G_a Z_as x_s: the product with the stuck part only, on the active rows, from the
+        # stuck DOFs where x_s is not zero (one column per node for the wear rate's dU/dW)
         dofs = (act[:, None] * d + np.arange(d)[None, :]).reshape(-1)
+        xs = x.reshape(Z.m, Z.H, k)
+        cols = np.flatnonzero(np.any(xs != 0.0, axis=(1, 2)))
+        ZX = Z.apply_sub(dofs, cols, xs[cols])  # (na d, H, k) = rows of the active nodes
+        rhs = B.reshape(self.nc, dH, k)[act] - np.matmul(
+            self.G[act], ZX.reshape(act.size, dH, k))
         Za = HarmonicBlocks(Z.Zc[:, dofs][:, :, dofs]).dense()  # (na dH, na dH) DOF-major
         na = act.size
         Ja = np.matmul(self.G[act], Za.reshape(na, dH, na * dH)).reshape(na * dH, na * dH)

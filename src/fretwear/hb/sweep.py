@@ -175,11 +175,20 @@ def frequency_grid(f_min: float, f_max: float, n: int, spacing: str = "log") -> 
     return np.linspace(f_min, f_max, n)
 
 
+#: reduced models a sweep keeps (it revisits the last few frequencies: sub-steps, retries,
+#: arclength) at most, and the memory they may take together [bytes]: at 1024 contact nodes
+#: and 7 harmonics one reduced model is 1.2 GB, so two are kept there (docs/theory.md,
+#: "Large interfaces")
+CACHE_SIZE = 8
+CACHE_BYTES = 3 * 2**30
+
+
 class _Problems:
-    """DLFT problems per frequency, condensed once and cached (the sweep revisits them).
+    """DLFT problems per frequency, condensed once and cached (the sweep revisits them): at
+    most ``cache_size`` reduced models and :data:`CACHE_BYTES` of them (the newest always).
     ``eps``: a number [N/m], or ``"auto"`` (the spectral radius of each frequency's ``Z_r``)."""
 
-    def __init__(self, model, basis, gap, eps, cache_size=8):
+    def __init__(self, model, basis, gap, eps, cache_size=CACHE_SIZE):
         self.model, self.basis, self.gap, self.eps = model, basis, gap, eps
         self.orders = np.array([0, *basis.harmonics])
         self.cache: dict = {}
@@ -192,7 +201,8 @@ class _Problems:
         red = self.cache.get(key)
         if red is None:
             red = _condense(self.model, omega, self.orders)
-            if len(self.cache) >= self.size:
+            while self.cache and (len(self.cache) >= self.size or red.Z.nbytes + sum(
+                    r.Z.nbytes for r in self.cache.values()) > CACHE_BYTES):
                 self.cache.pop(next(iter(self.cache)))
             self.cache[key] = red
         return DLFTProblem(red, self.model.contact, self.basis, gap=self.gap, eps=self.eps,
@@ -294,14 +304,8 @@ def _arclength(probs, model, anchor, y_prev, y_last, omega_target, solver_tol, m
                 if len(best) > STALL_ITERATIONS and min(best[-STALL_ITERATIONS:]) > \
                         0.5 * min(best[:-STALL_ITERATIONS]):
                     break  # no progress: a shorter step rather than more iterations
-                n = f.size
-                A = np.zeros((n + 1, n + 1))
-                A[:n, :n] = J * sx
-                A[:n, n] = fw * sw
-                A[n] = t
-                rhs = -np.concatenate([f, [g]])
                 try:
-                    dy = np.linalg.solve(A, rhs)
+                    dy = _bordered_step(J, f, fw, g, t, sx, sw)
                 except np.linalg.LinAlgError:
                     break
                 y = y + dy
@@ -325,6 +329,26 @@ def _arclength(probs, model, anchor, y_prev, y_last, omega_target, solver_tol, m
         if nit <= 3:
             ds *= 1.5
     return out
+
+
+def _bordered_step(J, f, fw, g, t, sx, sw):
+    """The Newton step ``dy`` of the arclength system ``[[J sx, fw sw], [t]] dy = -[f, g]``
+    (scaled variables): by LU of the bordered matrix for a formed Jacobian, by block
+    elimination with two solves of ``J`` for the operator of large interfaces
+    (:class:`~fretwear.hb.krylov.KrylovJacobian`)."""
+    n = f.size
+    if isinstance(J, np.ndarray):
+        A = np.zeros((n + 1, n + 1))
+        A[:n, :n] = J * sx
+        A[:n, n] = fw * sw
+        A[n] = t
+        return np.linalg.solve(A, -np.concatenate([f, [g]]))
+    a, b = J.solve(np.column_stack([-f, fw * sw])).T  # J a = -f, J b = fw sw
+    den = t[n] - t[:n] @ b / sx
+    if not np.isfinite(den) or den == 0.0:
+        raise np.linalg.LinAlgError("singular bordered system")
+    dw = (-g - t[:n] @ a / sx) / den
+    return np.concatenate([(a - dw * b) / sx, [dw]])
 
 
 def _band(eps_band) -> tuple[float, float]:
