@@ -13,12 +13,15 @@ a dense matrix of the Jacobian's size fits in 4 GiB, one dense LU of that size t
 same process (what the dense path pays per iteration). CPU seconds of the process are
 printed beside wall seconds: the machine is shared.
 
-eps: a number, the largest diagonal entry of the static ``K_r`` (``eps="auto"``/``"static"``
-take every eigenvalue of every block, minutes at 1024 nodes: see the report of the penalty
-rule).
+eps: the default rule of each driver (``"auto"`` for the periodic solve and the wear run,
+``"top"`` for the sweep; fretwear.hb.penalty: a power-iteration estimate of the spectral radius
+above 256 rows), its cost included in the times.
 
-Optionally (``--sweep N`` / ``--wear N``) it times a sweep of N points from 4 to 6 kHz and a
-wear run of N slow steps at the largest size given to ``--extras-size``.
+Optionally (``--sweep N`` / ``--wear N``) it times a sweep of N points from 4 to 6 kHz (default
+options) and a wear run of N slow steps (explicit Euler with the adaptive jump: the
+linearly implicit default needs one solve per contact node for its slow Jacobian, see
+docs/theory.md "Large interfaces") at the size given to ``--extras-size``, each writing its
+checkpoint (sweep-checkpoint.npz, wear-checkpoint.npz, sizes printed) into a temporary folder.
 
 The last lines read ``solve_1024_s=``, ``condense_1024_s=`` and ``peak_rss_1024_gib=`` (CPU
 seconds and GiB of the 32 x 32 size, when it was run).
@@ -35,6 +38,7 @@ import os
 import resource
 import subprocess
 import sys
+import tempfile
 import time
 
 import numpy as np
@@ -96,35 +100,41 @@ def one(n: int, extras: dict) -> dict:
                    modal_vs_exact=float(max(np.abs(red.Z[b] - ex.Z[b]).max()
                                             / np.abs(ex.Z[b]).max() for b in range(H + 1))))
         del ex
-    eps = float(np.abs(np.diag(red.Z[0].real)).max())
-    out["eps"] = eps
     with Clock() as c:
-        anchor = static_anchor(model, eps=eps)  # the static preload state
-        sol = solve_periodic(model, basis, frequency=FREQ, reduced=red, eps=eps, anchor=anchor)
+        anchor = static_anchor(model)  # the static preload state (default eps)
+        sol = solve_periodic(model, basis, frequency=FREQ, reduced=red, anchor=anchor)
+    out["eps"] = sol.eps
     st = sol.stats
     frac = sol.state_fractions().mean(axis=0)
     out.update(solve_cpu=c.cpu, solve_wall=c.wall, success=sol.success, iterations=st.iterations,
                residual=st.residual, sep=frac[0], stick=frac[1], slip=frac[2],
                active_nodes=int(np.sum(np.any(sol.state != 1, axis=1))))
     out["peak_gib"] = peak_gib()  # condensation + solve
+    tmp = tempfile.mkdtemp(prefix="scale3d-")
     if extras.get("sweep"):
         from fretwear.hb.sweep import sweep
 
+        ck = os.path.join(tmp, "sweep-checkpoint.npz")
         with Clock() as c:
             res = sweep(model, basis, 4000.0, 6000.0, extras["sweep"], spacing="linear",
-                        eps=eps, anchor=sol.anchor)
+                        anchor=sol.anchor, checkpoint=ck)
         out.update(sweep_points=extras["sweep"], sweep_cpu=c.cpu, sweep_wall=c.wall,
-                   sweep_converged=int(sum(p.success for p in res.points)))
+                   sweep_converged=int(sum(p.success for p in res.points)),
+                   sweep_ckpt_mib=os.path.getsize(ck) / 2**20,
+                   peak_sweep_gib=peak_gib())
     if extras.get("wear"):
         from fretwear.wear.options import WearOptions
         from fretwear.wear.simulate import simulate_wear
 
+        ck = os.path.join(tmp, "wear-checkpoint.npz")
         with Clock() as c:
-            wr = simulate_wear(model, basis, frequency=FREQ, reduced=red, eps=eps,
-                               anchor=sol.anchor, U0=sol.U,
-                               options=WearOptions(max_steps=extras["wear"]))
-        out.update(wear_steps=len(wr.history.cycles) if hasattr(wr, "history") else None,
-                   wear_cpu=c.cpu, wear_wall=c.wall, wear_success=bool(wr.success))
+            wr = simulate_wear(model, basis, frequency=FREQ, reduced=red, anchor=sol.anchor,
+                               U0=sol.U, checkpoint=ck,
+                               options=WearOptions(max_steps=extras["wear"],
+                                                   scheme="explicit", checkpoint_every_s=0.0))
+        out.update(wear_steps=len(wr.history.cycles) - 1, wear_cpu=c.cpu, wear_wall=c.wall,
+                   wear_success=bool(wr.success), wear_message=wr.message,
+                   wear_ckpt_mib=os.path.getsize(ck) / 2**20)
     out["peak_extras_gib"] = peak_gib()
     nu = out["unknowns"]
     if 8.0 * nu * nu <= 4 * 2**30:  # last: its memory is not the solve's
@@ -168,7 +178,7 @@ def main():
                   f"wall; modal vs exact max rel. difference {r['modal_vs_exact']:.2g}")
         print(f"  periodic solve: {r['solve_cpu']:.1f} s CPU, {r['solve_wall']:.1f} s wall, "
               f"success {r['success']}, {r['iterations']} iterations (after the 1-harmonic "
-              f"start), residual {r['residual']:.2g}; states sep/stick/slip "
+              f"start), residual {r['residual']:.2g}, eps {r['eps']:.3g} N/m (default rule); states sep/stick/slip "
               f"{r['sep']:.3f}/{r['stick']:.3f}/{r['slip']:.3f}, {r['active_nodes']} nodes "
               "slip or separate")
         if "dense_lu_cpu" in r:
@@ -179,10 +189,13 @@ def main():
                   f"({8 * r['unknowns'] ** 2 / 2**30:.0f} GiB)")
         if "sweep_cpu" in r:
             print(f"  sweep of {r['sweep_points']} points: {r['sweep_cpu']:.1f} s CPU, "
-                  f"{r['sweep_wall']:.1f} s wall, {r['sweep_converged']} converged")
+                  f"{r['sweep_wall']:.1f} s wall, {r['sweep_converged']} converged, "
+                  f"peak {r['peak_sweep_gib']:.2f} GiB, sweep-checkpoint.npz "
+                  f"{r['sweep_ckpt_mib']:.1f} MiB")
         if "wear_cpu" in r:
-            print(f"  wear run ({r['wear_steps']} slow steps): {r['wear_cpu']:.1f} s CPU, "
-                  f"{r['wear_wall']:.1f} s wall, success {r['wear_success']}")
+            print(f"  wear run ({r['wear_steps']} slow steps, explicit): {r['wear_cpu']:.1f} s "
+                  f"CPU, {r['wear_wall']:.1f} s wall, success {r['wear_success']} "
+                  f"({r['wear_message']}), wear-checkpoint.npz {r['wear_ckpt_mib']:.1f} MiB")
         print(f"  peak memory {r['peak_gib']:.2f} GiB (condensation + solve), "
               f"{r['peak_extras_gib']:.2f} GiB with the sweep and wear run")
     if 16 in rows and 32 in rows:

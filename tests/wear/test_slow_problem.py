@@ -66,3 +66,18 @@ def test_slow_jacobian_equals_dense_path(case, monkeypatch, step):
     assert op._epsI_Z is None  # the n x n matrix was never formed
     assert np.abs(dUdW - dUdW0).max() <= 1e-8 * np.abs(dUdW0).max()
     assert np.abs(Js - Js0).max() <= 1e-8 * np.abs(Js0).max()
+
+
+def test_slow_radius_from_products_equals_the_eigenvalues(case, monkeypatch):
+    """With the GMRES step the spectral radius of the slow Jacobian comes from ARPACK on its
+    products (no nc solves); it equals the largest |eigenvalue| of the dense path's formed
+    slow Jacobian (numpy.linalg.eigvals) to the 1e-3 asked of ARPACK."""
+    U = case[4]
+    ref = slow(case, monkeypatch, False)
+    assert not ref.needs_iterative_solves(U)
+    rho0 = float(np.max(np.abs(np.linalg.eigvals(ref.slow_jacobian(U)))))
+    assert ref.slow_radius(U) == rho0
+    monkeypatch.setattr(krylov, "ACTIVE_DENSE_MAX", -1)
+    op = slow(case, monkeypatch, True)
+    assert op.needs_iterative_solves(U)
+    assert abs(op.slow_radius(U) - rho0) <= 1e-3 * rho0

@@ -156,7 +156,7 @@ class MeanGainPreconditioner:
     """
 
     def __init__(self, gbar: np.ndarray, Z: HarmonicBlocks, eps: float):
-        self.Z, self.k, self.m, self.H = Z, Z.k, Z.m, Z.H
+        self.k, self.m, self.H = Z.k, Z.m, Z.H  # (no reference to Z: kept across sweeps)
         self.lu0 = sla.lu_factor(self._block(gbar, Z.Z0, eps), overwrite_a=True,
                                  check_finite=False)
         self.lus = [sla.lu_factor(self._block(gbar, Z.Zc[b], eps), overwrite_a=True,

@@ -193,6 +193,7 @@ class _Problems:
         self.orders = np.array([0, *basis.harmonics])
         self.cache: dict = {}
         self.size = cache_size
+        self.last = None  # the last problem handed out
 
     def get(self, omega: float, anchor) -> DLFTProblem:
         """The problem at the circular frequency ``omega`` [rad/s] (the continuation
@@ -205,8 +206,14 @@ class _Problems:
                     r.Z.nbytes for r in self.cache.values()) > CACHE_BYTES):
                 self.cache.pop(next(iter(self.cache)))
             self.cache[key] = red
-        return DLFTProblem(red, self.model.contact, self.basis, gap=self.gap, eps=self.eps,
+        prob = DLFTProblem(red, self.model.contact, self.basis, gap=self.gap, eps=self.eps,
                            anchor=anchor)
+        # the GMRES preconditioner of large interfaces (fretwear.hb.krylov) is carried from
+        # the neighbouring frequency: GMRES still solves each step to its tolerance, and
+        # rebuilds it when it has become slow
+        prob._precond = getattr(self.last, "_precond", None)
+        self.last = prob
+        return prob
 
 
 def rebuild_point(model: Model, basis: FourierBasis, gap, entry: dict) -> SweepPoint:

@@ -65,8 +65,7 @@ def first_state(sp: SlowProblem, W0, anchor, U0, opts: WearOptions) -> tuple[dic
     g = sp.rate(U)
     rho = 0.0
     if np.any(g > 0):
-        ev = np.linalg.eigvals(sp.slow_jacobian(U))
-        rho = float(np.max(np.abs(ev)))
+        rho = sp.slow_radius(U)
     stab = 2.0 / rho if rho > 0 else math.inf
     if opts.initial_jump is not None:
         jump = float(opts.initial_jump)

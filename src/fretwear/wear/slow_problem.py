@@ -164,6 +164,45 @@ class SlowProblem:
         Js = np.diag(gW) + gU @ dUdW
         return (Js, dUdW) if with_dUdW else Js
 
+    def needs_iterative_solves(self, U) -> bool:
+        """Whether the balance's step at ``U`` is solved by GMRES (operator path, active set
+        above :data:`fretwear.hb.krylov.ACTIVE_DENSE_MAX`): then the slow Jacobian costs one
+        iterative solve per contact node and :meth:`slow_radius` estimates its spectral
+        radius from products instead."""
+        from fretwear.hb.krylov import ACTIVE_DENSE_MAX
+
+        if self.prob.jacobian == "dense":
+            return False
+        _, J = self.balance(U, True)
+        return (not isinstance(J, np.ndarray)
+                and J.active_nodes().size * self.dH > ACTIVE_DENSE_MAX)
+
+    def slow_radius(self, U) -> float:
+        """Spectral radius of the slow Jacobian ``Js`` at ``U`` (explicit Euler's stability
+        limit ``2 / rho``): the eigenvalues of :meth:`slow_jacobian`, or, when the step is
+        iterative (:meth:`needs_iterative_solves`), ARPACK on the products
+        ``Js v = dg/dW v - dg/dU~ J^-1 (df/dW v)`` (one solve each, to 1e-3 relative: a
+        bound on the jump, not a result)."""
+        if self.nc < 4 or not self.needs_iterative_solves(U):  # (ARPACK: k < nc - 1)
+            return float(np.max(np.abs(np.linalg.eigvals(self.slow_jacobian(U)))))
+        import scipy.sparse.linalg as spla
+
+        _, J = self.balance(U, True)
+        _, gU, gW, (lu, lx, state) = self.rate_and_gradient(U)
+        dfdW = self.dfdW(lu, lx, state)
+
+        def product(v):
+            v = np.real(np.asarray(v)).reshape(-1)
+            return gW * v - gU @ J.solve(dfdW @ v)
+
+        op = spla.LinearOperator((self.nc, self.nc), matvec=product, dtype=float)
+        try:
+            lam = spla.eigs(op, k=1, which="LM", tol=1e-3, return_eigenvectors=False,
+                            v0=np.ones(self.nc))
+        except spla.ArpackNoConvergence as e:
+            lam = e.eigenvalues
+        return float(np.max(np.abs(lam))) if np.size(lam) else 0.0
+
     # -- solves --------------------------------------------------------------------------
     def solve_balance(self, W, anchor, U0, *, solver, tol, max_iter, fast=True):
         """Periodic solution at wear ``W`` from ``U0``: ``(U (m, H), stats)``.
