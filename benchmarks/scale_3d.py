@@ -178,7 +178,8 @@ def main():
                   f"wall; modal vs exact max rel. difference {r['modal_vs_exact']:.2g}")
         print(f"  periodic solve: {r['solve_cpu']:.1f} s CPU, {r['solve_wall']:.1f} s wall, "
               f"success {r['success']}, {r['iterations']} iterations (after the 1-harmonic "
-              f"start), residual {r['residual']:.2g}, eps {r['eps']:.3g} N/m (default rule); states sep/stick/slip "
+              f"start), residual {r['residual']:.2g}, eps {r['eps']:.3g} N/m (default rule); "
+              "states sep/stick/slip "
               f"{r['sep']:.3f}/{r['stick']:.3f}/{r['slip']:.3f}, {r['active_nodes']} nodes "
               "slip or separate")
         if "dense_lu_cpu" in r:

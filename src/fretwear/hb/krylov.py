@@ -228,36 +228,40 @@ class KrylovJacobian:
         harmonic only, so ``|G Z~ e|^2 = sum_p z_p^T (G_p,cs^T G_p,cs) z_p`` with the small
         Gram matrices of the node blocks, plus the ``eps (I - G)`` term of the column's own
         node: ``4 d^2 nc n`` operations and no ``n x n`` intermediate. The real columns of
-        harmonic ``n`` are read in place from ``Re Z_n``, ``Im Z_n`` (no copies)."""
+        harmonic ``n`` are read a block at a time from ``Re Z_n``, ``Im Z_n``, both columns
+        ``(a_n, b_n)`` of a DOF from the same block."""
         Z, G, eps, d = self.Z, self.G, self.eps, self.d
         H, nc, dH, m = Z.H, self.nc, self.dH, Z.m
         Gr = G.reshape(nc, dH, d, H)
         out = np.zeros((m, H))
 
-        def quad(M, x, y):  # sum_p x_p^T M_p y_p per column, x, y (nc, d, ncol)
-            return np.einsum("pic,pic->c", x, np.matmul(M, y))
+        def quad(M, X):  # X_p^T M_p X_p per column, summed over the nodes; X (nc, r, ncol)
+            return np.einsum("pic,pic->c", X, np.matmul(M, X))
 
         for b in range(Z.nb):
             cs = [0] if b == 0 else [b, Z.k + b]
             nl = len(cs)
             Gs = np.ascontiguousarray(Gr[:, :, :, cs].reshape(nc, dH, d * nl))
             gram = np.matmul(np.transpose(Gs, (0, 2, 1)), Gs)  # (nc, d nl, d nl)
+            if b:
+                # in the order [Re rows; Im rows] of X = [x; y] (x = Re Z_n, y = Im Z_n):
+                # column (j, a_n) has entries (x, -y), column (j, b_n) entries (y, x), both
+                # interleaved per DOF in gram's order (DOF, coefficient)
+                g5 = gram.reshape(nc, d, 2, d, 2)
+                A, B, D = g5[:, :, 0, :, 0], g5[:, :, 0, :, 1], g5[:, :, 1, :, 1]
+                ga = np.block([[A, -B], [-np.transpose(B, (0, 2, 1)), D]])
+                gb = np.block([[D, np.transpose(B, (0, 2, 1))], [B, A]])
             for j0 in range(0, m, chunk):
                 sl = slice(j0, min(j0 + chunk, m))
                 js = np.arange(sl.start, sl.stop)
                 if b == 0:
                     x = Z.Z0[:, sl].reshape(nc, d, -1)
-                    sq = quad(gram, x, x)[:, None]
+                    sq = quad(gram, np.ascontiguousarray(x))[:, None]
                 else:
                     zb = Z.Zc[b][:, sl]
                     x, y = zb.real.reshape(nc, d, -1), zb.imag.reshape(nc, d, -1)
-                    A, B, D = gram[:, 0::2, 0::2], gram[:, 0::2, 1::2], gram[:, 1::2, 1::2]
-                    # column (j, a_n): entries (x, -y); column (j, b_n): entries (y, x)
-                    xAx, yAy, xDx, yDy = quad(A, x, x), quad(A, y, y), quad(D, x, x), \
-                        quad(D, y, y)
-                    xBy = quad(B, x, y)
-                    yBx = quad(B, y, x)
-                    sq = np.column_stack([xAx - 2.0 * xBy + yDy, yAy + 2.0 * yBx + xDx])
+                    X = np.concatenate([x, y], axis=1)  # (nc, 2d, ncol)
+                    sq = np.column_stack([quad(ga, X), quad(gb, X)])
                 # + eps (I - G) on the owner's block: column (j, c) -> node j // d, row j%d, c
                 q = js // d
                 ci = np.arange(js.size)
