@@ -8,15 +8,18 @@ After condensation the linear part of the balance is block-diagonal per harmonic
 it costs ``k m^2`` complex operations (the harmonic blocks) plus ``nc (dH)^2`` (the node
 blocks), against ``n^2`` memory and ``n^3 / 3`` operations for a dense LU.
 
-The Newton step ``J s = -f`` is solved by GMRES preconditioned with per-harmonic
-factorisations: replacing each node's time-varying gain by its mean over the period
-(``gbar_p``, the (0, 0) coefficient block of ``G_p``) makes the Jacobian block-diagonal per
-harmonic, ``P_n = eps I + gbar (Z_r(n w) - eps I)`` (``gbar`` block-diagonal per node), so the
-preconditioner is ``k + 1`` dense LUs of ``m x m``. It is exact for nodes whose gain does not
-vary over the period (stuck or separated all period) and for a linear interface; it is kept
-across Newton iterations and rebuilt when GMRES slows down. The contact law and the residual
-are those of the dense path: only the linear algebra of the step differs, so the converged
-answer is the same (tests/hb/test_krylov.py).
+The Newton step ``J s = -f`` is reduced to the nodes that slip or separate during the period
+(a node that sticks all period has ``G_p = 0``: its unknowns follow from its rows ``eps I``)
+and the active system is solved by a LAPACK LU when it is small, else by GMRES preconditioned
+with per-harmonic factorisations of the active block: replacing each node's time-varying gain
+by its mean over the period (``gbar_p``, the (0, 0) coefficient block of ``G_p``) makes it
+block-diagonal per harmonic, ``P_n = eps I + gbar (Z_aa(n w) - eps I)`` (``gbar``
+block-diagonal per node), so the preconditioner is ``k + 1`` dense LUs of ``m_a x m_a``
+(``m_a`` = active DOFs). It is exact for nodes whose gain does not vary over the period and
+for a linear interface; it is kept while the active set does not change and rebuilt when
+GMRES slows down. The contact law and the residual are those of the dense path: only the
+linear algebra of the step differs, so the converged answer is the same
+(tests/hb/test_krylov.py).
 """
 
 from __future__ import annotations
@@ -129,19 +132,6 @@ class HarmonicBlocks:
             self._ZcH = np.ascontiguousarray(np.conj(np.transpose(self.Zc, (0, 2, 1))))
         return self._apply(np.ascontiguousarray(self.Z0.T), self._ZcH, U)
 
-    def columns(self, b: int, js: np.ndarray) -> tuple[np.ndarray, list[int]]:
-        """The non-zero rows of the real columns ``(j, c)`` of ``Z~`` for the DOFs ``js`` and
-        the coefficients ``c`` of harmonic block ``b`` (``[0]`` or ``[b, k+b]``): returns
-        ``(Zs, cs)`` with ``Zs`` (m, len(cs), len(js) * len(cs)), rows (DOF, coefficient in
-        ``cs``), columns (DOF in ``js``, coefficient in ``cs``)."""
-        if b == 0:
-            return self.Z0[:, js][:, None, :], [0]
-        zr, zi = self.Zc[b][:, js].real, self.Zc[b][:, js].imag
-        Zs = np.empty((self.m, 2, js.size, 2))
-        Zs[:, 0, :, 0], Zs[:, 0, :, 1] = zr, zi
-        Zs[:, 1, :, 0], Zs[:, 1, :, 1] = -zi, zr
-        return Zs.reshape(self.m, 2, 2 * js.size), [b, self.k + b]
-
     def dense(self) -> np.ndarray:
         """The real (mH, mH) matrix (:func:`fretwear.hb.reduce.to_real_blocks`)."""
         from fretwear.hb.reduce import to_real_blocks
@@ -202,6 +192,7 @@ class KrylovJacobian:
         self.shape = (self.n, self.n)
         self.owner = owner if owner is not None else self
         self.gmres_iterations = 0
+        self._Za = self._Za_dofs = None  # the harmonic blocks of the active nodes
 
     # -- products -----------------------------------------------------------------------------
     def matvec(self, x) -> np.ndarray:
@@ -291,17 +282,6 @@ class KrylovJacobian:
         return J
 
     # -- the Newton step ----------------------------------------------------------------------
-    def _preconditioner(self, rebuild=False):
-        owner = self.owner
-        pc = getattr(owner, "_precond", None)
-        if pc is None or rebuild:
-            H = self.Z.H
-            Gr = self.G.reshape(self.nc, self.d, H, self.d, H)
-            pc = MeanGainPreconditioner(np.ascontiguousarray(Gr[:, :, 0, :, 0]), self.Z,
-                                        self.eps)
-            owner._precond = pc
-        return pc
-
     def active_nodes(self) -> np.ndarray:
         """Nodes whose block ``G_p`` is not zero: those that slip or separate during the
         period (a node that sticks all period has ``G_p = 0``, its rows of ``J`` are
@@ -315,53 +295,98 @@ class KrylovJacobian:
             (eps I + G_a (Z_aa - eps I)) x_a = b_a - G_a Z_as x_s,
 
         solved by a LAPACK LU when it has at most :data:`ACTIVE_DENSE_MAX` unknowns, else by
-        right-preconditioned GMRES on the whole system to :data:`GMRES_RTOL` (the
-        preconditioner is rebuilt from this Jacobian when the kept one needs more than
-        :data:`REBUILD_AFTER` iterations or fails)."""
+        right-preconditioned GMRES on that active system to :data:`GMRES_RTOL` (the
+        preconditioner, restricted to the active nodes, is rebuilt when the active set
+        changes, when the kept one needs more than :data:`REBUILD_AFTER` iterations or
+        fails). ``b`` (n,) or (n, r)."""
         b = np.asarray(b, float)
         act = self.active_nodes()
-        if act.size * self.dH <= ACTIVE_DENSE_MAX:
-            return self._solve_active(b, act)
-        if b.ndim == 2:  # several right-hand sides (e.g. the wear rate's dU/dW)
-            return np.column_stack([self._gmres(c) for c in b.T])
-        return self._gmres(b)
+        x, rhs, dofs = self._reduce(b, act)
+        if act.size:
+            solver = (self._lu_active if act.size * self.dH <= ACTIVE_DENSE_MAX
+                      else self._gmres_active)
+            x[act] = solver(rhs, act, dofs)
+        return x.reshape(b.shape)
 
-    def _solve_active(self, b, act) -> np.ndarray:
-        from fretwear.hb.solvers import solve_identity_rows
-
+    def _reduce(self, b, act):
+        """``x`` (nc, dH, r) with the stuck unknowns ``b_s / eps`` (active ones 0), the
+        active right-hand side ``b_a - G_a Z_as x_s`` (na, dH, r) and the active DOFs."""
         eps, dH, d, Z = self.eps, self.dH, self.d, self.Z
-        shape = b.shape
         B = b.reshape(self.n, -1)
-        k = B.shape[1]
-        x = (B / eps).reshape(self.nc, dH, k)
-        if not act.size:
-            return x.reshape(shape)
+        r = B.shape[1]
+        x = (B / eps).reshape(self.nc, dH, r)
         x[act] = 0.0
+        dofs = (act[:, None] * d + np.arange(d)[None, :]).reshape(-1)
+        if not act.size:
+            return x, None, dofs
         # G_a Z_as x_s: the product with the stuck part only, on the active rows, from the
         # stuck DOFs where x_s is not zero (one column per node for the wear rate's dU/dW)
-        dofs = (act[:, None] * d + np.arange(d)[None, :]).reshape(-1)
-        xs = x.reshape(Z.m, Z.H, k)
+        xs = x.reshape(Z.m, Z.H, r)
         cols = np.flatnonzero(np.any(xs != 0.0, axis=(1, 2)))
-        ZX = Z.apply_sub(dofs, cols, xs[cols])  # (na d, H, k) = rows of the active nodes
-        rhs = B.reshape(self.nc, dH, k)[act] - np.matmul(
-            self.G[act], ZX.reshape(act.size, dH, k))
-        Za = HarmonicBlocks(Z.Zc[:, dofs][:, :, dofs]).dense()  # (na dH, na dH) DOF-major
-        na = act.size
+        ZX = Z.apply_sub(dofs, cols, xs[cols])  # (na d, H, r) = rows of the active nodes
+        rhs = B.reshape(self.nc, dH, r)[act] - np.matmul(self.G[act],
+                                                         ZX.reshape(act.size, dH, r))
+        return x, rhs, dofs
+
+    def _active_blocks(self, dofs) -> HarmonicBlocks:
+        """The harmonic blocks of ``Z_aa`` (copied once per Jacobian)."""
+        if self._Za is None or not np.array_equal(self._Za_dofs, dofs):
+            self._Za = HarmonicBlocks(np.stack([z[np.ix_(dofs, dofs)] for z in self.Z.Zc]))
+            self._Za_dofs = dofs
+        return self._Za
+
+    def _lu_active(self, rhs, act, dofs) -> np.ndarray:
+        from fretwear.hb.solvers import solve_identity_rows
+
+        eps, dH = self.eps, self.dH
+        na, r = act.size, rhs.shape[2]
+        Za = HarmonicBlocks(np.stack([z[np.ix_(dofs, dofs)] for z in self.Z.Zc])).dense()
         Ja = np.matmul(self.G[act], Za.reshape(na, dH, na * dH)).reshape(na * dH, na * dH)
         for i in range(na):
             sl = slice(i * dH, (i + 1) * dH)
             Ja[sl, sl] -= eps * self.G[act[i]]
         Ja[np.diag_indices(na * dH)] += eps
-        x[act] = solve_identity_rows(Ja, rhs.reshape(na * dH, k)).reshape(na, dH, k)
-        return x.reshape(shape)
+        return solve_identity_rows(Ja, rhs.reshape(na * dH, r)).reshape(na, dH, r)
 
-    def _gmres(self, b) -> np.ndarray:
-        A = spla.LinearOperator(self.shape, matvec=self.matvec, dtype=float)
+    def _preconditioner(self, act, Za, rebuild=False):
+        owner = self.owner
+        pc = getattr(owner, "_precond", None)
+        if (pc is None or rebuild or pc.m != Za.m
+                or not np.array_equal(getattr(pc, "nodes", None), act)):
+            H = self.Z.H
+            Gr = self.G[act].reshape(act.size, self.d, H, self.d, H)
+            pc = MeanGainPreconditioner(np.ascontiguousarray(Gr[:, :, 0, :, 0]), Za, self.eps)
+            pc.nodes = act
+            owner._precond = pc
+        return pc
+
+    def _gmres_active(self, rhs, act, dofs) -> np.ndarray:
+        """GMRES on the active system, one right-hand side at a time."""
+        eps, dH = self.eps, self.dH
+        Za = self._active_blocks(dofs)
+        Ga = self.G[act]
+        na = act.size
+        n = na * dH
+
+        def matvec(v):
+            v = np.asarray(v, float).reshape(-1)
+            y = (Za.apply(v).reshape(-1) - eps * v).reshape(na, dH)
+            return eps * v + np.matmul(Ga, y[:, :, None])[:, :, 0].reshape(-1)
+
+        A = spla.LinearOperator((n, n), matvec=matvec, dtype=float)
+        out = np.empty_like(rhs)
+        for c in range(rhs.shape[2]):
+            out[:, :, c] = self._gmres(A, rhs[:, :, c].reshape(-1), act, Za).reshape(na, dH)
+        return out
+
+    def _gmres(self, A, b, act, Za) -> np.ndarray:
         x = None
         for attempt in range(2):
-            fresh = attempt > 0 or getattr(self.owner, "_precond", None) is None
-            pc = self._preconditioner(rebuild=attempt > 0)
-            M = spla.LinearOperator(self.shape, matvec=pc.apply, dtype=float)
+            pc0 = getattr(self.owner, "_precond", None)
+            fresh = attempt > 0 or pc0 is None or not np.array_equal(
+                getattr(pc0, "nodes", None), act)
+            pc = self._preconditioner(act, Za, rebuild=attempt > 0)
+            M = spla.LinearOperator(A.shape, matvec=pc.apply, dtype=float)
             count = [0]
 
             def cb(_r, count=count):
