@@ -36,6 +36,7 @@ import argparse
 import json
 import os
 import resource
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -110,18 +111,8 @@ def one(n: int, extras: dict) -> dict:
                residual=st.residual, sep=frac[0], stick=frac[1], slip=frac[2],
                active_nodes=int(np.sum(np.any(sol.state != 1, axis=1))))
     out["peak_gib"] = peak_gib()  # condensation + solve
+    print("PARTIAL " + json.dumps(out, default=float), flush=True)
     tmp = tempfile.mkdtemp(prefix="scale3d-")
-    if extras.get("sweep"):
-        from fretwear.hb.sweep import sweep
-
-        ck = os.path.join(tmp, "sweep-checkpoint.npz")
-        with Clock() as c:
-            res = sweep(model, basis, 4000.0, 6000.0, extras["sweep"], spacing="linear",
-                        anchor=sol.anchor, checkpoint=ck)
-        out.update(sweep_points=extras["sweep"], sweep_cpu=c.cpu, sweep_wall=c.wall,
-                   sweep_converged=int(sum(p.success for p in res.points)),
-                   sweep_ckpt_mib=os.path.getsize(ck) / 2**20,
-                   peak_sweep_gib=peak_gib())
     if extras.get("wear"):
         from fretwear.wear.options import WearOptions
         from fretwear.wear.simulate import simulate_wear
@@ -134,8 +125,21 @@ def one(n: int, extras: dict) -> dict:
                                                    scheme="explicit", checkpoint_every_s=0.0))
         out.update(wear_steps=len(wr.history.cycles) - 1, wear_cpu=c.cpu, wear_wall=c.wall,
                    wear_success=bool(wr.success), wear_message=wr.message,
-                   wear_ckpt_mib=os.path.getsize(ck) / 2**20)
+                   wear_ckpt_mib=os.path.getsize(ck) / 2**20, peak_wear_gib=peak_gib())
+    print("PARTIAL " + json.dumps(out, default=float), flush=True)
+    if extras.get("sweep"):
+        from fretwear.hb.sweep import sweep
+
+        ck = os.path.join(tmp, "sweep-checkpoint.npz")
+        with Clock() as c:
+            res = sweep(model, basis, 4000.0, 6000.0, extras["sweep"], spacing="linear",
+                        anchor=sol.anchor, checkpoint=ck)
+        out.update(sweep_points=extras["sweep"], sweep_cpu=c.cpu, sweep_wall=c.wall,
+                   sweep_converged=int(sum(p.success for p in res.points)),
+                   sweep_ckpt_mib=os.path.getsize(ck) / 2**20,
+                   peak_sweep_gib=peak_gib())
     out["peak_extras_gib"] = peak_gib()
+    shutil.rmtree(tmp, ignore_errors=True)
     nu = out["unknowns"]
     if 8.0 * nu * nu <= 4 * 2**30:  # last: its memory is not the solve's
         M = np.random.default_rng(0).standard_normal((nu, nu)) + nu * np.eye(nu)
@@ -196,7 +200,8 @@ def main():
         if "wear_cpu" in r:
             print(f"  wear run ({r['wear_steps']} slow steps, explicit): {r['wear_cpu']:.1f} s "
                   f"CPU, {r['wear_wall']:.1f} s wall, success {r['wear_success']} "
-                  f"({r['wear_message']}), wear-checkpoint.npz {r['wear_ckpt_mib']:.1f} MiB")
+                  f"({r['wear_message']}), peak {r['peak_wear_gib']:.2f} GiB, "
+                  f"wear-checkpoint.npz {r['wear_ckpt_mib']:.1f} MiB")
         print(f"  peak memory {r['peak_gib']:.2f} GiB (condensation + solve), "
               f"{r['peak_extras_gib']:.2f} GiB with the sweep and wear run")
     if 16 in rows and 32 in rows:
