@@ -11,6 +11,8 @@ Jacobian go through the step, exact to rounding by LU (1e-10) and to GMRES's 1e-
 residual (1e-8, the acceptance of issue 16).
 """
 
+import functools
+
 import numpy as np
 import pytest
 from helpers.blocks import block
@@ -23,9 +25,9 @@ from fretwear.hb.reduce import condense
 from fretwear.wear.slow_problem import SlowProblem
 
 
-@pytest.fixture(scope="module", params=[2, 3])
-def case(request):
-    model = block(request.param)
+@functools.cache
+def make_case(dim):
+    model = block(dim)
     basis = FourierBasis.up_to(3, 32)
     red = condense(model, 2000.0, basis.orders)
     anchor = static_anchor(model)
@@ -44,10 +46,12 @@ def slow(case, monkeypatch, operator):
     return sp
 
 
-@pytest.mark.parametrize("step", ["active", "gmres"])
-def test_slow_jacobian_equals_dense_path(case, monkeypatch, step):
+@pytest.mark.parametrize("dim, step", [(2, "active"), (3, "active"), (2, "gmres")])
+def test_slow_jacobian_equals_dense_path(dim, step, monkeypatch):
     """g, dg/dU~, dg/dW, dU~/dW and the slow Jacobian of the operator path equal the dense
-    path's (every contact state present, slipping nodes wear)."""
+    path's (every contact state present, slipping nodes wear; GMRES, one solve per node, in
+    2D only, for time)."""
+    case = make_case(dim)
     U = case[4]
     ref = slow(case, monkeypatch, False)
     g0, gU0, gW0, _ = ref.rate_and_gradient(U)
@@ -68,10 +72,12 @@ def test_slow_jacobian_equals_dense_path(case, monkeypatch, step):
     assert np.abs(Js - Js0).max() <= 1e-8 * np.abs(Js0).max()
 
 
-def test_slow_radius_from_products_equals_the_eigenvalues(case, monkeypatch):
+@pytest.mark.parametrize("dim", [2])
+def test_slow_radius_from_products_equals_the_eigenvalues(dim, monkeypatch):
     """With the GMRES step the spectral radius of the slow Jacobian comes from ARPACK on its
     products (no nc solves); it equals the largest |eigenvalue| of the dense path's formed
     slow Jacobian (numpy.linalg.eigvals) to the 1e-3 asked of ARPACK."""
+    case = make_case(dim)
     U = case[4]
     ref = slow(case, monkeypatch, False)
     assert not ref.needs_iterative_solves(U)
@@ -81,3 +87,21 @@ def test_slow_radius_from_products_equals_the_eigenvalues(case, monkeypatch):
     op = slow(case, monkeypatch, True)
     assert op.needs_iterative_solves(U)
     assert abs(op.slow_radius(U) - rho0) <= 1e-3 * rho0
+
+
+def test_implicit_schemes_refused_when_the_step_is_iterative(monkeypatch):
+    """A wear run whose balance needs GMRES (active set above the direct size) refuses the
+    linearly implicit default with one message naming the scheme, instead of running one
+    iterative solve per node at every step; the explicit scheme runs."""
+    from fretwear.errors import InputError
+    from fretwear.wear import WearOptions, simulate_wear
+
+    model, basis, red, anchor, U, _ = make_case(2)
+    monkeypatch.setattr(periodic, "DENSE_JACOBIAN_MAX", 0)
+    monkeypatch.setattr(krylov, "ACTIVE_DENSE_MAX", -1)
+    kw = dict(frequency=2000.0, reduced=red, anchor=anchor, U0=U)
+    with pytest.raises(InputError, match="scheme = 'rosenbrock'"):
+        simulate_wear(model, basis, options=WearOptions(max_steps=1), **kw)
+    res = simulate_wear(model, basis, options=WearOptions(max_steps=1, scheme="explicit"),
+                        **kw)
+    assert res.success

@@ -25,7 +25,7 @@ import time
 
 import numpy as np
 
-from fretwear.errors import ConvergenceError
+from fretwear.errors import ConvergenceError, InputError
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.solvers import SolveStats
 from fretwear.wear.history import solution_row
@@ -62,6 +62,12 @@ def first_state(sp: SlowProblem, W0, anchor, U0, opts: WearOptions) -> tuple[dic
             f"relative residual {st.residual:.3g} > {opts.tol:g}): no wear computed"
         )
     U = sol0.U.reshape(sp.m, sp.H)
+    if opts.scheme != "explicit" and sp.needs_iterative_solves(U):
+        raise InputError(
+            f"scheme = {opts.scheme!r}: {sp.nc} contact nodes with a slipping set too large "
+            "for a direct step; the slow Jacobian of this scheme would need one iterative "
+            f"solve per contact node ({sp.nc}) at every step: use scheme = \"explicit\" "
+            "(docs/theory.md, \"Large interfaces\")")
     g = sp.rate(U)
     rho = 0.0
     if np.any(g > 0):
