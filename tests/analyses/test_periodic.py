@@ -50,6 +50,7 @@ def test_periodic_writes_documented_results_figures_and_paraview(tmp_path, capsy
     ds = read_results(res / "results.nc")
     assert ds.attrs["analysis_type"] == "periodic"
     assert ds.attrs["converged"] == 1
+    assert ds.attrs["open_under_preload"] == "" and "warning" not in out
     assert ds.sizes == {"point": 1, "axis": 2, "contact_node": 11, "component": 2,
                         "harmonic_coefficient": 7, "tau": 32, "harmonic": 3}
     check_documented(ds, "periodic")
@@ -89,6 +90,26 @@ def test_quasi_static_needs_no_frequency_and_takes_a_list_of_harmonics(tmp_path,
     assert ds["harmonic"].values.tolist() == [1, 3]
     assert ds["harmonic_coefficient"].values.tolist() == ["0", "c1", "c3", "s1", "s3"]
     assert not (tmp_path / "qs-results" / "periodic.pvd").exists()
+
+
+def test_an_interface_open_under_the_preload_is_a_warning_and_an_attribute(tmp_path, capsys):
+    """The beam held above its flat by stiff vertical springs at its top corners (10 N of
+    pressure against 2 x 1e9 N/m: 5e-9 m, less than the 1e-6 m gap): no node touches under
+    the preload. The run goes on (a clearance the vibration closes may be meant), says so
+    before it starts and records the interface in the results."""
+    text = small_case(tmp_path, PERIODIC).read_text()
+    text = text.replace("gap = 0.0", "gap = 1e-6").replace(
+        "[[loads]]", "".join(f'[[springs]]\nat = "{at}"\ndirection = "y"\nstiffness = 1e9\n\n'
+                             for at in ("top_left", "top_right")) + "[[loads]]", 1)
+    path = tmp_path / "held.toml"
+    path.write_text(text + "[output]\nvtu = false\nfigures = false\n")
+    status, out, err = run(path, capsys)
+    assert status == 0, err
+    assert ("warning: interface 'contact' is open at all its 11 nodes under the static loads "
+            "(the preload; its smallest initial gap is 1e-06 m)") in out
+    ds = read_results(tmp_path / "held-results" / "results.nc")
+    assert ds.attrs["open_under_preload"] == "contact"
+    assert (ds["contact_state"].values == 0).all()  # and the vibration does not close it
 
 
 def test_a_periodic_solve_that_fails_saves_no_solution(tmp_path, capsys):

@@ -398,6 +398,60 @@ def test_zero_area_node_is_refused():
                       contact_tangential_dofs=[1], mu=0.3, area=0.0)
 
 
+def pressed_or_pulled_block(pressure):
+    """The block of :func:`block_on_base` on its base under a uniform ``pressure`` on its top
+    (negative: pulled away), held by springs at its top corners along x and y (1e6 N/m, so
+    that a pulled block is held)."""
+    upper = rectangle(0.02, 0.01, 4, 2, origin=(0.0, 0.005))
+    mesh = join(("block", upper), ("base", rectangle(0.02, 0.005, 4, 1)))
+    return from_mesh(
+        mesh, STEEL, springs=[Spring("block.top_left", "x", 1e7),
+                              Spring("block.top_left", "y", 1e6),
+                              Spring("block.top_right", "y", 1e6)],
+        fixed=[("base.bottom", "all")],
+        loads=[Traction("block.top", pressure=pressure, waveform="constant")],
+        contact=ContactSpec("block.bottom", mu=MU, partner="base.top", name="flat"))
+
+
+def test_interface_open_under_the_preload_is_flagged():
+    """A block pulled away from its base (the static load opens the interface): the static
+    contact problem finds no node in contact and the run's notes say so, naming the
+    interface. Pressed instead, every node is in contact and the normal forces carry the
+    part of the static load the springs do not: the equilibrium of the block along y (the
+    springs' force is k times the displacement of the spring nodes), to rounding (1e-9: the
+    static solve's 1e-10 convergence test)."""
+    from fretwear.analyses.common import preload_notes
+    from fretwear.hb.periodic import _static_solve, preload_contact
+    from fretwear.hb.reduce import condense_static
+
+    pulled = pressed_or_pulled_block(-1e6)
+    pre = preload_contact(pulled)
+    assert pre.success and pre.closed.tolist() == [0] and pre.open_interfaces() == ["flat"]
+    np.testing.assert_array_equal(pre.normal_force, 0.0)
+    notes, names = preload_notes(pulled)
+    assert names == ["flat"] and len(notes) == 1
+    assert notes[0].startswith("warning: interface 'flat' is open at all its 5 nodes under "
+                               "the static loads")
+
+    pressed = pressed_or_pulled_block(P0)
+    pre = preload_contact(pressed)
+    assert pre.closed.tolist() == [5] and preload_notes(pressed) == ([], [])
+    F = pressed.loads[0].vector  # the pressure on the top, as nodal forces [N]
+    load_y = float(np.sum(F[1::2]))  # pushing the block down: negative
+    assert load_y < 0
+    # the static field, to read the springs' forces k u_y at the block's top corners
+    prob, x, st = _static_solve(pressed, None, "static")
+    assert st.success
+    U = condense_static(pressed).recover(x, F)
+    pts = pressed.mesh.points
+    corners = [int(np.flatnonzero(np.all(np.isclose(pts, c), axis=1))[0])
+               for c in ((0.0, 0.015), (0.02, 0.015))]
+    spring_y = -1e6 * sum(U[2 * n + 1] for n in corners)  # on the block, upwards positive
+    total = float(np.sum(pre.normal_force))  # on the base, downwards; the base pushes back
+    assert 0 < spring_y < 1e-4 * total  # the springs hold the block's own weightless motion
+    np.testing.assert_allclose(total, -load_y - spring_y, rtol=1e-9)
+
+
 def test_rigid_obstacle_does_not_wear():
     with pytest.raises(InputError, match="partner_wear_coefficient .* without a partner"):
         ContactSpec("bottom", mu=MU, partner_wear_coefficient=1e-13)

@@ -1,6 +1,6 @@
 """Helpers shared by several analyses: observed points, figure paths, the geometry of a results
 dataset, the harmonic-balance keys of ``[analysis]`` tables, solver attributes, array padding,
-interface abscissae, SI prefixes and figure titles.
+interface abscissae, SI prefixes, figure titles and the contact under the preload.
 
 Figure functions shared by several analyses are in :mod:`fretwear.analyses.figures`.
 """
@@ -17,6 +17,7 @@ import xarray as xr
 from fretwear.files import inside, safe_name
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.penalty import RULES
+from fretwear.hb.periodic import preload_contact
 from fretwear.hb.solvers import SOLVERS, SolveStats
 from fretwear.io.results import label_coordinate, variable
 from fretwear.io.schema import AnyOf, Field, Integer, ListOf, Number, Text, fail, join
@@ -27,6 +28,43 @@ COMPONENTS = ("N", "T1", "T2")
 AXES = ("x", "y", "z")
 #: |v| below this fraction of its peak counts as stopped (as ``stops_per_period``)
 STOP_TOL = 5e-2
+
+
+# --- the contact under the preload ------------------------------------------------------------
+#: global attribute of the results of the analyses that run the contact law: the interfaces
+#: that no node of touches under the static loads (comma-separated; empty: none)
+OPEN_ATTRIBUTE = "open_under_preload"
+
+
+def preload_notes(model) -> tuple[list[str], list[str]]:
+    """Warnings about interfaces that no node touches under the static loads (the preload),
+    and the names of those interfaces (:func:`fretwear.hb.periodic.preload_contact`).
+
+    A run on such an interface is kept (a clearance that the vibration closes is a model a
+    user may mean), but it is almost always a mistake (a gap of the wrong sign, a load pulling
+    the bodies apart, a partner surface that is not the one meant), so the run says it before
+    it starts and the results file records it (:data:`OPEN_ATTRIBUTE`).
+    """
+    pre = preload_contact(model)
+    if not pre.success:
+        return ([f"warning: the static contact problem under the preload did not converge "
+                 f"({pre.message}); the contact of the interfaces before the vibration is not "
+                 "known"], [])
+    gap = np.broadcast_to(np.asarray(model.contact.gap, dtype=float), (model.contact.n_nodes,))
+    where = model.contact.interface_index()
+    notes = []
+    names = pre.open_interfaces()
+    for name in names:
+        k = pre.names.index(name)
+        nodes = where == k
+        why = (f"its smallest initial gap is {float(gap[nodes].min()):.3g} m"
+               if float(gap[nodes].min()) > 0 else
+               "the static loads do not press its nodes together")
+        notes.append(f"warning: interface {name!r} is open at all its {int(nodes.sum())} nodes "
+                     f"under the static loads (the preload; {why}): friction and wear can act "
+                     "there only where the vibration closes it; check the gap, the direction "
+                     "of the static loads and the contact surfaces")
+    return notes, names
 
 
 # --- observed points, figures, geometry -----------------------------------------------------

@@ -457,5 +457,6 @@ register(
     "period), `contact-profiles.png` (pressure, slip, friction energy along the interface), "
     "`hysteresis.png` (tangential force against slip for a few nodes) and, for meshes, "
     "`periodic.pvd` (the displacement field over the period; ParaView's time slider plays it).",
+    preload_check=True,
 )
 

@@ -82,6 +82,7 @@ class Analysis:
     schema: Table
     run: RunFunction
     files: tuple[str, ...] = ()
+    preload_check: bool = False
 
 
 _REGISTRY: dict[str, Analysis] = {}
@@ -89,7 +90,8 @@ _loaded = False
 
 
 def register(name: str, schema: Table | Mapping, run: RunFunction, *, doc: str = "",
-             checks: tuple = (), files: tuple[str, ...] = ()) -> None:
+             checks: tuple = (), files: tuple[str, ...] = (),
+             preload_check: bool = False) -> None:
     """Make an analysis available to case files as ``[analysis] type = name``.
 
     Parameters
@@ -109,6 +111,10 @@ def register(name: str, schema: Table | Mapping, run: RunFunction, *, doc: str =
     files : names of the files the analysis writes in ``outdir`` as it goes (checkpoints);
         :func:`fretwear.analyses.run.run_case` refuses a folder in their place before
         anything runs.
+    preload_check : the analysis runs the contact law (vibration, wear):
+        :func:`fretwear.analyses.run.run_case` first solves the static contact under the
+        preload and warns about an interface that no node of touches
+        (:func:`fretwear.hb.periodic.preload_contact`).
     """
     table = schema if isinstance(schema, Table) else Table(dict(schema), tuple(checks), doc)
     if "type" in table.fields:
@@ -116,7 +122,7 @@ def register(name: str, schema: Table | Mapping, run: RunFunction, *, doc: str =
     old = _REGISTRY.get(name)
     if old is not None and old.run is not run:
         raise ValueError(f"analysis {name!r} is already registered by {old.run.__module__}")
-    _REGISTRY[name] = Analysis(name, table, run, tuple(files))
+    _REGISTRY[name] = Analysis(name, table, run, tuple(files), bool(preload_check))
 
 
 def _load() -> None:

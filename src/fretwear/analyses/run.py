@@ -16,6 +16,7 @@ import time
 from pathlib import Path
 
 from fretwear import __version__
+from fretwear.analyses.common import OPEN_ATTRIBUTE, preload_notes
 from fretwear.analyses.registry import RunOutput, analysis_tables, get
 from fretwear.errors import InputError, interrupted
 from fretwear.files import remove_stale_temporaries
@@ -164,7 +165,14 @@ def run_case(path: Path | str, outdir: Path | str | None = None, progress: bool 
         model = build_model(case)
         for note in observed_notes(case, model):
             say(note)
+        open_names = None
+        if analysis.preload_check:
+            notes, open_names = preload_notes(model)
+            for note in notes:
+                say(note)
         out = analysis.run(model, case.analysis, case, out_dir, progress)
+        if open_names is not None:
+            out.dataset.attrs[OPEN_ATTRIBUTE] = ", ".join(open_names)
         out.results = write_results(
             results_path, out.dataset, title=case.title, analysis_type=analysis.name,
             converged=out.success, case_text=case.text, case_path=str(case.path),

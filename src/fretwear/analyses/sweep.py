@@ -348,4 +348,5 @@ register(
     "every grid frequency: `fretwear run CASE.toml --resume` continues a killed sweep to the "
     "same result. Writes `sweep-<point>.png` (amplitude against frequency, with the "
     "linear references) and `sweep-interface.png` (friction energy and contact states).",
+    preload_check=True,
 )

@@ -386,6 +386,7 @@ register(
     "undecided (`transient`) at max_periods. Writes `transient-<point>.png` (displacement "
     "over the last period), `poincare-<point>.png` (once-per-period samples and period means: "
     "drift, quasi-periodicity) and `contact-state.png`.",
+    preload_check=True,
 )
 
 
@@ -470,4 +471,5 @@ register(
     "load step, Archard wear (k_w = contact.wear_coefficient) applied after each step; "
     "inertia and damping are ignored. Writes `wear-profile.png` (wear depth along the "
     "interface at a few cycle counts).",
+    preload_check=True,
 )

@@ -543,4 +543,5 @@ DOC = (
     "mesh models the ParaView series `wear.pvd` of the worn surfaces."
 )
 
-register("wear", SCHEMA, run_wear, checks=CHECKS, doc=DOC, files=(CHECKPOINT_FILE,))
+register("wear", SCHEMA, run_wear, checks=CHECKS, doc=DOC, files=(CHECKPOINT_FILE,),
+         preload_check=True)

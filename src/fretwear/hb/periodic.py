@@ -575,6 +575,15 @@ def static_anchor(model: Model, *, quasi: Reduced | None = None, eps="auto") -> 
     then vibrate". ``eps``: the penalty of this static solve (the rule or a number, as for
     :class:`DLFTProblem`). Returns (nc, d-1) [m].
     """
+    prob, x, st = _static_solve(model, quasi, eps)
+    if not st.success:
+        return np.zeros((prob.nc, prob.d - 1))
+    U = x.reshape(prob.nc, prob.d, 1)
+    return U[:, 1:, 0].copy()
+
+
+def _static_solve(model: Model, quasi: Reduced | None, eps):
+    """The static contact problem of :func:`static_anchor`: ``(problem, x, stats)``."""
     basis = FourierBasis((), 1)
     red = quasi if quasi is not None else condense(model, 0.0, [0], quasi_static=True)
     prob = DLFTProblem(red, model.contact, basis, eps=eps)
@@ -585,10 +594,66 @@ def static_anchor(model: Model, *, quasi: Reduced | None = None, eps="auto") -> 
 
     x, _, st = solve(fun, U0.reshape(-1), lambda x: prob.scale(x.reshape(prob.m, prob.H)),
                      method="powell", tol=1e-10, max_iter=100)
+    return prob, x, st
+
+
+@dataclass
+class PreloadContact:
+    """The contact of every interface under the static loads alone (the preload), applied
+    from rest: what a vibration or a wear run starts from.
+
+    normal_force : (nc,) normal contact force of each node [N] (compression positive; 0 where
+        the node is open or touches without force), None when the static contact problem did
+        not converge; loaded : (nc,) bool, nodes that carry a normal force (more than ``1e-9``
+        of the largest static load or contact force) or have a prescribed normal load;
+    names : the interface names; closed : (n_interfaces,) number of loaded nodes of each.
+    """
+
+    normal_force: np.ndarray | None
+    loaded: np.ndarray
+    names: tuple
+    closed: np.ndarray
+    message: str = ""
+
+    @property
+    def success(self) -> bool:
+        """The static contact problem converged."""
+        return self.normal_force is not None
+
+    def open_interfaces(self) -> list[str]:
+        """Names of the interfaces with no node in contact under the preload."""
+        return [n for n, k in zip(self.names, self.closed, strict=True) if k == 0]
+
+
+def preload_contact(model: Model, *, eps="static") -> PreloadContact:
+    """Which contact nodes of ``model`` are pressed by its static loads (the preload).
+
+    The static contact problem of :func:`static_anchor` (exact contact, Coulomb friction,
+    loads applied from rest), solved once. An interface on which no node carries a normal
+    force under the preload (opened by its gap, pulled away, or touching without force) is
+    almost always a mistake in a vibration or wear run: its friction can only act where the
+    vibration itself closes it. Nodes with a prescribed normal load count as in contact.
+    """
+    c = model.contact
+    names = c.names()
+    where = c.interface_index()
+    prescribed = np.zeros(c.n_nodes, dtype=bool)
+    if c.normal_load is not None:
+        prescribed = np.isfinite(np.asarray(c.normal_load.vector, dtype=float))
+    prob, x, st = _static_solve(model, None, eps)
     if not st.success:
-        return np.zeros((prob.nc, prob.d - 1))
-    U = x.reshape(prob.nc, prob.d, 1)
-    return U[:, 1:, 0].copy()
+        loaded = prescribed
+        lam_n = None
+    else:
+        lu, lx, _, _ = prob.time_law(x.reshape(prob.m, prob.H))
+        lam = (lu - lx).reshape(prob.nc, prob.d)
+        lam_n = lam[:, 0].copy()
+        scale = max(float(np.max(np.abs(lam), initial=0.0)),
+                    float(np.max(np.abs(prob.F), initial=0.0)))
+        loaded = prescribed | (lam_n > 1e-9 * scale) if scale > 0 else prescribed.copy()
+    closed = np.bincount(where[loaded], minlength=len(names))
+    return PreloadContact(lam_n, loaded, tuple(names), closed,
+                          st.message if not st.success else "converged")
 
 
 def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
