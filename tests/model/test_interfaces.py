@@ -15,6 +15,7 @@ References independent of the code under test:
   k_w(side) / mu x friction energy per cycle (Coulomb slip: lambda_T . dx = mu lambda_N |dx|).
 """
 
+import dataclasses
 import math
 
 import numpy as np
@@ -25,7 +26,7 @@ from fretwear.errors import InputError
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import DLFTProblem, solve_periodic
 from fretwear.hb.reduce import condense, recover
-from fretwear.linear import frf
+from fretwear.linear import frf, modes
 from fretwear.model import (
     ContactSpec,
     Damping,
@@ -180,6 +181,39 @@ def test_cut_body_rejoined_stuck_is_the_uncut_body(method):
     whole = frf(cut_beam(False), f, interface="free")
     ref = whole.observed["tip"]
     np.testing.assert_allclose(cut.observed["tip"], ref, rtol=0, atol=1e-9 * np.abs(ref).max())
+
+
+def test_cut_body_rejoined_stuck_has_the_modes_of_the_uncut_body():
+    """Modes of the cut beam with its pairs stuck = modes of the uncut beam, to rounding
+    (1e-10 relative: the same eigenproblem in other coordinates; measured 3e-13)."""
+    a = modes(cut_beam(True), 6, interface="stuck")
+    b = modes(cut_beam(False), 6, interface="free")
+    np.testing.assert_allclose(a.frequency_hz, b.frequency_hz, rtol=1e-10)
+
+
+def test_sliding_pairs_are_the_normal_gap_tied_by_a_stiff_spring():
+    """Modes and FRF of the cut beam with its pairs sliding (relative normal displacement
+    held, tangential free, exact elimination) against the same two halves with nothing but a
+    stiff spring k = 1e16 N/m on the relative normal displacement of every pair (a penalty,
+    no contact law). The penalty's error is linear in 1/k: measured 4e-3, 4e-5 at k = 1e12,
+    1e14 on the FRF (1e-3, 1e-5 on the frequencies), so 4e-7 (1e-7) at 1e16; tolerances 1e-6
+    and 3e-7."""
+    cut = cut_beam(True)
+    c = cut.contact
+    normal = c.frame[:, 0, :]  # in the structure's axes
+    rows = np.repeat(np.arange(c.n_nodes), 4)
+    cols = np.concatenate([c.dofs, c.partner_dofs], axis=1).reshape(-1)
+    vals = np.concatenate([normal, -normal], axis=1).reshape(-1)
+    B = sp.csr_matrix((vals, (rows, cols)), shape=(c.n_nodes, cut.ndof))
+    tied = dataclasses.replace(cut, K=(cut.K + 1e16 * (B.T @ B)).tocsr())
+    f = np.array([300.0, 800.0, 2500.0])
+    ua = frf(cut, f, interface="sliding").observed["tip"]
+    ub = frf(tied, f, interface="free").observed["tip"]
+    np.testing.assert_allclose(ua, ub, rtol=0, atol=1e-6 * np.abs(ub).max())
+    ma = modes(cut, 4, interface="sliding").frequency_hz
+    mb = modes(tied, 4, interface="free").frequency_hz
+    np.testing.assert_allclose(ma, mb, rtol=3e-7)
+    assert ma[0] < 0.7 * modes(cut, 1, interface="stuck").frequency_hz[0]  # the halves slide
 
 
 def test_cut_body_with_preload_and_friction_vibrates_like_the_uncut_body():
