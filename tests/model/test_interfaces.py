@@ -285,6 +285,34 @@ def test_two_sided_archard_identity():
     np.testing.assert_allclose(worn_volume(Wb, sol.area), kb / MU * energy, rtol=1e-9)
 
 
+def test_two_sided_energy_law_identity():
+    """Energy law on both surfaces (k_e = 2e-15 and 5e-15 m^3/J): the worn volume per cycle
+    of the two surfaces = sum over the sides of k_e(side) x the friction energy per cycle
+    (PeriodicSolution.friction_energy: lambda_T . dX, a different integrand from the slip
+    work the wear rate is computed with); each side's share is its coefficient's. A
+    node-to-rigid model gives its partner side nothing. Tolerance 1e-9 as the Archard
+    identity's."""
+    ka, kb = 2e-15, 5e-15
+    model = block_on_base()
+    sol = solve_periodic(model, BASIS, frequency=F_HZ, tol=1e-12, raise_on_failure=True)
+    from fretwear.wear.kernels import slip_work
+
+    prob = DLFTProblem(condense(model, F_HZ, [0, *BASIS.harmonics]), model.contact, BASIS,
+                       eps=sol.eps, anchor=sol.anchor)
+    lu, lx, state, _ = prob.time_law(sol.U.reshape(prob.m, -1))
+    dW = wear_coefficients(model, "energy", ka, kb) * slip_work(lu, lx, state, sol.eps)
+    Wa, Wb = side_depths(model, dW, "energy", ka, kb)
+    energy = sol.friction_energy().sum()
+    assert energy > 0
+    volume = worn_volume(Wa, sol.area) + worn_volume(Wb, sol.area)
+    np.testing.assert_allclose(volume, (ka + kb) * energy, rtol=1e-9)
+    np.testing.assert_allclose(worn_volume(Wb, sol.area), kb * energy, rtol=1e-9)
+    rigid = block_on_rigid()
+    np.testing.assert_array_equal(wear_coefficients(rigid, "energy", ka, kb),
+                                  wear_coefficients(rigid, "energy", ka))
+    assert not np.any(side_depths(rigid, np.ones(rigid.contact.n_nodes), "energy", ka, kb)[1])
+
+
 def test_two_interfaces_on_two_separate_bodies():
     """Two blocks that do not touch each other, each on its own rigid flat with its own mu,
     as one model with two interfaces: each block's contact forces are those of the block

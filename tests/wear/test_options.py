@@ -33,12 +33,14 @@ def test_case_file_defaults_are_those_of_wear_options():
             assert a[f.name] == getattr(default, f.name), f.name
             assert type(a[f.name]) is type(getattr(default, f.name)), f.name
             compared += 1
-    assert compared == len(OPTION_KEYS) - 4
+    assert compared == len(OPTION_KEYS) - 5
     assert {k for k in OPTION_KEYS if k not in a} == {
-        "energy_coefficient", "initial_jump", "max_depth", "time_domain_steps"}
+        "energy_coefficient", "partner_energy_coefficient", "initial_jump", "max_depth",
+        "time_domain_steps"}
     assert default.max_depth == math.inf
     assert all(getattr(default, k) is None
-               for k in ("energy_coefficient", "initial_jump", "time_domain_steps"))
+               for k in ("energy_coefficient", "partner_energy_coefficient", "initial_jump",
+                         "time_domain_steps"))
     assert options_from_table(a) == default
 
 
@@ -47,6 +49,7 @@ def test_every_wear_key_of_a_case_file_reaches_wear_options():
     WearOptions of the run, and no other option changes."""
     given = {
         "solver": "hybr", "tol": 1e-10, "law": "energy", "energy_coefficient": 2e-13,
+        "partner_energy_coefficient": 3e-13,
         "scheme": "implicit", "adaptive": False, "tolerance": 3e-3, "initial_jump": 50.0,
         "max_jump": 1e7, "max_cycles": 2e8, "max_depth": 1e-6, "plateau_rate": 1e-2,
         "max_steps": 77, "time_domain_rescue": False, "time_domain_settle": 11,
@@ -69,8 +72,8 @@ def test_every_wear_key_of_a_case_file_reaches_wear_options():
     ("tolerance", 0.0), ("tolerance", "1e-2"), ("max_cycles", math.nan), ("max_jump", -1.0),
     ("min_jump", 0), ("max_depth", None), ("tol", True), ("plateau_rate", -1e-3),
     ("checkpoint_every_s", -1.0), ("initial_jump", 0.0), ("initial_jump", "1e4"),
-    ("energy_coefficient", -1e-13), ("law", "usui"), ("scheme", "rk4"), ("solver", "newton?"),
-    ("implicit_newton", "full"),
+    ("energy_coefficient", -1e-13), ("partner_energy_coefficient", -1e-13), ("law", "usui"),
+    ("scheme", "rk4"), ("solver", "newton?"), ("implicit_newton", "full"),
 ])
 def test_wear_options_refuse_bad_values_when_made(name, value):
     """A wrong type or value is refused at construction (and by dataclasses.replace), with an
@@ -88,3 +91,9 @@ def test_wear_options_accept_numbers_of_any_numeric_type():
     o = WearOptions(max_steps=np.int64(5), max_cycles=10**6, tolerance=np.float64(0.05),
                     time_domain_steps=512, initial_jump=100, max_depth=math.inf)
     assert o.max_steps == 5 and o.max_cycles == 1e6 and o.check() is o
+
+
+def test_partner_energy_coefficient_needs_the_energy_law():
+    with pytest.raises(InputError, match=r"^analysis.partner_energy_coefficient = 1e-13: "
+                                         r"expected no value with law = \"archard\""):
+        validated({"quasi_static": True, "partner_energy_coefficient": 1e-13})

@@ -85,13 +85,19 @@ def penalty_of(a: dict) -> dict:
 
 
 def _check_table(out: dict, path: str) -> None:
-    """Rules across keys: a frequency unless quasi-static; k_e with the energy law."""
+    """Rules across keys: a frequency unless quasi-static; k_e with the energy law (and the
+    partner surfaces' k_e only with it)."""
     if not out.get("quasi_static") and "frequency" not in out:
         fail(f"{path}.frequency" if path else "frequency", None,
              "an excitation frequency [Hz] (or quasi_static = true)")
     if out.get("law") == "energy" and "energy_coefficient" not in out:
         fail(f"{path}.energy_coefficient" if path else "energy_coefficient", None,
              "k_e [m^3/J] for law = \"energy\"")
+    if out.get("law") != "energy" and "partner_energy_coefficient" in out:
+        key = "partner_energy_coefficient"
+        fail(f"{path}.{key}" if path else key, out[key],
+             "no value with law = \"archard\" (the partner surfaces' Archard coefficient is "
+             "[[contact]] partner_wear_coefficient)")
 
 
 # --- dataset ------------------------------------------------------------------------------------
@@ -104,11 +110,11 @@ def _steps_kept(n: int, every: int) -> np.ndarray:
 
 
 def wear_dataset(model, result: WearResult, basis: FourierBasis, *, frequency_hz: float,
-                 record_every: int = 1, frf=None, law: str = "archard") -> xr.Dataset:
+                 record_every: int = 1, frf=None, law: str = "archard",
+                 energy_coefficients=(None, None)) -> xr.Dataset:
     """The results dataset of a wear run (``docs/results.md``, section ``wear``); ``law``
-    splits the wear depth between the two surfaces of a pair
-    (:func:`fretwear.wear.laws.side_depths`)."""
-    opts_law = law
+    and, for the energy law, ``energy_coefficients`` (node's surface, partner's) split the
+    wear depth between the two surfaces of a pair (:func:`fretwear.wear.laws.side_depths`)."""
     h = result.history
     keep = _steps_kept(h.n_steps, record_every)
     c = model.contact
@@ -139,7 +145,8 @@ def wear_dataset(model, result: WearResult, basis: FourierBasis, *, frequency_hz
         "contact_interface": interface_labels(model),
         "worn_depth_surface": variable(
             ("step", "contact_node", "surface"),
-            np.stack(side_depths(model, hist["wear_depth"], opts_law), axis=-1), "m",
+            np.stack(side_depths(model, hist["wear_depth"], law, *energy_coefficients),
+                     axis=-1), "m",
             "worn depth of each surface (the contact node's, its partner's); their sum is W"),
         "excitation_frequency": variable((), frequency_hz, "Hz",
                                          "excitation frequency (time scale only if quasi-static)"),
@@ -376,7 +383,9 @@ def run_wear(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOu
     elif fb is not None:
         frf_note = "FRF before/after skipped: the model has no observed point"
     ds = wear_dataset(model, result, basis, frequency_hz=f_hz, record_every=a["record_every"],
-                      frf=frf, law=opts.law)
+                      frf=frf, law=opts.law,
+                      energy_coefficients=(opts.energy_coefficient,
+                                           opts.partner_energy_coefficient))
     figures = _figures(ds, case, outdir, nodes)
     files = [outdir / CHECKPOINT_FILE]
     if model.mesh is not None and case.output["vtu"]:
@@ -490,8 +499,12 @@ SCHEMA = {
                   unit="-"),
     "law": option("law", Text(LAWS), '"archard" (k_w = contact.wear_coefficient, paper '
                   'eq. 29) or "energy" (worn volume = energy_coefficient x friction energy)'),
-    "energy_coefficient": option("energy_coefficient", Number(lo=0), "k_e of the energy law",
-                                 unit="m^3/J"),
+    "energy_coefficient": option("energy_coefficient", Number(lo=0), "k_e of the energy law "
+                                 "(the surface of every contact node)", unit="m^3/J"),
+    "partner_energy_coefficient": option(
+        "partner_energy_coefficient", Number(lo=0), "k_e of the energy law for the partner "
+        "surfaces of node-to-node pairs ([[contact]] partner); unset: they do not wear",
+        unit="m^3/J"),
     "scheme": option("scheme", Text(SCHEMES), '"rosenbrock" (linearly implicit Euler, stable '
                      'for any jump, the cheapest), "implicit" (backward Euler) or "explicit" '
                      "(explicit Euler, paper eq. 30: stable only for jumps below 2/rho)"),

@@ -7,7 +7,9 @@ Per node, per cycle, evaluated on the converged DLFT samples with the *corrected
   at a node-to-node pair both surfaces wear, each at its own coefficient, and the gap opens
   by the sum (``k_w = k_w(a) + k_w(b)``; :func:`side_depths` splits it);
 * energy (Fouvry et al. 2003): worn volume = ``k_e`` x friction energy, so
-  ``dW1_p = k_e E_p / area_p`` with ``E_p = sum_n lambda_T(n).(X_T(n) - X_T(n-1))``.
+  ``dW1_p = k_e E_p / area_p`` with ``E_p = sum_n lambda_T(n).(X_T(n) - X_T(n-1))``; at a
+  node-to-node pair each surface wears by its own coefficient times the energy dissipated
+  between them (``k_e = k_e(a) + k_e(b)``, the partner's ``k_e(b)`` given apart).
 
 With Coulomb slip ``E_p = mu sum_n lambda_N |dX_T|`` exactly, so both laws are ``c_p S_p`` with
 the slip work ``S_p`` of :mod:`fretwear.wear.kernels` and ``c_p = k_w / area_p`` or
@@ -27,7 +29,8 @@ LAWS = ("archard", "energy")
 
 
 def wear_coefficients(model: Model, law_name: str = "archard",
-                      energy_coefficient: float | None = None) -> np.ndarray:
+                      energy_coefficient: float | None = None,
+                      partner_energy_coefficient: float | None = None) -> np.ndarray:
     """Per-node factor ``c_p`` [1/N] with ``dW1_p = c_p S_p`` (module docstring).
 
     Parameters
@@ -36,7 +39,10 @@ def wear_coefficients(model: Model, law_name: str = "archard",
         ``contact.mu``).
     law_name : ``"archard"`` (eq. 29, ``c = k_w / area``) or ``"energy"``
         (``c = k_e mu / area``).
-    energy_coefficient : ``k_e`` [m^3/J] of the energy law.
+    energy_coefficient : ``k_e`` [m^3/J] of the energy law (the surface of every contact
+        node).
+    partner_energy_coefficient : ``k_e`` [m^3/J] of the partner surfaces of node-to-node
+        pairs (None: they do not wear).
     """
     c = model.contact
     area = np.asarray(c.area, dtype=float)
@@ -50,8 +56,23 @@ def wear_coefficients(model: Model, law_name: str = "archard",
         if energy_coefficient is None or not float(energy_coefficient) >= 0:
             raise InputError(f"energy_coefficient = {energy_coefficient!r}: the energy law needs "
                              "k_e >= 0 [m^3/J]")
-        return float(energy_coefficient) * c.mu_nodes() / area
+        ka, kb = energy_sides(model, energy_coefficient, partner_energy_coefficient)
+        return (ka + kb) * c.mu_nodes() / area
     raise InputError(f"law = {law_name!r}: expected one of {LAWS}")
+
+
+def energy_sides(model: Model, energy_coefficient, partner_energy_coefficient=None):
+    """Energy-law coefficients ``(k_e(a), k_e(b))`` (nc,) [m^3/J] of the two surfaces of every
+    contact node: ``k_e(b)`` is 0 at a node-to-rigid node and without a partner coefficient."""
+    n = model.contact.n_nodes
+    ka = np.full(n, float(energy_coefficient))
+    if partner_energy_coefficient is None:
+        return ka, np.zeros(n)
+    kb = float(partner_energy_coefficient)
+    if not kb >= 0:
+        raise InputError(f"partner_energy_coefficient = {partner_energy_coefficient!r}: "
+                         "expected k_e >= 0 [m^3/J]")
+    return ka, np.where(model.contact.paired(), kb, 0.0)
 
 
 def wear_per_cycle(sol: PeriodicSolution, *, law_name: str = "archard",
@@ -77,20 +98,25 @@ def wear_per_cycle(sol: PeriodicSolution, *, law_name: str = "archard",
     raise InputError(f"law = {law_name!r}: expected one of {LAWS}")
 
 
-def side_depths(model: Model, wear, law_name: str = "archard") -> tuple[np.ndarray, np.ndarray]:
+def side_depths(model: Model, wear, law_name: str = "archard",
+                energy_coefficient: float | None = None,
+                partner_energy_coefficient: float | None = None
+                ) -> tuple[np.ndarray, np.ndarray]:
     """Worn depths ``(W_a, W_b)`` [m] of the two surfaces of every contact node from the
     total ``wear`` (..., nc) [m] by which the gap opened.
 
-    Archard's law wears each surface at its own coefficient under the same pressure and slip
-    (eq. 29), so ``W_side = k_w(side) / (k_w(a) + k_w(b)) W``; a node-to-rigid node, a pair
-    whose partner's coefficient is 0 and the energy law (one coefficient ``k_e``) put all of
-    ``W`` on the surface of node ``a``.
+    Both laws wear each surface at its own coefficient under the same pressure and slip
+    (eq. 29) or the same dissipated energy, so ``W_side = k(side) / (k(a) + k(b)) W``; a
+    node-to-rigid node and a pair whose partner's coefficient is 0 (or, with the energy law,
+    not given) put all of ``W`` on the surface of node ``a``.
     """
     c = model.contact
     W = np.asarray(wear, dtype=float)
-    ka, kb = c.wear_nodes(), c.partner_wear_nodes()
-    if law_name != "archard":
-        kb = np.zeros_like(kb)
+    if law_name == "archard":
+        ka, kb = c.wear_nodes(), c.partner_wear_nodes()
+    else:
+        ka, kb = energy_sides(model, 1.0 if energy_coefficient is None else energy_coefficient,
+                              partner_energy_coefficient)
     tot = ka + kb
     share_b = np.divide(kb, tot, out=np.zeros_like(tot), where=tot > 0)
     Wb = W * share_b

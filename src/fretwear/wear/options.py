@@ -42,7 +42,10 @@ class WearOptions:
     ----------
     law : ``"archard"`` (eq. 29, coefficient ``model.contact.wear_coefficient`` [1/Pa]) or
         ``"energy"`` (Fouvry et al. 2003, ``energy_coefficient`` [m^3/J]).
-    energy_coefficient : ``k_e`` [m^3/J] of the energy law.
+    energy_coefficient : ``k_e`` [m^3/J] of the energy law (the surface of every contact
+        node).
+    partner_energy_coefficient : ``k_e`` [m^3/J] of the partner surfaces of node-to-node
+        pairs under the energy law (None: they do not wear); the gap of a pair opens by both.
     scheme : ``"rosenbrock"`` (linearly implicit Euler with the slow Jacobian; default: the
         cheapest for a given accuracy, docs/wear.md), ``"implicit"`` (backward Euler, every
         iterate a balanced solution) or ``"explicit"`` (explicit Euler, eq. 30).
@@ -82,6 +85,7 @@ class WearOptions:
 
     law: str = "archard"
     energy_coefficient: float | None = None
+    partner_energy_coefficient: float | None = None
     scheme: str = "rosenbrock"
     adaptive: bool = True
     tolerance: float = 1e-2
@@ -127,9 +131,10 @@ class WearOptions:
         if self.initial_jump is not None and not (_is_number(self.initial_jump)
                                                   and self.initial_jump > 0):
             raise InputError(f"initial_jump = {self.initial_jump!r}: expected > 0 cycles")
-        ke = self.energy_coefficient
-        if ke is not None and not (_is_number(ke) and ke >= 0):
-            raise InputError(f"energy_coefficient = {ke!r}: expected k_e >= 0 [m^3/J] or None")
+        for name in ("energy_coefficient", "partner_energy_coefficient"):
+            ke = getattr(self, name)
+            if ke is not None and not (_is_number(ke) and ke >= 0):
+                raise InputError(f"{name} = {ke!r}: expected k_e >= 0 [m^3/J] or None")
         for name in ("plateau_rate", "checkpoint_every_s"):
             v = getattr(self, name)
             if not (_is_number(v) and v >= 0):
@@ -157,6 +162,8 @@ class WearOptions:
         d = asdict(self)
         for k in ("checkpoint_every_s", "max_cycles", "max_depth", "plateau_rate", "max_steps"):
             d.pop(k)
+        if d["partner_energy_coefficient"] is None:  # the checkpoints written before it
+            d.pop("partner_energy_coefficient")
         return d
 
 

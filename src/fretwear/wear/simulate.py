@@ -108,7 +108,8 @@ def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
     nc, d = model.contact.dofs.shape
     if reduced is None:
         reduced = condense(model, frequency, basis.orders, quasi_static=quasi_static)
-    coef = wear_coefficients(model, opts.law, opts.energy_coefficient)
+    coef = wear_coefficients(model, opts.law, opts.energy_coefficient,
+                             opts.partner_energy_coefficient)
     W0 = np.zeros(nc) if W0 is None else np.broadcast_to(np.asarray(W0, float), (nc,)).copy()
     if anchor is None:
         anchor = static_anchor(model)
