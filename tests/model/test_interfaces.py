@@ -611,6 +611,52 @@ def test_time_integration_of_a_pair_on_a_stiff_held_body_is_the_rigid_obstacle_o
     np.testing.assert_allclose(tip_a, tip_b, rtol=0, atol=20 * ratio * np.abs(tip_b).max())
 
 
+def test_time_integration_takes_a_friction_coefficient_per_interface():
+    """Two blocks of different lengths (no shared eigenfrequencies), apart, each on its own
+    rigid flat with its own mu (0.3 and 0.4), integrated in time as one model with two
+    interfaces: each block's contact forces and states over the last of 10 periods are those
+    of the block integrated alone with its own mu (the bodies are uncoupled). Each run starts
+    from its own balance's state at t = 0 (as the pair test above), all balances at one eps
+    (a 3-harmonic balance depends on eps, and the default rule gives the joint model another
+    one). Tolerance 1e-10 of the largest force: the contact solves settle to 1e-10 of the
+    largest force of the model they solve; measured 4e-14."""
+    from fretwear.hb.periodic import initial_state
+    from fretwear.timedomain.integrate import integrate
+
+    sizes = {"one": (0.02, 4), "two": (0.015, 3)}
+
+    def block(name, origin=(0.0, 0.0)):
+        length, nx = sizes[name]
+        return rectangle(length, 0.01, nx, 2, origin=origin)
+
+    def run(model):
+        U0, V0 = initial_state(model, solve_periodic(model, BASIS, frequency=F_HZ, tol=1e-12,
+                                                     eps=1e9, raise_on_failure=True))
+        out = integrate(model, F_HZ, n_periods=10, steps_per_period=256, record="last",
+                        U0=U0, V0=V0)
+        assert out.success
+        return out
+
+    mesh = join(("one", block("one")), ("two", block("two", (0.05, 0.0))))
+    both = run(from_mesh(
+        mesh, STEEL, damping=Damping(loss_factor=0.02),
+        springs=[Spring("one.top_left", "x", 1e7), Spring("two.top_left", "x", 1e7)],
+        loads=block_loads("one.") + block_loads("two."),
+        contact=[ContactSpec("one.bottom", mu=0.3, name="soft"),
+                 ContactSpec("two.bottom", mu=0.4, name="high")]))
+    first = 0
+    for name, mu in (("one", 0.3), ("two", 0.4)):
+        alone = run(from_mesh(block(name), STEEL, damping=Damping(loss_factor=0.02),
+                              springs=[Spring("top_left", "x", 1e7)], loads=block_loads(),
+                              contact=ContactSpec("bottom", mu=mu)))
+        n = sizes[name][1] + 1
+        got = both.lam[:, first:first + n]
+        first += n
+        assert np.any(alone.state == 2) and np.any(alone.state == 1)  # stick-slip
+        np.testing.assert_array_equal(both.state[:, first - n:first], alone.state)
+        np.testing.assert_allclose(got, alone.lam, rtol=0, atol=1e-10 * np.abs(alone.lam).max())
+
+
 def mapped(nx, ny, x_of, height):
     """A structured Q4 mesh of the region ``x_of(u, y)`` (u in [0, 1], y in [0, height])."""
     m = rectangle(1.0, height, nx, ny)

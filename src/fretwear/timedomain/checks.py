@@ -44,12 +44,10 @@ def check_contact(model: Model) -> None:
     if fixed.size:
         raise InputError(f"contact DOF {int(fixed[0])} is also a fixed DOF; a contact node must "
                          "be free to move in all its directions for the time-domain solver")
-    if np.ndim(c.mu) != 0:
-        raise InputError(f"contact.mu differs between interfaces "
-                         f"({sorted(set(c.mu_nodes().tolist()))}); the time-domain solver "
-                         "takes one friction coefficient")
-    if not (np.isfinite(c.mu) and c.mu >= 0.0):
-        raise InputError(f"contact.mu = {c.mu!r}; expected a friction coefficient >= 0")
+    mu = c.mu_nodes()
+    if not np.all(np.isfinite(mu) & (mu >= 0.0)):
+        bad = float(mu[~(np.isfinite(mu) & (mu >= 0.0))][0])
+        raise InputError(f"contact.mu = {bad!r}; expected a friction coefficient >= 0")
     if getattr(c, "has_connectors", False):
         raise InputError("contact stiffness (kn, kt) and prescribed normal loads are modelled "
                          "by the harmonic balance only; the time-domain solver takes rigid "

@@ -198,7 +198,7 @@ class Integrator:
                 self.bq_m, self.bd_m, self.ftab, self.G, red.Tx, red.obs)))
         self.energy = EnergyTerms(float(h), *(c_float(a) for a in (
             self.ftil, m_v, k_v, c_v, m_m, k_m, c_m)))
-        self.contact = Contact(self.A, c_float(self.gap), float(c.mu), int(self.d))
+        self.contact = Contact(self.A, c_float(self.gap), c_float(c.mu_nodes()), int(self.d))
         self.settings = Settings(float(self.tol), float(self.fscale), int(60 + 4 * self.nc))
         self.setup_time = time.perf_counter() - t0
         self.r = r

@@ -60,7 +60,7 @@ class Contact(NamedTuple):
 
     A: np.ndarray  #: (m, m) symmetric condensed stiffness in the local frame [N/m]
     gap: np.ndarray  #: (nc,) gap, wear included [m] (``x_N <= gap``)
-    mu: float  #: friction coefficient [-]
+    mu: np.ndarray  #: (nc,) friction coefficient of every node [-]
     d: int  #: components per node, 2 or 3
 
 
@@ -246,7 +246,7 @@ def _cone_residual(A, x, lam, gap, xprev, mu, rn, rt, F, st):
         else:
             F[i0] = -rn[i] * (x[i0] - gap[i])
             ns = np.sqrt(s1 * s1 + s2 * s2)
-            rad = mu * sn
+            rad = mu[i] * sn
             if ns <= rad:
                 st[i] = STICK
                 F[i0 + 1] = -rt[i] * (x[i0 + 1] - xprev[i0 + 1])
@@ -412,17 +412,17 @@ def _solve_contact_cone(A, b, xref, gap, xprev, mu, status, tdir, x, lam, tol, f
                 n0 = s1 / ns
                 n1 = s2 / ns
                 na = n0 if a == 0 else n1
-                g = mu * sn / ns
+                g = mu[i] * sn / ns
                 # dF_Ta = dlam_Ta - mu n_a dsN - g sum_b (delta_ab - n_a n_b) dsT_b
                 # dsN = -A[N,:] dx + rn dx_N;  dsT_b = -A[T_b,:] dx + rt dx_Tb
                 p0 = g * ((1.0 if a == 0 else 0.0) - na * n0)
                 p1 = g * ((1.0 if a == 1 else 0.0) - na * n1)
                 s = -F[row]
                 for c in range(m):
-                    v = (-A[row, c] + mu * na * A[i0, c] + p0 * A[i0 + 1, c]
+                    v = (-A[row, c] + mu[i] * na * A[i0, c] + p0 * A[i0 + 1, c]
                          + p1 * A[i0 + 2, c])
                     if c == i0:
-                        v -= mu * na * rn[i]
+                        v -= mu[i] * na * rn[i]
                     elif c == i0 + 1:
                         v -= p0 * rt[i]
                     elif c == i0 + 2:
@@ -477,7 +477,7 @@ def solve_contact(A, b, xref, gap, xprev, mu, d, status, tdir, x, lam, tol, fsca
     b, xref : (m,) with ``lam = b - A (x - xref)`` ([N], [m]).
     gap : (nc,) gap including wear [m]; ``x_N <= gap``.
     xprev : (m,) local displacements at the previous step [m] (tangential part used).
-    mu : friction coefficient [-]. d : 2 or 3.
+    mu : (nc,) friction coefficient of every node [-]. d : 2 or 3.
     status : (nc,) int8, in: guess (warm start), out: solution statuses.
     tdir : (nc, d-1), in/out: unit slip direction (2D: +1 or -1).
     x, lam : (m,) out: local displacements [m] and contact forces [N].
@@ -604,12 +604,12 @@ def solve_contact(A, b, xref, gap, xprev, mu, d, status, tdir, x, lam, tol, fsca
                         for b_ in range(d - 1):
                             de[a_, b_] = ((1.0 if a_ == b_ else 0.0) - e[a_] * e[b_]) / nxi
                 ec = e[c - 1]
-                rhs[k] = -(lam[ri] - mu * lam[i0] * ec)
+                rhs[k] = -(lam[ri] - mu[i] * lam[i0] * ec)
                 for j in range(nf):
                     cj = cols[j]
-                    v = -A[ri, cj] + mu * ec * A[i0, cj]
+                    v = -A[ri, cj] + mu[i] * ec * A[i0, cj]
                     if cj >= i0 + 1 and cj < i0 + d:
-                        v -= mu * lam[i0] * de[c - 1, cj - i0 - 1]
+                        v -= mu[i] * lam[i0] * de[c - 1, cj - i0 - 1]
                     J[k, j] = v
         res = 0.0
         for k in range(nf):
@@ -649,18 +649,18 @@ def solve_contact(A, b, xref, gap, xprev, mu, d, status, tdir, x, lam, tol, fsca
             viol = 0.0
             if st == OPEN:
                 if sn > eps_f:
-                    new = STICK if nt <= mu * sn else SLIP
+                    new = STICK if nt <= mu[i] * sn else SLIP
                     viol = sn / eps_f
             elif sn < -eps_f:
                 new = OPEN
                 viol = -sn / eps_f
             elif st == STICK:
-                if nt > mu * sn + eps_f:
+                if nt > mu[i] * sn + eps_f:
                     new = SLIP
-                    viol = (nt - mu * sn) / eps_f
-            elif nt < mu * sn - eps_f:
+                    viol = (nt - mu[i] * sn) / eps_f
+            elif nt < mu[i] * sn - eps_f:
                 new = STICK
-                viol = (mu * sn - nt) / eps_f
+                viol = (mu[i] * sn - nt) / eps_f
             else:
                 dot = 0.0
                 for c in range(d - 1):
@@ -677,8 +677,8 @@ def solve_contact(A, b, xref, gap, xprev, mu, d, status, tdir, x, lam, tol, fsca
                         xi[c] = tdir[i, c]
                     if nxi > eps_x:
                         for c in range(1, d):
-                            r_ = abs(lam[i0 + c] - mu * lam[i0] * (x[i0 + c] - xprev[i0 + c])
-                                     / nxi)
+                            r_ = abs(lam[i0 + c]
+                                     - mu[i] * lam[i0] * (x[i0 + c] - xprev[i0 + c]) / nxi)
                             if r_ > resid:
                                 resid = r_
                         for c in range(1, d):

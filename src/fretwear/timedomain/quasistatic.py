@@ -116,7 +116,7 @@ def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int =
     rec = WearRecords(rec_every, np.zeros((nrec, nc)), np.zeros((nrec, nc)),
                       np.zeros((nrec, nc)), np.zeros(nrec), np.zeros(nrec, dtype=np.int64))
     nr, nfail, maxit = run_quasistatic(
-        Contact(A, gap, float(c.mu), int(d)), LoadCycle(btab, c_float(area), kw, jumps),
+        Contact(A, gap, c_float(c.mu_nodes()), int(d)), LoadCycle(btab, c_float(area), kw, jumps),
         Settings(float(tol), fscale, 60 + 4 * nc), WearState(x, wear, ContactState(status, tdir)),
         rec)
     if nfail and raise_on_failure:
