@@ -260,6 +260,16 @@ def _x_along(ds) -> tuple[np.ndarray, str]:
     return pos[:, k], f"{AXES[k]} [m]"
 
 
+def _profile(ax, x, y, **kw) -> None:
+    """``y`` against ``x`` over the contact nodes: a line through the nodes in the order of
+    ``x`` where each ``x`` is one node (a line interface), markers only where several nodes
+    share an ``x`` (a surface in 3D, several interfaces side by side: a line would zig-zag
+    between them; the maps of ``wear-maps.png`` show those)."""
+    o = np.argsort(x, kind="stable")
+    style = {} if np.unique(x).size == x.size else {"linestyle": "none"}
+    ax.plot(x[o], y[o], marker=".", **style, **kw)
+
+
 def plot_wear_profiles(ds, path: Path, *, title=None) -> Path:
     """Wear depth along the interface at selected cycle counts (paper Fig. 7, 21, 23)."""
     x, xl = _x_along(ds)
@@ -267,7 +277,7 @@ def plot_wear_profiles(ds, path: Path, *, title=None) -> Path:
     ax = axes[0, 0]
     cyc = ds["cycles"].values
     for i in selected_steps(cyc):
-        ax.plot(x, ds["wear_depth"].values[i] * 1e6, marker=".", label=f"N = {cyc[i]:.3g}")
+        _profile(ax, x, ds["wear_depth"].values[i] * 1e6, label=f"N = {cyc[i]:.3g}")
     ax.set_xlabel(xl)
     ax.set_ylabel("wear depth [um]")
     ax.grid(True, alpha=0.3)
@@ -314,8 +324,8 @@ def plot_pressure_slip(ds, path: Path, *, title=None) -> Path:
     cyc = ds["cycles"].values
     for i in selected_steps(cyc):
         lab = f"N = {cyc[i]:.3g}"
-        axes[0, 0].plot(x, ds["pressure_max"].values[i], marker=".", label=lab)
-        axes[1, 0].plot(x, ds["slip_amplitude"].values[i], marker=".", label=lab)
+        _profile(axes[0, 0], x, ds["pressure_max"].values[i], label=lab)
+        _profile(axes[1, 0], x, ds["slip_amplitude"].values[i], label=lab)
     axes[0, 0].set_ylabel("max normal pressure [Pa]")
     axes[1, 0].set_ylabel("tangential amplitude [m]")
     axes[1, 0].set_xlabel(xl)
