@@ -611,6 +611,29 @@ def test_time_integration_of_a_pair_on_a_stiff_held_body_is_the_rigid_obstacle_o
     np.testing.assert_allclose(tip_a, tip_b, rtol=0, atol=20 * ratio * np.abs(tip_b).max())
 
 
+def test_compare_on_a_pair_on_a_stiff_held_body_is_the_rigid_obstacle_one():
+    """`fretwear compare` (the DLFT periodic solution against the time-domain steady state)
+    on the soft block over a 1e6 times stiffer held base gives the table of the block on a
+    rigid flat: every quantity of both methods to 20 x the stiffness ratio (as the time
+    integration above)."""
+    from fretwear.analyses.compare import compare_periodic
+
+    ratio = 1e-6
+    scale = 1e7 / STEEL.E
+    soft = Material(1e7, 0.3, 7800.0 * scale)
+    table = {"frequency": F_HZ, "harmonics": 3, "n_samples": 32, "eps": "auto",
+             "solver": "powell", "tol": 1e-10, "max_iter": 100}
+    rows = [compare_periodic(m, table, None, steps_per_period=256, max_periods=3000)
+            for m in (block_on_base(E_base=1e7 / ratio, block=soft, scale=scale),
+                      block_on_rigid(block=soft, scale=scale))]
+    assert all(r.classification == "periodic" and r.dlft_converged for r in rows)
+    for (name, dlft, td, _), (name_r, dlft_r, td_r, _) in zip(rows[0].rows, rows[1].rows,
+                                                             strict=True):
+        assert name == name_r
+        np.testing.assert_allclose([dlft, td], [dlft_r, td_r], rtol=20 * ratio, err_msg=name)
+    assert 0 < rows[1].rows[-1][2] < 1  # stick-slip
+
+
 def test_time_integration_takes_a_friction_coefficient_per_interface():
     """Two blocks of different lengths (no shared eigenfrequencies), apart, each on its own
     rigid flat with its own mu (0.3 and 0.4), integrated in time as one model with two
