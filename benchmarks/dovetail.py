@@ -8,16 +8,20 @@ Prints, on this machine and in this run, with the number of unknowns of each sta
   coefficients), and as a machine reference the time of one dense LU factorisation of the
   Jacobian's size, timed in the same run (``solve_over_lu``);
 - one slow wear step of the wear example (its first step after the unworn balance);
+- before them, one untimed-in-the-figures warm-up solve (the numba kernels are compiled on
+  the first run of a fresh installation);
 - a nonlinear FRF of ``--points`` (default 50) points from 1.9 to 2.8 kHz with the example's
   settings (1 harmonic), and how many converged.
 
-Run: ``python benchmarks/dovetail.py [--points 50] [--quick]`` (``--quick`` skips the FRF).
+Run: ``python benchmarks/dovetail.py [--points 50] [--quick] [--verbose]`` (``--quick``
+skips the FRF, ``--verbose`` prints one line per FRF point: how it converged and its time).
 Quote the figures with the machine load (``uptime``).
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import time
 
 import numpy as np
@@ -32,17 +36,28 @@ from fretwear.hb.sweep import sweep
 from fretwear.io.case import build_model
 from fretwear.wear import WearOptions, simulate_wear
 
+CPU: list = [0.0]  # processor time of the last _timed call [s]
+
 
 def _timed(fn):
-    t0 = time.perf_counter()
+    """``(fn(), wall time [s])``; the processor time of the call is left in ``CPU[0]`` (on a
+    machine shared with other work the wall time grows with the load, the processor time
+    much less)."""
+    t0, c0 = time.perf_counter(), time.process_time()
     out = fn()
+    CPU[0] = time.process_time() - c0
     return out, time.perf_counter() - t0
+
+
+def _cpu() -> str:
+    return f" (processor {CPU[0]:.2f} s)"
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--points", type=int, default=50, help="points of the FRF sweep")
     ap.add_argument("--quick", action="store_true", help="skip the FRF sweep")
+    ap.add_argument("--verbose", action="store_true", help="one line per FRF point")
     args = ap.parse_args()
 
     model, t_build = _timed(lambda: build_model(load_case(example_path("dovetail-frf"))))
@@ -52,20 +67,29 @@ def main():
           f"{len(c.names())} flanks, {m} reduced DOFs; built in {t_build:.2f} s")
 
     f = 2400.0
-    for orders in ([0, 1], [0, 1, 2, 3]):
-        _, t = _timed(lambda o=orders: condense(model, f, o))
-        print(f"condensation, harmonics {orders}: {t:.2f} s")
+    print(f"load average at the start: {os.getloadavg()[0]:.2f} ({os.cpu_count()} cores)")
+    _, t = _timed(lambda: condense(model, 0.0, [0], quasi_static=True))
+    print(f"condensation set-up (once per model: blocks, static LU, harmonic 0): {t:.2f} s"
+          + _cpu())
+    basis = FourierBasis.up_to(1, 16)
+    _, t = _timed(lambda: solve_periodic(model, basis, frequency=0.95 * f, eps="static"))
+    print(f"warm-up: one periodic solve with its condensation {t:.2f} s (numba kernels "
+          "compiled, or loaded from their cache)")
+    for orders, fc in (([0, 1], f), ([0, 1, 2, 3], 1.01 * f)):  # no factorisation reused
+        _, t = _timed(lambda o=orders, fc=fc: condense(model, fc, o))
+        print(f"condensation at a new frequency, harmonics {orders}: {t:.2f} s" + _cpu())
 
     for nh in (1, 3):
         basis = FourierBasis.up_to(nh, 16 * nh)
         red = condense(model, f, [0, *basis.harmonics])
         sol, t = _timed(lambda b=basis, r=red: solve_periodic(model, b, frequency=f,
                                                               reduced=r, eps="static"))
+        cpu = _cpu()
         n = m * basis.size
         A = np.random.default_rng(0).standard_normal((n, n))
         _, t_lu = _timed(lambda a=A: sla.lu_factor(a))
         st = sol.stats
-        print(f"periodic solve, {nh} harmonic(s): {n} unknowns, {t:.2f} s "
+        print(f"periodic solve, {nh} harmonic(s): {n} unknowns, {t:.2f} s{cpu} "
               f"({st.iterations} iterations, success={sol.success}); dense LU of {n}: "
               f"{t_lu:.3f} s; solve_over_lu={t / t_lu:.1f}")
 
@@ -76,18 +100,31 @@ def main():
                                           eps="static", options=WearOptions(max_steps=1)))
     h = res.history
     print(f"wear: first slow step {h.wall_time[-1]:.2f} s (run with the unworn balance "
-          f"{t:.2f} s, {m * wb.size} unknowns, jump {h.jump[-1]:.3g} cycles, "
+          f"{t:.2f} s{_cpu()}, {m * wb.size} unknowns, jump {h.jump[-1]:.3g} cycles, "
           f"success={res.success})")
 
     if not args.quick:
         case = load_case(example_path("dovetail-frf"))
         a = case.analysis
         basis = FourierBasis.up_to(a["harmonics"], a["n_samples"])
+        t_sweep = [time.perf_counter()]
+
+        def show(i, n, pt):
+            now = time.perf_counter()
+            if args.verbose:
+                print(f"  {i + 1:3d}/{n} {pt.frequency_hz:8.1f} Hz {pt.how:22s} "
+                      f"{pt.stats.iterations:3d} it, {len(pt.attempts)} attempts, "
+                      f"{now - t_sweep[0]:6.1f} s, success={pt.success}", flush=True)
+            t_sweep[0] = now
+
         res, t = _timed(lambda: sweep(model, basis, a["f_min"], a["f_max"], args.points,
-                                      spacing="linear", eps="static", progress=False))
-        ok = int(np.sum(res.point_success))
-        print(f"FRF: {args.points} points, {m * basis.size} unknowns each, {t:.1f} s "
-              f"({t / args.points:.2f} s per point); sweep_converged={ok}/{len(res.points)}")
+                                      spacing="linear", eps=a["eps"], progress=show))
+        grid = [p for p in res.points if p.on_grid]
+        ok = sum(p.success for p in grid)
+        print(f"FRF: {args.points} points, {m * basis.size} unknowns each, {t:.1f} s"
+              f"{_cpu()}, {t / args.points:.2f} s per point; sweep_converged={ok}/{len(grid)} "
+              f"({len(res.points) - len(grid)} intermediate points)")
+    print(f"load average at the end: {os.getloadavg()[0]:.2f}")
 
 
 if __name__ == "__main__":
