@@ -53,7 +53,8 @@ def one_node(bn, bt, xprev_t, guess=STICK):
     status = np.array([guess], dtype=np.int8)
     tdir = np.ones((1, 1))
     x, lam = np.zeros(2), np.zeros(2)
-    its = solve_contact(A, b, np.zeros(2), np.zeros(1), np.array([0.0, xprev_t]), MU, 2,
+    its = solve_contact(A, b, np.zeros(2), np.zeros(1), np.array([0.0, xprev_t]),
+                        np.full(1, MU), 2,
                         status, tdir, x, lam, 1e-12, abs(bn) + abs(bt), 50,
                         np.zeros(2, np.int64), np.zeros(2, np.int64), np.zeros(2, np.int64),
                         np.zeros((2, 2)), np.zeros(2))
@@ -100,7 +101,7 @@ def solve3(A, b, xref, gap, xprev, status, tol=1e-12):
     tdir = np.zeros((nc, 2))
     tdir[:, 0] = 1.0
     x, lam = np.zeros(m), np.zeros(m)
-    its = solve_contact(A, b, xref, gap, xprev, MU, 3, status, tdir, x, lam, tol,
+    its = solve_contact(A, b, xref, gap, xprev, np.full(nc, MU), 3, status, tdir, x, lam, tol,
                         float(np.abs(b).max()), 60 + 4 * nc, np.zeros(m, np.int64),
                         np.zeros(m, np.int64), np.zeros(m, np.int64), np.zeros((m, m)),
                         np.zeros(m))
