@@ -25,12 +25,14 @@ from fretwear.hb.reduce import condense, loads_to_real, recover, to_real_blocks
 RTOL = 1e-9
 
 
-@pytest.fixture(autouse=True, params=["dense", "sparse"])
+@pytest.fixture(autouse=True, params=["batched", "dense", "sparse"])
 def condensation_path(request, monkeypatch):
-    """Every test runs on both paths of the condensation: LAPACK on dense blocks (small
+    """Every test runs on the three paths of the condensation: every harmonic in one batched
+    LAPACK solve (tiny models, reduce.BATCH_MAX), LAPACK per harmonic on dense blocks (small
     models, reduce.DENSE_MAX) and SuperLU with blocked multi-right-hand-side solves (BLOCK = 5
     columns, so the 12 contact DOFs of the truss take three blocks)."""
-    monkeypatch.setattr(reduce, "DENSE_MAX", 10**9 if request.param == "dense" else -1)
+    monkeypatch.setattr(reduce, "DENSE_MAX", -1 if request.param == "sparse" else 10**9)
+    monkeypatch.setattr(reduce, "BATCH_MAX", 10**9 if request.param == "batched" else -1)
     monkeypatch.setattr(reduce, "BLOCK", 5)
     monkeypatch.setattr(reduce, "_CONDENSERS", {})
     return request.param

@@ -64,52 +64,101 @@ def stiffness(contact: ContactInterface) -> np.ndarray:
     return out.reshape(-1)
 
 
-def connect(reduced: Reduced, contact: ContactInterface) -> Reduced:
+@dataclass(frozen=True)
+class Springs:
+    """The contact springs of an interface as :func:`connect` uses them, prepared once per
+    interface (a sweep connects the reduced model of every frequency through the same
+    springs). ``k`` (m,) [N/m] (:func:`stiffness`); ``f`` the directions with a finite
+    spring (their ``u`` is eliminated) and ``kf`` (nf,) their springs [N/m]; ``r`` the rigid
+    directions (``u = x`` along them); ``perm`` the order ``[r, f]`` (None when it is the
+    node-major order itself)."""
+
+    k: np.ndarray
+    f: np.ndarray
+    kf: np.ndarray
+    r: np.ndarray
+    perm: np.ndarray | None = None
+
+
+def springs(contact: ContactInterface) -> Springs | None:
+    """The prepared :class:`Springs` of ``contact``; None when the interface is rigid."""
+    if not contact.has_springs:
+        return None
+    k = stiffness(contact)
+    f = np.flatnonzero(np.isfinite(k))
+    r = np.flatnonzero(~np.isfinite(k))
+    perm = np.concatenate([r, f])
+    return Springs(k, f, k[f], r, None if np.array_equal(perm, np.arange(k.size)) else perm)
+
+
+def connect(reduced: Reduced, contact: ContactInterface,
+            prepared: Springs | None = None) -> Reduced:
     """The reduced model seen by the contact law through the contact springs of ``contact``
     (module docstring); ``reduced`` itself when the interface is rigid or ``reduced`` is
-    already a :class:`Connected`."""
-    if isinstance(reduced, Connected) or not contact.has_springs:
+    already a :class:`Connected`. ``prepared``: ``springs(contact)`` if already made.
+
+    With the finite directions ``f`` (springs ``K_f``) and the rigid ones ``r`` (``u_r =
+    x_r``), eliminating ``u_f`` harmonic by harmonic from
+    ``(Z_ff + K_f) u_f + Z_fr x_r - K_f x_f = F_f`` gives ``u_f = y - X x`` with
+    ``[X, y] = (Z_ff + K_f)^-1 [[Z_fr, -K_f], F_f]`` (columns ``x_r``, ``x_f``), and
+
+        Z_x = [[Z_rr, 0], [0, K_f]] - [[Z_rf], [-K_f]] X,   F_x = [F_r; 0] - [[Z_rf], [-K_f]] y
+
+    (rows ``r`` then ``f``): the module docstring's formulas with the rigid directions tied.
+    Every harmonic is eliminated at once (batched LAPACK)."""
+    if isinstance(reduced, Connected):
         return reduced
-    k = stiffness(contact)
+    sp = springs(contact) if prepared is None else prepared
+    if sp is None:
+        return reduced
     m = reduced.m
-    if k.size != m:
-        raise InputError(f"contact stiffness has {k.size} entries for {m} reduced DOFs")
-    f = np.flatnonzero(np.isfinite(k))  # directions with a spring: u_f is eliminated
-    rigid = ~np.isfinite(k)  # u = x along them
-    kf = np.where(rigid, 0.0, k)
-    nb = reduced.Z.shape[0]
-    Zx = np.empty_like(reduced.Z)
-    Fx = np.empty_like(reduced.F)
-    nA = np.empty((nb, m, m), dtype=complex)
-    nbv = np.empty((nb, m), dtype=complex)
-    for b in range(nb):
-        Z, F = reduced.Z[b], reduced.F[b]
-        # unknowns (u_f, x): u = E_f u_f + P_r x; stiffness [[Z + Kf, -Kf], [-Kf, Kf]] on (u, x)
-        Zu = Z + np.diag(kf)
-        Aff = Zu[np.ix_(f, f)]
-        # A'_fx = E_f^T (Zu P_r - Kf) ; A'_xx = P_r Zu P_r - P_r Kf - Kf P_r + Kf
-        Afx = Zu[f][:, rigid] @ np.eye(m)[rigid] - np.diag(kf)[f]
-        Pr = np.diag(rigid.astype(float))
-        Axx = Pr @ Zu @ Pr - Pr @ np.diag(kf) - np.diag(kf) @ Pr + np.diag(kf)
-        Ff = F[f]
-        Fxx = Pr @ F
-        try:
-            sol = np.linalg.solve(Aff, np.column_stack([Afx, Ff]))
-        except np.linalg.LinAlgError:
-            raise InputError(f"the structure with its contact springs is singular at harmonic "
-                             f"{int(reduced.orders[b])} ({reduced.frequency:.6g} Hz)") from None
-        X, y = sol[:, :m], sol[:, m]
-        Axf = (Pr @ Zu - np.diag(kf))[:, f]
-        Zx[b] = Axx - Axf @ X
-        Fx[b] = Fxx - Axf @ y
-        A = Pr.astype(complex)
-        A[f] -= X
-        nA[b] = A
-        bv = np.zeros(m, dtype=complex)
-        bv[f] = y
-        nbv[b] = bv
-    obs_A = np.einsum("bom,bmj->boj", reduced.obs_A, nA)
-    obs_b = reduced.obs_b + np.einsum("bom,bm->bo", reduced.obs_A, nbv)
+    if sp.k.size != m:
+        raise InputError(f"contact stiffness has {sp.k.size} entries for {m} reduced DOFs")
+    kf, nr = sp.kf, sp.r.size
+    Z, F = reduced.Z, reduced.F
+    if sp.perm is not None:  # rigid directions first: the blocks are then slices
+        Z, F = Z[:, sp.perm[:, None], sp.perm], F[:, sp.perm]
+    nb = Z.shape[0]
+    Kff = np.diag(kf)
+    Aff = Z[:, nr:, nr:] + Kff
+    # [X, y] = (Z_ff + K_f)^-1 [Z_fr, -K_f, F_f]
+    rhs = np.empty((nb, m - nr, m + 1), dtype=complex)
+    rhs[:, :, :nr] = Z[:, nr:, :nr]
+    rhs[:, :, nr:m] = -Kff
+    rhs[:, :, m] = F[:, nr:]
+    try:
+        sol = np.linalg.solve(Aff, rhs)
+    except np.linalg.LinAlgError:
+        for b in range(nb):  # name the singular harmonic
+            try:
+                np.linalg.solve(Aff[b], rhs[b])
+            except np.linalg.LinAlgError:
+                raise InputError(f"the structure with its contact springs is singular at "
+                                 f"harmonic {int(reduced.orders[b])} "
+                                 f"({reduced.frequency:.6g} Hz)") from None
+        raise
+    X, y = sol[:, :, :m], sol[:, :, m]  # u_f = y - X x
+    Axf = np.empty((nb, m, m - nr), dtype=complex)
+    Axf[:, :nr] = Z[:, :nr, nr:]
+    Axf[:, nr:] = -Kff
+    Zx = np.zeros_like(Z)
+    Zx[:, :nr, :nr] = Z[:, :nr, :nr]
+    Zx[:, nr:, nr:] = Kff
+    Zx -= Axf @ X
+    Fx = np.zeros_like(F)
+    Fx[:, :nr] = F[:, :nr]
+    Fx -= (Axf @ y[:, :, None])[:, :, 0]
+    nA = np.zeros((nb, m, m), dtype=complex)  # u = node_A x + node_b
+    nA[:, :nr, :nr] = np.eye(nr)
+    nA[:, nr:, :] = -X
+    nbv = np.zeros(F.shape, dtype=complex)
+    nbv[:, nr:] = y
+    if sp.perm is not None:  # back to the node-major order
+        inv = np.argsort(sp.perm)
+        Zx, Fx = Zx[:, inv[:, None], inv], Fx[:, inv]
+        nA, nbv = nA[:, inv[:, None], inv], nbv[:, inv]
+    obs_A = reduced.obs_A @ nA
+    obs_b = reduced.obs_b + (reduced.obs_A @ nbv[:, :, None])[:, :, 0]
     return Connected(reduced.omega, reduced.orders, Zx, Fx, obs_A, obs_b, reduced.obs_dofs,
                      reduced.quasi_static, reduced.frequency, node_A=nA, node_b=nbv,
                      structure=reduced)

@@ -14,6 +14,7 @@ harmonics).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -138,6 +139,11 @@ class FourierBasis:
         p[0] *= 0.5
         return p
 
+    def matrices(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(P, Q)``: :meth:`forward_matrix` and :meth:`inverse_matrix`, computed once per
+        basis and shared (read-only arrays: a sweep builds a problem per frequency)."""
+        return _matrices(self)
+
     def derivative_matrix(self, omega: float) -> np.ndarray:
         """``D`` (1+2k, 1+2k) with ``coeffs(du/dt) = D @ coeffs(u)`` [1/s]."""
         k = self.k
@@ -169,6 +175,14 @@ class FourierBasis:
         out[0] = c[0]
         out[1:] = c[1 : 1 + k] - 1j * c[1 + k :]
         return out
+
+
+@lru_cache(maxsize=64)
+def _matrices(basis: FourierBasis) -> tuple[np.ndarray, np.ndarray]:
+    P, Q = basis.forward_matrix(), basis.inverse_matrix()
+    for a in (P, Q):
+        a.flags.writeable = False
+    return P, Q
 
 
 def amplitude(coeffs: np.ndarray, basis: FourierBasis) -> np.ndarray:

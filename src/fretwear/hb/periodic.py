@@ -14,6 +14,7 @@ block-diagonal per node.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import time
 from dataclasses import dataclass, field
@@ -22,7 +23,8 @@ import numpy as np
 
 from fretwear.errors import InputError
 from fretwear.hb import contact as law
-from fretwear.hb.connectors import Connected, connect, node_displacements
+from fretwear.hb import small
+from fretwear.hb.connectors import Connected, connect, node_displacements, springs
 from fretwear.hb.fallback import TimeDomainFallback
 from fretwear.hb.fourier import FourierBasis, amplitude
 from fretwear.hb.krylov import HarmonicBlocks, KrylovJacobian
@@ -74,7 +76,9 @@ class DLFTProblem:
         exp = np.array([0, *basis.harmonics])
         if not np.array_equal(np.asarray(reduced.orders), exp):
             raise InputError(f"reduced model orders {list(reduced.orders)} != basis {list(exp)}")
-        reduced = connect(reduced, contact)
+        self._springs = springs(contact)
+        if self._springs is not None:
+            reduced = connect(reduced, contact, self._springs)
         self.reduced = reduced
         self.contact = contact
         self.blocks = HarmonicBlocks(reduced.Z)
@@ -85,16 +89,43 @@ class DLFTProblem:
             jacobian = "dense" if self.m * self.H <= DENSE_JACOBIAN_MAX else "krylov"
         self.jacobian = jacobian
         self.F = loads_to_real(reduced.F)
+        self._eps_rule = eps
         self.eps = penalty(eps, reduced=reduced, contact=contact)
+        self._Fnorm = None
         self.mu = contact.mu_nodes()
         self.normal = contact.normal_force_samples(basis.tau)  # None: all unilateral
         self.set_gap(contact.gap if gap is None else gap)
         self.anchor = np.zeros((nc, d - 1)) if anchor is None else np.array(anchor, float)
-        self.P = basis.forward_matrix()
-        self.Q = basis.inverse_matrix()
+        self.P, self.Q = basis.matrices()
+        # small problems: residual and Jacobian in one compiled call (hb/small.py)
+        self.small = self.jacobian == "dense" and self.m * self.H <= small.SMALL_MAX
+        self._normal = law._normal(self.normal, np.empty((nc, d, basis.n_samples)))
         self.tol = periodicity_tol
         self.max_sweeps = max_sweeps
         self.nfev = 0
+
+    def at(self, reduced: Reduced, anchor) -> DLFTProblem:
+        """The same problem (interface, basis, gap, eps rule, settings) on the reduced model
+        of another frequency (same orders), with the stick anchors ``anchor`` (nc, d-1) [m].
+        What does not depend on the frequency (the Fourier matrices, friction coefficients,
+        prescribed normal forces, a numeric eps, the contact springs) is shared, not rebuilt:
+        a sweep makes one problem per frequency."""
+        if isinstance(self._eps_rule, str):  # a rule evaluated on each reduced model
+            return DLFTProblem(reduced, self.contact, self.basis, gap=self.gap,
+                               eps=self._eps_rule, anchor=anchor, periodicity_tol=self.tol,
+                               max_sweeps=self.max_sweeps, jacobian=self.jacobian)
+        new = copy.copy(self)
+        if self._springs is not None:
+            reduced = connect(reduced, self.contact, self._springs)
+        new.reduced = reduced
+        new.blocks = HarmonicBlocks(reduced.Z)
+        new._Z = None
+        new.F = loads_to_real(reduced.F)
+        new._Fnorm = None
+        new.anchor = (np.zeros((self.nc, self.d - 1)) if anchor is None
+                      else np.array(anchor, float))
+        new.nfev = 0
+        return new
 
     def with_eps(self, eps: float) -> DLFTProblem:
         """The same problem (reduced model, gap, anchors) with the penalty ``eps`` [N/m]."""
@@ -133,15 +164,40 @@ class DLFTProblem:
 
     def time_law(self, U):
         """Time-domain law: ``(lam_u, lam_x, state, sweeps)`` with samples (nc, d, N)."""
+        if self.small:
+            return small.time_law(self._flat(U), self.Z, self.F.reshape(-1),
+                                  self.W.reshape(-1), self.eps, self.Q, self.mu,
+                                  self._x_start(), self.tol, self.max_sweeps, self._normal,
+                                  self.nc, self.d)
         lu = self.basis.to_time(self.lambda_u(U)).reshape(self.nc, self.d, -1)
         lu = np.ascontiguousarray(lu)
         lx, state, sweeps = law.dlft_time(lu, self.mu, self.eps * self.anchor, self.tol,
                                           self.max_sweeps, self.normal)
         return lu, lx, state, sweeps
 
+    def to_freq(self, samples) -> np.ndarray:
+        """Real coefficients (k, H) of time samples (k, N), as the residual takes them: by
+        the forward matrix ``P`` on the small-problem path, by FFT otherwise."""
+        if self.small:
+            return samples @ self.P.T
+        return self.basis.to_freq(samples)
+
+    def _flat(self, U):
+        return np.ascontiguousarray(U, dtype=float).reshape(-1)
+
+    def _x_start(self):
+        return np.ascontiguousarray(self.eps * self.anchor, dtype=float).reshape(self.nc,
+                                                                                  self.d - 1)
+
     def residual(self, U, jacobian=True):
         """``f`` (m*H,) and, if asked, ``J`` (m*H, m*H) at ``U`` (m, H)."""
         self.nfev += 1
+        if self.small:
+            f, J = small.residual(self._flat(U), self.Z, self.F.reshape(-1),
+                                  self.W.reshape(-1), self.eps, self.P, self.Q, self.mu,
+                                  self._x_start(), self.tol, self.max_sweeps, self._normal,
+                                  self.nc, self.d, bool(jacobian))
+            return f, (J if jacobian else None)
         lu, lx, state, _ = self.time_law(U)
         Lx = self.basis.to_freq(lx.reshape(self.m, -1))
         f = (self.eps * (U - self.W) - Lx).reshape(-1)
@@ -166,7 +222,9 @@ class DLFTProblem:
         """Reference magnitude of the convergence test: ``|Z_r U~|`` (section 3.2), or |F~|
         when that vanishes."""
         zu = np.linalg.norm(self.apply_Z(U))
-        return max(zu, np.linalg.norm(self.F), 1e-300)
+        if self._Fnorm is None:
+            self._Fnorm = float(np.linalg.norm(self.F))
+        return max(zu, self._Fnorm, 1e-300)
 
     def initial_guess(self):
         """Contact closed, tangential positions at the anchors, no vibration."""
@@ -817,18 +875,18 @@ def assemble_solution(prob: DLFTProblem, U, model: Model, stats: SolveStats) -> 
     x_t = lx / prob.eps
     b = prob.basis
     nc, d, H = prob.nc, prob.d, prob.H
-    lam = b.to_freq(lam_t.reshape(prob.m, -1)).reshape(nc, d, H)
-    X = b.to_freq(lx.reshape(prob.m, -1)).reshape(nc, d, H) / prob.eps
+    both = prob.to_freq(np.concatenate([lam_t, lx]).reshape(2 * prob.m, -1))
+    lam = both[: prob.m].reshape(nc, d, H)
+    X = both[prob.m :].reshape(nc, d, H) / prob.eps
     X[:, 0, 0] += prob.gap  # X~ = U~ - W~ at convergence; report positions
-    x_t = x_t.copy()
     x_t[:, 0, :] += prob.gap[:, None]
     red = prob.reduced
     observed = {}
     U_node = None
+    Uc = b.to_complex(U)  # (k+1, m) complex
     if isinstance(red, Connected):
-        U_node = b.from_complex(node_displacements(red, b.to_complex(U))).reshape(nc, d, H)
+        U_node = b.from_complex(node_displacements(red, Uc)).reshape(nc, d, H)
     if red.obs_dofs.size:
-        Uc = b.to_complex(U)  # (k+1, m) complex
         Uo = np.einsum("bom,bm->bo", red.obs_A, Uc) + red.obs_b
         real = b.from_complex(Uo)  # (no, H)
         i = 0

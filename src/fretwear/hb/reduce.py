@@ -239,6 +239,10 @@ def _factor(Zii, n: int, omega: float):
 #: the sparse machinery costs more than the arithmetic (docs/theory.md, "Cost of the
 #: condensation": measured crossover 100-180 interior DOFs, benchmarks/condense_small.py).
 DENSE_MAX = 150
+#: at most this many interior DOFs: the harmonics of a dense condensation are condensed
+#: together in one batched solve (:meth:`Condenser._reduced_batched`); above it the
+#: arithmetic dominates and the per-harmonic LUs are kept for the recovery
+BATCH_MAX = 32
 #: right-hand sides per block of the multi-RHS sparse solves: bounds the memory of
 #: ``Z_ii^-1 Z_ic`` to ``n_i x BLOCK`` complex values.
 BLOCK = 256
@@ -296,6 +300,7 @@ class Condenser:
         self.obs_i = [(j, pos_i[int(g)]) for j, g in enumerate(s.obs) if int(g) in pos_i]
         self._lus: dict = {}
         self._static = None
+        self._load_cache: dict = {}
 
     # -- the blocks of Z_n ------------------------------------------------------------------
     def _z(self, part: str, omega: float, n: int, quasi_static: bool):
@@ -380,7 +385,12 @@ class Condenser:
         """The :class:`Reduced` model on harmonic ``orders`` at ``omega`` [rad/s]."""
         orders = np.asarray(orders, dtype=np.int64)
         m, no, nb = self.m, self.structure.obs.size, orders.size
-        F_all = self.structure.load_harmonics(int(orders.max()) if orders.size else 0)
+        F_all = self.load_harmonics(int(orders.max()) if orders.size else 0)
+        if (self.dense and self.ni <= BATCH_MAX and isinstance(self.R, np.ndarray)
+                and not quasi_static and omega > 0):
+            out = self._reduced_batched(omega, orders, F_all)
+            if out is not None:
+                return self._result(omega, orders, *out, quasi_static, frequency)
         Zr = np.zeros((nb, m, m), dtype=complex)
         Fr = np.zeros((nb, m), dtype=complex)
         oA = np.zeros((nb, no, m), dtype=complex)
@@ -401,6 +411,98 @@ class Condenser:
             for j, i in self.obs_i:
                 ob[b, j] = xf[i]
         return self._result(omega, orders, Zr, Fr, oA, ob, quasi_static, frequency)
+
+    def load_harmonics(self, nmax: int) -> np.ndarray:
+        """The structure's load amplitudes (nmax+1, ndof) complex [N], kept until
+        :func:`condenser` reads the model's loads again (a sweep condenses the same loads at
+        every frequency)."""
+        F = self._load_cache.get(nmax)
+        if F is None:
+            F = np.asarray(self.structure.load_harmonics(nmax))
+            F.flags.writeable = False
+            self._load_cache = {nmax: F}
+        return F
+
+    def _obs_rows(self, Xo):
+        """Observation rows ``A`` (.., no, m): ``U_o = A u_loc`` (+ the load part), from the
+        rows ``Xo`` (.., len(obs_i), m) of ``Z_ii^-1 Z_ic`` at the interior observed DOFs."""
+        A = np.zeros(Xo.shape[:-2] + (self.structure.obs.size, self.m), dtype=complex)
+        for j, c in self.obs_c:
+            A[..., j, :] = _column(self.R, c)  # U_c = R^T u_loc
+        for k, (j, _) in enumerate(self.obs_i):
+            A[..., j, :] = -(Xo[..., k, :] @ self.R.T)
+        return A
+
+    def _reduced_batched(self, omega: float, orders, F_all):
+        """``(Z_r, F_r, obs_A, obs_b)`` of a tiny dense model (``n_i <= BATCH_MAX``) with the
+        harmonics ``n >= 1`` condensed together (one batched LAPACK solve): the same eq. 19
+        as :meth:`schur` and :meth:`loads`, without their per-harmonic Python work, which
+        dominated small sweeps. Harmonic 0 (the kept static condensation) and the load
+        blocks do not depend on the frequency and are prepared once per ``orders``. None
+        when a ``Z_ii`` is (nearly) singular: the per-harmonic path then says why."""
+        m = self.m
+        key = ("batched", orders.tobytes())
+        prep = self._load_cache.get(key)
+        if prep is None:
+            prep = self._load_cache[key] = self._batched_prep(orders, F_all)
+        dyn, n_dyn, Fc, Fi_eye, Zr, Fr, oA, ob = prep
+        Zr, Fr, oA, ob = Zr.copy(), Fr.copy(), oA.copy(), ob.copy()
+        w = n_dyn * omega
+        R = self.R
+
+        def block(part):
+            Z = getattr(self.K, part) - (w * w)[:, None, None] * getattr(self.M, part)
+            if self.D is not None:
+                Z = Z + 1j * getattr(self.D, part)
+            if self.C is not None:
+                Z = Z + (1j * w)[:, None, None] * getattr(self.C, part)
+            return Z.astype(complex, copy=False)
+
+        S = block("cc")
+        if self.ni:
+            Zii = block("ii")
+            Zci = block("ci")
+            try:  # [Z_ii^-1 Z_ic, Z_ii^-1 F_i, Z_ii^-1]
+                X = np.linalg.solve(Zii, np.concatenate([block("ic"), Fi_eye], axis=2))
+            except np.linalg.LinAlgError:
+                return None
+            inv = X[:, :, m + 1:]  # condition number (1-norm) beyond 1e13: nearly singular
+            cond = (np.abs(Zii).sum(axis=1).max(axis=1) * np.abs(inv).sum(axis=1).max(axis=1))
+            if not (np.all(np.isfinite(cond)) and np.all(cond < 1e13)):
+                return None
+            S = S - Zci @ X[:, :, :m]
+            Fc = Fc - (Zci @ X[:, :, m:])[:, :, 0]
+            rows = np.array([i for _, i in self.obs_i], dtype=np.int64)
+            oA[dyn] = self._obs_rows(X[:, rows, :m])
+            ob[np.ix_(dyn, [j for j, _ in self.obs_i])] = X[:, rows, m]
+        Zr[dyn] = R @ S @ R.T
+        Fr[dyn] = Fc @ R.T
+        return Zr, Fr, oA, ob
+
+    def _batched_prep(self, orders, F_all):
+        """What :meth:`_reduced_batched` reuses at every frequency for ``orders``: the
+        dynamic harmonics, their loads on the contact and interior DOFs (the latter with the
+        identity beside them: the batched solve also gives ``Z_ii^-1``), and the arrays of
+        the result with harmonic 0 (and the observation rows without interior DOFs) filled."""
+        m, no, nb = self.m, self.structure.obs.size, orders.size
+        dyn = np.flatnonzero(orders > 0)
+        Fd = F_all[orders[dyn]]
+        Zr = np.zeros((nb, m, m), dtype=complex)
+        Fr = np.zeros((nb, m), dtype=complex)
+        oA = np.zeros((nb, no, m), dtype=complex)
+        ob = np.zeros((nb, no), dtype=complex)
+        if not self.ni:
+            oA[dyn] = self._obs_rows(np.zeros((dyn.size, 0, m)))
+        for b in np.flatnonzero(orders == 0):  # the static condensation
+            Zr_0, lu, Zci, Xo = self.schur(0.0, 0)
+            Zr[b] = Zr_0
+            oA[b] = self._obs_rows(Xo)
+            Fr[b], xf = self.loads(F_all[0], lu, Zci)
+            for j, i in self.obs_i:
+                ob[b, j] = xf[i]
+        Fi_eye = np.concatenate([Fd[:, self.idofs, None],
+                                 np.eye(self.ni)[None].repeat(dyn.size, axis=0)], axis=2)
+        return dyn, orders[dyn].astype(float), Fd[:, self.cdofs], Fi_eye, Zr, Fr, oA, ob
 
     def _result(self, omega, orders, Zr, Fr, oA, ob, quasi_static, frequency) -> Reduced:
         """The :class:`Reduced` model, its observed rows mapped back from the relative
@@ -473,6 +575,7 @@ def condenser(model: Model) -> Condenser:
     hit = _CONDENSERS.get(key)
     if hit is not None and hit[0]() is model and hit[1] == fp:
         cond = hit[2]  # the loads are read anew (in relative coordinates with pairs)
+        cond._load_cache = {}
         s, P = cond.structure, cond.structure.P
         if P is None:
             s.load_harmonics = model.load_harmonics
@@ -606,14 +709,15 @@ def to_real_blocks(Zc: np.ndarray, orders: np.ndarray) -> np.ndarray:
     k = nb - 1
     H = 1 + 2 * k
     out = np.zeros((m, H, m, H))
-    out[:, 0, :, 0] = Zc[0].real
-    for b in range(1, nb):
-        zr, zi = Zc[b].real, Zc[b].imag
-        ca, cb = b, k + b
-        out[:, ca, :, ca] = zr
-        out[:, ca, :, cb] = zi
-        out[:, cb, :, ca] = -zi
-        out[:, cb, :, cb] = zr
+    view = out.transpose(1, 3, 0, 2)  # (H, H, m, m): the coefficient blocks, every harmonic
+    view[0, 0] = Zc[0].real
+    ca = np.arange(1, nb)
+    cb = ca + k
+    zr, zi = Zc[1:].real, Zc[1:].imag
+    view[ca, ca] = zr
+    view[ca, cb] = zi
+    view[cb, ca] = -zi
+    view[cb, cb] = zr
     return out.reshape(m * H, m * H)
 
 

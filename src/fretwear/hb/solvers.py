@@ -19,7 +19,6 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg as sla
 import scipy.optimize as so
 
 SOLVERS = ("powell", "newton", "hybr")
@@ -78,12 +77,14 @@ def solve_identity_rows(J, B):
 
 
 def _dense_solve(A, B):
+    """LAPACK LU solve (``gesv``: the factorisation and solve of ``scipy.linalg.lu_factor``
+    and ``lu_solve`` without their wrappers' per-call checks, which weighed on small
+    problems); least squares when ``A`` is singular."""
     try:
-        lu = sla.lu_factor(A, check_finite=False)
-        X = sla.lu_solve(lu, B, check_finite=False)
+        X = np.linalg.solve(A, B)
         if np.all(np.isfinite(X)):
             return X
-    except (sla.LinAlgError, ValueError):
+    except (np.linalg.LinAlgError, ValueError):
         pass
     return np.linalg.lstsq(A, B, rcond=None)[0]
 

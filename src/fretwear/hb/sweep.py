@@ -37,7 +37,8 @@ from fretwear.hb.periodic import (
     solve_strategy,
     static_anchor,
 )
-from fretwear.hb.reduce import _condense
+from fretwear.hb.connectors import connect, springs
+from fretwear.hb.reduce import _condense, condenser
 from fretwear.hb.solvers import SolveStats, solve
 from fretwear.hb.sweep_checkpoint import (
     WHAT,
@@ -194,6 +195,11 @@ class _Problems:
         self.cache: dict = {}
         self.size = cache_size
         self.last = None  # the last problem handed out
+        # the model does not change during a sweep: its condenser (and loads) are read once,
+        # the contact springs prepared once, and the problems share their set-up
+        self.condenser = condenser(model)
+        self.springs = springs(model.contact)
+        self.template = None
 
     def get(self, omega: float, anchor) -> DLFTProblem:
         """The problem at the circular frequency ``omega`` [rad/s] (the continuation
@@ -201,13 +207,18 @@ class _Problems:
         key = float(omega)
         red = self.cache.get(key)
         if red is None:
-            red = _condense(self.model, omega, self.orders)
+            red = self.condenser.reduced(omega, self.orders)
+            if self.springs is not None:
+                red = connect(red, self.model.contact, self.springs)
             while self.cache and (len(self.cache) >= self.size or red.Z.nbytes + sum(
                     r.Z.nbytes for r in self.cache.values()) > CACHE_BYTES):
                 self.cache.pop(next(iter(self.cache)))
             self.cache[key] = red
-        prob = DLFTProblem(red, self.model.contact, self.basis, gap=self.gap, eps=self.eps,
-                           anchor=anchor)
+        if self.template is None:
+            prob = self.template = DLFTProblem(red, self.model.contact, self.basis,
+                                               gap=self.gap, eps=self.eps, anchor=anchor)
+        else:
+            prob = self.template.at(red, anchor)
         # the GMRES preconditioner of large interfaces (fretwear.hb.krylov) is carried from
         # the neighbouring frequency: GMRES still solves each step to its tolerance, and
         # rebuilds it when it has become slow
