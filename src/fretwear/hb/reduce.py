@@ -264,6 +264,10 @@ class _Blocks:
 def _split(A, cdofs, idofs, dense: bool) -> _Blocks | None:
     if A is None:
         return None
+    if dense and A.shape[0] <= 2 * DENSE_MAX:  # a small matrix: numpy slicing is cheaper
+        A = A.toarray()
+        return _Blocks(A[np.ix_(cdofs, cdofs)], A[np.ix_(cdofs, idofs)],
+                       A[np.ix_(idofs, cdofs)], A[np.ix_(idofs, idofs)])
     A = A.tocsr()
     rows_c, rows_i = A[cdofs], A[idofs]
     ci, ic, ii = rows_c[:, idofs], rows_i[:, cdofs].tocsc(), rows_i[:, idofs].tocsc()

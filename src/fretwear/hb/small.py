@@ -34,7 +34,6 @@ def time_law(U, Z, F, W, eps, Q, mu, x_start, tol, max_sweeps, normal, nc, d):
     """``(lambda_u, lambda_x, state, sweeps)`` at the real coefficients ``U`` (m*H,),
     DOF-major: ``lambda_u`` and ``lambda_x`` samples (nc, d, N), the law's state (nc, N) and
     the passes per node (:func:`fretwear.hb.contact.dlft_time`)."""
-    n = U.size
     N, H = Q.shape
     lu_c = F - np.dot(Z, U) + eps * (U - W)
     lam_u = np.empty((nc, d, N))

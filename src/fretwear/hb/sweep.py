@@ -24,6 +24,7 @@ import numpy as np
 
 from fretwear.errors import InputError
 from fretwear.files import check_state_file
+from fretwear.hb.connectors import connect, springs
 from fretwear.hb.fallback import TimeDomainFallback
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.penalty import sweep_penalty
@@ -37,7 +38,6 @@ from fretwear.hb.periodic import (
     solve_strategy,
     static_anchor,
 )
-from fretwear.hb.connectors import connect, springs
 from fretwear.hb.reduce import _condense, condenser
 from fretwear.hb.solvers import SolveStats, solve
 from fretwear.hb.sweep_checkpoint import (
