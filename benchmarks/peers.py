@@ -32,6 +32,12 @@ points refined by a parabola through the three points around it.
 Prints per code, problem and H: points, converged, warm and cold wall time [s], peak amplitude
 and frequency errors (relative); then the machine load; the last line is
 ``speedup_vs_pyharm_warm=<geometric mean over problems and H of pyHarm warm / fretwear warm>``.
+
+``--first-ever`` adds, per code, the cold run of problem (a) at the first H in a process whose
+caches are empty: numba's on-disk cache of compiled kernels (``NUMBA_CACHE_DIR``) and Python's
+bytecode cache (``PYTHONPYCACHEPREFIX``, so every imported module, numpy and scipy included,
+is compiled from source as on a fresh installation), both in a temporary folder: the cost of a
+user's very first run.
 """
 
 from __future__ import annotations
@@ -199,6 +205,8 @@ def main(argv=None):
                                                        "/tmp/pyharm-venv/bin/python"),
                     help="python of the environment where pyharm-os 1.2.2 is installed")
     ap.add_argument("--harmonics", type=int, nargs="+", default=[7, 15])
+    ap.add_argument("--first-ever", action="store_true",
+                    help="also time a first run with empty numba and bytecode caches")
     args = ap.parse_args(argv)
     have_pyharm = Path(args.pyharm).exists()
     if not have_pyharm:
@@ -236,6 +244,26 @@ def main(argv=None):
                       f"{wp / w_ref - 1:+10.2e}  {note}")
             if all(c in rows and "error" not in rows[c] for c in ("fretwear", "pyHarm")):
                 ratios.append(rows["pyHarm"]["warm"] / rows["fretwear"]["warm"])
+    if args.first_ever:
+        H = args.harmonics[0]
+        for code, python, src, cargs in (
+                ("fretwear", sys.executable, FRETWEAR_CHILD,
+                 ["a", H, N_POINTS["a"], *BAND["a"], "top"]),
+                ("pyHarm", args.pyharm if have_pyharm else None, PYHARM_CHILD,
+                 ["a", H, *BAND["a"]])):
+            if python is None:
+                continue
+            with tempfile.TemporaryDirectory() as tmp:
+                fresh = dict(env, NUMBA_CACHE_DIR=str(Path(tmp) / "numba"),
+                             PYTHONPYCACHEPREFIX=str(Path(tmp) / "pycache"))
+                t0 = time.perf_counter()
+                r = child(python, src, cargs, fresh)
+                wall = time.perf_counter() - t0
+            if "error" in r:
+                print(f"# first-ever {code}: failed: {r['error']}")
+            else:
+                print(f"# first-ever run, empty caches, (a) H = {H}: {code} cold "
+                      f"{r['cold']:.2f} s (process wall time {wall:.2f} s)")
     print(f"# machine load (uptime): {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f} "
           f"{os.getloadavg()[2]:.2f} on {os.cpu_count()} cores")
     gm = math.exp(sum(map(math.log, ratios)) / len(ratios)) if ratios else math.nan

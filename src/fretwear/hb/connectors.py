@@ -169,4 +169,4 @@ def node_displacements(reduced: Reduced, X: np.ndarray) -> np.ndarray:
     points' ``X`` (nb, m) complex [m]: ``X`` itself without contact springs."""
     if not isinstance(reduced, Connected):
         return X
-    return np.einsum("bmj,bj->bm", reduced.node_A, X) + reduced.node_b
+    return (reduced.node_A @ X[:, :, None])[:, :, 0] + reduced.node_b

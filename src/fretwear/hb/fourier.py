@@ -159,6 +159,13 @@ class FourierBasis:
         """Real coefficients ``(..., 1+2k)`` from complex amplitudes ``(k+1, ...)`` ordered as
         :attr:`orders`, with ``u = Re sum_n U_n e^{i n tau}`` (so ``a = Re U``, ``b = -Im U``)."""
         amps = np.asarray(amps)
+        if amps.ndim == 2:  # (k+1, m) -> (m, 1+2k): the common case, without concatenations
+            k = amps.shape[0] - 1
+            out = np.empty((amps.shape[1], 1 + 2 * k))
+            out[:, 0] = amps[0].real
+            out[:, 1 : 1 + k] = amps[1:].real.T
+            out[:, 1 + k :] = -amps[1:].imag.T
+            return out
         a0 = amps[0].real
         a = amps[1:].real
         b = -amps[1:].imag
@@ -170,7 +177,7 @@ class FourierBasis:
         """Inverse of :meth:`from_complex`: complex amplitudes ``(k+1, ...)``."""
         coeffs = np.asarray(coeffs, dtype=float)
         k = self.k
-        c = np.moveaxis(coeffs, -1, 0)
+        c = coeffs.T if coeffs.ndim <= 2 else np.moveaxis(coeffs, -1, 0)
         out = np.empty((k + 1,) + c.shape[1:], dtype=complex)
         out[0] = c[0]
         out[1:] = c[1 : 1 + k] - 1j * c[1 + k :]

@@ -35,8 +35,8 @@ from numbers import Real
 import numpy as np
 
 from fretwear.errors import InputError
-from fretwear.hb.connectors import connect
-from fretwear.hb.reduce import Reduced, condense
+from fretwear.hb.connectors import connect, springs
+from fretwear.hb.reduce import Reduced, condense, condenser
 from fretwear.model.core import Model
 
 #: the rules :func:`penalty` accepts besides a positive number [N/m]
@@ -157,5 +157,12 @@ def sweep_penalty(rule, model: Model, orders, f_min: float, f_max: float, *,
     if rule == "static":
         return penalty(rule, model=model)
     grid = (np.geomspace if spacing == "log" else np.linspace)(f_min, f_max, SWEEP_SAMPLES)
-    return float(np.median([penalty("top", model=model, frequency=float(f), orders=orders)
-                            for f in grid]))
+    cond, prepared = condenser(model), springs(model.contact)  # prepared once for the band
+    top = np.asarray(orders)[-1:]
+    values = []
+    for f in grid:
+        red = cond.reduced(2 * np.pi * float(f), top, False, float(f))  # = condense(...)
+        if prepared is not None:
+            red = connect(red, model.contact, prepared)
+        values.append(penalty("top", reduced=red, contact=model.contact))
+    return float(np.median(values))

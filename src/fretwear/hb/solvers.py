@@ -97,6 +97,14 @@ def _lu_step(J, f):
     return -J.solve(f)
 
 
+def vector_norm(x):
+    """The 2-norm of a real vector: ``sqrt(x . x)``, what ``numpy.linalg.norm`` computes for
+    it, without that function's dispatch (a solve of a small problem calls it dozens of
+    times)."""
+    x = np.ravel(x)
+    return np.sqrt(x.dot(x))
+
+
 def _column_norms(J):
     if isinstance(J, np.ndarray):
         return np.linalg.norm(J, axis=0)
@@ -114,7 +122,7 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None):
     x = np.array(x0, dtype=float)
     f, J = fun(x, True)
     nfev = njev = 1
-    fn = np.linalg.norm(f)
+    fn = vector_norm(f)
     dscale = _column_norms(J)
     dscale[dscale == 0] = 1.0
     delta = None  # first trial: the full Newton step
@@ -131,7 +139,7 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None):
             break
         it += 1
         sn = _lu_step(J, f)
-        snd = np.linalg.norm(dscale * sn)
+        snd = vector_norm(dscale * sn)
         if delta is None:
             delta = snd
         if snd <= delta:
@@ -141,7 +149,7 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None):
             Jg = J @ (g / dscale)
             alpha = (g @ g) / max(Jg @ Jg, 1e-300)
             sc_s = -alpha * g  # scaled Cauchy step
-            scn = np.linalg.norm(sc_s)
+            scn = vector_norm(sc_s)
             if scn >= delta:
                 s_s = sc_s * (delta / scn)
             else:
@@ -152,12 +160,12 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None):
                 t = (-b + np.sqrt(max(b * b - 4.0 * a * c, 0.0))) / (2.0 * a)
                 s_s = sc_s + t * dd
             s = s_s / dscale
-        pnorm = np.linalg.norm(dscale * s)
-        pred = fn * fn - np.linalg.norm(f + J @ s) ** 2
+        pnorm = vector_norm(dscale * s)
+        pred = fn * fn - vector_norm(f + J @ s) ** 2
         xn = x + s
         fnew, _ = fun(xn, False)
         nfev += 1
-        fnn = np.linalg.norm(fnew)
+        fnn = vector_norm(fnew)
         actual = fn * fn - fnn * fnn
         ratio = actual / pred if pred > 0 else -1.0
         if ratio < 0.1:
@@ -179,7 +187,7 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None):
             stall += 1
         if callback is not None:
             callback(it, x, fn)
-        if delta <= 1e-14 * max(np.linalg.norm(dscale * x), 1e-300) or stall > 40:
+        if delta <= 1e-14 * max(vector_norm(dscale * x), 1e-300) or stall > 40:
             msg = "trust region collapsed: no further decrease of |f| (non-smooth stall)"
             break
     wall = time.perf_counter() - t0
@@ -193,7 +201,7 @@ def newton(fun, x0, scale, *, tol=1e-8, max_iter=100, callback=None):
     x = np.array(x0, dtype=float)
     f, J = fun(x, True)
     nfev = njev = 1
-    fn = np.linalg.norm(f)
+    fn = vector_norm(f)
     it = 0
     ok = False
     msg = "maximum number of iterations reached"
@@ -210,7 +218,7 @@ def newton(fun, x0, scale, *, tol=1e-8, max_iter=100, callback=None):
         for _ in range(30):
             fnew, _ = fun(x + t * s, False)
             nfev += 1
-            fnn = np.linalg.norm(fnew)
+            fnn = vector_norm(fnew)
             if fnn <= (1.0 - 1e-4 * t) * fn:
                 accepted = True
                 break
@@ -241,7 +249,7 @@ def hybr(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None):
     sol = so.root(fj, np.array(x0, dtype=float), jac=True, method="hybr",
                   options={"xtol": 1e-13, "maxfev": max_iter * 10})
     f, _ = fun(sol.x, False)
-    fn = np.linalg.norm(f)
+    fn = vector_norm(f)
     ok = bool(fn <= tol * scale(sol.x))
     wall = time.perf_counter() - t0
     st = SolveStats(ok, float(fn / max(scale(sol.x), 1e-300)), int(sol.nfev), int(sol.nfev),
