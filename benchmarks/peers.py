@@ -26,7 +26,8 @@ imports and just-in-time compilation included) and runs the same analysis again 
 process (``warm``). fretwear: 121 (a) / 137 (b) linearly spaced frequencies (``fretwear.sweep``,
 default eps rule "top"; on (b) also with pyHarm's eps = 1000, row ``fretwear*``); pyHarm: its
 arclength continuation over the same band (step ``ds = 0.05``:
-its default continuation did not end on (b)). The peak of each curve is the largest A1 of its
+its default continuation did not end on (b)), stopped after ``PYHARM_MAX_SOLUTIONS`` solutions
+if it has not left the band by then. The peak of each curve is the largest A1 of its
 points refined by a parabola through the three points around it.
 
 Prints per code, problem and H: points, converged, warm and cold wall time [s], peak amplitude
@@ -58,6 +59,10 @@ sys.path.insert(0, str(HERE))
 import reference_oscillators as ref  # noqa: E402
 
 BAND = {"a": (0.7, 1.3), "b": (1.0, 1.8)}  # rad/s
+#: pyHarm's continuation stops at this many solutions if it has not left the band (without it,
+#: on (b) at H = 7, it was still running after 39 min, 12 min of CPU; 300 solutions end at
+#: w = 1.53 rad/s, past the peak)
+PYHARM_MAX_SOLUTIONS = 300
 N_POINTS = {"a": 121, "b": 137}
 
 FRETWEAR_CHILD = r'''
@@ -111,6 +116,7 @@ import numpy as np
 from pyHarm.Maestro import Maestro
 
 prob, H, w0, w1 = sys.argv[1], int(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4])
+MAX_SOLUTIONS = int(sys.argv[5])
 if prob == "a":
     subs = {"m": {"type": "onlydofs", "ndofs": 1, "nnodes": 1}}
     con = {"k": {"type": "LinearSpring", "connect": {"m": [0]}, "dirs": [0], "k": 1.0},
@@ -137,7 +143,9 @@ else:
 idata = {"system": {"type": "Base", "nh": H, "nti": 128}, "substructures": subs,
          "connectors": con,
          "analysis": {"frf": {"study": "frf", "puls_inf": w0, "puls_sup": w1, "ds0": 0.05,
-                              "ds_max": 0.05, "ds_min": 1e-6, "verbose": False}}}
+                              "ds_max": 0.05, "ds_min": 1e-6, "verbose": False,
+                              "stopper": "solnumber",
+                              "stopper_options": {"max_solutions": MAX_SOLUTIONS}}}}
 
 
 def run():
@@ -231,8 +239,8 @@ def main(argv=None):
                 rows["fretwear*"] = child(sys.executable, FRETWEAR_CHILD,
                                           [prob, H, N_POINTS[prob], *BAND[prob], 1000.0], env)
             if have_pyharm:
-                rows["pyHarm"] = child(args.pyharm, PYHARM_CHILD, [prob, H, *BAND[prob]],
-                                       env)
+                rows["pyHarm"] = child(args.pyharm, PYHARM_CHILD,
+                                       [prob, H, *BAND[prob], PYHARM_MAX_SOLUTIONS], env)
             for code, r in rows.items():
                 if "error" in r:
                     print(f"{code:9s} {prob:4s} {H:3d}  failed: {r['error']}")
@@ -250,7 +258,7 @@ def main(argv=None):
                 ("fretwear", sys.executable, FRETWEAR_CHILD,
                  ["a", H, N_POINTS["a"], *BAND["a"], "top"]),
                 ("pyHarm", args.pyharm if have_pyharm else None, PYHARM_CHILD,
-                 ["a", H, *BAND["a"]])):
+                 ["a", H, *BAND["a"], PYHARM_MAX_SOLUTIONS])):
             if python is None:
                 continue
             with tempfile.TemporaryDirectory() as tmp:

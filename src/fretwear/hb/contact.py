@@ -359,6 +359,9 @@ def _dlft_jacobian(lam_u, lam_x, state, mu, P, Q, x_start, tol, max_sweeps, norm
     that = np.zeros(dt)
     tmpA = np.zeros((dt, dH))
     tmpS = np.zeros((dt, dt))
+    Abuf = np.empty((d, N, dH))  # A0 and S at every instant, per component
+    Sbuf = np.empty((d, N, dt))
+    P = np.ascontiguousarray(P)
     for p in range(nc):
         A0[:, :] = 0.0
         S[:, :] = 0.0
@@ -387,16 +390,16 @@ def _dlft_jacobian(lam_u, lam_x, state, mu, P, Q, x_start, tol, max_sweeps, norm
                 all_stick = False
                 slip_derivative_step(lam_u[p], lam_x[p], n, n - 1 if n > 0 else N - 1, mu[p],
                                      Q, A0, S, that, B, tmpA, tmpS, normal[p, n])
-            # accumulate the DFT of the derivative
+            # keep the derivative at instant n; its DFT is taken below by one product per
+            # component (BLAS: the per-instant accumulation dominated the Jacobian's cost)
             for c in range(d):
-                for h in range(H):
-                    w = P[h, n]
-                    if w != 0.0:
-                        row = c * H + h
-                        for j in range(dH):
-                            Gp[row, j] += w * A0[c, j]
-                        for j in range(dt):
-                            PS[row, j] += w * S[c, j]
+                for j in range(dH):
+                    Abuf[c, n, j] = A0[c, j]
+                for j in range(dt):
+                    Sbuf[c, n, j] = S[c, j]
+        for c in range(d):
+            Gp[c * H:(c + 1) * H, :] = np.dot(P, Abuf[c])
+            PS[c * H:(c + 1) * H, :] = np.dot(P, Sbuf[c])
         # seed = A_T(-1) = A_T(N-1) = A0_T(N-1) + S_T(N-1) seed  ->  (I - S_T) seed = A0_T
         M = np.eye(dt)
         for a in range(dt):
