@@ -70,7 +70,7 @@ def _up_to_date(results: Path, case) -> bool:
     return attrs.get("case_file") == case.text and int(attrs.get("converged", 0)) == 1
 
 
-def _check_output(out_dir: Path, names: list[str]) -> bool:
+def check_output(out_dir: Path, names=()) -> bool:
     """Refuse, before anything runs, an output folder that cannot be written (a file, a path
     under a file, no permission, a name too long for the file system) and a folder where a
     file will be written (the run would fail at its first save). Makes the folder and proves
@@ -151,7 +151,7 @@ def run_case(path: Path | str, outdir: Path | str | None = None, progress: bool 
     analysis = get(case.analysis["type"])
     out_dir = case.output_dir(outdir)
     results_path = out_dir / RESULTS_FILE
-    made = _check_output(out_dir, [RESULTS_FILE, *analysis.files])
+    made = check_output(out_dir, [RESULTS_FILE, *analysis.files])
     say = print if echo else (lambda *a, **k: None)
     say(f"fretwear {__version__}: {case.title} ({case.path.name}, analysis {analysis.name})")
     for p in remove_stale_temporaries(out_dir):

@@ -4,11 +4,11 @@ write ``study.nc`` and the figures (``fretwear study STUDY.toml`` and
 
 from __future__ import annotations
 
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from fretwear import __version__
+from fretwear.analyses.run import check_output
 from fretwear.errors import InputError, interrupted
 from fretwear.files import atomic_write, remove_stale_temporaries
 from fretwear.study.aggregate import aggregate
@@ -41,22 +41,6 @@ class StudyInterrupted(KeyboardInterrupt):
     def __init__(self, message: str):
         super().__init__(message)
         self.message = message
-
-
-def _check_output(out_dir: Path) -> None:
-    """Refuse, before anything runs, an output folder that cannot be written."""
-    where = "choose another folder with -o DIR (or [output] directory)"
-    try:
-        if out_dir.exists() and not out_dir.is_dir():
-            raise InputError(f"the output folder {str(out_dir)!r} is a file: {where}")
-        out_dir.mkdir(parents=True, exist_ok=True)
-        with tempfile.TemporaryFile(dir=out_dir):
-            pass
-    except InputError:
-        raise
-    except OSError as exc:
-        raise InputError(f"cannot write in the output folder {str(out_dir)!r} "
-                         f"({exc.strerror or type(exc).__name__}): {where}") from None
 
 
 def _write_dataset(path: Path, ds) -> Path:
@@ -139,7 +123,7 @@ def run_study(path, outdir=None, *, scheduler=None, workers: int | None = None,
     if isinstance(address, str) and not collect:
         check_scheduler_address(address)  # before anything is written
     out_dir = study.output_dir(outdir)
-    _check_output(out_dir)
+    check_output(out_dir)
     say = print if echo else (lambda *a, **k: None)
     say(f"fretwear {__version__}: study {study.title} ({study.path.name}, {len(members)} "
         f"members, base {study.base.name}) -> {out_dir}")
