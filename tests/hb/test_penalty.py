@@ -193,3 +193,83 @@ def test_radius_estimate_of_large_blocks():
     assert radius(Z) == pytest.approx(abs(lam[7]), rel=1e-3)
     assert radius(Z[:40, :40]) == pytest.approx(np.abs(np.linalg.eigvals(Z[:40, :40])).max(),
                                                 rel=1e-12)
+
+
+# --- contact springs: eps = k makes the DLFT the alternating frequency-time balance --------
+
+def _jenkins_aft(w, H, N, m=1.0, k=1.0, c=0.02, kt=0.5, slip=0.5, f0=0.2):
+    """Periodic response x(t_n), t_n = n T / N, of ``m x'' + c x' + k x + f = f0 cos(w t)``
+    with ``f`` a spring ``kt`` in series with a Coulomb slider of threshold ``slip``, by the
+    harmonic balance on H harmonics with the force evaluated in time from the truncated
+    displacement (return mapping over periods until the force repeats), solved by scipy's
+    hybrid method with finite-difference Jacobians. Written here from the equations, sharing
+    nothing with fretwear."""
+    from scipy.optimize import root
+
+    t = np.arange(N) / N * 2 * np.pi
+    n = np.arange(1, H + 1)
+    C, S = np.cos(np.outer(n, t)), np.sin(np.outer(n, t))
+
+    def signal(z):  # z = [a0, a1..aH, b1..bH]: x = a0 + sum a_n cos + b_n sin
+        return z[0] + z[1:H + 1] @ C + z[H + 1:] @ S
+
+    def force(x):
+        f = 0.0
+        for _ in range(50):  # passes until the start state repeats
+            start, out = f, np.empty(N)
+            for i in range(N):
+                f = np.clip(f + kt * (x[i] - x[i - 1]), -slip, slip)
+                out[i] = f
+            if abs(f - start) < 1e-15:
+                break
+        return out
+
+    def residual(z):
+        f = force(signal(z))
+        fa0, fa, fb = f.mean(), 2 * C @ f / N, 2 * S @ f / N
+        a, b = z[1:H + 1], z[H + 1:]
+        d = k - m * (n * w) ** 2
+        ra = d * a + c * n * w * b + fa - f0 * (n == 1)
+        rb = d * b - c * n * w * a + fb
+        return np.concatenate([[k * z[0] + fa0], ra, rb])
+
+    z0 = np.zeros(2 * H + 1)
+    z0[1] = f0 / abs(k + kt - m * w * w)
+    sol = root(residual, z0, method="hybr", options={"xtol": 1e-14})
+    assert np.max(np.abs(residual(sol.x))) < 1e-12
+    return signal(sol.x)
+
+
+@pytest.mark.parametrize("w, f0", [(1.18, 0.2), (1.1, 0.5)])
+def test_jenkins_eps_is_its_spring_and_equals_the_aft_balance(w, f0):
+    """A Jenkins element (``kt`` in series with a slider, prescribed normal load): every eps
+    rule gives ``kt``, and the DLFT answer at that eps is the alternating frequency-time
+    balance of the spring-slider law (independent implementation above, hybrid solver with
+    finite differences). It is an identity of the two sets of discrete equations
+    (hb/penalty.spring_penalty), so both solvers reach the same root to rounding (1e-15
+    measured; 1e-10 allows for the reference's finite-difference solver); at the previous
+    value of the "top" rule (0.505 N/m, the top harmonic's spectral radius) the two
+    differ by far more, so the comparison can fail. Both frequencies slip in both directions
+    every period (amplitude above ``mu N / kt``), where the periodic state is unique (a
+    Jenkins element that sticks all period has a free mean)."""
+    from fretwear.model.matrices import from_matrices
+
+    H, N = 5, 64
+    model = from_matrices([[1.0]], [[1.0]], C=[[0.02]], contact_normal_dofs=None,
+                          contact_tangential_dofs=[0], mu=0.5, normal_load=1.0, kt=0.5,
+                          loads=[Load(np.array([f0]), "cos")], observed={"x": 0})
+    basis = FourierBasis.up_to(H, N)
+    for rule in ("top", "auto", "static"):
+        assert penalty(rule, model=model, frequency=w / (2 * np.pi),
+                       orders=basis.orders) == 0.5
+    ref = _jenkins_aft(w, H, N, f0=f0)
+    assert np.ptp(ref) / 2 > 0.5 / 0.5  # slips both ways: amplitude above mu N / kt
+    scale = np.max(np.abs(ref))
+
+    def error(eps):
+        sol = solve_periodic(model, basis, frequency=w / (2 * np.pi), eps=eps, tol=1e-12)
+        assert sol.success
+        return np.max(np.abs(sol.observed_time("x")[0][0] - ref)) / scale
+
+    assert error("top") < 1e-10
+    assert error(0.505) > 1e-5

@@ -17,7 +17,12 @@ files and in Python:
   where the per-frequency maximum over the harmonics (``"auto"``) picks the resonance and
   ``"static"`` a value far too small for a contact behind a mass. A sweep takes one ``"top"``
   eps for all its points: the median of the rule at :data:`SWEEP_SAMPLES` frequencies
-  spread over its band (:func:`sweep_penalty`).
+  spread over its band (:func:`sweep_penalty`). On an interface whose law acts through one
+  contact stiffness ``k`` on every row (a Jenkins element ``kt`` under a prescribed normal
+  load; ``kn = kt`` on a unilateral contact), ``"top"`` is ``k`` itself, the limit of the
+  spectral radius at high harmonics: with ``eps = k`` the DLFT balance is exactly the
+  alternating frequency-time balance of the spring-slider law (:func:`spring_penalty`). The
+  other rules give ``k`` there too: it removes the penalty's effect on the answer.
 * a positive number [N/m], used as given.
 
 Rows of nodes with a prescribed normal load (no unilateral normal contact) are left out: their
@@ -35,7 +40,7 @@ from numbers import Real
 import numpy as np
 
 from fretwear.errors import InputError
-from fretwear.hb.connectors import connect, springs
+from fretwear.hb.connectors import connect, springs, stiffness
 from fretwear.hb.reduce import Reduced, condense, condenser
 from fretwear.model.core import Model
 
@@ -84,6 +89,34 @@ def _law_rows(contact, m: int):
     return np.flatnonzero(keep)
 
 
+def spring_penalty(contact) -> float | None:
+    """The contact stiffness ``k`` [N/m] shared by every row of the law (:func:`_law_rows`) of
+    ``contact``, or None when a row is rigid or the rows' springs differ.
+
+    Why ``eps = k`` is exact (hb/connectors.py's notation, harmonic by harmonic, one spring
+    ``k`` on every law row): ``Z_x = k - k^2 (Z_r + k)^-1`` and ``F_x = k (Z_r + k)^-1 F_r``,
+    so the DLFT predictor ``lambda_u = F_x - Z_x X + eps (X - W)`` (eq. 23) is, for
+    ``eps = k``, ``k (U - W)`` with ``U = (Z_r + k)^-1 (F_r + k X)`` the structure's contact
+    displacement. The correction (eq. 24-28) applied to ``k (u(t) - w(t))`` is the return
+    mapping of a spring ``k`` in series with a Coulomb slider (stick: the force follows
+    ``k du``; slip: it sits on the cone); ``lambda_N = max(k (u_N - g), 0)`` on a unilateral
+    row. At convergence ``X`` is the slider's motion projected on the kept harmonics and
+    ``Z_r U + lambda~ = F_r``: the harmonic balance of the structure with the law's force
+    evaluated in the time domain from its truncated displacement, which is the alternating
+    frequency-time method with the exact elastic-slider law, no penalty left
+    (tests/hb/test_penalty.py compares with an independent implementation)."""
+    if contact is None:
+        return None
+    k = stiffness(contact)
+    rows = _law_rows(contact, k.size)
+    k = k if rows is None else k[rows]
+    if k.size == 0 or not np.all(np.isfinite(k)):
+        return None
+    if np.max(k) - np.min(k) > 1e-12 * np.max(k):
+        return None
+    return float(k[0])
+
+
 def check_rule(rule) -> str | float:
     """``rule`` if it is ``"auto"``, ``"static"`` or a positive finite number (as a float);
     otherwise an :class:`~fretwear.errors.InputError` (a ``ValueError``) naming ``eps``."""
@@ -124,6 +157,8 @@ def penalty(rule, *, model: Model | None = None, frequency: float = 0.0, orders=
         return rule
     if contact is None and model is not None:
         contact = model.contact
+    if (k := spring_penalty(contact)) is not None:  # every rule: exact on spring rows
+        return k
     if rule in ("auto", "top"):
         if reduced is None:
             if model is None or orders is None:
@@ -152,7 +187,11 @@ def sweep_penalty(rule, model: Model, orders, f_min: float, f_max: float, *,
     :data:`SWEEP_SAMPLES` frequencies spread over the band (``spacing`` as the sweep's grid);
     ``"auto"`` is returned as is (the paper's rule point by point, kept for comparison)."""
     rule = check_rule(rule)
-    if rule == "auto" or not isinstance(rule, str):
+    if not isinstance(rule, str):
+        return rule
+    if (k := spring_penalty(model.contact)) is not None:  # every rule: exact on spring rows
+        return k
+    if rule == "auto":
         return rule
     if rule == "static":
         return penalty(rule, model=model)
