@@ -187,3 +187,34 @@ def test_examples_share_the_model_of_the_linear_example(name):
     case = load_case(path)
     assert case.analysis["type"] in ("periodic", "sweep")
     assert case.title.startswith("Salles 2011 section 4.2 beam")
+
+
+@pytest.mark.parametrize("analysis", ["periodic", "sweep"])
+def test_a_failed_static_preload_solve_is_a_warning_and_an_attribute(tmp_path, capsys,
+                                                                      monkeypatch, analysis):
+    """The static contact problem under the preload (whose solution gives the stick anchors)
+    is given no iteration (its start, contact closed and stuck, is not its solution): the run
+    goes on with anchors at 0 but says so, on the terminal and in the ``warnings`` attribute
+    of the results; with the normal iteration limit the attribute is empty (the warning comes
+    from the failed solve)."""
+    from fretwear.hb import periodic
+
+    table = PERIODIC if analysis == "periodic" else (
+        '[analysis]\ntype = "sweep"\nf_min = 9e3\nf_max = 1e4\nn_points = 2\nharmonics = 1\n'
+        "n_samples = 16\n")
+    path = small_case(tmp_path, table + "[output]\nvtu = false\nfigures = false\n")
+    status, out, err = run(path, capsys)
+    assert status == 0, err
+    ds = read_results(tmp_path / "beam-results" / "results.nc")
+    assert ds.attrs["warnings"] == "" and "warning" not in out
+
+    monkeypatch.setattr(periodic, "STATIC_MAX_ITER", 0)
+    path = tmp_path / "starved.toml"
+    path.write_text(small_case(tmp_path, table).read_text()
+                    + "[output]\nvtu = false\nfigures = false\n")
+    status, out, err = run(path, capsys)
+    ds = read_results(tmp_path / "starved-results" / "results.nc")
+    expected = "the static contact problem under the preload did not converge ("
+    assert ds.attrs["warnings"].startswith(expected), ds.attrs["warnings"]
+    assert "stick anchors are set to 0" in ds.attrs["warnings"]
+    assert f"warning: {ds.attrs['warnings']}" in out

@@ -34,6 +34,8 @@ STOP_TOL = 5e-2
 #: global attribute of the results of the analyses that run the contact law: the interfaces
 #: that no node of touches under the static loads (comma-separated; empty: none)
 OPEN_ATTRIBUTE = "open_under_preload"
+#: global attribute of every results file: the run's warnings, one per line (empty: none)
+WARNINGS_ATTRIBUTE = "warnings"
 
 
 def preload_notes(model) -> tuple[list[str], list[str]]:

@@ -216,7 +216,8 @@ def run_periodic(model, analysis: dict, case, outdir: Path, progress: bool) -> R
     where = _frequency_text(f_hz, qs)
     if not sol.success:  # never saved as a result: the diagnostics only
         return RunOutput(xr.Dataset(attrs=attrs), [],
-                         _failure_summary(stats, analysis, where, sol), False)
+                         _failure_summary(stats, analysis, where, sol), False,
+                         warnings=list(sol.warnings))
     points = [p.name for p in model.observed]
     ds = periodic_dataset(model, sol, points)
     ds.attrs.update(attrs)
@@ -224,7 +225,8 @@ def run_periodic(model, analysis: dict, case, outdir: Path, progress: bool) -> R
     files = []
     if model.mesh is not None and case.output["vtu"]:
         files.append(write_period_fields(model, sol, outdir / "periodic.pvd"))
-    return RunOutput(ds, figures, _periodic_summary(sol, ds, analysis, where), True, files)
+    return RunOutput(ds, figures, _periodic_summary(sol, ds, analysis, where), True, files,
+                     warnings=list(sol.warnings))
 
 
 def _periodic_figures(ds: xr.Dataset, case, outdir: Path, title: str) -> list[Path]:

@@ -55,6 +55,9 @@ class RunOutput:
         ``converged`` attribute).
     files : other files written (e.g. ParaView ``.vtu``/``.pvd``).
     results : the results file, set by :func:`run_case`.
+    warnings : reasons for caution about the whole run, one line each (e.g. the static preload
+        solve that gives the stick anchors did not converge); :func:`run_case` prints them and
+        records them in the ``warnings`` attribute of the results.
     """
 
     dataset: xr.Dataset
@@ -63,6 +66,7 @@ class RunOutput:
     success: bool = True
     files: list[Path] = field(default_factory=list)
     results: Path | None = None
+    warnings: list[str] = field(default_factory=list)
 
     @property
     def message(self) -> str:

@@ -16,7 +16,7 @@ import time
 from pathlib import Path
 
 from fretwear import __version__
-from fretwear.analyses.common import OPEN_ATTRIBUTE, preload_notes
+from fretwear.analyses.common import OPEN_ATTRIBUTE, WARNINGS_ATTRIBUTE, preload_notes
 from fretwear.analyses.registry import RunOutput, analysis_tables, get
 from fretwear.errors import InputError, interrupted
 from fretwear.files import remove_stale_temporaries
@@ -173,6 +173,7 @@ def run_case(path: Path | str, outdir: Path | str | None = None, progress: bool 
         out = analysis.run(model, case.analysis, case, out_dir, progress)
         if open_names is not None:
             out.dataset.attrs[OPEN_ATTRIBUTE] = ", ".join(open_names)
+        out.dataset.attrs[WARNINGS_ATTRIBUTE] = "\n".join(out.warnings)
         out.results = write_results(
             results_path, out.dataset, title=case.title, analysis_type=analysis.name,
             converged=out.success, case_text=case.text, case_path=str(case.path),
@@ -188,6 +189,8 @@ def run_case(path: Path | str, outdir: Path | str | None = None, progress: bool 
         raise
     if out.summary:
         say(out.summary)
+    for w in out.warnings:
+        say(f"warning: {w}")
     if not out.success:
         say("warning: some solves did not converge (results.nc has converged = 0)")
     say(f"results: {out.results}  ({time.time() - start:.1f} s)")

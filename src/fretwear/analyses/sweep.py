@@ -220,7 +220,8 @@ def run_sweep(model, analysis: dict, case, outdir: Path, progress: bool) -> RunO
         figures.append(plot_sweep_interface(ds, p, title=titled(case.title,
                                                                   "contact interface")))
     grid_ok = all(p.success for p in result.points if p.on_grid)
-    return RunOutput(ds, figures, _sweep_summary(result, ds), grid_ok)
+    return RunOutput(ds, figures, _sweep_summary(result, ds), grid_ok,
+                     warnings=list(result.warnings))
 
 
 # --- figures -------------------------------------------------------------------------------

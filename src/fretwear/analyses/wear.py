@@ -414,7 +414,11 @@ def run_wear(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOu
     ]
     if frf_note:
         lines.append(frf_note)
-    return RunOutput(ds, figures, "\n".join(lines), result.success, files)
+    warnings = list(result.warnings)
+    for name, sw in (sweeps.items() if frf is not None else ()):
+        warnings += [f"FRF {name}: {w}" for w in sw.warnings]
+    return RunOutput(ds, figures, "\n".join(lines), result.success, files,
+                     warnings=warnings)
 
 
 def write_wear_fields(model, ds, pvd: Path) -> Path:

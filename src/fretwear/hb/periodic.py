@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -39,6 +40,10 @@ JACOBIANS = ("auto", "dense", "krylov")
 #: ``"auto"`` forms the Jacobian up to this many unknowns ``m H`` (docs/theory.md, "Large
 #: interfaces": measured crossover, benchmarks/scale_3d.py)
 DENSE_JACOBIAN_MAX = 3000
+#: relative residual and iteration limit of the static contact problem under the preload
+#: (:func:`preload_anchor`, :func:`preload_contact`)
+STATIC_TOL = 1e-10
+STATIC_MAX_ITER = 100
 
 
 class DLFTProblem:
@@ -274,6 +279,8 @@ class PeriodicSolution:
     time_domain : what a time integration found where the balance failed (``"time-start"``
         of :func:`solve_periodic`; e.g. "quasi-periodic ...: no periodic steady state"), ``""``
         when none ran.
+    warnings : reasons for caution about the inputs of the solve, one line each (e.g. the
+        static preload solve that gives the default stick anchors did not converge).
     """
 
     frequency: float
@@ -297,6 +304,7 @@ class PeriodicSolution:
     U_node: np.ndarray | None = None
     attempts: list = field(default_factory=list)
     time_domain: str = ""
+    warnings: list = field(default_factory=list)
 
     @property
     def success(self) -> bool:
@@ -625,19 +633,55 @@ def check_inputs(model, basis, frequency, *, quasi_static: bool = False, anchor=
     return f
 
 
-def static_anchor(model: Model, *, quasi: Reduced | None = None, eps="auto") -> np.ndarray:
-    """Tangential positions of the contact nodes after the static loads are applied from rest.
+@dataclass
+class StaticAnchor:
+    """The stick anchors of the preload state (:func:`preload_anchor`).
+
+    values : (nc, d-1) tangential positions of the contact nodes [m] after the static loads
+    are applied from rest; 0 (the undeformed position) when the static contact problem did not
+    converge. success : that problem converged. message : why its solver stopped.
+    """
+
+    values: np.ndarray
+    success: bool
+    message: str
+
+    @property
+    def warning(self) -> str:
+        """One line for the user when the static solve failed (``""`` when it converged)."""
+        if self.success:
+            return ""
+        return (f"the static contact problem under the preload did not converge "
+                f"({self.message}): the stick anchors are set to 0 (the undeformed position) "
+                "instead of the preload state, so the mean tangential positions of stuck "
+                "nodes may be wrong")
+
+
+def preload_anchor(model: Model, *, quasi: Reduced | None = None, eps="auto") -> StaticAnchor:
+    """Tangential positions of the contact nodes after the static loads are applied from rest,
+    with whether the static solve converged.
 
     Solves the static contact problem (one instant) starting from a stress-free state in which
     every node that touches sticks where it is (anchor 0): the loading history "preload first,
     then vibrate". ``eps``: the penalty of this static solve (the rule or a number, as for
-    :class:`DLFTProblem`). Returns (nc, d-1) [m].
+    :class:`DLFTProblem`). When it does not converge the anchors are 0 and the result says so
+    (``success``, ``warning``): the callers put the warning in their results.
     """
     prob, x, st = _static_solve(model, quasi, eps)
     if not st.success:
-        return np.zeros((prob.nc, prob.d - 1))
+        return StaticAnchor(np.zeros((prob.nc, prob.d - 1)), False, st.message)
     U = x.reshape(prob.nc, prob.d, 1)
-    return U[:, 1:, 0].copy()
+    return StaticAnchor(U[:, 1:, 0].copy(), True, st.message)
+
+
+def static_anchor(model: Model, *, quasi: Reduced | None = None, eps="auto") -> np.ndarray:
+    """The anchors of :func:`preload_anchor` alone, (nc, d-1) [m]; a
+    :class:`RuntimeWarning` says when the static solve did not converge (the anchors are then
+    0)."""
+    a = preload_anchor(model, quasi=quasi, eps=eps)
+    if not a.success:
+        warnings.warn(a.warning, RuntimeWarning, stacklevel=2)
+    return a.values
 
 
 def _static_solve(model: Model, quasi: Reduced | None, eps):
@@ -651,7 +695,7 @@ def _static_solve(model: Model, quasi: Reduced | None, eps):
         return prob.residual(x.reshape(prob.m, prob.H), jac)
 
     x, _, st = solve(fun, U0.reshape(-1), lambda x: prob.scale(x.reshape(prob.m, prob.H)),
-                     method="powell", tol=1e-10, max_iter=100)
+                     method="powell", tol=STATIC_TOL, max_iter=STATIC_MAX_ITER)
     return prob, x, st
 
 
@@ -735,7 +779,8 @@ def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
         harmonics (the paper), ``"static"`` that of the static ``K_r``, or a positive number
         [N/m] (:func:`fretwear.hb.penalty.penalty`).
     anchor : (nc, d-1) stick anchors [m]; default: the static preload state
-        (:func:`static_anchor`), the documented rule for the mean tangential position.
+        (:func:`preload_anchor`), the documented rule for the mean tangential position (when
+        that static solve does not converge the anchors are 0 and ``warnings`` says so).
     U0 : (nc, d, H) starting point (e.g. a neighbouring solution).
     solver : ``"powell"`` (dog-leg at LAPACK speed), ``"newton"`` or ``"hybr"`` (MINPACK).
     tol : relative residual ``eps_r`` of the test ``|f| <= eps_r |Z_r U|``.
@@ -768,8 +813,10 @@ def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
         reduced = condense(model, frequency, _orders(basis), quasi_static=quasi_static)
     reduced = connect(reduced, model.contact)
     eps = penalty(eps, model=model, reduced=reduced)
+    preload = None
     if anchor is None:
-        anchor = static_anchor(model)
+        preload = preload_anchor(model)
+        anchor = preload.values
     prob = DLFTProblem(reduced, model.contact, basis, gap=gap, eps=eps, anchor=anchor)
     if U0 is None and basis.k > 3:
         U0 = _harmonic_continuation_start(model, basis, reduced, prob, solver, tol, max_iter)
@@ -804,6 +851,8 @@ def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
         sol.time_domain = found
         if not sol.success:
             sol.flags.append(found)
+    if preload is not None and not preload.success:
+        sol.warnings.append(preload.warning)
     return sol
 
 

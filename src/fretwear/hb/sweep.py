@@ -35,8 +35,8 @@ from fretwear.hb.periodic import (
     _first_harmonic_start,
     assemble_solution,
     check_inputs,
+    preload_anchor,
     solve_strategy,
-    static_anchor,
 )
 from fretwear.hb.reduce import _condense, condenser
 from fretwear.hb.solvers import SolveStats, solve
@@ -92,12 +92,15 @@ class SweepResult:
 
     ``success`` is True when every point converged; ``message`` counts the converged and
     failed grid frequencies; ``point_success`` is the per-point array; ``resumed_from`` is the
-    number of grid frequencies read from a checkpoint (-1: none was read).
+    number of grid frequencies read from a checkpoint (-1: none was read); ``warnings`` are
+    reasons for caution that concern the whole sweep (e.g. the static preload solve that gives
+    the stick anchors did not converge), one line each.
     """
 
     points: list
     wall_time: float = 0.0
     resumed_from: int = -1
+    warnings: list = field(default_factory=list)
 
     @property
     def frequency_hz(self) -> np.ndarray:
@@ -444,8 +447,12 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
     band = (f_min, f_max) if eps_band is None else _band(eps_band)
     eps = sweep_penalty(eps, model, [0, *basis.harmonics], *band, spacing=spacing)
     probs = _Problems(model, basis, gap, eps)
+    warnings = []
     if anchor is None:
-        anchor = static_anchor(model)
+        preload = preload_anchor(model)
+        anchor = preload.values
+        if not preload.success:
+            warnings.append(preload.warning)
     history: list = []  # converged (omega, U (m, H)) in order
     last_solution: list = [None]
     points: list = []
@@ -610,4 +617,4 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
             progress(i, len(grid), pt)
     points.sort(key=lambda p: p.frequency_hz)
     return SweepResult(points, time.perf_counter() - t_start,
-                       first if key is not None and resume and first else -1)
+                       first if key is not None and resume and first else -1, warnings)

@@ -111,7 +111,9 @@ class WearResult:
     solution, so ``initial`` is None when the run started from a time integration (the unworn
     interface had no balance) and both are None when no step was balanced; penalty : the
     DLFT eps [N/m]; wall_time : [s]; stability_jump : explicit Euler's stability limit
-    ``2/rho`` estimated from the slow Jacobian at the start [cycles] (nan if not computed).
+    ``2/rho`` estimated from the slow Jacobian at the start [cycles] (nan if not computed);
+    warnings : reasons for caution about the whole run, one line each (e.g. the static preload
+    solve that gives the stick anchors did not converge).
     """
 
     history: WearHistory
@@ -125,6 +127,7 @@ class WearResult:
     resumed_from: int = -1
     penalty: float = math.nan
     extra: dict = field(default_factory=dict)
+    warnings: list = field(default_factory=list)
 
     @property
     def final_wear(self) -> np.ndarray:

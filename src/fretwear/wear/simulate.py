@@ -27,7 +27,7 @@ import numpy as np
 from fretwear.errors import InputError, interrupted
 from fretwear.hb.fallback import TimeDomainFallback
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import PeriodicSolution, check_inputs, static_anchor
+from fretwear.hb.periodic import PeriodicSolution, check_inputs, preload_anchor
 from fretwear.hb.reduce import Reduced, condense
 from fretwear.hb.solvers import SolveStats
 from fretwear.model.core import Model
@@ -64,7 +64,8 @@ def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
     eps : DLFT penalty: ``"auto"`` (default) the spectral radius of ``Z_r`` (the paper),
         ``"static"`` that of the static ``K_r``, or a positive number [N/m]
         (:func:`fretwear.hb.penalty.penalty`).
-    anchor : (nc, d-1) stick anchors of the first solve [m] (default: static preload state).
+    anchor : (nc, d-1) stick anchors of the first solve [m] (default: static preload state;
+        0 when that static solve does not converge, and the result's ``warnings`` says so).
     W0 : (nc,) initial wear [m] (default 0).
     U0 : (nc, d, H) or (m, H) start of the first periodic solve.
     checkpoint : ``.npz`` file for the state (written atomically as the run goes).
@@ -111,8 +112,12 @@ def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
     coef = wear_coefficients(model, opts.law, opts.energy_coefficient,
                              opts.partner_energy_coefficient)
     W0 = np.zeros(nc) if W0 is None else np.broadcast_to(np.asarray(W0, float), (nc,)).copy()
+    warnings = []
     if anchor is None:
-        anchor = static_anchor(model)
+        preload = preload_anchor(model)
+        anchor = preload.values
+        if not preload.success:
+            warnings.append(preload.warning)
     anchor = np.array(anchor, float).reshape(nc, d - 1)
     sp = SlowProblem(model, reduced, basis, coef, eps=eps, anchor=anchor,
                      time_domain=time_domain if opts.time_domain_rescue and not quasi_static
@@ -170,7 +175,8 @@ def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
     final = _assemble(sp, last[-1]) if last else None
     return WearResult(hist, initial, final, reason, _message(reason, state, opts, extra),
                       reason != "solver_failed", time.perf_counter() - t_start,
-                      float(state["stability_jump"]), resumed_from, penalty=sp.eps)
+                      float(state["stability_jump"]), resumed_from, penalty=sp.eps,
+                      warnings=warnings)
 
 
 def _assemble(sp: SlowProblem, row: dict) -> PeriodicSolution:
