@@ -276,7 +276,9 @@ def _arclength(probs, model, anchor, y_prev, y_last, omega_target, solver_tol, m
                max_iter=20):
     """Pseudo-arclength continuation from ``y_last`` (secant from ``y_prev``) until the
     frequency passes ``omega_target``. ``y = (U (m*H,), omega)``. Returns the list of converged
-    ``(U, omega, stats)`` along the branch (the last one is past or at the target) or []."""
+    ``(U, omega, stats, problem)`` along the branch (the last one is past or at the target) or
+    [] (the problem is the one the point converged on: recording the point needs no new
+    condensation)."""
     U1, w1 = y_last
     U0, w0 = y_prev
     sx = max(np.linalg.norm(U1), 1e-30)
@@ -329,6 +331,12 @@ def _arclength(probs, model, anchor, y_prev, y_last, omega_target, solver_tol, m
                     dy = _bordered_step(J, f, fw, g, t, sx, sw)
                 except np.linalg.LinAlgError:
                     break
+                if abs(dy[-1] * sw) > abs(omega_target - w1):
+                    # a Newton step of the corrector that moves the frequency by more than
+                    # the whole step to the target is diverging (seen past folds of the
+                    # dovetail's FRF: 70 Hz jumps on an 18 Hz grid): a shorter step at once,
+                    # rather than more iterates, each a condensation at a new frequency
+                    break
                 y = y + dy
                 nit += 1
             if converged:
@@ -340,7 +348,7 @@ def _arclength(probs, model, anchor, y_prev, y_last, omega_target, solver_tol, m
         st = SolveStats(True, float(np.linalg.norm(f) / prob.scale(U.reshape(prob.m, prob.H))),
                         nit, nf * 2, nf, time.perf_counter() - t0, "converged (arclength)",
                         "arclength")
-        out.append((U, w, st))
+        out.append((U, w, st, prob))
         tn = y - yk
         tn /= np.linalg.norm(tn)
         t = tn
@@ -546,8 +554,7 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
             t_arc = time.perf_counter()
             branch = _arclength(probs, model, anc, (history[-2][1].reshape(-1), history[-2][0]),
                                 (history[-1][1].reshape(-1), history[-1][0]), omega, tol)
-            for Ub, wb, stb in branch:
-                pb = probs.get(wb, anc)
+            for Ub, wb, stb, pb in branch:
                 points.append(record(wb, pb, Ub.reshape(pb.m, pb.H), stb, "arclength"))
             if branch:
                 prob, U, st = _solve_at(probs, omega, current_anchor(), history[-1][1], solver,
