@@ -40,9 +40,15 @@ def test_sweep_writes_documented_results_and_figures(tmp_path, capsys):
     assert ds.sizes["interface"] == 2 and ds.sizes["harmonic"] == 3
     amp = ds["response_amplitude"].sel(point="Pe", axis="x", harmonic=1).values
     assert np.all(np.isfinite(amp[conv == 1])) and np.all(amp[conv == 1] > 0)
-    # with friction the response lies between the stuck and the frictionless limits
+    # with friction the response lies between the stuck and the frictionless limits; the
+    # linear references have their own fine grid (1000 points over the band, log spacing)
+    # that holds the sweep's frequencies too
+    lf = ds["linear_frequency"].values
+    assert ds.sizes["linear_frequency"] >= 1000 and np.all(np.diff(lf) > 0)
+    assert lf[[0, -1]].tolist() == pytest.approx([1e3, 2e4])
     lin = ds["linear_response_amplitude"].sel(point="Pe", axis="x")
-    assert np.all(amp[conv == 1] > lin.sel(interface="stuck").values[conv == 1])
+    stuck = lin.sel(interface="stuck", linear_frequency=ds["frequency"].values).values
+    assert np.all(amp[conv == 1] > stuck[conv == 1])
     frac = ds[["separation_fraction", "stick_fraction", "slip_fraction"]].to_array().sum("variable")
     np.testing.assert_allclose(frac.values[conv == 1], 1.0)
     for stem in ("sweep-Pe", "sweep-interface"):

@@ -143,8 +143,13 @@ def test_split_sweep_joins_checked_and_equal_to_the_whole_sweep(tmp_path, client
     """A sweep cut into 2 chunks: the joined curve covers the base sweep's frequencies, the
     join is within join_rtol, and every point equals the unsplit sweep run by `fretwear run`
     to the solver's tolerance (the two started their continuations from different points, so
-    they agree as two converged solutions of one balance do, not bit for bit)."""
-    base = base_case(tmp_path, SWEEP)
+    they agree as two converged solutions of one balance do, not bit for bit). The chunks'
+    linear references, each on its own fine grid, are joined into one increasing grid over
+    the band, and agree with the whole sweep's at the sweep's frequencies (both hold them) to
+    the projected FRF's accuracy (backward error 1e-8: 1e-6 relative leaves a margin)."""
+    assert 'linear_references = []' in SWEEP
+    base = base_case(tmp_path, SWEEP.replace('linear_references = []',
+                                             'linear_references = ["stuck"]'))
     path = study_file(tmp_path, "[split]\nchunks = 2\n")
     out = tmp_path / "out"
     res = run_study(path, out, scheduler=client, progress=False, echo=False)
@@ -158,6 +163,13 @@ def test_split_sweep_joins_checked_and_equal_to_the_whole_sweep(tmp_path, client
     a, b = ds["response_amplitude"].values, whole["response_amplitude"].values
     # 1e-6 of the largest amplitude: the join tolerance, far above the balance's residual
     # tolerance and far below any difference between two different periodic solutions
+    assert np.max(np.abs(a - b)) <= 1e-6 * np.max(np.abs(b))
+    lf = ds["linear_frequency"].values
+    assert np.all(np.diff(lf) > 0) and lf[0] == ds["frequency"].values[0]
+    assert lf[-1] == ds["frequency"].values[-1] and lf.size > whole.sizes["linear_frequency"]
+    a = ds["linear_response_amplitude"].sel(linear_frequency=ds["frequency"].values).values
+    b = whole["linear_response_amplitude"].sel(
+        linear_frequency=whole["frequency"].values).values  # the same to 1e-14 (above)
     assert np.max(np.abs(a - b)) <= 1e-6 * np.max(np.abs(b))
 
 

@@ -116,24 +116,44 @@ def _sweep_point_variables(result: SweepResult) -> dict:
     return data
 
 
+def linear_reference_grid(f_min: float, f_max: float, spacing: str, sweep_hz,
+                          linear_points: int = 1000) -> np.ndarray:
+    """The frequencies [Hz] of the linear reference FRFs of a sweep: ``linear_points`` over
+    ``[f_min, f_max]`` with the sweep's ``spacing``, and every frequency of the sweep itself
+    (so that the nonlinear and the linear responses compare point by point), in increasing
+    order. A linear FRF costs a few sparse solves per resonance however fine its grid
+    (:func:`fretwear.linear.frf`, ``method="projected"``), so the default resolves resonance
+    peaks far narrower than the nonlinear grid does."""
+    grid = linear.frequency_grid(f_min, f_max, linear_points, spacing)
+    own = np.unique(np.asarray(sweep_hz, float))
+    if own.size:  # a grid point within rounding of a sweep frequency is that frequency
+        i = np.clip(np.searchsorted(own, grid), 1, max(own.size - 1, 1))
+        near = np.minimum(np.abs(grid - own[i - 1]), np.abs(grid - own[np.minimum(
+            i, own.size - 1)]))
+        grid = grid[near > 1e-9 * grid]
+    return np.unique(np.concatenate([grid, own]))
+
+
 def _linear_references(model, freqs: np.ndarray, interfaces: list[str], points: list[str],
                        n_axes: int) -> dict:
-    """Amplitudes of the linear FRFs with the requested interfaces at the sweep frequencies."""
+    """Amplitudes of the linear FRFs with the requested interfaces at ``freqs`` [Hz]
+    (the ``linear_frequency`` dimension)."""
     amp = np.full((len(interfaces), freqs.size, len(points), n_axes), np.nan)
     for i, interface in enumerate(interfaces):
-        r = linear.frf(model, freqs, interface=interface)
+        r = linear.frf(model, freqs, interface=interface, method="projected")
         for j, name in enumerate(points):
             u = np.abs(r.observed[name])
             amp[i, :, j, : u.shape[1]] = u
     return {"linear_response_amplitude": variable(
-        ("interface", "frequency", "point", "axis"), amp, "m",
+        ("interface", "linear_frequency", "point", "axis"), amp, "m",
         "amplitude of the linear FRF with the interface held (stuck) or frictionless "
         "(sliding), harmonic 1 of the loads")}
 
 
 def sweep_dataset(model, result: SweepResult, basis: FourierBasis, points: list[str],
-                  references: list[str]) -> xr.Dataset:
-    """The results dataset of a sweep (``docs/results.md``)."""
+                  references: list[str], linear_hz=None) -> xr.Dataset:
+    """The results dataset of a sweep (``docs/results.md``); ``linear_hz``: the frequencies
+    of the linear references [Hz] (:func:`linear_reference_grid`; default the sweep's own)."""
     coords, data = geometry(model, points)
     freqs = result.frequency_hz
     coords["frequency"] = variable("frequency", freqs, "Hz", "excitation frequency")
@@ -142,8 +162,11 @@ def sweep_dataset(model, result: SweepResult, basis: FourierBasis, points: list[
     data.update(_response_variables(result, basis, model, points, n_axes))
     data.update(_sweep_point_variables(result))
     if references:
+        lf = freqs if linear_hz is None else np.asarray(linear_hz, float)
         coords["interface"] = label_coordinate("interface", references)
-        data.update(_linear_references(model, freqs, references, points, n_axes))
+        coords["linear_frequency"] = variable("linear_frequency", lf, "Hz",
+                                              "frequency of the linear reference FRFs")
+        data.update(_linear_references(model, lf, references, points, n_axes))
     return xr.Dataset(data, coords=coords)
 
 
@@ -198,7 +221,10 @@ def run_sweep(model, analysis: dict, case, outdir: Path, progress: bool) -> RunO
                               if analysis["check_stability"] else None),
                        progress=tick, checkpoint=outdir / CHECKPOINT_FILE,
                        resume=bool(case.resume))
-    ds = sweep_dataset(model, result, basis, points, analysis["linear_references"])
+    linear_hz = linear_reference_grid(analysis["f_min"], analysis["f_max"],
+                                      analysis["spacing"], result.frequency_hz,
+                                      analysis["linear_points"])
+    ds = sweep_dataset(model, result, basis, points, analysis["linear_references"], linear_hz)
     flagged = [f"{p.frequency_hz:.6g} Hz: " + "; ".join(p.flags)
                for p in result.points if p.flags]
     ds.attrs.update({
@@ -250,10 +276,11 @@ def plot_sweep(ds: xr.Dataset, path: Path, point: str, *, title: str | None = No
     flagged = np.array([bool(s) for s in ds["flags"].values])
     for ax, axis in zip(axes[:, 0], axes_names, strict=True):
         if "linear_response_amplitude" in ds:
+            lin = ds["linear_response_amplitude"]
+            fl = ds[lin.dims[1]].values  # linear_frequency (frequency in older files)
             for interface in ds["interface"].values:
-                y = ds["linear_response_amplitude"].sel(interface=interface, point=point,
-                                                        axis=axis).values
-                ax.plot(f, np.where(y > 0, y, np.nan), label=f"linear, {interface}",
+                y = lin.sel(interface=interface, point=point, axis=axis).values
+                ax.plot(fl, np.where(y > 0, y, np.nan), label=f"linear, {interface}",
                         **plots.INTERFACE_STYLE.get(str(interface), {}))
         y = ds["response_amplitude"].sel(point=point, axis=axis, harmonic=h).values
         ax.plot(f, np.where(y > 0, y, np.nan), color="k", marker=".", ms=3,
@@ -331,6 +358,11 @@ register(
             ListOf(Text(linear.INTERFACES), unique=True),
             'linear FRFs drawn with the nonlinear one: "sliding" (frictionless), "stuck", '
             '"free"', default=[]),
+        "linear_points": Field(Integer(lo=2, hi=100_000), "frequencies of the linear "
+                               "references over [f_min, f_max] (the sweep's spacing; the "
+                               "sweep's own frequencies are added): their own fine grid, a "
+                               "few sparse solves per resonance however many points",
+                               default=default_of(linear_reference_grid, "linear_points")),
         **harmonic_balance_fields(
             sweep,
             'DLFT penalty, one value for the whole sweep (a smooth FRF): "top": the spectral '

@@ -273,9 +273,10 @@ def fig_frf(figdir, frf, marks) -> str | None:
     for k, lo in enumerate((1.0, 1e4)):
         axk = ax[0, k]
         if refs is not None:
+            fl = frf[refs.dims[1]].values  # linear_frequency (frequency in older files)
             for itf in frf["interface"].values:
                 y = refs.sel(interface=itf, point="Pe").isel(axis=0).values
-                axk.loglog(f, y, label=f"linear, {itf}", **plots.INTERFACE_STYLE[str(itf)])
+                axk.loglog(fl, y, label=f"linear, {itf}", **plots.INTERFACE_STYLE[str(itf)])
         axk.loglog(f, a, "k.-", ms=3, label="frictional (DLFT)")
         for fp in marks:
             axk.axvline(fp, color="0.6", lw=0.8, ls=":")

@@ -62,7 +62,15 @@ def join_chunks(study, members, records, outdir) -> xr.Dataset:
                            data_vars="all", coords="minimal", compat="override",
                            join="outer")
         rest = pieces[0].drop_vars(by_freq).drop_dims("frequency", errors="ignore")
-        joined = xr.merge([joined, rest], compat="override", join="outer")
+        parts = [joined]
+        by_lin = [n for n, v in rest.data_vars.items() if "linear_frequency" in v.dims]
+        if by_lin:  # each chunk's linear references on its own grid: their union
+            lin = xr.concat([p[by_lin] for p in pieces], dim="linear_frequency",
+                            data_vars="all", coords="minimal", compat="override",
+                            join="outer")
+            parts.append(lin.drop_duplicates("linear_frequency").sortby("linear_frequency"))
+            rest = rest.drop_vars(by_lin).drop_dims("linear_frequency", errors="ignore")
+        joined = xr.merge([*parts, rest], compat="override", join="outer")
     else:
         joined = xr.Dataset()
     joined["join_frequency"] = ("join", np.array(freqs, float),
