@@ -434,7 +434,8 @@ def test_platform_damper_example_damps_the_stuck_resonance(tmp_path):
     three frequencies around the stuck resonance (39.7 kHz) with one harmonic: every point
     converges, the damper slips and dissipates (friction energy > 0; both interfaces named
     per node), and its response stays below the linear one with a stuck damper, whose
-    resonance it damps (measured: 13 times below at 39.7 kHz)."""
+    resonance it damps (measured: 13 times below at 39.7 kHz). The per-interface totals of
+    the results are consistent with the whole interface's."""
     shutil.copy(EXAMPLES / "platform-damper.msh", tmp_path)  # the case's mesh file
     ds = run_reduced("platform-damper-frf.toml", tmp_path,
                      numerics={"harmonics": 1, "n_samples": 16, "n_points": 3,
@@ -445,3 +446,18 @@ def test_platform_damper_example_damps_the_stuck_resonance(tmp_path):
     stuck = ds["linear_response_amplitude"].sel(interface="stuck", point="left_tip",
                                                 axis="y").values
     assert nonlinear.max() < stuck.max()
+    # per interface: the same per-node energies and states aggregated per face; the faces'
+    # energies add up to the total and their area-weighted fractions to the whole interface's
+    # (exact identities: rounding), each face's fractions sum to 1, and both faces slip
+    assert ds["contact_name"].values.tolist() == ["left", "right"]
+    e = ds["interface_friction_energy"]
+    np.testing.assert_allclose(e.sum("contact_name"), ds["friction_energy"], rtol=1e-12)
+    assert (e.values > 0).all()
+    area = ds["contact_area"].groupby(ds["contact_interface"]).sum().sel(
+        contact_interface=["left", "right"]).values
+    for state in ("separation", "stick", "slip"):
+        per = ds[f"interface_{state}_fraction"].values  # (frequency, contact_name)
+        np.testing.assert_allclose(per @ area / area.sum(), ds[f"{state}_fraction"].values,
+                                   rtol=1e-12, atol=1e-15)
+    total = sum(ds[f"interface_{s}_fraction"] for s in ("separation", "stick", "slip"))
+    np.testing.assert_allclose(total.values, 1.0, rtol=1e-12)

@@ -116,6 +116,35 @@ def _sweep_point_variables(result: SweepResult) -> dict:
     return data
 
 
+def _per_interface_variables(result: SweepResult, model) -> dict:
+    """Friction energy and contact-state fractions of each contact interface (the
+    ``contact_name`` dimension, in the order of ``[[contact]]``), NaN where not converged."""
+    c = model.contact
+    where = c.interface_index()
+    names = c.names()
+    area = np.asarray(c.area, float)
+    nf, ni = len(result.points), len(names)
+    energy = np.full((nf, ni), np.nan)
+    frac = np.full((nf, ni, 3), np.nan)
+    for i, p in enumerate(result.points):
+        if not p.success:
+            continue
+        e = p.solution.friction_energy()
+        states = p.solution.state_fractions()
+        for k in range(ni):
+            nodes = where == k
+            energy[i, k] = e[nodes].sum()
+            w = area[nodes] / area[nodes].sum()
+            frac[i, k] = w @ states[nodes]
+    dims = ("frequency", "contact_name")
+    data = {"interface_friction_energy": variable(
+        dims, energy, "J", "energy dissipated by friction per period over each interface")}
+    for s, name in enumerate(STATE_NAMES):
+        data[f"interface_{name}_fraction"] = variable(
+            dims, frac[:, :, s], "1", f"fraction of each interface's area x period in {name}")
+    return data
+
+
 def linear_reference_grid(f_min: float, f_max: float, spacing: str, sweep_hz,
                           linear_points: int = 1000) -> np.ndarray:
     """The frequencies [Hz] of the linear reference FRFs of a sweep: ``linear_points`` over
@@ -161,6 +190,8 @@ def sweep_dataset(model, result: SweepResult, basis: FourierBasis, points: list[
     n_axes = coords["axis"].size
     data.update(_response_variables(result, basis, model, points, n_axes))
     data.update(_sweep_point_variables(result))
+    coords["contact_name"] = label_coordinate("contact_name", model.contact.names())
+    data.update(_per_interface_variables(result, model))
     if references:
         lf = freqs if linear_hz is None else np.asarray(linear_hz, float)
         coords["interface"] = label_coordinate("interface", references)
@@ -306,11 +337,19 @@ def plot_sweep_interface(ds: xr.Dataset, path: Path, *, title: str | None = None
     fig, axes = plots.new_figure(2, 1, title=title, panel_size=(7.5, 3.2), sharex=True)
     ax = axes[0, 0]
     e = ds["friction_energy"].values
-    ax.plot(f, np.where(e > 0, e, np.nan), color="tab:purple", marker=".", ms=3)
+    several = "contact_name" in ds.dims and ds.sizes["contact_name"] > 1
+    ax.plot(f, np.where(e > 0, e, np.nan), color="tab:purple", marker=".", ms=3,
+            label="all interfaces" if several else None)
+    if several:  # each interface's share, e.g. the two flanks of a blade root
+        styles = ("--", ":", "-.", (0, (5, 1)), (0, (1, 3)))
+        for k, name in enumerate(ds["contact_name"].values):
+            ek = ds["interface_friction_energy"].sel(contact_name=name).values
+            ax.plot(f, np.where(ek > 0, ek, np.nan), color="0.35",
+                    linestyle=styles[k % len(styles)], lw=1.0, label=str(name))
     _mark_failures(ax, f, conv, flagged, e)
     ax.set_yscale("log")
     ax.set_ylabel("friction energy\nper period [J]")
-    if not conv.all() or (flagged & conv).any():
+    if several or not conv.all() or (flagged & conv).any():
         ax.legend(fontsize="small")
     ax = axes[1, 0]
     for colour, name in zip(plots.STATE_COLOURS, STATE_NAMES, strict=True):
