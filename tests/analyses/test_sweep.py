@@ -34,6 +34,7 @@ def test_sweep_writes_documented_results_and_figures(tmp_path, capsys):
     n = ds.sizes["frequency"]
     assert n >= 4 and conv.any()
     assert ds.attrs["sweep_converged"] == f"{int(conv.sum())}/{n}"
+    assert ds.attrs["warnings"] == ""  # the static preload solve converged
     assert out.splitlines()[1] == f"sweep_converged={int(conv.sum())}/{n}"
     check_documented(ds, "sweep")
     assert ds["frequency"].values[[0, -1]].tolist() == pytest.approx([1e3, 2e4])
