@@ -10,11 +10,16 @@ Prints, on this machine and in this run, with the number of unknowns of each sta
 - one slow wear step of the wear example (its first step after the unworn balance);
 - before them, one untimed-in-the-figures warm-up solve (the numba kernels are compiled on
   the first run of a fresh installation);
+- the linear references of the FRF (sliding and stuck flanks) on the 1000 frequencies of a
+  sweep's own grid by projection (``fretwear.linear.frf(method="projected")``: its sparse
+  solves counted), against the direct FRF (one sparse solve per frequency) at 10 of them,
+  timed in the same run, with the largest relative difference;
 - a nonlinear FRF of ``--points`` (default 50) points from 1.9 to 2.8 kHz with the example's
   settings (1 harmonic), and how many converged.
 
 Run: ``python benchmarks/dovetail.py [--points 50] [--quick] [--verbose]`` (``--quick``
-skips the FRF, ``--verbose`` prints one line per FRF point: how it converged and its time).
+skips the nonlinear FRF, ``--verbose`` prints one line per FRF point: how it converged and
+its time).
 Quote the figures with the machine load (``uptime``).
 """
 
@@ -27,6 +32,7 @@ import time
 import numpy as np
 import scipy.linalg as sla
 
+from fretwear import linear
 from fretwear.analyses.run import load_case
 from fretwear.examples import example_path
 from fretwear.hb.fourier import FourierBasis
@@ -102,6 +108,30 @@ def main():
     print(f"wear: first slow step {h.wall_time[-1]:.2f} s (run with the unworn balance "
           f"{t:.2f} s{_cpu()}, {m * wb.size} unknowns, jump {h.jump[-1]:.3g} cycles, "
           f"success={res.success})")
+
+    freqs = linear.frequency_grid(1900.0, 2800.0, 1000, "linear")
+    some = freqs[::100]
+    solves = [0]
+    real = linear._solve
+
+    def counted(*a, **k):
+        solves[0] += 1
+        return real(*a, **k)
+
+    for interface in ("sliding", "stuck"):
+        solves[0] = 0
+        linear._solve = counted
+        try:
+            r, t_p = _timed(lambda i=interface: linear.frf(model, freqs, interface=i,
+                                                           method="projected"))
+        finally:
+            linear._solve = real
+        d, t_d = _timed(lambda i=interface: linear.frf(model, some, interface=i))
+        diff = max(float((np.abs(r.observed[k][::100] - d.observed[k]).max(axis=1)
+                          / np.abs(d.observed[k]).max(axis=1)).max()) for k in d.observed)
+        print(f"linear FRF, {interface} flanks: {freqs.size} frequencies by projection "
+              f"{t_p:.1f} s ({solves[0]} sparse solves); direct {t_d / some.size:.2f} s per "
+              f"frequency; largest relative difference at {some.size} frequencies {diff:.1e}")
 
     if not args.quick:
         case = load_case(example_path("dovetail-frf"))
