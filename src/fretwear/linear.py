@@ -426,6 +426,15 @@ def _orthonormal_extension(V: np.ndarray, X: np.ndarray) -> np.ndarray:
     return V
 
 
+def _small_solve(A: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``A^-1 b`` of a projected system, NaN where ``A`` is singular (the frequency is then
+    solved directly, which says why it is singular)."""
+    try:
+        return np.linalg.solve(A, b)
+    except np.linalg.LinAlgError:
+        return np.full(b.shape, np.nan, dtype=complex)
+
+
 def _projected_solutions(ff: _Pencil, Ff: np.ndarray, freqs: np.ndarray, interface: str,
                          tol: float = PROJECTED_TOL):
     """(nf, n) solutions of ``Z_ff(w) q = F_f`` by projection on the exact solutions at a
@@ -434,14 +443,16 @@ def _projected_solutions(ff: _Pencil, Ff: np.ndarray, freqs: np.ndarray, interfa
     The space starts with the solutions at the two ends and the middle of the band; the
     system is projected on it (real basis ``V`` spanning the real and imaginary parts,
     ``V^T Z(w) V y = V^T F``) and solved at every frequency, and the true residual
-    ``|Z(w) V y - F| / |F|`` of each is evaluated exactly (``Z(w) V y`` is ``B c(w)`` with
-    ``B = [K V, M V, D V, C V, F]``: its norm is that of ``R c(w)``, ``B = Q R``). The
-    frequency with the largest residual adds its exact solution to the space, until every
-    residual is below ``tol``. The projected system reproduces the exact solution wherever it
-    lies in the space (at every added frequency), so the error is that of the residual test;
-    frequencies where the space stops improving are solved directly. Costs one sparse
-    factorisation per added frequency (a few per resonance in the band) instead of one per
-    frequency."""
+    ``Z(w) V y - F`` of each is evaluated exactly (it is ``B c(w)`` with
+    ``B = [K V, M V, D V, C V, F]``: its norm is that of ``R c(w)``, ``B = Q R``), as a
+    backward error: relative to the sum of the norms of its terms (:data:`PROJECTED_TOL`).
+    The frequency not yet in the space with the largest one adds its exact solution, until
+    every one is below ``tol``. The projected system reproduces the exact solution wherever
+    it lies in the space (at every added frequency), so the error is that of the residual
+    test; where the space stops growing, or after ``nf // 4`` added frequencies (direct
+    solves would then cost about as much), the frequencies still above ``tol`` are solved
+    directly. Costs one sparse factorisation per added frequency (a few per resonance in
+    the band) instead of one per frequency."""
     nf = freqs.size
     if nf <= 3:
         return _direct_solutions(ff, Ff, freqs, interface)
@@ -456,6 +467,7 @@ def _projected_solutions(ff: _Pencil, Ff: np.ndarray, freqs: np.ndarray, interfa
     added: list[int] = []
     todo = [0, nf // 2, nf - 1]
     Y = rel = None
+    width = 0  # columns of V before the last added frequencies
     while todo:
         for i in todo:
             q = _solve(ff(w[i]), Ff, freqs[i], interface)
@@ -465,8 +477,8 @@ def _projected_solutions(ff: _Pencil, Ff: np.ndarray, freqs: np.ndarray, interfa
         prod = {k: mats[k] @ V for k in "KMDC"}
         red = {k: V.T @ prod[k] for k in "KMDC"}
         Fr = V.T @ Ff
-        Y = np.array([np.linalg.solve(red["K"] - wi * wi * red["M"]
-                                      + 1j * (red["D"] + wi * red["C"]), Fr) for wi in w])
+        Y = np.array([_small_solve(red["K"] - wi * wi * red["M"]
+                                   + 1j * (red["D"] + wi * red["C"]), Fr) for wi in w])
         _, R = np.linalg.qr(np.column_stack([prod[k] for k in "KMDC"] + [Ff]))
         r = V.shape[1]
         terms = [Y, -(w * w)[:, None] * Y, 1j * Y, 1j * w[:, None] * Y]
@@ -474,9 +486,13 @@ def _projected_solutions(ff: _Pencil, Ff: np.ndarray, freqs: np.ndarray, interfa
         size = fnorm + sum(np.linalg.norm(t @ R[:, k * r:(k + 1) * r].T, axis=1)
                            for k, t in enumerate(terms))
         rel = np.linalg.norm(c @ R.T, axis=1) / size
-        worst = int(np.argmax(rel))
-        if rel[worst] > tol and worst not in added and len(added) < nf:
+        rel[~np.isfinite(rel)] = np.inf  # a singular projected system: solve it directly
+        left = rel.copy()
+        left[added] = -np.inf
+        worst = int(np.argmax(left))
+        if left[worst] > tol and V.shape[1] > width and len(added) < max(nf // 4, 3):
             todo = [worst]
+        width = V.shape[1]
     Q = Y @ V.T
     for i in np.flatnonzero(rel > tol):  # the space stopped improving there
         Q[i] = _solve(ff(w[i]), Ff, freqs[i], interface)
