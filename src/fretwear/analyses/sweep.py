@@ -134,7 +134,8 @@ def _per_interface_variables(result: SweepResult, model) -> dict:
         for k in range(ni):
             nodes = where == k
             energy[i, k] = e[nodes].sum()
-            w = area[nodes] / area[nodes].sum()
+            a = area[nodes]
+            w = a / a.sum() if a.sum() > 0 else np.full(a.size, 1.0 / a.size)
             frac[i, k] = w @ states[nodes]
     dims = ("frequency", "contact_name")
     data = {"interface_friction_energy": variable(
