@@ -44,14 +44,19 @@ def run(prob, tol=1e-12, x0=None):
     return x
 
 
-@pytest.fixture(scope="module", params=[2, 3])
+@pytest.fixture(scope="module", params=[(2, 0.0), (3, 0.0), (2, 0.05), (3, 0.05)],
+                ids=["2", "3", "2-damped", "3-damped"])
 def case(request):
-    model = block(request.param)
+    """Undamped blocks (real Z_r blocks: the operator's real-arithmetic path) and damped ones
+    (complex blocks: the complex path), each with every contact state."""
+    dim, eta = request.param
+    model = block(dim, eta)
     dense = problem(model, "dense")
     x = run(dense)
     _, _, state, _ = dense.time_law(x.reshape(dense.m, dense.H))
     for s in (law.SEPARATION, law.STICK, law.SLIP):
-        assert np.any(state == s), f"no {law.STATE_NAMES[s]} in the {request.param}D case"
+        assert np.any(state == s), f"no {law.STATE_NAMES[s]} in the {request.param} case"
+    assert problem(model, "krylov").blocks.real == (eta == 0.0)
     return model, x
 
 
@@ -118,23 +123,36 @@ def test_step_equals_lu_step(case, limit, monkeypatch):
             assert np.linalg.norm(J @ s - rhs) <= 1e-9 * np.linalg.norm(rhs)
 
 
+@pytest.mark.parametrize("real", [False, True], ids=["complex", "real"])
 @pytest.mark.parametrize("symmetric", [True, False])
-def test_harmonic_blocks_products_equal_real_blocks(symmetric):
-    """Z~ U and Z~^T U by harmonic blocks equal the products with the formed real operator
-    (reduce.to_real_blocks, independent code) for complex symmetric blocks (the shortcut
-    Z^H = conj(Z)) and general ones (the transposed copy); rounding only: 1e-13."""
+def test_harmonic_blocks_products_equal_real_blocks(symmetric, real):
+    """Z~ U, Z~^T U, the products on a subset of rows and columns and the node rows by
+    harmonic blocks equal the products with the formed real operator (reduce.to_real_blocks,
+    independent code) for complex symmetric blocks (the shortcut Z^H = conj(Z)) and general
+    ones (the transposed copy), complex and real-valued (the real-arithmetic path of
+    undamped structures); rounding only: 1e-13 of the largest term."""
     rng = np.random.default_rng(2)
-    Zc = rng.standard_normal((4, 6, 6)) + 1j * rng.standard_normal((4, 6, 6))
+    Zc = rng.standard_normal((4, 6, 6)) + 1j * rng.standard_normal((4, 6, 6)) * (not real)
     Zc[0] = Zc[0].real
     if symmetric:
         Zc = Zc + np.transpose(Zc, (0, 2, 1))
     hb = krylov.HarmonicBlocks(Zc)
+    assert hb.real == real
     Zd = hb.dense()
     U = rng.standard_normal((6, 7))
     assert hb.symmetric() == symmetric
     np.testing.assert_allclose(hb.apply(U).reshape(-1), Zd @ U.reshape(-1), rtol=0, atol=1e-13 * 50)
     np.testing.assert_allclose(hb.apply_T(U).reshape(-1), Zd.T @ U.reshape(-1), rtol=0,
                                atol=1e-13 * 50)
+    rows, cols = np.array([0, 2, 5]), np.array([1, 2, 4])
+    Us = rng.standard_normal((3, 7, 2))
+    Ufull = np.zeros((6, 7, 2))
+    Ufull[cols] = Us
+    ref = (Zd @ Ufull.reshape(42, 2)).reshape(6, 7, 2)[rows]
+    np.testing.assert_allclose(hb.apply_sub(rows, cols, Us), ref, rtol=0, atol=1e-13 * 50)
+    V = rng.standard_normal((2, 21))  # 2 nodes of 3 DOFs, node-major (DOF, coefficient)
+    ref = np.stack([V[p] @ Zd[p * 21 : (p + 1) * 21] for p in range(2)])
+    np.testing.assert_allclose(hb.node_rows(V), ref, rtol=0, atol=1e-13 * 50)
 
 
 def test_arclength_step_with_the_operator_equals_the_bordered_lu(case):

@@ -4,16 +4,26 @@ compared with the dense ones."""
 
 import numpy as np
 
-from fretwear.model import ContactSpec, Material, Spring, Traction, box, from_mesh, rectangle
+from fretwear.model import (
+    ContactSpec,
+    Damping,
+    Material,
+    Spring,
+    Traction,
+    box,
+    from_mesh,
+    rectangle,
+)
 
 P0, MU = 1e6, 0.5  # Pa, -
 
 
-def block(dim):
+def block(dim, loss_factor=0.0):
     """A steel block on a rigid flat, pressed by P0, under a cyclic tangential traction (mu P0
     in 3D, 0.5 mu P0 in 2D) and a cyclic normal traction growing along x to 1.3 P0 (in
     quadrature), so that the edge at large x lifts off during part of the period while the
-    other edge sticks."""
+    other edge sticks. ``loss_factor``: hysteretic damping (complex ``Z_r`` blocks; without
+    it they are real)."""
     a = 0.01
     if dim == 2:
         mesh, top, bottom = rectangle(a, 0.004, 6, 2), "top", "bottom"
@@ -25,7 +35,8 @@ def block(dim):
         cyc = (MU * P0, 0.0, 0.0)
         lift = (lambda x: np.column_stack([0 * x[:, 0], 0 * x[:, 0], 1.3 * P0 * x[:, 0] / a]))
         springs = [Spring(top, "x", 1e7), Spring(top, "y", 1e7)]
-    return from_mesh(mesh, Material(210e9, 0.3, 7800.0), springs=springs,
+    damping = Damping(loss_factor=loss_factor) if loss_factor else None
+    return from_mesh(mesh, Material(210e9, 0.3, 7800.0), springs=springs, damping=damping,
                      loads=[Traction(top, pressure=P0),
                             Traction(top, traction=cyc, waveform="cos"),
                             Traction(top, traction=lift, waveform="sin")],

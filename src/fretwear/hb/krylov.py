@@ -39,7 +39,7 @@ GMRES_MAXITER = 4
 REBUILD_AFTER = 25
 #: the step is solved by a LAPACK LU of the active block up to this many unknowns (slipping
 #: or separating nodes x d x H), by GMRES above (docs/theory.md, "Large interfaces")
-ACTIVE_DENSE_MAX = 6000
+ACTIVE_DENSE_MAX = 3000
 
 
 class HarmonicBlocks:
@@ -58,13 +58,47 @@ class HarmonicBlocks:
         self.Z0 = np.ascontiguousarray(Zc[0].real)
         self._ZcH = None
         self._symmetric = None
+        self._real = None
+        self._Zr = None
+
+    @property
+    def real(self) -> bool:
+        """Whether every block is real (an undamped structure: ``Z_n = K - (n w)^2 M``).
+        Products, factorisations and column norms then use real arithmetic on the real
+        blocks (:attr:`Zr`): half the memory traffic of the complex products and a quarter
+        of the operations of a complex LU, with the same result to rounding."""
+        if self._real is None:
+            self._real = not np.iscomplexobj(self.Zc) or not np.any(self.Zc.imag)
+        return self._real
+
+    @property
+    def Zr(self) -> np.ndarray:
+        """The real blocks (nb, m, m) of a real operator (:attr:`real`), copied once."""
+        if self._Zr is None:
+            self._Zr = (self.Zc if not np.iscomplexobj(self.Zc)
+                        else np.ascontiguousarray(self.Zc.real))
+        return self._Zr
+
+    def block(self, b: int) -> np.ndarray:
+        """Block ``b`` as the products use it: real (:attr:`Zr`) when :attr:`real`."""
+        return self.Zr[b] if self.real else self.Zc[b]
+
+    def sub(self, dofs: np.ndarray) -> HarmonicBlocks:
+        """The blocks restricted to the rows and columns ``dofs`` (real when these are)."""
+        src = self.Zr if self.real else self.Zc
+        return HarmonicBlocks(np.stack([z[np.ix_(dofs, dofs)] for z in src]))
 
     def _apply(self, Z0, Zc, U, conj=False):
         U = U.reshape(self.m, self.H)
         k = self.k
         out = np.empty((self.m, self.H))
         out[:, 0] = Z0 @ U[:, 0]
-        if k:
+        if k and self.real:  # conj(Z) = Z: U_n = a_n - i b_n by two real columns
+            ab = np.stack([U[:, 1 : k + 1].T, U[:, k + 1 :].T], axis=2)  # (k, m, 2)
+            y = np.matmul(self.Zr[1:] if Zc is self.Zc else Zc[1:], ab)  # Z a, Z b
+            out[:, 1 : k + 1] = y[:, :, 0].T
+            out[:, k + 1 :] = y[:, :, 1].T
+        elif k:
             c = (U[:, 1 : k + 1] - 1j * U[:, k + 1 :]).T  # (k, m): U_n = a_n - i b_n
             if conj:  # conj(Z) c = conj(Z conj(c))
                 y = np.conj(np.matmul(Zc[1:], np.conj(c)[:, :, None])[:, :, 0])
@@ -98,9 +132,13 @@ class HarmonicBlocks:
         if np.any(U[:, 0]):
             out[:, 0] = self.Z0[np.ix_(rows, cols)] @ U[:, 0]
         for b in range(1, k + 1):
-            c = U[:, b] - 1j * U[:, k + b]
-            if np.any(c):
-                y = self.Zc[b][np.ix_(rows, cols)] @ c
+            if not (np.any(U[:, b]) or np.any(U[:, k + b])):
+                continue
+            Zs = self.block(b)[np.ix_(rows, cols)]
+            if self.real:
+                out[:, b], out[:, k + b] = Zs @ U[:, b], Zs @ U[:, k + b]
+            else:
+                y = Zs @ (U[:, b] - 1j * U[:, k + b])
                 out[:, b], out[:, k + b] = y.real, -y.imag
         return out
 
@@ -119,6 +157,11 @@ class HarmonicBlocks:
             # row (r, a_n) of Z~ is [Re Z_n, Im Z_n], row (r, b_n) is [-Im Z_n, Re Z_n]:
             # (V_a + i V_b) Z_n gives the a-columns in its real part, the b-columns in its
             # imaginary part
+            if self.real:
+                Zb = self.Zr[b].reshape(nc, d, m)
+                out[:, :, b] = np.einsum("pi,pij->pj", V[:, :, b], Zb)
+                out[:, :, k + b] = np.einsum("pi,pij->pj", V[:, :, k + b], Zb)
+                continue
             w = V[:, :, b] + 1j * V[:, :, k + b]
             y = np.einsum("pi,pij->pj", w, self.Zc[b].reshape(nc, d, m))
             out[:, :, b], out[:, :, k + b] = y.real, y.imag
@@ -129,7 +172,8 @@ class HarmonicBlocks:
         if self.symmetric():
             return self._apply(self.Z0, self.Zc, U, conj=True)
         if self._ZcH is None:
-            self._ZcH = np.ascontiguousarray(np.conj(np.transpose(self.Zc, (0, 2, 1))))
+            src = self.Zr if self.real else self.Zc
+            self._ZcH = np.ascontiguousarray(np.conj(np.transpose(src, (0, 2, 1))))
         return self._apply(np.ascontiguousarray(self.Z0.T), self._ZcH, U)
 
     def dense(self) -> np.ndarray:
@@ -149,7 +193,9 @@ class MeanGainPreconditioner:
         self.k, self.m, self.H = Z.k, Z.m, Z.H  # (no reference to Z: kept across sweeps)
         self.lu0 = sla.lu_factor(self._block(gbar, Z.Z0, eps), overwrite_a=True,
                                  check_finite=False)
-        self.lus = [sla.lu_factor(self._block(gbar, Z.Zc[b], eps), overwrite_a=True,
+        # real blocks (undamped): real LUs, a complex right-hand side as two real columns
+        self.real = Z.real
+        self.lus = [sla.lu_factor(self._block(gbar, Z.block(b), eps), overwrite_a=True,
                                   check_finite=False) for b in range(1, Z.nb)]
 
     @staticmethod
@@ -170,6 +216,10 @@ class MeanGainPreconditioner:
         out = np.empty_like(r)
         out[:, 0] = sla.lu_solve(self.lu0, r[:, 0], check_finite=False)
         for b in range(1, k + 1):
+            if self.real:  # P_n (a - i b) = P_n a - i P_n b
+                y = sla.lu_solve(self.lus[b - 1], r[:, [b, k + b]], check_finite=False)
+                out[:, b], out[:, k + b] = y[:, 0], y[:, 1]
+                continue
             y = sla.lu_solve(self.lus[b - 1], r[:, b] - 1j * r[:, k + b], check_finite=False)
             out[:, b], out[:, k + b] = y.real, -y.imag
         return out.reshape(-1)
@@ -225,20 +275,28 @@ class KrylovJacobian:
         H, nc, dH, m = Z.H, self.nc, self.dH, Z.m
         Gr = G.reshape(nc, dH, d, H)
         out = np.zeros((m, H))
+        act = self.active_nodes()  # the Gram matrices of the stuck nodes vanish
 
-        def quad(M, X):  # X_p^T M_p X_p per column, summed over the nodes; X (nc, r, ncol)
+        def quad(M, X):  # X_p^T M_p X_p per column, summed over the active nodes
+            X = X[act]  # X (nc, r, ncol)
             return np.einsum("pic,pic->c", X, np.matmul(M, X))
 
         for b in range(Z.nb):
             cs = [0] if b == 0 else [b, Z.k + b]
             nl = len(cs)
             Gs = np.ascontiguousarray(Gr[:, :, :, cs].reshape(nc, dH, d * nl))
-            gram = np.matmul(np.transpose(Gs, (0, 2, 1)), Gs)  # (nc, d nl, d nl)
-            if b:
+            gram = np.matmul(np.transpose(Gs[act], (0, 2, 1)), Gs[act])  # (na, d nl, d nl)
+            if b and Z.real:
+                # Im Z_n = 0: column (j, a_n) is (x, 0) and (j, b_n) is (0, x) in the
+                # coefficient pairs, so only the (a, a) and (b, b) parts of the Gram matrix act
+                g5 = gram.reshape(act.size, d, 2, d, 2)
+                ga = np.ascontiguousarray(g5[:, :, 0, :, 0])
+                gb = np.ascontiguousarray(g5[:, :, 1, :, 1])
+            elif b:
                 # in the order [Re rows; Im rows] of X = [x; y] (x = Re Z_n, y = Im Z_n):
                 # column (j, a_n) has entries (x, -y), column (j, b_n) entries (y, x), both
                 # interleaved per DOF in gram's order (DOF, coefficient)
-                g5 = gram.reshape(nc, d, 2, d, 2)
+                g5 = gram.reshape(act.size, d, 2, d, 2)
                 A, B, D = g5[:, :, 0, :, 0], g5[:, :, 0, :, 1], g5[:, :, 1, :, 1]
                 ga = np.block([[A, -B], [-np.transpose(B, (0, 2, 1)), D]])
                 gb = np.block([[D, np.transpose(B, (0, 2, 1))], [B, A]])
@@ -248,6 +306,10 @@ class KrylovJacobian:
                 if b == 0:
                     x = Z.Z0[:, sl].reshape(nc, d, -1)
                     sq = quad(gram, np.ascontiguousarray(x))[:, None]
+                elif Z.real:
+                    x = Z.Zr[b][:, sl].reshape(nc, d, -1)
+                    y = None
+                    sq = np.column_stack([quad(ga, x), quad(gb, x)])
                 else:
                     zb = Z.Zc[b][:, sl]
                     x, y = zb.real.reshape(nc, d, -1), zb.imag.reshape(nc, d, -1)
@@ -259,7 +321,8 @@ class KrylovJacobian:
                 if b == 0:
                     zz = [x[q, :, ci]]  # (ncol, d nl): the column's entries at its node
                 else:
-                    xo, yo = x[q, :, ci], y[q, :, ci]
+                    xo = x[q, :, ci]
+                    yo = np.zeros_like(xo) if y is None else y[q, :, ci]
                     zz = [np.stack([xo, -yo], axis=2).reshape(js.size, d * nl),
                           np.stack([yo, xo], axis=2).reshape(js.size, d * nl)]
                 for t, c in enumerate(cs):
@@ -331,7 +394,7 @@ class KrylovJacobian:
     def _active_blocks(self, dofs) -> HarmonicBlocks:
         """The harmonic blocks of ``Z_aa`` (copied once per Jacobian)."""
         if self._Za is None or not np.array_equal(self._Za_dofs, dofs):
-            self._Za = HarmonicBlocks(np.stack([z[np.ix_(dofs, dofs)] for z in self.Z.Zc]))
+            self._Za = self.Z.sub(dofs)
             self._Za_dofs = dofs
         return self._Za
 
@@ -340,7 +403,7 @@ class KrylovJacobian:
 
         eps, dH = self.eps, self.dH
         na, r = act.size, rhs.shape[2]
-        Za = HarmonicBlocks(np.stack([z[np.ix_(dofs, dofs)] for z in self.Z.Zc])).dense()
+        Za = self.Z.sub(dofs).dense()
         Ja = np.matmul(self.G[act], Za.reshape(na, dH, na * dH)).reshape(na * dH, na * dH)
         for i in range(na):
             sl = slice(i * dH, (i + 1) * dH)

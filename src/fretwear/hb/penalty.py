@@ -64,6 +64,8 @@ def radius(Z: np.ndarray, rows=None) -> float:
         return 0.0
     if Z.shape[0] <= EXACT_SIZE:
         return float(np.max(np.abs(np.linalg.eigvals(Z))))
+    if np.iscomplexobj(Z) and not np.any(Z.imag):  # undamped: the same iteration in reals,
+        Z = np.ascontiguousarray(Z.real)  # half the memory traffic of the complex products
     v = np.random.default_rng(0).standard_normal(Z.shape[0]).astype(Z.dtype)
     sigma = 0.0
     for _ in range(20):

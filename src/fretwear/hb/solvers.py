@@ -123,8 +123,10 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None):
     f, J = fun(x, True)
     nfev = njev = 1
     fn = vector_norm(f)
-    dscale = _column_norms(J)
-    dscale[dscale == 0] = 1.0
+    # the column norms that scale the variables are formed when the first step is taken: a
+    # start that already meets the test (a sweep's predictor, a continuation's last stage)
+    # does not pay for them (on a large interface they cost as much as a step)
+    dscale = None
     delta = None  # first trial: the full Newton step
     it = 0
     msg = "maximum number of iterations reached"
@@ -138,6 +140,9 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None):
         if it >= max_iter:
             break
         it += 1
+        if dscale is None:
+            dscale = _column_norms(J)
+            dscale[dscale == 0] = 1.0
         sn = _lu_step(J, f)
         snd = vector_norm(dscale * sn)
         if delta is None:
