@@ -23,10 +23,15 @@ linearly implicit default needs one solve per contact node for its slow Jacobian
 docs/theory.md "Large interfaces") at the size given to ``--extras-size``, each writing its
 checkpoint (sweep-checkpoint.npz, wear-checkpoint.npz, sizes printed) into a temporary folder.
 
+Sizes: 8, 16, 32 and 64 nodes a side (64 to 4096 contact nodes). A size whose estimated peak
+memory (:func:`estimate_gib`, checked against the measured peak of the sizes that run) is
+above ``LIMIT_GIB`` = 12 GiB is not run: the estimate and its parts are printed instead
+(4096 nodes: about 54 GiB). Every size runs under that address-space limit.
+
 The last lines read ``solve_1024_s=``, ``condense_1024_s=`` and ``peak_rss_1024_gib=`` (CPU
 seconds and GiB of the 32 x 32 size, when it was run).
 
-Run: ``python benchmarks/scale_3d.py [--sizes 8,16,32] [--sweep 50 --wear 20
+Run: ``python benchmarks/scale_3d.py [--sizes 8,16,32,64] [--sweep 50 --wear 20
 --extras-size 32]``.
 """
 
@@ -45,6 +50,30 @@ import time
 import numpy as np
 
 A, P0, MU, FREQ, H = 0.01, 1e6, 0.5, 5000.0, 7
+#: no size is run whose estimated peak memory (:func:`estimate_gib`) is above this, and
+#: every size runs under this address-space limit (the machine is shared)
+LIMIT_GIB = 12.0
+
+
+def layers(n: int) -> int:
+    """Element layers through the thickness of the pad with n x n contact nodes."""
+    return max(1, round((n - 1) / 8))
+
+
+def estimate_gib(n: int) -> dict:
+    """Peak memory [GiB] of one size, estimated from the arrays that grow with it (the sizes
+    measured at 32 x 32 check it, docs/theory.md): the reduced model ``Z_r`` (H + 1 complex
+    m x m blocks), the real copy of its blocks the operator products use (undamped pad),
+    the static constraint modes ``Psi`` (n_i x m reals) with one product of their size while
+    they are projected, four complex m x m work arrays (a harmonic's condensation, the kept
+    harmonic 0) and 0.4 GiB of Python, NumPy, SciPy and numba."""
+    m = 3 * n * n
+    ni = 3 * n * n * (layers(n) + 1) - m
+    parts = {"Z_r": (H + 1) * m * m * 16, "real blocks": (H + 1) * m * m * 8,
+             "Psi": 2 * ni * m * 8, "work": 4 * m * m * 16, "base": 0.4 * 2**30}
+    parts = {k: v / 2**30 for k, v in parts.items()}
+    parts["total"] = sum(parts.values())
+    return parts
 
 
 def pad(n: int):
@@ -52,8 +81,7 @@ def pad(n: int):
     from fretwear.model import ContactSpec, Material, Spring, Traction, box, from_mesh
 
     ne = n - 1
-    nz = max(1, round(ne / 8))
-    return from_mesh(box(A, A, A / 8, ne, ne, nz), Material(210e9, 0.3, 7800.0),
+    return from_mesh(box(A, A, A / 8, ne, ne, layers(n)), Material(210e9, 0.3, 7800.0),
                      springs=[Spring("zmax", "x", 1e7), Spring("zmax", "y", 1e7)],
                      loads=[Traction("zmax", pressure=P0),
                             Traction("zmax", traction=(0.8 * MU * P0, 0.0, 0.0),
@@ -149,9 +177,15 @@ def one(n: int, extras: dict) -> dict:
     return out
 
 
+def _limit_memory():
+    """The address-space limit of a size's process (``ulimit -v``)."""
+    cap = int(LIMIT_GIB * 2**30)
+    resource.setrlimit(resource.RLIMIT_AS, (cap, cap))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--sizes", default="8,16,32", help="nodes per side of the contact face")
+    ap.add_argument("--sizes", default="8,16,32,64", help="nodes per side of the contact face")
     ap.add_argument("--sweep", type=int, default=0, help="points of the sweep (0: none)")
     ap.add_argument("--wear", type=int, default=0, help="slow steps of the wear run (0: none)")
     ap.add_argument("--extras-size", type=int, default=32, help="size of the sweep/wear run")
@@ -164,9 +198,17 @@ def main():
     print(f"load: {os.getloadavg()}; OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS')}")
     rows = {}
     for n in (int(s) for s in args.sizes.split(",")):
+        est = estimate_gib(n)
+        if est["total"] > LIMIT_GIB:
+            print(f"\n{n * n} contact nodes, H = {H}: {3 * n * n * (2 * H + 1)} unknowns: not "
+                  f"run: estimated peak memory {est['total']:.1f} GiB > {LIMIT_GIB:g} GiB ("
+                  + ", ".join(f"{k} {v:.1f}" for k, v in est.items() if k != "total")
+                  + " GiB)")
+            continue
         extras = ({"sweep": args.sweep, "wear": args.wear} if n == args.extras_size else {})
         proc = subprocess.run([sys.executable, __file__, "--one", str(n), "--extras",
-                               json.dumps(extras)], capture_output=True, text=True)
+                               json.dumps(extras)], capture_output=True, text=True,
+                              preexec_fn=_limit_memory)
         line = [x for x in proc.stdout.splitlines() if x.startswith("RESULT ")]
         if proc.returncode or not line:
             print(f"n = {n}: failed\n{proc.stderr[-2000:]}")
@@ -203,7 +245,8 @@ def main():
                   f"({r['wear_message']}), peak {r['peak_wear_gib']:.2f} GiB, "
                   f"wear-checkpoint.npz {r['wear_ckpt_mib']:.1f} MiB")
         print(f"  peak memory {r['peak_gib']:.2f} GiB (condensation + solve), "
-              f"{r['peak_extras_gib']:.2f} GiB with the sweep and wear run")
+              f"{r['peak_extras_gib']:.2f} GiB with the sweep and wear run; estimated "
+              f"{est['total']:.2f} GiB")
     if 16 in rows and 32 in rows:
         g = np.log(rows[32]["solve_cpu"] / rows[16]["solve_cpu"]) / np.log(
             rows[32]["unknowns"] / rows[16]["unknowns"])
