@@ -83,6 +83,15 @@ class HarmonicBlocks:
         """Block ``b`` as the products use it: real (:attr:`Zr`) when :attr:`real`."""
         return self.Zr[b] if self.real else self.Zc[b]
 
+    def leading(self, nb: int) -> HarmonicBlocks:
+        """The blocks of the first ``nb`` harmonics, sharing this object's arrays (and its
+        real copies)."""
+        out = HarmonicBlocks(self.Zc[:nb])
+        out._real = self.real
+        if self.real:
+            out._Zr = self.Zr[:nb]
+        return out
+
     def sub(self, dofs: np.ndarray) -> HarmonicBlocks:
         """The blocks restricted to the rows and columns ``dofs`` (real when these are)."""
         src = self.Zr if self.real else self.Zc
@@ -242,7 +251,6 @@ class KrylovJacobian:
         self.shape = (self.n, self.n)
         self.owner = owner if owner is not None else self
         self.gmres_iterations = 0
-        self._Za = self._Za_dofs = None  # the harmonic blocks of the active nodes
 
     # -- products -----------------------------------------------------------------------------
     def matvec(self, x) -> np.ndarray:
@@ -392,11 +400,15 @@ class KrylovJacobian:
         return x, rhs, dofs
 
     def _active_blocks(self, dofs) -> HarmonicBlocks:
-        """The harmonic blocks of ``Z_aa`` (copied once per Jacobian)."""
-        if self._Za is None or not np.array_equal(self._Za_dofs, dofs):
-            self._Za = self.Z.sub(dofs)
-            self._Za_dofs = dofs
-        return self._Za
+        """The harmonic blocks of ``Z_aa``, copied once and kept by the owner while the
+        active DOFs (and the operator ``Z``) do not change: Powell's successive Jacobians
+        near a solution share them."""
+        kept = getattr(self.owner, "_active_Z", None)
+        if kept is not None and kept[0] is self.Z and np.array_equal(kept[1], dofs):
+            return kept[2]
+        Za = self.Z.sub(dofs)
+        self.owner._active_Z = (self.Z, dofs, Za)
+        return Za
 
     def _lu_active(self, rhs, act, dofs) -> np.ndarray:
         from fretwear.hb.solvers import solve_identity_rows

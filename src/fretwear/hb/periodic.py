@@ -87,6 +87,7 @@ class DLFTProblem:
         self.contact = contact
         self.blocks = HarmonicBlocks(reduced.Z)
         self._Z = None
+        self._zu = None
         if jacobian not in JACOBIANS:
             raise InputError(f"jacobian = {jacobian!r}: expected one of {JACOBIANS}")
         if jacobian == "auto":
@@ -124,7 +125,7 @@ class DLFTProblem:
             reduced = connect(reduced, self.contact, self._springs)
         new.reduced = reduced
         new.blocks = HarmonicBlocks(reduced.Z)
-        new._Z = None
+        new._Z = new._zu = None
         new.F = loads_to_real(reduced.F)
         new._Fnorm = None
         new.anchor = (np.zeros((self.nc, self.d - 1)) if anchor is None
@@ -165,7 +166,10 @@ class DLFTProblem:
     # -- evaluation ---------------------------------------------------------------------
     def lambda_u(self, U):
         """``lambda_u~ = F~ - Z U~ + eps (U~ - W~)`` (m, H) (eq. 23)."""
-        return self.F - self.apply_Z(U) + self.eps * (U - self.W)
+        ZU = self.apply_Z(U)
+        if self.jacobian == "krylov":  # |Z U~| of the convergence test at the same U~
+            self._zu = (np.array(U, dtype=float), vector_norm(ZU))
+        return self.F - ZU + self.eps * (U - self.W)
 
     def time_law(self, U):
         """Time-domain law: ``(lam_u, lam_x, state, sweeps)`` with samples (nc, d, N)."""
@@ -226,7 +230,11 @@ class DLFTProblem:
     def scale(self, U):
         """Reference magnitude of the convergence test: ``|Z_r U~|`` (section 3.2), or |F~|
         when that vanishes."""
-        zu = vector_norm(self.apply_Z(U))
+        kept = self._zu
+        if kept is not None and np.array_equal(kept[0], U):  # from the residual at this U
+            zu = kept[1]
+        else:
+            zu = vector_norm(self.apply_Z(U))
         if self._Fnorm is None:
             self._Fnorm = float(np.linalg.norm(self.F))
         return max(zu, self._Fnorm, 1e-300)
@@ -899,6 +907,8 @@ def _first_harmonic_start(prob, solver, tol, max_iter):
         cut.update(node_A=reduced.node_A[:2], node_b=reduced.node_b[:2])
     red = dataclasses.replace(reduced, **cut)
     p1 = DLFTProblem(red, prob.contact, sub, gap=prob.gap, eps=prob.eps, anchor=prob.anchor)
+    if p1.jacobian == "krylov":  # the full problem's blocks (and their real copies), shared
+        p1.blocks = prob.blocks.leading(2)
 
     def fun(x, jac=True):
         return p1.residual(x.reshape(p1.m, p1.H), jac)
