@@ -154,14 +154,17 @@ def one(n: int, extras: dict) -> dict:
         out.update(wear_steps=len(wr.history.cycles) - 1, wear_cpu=c.cpu, wear_wall=c.wall,
                    wear_success=bool(wr.success), wear_message=wr.message,
                    wear_ckpt_mib=os.path.getsize(ck) / 2**20, peak_wear_gib=peak_gib())
+        del wr
     print("PARTIAL " + json.dumps(out, default=float), flush=True)
+    anchor = sol.anchor
+    del red, sol  # the sweep condenses each of its frequencies itself
     if extras.get("sweep"):
         from fretwear.hb.sweep import sweep
 
         ck = os.path.join(tmp, "sweep-checkpoint.npz")
         with Clock() as c:
             res = sweep(model, basis, 4000.0, 6000.0, extras["sweep"], spacing="linear",
-                        anchor=sol.anchor, checkpoint=ck)
+                        anchor=anchor, checkpoint=ck)
         out.update(sweep_points=extras["sweep"], sweep_cpu=c.cpu, sweep_wall=c.wall,
                    sweep_converged=int(sum(p.success for p in res.points)),
                    sweep_ckpt_mib=os.path.getsize(ck) / 2**20,

@@ -210,16 +210,24 @@ class _Problems:
         key = float(omega)
         red = self.cache.get(key)
         if red is None:
+            # room is made before the new model is condensed (every frequency's has the
+            # size of the cached ones): at 1024 nodes one model less held at the peak
+            size = next(iter(self.cache.values())).Z.nbytes if self.cache else 0
+            while self.cache and (len(self.cache) >= self.size or size + sum(
+                    r.Z.nbytes for r in self.cache.values()) > CACHE_BYTES):
+                self.cache.pop(next(iter(self.cache)))
             red = self.condenser.reduced(omega, self.orders)
             if self.springs is not None:
                 red = connect(red, self.model.contact, self.springs)
-            while self.cache and (len(self.cache) >= self.size or red.Z.nbytes + sum(
-                    r.Z.nbytes for r in self.cache.values()) > CACHE_BYTES):
-                self.cache.pop(next(iter(self.cache)))
             self.cache[key] = red
         if self.template is None:
-            prob = self.template = DLFTProblem(red, self.model.contact, self.basis,
-                                               gap=self.gap, eps=self.eps, anchor=anchor)
+            prob = DLFTProblem(red, self.model.contact, self.basis, gap=self.gap,
+                               eps=self.eps, anchor=anchor)
+            # the set-up the other frequencies share (DLFTProblem.at), without this
+            # frequency's reduced model and blocks: they are not pinned for the whole sweep
+            self.template = object.__new__(DLFTProblem)
+            self.template.__dict__.update(prob.__dict__)
+            self.template.reduced = self.template.blocks = self.template.F = None
         else:
             prob = self.template.at(red, anchor)
         # the GMRES preconditioner of large interfaces (fretwear.hb.krylov) is carried from
