@@ -745,3 +745,26 @@ def test_a_failed_static_preload_solve_is_reported_not_silent():
     assert pre.success and pre.warning == ""
     np.testing.assert_allclose(pre.values, 0.0, atol=1e-12)  # stuck where it touched
     assert solve_periodic(good, basis, frequency=15.0, strategy=("start",)).warnings == []
+
+
+def test_strategy_without_an_attempt_at_the_target_reports_the_start_residual():
+    """When no attempt runs at the target eps (a sweep passes only its later steps, and they
+    fail or do not apply), the unconverged answer is the start and its reported relative
+    residual is the start's, |f(x0)| / scale(x0) evaluated here with numpy's norm, not inf
+    (which the sweeps' messages printed before)."""
+    from fretwear.hb.periodic import solve_strategy
+    from fretwear.model.matrices import from_matrices
+
+    model = from_matrices(np.array([[2.0, -1.0], [-1.0, 1.0]]), np.eye(2), C=0.02 * np.eye(2),
+                          contact_normal_dofs=None, contact_tangential_dofs=[1], mu=0.5,
+                          normal_load=1.0, loads=[Load(np.array([0.2, 0.0]), "cos")],
+                          observed={"x": 0})
+    basis = FourierBasis.up_to(3, 32)
+    red = condense(model, 1.49 / (2 * np.pi), basis.orders)
+    prob = DLFTProblem(red, model.contact, basis, eps=1.0)
+    x0 = np.full((prob.m, prob.H), 0.1)
+    x, st = solve_strategy(prob, x0, steps=())
+    f, _ = prob.residual(x0, jacobian=False)
+    assert not st.success and np.array_equal(x, x0)
+    assert st.residual == pytest.approx(np.linalg.norm(f) / prob.scale(x0), rel=1e-12)
+    assert "no attempt converged (none)" in st.message

@@ -578,8 +578,11 @@ def solve_strategy(prob: DLFTProblem, x0, *, solver="powell", tol=1e-8, max_iter
                                     "the first harmonic alone did not converge"))
     if best is None:  # nothing ran at the target eps: the start, unconverged
         tried = ", ".join(a.method for a in attempts) or "none"
-        best = (x0, SolveStats(False, float("inf"), 0, 0, 0, 0.0,
-                               f"no attempt converged ({tried})", solver))
+        x0 = np.asarray(x0, float).reshape(prob.m, prob.H)
+        f, _ = prob.residual(x0, False)  # the start's relative residual, as the solvers give
+        rel = float(vector_norm(f) / max(prob.scale(x0), 1e-300))
+        best = (x0, SolveStats(False, rel, 0, 1, 0, 0.0, f"no attempt converged ({tried})",
+                               solver))
     return best
 
 
