@@ -147,7 +147,7 @@ def _per_interface_variables(result: SweepResult, model) -> dict:
 
 
 def linear_reference_grid(f_min: float, f_max: float, spacing: str, sweep_hz,
-                          linear_points: int = 1000) -> np.ndarray:
+                          linear_points: int = 200) -> np.ndarray:
     """The frequencies [Hz] of the linear reference FRFs of a sweep: ``linear_points`` over
     ``[f_min, f_max]`` with the sweep's ``spacing``, and every frequency of the sweep itself
     (so that the nonlinear and the linear responses compare point by point), in increasing
