@@ -195,6 +195,31 @@ def test_radius_estimate_of_large_blocks():
                                                 rel=1e-12)
 
 
+def test_radius_of_several_blocks_warm_started():
+    """radius_max over several large blocks (each power iteration started from the previous
+    block's vector plus the cold start) against the known spectra (Q diag(l_b) Q^T, real
+    orthogonal Q: the radius of block b is max |l_b|): to 1e-3, the iteration's stopping
+    test. The blocks' top modes are orthogonal columns of Q, so a start from the previous
+    block's vector alone would have no component on the next top mode and stop at the
+    second eigenvalue (0.4 of the top one: far outside the tolerance); the largest radius is
+    that of the last block."""
+    from fretwear.hb.penalty import EXACT_SIZE, radius, radius_max
+
+    n = EXACT_SIZE + 44
+    rng = np.random.default_rng(3)
+    Q, _ = np.linalg.qr(rng.standard_normal((n, n)))
+    blocks, tops = [], []
+    for b, top in enumerate((5.0, 6.0, 7.0)):
+        lam = rng.uniform(1.0, 2.0, n)
+        lam[b] = top  # block b's top mode: column b of Q
+        blocks.append((Q * lam) @ Q.T)
+        tops.append(top)
+    assert radius_max(blocks) == pytest.approx(7.0, rel=1e-3)
+    # each block alone (cold start) gives the same
+    for Z, top in zip(blocks, tops, strict=True):
+        assert radius(Z) == pytest.approx(top, rel=1e-3)
+
+
 # --- contact springs: eps = k makes the DLFT the alternating frequency-time balance --------
 
 def _jenkins_aft(w, H, N, m=1.0, k=1.0, c=0.02, kt=0.5, slip=0.5, f0=0.2):

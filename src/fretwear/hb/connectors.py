@@ -141,7 +141,7 @@ def connect(reduced: Reduced, contact: ContactInterface,
     Axf = np.empty((nb, m, m - nr), dtype=complex)
     Axf[:, :nr] = Z[:, :nr, nr:]
     Axf[:, nr:] = -Kff
-    Zx = np.zeros_like(Z)
+    Zx = np.zeros(Z.shape, dtype=complex)  # Z may be real (undamped), X is complex
     Zx[:, :nr, :nr] = Z[:, :nr, :nr]
     Zx[:, nr:, nr:] = Kff
     Zx -= Axf @ X

@@ -230,14 +230,17 @@ class ModalCondenser(Condenser):
         orders = np.asarray(orders, dtype=np.int64)
         m, no, nb, R = self.m, self.structure.obs.size, orders.size, self.R
         F_all = self.structure.load_harmonics(int(orders.max()) if orders.size else 0)
-        Zr = np.zeros((nb, m, m), dtype=complex)
+        # undamped (or static) blocks are real: stored real, half the memory, and the
+        # solvers' products need no real copy of them (hb/krylov.py)
+        real = quasi_static or not np.any(orders) or not ({"C", "D"} & set(self.proj))
+        Zr = np.zeros((nb, m, m), dtype=float if real else complex)
         Fr = np.zeros((nb, m), dtype=complex)
         oA = np.zeros((nb, no, m), dtype=complex)
         ob = np.zeros((nb, no), dtype=complex)
         rows = np.array([i for _, i in self.obs_i], dtype=np.int64)
         for b, n in enumerate(orders):
             static = int(n) == 0 or quasi_static  # the same at every frequency: kept
-            key = (int(n), bool(quasi_static))
+            key = (int(n), bool(quasi_static) and int(n) != 0)  # harmonic 0: K alone, either way
             kept = self._static.get(key) if static else None
             if kept is not None and np.array_equal(kept[0], F_all[n]):  # same loads
                 Zr[b], Fr[b], oA[b], ob[b] = kept[1:]

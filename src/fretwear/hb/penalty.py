@@ -57,16 +57,41 @@ def radius(Z: np.ndarray, rows=None) -> float:
     exact up to :data:`EXACT_SIZE` rows, else the largest singular value by power iteration
     on ``Z^H Z`` until it changes by less than 1e-3 (at most 20 iterations: ample for a
     penalty whose effect is measured over decades)."""
-    Z = np.asarray(Z)
+    return radius_max([Z], rows)
+
+
+def radius_max(blocks, rows=None) -> float:
+    """The largest :func:`radius` [N/m] of the (m, m) ``blocks`` (e.g. ``Z_r`` at every kept
+    harmonic). Above :data:`EXACT_SIZE` rows each block's power iteration starts from the
+    previous block's converged vector: the blocks ``Z_r(n w)`` of one solve share their
+    stiffest modes (the mesh-scale ones, far above the kept harmonics), so after the first
+    block each converges in about two iterations instead of ten or more."""
+    best, v = 0.0, None
+    for Z in blocks:
+        sigma, v = _radius(np.asarray(Z), rows, v)
+        best = max(best, sigma)
+    return best
+
+
+def _radius(Z: np.ndarray, rows, v):
+    """:func:`radius` of one block and the start vector for the next (None when exact)."""
     if rows is not None:
         Z = Z[np.ix_(rows, rows)]
     if Z.shape[0] == 0:
-        return 0.0
+        return 0.0, None
     if Z.shape[0] <= EXACT_SIZE:
-        return float(np.max(np.abs(np.linalg.eigvals(Z))))
+        return float(np.max(np.abs(np.linalg.eigvals(Z)))), None
     if np.iscomplexobj(Z) and not np.any(Z.imag):  # undamped: the same iteration in reals,
         Z = np.ascontiguousarray(Z.real)  # half the memory traffic of the complex products
-    v = np.random.default_rng(0).standard_normal(Z.shape[0]).astype(Z.dtype)
+    start = np.random.default_rng(0).standard_normal(Z.shape[0])
+    if v is not None and v.shape[0] == Z.shape[0]:
+        # the previous block's vector plus the cold start, of equal norms: as fast as the
+        # previous vector where the blocks share their top mode, never worse than half the
+        # cold start where they do not (the previous vector alone could be orthogonal to
+        # this block's top mode, and the iteration would stall on a lower one)
+        v = v.real if not np.iscomplexobj(Z) else v
+        start = v / np.linalg.norm(v) + start / np.linalg.norm(start)
+    v = start.astype(Z.dtype)
     sigma = 0.0
     # Z^H Z v without forming Z^H, a block of about 1 MiB of rows at a time so that each
     # block is read from memory once for both products (30 % faster at 3072 rows)
@@ -79,13 +104,13 @@ def radius(Z: np.ndarray, rows=None) -> float:
         w = w.conj()
         nrm = np.linalg.norm(w)
         if nrm == 0.0:
-            return 0.0
+            return 0.0, None
         sigma_new = math.sqrt(nrm / np.linalg.norm(v))
         v = w / nrm
         if abs(sigma_new - sigma) <= 1e-3 * sigma_new:
-            return float(sigma_new)
+            return float(sigma_new), v
         sigma = sigma_new
-    return float(sigma)
+    return float(sigma), v
 
 
 def _law_rows(contact, m: int):
@@ -179,8 +204,7 @@ def penalty(rule, *, model: Model | None = None, frequency: float = 0.0, orders=
             reduced = connect(condense(model, frequency, orders, quasi_static=quasi_static),
                               model.contact)
         rows = _law_rows(contact, reduced.m)
-        blocks = reduced.Z if rule == "auto" else reduced.Z[-1:]
-        return max(radius(z, rows) for z in blocks)
+        return radius_max(reduced.Z if rule == "auto" else reduced.Z[-1:], rows)
     if model is not None:
         red = connect(condense(model, 0.0, [0], quasi_static=True), model.contact)
         return radius(red.Z[0], _law_rows(contact, red.m))

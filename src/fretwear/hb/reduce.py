@@ -47,7 +47,9 @@ class Reduced:
         ``quasi_static``).
     orders : (nb,) harmonic orders ``[0, h1, .., hk]``.
     Z : (nb, m, m) complex reduced dynamic stiffness [N/m] in contact-local coordinates,
-        ``m = n_contact * d``, rows/columns node-major ``[N, T1, (T2)]``.
+        ``m = n_contact * d``, rows/columns node-major ``[N, T1, (T2)]``; real when every
+        block is (an undamped structure or a static problem through the modal condensation of
+        fretwear.hb.modal: half the memory, no real copy for the solvers' products).
     F : (nb, m) complex reduced load amplitudes [N] (``F[0]`` is the static load).
     obs_A, obs_b : (nb, no, m), (nb, no) complex: observed DOFs ``U_o = obs_A @ u_loc + obs_b``.
     obs_dofs : (no,) global DOFs of the observed points, in the order of ``model.observed``.
