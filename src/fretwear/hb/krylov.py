@@ -27,11 +27,16 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse.linalg as spla
+from numba import njit
 
 #: relative residual to which GMRES solves the Newton step (the dense LU is exact to rounding;
 #: an inexact step changes the iterates, not the converged answer, which the residual test of
 #: the nonlinear solver decides)
 GMRES_RTOL = 1e-10
+#: power-iteration steps that estimate how well one harmonic's preconditioner factors serve
+#: another, and the estimate below which they are shared (MeanGainPreconditioner._close)
+SHARE_PROBES = 2
+SHARE_BELOW = 0.25
 #: Krylov vectors kept before a restart, and restarts allowed
 GMRES_RESTART = 60
 GMRES_MAXITER = 4
@@ -40,6 +45,56 @@ REBUILD_AFTER = 25
 #: the step is solved by a LAPACK LU of the active block up to this many unknowns (slipping
 #: or separating nodes x d x H), by GMRES above (docs/theory.md, "Large interfaces")
 ACTIVE_DENSE_MAX = 3000
+
+
+@njit(cache=True)
+def _gram_quad(Are, Aim, rows, M, c0, c1):
+    """``out[t, c] = sum_p x_pc^T M[t, p] x_pc`` for the columns ``c0 <= c < c1`` of a block,
+    where ``x_pc`` (r,) holds the block's entries in the rows ``rows[p]`` (d,) of node ``p``:
+    ``Are[rows[p], c]`` if ``r = d``, followed by ``Aim[rows[p], c]`` if ``r = 2 d`` (the
+    real and imaginary parts of a complex block). One pass over the active rows, without
+    the copies and the ``(na, r, ncol)`` product of the batched NumPy form."""
+    nt, na, r, _ = M.shape
+    d = rows.shape[1]
+    out = np.zeros((nt, c1 - c0))
+    x = np.empty(r)
+    for p in range(na):
+        for c in range(c0, c1):
+            for i in range(d):
+                x[i] = Are[rows[p, i], c]
+                if r > d:
+                    x[d + i] = Aim[rows[p, i], c]
+            for t in range(nt):
+                acc = 0.0
+                for i in range(r):
+                    s = 0.0
+                    for j in range(r):
+                        s += M[t, p, i, j] * x[j]
+                    acc += x[i] * s
+                out[t, c - c0] += acc
+    return out
+
+
+@njit(cache=True)
+def _gram_quad_real3(A, rows, M, c0, c1):
+    """:func:`_gram_quad` for a real block and 3 DOFs per node (3D), the common case of
+    large interfaces: the symmetric form ``sum_ij M_ij x_i x_j`` with its six coefficients
+    taken out of the loop over the columns (five times faster)."""
+    nt, na = M.shape[0], M.shape[1]
+    out = np.zeros((nt, c1 - c0))
+    for p in range(na):
+        r0, r1, r2 = A[rows[p, 0]], A[rows[p, 1]], A[rows[p, 2]]
+        for t in range(nt):
+            m00, m11, m22 = M[t, p, 0, 0], M[t, p, 1, 1], M[t, p, 2, 2]
+            m01 = M[t, p, 0, 1] + M[t, p, 1, 0]
+            m02 = M[t, p, 0, 2] + M[t, p, 2, 0]
+            m12 = M[t, p, 1, 2] + M[t, p, 2, 1]
+            o = out[t]
+            for c in range(c0, c1):
+                a, b, e = r0[c], r1[c], r2[c]
+                o[c - c0] += (m00 * a * a + m11 * b * b + m22 * e * e + m01 * a * b
+                              + m02 * a * e + m12 * b * e)
+    return out
 
 
 class HarmonicBlocks:
@@ -198,17 +253,28 @@ class HarmonicBlocks:
 class MeanGainPreconditioner:
     """``P^-1`` with ``P_n = eps I + gbar (Z_n - eps I)`` per harmonic (module docstring).
 
-    gbar : (nc, d, d) mean gain of each node over the period; Z : :class:`HarmonicBlocks`.
+    gbar : (nc, d, d) mean gain of each node over the period; Z : :class:`HarmonicBlocks`;
+    share : let a harmonic use the factors of the last factored one when they precondition
+    it well (:meth:`_close`): below the structure's first resonances ``Z_n`` hardly differs
+    from ``Z_0`` (``-(n w)^2 M_r`` against the stiffness) and one LU serves several
+    harmonics. A rebuild after a GMRES failure does not share.
     """
 
-    def __init__(self, gbar: np.ndarray, Z: HarmonicBlocks, eps: float):
+    def __init__(self, gbar: np.ndarray, Z: HarmonicBlocks, eps: float, share: bool = True):
         self.k, self.m, self.H = Z.k, Z.m, Z.H  # (no reference to Z: kept across sweeps)
-        self.lu0 = sla.lu_factor(self._block(gbar, Z.Z0, eps), overwrite_a=True,
-                                 check_finite=False)
-        # real blocks (undamped): real LUs, a complex right-hand side as two real columns
-        self.real = Z.real
-        self.lus = [sla.lu_factor(self._block(gbar, Z.block(b), eps), overwrite_a=True,
-                                  check_finite=False) for b in range(1, Z.nb)]
+        self.factors = []  # per harmonic block: LAPACK LU of P_n or of a close P_b
+        self.shared = 0
+        last = None  # (Z_b, its LU) of the last factored harmonic
+        for b in range(Z.nb):
+            Zb = Z.Z0 if b == 0 else Z.block(b)
+            if share and last is not None and self._close(gbar, Zb, last, eps):
+                self.factors.append(last[1])
+                self.shared += 1
+                continue
+            lu = sla.lu_factor(self._block(gbar, Zb, eps), overwrite_a=True,
+                               check_finite=False)
+            self.factors.append(lu)
+            last = (Zb, lu)
 
     @staticmethod
     def _block(gbar, Zn, eps):
@@ -222,17 +288,50 @@ class MeanGainPreconditioner:
         P[np.diag_indices(m)] += eps
         return P
 
+    @staticmethod
+    def _solve(lu, b):
+        """``P^-1 b`` by the factors ``lu``; a complex ``b`` with real factors as its real and
+        imaginary parts (a mixed call would copy the factors to complex)."""
+        if np.iscomplexobj(b) and not np.iscomplexobj(lu[0]):
+            y = sla.lu_solve(lu, np.column_stack([b.real, b.imag]), check_finite=False)
+            return y[:, 0] + 1j * y[:, 1]
+        return sla.lu_solve(lu, b, check_finite=False)
+
+    @classmethod
+    def _close(cls, gbar, Zn, last, eps) -> bool:
+        """Whether the factors of ``P_b`` (``last`` = ``(Z_b, LU)``) precondition ``P_n``
+        well: ``P_b^-1 P_n = I + E`` with ``E = P_b^-1 gbar (Z_n - Z_b)``, and GMRES on it
+        converges about as fast as on ``I`` when ``E`` is small. Its size is estimated by
+        :data:`SHARE_PROBES` steps of the power iteration from a fixed random vector
+        (``2 SHARE_PROBES`` products and solves of ``m^2`` operations, against the ``m^3``
+        of an LU): shared when below :data:`SHARE_BELOW`. An isolated large eigenvalue of
+        ``E`` that the probe misses costs GMRES about one iteration."""
+        Zb, lu = last
+        nc, d, _ = gbar.shape
+        m = Zn.shape[0]
+        v = np.random.default_rng(0).standard_normal(m)
+        size = 0.0
+        for _ in range(SHARE_PROBES):
+            y = (Zn @ v - Zb @ v).reshape(nc, d)
+            w = cls._solve(lu, np.matmul(gbar, y[:, :, None])[:, :, 0].reshape(-1))
+            size = float(np.linalg.norm(w) / np.linalg.norm(v))
+            v = w
+            if not np.isfinite(size) or size == 0.0:
+                break
+        return bool(np.isfinite(size) and size <= SHARE_BELOW)
+
     def apply(self, r) -> np.ndarray:
         r = np.asarray(r).reshape(self.m, self.H)
         k = self.k
         out = np.empty_like(r)
-        out[:, 0] = sla.lu_solve(self.lu0, r[:, 0], check_finite=False)
+        out[:, 0] = self._solve(self.factors[0], r[:, 0]).real
         for b in range(1, k + 1):
-            if self.real:  # P_n (a - i b) = P_n a - i P_n b
-                y = sla.lu_solve(self.lus[b - 1], r[:, [b, k + b]], check_finite=False)
+            lu = self.factors[b]
+            if not np.iscomplexobj(lu[0]):  # real P_n: P_n (a - i b) = P_n a - i P_n b
+                y = sla.lu_solve(lu, r[:, [b, k + b]], check_finite=False)
                 out[:, b], out[:, k + b] = y[:, 0], y[:, 1]
                 continue
-            y = sla.lu_solve(self.lus[b - 1], r[:, b] - 1j * r[:, k + b], check_finite=False)
+            y = sla.lu_solve(lu, r[:, b] - 1j * r[:, k + b], check_finite=False)
             out[:, b], out[:, k + b] = y.real, -y.imag
         return out.reshape(-1)
 
@@ -274,66 +373,66 @@ class KrylovJacobian:
     def T(self):
         return _Transposed(self)
 
-    def column_norms(self, chunk: int = 256) -> np.ndarray:
+    def column_norms(self, chunk: int = 1024) -> np.ndarray:
         """Euclidean norm of every column of ``J`` (what MINPACK scales the variables by),
         exact: column ``(j, c)`` of ``Z~`` has non-zeros in the coefficients ``cs`` of its
         harmonic only, so ``|G Z~ e|^2 = sum_p z_p^T (G_p,cs^T G_p,cs) z_p`` with the small
         Gram matrices of the node blocks, plus the ``eps (I - G)`` term of the column's own
-        node: ``4 d^2 nc n`` operations and no ``n x n`` intermediate. The real columns of
-        harmonic ``n`` are read a block at a time from ``Re Z_n``, ``Im Z_n``, both columns
-        ``(a_n, b_n)`` of a DOF from the same block."""
+        node: ``4 d^2 nc n`` operations and no ``n x n`` intermediate. Only the rows of the
+        active nodes enter the sums (the Gram matrices of the stuck nodes vanish), read in
+        place by a compiled kernel (:func:`_gram_quad`); the own-node entries come from the
+        diagonal node blocks. The real columns of harmonic ``n`` come from ``Re Z_n``,
+        ``Im Z_n``, both columns ``(a_n, b_n)`` of a DOF from the same rows."""
         Z, G, eps, d = self.Z, self.G, self.eps, self.d
         H, nc, dH, m = Z.H, self.nc, self.dH, Z.m
         Gr = G.reshape(nc, dH, d, H)
         out = np.zeros((m, H))
         act = self.active_nodes()  # the Gram matrices of the stuck nodes vanish
-
-        def quad(M, X):  # X_p^T M_p X_p per column, summed over the active nodes
-            X = X[act]  # X (nc, r, ncol)
-            return np.einsum("pic,pic->c", X, np.matmul(M, X))
+        na = act.size
+        rows = np.ascontiguousarray(act[:, None] * d + np.arange(d))  # (na, d)
+        idx = np.arange(nc)
 
         for b in range(Z.nb):
             cs = [0] if b == 0 else [b, Z.k + b]
             nl = len(cs)
             Gs = np.ascontiguousarray(Gr[:, :, :, cs].reshape(nc, dH, d * nl))
-            gram = np.matmul(np.transpose(Gs[act], (0, 2, 1)), Gs[act])  # (na, d nl, d nl)
-            if b and Z.real:
+            Ga = Gs[act]
+            gram = np.matmul(np.transpose(Ga, (0, 2, 1)), Ga)  # (na, d nl, d nl)
+            Zb = Z.Z0 if b == 0 else Z.block(b)
+            if b == 0:
+                M = gram[None]
+            elif Z.real:
                 # Im Z_n = 0: column (j, a_n) is (x, 0) and (j, b_n) is (0, x) in the
                 # coefficient pairs, so only the (a, a) and (b, b) parts of the Gram matrix act
-                g5 = gram.reshape(act.size, d, 2, d, 2)
-                ga = np.ascontiguousarray(g5[:, :, 0, :, 0])
-                gb = np.ascontiguousarray(g5[:, :, 1, :, 1])
-            elif b:
+                g5 = gram.reshape(na, d, 2, d, 2)
+                M = np.stack([g5[:, :, 0, :, 0], g5[:, :, 1, :, 1]])
+            else:
                 # in the order [Re rows; Im rows] of X = [x; y] (x = Re Z_n, y = Im Z_n):
                 # column (j, a_n) has entries (x, -y), column (j, b_n) entries (y, x), both
                 # interleaved per DOF in gram's order (DOF, coefficient)
-                g5 = gram.reshape(act.size, d, 2, d, 2)
+                g5 = gram.reshape(na, d, 2, d, 2)
                 A, B, D = g5[:, :, 0, :, 0], g5[:, :, 0, :, 1], g5[:, :, 1, :, 1]
-                ga = np.block([[A, -B], [-np.transpose(B, (0, 2, 1)), D]])
-                gb = np.block([[D, np.transpose(B, (0, 2, 1))], [B, A]])
+                M = np.stack([np.block([[A, -B], [-np.transpose(B, (0, 2, 1)), D]]),
+                              np.block([[D, np.transpose(B, (0, 2, 1))], [B, A]])])
+            M = np.ascontiguousarray(M)
+            Are, Aim = (Zb.real, Zb.imag) if np.iscomplexobj(Zb) else (Zb, Zb)
+            diag = Zb.reshape(nc, d, nc, d)[idx, :, idx, :]  # (nc, d, d) own-node blocks
             for j0 in range(0, m, chunk):
                 sl = slice(j0, min(j0 + chunk, m))
                 js = np.arange(sl.start, sl.stop)
-                if b == 0:
-                    x = Z.Z0[:, sl].reshape(nc, d, -1)
-                    sq = quad(gram, np.ascontiguousarray(x))[:, None]
-                elif Z.real:
-                    x = Z.Zr[b][:, sl].reshape(nc, d, -1)
-                    y = None
-                    sq = np.column_stack([quad(ga, x), quad(gb, x)])
+                if d == 3 and not np.iscomplexobj(Zb):
+                    sq = _gram_quad_real3(Zb, rows, M, sl.start, sl.stop).T  # (ncol, nl)
                 else:
-                    zb = Z.Zc[b][:, sl]
-                    x, y = zb.real.reshape(nc, d, -1), zb.imag.reshape(nc, d, -1)
-                    X = np.concatenate([x, y], axis=1)  # (nc, 2d, ncol)
-                    sq = np.column_stack([quad(ga, X), quad(gb, X)])
+                    sq = _gram_quad(Are, Aim, rows, M, sl.start, sl.stop).T
                 # + eps (I - G) on the owner's block: column (j, c) -> node j // d, row j%d, c
                 q = js // d
                 ci = np.arange(js.size)
+                own = diag[q, :, js % d]  # (ncol, d): the column's entries at its node
                 if b == 0:
-                    zz = [x[q, :, ci]]  # (ncol, d nl): the column's entries at its node
+                    zz = [own.real]
                 else:
-                    xo = x[q, :, ci]
-                    yo = np.zeros_like(xo) if y is None else y[q, :, ci]
+                    xo, yo = own.real, (own.imag if np.iscomplexobj(own)
+                                        else np.zeros_like(own))
                     zz = [np.stack([xo, -yo], axis=2).reshape(js.size, d * nl),
                           np.stack([yo, xo], axis=2).reshape(js.size, d * nl)]
                 for t, c in enumerate(cs):
@@ -433,7 +532,8 @@ class KrylovJacobian:
                 or not np.array_equal(getattr(pc, "nodes", None), act)):
             H = self.Z.H
             Gr = self.G[act].reshape(act.size, self.d, H, self.d, H)
-            pc = MeanGainPreconditioner(np.ascontiguousarray(Gr[:, :, 0, :, 0]), Za, self.eps)
+            pc = MeanGainPreconditioner(np.ascontiguousarray(Gr[:, :, 0, :, 0]), Za, self.eps,
+                                        share=not rebuild)
             pc.nodes = act
             owner._precond = pc
         return pc
@@ -478,7 +578,7 @@ class KrylovJacobian:
                 if count[0] > REBUILD_AFTER and not fresh:
                     self.owner._precond = None  # slow: rebuild at the next Jacobian
                 break
-            if fresh:
+            if fresh and not pc.shared:
                 break  # the best preconditioner at hand: GMRES's last iterate
         return x
 

@@ -48,6 +48,8 @@ from fretwear.model.core import Model
 RULES = ("auto", "static", "top")
 #: blocks up to this size get exact eigenvalues; larger ones a power-iteration estimate
 EXACT_SIZE = 256
+#: weight of the cold (random) start added to a warm start (:func:`radius_max`)
+WARM_MIX = 0.1
 #: frequencies of a sweep's band at which ``"top"`` is evaluated (its median is the sweep's eps)
 SWEEP_SAMPLES = 5
 
@@ -85,12 +87,12 @@ def _radius(Z: np.ndarray, rows, v):
         Z = np.ascontiguousarray(Z.real)  # half the memory traffic of the complex products
     start = np.random.default_rng(0).standard_normal(Z.shape[0])
     if v is not None and v.shape[0] == Z.shape[0]:
-        # the previous block's vector plus the cold start, of equal norms: as fast as the
-        # previous vector where the blocks share their top mode, never worse than half the
-        # cold start where they do not (the previous vector alone could be orthogonal to
-        # this block's top mode, and the iteration would stall on a lower one)
+        # the previous block's vector plus a tenth of the cold start: nearly as fast as the
+        # previous vector where the blocks share their top mode; where they do not, the
+        # previous vector alone could be orthogonal to this block's top mode and the
+        # iteration would stall on a lower one (tests/hb/test_penalty.py)
         v = v.real if not np.iscomplexobj(Z) else v
-        start = v / np.linalg.norm(v) + start / np.linalg.norm(start)
+        start = v / np.linalg.norm(v) + WARM_MIX * start / np.linalg.norm(start)
     v = start.astype(Z.dtype)
     sigma = 0.0
     # Z^H Z v without forming Z^H, a block of about 1 MiB of rows at a time so that each
