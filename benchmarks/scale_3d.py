@@ -26,7 +26,7 @@ checkpoint (sweep-checkpoint.npz, wear-checkpoint.npz, sizes printed) into a tem
 Sizes: 8, 16, 32 and 64 nodes a side (64 to 4096 contact nodes). A size whose estimated peak
 memory (:func:`estimate_gib`, checked against the measured peak of the sizes that run) is
 above ``LIMIT_GIB`` = 12 GiB is not run: the estimate and its parts are printed instead
-(4096 nodes: about 63 GiB). Every size runs under that address-space limit.
+(4096 nodes: about 39 GiB). Every size runs under that address-space limit.
 
 The last lines read ``solve_1024_s=``, ``condense_1024_s=`` and ``peak_rss_1024_gib=`` (CPU
 seconds and GiB of the 32 x 32 size, when it was run).
@@ -62,17 +62,17 @@ def layers(n: int) -> int:
 
 def estimate_gib(n: int) -> dict:
     """Peak memory [GiB] of one size, estimated from the arrays that grow with it (the sizes
-    measured at 32 x 32 check it, docs/theory.md): the reduced model ``Z_r`` (H + 1 complex
-    m x m blocks), the real copy of its blocks the operator products use (undamped pad),
-    the static constraint modes ``Psi`` (n_i x m reals) with one product of their size while
-    they are projected, and work arrays: eight complex m x m (a harmonic's condensation, the
-    kept harmonic 0, the projected matrices in both frames, the active sub-blocks and the
-    preconditioner's factors of a solve whose nodes all slip; calibrated on the 3.77 GiB
-    measured at 1024 nodes) and 0.4 GiB of Python, NumPy, SciPy and numba."""
+    measured at 32 x 32 check it, docs/theory.md): the reduced model ``Z_r`` (H + 1 real
+    m x m blocks: the pad is undamped, and fretwear.hb.modal stores such blocks real), the
+    static constraint modes ``Psi`` (n_i x m reals) with one product of their size while
+    they are projected, and work arrays: ten real m x m (the projected stiffness and mass in
+    both frames, a harmonic's condensation, the kept harmonic 0, the active sub-blocks and
+    the preconditioner's factors; calibrated on the 2.2 GiB measured at 1024 nodes) and
+    0.4 GiB of Python, NumPy, SciPy and numba."""
     m = 3 * n * n
     ni = 3 * n * n * (layers(n) + 1) - m
-    parts = {"Z_r": (H + 1) * m * m * 16, "real blocks": (H + 1) * m * m * 8,
-             "Psi": 2 * ni * m * 8, "work": 8 * m * m * 16, "base": 0.4 * 2**30}
+    parts = {"Z_r": (H + 1) * m * m * 8, "Psi": 2 * ni * m * 8, "work": 10 * m * m * 8,
+             "base": 0.4 * 2**30}
     parts = {k: v / 2**30 for k, v in parts.items()}
     parts["total"] = sum(parts.values())
     return parts

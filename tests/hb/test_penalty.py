@@ -218,6 +218,14 @@ def test_radius_of_several_blocks_warm_started():
     # each block alone (cold start) gives the same
     for Z, top in zip(blocks, tops, strict=True):
         assert radius(Z) == pytest.approx(top, rel=1e-3)
+    # the previous block's top mode is kept (10) and a new one 1.5 times larger appears (a
+    # harmonic nearing a resonance): the warm vector dominates the start, the random part
+    # must still let the new mode take over (a tenth of it stops at 10.002, measured)
+    base = rng.uniform(1.0, 2.0, n)
+    a, b = base.copy(), base.copy()
+    a[0] = b[0] = 10.0
+    b[1] = 15.0
+    assert radius_max([(Q * a) @ Q.T, (Q * b) @ Q.T]) == pytest.approx(15.0, rel=1e-3)
 
 
 # --- contact springs: eps = k makes the DLFT the alternating frequency-time balance --------

@@ -526,14 +526,18 @@ class KrylovJacobian:
         return solve_identity_rows(Ja, rhs.reshape(na * dH, r)).reshape(na, dH, r)
 
     def _preconditioner(self, act, Za, rebuild=False):
+        """The kept preconditioner, or a new one for the active nodes ``act``: sharing
+        factors between harmonics unless ``rebuild`` (GMRES failed with the kept one) or
+        shared factors made GMRES slow before on this owner."""
         owner = self.owner
         pc = getattr(owner, "_precond", None)
         if (pc is None or rebuild or pc.m != Za.m
                 or not np.array_equal(getattr(pc, "nodes", None), act)):
             H = self.Z.H
             Gr = self.G[act].reshape(act.size, self.d, H, self.d, H)
+            share = not (rebuild or getattr(owner, "_no_share", False))
             pc = MeanGainPreconditioner(np.ascontiguousarray(Gr[:, :, 0, :, 0]), Za, self.eps,
-                                        share=not rebuild)
+                                        share=share)
             pc.nodes = act
             owner._precond = pc
         return pc
@@ -558,12 +562,16 @@ class KrylovJacobian:
         return out
 
     def _gmres(self, A, b, act, Za) -> np.ndarray:
+        """GMRES on one right-hand side, with at most one more run from its last iterate
+        when it fails: with a preconditioner rebuilt from this Jacobian (unshared) when the
+        first was kept from an earlier one or shared factors, else with the same one."""
         x = None
+        pc0 = getattr(self.owner, "_precond", None)
+        fresh = pc0 is None or not np.array_equal(getattr(pc0, "nodes", None), act)
+        pc = None
         for attempt in range(2):
-            pc0 = getattr(self.owner, "_precond", None)
-            fresh = attempt > 0 or pc0 is None or not np.array_equal(
-                getattr(pc0, "nodes", None), act)
-            pc = self._preconditioner(act, Za, rebuild=attempt > 0)
+            if pc is None or not fresh or pc.shared:
+                pc = self._preconditioner(act, Za, rebuild=attempt > 0)
             M = spla.LinearOperator(A.shape, matvec=pc.apply, dtype=float)
             count = [0]
 
@@ -575,11 +583,11 @@ class KrylovJacobian:
                                  callback=cb, callback_type="pr_norm")
             self.gmres_iterations += count[0]
             if info == 0:
-                if count[0] > REBUILD_AFTER and not fresh:
+                if count[0] > REBUILD_AFTER and (not fresh or pc.shared):
                     self.owner._precond = None  # slow: rebuild at the next Jacobian
+                    if pc.shared:  # shared factors served badly here: no more sharing
+                        self.owner._no_share = True
                 break
-            if fresh and not pc.shared:
-                break  # the best preconditioner at hand: GMRES's last iterate
         return x
 
 

@@ -254,8 +254,8 @@ class ModalCondenser(Condenser):
                 A = self.Psi[rows] @ R.T - self.V[rows] @ Y
                 for (j, _), a, bo in zip(self.obs_i, A, self.V[rows] @ qF, strict=True):
                     oA[b, j], ob[b, j] = a, bo
-            if static and int(n) == 0:
-                self._static[key] = (np.array(F_all[n]), Zr[b].copy(), Fr[b].copy(),
+            if static and int(n) == 0:  # K alone: real, whatever the storage of this call
+                self._static[key] = (np.array(F_all[n]), Zr[b].real.copy(), Fr[b].copy(),
                                      oA[b].copy(), ob[b].copy())
         return self._result(omega, orders, Zr, Fr, oA, ob, quasi_static, frequency)
 

@@ -27,7 +27,10 @@ from fretwear.model.core import Model
 from fretwear.wear.history import HISTORY_FIELDS, LATE_HISTORY_FIELDS, WearHistory
 from fretwear.wear.options import WearOptions
 
-CHECKPOINT_VERSION = 2
+#: 3: the fingerprint hashes the reduced model as stored, real for an undamped modal
+#: condensation (complex before), so an earlier checkpoint cannot match it: say so by the
+#: version rather than by "written for a different model"
+CHECKPOINT_VERSION = 3
 
 
 def _mu_key(mu):
