@@ -207,10 +207,10 @@ def test_real_storage_gives_the_same_answer(limit, monkeypatch):
 def test_preconditioner_shares_factors_only_between_close_harmonics():
     """A harmonic uses the LU of the last factored one when ``E = P_b^-1 gbar (Z_n - Z_b)``
     is small (MeanGainPreconditioner._close, a two-step power estimate). Reference: the
-    2-norm of E formed densely with numpy. Blocks ``K - (n w)^2 M`` of a chain: well below
-    its first resonance |E| is ~1e-3 (shared), across it |E| is above 1 (not shared: GMRES
-    would need many iterations); a harmonic that is not shared is factored itself, and the
-    next one compares with it."""
+    2-norm of E formed densely with numpy. Blocks ``K - (n w)^2 M`` of a chain (harmonic 1
+    damped): between harmonics on one side of its first resonance |E| is 0.005-0.01
+    (shared), across it 3.0 (not shared: GMRES would need many iterations); a harmonic that
+    is not shared is factored itself, and the next one compares with it."""
     nc, d = 40, 2
     m = nc * d
     rng = np.random.default_rng(4)
@@ -239,7 +239,7 @@ def test_preconditioner_shares_factors_only_between_close_harmonics():
     f = pc.factors
     assert f[1] is f[0] and f[2] is not f[0] and f[3] is f[2] and pc.shared == 2
     # the shared factors applied: P_0^-1 on harmonic 1's coefficients (U_1 = a_1 - i b_1),
-    # to rounding of a solve with condition number ~4e3 (1e-12)
+    # to rounding of a solve with condition number 2.6e3 (1e-12)
     r = rng.standard_normal((m, 7))
     P0 = krylov.MeanGainPreconditioner._block(gbar, Zc[0].real, eps)
     out = pc.apply(r).reshape(m, 7)
