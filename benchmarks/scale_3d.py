@@ -31,8 +31,13 @@ above ``LIMIT_GIB`` = 12 GiB is not run: the estimate and its parts are printed 
 The last lines read ``solve_1024_s=``, ``condense_1024_s=`` and ``peak_rss_1024_gib=`` (CPU
 seconds and GiB of the 32 x 32 size, when it was run).
 
+With ``--alternate N`` it also times the 256- and 1024-node solves alternately in one
+process, N times each, and prints the growth of their medians: the machine's speed drifts
+(30 % within an hour was measured), and two sizes run minutes apart carry that drift into
+their ratio.
+
 Run: ``python benchmarks/scale_3d.py [--sizes 8,16,32,64] [--sweep 50 --wear 20
---extras-size 32]``.
+--extras-size 32] [--alternate 4]``.
 """
 
 from __future__ import annotations
@@ -104,6 +109,25 @@ def peak_gib() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20
 
 
+def warm_up():
+    """Untimed: a 16-node solve and one Jacobian of it on the operator path (the column norms'
+    kernel), which load the compiled kernels from numba's cache (about 0.7 s, the same at
+    every size), so that the solve times and their growth with the size are those of the
+    solve. The 256-node solve takes the dense path, the 1024-node one the operator path:
+    without the second part only the latter would pay for loading its kernel."""
+    from fretwear.hb.fourier import FourierBasis
+    from fretwear.hb.periodic import DLFTProblem, solve_periodic, static_anchor
+    from fretwear.hb.reduce import condense
+
+    small, basis = pad(4), FourierBasis.up_to(H, 128)
+    anchor = static_anchor(small)
+    sol = solve_periodic(small, basis, frequency=FREQ, anchor=anchor)
+    prob = DLFTProblem(condense(small, FREQ, basis.orders), small.contact, basis, eps=sol.eps,
+                       anchor=anchor, jacobian="krylov")
+    _, J = prob.residual(sol.U.reshape(prob.m, prob.H), True)
+    J.column_norms()
+
+
 def one(n: int, extras: dict) -> dict:
     """Everything for one size (run in its own process)."""
     import scipy.linalg as sla
@@ -114,15 +138,9 @@ def one(n: int, extras: dict) -> dict:
     from fretwear.hb.reduce import Condenser, _structure
 
     out = {"n": n, "nodes": n * n}
-    # untimed warm-up on a 16-node pad: loads the compiled kernels from numba's cache (about
-    # 0.7 s, the same at every size), so that the solve times below, and their growth with
-    # the size, are those of the solve
-    small = pad(4)
     with Clock() as c:
-        solve_periodic(small, FourierBasis.up_to(H, 128), frequency=FREQ,
-                       anchor=static_anchor(small))
+        warm_up()
     out["warmup_cpu"] = c.cpu
-    del small
     with Clock() as c:
         model = pad(n)
     out.update(ndof=model.ndof, build_cpu=c.cpu, build_wall=c.wall)
@@ -191,6 +209,33 @@ def one(n: int, extras: dict) -> dict:
     return out
 
 
+def alternate(sizes: tuple[int, int], reps: int) -> dict:
+    """The solves of two sizes timed alternately in one process, ``reps`` times each (the
+    machine's speed drifts between separate runs; alternating exposes both sizes to the
+    same drift). Each timing is what ``one`` times: the static preload solve and the
+    periodic solve on the condensation of the frequency, harmonic 0 condensed afresh."""
+    from fretwear.hb.fourier import FourierBasis
+    from fretwear.hb.modal import use_modal
+    from fretwear.hb.periodic import solve_periodic, static_anchor
+
+    basis = FourierBasis.up_to(H, 128)
+    warm_up()  # untimed, as in one()
+    cases = {n: (lambda m: (m, use_modal(m, FREQ * 1.2, H)))(pad(n)) for n in sizes}
+    times = {n: [] for n in sizes}
+    for _ in range(reps):
+        for n in sizes:
+            model, mc = cases[n]
+            mc._static.clear()  # as in a fresh process: harmonic 0 not kept yet
+            red = mc.reduced(2 * np.pi * FREQ, basis.orders, frequency=FREQ)
+            with Clock() as c:
+                sol = solve_periodic(model, basis, frequency=FREQ, reduced=red,
+                                     anchor=static_anchor(model))
+            if not sol.success:
+                raise RuntimeError(f"{n * n} nodes: the periodic solve did not converge")
+            times[n].append(c.cpu)
+    return {"sizes": list(sizes), "times": {str(n): t for n, t in times.items()}}
+
+
 def _limit_memory():
     """The address-space limit of a size's process (``ulimit -v``)."""
     cap = int(LIMIT_GIB * 2**30)
@@ -203,11 +248,18 @@ def main():
     ap.add_argument("--sweep", type=int, default=0, help="points of the sweep (0: none)")
     ap.add_argument("--wear", type=int, default=0, help="slow steps of the wear run (0: none)")
     ap.add_argument("--extras-size", type=int, default=32, help="size of the sweep/wear run")
+    ap.add_argument("--alternate", type=int, default=0,
+                    help="also time the 256- and 1024-node solves alternately in one process, "
+                         "this many times each, and print the growth of their medians")
     ap.add_argument("--one", type=int, help=argparse.SUPPRESS)
     ap.add_argument("--extras", default="{}", help=argparse.SUPPRESS)
+    ap.add_argument("--alternate-in", type=int, help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.one:
         print("RESULT " + json.dumps(one(args.one, json.loads(args.extras)), default=float))
+        return
+    if args.alternate_in:
+        print("RESULT " + json.dumps(alternate((16, 32), args.alternate_in)))
         return
     print(f"load: {os.getloadavg()}; OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS')}")
     rows = {}
@@ -236,8 +288,8 @@ def main():
         if "exact_cpu" in r:
             print(f"  exact condensation: {r['exact_cpu']:.1f} s CPU, {r['exact_wall']:.1f} s "
                   f"wall; modal vs exact max rel. difference {r['modal_vs_exact']:.2g}")
-        print(f"  (untimed warm-up: a 16-node solve loading the compiled kernels, "
-              f"{r['warmup_cpu']:.1f} s CPU)")
+        print(f"  (untimed warm-up: a 16-node solve and Jacobian loading the compiled "
+              f"kernels, {r['warmup_cpu']:.1f} s CPU)")
         print(f"  periodic solve: {r['solve_cpu']:.2f} s CPU, {r['solve_wall']:.1f} s wall, "
               f"success {r['success']}, {r['iterations']} iterations (after the 1-harmonic "
               f"start), residual {r['residual']:.2g}, eps {r['eps']:.3g} N/m (default rule); "
@@ -267,6 +319,23 @@ def main():
         g = np.log(rows[32]["solve_cpu"] / rows[16]["solve_cpu"]) / np.log(
             rows[32]["unknowns"] / rows[16]["unknowns"])
         print(f"\nsolve time ~ unknowns^{g:.2f} from 256 to 1024 nodes")
+    if args.alternate:
+        proc = subprocess.run([sys.executable, __file__, "--alternate-in",
+                               str(args.alternate)], capture_output=True, text=True,
+                              preexec_fn=_limit_memory)
+        line = [x for x in proc.stdout.splitlines() if x.startswith("RESULT ")]
+        if proc.returncode or not line:
+            print(f"alternating solves: failed\n{proc.stderr[-2000:]}")
+        else:
+            t = json.loads(line[0][7:])["times"]
+            a, b = np.asarray(t["16"]), np.asarray(t["32"])
+            g = np.log(b / a) / np.log(4.0)  # unknowns grow 4 times
+            print(f"\nalternating in one process ({args.alternate} times each): solve "
+                  f"256 nodes {' '.join(f'{x:.2f}' for x in a)} s, 1024 nodes "
+                  f"{' '.join(f'{x:.2f}' for x in b)} s; medians {np.median(a):.3f} s and "
+                  f"{np.median(b):.3f} s: unknowns^"
+                  f"{np.log(np.median(b) / np.median(a)) / np.log(4.0):.2f} (single pairs "
+                  f"^{g.min():.2f} to ^{g.max():.2f})")
     print(f"load: {os.getloadavg()}")
     r = rows.get(32, {})
     print(f"solve_1024_s={r.get('solve_cpu', float('nan')):.1f}")

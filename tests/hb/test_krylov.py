@@ -246,6 +246,14 @@ def test_preconditioner_shares_factors_only_between_close_harmonics():
     y = np.linalg.solve(P0.astype(complex), r[:, 1] - 1j * r[:, 4])
     np.testing.assert_allclose(out[:, 1], y.real, rtol=1e-12, atol=0)
     np.testing.assert_allclose(out[:, 4], -y.imag, rtol=1e-12, atol=0)
+    # harmonics 2 and 3 share the complex factors of P_2 (the blocks are complex here), solved
+    # together: each equals the dense complex solve (condition number of P_2 2.6e3, as P_0's:
+    # 1e-11 leaves a margin over the 1e-12 of harmonic 1)
+    P2 = krylov.MeanGainPreconditioner._block(gbar, Zc[2], eps)
+    for b in (2, 3):
+        y = np.linalg.solve(P2, r[:, b] - 1j * r[:, 3 + b])
+        np.testing.assert_allclose(out[:, b], y.real, rtol=1e-11, atol=0)
+        np.testing.assert_allclose(out[:, 3 + b], -y.imag, rtol=1e-11, atol=0)
     unshared = krylov.MeanGainPreconditioner(gbar, krylov.HarmonicBlocks(Zc), eps, share=False)
     assert unshared.shared == 0 and len({id(x) for x in unshared.factors}) == 4
 

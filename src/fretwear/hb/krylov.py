@@ -321,18 +321,23 @@ class MeanGainPreconditioner:
         return bool(np.isfinite(size) and size <= SHARE_BELOW)
 
     def apply(self, r) -> np.ndarray:
+        """``P^-1 r``: the harmonics that share factors are solved together, one call with
+        all their columns (the factors are read once)."""
         r = np.asarray(r).reshape(self.m, self.H)
         k = self.k
         out = np.empty_like(r)
-        out[:, 0] = self._solve(self.factors[0], r[:, 0]).real
-        for b in range(1, k + 1):
-            lu = self.factors[b]
+        groups: dict = {}
+        for b, lu in enumerate(self.factors):
+            groups.setdefault(id(lu), (lu, []))[1].append(b)
+        for lu, hs in groups.values():
             if not np.iscomplexobj(lu[0]):  # real P_n: P_n (a - i b) = P_n a - i P_n b
-                y = sla.lu_solve(lu, r[:, [b, k + b]], check_finite=False)
-                out[:, b], out[:, k + b] = y[:, 0], y[:, 1]
+                cols = [c for b in hs for c in ([0] if b == 0 else [b, k + b])]
+                out[:, cols] = sla.lu_solve(lu, r[:, cols], check_finite=False)
                 continue
-            y = sla.lu_solve(lu, r[:, b] - 1j * r[:, k + b], check_finite=False)
-            out[:, b], out[:, k + b] = y.real, -y.imag
+            # complex factors (a damped harmonic; never harmonic 0, whose block is real)
+            y = sla.lu_solve(lu, (r[:, hs] - 1j * r[:, [k + b for b in hs]]),
+                             check_finite=False)
+            out[:, hs], out[:, [k + b for b in hs]] = y.real, -y.imag
         return out.reshape(-1)
 
 
