@@ -567,16 +567,18 @@ class KrylovJacobian:
         return out
 
     def _gmres(self, A, b, act, Za) -> np.ndarray:
-        """GMRES on one right-hand side, with at most one more run from its last iterate
-        when it fails: with a preconditioner rebuilt from this Jacobian (unshared) when the
-        first was kept from an earlier one or shared factors, else with the same one."""
+        """GMRES on one right-hand side. When it fails with a preconditioner kept from an
+        earlier Jacobian or with shared factors, one more run from its last iterate with a
+        preconditioner rebuilt from this Jacobian without sharing; a fresh unshared one is
+        the best at hand (GMRES's last iterate is returned). When shared factors converge
+        slowly, the owner stops sharing and keeps an unshared preconditioner of this
+        Jacobian."""
         x = None
-        pc0 = getattr(self.owner, "_precond", None)
-        fresh = pc0 is None or not np.array_equal(getattr(pc0, "nodes", None), act)
-        pc = None
         for attempt in range(2):
-            if pc is None or not fresh or pc.shared:
-                pc = self._preconditioner(act, Za, rebuild=attempt > 0)
+            pc0 = getattr(self.owner, "_precond", None)
+            fresh = attempt > 0 or pc0 is None or not np.array_equal(
+                getattr(pc0, "nodes", None), act)
+            pc = self._preconditioner(act, Za, rebuild=attempt > 0)
             M = spla.LinearOperator(A.shape, matvec=pc.apply, dtype=float)
             count = [0]
 
@@ -588,11 +590,14 @@ class KrylovJacobian:
                                  callback=cb, callback_type="pr_norm")
             self.gmres_iterations += count[0]
             if info == 0:
-                if count[0] > REBUILD_AFTER and (not fresh or pc.shared):
+                if count[0] > REBUILD_AFTER and pc.shared:
+                    self.owner._no_share = True  # shared factors served badly here
+                    self._preconditioner(act, Za, rebuild=True)  # kept for what follows
+                elif count[0] > REBUILD_AFTER and not fresh:
                     self.owner._precond = None  # slow: rebuild at the next Jacobian
-                    if pc.shared:  # shared factors served badly here: no more sharing
-                        self.owner._no_share = True
                 break
+            if fresh and not pc.shared:
+                break  # the best preconditioner at hand: GMRES's last iterate
         return x
 
 
