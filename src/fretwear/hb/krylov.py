@@ -275,6 +275,11 @@ class MeanGainPreconditioner:
                                check_finite=False)
             self.factors.append(lu)
             last = (Zb, lu)
+        # the harmonics of each set of factors, solved together by apply()
+        groups: dict = {}
+        for b, lu in enumerate(self.factors):
+            groups.setdefault(id(lu), (lu, []))[1].append(b)
+        self.groups = list(groups.values())
 
     @staticmethod
     def _block(gbar, Zn, eps):
@@ -326,10 +331,7 @@ class MeanGainPreconditioner:
         r = np.asarray(r).reshape(self.m, self.H)
         k = self.k
         out = np.empty_like(r)
-        groups: dict = {}
-        for b, lu in enumerate(self.factors):
-            groups.setdefault(id(lu), (lu, []))[1].append(b)
-        for lu, hs in groups.values():
+        for lu, hs in self.groups:
             if not np.iscomplexobj(lu[0]):  # real P_n: P_n (a - i b) = P_n a - i P_n b
                 cols = [c for b in hs for c in ([0] if b == 0 else [b, k + b])]
                 out[:, cols] = sla.lu_solve(lu, r[:, cols], check_finite=False)
