@@ -37,7 +37,8 @@ SHORTEN = {
     "salles2011-35khz": {"max_cycles": 2e6},
     "salles2011-70khz": {"max_cycles": 5e5},
     "salles2011-79khz": {"max_cycles": 5e5},
-    "salles2011-79khz-frf-worn": {"max_cycles": 5e5},
+    "salles2011-79khz-frf-worn": {"max_cycles": 5e5, "frf_before_after": {
+        "f_min": 7.6e4, "f_max": 8.2e4, "n_points": 7, "spacing": "linear"}},
     "dovetail-frf": {"n_points": 8, "linear_points": 100},
     "dovetail-wear": {"max_cycles": 1e5},
     "platform-damper-frf": {"n_points": 12},
