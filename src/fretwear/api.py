@@ -4,7 +4,9 @@ argument: here it is on by default, as in case files (one default for both).
 :func:`fretwear.hb.sweep.sweep` and :func:`fretwear.wear.simulate.simulate_wear` never import
 the time-domain solver (:mod:`fretwear.hb.fallback`); these wrappers pass
 :data:`fretwear.timedomain.fallback.FALLBACK` unless ``time_domain=False``. Everything else is
-passed through unchanged.
+passed through unchanged, ``condenser=`` among it: the condenser of the model
+(:func:`fretwear.hb.reduce.exact_condenser` or :func:`fretwear.hb.modal.modal_condenser`),
+built once by the caller and passed to every driver that condenses the same model.
 """
 
 from __future__ import annotations
@@ -28,10 +30,11 @@ def solve_periodic(model, basis, *, time_domain: bool = True,
 
     :func:`fretwear.hb.periodic.solve_periodic` (every other keyword: ``frequency``,
     ``quasi_static``, ``gap`` [m], ``eps``, ``anchor``, ``U0``, ``solver``, ``tol``,
-    ``max_iter``, ``strategy``, ``time_domain_periods``, ...) with the time-domain fallback
-    when every attempt of the solve strategy failed (``time_domain=True``, as the case-file
-    key ``time_domain`` of a periodic analysis): a periodic steady state of a time integration
-    starts one more solve; any other response is reported (``solution.time_domain``).
+    ``max_iter``, ``strategy``, ``time_domain_periods``, ``condenser``, ...) with the
+    time-domain fallback when every attempt of the solve strategy failed
+    (``time_domain=True``, as the case-file key ``time_domain`` of a periodic analysis): a
+    periodic steady state of a time integration starts one more solve; any other response is
+    reported (``solution.time_domain``).
 
     Returns
     -------
@@ -48,9 +51,9 @@ def sweep(model, basis, f_min: float, f_max: float, n_points: int, *, time_domai
 
     :func:`fretwear.hb.sweep.sweep` (every other keyword: ``spacing``, ``gap`` [m], ``eps``
     [N/m or "static"/"auto"], ``solver``, ``tol``, ``max_iter``, ``continuation``, ``check``,
-    ``time_domain_periods``, ``checkpoint``, ``resume``, ...) with the time-domain fallback at
-    points whose balance fails (``time_domain=True``, as the case-file key ``time_domain`` of a
-    sweep).
+    ``time_domain_periods``, ``checkpoint``, ``resume``, ``condenser``, ...) with the
+    time-domain fallback at points whose balance fails (``time_domain=True``, as the
+    case-file key ``time_domain`` of a sweep).
 
     Returns
     -------
@@ -69,8 +72,8 @@ def simulate_wear(model, basis, *, time_domain: bool = True, **kwargs) -> _wear.
 
     :func:`fretwear.wear.simulate.simulate_wear` (every other keyword: ``frequency``,
     ``quasi_static``, ``options`` (:class:`~fretwear.wear.options.WearOptions`), ``eps``,
-    ``W0`` [m], ``checkpoint``, ``resume``, ...) with the time-domain fallback of steps whose
-    balance fails (``time_domain=True``; whether it is used is
+    ``W0`` [m], ``checkpoint``, ``resume``, ``condenser``, ...) with the time-domain fallback
+    of steps whose balance fails (``time_domain=True``; whether it is used is
     ``options.time_domain_rescue``, default true, as in case files).
 
     Returns
@@ -87,7 +90,8 @@ def simulate_wear(model, basis, *, time_domain: bool = True, **kwargs) -> _wear.
 def frf_worn(model, wear, frequencies_hz, basis, *, time_domain: bool = True, **kwargs):
     """Nonlinear FRF with the worn gap ``gap + wear`` (paper Fig. 24), ``wear`` (nc,) [m],
     ``frequencies_hz = (f_min, f_max, n_points)`` [Hz]: :func:`fretwear.wear.worn_frf.frf_worn`
-    with the time-domain fallback (``time_domain=True``).
+    (every other keyword, e.g. ``condenser``, passed through) with the time-domain fallback
+    (``time_domain=True``).
 
     Returns
     -------
