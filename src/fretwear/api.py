@@ -16,7 +16,9 @@ do without: it then only scales time). The older spellings (``stick_anchor``, ``
 in case files, whose key ``time_domain`` is this argument (the analyses of
 :mod:`fretwear.analyses` call these drivers). Every other keyword is passed to the function
 named in the docstring unchanged, with its default: each option has one default, that of the
-function that uses it.
+function that uses it. ``condenser=`` is among them: the condenser of the model
+(:func:`fretwear.hb.reduce.exact_condenser` or :func:`fretwear.hb.modal.modal_condenser`),
+built once by the caller and passed to every driver that condenses the same model.
 """
 
 from __future__ import annotations

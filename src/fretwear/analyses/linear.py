@@ -18,6 +18,7 @@ from fretwear.analyses import figures as plots
 from fretwear.analyses.base import Analysis, RunContext, RunOutput
 from fretwear.analyses.common import AXES, check_points, default_of, figure_path, geometry
 from fretwear.errors import InputError
+from fretwear.hb.reduce import exact_condenser
 from fretwear.io.results import (
     complex_variables,
     label_coordinate,
@@ -147,11 +148,14 @@ MODES = Analysis.define(
 
 
 # --- FRF ------------------------------------------------------------------------------------
-def _frf_chunked(model, freqs, interface: str, method: str, bar) -> linear.FRFResult:
-    """:func:`fretwear.linear.frf` in chunks so that the progress bar moves."""
+def _frf_chunked(model, freqs, interface: str, method: str, bar,
+                 condenser=None) -> linear.FRFResult:
+    """:func:`fretwear.linear.frf` in chunks so that the progress bar moves (``condenser``:
+    the run's, for ``method = "condensed"``)."""
     parts = []
     for chunk in np.array_split(freqs, min(len(freqs), 50)):
-        parts.append(linear.frf(model, chunk, interface=interface, method=method))
+        parts.append(linear.frf(model, chunk, interface=interface, method=method,
+                                condenser=condenser))
         bar.update(len(chunk))
     return linear.FRFResult(
         interface, freqs,
@@ -169,12 +173,15 @@ def run_frf(model, analysis: dict, case, context: RunContext) -> RunOutput:
     freqs = linear.frequency_grid(analysis["f_min"], analysis["f_max"], analysis["n_points"],
                                   analysis["spacing"])
     interfaces = analysis["interfaces"]
+    # the run's condensation of the model, for every chunk and interface (condensed FRFs)
+    cond = exact_condenser(model) if analysis["method"] == "condensed" else None
     results = []
     with tqdm(total=len(freqs) * len(interfaces), desc="frf", disable=not context.progress,
               leave=False, unit="freq") as bar:
         for interface in interfaces:
             bar.set_postfix_str(interface)
-            results.append(_frf_chunked(model, freqs, interface, analysis["method"], bar))
+            results.append(_frf_chunked(model, freqs, interface, analysis["method"], bar,
+                                        cond))
     coords, data = geometry(model, points)
     n_axes = coords["axis"].size
     coords["interface"] = label_coordinate("interface", interfaces)

@@ -34,6 +34,7 @@ from fretwear.analyses.common import (
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import PeriodicSolution
+from fretwear.hb.reduce import exact_condenser
 from fretwear.hb.sweep import SweepResult, sweep
 from fretwear.io.results import label_coordinate, variable
 from fretwear.io.schema import Field, Flag, Integer, ListOf, Number, Text, increasing
@@ -236,6 +237,7 @@ def run_sweep(model, analysis: dict, case, context: RunContext) -> RunOutput:
     points = check_points(model, analysis.get("points"))
     basis = basis_of(analysis)
     n = analysis["n_points"]
+    cond = exact_condenser(model)  # the run's condensation of the model, for every call
     with tqdm(total=n, desc="sweep", disable=not context.progress, leave=False,
               unit="freq") as bar:
         def tick(i, total, pt):
@@ -250,10 +252,11 @@ def run_sweep(model, analysis: dict, case, context: RunContext) -> RunOutput:
                            continuation=analysis["continuation"],
                            time_domain=analysis["time_domain"],
                            time_domain_periods=analysis["time_domain_periods"],
-                           check=(sweep_check(model, max_periods=analysis["time_domain_periods"])
+                           check=(sweep_check(model, max_periods=analysis["time_domain_periods"],
+                                              condenser=cond)
                                   if analysis["check_stability"] else None),
                            progress=tick, checkpoint=context.out_dir / CHECKPOINT_FILE,
-                           resume=context.resume)
+                           resume=context.resume, condenser=cond)
     linear_hz = linear_reference_grid(analysis["f_min"], analysis["f_max"],
                                       analysis["spacing"], result.frequency_hz,
                                       analysis["linear_points"])

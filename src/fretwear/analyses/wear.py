@@ -25,6 +25,7 @@ from fretwear.files import safe_name
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.penalty import RULES
+from fretwear.hb.reduce import exact_condenser
 from fretwear.hb.solvers import SOLVERS
 from fretwear.hb.sweep import frequency_grid
 from fretwear.io.results import label_coordinate, variable, write_pvd, write_vtu
@@ -376,16 +377,18 @@ def run_wear(model, analysis: dict, case, context: RunContext) -> RunOutput:
     if nodes is not None and any(p >= nc for p in nodes):
         fail("analysis.plot_nodes", nodes, f"contact node numbers from 0 to {nc - 1}")
     # the time-domain rescue: api.simulate_wear's fallback, used as opts.time_domain_rescue says
+    cond = exact_condenser(model)  # the run's condensation of the model: wear run and FRFs
     result = api.simulate_wear(model, basis, frequency=f_hz, quasi_static=quasi, options=opts,
                                checkpoint=context.out_dir / CHECKPOINT_FILE, **penalty_of(a),
-                               resume=context.resume, progress=context.progress)
+                               resume=context.resume, progress=context.progress,
+                               condenser=cond)
     frf, frf_note = None, ""
     fb = a.get("frf_before_after")
     if fb is not None and model.observed:
         grid = (fb["f_min"], fb["f_max"], fb["n_points"])
         sweeps = {name: api.frf_worn(model, basis, w, *grid, solver=a["solver"],
                                      **penalty_of(a), spacing=fb["spacing"],
-                                     time_domain=fb["time_domain"])
+                                     time_domain=fb["time_domain"], condenser=cond)
                   for name, w in (("unworn", 0.0), ("worn", result.final_wear))}
         frf = _frf_data(model, sweeps, frequency_grid(*grid, fb["spacing"]))
         frf_note = "\n".join(f"FRF {k}: {int(v.point_success.sum())}/{len(v.points)} converged"

@@ -30,6 +30,7 @@ from fretwear.errors import FretwearError, InputError
 from fretwear.examples.builders import stromberg_beam
 from fretwear.files import atomic_write
 from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.reduce import exact_condenser
 from fretwear.io.case import build_model
 from fretwear.paper.catalogue import (
     EXTRA_KEYS,
@@ -142,10 +143,11 @@ def _frf_worn(folder: Path, wear_dir: Path, quick: bool) -> str:
         return "up to date"
     model = build_model(load_case(wear_dir / "case.toml"))
     basis = FourierBasis.up_to(h, s)
+    cond = exact_condenser(model)  # one condensation of the beam for both FRFs
     out = {}
     for name, w in (("unworn", np.zeros_like(wear)), ("worn", wear)):
         r = api.frf_worn(model, basis, w, f_min, f_max, n, spacing="linear",
-                         time_domain=True)
+                         time_domain=True, condenser=cond)
         out[f"{name}_summary"] = r.summary()
         out[f"{name}_frequency"] = r.frequency_hz
         out[f"{name}_amplitude"] = r.amplitude("Pe", 0, 1)

@@ -33,7 +33,7 @@ from fretwear.timedomain.results import IncrementalWearResult
 def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int = 100,
                      cycle_jump: int = 1, k_w: float | None = None, record_every: int = 1,
                      wear0=None, tol: float = 1e-10, progress: bool = False,
-                     raise_on_failure: bool = True) -> IncrementalWearResult:
+                     raise_on_failure: bool = True, condenser=None) -> IncrementalWearResult:
     """Quasi-static fretting wear by load steps (in the spirit of Stromberg 1997).
 
     At every load step ``tau_k = 2 pi k / steps_per_cycle`` the static equilibrium
@@ -64,6 +64,8 @@ def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int =
     raise_on_failure : raise :class:`~fretwear.errors.ConvergenceError` when the contact
         problem of some load step does not settle (default); False: return the result with
         ``success`` False and the count in ``message``.
+    condenser : the condenser of ``model`` (:func:`fretwear.hb.reduce.exact_condenser`) whose
+        static condensation is used (None: a new exact one).
 
     Returns
     -------
@@ -93,7 +95,7 @@ def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int =
     if area.shape != (nc,) or np.any(area <= 0):
         raise InputError(f"contact.area must be ({nc},) positive areas [m^2]")
     check_contact(model)
-    cond = condense_static(model)
+    cond = condense_static(model, condenser=condenser)
     A = cond.K
     tau = 2.0 * np.pi * np.arange(N) / N
     Ft = model.load_time(tau) if model.loads else np.zeros((N, model.ndof))

@@ -28,7 +28,7 @@ from fretwear.errors import InputError, interrupted
 from fretwear.hb.fallback import TimeDomainFallback
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import PeriodicSolution, check_inputs, preload_anchor
-from fretwear.hb.reduce import Reduced, condense
+from fretwear.hb.reduce import Reduced, condense, condenser_for
 from fretwear.hb.solvers import SolveStats
 from fretwear.model.core import Model
 from fretwear.wear.checkpoint import (
@@ -50,7 +50,8 @@ def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
                   reduced: Reduced | None = None, eps: str | float = "auto", anchor=None,
                   W0=None, U0=None, checkpoint: Path | str | None = None, resume: bool = False,
                   progress: bool = False, callback: Callable | None = None,
-                  time_domain: TimeDomainFallback | None = None) -> WearResult:
+                  time_domain: TimeDomainFallback | None = None,
+                  condenser=None) -> WearResult:
     """Integrate fretting wear over the slow time scale (paper Fig. 3, eq. 29-30).
 
     Parameters
@@ -78,6 +79,9 @@ def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
         balance fails (``options.time_domain_rescue``, dynamic cases); ``None``: no fallback
         (a failed balance stops the run). :func:`fretwear.simulate_wear` passes
         :data:`fretwear.timedomain.fallback.FALLBACK`.
+    condenser : the condenser of ``model`` (:func:`fretwear.hb.reduce.exact_condenser` or
+        :func:`fretwear.hb.modal.modal_condenser`) used by every condensation and recovery of
+        the run; None: a new exact one, built once for the run.
 
     Returns
     -------
@@ -107,21 +111,23 @@ def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
         check_checkpoint_path(ckpt)  # a folder there: refused before anything is computed
     t_start = time.perf_counter()
     nc, d = model.contact.dofs.shape
+    condenser = condenser_for(model, condenser)  # one for every condensation of the run
     if reduced is None:
-        reduced = condense(model, frequency, basis.orders, quasi_static=quasi_static)
+        reduced = condense(model, frequency, basis.orders, quasi_static=quasi_static,
+                           condenser=condenser)
     coef = wear_coefficients(model, opts.law, opts.energy_coefficient,
                              opts.partner_energy_coefficient)
     W0 = np.zeros(nc) if W0 is None else np.broadcast_to(np.asarray(W0, float), (nc,)).copy()
     warnings = []
     if anchor is None:
-        preload = preload_anchor(model)
+        preload = preload_anchor(model, condenser=condenser)
         anchor = preload.values
         if not preload.success:
             warnings.append(preload.warning)
     anchor = np.array(anchor, float).reshape(nc, d - 1)
     sp = SlowProblem(model, reduced, basis, coef, eps=eps, anchor=anchor,
                      time_domain=time_domain if opts.time_domain_rescue and not quasi_static
-                     else None)
+                     else None, condenser=condenser)
     key = fingerprint(model, reduced, basis, sp.eps, coef, opts, W0, anchor)
 
     state, rows, resumed_from = None, [], -1

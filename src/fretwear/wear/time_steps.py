@@ -89,7 +89,7 @@ def time_domain_step(sp: SlowProblem, st: dict, opts: WearOptions):
         U0, V0 = st["td_U"], st["td_V"]
     else:
         last = sp.solution(st["U"], W_k, st["anchor"], SolveStats(True, 0.0, 0, 0, 0, 0.0, "", ""))
-        U0, V0 = initial_state(sp.model, last)
+        U0, V0 = initial_state(sp.model, last, sp.condenser)
     dN = min(float(st["jump"]), opts.max_jump, opts.max_cycles - cycles)
     floor = max(opts.min_jump, MIN_JUMP_FRACTION * cycles)
     rejected = iters = 0

@@ -9,7 +9,8 @@ from fretwear.model.core import Model
 
 
 def frf_worn(model: Model, basis: FourierBasis, wear, f_min: float, f_max: float,
-             n_points: int, *, anchor=None, spacing: str = "linear", **kwargs):
+             n_points: int, *, anchor=None, spacing: str = "linear", condenser=None,
+             **kwargs):
     """Nonlinear FRF with the worn gap ``gap + wear`` (paper Fig. 24): the sweep of
     :func:`fretwear.hb.sweep.sweep` (same argument order) with the model's gap opened by
     ``wear``.
@@ -24,6 +25,9 @@ def frf_worn(model: Model, basis: FourierBasis, wear, f_min: float, f_max: float
     **kwargs : the other keywords of :func:`fretwear.hb.sweep.sweep` (``eps``, ``solver``,
         ``time_domain``, ...), with its defaults. Read amplitudes with
         ``SweepResult.amplitude(point, axis)``.
+    condenser : the condenser of ``model`` (:func:`fretwear.hb.reduce.exact_condenser` or
+        :func:`fretwear.hb.modal.modal_condenser`, e.g. the wear run's); None: a new exact one
+        for the sweep.
 
     Returns
     -------
@@ -34,4 +38,4 @@ def frf_worn(model: Model, basis: FourierBasis, wear, f_min: float, f_max: float
     gap = np.broadcast_to(np.asarray(model.contact.gap, float), (model.contact.n_nodes,))
     gap = gap + np.asarray(wear, float)
     return sweep(model, basis, float(f_min), float(f_max), int(n_points), spacing=spacing,
-                 gap=gap, anchor=anchor, **kwargs)
+                 gap=gap, anchor=anchor, condenser=condenser, **kwargs)
