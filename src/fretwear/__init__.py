@@ -52,6 +52,7 @@ _API = {
     # wear
     "simulate_wear": "fretwear.api", "frf_worn": "fretwear.api",
     "WearOptions": "fretwear.wear", "WearResult": "fretwear.wear",
+    "BalanceSetup": "fretwear.wear", "RunControl": "fretwear.wear",
     # time domain
     "integrate": "fretwear.timedomain.integrate", "steady_state": "fretwear.timedomain.steady",
     "incremental_wear": "fretwear.timedomain.quasistatic",

@@ -65,13 +65,14 @@ def sweep(model, basis, f_min: float, f_max: float, n_points: int, *, time_domai
 
 def simulate_wear(model, basis, *, time_domain: bool = True, **kwargs) -> _wear.WearResult:
     """Fretting wear on the slow time scale (paper section 3.3, eq. 29-30) at the excitation
-    ``frequency`` [Hz] (keyword, default 1 Hz) or ``quasi_static=True``.
+    ``frequency`` [Hz] (keyword, required unless ``quasi_static=True``).
 
     :func:`fretwear.wear.simulate.simulate_wear` (every other keyword: ``frequency``,
-    ``quasi_static``, ``options`` (:class:`~fretwear.wear.options.WearOptions`), ``eps``,
-    ``W0`` [m], ``checkpoint``, ``resume``, ...) with the time-domain fallback of steps whose
-    balance fails (``time_domain=True``; whether it is used is
-    ``options.time_domain_rescue``, default true, as in case files).
+    ``quasi_static``, ``options`` (:class:`~fretwear.wear.options.WearOptions`), ``wear0``
+    [m], ``balance`` (:class:`~fretwear.wear.simulate.BalanceSetup`: ``eps``, ``anchor``, ...),
+    ``run`` (:class:`~fretwear.wear.simulate.RunControl`: ``checkpoint``, ``resume``, ...))
+    with the time-domain fallback of steps whose balance fails (``time_domain=True``; whether
+    it is used is ``options.time_domain_rescue``, default true, as in case files).
 
     Returns
     -------

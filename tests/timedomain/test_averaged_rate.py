@@ -29,7 +29,14 @@ from fretwear.hb.reduce import condense
 from fretwear.model.build import ContactSpec, Damping, Material, Spring, Traction, from_mesh
 from fretwear.model.mesh import rectangle
 from fretwear.timedomain.averaged_rate import RESPONSE_KINDS, time_averaged_rate
-from fretwear.wear import SlowProblem, WearOptions, wear_coefficients, without_growth
+from fretwear.wear import (
+    Rescue,
+    RunControl,
+    SlowProblem,
+    WearOptions,
+    wear_coefficients,
+    without_growth,
+)
 from fretwear.wear.options import START_JUMP, START_SETTLE
 
 KW = 1e-11
@@ -175,8 +182,8 @@ def test_time_domain_steps_return_to_balanced_solutions(monkeypatch):
     r = simulate_wear(m, BASIS, frequency=F_HZ, options=WearOptions(**OPTS))
     h = r.history
     assert r.success and h.n_steps == 5
-    np.testing.assert_array_equal(h.rescued[:2], [0, 0])
-    assert np.all(h.rescued[2:] == 1)
+    np.testing.assert_array_equal(h.rescued[:2], [Rescue.BALANCED] * 2)
+    assert np.all(h.rescued[2:] == Rescue.TIME_START)
     assert np.all(h.response[2:] == RESPONSE_KINDS.index("periodic"))
     red = condense(m, F_HZ, BASIS.orders)
     spb = SlowProblem(m, red, BASIS, wear_coefficients(m), eps=r.penalty)
@@ -201,7 +208,7 @@ def test_time_averaged_steps_follow_the_time_integration(monkeypatch, tmp_path, 
     full = simulate_wear(m, BASIS, frequency=F_HZ, options=opts)
     h = full.history
     assert full.success and h.n_steps == 5
-    assert np.all(h.rescued[2:] == 2)
+    assert np.all(h.rescued[2:] == Rescue.TIME_AVERAGED)
     # the uncertainty of the averaged rates is recorded; balanced rates are exact (NaN)
     assert np.all(np.isnan(h.rate_scatter[:2]))
     assert np.all((h.rate_scatter[2:] >= 0) & (h.rate_scatter[2:] < 1))
@@ -228,9 +235,11 @@ def test_time_averaged_steps_follow_the_time_integration(monkeypatch, tmp_path, 
             raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
-        simulate_wear(m, BASIS, frequency=F_HZ, options=opts, checkpoint=ck, callback=stop)
+        simulate_wear(m, BASIS, frequency=F_HZ, options=opts,
+                      run=RunControl(checkpoint=ck, callback=stop))
     _forced_failures(monkeypatch, balance_fails=True, first_ok=False)
-    resumed = simulate_wear(m, BASIS, frequency=F_HZ, options=opts, checkpoint=ck, resume=True)
+    resumed = simulate_wear(m, BASIS, frequency=F_HZ, options=opts,
+                            run=RunControl(checkpoint=ck, resume=True))
     assert resumed.resumed_from == 3
     for name in ("cycles", "wear_depth", "wear_rate", "U", "rescued", "rate_scatter"):
         np.testing.assert_array_equal(getattr(h, name), getattr(resumed.history, name),
@@ -256,14 +265,14 @@ def test_run_starts_from_a_time_integration_when_the_unworn_balance_fails(monkey
     opts = WearOptions(**OPTS)
     r = simulate_wear(m, BASIS, frequency=F_HZ, options=opts)
     h = r.history
-    assert r.success and h.n_steps == 5 and h.rescued[0] == 2
+    assert r.success and h.n_steps == 5 and h.rescued[0] == Rescue.TIME_AVERAGED
     ref = time_averaged_rate(m, F_HZ, BASIS, wear_coefficients(m), np.zeros(h.wear_depth.shape[1]),
                              U0=None, V0=None, settle=START_SETTLE, average=64,
                              steps_per_period=512)
     np.testing.assert_array_equal(h.wear_rate[0], ref.g)
     assert h.jump[1] == START_JUMP
     # the response is periodic: the balance converges from it at step 1, then ordinary steps
-    assert h.rescued[1] == 1 and np.all(h.rescued[2:] == 0)
+    assert h.rescued[1] == Rescue.TIME_START and np.all(h.rescued[2:] == Rescue.BALANCED)
     # only the wear module's start was forced
     assert fretwear.hb.periodic.solve_periodic is not failing
 

@@ -246,8 +246,8 @@ def test_checkpoint_of_another_model_shape(reference):
     with np.load(ck) as z:
         key = str(z["fingerprint"])
         nc, d, H = z["hist_U"].shape[1:]
-    state, rows = load_checkpoint(ck, key, shape=(nc, d, H))
-    assert int(state["step"]) == N_STEPS and len(rows) == N_STEPS + 1
+    state, records = load_checkpoint(ck, key, shape=(nc, d, H))
+    assert state.step == N_STEPS and len(records) == N_STEPS + 1
     with pytest.raises(InputError, match="different model .*11 contact nodes"):
         load_checkpoint(ck, key, shape=(nc + 1, d, H))
     with pytest.raises(InputError, match="different model"):

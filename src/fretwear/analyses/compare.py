@@ -226,14 +226,14 @@ def compare_wear(model, analysis: dict, outdir: Path | None, *, steps_per_cycle:
                  title: str | None = None) -> Comparison:
     """DLFT wear against incremental wear at the DLFT run's final cycle count."""
     from fretwear.analyses.wear import options_from_table, penalty_of
-    from fretwear.wear import simulate_wear
+    from fretwear.wear import BalanceSetup, simulate_wear
 
     if not analysis.get("quasi_static"):
         raise InputError("compare: the incremental wear reference is quasi-static; set "
                          "quasi_static = true in the wear case")
     basis = basis_of(analysis)
     res = simulate_wear(model, basis, quasi_static=True, options=options_from_table(analysis),
-                        **penalty_of(analysis))
+                        balance=BalanceSetup(**penalty_of(analysis)))
     n = int(round(float(res.history.cycles[-1])))
     jump = _reference_jump(n, res.stability_jump)
     inc = incremental_wear(model, steps_per_cycle=steps_per_cycle, n_cycles=max(n, 1),

@@ -44,8 +44,18 @@ from fretwear.io.schema import (
 )
 from fretwear.timedomain.averaged_rate import RESPONSE_KINDS
 from fretwear.timedomain.fallback import FALLBACK
-from fretwear.wear import LAWS, SCHEMES, WearOptions, WearResult, frf_worn, simulate_wear
+from fretwear.wear import (
+    LAWS,
+    SCHEMES,
+    BalanceSetup,
+    RunControl,
+    WearOptions,
+    WearResult,
+    frf_worn,
+    simulate_wear,
+)
 from fretwear.wear.laws import side_depths
+from fretwear.wear.simulate import QUASI_STATIC_FREQUENCY
 
 #: the two worn surfaces of a contact node: its own, and its partner's (node-to-node pairs)
 SURFACES = ("contact", "partner")
@@ -370,15 +380,17 @@ def run_wear(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOu
     a = analysis
     opts = options_from_table(a)
     quasi = bool(a["quasi_static"])
-    f_hz = float(a.get("frequency", default_of(simulate_wear, "frequency")))
+    f_hz = float(a.get("frequency", QUASI_STATIC_FREQUENCY))
     basis = FourierBasis.up_to(a["harmonics"], a["n_samples"])
     nc = model.contact.n_nodes
     nodes = a.get("plot_nodes")
     if nodes is not None and any(p >= nc for p in nodes):
         fail("analysis.plot_nodes", nodes, f"contact node numbers from 0 to {nc - 1}")
-    result = simulate_wear(model, basis, frequency=f_hz, quasi_static=quasi,
-                           options=opts, checkpoint=outdir / CHECKPOINT_FILE, **penalty_of(a),
-                           resume=bool(case.resume), progress=progress, time_domain=FALLBACK)
+    result = simulate_wear(model, basis, frequency=f_hz, quasi_static=quasi, options=opts,
+                           balance=BalanceSetup(**penalty_of(a)),
+                           run=RunControl(checkpoint=outdir / CHECKPOINT_FILE,
+                                          resume=bool(case.resume), progress=progress),
+                           time_domain=FALLBACK)
     frf, frf_note = None, ""
     fb = a.get("frf_before_after")
     if fb is not None and model.observed:
