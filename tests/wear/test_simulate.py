@@ -470,6 +470,28 @@ def test_no_wear_without_slip(tmp_path):
     assert np.all(r.final_wear == 0.0) and math.isfinite(r.wall_time)
 
 
+def test_dynamic_run_needs_a_frequency(monkeypatch):
+    """A dynamic wear run without ``frequency`` (which used to default to 1 Hz) is refused in
+    one line naming it, before anything is computed, at both entry points; settings records of
+    the wrong kind are refused by name."""
+    import fretwear
+    import fretwear.wear.simulate as driver
+    from fretwear.errors import InputError
+
+    def no_condensation(*args, **kwargs):
+        raise AssertionError("condensed before the check")
+
+    monkeypatch.setattr(driver, "condense", no_condensation)
+    m = block()
+    for func in (simulate_wear, fretwear.simulate_wear):
+        with pytest.raises(InputError, match="frequency = None") as err:
+            func(m, BASIS, options=WearOptions(max_steps=1))
+        assert "\n" not in str(err.value) and "quasi_static=True" in str(err.value)
+    for name, value in (("balance", {"eps": 1e9}), ("run", {"resume": True})):
+        with pytest.raises(TypeError, match=f"{name} = .*: expected a"):
+            simulate_wear(m, BASIS, quasi_static=True, **{name: value})
+
+
 def test_progress_bar_shows_cycles_volume_rate_and_time_left(blk, capsys):
     """The progress bar (stderr) names the cycles reached, the worn volume, the worn-volume
     rate and the time left; its worn volume is the history's (area . W)."""
