@@ -132,7 +132,7 @@ def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float | None 
     KeyboardInterrupt
         On Ctrl-C (the last accepted state is in the checkpoint first).
     """
-    balance, run, opts = _records(balance, run, options)
+    balance, run, opts = _settings(balance, run, options)
     frequency = check_inputs(model, basis, _frequency(frequency, quasi_static),
                              quasi_static=quasi_static, anchor=balance.anchor, U0=balance.U0)
     if model.contact.prescribed_nodes().any():
@@ -157,12 +157,12 @@ def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float | None 
                      else None)
     saver = _Saver(run.checkpoint, fingerprint(model, reduced, basis, sp.eps, coef, opts, wear0,
                                                anchor), opts.checkpoint_every_s)
-    state, records, resumed_from = None, [], -1
     if run.resume and saver.exists():  # damaged: an InputError, never ignored
         state, records = saver.load(shape=(nc, d, sp.H))
         resumed_from = state.step
-    if state is None:
+    else:
         state, records = first_state(sp, wear0, anchor, balance.U0, opts)
+        resumed_from = -1
     balanced = [r for r in records if r.has_balance]
     initial = _assemble(sp, balanced[0]) if balanced else None
     state, reason, extra = _integrate(sp, state, records, opts, run, saver)
@@ -176,7 +176,7 @@ def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float | None 
                       penalty=sp.eps, warnings=warnings)
 
 
-def _records(balance, run, options) -> tuple[BalanceSetup, RunControl, WearOptions]:
+def _settings(balance, run, options) -> tuple[BalanceSetup, RunControl, WearOptions]:
     """The settings records of a run, checked, defaults for those not given."""
     for name, value, kind in (("balance", balance, BalanceSetup), ("run", run, RunControl),
                               ("options", options, WearOptions)):
