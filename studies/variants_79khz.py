@@ -16,9 +16,9 @@ through the height, plane strain / plane stress) and, for each variant, records:
 * its time-domain stability (:func:`fretwear.timedomain.stability.check_periodic`);
 * the wear run (:func:`fretwear.wear.simulate.simulate_wear`, adaptive linearly implicit Euler,
   tolerance 1e-2, ``max_cycles`` 1e8 by default): N where the balance first fails (first
-  step with ``rescued == Rescue.TIME_AVERAGED``, 2), stop reason, N reached, worn volume, max depth, worn-volume rate
-  at the end / initial, steps and wall time, zero-wear zones (nodes with wear < 1 % of the
-  max, the paper's "pillars").
+  step with ``rescued == Rescue.TIME_AVERAGED``, 2), stop reason, N reached, worn volume,
+  max depth, worn-volume rate at the end / initial, steps and wall time, zero-wear zones
+  (nodes with wear < 1 % of the max, the paper's "pillars").
 
 Everything is cached in ``docs/studies/figures/variants-79khz.json`` after each stage, so an
 interrupted study loses nothing; the wear runs also keep a checkpoint (``--work``) and resume

@@ -198,12 +198,13 @@ def test_time_domain_steps_return_to_balanced_solutions(monkeypatch):
 @pytest.mark.parametrize("scheme", ["explicit", "rosenbrock"])
 def test_time_averaged_steps_follow_the_time_integration(monkeypatch, tmp_path, scheme):
     """With no balance at all after step 1, the run goes on with time-averaged rates
-    (rescued = Rescue.TIME_AVERAGED). Each step's wear is the explicit Euler update (eq. 30) with the previous
-    step's rate, or the linearly implicit one with the slow Jacobian of the last balanced step
-    (recomputed here from the recorded step 1) without its growing modes. Interrupting after
-    step 3 and resuming gives the same history bit for bit (the integration state is in the
-    checkpoint), from this checkpoint format and from format 3 (the same state in its earlier
-    names, written by the format-3 writer kept in tests/helpers)."""
+    (rescued = Rescue.TIME_AVERAGED). Each step's wear is the explicit Euler update (eq. 30)
+    with the previous step's rate, or the linearly implicit one with the slow Jacobian of the
+    last balanced step (recomputed here from the recorded step 1) without its growing modes.
+    Interrupting after step 3 and resuming gives the same history bit for bit (the
+    integration state is in the checkpoint), from this checkpoint format and from format 3
+    (the same state in its earlier names, written by the format-3 writer kept in
+    tests/helpers)."""
     m = damped_block()
     _forced_failures(monkeypatch, balance_fails=True)
     opts = WearOptions(scheme=scheme, **OPTS)
