@@ -455,8 +455,8 @@ def test_frf_worn_uniform_wear_is_a_rigid_shift(blk):
 
     m, _, anc = blk
     grid = (2e3, 3e3, 3)
-    a = frf_worn(m, 0.0, grid, BASIS, anchor=anc)
-    b = frf_worn(m, np.full(m.contact.n_nodes, 1e-9), grid, BASIS, anchor=anc)
+    a = frf_worn(m, BASIS, 0.0, *grid, anchor=anc)
+    b = frf_worn(m, BASIS, np.full(m.contact.n_nodes, 1e-9), *grid, anchor=anc)
     assert a.success and b.success
     np.testing.assert_allclose(b.frequency_hz, a.frequency_hz)
     np.testing.assert_allclose(b.amplitude("Pe", 0), a.amplitude("Pe", 0), rtol=1e-6)

@@ -28,12 +28,13 @@ from pathlib import Path
 import numpy as np
 from matplotlib.colors import BoundaryNorm, ListedColormap
 
+from fretwear import api
 from fretwear.analyses import figures as plots
 from fretwear.analyses.common import basis_of, cell_edges, interface_abscissa, si_scale
 from fretwear.analyses.run import load_case
 from fretwear.analyses.transient import period_friction_energy, state_fractions
 from fretwear.errors import InputError
-from fretwear.hb.periodic import PeriodicSolution, solve_periodic
+from fretwear.hb.periodic import PeriodicSolution
 from fretwear.hb.reduce import condense
 from fretwear.io.case import build_model
 from fretwear.timedomain.quasistatic import incremental_wear
@@ -191,9 +192,10 @@ def compare_periodic(model, analysis: dict, outdir: Path | None, *, steps_per_pe
     f_hz = float(analysis["frequency"])
     t0 = time.perf_counter()
     reduced = condense(model, f_hz, basis.orders)
-    sol = solve_periodic(model, basis, frequency=f_hz, reduced=reduced, eps=analysis["eps"],
-                         solver=analysis["solver"], tol=analysis["tol"],
-                         max_iter=analysis["max_iter"])
+    # the DLFT alone: never started by the time integration it is compared with
+    sol = api.solve_periodic(model, basis, frequency=f_hz, reduced=reduced, eps=analysis["eps"],
+                             solver=analysis["solver"], tol=analysis["tol"],
+                             max_iter=analysis["max_iter"], time_domain=False)
     stats = sol.stats
     if not sol.success:  # a failed solve is never compared (its last iterate is no result)
         sol = None
@@ -226,14 +228,15 @@ def compare_wear(model, analysis: dict, outdir: Path | None, *, steps_per_cycle:
                  title: str | None = None) -> Comparison:
     """DLFT wear against incremental wear at the DLFT run's final cycle count."""
     from fretwear.analyses.wear import options_from_table, penalty_of
-    from fretwear.wear import BalanceSetup, simulate_wear
+    from fretwear.wear import BalanceSetup
 
     if not analysis.get("quasi_static"):
         raise InputError("compare: the incremental wear reference is quasi-static; set "
                          "quasi_static = true in the wear case")
     basis = basis_of(analysis)
-    res = simulate_wear(model, basis, quasi_static=True, options=options_from_table(analysis),
-                        balance=BalanceSetup(**penalty_of(analysis)))
+    res = api.simulate_wear(model, basis, quasi_static=True,
+                            options=options_from_table(analysis),
+                            balance=BalanceSetup(**penalty_of(analysis)), time_domain=False)
     n = int(round(float(res.history.cycles[-1])))
     jump = _reference_jump(n, res.stability_jump)
     inc = incremental_wear(model, steps_per_cycle=steps_per_cycle, n_cycles=max(n, 1),

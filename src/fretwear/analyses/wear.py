@@ -19,8 +19,8 @@ import xarray as xr
 
 from fretwear import api
 from fretwear.analyses import figures as plots
+from fretwear.analyses.base import Analysis, RunContext, RunOutput
 from fretwear.analyses.common import default_of, interface_labels
-from fretwear.analyses.registry import RunOutput, register
 from fretwear.files import safe_name
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.fourier import FourierBasis
@@ -43,7 +43,6 @@ from fretwear.io.schema import (
     increasing,
 )
 from fretwear.timedomain.averaged_rate import RESPONSE_KINDS
-from fretwear.timedomain.fallback import FALLBACK
 from fretwear.wear import (
     LAWS,
     SCHEMES,
@@ -375,7 +374,7 @@ def plot_frf_before_after(ds, path: Path, point: str, *, title=None) -> Path:
 
 
 # --- the analysis -----------------------------------------------------------------------------
-def run_wear(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOutput:
+def run_wear(model, analysis: dict, case, context: RunContext) -> RunOutput:
     """Fretting wear to a plateau, a depth or a cycle count (see module docstring)."""
     a = analysis
     opts = options_from_table(a)
@@ -386,18 +385,18 @@ def run_wear(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOu
     nodes = a.get("plot_nodes")
     if nodes is not None and any(p >= nc for p in nodes):
         fail("analysis.plot_nodes", nodes, f"contact node numbers from 0 to {nc - 1}")
-    result = simulate_wear(model, basis, frequency=f_hz, quasi_static=quasi, options=opts,
-                           balance=BalanceSetup(**penalty_of(a)),
-                           run=RunControl(checkpoint=outdir / CHECKPOINT_FILE,
-                                          resume=bool(case.resume), progress=progress),
-                           time_domain=FALLBACK)
+    # the time-domain rescue: api.simulate_wear's fallback, used as opts.time_domain_rescue says
+    result = api.simulate_wear(model, basis, frequency=f_hz, quasi_static=quasi, options=opts,
+                               balance=BalanceSetup(**penalty_of(a)),
+                               run=RunControl(checkpoint=context.out_dir / CHECKPOINT_FILE,
+                                              resume=context.resume, progress=context.progress))
     frf, frf_note = None, ""
     fb = a.get("frf_before_after")
     if fb is not None and model.observed:
         grid = (fb["f_min"], fb["f_max"], fb["n_points"])
-        sweeps = {name: frf_worn(model, w, grid, basis, solver=a["solver"], **penalty_of(a),
-                                 spacing=fb["spacing"],
-                                 time_domain=FALLBACK if fb["time_domain"] else None)
+        sweeps = {name: api.frf_worn(model, basis, w, *grid, solver=a["solver"],
+                                     **penalty_of(a), spacing=fb["spacing"],
+                                     time_domain=fb["time_domain"])
                   for name, w in (("unworn", 0.0), ("worn", result.final_wear))}
         frf = _frf_data(model, sweeps, frequency_grid(*grid, fb["spacing"]))
         frf_note = "\n".join(f"FRF {k}: {int(v.point_success.sum())}/{len(v.points)} converged"
@@ -408,10 +407,10 @@ def run_wear(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOu
                       frf=frf, law=opts.law,
                       energy_coefficients=(opts.energy_coefficient,
                                            opts.partner_energy_coefficient))
-    figures = _figures(ds, case, outdir, nodes)
-    files = [outdir / CHECKPOINT_FILE]
+    figures = _figures(ds, case, context.out_dir, nodes)
+    files = [context.out_dir / CHECKPOINT_FILE]
     if model.mesh is not None and case.output["vtu"]:
-        files.append(write_wear_fields(model, ds, outdir / "wear.pvd"))
+        files.append(write_wear_fields(model, ds, context.out_dir / "wear.pvd"))
     h = result.history
     area = np.asarray(model.contact.area, float)
     w = h.wear_depth[-1]
@@ -582,5 +581,5 @@ DOC = (
     "mesh models the ParaView series `wear.pvd` of the worn surfaces."
 )
 
-register("wear", SCHEMA, run_wear, checks=CHECKS, doc=DOC, files=(CHECKPOINT_FILE,),
-         preload_check=True)
+WEAR = Analysis.define("wear", SCHEMA, run_wear, checks=CHECKS, doc=DOC,
+                       files=(CHECKPOINT_FILE,), preload_check=True)
