@@ -40,7 +40,7 @@ from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.reduce import condense, exact_condenser
 from fretwear.hb.sweep import sweep
 from fretwear.io.case import build_model
-from fretwear.wear import WearOptions, simulate_wear
+from fretwear.wear import BalanceSetup, WearOptions, simulate_wear
 
 CPU: list = [0.0]  # processor time of the last _timed call [s]
 
@@ -110,7 +110,8 @@ def main():
     wcase = load_case(example_path("dovetail-wear"))
     wb = FourierBasis.up_to(wcase.analysis["harmonics"], wcase.analysis["n_samples"])
     res, t = _timed(lambda: simulate_wear(wear_model, wb, frequency=wcase.analysis["frequency"],
-                                          eps="static", options=WearOptions(max_steps=1)))
+                                          balance=BalanceSetup(eps="static"),
+                                          options=WearOptions(max_steps=1)))
     h = res.history
     print(f"wear: first slow step {h.wall_time[-1]:.2f} s (run with the unworn balance "
           f"{t:.2f} s{_cpu()}, {m * wb.size} unknowns, jump {h.jump[-1]:.3g} cycles, "

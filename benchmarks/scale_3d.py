@@ -173,12 +173,14 @@ def one(n: int, extras: dict) -> dict:
     tmp = tempfile.mkdtemp(prefix="scale3d-")
     if extras.get("wear"):
         from fretwear.wear.options import WearOptions
-        from fretwear.wear.simulate import simulate_wear
+        from fretwear.wear.simulate import BalanceSetup, RunControl, simulate_wear
 
         ck = os.path.join(tmp, "wear-checkpoint.npz")
         with Clock() as c:
-            wr = simulate_wear(model, basis, frequency=FREQ, reduced=red, anchor=sol.anchor,
-                               U0=sol.U, checkpoint=ck, condenser=mc,
+            wr = simulate_wear(model, basis, frequency=FREQ,
+                               balance=BalanceSetup(reduced=red, anchor=sol.anchor, U0=sol.U,
+                                                    condenser=mc),
+                               run=RunControl(checkpoint=ck),
                                options=WearOptions(max_steps=extras["wear"],
                                                    scheme="explicit", checkpoint_every_s=0.0))
         out.update(wear_steps=len(wr.history.cycles) - 1, wear_cpu=c.cpu, wear_wall=c.wall,

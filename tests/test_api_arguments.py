@@ -168,7 +168,7 @@ def test_other_spellings_are_refused_with_the_public_one(block, call, old, new):
 def test_public_names_reach_the_core(block):
     """``anchor`` of fw.integrate is the time-domain solver's ``stick_anchor`` (the same run
     bit for bit, and not the run without it); ``wear_coefficient`` of fw.incremental_wear is
-    its ``k_w`` (0: no wear at all); ``wear0`` of fw.simulate_wear is the initial wear (the
+    its own (0: no wear at all); ``wear0`` of fw.simulate_wear is the initial wear (the
     first row of the history)."""
     from fretwear.timedomain.integrate import integrate
     from fretwear.timedomain.quasistatic import incremental_wear
@@ -183,7 +183,7 @@ def test_public_names_reach_the_core(block):
     w = fw.incremental_wear(block, steps_per_cycle=8, n_cycles=2, wear_coefficient=0.0)
     assert w.k_w == 0.0 and not np.any(w.wear)
     assert np.array_equal(w.slip, incremental_wear(block, steps_per_cycle=8, n_cycles=2,
-                                                   k_w=0.0).slip)
+                                                   wear_coefficient=0.0).slip)
     wear0 = np.linspace(0.0, 1e-9, nc)
     r = fw.simulate_wear(block, BASIS, quasi_static=True, wear0=wear0,
                          options=fw.WearOptions(max_steps=1))

@@ -64,6 +64,7 @@ _API = {
     # wear
     "simulate_wear": "fretwear.api", "frf_worn": "fretwear.api",
     "WearOptions": "fretwear.wear", "WearResult": "fretwear.wear",
+    "BalanceSetup": "fretwear.wear", "RunControl": "fretwear.wear",
     # time domain
     "integrate": "fretwear.api", "steady_state": "fretwear.api",
     "incremental_wear": "fretwear.api",

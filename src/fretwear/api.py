@@ -23,6 +23,8 @@ built once by the caller and passed to every driver that condenses the same mode
 
 from __future__ import annotations
 
+import dataclasses
+
 from fretwear import wear as _wear
 from fretwear.errors import InputError
 from fretwear.hb import periodic as _periodic
@@ -122,7 +124,8 @@ def sweep(model, basis, f_min: float, f_max: float, n_points: int, *, time_domai
 
 
 def simulate_wear(model, basis, frequency: float | None = None, *, quasi_static: bool = False,
-                  wear0=None, time_domain: bool = True, **kwargs) -> _wear.WearResult:
+                  wear0=None, time_domain: bool = True, condenser=None,
+                  **kwargs) -> _wear.WearResult:
     """Fretting wear on the slow time scale (paper section 3.3, eq. 29-30) at the excitation
     ``frequency`` [Hz] or under quasi-static loading.
 
@@ -135,10 +138,13 @@ def simulate_wear(model, basis, frequency: float | None = None, *, quasi_static:
     wear0 : (nc,) initial wear [m] (default 0).
     time_domain : the time-domain fallback of the steps whose balance fails (whether it is
         used is ``options.time_domain_rescue``, default true, as in case files).
+    condenser : the condenser of the model, as every driver takes it (it becomes the
+        ``condenser`` of ``balance``; giving both is an error).
     **kwargs : the other keywords of :func:`fretwear.wear.simulate.simulate_wear`, with its
-        defaults: ``options`` (:class:`~fretwear.wear.options.WearOptions`), ``reduced``,
-        ``eps``, ``anchor`` (nc, d-1) [m], ``U0``, ``checkpoint``, ``resume``, ``progress``,
-        ``callback``.
+        defaults: ``options`` (:class:`~fretwear.wear.options.WearOptions`), ``balance``
+        (:class:`~fretwear.wear.simulate.BalanceSetup`: ``reduced``, ``eps``, ``anchor``
+        (nc, d-1) [m], ``U0``), ``run`` (:class:`~fretwear.wear.simulate.RunControl`:
+        ``checkpoint``, ``resume``, ``progress``, ``callback``).
 
     Returns
     -------
@@ -149,8 +155,14 @@ def simulate_wear(model, basis, frequency: float | None = None, *, quasi_static:
     from a time integration).
     """
     _public_names("simulate_wear", kwargs)
+    if condenser is not None:
+        balance = kwargs.pop("balance", None) or _wear.BalanceSetup()
+        if balance.condenser is not None:
+            raise InputError("simulate_wear: condenser given twice (condenser= and "
+                             "balance.condenser); give one")
+        kwargs["balance"] = dataclasses.replace(balance, condenser=condenser)
     return _wear.simulate_wear(model, basis, **_frequency(frequency, quasi_static),
-                               quasi_static=quasi_static, W0=wear0,
+                               quasi_static=quasi_static, wear0=wear0,
                                time_domain=_fallback(time_domain), **kwargs)
 
 
@@ -246,4 +258,5 @@ def incremental_wear(model, *, wear_coefficient: float | None = None, wear0=None
     wear [m] per recorded cycle.
     """
     _public_names("incremental_wear", kwargs)
-    return _quasistatic.incremental_wear(model, k_w=wear_coefficient, wear0=wear0, **kwargs)
+    return _quasistatic.incremental_wear(model, wear_coefficient=wear_coefficient, wear0=wear0,
+                                         **kwargs)

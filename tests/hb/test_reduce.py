@@ -311,7 +311,7 @@ def test_one_driver_call_builds_one_condenser(constructions):
     from fretwear.hb.periodic import solve_periodic
     from fretwear.hb.sweep import sweep
     from fretwear.linear import frf
-    from fretwear.wear import WearOptions, simulate_wear
+    from fretwear.wear import BalanceSetup, WearOptions, simulate_wear
 
     model = oscillator()
     basis = FourierBasis.up_to(3, 64)
@@ -322,7 +322,8 @@ def test_one_driver_call_builds_one_condenser(constructions):
                                                    condenser=c),
         "sweep": lambda c: sweep(model, basis, 8.0, 12.0, 3, condenser=c),
         "simulate_wear": lambda c: simulate_wear(wear_model, basis, quasi_static=True,
-                                                 options=wear_opts, condenser=c),
+                                                 options=wear_opts,
+                                                 balance=BalanceSetup(condenser=c)),
         "frf": lambda c: frf(truss(), [10.0, 20.0, 30.0], method="condensed", condenser=c),
     }
     for name, run in runs.items():

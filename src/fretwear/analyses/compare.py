@@ -229,6 +229,7 @@ def compare_wear(model, analysis: dict, outdir: Path | None, *, steps_per_cycle:
                  title: str | None = None) -> Comparison:
     """DLFT wear against incremental wear at the DLFT run's final cycle count."""
     from fretwear.analyses.wear import options_from_table, penalty_of
+    from fretwear.wear import BalanceSetup
 
     if not analysis.get("quasi_static"):
         raise InputError("compare: the incremental wear reference is quasi-static; set "
@@ -236,8 +237,9 @@ def compare_wear(model, analysis: dict, outdir: Path | None, *, steps_per_cycle:
     basis = basis_of(analysis)
     cond = exact_condenser(model)  # shared by both methods: the same static condensation
     res = api.simulate_wear(model, basis, quasi_static=True,
-                            options=options_from_table(analysis), **penalty_of(analysis),
-                            time_domain=False, condenser=cond)
+                            options=options_from_table(analysis),
+                            balance=BalanceSetup(condenser=cond, **penalty_of(analysis)),
+                            time_domain=False)
     n = int(round(float(res.history.cycles[-1])))
     jump = _reference_jump(n, res.stability_jump)
     inc = incremental_wear(model, steps_per_cycle=steps_per_cycle, n_cycles=max(n, 1),

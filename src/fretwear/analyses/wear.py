@@ -44,8 +44,18 @@ from fretwear.io.schema import (
     increasing,
 )
 from fretwear.timedomain.averaged_rate import RESPONSE_KINDS
-from fretwear.wear import LAWS, SCHEMES, WearOptions, WearResult, frf_worn, simulate_wear
+from fretwear.wear import (
+    LAWS,
+    SCHEMES,
+    BalanceSetup,
+    RunControl,
+    WearOptions,
+    WearResult,
+    frf_worn,
+    simulate_wear,
+)
 from fretwear.wear.laws import side_depths
+from fretwear.wear.simulate import QUASI_STATIC_FREQUENCY
 
 #: the two worn surfaces of a contact node: its own, and its partner's (node-to-node pairs)
 SURFACES = ("contact", "partner")
@@ -370,7 +380,7 @@ def run_wear(model, analysis: dict, case, context: RunContext) -> RunOutput:
     a = analysis
     opts = options_from_table(a)
     quasi = bool(a["quasi_static"])
-    f_hz = float(a.get("frequency", default_of(simulate_wear, "frequency")))
+    f_hz = float(a.get("frequency", QUASI_STATIC_FREQUENCY))
     basis = FourierBasis.up_to(a["harmonics"], a["n_samples"])
     nc = model.contact.n_nodes
     nodes = a.get("plot_nodes")
@@ -379,9 +389,9 @@ def run_wear(model, analysis: dict, case, context: RunContext) -> RunOutput:
     # the time-domain rescue: api.simulate_wear's fallback, used as opts.time_domain_rescue says
     cond = exact_condenser(model)  # the run's condensation of the model: wear run and FRFs
     result = api.simulate_wear(model, basis, frequency=f_hz, quasi_static=quasi, options=opts,
-                               checkpoint=context.out_dir / CHECKPOINT_FILE, **penalty_of(a),
-                               resume=context.resume, progress=context.progress,
-                               condenser=cond)
+                               balance=BalanceSetup(condenser=cond, **penalty_of(a)),
+                               run=RunControl(checkpoint=context.out_dir / CHECKPOINT_FILE,
+                                              resume=context.resume, progress=context.progress))
     frf, frf_note = None, ""
     fb = a.get("frf_before_after")
     if fb is not None and model.observed:
