@@ -86,21 +86,28 @@ from fretwear.model.core import Model
 #: Hill's matrix is formed and its quadratic eigenvalue problem solved densely up to this
 #: many unknowns ``m H`` (the companion pencil has twice as many)
 DENSE_MAX = 1500
+#: an exponent within this of Im s = +-w/2 (in units of w) is a real negative multiplier: its
+#: conjugate is the other member of its family (the truncated problem puts the two a little
+#: off the line: 1e-4 measured on a two-DOF oscillator near period doubling)
+EDGE_TOL = 1e-3
+#: exponents whose multiplier is below this are not refined (they decay within a period; the
+#: factor e^{-s h} of the law's memory would overflow over a period)
+NEGLIGIBLE = 1e-8
 
 
 @dataclass(frozen=True)
 class HillOptions:
     """Settings of :func:`hill_stability`.
 
-    refine : how many of the sorted exponents with the largest real parts are refined by
-        Newton's method on the exact ``T(s)`` (0: the Taylor candidates as they are).
+    refine : at most this many exponents (those with the largest real parts) are refined on
+        the exact ``T(s)`` when the law has a memory (0: the candidates as they are).
     step : step of the forward difference of ``T`` in ``s / w`` (Newton's derivative).
     newton_tol : relative residual ``|T v| / (|T| |v|)`` at which a refinement stops.
     newton_max_iter : iterations of one refinement.
     stable_tol : ``|rho| <= 1 + stable_tol`` counts as stable (rounding of a neutral exponent).
     """
 
-    refine: int = 4
+    refine: int = 8
     step: float = 1e-6
     newton_tol: float = 1e-12
     newton_max_iter: int = 20
@@ -131,11 +138,15 @@ class FloquetResult:
     multipliers : (k,) complex ``e^{s T}`` [-].
     centroid : (k,) harmonic centroid of each eigenvector [-] (:func:`centroid`).
     residual : (k,) relative residual ``|T(s) v| / (|T(s)| |v|)`` (NaN unless refined).
-    kind : (k,) ``"refined"`` (an exponent of the exact ``T(s)``), ``"held"`` (a mode in
-        which the contact points do not move: exact, and not coupled to the law), ``"mean"``
-        (an eigenvalue of the time-invariant problem, not refined: ``options.refine`` were
-        refined before it, all with larger real parts) or ``"failed"`` (its refinement did not
-        converge: the time-invariant value).
+    kind : (k,) ``"exact"`` (the law has no memory at this solution: the quadratic problem
+        is exact), ``"refined"`` (refined on the exact ``T(s)``), ``"held"`` (a mode in which
+        the contact points do not move: exact, not coupled to the law) or ``"candidate"`` (an
+        eigenvalue of the quadratic problem with the memory frozen, not refined: its
+        multiplier is below :data:`NEGLIGIBLE`, or ``options.refine`` exponents with larger
+        real parts were refined before it).
+    spurious : candidates of the frozen-memory problem near which the exact ``T(s)`` has no
+        exponent (their refinement did not converge) [1/s]: not exponents, listed for
+        inspection.
     neutral : tangential directions of nodes that stick all period: multipliers exactly 1
         (a family of stuck states; the anchors select the member), not in ``exponents``.
     omega : circular frequency of the solution [rad/s].
@@ -149,6 +160,7 @@ class FloquetResult:
     kind: np.ndarray
     neutral: int
     omega: float
+    spurious: np.ndarray
     evaluations: int
     wall_time: float
     stable_tol: float = 1e-6
@@ -169,10 +181,11 @@ class FloquetResult:
 
     @property
     def reliable(self) -> bool:
-        """No refinement failed and every refined eigenvector is centred (``|kappa| <= 1/2``)."""
-        bad = (self.kind == "failed") | ((self.kind == "refined")
-                                          & (np.abs(self.centroid) > 0.5))
-        return not bool(np.any(bad))
+        """Every exponent was refined or is exact, and every eigenvector is centred on the kept
+        harmonics (``|kappa| <= 1/2``): no candidate was left unrefined."""
+        return not bool(np.any((self.kind == "candidate")
+                               & (np.abs(self.multipliers) > NEGLIGIBLE))
+                        or np.any(np.abs(self.centroid) > 0.5 + EDGE_TOL))
 
     def in_strip(self) -> np.ndarray:
         """The exponents shifted by multiples of ``i w`` into ``-w/2 < Im s <= w/2`` (the
@@ -382,25 +395,15 @@ class HillProblem:
         self.G0 = law.dlft_jacobian(self.lu, self.lx, self.state, prob.mu, prob.P, prob.Q,
                                     prob.eps * prob.anchor, prob.tol, prob.max_sweeps,
                                     prob.normal)
-        d, H = prob.d, prob.H
-        # the mean gain of every node (the harmonic-0 coefficients of G): a time-invariant law
-        self.gbar = self.G0[:, ::H, ::H].copy()  # (nc, d, d)
-        self.Gbar = np.einsum("pab,hk->pahbk", self.gbar, np.eye(H)).reshape(prob.nc, d * H,
-                                                                              d * H)
         self.evaluations = 0
 
-    def gain(self, sigma: complex, theta: float = 1.0) -> np.ndarray:
-        """``G(s)`` at ``s = sigma w`` (the solve's own ``G`` at 0); with ``theta < 1`` the
-        homotopy ``theta G(s) + (1 - theta) Gbar`` from the time-invariant mean gain."""
+    def gain(self, sigma: complex) -> np.ndarray:
+        """``G(s)`` at ``s = sigma w`` (the solve's own ``G`` at 0)."""
         p = self.prob
         if sigma == 0:
-            G = self.G0.astype(complex)
-        else:
-            z = np.exp(-2.0 * np.pi * complex(sigma) / self.N)  # e^{-s h}: h = T / N
-            G = shifted_gain(self.lu, self.lx, self.state, p.mu, p.P, p.Q, z, p.normal)
-        if theta != 1.0:
-            G = theta * G + (1.0 - theta) * self.Gbar
-        return G
+            return self.G0.astype(complex)
+        z = np.exp(-2.0 * np.pi * complex(sigma) / self.N)  # e^{-s h}: h = T / N
+        return shifted_gain(self.lu, self.lx, self.state, p.mu, p.P, p.Q, z, p.normal)
 
     def stiffness(self, sigma: complex) -> np.ndarray:
         """``Z(s)`` (m H, m H) at ``s = sigma w``: ``Z_r(s + i n w)`` with the hysteretic
@@ -413,10 +416,10 @@ class HillProblem:
         Zr = self.dyn.condensed(lam * lam, lam, 1j * np.sign(lam.imag))
         return hill_blocks(Zr[0], Zr[1:k + 1], Zr[k + 1:])
 
-    def matrix(self, sigma: complex, theta: float = 1.0) -> np.ndarray:
-        """``T(s)`` (m H, m H) complex at ``s = sigma w`` (``theta``: :meth:`gain`)."""
+    def matrix(self, sigma: complex) -> np.ndarray:
+        """``T(s)`` (m H, m H) complex at ``s = sigma w``."""
         self.evaluations += 1
-        return jacobian_form(self.gain(sigma, theta), self.stiffness(sigma), self.prob.eps)
+        return jacobian_form(self.gain(sigma), self.stiffness(sigma), self.prob.eps)
 
     def neutral(self) -> int:
         """Tangential directions of the nodes that stick all period (multiplier 1)."""
@@ -559,8 +562,7 @@ def quadratic_eigen(A0: np.ndarray, A1: np.ndarray, A2: np.ndarray):
     return vals, vecs
 
 
-def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions,
-           theta: float = 1.0):
+def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions):
     """The exponent of the exact ``T`` continued from ``sigma`` with eigenvector ``v``: the
     scalar equation ``mu(sigma) = 0`` for the eigenvalue ``mu`` of the linear problem
     ``T(sigma) y = mu y`` whose eigenvector continues ``v`` (largest overlap with the previous
@@ -571,8 +573,11 @@ def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions,
     see. Returns ``(sigma, v, residual, converged)``; the residual is ``|mu| / |T|``."""
     prev = None
     res = np.inf
+    start = sigma
     for _ in range(opt.newton_max_iter):
-        T = hp.matrix(sigma, theta)
+        if abs(sigma - start) > 0.5 or 2.0 * np.pi * sigma.real < np.log(NEGLIGIBLE):
+            break  # left the neighbourhood of the candidate: not its exponent
+        T = hp.matrix(sigma)
         mus, Y = np.linalg.eig(T)
         Y = Y / np.linalg.norm(Y, axis=0)
         overlap = np.abs(np.conj(v) @ Y) / np.linalg.norm(v)
@@ -582,7 +587,7 @@ def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions,
         if res <= opt.newton_tol:
             return sigma, v, res, True
         if prev is None:  # first step: the derivative by a forward difference
-            dmu = _mu_derivative(hp, sigma, v, T, opt.step, theta)
+            dmu = _mu_derivative(hp, sigma, v, T, opt.step)
             new = sigma - mu / dmu if dmu != 0 else sigma
         else:
             s0, mu0 = prev
@@ -595,7 +600,7 @@ def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions,
 
 
 def _mu_derivative(hp: HillProblem, sigma: complex, v: np.ndarray, T: np.ndarray,
-                   step: float, theta: float = 1.0) -> complex:
+                   step: float) -> complex:
     """``d mu / d sigma = w^H T' v / w^H v`` of a simple eigenvalue with right eigenvector
     ``v`` (left eigenvector ``w`` of ``T``, from the transposed problem), ``T'`` by a forward
     difference."""
@@ -603,7 +608,7 @@ def _mu_derivative(hp: HillProblem, sigma: complex, v: np.ndarray, T: np.ndarray
     Tv = T @ v
     mu = np.vdot(v, Tv) / np.vdot(v, v)
     w = W[:, int(np.argmin(np.abs(np.conj(mus) - mu)))]
-    dT = (hp.matrix(sigma + step, theta) - T) / step
+    dT = (hp.matrix(sigma + step) - T) / step
     den = np.vdot(w, v)
     return complex(np.vdot(w, dT @ v) / den) if den != 0 else 0.0
 
@@ -628,14 +633,15 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
     order = np.argsort(-vals[idx].real, kind="stable")
     idx, kap = idx[order], kap[order]
     exact = hp.memoryless() and dyn.exact
-    sig, kaps, res, kind = [], [], [], []
+    sig, kaps, res, kind, spurious = [], [], [], [], []
     refined = 0
     for i, kp in zip(idx, kap, strict=True):
         s0 = complex(vals[i])
         y = vecs[:, i]
         vx = y[:m * H]
         held = np.linalg.norm(vx) < 1e-8 * np.linalg.norm(y)
-        if held or exact or refined >= opt.refine:
+        negligible = 2.0 * np.pi * s0.real < np.log(NEGLIGIBLE)
+        if held or exact or negligible or refined >= opt.refine:
             sig.append(s0)
             kaps.append(kp)
             res.append(np.nan)
@@ -643,32 +649,35 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
             continue
         refined += 1
         s1, v1, r1, conv = _track(hp, s0, vx, opt)
-        good = conv and abs(s1 - s0) < 0.5
-        sig.append(s1 if good else s0)
-        kaps.append(centroid(v1.reshape(m, H), k) if good else kp)
+        if not conv:  # no exponent of the exact problem near it: an artefact of the frozen
+            spurious.append(s0)  # memory (a node that sticks part of the period)
+            continue
+        sig.append(s1)
+        kaps.append(centroid(v1.reshape(m, H), k))
         res.append(r1)
-        kind.append("refined" if good else "failed")
+        kind.append("refined")
     sig = np.array(sig, dtype=complex)
     kaps = np.array(kaps)
     res = np.array(res)
     kind = np.array(kind, dtype=object)
-    # the conjugates of the complex exponents (the problem is real), then one exponent per
-    # multiplier (a real negative multiplier has a pair of members at Im s = +-w/2)
-    cplx = np.abs(sig.imag) > 1e-9 * np.maximum(np.abs(sig), 1.0)
+    # one multiplier per family: the conjugate of a complex exponent is another family,
+    # except at Im s = w/2, where s and its conjugate s - i w are the two members of one
+    # family with a real negative multiplier (a period-doubling direction)
+    edge = np.abs(np.abs(sig.imag) - 0.5) <= EDGE_TOL
+    cplx = (np.abs(sig.imag) > 1e-9 * np.maximum(np.abs(sig), 1.0)) & ~edge
     allsig = np.concatenate([sig, np.conj(sig[cplx])])
     allkap = np.concatenate([kaps, -kaps[cplx]])
     allres = np.concatenate([res, res[cplx]])
     allkind = np.concatenate([kind, kind[cplx]])
     mult = np.exp(2.0 * np.pi * allsig)
-    chosen: list = []
-    for j in np.argsort(np.abs(allkap), kind="stable"):
-        if all(abs(mult[j] - mult[i]) > 1e-8 * max(1.0, abs(mult[j])) for i in chosen):
-            chosen.append(j)
-    chosen = np.array(sorted(chosen, key=lambda j: -allsig[j].real), dtype=np.int64)
+    redge = np.concatenate([edge, np.zeros(int(cplx.sum()), dtype=bool)])
+    mult[redge] = -np.exp(2.0 * np.pi * allsig[redge].real)
+    chosen = np.argsort(-allsig.real, kind="stable")
     w = hp.omega
     return FloquetResult(exponents=allsig[chosen] * w, multipliers=mult[chosen],
                          centroid=allkap[chosen], residual=allres[chosen],
                          kind=allkind[chosen], neutral=hp.neutral(), omega=w,
+                         spurious=np.array(spurious, dtype=complex) * w,
                          evaluations=hp.evaluations, wall_time=time.perf_counter() - t0,
                          stable_tol=opt.stable_tol)
 
