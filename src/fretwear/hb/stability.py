@@ -574,6 +574,8 @@ def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions):
     prev = None
     res = np.inf
     start = sigma
+    real = sigma.imag == 0.0  # a real exponent of the real problem stays real (until it
+    # meets another one, which the frozen-memory candidates would show as a pair)
     for _ in range(opt.newton_max_iter):
         if abs(sigma - start) > 0.5 or 2.0 * np.pi * sigma.real < np.log(NEGLIGIBLE):
             break  # left the neighbourhood of the candidate: not its exponent
@@ -593,6 +595,8 @@ def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions):
             s0, mu0 = prev
             new = sigma - mu * (sigma - s0) / (mu - mu0) if mu != mu0 else sigma
         prev = (sigma, mu)
+        if real:
+            new = complex(new.real, 0.0)
         if not np.isfinite(new) or new == sigma:
             break
         sigma = complex(new)
