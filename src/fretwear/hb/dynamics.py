@@ -12,8 +12,9 @@ for coefficients ``(a, b, c)``: ``(lambda^2, lambda, +-i)`` for Hill's method (t
 ``D`` keeps the sign of the harmonic it acts on, as in the balance; it is absent from harmonic
 0, where the balance has ``Z_0 = K``), ``(-(n w)^2 - i n w xi, i n w, i)`` for a mode.
 
-:class:`StructureDynamics` holds the structure in Craig-Bampton coordinates ``(u_c, q)``,
-``u_c`` the contact DOFs in their local frames and ``u_i = Psi u_c + V q`` the interior:
+:class:`StructureDynamics` holds the structure in coordinates ``(x, q)``: ``x`` the contact
+points the law acts on, ``q`` everything else. Without contact springs ``x = u_c`` are the
+contact DOFs in their local frames and the interior is ``u_i = Psi u_c + V q``:
 
 * a model with at most :data:`DENSE_INTERIOR_MAX` interior DOFs: ``Psi = -K_ii^-1 K_ic`` and
   ``V = I`` (``q`` the interior motion relative to the static shape): the transformation is
@@ -22,9 +23,13 @@ for coefficients ``(a, b, c)``: ``(lambda^2, lambda, +-i)`` for Hill's method (t
   matrices (``V`` the fixed-interface modes kept and the loads' static responses), with the
   error that representation was checked for.
 
-The projected blocks are dense: ``Z_r(lambda) = Z^cc - Z^cq (Z^qq)^-1 Z^qc`` costs a ``q x q``
-solve with ``m`` right-hand sides per value of ``lambda`` (batched). Contact springs are then
-applied as the balance applies them (:func:`fretwear.hb.connectors.connect`).
+A contact spring joins the structure's contact DOF to a massless contact point
+(:mod:`fretwear.hb.connectors`): the point is in ``x``, the structure's DOF moves to ``q``, so
+that the blocks stay quadratic in ``lambda`` (Hill's quadratic problem) and the structure's
+modes with the contact points held are those of ``(K_qq, M_qq)`` (the nonlinear modes' master
+coordinates). The blocks are dense: ``Z_r(lambda) = Z^xx - Z^xq (Z^qq)^-1 Z^qx`` costs a
+``q x q`` solve with ``m`` right-hand sides per value of ``lambda`` (batched), and equals the
+balance's condensation through the springs (tests/hb/test_stability.py).
 """
 
 from __future__ import annotations

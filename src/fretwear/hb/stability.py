@@ -32,25 +32,28 @@ the truncated (DLFT-discretised) periodic solution.
 
 How they are computed
 ---------------------
-1. **Candidates**: ``T`` is expanded to second order at ``s = 0`` (``J0 = T(0)``, ``J1``,
-   ``J2`` by central differences of the exact ``T``), and the quadratic eigenvalue problem
-   ``(J0 + s J1 + s^2 J2) p = 0`` is solved densely (companion pencil of twice the size).
+1. **Candidates**: on the structure's coordinates ``(x, q)`` (:mod:`fretwear.hb.dynamics`:
+   the contact points and everything else, nothing condensed) the structure is exactly
+   quadratic in ``s``; with the law's memory frozen (``G(s) = G(0)``) Hill's matrix is the
+   polynomial ``A0 + sigma A1 + sigma^2 A2`` in ``sigma = s / w`` (:meth:`HillProblem.pencil`),
+   whose eigenvalues are computed densely (:func:`quadratic_eigen`: massless coordinates
+   eliminated, a standard eigenvalue problem of twice the size). Where no node sticks (nor
+   slips in 3D) and the structure is exact, they are the exponents.
 2. **Sorting**: the truncated Hill problem has, for every exponent ``s``, copies
-   ``s + i k w`` with the eigenvectors ``p e^{-i k w t}``, accurate only while the shifted
+   ``s + i j w`` with the eigenvectors ``p e^{-i j w t}``, accurate only while the shifted
    eigenvector still fits in the kept harmonics. Each eigenvector has a harmonic centroid
-   ``kappa`` (the mean harmonic index of its complex-exponential content, weighted by
-   ``|c_k|^2``), and a copy shifted by ``k`` has ``kappa - k``: keeping ``|kappa| <= 1/2``
-   picks one member per family, the one whose eigenvector is centred on the kept harmonics
-   and therefore the least truncated (default ``sorting="centroid"``). The usual alternative
-   (``sorting="imag"``: ``|Im s| <= w/2``) also picks one member per family but, for an
-   exponent of a mode far above ``w``, the member whose eigenvector sits ``k`` harmonics off
-   centre, where the truncation acts; both give the same multipliers where both are accurate
-   (tests/hb/test_stability.py).
-3. **Refinement**: the sorted exponents with the largest real parts (``options.refine`` of
-   them, which decide stability) are refined by Newton's method on the exact ``T(s)``
-   (nonlinear inverse iteration, ``T'`` by central differences); the Taylor candidates are
-   approximate where ``Z_r(lambda)`` has a pole (a resonance of the structure with the
-   interface held) within the strip, or where the memory matters.
+   ``kappa`` (:func:`centroid`), and a copy shifted by ``j`` has ``kappa - j``: keeping
+   ``|kappa| <= 1/2`` picks one member per family, the one centred on the kept harmonics and
+   therefore the least truncated. The usual alternative (``|Im s| <= w/2``) also picks one
+   member per family but, for a mode far above ``w``, the member whose eigenvector sits
+   ``j`` harmonics off centre, where the truncation acts. At ``Im s = +-w/2`` (a real negative
+   multiplier) the two members tie and count once (:data:`EDGE_TOL`).
+3. **Refinement** (a node sticks: the memory matters): in decreasing order of their real
+   parts, candidates are refined on the exact ``T(s)`` (condensed on the contact points,
+   ``m H`` unknowns) until ``options.refine`` have converged (:func:`_track`: the secant
+   method on the eigenvalue of ``T(s)`` whose eigenvector continues the candidate's). A
+   candidate near which the exact problem has no exponent is an artefact of the frozen memory
+   (:attr:`FloquetResult.spurious`).
 
 Exponents not reported: a node that sticks all period (or a contact point behind a spring that
 sticks all period) holds its contact DOFs, so the modes of the structure with that part of the
@@ -59,9 +62,12 @@ its tangential position is the member of a family of stuck states that the stick
 select (docs/theory.md, "Full stick"), a neutral direction with multiplier exactly 1 that
 :attr:`FloquetResult.neutral` counts.
 
-Cost: the solve's Jacobian ``T(0)``, two more evaluations of ``T`` and one dense eigenvalue
-problem of twice the size, then a few evaluations and LUs per refined exponent. Dense: up to
-:data:`DENSE_MAX` unknowns.
+Cost: one dense eigenvalue problem of ``2 (m' + q) H`` unknowns (``m'`` contact points with
+mass, ``q`` other coordinates) and, with a memory, a few evaluations of ``T(s)`` and ``m H``
+eigenvalue problems per refined exponent. Measured at 13-22 times a warm-started sweep
+point's solve on small models (docs/theory.md, section 9): the whole spectrum at every point
+is what costs; tracking the exponents along a sweep would not. Dense up to
+:data:`DENSE_MAX` unknowns of the balance.
 """
 
 from __future__ import annotations
@@ -80,7 +86,7 @@ from fretwear.hb.contact import SEPARATION, STICK
 from fretwear.hb.dynamics import StructureDynamics, structure_dynamics
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import DLFTProblem, PeriodicSolution
-from fretwear.hb.reduce import condense
+from fretwear.hb.reduce import condense, to_real_blocks
 from fretwear.model.core import Model
 
 #: Hill's matrix is formed and its quadratic eigenvalue problem solved densely up to this
@@ -99,17 +105,18 @@ NEGLIGIBLE = 1e-8
 class HillOptions:
     """Settings of :func:`hill_stability`.
 
-    refine : at most this many exponents (those with the largest real parts) are refined on
-        the exact ``T(s)`` when the law has a memory (0: the candidates as they are).
+    refine : when the law has a memory, the candidates are refined on the exact ``T(s)`` in
+        decreasing order of their real parts until this many have converged (each with its
+        conjugate; the rest stay candidates; 0: none refined).
     step : step of the forward difference of ``T`` in ``s / w`` (Newton's derivative).
     newton_tol : relative residual ``|T v| / (|T| |v|)`` at which a refinement stops.
     newton_max_iter : iterations of one refinement.
     stable_tol : ``|rho| <= 1 + stable_tol`` counts as stable (rounding of a neutral exponent).
     """
 
-    refine: int = 8
+    refine: int = 2
     step: float = 1e-6
-    newton_tol: float = 1e-12
+    newton_tol: float = 1e-10
     newton_max_iter: int = 20
     stable_tol: float = 1e-6
 
@@ -441,63 +448,46 @@ class HillProblem:
         Exact for a law without memory (:meth:`memoryless`); the hysteretic damping keeps
         the sign of ``n`` (none on the static coefficient)."""
         dyn, prob, w = self.dyn, self.prob, self.omega
-        k = self.harmonics.size
-        n_h = self.harmonics
-        names = [x for x in ("K", "M", "C", "D") if x in dyn.blocks]
+        orders = prob.basis.orders
+        nw = orders * w
+        q = dyn.q
 
-        def coef(nm, power):
-            """The (x, q) Hill blocks of the coefficient of ``sigma^power`` of matrix ``nm``."""
-            out = []
-            for blk in dyn.blocks[nm]:
-                B = np.asarray(blk, dtype=float)
-                if nm == "K":
-                    c0, cp = (1.0, np.ones(k)) if power == 0 else (0.0, np.zeros(k))
-                    cm = cp
-                elif nm == "D":
-                    c0 = 0.0
-                    cp = 1j * np.ones(k) if power == 0 else np.zeros(k)
-                    cm = -cp
-                elif nm == "C":
-                    c0 = w if power == 1 else 0.0
-                    cp = (1j * n_h * w if power == 0 else np.full(k, w) if power == 1
-                          else np.zeros(k))
-                    cm = np.conj(cp)
-                else:  # M: lambda^2 = w^2 (sigma^2 + 2 i n sigma - n^2)
-                    c0 = w * w if power == 2 else 0.0
-                    cp = (-(n_h * w) ** 2 + 0j if power == 0 else 2j * n_h * w * w
-                          if power == 1 else np.full(k, w * w) + 0j)
-                    cm = np.conj(cp)
-                out.append(hill_blocks(c0 * B, cp[:, None, None] * B,
-                                       np.asarray(cm)[:, None, None] * B))
-            return out
+        def full(name):
+            if name not in dyn.blocks:
+                return None
+            xx, xq, qx, qq = (np.asarray(b, dtype=float) for b in dyn.blocks[name])
+            return np.block([[xx, xq], [qx, qq]]) if q else xx
 
+        K, M, C, D = (full(nm) for nm in ("K", "M", "C", "D"))
+        nb = orders.size
+        # complex blocks per harmonic of the coefficients of sigma^0, sigma^1, sigma^2 of
+        # Z(lambda), lambda = w (sigma + i n), in the layout of reduce.to_real_blocks
+        Z0 = np.repeat(K[None].astype(complex), nb, axis=0)
+        Z0 -= (nw ** 2)[:, None, None] * M
+        Z1 = np.repeat((2j * w * nw)[:, None, None] * M, 1, axis=0)
+        if C is not None:
+            Z0 += (1j * nw)[:, None, None] * C
+            Z1 = Z1 + w * C
+        if D is not None:
+            Z0[1:] += 1j * D
+        Z2 = np.repeat((w * w * M)[None], nb, axis=0).astype(complex)
         H = prob.H
-        m, q = dyn.m, dyn.q
-        nx, n = m * H, (m + q) * H
+        nx = prob.m * H
+        n = (prob.m + q) * H
         G = self.G0
         mats = []
-        for power in (0, 1, 2):
-            xx = np.zeros((nx, nx), dtype=complex)
-            xq = np.zeros((nx, q * H), dtype=complex)
-            qx = np.zeros((q * H, nx), dtype=complex)
-            qq = np.zeros((q * H, q * H), dtype=complex)
-            for nm in names:
-                bxx, bxq, bqx, bqq = coef(nm, power)
-                xx += bxx
-                xq += bxq
-                qx += bqx
-                qq += bqq
-            A = np.zeros((n, n), dtype=complex)
-            # rows of x: eps x - G (eps x - Z^xx x - Z^xq q) = jacobian_form on Z^xx, G Z^xq
+        for power, Zc in enumerate((Z0, Z1, Z2)):
+            Z = to_real_blocks(Zc, orders)
+            A = np.empty((n, n))
+            # rows of x: eps x - G (eps x - Z^xx x - Z^xq q); rows of q: Z^qx x + Z^qq q
+            A[:nx] = np.matmul(G, Z[:nx].reshape(prob.nc, -1, n)).reshape(nx, n)
             if power == 0:
-                A[:nx, :nx] = jacobian_form(G.astype(complex), xx, prob.eps)
-            else:
-                A[:nx, :nx] = np.matmul(G, xx.reshape(prob.nc, -1, nx)).reshape(nx, nx)
-            if q:
-                A[:nx, nx:] = np.matmul(G, xq.reshape(prob.nc, -1, q * H)).reshape(nx, q * H)
-                A[nx:, :nx] = qx
-                A[nx:, nx:] = qq
-            mats.append(A.real.copy())  # real: the cosine/sine blocks of real matrices
+                for p in range(prob.nc):
+                    sl = slice(p * G.shape[1], (p + 1) * G.shape[1])
+                    A[sl, sl] -= prob.eps * G[p]
+                A[np.arange(nx), np.arange(nx)] += prob.eps
+            A[nx:] = Z[nx:]
+            mats.append(A)
         return tuple(mats)
 
 
@@ -645,14 +635,14 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
         vx = y[:m * H]
         held = np.linalg.norm(vx) < 1e-8 * np.linalg.norm(y)
         negligible = 2.0 * np.pi * s0.real < np.log(NEGLIGIBLE)
-        if held or exact or negligible or refined >= opt.refine:
+        if held or exact or negligible or refined >= opt.refine:  # refined: successes
             sig.append(s0)
             kaps.append(kp)
             res.append(np.nan)
             kind.append("held" if held else "exact" if exact else "candidate")
             continue
-        refined += 1
         s1, v1, r1, conv = _track(hp, s0, vx, opt)
+        refined += conv
         if not conv:  # no exponent of the exact problem near it: an artefact of the frozen
             spurious.append(s0)  # memory (a node that sticks part of the period)
             continue
