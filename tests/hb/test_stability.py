@@ -112,7 +112,7 @@ def two_dof_flow(omega, kn=10.0, gap=0.5, force=0.1):
     return flow
 
 
-def jenkins_flow(omega, force, m=1.0, k=1.0, c=0.02, kt=0.5, slip=0.5, n=2000):
+def jenkins_flow(omega, force, m=1.0, k=1.0, c=0.02, kt=0.5, slip=0.5, n=1000):
     """Period map of ``(u, v, f)``: RK4 on the mass with the element's force ``f`` advanced by
     the return map of a spring in series with a slider (clip of ``f + kt du``)."""
     h = 2 * np.pi / omega / n
