@@ -19,8 +19,8 @@ contact DOFs in their local frames and the interior is ``u_i = Psi u_c + V q``:
 * a model with at most :data:`DENSE_INTERIOR_MAX` interior DOFs: ``Psi = -K_ii^-1 K_ic`` and
   ``V = I`` (``q`` the interior motion relative to the static shape): the transformation is
   one-to-one, so every ``Z_r(lambda)`` is exact;
-* a model with a modal representation (:func:`fretwear.hb.modal.use_modal`): its projected
-  matrices (``V`` the fixed-interface modes kept and the loads' static responses), with the
+* a model with a modal condenser (:func:`fretwear.hb.modal.modal_condenser`, passed as
+  ``condenser``): its projected matrices (``V`` the fixed-interface modes kept and the loads' static responses), with the
   error that representation was checked for.
 
 A contact spring joins the structure's contact DOF to a massless contact point
@@ -42,11 +42,11 @@ import scipy.linalg as sla
 from fretwear.errors import InputError
 from fretwear.hb.connectors import springs
 from fretwear.hb.modal import ModalCondenser
-from fretwear.hb.reduce import condenser
+from fretwear.hb.reduce import condenser_for
 from fretwear.model.core import Model
 
 #: at most this many interior DOFs: the exact transformation is formed densely; above, the
-#: model needs a modal representation (:func:`fretwear.hb.modal.use_modal`)
+#: model needs a modal condenser (:func:`fretwear.hb.modal.modal_condenser`)
 DENSE_INTERIOR_MAX = 600
 MATRICES = ("K", "M", "C", "D")
 
@@ -144,12 +144,12 @@ def _with_springs(blocks: dict, load_c, load_q, contact):
     return out, lx, np.concatenate([load_c[f], load_q])
 
 
-def structure_dynamics(model: Model) -> StructureDynamics:
-    """The :class:`StructureDynamics` of ``model``: its modal representation when one is
-    installed (:func:`fretwear.hb.modal.use_modal`), else the exact transformation (at most
-    :data:`DENSE_INTERIOR_MAX` interior DOFs; an InputError above, saying to install a modal
-    representation)."""
-    cond = condenser(model)
+def structure_dynamics(model: Model, condenser=None) -> StructureDynamics:
+    """The :class:`StructureDynamics` of ``model``: that of its modal condenser when
+    ``condenser`` is one (:func:`fretwear.hb.modal.modal_condenser`), else the exact
+    transformation (at most :data:`DENSE_INTERIOR_MAX` interior DOFs; an InputError above,
+    saying to pass a modal condenser)."""
+    cond = condenser_for(model, condenser)
     if isinstance(cond, ModalCondenser):
         blocks = {name: tuple(np.asarray(b) for b in cond.proj_local[name])
                   for name in MATRICES if name in cond.proj_local}
@@ -161,8 +161,8 @@ def structure_dynamics(model: Model) -> StructureDynamics:
     if cond.ni > DENSE_INTERIOR_MAX:
         raise InputError(
             f"the model has {cond.ni} interior DOFs: Hill's method and nonlinear modes form "
-            f"the structure's matrices densely up to {DENSE_INTERIOR_MAX}; install a modal "
-            "representation first (fretwear.hb.modal.use_modal(model, f_max, max_order))")
+            f"the structure's matrices densely up to {DENSE_INTERIOR_MAX}; pass a modal "
+            "condenser (condenser=fretwear.modal_condenser(model, f_max, max_order))")
     R = np.asarray(cond.R.toarray() if hasattr(cond.R, "toarray") else cond.R, dtype=float)
 
     def dense(A):
