@@ -40,7 +40,7 @@ def pad(n, ratio):
     return from_mesh(
         box(0.01, 0.01, 0.005, n, n, 1), Material(210e9, 0.3, 7800.0),
         damping=Damping(rayleigh_stiffness=0.02 / (2 * np.pi * 1e5)),
-        springs=[Spring("zmax", "x", 1e7), Spring("zmax", "y", 1e7)],
+        supports=[Spring("zmax", "x", 1e7), Spring("zmax", "y", 1e7)],
         loads=[Traction("zmax", pressure=P),
                Traction("zmax", traction=(q * np.cos(t), q * np.sin(t), 0.0), waveform="cos")],
         contact=ContactSpec("zmin", mu=MU, wear_coefficient=1e-14),

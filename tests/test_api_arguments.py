@@ -21,7 +21,7 @@ from fretwear.model.core import Load
 @pytest.fixture(scope="module")
 def block():
     return from_mesh(rectangle(0.02, 0.01, 4, 2), Material(210e9, 0.3, 7800.0), thickness=0.01,
-                     springs=[Spring(at=(0.0, 0.005), direction="x", stiffness=1e7)],
+                     supports=[Spring(at=(0.0, 0.005), direction="x", stiffness=1e7)],
                      loads=[Traction("top", pressure=1e6),
                             Traction("right", pressure=1e5, waveform="cos")],
                      contact=ContactSpec("bottom", mu=0.3), observed={"Pe": (0.02, 0.005)})
@@ -57,7 +57,7 @@ def test_load_on_a_harmonic_that_is_not_kept_is_refused():
     """A load on harmonic 5 with harmonics 1..3 kept would give a static response reported
     as converged: refused, naming both."""
     m = from_mesh(rectangle(0.02, 0.01, 4, 2), Material(210e9, 0.3, 7800.0), thickness=0.01,
-                  springs=[Spring(at=(0.0, 0.005), direction="x", stiffness=1e7)],
+                  supports=[Spring(at=(0.0, 0.005), direction="x", stiffness=1e7)],
                   loads=[Traction("top", pressure=1e6),
                          Traction("right", pressure=1e5, waveform="fourier",
                                   coefficients={5: (1.0, 0.0)})],
@@ -99,15 +99,15 @@ def test_fourier_basis_bad_arguments(harmonics, samples, match):
 def test_complex_stiffness_is_refused_not_cut():
     K = sp.csr_matrix(np.array([[2.0, -1.0], [-1.0, 2.0]]) * (1 + 0.01j))
     with pytest.raises(InputError, match="K holds complex values"):
-        fw.from_matrices(K, sp.identity(2), contact_normal_dofs=[0],
-                         contact_tangential_dofs=[1], mu=0.3)
+        fw.from_matrices(K, sp.identity(2),
+                         contact=fw.ContactDofs(normal_dofs=[0], tangential_dofs=[1], mu=0.3))
 
 
 def test_nan_load_is_refused():
     K = sp.csr_matrix(np.array([[2.0, -1.0], [-1.0, 2.0]]))
     with pytest.raises(InputError, match="finite nodal forces"):
-        fw.from_matrices(K, sp.identity(2), contact_normal_dofs=[0],
-                         contact_tangential_dofs=[1], mu=0.3,
+        fw.from_matrices(K, sp.identity(2),
+                         contact=fw.ContactDofs(normal_dofs=[0], tangential_dofs=[1], mu=0.3),
                          loads=[Load(np.array([np.nan, 0.0]), "cos")])
 
 

@@ -42,6 +42,7 @@ _API = {
     "Damping": "fretwear.model.build", "Spring": "fretwear.model.build",
     "Traction": "fretwear.model.build", "NodalForce": "fretwear.model.build",
     "from_matrices": "fretwear.model.matrices", "read_matrix_market": "fretwear.model.matrices",
+    "ContactDofs": "fretwear.model.matrices",
     # harmonic balance
     "FourierBasis": "fretwear.hb.fourier", "condense": "fretwear.hb.reduce",
     "Reduced": "fretwear.hb.reduce", "solve_periodic": "fretwear.api",
