@@ -1,4 +1,5 @@
-"""Direct tests of the numba kernels of the time-domain solvers (fretwear.timedomain.kernels).
+"""Direct tests of the contact solves of the time-domain solvers
+(fretwear.timedomain.contact_solve).
 
 * ``_gauss_solve`` (Gaussian elimination with partial pivoting, in place) against
   ``numpy.linalg.solve`` (LAPACK): random systems of condition ~10 agree to 1e-12 relative
@@ -21,7 +22,7 @@ import numpy as np
 import pytest
 from helpers.pads import F_PAD, pad_3d
 
-from fretwear.timedomain.kernels import OPEN, SLIP, STICK, _gauss_solve, solve_contact
+from fretwear.timedomain.contact_solve import OPEN, SLIP, STICK, _gauss_solve, solve_contact
 
 RNG = np.random.default_rng(11)
 

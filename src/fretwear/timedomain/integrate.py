@@ -32,7 +32,8 @@ Signorini exactly and the slip increment ``x_T(n+1) - x_T(n)`` satisfies Coulomb
 Speed: for a fixed step the step matrix is constant, so the structure is reduced exactly
 (Craig-Bampton on the contact DOFs with the fixed-interface modes below a cutoff and one
 static mode per load vector), diagonalised, and each step is a small dense update plus one
-contact problem (numba kernels in :mod:`fretwear.timedomain.kernels`).
+contact problem (numba kernels in :mod:`fretwear.timedomain.kernels` and
+:mod:`fretwear.timedomain.contact_solve`).
 
 Damping: the viscous ``C`` as given; the hysteretic ``D`` has no causal time-domain form and
 is replaced by the equivalent viscous damping at the forcing frequency, ``C_eq = D / omega``.
@@ -51,15 +52,11 @@ from fretwear.limits import check_range
 from fretwear.model.core import Model
 from fretwear.resources import require_memory
 from fretwear.timedomain.checks import c_float, count, node_wear, positive
+from fretwear.timedomain.contact_solve import OPEN, STICK, Contact, ContactState, Settings
 from fretwear.timedomain.kernels import (
-    OPEN,
-    STICK,
-    Contact,
-    ContactState,
     DynamicState,
     EnergyTerms,
     Records,
-    Settings,
     StepOperator,
     run_dynamic,
 )

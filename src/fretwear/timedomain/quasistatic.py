@@ -13,17 +13,8 @@ from fretwear.errors import ConvergenceError, InputError
 from fretwear.hb.reduce import condense_static
 from fretwear.model.core import Model
 from fretwear.timedomain.checks import c_float, check_contact, count, node_wear
-from fretwear.timedomain.kernels import (
-    OPEN,
-    STICK,
-    Contact,
-    ContactState,
-    LoadCycle,
-    Settings,
-    WearRecords,
-    WearState,
-    run_quasistatic,
-)
+from fretwear.timedomain.contact_solve import OPEN, STICK, Contact, ContactState, Settings
+from fretwear.timedomain.kernels import LoadCycle, WearRecords, WearState, run_quasistatic
 from fretwear.timedomain.results import IncrementalWearResult
 
 
