@@ -16,6 +16,7 @@ import fretwear as fw
 from fretwear.errors import InputError
 from fretwear.model import ContactSpec, Material, Spring, Traction, from_mesh, rectangle
 from fretwear.model.core import Load
+from fretwear.timedomain.options import IntegrationOptions
 
 
 @pytest.fixture(scope="module")
@@ -131,4 +132,4 @@ def test_time_steps_that_cannot_be_recorded_are_refused(block):
     """1e9 steps per period recorded: refused with the memory estimate, before allocating."""
     with pytest.raises(InputError, match=r"recording 1 periods of 1000000000 time steps needs "
                                          r"about .* GiB"):
-        fw.integrate(block, 1500.0, n_periods=1, steps_per_period=10**9)
+        fw.integrate(block, 1500.0, options=IntegrationOptions(steps_per_period=10**9), n_periods=1)

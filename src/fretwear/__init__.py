@@ -57,6 +57,10 @@ _API = {
     "integrate": "fretwear.timedomain.integrate", "steady_state": "fretwear.timedomain.steady",
     "incremental_wear": "fretwear.timedomain.quasistatic",
     "check_periodic": "fretwear.timedomain.stability",
+    "IntegrationOptions": "fretwear.timedomain.options",
+    "InitialState": "fretwear.timedomain.options",
+    "SteadyStateOptions": "fretwear.timedomain.options",
+    "IncrementalWearOptions": "fretwear.timedomain.options",
     # case files and results
     "run_case": "fretwear.analyses.run", "load_case": "fretwear.analyses.run",
     "read_results": "fretwear.io.results",

@@ -43,6 +43,7 @@ from fretwear.model import (
 )
 from fretwear.model.core import ContactInterface, Load, Model
 from fretwear.model.interfaces import pair_transform
+from fretwear.timedomain.options import InitialState, IntegrationOptions
 from fretwear.wear.laws import side_depths, wear_coefficients, worn_volume
 
 STEEL = Material(210e9, 0.3, 7800.0)
@@ -602,8 +603,8 @@ def test_time_integration_of_a_pair_on_a_stiff_held_body_is_the_rigid_obstacle_o
     run = {}
     for key, model in (("pair", pair), ("rigid", rigid)):
         U0, V0 = initial_state(model, solve_periodic(model, BASIS, frequency=F_HZ, tol=1e-12))
-        run[key] = integrate(model, F_HZ, n_periods=10, steps_per_period=256, record="last",
-                             U0=U0, V0=V0)
+        run[key] = integrate(model, F_HZ, options=IntegrationOptions(steps_per_period=256),
+                             start=InitialState(U0=U0, V0=V0), n_periods=10, record="last")
     a, b = run["pair"], run["rigid"]
     assert a.success and b.success and np.any(b.state == 2)
     np.testing.assert_allclose(a.lam, b.lam, rtol=0, atol=20 * ratio * np.abs(b.lam).max())
@@ -655,8 +656,8 @@ def test_time_integration_takes_a_friction_coefficient_per_interface():
     def run(model):
         U0, V0 = initial_state(model, solve_periodic(model, BASIS, frequency=F_HZ, tol=1e-12,
                                                      eps=1e9, raise_on_failure=True))
-        out = integrate(model, F_HZ, n_periods=10, steps_per_period=256, record="last",
-                        U0=U0, V0=V0)
+        out = integrate(model, F_HZ, options=IntegrationOptions(steps_per_period=256),
+                        start=InitialState(U0=U0, V0=V0), n_periods=10, record="last")
         assert out.success
         return out
 

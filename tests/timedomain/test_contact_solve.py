@@ -189,10 +189,10 @@ def pad_delassus():
     """The step's Delassus operator of the 16-node pad (``A = W^-1``, 48 x 48, SPD, with
     strong coupling between the nodes), as the time integrator builds it."""
     from fretwear.timedomain.integrate import Integrator
+    from fretwear.timedomain.options import IntegrationOptions
 
-    integ = Integrator(pad_3d(), 2 * np.pi * F_PAD, steps_per_period=256, modal_cutoff=None,
-                       n_modes=None, gamma=0.5, tol=1e-10, wear=None, U0=None, V0=None,
-                       stick_anchor=None)
+    integ = Integrator(pad_3d(), 2 * np.pi * F_PAD,
+                       IntegrationOptions(steps_per_period=256, gamma=0.5, contact_tol=1e-10))
     return integ.A
 
 

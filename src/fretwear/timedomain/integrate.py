@@ -60,43 +60,18 @@ from fretwear.timedomain.kernels import (
     StepOperator,
     run_dynamic,
 )
+from fretwear.timedomain.options import (
+    DEFAULT_STEPS,
+    INTEGRATION,
+    InitialState,
+    IntegrationOptions,
+)
 from fretwear.timedomain.reduction import HF_GAMMA, HF_LIMIT, reduce_dynamics, submatrix
 from fretwear.timedomain.results import TransientResult
 
-__all__ = ["DEFAULT_STEPS", "Integrator", "integrate"]
+__all__ = ["DEFAULT_STEPS", "InitialState", "IntegrationOptions", "Integrator", "integrate"]
 
-DEFAULT_STEPS = 256  # time steps per forcing period (case files take it too)
 CHUNK_STEPS = 2_000_000  # steps per kernel call (progress, interruption)
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
 
 
 # --------------------------------------------------------------------------------------------
@@ -105,19 +80,24 @@ CHUNK_STEPS = 2_000_000  # steps per kernel call (progress, interruption)
 class Integrator:
     """Holds the reduced step operator and the current state; runs whole periods."""
 
-    def __init__(self, model: Model, omega: float, *, steps_per_period, modal_cutoff, n_modes,
-                 gamma, tol, wear, U0, V0, stick_anchor, hf_damping=False):
+    def __init__(self, model: Model, omega: float, options: IntegrationOptions = INTEGRATION,
+                 start: InitialState | None = None):
+        """The step operator of ``model`` at ``omega`` [rad/s] with ``options``, in the state
+        ``start`` (default: rest, unworn)."""
+        if not isinstance(options, IntegrationOptions):
+            raise InputError(f"options = {options!r}; expected an IntegrationOptions(...)")
+        start = InitialState() if start is None else start
+        if not isinstance(start, InitialState):
+            raise InputError(f"start = {start!r}; expected an InitialState(U0, V0, wear, "
+                             "stick_anchor)")
         self.model = model
         self.omega = positive(omega, "omega")
-        self.N = N = count(steps_per_period, "steps_per_period", 4)
-        gamma = float(gamma)
-        if not (0.5 <= gamma <= 1.0):
-            raise InputError(f"gamma = {gamma!r}; expected 0.5 (trapezoidal, default) to 1")
-        self.gamma = gamma
-        self.tol = positive(tol, "tol")
+        self.N = N = options.steps_per_period
+        self.gamma = gamma = options.gamma
+        self.tol = options.contact_tol
         t0 = time.perf_counter()
-        red = self.red = reduce_dynamics(model, self.omega, modal_cutoff=modal_cutoff,
-                                         n_modes=n_modes, steps_per_period=N)
+        red = self.red = reduce_dynamics(model, self.omega, modal_cutoff=options.modal_cutoff,
+                                         n_modes=options.n_modes, steps_per_period=N)
         c = model.contact
         self.nc, self.d = c.dofs.shape
         self.m = self.nc * self.d
@@ -125,7 +105,7 @@ class Integrator:
         r = red.basis.shape[1]
         # Newmark parameters, per mode in modal coordinates (high modes may get more damping)
         g = np.full(r, gamma)
-        if red.diag and hf_damping:
+        if red.diag and options.hf_damping:
             g[np.sqrt(np.maximum(red.K, 0.0)) * h > HF_LIMIT] = HF_GAMMA
         b = 0.25 * (g + 0.5) ** 2
         self.g_modes = g
@@ -178,7 +158,7 @@ class Integrator:
             raise InputError("the contact DOFs' step mobility (Delassus operator) is singular: "
                              "a contact direction carries no mass nor stiffness") from None
         self.A = np.ascontiguousarray(0.5 * (self.A + self.A.T))
-        self.gap = np.asarray(c.gap, dtype=float) + node_wear(wear, self.nc)
+        self.gap = np.asarray(c.gap, dtype=float) + node_wear(start.wear, self.nc)
         if red.diag:
             m_v, k_v, c_v = red.M, red.K, red.C
             m_m = k_m = c_m = z0
@@ -200,7 +180,7 @@ class Integrator:
         self.setup_time = time.perf_counter() - t0
         self.r = r
         # initial state
-        self._set_state(U0, V0, stick_anchor)
+        self._set_state(start.U0, start.V0, start.stick_anchor)
         self.periods_done = 0
         self.n_fail = 0
         self.max_it = 0
@@ -356,10 +336,9 @@ class Integrator:
 
 
 def integrate(model: Model, frequency: float, *, n_periods: int,
-              steps_per_period: int = DEFAULT_STEPS, record="last", U0=None, V0=None,
-              wear=None, stick_anchor=None, modal_cutoff=None, n_modes=None,
-              gamma: float = 0.5, hf_damping: bool = False, keep_poincare: int = 10_000,
-              tol: float = 1e-10, progress: bool = False) -> TransientResult:
+              options: IntegrationOptions = INTEGRATION, start: InitialState | None = None,
+              record="last", keep_poincare: int = 10_000, progress: bool = False
+              ) -> TransientResult:
     """Integrate the forced response in time with exact contact and friction.
 
     Parameters
@@ -367,31 +346,14 @@ def integrate(model: Model, frequency: float, *, n_periods: int,
     model : the structure (:class:`~fretwear.model.core.Model`).
     frequency : forcing frequency ``f`` [Hz]; the loads are ``F(omega t)``, ``omega = 2 pi f``.
     n_periods : number of forcing periods ``T = 1 / f`` to simulate.
-    steps_per_period : fixed steps per period (``h = T / steps_per_period``). Guidance: >= 20
-        steps per period of the highest harmonic you want accurate (phase error of the
-        trapezoidal rule ``(omega h)^2 / 12``); stick-slip events are first order in ``h``.
+    options : :class:`~fretwear.timedomain.options.IntegrationOptions`: steps per period,
+        Newmark gamma, high-frequency damping, modal reduction, contact solver tolerance.
+    start : :class:`~fretwear.timedomain.options.InitialState`: initial displacement and
+        velocity (default rest; ``result.U, result.V`` continue a run exactly), wear, stick
+        anchors.
     record : ``"last"`` (the last period) or the number of periods recorded at the end
         (every step), 0 for none.
-    U0, V0 : (ndof,) initial displacement [m] and velocity [m/s] at ``t = 0``; default rest.
-        ``result.U, result.V`` continue a run exactly.
-    wear : (nc,) wear depth per contact node [m] (opens the gap).
-    stick_anchor : (nc, d-1) tangential positions [m] from which the first step's slip is
-        measured (default: those of ``U0``).
-    modal_cutoff : frequency [Hz] below which the fixed-interface modes are kept
-        (Craig-Bampton); default ``steps_per_period * f / 8`` (modes the step resolves with at
-        least 8 steps per period); ``"all"`` for no reduction. The truncated modes keep their
-        static contribution (constraint modes and one static mode per load vector).
-    n_modes : keep exactly this many fixed-interface modes instead (overrides the cutoff).
-    gamma : Newmark gamma (``beta = (gamma + 1/2)^2 / 4``); 0.5 (default) is the trapezoidal
-        rule (second order, energy conserving); larger values damp the highest frequencies
-        (first order).
-    hf_damping : integrate the modes of the reduced model that the step does not resolve
-        (``omega_j h > 1``, fewer than 2 pi steps per period) with ``gamma = 1`` (spectral
-        radius 1/3 at infinity) instead of ``gamma``: removes their spurious ringing, at the
-        cost of numerical dissipation (``energy["numerical"]``) and of whatever physics they
-        carry (a friction-induced self-excited oscillation may need them: off by default).
     keep_poincare : once-per-period samples kept (the last ones).
-    tol : relative tolerance of the contact solver status tests.
     progress : show a progress bar.
 
     Returns
@@ -409,28 +371,16 @@ def integrate(model: Model, frequency: float, *, n_periods: int,
             raise InputError(f"record = {record} periods but n_periods = {n_periods}")
     n_keep = min(count(keep_poincare, "keep_poincare", 0), n_periods)
     omega = 2 * np.pi * check_range(positive(frequency, "frequency"), "frequency", "frequency")
-    steps = count(steps_per_period, "steps_per_period", 4)
+    if not isinstance(options, IntegrationOptions):
+        raise InputError(f"options = {options!r}; expected an IntegrationOptions(...)")
+    steps = options.steps_per_period
     # recorded samples: observed displacements and velocities, contact positions and forces,
     # states and six energy terms per step [8 bytes each]
     width = 2 * model.ndof + 2 * model.contact.dofs.size + model.contact.n_nodes + 6
     require_memory(8.0 * n_rec * steps * width,
                    f"recording {n_rec} periods of {steps} time steps")
-    integ = Integrator(model, omega, steps_per_period=steps_per_period,
-                        modal_cutoff=modal_cutoff, n_modes=n_modes, gamma=gamma, tol=tol,
-                        wear=wear, U0=U0, V0=V0, stick_anchor=stick_anchor,
-                        hf_damping=hf_damping)
+    integ = Integrator(model, omega, options, start)
     t0 = time.perf_counter()
     raw = integ.run(n_periods, n_rec, n_keep, progress=progress)
     wall = time.perf_counter() - t0
     return integ.result(raw, n_periods, wall)
-
-
-
-
-
-
-
-
-
-
-
