@@ -119,45 +119,12 @@ class Integrator:
         self.ftil = w1 * np.roll(Fr, -1, axis=0) + w0 * Fr + wm * np.roll(Fr, 1, axis=0)
         z0 = np.zeros((0, 0))
         if red.diag:
-            k, mm, cc, U, R = red.K, red.M, red.C, red.U, red.R
-            ds = mm + g * h * cc + b * h * h * k
-            self.a_v = mm - (1 - g) * h * cc + wm * h * h * k
-            self.b_v = -h * h * k
-            self.ds = ds
-            self.hc = (1 - g) * h
-            # S^-1 = (Ds + Gam U R U^T)^-1 = Ds^-1 - P Qt (Woodbury), Gam = diag(g h)
-            self.P = np.ascontiguousarray((g * h / ds)[:, None] * U)
-            core = np.eye(U.shape[1]) + R @ (U.T @ self.P)
-            self.Qt = np.ascontiguousarray(np.linalg.solve(core, R @ (U.T / ds[None, :])))
-            self.U, self.R = U, R
-
-            def s_inv(Y):
-                return Y / ds[:, None] - self.P @ (self.Qt @ Y)
-
-            self.bq_m = self.bd_m = z0
-            self.ftab = h * h * s_inv(self.ftil.T).T
-            G = h * h * s_inv(red.Tx.T)
+            G = self._diagonal_step(g, b, wm)
         else:
-            S2 = red.M + gamma * h * red.C + b[0] * h * h * red.K
-            lu = sla.lu_factor(S2)
-            self.bq_m = -h * h * sla.lu_solve(lu, red.K)
-            self.bd_m = sla.lu_solve(lu, red.M - (1 - gamma) * h * red.C
-                                     + wm[0] * h * h * red.K)
-            self.a_v = self.b_v = self.ds = self.hc = np.zeros(0)
-            self.U, self.R, self.P, self.Qt = np.zeros((r, 0)), z0, np.zeros((r, 0)), z0
-            self.ftab = h * h * sla.lu_solve(lu, self.ftil.T).T
-            G = h * h * sla.lu_solve(lu, red.Tx.T)
+            G = self._dense_step(b[0], wm[0])
         self.ftab = np.ascontiguousarray(self.ftab)
         self.G = np.ascontiguousarray(G)
-        W = red.Tx @ G
-        W = 0.5 * (W + W.T)
-        try:
-            cf = sla.cho_factor(W)
-            self.A = sla.cho_solve(cf, np.eye(self.m))
-        except np.linalg.LinAlgError:
-            raise InputError("the contact DOFs' step mobility (Delassus operator) is singular: "
-                             "a contact direction carries no mass nor stiffness") from None
-        self.A = np.ascontiguousarray(0.5 * (self.A + self.A.T))
+        self.A = self._inverse_delassus(G)
         self.gap = np.asarray(c.gap, dtype=float) + node_wear(start.wear, self.nc)
         if red.diag:
             m_v, k_v, c_v = red.M, red.K, red.C
@@ -185,6 +152,57 @@ class Integrator:
         self.n_fail = 0
         self.max_it = 0
         self.first_fail_time = None
+
+    # the step operator -------------------------------------------------------------------------
+    def _diagonal_step(self, g, b, wm):
+        """The step in modal coordinates (diagonal mass, stiffness and damping plus the
+        low-rank ``U R U^T``): its per-mode weights, the Woodbury factors of ``S^-1``, the
+        forcing increments ``ftab``; returns ``G = h^2 S^-1 Tx^T``."""
+        red, h = self.red, self.h
+        k, mm, cc, U, R = red.K, red.M, red.C, red.U, red.R
+        ds = mm + g * h * cc + b * h * h * k
+        self.a_v = mm - (1 - g) * h * cc + wm * h * h * k
+        self.b_v = -h * h * k
+        self.ds = ds
+        self.hc = (1 - g) * h
+        # S^-1 = (Ds + Gam U R U^T)^-1 = Ds^-1 - P Qt (Woodbury), Gam = diag(g h)
+        self.P = np.ascontiguousarray((g * h / ds)[:, None] * U)
+        core = np.eye(U.shape[1]) + R @ (U.T @ self.P)
+        self.Qt = np.ascontiguousarray(np.linalg.solve(core, R @ (U.T / ds[None, :])))
+        self.U, self.R = U, R
+
+        def s_inv(Y):
+            return Y / ds[:, None] - self.P @ (self.Qt @ Y)
+
+        self.bq_m = self.bd_m = np.zeros((0, 0))
+        self.ftab = h * h * s_inv(self.ftil.T).T
+        return h * h * s_inv(red.Tx.T)
+
+    def _dense_step(self, b: float, wm: float):
+        """The step with dense reduced matrices (one LU of ``S``): ``S^-1 B_q``, ``S^-1 B_d``,
+        the forcing increments ``ftab``; returns ``G = h^2 S^-1 Tx^T``."""
+        red, h, gamma, r = self.red, self.h, self.gamma, self.red.basis.shape[1]
+        z0 = np.zeros((0, 0))
+        S2 = red.M + gamma * h * red.C + b * h * h * red.K
+        lu = sla.lu_factor(S2)
+        self.bq_m = -h * h * sla.lu_solve(lu, red.K)
+        self.bd_m = sla.lu_solve(lu, red.M - (1 - gamma) * h * red.C + wm * h * h * red.K)
+        self.a_v = self.b_v = self.ds = self.hc = np.zeros(0)
+        self.U, self.R, self.P, self.Qt = np.zeros((r, 0)), z0, np.zeros((r, 0)), z0
+        self.ftab = h * h * sla.lu_solve(lu, self.ftil.T).T
+        return h * h * sla.lu_solve(lu, red.Tx.T)
+
+    def _inverse_delassus(self, G) -> np.ndarray:
+        """``A = W^-1``, ``W = Tx G`` the contact DOFs' step mobility (symmetrised)."""
+        W = self.red.Tx @ G
+        W = 0.5 * (W + W.T)
+        try:
+            cf = sla.cho_factor(W)
+            A = sla.cho_solve(cf, np.eye(self.m))
+        except np.linalg.LinAlgError:
+            raise InputError("the contact DOFs' step mobility (Delassus operator) is singular: "
+                             "a contact direction carries no mass nor stiffness") from None
+        return np.ascontiguousarray(0.5 * (A + A.T))
 
     # state <-> full vectors ------------------------------------------------------------------
     def _project(self, U, what):
