@@ -144,6 +144,19 @@ def _gauss_solve(a, rhs, n):
     return True
 
 
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _forces(A, b, x, xref, lam):
+    """The contact forces ``lam = b - A (x - xref)`` [N] in full (into ``lam``). Inlined (numba
+    IR) where it is called, as :func:`contact_buffers` is, so that the callers compile as with
+    the loop written out in them."""
+    m = lam.shape[0]
+    for r in range(m):
+        s = b[r]
+        for c in range(m):
+            s -= A[r, c] * (x[c] - xref[c])
+        lam[r] = s
+
+
 @njit(cache=True, fastmath=FASTMATH)
 def _cone_residual(A, x, lam, gap, xprev, mu, rn, rt, F, st):
     """Alart-Curnier residual of the 3D contact problem at ``x`` (``lam`` the matching forces).
@@ -236,11 +249,7 @@ def _solve_contact_cone(A, b, xref, gap, xprev, mu, status, tdir, x, lam, tol, f
             x[i0] = gap[i]
             x[i0 + 1] = xprev[i0 + 1]
             x[i0 + 2] = xprev[i0 + 2]
-    for r in range(m):
-        s = b[r]
-        for c in range(m):
-            s -= A[r, c] * (x[c] - xref[c])
-        lam[r] = s
+    _forces(A, b, x, xref, lam)
     F = np.empty(m)
     dx = np.empty(m)
     adx = np.empty(m)
@@ -274,11 +283,7 @@ def _solve_contact_cone(A, b, xref, gap, xprev, mu, status, tdir, x, lam, tol, f
                 if st[i] == STICK:
                     x[i0 + 1] = xprev[i0 + 1]
                     x[i0 + 2] = xprev[i0 + 2]
-            for r in range(m):
-                s = b[r]
-                for c in range(m):
-                    s -= A[r, c] * (x[c] - xref[c])
-                lam[r] = s
+            _forces(A, b, x, xref, lam)
             phi, fmax = _cone_residual(A, x, lam, gap, xprev, mu, rn, rt, F, st)
             if fmax <= eps_f:
                 for i in range(nc):
@@ -469,11 +474,7 @@ def solve_contact(A, b, xref, gap, xprev, mu, d, status, tdir, x, lam, tol, fsca
         # contact forces at the current iterate: in full at the first iteration, then
         # updated with the components whose prescribed value changed (A is symmetric)
         if it == 1:
-            for r in range(m):
-                s = b[r]
-                for c in range(m):
-                    s -= A[r, c] * (x[c] - xref[c])
-                lam[r] = s
+            _forces(A, b, x, xref, lam)
         else:
             for c in range(m):
                 dx = x[c] - xs[c]
