@@ -89,7 +89,7 @@ class Integrator:
         start = InitialState() if start is None else start
         if not isinstance(start, InitialState):
             raise InputError(f"start = {start!r}; expected an InitialState(U0, V0, wear, "
-                             "stick_anchor)")
+                             "anchor)")
         self.model = model
         self.omega = positive(omega, "omega")
         self.N = N = options.steps_per_period
@@ -147,7 +147,7 @@ class Integrator:
         self.setup_time = time.perf_counter() - t0
         self.r = r
         # initial state
-        self._set_state(start.U0, start.V0, start.stick_anchor)
+        self._set_state(start.U0, start.V0, start.anchor)
         self.periods_done = 0
         self.n_fail = 0
         self.max_it = 0
@@ -226,7 +226,7 @@ class Integrator:
         except np.linalg.LinAlgError:
             return np.zeros(self.r)
 
-    def _set_state(self, U0, V0, stick_anchor):
+    def _set_state(self, U0, V0, anchor):
         q = np.zeros(self.r) if U0 is None else self._project(U0, "U0")
         v = np.zeros(self.r) if V0 is None else self._project(V0, "V0")
         # midpoint velocity w_{-1/2} = V0 - h/2 a0 (a0 without damping and contact)
@@ -237,12 +237,12 @@ class Integrator:
         self.xprev = Tx @ q
         self.xprev2 = Tx @ (q - self.dq)
         d = self.d
-        if stick_anchor is not None:
-            a = np.asarray(stick_anchor, dtype=float)
+        if anchor is not None:
+            a = np.asarray(anchor, dtype=float)
             if a.shape == (self.nc,) and d == 2:
                 a = a[:, None]
             if a.shape != (self.nc, d - 1):
-                raise InputError(f"stick_anchor has shape {a.shape}; expected ({self.nc}, "
+                raise InputError(f"anchor has shape {a.shape}; expected ({self.nc}, "
                                  f"{d - 1}) tangential positions [m]")
             xp = self.xprev.reshape(self.nc, d)
             xp[:, 1:] = a

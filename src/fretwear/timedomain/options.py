@@ -91,14 +91,14 @@ class InitialState:
     U0, V0 : (ndof,) initial displacement [m] and velocity [m/s] at ``t = 0``; default rest.
         ``result.U, result.V`` of a run continue it exactly.
     wear : (nc,) wear depth per contact node [m] (opens the gap).
-    stick_anchor : (nc, d-1) tangential positions [m] from which the first step's slip is
-        measured (default: those of ``U0``).
+    anchor : (nc, d-1) tangential positions [m] from which the first step's slip is measured
+        (the stick anchors; default: those of ``U0``).
     """
 
     U0: object = None
     V0: object = None
     wear: object = None
-    stick_anchor: object = None
+    anchor: object = None
 
 
 @dataclass(frozen=True)

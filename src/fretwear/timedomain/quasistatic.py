@@ -24,8 +24,8 @@ from fretwear.timedomain.results import IncrementalWearResult
 # --------------------------------------------------------------------------------------------
 def incremental_wear(model: Model, *, n_cycles: int = 100,
                      options: IncrementalWearOptions = INCREMENTAL_WEAR,
-                     k_w: float | None = None, wear0=None, progress: bool = False,
-                     raise_on_failure: bool = True) -> IncrementalWearResult:
+                     wear_coefficient: float | None = None, wear0=None, progress: bool = False,
+                     raise_on_failure: bool = True, condenser=None) -> IncrementalWearResult:
     """Quasi-static fretting wear by load steps (in the spirit of Stromberg 1997).
 
     At every load step ``tau_k = 2 pi k / steps_per_cycle`` the static equilibrium
@@ -50,13 +50,16 @@ def incremental_wear(model: Model, *, n_cycles: int = 100,
         cycle ``steps_per_cycle``, cycles represented by each computed cycle ``cycle_jump``,
         ``record_every`` computed cycles a record (and the last), the contact solver's
         relative tolerance ``contact_tol``.
-    k_w : Archard coefficient [1/Pa]; default ``model.contact.wear_coefficient`` (plus the
-        partners' coefficient at node-to-node pairs: the gap opens by both worn depths).
+    wear_coefficient : Archard coefficient k_w [1/Pa]; default
+        ``model.contact.wear_coefficient`` (plus the partners' coefficient at node-to-node
+        pairs: the gap opens by both worn depths).
     wear0 : (nc,) initial wear [m].
     progress : accepted for the analyses' common call (the run prints nothing).
     raise_on_failure : raise :class:`~fretwear.errors.ConvergenceError` when the contact
         problem of some load step does not settle (default); False: return the result with
         ``success`` False and the count in ``message``.
+    condenser : the condenser of ``model`` (:func:`fretwear.hb.reduce.exact_condenser`) whose
+        static condensation is used (None: a new exact one).
 
     Returns
     -------
@@ -69,7 +72,7 @@ def incremental_wear(model: Model, *, n_cycles: int = 100,
     n_cycles = count(n_cycles, "n_cycles", 1)
     J = options.cycle_jump
     rec_every = options.record_every
-    kw = _archard_coefficient(model, k_w)
+    kw = _archard_coefficient(model, wear_coefficient)
     t0 = time.perf_counter()
     c = model.contact
     nc, d = c.dofs.shape
@@ -77,7 +80,7 @@ def incremental_wear(model: Model, *, n_cycles: int = 100,
     if area.shape != (nc,) or np.any(area <= 0):
         raise InputError(f"contact.area must be ({nc},) positive areas [m^2]")
     check_contact(model)
-    cond = condense_static(model)
+    cond = condense_static(model, condenser=condenser)
     A = cond.K
     tau = 2.0 * np.pi * np.arange(N) / N
     Ft = model.load_time(tau) if model.loads else np.zeros((N, model.ndof))
@@ -115,10 +118,10 @@ def incremental_wear(model: Model, *, n_cycles: int = 100,
         info={"max_active_set_iterations": int(maxit), "records": int(nr)})
 
 
-def _archard_coefficient(model: Model, k_w) -> float:
-    """``k_w`` [1/Pa] checked, or by default the model's (both surfaces of a pair summed: the
-    gap opens at their summed rate), which must be the same at every node."""
-    if k_w is None:
+def _archard_coefficient(model: Model, wear_coefficient) -> float:
+    """``wear_coefficient`` k_w [1/Pa] checked, or by default the model's (both surfaces of a
+    pair summed: the gap opens by both worn depths), which must be the same at every node."""
+    if wear_coefficient is None:
         both = model.contact.wear_nodes() + model.contact.partner_wear_nodes()
         if np.ptp(both) > 0.0:
             raise InputError(f"contact: the Archard coefficients (both surfaces summed) differ "
@@ -126,10 +129,11 @@ def _archard_coefficient(model: Model, k_w) -> float:
                              "incremental_wear takes one coefficient k_w")
         kw = both[0]
     else:
-        kw = k_w
+        kw = wear_coefficient
     kw = float(kw)
     if not (math.isfinite(kw) and kw >= 0.0):
-        raise InputError(f"k_w = {k_w!r}; expected an Archard coefficient >= 0 [1/Pa]")
+        raise InputError(f"wear_coefficient = {wear_coefficient!r}; expected an Archard "
+                         "coefficient k_w >= 0 [1/Pa]")
     return kw
 
 
