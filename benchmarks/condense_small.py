@@ -21,9 +21,17 @@ import numpy as np
 import scipy.sparse as sp
 
 from fretwear.hb import reduce
-from fretwear.model import ContactSpec, Material, Spring, Traction, from_mesh, rectangle
+from fretwear.model import (
+    ContactSpec,
+    Damping,
+    Material,
+    Spring,
+    Traction,
+    from_mesh,
+    rectangle,
+)
 from fretwear.model.core import Load
-from fretwear.model.matrices import from_matrices
+from fretwear.model.matrices import ContactDofs, from_matrices
 
 ORDERS = np.arange(8)
 
@@ -34,14 +42,14 @@ def chain():
     K = sp.csr_matrix(np.array([[2.0, -1.0, 0.0], [-1.0, 1.0, 0.0], [0.0, 0.0, 1e3]]))
     M = sp.csr_matrix(np.diag([1.0, 1.0, 0.0]))
     C = sp.csr_matrix(np.array([[0.04, -0.02, 0.0], [-0.02, 0.02, 0.0], [0.0, 0.0, 0.0]]))
-    return from_matrices(K, M, C=C, contact_normal_dofs=[2], contact_tangential_dofs=[1],
-                         mu=0.5, loads=[Load(np.array([0.0, 0.0, 1.0]), "constant"),
-                                        Load(np.array([0.2, 0.0, 0.0]), "cos")])
+    return from_matrices(K, M, contact=ContactDofs(normal_dofs=[2], tangential_dofs=[1], mu=0.5),
+                         damping=Damping(C=C), loads=[Load(np.array([0.0, 0.0, 1.0]), "constant"),
+                                                      Load(np.array([0.2, 0.0, 0.0]), "cos")])
 
 
 def block(nx, ny):
     return from_mesh(rectangle(0.01, 0.004, nx, ny), Material(210e9, 0.3, 7800.0),
-                     springs=[Spring("top", "x", 1e7)],
+                     supports=[Spring("top", "x", 1e7)],
                      loads=[Traction("top", pressure=1e6),
                             Traction("top", traction=(3e5, 0.0), waveform="cos")],
                      contact=ContactSpec("bottom", mu=0.5))

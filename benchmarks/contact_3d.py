@@ -29,6 +29,7 @@ import scipy.linalg as sla
 from fretwear.model.build import ContactSpec, Damping, Material, Spring, Traction, from_mesh
 from fretwear.model.mesh import box
 from fretwear.timedomain.integrate import integrate
+from fretwear.timedomain.options import IncrementalWearOptions, IntegrationOptions
 from fretwear.timedomain.quasistatic import incremental_wear
 
 MU, P = 0.3, 10e6
@@ -40,7 +41,7 @@ def pad(n, ratio):
     return from_mesh(
         box(0.01, 0.01, 0.005, n, n, 1), Material(210e9, 0.3, 7800.0),
         damping=Damping(rayleigh_stiffness=0.02 / (2 * np.pi * 1e5)),
-        springs=[Spring("zmax", "x", 1e7), Spring("zmax", "y", 1e7)],
+        supports=[Spring("zmax", "x", 1e7), Spring("zmax", "y", 1e7)],
         loads=[Traction("zmax", pressure=P),
                Traction("zmax", traction=(q * np.cos(t), q * np.sin(t), 0.0), waveform="cos")],
         contact=ContactSpec("zmin", mu=MU, wear_coefficient=1e-14),
@@ -63,8 +64,8 @@ def main():
     args = ap.parse_args()
     # compile the kernels once (cached on disk afterwards)
     t0 = time.perf_counter()
-    integrate(pad(1, 0.8), 1e3, n_periods=1, steps_per_period=16)
-    incremental_wear(pad(1, 0.8), steps_per_cycle=8, n_cycles=1)
+    integrate(pad(1, 0.8), 1e3, options=IntegrationOptions(steps_per_period=16), n_periods=1)
+    incremental_wear(pad(1, 0.8), options=IncrementalWearOptions(steps_per_cycle=8), n_cycles=1)
     print(f"warm-up (numba compile or cache load): {time.perf_counter() - t0:.2f} s")
     for n in args.sizes:
         nodes = (n + 1) ** 2
@@ -75,13 +76,15 @@ def main():
             steps, periods = 256, 20
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", RuntimeWarning)
-                res = integrate(model, 1e3, n_periods=periods, steps_per_period=steps)
+                res = integrate(model, 1e3, options=IntegrationOptions(steps_per_period=steps),
+                                n_periods=periods)
             per_step = res.wall_time / (steps * periods)
             print(f"pad {nodes} nodes, ratio {ratio}: integrate {res.wall_time:.2f} s "
                   f"({per_step * 1e6:.0f} us/step, step_over_lu={per_step / t_lu:.1f}, "
                   f"lu {t_lu * 1e6:.0f} us), failed={res.info['failed_steps']}, "
                   f"max_iterations={res.info['max_active_set_iterations']}")
-            wr = incremental_wear(model, steps_per_cycle=64, n_cycles=5, raise_on_failure=False)
+            wr = incremental_wear(model, options=IncrementalWearOptions(steps_per_cycle=64),
+                                  n_cycles=5, raise_on_failure=False)
             print(f"pad {nodes} nodes, ratio {ratio}: incremental_wear {wr.wall_time:.2f} s, "
                   f"success={wr.success}, max_iterations="
                   f"{wr.info['max_active_set_iterations']}")

@@ -25,17 +25,20 @@ from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.nonlinear_modes import nonlinear_mode
 from fretwear.hb.stability import stability
 from fretwear.hb.sweep import sweep
+from fretwear.model.build import Damping
 from fretwear.model.core import Load
-from fretwear.model.matrices import from_matrices
+from fretwear.model.matrices import ContactDofs, from_matrices
 
 M_, K_, KT, FS = 1.0, 1.0, 1.0, 0.1
 
 
 def jenkins(force=None, c=0.0):
     loads = [Load(np.array([force]), "cos")] if force else []
-    return from_matrices([[K_]], [[M_]], C=[[c]] if c else None, contact_normal_dofs=None,
-                         contact_tangential_dofs=[0], mu=FS, normal_load=1.0, kt=KT,
-                         loads=loads, observed={"x": 0})
+    return from_matrices([[K_]], [[M_]],
+                         contact=ContactDofs(normal_dofs=None, tangential_dofs=[0], mu=FS,
+                                             normal_load=1.0, kt=KT),
+                         damping=Damping(C=[[c]] if c else None), loads=loads,
+                         observed={"x": 0})
 
 
 def two_dof(kn=10.0, gap=0.5, force=0.1):
@@ -43,9 +46,10 @@ def two_dof(kn=10.0, gap=0.5, force=0.1):
     K[:2, :2] = [[1.0, -1.0], [-1.0, 2.0]]
     C = 0.03 * K
     C[2, 2] = 1.0
-    return from_matrices(K, np.eye(3), C=C, contact_normal_dofs=[0], contact_tangential_dofs=[2],
-                         gap=gap, mu=0.0, kn=kn, kt=kn,
-                         loads=[Load(np.array([0.0, force, 0.0]), "cos")],
+    return from_matrices(K, np.eye(3),
+                         contact=ContactDofs(normal_dofs=[0], tangential_dofs=[2], gap=gap,
+                                             mu=0.0, kn=kn, kt=kn),
+                         damping=Damping(C=C), loads=[Load(np.array([0.0, force, 0.0]), "cos")],
                          observed={"x1": 0, "x2": 1})
 
 

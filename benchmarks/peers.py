@@ -80,7 +80,8 @@ import numpy as np
 import fretwear
 from fretwear.hb.fourier import FourierBasis
 from fretwear.model.core import Load
-from fretwear.model.matrices import from_matrices
+from fretwear.model.build import Damping
+from fretwear.model.matrices import ContactDofs, from_matrices
 
 prob, H, n, w0, w1 = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), float(sys.argv[4]), \
     float(sys.argv[5])
@@ -89,13 +90,16 @@ eps = sys.argv[6] if sys.argv[6] in ("top", "auto", "static") else float(sys.arg
 
 def model():
     if prob == "a":
-        return from_matrices([[1.0]], [[1.0]], C=[[0.02]], contact_normal_dofs=None,
-                             contact_tangential_dofs=[0], mu=0.5, normal_load=1.0, kt=0.5,
-                             loads=[Load(np.array([0.2]), "cos")], observed={"x": 0})
-    return from_matrices(np.array([[2.0, -1.0], [-1.0, 1.0]]), np.eye(2), C=0.02 * np.eye(2),
-                         contact_normal_dofs=None, contact_tangential_dofs=[1], mu=0.5,
-                         normal_load=1.0, loads=[Load(np.array([0.2, 0.0]), "cos")],
-                         observed={"x": 0})
+        return from_matrices([[1.0]], [[1.0]],
+                             contact=ContactDofs(normal_dofs=None, tangential_dofs=[0], mu=0.5,
+                                                 normal_load=1.0, kt=0.5),
+                             damping=Damping(C=[[0.02]]), loads=[Load(np.array([0.2]), "cos")],
+                             observed={"x": 0})
+    return from_matrices(np.array([[2.0, -1.0], [-1.0, 1.0]]), np.eye(2),
+                         contact=ContactDofs(normal_dofs=None, tangential_dofs=[1], mu=0.5,
+                                             normal_load=1.0),
+                         damping=Damping(C=0.02 * np.eye(2)),
+                         loads=[Load(np.array([0.2, 0.0]), "cos")], observed={"x": 0})
 
 
 def run():

@@ -89,7 +89,7 @@ def pad(n: int):
 
     ne = n - 1
     return from_mesh(box(A, A, A / 8, ne, ne, layers(n)), Material(210e9, 0.3, 7800.0),
-                     springs=[Spring("zmax", "x", 1e7), Spring("zmax", "y", 1e7)],
+                     supports=[Spring("zmax", "x", 1e7), Spring("zmax", "y", 1e7)],
                      loads=[Traction("zmax", pressure=P0),
                             Traction("zmax", traction=(0.8 * MU * P0, 0.0, 0.0),
                                      waveform="cos")],

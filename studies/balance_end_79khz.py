@@ -93,6 +93,7 @@ def main(argv=None) -> int:
     from fretwear.hb.solvers import SolveStats
     from fretwear.io.case import build_model
     from fretwear.timedomain.averaged_rate import time_averaged_rate
+    from fretwear.timedomain.options import AveragingOptions
     from fretwear.wear import Rescue, SlowProblem, read_history, wear_coefficients
 
     with contextlib.ExitStack() as stack:
@@ -160,13 +161,14 @@ def main(argv=None) -> int:
             sp.set_state(W, anchor)
             g = sp.rate(Ub)
             Ut, Vt = initial_state(model, sp.solution(Ub, W, anchor, ok))
-            tr = time_averaged_rate(model, f_hz, basis, coef, W, U0=Ut, V0=Vt, settle=600,
-                                    average=200)
+            tr = time_averaged_rate(model, f_hz, basis, coef, W, U0=Ut, V0=Vt,
+                                    options=AveragingOptions(settle=600, average=200))
             print(f"  {label} = {N0 + s * (N1 - N0):.5g}: {tr.kind}; its wear rate differs from "
                   f"the balance's by {np.abs(tr.g - g).max() / g.max():.3f} of the largest rate")
             if label == "N*":  # and on to N1 from there
-                tr1 = time_averaged_rate(model, f_hz, basis, coef, W0 + dW, U0=tr.U_end,
-                                         V0=tr.V_end, settle=600, average=200)
+                tr1 = time_averaged_rate(model, f_hz, basis, coef, W0 + dW,
+                                         options=AveragingOptions(settle=600, average=200),
+                                         U0=tr.U_end, V0=tr.V_end)
                 print(f"  N1 = {N1:.5g} (continuing from N*): {tr1.kind}")
     return 0
 

@@ -35,19 +35,23 @@ import fretwear  # noqa: E402
 from fretwear.examples.builders import paper_beam  # noqa: E402
 from fretwear.hb.fourier import FourierBasis  # noqa: E402
 from fretwear.hb.periodic import solve_periodic  # noqa: E402
+from fretwear.model.build import Damping  # noqa: E402
 from fretwear.model.core import Load  # noqa: E402
-from fretwear.model.matrices import from_matrices  # noqa: E402
+from fretwear.model.matrices import ContactDofs, from_matrices  # noqa: E402
 
 
 def oscillator(prob: str):
     if prob == "a":
-        return from_matrices([[1.0]], [[1.0]], C=[[0.02]], contact_normal_dofs=None,
-                             contact_tangential_dofs=[0], mu=0.5, normal_load=1.0, kt=0.5,
-                             loads=[Load(np.array([0.2]), "cos")], observed={"x": 0})
-    return from_matrices(np.array([[2.0, -1.0], [-1.0, 1.0]]), np.eye(2), C=0.02 * np.eye(2),
-                         contact_normal_dofs=None, contact_tangential_dofs=[1], mu=0.5,
-                         normal_load=1.0, loads=[Load(np.array([0.2, 0.0]), "cos")],
-                         observed={"x": 0})
+        return from_matrices([[1.0]], [[1.0]],
+                             contact=ContactDofs(normal_dofs=None, tangential_dofs=[0], mu=0.5,
+                                                 normal_load=1.0, kt=0.5),
+                             damping=Damping(C=[[0.02]]), loads=[Load(np.array([0.2]), "cos")],
+                             observed={"x": 0})
+    return from_matrices(np.array([[2.0, -1.0], [-1.0, 1.0]]), np.eye(2),
+                         contact=ContactDofs(normal_dofs=None, tangential_dofs=[1], mu=0.5,
+                                             normal_load=1.0),
+                         damping=Damping(C=0.02 * np.eye(2)),
+                         loads=[Load(np.array([0.2, 0.0]), "cos")], observed={"x": 0})
 
 
 def part1(harmonics, eps_list):

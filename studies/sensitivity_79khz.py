@@ -60,13 +60,14 @@ def period_starts(model, frequency, U0, V0, wear, periods, steps):
     import numpy as np
 
     from fretwear.timedomain.integrate import integrate
+    from fretwear.timedomain.options import InitialState, IntegrationOptions
 
     out, U, V, ptp = [], U0, V0, 0.0
     done = 0
     while done < periods:
         n = min(CHUNK, periods - done)
-        r = integrate(model, frequency, n_periods=n, steps_per_period=steps, record=n, U0=U, V0=V,
-                      wear=wear)
+        r = integrate(model, frequency, options=IntegrationOptions(steps_per_period=steps),
+                      start=InitialState(U0=U, V0=V, wear=wear), n_periods=n, record=n)
         x = r.u_loc.reshape(r.u_loc.shape[0], -1)
         out.append(x[::steps])
         ptp = float(np.ptp(x, axis=0).max())
@@ -97,6 +98,7 @@ def fast_twins(folder: Path, periods: int) -> None:
     from fretwear.hb.fourier import FourierBasis
     from fretwear.io.case import build_model
     from fretwear.timedomain.averaged_rate import default_steps, time_averaged_rate
+    from fretwear.timedomain.options import AveragingOptions
     from fretwear.wear import wear_coefficients
 
     with np.load(folder / "wear-checkpoint.npz") as z:
@@ -128,7 +130,8 @@ def fast_twins(folder: Path, periods: int) -> None:
     area = np.asarray(model.contact.area, float)
     ga = time_averaged_rate(model, f_hz, basis, coef, W, U0=U0, V0=V0)
     gb = time_averaged_rate(model, f_hz, basis, coef, W, U0=U0, V0=V0 * (1 + PERTURBATION))
-    ga2 = time_averaged_rate(model, f_hz, basis, coef, W, U0=ga.U_end, V0=ga.V_end, settle=0)
+    ga2 = time_averaged_rate(model, f_hz, basis, coef, W, U0=ga.U_end, V0=ga.V_end,
+                             options=AveragingOptions(settle=0))
 
     def diff(g1, g2):
         return (f"{np.abs(g1.g - g2.g).max() / g1.g.max():.3f} of the largest node rate, "

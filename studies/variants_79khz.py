@@ -94,7 +94,7 @@ def build(nx=30, ny=4, damping="loss", spring_at="bottom_left", plane="strain"):
         Material(E, nu, 7800.0),
         thickness=WIDTH,
         damping=damp,
-        springs=[Spring(at[spring_at], "x", 1e4)],
+        supports=[Spring(at[spring_at], "x", 1e4)],
         loads=[Traction("top", pressure=1e4, waveform="constant", name="P"),
                Traction("right", pressure=1e4, waveform="sin", name="Q")],
         contact=ContactSpec("bottom", mu=0.3, normal=(0.0, -1.0), gap=0.0,

@@ -16,12 +16,13 @@ import fretwear as fw
 from fretwear.errors import InputError
 from fretwear.model import ContactSpec, Material, Spring, Traction, from_mesh, rectangle
 from fretwear.model.core import Load
+from fretwear.timedomain.options import InitialState, IntegrationOptions
 
 
 @pytest.fixture(scope="module")
 def block():
     return from_mesh(rectangle(0.02, 0.01, 4, 2), Material(210e9, 0.3, 7800.0), thickness=0.01,
-                     springs=[Spring(at=(0.0, 0.005), direction="x", stiffness=1e7)],
+                     supports=[Spring(at=(0.0, 0.005), direction="x", stiffness=1e7)],
                      loads=[Traction("top", pressure=1e6),
                             Traction("right", pressure=1e5, waveform="cos")],
                      contact=ContactSpec("bottom", mu=0.3), observed={"Pe": (0.02, 0.005)})
@@ -57,7 +58,7 @@ def test_load_on_a_harmonic_that_is_not_kept_is_refused():
     """A load on harmonic 5 with harmonics 1..3 kept would give a static response reported
     as converged: refused, naming both."""
     m = from_mesh(rectangle(0.02, 0.01, 4, 2), Material(210e9, 0.3, 7800.0), thickness=0.01,
-                  springs=[Spring(at=(0.0, 0.005), direction="x", stiffness=1e7)],
+                  supports=[Spring(at=(0.0, 0.005), direction="x", stiffness=1e7)],
                   loads=[Traction("top", pressure=1e6),
                          Traction("right", pressure=1e5, waveform="fourier",
                                   coefficients={5: (1.0, 0.0)})],
@@ -99,15 +100,15 @@ def test_fourier_basis_bad_arguments(harmonics, samples, match):
 def test_complex_stiffness_is_refused_not_cut():
     K = sp.csr_matrix(np.array([[2.0, -1.0], [-1.0, 2.0]]) * (1 + 0.01j))
     with pytest.raises(InputError, match="K holds complex values"):
-        fw.from_matrices(K, sp.identity(2), contact_normal_dofs=[0],
-                         contact_tangential_dofs=[1], mu=0.3)
+        fw.from_matrices(K, sp.identity(2),
+                         contact=fw.ContactDofs(normal_dofs=[0], tangential_dofs=[1], mu=0.3))
 
 
 def test_nan_load_is_refused():
     K = sp.csr_matrix(np.array([[2.0, -1.0], [-1.0, 2.0]]))
     with pytest.raises(InputError, match="finite nodal forces"):
-        fw.from_matrices(K, sp.identity(2), contact_normal_dofs=[0],
-                         contact_tangential_dofs=[1], mu=0.3,
+        fw.from_matrices(K, sp.identity(2),
+                         contact=fw.ContactDofs(normal_dofs=[0], tangential_dofs=[1], mu=0.3),
                          loads=[Load(np.array([np.nan, 0.0]), "cos")])
 
 
@@ -131,7 +132,7 @@ def test_time_steps_that_cannot_be_recorded_are_refused(block):
     """1e9 steps per period recorded: refused with the memory estimate, before allocating."""
     with pytest.raises(InputError, match=r"recording 1 periods of 1000000000 time steps needs "
                                          r"about .* GiB"):
-        fw.integrate(block, 1500.0, n_periods=1, steps_per_period=10**9)
+        fw.integrate(block, 1500.0, options=IntegrationOptions(steps_per_period=10**9), n_periods=1)
 
 
 # --- one vocabulary and argument order (fretwear.api) -----------------------------------------
@@ -166,23 +167,26 @@ def test_other_spellings_are_refused_with_the_public_one(block, call, old, new):
 
 
 def test_public_names_reach_the_core(block):
-    """``anchor`` of fw.integrate is the time-domain solver's ``stick_anchor`` (the same run
-    bit for bit, and not the run without it); ``wear_coefficient`` of fw.incremental_wear is
-    its own (0: no wear at all); ``wear0`` of fw.simulate_wear is the initial wear (the
-    first row of the history)."""
+    """``anchor`` of the initial state of fw.integrate reaches the time-domain solver (the
+    same run bit for bit as the solver's own, and not the run without it);
+    ``wear_coefficient`` of fw.incremental_wear is its own (0: no wear at all); ``wear0`` of
+    fw.simulate_wear is the initial wear (the first row of the history)."""
     from fretwear.timedomain.integrate import integrate
     from fretwear.timedomain.quasistatic import incremental_wear
 
     nc = block.contact.n_nodes
     anchor = np.full((nc, 1), 1e-7)
-    a = fw.integrate(block, 1500.0, n_periods=1, steps_per_period=16, anchor=anchor)
-    b = integrate(block, 1500.0, n_periods=1, steps_per_period=16, stick_anchor=anchor)
-    c = integrate(block, 1500.0, n_periods=1, steps_per_period=16)
+    scheme = fw.IntegrationOptions(steps_per_period=16)
+    a = fw.integrate(block, 1500.0, n_periods=1, options=scheme,
+                     start=fw.InitialState(anchor=anchor))
+    b = integrate(block, 1500.0, n_periods=1, options=scheme, start=InitialState(anchor=anchor))
+    c = integrate(block, 1500.0, n_periods=1, options=scheme)
     np.testing.assert_array_equal(a.U, b.U)
     assert not np.array_equal(a.U, c.U)
-    w = fw.incremental_wear(block, steps_per_cycle=8, n_cycles=2, wear_coefficient=0.0)
+    steps = fw.IncrementalWearOptions(steps_per_cycle=8)
+    w = fw.incremental_wear(block, n_cycles=2, options=steps, wear_coefficient=0.0)
     assert w.k_w == 0.0 and not np.any(w.wear)
-    assert np.array_equal(w.slip, incremental_wear(block, steps_per_cycle=8, n_cycles=2,
+    assert np.array_equal(w.slip, incremental_wear(block, n_cycles=2, options=steps,
                                                    wear_coefficient=0.0).slip)
     wear0 = np.linspace(0.0, 1e-9, nc)
     r = fw.simulate_wear(block, BASIS, quasi_static=True, wear0=wear0,

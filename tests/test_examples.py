@@ -25,6 +25,7 @@ from fretwear.examples.builders import stromberg_beam
 from fretwear.io.case import build_model
 from fretwear.io.results import read_results
 from fretwear.paper.catalogue import edit_case_text
+from fretwear.timedomain.options import IncrementalWearOptions
 from fretwear.timedomain.quasistatic import incremental_wear
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
@@ -217,7 +218,7 @@ def test_quasi_static_periodic_example_agrees_with_load_stepping(tmp_path):
     ds = run_reduced("beam-quasistatic-periodic.toml", tmp_path, numerics={})
     assert ds.attrs["converged"] == 1
     model = build_model(load_case(EXAMPLES / "beam-quasistatic-periodic.toml"))
-    ref = incremental_wear(model, steps_per_cycle=128, n_cycles=3,
+    ref = incremental_wear(model, n_cycles=3, options=IncrementalWearOptions(steps_per_cycle=128),
                            wear_coefficient=0.0).slip[-1]
     path = ds["slip_path"].values
     assert np.abs(path - ref).max() <= 5e-3 * ref.max()
@@ -355,8 +356,9 @@ def load_stepping_wear(waveform: str) -> np.ndarray:
     measured: 1.5e-3 of the deepest wear (jumps of 10 against 2), 5e-4 (64 against 256 steps).
     """
     model = stromberg_beam(waveform=waveform)
-    return incremental_wear(model, steps_per_cycle=64, n_cycles=STROMBERG_CYCLES,
-                            cycle_jump=10).wear[-1]
+    return incremental_wear(model,
+                            options=IncrementalWearOptions(steps_per_cycle=64, cycle_jump=10),
+                            n_cycles=STROMBERG_CYCLES).wear[-1]
 
 
 def test_stromberg_dlft_wear_agrees_with_load_stepping(tmp_path):

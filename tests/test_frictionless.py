@@ -27,7 +27,7 @@ def block(mu):
     return from_mesh(
         rectangle(L, H, nx=6, ny=2), Material(210e9, 0.3, 7800.0), thickness=W,
         damping=Damping(rayleigh_stiffness=5e-6),
-        springs=[Spring(at=(0.0, H / 2), direction="x", stiffness=1e7)],
+        supports=[Spring(at=(0.0, H / 2), direction="x", stiffness=1e7)],
         loads=[Traction("top", pressure=P),
                Traction("right", pressure=0.1 * P, waveform="cos")],
         contact=ContactSpec("bottom", mu=mu, wear_coefficient=1e-14),

@@ -342,7 +342,7 @@ def paper_beam(ny=3):
     from fretwear.model.build import ContactSpec, Damping, Material, Spring, Traction, from_mesh
     return from_mesh(
         fmesh.rectangle(L, H, 30, ny), Material(210e9, 0.3, 7800.0), thickness=WIDTH,
-        damping=Damping(loss_factor=1e-3), springs=[Spring("bottom_left", "x", 1e4)],
+        damping=Damping(loss_factor=1e-3), supports=[Spring("bottom_left", "x", 1e4)],
         loads=[Traction("top", pressure=1e4), Traction("right", pressure=1e4, waveform="cos")],
         contact=ContactSpec("bottom", mu=0.3), observed={"Pe": (L, H / 2)})
 

@@ -22,6 +22,11 @@ from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.sweep import sweep
 from fretwear.io.case import build_model
 from fretwear.timedomain.integrate import integrate
+from fretwear.timedomain.options import (
+    IncrementalWearOptions,
+    IntegrationOptions,
+    SteadyStateOptions,
+)
 from fretwear.timedomain.quasistatic import incremental_wear
 from fretwear.timedomain.steady import steady_state
 from fretwear.wear import SlowProblem, WearOptions, simulate_wear
@@ -84,29 +89,31 @@ def test_simulate_wear(monkeypatch):
 
 
 def test_integrate(tmp_path):
-    res = integrate(oscillator(), F_HZ, n_periods=2, steps_per_period=64)
+    res = integrate(oscillator(), F_HZ, n_periods=2,
+                    options=IntegrationOptions(steps_per_period=64))
     check_shape(res, True)
     # the 10 x 2 beam of tests/analyses/test_transient.py at 1 kHz with a coarse step: one
     # contact solve of its third period does not settle (measured; the run warns and says so)
     model = build_model(load_case(small_case(tmp_path, FIXED)))
     with pytest.warns(RuntimeWarning, match="did not settle"):
-        bad = integrate(model, 1e3, n_periods=3, steps_per_period=64)
+        bad = integrate(model, 1e3, options=IntegrationOptions(steps_per_period=64), n_periods=3)
     check_shape(bad, False)
     assert "did not settle" in bad.message
 
 
 def test_steady_state():
     model = oscillator()
-    res = steady_state(model, F_HZ, steps_per_period=64)
+    res = steady_state(model, F_HZ, integration=IntegrationOptions(steps_per_period=64))
     check_shape(res, True)
     assert res.classification == "periodic" and res.periodic
-    short = steady_state(model, F_HZ, steps_per_period=64, max_periods=2)
+    short = steady_state(model, F_HZ, options=SteadyStateOptions(max_periods=2),
+                         integration=IntegrationOptions(steps_per_period=64))
     check_shape(short, False)
     assert short.classification == "transient" and not short.periodic
 
 
 @pytest.mark.parametrize("raise_on_failure", [True, False])
 def test_incremental_wear(raise_on_failure):
-    res = incremental_wear(sliders(), steps_per_cycle=16, n_cycles=3,
-                           raise_on_failure=raise_on_failure)
+    res = incremental_wear(sliders(), options=IncrementalWearOptions(steps_per_cycle=16),
+                           n_cycles=3, raise_on_failure=raise_on_failure)
     check_shape(res, True)

@@ -53,6 +53,7 @@ _API = {
     "Damping": "fretwear.model.build", "Spring": "fretwear.model.build",
     "Traction": "fretwear.model.build", "NodalForce": "fretwear.model.build",
     "from_matrices": "fretwear.model.matrices", "read_matrix_market": "fretwear.model.matrices",
+    "ContactDofs": "fretwear.model.matrices",
     # harmonic balance
     "FourierBasis": "fretwear.hb.fourier", "condense": "fretwear.hb.reduce",
     "exact_condenser": "fretwear.hb.reduce", "modal_condenser": "fretwear.hb.modal",
@@ -69,6 +70,10 @@ _API = {
     "integrate": "fretwear.api", "steady_state": "fretwear.api",
     "incremental_wear": "fretwear.api",
     "check_periodic": "fretwear.timedomain.stability",
+    "IntegrationOptions": "fretwear.timedomain.options",
+    "InitialState": "fretwear.timedomain.options",
+    "SteadyStateOptions": "fretwear.timedomain.options",
+    "IncrementalWearOptions": "fretwear.timedomain.options",
     # case files and results
     "run_case": "fretwear.analyses.run", "load_case": "fretwear.analyses.run",
     "read_results": "fretwear.io.results",

@@ -45,11 +45,16 @@ def _fallback(time_domain: bool):
     return FALLBACK if time_domain else None
 
 
-def _public_names(func: str, kwargs: dict) -> None:
-    """A TypeError for a keyword spelt as another entry point spells it."""
+#: where the time-domain drivers take the stick anchors
+_IN_START = {"anchor": " (start=InitialState(anchor=...))"}
+
+
+def _public_names(func: str, kwargs: dict, where: dict | None = None) -> None:
+    """A TypeError for a keyword spelt as another entry point spells it (``where``: the
+    record that holds the public name, for the drivers that take it in one)."""
     for old, new in _RENAMED.items():
         if old in kwargs:
-            raise TypeError(f"{func}() takes {new}, not {old}")
+            raise TypeError(f"{func}() takes {new}, not {old}{(where or {}).get(new, '')}")
 
 
 def _frequency(frequency, quasi_static: bool) -> dict:
@@ -190,7 +195,7 @@ def frf_worn(model, basis, wear, f_min: float, f_max: float, n_points: int, *,
                           time_domain=_fallback(time_domain), **kwargs)
 
 
-def integrate(model, frequency: float, *, anchor=None, **kwargs):
+def integrate(model, frequency: float, **kwargs):
     """Integrate the forced response at ``frequency`` [Hz] in time with exact contact and
     friction.
 
@@ -198,23 +203,25 @@ def integrate(model, frequency: float, *, anchor=None, **kwargs):
     ----------
     model : the structure.
     frequency : forcing frequency [Hz].
-    anchor : (nc, d-1) tangential positions [m] from which the first step's slip is measured
-        (default: those of ``U0``).
-    **kwargs : the other keywords of :func:`fretwear.timedomain.integrate.integrate`, with
-        its defaults: ``n_periods`` (required), ``steps_per_period``, ``record``, ``U0`` [m],
-        ``V0`` [m/s], ``wear`` (nc,) [m], ``modal_cutoff`` [Hz], ``n_modes``, ``gamma``,
-        ``hf_damping``, ``keep_poincare``, ``tol``, ``progress``.
+    **kwargs : the keywords of :func:`fretwear.timedomain.integrate.integrate`, with its
+        defaults: ``n_periods`` (required), ``options`` (an
+        :class:`~fretwear.timedomain.options.IntegrationOptions`: ``steps_per_period``,
+        ``gamma``, ``hf_damping``, ``modal_cutoff`` [Hz], ``n_modes``, ``contact_tol``),
+        ``start`` (an :class:`~fretwear.timedomain.options.InitialState`: ``U0`` [m], ``V0``
+        [m/s], ``wear`` (nc,) [m], ``anchor`` (nc, d-1) [m], the tangential positions from
+        which the first step's slip is measured), ``record``, ``keep_poincare``,
+        ``progress``.
 
     Returns
     -------
     :class:`~fretwear.timedomain.results.TransientResult`: ``success``, ``message``, the
     recorded samples and the final state ``U, V`` to continue the run.
     """
-    _public_names("integrate", kwargs)
-    return _integrate.integrate(model, frequency, stick_anchor=anchor, **kwargs)
+    _public_names("integrate", kwargs, _IN_START)
+    return _integrate.integrate(model, frequency, **kwargs)
 
 
-def steady_state(model, frequency: float, *, anchor=None, **kwargs):
+def steady_state(model, frequency: float, **kwargs):
     """Integrate at ``frequency`` [Hz] until the response is periodic (or classified
     otherwise).
 
@@ -222,11 +229,12 @@ def steady_state(model, frequency: float, *, anchor=None, **kwargs):
     ----------
     model : the structure.
     frequency : forcing frequency [Hz].
-    anchor : (nc, d-1) tangential positions [m] from which the first step's slip is measured.
-    **kwargs : the other keywords of :func:`fretwear.timedomain.steady.steady_state`, with its
-        defaults: ``max_periods``, ``tol``, ``steps_per_period``, ``harmonics``,
-        ``check_every``, ``window``, ``min_periods``, ``U0``, ``V0``, ``wear`` [m],
-        ``modal_cutoff`` [Hz], ``n_modes``, ``gamma``, ``hf_damping``, ``contact_tol``,
+    **kwargs : the keywords of :func:`fretwear.timedomain.steady.steady_state`, with its
+        defaults: ``options`` (a :class:`~fretwear.timedomain.options.SteadyStateOptions`:
+        ``max_periods``, ``tol``, ``harmonics``, ``check_every``, ``window``,
+        ``min_periods``), ``integration`` (an
+        :class:`~fretwear.timedomain.options.IntegrationOptions`), ``start`` (an
+        :class:`~fretwear.timedomain.options.InitialState`, with the stick ``anchor``),
         ``progress``.
 
     Returns
@@ -234,8 +242,8 @@ def steady_state(model, frequency: float, *, anchor=None, **kwargs):
     :class:`~fretwear.timedomain.results.SteadyStateResult`: ``success``, ``message``,
     ``classification``, the harmonics of the last period.
     """
-    _public_names("steady_state", kwargs)
-    return _steady.steady_state(model, frequency, stick_anchor=anchor, **kwargs)
+    _public_names("steady_state", kwargs, _IN_START)
+    return _steady.steady_state(model, frequency, **kwargs)
 
 
 def incremental_wear(model, *, wear_coefficient: float | None = None, wear0=None, **kwargs):
@@ -249,8 +257,10 @@ def incremental_wear(model, *, wear_coefficient: float | None = None, wear0=None
     wear0 : (nc,) initial wear [m].
     **kwargs : the other keywords of
         :func:`fretwear.timedomain.quasistatic.incremental_wear`, with its defaults:
-        ``steps_per_cycle``, ``n_cycles``, ``cycle_jump``, ``record_every``, ``tol``,
-        ``progress``, ``raise_on_failure``.
+        ``n_cycles``, ``options`` (an
+        :class:`~fretwear.timedomain.options.IncrementalWearOptions`: ``steps_per_cycle``,
+        ``cycle_jump``, ``record_every``, ``contact_tol``), ``progress``,
+        ``raise_on_failure``, ``condenser``.
 
     Returns
     -------

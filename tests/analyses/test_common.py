@@ -1,6 +1,7 @@
 """One definition per option: the default of every case-file key that is a keyword of the
-Python function its analysis calls is that keyword's default (the schema takes it from the
-signature, :func:`fretwear.analyses.common.default_of`).
+Python function its analysis calls, or a field of the option record that function takes, is
+that keyword's or field's default (the schema takes it from the signature,
+:func:`fretwear.analyses.common.default_of`).
 
 The table below restates, independently of the schemas, which function and keyword each key
 maps to; the test validates minimal case files and compares the filled-in defaults with the
@@ -21,6 +22,11 @@ from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.sweep import sweep
 from fretwear.io.case import validate
 from fretwear.timedomain.integrate import integrate
+from fretwear.timedomain.options import (
+    IncrementalWearOptions,
+    IntegrationOptions,
+    SteadyStateOptions,
+)
 from fretwear.timedomain.quasistatic import incremental_wear
 from fretwear.timedomain.steady import steady_state
 from fretwear.wear import BalanceSetup, WearOptions, frf_worn, simulate_wear
@@ -44,10 +50,12 @@ CASES = {
                                             "eps", "solver", "tol", "max_iter")},
         "time_domain": (api.sweep, "time_domain")}),
     "transient": ({"frequency": 10.0}, {
-        "steps_per_period": (steady_state, "steps_per_period"),
-        **{k: (steady_state, k) for k in ("max_periods", "tol", "harmonics")}}),
-    "incremental-wear": ({}, {k: (incremental_wear, k) for k in (
-        "steps_per_cycle", "n_cycles", "cycle_jump", "record_every")}),
+        "steps_per_period": (IntegrationOptions, "steps_per_period"),
+        **{k: (SteadyStateOptions, k) for k in ("max_periods", "tol", "harmonics")}}),
+    "incremental-wear": ({}, {
+        "n_cycles": (incremental_wear, "n_cycles"),
+        **{k: (IncrementalWearOptions, k) for k in (
+            "steps_per_cycle", "cycle_jump", "record_every")}}),
     "wear": ({"frequency": 10.0, "frf_before_after": {"f_min": 1.0, "f_max": 10.0}}, {
         **BASIS, "quasi_static": (simulate_wear, "quasi_static"),
         "frf_before_after.spacing": (frf_worn, "spacing"),
@@ -91,10 +99,10 @@ def test_wear_options_defaults():
 
 def test_integrate_and_steady_state_share_their_step_and_frequency_defaults():
     """The transient analysis calls integrate (fixed) or steady_state: one default for the
-    steps per period; and the frequency of a quasi-static solve (case files: 1 Hz) is the
-    same for the periodic solve and the wear run."""
-    assert (python_default(integrate, "steps_per_period")
-            == python_default(steady_state, "steps_per_period"))
+    time scheme (the same IntegrationOptions, hence the same steps per period); and the
+    frequency of a quasi-static solve (case files: 1 Hz) is the same for the periodic solve and
+    the wear run."""
+    assert python_default(integrate, "options") == python_default(steady_state, "integration")
     assert (python_default(solve_periodic, "frequency")
             == QUASI_STATIC_FREQUENCY == 1.0)
 

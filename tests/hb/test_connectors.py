@@ -20,8 +20,9 @@ from fretwear.hb.connectors import Connected, connect
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import initial_state, solve_periodic
 from fretwear.hb.reduce import condense
+from fretwear.model.build import Damping
 from fretwear.model.core import Load
-from fretwear.model.matrices import from_matrices
+from fretwear.model.matrices import ContactDofs, from_matrices
 
 BASIS = FourierBasis.up_to(3, 32)
 TOL = 1e-11  # solver tolerance: both models converged far below the comparison tolerance
@@ -38,12 +39,15 @@ def jenkins(kt, *, explicit, mu=0.5, normal=1.0, force=0.2):
     load = Load(np.array([force] + [0.0] * explicit), "cos")
     if explicit:
         K = np.array([[1.0 + kt, -kt], [-kt, kt]])
-        return from_matrices(K, np.diag([1.0, 0.0]), C=np.diag([0.02, 0.0]),
-                             contact_normal_dofs=None, contact_tangential_dofs=[1], mu=mu,
-                             normal_load=normal, loads=[load], observed={"u": 0})
-    return from_matrices([[1.0]], [[1.0]], C=[[0.02]], contact_normal_dofs=None,
-                         contact_tangential_dofs=[0], mu=mu, normal_load=normal, kt=kt,
-                         loads=[load], observed={"u": 0})
+        return from_matrices(K, np.diag([1.0, 0.0]),
+                             contact=ContactDofs(normal_dofs=None, tangential_dofs=[1], mu=mu,
+                                                 normal_load=normal),
+                             damping=Damping(C=np.diag([0.02, 0.0])), loads=[load],
+                             observed={"u": 0})
+    return from_matrices([[1.0]], [[1.0]],
+                         contact=ContactDofs(normal_dofs=None, tangential_dofs=[0], mu=mu,
+                                             normal_load=normal, kt=kt),
+                         damping=Damping(C=[[0.02]]), loads=[load], observed={"u": 0})
 
 
 @pytest.mark.parametrize("w", [1.18, 1.24, 1.3])
@@ -96,12 +100,15 @@ def test_normal_and_tangential_stiffness_match_explicit_dofs():
         K[np.ix_([i, 2 + i], [i, 2 + i])] += k * np.array([[1.0, -1.0], [-1.0, 1.0]])
     M = np.diag([1.0, 1.0, 0.0, 0.0])
     C = np.diag([0.05, 0.05, 0.0, 0.0])
-    explicit = from_matrices(K, M, C=C, contact_normal_dofs=[2], contact_tangential_dofs=[3],
-                             mu=0.4, loads=F, observed={"m": [0, 1]})
+    explicit = from_matrices(K, M,
+                             contact=ContactDofs(normal_dofs=[2], tangential_dofs=[3], mu=0.4),
+                             damping=Damping(C=C), loads=F, observed={"m": [0, 1]})
     K2 = np.eye(2)
     # the connected model: the mass is the contact node; the springs are the interface's
-    connected = from_matrices(K2, M[:2, :2], C=C[:2, :2], contact_normal_dofs=[0],
-                              contact_tangential_dofs=[1], mu=0.4, kn=kn, kt=kt,
+    connected = from_matrices(K2, M[:2, :2],
+                              contact=ContactDofs(normal_dofs=[0], tangential_dofs=[1], mu=0.4,
+                                                  kn=kn, kt=kt),
+                              damping=Damping(C=C[:2, :2]),
                               loads=[Load(ld.vector[:2], ld.waveform) for ld in F],
                               observed={"m": [0, 1]})
     f = 0.9 / (2 * np.pi)
@@ -128,8 +135,9 @@ def test_connect_matches_closed_form_and_rigid_limit():
     M = np.diag([1.0, 2.0])
 
     def model(kn, kt):
-        return from_matrices(K, M, contact_normal_dofs=[0], contact_tangential_dofs=[1],
-                             mu=0.3, kn=kn, kt=kt, loads=[Load(np.array([1.0, 0.5]), "cos")])
+        return from_matrices(K, M, contact=ContactDofs(normal_dofs=[0], tangential_dofs=[1],
+                                                       mu=0.3, kn=kn, kt=kt),
+                             loads=[Load(np.array([1.0, 0.5]), "cos")])
 
     red = condense(model(None, None), 0.2, [0, 1, 2])
     kn, kt = 2.0, 0.7

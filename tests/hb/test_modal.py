@@ -28,7 +28,7 @@ def model():
     """A 10 x 10 x 5 mm steel block (4 x 4 x 2 hexahedra) on a rigid flat, pressed and
     loaded tangentially on top, observed at a top corner."""
     return from_mesh(box(0.01, 0.01, 0.005, 4, 4, 2), Material(210e9, 0.3, 7800.0),
-                     springs=[Spring("zmax", "x", 1e7), Spring("zmax", "y", 1e7)],
+                     supports=[Spring("zmax", "x", 1e7), Spring("zmax", "y", 1e7)],
                      loads=[Traction("zmax", pressure=1e6),
                             Traction("zmax", traction=(3e5, 0.0, 0.0), waveform="cos")],
                      contact=ContactSpec("zmin", mu=0.5), observed={"corner": (0.01, 0.01,
@@ -93,7 +93,7 @@ def test_modal_condenser_passed_is_used_after_other_models(model):
     first = frf(model, f_frf, method="condensed", condenser=mc)
     for nx in (2, 3, 4, 5, 6):  # five other models, each condensed
         other = from_mesh(box(0.01, 0.01, 0.005, nx, 2, 1), Material(210e9, 0.3, 7800.0),
-                          springs=[Spring("zmax", "x", 1e7), Spring("zmax", "y", 1e7)],
+                          supports=[Spring("zmax", "x", 1e7), Spring("zmax", "y", 1e7)],
                           loads=[Traction("zmax", pressure=1e6)],
                           contact=ContactSpec("zmin", mu=0.5))
         reduce.condense(other, F_MAX, [0, 1])
@@ -115,7 +115,7 @@ def test_modal_condenser_refuses_another_model(model):
     refuses it in one line instead of condensing the wrong structure."""
     mc = ModalCondenser(model, F_MAX, 7, tol=1e-2)
     twin = from_mesh(box(0.01, 0.01, 0.005, 4, 4, 2), Material(210e9, 0.3, 7800.0),
-                     springs=[Spring("zmax", "x", 1e7), Spring("zmax", "y", 1e7)],
+                     supports=[Spring("zmax", "x", 1e7), Spring("zmax", "y", 1e7)],
                      loads=[Traction("zmax", pressure=1e6),
                             Traction("zmax", traction=(3e5, 0.0, 0.0), waveform="cos")],
                      contact=ContactSpec("zmin", mu=0.5))
@@ -135,7 +135,7 @@ def test_undamped_blocks_are_stored_real(loss_factor):
     from fretwear.model import Damping
 
     m = from_mesh(box(0.01, 0.01, 0.005, 4, 4, 2), Material(210e9, 0.3, 7800.0),
-                  springs=[Spring("zmax", "x", 1e7), Spring("zmax", "y", 1e7)],
+                  supports=[Spring("zmax", "x", 1e7), Spring("zmax", "y", 1e7)],
                   loads=[Traction("zmax", pressure=1e6)], contact=ContactSpec("zmin", mu=0.5),
                   damping=Damping(loss_factor=loss_factor))
     mc = ModalCondenser(m, F_MAX, 7, tol=1e-2)

@@ -31,16 +31,18 @@ import pytest
 
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.nonlinear_modes import nonlinear_mode
+from fretwear.model.build import Damping
 from fretwear.model.core import Load
-from fretwear.model.matrices import from_matrices
+from fretwear.model.matrices import ContactDofs, from_matrices
 
 M_, K_, KT, FS = 1.0, 1.0, 1.0, 0.1  # kg, N/m, N/m, N
 
 
 def jenkins_model(c=0.0):
-    return from_matrices([[K_]], [[M_]], C=None if c == 0 else [[c]], contact_normal_dofs=None,
-                         contact_tangential_dofs=[0], mu=FS, normal_load=1.0, kt=KT,
-                         observed={"x": 0})
+    return from_matrices([[K_]], [[M_]],
+                         contact=ContactDofs(normal_dofs=None, tangential_dofs=[0], mu=FS,
+                                             normal_load=1.0, kt=KT),
+                         damping=Damping(C=None if c == 0 else [[c]]), observed={"x": 0})
 
 
 def describing_function(a):
@@ -136,8 +138,9 @@ def test_rigid_contact_mode_with_a_master_coordinate():
     light node's inertia neglected: 2e-3 (measured 5e-4)."""
     ms, kz = 1e-3, 10.0
     K = np.array([[K_ + KT, -KT, 0], [-KT, KT, 0], [0, 0, kz]])
-    model = from_matrices(K, np.diag([M_, ms, ms]), contact_normal_dofs=[2],
-                          contact_tangential_dofs=[1], gap=0.0, mu=FS,
+    model = from_matrices(K, np.diag([M_, ms, ms]),
+                          contact=ContactDofs(normal_dofs=[2], tangential_dofs=[1], gap=0.0,
+                                              mu=FS),
                           loads=[Load(np.array([0, 0, 1.0]), "constant")], observed={"x": 0})
     amps = np.geomspace(0.01, 10.0, 13)
     bb = nonlinear_mode(model, FourierBasis((1,), 512), amps, eps=KT)

@@ -285,12 +285,15 @@ def test_jenkins_eps_is_its_spring_and_equals_the_aft_balance(w, f0):
     differ by far more, so the comparison can fail. Both frequencies slip in both directions
     every period (amplitude above ``mu N / kt``), where the periodic state is unique (a
     Jenkins element that sticks all period has a free mean)."""
-    from fretwear.model.matrices import from_matrices
+    from fretwear.model.build import Damping
+    from fretwear.model.matrices import ContactDofs, from_matrices
 
     H, N = 5, 64
-    model = from_matrices([[1.0]], [[1.0]], C=[[0.02]], contact_normal_dofs=None,
-                          contact_tangential_dofs=[0], mu=0.5, normal_load=1.0, kt=0.5,
-                          loads=[Load(np.array([f0]), "cos")], observed={"x": 0})
+    model = from_matrices([[1.0]], [[1.0]],
+                          contact=ContactDofs(normal_dofs=None, tangential_dofs=[0], mu=0.5,
+                                              normal_load=1.0, kt=0.5),
+                          damping=Damping(C=[[0.02]]), loads=[Load(np.array([f0]), "cos")],
+                          observed={"x": 0})
     basis = FourierBasis.up_to(H, N)
     for rule in ("top", "auto", "static"):
         assert penalty(rule, model=model, frequency=w / (2 * np.pi),

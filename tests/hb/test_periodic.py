@@ -321,7 +321,7 @@ def fe_block(q_ratio=0.8):
     return from_mesh(
         mesh, Material(210e9, 0.3, 7800.0), thickness=W_B,
         damping=Damping(rayleigh_stiffness=RAYLEIGH_B),
-        springs=[Spring(at=(0.0, H_B / 2), direction="x", stiffness=1e7)],
+        supports=[Spring(at=(0.0, H_B / 2), direction="x", stiffness=1e7)],
         loads=[Traction("top", pressure=P_B),
                Traction("right", pressure=q_ratio * MU_B * P_B * L_B / H_B, waveform="cos")],
         contact=ContactSpec("bottom", mu=MU_B),
@@ -506,7 +506,7 @@ def block_3d(angle_deg, q_ratio=2.0, nu=0.0):
     t = np.radians(angle_deg)
     return from_mesh(
         mesh, Material(210e9, nu, 7800.0),
-        springs=[Spring("zmax", "x", 1e7), Spring("zmax", "y", 1e7)],
+        supports=[Spring("zmax", "x", 1e7), Spring("zmax", "y", 1e7)],
         loads=[Traction("zmax", pressure=P_B),
                Traction("zmax", traction=(q * np.cos(t), q * np.sin(t), 0.0), waveform="cos")],
         contact=ContactSpec("zmin", mu=MU_B))
@@ -617,12 +617,14 @@ def test_strategy_records_every_attempt_and_ends_at_the_target_eps():
     evaluates the residual of the returned harmonics below the tolerance, and the attempts
     are recorded in order with only the last one successful."""
     from fretwear.hb.fourier import FourierBasis as FB
-    from fretwear.model.matrices import from_matrices
+    from fretwear.model.build import Damping
+    from fretwear.model.matrices import ContactDofs, from_matrices
 
-    model = from_matrices(np.array([[2.0, -1.0], [-1.0, 1.0]]), np.eye(2), C=0.02 * np.eye(2),
-                          contact_normal_dofs=None, contact_tangential_dofs=[1], mu=0.5,
-                          normal_load=1.0, loads=[Load(np.array([0.2, 0.0]), "cos")],
-                          observed={"x": 0})
+    model = from_matrices(np.array([[2.0, -1.0], [-1.0, 1.0]]), np.eye(2),
+                          contact=ContactDofs(normal_dofs=None, tangential_dofs=[1], mu=0.5,
+                                              normal_load=1.0),
+                          damping=Damping(C=0.02 * np.eye(2)),
+                          loads=[Load(np.array([0.2, 0.0]), "cos")], observed={"x": 0})
     basis = FB.up_to(15, 128)
     sol = solve_periodic(model, basis, frequency=1.4905405 / (2 * np.pi), eps=1.0)
     assert sol.success and sol.eps == 1.0
@@ -753,12 +755,14 @@ def test_strategy_without_an_attempt_at_the_target_reports_the_start_residual():
     residual is the start's, |f(x0)| / scale(x0) evaluated here with numpy's norm, not inf
     (which the sweeps' messages printed before)."""
     from fretwear.hb.periodic import solve_strategy
-    from fretwear.model.matrices import from_matrices
+    from fretwear.model.build import Damping
+    from fretwear.model.matrices import ContactDofs, from_matrices
 
-    model = from_matrices(np.array([[2.0, -1.0], [-1.0, 1.0]]), np.eye(2), C=0.02 * np.eye(2),
-                          contact_normal_dofs=None, contact_tangential_dofs=[1], mu=0.5,
-                          normal_load=1.0, loads=[Load(np.array([0.2, 0.0]), "cos")],
-                          observed={"x": 0})
+    model = from_matrices(np.array([[2.0, -1.0], [-1.0, 1.0]]), np.eye(2),
+                          contact=ContactDofs(normal_dofs=None, tangential_dofs=[1], mu=0.5,
+                                              normal_load=1.0),
+                          damping=Damping(C=0.02 * np.eye(2)),
+                          loads=[Load(np.array([0.2, 0.0]), "cos")], observed={"x": 0})
     basis = FourierBasis.up_to(3, 32)
     red = condense(model, 1.49 / (2 * np.pi), basis.orders)
     prob = DLFTProblem(red, model.contact, basis, eps=1.0)

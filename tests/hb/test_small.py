@@ -21,24 +21,27 @@ from fretwear.hb.reduce import condense
 from fretwear.hb.sweep import sweep
 from fretwear.model import ContactSpec, Damping, Material, Spring, Traction, from_mesh, rectangle
 from fretwear.model.core import Load
-from fretwear.model.matrices import from_matrices
+from fretwear.model.matrices import ContactDofs, from_matrices
 
 W_HZ = 1.0 / (2 * np.pi)  # the oscillators' frequencies are given in rad/s
 
 
 def jenkins():
     """(a): m = 1, k = 1, c = 0.02, a Jenkins element kt = 0.5 under mu N = 0.5."""
-    return from_matrices([[1.0]], [[1.0]], C=[[0.02]], contact_normal_dofs=None,
-                         contact_tangential_dofs=[0], mu=0.5, normal_load=1.0, kt=0.5,
-                         loads=[Load(np.array([0.2]), "cos")], observed={"x": 0})
+    return from_matrices([[1.0]], [[1.0]],
+                         contact=ContactDofs(normal_dofs=None, tangential_dofs=[0], mu=0.5,
+                                             normal_load=1.0, kt=0.5),
+                         damping=Damping(C=[[0.02]]), loads=[Load(np.array([0.2]), "cos")],
+                         observed={"x": 0})
 
 
 def chain():
     """(b): two masses, mass 2 on a rigid Coulomb contact under a constant normal load."""
-    return from_matrices(np.array([[2.0, -1.0], [-1.0, 1.0]]), np.eye(2), C=0.02 * np.eye(2),
-                         contact_normal_dofs=None, contact_tangential_dofs=[1], mu=0.5,
-                         normal_load=1.0, loads=[Load(np.array([0.2, 0.0]), "cos")],
-                         observed={"x": 0})
+    return from_matrices(np.array([[2.0, -1.0], [-1.0, 1.0]]), np.eye(2),
+                         contact=ContactDofs(normal_dofs=None, tangential_dofs=[1], mu=0.5,
+                                             normal_load=1.0),
+                         damping=Damping(C=0.02 * np.eye(2)),
+                         loads=[Load(np.array([0.2, 0.0]), "cos")], observed={"x": 0})
 
 
 def block():
@@ -49,7 +52,7 @@ def block():
     return from_mesh(
         rectangle(L, H, nx=4, ny=2), Material(210e9, 0.3, 7800.0), thickness=0.01,
         damping=Damping(rayleigh_stiffness=5e-6),
-        springs=[Spring(at=(0.0, H / 2), direction="x", stiffness=1e7)],
+        supports=[Spring(at=(0.0, H / 2), direction="x", stiffness=1e7)],
         loads=[Traction("top", pressure=1e6),
                Traction("right", pressure=2e6, waveform="cos")],
         contact=ContactSpec("bottom", mu=0.8), observed={"Pe": (L, H / 2)})

@@ -31,8 +31,9 @@ from fretwear.hb.stability import (
     shifted_gain,
     stability,
 )
+from fretwear.model.build import Damping
 from fretwear.model.core import Load
-from fretwear.model.matrices import from_matrices
+from fretwear.model.matrices import ContactDofs, from_matrices
 
 # --- models --------------------------------------------------------------------------------
 K2 = np.array([[1.0, -1.0], [-1.0, 2.0]])  # two masses of 1 kg: springs 0, 1, 1 N/m
@@ -49,18 +50,21 @@ def two_dof(kn=10.0, gap=0.5, force=0.1):
     C = np.zeros((3, 3))
     C[:2, :2] = C2
     C[2, 2] = 1.0
-    return from_matrices(K, np.eye(3), C=C, contact_normal_dofs=[0], contact_tangential_dofs=[2],
-                         gap=gap, mu=0.0, kn=kn, kt=kn,
-                         loads=[Load(np.array([0.0, force, 0.0]), "cos")],
+    return from_matrices(K, np.eye(3),
+                         contact=ContactDofs(normal_dofs=[0], tangential_dofs=[2], gap=gap,
+                                             mu=0.0, kn=kn, kt=kn),
+                         damping=Damping(C=C), loads=[Load(np.array([0.0, force, 0.0]), "cos")],
                          observed={"x1": 0, "x2": 1})
 
 
 def jenkins(force, m=1.0, k=1.0, c=0.02, kt=0.5, slip=0.5):
     """A mass on a spring ``k`` and a Jenkins element (``kt`` in series with a slider of
     threshold ``slip`` = mu N, N prescribed)."""
-    return from_matrices([[k]], [[m]], C=[[c]], contact_normal_dofs=None,
-                         contact_tangential_dofs=[0], mu=slip, normal_load=1.0, kt=kt,
-                         loads=[Load(np.array([force]), "cos")], observed={"x": 0})
+    return from_matrices([[k]], [[m]],
+                         contact=ContactDofs(normal_dofs=None, tangential_dofs=[0], mu=slip,
+                                             normal_load=1.0, kt=kt),
+                         damping=Damping(C=[[c]]), loads=[Load(np.array([force]), "cos")],
+                         observed={"x": 0})
 
 
 def continued(model, basis, omegas):

@@ -25,7 +25,7 @@ def closed_block(mu=0.0, q=1e5):
     driven by a cosine pressure ``q`` [Pa] on its right face (0.1 MPa: stays closed)."""
     return from_mesh(rectangle(L, H, nx=6, ny=2), Material(210e9, 0.3, 7800.0), thickness=0.01,
                      damping=Damping(rayleigh_stiffness=5e-6),
-                     springs=[Spring(at=(0.0, H / 2), direction="x", stiffness=1e7)],
+                     supports=[Spring(at=(0.0, H / 2), direction="x", stiffness=1e7)],
                      loads=[Traction("top", pressure=1e6),
                             Traction("right", pressure=q, waveform="cos")],
                      contact=ContactSpec("bottom", mu=mu),
@@ -75,13 +75,15 @@ def test_point_passed_by_eps_continuation_keeps_the_sweep_eps_and_its_attempts()
     harmonics is below the tolerance."""
     from fretwear.hb.periodic import DLFTProblem
     from fretwear.hb.reduce import condense
+    from fretwear.model.build import Damping
     from fretwear.model.core import Load
-    from fretwear.model.matrices import from_matrices
+    from fretwear.model.matrices import ContactDofs, from_matrices
 
-    model = from_matrices(np.array([[2.0, -1.0], [-1.0, 1.0]]), np.eye(2), C=0.02 * np.eye(2),
-                          contact_normal_dofs=None, contact_tangential_dofs=[1], mu=0.5,
-                          normal_load=1.0, loads=[Load(np.array([0.2, 0.0]), "cos")],
-                          observed={"x": 0})
+    model = from_matrices(np.array([[2.0, -1.0], [-1.0, 1.0]]), np.eye(2),
+                          contact=ContactDofs(normal_dofs=None, tangential_dofs=[1], mu=0.5,
+                                              normal_load=1.0),
+                          damping=Damping(C=0.02 * np.eye(2)),
+                          loads=[Load(np.array([0.2, 0.0]), "cos")], observed={"x": 0})
     basis = FourierBasis.up_to(15, 128)
     f = 1.4905405 / (2 * np.pi)
     res = sweep(model, basis, f, 1.01 * f, 2, eps=1.0, time_domain=None)

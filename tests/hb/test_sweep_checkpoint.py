@@ -34,7 +34,7 @@ def slipping_block():
     (near resonance) separation along the sweep."""
     return from_mesh(rectangle(L, H, nx=6, ny=2), Material(210e9, 0.3, 7800.0), thickness=0.01,
                      damping=Damping(rayleigh_stiffness=5e-6),
-                     springs=[Spring(at=(0.0, H / 2), direction="x", stiffness=1e7)],
+                     supports=[Spring(at=(0.0, H / 2), direction="x", stiffness=1e7)],
                      loads=[Traction("top", pressure=1e6),
                             Traction("right", pressure=5e5, waveform="cos")],
                      contact=ContactSpec("bottom", mu=0.3), observed={"Pe": (L, H / 2)})

@@ -36,7 +36,7 @@ def block(dim, loss_factor=0.0):
         lift = (lambda x: np.column_stack([0 * x[:, 0], 0 * x[:, 0], 1.3 * P0 * x[:, 0] / a]))
         springs = [Spring(top, "x", 1e7), Spring(top, "y", 1e7)]
     damping = Damping(loss_factor=loss_factor) if loss_factor else None
-    return from_mesh(mesh, Material(210e9, 0.3, 7800.0), springs=springs, damping=damping,
+    return from_mesh(mesh, Material(210e9, 0.3, 7800.0), supports=springs, damping=damping,
                      loads=[Traction(top, pressure=P0),
                             Traction(top, traction=cyc, waveform="cos"),
                             Traction(top, traction=lift, waveform="sin")],

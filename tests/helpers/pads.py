@@ -23,7 +23,7 @@ def pad_3d(n=3, ratio=0.8, angle_deg=30.0, k_w=0.0):
     return from_mesh(
         box(0.01, 0.01, 0.005, n, n, 1), Material(210e9, 0.3, 7800.0),
         damping=Damping(rayleigh_stiffness=0.02 / (2 * np.pi * 1e5)),
-        springs=[Spring("zmax", "x", 1e7), Spring("zmax", "y", 1e7)],
+        supports=[Spring("zmax", "x", 1e7), Spring("zmax", "y", 1e7)],
         loads=[Traction("zmax", pressure=P_PAD),
                Traction("zmax", traction=(q * np.cos(t), q * np.sin(t), 0.0), waveform="cos")],
         contact=ContactSpec("zmin", mu=MU_PAD, wear_coefficient=k_w),

@@ -28,6 +28,7 @@ from fretwear.hb.periodic import DLFTProblem, solve_periodic
 from fretwear.hb.reduce import condense, recover
 from fretwear.linear import frf, modes
 from fretwear.model import (
+    ContactDofs,
     ContactSpec,
     Damping,
     Material,
@@ -42,6 +43,7 @@ from fretwear.model import (
 )
 from fretwear.model.core import ContactInterface, Load, Model
 from fretwear.model.interfaces import pair_transform
+from fretwear.timedomain.options import InitialState, IntegrationOptions
 from fretwear.wear.laws import side_depths, wear_coefficients, worn_volume
 
 STEEL = Material(210e9, 0.3, 7800.0)
@@ -71,8 +73,7 @@ def block_on_base(E_base=210e9, theta=0.0, kw=(1e-13, 0.0), block=STEEL, scale=1
     return from_mesh(
         mesh, {"block": block, "base": Material(E_base, 0.3, 7800.0)},
         damping=Damping(loss_factor=0.02),
-        springs=[Spring("block.top_left", tuple(R[:, 0]), scale * 1e7)],
-        fixed=[("base.bottom", "all")],
+        supports=[Spring("block.top_left", tuple(R[:, 0]), scale * 1e7), ("base.bottom", "all")],
         loads=[Traction("block.top", pressure=scale * P0, waveform="constant"),
                Traction("block.right", traction=tuple(-scale * Q0 * R[:, 0]), waveform="cos")],
         contact=ContactSpec("block.bottom", mu=MU, partner="base.top", wear_coefficient=kw[0],
@@ -85,7 +86,7 @@ def block_on_rigid(block=STEEL, scale=1.0):
     """The block of :func:`block_on_base` alone on a rigid flat."""
     return from_mesh(
         rectangle(0.02, 0.01, 4, 2, origin=(0.0, 0.005)), block,
-        damping=Damping(loss_factor=0.02), springs=[Spring("top_left", "x", scale * 1e7)],
+        damping=Damping(loss_factor=0.02), supports=[Spring("top_left", "x", scale * 1e7)],
         loads=block_loads(scale=scale), contact=ContactSpec("bottom", mu=MU),
         observed={"tip": (0.02, 0.015)},
     )
@@ -155,14 +156,14 @@ def cut_beam(cut: bool, preload=0.0):
         mesh = rectangle(0.1, 0.01, 10, 2)
         mesh.boundaries["far"] = mesh.boundaries["bottom"][5:6]
         return from_mesh(mesh, STEEL, damping=Damping(loss_factor=0.01),
-                         fixed=[("left", "all")],
+                         supports=[("left", "all")],
                          loads=[Traction("right", traction=(0.0, 1e5), waveform="cos")],
                          observed=obs,
                          contact=ContactSpec("far", mu=MU, normal=(0.0, -1.0), gap=1.0))
     mesh = join(("lower", rectangle(0.1, 0.005, 10, 1)),
                 ("upper", rectangle(0.1, 0.005, 10, 1, origin=(0.0, 0.005))))
     return from_mesh(mesh, STEEL, damping=Damping(loss_factor=0.01),
-                     fixed=[("lower.left", "all"), ("upper.top_left", "all")],
+                     supports=[("lower.left", "all"), ("upper.top_left", "all")],
                      loads=[Traction("lower.right", traction=(0.0, 1e5), waveform="cos"),
                             Traction("upper.right", traction=(0.0, 1e5), waveform="cos"),
                             Traction("upper.top", pressure=preload, waveform="constant"),
@@ -324,7 +325,7 @@ def test_two_interfaces_on_two_separate_bodies():
     mesh = join(("one", block((0.0, 0.0))), ("two", block((0.05, 0.0))))
     model = from_mesh(
         mesh, STEEL, damping=Damping(loss_factor=0.02),
-        springs=[Spring("one.top_left", "x", 1e7), Spring("two.top_left", "x", 1e7)],
+        supports=[Spring("one.top_left", "x", 1e7), Spring("two.top_left", "x", 1e7)],
         loads=block_loads("one.") + block_loads("two."),
         contact=[ContactSpec("one.bottom", mu=0.3, name="soft"),
                  ContactSpec("two.bottom", mu=0.6, name="hard")],
@@ -336,7 +337,7 @@ def test_two_interfaces_on_two_separate_bodies():
     both = solve_periodic(model, BASIS, frequency=F_HZ, tol=1e-12, raise_on_failure=True)
     for k, mu in enumerate((0.3, 0.6)):
         alone = from_mesh(block((0.0, 0.0)), STEEL, damping=Damping(loss_factor=0.02),
-                          springs=[Spring("top_left", "x", 1e7)], loads=block_loads(),
+                          supports=[Spring("top_left", "x", 1e7)], loads=block_loads(),
                           contact=ContactSpec("bottom", mu=mu))
         ref = solve_periodic(alone, BASIS, frequency=F_HZ, tol=1e-12, raise_on_failure=True)
         got = both.lam[c.interface_index() == k]
@@ -433,7 +434,7 @@ def test_unmatched_pair_names_the_node_and_its_distance():
     mesh = join(("block", block), ("base", base))
     with pytest.raises(InputError, match=r"node \d+ at \(.*\) has no node of boundary "
                                          r"'base.top' within .* m away"):
-        from_mesh(mesh, STEEL, fixed=[("base.bottom", "all")],
+        from_mesh(mesh, STEEL, supports=[("base.bottom", "all")],
                   contact=ContactSpec("block.bottom", mu=MU, partner="base.top"))
 
 
@@ -456,8 +457,8 @@ def test_interfaces_need_distinct_names():
 
 def test_zero_area_node_is_refused():
     with pytest.raises(InputError, match="area"):
-        from_matrices(np.eye(2), np.eye(2), contact_normal_dofs=[0],
-                      contact_tangential_dofs=[1], mu=0.3, area=0.0)
+        from_matrices(np.eye(2), np.eye(2),
+                      contact=ContactDofs(normal_dofs=[0], tangential_dofs=[1], mu=0.3, area=0.0))
 
 
 def pressed_or_pulled_block(pressure):
@@ -467,10 +468,9 @@ def pressed_or_pulled_block(pressure):
     upper = rectangle(0.02, 0.01, 4, 2, origin=(0.0, 0.005))
     mesh = join(("block", upper), ("base", rectangle(0.02, 0.005, 4, 1)))
     return from_mesh(
-        mesh, STEEL, springs=[Spring("block.top_left", "x", 1e7),
-                              Spring("block.top_left", "y", 1e6),
-                              Spring("block.top_right", "y", 1e6)],
-        fixed=[("base.bottom", "all")],
+        mesh, STEEL, supports=[Spring("block.top_left", "x", 1e7),
+                               Spring("block.top_left", "y", 1e6),
+                               Spring("block.top_right", "y", 1e6), ("base.bottom", "all")],
         loads=[Traction("block.top", pressure=pressure, waveform="constant")],
         contact=ContactSpec("block.bottom", mu=MU, partner="base.top", name="flat"))
 
@@ -538,18 +538,19 @@ def test_explicit_pairs_from_matrices_match_the_mesh_model():
     mesh_model = block_on_base(theta=0.7)
     c = mesh_model.contact
     model = from_matrices(
-        mesh_model.K, mesh_model.M, D=mesh_model.D, contact_normal_dofs=c.dofs[:, 0],
-        contact_tangential_dofs=c.dofs[:, 1], mu=MU, area=c.area,
-        contact_partner_dofs=c.partner_dofs, contact_frames=c.frame,
-        loads=mesh_model.loads, fixed_dofs=mesh_model.fixed_dofs)
+        mesh_model.K, mesh_model.M,
+        contact=ContactDofs(normal_dofs=c.dofs[:, 0], tangential_dofs=c.dofs[:, 1], mu=MU,
+                            area=c.area, partner_dofs=c.partner_dofs, frames=c.frame),
+        damping=Damping(D=mesh_model.D), loads=mesh_model.loads,
+        fixed_dofs=mesh_model.fixed_dofs)
     a = condense(mesh_model, F_HZ, [0, 1])
     b = condense(model, F_HZ, [0, 1])
     np.testing.assert_allclose(b.Z, a.Z, rtol=0, atol=1e-12 * np.abs(a.Z).max())
     np.testing.assert_allclose(b.F, a.F, rtol=0, atol=1e-12 * np.abs(a.F).max())
     with pytest.raises(InputError, match=r"contact_frames\[0\] is not orthonormal"):
-        from_matrices(mesh_model.K, mesh_model.M, contact_normal_dofs=c.dofs[:, 0],
-                      contact_tangential_dofs=c.dofs[:, 1], mu=MU,
-                      contact_partner_dofs=c.partner_dofs, contact_frames=2 * c.frame,
+        from_matrices(mesh_model.K, mesh_model.M,
+                      contact=ContactDofs(normal_dofs=c.dofs[:, 0], tangential_dofs=c.dofs[:, 1],
+                                          mu=MU, partner_dofs=c.partner_dofs, frames=2 * c.frame),
                       fixed_dofs=mesh_model.fixed_dofs)
 
 
@@ -602,8 +603,8 @@ def test_time_integration_of_a_pair_on_a_stiff_held_body_is_the_rigid_obstacle_o
     run = {}
     for key, model in (("pair", pair), ("rigid", rigid)):
         U0, V0 = initial_state(model, solve_periodic(model, BASIS, frequency=F_HZ, tol=1e-12))
-        run[key] = integrate(model, F_HZ, n_periods=10, steps_per_period=256, record="last",
-                             U0=U0, V0=V0)
+        run[key] = integrate(model, F_HZ, options=IntegrationOptions(steps_per_period=256),
+                             start=InitialState(U0=U0, V0=V0), n_periods=10, record="last")
     a, b = run["pair"], run["rigid"]
     assert a.success and b.success and np.any(b.state == 2)
     np.testing.assert_allclose(a.lam, b.lam, rtol=0, atol=20 * ratio * np.abs(b.lam).max())
@@ -655,22 +656,22 @@ def test_time_integration_takes_a_friction_coefficient_per_interface():
     def run(model):
         U0, V0 = initial_state(model, solve_periodic(model, BASIS, frequency=F_HZ, tol=1e-12,
                                                      eps=1e9, raise_on_failure=True))
-        out = integrate(model, F_HZ, n_periods=10, steps_per_period=256, record="last",
-                        U0=U0, V0=V0)
+        out = integrate(model, F_HZ, options=IntegrationOptions(steps_per_period=256),
+                        start=InitialState(U0=U0, V0=V0), n_periods=10, record="last")
         assert out.success
         return out
 
     mesh = join(("one", block("one")), ("two", block("two", (0.05, 0.0))))
     both = run(from_mesh(
         mesh, STEEL, damping=Damping(loss_factor=0.02),
-        springs=[Spring("one.top_left", "x", 1e7), Spring("two.top_left", "x", 1e7)],
+        supports=[Spring("one.top_left", "x", 1e7), Spring("two.top_left", "x", 1e7)],
         loads=block_loads("one.") + block_loads("two."),
         contact=[ContactSpec("one.bottom", mu=0.3, name="soft"),
                  ContactSpec("two.bottom", mu=0.4, name="high")]))
     first = 0
     for name, mu in (("one", 0.3), ("two", 0.4)):
         alone = run(from_mesh(block(name), STEEL, damping=Damping(loss_factor=0.02),
-                              springs=[Spring("top_left", "x", 1e7)], loads=block_loads(),
+                              supports=[Spring("top_left", "x", 1e7)], loads=block_loads(),
                               contact=ContactSpec("bottom", mu=mu)))
         n = sizes[name][1] + 1
         got = both.lam[:, first:first + n]
@@ -704,7 +705,7 @@ def dovetail_2d():
     mesh = join(("root", root), ("left", left), ("right", right))
     return from_mesh(
         mesh, STEEL, thickness=0.01, damping=Damping(loss_factor=0.01),
-        fixed=[("left.bottom", "all"), ("right.bottom", "all")],
+        supports=[("left.bottom", "all"), ("right.bottom", "all")],
         loads=[Traction("root.top", traction=(0.0, 200e6), waveform="constant"),
                Traction("root.top", traction=(0.0, 150e6), waveform="cos")],
         contact=[ContactSpec("root.left", mu=MU, partner="left.right", name="west",

@@ -11,8 +11,9 @@ import scipy.io
 import scipy.sparse as sp
 
 from fretwear.errors import InputError
+from fretwear.model.build import Damping
 from fretwear.model.core import ContactInterface, Load, Model, ObservedPoint
-from fretwear.model.matrices import from_matrices, read_matrix_market
+from fretwear.model.matrices import ContactDofs, from_matrices, read_matrix_market
 
 k1, k2, k3 = 2e6, 1e6, 5e5
 m1, m2 = 0.3, 0.1
@@ -32,11 +33,12 @@ def test_chain_matches_hand_built_model():
     observed DOF."""
     K, M = chain()
     f = np.array([1.0, 0.0, 0.0])
-    got = from_matrices(K, sp.csr_matrix(M), contact_normal_dofs=[1],
-                        contact_tangential_dofs=[2], gap=1e-6, area=2e-4, mu=0.4,
-                        normal_sign=-1, loss_factor=0.01,
-                        loads=[Load(f, "cos", name="drive")], observed={"mass 1": 0},
-                        wear_coefficient=1e-11, coords=[[0.5, 0.0]], name="chain")
+    got = from_matrices(K, sp.csr_matrix(M),
+                        contact=ContactDofs(normal_dofs=[1], tangential_dofs=[2], gap=1e-6,
+                                            area=2e-4, mu=0.4, normal_sign=-1,
+                                            wear_coefficient=1e-11, coords=[[0.5, 0.0]]),
+                        damping=Damping(loss_factor=0.01), loads=[Load(f, "cos", name="drive")],
+                        observed={"mass 1": 0}, name="chain")
     hand = Model(
         K=sp.csr_matrix(K), M=sp.csr_matrix(M),
         contact=ContactInterface(dofs=np.array([[1, 2]]), frame=np.array([[[-1.0, 0.0],
@@ -62,8 +64,9 @@ def test_3d_contact_and_fixed_dofs():
     """Two tangential DOFs per node give a 3D interface with an identity frame; fixed DOFs
     are kept sorted."""
     K = sp.diags([1.0, 2.0, 3.0, 4.0, 5.0]) * 1e5
-    model = from_matrices(K, sp.eye(5), contact_normal_dofs=[0], contact_tangential_dofs=[[1, 2]],
-                          mu=0.1, fixed_dofs=[4, 3], observed={"pair": [1, 2]})
+    model = from_matrices(K, sp.eye(5),
+                          contact=ContactDofs(normal_dofs=[0], tangential_dofs=[[1, 2]], mu=0.1),
+                          fixed_dofs=[4, 3], observed={"pair": [1, 2]})
     assert model.dim == 3 and model.contact.dofs.tolist() == [[0, 1, 2]]
     np.testing.assert_array_equal(model.contact.frame[0], np.eye(3))
     assert model.fixed_dofs.tolist() == [4, 3] and model.free_dofs().tolist() == [0, 1, 2]
@@ -89,13 +92,43 @@ def test_matrix_market_round_trip(tmp_path):
         read_matrix_market(tmp_path / "bad.mtx")
 
 
+def test_damping_record_of_user_matrices():
+    """Damping(C, rayleigh_mass=a, rayleigh_stiffness=b) gives C + a M + b K (the definition,
+    written out with the chain's matrices: exact up to the order of three additions, 1e-15
+    relative); a prescribed normal load without normal DOFs adds one undamped DOF per node;
+    from_mesh refuses the matrices (its damping is the factors)."""
+    K, M = chain()
+    C0 = np.diag([0.1, 0.0, 0.2])
+    a, b = 3.0, 1e-5
+    got = build(damping=dict(C=C0, rayleigh_mass=a, rayleigh_stiffness=b)).C.toarray()
+    np.testing.assert_allclose(got, C0 + a * M + b * K, rtol=1e-15, atol=0)
+    padded = from_matrices(K, M, contact=ContactDofs(normal_dofs=None, tangential_dofs=[2],
+                                                     mu=0.3, normal_load=1.0),
+                           damping=Damping(rayleigh_stiffness=b, loss_factor=0.02))
+    assert padded.K.shape == (4, 4)
+    np.testing.assert_allclose(padded.C.toarray()[:3, :3], b * K, rtol=1e-15, atol=0)
+    assert not padded.C.toarray()[3].any() and not padded.D.toarray()[3].any()
+    from fretwear.model.build import ContactSpec, Material, from_mesh
+    from fretwear.model.mesh import rectangle
+
+    with pytest.raises(InputError, match="matrices C and D are for user matrices"):
+        from_mesh(rectangle(0.1, 0.01, 4, 1), Material(2e11, 0.3),
+                  damping=Damping(C=np.eye(20)), contact=ContactSpec("bottom", mu=0.3))
+    with pytest.raises(InputError, match="expected a ContactDofs"):
+        from_matrices(K, M, contact=dict(normal_dofs=[1], tangential_dofs=[2], mu=0.3))
+
+
 # --------------------------------------------------------------------------------------------
 # bad inputs
 # --------------------------------------------------------------------------------------------
-def build(K=None, M=None, **kw):
+def build(K=None, M=None, *, damping=None, loads=(), fixed_dofs=(), **contact):
+    """The chain with a contact node on DOFs [1, 2] (mu = 0.3) and ``contact`` fields
+    changed."""
     K0, M0 = chain()
-    args = dict(contact_normal_dofs=[1], contact_tangential_dofs=[2], mu=0.3) | kw
-    return from_matrices(K0 if K is None else K, M0 if M is None else M, **args)
+    args = dict(normal_dofs=[1], tangential_dofs=[2], mu=0.3) | contact
+    return from_matrices(K0 if K is None else K, M0 if M is None else M,
+                         contact=ContactDofs(**args), damping=None if damping is None
+                         else Damping(**damping), loads=loads, fixed_dofs=fixed_dofs)
 
 
 def test_mismatched_sizes():
@@ -115,25 +148,25 @@ def test_non_symmetric_K():
 def test_contact_dof_out_of_range():
     with pytest.raises(InputError, match=r"contact_normal_dofs: DOF 3 is out of range; "
                                          r"expected indices in \[0, 2\]"):
-        build(contact_normal_dofs=[3])
+        build(normal_dofs=[3])
     with pytest.raises(InputError, match=r"DOF -1 is out of range"):
-        build(contact_tangential_dofs=[-1])
+        build(tangential_dofs=[-1])
 
 
 def test_other_bad_inputs():
     with pytest.raises(InputError, match="contact DOF 1 is listed more than once"):
-        build(contact_tangential_dofs=[1])
+        build(tangential_dofs=[1])
     with pytest.raises(InputError, match="DOF 2 is both a contact DOF and a fixed DOF"):
         build(fixed_dofs=[2])
     with pytest.raises(InputError, match="contact_normal_dofs is empty"):
-        build(contact_normal_dofs=[], contact_tangential_dofs=[])
+        build(normal_dofs=[], tangential_dofs=[])
     with pytest.raises(InputError, match=r"shape \(1, 3\); expected \(1,\) in 2D or \(1, 2\)"):
-        build(contact_tangential_dofs=[[0, 2, 2]])
+        build(tangential_dofs=[[0, 2, 2]])
     with pytest.raises(InputError, match="either D or loss_factor"):
-        build(D=np.eye(3), loss_factor=0.1)
+        build(damping=dict(D=np.eye(3), loss_factor=0.1))
     for eta in (1e300, -0.1, float("nan")):  # the bound of case files and Damping: [0, 10]
         with pytest.raises(InputError, match=r"loss_factor = .*; expected a value in \[0, 10\]"):
-            build(loss_factor=eta)
+            build(damping=dict(loss_factor=eta))
     with pytest.raises(InputError, match="normal_sign"):
         build(normal_sign=2)
     with pytest.raises(InputError, match="area: 0; expected values > 0"):
@@ -150,7 +183,7 @@ def test_singular_stiffness_is_refused():
     K = np.array([[k2, -k2, 0.0], [-k2, k2, 0.0], [0.0, 0.0, k3]])
     with pytest.raises(InputError, match=r"singular .* DOFs \[0, 1\] can move with nothing to "
                                          r"hold them but friction"):
-        build(K=K, contact_normal_dofs=[2], contact_tangential_dofs=[1])
+        build(K=K, normal_dofs=[2], tangential_dofs=[1])
     with pytest.raises(InputError, match=r"DOF\(s\) \[0\] have no stiffness"):
         build(K=np.diag([0.0, 1.0, 1.0]))
 
@@ -163,7 +196,7 @@ def _chain(n=6, k=1.0):
 
 
 def _contact_kw():
-    return dict(contact_normal_dofs=[0], contact_tangential_dofs=[1], mu=0.3)
+    return dict(contact=ContactDofs(normal_dofs=[0], tangential_dofs=[1], mu=0.3))
 
 
 def test_indefinite_stiffness_is_refused_with_its_eigenvalue():
@@ -192,14 +225,14 @@ def test_damping_that_feeds_energy_in_is_refused(which):
     K = sp.csr_matrix(np.array([[2.0, -1.0], [-1.0, 2.0]]))
     bad = -0.01 * sp.identity(2)  # x^T C x < 0 for every x: an energy source
     with pytest.raises(InputError, match=rf"{which} is indefinite.*no energy source"):
-        from_matrices(K, sp.identity(2), **{which: bad}, **_contact_kw())
+        from_matrices(K, sp.identity(2), damping=Damping(**{which: bad}), **_contact_kw())
 
 
 def test_gyroscopic_damping_is_accepted():
     """A skew-symmetric part does no work (x^T G x = 0): only the symmetric part counts."""
     K = sp.csr_matrix(np.array([[2.0, -1.0], [-1.0, 2.0]]))
     C = sp.csr_matrix(np.array([[0.1, 1.0], [-1.0, 0.1]]))
-    from_matrices(K, sp.identity(2), C=C, **_contact_kw())
+    from_matrices(K, sp.identity(2), damping=Damping(C=C), **_contact_kw())
 
 
 def test_sparse_inertia_counts_the_negative_eigenvalues():

@@ -1,6 +1,6 @@
-"""Tests of the wear rate averaged over a time integration (fretwear.timedomain.averaged_rate) and
-of the
-time-domain steps of the slow-scale driver (fretwear.wear.simulate, fretwear.wear.time_steps).
+"""Tests of the wear rate averaged over a time integration (fretwear.timedomain.averaged_rate),
+the call the wear driver makes of it (fretwear.timedomain.fallback), and of the time-domain
+steps of the slow-scale driver (fretwear.wear.simulate, fretwear.wear.time_steps).
 
 References, each independent of the code under test:
 
@@ -30,6 +30,7 @@ from fretwear.hb.reduce import condense
 from fretwear.model.build import ContactSpec, Damping, Material, Spring, Traction, from_mesh
 from fretwear.model.mesh import rectangle
 from fretwear.timedomain.averaged_rate import RESPONSE_KINDS, time_averaged_rate
+from fretwear.timedomain.options import AveragingOptions
 from fretwear.wear import (
     Rescue,
     RunControl,
@@ -52,7 +53,7 @@ def damped_block(q_ratio=0.5):
     q = q_ratio * 1e6 * MU * 0.02 / 0.004
     return from_mesh(rectangle(0.02, 0.004, 10, 2), Material(210e9, 0.3, 7800), thickness=0.01,
                      damping=Damping(rayleigh_stiffness=0.04 / (2 * np.pi * 6e4)),
-                     springs=[Spring("bottom_left", "x", 1e5)],
+                     supports=[Spring("bottom_left", "x", 1e5)],
                      loads=[Traction("top", pressure=1e6),
                             Traction("right", pressure=q, waveform="sin")],
                      contact=ContactSpec("bottom", mu=MU, normal=(0, -1), wear_coefficient=KW),
@@ -72,7 +73,8 @@ def periodic():
     coef = wear_coefficients(m)
     U0, V0 = initial_state(m, sol)
     tr = time_averaged_rate(m, F_HZ, basis, coef, np.zeros(len(coef)), U0=U0, V0=V0,
-                            settle=200, average=100, steps_per_period=1024)
+                            options=AveragingOptions(settle=200, average=100,
+                                                     steps_per_period=1024))
     return m, basis, sol, coef, tr
 
 
@@ -126,14 +128,37 @@ def test_rate_scatter_is_the_difference_of_the_two_half_windows():
     area = m.contact.area
     W = np.zeros(len(coef))
     kw = dict(settle=0, steps_per_period=256)
-    full = time_averaged_rate(m, F_HZ, BASIS, coef, W, U0=None, V0=None, average=32, **kw)
-    first = time_averaged_rate(m, F_HZ, BASIS, coef, W, U0=None, V0=None, average=16, **kw)
+    full = time_averaged_rate(m, F_HZ, BASIS, coef, W, U0=None, V0=None,
+                              options=AveragingOptions(average=32, **kw))
+    first = time_averaged_rate(m, F_HZ, BASIS, coef, W, U0=None, V0=None,
+                               options=AveragingOptions(average=16, **kw))
     second = time_averaged_rate(m, F_HZ, BASIS, coef, W, U0=first.U_end, V0=first.V_end,
-                                average=16, **kw)
+                                options=AveragingOptions(average=16, **kw))
     v1, v2 = area @ first.g, area @ second.g
     expected = abs(v1 - v2) / (v1 + v2)
     assert expected > 0.05  # the check is not trivial: the halves differ
     assert full.scatter == pytest.approx(expected, abs=1e-4)
+
+
+def test_fallback_call_is_the_averaged_rate_with_its_options():
+    """The fallback the wear driver calls takes the averaging settings as keywords (the wear
+    package cannot import the time-domain records): the same rate, bit for bit, as
+    time_averaged_rate with the AveragingOptions of those keywords; an unknown keyword is
+    refused."""
+    from fretwear.timedomain.fallback import FALLBACK
+
+    m = damped_block()
+    coef = wear_coefficients(m)
+    W = np.zeros(len(coef))
+    a = FALLBACK.averaged_rate(m, F_HZ, BASIS, coef, W, U0=None, V0=None, settle=2, average=3,
+                               steps_per_period=64)
+    b = time_averaged_rate(m, F_HZ, BASIS, coef, W, U0=None, V0=None,
+                           options=AveragingOptions(settle=2, average=3, steps_per_period=64))
+    assert a.periods == 5
+    for name in ("g", "slip_work", "U", "lam", "U_end", "V_end"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
+    with pytest.raises(TypeError, match="settling"):
+        FALLBACK.averaged_rate(m, F_HZ, BASIS, coef, W, U0=None, V0=None, settling=2)
 
 
 def test_bad_window_is_refused():
@@ -275,8 +300,9 @@ def test_run_starts_from_a_time_integration_when_the_unworn_balance_fails(monkey
     h = r.history
     assert r.success and h.n_steps == 5 and h.rescued[0] == Rescue.TIME_AVERAGED
     ref = time_averaged_rate(m, F_HZ, BASIS, wear_coefficients(m), np.zeros(h.wear_depth.shape[1]),
-                             U0=None, V0=None, settle=START_SETTLE, average=64,
-                             steps_per_period=512)
+                             U0=None, V0=None,
+                             options=AveragingOptions(settle=START_SETTLE, average=64,
+                                                      steps_per_period=512))
     np.testing.assert_array_equal(h.wear_rate[0], ref.g)
     assert h.jump[1] == START_JUMP
     # the response is periodic: the balance converges from it at step 1, then ordinary steps

@@ -23,6 +23,12 @@ from fretwear.hb.periodic import initial_state, solve_periodic
 from fretwear.model.core import ContactInterface, Load, Model, ObservedPoint
 from fretwear.timedomain import integrate as tr
 from fretwear.timedomain import quasistatic, reduction, steady
+from fretwear.timedomain.options import (
+    IncrementalWearOptions,
+    InitialState,
+    IntegrationOptions,
+    SteadyStateOptions,
+)
 
 
 def hz(w: float) -> float:
@@ -204,7 +210,7 @@ def test_den_hartog_continuous_slip(r):
     w = r
     N = 1024
     model = slider(mu=Ff, N=1.0)
-    res = tr.integrate(model, hz(w), n_periods=200, steps_per_period=N)
+    res = tr.integrate(model, hz(w), options=IntegrationOptions(steps_per_period=N), n_periods=200)
     xa, va, X = den_hartog(res.t, m=m, k=k, Ff=Ff, F0=F0, w=w)
     # the analytic solution has no stops: the velocity changes sign twice per period only
     tt = np.linspace(0, 2 * np.pi / w, 4001)[:-1]
@@ -236,7 +242,8 @@ def test_stick_slip_with_stops_vs_event_driven(Ff):
     n = 25
     T = 2 * np.pi / w
     h = T / N
-    res = tr.integrate(slider(mu=Ff), hz(w), n_periods=n, steps_per_period=N)
+    res = tr.integrate(slider(mu=Ff), hz(w), options=IntegrationOptions(steps_per_period=N),
+                       n_periods=n)
     ref, sticks = event_driven(m=m, k=k, Ff=Ff, F0=F0, w=w, t_end=n * T + 1e-9, t_eval=res.t)
     last = [s for s in sticks if s[0] > (n - 1) * T]
     assert len(last) == 2  # two stops per period: a genuine stick-slip case
@@ -265,7 +272,8 @@ def test_3d_rotating_force_circular_slip():
     X = np.sqrt(F0**2 - (mu * N) ** 2) / abs(k - m * w * w)
     errs = []
     for steps in (128, 256):
-        res = tr.integrate(slider3d(mu=mu), hz(w), n_periods=150, steps_per_period=steps)
+        res = tr.integrate(slider3d(mu=mu), hz(w),
+                           options=IntegrationOptions(steps_per_period=steps), n_periods=150)
         rad = np.hypot(*res.observed["x"].T)
         err = np.max(np.abs(rad / X - 1))
         lag = mu * N * (w * 2 * np.pi / (w * steps) / 2) / np.sqrt(F0**2 - (mu * N) ** 2)
@@ -338,8 +346,8 @@ def test_3d_pad_agrees_with_the_dlft(pad_dlft):
     U0, V0 = initial_state(model, sols[12])
     td = {}
     for steps, periods in ((4096, 8), (8192, 6)):
-        res = tr.integrate(model, F_PAD, n_periods=periods, steps_per_period=steps, U0=U0,
-                           V0=V0, record=1)
+        res = tr.integrate(model, F_PAD, options=IntegrationOptions(steps_per_period=steps),
+                           start=InitialState(U0=U0, V0=V0), n_periods=periods, record=1)
         assert res.success and res.info["failed_steps"] == 0, res.message
         assert check_cone(res, MU_PAD) > 0
         c = np.fft.rfft(res.observed["top"], axis=0)[1] * 2 / steps
@@ -389,8 +397,9 @@ def test_energy_conserved_without_friction_and_damping():
         model = chain(mu=0.0, gap=1.0, N=0.0, F=0.0)
         V0 = np.zeros(model.ndof)
         V0[5] = 1e-3
-        res = tr.integrate(model, hz(1.0), n_periods=200, steps_per_period=64, V0=V0, record=200,
-                           modal_cutoff=cut)
+        res = tr.integrate(model, hz(1.0),
+                           options=IntegrationOptions(steps_per_period=64, modal_cutoff=cut),
+                           start=InitialState(V0=V0), n_periods=200, record=200)
         E = res.energy["mechanical"]
         assert np.all(res.state == 0)
         assert np.ptp(E) / E[0] < 1e-12
@@ -398,7 +407,8 @@ def test_energy_conserved_without_friction_and_damping():
     V0 = np.zeros(model.ndof)
     V0[1:4] = 1e-3
     V0[0] = 1e-3  # the contact node moves towards the obstacle
-    res = tr.integrate(model, hz(1.0), n_periods=50, steps_per_period=64, V0=V0, record=50)
+    res = tr.integrate(model, hz(1.0), options=IntegrationOptions(steps_per_period=64),
+                       start=InitialState(V0=V0), n_periods=50, record=50)
     E = res.energy["mechanical"]
     wn = np.diff(res.energy["normal"])
     assert np.any(res.state > 0)  # it hits
@@ -424,7 +434,8 @@ def test_energy_balance_with_friction_and_damping():
     """
     model = chain(mu=0.3, N=1.0, F=1.5, c_a=1e-2, c_b=2e-2)
     steps = 256
-    res = tr.integrate(model, hz(0.5), n_periods=300, steps_per_period=steps, record=2)
+    res = tr.integrate(model, hz(0.5), options=IntegrationOptions(steps_per_period=steps),
+                       n_periods=300, record=2)
     assert res.info["diagonal"] and res.info["damping"]["low_rank"] == 1
     assert np.any(res.state[:, 0] == 1) and np.any(res.state[:, 0] == 2)  # stick and slip
     e = {key: val[steps] - val[0] for key, val in res.energy.items()}  # over one period
@@ -445,9 +456,8 @@ def test_low_rank_damping_step_matches_dense():
     """The Woodbury form of the step (modal damping ``diag + U R U^T``) against a dense solve
     of ``S = M + gamma h C + beta h^2 K`` in the same coordinates (round-off)."""
     model = chain(mu=0.3, c_a=2e-3, c_b=1e-3)
-    integ = tr.Integrator(model, 1.2, steps_per_period=64, modal_cutoff=None, n_modes=None,
-                           gamma=0.5, tol=1e-10, wear=None, U0=None, V0=None,
-                           stick_anchor=None)
+    integ = tr.Integrator(model, 1.2, IntegrationOptions(steps_per_period=64, gamma=0.5,
+                                                         contact_tol=1e-10))
     red, h = integ.red, integ.h
     C = np.diag(red.C) + red.U @ red.R @ red.U.T
     S = np.eye(integ.r) + 0.5 * h * C + 0.25 * h * h * np.diag(red.K)
@@ -506,7 +516,9 @@ def _check_linear_limit(model):
     f[-1] = 1.0
     u = np.linalg.solve(Z[np.ix_(keep, keep)], f[keep])[-1]
     for cut, tol in (("all", 1e-9), (None, 1.0 / 64)):
-        res = tr.integrate(model, hz(w), n_periods=400, steps_per_period=steps, modal_cutoff=cut)
+        res = tr.integrate(model, hz(w),
+                           options=IntegrationOptions(steps_per_period=steps, modal_cutoff=cut),
+                           n_periods=400)
         c = steady.fourier_coefficients(res.observed["end"][:, 0], 3)
         assert abs((c[1] - 1j * c[4]) / u - 1) < tol
     assert res.info["r"] < model.ndof  # the default did truncate
@@ -517,9 +529,10 @@ def test_restart_is_exact():
     """Two runs of 15 periods chained through ``U, V`` equal one run of 30 periods to
     round-off (the final state encodes the two-step history exactly)."""
     model = chain(mu=0.3, N=2.0, F=1.5, c_a=2e-3)
-    a = tr.integrate(model, hz(1.2), n_periods=30, steps_per_period=64)
-    b = tr.integrate(model, hz(1.2), n_periods=15, steps_per_period=64)
-    b = tr.integrate(model, hz(1.2), n_periods=15, steps_per_period=64, U0=b.U, V0=b.V)
+    a = tr.integrate(model, hz(1.2), options=IntegrationOptions(steps_per_period=64), n_periods=30)
+    b = tr.integrate(model, hz(1.2), options=IntegrationOptions(steps_per_period=64), n_periods=15)
+    b = tr.integrate(model, hz(1.2), options=IntegrationOptions(steps_per_period=64),
+                     start=InitialState(U0=b.U, V0=b.V), n_periods=15)
     scale = np.abs(a.U).max()
     np.testing.assert_allclose(b.U, a.U, atol=1e-9 * scale)
     np.testing.assert_allclose(b.observed["end"], a.observed["end"], atol=1e-9 * scale)
@@ -562,7 +575,8 @@ def test_incremental_wear_flat_punch():
     model = punch(p=p)
     c = model.contact
     k, mu, Q0, kw = 1e6, c.mu, 120.0, c.wear_coefficient
-    res = quasistatic.incremental_wear(model, steps_per_cycle=16, n_cycles=10)
+    res = quasistatic.incremental_wear(model, options=IncrementalWearOptions(steps_per_cycle=16),
+                                       n_cycles=10)
     X = (Q0 - mu * p * c.area) / k
     rate = np.diff(res.wear, axis=0)[1:]
     expected = np.broadcast_to(kw * p[:3] * 4 * X[:3], rate[:, :3].shape)
@@ -572,7 +586,8 @@ def test_incremental_wear_flat_punch():
     np.testing.assert_allclose(res.pressure[-1], p, rtol=1e-10)
     np.testing.assert_allclose(np.diff(res.worn_volume)[1:], kw / mu * res.dissipation[2:],
                                rtol=1e-10)
-    jumped = quasistatic.incremental_wear(model, steps_per_cycle=16, n_cycles=10, cycle_jump=3)
+    jumped = quasistatic.incremental_wear(
+        model, options=IncrementalWearOptions(steps_per_cycle=16, cycle_jump=3), n_cycles=10)
     assert jumped.computed_cycles == 4 and jumped.cycles[-1] == 10
     np.testing.assert_allclose(jumped.wear[-1], res.wear[-1], rtol=1e-10, atol=1e-20)
 
@@ -582,7 +597,9 @@ def test_incremental_wear_gap_grows_with_wear():
     constant load) sits exactly at the wear of the step before the last (the last step's
     wear is added after its solve), and the normal force stays the applied load."""
     steps = 8
-    res = quasistatic.incremental_wear(punch(p=[1e6]), steps_per_cycle=steps, n_cycles=5)
+    res = quasistatic.incremental_wear(punch(p=[1e6]),
+                                       options=IncrementalWearOptions(steps_per_cycle=steps),
+                                       n_cycles=5)
     w_last, w_prev = res.wear[-1, 0], res.wear[-2, 0]
     assert w_prev < res.U[0] < w_last
     # one step's wear at most: the slip per step is at most the cycle's slip over 2
@@ -653,7 +670,8 @@ def test_steady_state_classifies_real_responses():
     """
     m = k = F0 = 1.0
     Ff, w = 0.5, 0.5
-    ss = steady.steady_state(slider(mu=Ff), hz(w), steps_per_period=512, tol=1e-8)
+    ss = steady.steady_state(slider(mu=Ff), hz(w), options=SteadyStateOptions(tol=1e-8),
+                             integration=IntegrationOptions(steps_per_period=512))
     assert ss.classification == "periodic" and ss.periodic and ss.success, ss.message
     T = 2 * np.pi / w
     n = ss.n_periods
@@ -670,7 +688,9 @@ def test_steady_state_classifies_real_responses():
     loads = [Load(np.array([1.0, 0.3]), "constant"), Load(np.array([0.6, 0.0]), "cos")]
     rat = Model(K=Kd, M=sp.identity(2, format="csr"), contact=contact, loads=loads,
                 observed=[ObservedPoint("x", np.array([1]), np.zeros(1))])
-    ss = steady.steady_state(rat, hz(1.0), steps_per_period=64, min_periods=64, check_every=32)
+    ss = steady.steady_state(rat, hz(1.0),
+                             options=SteadyStateOptions(min_periods=64, check_every=32),
+                             integration=IntegrationOptions(steps_per_period=64))
     assert ss.classification == "drifting"
     assert ss.diagnostics.drift_rate > 0
 
@@ -679,8 +699,10 @@ def test_steady_state_classifies_real_responses():
     model = chain(n=1, k=1.0, kg=0.0, mu=10.0, N=1.0, F=0.5)
     V0 = np.zeros(model.ndof)
     V0[2] = 0.2
-    ss = steady.steady_state(model, hz(wq), steps_per_period=64, V0=V0, min_periods=64,
-                             max_periods=600)
+    ss = steady.steady_state(model, hz(wq),
+                             options=SteadyStateOptions(min_periods=64, max_periods=600),
+                             integration=IntegrationOptions(steps_per_period=64),
+                             start=InitialState(V0=V0))
     assert ss.classification == "quasi-periodic"
     assert np.all(ss.last.state == 1)
     nu = np.mod(1.0 / wq, 1.0)
@@ -696,11 +718,11 @@ def test_bad_inputs_are_reported():
     with pytest.raises(InputError, match="record"):
         tr.integrate(model, 1.0, n_periods=2, record=3)
     with pytest.raises(InputError, match="modal_cutoff"):
-        tr.integrate(model, 1.0, n_periods=1, modal_cutoff="some")
+        tr.integrate(model, 1.0, options=IntegrationOptions(modal_cutoff="some"), n_periods=1)
     with pytest.raises(InputError, match="frequency"):
         tr.integrate(model, -1.0, n_periods=1)
     with pytest.raises(InputError, match="wear"):
-        tr.integrate(model, 1.0, n_periods=1, wear=[0.0, 1.0])
+        tr.integrate(model, 1.0, start=InitialState(wear=[0.0, 1.0]), n_periods=1)
     fixed = slider()
     fixed.fixed_dofs = np.array([1])
     with pytest.raises(InputError, match="fixed"):
@@ -715,9 +737,11 @@ def test_energy_is_cumulative_across_kernel_chunks(monkeypatch):
     crosses a chunk boundary (round-off, 1e-9 of the external work as above)."""
     model = chain(mu=0.3, N=1.0, F=1.5, c_a=1e-2, c_b=2e-2)
     steps = 64
-    whole = tr.integrate(model, hz(0.5), n_periods=40, steps_per_period=steps, record=6)
+    whole = tr.integrate(model, hz(0.5), options=IntegrationOptions(steps_per_period=steps),
+                         n_periods=40, record=6)
     monkeypatch.setattr(tr, "CHUNK_STEPS", steps)  # one period per kernel call
-    cut = tr.integrate(model, hz(0.5), n_periods=40, steps_per_period=steps, record=6)
+    cut = tr.integrate(model, hz(0.5), options=IntegrationOptions(steps_per_period=steps),
+                       n_periods=40, record=6)
     for key in whole.energy:
         np.testing.assert_array_equal(cut.energy[key], whole.energy[key], err_msg=key)
     e = {key: val[-1] - val[0] for key, val in cut.energy.items()}  # five chunk boundaries

@@ -1,234 +1,96 @@
-"""Direct tests of the numba kernels of the time-domain solvers (fretwear.timedomain.kernels).
+"""Direct tests of the integration loops of the time-domain solvers
+(fretwear.timedomain.kernels), on records written by hand.
 
-* ``_gauss_solve`` (Gaussian elimination with partial pivoting, in place) against
-  ``numpy.linalg.solve`` (LAPACK): random systems of condition ~10 agree to 1e-12 relative
-  (both backward stable: error ~ cond x n x 1e-16); a singular system is reported.
-* ``solve_contact`` on one 2D node with a diagonal condensed stiffness, where the frictional
-  contact problem has a closed-form answer: open (``x = xref + A^-1 b``, no force), stick
-  (``x_T`` = previous, ``lam_T = b_T - k_t x_T``) and slip (``lam_T = mu lam_N sign``). The
-  answers are a division or two, so 1e-12 relative.
-* ``solve_contact`` on one 3D node with ``A = diag(kN, kT, kT)``: the closed-form answer of the
-  isotropic cone (open; stick; slip along the trial force ``b_T - kT x_prev,T`` with
-  ``|lam_T| = mu lam_N``, the radial return), from every warm-start status, to 1e-12.
-* ``solve_contact`` on many 3D nodes (16, the Delassus operator of a hexahedral pad), where
-  there is no closed form: every answer satisfies Signorini and Coulomb's law on the isotropic
-  cone, checked directly on ``lam = b - A (x - xref)`` (an independent evaluation of the laws,
-  not the solver's residual), sticking nodes do not move by one rounding unit, and starts from
-  different statuses reach the same answer (the problem has one solution).
+* ``run_dynamic`` on two undamped modal oscillators whose contact never closes: the loop is
+  then the trapezoidal rule, whose discrete free vibration is known in closed form,
+  ``q_n = q_0 cos(n theta)`` with ``cos theta = (1 - a) / (1 + a)``, ``a = (omega h)^2 / 4``
+  (the start ``dq_0 = q_0 (1 - cos theta)`` puts ``q_-1`` on that cosine); and its discrete
+  energy ``E_{n+1/2}`` is conserved (the identity of the scheme, docs/transient.md). Both to
+  rounding over 64 steps (1e-12 relative).
+* ``run_quasistatic`` on one 2D node pressed by a constant normal force ``P`` and pulled by a
+  tangential spring load ``Q cos(2 pi k / N)`` (a Jenkins element, ``Q > mu P``): the node
+  slides ``2 (Q - mu P) / kT`` each half cycle (``(Q - mu P) / kT`` more at the first step,
+  from rest), the friction force does ``mu P`` times the slip, and Archard's law wears
+  ``kw P / area`` times the slip, counted ``jump`` times per computed cycle. Sums of a few
+  exact increments: 1e-12 relative.
 """
 
 import numpy as np
 import pytest
-from helpers.pads import F_PAD, pad_3d
 
-from fretwear.timedomain.kernels import OPEN, SLIP, STICK, _gauss_solve, solve_contact
-
-RNG = np.random.default_rng(11)
-
-
-@pytest.mark.parametrize("n", [1, 3, 8])
-def test_gauss_solve_against_lapack(n):
-    a = RNG.standard_normal((n, n)) + 3 * np.eye(n)
-    b = RNG.standard_normal(n)
-    ref = np.linalg.solve(a, b)
-    work, rhs = a.copy(), np.r_[b, 7.0]  # an extra entry beyond n is left alone
-    assert _gauss_solve(work, rhs, n)
-    np.testing.assert_allclose(rhs[:n], ref, rtol=1e-12, atol=1e-12 * np.abs(ref).max())
-    assert rhs[n] == 7.0
+from fretwear.timedomain.contact_solve import OPEN, STICK, Contact, ContactState, Settings
+from fretwear.timedomain.kernels import (
+    DynamicState,
+    EnergyTerms,
+    LoadCycle,
+    Records,
+    StepOperator,
+    WearRecords,
+    WearState,
+    run_dynamic,
+    run_quasistatic,
+)
 
 
-def test_gauss_solve_reports_a_singular_system():
-    a = np.array([[1.0, 2.0], [2.0, 4.0]])
-    assert not _gauss_solve(a.copy(), np.ones(2), 2)
-    assert not _gauss_solve(np.zeros((2, 2)), np.ones(2), 2)
+def test_dynamic_loop_is_the_trapezoidal_rule():
+    """Two modes (omega 1 and 2.5 rad/s, h = 0.1 s, 32 steps per period, two periods), each
+    the local displacement of one component of a contact node 10 m from its obstacle."""
+    w = np.array([1.0, 2.5])
+    h, N, periods = 0.1, 32, 2
+    r = m = 2
+    a = (w * h) ** 2 / 4
+    theta = np.arccos((1 - a) / (1 + a))
+    q0 = np.array([1.0, 0.5])
+    ds = 1.0 + a  # m + g h c + b h^2 k with m = 1, c = 0, g = 1/2, b = 1/4
+    z = np.zeros((r, 0))
+    G = np.diag(h * h / ds)
+    op = StepOperator(True, ds.copy(), -h * h * w**2, ds.copy(), np.full(r, 0.5 * h), z.copy(),
+                      np.zeros((0, 0)), z.copy(), np.zeros((0, r)), np.zeros((0, 0)),
+                      np.zeros((0, 0)), np.zeros((N, r)), G, np.eye(m), np.eye(r))
+    en = EnergyTerms(h, np.zeros((N, r)), np.ones(r), w**2, np.zeros(r), np.zeros((0, 0)),
+                     np.zeros((0, 0)), np.zeros((0, 0)))
+    con = Contact(np.linalg.inv(G), np.array([10.0]), np.array([0.3]), 2)
+    dq = q0 * (1 - np.cos(theta))
+    st = DynamicState(q0.copy(), dq.copy(), q0.copy(), q0 - dq,
+                      ContactState(np.array([OPEN], dtype=np.int8), np.ones((1, 1))))
+    ns = periods * N
+    rec = Records(0, np.zeros((periods, 4)), np.zeros((periods, 4)), np.zeros((periods, 4)), 0,
+                  np.zeros((ns, r)), np.zeros((ns, r)), np.zeros((ns, m)), np.zeros((ns, m)),
+                  np.zeros((ns, 1), dtype=np.int8), np.zeros((ns, 6)))
+    n_fail, _, first = run_dynamic(op, en, con, Settings(1e-10, 1.0, 60), st, rec, periods, 0)
+    assert n_fail == 0 and first == -1
+    n = np.arange(ns)[:, None]
+    np.testing.assert_allclose(rec.obs, q0 * np.cos(n * theta), rtol=0, atol=1e-12)
+    assert np.all(rec.lam == 0.0) and np.all(rec.state == OPEN)
+    e = rec.energy[:, 4]  # E_{n+1/2}: the same at every step
+    assert np.abs(e - e[0]).max() <= 1e-12 * e[0]
+    np.testing.assert_array_equal(rec.mon_start[:, :r], rec.obs[::N])
 
 
-KN, KT, MU = 1e8, 5e7, 0.3
-
-
-def one_node(bn, bt, xprev_t, guess=STICK):
-    """Solve one node (components N, T) with ``A = diag(KN, KT)``, ``xref = 0``, gap 0."""
-    A = np.diag([KN, KT])
-    b = np.array([bn, bt])
-    status = np.array([guess], dtype=np.int8)
-    tdir = np.ones((1, 1))
-    x, lam = np.zeros(2), np.zeros(2)
-    its = solve_contact(A, b, np.zeros(2), np.zeros(1), np.array([0.0, xprev_t]),
-                        np.full(1, MU), 2,
-                        status, tdir, x, lam, 1e-12, abs(bn) + abs(bt), 50,
-                        np.zeros(2, np.int64), np.zeros(2, np.int64), np.zeros(2, np.int64),
-                        np.zeros((2, 2)), np.zeros(2))
-    assert its >= 0
-    return int(status[0]), x, lam
-
-
-def test_open_node_carries_no_force():
-    """Pulled away (b_N < 0): free, x = A^-1 b below the gap."""
-    st, x, lam = one_node(-100.0, 10.0, 0.0)
-    assert st == OPEN
-    np.testing.assert_allclose(x, [-100.0 / KN, 10.0 / KT], rtol=1e-12)
-    np.testing.assert_allclose(lam, 0.0, atol=1e-9)
-
-
-def test_sticking_node_keeps_its_tangential_position():
-    """Pressed (b_N = 100 N) with |b_T - KT x_prev| = 10 N < mu x 100 N: stick."""
-    xp = 1e-7
-    st, x, lam = one_node(100.0, 10.0 + KT * xp, xp)
-    assert st == STICK
-    np.testing.assert_allclose(x, [0.0, xp], atol=1e-18)
-    np.testing.assert_allclose(lam, [100.0, 10.0], rtol=1e-12)
-
-
-@pytest.mark.parametrize("sign", [1.0, -1.0])
-def test_slipping_node_carries_mu_times_the_normal_force(sign):
-    """Pressed by 100 N, tangential load 50 N > 30 N: slip along the load,
-    lam_T = mu lam_N, x_T = (b_T - lam_T) / KT."""
-    st, x, lam = one_node(100.0, sign * 50.0, 0.0)
-    assert st == SLIP
-    np.testing.assert_allclose(lam, [100.0, sign * MU * 100.0], rtol=1e-12)
-    np.testing.assert_allclose(x[1], sign * (50.0 - 30.0) / KT, rtol=1e-12)
-    assert abs(x[0]) <= 1e-12 * 100.0 / KN
-
-
-# --------------------------------------------------------------------------------------------
-# 3D: the isotropic Coulomb cone
-# --------------------------------------------------------------------------------------------
-def solve3(A, b, xref, gap, xprev, status, tol=1e-12):
-    """``solve_contact`` in 3D with fresh work arrays; returns (iterations, status, x, lam)."""
-    m = b.size
-    nc = m // 3
-    status = np.array(status, dtype=np.int8)
-    tdir = np.zeros((nc, 2))
-    tdir[:, 0] = 1.0
-    x, lam = np.zeros(m), np.zeros(m)
-    its = solve_contact(A, b, xref, gap, xprev, np.full(nc, MU), 3, status, tdir, x, lam, tol,
-                        float(np.abs(b).max()), 60 + 4 * nc, np.zeros(m, np.int64),
-                        np.zeros(m, np.int64), np.zeros(m, np.int64), np.zeros((m, m)),
-                        np.zeros(m))
-    return its, status, x, lam
-
-
-GUESSES = [OPEN, STICK, SLIP]
-
-
-@pytest.mark.parametrize("guess", GUESSES)
-def test_3d_node_open(guess):
-    """Pulled away (b_N < 0): free, x = A^-1 b, no force."""
-    A = np.diag([KN, KT, KT])
-    b = np.array([-100.0, 10.0, -20.0])
-    its, st, x, lam = solve3(A, b, np.zeros(3), np.zeros(1), np.zeros(3), [guess])
-    assert its >= 0 and st[0] == OPEN
-    np.testing.assert_allclose(x, b / np.diag(A), rtol=1e-12)
-    np.testing.assert_allclose(lam, 0.0, atol=1e-12 * 100.0)
-
-
-@pytest.mark.parametrize("guess", GUESSES)
-def test_3d_node_stick(guess):
-    """Pressed by 100 N, trial tangential force of 25 N < mu x 100 N at 40 deg: stick; the
-    tangential position is the previous one to the last bit."""
-    xp = np.array([0.0, 1e-7, -3e-8])
-    trial = 25.0 * np.array([np.cos(0.7), np.sin(0.7)])
-    A = np.diag([KN, KT, KT])
-    b = np.r_[100.0, trial + KT * xp[1:]]
-    its, st, x, lam = solve3(A, b, np.zeros(3), np.zeros(1), xp, [guess])
-    assert its >= 0 and st[0] == STICK
-    assert np.all(x[1:] == xp[1:])
-    np.testing.assert_allclose(lam, np.r_[100.0, trial], rtol=1e-12)
-
-
-@pytest.mark.parametrize("guess", GUESSES)
-@pytest.mark.parametrize("angle", [0.0, 0.7, 2.0, -2.9])
-def test_3d_node_slip_is_the_radial_return(guess, angle):
-    """Pressed by 100 N, trial tangential force of 50 N > 30 N: slip along the trial force
-    (isotropic cone and isotropic tangential stiffness: the radial return),
-    lam_T = mu lam_N e, x_T = x_prev,T + (50 - 30) / kT e, whatever the direction (a
-    component-wise or polygonal cone would bend it)."""
-    xp = np.array([0.0, 2e-7, 1e-7])
-    e = np.array([np.cos(angle), np.sin(angle)])
-    A = np.diag([KN, KT, KT])
-    b = np.r_[100.0, 50.0 * e + KT * xp[1:]]
-    its, st, x, lam = solve3(A, b, np.zeros(3), np.zeros(1), xp, [guess])
-    assert its >= 0 and st[0] == SLIP
-    np.testing.assert_allclose(lam, np.r_[100.0, MU * 100.0 * e], rtol=1e-12, atol=1e-12 * 100)
-    np.testing.assert_allclose(x[1:], xp[1:] + (50.0 - MU * 100.0) / KT * e, rtol=1e-12,
-                               atol=1e-12 * 20.0 / KT)
-    assert abs(x[0]) <= 1e-12 * 100.0 / KN
-
-
-def check_laws(A, b, xref, gap, xprev, x, status, tol):
-    """Signorini and incremental Coulomb on the isotropic cone at ``x``, with the forces
-    recomputed here (``lam = b - A (x - xref)``); errors relative to the largest force (and to
-    the displacement it causes through the stiffest diagonal term)."""
-    nc = gap.size
-    lam = (b - A @ (x - xref)).reshape(nc, 3)
-    X = x.reshape(nc, 3)
-    xi = X[:, 1:] - xprev.reshape(nc, 3)[:, 1:]
-    fs = np.abs(lam).max()
-    xs = fs / np.diag(A).max()
-    ln, lt = lam[:, 0], np.linalg.norm(lam[:, 1:], axis=1)
-    nxi = np.linalg.norm(xi, axis=1)
-    closed = status != OPEN
-    assert np.all(X[:, 0] - gap <= tol * xs)
-    assert np.all(ln >= -tol * fs)
-    assert np.all(np.abs(ln[~closed]) <= tol * fs)  # open: no force
-    assert np.all(X[closed, 0] == gap[closed])  # closed: exactly at the gap
-    assert np.all(lt <= MU * ln + tol * fs)  # inside the cone
-    stick = status == STICK
-    assert np.all(xi[stick] == 0.0)  # sticking nodes do not move at all
-    slip = status == SLIP
-    assert np.all(nxi[slip] > 0.0)
-    # slip: the force is on the cone and points along the slip
-    err = lam[slip, 1:] - MU * ln[slip, None] * xi[slip] / nxi[slip, None]
-    assert np.all(np.abs(err) <= tol * fs)
-    return lam
-
-
-@pytest.fixture(scope="module")
-def pad_delassus():
-    """The step's Delassus operator of the 16-node pad (``A = W^-1``, 48 x 48, SPD, with
-    strong coupling between the nodes), as the time integrator builds it."""
-    from fretwear.timedomain.integrate import Integrator
-
-    integ = Integrator(pad_3d(), 2 * np.pi * F_PAD, steps_per_period=256, modal_cutoff=None,
-                       n_modes=None, gamma=0.5, tol=1e-10, wear=None, U0=None, V0=None,
-                       stick_anchor=None)
-    return integ.A
-
-
-def test_3d_many_nodes_satisfy_the_laws_from_any_start(pad_delassus):
-    """40 random contact problems on the pad (free positions pressing or lifting nodes,
-    tangential motions of the whole pad and of single nodes from 0.1 nm to 0.1 um, some
-    initial gaps; mu = 0.3): each is solved (a few Newton iterations: the semismooth Newton
-    method converges quadratically once the statuses are right), satisfies the laws to the
-    tolerance asked (1e-12, tested at 1e-10: the forces are recomputed here in another order),
-    and three starts (all open, all stick, all slip) give the same answer to 1e-9 of the
-    largest force (one solution; the starts differ by the solver's tolerance)."""
-    A = pad_delassus
-    nc = A.shape[0] // 3
-    rng = np.random.default_rng(3)
-    n_states = np.zeros(3, dtype=int)
-    for _ in range(40):
-        s = 10.0 ** rng.uniform(-10, -7)  # size of the tangential motions [m]
-        xref = np.zeros(3 * nc)
-        xref[0::3] = rng.normal(0.5, 1.0, nc) * 1e-7
-        xref[1::3] = rng.normal(0, 0.1 * s, nc) + rng.normal() * s
-        xref[2::3] = rng.normal(0, 0.1 * s, nc) + rng.normal() * s
-        xprev = xref.copy()
-        xprev[1::3] += rng.normal(0, 0.1 * s, nc)
-        xprev[2::3] += rng.normal(0, 0.1 * s, nc)
-        gap = np.abs(rng.normal(size=nc)) * 1e-8 * rng.integers(0, 2)
-        b = np.zeros(3 * nc)
-        answers = []
-        for guess in GUESSES:
-            its, st, x, lam = solve3(A, b, xref, gap, xprev, [guess] * nc)
-            assert 0 <= its <= 20
-            lam_here = check_laws(A, b, xref, gap, xprev, x, st, 1e-10)
-            np.testing.assert_allclose(lam, lam_here.ravel(), rtol=0,
-                                       atol=1e-10 * np.abs(lam_here).max())
-            answers.append((st, lam))
-        for st, lam in answers[1:]:
-            assert np.array_equal(st, answers[0][0])
-            np.testing.assert_allclose(lam, answers[0][1], rtol=0,
-                                       atol=1e-9 * np.abs(lam).max())
-        n_states += np.bincount(answers[0][0], minlength=3)
-    assert np.all(n_states > 20)  # every status occurs often
+@pytest.mark.parametrize("jump", [1, 3])
+def test_quasistatic_loop_on_a_jenkins_element(jump):
+    """P = 10 N, mu = 0.3, Q = 8 N, kT = 1e4 N/m, area 1e-4 m^2, kw = 1e-13 1/Pa, 16 steps
+    per cycle (the extremes +-Q are steps), 4 computed cycles; the normal row of A is zero, so
+    the normal force stays P whatever the wear."""
+    P, mu, Q, kT, area, kw, N = 10.0, 0.3, 8.0, 1e4, 1e-4, 1e-13, 16
+    tau = 2 * np.pi * np.arange(N) / N
+    btab = np.column_stack([np.full(N, P), Q * np.cos(tau)])
+    jumps = np.array([1] + [jump] * 3, dtype=np.int64)
+    x = np.zeros(2)
+    wear = np.zeros(1)
+    rec = WearRecords(1, np.zeros((4, 1)), np.zeros((4, 1)), np.zeros((4, 1)), np.zeros(4),
+                      np.zeros(4, dtype=np.int64))
+    con = Contact(np.diag([0.0, kT]), np.zeros(1), np.array([mu]), 2)
+    nrec, n_fail, _ = run_quasistatic(
+        con, LoadCycle(btab, np.array([area]), kw, jumps), Settings(1e-12, Q, 60),
+        WearState(x, wear, ContactState(np.array([STICK], dtype=np.int8), np.ones((1, 1)))),
+        rec)
+    assert nrec == 4 and n_fail == 0
+    travel = 2 * (Q - mu * P) / kT
+    slip = np.array([2.5, 2, 2, 2]) * travel  # the first cycle starts from rest
+    np.testing.assert_allclose(rec.slip[:, 0], slip, rtol=1e-12)
+    np.testing.assert_allclose(rec.diss, mu * P * slip, rtol=1e-12)
+    np.testing.assert_allclose(rec.press[:, 0], P / area, rtol=1e-12)
+    np.testing.assert_allclose(rec.wear[:, 0], np.cumsum(jumps * kw * P / area * slip),
+                               rtol=1e-12)
+    assert rec.cycle.tolist() == np.cumsum(jumps).tolist()

@@ -15,9 +15,11 @@ from fretwear.hb.dynamics import structure_dynamics
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import initial_state, solve_periodic
 from fretwear.hb.stability import stability
+from fretwear.model.build import Damping
 from fretwear.model.core import Load
-from fretwear.model.matrices import from_matrices
-from fretwear.timedomain.monodromy import monodromy
+from fretwear.model.matrices import ContactDofs, from_matrices
+from fretwear.timedomain.monodromy import SHOOTING, monodromy
+from fretwear.timedomain.options import InitialState
 
 MS = 1e-3  # mass of the contact node [kg]
 
@@ -30,9 +32,9 @@ def unilateral(kn=10.0, gap=0.5, force=0.1):
     K = np.array([[1 + kn, -1, -kn, 0], [-1, 2, 0, 0], [-kn, 0, kn, 0], [0, 0, 0, 1.0]])
     C = np.array([[0.03 + cs, -0.03, -cs, 0], [-0.03, 0.06, 0, 0], [-cs, 0, cs, 0],
                   [0, 0, 0, 1.0]])
-    return from_matrices(K, np.diag([1.0, 1.0, MS, 1.0]), C=C, contact_normal_dofs=[2],
-                         contact_tangential_dofs=[3], gap=gap, mu=0.0,
-                         loads=[Load(np.array([0, force, 0, 0]), "cos")],
+    return from_matrices(K, np.diag([1.0, 1.0, MS, 1.0]),
+                         contact=ContactDofs(normal_dofs=[2], tangential_dofs=[3], gap=gap, mu=0.0),
+                         damping=Damping(C=C), loads=[Load(np.array([0, force, 0, 0]), "cos")],
                          observed={"x1": 0, "x2": 1})
 
 
@@ -43,8 +45,9 @@ def friction(force, kt=0.5, mu=0.5, normal=1.0):
     cs, cz = 2 * 0.2 * np.sqrt(kt * MS), 2 * 0.2 * np.sqrt(kz * MS)
     K = np.array([[1 + kt, -kt, 0], [-kt, kt, 0], [0, 0, kz]])
     C = np.array([[0.02 + cs, -cs, 0], [-cs, cs, 0], [0, 0, cz]])
-    return from_matrices(K, np.diag([1.0, MS, MS]), C=C, contact_normal_dofs=[2],
-                         contact_tangential_dofs=[1], gap=0.0, mu=mu,
+    return from_matrices(K, np.diag([1.0, MS, MS]),
+                         contact=ContactDofs(normal_dofs=[2], tangential_dofs=[1], gap=0.0, mu=mu),
+                         damping=Damping(C=C),
                          loads=[Load(np.array([force, 0, 0]), "cos"),
                                 Load(np.array([0, 0, normal]), "constant")],
                          observed={"x": 0})
@@ -61,7 +64,7 @@ def test_linear_response_multipliers_are_the_state_matrix_exponentials():
     sol = solve_periodic(model, FourierBasis.up_to(3, 32), frequency=w / (2 * np.pi),
                          time_domain=None)
     U0, V0 = initial_state(model, sol)
-    mono = monodromy(model, w / (2 * np.pi), U0=U0, V0=V0, steps_per_period=1024)
+    mono = monodromy(model, w / (2 * np.pi), start=InitialState(U0=U0, V0=V0))
     assert mono.success and mono.iterations <= 1
     K = model.K.toarray()
     M = model.M.toarray()
@@ -89,7 +92,8 @@ def test_unilateral_contact_hill_agrees_with_the_time_integration():
     assert sol.success and 0.0 < sol.state_fractions()[0, 2] + sol.state_fractions()[0, 1]
     hill = stability(model, sol, dyn=structure_dynamics(model))
     U0, V0 = initial_state(model, sol)
-    mono = monodromy(model, w / (2 * np.pi), U0=U0, V0=V0, steps_per_period=2048)
+    mono = monodromy(model, w / (2 * np.pi), start=InitialState(U0=U0, V0=V0),
+                     integration=SHOOTING.replace(steps_per_period=2048))
     assert mono.success
     tangential = np.exp(-np.pi / w)  # |rho| of the separate tangential oscillator
     main = hill.multipliers[np.abs(np.abs(hill.multipliers) - tangential) > 1e-6]
@@ -114,7 +118,8 @@ def test_friction_hill_agrees_with_the_time_integration():
     main = hill.multipliers[hill.kind == "refined"]
     assert main.size == 2 and np.all(np.abs(hill.multipliers[hill.kind != "refined"]) < 1e-8)
     U0, V0 = initial_state(model, sol)
-    mono = monodromy(model, w / (2 * np.pi), U0=U0, V0=V0, steps_per_period=2048)
+    mono = monodromy(model, w / (2 * np.pi), start=InitialState(U0=U0, V0=V0),
+                     integration=SHOOTING.replace(steps_per_period=2048))
     assert mono.success
     for r in main:
         assert np.min(np.abs(mono.multipliers[:2] - r)) < 1e-2

@@ -20,6 +20,7 @@ from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.reduce import condense
 from fretwear.model.core import ContactInterface, Load, Model
+from fretwear.timedomain.options import IncrementalWearOptions
 from fretwear.timedomain.quasistatic import incremental_wear
 from fretwear.wear import SlowProblem, wear_coefficients
 
@@ -60,7 +61,8 @@ def test_3d_node_under_a_rotating_load_slides_on_the_discrete_circle(steps):
                   loads=[Load(np.array([n0, 0.0, 0.0]), "constant"),
                          Load(np.array([0.0, f0, 0.0]), "cos"),
                          Load(np.array([0.0, 0.0, f0]), "sin")], dim=3)
-    res = incremental_wear(model, steps_per_cycle=steps, n_cycles=10)
+    res = incremental_wear(model, n_cycles=10,
+                           options=IncrementalWearOptions(steps_per_cycle=steps))
     assert res.success, res.message
     s = np.pi / steps
     phi = np.arcsin(mu * n0 * np.cos(s) / f0)
@@ -85,7 +87,7 @@ def test_3d_pad_wear_per_cycle_agrees_with_the_dlft():
     model = pad_3d(k_w=KW)
     v = {}
     for N in (128, 256):
-        res = incremental_wear(model, steps_per_cycle=N, n_cycles=3)
+        res = incremental_wear(model, options=IncrementalWearOptions(steps_per_cycle=N), n_cycles=3)
         assert res.success, res.message
         v[N] = np.diff(res.worn_volume)[-1]
         # Archard with Coulomb slip: worn volume = k_w / mu x friction energy, per cycle
@@ -108,7 +110,7 @@ def test_3d_pad_sliding_bodily_wears_every_node():
     ``4 F (Q0 - F) / k``, to 3 % (the pad's elasticity and its pressure peaks at the edges
     make the slip start at different instants over the face; measured 1.6 %)."""
     model = pad_3d(ratio=1.5, k_w=KW)
-    res = incremental_wear(model, steps_per_cycle=64, n_cycles=3)
+    res = incremental_wear(model, options=IncrementalWearOptions(steps_per_cycle=64), n_cycles=3)
     assert res.success, res.message
     dv = np.diff(res.worn_volume)
     assert dv[1] == pytest.approx(dv[0], rel=1e-9)

@@ -61,7 +61,7 @@ def block(q_ratio=0.5):
     worth ``q_ratio`` of the friction capacity: partial slip next to the loaded end."""
     q = q_ratio * 1e6 * MU * 0.02 / 0.004
     return from_mesh(rectangle(0.02, 0.004, 10, 2), Material(210e9, 0.3, 7800), thickness=0.01,
-                     springs=[Spring("bottom_left", "x", 1e5)],
+                     supports=[Spring("bottom_left", "x", 1e5)],
                      loads=[Traction("top", pressure=1e6),
                             Traction("right", pressure=q, waveform="sin")],
                      contact=ContactSpec("bottom", mu=MU, normal=(0, -1), wear_coefficient=KW),

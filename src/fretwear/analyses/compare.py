@@ -37,6 +37,11 @@ from fretwear.errors import InputError
 from fretwear.hb.periodic import PeriodicSolution
 from fretwear.hb.reduce import condense, exact_condenser
 from fretwear.io.case import build_model
+from fretwear.timedomain.options import (
+    IncrementalWearOptions,
+    IntegrationOptions,
+    SteadyStateOptions,
+)
 from fretwear.timedomain.quasistatic import incremental_wear
 from fretwear.timedomain.results import SteadyStateResult
 from fretwear.timedomain.steady import steady_state
@@ -201,8 +206,10 @@ def compare_periodic(model, analysis: dict, outdir: Path | None, *, steps_per_pe
     if not sol.success:  # a failed solve is never compared (its last iterate is no result)
         sol = None
     t_dlft = time.perf_counter() - t0
-    ss = steady_state(model, f_hz, max_periods=max_periods, steps_per_period=steps_per_period,
-                      harmonics=max(basis.harmonics))
+    ss = steady_state(model, f_hz,
+                      options=SteadyStateOptions(max_periods=max_periods,
+                                                 harmonics=max(basis.harmonics)),
+                      integration=IntegrationOptions(steps_per_period=steps_per_period))
     out = Comparison(periodic_rows(model, sol, ss), ss.classification, sol is not None,
                      {"DLFT": t_dlft, "time domain": ss.wall_time})
     out.notes.append(f"time domain: {ss.n_periods} periods x {steps_per_period} steps")
@@ -242,8 +249,10 @@ def compare_wear(model, analysis: dict, outdir: Path | None, *, steps_per_cycle:
                             time_domain=False)
     n = int(round(float(res.history.cycles[-1])))
     jump = _reference_jump(n, res.stability_jump)
-    inc = incremental_wear(model, steps_per_cycle=steps_per_cycle, n_cycles=max(n, 1),
-                           cycle_jump=jump, condenser=cond)
+    inc = incremental_wear(model, n_cycles=max(n, 1),
+                           options=IncrementalWearOptions(steps_per_cycle=steps_per_cycle,
+                                                          cycle_jump=jump),
+                           condenser=cond)
     w_d, w_t = res.final_wear, inc.wear[-1]
     area = np.asarray(model.contact.area, float)
     rows = [("maximum wear depth [m]", w_d.max(), w_t.max(), relative(w_d.max(), w_t.max())),

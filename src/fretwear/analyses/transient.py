@@ -36,6 +36,12 @@ from fretwear.hb.fourier import FourierBasis, amplitude
 from fretwear.io.results import label_coordinate, variable
 from fretwear.io.schema import Field, Integer, Number, Text, fail, join
 from fretwear.timedomain.integrate import integrate
+from fretwear.timedomain.options import (
+    IncrementalWearOptions,
+    InitialState,
+    IntegrationOptions,
+    SteadyStateOptions,
+)
 from fretwear.timedomain.quasistatic import incremental_wear
 from fretwear.timedomain.results import IncrementalWearResult, TransientResult
 from fretwear.timedomain.steady import classify_sequence, fourier_coefficients, steady_state
@@ -61,8 +67,9 @@ ENERGY_TERMS = {
 def _continue(model, frequency: float, U, V, n_periods: int, steps: int) -> TransientResult:
     """``n_periods`` more periods at ``frequency`` [Hz] from the state ``(U, V)``, the last
     one recorded."""
-    return integrate(model, frequency, n_periods=n_periods, steps_per_period=steps, record=1,
-                     U0=U, V0=V, keep_poincare=n_periods)
+    return integrate(model, frequency, n_periods=n_periods,
+                     options=IntegrationOptions(steps_per_period=steps),
+                     start=InitialState(U0=U, V0=V), record=1, keep_poincare=n_periods)
 
 
 def _classify_record(run: TransientResult, tol: float):
@@ -90,13 +97,16 @@ def time_run(model, analysis: dict, frequency: float, progress: bool):
     steps = analysis["steps_per_period"]
     if analysis["mode"] == "fixed":
         n = analysis["n_periods"]
-        last = integrate(model, frequency, n_periods=n, steps_per_period=steps, record=1,
+        last = integrate(model, frequency, n_periods=n,
+                         options=IntegrationOptions(steps_per_period=steps), record=1,
                          keep_poincare=n, progress=progress)
         cls = _classify_record(last, analysis["tol"])
         return last, cls, 0, {"periods": n, "time_wall_time": last.wall_time}
-    ss = steady_state(model, frequency, max_periods=analysis["max_periods"],
-                      tol=analysis["tol"], steps_per_period=steps,
-                      harmonics=analysis["harmonics"])
+    ss = steady_state(model, frequency,
+                      options=SteadyStateOptions(max_periods=analysis["max_periods"],
+                                                 tol=analysis["tol"],
+                                                 harmonics=analysis["harmonics"]),
+                      integration=IntegrationOptions(steps_per_period=steps))
     last = _continue(model, frequency, ss.U, ss.V, POINCARE_PERIODS, steps)
     info = {"periods": ss.n_periods + POINCARE_PERIODS,
             "time_wall_time": ss.wall_time + last.wall_time}
@@ -366,15 +376,15 @@ TRANSIENT = Analysis.define(
                       'quasi-periodic, irregular) or max_periods; "fixed": exactly n_periods',
                       default="steady-state"),
         "steps_per_period": Field(Integer(lo=8), "fixed time steps per forcing period",
-                                  default=default_of(integrate, "steps_per_period")),
+                                  default=default_of(IntegrationOptions, "steps_per_period")),
         "max_periods": Field(Integer(lo=1), "steady-state: give up after this many periods",
-                             default=default_of(steady_state, "max_periods")),
+                             default=default_of(SteadyStateOptions, "max_periods")),
         "n_periods": Field(Integer(lo=1), "fixed: periods integrated from rest", default=200),
         "tol": Field(Number(lo=0, lo_open=True), "relative periodicity tolerance of the "
-                     "classification", default=default_of(steady_state, "tol"), unit="-"),
+                     "classification", default=default_of(SteadyStateOptions, "tol"), unit="-"),
         "harmonics": Field(Integer(lo=1), "highest harmonic of the last period reported: "
                            "Nh reports 1, 2, .., Nh",
-                           default=default_of(steady_state, "harmonics")),
+                           default=default_of(SteadyStateOptions, "harmonics")),
     },
     run_transient,
     checks=(_check_harmonics,),
@@ -432,9 +442,12 @@ def plot_incremental_profiles(ds: xr.Dataset, path: Path, *, title: str | None =
 
 def run_incremental_wear(model, analysis: dict, case, context: RunContext) -> RunOutput:
     """Quasi-static incremental wear (:func:`fretwear.timedomain.quasistatic.incremental_wear`)."""
-    r = incremental_wear(model, steps_per_cycle=analysis["steps_per_cycle"],
-                         n_cycles=analysis["n_cycles"], cycle_jump=analysis["cycle_jump"],
-                         record_every=analysis["record_every"], progress=context.progress)
+    r = incremental_wear(model, n_cycles=analysis["n_cycles"],
+                         options=IncrementalWearOptions(
+                             steps_per_cycle=analysis["steps_per_cycle"],
+                             cycle_jump=analysis["cycle_jump"],
+                             record_every=analysis["record_every"]),
+                         progress=context.progress)
     ds = incremental_dataset(model, r)
     ds.attrs.update({"computed_cycles": int(r.computed_cycles), "cycle_jump": int(r.cycle_jump),
                      "steps_per_cycle": int(r.steps_per_cycle), "k_w": float(r.k_w),
@@ -454,14 +467,15 @@ INCREMENTAL_WEAR = Analysis.define(
     "incremental-wear",
     {
         "steps_per_cycle": Field(Integer(lo=2), "quasi-static load steps per cycle",
-                                 default=default_of(incremental_wear, "steps_per_cycle")),
+                                 default=default_of(IncrementalWearOptions, "steps_per_cycle")),
         "n_cycles": Field(Integer(lo=1), "load cycles (physical, counting the jumps)",
                           default=default_of(incremental_wear, "n_cycles")),
         "cycle_jump": Field(Integer(lo=1), "cycles represented by each computed cycle "
                             "(explicit Euler on the slow scale)",
-                            default=default_of(incremental_wear, "cycle_jump")),
+                            default=default_of(IncrementalWearOptions, "cycle_jump")),
         "record_every": Field(Integer(lo=1), "record every this many computed cycles (and "
-                              "the last)", default=default_of(incremental_wear, "record_every")),
+                              "the last)",
+                              default=default_of(IncrementalWearOptions, "record_every")),
     },
     run_incremental_wear,
     doc="Quasi-static fretting wear by load steps "

@@ -660,8 +660,7 @@ def _build_from_mesh(m: dict, title: str, given: Mapping):
         thickness=thickness,
         damping=build.Damping(damp["loss_factor"], damp["rayleigh_mass"],
                               damp["rayleigh_stiffness"]),
-        springs=springs,
-        fixed=fixed,
+        supports=[*springs, *fixed],
         loads=loads,
         contact=contact,
         observed=observed,
@@ -718,8 +717,9 @@ def _read_vector(path: Path, key: str, n: int) -> np.ndarray:
 
 
 def _build_from_matrices(m: dict, title: str):
+    from fretwear.model.build import Damping
     from fretwear.model.core import Load
-    from fretwear.model.matrices import from_matrices, read_matrix_market
+    from fretwear.model.matrices import ContactDofs, from_matrices, read_matrix_market
 
     spec = m["model"]
     base = spec["first_dof"]
@@ -747,28 +747,30 @@ def _build_from_matrices(m: dict, title: str):
                                  base).tolist()
                 for name, d in m.get("observed", {}).items()}
     gap, area = c["gap"], c["area"]
-    return from_matrices(
-        K,
-        M,
-        contact_normal_dofs=normal,
-        contact_tangential_dofs=tangential,
+    contact = ContactDofs(
+        normal_dofs=normal,
+        tangential_dofs=tangential,
+        mu=c["mu"],
         gap=np.asarray(gap, dtype=float) if isinstance(gap, list) else gap,
         area=np.asarray(area, dtype=float) if isinstance(area, list) else area,
-        mu=c["mu"],
         normal_sign=c["normal_sign"],
-        C=C,
-        D=D,
-        loads=loads,
-        fixed_dofs=_read_dofs(spec["fixed_dofs"], "model.fixed_dofs", base),
-        observed=observed or None,
         wear_coefficient=c["wear_coefficient"],
-        name=title,
         normal_load=(None if "normal_load" not in c else
                      Load(np.broadcast_to(np.asarray(c["normal_load"], float),
                                           (len(tangential),)).copy(), c["normal_waveform"],
                           None, "normal load")),
         kn=_per_node_or_none(c["kn"]),
         kt=_per_node_or_none(c["kt"]),
+    )
+    return from_matrices(
+        K,
+        M,
+        contact=contact,
+        damping=Damping(C=C, D=D),
+        loads=loads,
+        fixed_dofs=_read_dofs(spec["fixed_dofs"], "model.fixed_dofs", base),
+        observed=observed or None,
+        name=title,
     )
 
 

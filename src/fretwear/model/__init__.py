@@ -7,9 +7,7 @@ from fretwear.model.build import (
     NodalForce,
     Spring,
     Traction,
-    check_supported,
     from_mesh,
-    rigid_motion_check,
 )
 from fretwear.model.core import ContactInterface, Load, Mesh, Model, ObservedPoint
 from fretwear.model.fem import assemble
@@ -21,11 +19,13 @@ from fretwear.model.loads import (
     nodal_force,
     resultant,
 )
-from fretwear.model.matrices import from_matrices, read_matrix_market
+from fretwear.model.matrices import ContactDofs, from_matrices, read_matrix_market
 from fretwear.model.mesh import box, join, rectangle, transformed
 from fretwear.model.mesh import read as read_mesh
+from fretwear.model.supports import check_supported, rigid_motion_check
 
 __all__ = [
+    "ContactDofs",
     "ContactInterface",
     "ContactSpec",
     "Damping",

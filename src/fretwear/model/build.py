@@ -6,35 +6,32 @@ The user describes the structure with small dataclasses (:class:`Material`, :cla
 :class:`~fretwear.errors.InputError` naming the value and what is expected.
 
 Places (``at=``) are given either as the name of a node set or boundary of the mesh (all its
-nodes) or as a coordinate tuple (the node at that point, within ``1e-6`` of the model size).
+nodes) or as a coordinate tuple (the node at that point, within ``1e-6`` of the model size;
+:mod:`fretwear.model.places`).
 
-:func:`check_supported` and :func:`rigid_motion_check` refuse models that the contact alone
-cannot hold: with every contact node held in its normal direction (as a frictionless contact
-does) and every fixed DOF held, the stiffness must be non-singular; otherwise nothing but
-friction holds the structure and the problem has no unique solution.
+The model is refused when the contact alone cannot hold it
+(:func:`fretwear.model.supports.check_supported`).
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.linalg as sla
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from fretwear.errors import InputError
 from fretwear.limits import check_loss_factor
 from fretwear.model.core import WAVEFORMS, ContactInterface, Load, Mesh, Model, ObservedPoint
 from fretwear.model.fem import assemble, check_material, check_thickness
-from fretwear.model.interfaces import combine, relative_model
+from fretwear.model.interfaces import combine
 from fretwear.model.loads import boundary_load, nodal_areas
 from fretwear.model.mesh import boundary as _boundary
 from fretwear.model.mesh import check_cells, facet_normals, model_size, orient_facets
-
-AXES = "xyz"
+from fretwear.model.places import AXES, axis_index, find_node, nodes_at, unit_direction
+from fretwear.model.supports import check_supported
 
 
 # --------------------------------------------------------------------------------------------
@@ -101,17 +98,24 @@ class Damping:
         ``K (1 + i eta)`` on harmonics ``n >= 1``).
     rayleigh_mass, rayleigh_stiffness : ``Model.C = a M + b K`` with ``a`` [1/s] and ``b`` [s].
     ``K`` is the stiffness of the structure alone (springs to ground are undamped).
+    C, D : viscous [N s/m] and hysteretic [N/m] damping matrices on the DOFs of user matrices
+        (:func:`fretwear.model.matrices.from_matrices` only): ``C`` is added to the Rayleigh
+        damping; ``D`` is the hysteretic damping instead of ``loss_factor`` (not both).
     """
 
     loss_factor: float = 0.0
     rayleigh_mass: float = 0.0
     rayleigh_stiffness: float = 0.0
+    C: object = field(default=None, repr=False, compare=False)
+    D: object = field(default=None, repr=False, compare=False)
 
     def __post_init__(self):
         self.loss_factor = check_loss_factor(self.loss_factor, "damping loss_factor")
         self.rayleigh_mass = _finite(self.rayleigh_mass, "damping rayleigh_mass", minimum=0.0)
         self.rayleigh_stiffness = _finite(self.rayleigh_stiffness,
                                           "damping rayleigh_stiffness", minimum=0.0)
+        if self.D is not None and self.loss_factor > 0.0:
+            raise InputError("give either D or loss_factor (D = loss_factor * K), not both")
 
 
 @dataclass
@@ -260,120 +264,27 @@ class ContactSpec:
 
 
 # --------------------------------------------------------------------------------------------
-# locating nodes and directions
-# --------------------------------------------------------------------------------------------
-def find_node(mesh: Mesh, point, *, tol: float | None = None, what: str = "point") -> int:
-    """Number of the node at ``point`` [m].
-
-    Raises InputError if the nearest node is farther than ``tol`` (default ``1e-6`` times the
-    model size); ``tol = math.inf`` accepts the nearest node whatever its distance.
-    """
-    p = np.asarray(point, dtype=float).reshape(-1) if not isinstance(point, str) else None
-    if p is None or p.size != mesh.dim or not np.all(np.isfinite(p)):
-        raise InputError(f"{what} = {point!r}; expected {mesh.dim} coordinates [m]")
-    dist = np.linalg.norm(mesh.points - p, axis=1)
-    i = int(np.argmin(dist))
-    tol = 1e-6 * model_size(mesh) if tol is None else tol
-    if dist[i] > tol:
-        raise InputError(
-            f"{what} = {tuple(p.tolist())}: no mesh node there (nearest node {i} at "
-            f"{tuple(mesh.points[i].tolist())}, {dist[i]:.3g} m away; tolerance {tol:.3g} m)"
-        )
-    return i
-
-
-def nodes_at(mesh: Mesh, at, what: str = "at") -> np.ndarray:
-    """Nodes named by ``at``: a node-set or boundary name, or coordinates of one node."""
-    if isinstance(at, str):
-        if at in mesh.node_sets:
-            nodes = np.unique(np.asarray(mesh.node_sets[at], dtype=np.int64))
-        elif at in mesh.boundaries:
-            nodes = np.unique(np.asarray(mesh.boundaries[at], dtype=np.int64))
-        else:
-            raise InputError(
-                f"{what} = {at!r}: no node set or boundary of that name; the mesh has node "
-                f"sets {sorted(mesh.node_sets)} and boundaries {sorted(mesh.boundaries)}"
-            )
-        if nodes.size == 0:
-            raise InputError(f"{what} = {at!r} names an empty set of nodes")
-        return nodes
-    return np.array([find_node(mesh, at, what=what)])
-
-
-def unit_direction(direction, dim: int, what: str = "direction") -> np.ndarray:
-    """Unit vector from ``"x"``, ``"y"``, ``"z"`` or a vector of ``dim`` components."""
-    if isinstance(direction, str):
-        key = direction.strip().lower()
-        if key not in AXES[:dim]:
-            raise InputError(
-                f"{what} = {direction!r}; expected one of {list(AXES[:dim])} or a vector of "
-                f"{dim} components"
-            )
-        return np.eye(dim)[AXES.index(key)]
-    try:
-        v = np.asarray(direction, dtype=float).reshape(-1)
-    except (TypeError, ValueError):
-        v = np.zeros(0)
-    big = np.abs(v).max() if v.size == dim and np.all(np.isfinite(v)) else 0.0
-    if big > 0.0:  # only the direction counts: scale first so that the norm cannot overflow
-        v = v / big
-    n = np.linalg.norm(v) if big > 0.0 else 0.0
-    if n == 0.0:
-        raise InputError(
-            f"{what} = {direction!r}; expected one of {list(AXES[:dim])} or a non-zero vector "
-            f"of {dim} components"
-        )
-    return v / n
-
-
-def _axis_index(direction: np.ndarray) -> int | None:
-    big = np.flatnonzero(np.abs(direction) > 1.0 - 1e-12)
-    return int(big[0]) if big.size == 1 else None
-
-
-# --------------------------------------------------------------------------------------------
 # pieces of the model
 # --------------------------------------------------------------------------------------------
-def _springs_and_fixed(mesh: Mesh, springs, fixed) -> tuple[sp.csr_matrix, np.ndarray]:
+def _supports(mesh: Mesh, supports) -> tuple[sp.csr_matrix, np.ndarray]:
+    """The springs' stiffness ``Ks`` and the fixed DOFs of ``supports`` (springs and pairs
+    ``(at, direction)``, in any order)."""
     d = mesh.dim
     ndof = d * mesh.points.shape[0]
     rows, cols, vals, held = [], [], [], []
-    for s in springs:
-        if not isinstance(s, Spring):
-            raise InputError(f"springs: {s!r} is not a Spring(at, direction, stiffness)")
-        what = f"spring at {s.at!r}"
-        nodes = nodes_at(mesh, s.at, f"{what}: at")
-        n = unit_direction(s.direction, d, f"{what}: direction")
-        if math.isinf(s.stiffness):
-            axis = _axis_index(n)
-            if axis is None:
-                raise InputError(
-                    f"{what}: an infinite stiffness (fixed DOF) needs an axis direction "
-                    f"({list(AXES[:d])}); got direction {s.direction!r}"
-                )
-            held.append(d * nodes + axis)
+    for item in supports:
+        if not isinstance(item, Spring):
+            held.append(_fixed(mesh, item))
             continue
-        if s.stiffness == 0.0:
-            continue
-        k = s.stiffness / nodes.size
-        dofs = d * nodes[:, None] + np.arange(d)  # (n, d)
-        rows.append(np.repeat(dofs, d, axis=1).ravel())
-        cols.append(np.tile(dofs, (1, d)).ravel())
-        vals.append(np.tile(k * np.outer(n, n).ravel(), nodes.size))
-    for item in fixed:
-        if isinstance(item, str) or not isinstance(item, Sequence) or len(item) != 2:
-            raise InputError(f"fixed: {item!r}; expected a pair (at, direction) with direction "
-                             f"one of {list(AXES[:d])} or 'all'")
-        at, direction = item
-        nodes = nodes_at(mesh, at, f"fixed {item!r}: at")
-        if isinstance(direction, str) and direction.strip().lower() == "all":
-            held.append((d * nodes[:, None] + np.arange(d)).ravel())
-            continue
-        axis = _axis_index(unit_direction(direction, d, f"fixed {item!r}: direction"))
-        if axis is None:
-            raise InputError(f"fixed {item!r}: direction must be an axis {list(AXES[:d])} or "
-                             f"'all'; got {direction!r}")
-        held.append(d * nodes + axis)
+        nodes, n = _spring_place(mesh, item)
+        if math.isinf(item.stiffness):
+            held.append(d * nodes + _spring_axis(item, n, d))
+        elif item.stiffness != 0.0:
+            k = item.stiffness / nodes.size
+            dofs = d * nodes[:, None] + np.arange(d)  # (n, d)
+            rows.append(np.repeat(dofs, d, axis=1).ravel())
+            cols.append(np.tile(dofs, (1, d)).ravel())
+            vals.append(np.tile(k * np.outer(n, n).ravel(), nodes.size))
     if rows:
         Ks = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                            shape=(ndof, ndof))
@@ -381,6 +292,42 @@ def _springs_and_fixed(mesh: Mesh, springs, fixed) -> tuple[sp.csr_matrix, np.nd
         Ks = sp.csr_matrix((ndof, ndof))
     fixed_dofs = np.unique(np.concatenate(held)) if held else np.zeros(0, dtype=np.int64)
     return Ks, fixed_dofs.astype(np.int64)
+
+
+def _spring_place(mesh: Mesh, s: Spring) -> tuple[np.ndarray, np.ndarray]:
+    """The nodes of a spring and its unit direction."""
+    what = f"spring at {s.at!r}"
+    return (nodes_at(mesh, s.at, f"{what}: at"),
+            unit_direction(s.direction, mesh.dim, f"{what}: direction"))
+
+
+def _spring_axis(s: Spring, n: np.ndarray, d: int) -> int:
+    """The axis an infinite spring holds (it must lie along one)."""
+    axis = axis_index(n)
+    if axis is None:
+        raise InputError(
+            f"spring at {s.at!r}: an infinite stiffness (fixed DOF) needs an axis direction "
+            f"({list(AXES[:d])}); got direction {s.direction!r}"
+        )
+    return axis
+
+
+def _fixed(mesh: Mesh, item) -> np.ndarray:
+    """The DOFs a pair ``(at, direction)`` holds (``direction`` an axis or ``"all"``)."""
+    d = mesh.dim
+    if isinstance(item, str) or not isinstance(item, Sequence) or len(item) != 2:
+        raise InputError(f"supports: {item!r}; expected a Spring(at, direction, stiffness) or "
+                         f"a pair (at, direction) with direction one of {list(AXES[:d])} or "
+                         "'all'")
+    at, direction = item
+    nodes = nodes_at(mesh, at, f"fixed {item!r}: at")
+    if isinstance(direction, str) and direction.strip().lower() == "all":
+        return (d * nodes[:, None] + np.arange(d)).ravel()
+    axis = axis_index(unit_direction(direction, d, f"fixed {item!r}: direction"))
+    if axis is None:
+        raise InputError(f"fixed {item!r}: direction must be an axis {list(AXES[:d])} or "
+                         f"'all'; got {direction!r}")
+    return d * nodes + axis
 
 
 def _loads(mesh: Mesh, loads, thickness: float) -> list[Load]:
@@ -670,8 +617,7 @@ def _observed(mesh: Mesh, observed) -> list[ObservedPoint]:
 # the model
 # --------------------------------------------------------------------------------------------
 def from_mesh(mesh: Mesh, material: Material, *, thickness=1.0, damping: Damping | None = None,
-              springs=(), fixed=(), loads=(), contact, observed=None,
-              name: str = "model") -> Model:
+              supports=(), loads=(), contact, observed=None, name: str = "model") -> Model:
     """A linear elastic model of a mesh with one or several contact interfaces.
 
     Parameters
@@ -686,10 +632,11 @@ def from_mesh(mesh: Mesh, material: Material, *, thickness=1.0, damping: Damping
     thickness : float
         Out-of-plane width [m] of a 2D mesh; 1 in 3D.
     damping : Damping, optional
-    springs : sequence of Spring
-        Springs to ground, added to ``K`` (infinite ones become fixed DOFs).
-    fixed : sequence of (at, direction)
-        DOFs held at zero; ``direction`` is an axis name or ``"all"``.
+        Loss factor and Rayleigh factors (not matrices).
+    supports : sequence of Spring and (at, direction) pairs
+        How the structure is held: springs to ground, added to ``K`` (infinite ones hold
+        their DOFs), and pairs ``(at, direction)`` holding DOFs at zero (``direction`` an
+        axis name or ``"all"``), in any order.
     loads : sequence of Traction, NodalForce or core.Load
     contact : ContactSpec or sequence of ContactSpec
         The interfaces (node-to-rigid, or node-to-node with ``partner``), one record for
@@ -708,13 +655,16 @@ def from_mesh(mesh: Mesh, material: Material, *, thickness=1.0, damping: Damping
     ------
     InputError
         For any bad input, a contact node with a fixed DOF, or a structure that only
-        friction could hold (:func:`check_supported`).
+        friction could hold (:func:`fretwear.model.supports.check_supported`).
     """
     if not isinstance(mesh, Mesh):
         raise InputError(f"mesh = {mesh!r} is not a fretwear Mesh")
     check_cells(mesh)
     if damping is not None and not isinstance(damping, Damping):
         raise InputError(f"damping = {damping!r} is not a Damping(...)")
+    if damping is not None and (damping.C is not None or damping.D is not None):
+        raise InputError("damping: the matrices C and D are for user matrices (from_matrices); "
+                         "a mesh model takes loss_factor and the Rayleigh factors")
     thickness = check_thickness(thickness, mesh.dim)
     if isinstance(material, dict):
         K0, M = _assemble_bodies(mesh, material, thickness)
@@ -723,27 +673,12 @@ def from_mesh(mesh: Mesh, material: Material, *, thickness=1.0, damping: Damping
         raise InputError(f"material = {material!r} is not a Material(E, nu, rho)")
     else:
         K0, M = assemble(mesh, material.E, material.nu, material.rho, thickness)
-    Ks, fixed_dofs = _springs_and_fixed(mesh, springs, fixed)
+    Ks, fixed_dofs = _supports(mesh, supports)
     specs = [contact] if isinstance(contact, ContactSpec) else list(contact) \
         if isinstance(contact, Sequence) and not isinstance(contact, str) else [contact]
     interface = combine([_contact(mesh, spec, thickness) for spec in specs])
-    clash = np.intersect1d(interface.dofs.ravel(), fixed_dofs)
-    if clash.size:
-        node = int(clash[0]) // mesh.dim
-        which = interface.names()[int(interface.interface_index()[
-            np.flatnonzero(np.any(interface.dofs == clash[0], axis=1))[0]])]
-        raise InputError(
-            f"contact {which!r}: node {node} at {tuple(mesh.points[node].tolist())} "
-            f"is a contact node with a fixed DOF ({AXES[int(clash[0]) % mesh.dim]}); contact "
-            "DOFs cannot be fixed: hold the structure at nodes off the contact boundary, or "
-            "use a stiff finite spring"
-        )
-    C = D = None
-    if damping is not None:
-        if damping.loss_factor > 0.0:
-            D = (damping.loss_factor * K0).tocsr()
-        if damping.rayleigh_mass > 0.0 or damping.rayleigh_stiffness > 0.0:
-            C = (damping.rayleigh_mass * M + damping.rayleigh_stiffness * K0).tocsr()
+    _check_contact_free(mesh, interface, fixed_dofs)
+    C, D = _damping(damping, K0, M)
     model = Model(
         K=(K0 + Ks).tocsr(),
         M=M,
@@ -762,6 +697,33 @@ def from_mesh(mesh: Mesh, material: Material, *, thickness=1.0, damping: Damping
     )
     check_supported(model)
     return model
+
+
+def _check_contact_free(mesh: Mesh, interface: ContactInterface, fixed_dofs) -> None:
+    """Refuse a contact node with a fixed DOF, naming its interface, node and direction."""
+    clash = np.intersect1d(interface.dofs.ravel(), fixed_dofs)
+    if clash.size:
+        node = int(clash[0]) // mesh.dim
+        which = interface.names()[int(interface.interface_index()[
+            np.flatnonzero(np.any(interface.dofs == clash[0], axis=1))[0]])]
+        raise InputError(
+            f"contact {which!r}: node {node} at {tuple(mesh.points[node].tolist())} "
+            f"is a contact node with a fixed DOF ({AXES[int(clash[0]) % mesh.dim]}); contact "
+            "DOFs cannot be fixed: hold the structure at nodes off the contact boundary, or "
+            "use a stiff finite spring"
+        )
+
+
+def _damping(damping: Damping | None, K0, M):
+    """``C, D`` of a mesh model: Rayleigh ``a M + b K0`` and ``D = eta K0`` (K0 without the
+    springs), None where zero."""
+    C = D = None
+    if damping is not None:
+        if damping.loss_factor > 0.0:
+            D = (damping.loss_factor * K0).tocsr()
+        if damping.rayleigh_mass > 0.0 or damping.rayleigh_stiffness > 0.0:
+            C = (damping.rayleigh_mass * M + damping.rayleigh_stiffness * K0).tocsr()
+    return C, D
 
 
 def _assemble_bodies(mesh: Mesh, materials: dict, thickness: float):
@@ -808,222 +770,3 @@ def _assemble_bodies(mesh: Mesh, materials: dict, thickness: float):
         raise InputError(f"material: cell {c} (nodes {cells[c].tolist()}) belongs to none of the "
                          f"bodies {list(materials)}")
     return K.tocsr(), M.tocsr()
-
-
-# --------------------------------------------------------------------------------------------
-# support checks
-# --------------------------------------------------------------------------------------------
-def rigid_body_modes(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
-    """Rigid-body displacement fields of a set of nodes.
-
-    Returns
-    -------
-    R : (ndof, 3) in 2D, (ndof, 6) in 3D
-        Columns: unit translations along x, y(, z), then rotations about the z axis (2D) or
-        about x, y, z (3D) through the centroid, scaled by ``1 / size`` so that every entry
-        is at most about 1 [m/m].
-    centre : (d,) centroid [m]; size : bounding-box diagonal [m].
-    """
-    points = np.asarray(points, dtype=float)
-    nn, d = points.shape
-    centre = points.mean(axis=0)
-    size = float(np.linalg.norm(np.ptp(points, axis=0))) or 1.0
-    x = (points - centre) / size
-    if d == 2:
-        rot = [np.column_stack([-x[:, 1], x[:, 0]])]
-    else:
-        rot = [np.cross(e, x) for e in np.eye(3)]
-    cols = [np.tile(e, nn) for e in np.eye(d)] + [r.ravel() for r in rot]
-    return np.column_stack(cols), centre, size
-
-
-def _rref(N: np.ndarray) -> np.ndarray:
-    """Reduced row echelon form of the rows of N (k, nr), to describe motions simply."""
-    A = N.copy()
-    r = 0
-    for c in range(A.shape[1]):
-        if r == A.shape[0]:
-            break
-        p = r + int(np.argmax(np.abs(A[r:, c])))
-        if abs(A[p, c]) < 1e-8:
-            continue
-        A[[r, p]] = A[[p, r]]
-        A[r] /= A[r, c]
-        others = np.arange(A.shape[0]) != r
-        A[others] -= np.outer(A[others, c], A[r])
-        r += 1
-    A[np.abs(A) < 1e-10] = 0.0
-    return A[:r]
-
-
-def _fmt_vec(v: np.ndarray) -> str:
-    axis = _axis_index(v / np.linalg.norm(v))
-    if axis is not None:
-        return AXES[axis]
-    return "(" + ", ".join(f"{c:.3g}" for c in v / np.linalg.norm(v)) + ")"
-
-
-def _describe(a: np.ndarray, d: int, centre: np.ndarray, size: float) -> str:
-    """Words for the rigid motion with coefficients ``a`` on :func:`rigid_body_modes`."""
-    t = a[:d]
-    w = a[d:] / size  # rotation per unit of the coefficient [rad]
-    if np.linalg.norm(w) * size < 1e-9:
-        return f"translate along {_fmt_vec(t)}"
-    pt = lambda p: "(" + ", ".join(  # noqa: E731
-        f"{c:.4g}" for c in np.round(p / size, 5) * size + 0.0) + ")"
-    if d == 2:
-        w = float(w[0])
-        p = centre + np.array([-t[1], t[0]]) / w
-        return f"rotate about the z axis through {pt(p)}"
-    p = centre + np.cross(w, t) / (w @ w)
-    slide = (w @ t) / np.linalg.norm(w)
-    extra = " and slide along it" if abs(slide) > 1e-9 * np.linalg.norm(t) + 1e-300 else ""
-    return f"rotate about an axis along {_fmt_vec(w)} through {pt(p)}{extra}"
-
-
-def check_supported(model: Model) -> None:
-    """Refuse a model that only friction could hold.
-
-    With every contact node held in its normal direction and every fixed DOF held, ``K``
-    must be non-singular. For a model with a mesh, the rigid-body modes of the nodes are
-    tested exactly (a mode is free if it moves no held direction and costs no strain or
-    spring energy); for a model from matrices :func:`rigid_motion_check` is used.
-
-    Raises
-    ------
-    InputError
-        Naming the free motion(s), e.g. "the structure can translate along x".
-    """
-    if model.mesh is None:
-        c = model.contact
-        normal_dofs = c.dofs[np.arange(c.n_nodes), np.argmax(np.abs(c.frame[:, 0, :]), axis=1)]
-        # pairs: in the relative coordinates the normal DOF of node a holds n . (U_a - U_b)
-        rigid_motion_check(relative_model(model)[0].K, np.union1d(normal_dofs,
-                                                                  model.fixed_dofs))
-        return
-    d = model.dim
-    points = model.mesh.points
-    body = bodies(model.mesh)
-    nb = int(body.max()) + 1
-    # the rigid-body modes of every body (a mesh of several bodies: join, node-to-node pairs)
-    parts = []
-    for k in range(nb):
-        nodes = np.flatnonzero(body == k)
-        Rk, centre_k, size_k = rigid_body_modes(points[nodes])
-        dofs = (d * nodes[:, None] + np.arange(d)).ravel()
-        Rfull = np.zeros((model.ndof, Rk.shape[1]))
-        Rfull[dofs] = Rk
-        parts.append((Rfull, centre_k, size_k, int(nodes[0])))
-    R = np.hstack([p[0] for p in parts])
-    c = model.contact
-    # K R vanishes for the elastic structure (up to rounding); what remains is the springs'
-    # reaction to each rigid mode. Entries within a rounding bound are cleared, and each
-    # remaining row (a DOF with a spring) becomes a constraint like a held DOF.
-    KR = model.K @ R
-    KR[np.abs(KR) <= 64 * np.finfo(float).eps * (abs(model.K) @ np.abs(R))] = 0.0
-    springs = KR[np.any(KR != 0.0, axis=1)]
-    springs = springs / np.linalg.norm(springs, axis=1, keepdims=True)
-    Rrel = R[c.dofs]
-    if c.has_pairs:  # a pair holds the relative normal displacement n . (U_a - U_b)
-        pd = np.asarray(c.partner_dofs)
-        Rrel = Rrel - np.where(pd[..., None] >= 0, R[np.maximum(pd, 0)], 0.0)
-    A = np.vstack([
-        np.einsum("nd,ndr->nr", c.frame[:, 0, :], Rrel),
-        R[np.asarray(model.fixed_dofs, dtype=np.int64)],
-        springs,
-    ])
-    _, s, Vt = np.linalg.svd(A)
-    rank = int(np.sum(s > 1e-8 * max(1.0, s.max(initial=0.0))))
-    free = Vt[rank:].T  # rigid motions that move no held direction and strain no spring
-    if free.shape[1] == 0:
-        return
-    nr = parts[0][0].shape[1]
-    motions = []
-    for a in _rref(free.T):
-        k = int(np.argmax([np.abs(a[j * nr:(j + 1) * nr]).max() for j in range(nb)]))
-        _, centre_k, size_k, first = parts[k]
-        words = _describe(a[k * nr:(k + 1) * nr], d, centre_k, size_k)
-        if nb > 1:
-            others = [j for j in range(nb) if j != k and np.abs(a[j * nr:(j + 1) * nr]).max()
-                      > 1e-8]
-            who = f"the body of node {first}" + (" (with others)" if others else "")
-            words = f"{who} can {words}"
-        motions.append(words)
-    hint = ", ".join(f"Spring(at, {AXES[i]!r}, stiffness)" for i in range(d))
-    lead = "the structure can " if nb == 1 else ""
-    raise InputError(
-        "with the contact held only along its normal (frictionless), " + lead
-        + (", ".join(motions[:-1]) + " and " if len(motions) > 1 else "") + motions[-1]
-        + " with nothing to hold it but friction: add a spring or a fixed DOF (springs = ["
-        + hint + "] or fixed = [(at, direction)]) at a node off the contact boundary"
-    )
-
-
-def bodies(mesh: Mesh) -> np.ndarray:
-    """The body of every node (nn,) int: the connected components of the mesh's cells."""
-    from scipy.sparse.csgraph import connected_components
-
-    cells = np.asarray(mesh.cells, dtype=np.int64)
-    nn = mesh.points.shape[0]
-    k = cells.shape[1]
-    rows = np.repeat(cells, k, axis=1).ravel()
-    cols = np.tile(cells, (1, k)).ravel()
-    graph = sp.csr_matrix((np.ones(rows.size), (rows, cols)), shape=(nn, nn))
-    return connected_components(graph, directed=False)[1]
-
-
-def rigid_motion_check(K, held_dofs, *, dense_limit: int = 600) -> None:
-    """Refuse a stiffness matrix that is singular once ``held_dofs`` are held.
-
-    The matrix restricted to the other DOFs is scaled to unit diagonal and its smallest
-    eigenvalues are computed (dense below ``dense_limit`` DOFs, else shift-invert Lanczos);
-    an eigenvalue below ``1e-12`` times the largest (a zero-energy motion up to rounding)
-    means the structure can move with nothing but friction to hold it.
-
-    Parameters
-    ----------
-    K : (n, n) sparse or dense symmetric stiffness [N/m]
-    held_dofs : int array
-        DOFs held (contact normal DOFs and fixed DOFs).
-
-    Raises
-    ------
-    InputError
-        Naming the DOFs that move in a zero-energy motion.
-    """
-    K = sp.csr_matrix(K)
-    n = K.shape[0]
-    mask = np.ones(n, dtype=bool)
-    mask[np.asarray(held_dofs, dtype=np.int64)] = False
-    free = np.flatnonzero(mask)
-    if free.size == 0:
-        return
-    Kff = K[free][:, free]
-    diag = Kff.diagonal()
-    zero = np.flatnonzero(diag <= 0.0)
-    if zero.size:
-        raise InputError(
-            f"DOF(s) {free[zero][:10].tolist()} have no stiffness (diagonal of K <= 0) and are "
-            "neither contact normal DOFs nor fixed: nothing holds them but friction; add "
-            "stiffness (a spring to ground) or fix them (fixed_dofs)"
-        )
-    s = 1.0 / np.sqrt(diag)
-    S = sp.diags(s) @ Kff @ sp.diags(s)
-    scale = float(abs(S).sum(axis=1).max())  # >= largest eigenvalue
-    if free.size <= dense_limit:
-        lam, V = sla.eigh(S.toarray())
-        lam, V = lam[:6], V[:, :6]
-    else:
-        lam, V = spla.eigsh(S.tocsc(), k=6, sigma=-1e-6 * scale, which="LM")
-    bad = lam < 1e-12 * scale
-    if not np.any(bad):
-        return
-    u = s * V[:, int(np.argmin(lam))]
-    moving = free[np.abs(u) > 0.1 * np.abs(u).max()]
-    listed = moving[:10].tolist() + (["..."] if moving.size > 10 else [])
-    raise InputError(
-        f"the stiffness matrix with the contact normal DOFs and the fixed DOFs held is "
-        f"singular ({int(bad.sum())} zero-energy motion(s)): DOFs {listed} can move with "
-        "nothing to hold them but friction; add stiffness there (a spring to ground) or fix "
-        "DOFs (fixed_dofs)"
-    )

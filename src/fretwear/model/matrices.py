@@ -8,6 +8,7 @@ on ``[normal, tangential(s)]``, with the sign of the normal DOF flipped when
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -15,10 +16,10 @@ import scipy.io
 import scipy.sparse as sp
 
 from fretwear.errors import InputError
-from fretwear.limits import check_loss_factor
-from fretwear.model.build import rigid_motion_check
+from fretwear.model.build import Damping
 from fretwear.model.core import WAVEFORMS, ContactInterface, Load, Model, ObservedPoint
 from fretwear.model.interfaces import relative_model
+from fretwear.model.supports import rigid_motion_check
 from fretwear.resources import require_memory
 
 SYMMETRY_TOL = 1e-9  # max |A - A^T| relative to max |A|
@@ -162,60 +163,46 @@ def _nonnegative(value, what: str) -> float:
     return v
 
 
-def from_matrices(K, M, *, contact_normal_dofs, contact_tangential_dofs, gap=0.0, area=1.0,
-                  mu, normal_sign=1, C=None, D=None, loss_factor=None, loads=(),
-                  fixed_dofs=(), observed=None, wear_coefficient=0.0, coords=None,
-                  name: str = "matrices", contact_name: str = "contact",
-                  contact_partner_dofs=None, contact_frames=None,
-                  partner_wear_coefficient=0.0, normal_load=None, kn=None, kt=None) -> Model:
-    """A model from stiffness and mass matrices and a list of contact DOFs.
+@dataclass
+class ContactDofs:
+    """A frictional contact interface on the DOFs of user matrices: the contact record of
+    :func:`from_matrices` (as :class:`~fretwear.model.build.ContactSpec` is the record of a
+    mesh boundary for :func:`~fretwear.model.build.from_mesh`). Checked by
+    :func:`from_matrices`, which knows the number of DOFs; its messages name a field ``f`` of
+    the DOFs and frames as ``contact_f``.
 
-    Parameters
+    Attributes
     ----------
-    K, M : (n, n) array or scipy.sparse
-        Symmetric stiffness [N/m] and mass [kg] (``M`` may be singular, e.g. massless contact
-        DOFs). Symmetry is checked to ``1e-9`` relative and then enforced exactly.
-    contact_normal_dofs : (nc,) int, or None with ``normal_load``
+    normal_dofs : (nc,) int, or None with ``normal_load``
         The normal DOF of each contact node. None: the nodes have no normal DOF in the
         matrices (e.g. a one-DOF oscillator rubbing under a known normal force); their normal
         force is ``normal_load``. A normal DOF held at zero is then added per node (stiffness
         ``max diag K``, no mass, loaded by ``N(t)`` so that it stays at 0), invisible to the
         friction law, which takes ``lambda_N = N(t)``.
-    contact_tangential_dofs : (nc,) int (2D) or (nc, 2) int (3D)
+    tangential_dofs : (nc,) int (2D) or (nc, 2) int (3D)
         Its tangential DOF(s).
+    mu : float
+        Coulomb friction coefficient [-] (>= 0).
     gap : float or (nc,)
         Initial normal gap [m] (>= 0 open; negative = initial interference).
     area : float or (nc,)
         Contact area of each node [m^2] (> 0); pressures are forces divided by it.
-    mu : float
-        Coulomb friction coefficient [-] (>= 0).
     normal_sign : +1, -1 or (nc,) of them
         +1 if a positive displacement of the normal DOF closes the gap, else -1.
-    C, D : (n, n), optional
-        Viscous [N s/m] and hysteretic [N/m] damping matrices.
-    loss_factor : float, optional
-        Hysteretic loss factor eta: ``D = eta K`` (not with ``D``).
-    loads : sequence of :class:`~fretwear.model.core.Load` with (n,) vectors [N].
-    fixed_dofs : int sequence
-        DOFs held at zero (never contact DOFs).
-    observed : dict, optional
-        name -> DOF index or list of DOF indices.
-    wear_coefficient : float
-        Archard coefficient k_w [1/Pa].
-    coords : (nc, d), optional
-        Positions of the contact nodes [m], for output (zeros if not given).
-    name : str
-        Label of the model.
-    contact_name : str
-        Label of the contact interface.
-    contact_partner_dofs : (nc, d) int, optional
-        Node-to-node contact: the DOFs of each contact node's partner on the second body, in
-        the order of the node's own DOFs ``[normal, tangential..]`` (the same axes); the law
-        acts on the relative displacement, with equal and opposite forces.
-    contact_frames : (nc, d, d), optional
+    frames : (nc, d, d), optional
         Orthonormal rows ``[n, t1(, t2)]`` of each node's frame in the axes of its DOFs
         ``[normal, tangential..]`` (e.g. DOF triplets x, y, z of a node on an inclined
         flank); default: the identity, with ``normal_sign`` on the normal.
+    coords : (nc, d), optional
+        Positions of the contact nodes [m], for output (zeros if not given).
+    wear_coefficient : float
+        Archard coefficient k_w [1/Pa].
+    name : str
+        Label of the contact interface.
+    partner_dofs : (nc, d) int, optional
+        Node-to-node contact: the DOFs of each contact node's partner on the second body, in
+        the order of the node's own DOFs ``[normal, tangential..]`` (the same axes); the law
+        acts on the relative displacement, with equal and opposite forces.
     partner_wear_coefficient : float
         Archard coefficient k_w [1/Pa] of the partners' surface (pairs only).
     normal_load : float, (nc,) or Load, optional
@@ -227,6 +214,48 @@ def from_matrices(K, M, *, contact_normal_dofs, contact_tangential_dofs, gap=0.0
         Normal and tangential contact stiffness [N/m] (> 0, ``inf`` rigid; default rigid), in
         series with the contact law (:mod:`fretwear.hb.connectors`): a finite ``kt`` is a
         Jenkins element.
+    """
+
+    normal_dofs: object
+    tangential_dofs: object
+    mu: float
+    gap: object = 0.0
+    area: object = 1.0
+    normal_sign: object = 1
+    frames: object = None
+    coords: object = None
+    wear_coefficient: float = 0.0
+    name: str = "contact"
+    partner_dofs: object = None
+    partner_wear_coefficient: float = 0.0
+    normal_load: object = None
+    kn: object = None
+    kt: object = None
+
+
+def from_matrices(K, M, *, contact: ContactDofs, damping: Damping | None = None, loads=(),
+                  fixed_dofs=(), observed=None, name: str = "matrices") -> Model:
+    """A model from stiffness and mass matrices and a list of contact DOFs.
+
+    Parameters
+    ----------
+    K, M : (n, n) array or scipy.sparse
+        Symmetric stiffness [N/m] and mass [kg] (``M`` may be singular, e.g. massless contact
+        DOFs). Symmetry is checked to ``1e-9`` relative and then enforced exactly.
+    contact : ContactDofs
+        The contact nodes: their DOFs, frames, gaps, areas, friction and wear coefficients,
+        partners, prescribed normal load and contact stiffness.
+    damping : Damping, optional
+        :class:`~fretwear.model.build.Damping`: the viscous ``C`` [N s/m] and hysteretic
+        ``D`` [N/m] matrices (n, n), the loss factor eta (``D = eta K``, not with ``D``) and
+        the Rayleigh factors (``C = a M + b K``, added to ``C``).
+    loads : sequence of :class:`~fretwear.model.core.Load` with (n,) vectors [N].
+    fixed_dofs : int sequence
+        DOFs held at zero (never contact DOFs).
+    observed : dict, optional
+        name -> DOF index or list of DOF indices.
+    name : str
+        Label of the model.
 
     Returns
     -------
@@ -241,26 +270,61 @@ def from_matrices(K, M, *, contact_normal_dofs, contact_tangential_dofs, gap=0.0
         contact DOFs fixed, or a stiffness left singular with the contact normal DOFs and
         fixed DOFs held.
     """
+    if not isinstance(contact, ContactDofs):
+        raise InputError(f"contact = {contact!r}; expected a ContactDofs(normal_dofs, "
+                         "tangential_dofs, mu, ...)")
+    if damping is not None and not isinstance(damping, Damping):
+        raise InputError(f"damping = {damping!r} is not a Damping(...)")
     K = _symmetric(_matrix(K, "K"), "K")
-    n = K.shape[0]
-    M = _symmetric(_matrix(M, "M", n), "M")
+    n_user = K.shape[0]
+    M = _symmetric(_matrix(M, "M", n_user), "M")
     check_semidefinite(K, "K")
     check_semidefinite(M, "M")
+    K, M, dofs = _contact_dofs(contact, K, M)
+    n = K.shape[0]
+    fixed = _fixed_dofs(fixed_dofs, n, dofs)
+    interface = _interface(contact, dofs, n)
+    C, D = _damping(damping, K, M, n_user)
+    model = Model(
+        K=K,
+        M=M,
+        contact=interface,
+        C=C,
+        D=D,
+        loads=_padded_loads(_loads(loads, n_user), n_user, contact, interface),
+        observed=_observed(observed, n_user),
+        fixed_dofs=fixed,
+        dim=dofs.shape[1],
+        mesh=None,
+        thickness=1.0,
+        name=str(name),
+        meta={"source": "matrices"},
+    )
+    # the DOF nearest to each normal is held; for pairs in the relative coordinates, where
+    # it holds n . (U_a - U_b)
+    frame = interface.frame
+    held = np.union1d(dofs[np.arange(dofs.shape[0]), np.argmax(np.abs(frame[:, 0, :]), axis=1)],
+                      fixed)
+    rigid_motion_check(relative_model(model)[0].K, held)
+    return model
 
-    tang = _dofs(contact_tangential_dofs, n, "contact_tangential_dofs")
-    n_user = n
-    if contact_normal_dofs is None:
-        if normal_load is None:
+
+def _contact_dofs(contact: ContactDofs, K, M):
+    """``K, M`` (with a held normal DOF added per node when ``normal_dofs`` is None) and the
+    contact DOFs (nc, d) ``[normal, tangential..]`` of every node, checked."""
+    n = K.shape[0]
+    tang = _dofs(contact.tangential_dofs, n, "contact_tangential_dofs")
+    if contact.normal_dofs is None:
+        if contact.normal_load is None:
             raise InputError("contact_normal_dofs = None: expected a normal_load (the normal "
                              "force of contact nodes without a normal DOF)")
         nc = tang.shape[0]
         k_pad = float(np.max(np.abs(K.diagonal()))) if K.nnz else 1.0
         K = sp.block_diag([K, sp.identity(nc) * (k_pad or 1.0)], format="csr")
         M = sp.block_diag([M, sp.csr_matrix((nc, nc))], format="csr")
-        n = n + nc
-        normal = np.arange(n_user, n, dtype=np.int64)
+        normal = np.arange(n, n + nc, dtype=np.int64)
     else:
-        normal = _dofs(contact_normal_dofs, n, "contact_normal_dofs").reshape(-1)
+        normal = _dofs(contact.normal_dofs, n, "contact_normal_dofs").reshape(-1)
     nc = normal.size
     if nc == 0:
         raise InputError("contact_normal_dofs is empty; expected at least one contact node")
@@ -268,16 +332,19 @@ def from_matrices(K, M, *, contact_normal_dofs, contact_tangential_dofs, gap=0.0
         tang = tang[:, None]
     if tang.ndim != 2 or tang.shape[0] != nc or tang.shape[1] not in (1, 2):
         raise InputError(
-            f"contact_tangential_dofs has shape {np.shape(contact_tangential_dofs)}; expected "
+            f"contact_tangential_dofs has shape {np.shape(contact.tangential_dofs)}; expected "
             f"({nc},) in 2D or ({nc}, 2) in 3D for {nc} contact normal DOFs"
         )
     dofs = np.column_stack([normal, tang])
-    dim = dofs.shape[1]
     values, counts = np.unique(dofs, return_counts=True)
     if np.any(counts > 1):
         raise InputError(f"contact DOF {int(values[counts > 1][0])} is listed more than once; "
                          "each contact DOF must be distinct")
+    return K, M, dofs
 
+
+def _fixed_dofs(fixed_dofs, n: int, dofs: np.ndarray) -> np.ndarray:
+    """The fixed DOFs, checked: in range, listed once, no contact DOF."""
     fixed = _dofs(fixed_dofs, n, "fixed_dofs").reshape(-1)
     values, counts = np.unique(fixed, return_counts=True)
     if np.any(counts > 1):
@@ -286,104 +353,109 @@ def from_matrices(K, M, *, contact_normal_dofs, contact_tangential_dofs, gap=0.0
     if clash.size:
         raise InputError(f"DOF {int(clash[0])} is both a contact DOF and a fixed DOF; contact "
                          "DOFs cannot be fixed")
+    return fixed
 
-    sign = _per_node(normal_sign, nc, "normal_sign", signs=True)
-    frame = np.broadcast_to(np.eye(dim), (nc, dim, dim)).copy()
-    frame[:, 0, 0] = sign
-    if contact_frames is not None:
-        frame = np.asarray(contact_frames, dtype=float)
-        if frame.shape != (nc, dim, dim) or not np.all(np.isfinite(frame)):
-            raise InputError(f"contact_frames has shape {frame.shape}; expected ({nc}, {dim}, "
-                             f"{dim}) finite frames [n, t1(, t2)] of the {nc} contact nodes")
-        err = np.abs(frame @ np.swapaxes(frame, 1, 2) - np.eye(dim)).max(axis=(1, 2))
-        if np.any(err > 1e-9):
-            p = int(np.argmax(err))
-            raise InputError(f"contact_frames[{p}] is not orthonormal (rows [n, t1(, t2)] "
-                             f"off by {err[p]:.3g})")
-    partner = None
-    if contact_partner_dofs is not None:
-        partner = _dofs(contact_partner_dofs, n, "contact_partner_dofs")
-        if partner.shape != (nc, dim):
-            raise InputError(f"contact_partner_dofs has shape {partner.shape}; expected "
-                             f"({nc}, {dim}): the DOFs of each node's partner, ordered like "
-                             "its own [normal, tangential..]")
-        clash = np.intersect1d(partner, dofs)
-        if clash.size or np.unique(partner).size != partner.size:
-            raise InputError("contact_partner_dofs: a partner DOF is also a contact DOF or "
-                             "is listed twice; each pair has its own two nodes")
-    if coords is None:
+
+def _interface(contact: ContactDofs, dofs: np.ndarray, n: int) -> ContactInterface:
+    """The model's :class:`ContactInterface` from the record (every field checked)."""
+    nc, dim = dofs.shape
+    frame = _frames(contact, nc, dim)
+    partner = _partner(contact.partner_dofs, dofs, n)
+    if contact.coords is None:
         xyz = np.zeros((nc, dim))
     else:
-        xyz = np.asarray(coords, dtype=float)
+        xyz = np.asarray(contact.coords, dtype=float)
         if xyz.shape != (nc, dim) or not np.all(np.isfinite(xyz)):
             raise InputError(f"coords has shape {xyz.shape}; expected ({nc}, {dim}) finite "
                              "positions [m] of the contact nodes")
     interface = ContactInterface(
         dofs=dofs,
         frame=frame,
-        gap=_per_node(gap, nc, "gap"),
-        area=_per_node(area, nc, "area", positive=True),
-        mu=_nonnegative(mu, "friction coefficient mu"),
+        gap=_per_node(contact.gap, nc, "gap"),
+        area=_per_node(contact.area, nc, "area", positive=True),
+        mu=_nonnegative(contact.mu, "friction coefficient mu"),
         coords=xyz,
         node_ids=np.full(nc, -1, dtype=np.int64),
-        wear_coefficient=_nonnegative(wear_coefficient, "wear_coefficient"),
-        name=str(contact_name),
+        wear_coefficient=_nonnegative(contact.wear_coefficient, "wear_coefficient"),
+        name=str(contact.name),
         partner_dofs=partner,
         partner_ids=None if partner is None else np.full(nc, -1, dtype=np.int64),
-        partner_wear_coefficient=_nonnegative(partner_wear_coefficient,
+        partner_wear_coefficient=_nonnegative(contact.partner_wear_coefficient,
                                               "partner_wear_coefficient"),
-        normal_load=_normal_load(normal_load, nc),
-        kn=_stiffness(kn, nc, "kn"),
-        kt=_stiffness(kt, nc, "kt"),
+        normal_load=_normal_load(contact.normal_load, nc),
+        kn=_stiffness(contact.kn, nc, "kn"),
+        kt=_stiffness(contact.kt, nc, "kt"),
     )
-    if contact_normal_dofs is None and np.isnan(interface.normal_load.vector).any():
+    if contact.normal_dofs is None and np.isnan(interface.normal_load.vector).any():
         raise InputError("normal_load has NaN entries (unilateral nodes) but the nodes have no "
                          "normal DOF (contact_normal_dofs = None)")
+    return interface
 
+
+def _frames(contact: ContactDofs, nc: int, dim: int) -> np.ndarray:
+    """Each node's frame (nc, d, d): ``contact.frames`` checked orthonormal, or the identity
+    with ``normal_sign`` on the normal."""
+    sign = _per_node(contact.normal_sign, nc, "normal_sign", signs=True)
+    frame = np.broadcast_to(np.eye(dim), (nc, dim, dim)).copy()
+    frame[:, 0, 0] = sign
+    if contact.frames is None:
+        return frame
+    frame = np.asarray(contact.frames, dtype=float)
+    if frame.shape != (nc, dim, dim) or not np.all(np.isfinite(frame)):
+        raise InputError(f"contact_frames has shape {frame.shape}; expected ({nc}, {dim}, "
+                         f"{dim}) finite frames [n, t1(, t2)] of the {nc} contact nodes")
+    err = np.abs(frame @ np.swapaxes(frame, 1, 2) - np.eye(dim)).max(axis=(1, 2))
+    if np.any(err > 1e-9):
+        p = int(np.argmax(err))
+        raise InputError(f"contact_frames[{p}] is not orthonormal (rows [n, t1(, t2)] "
+                         f"off by {err[p]:.3g})")
+    return frame
+
+
+def _partner(partner_dofs, dofs: np.ndarray, n: int) -> np.ndarray | None:
+    """The partners' DOFs (nc, d) of node-to-node pairs, checked; None without pairs."""
+    if partner_dofs is None:
+        return None
+    nc, dim = dofs.shape
+    partner = _dofs(partner_dofs, n, "contact_partner_dofs")
+    if partner.shape != (nc, dim):
+        raise InputError(f"contact_partner_dofs has shape {partner.shape}; expected "
+                         f"({nc}, {dim}): the DOFs of each node's partner, ordered like "
+                         "its own [normal, tangential..]")
+    clash = np.intersect1d(partner, dofs)
+    if clash.size or np.unique(partner).size != partner.size:
+        raise InputError("contact_partner_dofs: a partner DOF is also a contact DOF or "
+                         "is listed twice; each pair has its own two nodes")
+    return partner
+
+
+def _damping(damping: Damping | None, K: sp.csr_matrix, M: sp.csr_matrix, n_user: int):
+    """``C, D`` (n, n) of the model from the user's ``damping``, zero on the added normal DOFs
+    (``K, M`` of size n >= n_user)."""
+    if damping is None:
+        return None, None
+    n = K.shape[0]
     pad = sp.csr_matrix((n - n_user, n - n_user))
-    if C is not None:
-        C = _matrix(C, "C", n_user)
+    C = D = None
+    if damping.C is not None:
+        C = _matrix(damping.C, "C", n_user)
         check_semidefinite(C, "C")
+    if damping.rayleigh_mass > 0.0 or damping.rayleigh_stiffness > 0.0:
+        Cr = (damping.rayleigh_mass * M[:n_user, :n_user]
+              + damping.rayleigh_stiffness * K[:n_user, :n_user])
+        C = _matrix(Cr if C is None else C + Cr, "C")
+    if C is not None:
         C = sp.block_diag([C, pad], format="csr")
-    if D is not None and loss_factor is not None:
-        raise InputError("give either D or loss_factor (D = loss_factor * K), not both")
-    if D is not None:
-        D = _matrix(D, "D", n_user)
+    if damping.D is not None:
+        D = _matrix(damping.D, "D", n_user)
         check_semidefinite(D, "D")
         D = sp.block_diag([D, pad], format="csr")
-    elif loss_factor is not None and check_loss_factor(loss_factor) > 0.0:
-        D = (float(loss_factor) * K).tocsr()
+    elif damping.loss_factor > 0.0:
+        D = (damping.loss_factor * K).tocsr()
         if n > n_user:
             D[n_user:, n_user:] = 0.0
             D.eliminate_zeros()
-    loads = _loads(loads, n_user)
-    if n > n_user:  # the added normal DOFs: loaded by N(t) so that they stay at 0
-        loads = [Load(np.concatenate([ld.vector, np.zeros(n - n_user)]), ld.waveform,
-                      ld.coefficients, ld.name) for ld in loads]
-        nl = interface.normal_load
-        loads.append(Load(np.concatenate([np.zeros(n_user), sign * nl.vector]), nl.waveform,
-                          nl.coefficients, "normal load"))
-
-    model = Model(
-        K=K,
-        M=M,
-        contact=interface,
-        C=C,
-        D=D,
-        loads=loads,
-        observed=_observed(observed, n_user),
-        fixed_dofs=fixed,
-        dim=dim,
-        mesh=None,
-        thickness=1.0,
-        name=str(name),
-        meta={"source": "matrices"},
-    )
-    # the DOF nearest to each normal is held; for pairs in the relative coordinates, where
-    # it holds n . (U_a - U_b)
-    held = np.union1d(dofs[np.arange(nc), np.argmax(np.abs(frame[:, 0, :]), axis=1)], fixed)
-    rigid_motion_check(relative_model(model)[0].K, held)
-    return model
+    return C, D
 
 
 def _normal_load(value, nc: int) -> Load | None:
@@ -437,6 +509,22 @@ def _loads(loads, n: int) -> list[Load]:
             raise InputError(f"load {load.name!r}: waveform {load.waveform!r}; expected one of "
                              f"{list(WAVEFORMS)}")
         out.append(Load(vec.copy(), load.waveform, load.coefficients, load.name))
+    return out
+
+
+def _padded_loads(loads: list[Load], n_user: int, contact: ContactDofs,
+                  interface: ContactInterface) -> list[Load]:
+    """The loads on the normal DOFs added for a prescribed normal load (``normal_dofs`` None):
+    zero there, and the load ``N(t)`` on them so that they stay at 0."""
+    if contact.normal_dofs is not None:
+        return loads
+    nc = interface.n_nodes
+    sign = _per_node(contact.normal_sign, nc, "normal_sign", signs=True)
+    out = [Load(np.concatenate([ld.vector, np.zeros(nc)]), ld.waveform, ld.coefficients,
+                ld.name) for ld in loads]
+    nl = interface.normal_load
+    out.append(Load(np.concatenate([np.zeros(n_user), sign * nl.vector]), nl.waveform,
+                    nl.coefficients, "normal load"))
     return out
 
 

@@ -45,6 +45,7 @@ from fretwear.paper.catalogue import (
     toml_value,
 )
 from fretwear.paper.report import load, write_report
+from fretwear.timedomain.options import IncrementalWearOptions
 from fretwear.timedomain.quasistatic import incremental_wear
 
 
@@ -118,8 +119,9 @@ def _load_stepping(folder: Path, quick: bool) -> str:
     if _settings_match(path, settings):
         return "up to date"
     model = stromberg_beam()
-    res = incremental_wear(model, steps_per_cycle=steps, n_cycles=cycles,
-                           cycle_jump=STROMBERG_JUMP)
+    res = incremental_wear(model, n_cycles=cycles,
+                           options=IncrementalWearOptions(steps_per_cycle=steps,
+                                                          cycle_jump=STROMBERG_JUMP))
     x = np.asarray(model.contact.coords, float)[:, 0]
     _save_npz(path, settings=settings, x=x, wear=np.asarray(res.wear)[-1],
               cycles=float(cycles), steps=steps, jump=STROMBERG_JUMP)

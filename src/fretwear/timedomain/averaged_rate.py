@@ -20,7 +20,8 @@ that sticks wears exactly nothing (its slip increments are zero by the exact sti
 
 The integration starts from a state the caller gives (the last periodic solution, or the end of
 the previous time-averaged step, so that the slow drift of the mean position and the transient
-carry over), runs ``settle`` periods, then averages over ``average`` periods.
+carry over), runs ``settle`` periods, then averages over ``average`` periods
+(:class:`~fretwear.timedomain.options.AveragingOptions`).
 """
 
 from __future__ import annotations
@@ -34,6 +35,12 @@ from fretwear.hb import contact as law
 from fretwear.hb.fourier import FourierBasis
 from fretwear.model.core import Model
 from fretwear.timedomain.integrate import integrate
+from fretwear.timedomain.options import (
+    AVERAGING,
+    AveragingOptions,
+    InitialState,
+    IntegrationOptions,
+)
 from fretwear.timedomain.steady import classify_sequence, fourier_coefficients
 from fretwear.wear.kernels import slip_work_samples
 
@@ -130,9 +137,7 @@ def _sum_in_time(a: np.ndarray) -> np.ndarray:
 
 
 def time_averaged_rate(model: Model, frequency: float, basis: FourierBasis, coef, wear, *, U0, V0,
-                       settle: int = 300, average: int = 500,
-                       steps_per_period: int | None = None,
-                       classify_tol: float = 1e-4) -> TimeAveragedRate:
+                       options: AveragingOptions = AVERAGING) -> TimeAveragedRate:
     """Mean wear per cycle over a time integration at wear ``wear`` (module docstring).
 
     Parameters
@@ -142,17 +147,20 @@ def time_averaged_rate(model: Model, frequency: float, basis: FourierBasis, coef
     coef : (nc,) factor ``c_p`` of the wear law [1/N] (``dW1 = c S``).
     wear : (nc,) wear depth [m] (opens the normal gap).
     U0, V0 : (ndof,) start state [m], [m/s].
-    settle : periods integrated before averaging; average : periods averaged (>= 2).
-    steps_per_period : time steps per period (default: :func:`default_steps`).
-    classify_tol : relative periodicity tolerance of the response classification.
+    options : :class:`~fretwear.timedomain.options.AveragingOptions`: ``settle`` periods
+        integrated before averaging, ``average`` periods averaged (>= 2), ``steps_per_period``
+        (default: :func:`default_steps`), ``classify_tol`` the relative periodicity tolerance
+        of the response classification.
     """
 
     t0 = time.perf_counter()
     hmax = max(basis.harmonics) if basis.harmonics else 1
-    nsteps = default_steps(basis, steps_per_period)
-    average = max(int(average), 2)
-    r = integrate(model, frequency, n_periods=int(settle) + average, steps_per_period=nsteps,
-                  record=average, U0=U0, V0=V0, wear=wear)
+    nsteps = default_steps(basis, options.steps_per_period)
+    settle = int(options.settle)
+    average = max(int(options.average), 2)
+    r = integrate(model, frequency, n_periods=settle + average,
+                  options=IntegrationOptions(steps_per_period=nsteps), record=average,
+                  start=InitialState(U0=U0, V0=V0, wear=wear))
     x, f, s = window_samples(r.u_loc, r.lam, r.state)
     nc, d, ns = x.shape
     cycles = (ns - 1) / nsteps  # steps whose slip is counted, in periods
@@ -179,7 +187,7 @@ def time_averaged_rate(model: Model, frequency: float, basis: FourierBasis, coef
     # response over the window: once-per-period samples of the contact displacements
     poinc = x[..., ::nsteps].reshape(nc * d, -1).T
     ptp = float(np.ptp(x[..., last], axis=-1).max())
-    c = classify_sequence(poinc, tol=classify_tol, scale=max(ptp, 1e-300),
+    c = classify_sequence(poinc, tol=options.classify_tol, scale=max(ptp, 1e-300),
                           min_window=min(64, poinc.shape[0]))
     return TimeAveragedRate(
         g=np.asarray(coef, float) * S, slip_work=S, pressure_mean=p[:, 1:].mean(axis=1),
@@ -188,6 +196,6 @@ def time_averaged_rate(model: Model, frequency: float, basis: FourierBasis, coef
         state_fraction=np.stack([(s[:, 1:] == k).mean(axis=1) for k in range(3)], axis=1),
         friction_energy=law.friction_work(f, x, s) / cycles, U=U, lam=lam_h,
         anchor=U[:, 1:, 0].copy(), kind=c.kind, rotation=float(c.rotation), order=int(c.order),
-        U_end=r.U, V_end=r.V, periods=int(settle) + average,
+        U_end=r.U, V_end=r.V, periods=settle + average,
         wall_time=time.perf_counter() - t0, scatter=float(scatter))
 

@@ -32,7 +32,8 @@ Signorini exactly and the slip increment ``x_T(n+1) - x_T(n)`` satisfies Coulomb
 Speed: for a fixed step the step matrix is constant, so the structure is reduced exactly
 (Craig-Bampton on the contact DOFs with the fixed-interface modes below a cutoff and one
 static mode per load vector), diagonalised, and each step is a small dense update plus one
-contact problem (numba kernels in :mod:`fretwear.timedomain.kernels`).
+contact problem (numba kernels in :mod:`fretwear.timedomain.kernels` and
+:mod:`fretwear.timedomain.contact_solve`).
 
 Damping: the viscous ``C`` as given; the hysteretic ``D`` has no causal time-domain form and
 is replaced by the equivalent viscous damping at the forcing frequency, ``C_eq = D / omega``.
@@ -51,55 +52,26 @@ from fretwear.limits import check_range
 from fretwear.model.core import Model
 from fretwear.resources import require_memory
 from fretwear.timedomain.checks import c_float, count, node_wear, positive
+from fretwear.timedomain.contact_solve import OPEN, STICK, Contact, ContactState, Settings
 from fretwear.timedomain.kernels import (
-    OPEN,
-    STICK,
-    Contact,
-    ContactState,
     DynamicState,
     EnergyTerms,
     Records,
-    Settings,
     StepOperator,
     run_dynamic,
+)
+from fretwear.timedomain.options import (
+    DEFAULT_STEPS,
+    INTEGRATION,
+    InitialState,
+    IntegrationOptions,
 )
 from fretwear.timedomain.reduction import HF_GAMMA, HF_LIMIT, reduce_dynamics, submatrix
 from fretwear.timedomain.results import TransientResult
 
-__all__ = ["DEFAULT_STEPS", "Integrator", "integrate"]
+__all__ = ["DEFAULT_STEPS", "InitialState", "IntegrationOptions", "Integrator", "integrate"]
 
-DEFAULT_STEPS = 256  # time steps per forcing period (case files take it too)
 CHUNK_STEPS = 2_000_000  # steps per kernel call (progress, interruption)
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
 
 
 # --------------------------------------------------------------------------------------------
@@ -108,19 +80,24 @@ CHUNK_STEPS = 2_000_000  # steps per kernel call (progress, interruption)
 class Integrator:
     """Holds the reduced step operator and the current state; runs whole periods."""
 
-    def __init__(self, model: Model, omega: float, *, steps_per_period, modal_cutoff, n_modes,
-                 gamma, tol, wear, U0, V0, stick_anchor, hf_damping=False):
+    def __init__(self, model: Model, omega: float, options: IntegrationOptions = INTEGRATION,
+                 start: InitialState | None = None):
+        """The step operator of ``model`` at ``omega`` [rad/s] with ``options``, in the state
+        ``start`` (default: rest, unworn)."""
+        if not isinstance(options, IntegrationOptions):
+            raise InputError(f"options = {options!r}; expected an IntegrationOptions(...)")
+        start = InitialState() if start is None else start
+        if not isinstance(start, InitialState):
+            raise InputError(f"start = {start!r}; expected an InitialState(U0, V0, wear, "
+                             "anchor)")
         self.model = model
         self.omega = positive(omega, "omega")
-        self.N = N = count(steps_per_period, "steps_per_period", 4)
-        gamma = float(gamma)
-        if not (0.5 <= gamma <= 1.0):
-            raise InputError(f"gamma = {gamma!r}; expected 0.5 (trapezoidal, default) to 1")
-        self.gamma = gamma
-        self.tol = positive(tol, "tol")
+        self.N = N = options.steps_per_period
+        self.gamma = gamma = options.gamma
+        self.tol = options.contact_tol
         t0 = time.perf_counter()
-        red = self.red = reduce_dynamics(model, self.omega, modal_cutoff=modal_cutoff,
-                                         n_modes=n_modes, steps_per_period=N)
+        red = self.red = reduce_dynamics(model, self.omega, modal_cutoff=options.modal_cutoff,
+                                         n_modes=options.n_modes, steps_per_period=N)
         c = model.contact
         self.nc, self.d = c.dofs.shape
         self.m = self.nc * self.d
@@ -128,7 +105,7 @@ class Integrator:
         r = red.basis.shape[1]
         # Newmark parameters, per mode in modal coordinates (high modes may get more damping)
         g = np.full(r, gamma)
-        if red.diag and hf_damping:
+        if red.diag and options.hf_damping:
             g[np.sqrt(np.maximum(red.K, 0.0)) * h > HF_LIMIT] = HF_GAMMA
         b = 0.25 * (g + 0.5) ** 2
         self.g_modes = g
@@ -142,46 +119,13 @@ class Integrator:
         self.ftil = w1 * np.roll(Fr, -1, axis=0) + w0 * Fr + wm * np.roll(Fr, 1, axis=0)
         z0 = np.zeros((0, 0))
         if red.diag:
-            k, mm, cc, U, R = red.K, red.M, red.C, red.U, red.R
-            ds = mm + g * h * cc + b * h * h * k
-            self.a_v = mm - (1 - g) * h * cc + wm * h * h * k
-            self.b_v = -h * h * k
-            self.ds = ds
-            self.hc = (1 - g) * h
-            # S^-1 = (Ds + Gam U R U^T)^-1 = Ds^-1 - P Qt (Woodbury), Gam = diag(g h)
-            self.P = np.ascontiguousarray((g * h / ds)[:, None] * U)
-            core = np.eye(U.shape[1]) + R @ (U.T @ self.P)
-            self.Qt = np.ascontiguousarray(np.linalg.solve(core, R @ (U.T / ds[None, :])))
-            self.U, self.R = U, R
-
-            def s_inv(Y):
-                return Y / ds[:, None] - self.P @ (self.Qt @ Y)
-
-            self.bq_m = self.bd_m = z0
-            self.ftab = h * h * s_inv(self.ftil.T).T
-            G = h * h * s_inv(red.Tx.T)
+            G = self._diagonal_step(g, b, wm)
         else:
-            S2 = red.M + gamma * h * red.C + b[0] * h * h * red.K
-            lu = sla.lu_factor(S2)
-            self.bq_m = -h * h * sla.lu_solve(lu, red.K)
-            self.bd_m = sla.lu_solve(lu, red.M - (1 - gamma) * h * red.C
-                                     + wm[0] * h * h * red.K)
-            self.a_v = self.b_v = self.ds = self.hc = np.zeros(0)
-            self.U, self.R, self.P, self.Qt = np.zeros((r, 0)), z0, np.zeros((r, 0)), z0
-            self.ftab = h * h * sla.lu_solve(lu, self.ftil.T).T
-            G = h * h * sla.lu_solve(lu, red.Tx.T)
+            G = self._dense_step(b[0], wm[0])
         self.ftab = np.ascontiguousarray(self.ftab)
         self.G = np.ascontiguousarray(G)
-        W = red.Tx @ G
-        W = 0.5 * (W + W.T)
-        try:
-            cf = sla.cho_factor(W)
-            self.A = sla.cho_solve(cf, np.eye(self.m))
-        except np.linalg.LinAlgError:
-            raise InputError("the contact DOFs' step mobility (Delassus operator) is singular: "
-                             "a contact direction carries no mass nor stiffness") from None
-        self.A = np.ascontiguousarray(0.5 * (self.A + self.A.T))
-        self.gap = np.asarray(c.gap, dtype=float) + node_wear(wear, self.nc)
+        self.A = self._inverse_delassus(G)
+        self.gap = np.asarray(c.gap, dtype=float) + node_wear(start.wear, self.nc)
         if red.diag:
             m_v, k_v, c_v = red.M, red.K, red.C
             m_m = k_m = c_m = z0
@@ -203,11 +147,62 @@ class Integrator:
         self.setup_time = time.perf_counter() - t0
         self.r = r
         # initial state
-        self._set_state(U0, V0, stick_anchor)
+        self._set_state(start.U0, start.V0, start.anchor)
         self.periods_done = 0
         self.n_fail = 0
         self.max_it = 0
         self.first_fail_time = None
+
+    # the step operator -------------------------------------------------------------------------
+    def _diagonal_step(self, g, b, wm):
+        """The step in modal coordinates (diagonal mass, stiffness and damping plus the
+        low-rank ``U R U^T``): its per-mode weights, the Woodbury factors of ``S^-1``, the
+        forcing increments ``ftab``; returns ``G = h^2 S^-1 Tx^T``."""
+        red, h = self.red, self.h
+        k, mm, cc, U, R = red.K, red.M, red.C, red.U, red.R
+        ds = mm + g * h * cc + b * h * h * k
+        self.a_v = mm - (1 - g) * h * cc + wm * h * h * k
+        self.b_v = -h * h * k
+        self.ds = ds
+        self.hc = (1 - g) * h
+        # S^-1 = (Ds + Gam U R U^T)^-1 = Ds^-1 - P Qt (Woodbury), Gam = diag(g h)
+        self.P = np.ascontiguousarray((g * h / ds)[:, None] * U)
+        core = np.eye(U.shape[1]) + R @ (U.T @ self.P)
+        self.Qt = np.ascontiguousarray(np.linalg.solve(core, R @ (U.T / ds[None, :])))
+        self.U, self.R = U, R
+
+        def s_inv(Y):
+            return Y / ds[:, None] - self.P @ (self.Qt @ Y)
+
+        self.bq_m = self.bd_m = np.zeros((0, 0))
+        self.ftab = h * h * s_inv(self.ftil.T).T
+        return h * h * s_inv(red.Tx.T)
+
+    def _dense_step(self, b: float, wm: float):
+        """The step with dense reduced matrices (one LU of ``S``): ``S^-1 B_q``, ``S^-1 B_d``,
+        the forcing increments ``ftab``; returns ``G = h^2 S^-1 Tx^T``."""
+        red, h, gamma, r = self.red, self.h, self.gamma, self.red.basis.shape[1]
+        z0 = np.zeros((0, 0))
+        S2 = red.M + gamma * h * red.C + b * h * h * red.K
+        lu = sla.lu_factor(S2)
+        self.bq_m = -h * h * sla.lu_solve(lu, red.K)
+        self.bd_m = sla.lu_solve(lu, red.M - (1 - gamma) * h * red.C + wm * h * h * red.K)
+        self.a_v = self.b_v = self.ds = self.hc = np.zeros(0)
+        self.U, self.R, self.P, self.Qt = np.zeros((r, 0)), z0, np.zeros((r, 0)), z0
+        self.ftab = h * h * sla.lu_solve(lu, self.ftil.T).T
+        return h * h * sla.lu_solve(lu, red.Tx.T)
+
+    def _inverse_delassus(self, G) -> np.ndarray:
+        """``A = W^-1``, ``W = Tx G`` the contact DOFs' step mobility (symmetrised)."""
+        W = self.red.Tx @ G
+        W = 0.5 * (W + W.T)
+        try:
+            cf = sla.cho_factor(W)
+            A = sla.cho_solve(cf, np.eye(self.m))
+        except np.linalg.LinAlgError:
+            raise InputError("the contact DOFs' step mobility (Delassus operator) is singular: "
+                             "a contact direction carries no mass nor stiffness") from None
+        return np.ascontiguousarray(0.5 * (A + A.T))
 
     # state <-> full vectors ------------------------------------------------------------------
     def _project(self, U, what):
@@ -231,7 +226,7 @@ class Integrator:
         except np.linalg.LinAlgError:
             return np.zeros(self.r)
 
-    def _set_state(self, U0, V0, stick_anchor):
+    def _set_state(self, U0, V0, anchor):
         q = np.zeros(self.r) if U0 is None else self._project(U0, "U0")
         v = np.zeros(self.r) if V0 is None else self._project(V0, "V0")
         # midpoint velocity w_{-1/2} = V0 - h/2 a0 (a0 without damping and contact)
@@ -242,12 +237,12 @@ class Integrator:
         self.xprev = Tx @ q
         self.xprev2 = Tx @ (q - self.dq)
         d = self.d
-        if stick_anchor is not None:
-            a = np.asarray(stick_anchor, dtype=float)
+        if anchor is not None:
+            a = np.asarray(anchor, dtype=float)
             if a.shape == (self.nc,) and d == 2:
                 a = a[:, None]
             if a.shape != (self.nc, d - 1):
-                raise InputError(f"stick_anchor has shape {a.shape}; expected ({self.nc}, "
+                raise InputError(f"anchor has shape {a.shape}; expected ({self.nc}, "
                                  f"{d - 1}) tangential positions [m]")
             xp = self.xprev.reshape(self.nc, d)
             xp[:, 1:] = a
@@ -359,10 +354,9 @@ class Integrator:
 
 
 def integrate(model: Model, frequency: float, *, n_periods: int,
-              steps_per_period: int = DEFAULT_STEPS, record="last", U0=None, V0=None,
-              wear=None, stick_anchor=None, modal_cutoff=None, n_modes=None,
-              gamma: float = 0.5, hf_damping: bool = False, keep_poincare: int = 10_000,
-              tol: float = 1e-10, progress: bool = False) -> TransientResult:
+              options: IntegrationOptions = INTEGRATION, start: InitialState | None = None,
+              record="last", keep_poincare: int = 10_000, progress: bool = False
+              ) -> TransientResult:
     """Integrate the forced response in time with exact contact and friction.
 
     Parameters
@@ -370,31 +364,14 @@ def integrate(model: Model, frequency: float, *, n_periods: int,
     model : the structure (:class:`~fretwear.model.core.Model`).
     frequency : forcing frequency ``f`` [Hz]; the loads are ``F(omega t)``, ``omega = 2 pi f``.
     n_periods : number of forcing periods ``T = 1 / f`` to simulate.
-    steps_per_period : fixed steps per period (``h = T / steps_per_period``). Guidance: >= 20
-        steps per period of the highest harmonic you want accurate (phase error of the
-        trapezoidal rule ``(omega h)^2 / 12``); stick-slip events are first order in ``h``.
+    options : :class:`~fretwear.timedomain.options.IntegrationOptions`: steps per period,
+        Newmark gamma, high-frequency damping, modal reduction, contact solver tolerance.
+    start : :class:`~fretwear.timedomain.options.InitialState`: initial displacement and
+        velocity (default rest; ``result.U, result.V`` continue a run exactly), wear, stick
+        anchors.
     record : ``"last"`` (the last period) or the number of periods recorded at the end
         (every step), 0 for none.
-    U0, V0 : (ndof,) initial displacement [m] and velocity [m/s] at ``t = 0``; default rest.
-        ``result.U, result.V`` continue a run exactly.
-    wear : (nc,) wear depth per contact node [m] (opens the gap).
-    stick_anchor : (nc, d-1) tangential positions [m] from which the first step's slip is
-        measured (default: those of ``U0``).
-    modal_cutoff : frequency [Hz] below which the fixed-interface modes are kept
-        (Craig-Bampton); default ``steps_per_period * f / 8`` (modes the step resolves with at
-        least 8 steps per period); ``"all"`` for no reduction. The truncated modes keep their
-        static contribution (constraint modes and one static mode per load vector).
-    n_modes : keep exactly this many fixed-interface modes instead (overrides the cutoff).
-    gamma : Newmark gamma (``beta = (gamma + 1/2)^2 / 4``); 0.5 (default) is the trapezoidal
-        rule (second order, energy conserving); larger values damp the highest frequencies
-        (first order).
-    hf_damping : integrate the modes of the reduced model that the step does not resolve
-        (``omega_j h > 1``, fewer than 2 pi steps per period) with ``gamma = 1`` (spectral
-        radius 1/3 at infinity) instead of ``gamma``: removes their spurious ringing, at the
-        cost of numerical dissipation (``energy["numerical"]``) and of whatever physics they
-        carry (a friction-induced self-excited oscillation may need them: off by default).
     keep_poincare : once-per-period samples kept (the last ones).
-    tol : relative tolerance of the contact solver status tests.
     progress : show a progress bar.
 
     Returns
@@ -412,28 +389,16 @@ def integrate(model: Model, frequency: float, *, n_periods: int,
             raise InputError(f"record = {record} periods but n_periods = {n_periods}")
     n_keep = min(count(keep_poincare, "keep_poincare", 0), n_periods)
     omega = 2 * np.pi * check_range(positive(frequency, "frequency"), "frequency", "frequency")
-    steps = count(steps_per_period, "steps_per_period", 4)
+    if not isinstance(options, IntegrationOptions):
+        raise InputError(f"options = {options!r}; expected an IntegrationOptions(...)")
+    steps = options.steps_per_period
     # recorded samples: observed displacements and velocities, contact positions and forces,
     # states and six energy terms per step [8 bytes each]
     width = 2 * model.ndof + 2 * model.contact.dofs.size + model.contact.n_nodes + 6
     require_memory(8.0 * n_rec * steps * width,
                    f"recording {n_rec} periods of {steps} time steps")
-    integ = Integrator(model, omega, steps_per_period=steps_per_period,
-                        modal_cutoff=modal_cutoff, n_modes=n_modes, gamma=gamma, tol=tol,
-                        wear=wear, U0=U0, V0=V0, stick_anchor=stick_anchor,
-                        hf_damping=hf_damping)
+    integ = Integrator(model, omega, options, start)
     t0 = time.perf_counter()
     raw = integ.run(n_periods, n_rec, n_keep, progress=progress)
     wall = time.perf_counter() - t0
     return integ.result(raw, n_periods, wall)
-
-
-
-
-
-
-
-
-
-
-

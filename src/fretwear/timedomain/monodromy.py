@@ -32,6 +32,11 @@ import numpy as np
 from fretwear.model.core import Model
 from fretwear.timedomain.checks import count, positive
 from fretwear.timedomain.integrate import Integrator
+from fretwear.timedomain.options import InitialState, IntegrationOptions
+
+#: the integration of the shooting: no modal reduction (the multipliers are those of the
+#: model), 1024 steps per period, a contact tolerance of 1e-12
+SHOOTING = IntegrationOptions(steps_per_period=1024, modal_cutoff="all", contact_tol=1e-12)
 
 
 @dataclass
@@ -120,24 +125,26 @@ def _jacobian(P: PeriodMap, x: np.ndarray, h: np.ndarray, central: bool) -> np.n
     return J
 
 
-def monodromy(model: Model, frequency: float, *, U0, V0, steps_per_period: int = 1024,
-              modal_cutoff="all", perturbation: float = 1e-6, tol: float = 1e-10,
-              max_iter: int = 20, stick_anchor=None) -> Monodromy:
+def monodromy(model: Model, frequency: float, *, start: InitialState,
+              integration: IntegrationOptions = SHOOTING, perturbation: float = 1e-6,
+              tol: float = 1e-10, max_iter: int = 20) -> Monodromy:
     """Floquet multipliers of the periodic response of ``model`` at ``frequency`` [Hz] by the
     exact time integration (module docstring).
 
     Parameters
     ----------
-    U0, V0 : (ndof,) start of the shooting: displacement [m] and velocity [m/s] at ``t = 0``
-        (e.g. :func:`fretwear.hb.periodic.initial_state` of a harmonic-balance solution).
-    steps_per_period : time steps per forcing period.
-    modal_cutoff : as :func:`fretwear.timedomain.integrate.integrate` (default ``"all"``: no
-        reduction, every DOF of the model; the multipliers are those of that model).
+    start : :class:`~fretwear.timedomain.options.InitialState`: the start of the shooting,
+        ``U0, V0`` (ndof,) displacement [m] and velocity [m/s] at ``t = 0`` (e.g.
+        :func:`fretwear.hb.periodic.initial_state` of a harmonic-balance solution), and the
+        ``anchor`` (nc, d-1) tangential positions [m] the first step's slip is measured from
+        (default: those of ``U0``).
+    integration : :class:`~fretwear.timedomain.options.IntegrationOptions` of the period map
+        (default :data:`SHOOTING`: 1024 steps per forcing period (>= 8), ``modal_cutoff =
+        "all"``: no reduction, every DOF of the model, so the multipliers are those of that
+        model; contact tolerance 1e-12).
     perturbation : relative size of the finite differences.
     tol : relative residual ``|P(x) - x| / |x|`` of the fixed point.
     max_iter : Newton iterations of the shooting.
-    stick_anchor : tangential positions [m] the first step's slip is measured from (default:
-        those of ``U0``).
 
     Returns
     -------
@@ -146,13 +153,11 @@ def monodromy(model: Model, frequency: float, *, U0, V0, steps_per_period: int =
     """
     t0 = time.perf_counter()
     f = positive(frequency, "frequency")
-    steps = count(steps_per_period, "steps_per_period", 8)
+    steps = count(integration.steps_per_period, "steps_per_period", 8)
     count(max_iter, "max_iter", 0)
     positive(perturbation, "perturbation")
     positive(tol, "tol")
-    integ = Integrator(model, 2.0 * np.pi * f, steps_per_period=steps, modal_cutoff=modal_cutoff,
-                       n_modes=None, gamma=0.5, tol=1e-12, wear=None, U0=U0, V0=V0,
-                       stick_anchor=stick_anchor)
+    integ = Integrator(model, 2.0 * np.pi * f, integration, start)
     P = PeriodMap(integ)
     x = P.state()
     r = P.r

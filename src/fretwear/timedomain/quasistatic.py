@@ -13,27 +13,18 @@ from fretwear.errors import ConvergenceError, InputError
 from fretwear.hb.reduce import condense_static
 from fretwear.model.core import Model
 from fretwear.timedomain.checks import c_float, check_contact, count, node_wear
-from fretwear.timedomain.kernels import (
-    OPEN,
-    STICK,
-    Contact,
-    ContactState,
-    LoadCycle,
-    Settings,
-    WearRecords,
-    WearState,
-    run_quasistatic,
-)
+from fretwear.timedomain.contact_solve import OPEN, STICK, Contact, ContactState, Settings
+from fretwear.timedomain.kernels import LoadCycle, WearRecords, WearState, run_quasistatic
+from fretwear.timedomain.options import INCREMENTAL_WEAR, IncrementalWearOptions
 from fretwear.timedomain.results import IncrementalWearResult
 
 
 # --------------------------------------------------------------------------------------------
 # quasi-static incremental wear
 # --------------------------------------------------------------------------------------------
-def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int = 100,
-                     cycle_jump: int = 1, wear_coefficient: float | None = None,
-                     record_every: int = 1,
-                     wear0=None, tol: float = 1e-10, progress: bool = False,
+def incremental_wear(model: Model, *, n_cycles: int = 100,
+                     options: IncrementalWearOptions = INCREMENTAL_WEAR,
+                     wear_coefficient: float | None = None, wear0=None, progress: bool = False,
                      raise_on_failure: bool = True, condenser=None) -> IncrementalWearResult:
     """Quasi-static fretting wear by load steps (in the spirit of Stromberg 1997).
 
@@ -54,15 +45,16 @@ def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int =
     Parameters
     ----------
     model : the structure (inertia and damping are ignored).
-    steps_per_cycle : load steps per cycle.
     n_cycles : number of load cycles (physical, counting the jumps).
-    cycle_jump : cycles represented by each computed cycle.
+    options : :class:`~fretwear.timedomain.options.IncrementalWearOptions`: load steps per
+        cycle ``steps_per_cycle``, cycles represented by each computed cycle ``cycle_jump``,
+        ``record_every`` computed cycles a record (and the last), the contact solver's
+        relative tolerance ``contact_tol``.
     wear_coefficient : Archard coefficient k_w [1/Pa]; default
         ``model.contact.wear_coefficient`` (plus the partners' coefficient at node-to-node
         pairs: the gap opens by both worn depths).
-    record_every : record every this many computed cycles (and the last).
     wear0 : (nc,) initial wear [m].
-    tol : relative tolerance of the contact solver.
+    progress : accepted for the analyses' common call (the run prints nothing).
     raise_on_failure : raise :class:`~fretwear.errors.ConvergenceError` when the contact
         problem of some load step does not settle (default); False: return the result with
         ``success`` False and the count in ``message``.
@@ -74,23 +66,13 @@ def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int =
     :class:`IncrementalWearResult`: ``success``, ``message``, and per recorded cycle the
     wear [m], pressure [Pa], slip [m], worn volume [m^3] and dissipation [J].
     """
-    N = count(steps_per_cycle, "steps_per_cycle", 2)
+    if not isinstance(options, IncrementalWearOptions):
+        raise InputError(f"options = {options!r}; expected an IncrementalWearOptions(...)")
+    N = options.steps_per_cycle
     n_cycles = count(n_cycles, "n_cycles", 1)
-    J = count(cycle_jump, "cycle_jump", 1)
-    rec_every = count(record_every, "record_every", 1)
-    if wear_coefficient is None:  # both surfaces of a pair wear: the gap opens by both
-        both = model.contact.wear_nodes() + model.contact.partner_wear_nodes()
-        if np.ptp(both) > 0.0:
-            raise InputError(f"contact: the Archard coefficients (both surfaces summed) differ "
-                             f"between nodes ({sorted(set(both.tolist()))[:4]} 1/Pa); "
-                             "incremental_wear takes one coefficient k_w")
-        kw = both[0]
-    else:
-        kw = wear_coefficient
-    kw = float(kw)
-    if not (math.isfinite(kw) and kw >= 0.0):
-        raise InputError(f"wear_coefficient = {wear_coefficient!r}; expected an Archard "
-                         "coefficient k_w >= 0 [1/Pa]")
+    J = options.cycle_jump
+    rec_every = options.record_every
+    kw = _archard_coefficient(model, wear_coefficient)
     t0 = time.perf_counter()
     c = model.contact
     nc, d = c.dofs.shape
@@ -104,12 +86,7 @@ def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int =
     Ft = model.load_time(tau) if model.loads else np.zeros((N, model.ndof))
     btab = np.ascontiguousarray(cond.loads(Ft))
     fscale = float(np.abs(btab).max(initial=0.0))
-    jumps = [1]
-    left = n_cycles - 1
-    while left > 0:
-        jumps.append(min(J, left))
-        left -= jumps[-1]
-    jumps = np.asarray(jumps, dtype=np.int64)
+    jumps = _cycle_jumps(n_cycles, J)
     ncomp = jumps.size
     nrec = sum(1 for i in range(ncomp) if (i + 1) % rec_every == 0 or i == ncomp - 1)
     wear = node_wear(wear0, nc, "wear0")
@@ -122,8 +99,8 @@ def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int =
                       np.zeros((nrec, nc)), np.zeros(nrec), np.zeros(nrec, dtype=np.int64))
     nr, nfail, maxit = run_quasistatic(
         Contact(A, gap, c_float(c.mu_nodes()), int(d)), LoadCycle(btab, c_float(area), kw, jumps),
-        Settings(float(tol), fscale, 60 + 4 * nc), WearState(x, wear, ContactState(status, tdir)),
-        rec)
+        Settings(options.contact_tol, fscale, 60 + 4 * nc),
+        WearState(x, wear, ContactState(status, tdir)), rec)
     if nfail and raise_on_failure:
         raise ConvergenceError(f"incremental_wear: {nfail} load steps where the contact solve "
                                "did not settle (singular or cycling); check that the contact "
@@ -139,3 +116,33 @@ def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int =
         worn_volume=rec.wear @ area, dissipation=rec.diss, computed_cycles=ncomp, cycle_jump=J,
         steps_per_cycle=N, k_w=kw, wall_time=time.perf_counter() - t0, U=U, lam=lam,
         info={"max_active_set_iterations": int(maxit), "records": int(nr)})
+
+
+def _archard_coefficient(model: Model, wear_coefficient) -> float:
+    """``wear_coefficient`` k_w [1/Pa] checked, or by default the model's (both surfaces of a
+    pair summed: the gap opens by both worn depths), which must be the same at every node."""
+    if wear_coefficient is None:
+        both = model.contact.wear_nodes() + model.contact.partner_wear_nodes()
+        if np.ptp(both) > 0.0:
+            raise InputError(f"contact: the Archard coefficients (both surfaces summed) differ "
+                             f"between nodes ({sorted(set(both.tolist()))[:4]} 1/Pa); "
+                             "incremental_wear takes one coefficient k_w")
+        kw = both[0]
+    else:
+        kw = wear_coefficient
+    kw = float(kw)
+    if not (math.isfinite(kw) and kw >= 0.0):
+        raise InputError(f"wear_coefficient = {wear_coefficient!r}; expected an Archard "
+                         "coefficient k_w >= 0 [1/Pa]")
+    return kw
+
+
+def _cycle_jumps(n_cycles: int, J: int) -> np.ndarray:
+    """The cycles each computed cycle stands for: 1 (the first, with the initial loading),
+    then ``J``, the last shortened so that they add up to ``n_cycles``."""
+    jumps = [1]
+    left = n_cycles - 1
+    while left > 0:
+        jumps.append(min(J, left))
+        left -= jumps[-1]
+    return np.asarray(jumps, dtype=np.int64)

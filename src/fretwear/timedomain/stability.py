@@ -25,6 +25,7 @@ import numpy as np
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import PeriodicSolution, initial_state
 from fretwear.model.core import Model
+from fretwear.timedomain.options import InitialState, IntegrationOptions, SteadyStateOptions
 from fretwear.timedomain.steady import steady_state, steady_state_at_omega
 
 VERDICTS = ("stable", "settles elsewhere", "drifting", "quasi-periodic", "irregular",
@@ -105,10 +106,12 @@ def check_periodic(model: Model, sol: PeriodicSolution, *, max_periods: int = 30
     vmax = np.abs(V0).max()
     V0 = V0 + perturbation * vmax * rng.standard_normal(V0.shape)
     nsteps = steps_per_period or max(128, 8 * max(sol.basis.harmonics))
-    res = steady_state_at_omega(model, sol.omega, max_periods=max_periods,
-                                tol=periodicity_tol, steps_per_period=nsteps,
-                                harmonics=max(sol.basis.harmonics), U0=U0, V0=V0,
-                                wear=sol.gap - np.asarray(model.contact.gap, float))
+    res = steady_state_at_omega(
+        model, sol.omega,
+        options=SteadyStateOptions(max_periods=max_periods, tol=periodicity_tol,
+                                   harmonics=max(sol.basis.harmonics)),
+        integration=IntegrationOptions(steps_per_period=nsteps),
+        start=InitialState(U0=U0, V0=V0, wear=sol.gap - np.asarray(model.contact.gap, float)))
     kind = res.classification
     # distance between the settled period and the periodic solution, on the observed points
     dist = 0.0
@@ -199,8 +202,11 @@ def time_domain_start(model: Model, frequency: float, basis,
         wear = start.gap - np.asarray(model.contact.gap, float)
     hmax = max(basis.harmonics) if basis.harmonics else 1
     nsteps = steps_per_period or max(128, 8 * hmax)
-    res = steady_state(model, frequency, max_periods=max_periods, tol=periodicity_tol,
-                       steps_per_period=nsteps, harmonics=hmax, U0=U0, V0=V0, wear=wear)
+    res = steady_state(model, frequency,
+                       options=SteadyStateOptions(max_periods=max_periods, tol=periodicity_tol,
+                                                  harmonics=hmax),
+                       integration=IntegrationOptions(steps_per_period=nsteps),
+                       start=InitialState(U0=U0, V0=V0, wear=wear))
     kind = res.classification
     n = res.n_periods
     if kind == "periodic":

@@ -3,7 +3,6 @@ drifting, quasi-periodic, irregular), with the harmonics of the last period."""
 
 from __future__ import annotations
 
-import inspect
 import time
 
 import numpy as np
@@ -11,8 +10,15 @@ import numpy as np
 from fretwear.errors import InputError
 from fretwear.limits import check_range
 from fretwear.model.core import Model
-from fretwear.timedomain.checks import count, positive
-from fretwear.timedomain.integrate import DEFAULT_STEPS, Integrator
+from fretwear.timedomain.checks import positive
+from fretwear.timedomain.integrate import Integrator
+from fretwear.timedomain.options import (
+    INTEGRATION,
+    STEADY_STATE,
+    InitialState,
+    IntegrationOptions,
+    SteadyStateOptions,
+)
 from fretwear.timedomain.results import Classification, SteadyStateResult
 
 
@@ -150,12 +156,10 @@ def classify_sequence(poincare, means=None, *, tol: float = 1e-6, scale: float |
     return out
 
 
-def steady_state(model: Model, frequency: float, *, max_periods: int = 20_000, tol: float = 1e-6,
-                 steps_per_period: int = DEFAULT_STEPS, harmonics: int = 7,
-                 check_every: int = 16, window: int = 512, min_periods: int = 128, U0=None,
-                 V0=None, wear=None, stick_anchor=None, modal_cutoff=None, n_modes=None,
-                 gamma: float = 0.5, hf_damping: bool = False, contact_tol: float = 1e-10,
-                 progress: bool = False) -> SteadyStateResult:
+def steady_state(model: Model, frequency: float, *, options: SteadyStateOptions = STEADY_STATE,
+                 integration: IntegrationOptions = INTEGRATION,
+                 start: InitialState | None = None, progress: bool = False
+                 ) -> SteadyStateResult:
     """Integrate until the response is periodic (or classified otherwise).
 
     The monitored quantities are the observed DOFs and the local contact displacements,
@@ -169,79 +173,42 @@ def steady_state(model: Model, frequency: float, *, max_periods: int = 20_000, t
 
     Parameters
     ----------
-    model, frequency : as :func:`integrate` (``frequency`` [Hz]).
-    max_periods : give up after this many periods (classification then as found).
-    tol : relative periodicity tolerance (see :func:`classify_sequence`).
-    harmonics : highest harmonic of the last period reported (1 .. harmonics).
-    Others as :func:`integrate` (``contact_tol`` is its ``tol``).
+    model, frequency : as :func:`~fretwear.timedomain.integrate.integrate` (``frequency``
+        [Hz]).
+    options : :class:`~fretwear.timedomain.options.SteadyStateOptions`: the period budget
+        ``max_periods``, the periodicity tolerance ``tol`` (see :func:`classify_sequence`),
+        the highest harmonic reported ``harmonics``, ``check_every``, ``window``,
+        ``min_periods``.
+    integration, start : the time scheme and the initial state, as
+        :func:`~fretwear.timedomain.integrate.integrate` takes them.
+    progress : print the classification at every check.
 
     Returns
     -------
     :class:`SteadyStateResult`: ``success`` when the response was classified with every
     contact solve settled; ``classification`` and ``message`` say what it is.
     """
-    return _steady_state(model, 2 * np.pi * check_range(positive(frequency, "frequency"),
-                                                        "frequency", "frequency"),
-                         max_periods=max_periods, tol=tol, steps_per_period=steps_per_period,
-                         harmonics=harmonics, check_every=check_every, window=window,
-                         min_periods=min_periods, U0=U0, V0=V0, wear=wear,
-                         stick_anchor=stick_anchor, modal_cutoff=modal_cutoff, n_modes=n_modes,
-                         gamma=gamma, hf_damping=hf_damping, contact_tol=contact_tol,
-                         progress=progress)
+    omega = 2 * np.pi * check_range(positive(frequency, "frequency"), "frequency", "frequency")
+    return steady_state_at_omega(model, omega, options=options, integration=integration,
+                                 start=start, progress=progress)
 
 
-def steady_state_at_omega(model: Model, omega: float, **kwargs) -> SteadyStateResult:
+def steady_state_at_omega(model: Model, omega: float, *,
+                          options: SteadyStateOptions = STEADY_STATE,
+                          integration: IntegrationOptions = INTEGRATION,
+                          start: InitialState | None = None,
+                          progress: bool = False) -> SteadyStateResult:
     """:func:`steady_state` at the circular frequency ``omega`` [rad/s] of a periodic solution
     (no conversion to Hz and back), with its keywords and defaults."""
-    bound = inspect.signature(steady_state).bind(model, 0.0, **kwargs)
-    bound.apply_defaults()
-    args = dict(bound.arguments)
-    del args["model"], args["frequency"]
-    return _steady_state(model, omega, **args)
-
-
-def _steady_state(model: Model, omega: float, *, max_periods, tol, steps_per_period, harmonics,
-                  check_every, window, min_periods, U0, V0, wear, stick_anchor, modal_cutoff,
-                  n_modes, gamma, hf_damping, contact_tol, progress) -> SteadyStateResult:
-    """:func:`steady_state` at the circular frequency ``omega`` [rad/s] (every argument
-    given)."""
-    max_periods = count(max_periods, "max_periods", 1)
-    check_every = count(check_every, "check_every", 1)
-    window = count(window, "window", 8)
-    tol = positive(tol, "tol")
+    if not isinstance(options, SteadyStateOptions):
+        raise InputError(f"options = {options!r}; expected a SteadyStateOptions(...)")
     t_start = time.perf_counter()
-    integ = Integrator(model, omega, steps_per_period=steps_per_period,
-                        modal_cutoff=modal_cutoff, n_modes=n_modes, gamma=gamma, tol=contact_tol,
-                        wear=wear, U0=U0, V0=V0, stick_anchor=stick_anchor,
-                        hf_damping=hf_damping)
-    P = np.zeros((0, integ.red.obs.shape[0] + integ.m))
-    Mn = P.copy()
-    chunk = check_every
-    prev = None
-    cls = Classification(kind="transient", periodicity_error=np.inf, scale=1.0)
-    history = []
-    done = 0
-    while done < max_periods:
-        k = min(chunk, max_periods - done)
-        raw = integ.run(k, 0, k, progress=False)
-        done += k
-        P = np.vstack([P, raw["mon_start"]])[-window:]
-        Mn = np.vstack([Mn, raw["mon_mean"]])[-window:]
-        scale = float(raw["mon_ptp"][-1].max())
-        cls = classify_sequence(P, Mn, tol=tol, scale=scale, min_window=min_periods)
-        history.append((done, cls.kind, cls.periodicity_error))
-        if progress:
-            print(f"[steady_state] {done} periods: {cls.kind}, periodicity error "
-                  f"{cls.periodicity_error:.3g}")
-        if cls.kind in ("periodic", "subharmonic"):
-            break
-        if cls.kind in ("drifting", "quasi-periodic", "irregular") and cls.kind == prev:
-            break
-        prev = cls.kind
-        chunk = min(2 * chunk, 512)
+    integ = Integrator(model, omega, integration, start)
+    cls, P, done, history = _run_until_classified(integ, options, progress)
     t0 = time.perf_counter()
     raw = integ.run(1, 1, 1)
     last = integ.result(raw, 1, time.perf_counter() - t0)
+    harmonics = options.harmonics
     harm = {name: fourier_coefficients(x, harmonics) for name, x in last.observed.items()}
     charm = {"lam": fourier_coefficients(last.lam, harmonics),
              "u_loc": fourier_coefficients(last.u_loc, harmonics)}
@@ -259,3 +226,38 @@ def _steady_state(model: Model, omega: float, *, max_periods, tol, steps_per_per
         periodic=cls.kind in ("periodic", "subharmonic"), last=last, harmonics=harm,
         contact_harmonics=charm, diagnostics=cls, poincare=P, U=last.U, V=last.V,
         wall_time=time.perf_counter() - t_start, info=info)
+
+
+def _run_until_classified(integ: Integrator, options: SteadyStateOptions, progress: bool):
+    """Run ``integ`` in chunks of periods (``check_every``, doubling up to 512), classifying
+    the last ``window`` once-per-period samples after each, until the response is classified
+    (see :func:`steady_state`) or ``max_periods``. Returns ``(classification, poincare,
+    periods, history)``."""
+    window = options.window
+    P = np.zeros((0, integ.red.obs.shape[0] + integ.m))
+    Mn = P.copy()
+    chunk = options.check_every
+    prev = None
+    cls = Classification(kind="transient", periodicity_error=np.inf, scale=1.0)
+    history = []
+    done = 0
+    while done < options.max_periods:
+        k = min(chunk, options.max_periods - done)
+        raw = integ.run(k, 0, k, progress=False)
+        done += k
+        P = np.vstack([P, raw["mon_start"]])[-window:]
+        Mn = np.vstack([Mn, raw["mon_mean"]])[-window:]
+        scale = float(raw["mon_ptp"][-1].max())
+        cls = classify_sequence(P, Mn, tol=options.tol, scale=scale,
+                                min_window=options.min_periods)
+        history.append((done, cls.kind, cls.periodicity_error))
+        if progress:
+            print(f"[steady_state] {done} periods: {cls.kind}, periodicity error "
+                  f"{cls.periodicity_error:.3g}")
+        if cls.kind in ("periodic", "subharmonic"):
+            break
+        if cls.kind in ("drifting", "quasi-periodic", "irregular") and cls.kind == prev:
+            break
+        prev = cls.kind
+        chunk = min(2 * chunk, 512)
+    return cls, P, done, history
