@@ -20,8 +20,8 @@ contact DOFs in their local frames and the interior is ``u_i = Psi u_c + V q``:
   ``V = I`` (``q`` the interior motion relative to the static shape): the transformation is
   one-to-one, so every ``Z_r(lambda)`` is exact;
 * a model with a modal condenser (:func:`fretwear.hb.modal.modal_condenser`, passed as
-  ``condenser``): its projected matrices (``V`` the fixed-interface modes kept and the loads' static responses), with the
-  error that representation was checked for.
+  ``condenser``): its projected matrices (``V`` the fixed-interface modes kept and the
+  loads' static responses), with the error that representation was checked for.
 
 A contact spring joins the structure's contact DOF to a massless contact point
 (:mod:`fretwear.hb.connectors`): the point is in ``x``, the structure's DOF moves to ``q``, so
