@@ -114,3 +114,39 @@ def sliders(nc=3, P=1e6, A=1e-4, kn=1.0, kt=1e8, ratio=3.0):
     return Model(K=K, M=sp.csr_matrix((n, n)), contact=c,
                  loads=[Load(fn, "constant"), Load(ft, "sin")], dim=2)
 
+
+
+# --- a contact node on a chain of masses (the time-domain tests) --------------------------
+def chain(*, n=12, k=100.0, kg=30.0, mu=0.3, gap=0.0, N=5.0, F=2.0, ks_normal=0.0, c_a=0.0,
+          c_b=0.0):
+    """A contact node (DOFs 0 = normal, 1 = tangential) on a chain of ``n`` unit masses
+    (DOFs 2..n+1) with springs k, the last mass grounded by ``kg`` (an undamped spring to
+    ground), a force ``F cos(wt)`` on the last mass, and a constant normal load N. Damping
+    ``c_a K0 + c_b M`` with ``K0`` the chain without the ground spring."""
+    nd = n + 2
+    rows, cols, vals = [], [], []
+
+    def spring(i, j, kk):
+        rows.extend([i, j, i, j])
+        cols.extend([i, j, j, i])
+        vals.extend([kk, kk, -kk, -kk])
+
+    spring(1, 2, k)
+    for i in range(2, n + 1):
+        spring(i, i + 1, k)
+    K0 = sp.csr_matrix((vals, (rows, cols)), shape=(nd, nd))
+    Kn = sp.csr_matrix(([ks_normal], ([0], [0])), shape=(nd, nd))
+    Kg = sp.csr_matrix(([kg], ([nd - 1], [nd - 1])), shape=(nd, nd))
+    M = sp.identity(nd, format="csr")
+    C = (c_a * K0 + c_b * M).tocsr() if (c_a or c_b) else None
+    contact = ContactInterface(dofs=np.array([[0, 1]]), frame=np.eye(2)[None],
+                               gap=np.array([gap]), area=np.ones(1), mu=mu,
+                               coords=np.zeros((1, 2)))
+    fN = np.zeros(nd)
+    fN[0] = N
+    fQ = np.zeros(nd)
+    fQ[nd - 1] = F
+    loads = [Load(fN, "constant", name="normal"), Load(fQ, "cos", name="Q")]
+    return Model(K=(K0 + Kn + Kg).tocsr(), M=M, C=C, contact=contact, loads=loads,
+                 observed=[ObservedPoint("end", np.array([nd - 1]), np.zeros(1)),
+                           ObservedPoint("all", np.arange(nd), np.zeros(1))])
