@@ -99,3 +99,5 @@ def test_studies_are_found_by_file_or_by_shipped_name(tmp_path):
         resolve_study("nope")
     with pytest.raises(InputError, match=r"study file '.*missing.toml' does not exist"):
         resolve_study(tmp_path / "missing.toml")
+    with pytest.raises(InputError, match=r"study file 'nowhere.toml' does not exist"):
+        resolve_study("nowhere.toml")  # a file name, not a shipped study's name
