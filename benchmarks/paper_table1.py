@@ -58,12 +58,12 @@ def beam():
 def run_case(name, model, basis, *, frequency, quasi_static, options):
     """Run one case; returns (result or None, wall [s], message)."""
     from fretwear.errors import ConvergenceError
-    from fretwear.wear import simulate_wear
+    from fretwear.wear import RunControl, simulate_wear
 
     t0 = time.perf_counter()
     try:
         r = simulate_wear(model, basis, frequency=frequency, quasi_static=quasi_static,
-                          options=options, progress=sys.stderr.isatty())
+                          options=options, run=RunControl(progress=sys.stderr.isatty()))
     except ConvergenceError as exc:
         return None, time.perf_counter() - t0, f"{name}: {exc}"
     return r, time.perf_counter() - t0, f"{name}: {r.message}"
@@ -71,6 +71,8 @@ def run_case(name, model, basis, *, frequency, quasi_static, options):
 
 def report(name, r, wall):
     import numpy as np
+
+    from fretwear.wear import Rescue
 
     h = r.history
     steps, its = h.n_steps - 1, int(h.newton_iterations.sum())
@@ -84,11 +86,12 @@ def report(name, r, wall):
     print(f"{'':>12}   N = {h.cycles[-1]:.4g} cycles, worn volume {h.worn_volume[-1]:.5e} m^3, "
           f"max depth {w.max():.5e} m at x = {r.final.coords[int(np.argmax(w)), 0]:.4g} m; "
           f"rate < 1e-3 x initial at N = {at}; rejected attempts {int(h.rejected.sum())}")
-    td = int(np.sum(h.rescued == 2))
+    td = int(np.sum(h.rescued == Rescue.TIME_AVERAGED))
     if td:
         print(f"{'':>12}   {td} steps took their wear rate from time integrations (no periodic "
-              f"balance) from N = {h.cycles[np.argmax(h.rescued == 2)]:.3g}; "
-              f"{int(np.sum(h.rescued == 1))} balances restarted from one")
+              f"balance) from N = {h.cycles[np.argmax(h.rescued == Rescue.TIME_AVERAGED)]:.3g}"
+              f"; "
+              f"{int(np.sum(h.rescued == Rescue.TIME_START))} balances restarted from one")
     print(f"{'':>12}   explicit Euler stability limit at the start 2/rho = "
           f"{r.stability_jump:.3g} cycles; largest jump {h.jump.max():.3g} cycles")
 
@@ -167,14 +170,14 @@ def reference_profile(model, basis):
     """The quasi-static reference: explicit Euler, fixed jumps of 2e5 cycles, to N = 3e9."""
     import numpy as np
 
-    from fretwear.wear import WearOptions, simulate_wear
+    from fretwear.wear import RunControl, WearOptions, simulate_wear
 
     t0 = time.perf_counter()
     r = simulate_wear(model, basis, frequency=1.0, quasi_static=True,
                       options=WearOptions(scheme="explicit", adaptive=False,
                                           initial_jump=REFERENCE_JUMP, max_cycles=N_QS,
                                           plateau_rate=0.0, max_steps=10**6),
-                      progress=sys.stderr.isatty())
+                      run=RunControl(progress=sys.stderr.isatty()))
     w = r.history.wear_depth[-1]
     print(f"reference: {r.history.n_steps - 1} steps, {time.perf_counter() - t0:.0f} s; "
           f"profile [pm]: {np.round(w * 1e12, 4).tolist()}")

@@ -133,9 +133,9 @@ def one(n: int, extras: dict) -> dict:
     import scipy.linalg as sla
 
     from fretwear.hb.fourier import FourierBasis
-    from fretwear.hb.modal import use_modal
+    from fretwear.hb.modal import modal_condenser
     from fretwear.hb.periodic import solve_periodic, static_anchor
-    from fretwear.hb.reduce import Condenser, _structure
+    from fretwear.hb.reduce import exact_condenser
 
     out = {"n": n, "nodes": n * n}
     with Clock() as c:
@@ -147,20 +147,21 @@ def one(n: int, extras: dict) -> dict:
     basis = FourierBasis.up_to(H, 128)
     out["unknowns"] = 3 * n * n * basis.size
     with Clock() as c:
-        mc = use_modal(model, FREQ * 1.2, H)
+        mc = modal_condenser(model, FREQ * 1.2, H)  # passed to every call below
         red = mc.reduced(2 * np.pi * FREQ, basis.orders, frequency=FREQ)
     out.update(condense_cpu=c.cpu, condense_wall=c.wall, modes=mc.n_modes, q=mc.q,
                modal_error=mc.error)
     if n * n <= 256:  # the exact condensation, for comparison
         with Clock() as c:
-            ex = Condenser(_structure(model)).reduced(2 * np.pi * FREQ, basis.orders)
+            ex = exact_condenser(model).reduced(2 * np.pi * FREQ, basis.orders)
         out.update(exact_cpu=c.cpu, exact_wall=c.wall,
                    modal_vs_exact=float(max(np.abs(red.Z[b] - ex.Z[b]).max()
                                             / np.abs(ex.Z[b]).max() for b in range(H + 1))))
         del ex
     with Clock() as c:
-        anchor = static_anchor(model)  # the static preload state (default eps)
-        sol = solve_periodic(model, basis, frequency=FREQ, reduced=red, anchor=anchor)
+        anchor = static_anchor(model, condenser=mc)  # the static preload state (default eps)
+        sol = solve_periodic(model, basis, frequency=FREQ, reduced=red, anchor=anchor,
+                             condenser=mc)
     out["eps"] = sol.eps
     st = sol.stats
     frac = sol.state_fractions().mean(axis=0)
@@ -172,12 +173,14 @@ def one(n: int, extras: dict) -> dict:
     tmp = tempfile.mkdtemp(prefix="scale3d-")
     if extras.get("wear"):
         from fretwear.wear.options import WearOptions
-        from fretwear.wear.simulate import simulate_wear
+        from fretwear.wear.simulate import BalanceSetup, RunControl, simulate_wear
 
         ck = os.path.join(tmp, "wear-checkpoint.npz")
         with Clock() as c:
-            wr = simulate_wear(model, basis, frequency=FREQ, reduced=red, anchor=sol.anchor,
-                               U0=sol.U, checkpoint=ck,
+            wr = simulate_wear(model, basis, frequency=FREQ,
+                               balance=BalanceSetup(reduced=red, anchor=sol.anchor, U0=sol.U,
+                                                    condenser=mc),
+                               run=RunControl(checkpoint=ck),
                                options=WearOptions(max_steps=extras["wear"],
                                                    scheme="explicit", checkpoint_every_s=0.0))
         out.update(wear_steps=len(wr.history.cycles) - 1, wear_cpu=c.cpu, wear_wall=c.wall,
@@ -186,14 +189,14 @@ def one(n: int, extras: dict) -> dict:
         del wr
     print("PARTIAL " + json.dumps(out, default=float), flush=True)
     anchor = sol.anchor
-    del red, sol  # the sweep condenses each of its frequencies itself
+    del red, sol  # the sweep condenses each of its frequencies itself (with mc)
     if extras.get("sweep"):
         from fretwear.hb.sweep import sweep
 
         ck = os.path.join(tmp, "sweep-checkpoint.npz")
         with Clock() as c:
             res = sweep(model, basis, 4000.0, 6000.0, extras["sweep"], spacing="linear",
-                        anchor=anchor, checkpoint=ck)
+                        anchor=anchor, checkpoint=ck, condenser=mc)
         out.update(sweep_points=extras["sweep"], sweep_cpu=c.cpu, sweep_wall=c.wall,
                    sweep_converged=int(sum(p.success for p in res.points)),
                    sweep_ckpt_mib=os.path.getsize(ck) / 2**20,
@@ -215,7 +218,7 @@ def alternate(sizes: tuple[int, int], reps: int) -> dict:
     same drift). Each timing is what ``one`` times: the static preload solve and the
     periodic solve on the condensation of the frequency (condensed once per size)."""
     from fretwear.hb.fourier import FourierBasis
-    from fretwear.hb.modal import use_modal
+    from fretwear.hb.modal import modal_condenser
     from fretwear.hb.periodic import solve_periodic, static_anchor
 
     basis = FourierBasis.up_to(H, 128)
@@ -223,15 +226,15 @@ def alternate(sizes: tuple[int, int], reps: int) -> dict:
     cases = {}
     for n in sizes:
         model = pad(n)
-        mc = use_modal(model, FREQ * 1.2, H)
-        cases[n] = model, mc.reduced(2 * np.pi * FREQ, basis.orders, frequency=FREQ)
+        mc = modal_condenser(model, FREQ * 1.2, H)
+        cases[n] = model, mc, mc.reduced(2 * np.pi * FREQ, basis.orders, frequency=FREQ)
     times = {n: [] for n in sizes}
     for _ in range(reps):
         for n in sizes:
-            model, red = cases[n]
+            model, mc, red = cases[n]
             with Clock() as c:
                 sol = solve_periodic(model, basis, frequency=FREQ, reduced=red,
-                                     anchor=static_anchor(model))
+                                     anchor=static_anchor(model, condenser=mc), condenser=mc)
             if not sol.success:
                 raise RuntimeError(f"{n * n} nodes: the periodic solve did not converge")
             times[n].append(c.cpu)

@@ -19,7 +19,7 @@ import numpy as np
 from fretwear.examples.builders import paper_beam
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import solve_periodic, static_anchor
-from fretwear.hb.reduce import condense
+from fretwear.hb.reduce import condense, exact_condenser
 
 
 def describe(sol):
@@ -33,12 +33,13 @@ def main():
     freqs = [float(f) for f in sys.argv[1:]] or [10e3, 70e3, 79e3]
     model = paper_beam()
     basis = FourierBasis.up_to(7, 128)
-    a0 = static_anchor(model)
+    cond = exact_condenser(model)  # one condensation of the beam for every frequency
+    a0 = static_anchor(model, condenser=cond)
     rules = {"preload (default)": a0, "zero (usual DLFT)": np.zeros_like(a0),
              "preload + 1 um": a0 + 1e-6, "preload - 1 um": a0 - 1e-6,
              "preload + 5 um": a0 + 5e-6, "preload - 5 um": a0 - 5e-6}
     for f in freqs:
-        red = condense(model, f, [0, *basis.harmonics])
+        red = condense(model, f, [0, *basis.harmonics], condenser=cond)
         ref = None
         print(f"\nf = {f:g} Hz")
         print(f"{'anchors':20s} {'conv':>5s} {'|u_x1(Pe)| [m]':>15s} {'E_fric [J]':>11s} "

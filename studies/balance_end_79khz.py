@@ -93,7 +93,7 @@ def main(argv=None) -> int:
     from fretwear.hb.solvers import SolveStats
     from fretwear.io.case import build_model
     from fretwear.timedomain.averaged_rate import time_averaged_rate
-    from fretwear.wear import SlowProblem, read_history, wear_coefficients
+    from fretwear.wear import Rescue, SlowProblem, read_history, wear_coefficients
 
     with contextlib.ExitStack() as stack:
         workdir = args.workdir or Path(stack.enter_context(tempfile.TemporaryDirectory()))
@@ -101,7 +101,7 @@ def main(argv=None) -> int:
         folder = run_to_failure(workdir, args.max_cycles)
         print(f"run to N = {args.max_cycles:.3g}: {time.perf_counter() - t0:.1f} s")
         h = read_history(folder / "wear-checkpoint.npz")
-        averaged = np.flatnonzero(np.asarray(h.rescued) == 2)
+        averaged = np.flatnonzero(np.asarray(h.rescued) == Rescue.TIME_AVERAGED)
         if averaged.size == 0:
             print("the balance held to the end of the run: raise --max-cycles")
             return 1

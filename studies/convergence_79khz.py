@@ -306,7 +306,7 @@ class Study:
     def wear(self, v, sol, eps, *, max_cycles, plateau_rate, cap_s, suffix=""):
         """Wear run (resumed from the variant's checkpoint when there is one)."""
         from fretwear.hb.fourier import FourierBasis
-        from fretwear.wear import WearOptions, simulate_wear
+        from fretwear.wear import BalanceSetup, RunControl, WearOptions, simulate_wear
 
         model, anchor = self.model(v["nx"])
         basis = FourierBasis.up_to(v["nh"], v["ns"])
@@ -320,9 +320,10 @@ class Study:
         alarm = _Alarm(cap_s)
         try:
             with alarm:
-                r = simulate_wear(model, basis, frequency=FREQ, reduced=red, eps=eps,
-                                  anchor=anchor, U0=sol.U, options=opts, checkpoint=ckpt,
-                                  resume=True)
+                r = simulate_wear(model, basis, frequency=FREQ, options=opts,
+                                  balance=BalanceSetup(reduced=red, eps=eps, anchor=anchor,
+                                                       U0=sol.U),
+                                  run=RunControl(checkpoint=ckpt, resume=True))
         except KeyboardInterrupt:
             if not alarm.fired:
                 raise

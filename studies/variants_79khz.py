@@ -16,9 +16,9 @@ through the height, plane strain / plane stress) and, for each variant, records:
 * its time-domain stability (:func:`fretwear.timedomain.stability.check_periodic`);
 * the wear run (:func:`fretwear.wear.simulate.simulate_wear`, adaptive linearly implicit Euler,
   tolerance 1e-2, ``max_cycles`` 1e8 by default): N where the balance first fails (first
-  step with ``rescued == 2``), stop reason, N reached, worn volume, max depth, worn-volume rate
-  at the end / initial, steps and wall time, zero-wear zones (nodes with wear < 1 % of the
-  max, the paper's "pillars").
+  step with ``rescued == Rescue.TIME_AVERAGED``, 2), stop reason, N reached, worn volume,
+  max depth, worn-volume rate at the end / initial, steps and wall time, zero-wear zones
+  (nodes with wear < 1 % of the max, the paper's "pillars").
 
 Everything is cached in ``docs/studies/figures/variants-79khz.json`` after each stage, so an
 interrupted study loses nothing; the wear runs also keep a checkpoint (``--work``) and resume
@@ -174,7 +174,14 @@ def wear_run(name, model, basis, max_cycles, wall_budget, work: Path, fresh: boo
     """The wear run, with a checkpoint; stops (resumably) after ``wall_budget`` seconds."""
     from fretwear.errors import ConvergenceError
     from fretwear.timedomain.averaged_rate import RESPONSE_KINDS
-    from fretwear.wear import HISTORY_FIELDS, WearHistory, WearOptions, simulate_wear
+    from fretwear.wear import (
+        HISTORY_FIELDS,
+        Rescue,
+        RunControl,
+        WearHistory,
+        WearOptions,
+        simulate_wear,
+    )
 
     work.mkdir(parents=True, exist_ok=True)
     ckpt = work / f"{name}.npz"
@@ -183,11 +190,11 @@ def wear_run(name, model, basis, max_cycles, wall_budget, work: Path, fresh: boo
     opts = WearOptions(tolerance=1e-2, max_cycles=max_cycles, checkpoint_every_s=0.0)
     t0 = time.perf_counter()
 
-    def log(step, row):
-        kind = int(row["response"])
-        print(f"  [{name}] step {step:4d}  N = {row['cycles']:.4g}  jump {row['jump']:.3g}  "
-              f"V = {row['worn_volume']:.4e} m^3  dV/dN = {row['volume_rate']:.3e}  "
-              f"rescued {int(row['rescued'])}"
+    def log(step, record):
+        kind = int(record.response)
+        print(f"  [{name}] step {step:4d}  N = {record.cycles:.4g}  jump {record.jump:.3g}  "
+              f"V = {record.worn_volume:.4e} m^3  dV/dN = {record.volume_rate:.3e}  "
+              f"rescued {int(record.rescued)}"
               + (f" ({RESPONSE_KINDS[kind]})" if kind >= 0 else "")
               + f"  {time.perf_counter() - t0:.0f} s", flush=True)
         if time.perf_counter() - t0 > wall_budget:
@@ -196,7 +203,7 @@ def wear_run(name, model, basis, max_cycles, wall_budget, work: Path, fresh: boo
     stop = ""
     try:
         r = simulate_wear(model, basis, frequency=F_HZ, options=opts,
-                          checkpoint=ckpt, resume=True, callback=log)
+                          run=RunControl(checkpoint=ckpt, resume=True, callback=log))
         hist, stop, msg = r.history, r.stop_reason, r.message
     except ConvergenceError as exc:
         return {"stop_reason": "unworn_failed", "message": str(exc)}
@@ -206,7 +213,7 @@ def wear_run(name, model, basis, max_cycles, wall_budget, work: Path, fresh: boo
         stop, msg = "wall_budget", f"stopped after the wall budget of {wall_budget:g} s"
     wall = time.perf_counter() - t0
     resc = np.asarray(hist.rescued)
-    td = np.flatnonzero(resc == 2)
+    td = np.flatnonzero(resc == Rescue.TIME_AVERAGED)
     w = np.asarray(hist.wear_depth[-1])
     x = model.contact.coords[:, 0]
     vr = np.asarray(hist.volume_rate)

@@ -132,3 +132,75 @@ def test_time_steps_that_cannot_be_recorded_are_refused(block):
     with pytest.raises(InputError, match=r"recording 1 periods of 1000000000 time steps needs "
                                          r"about .* GiB"):
         fw.integrate(block, 1500.0, n_periods=1, steps_per_period=10**9)
+
+
+# --- one vocabulary and argument order (fretwear.api) -----------------------------------------
+def test_frequency_is_required_where_it_matters(block):
+    """A dynamic solve without a frequency is refused (it used to run at 1 Hz); a quasi-static
+    one may go without (the frequency then only scales time); the frequency may be given by
+    position, after (model, basis), with the same answer bit for bit."""
+    for call in (lambda: fw.solve_periodic(block, BASIS),
+                 lambda: fw.simulate_wear(block, BASIS, options=fw.WearOptions(max_steps=1))):
+        with pytest.raises(InputError, match=r"frequency = None: expected the excitation "
+                                             r"frequency \[Hz\]"):
+            call()
+    assert fw.solve_periodic(block, BASIS, quasi_static=True).success
+    a = fw.solve_periodic(block, BASIS, 1500.0)
+    b = fw.solve_periodic(block, BASIS, frequency=1500.0)
+    assert a.success and a.frequency == 1500.0
+    np.testing.assert_array_equal(a.U, b.U)
+
+
+@pytest.mark.parametrize("call,old,new", [
+    (lambda m, kw: fw.solve_periodic(m, BASIS, 1500.0, **kw), "stick_anchor", "anchor"),
+    (lambda m, kw: fw.simulate_wear(m, BASIS, 1500.0, **kw), "W0", "wear0"),
+    (lambda m, kw: fw.integrate(m, 1500.0, n_periods=1, **kw), "stick_anchor", "anchor"),
+    (lambda m, kw: fw.steady_state(m, 1500.0, **kw), "stick_anchor", "anchor"),
+    (lambda m, kw: fw.incremental_wear(m, **kw), "k_w", "wear_coefficient"),
+    (lambda m, kw: fw.frf_worn(m, BASIS, 0.0, 1e3, 2e3, 2, **kw), "frequencies_hz",
+     "f_min, f_max, n_points"),
+])
+def test_other_spellings_are_refused_with_the_public_one(block, call, old, new):
+    with pytest.raises(TypeError, match=f"takes {new}, not {old}"):
+        call(block, {old: None})
+
+
+def test_public_names_reach_the_core(block):
+    """``anchor`` of fw.integrate is the time-domain solver's ``stick_anchor`` (the same run
+    bit for bit, and not the run without it); ``wear_coefficient`` of fw.incremental_wear is
+    its own (0: no wear at all); ``wear0`` of fw.simulate_wear is the initial wear (the
+    first row of the history)."""
+    from fretwear.timedomain.integrate import integrate
+    from fretwear.timedomain.quasistatic import incremental_wear
+
+    nc = block.contact.n_nodes
+    anchor = np.full((nc, 1), 1e-7)
+    a = fw.integrate(block, 1500.0, n_periods=1, steps_per_period=16, anchor=anchor)
+    b = integrate(block, 1500.0, n_periods=1, steps_per_period=16, stick_anchor=anchor)
+    c = integrate(block, 1500.0, n_periods=1, steps_per_period=16)
+    np.testing.assert_array_equal(a.U, b.U)
+    assert not np.array_equal(a.U, c.U)
+    w = fw.incremental_wear(block, steps_per_cycle=8, n_cycles=2, wear_coefficient=0.0)
+    assert w.k_w == 0.0 and not np.any(w.wear)
+    assert np.array_equal(w.slip, incremental_wear(block, steps_per_cycle=8, n_cycles=2,
+                                                   wear_coefficient=0.0).slip)
+    wear0 = np.linspace(0.0, 1e-9, nc)
+    r = fw.simulate_wear(block, BASIS, quasi_static=True, wear0=wear0,
+                         options=fw.WearOptions(max_steps=1))
+    np.testing.assert_array_equal(r.history.wear_depth[0], wear0)
+
+
+def test_frf_worn_is_the_sweep_of_the_worn_gap(block):
+    """fw.frf_worn(model, basis, wear, f_min, f_max, n_points) in the order of fw.sweep is
+    fw.sweep with the gap opened by the wear and a linear grid (its definition, paper
+    Fig. 24): the same solves, so the same amplitudes bit for bit. The former order
+    (model, wear, (f_min, f_max, n_points), basis) is refused."""
+    gap = np.broadcast_to(np.asarray(block.contact.gap, float), (block.contact.n_nodes,))
+    wear = np.linspace(0.0, 2e-9, block.contact.n_nodes)
+    a = fw.frf_worn(block, BASIS, wear, 1400.0, 1600.0, 2)
+    b = fw.sweep(block, BASIS, 1400.0, 1600.0, 2, spacing="linear", gap=gap + wear)
+    assert a.success == b.success and a.point_success.any()
+    np.testing.assert_array_equal(a.frequency_hz, b.frequency_hz)
+    np.testing.assert_array_equal(a.amplitude("Pe", 0), b.amplitude("Pe", 0))
+    with pytest.raises(TypeError):
+        fw.frf_worn(block, wear, (1400.0, 1600.0, 2), BASIS)

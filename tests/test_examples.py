@@ -217,7 +217,8 @@ def test_quasi_static_periodic_example_agrees_with_load_stepping(tmp_path):
     ds = run_reduced("beam-quasistatic-periodic.toml", tmp_path, numerics={})
     assert ds.attrs["converged"] == 1
     model = build_model(load_case(EXAMPLES / "beam-quasistatic-periodic.toml"))
-    ref = incremental_wear(model, steps_per_cycle=128, n_cycles=3, k_w=0.0).slip[-1]
+    ref = incremental_wear(model, steps_per_cycle=128, n_cycles=3,
+                           wear_coefficient=0.0).slip[-1]
     path = ds["slip_path"].values
     assert np.abs(path - ref).max() <= 5e-3 * ref.max()
     np.testing.assert_array_equal(path > 1e-3 * ref.max(), ref > 1e-3 * ref.max())

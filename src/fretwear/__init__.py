@@ -7,17 +7,28 @@ slow-time steps, time-domain reference solvers).
 The public API, stage by stage (data flows one way; each stage returns a plain data object)::
 
     model = fretwear.rectangle(...) / fretwear.from_mesh(...) / fretwear.from_matrices(...)
-    red   = fretwear.condense(model, frequency, basis.orders)     # Reduced: Z_r per harmonic
-    sol   = fretwear.solve_periodic(model, basis, frequency=...)  # PeriodicSolution
-    frf   = fretwear.sweep(model, basis, f_min, f_max, n)         # SweepResult
-    wear  = fretwear.simulate_wear(model, basis, frequency=...)   # WearResult
+    cond  = fretwear.exact_condenser(model)                       # Condenser: built once
+    red   = fretwear.condense(model, frequency, basis.orders, condenser=cond)  # Reduced (Z_r)
+    sol   = fretwear.solve_periodic(model, basis, frequency, condenser=cond)   # PeriodicSolution
+    frf   = fretwear.sweep(model, basis, f_min, f_max, n, condenser=cond)     # SweepResult
+    wear  = fretwear.simulate_wear(model, basis, frequency, condenser=cond)   # WearResult
+    worn  = fretwear.frf_worn(model, basis, wear.final_wear, f_min, f_max, n)  # SweepResult
     run   = fretwear.integrate(model, frequency, n_periods=...)   # TransientResult
     out   = fretwear.run_case("case.toml", "out/")                # a case file end to end
     ds    = fretwear.read_results("out/results.nc")               # an xarray Dataset
     st    = fretwear.run_study("study.toml", "out/")              # members on Dask (study.nc)
 
-Every frequency argument is in Hz (``frequency``, ``f_min``, ``f_max``); objects also keep
-the circular frequency ``omega = 2 pi frequency`` [rad/s] where the equations use it. Every
+The condensation of a model is an object its caller owns (``exact_condenser``, or the
+Craig-Bampton ``modal_condenser`` for large interfaces): build it once and pass it as
+``condenser=`` to every driver that condenses the same model; without it each call builds
+its own exact one.
+
+One vocabulary and argument order at every entry point (:mod:`fretwear.api`): ``model, basis``
+first, then the frequency or the band; the stick anchors are ``anchor``, the initial wear
+``wear0``, the Archard coefficient ``wear_coefficient``; ``frequency`` is required wherever it
+matters (a quasi-static solve can do without). Every frequency argument is in Hz
+(``frequency``, ``f_min``, ``f_max``); objects also keep the circular frequency
+``omega = 2 pi frequency`` [rad/s] where the equations use it. Every
 result has ``success`` (bool) and ``message`` (str), as :class:`scipy.optimize.OptimizeResult`.
 
 Names are loaded on first use, so ``import fretwear`` stays light (the command line sets its
@@ -44,6 +55,7 @@ _API = {
     "from_matrices": "fretwear.model.matrices", "read_matrix_market": "fretwear.model.matrices",
     # harmonic balance
     "FourierBasis": "fretwear.hb.fourier", "condense": "fretwear.hb.reduce",
+    "exact_condenser": "fretwear.hb.reduce", "modal_condenser": "fretwear.hb.modal",
     "Reduced": "fretwear.hb.reduce", "solve_periodic": "fretwear.api",
     "PeriodicSolution": "fretwear.hb.periodic", "SweepResult": "fretwear.hb.sweep",
     "sweep": "fretwear.api",
@@ -52,9 +64,10 @@ _API = {
     # wear
     "simulate_wear": "fretwear.api", "frf_worn": "fretwear.api",
     "WearOptions": "fretwear.wear", "WearResult": "fretwear.wear",
+    "BalanceSetup": "fretwear.wear", "RunControl": "fretwear.wear",
     # time domain
-    "integrate": "fretwear.timedomain.integrate", "steady_state": "fretwear.timedomain.steady",
-    "incremental_wear": "fretwear.timedomain.quasistatic",
+    "integrate": "fretwear.api", "steady_state": "fretwear.api",
+    "incremental_wear": "fretwear.api",
     "check_periodic": "fretwear.timedomain.stability",
     # case files and results
     "run_case": "fretwear.analyses.run", "load_case": "fretwear.analyses.run",

@@ -1,18 +1,42 @@
-"""The drivers of the public API whose numerical core takes the time-domain fallback as an
-argument: here it is on by default, as in case files (one default for both).
+"""The drivers of the public API (:mod:`fretwear`), and the one place that decides the
+time-domain fallback for them and for the case-file analyses.
 
-:func:`fretwear.hb.sweep.sweep` and :func:`fretwear.wear.simulate.simulate_wear` never import
-the time-domain solver (:mod:`fretwear.hb.fallback`); these wrappers pass
-:data:`fretwear.timedomain.fallback.FALLBACK` unless ``time_domain=False``. Everything else is
-passed through unchanged.
+One vocabulary and one argument order at every entry point: ``(model, basis, ...)`` first
+(``model`` alone for the time-domain drivers, which have no Fourier basis), then what the call
+is about (``frequency`` [Hz], or ``f_min, f_max, n_points`` [Hz] for a frequency band); the
+stick anchors are ``anchor``, the initial wear ``wear0``, the Archard coefficient
+``wear_coefficient``; ``frequency`` is required wherever it matters (a quasi-static solve can
+do without: it then only scales time). The older spellings (``stick_anchor``, ``W0``,
+``k_w``) are refused with a TypeError that names the new one.
+
+:func:`fretwear.hb.sweep.sweep`, :func:`fretwear.hb.periodic.solve_periodic` and
+:func:`fretwear.wear.simulate.simulate_wear` never import the time-domain solver
+(:mod:`fretwear.hb.fallback`); the drivers here pass
+:data:`fretwear.timedomain.fallback.FALLBACK` unless ``time_domain=False``: on by default, as
+in case files, whose key ``time_domain`` is this argument (the analyses of
+:mod:`fretwear.analyses` call these drivers). Every other keyword is passed to the function
+named in the docstring unchanged, with its default: each option has one default, that of the
+function that uses it. ``condenser=`` is among them: the condenser of the model
+(:func:`fretwear.hb.reduce.exact_condenser` or :func:`fretwear.hb.modal.modal_condenser`),
+built once by the caller and passed to every driver that condenses the same model.
 """
 
 from __future__ import annotations
 
+import dataclasses
+
 from fretwear import wear as _wear
+from fretwear.errors import InputError
 from fretwear.hb import periodic as _periodic
 from fretwear.hb import sweep as _sweep
+from fretwear.timedomain import integrate as _integrate
+from fretwear.timedomain import quasistatic as _quasistatic
+from fretwear.timedomain import steady as _steady
 from fretwear.timedomain.fallback import FALLBACK
+
+#: spellings of other entry points -> the public one
+_RENAMED = {"stick_anchor": "anchor", "W0": "wear0", "k_w": "wear_coefficient",
+            "frequencies_hz": "f_min, f_max, n_points"}
 
 
 def _fallback(time_domain: bool):
@@ -21,24 +45,53 @@ def _fallback(time_domain: bool):
     return FALLBACK if time_domain else None
 
 
-def solve_periodic(model, basis, *, time_domain: bool = True,
-                   **kwargs) -> _periodic.PeriodicSolution:
-    """Periodic response of ``model`` at the excitation ``frequency`` [Hz] (keyword, default
-    1 Hz) with the DLFT (paper section 3.1-3.2).
+def _public_names(func: str, kwargs: dict) -> None:
+    """A TypeError for a keyword spelt as another entry point spells it."""
+    for old, new in _RENAMED.items():
+        if old in kwargs:
+            raise TypeError(f"{func}() takes {new}, not {old}")
 
-    :func:`fretwear.hb.periodic.solve_periodic` (every other keyword: ``frequency``,
-    ``quasi_static``, ``gap`` [m], ``eps``, ``anchor``, ``U0``, ``solver``, ``tol``,
-    ``max_iter``, ``strategy``, ``time_domain_periods``, ...) with the time-domain fallback
-    when every attempt of the solve strategy failed (``time_domain=True``, as the case-file
-    key ``time_domain`` of a periodic analysis): a periodic steady state of a time integration
-    starts one more solve; any other response is reported (``solution.time_domain``).
+
+def _frequency(frequency, quasi_static: bool) -> dict:
+    """The ``frequency`` keyword of the core function: required unless ``quasi_static``
+    (where it only scales time, and the core's default applies)."""
+    if frequency is None:
+        if quasi_static:
+            return {}
+        raise InputError("frequency = None: expected the excitation frequency [Hz], a number "
+                         "> 0 (only a quasi_static solve can do without)")
+    return {"frequency": frequency}
+
+
+def solve_periodic(model, basis, frequency: float | None = None, *, quasi_static: bool = False,
+                   time_domain: bool = True, **kwargs) -> _periodic.PeriodicSolution:
+    """Periodic response of ``model`` at the excitation ``frequency`` [Hz] with the DLFT (paper
+    section 3.1-3.2).
+
+    Parameters
+    ----------
+    model, basis : the structure and the Fourier basis (kept harmonics, samples per period).
+    frequency : excitation frequency [Hz]; required unless ``quasi_static`` (then it only
+        scales time; default 1 Hz).
+    quasi_static : drop inertia and damping (slow cyclic loading).
+    time_domain : when every attempt of the solve strategy failed, integrate in time from rest:
+        a periodic steady state starts one more solve, any other response is reported
+        (``solution.time_domain``). The case-file key ``time_domain`` of a periodic analysis.
+    **kwargs : the other keywords of :func:`fretwear.hb.periodic.solve_periodic`, with its
+        defaults: ``reduced`` (a :class:`~fretwear.hb.reduce.Reduced` to reuse), ``gap``
+        (nc,) [m], ``eps`` (DLFT penalty [N/m] or ``"auto"``/``"top"``/``"static"``),
+        ``anchor`` (nc, d-1) stick anchors [m], ``U0`` (start), ``solver``, ``tol``,
+        ``max_iter``, ``raise_on_failure``, ``strategy``, ``time_domain_periods``.
 
     Returns
     -------
     :class:`~fretwear.hb.periodic.PeriodicSolution`: ``success``, ``message``, ``attempts``,
     the harmonics and time histories of the contact (see its docstring).
     """
-    return _periodic.solve_periodic(model, basis, time_domain=_fallback(time_domain), **kwargs)
+    _public_names("solve_periodic", kwargs)
+    return _periodic.solve_periodic(model, basis, **_frequency(frequency, quasi_static),
+                                    quasi_static=quasi_static,
+                                    time_domain=_fallback(time_domain), **kwargs)
 
 
 def sweep(model, basis, f_min: float, f_max: float, n_points: int, *, time_domain: bool = True,
@@ -46,11 +99,17 @@ def sweep(model, basis, f_min: float, f_max: float, n_points: int, *, time_domai
     """Nonlinear FRF: periodic solutions of the DLFT from ``f_min`` to ``f_max`` [Hz] on
     ``n_points`` grid frequencies, each starting from its neighbours (continuation).
 
-    :func:`fretwear.hb.sweep.sweep` (every other keyword: ``spacing``, ``gap`` [m], ``eps``
-    [N/m or "static"/"auto"], ``solver``, ``tol``, ``max_iter``, ``continuation``, ``check``,
-    ``time_domain_periods``, ``checkpoint``, ``resume``, ...) with the time-domain fallback at
-    points whose balance fails (``time_domain=True``, as the case-file key ``time_domain`` of a
-    sweep).
+    Parameters
+    ----------
+    model, basis : the structure and the Fourier basis.
+    f_min, f_max, n_points : the frequency band [Hz] and its number of grid frequencies.
+    time_domain : at points whose balance still fails, integrate in time from the neighbour
+        (the case-file key ``time_domain`` of a sweep).
+    **kwargs : the other keywords of :func:`fretwear.hb.sweep.sweep`, with its defaults:
+        ``spacing`` (``"log"``/``"linear"``), ``gap`` (nc,) [m], ``eps`` [N/m or
+        ``"top"``/``"static"``/``"auto"``], ``eps_band`` [Hz], ``anchor`` (nc, d-1) [m],
+        ``solver``, ``tol``, ``max_iter``, ``continuation``, ``max_bisections``, ``check``,
+        ``time_domain_periods``, ``progress``, ``checkpoint``, ``resume``.
 
     Returns
     -------
@@ -59,19 +118,33 @@ def sweep(model, basis, f_min: float, f_max: float, n_points: int, *, time_domai
     with ``frequency_hz`` [Hz], ``solution`` or None, ``success``, ``message``, ``flags``),
     ``frequency_hz`` [Hz], ``point_success``, ``amplitude(point, axis)`` [m].
     """
+    _public_names("sweep", kwargs)
     return _sweep.sweep(model, basis, f_min, f_max, n_points,
                         time_domain=_fallback(time_domain), **kwargs)
 
 
-def simulate_wear(model, basis, *, time_domain: bool = True, **kwargs) -> _wear.WearResult:
+def simulate_wear(model, basis, frequency: float | None = None, *, quasi_static: bool = False,
+                  wear0=None, time_domain: bool = True, condenser=None,
+                  **kwargs) -> _wear.WearResult:
     """Fretting wear on the slow time scale (paper section 3.3, eq. 29-30) at the excitation
-    ``frequency`` [Hz] (keyword, default 1 Hz) or ``quasi_static=True``.
+    ``frequency`` [Hz] or under quasi-static loading.
 
-    :func:`fretwear.wear.simulate.simulate_wear` (every other keyword: ``frequency``,
-    ``quasi_static``, ``options`` (:class:`~fretwear.wear.options.WearOptions`), ``eps``,
-    ``W0`` [m], ``checkpoint``, ``resume``, ...) with the time-domain fallback of steps whose
-    balance fails (``time_domain=True``; whether it is used is
-    ``options.time_domain_rescue``, default true, as in case files).
+    Parameters
+    ----------
+    model, basis : the structure (``contact.wear_coefficient`` [1/Pa]) and the Fourier basis.
+    frequency : excitation frequency [Hz]; required unless ``quasi_static`` (then it only
+        scales time; default 1 Hz).
+    quasi_static : drop inertia and damping.
+    wear0 : (nc,) initial wear [m] (default 0).
+    time_domain : the time-domain fallback of the steps whose balance fails (whether it is
+        used is ``options.time_domain_rescue``, default true, as in case files).
+    condenser : the condenser of the model, as every driver takes it (it becomes the
+        ``condenser`` of ``balance``; giving both is an error).
+    **kwargs : the other keywords of :func:`fretwear.wear.simulate.simulate_wear`, with its
+        defaults: ``options`` (:class:`~fretwear.wear.options.WearOptions`), ``balance``
+        (:class:`~fretwear.wear.simulate.BalanceSetup`: ``reduced``, ``eps``, ``anchor``
+        (nc, d-1) [m], ``U0``), ``run`` (:class:`~fretwear.wear.simulate.RunControl`:
+        ``checkpoint``, ``resume``, ``progress``, ``callback``).
 
     Returns
     -------
@@ -81,17 +154,109 @@ def simulate_wear(model, basis, *, time_domain: bool = True, **kwargs) -> _wear.
     ``final_wear`` [m], ``initial`` and ``final`` periodic solutions (None where the rate came
     from a time integration).
     """
-    return _wear.simulate_wear(model, basis, time_domain=_fallback(time_domain), **kwargs)
+    _public_names("simulate_wear", kwargs)
+    if condenser is not None:
+        balance = kwargs.pop("balance", None) or _wear.BalanceSetup()
+        if balance.condenser is not None:
+            raise InputError("simulate_wear: condenser given twice (condenser= and "
+                             "balance.condenser); give one")
+        kwargs["balance"] = dataclasses.replace(balance, condenser=condenser)
+    return _wear.simulate_wear(model, basis, **_frequency(frequency, quasi_static),
+                               quasi_static=quasi_static, wear0=wear0,
+                               time_domain=_fallback(time_domain), **kwargs)
 
 
-def frf_worn(model, wear, frequencies_hz, basis, *, time_domain: bool = True, **kwargs):
-    """Nonlinear FRF with the worn gap ``gap + wear`` (paper Fig. 24), ``wear`` (nc,) [m],
-    ``frequencies_hz = (f_min, f_max, n_points)`` [Hz]: :func:`fretwear.wear.worn_frf.frf_worn`
-    with the time-domain fallback (``time_domain=True``).
+def frf_worn(model, basis, wear, f_min: float, f_max: float, n_points: int, *,
+             time_domain: bool = True, **kwargs) -> _sweep.SweepResult:
+    """Nonlinear FRF with the worn gap ``gap + wear`` (paper Fig. 24) from ``f_min`` to
+    ``f_max`` [Hz] on ``n_points`` grid frequencies, as :func:`sweep`.
+
+    Parameters
+    ----------
+    model, basis : the structure and the Fourier basis.
+    wear : (nc,) wear depths [m] (e.g. ``result.final_wear``, or 0).
+    f_min, f_max, n_points : the frequency band [Hz] and its number of grid frequencies.
+    time_domain : at points whose balance still fails, integrate in time from the neighbour
+        (the key ``time_domain`` of a wear analysis's ``frf_before_after``).
+    **kwargs : the other keywords of :func:`fretwear.wear.worn_frf.frf_worn` (``anchor``,
+        ``spacing``, default ``"linear"``) and of :func:`fretwear.hb.sweep.sweep`.
 
     Returns
     -------
     :class:`~fretwear.hb.sweep.SweepResult` (``success``, ``message``, as :func:`sweep`).
     """
-    return _wear.frf_worn(model, wear, frequencies_hz, basis,
+    _public_names("frf_worn", kwargs)
+    return _wear.frf_worn(model, basis, wear, f_min, f_max, n_points,
                           time_domain=_fallback(time_domain), **kwargs)
+
+
+def integrate(model, frequency: float, *, anchor=None, **kwargs):
+    """Integrate the forced response at ``frequency`` [Hz] in time with exact contact and
+    friction.
+
+    Parameters
+    ----------
+    model : the structure.
+    frequency : forcing frequency [Hz].
+    anchor : (nc, d-1) tangential positions [m] from which the first step's slip is measured
+        (default: those of ``U0``).
+    **kwargs : the other keywords of :func:`fretwear.timedomain.integrate.integrate`, with
+        its defaults: ``n_periods`` (required), ``steps_per_period``, ``record``, ``U0`` [m],
+        ``V0`` [m/s], ``wear`` (nc,) [m], ``modal_cutoff`` [Hz], ``n_modes``, ``gamma``,
+        ``hf_damping``, ``keep_poincare``, ``tol``, ``progress``.
+
+    Returns
+    -------
+    :class:`~fretwear.timedomain.results.TransientResult`: ``success``, ``message``, the
+    recorded samples and the final state ``U, V`` to continue the run.
+    """
+    _public_names("integrate", kwargs)
+    return _integrate.integrate(model, frequency, stick_anchor=anchor, **kwargs)
+
+
+def steady_state(model, frequency: float, *, anchor=None, **kwargs):
+    """Integrate at ``frequency`` [Hz] until the response is periodic (or classified
+    otherwise).
+
+    Parameters
+    ----------
+    model : the structure.
+    frequency : forcing frequency [Hz].
+    anchor : (nc, d-1) tangential positions [m] from which the first step's slip is measured.
+    **kwargs : the other keywords of :func:`fretwear.timedomain.steady.steady_state`, with its
+        defaults: ``max_periods``, ``tol``, ``steps_per_period``, ``harmonics``,
+        ``check_every``, ``window``, ``min_periods``, ``U0``, ``V0``, ``wear`` [m],
+        ``modal_cutoff`` [Hz], ``n_modes``, ``gamma``, ``hf_damping``, ``contact_tol``,
+        ``progress``.
+
+    Returns
+    -------
+    :class:`~fretwear.timedomain.results.SteadyStateResult`: ``success``, ``message``,
+    ``classification``, the harmonics of the last period.
+    """
+    _public_names("steady_state", kwargs)
+    return _steady.steady_state(model, frequency, stick_anchor=anchor, **kwargs)
+
+
+def incremental_wear(model, *, wear_coefficient: float | None = None, wear0=None, **kwargs):
+    """Quasi-static fretting wear by load steps (in the spirit of Stromberg 1997).
+
+    Parameters
+    ----------
+    model : the structure (inertia and damping are ignored).
+    wear_coefficient : Archard coefficient [1/Pa]; default ``model.contact.wear_coefficient``
+        (plus the partners' at node-to-node pairs).
+    wear0 : (nc,) initial wear [m].
+    **kwargs : the other keywords of
+        :func:`fretwear.timedomain.quasistatic.incremental_wear`, with its defaults:
+        ``steps_per_cycle``, ``n_cycles``, ``cycle_jump``, ``record_every``, ``tol``,
+        ``progress``, ``raise_on_failure``.
+
+    Returns
+    -------
+    :class:`~fretwear.timedomain.results.IncrementalWearResult`: ``success``, ``message``,
+    wear [m] per recorded cycle.
+    """
+    _public_names("incremental_wear", kwargs)
+    return _quasistatic.incremental_wear(model, wear_coefficient=wear_coefficient, wear0=wear0,
+                                         **kwargs)

@@ -32,7 +32,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from fretwear.errors import InputError
-from fretwear.hb.reduce import condense
+from fretwear.hb.reduce import condenser_for
 from fretwear.model.core import Model
 from fretwear.model.interfaces import pair_transform
 
@@ -540,13 +540,14 @@ def _split_observed(model: Model, Uo: np.ndarray) -> dict:
     return observed
 
 
-def _frf_condensed(model: Model, freqs: np.ndarray, interface: str):
+def _frf_condensed(model: Model, freqs: np.ndarray, interface: str, condenser=None):
+    cond = condenser_for(model, condenser)  # one for every frequency
     nc, d = model.contact.dofs.shape
     held = _held_local(model, interface).reshape(-1)
     keep = np.flatnonzero(~held)
     obs, con, rea = [], [], []
     for f in freqs:
-        red = condense(model, f, [1])
+        red = cond.reduced(2 * np.pi * f, [1], False, f)  # = condense(model, f, [1])
         Z, Fr = red.Z[0], red.F[0]
         u = np.zeros(nc * d, dtype=complex)
         if keep.size:
@@ -560,7 +561,7 @@ def _frf_condensed(model: Model, freqs: np.ndarray, interface: str):
 
 
 def frf(model: Model, frequencies_hz, *, interface: str = "sliding",
-        method: str = "direct") -> FRFResult:
+        method: str = "direct", condenser=None) -> FRFResult:
     """Frequency response to the harmonic (n = 1) part of the model loads.
 
     Parameters
@@ -576,6 +577,10 @@ def frf(model: Model, frequencies_hz, *, interface: str = "sliding",
         the relative residual ``|Z q - F| / |F|`` is below :data:`PROJECTED_TOL` at every
         frequency (one sparse solve per chosen frequency, a few per resonance; see
         ``_projected_solutions``).
+    condenser : with ``method="condensed"``, the condenser of ``model``
+        (:func:`fretwear.hb.reduce.exact_condenser` or
+        :func:`fretwear.hb.modal.modal_condenser`); None: a new exact one for the call. The
+        other methods solve the whole model and take none.
 
     Returns
     -------
@@ -592,7 +597,7 @@ def frf(model: Model, frequencies_hz, *, interface: str = "sliding",
         observed, con, rea = _frf_direct(model, freqs, interface, F,
                                          projected=method == "projected")
     else:
-        observed, con, rea = _frf_condensed(model, freqs, interface)
+        observed, con, rea = _frf_condensed(model, freqs, interface, condenser)
     return FRFResult(interface, freqs, observed, con, rea, method)
 
 

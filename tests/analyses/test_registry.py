@@ -1,36 +1,55 @@
-"""The analysis registry (fretwear.analyses.registry): lookup by name, its messages, the refusal
-of a second registration under a taken name, and the order of the tables.
+"""The analysis registry (fretwear.analyses.registry): lookup by name, its messages, the order of
+the tables, the refusal of a name defined twice, and that it lists exactly the analyses the
+analysis modules define.
 
-Reference: the registry's contract written out here (the modules of ANALYSIS_MODULES in their
-order, each registering its names; one clear InputError line for an unknown type).
+Reference: the registry's contract written out here (the seven analyses in the order of
+docs/case-files.md; one clear InputError line for an unknown type), and, independently of the
+registry's own list, the Analysis objects found by walking the modules of fretwear.analyses.
 """
+
+import importlib
+import pkgutil
 
 import pytest
 
+import fretwear.analyses
 from fretwear.analyses import registry
+from fretwear.analyses.base import Analysis
 from fretwear.errors import InputError
-from fretwear.io.schema import Field, Integer
+from fretwear.io.schema import Field, Integer, Table
 
 EXPECTED = ["modes", "frf", "periodic", "sweep", "transient", "incremental-wear", "wear"]
 
 
-@pytest.fixture
-def scratch():
-    """Names registered by a test are removed after it."""
-    before = dict(registry._REGISTRY)
-    yield
-    registry._REGISTRY.clear()
-    registry._REGISTRY.update(before)
-
-
-def test_every_analysis_is_listed_in_module_order():
+def test_every_analysis_is_listed_in_order():
     assert registry.available() == EXPECTED
     assert list(registry.analysis_tables()) == EXPECTED
+    assert [a.name for a in registry.ANALYSES] == EXPECTED
     for name in EXPECTED:
         a = registry.get(name)
         assert a.name == name and callable(a.run)
-        assert a.run.__module__ in registry.ANALYSIS_MODULES
+        assert a.run.__module__.startswith("fretwear.analyses.")
     assert registry.get("wear").files  # the checkpoint file it keeps
+
+
+def defined_by_modules() -> dict[str, Analysis]:
+    """Every Analysis a module of fretwear.analyses defines (its run function is its own),
+    found by importing each module: what the registry must list, no more, no less."""
+    found = {}
+    for info in pkgutil.iter_modules(fretwear.analyses.__path__):
+        module = importlib.import_module(f"fretwear.analyses.{info.name}")
+        for value in vars(module).values():
+            if isinstance(value, Analysis) and value.run.__module__ == module.__name__:
+                assert value.name not in found or found[value.name] is value, value.name
+                found[value.name] = value
+    return found
+
+
+def test_the_registry_lists_exactly_what_the_modules_define():
+    found = defined_by_modules()
+    assert set(found) == set(EXPECTED)
+    for name, a in found.items():
+        assert registry.get(name) is a, name
 
 
 def test_unknown_type_names_the_available_ones():
@@ -40,30 +59,38 @@ def test_unknown_type_names_the_available_ones():
                             + ", ".join(EXPECTED))
 
 
-def run_a(model, analysis, case, outdir, progress):
+def run_a(model, analysis, case, context):
     raise AssertionError("not run here")
 
 
-def run_b(model, analysis, case, outdir, progress):
+def run_b(model, analysis, case, context):
     raise AssertionError("not run here")
 
 
-def test_register_and_get(scratch):
-    registry.register("scratch", {"n": Field(Integer(lo=1), "a count", default=2)}, run_a,
-                      doc="A test analysis.")
-    a = registry.get("scratch")
-    assert a.run is run_a and "n" in a.schema.fields and a.files == ()
-    assert "scratch" in registry.analysis_tables()
-    registry.register("scratch", a.schema, run_a)  # the same function again: accepted
+def test_define_and_look_up():
+    a = Analysis.define("scratch", {"n": Field(Integer(lo=1), "a count", default=2)}, run_a,
+                        doc="A test analysis.", files=("state.npz",))
+    assert a.run is run_a and "n" in a.schema.fields and a.files == ("state.npz",)
+    assert a.schema.doc == "A test analysis." and not a.preload_check
+    assert Analysis.define("scratch", a.schema, run_a).schema is a.schema  # a Table as is
+    table = registry.by_name([registry.get("modes"), a])
+    assert list(table) == ["modes", "scratch"] and table["scratch"] is a
+    with pytest.raises(TypeError):
+        table["other"] = a  # read-only
 
 
-def test_a_taken_name_is_refused(scratch):
-    registry.register("scratch", {}, run_a)
-    with pytest.raises(ValueError, match="'scratch' is already registered by"):
-        registry.register("scratch", {}, run_b)
-    assert registry.get("scratch").run is run_a
+def test_a_name_defined_twice_is_refused():
+    a = Analysis.define("scratch", {}, run_a)
+    b = Analysis.define("scratch", {}, run_b)
+    with pytest.raises(ValueError, match=r"'scratch' is defined twice: by \S*\.run_a and "
+                                         r"by \S*\.run_b"):
+        registry.by_name([a, b])
+    with pytest.raises(ValueError, match="'periodic' is defined twice"):
+        registry.by_name([*registry.ANALYSES, Analysis.define("periodic", {}, run_a)])
 
 
-def test_type_is_not_a_schema_key(scratch):
+def test_type_is_not_a_schema_key():
     with pytest.raises(ValueError, match="'type' is added by the registry"):
-        registry.register("scratch", {"type": Field(Integer(), "no")}, run_a)
+        Analysis.define("scratch", {"type": Field(Integer(), "no")}, run_a)
+    with pytest.raises(ValueError, match="'type' is added by the registry"):
+        Analysis("scratch", Table({"type": Field(Integer(), "no")}), run_a)

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from helpers.cases import WEAR_BLOCK, check_documented
 
-import fretwear.analyses.wear as wear_analysis
+from fretwear import api
 from fretwear.analyses.run import run_case
 from fretwear.io.results import read_results
 
@@ -34,25 +34,7 @@ n_points = 3
 """
 
 
-@pytest.fixture
-def wear_registered():
-    """Import the analysis for this test only (the registry line in runner.ANALYSIS_MODULES
-    and the regenerated docs/case-files.md come with the merge)."""
-    from fretwear.analyses import registry as runner
-
-    before = "wear" in runner._REGISTRY
-    import fretwear.analyses.wear  # noqa: F401
-
-    if "wear" not in runner._REGISTRY:  # imported earlier, then removed by this fixture
-        rw = fretwear.analyses.wear
-        runner.register("wear", rw.SCHEMA, rw.run_wear, checks=rw.CHECKS, doc=rw.DOC,
-                        files=(rw.CHECKPOINT_FILE,))
-    yield
-    if not before:
-        runner._REGISTRY.pop("wear", None)
-
-
-def test_case_file_run_and_resume(tmp_path, wear_registered):
+def test_case_file_run_and_resume(tmp_path):
     """`analysis = "wear"` end to end: results.nc follows the schema (units on every variable,
     dims step/contact_node), figures exist, the checkpoint is there, and --resume of a finished
     run reports it up to date."""
@@ -77,7 +59,7 @@ def test_case_file_run_and_resume(tmp_path, wear_registered):
     assert again.summary == "up to date"
 
 
-def test_case_file_needs_frequency(tmp_path, wear_registered):
+def test_case_file_needs_frequency(tmp_path):
     from fretwear.analyses.run import load_case
     from fretwear.errors import InputError
 
@@ -89,14 +71,14 @@ def test_case_file_needs_frequency(tmp_path, wear_registered):
 
 def test_dataset_is_the_wear_result_it_came_from(tmp_path, monkeypatch):
     caught = []
-    real = wear_analysis.simulate_wear
+    real = api.simulate_wear  # the driver the analysis calls
 
-    @functools.wraps(real)  # the analysis reads the defaults from the signature
+    @functools.wraps(real)
     def simulate_wear(*args, **kw):
         caught.append(real(*args, **kw))
         return caught[-1]
 
-    monkeypatch.setattr(wear_analysis, "simulate_wear", simulate_wear)
+    monkeypatch.setattr(api, "simulate_wear", simulate_wear)
     case = tmp_path / "w.toml"
     case.write_text(CASE[: CASE.index("[analysis.frf_before_after]")].replace(
         "max_cycles = 3e5", "max_cycles = 1e5"))

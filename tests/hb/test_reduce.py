@@ -15,12 +15,19 @@ formula error (a missing term, a wrong sign or frame) gives O(1) errors.
 import numpy as np
 import pytest
 import scipy.linalg as sla
-from helpers.models import RNG, truss
+from helpers.models import RNG, oscillator, sliders, truss
 
 from fretwear.errors import InputError
 from fretwear.hb import reduce
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.reduce import condense, loads_to_real, recover, to_real_blocks
+from fretwear.hb.reduce import (
+    condense,
+    condense_static,
+    exact_condenser,
+    loads_to_real,
+    recover,
+    to_real_blocks,
+)
 
 RTOL = 1e-9
 
@@ -34,7 +41,6 @@ def condensation_path(request, monkeypatch):
     monkeypatch.setattr(reduce, "DENSE_MAX", -1 if request.param == "sparse" else 10**9)
     monkeypatch.setattr(reduce, "BATCH_MAX", 10**9 if request.param == "batched" else -1)
     monkeypatch.setattr(reduce, "BLOCK", 5)
-    monkeypatch.setattr(reduce, "_CONDENSERS", {})
     return request.param
 
 
@@ -201,21 +207,133 @@ def test_real_blocks_match_time_domain_operator():
     np.testing.assert_allclose(loads_to_real(F), basis.to_freq(samples.T), rtol=0, atol=1e-12)
 
 
-def test_condenser_reused_until_the_model_changes():
-    """A second condensation of the same model reuses the prepared condenser (and its static
-    LU); replacing or editing a matrix in place gives a new one, whose result is that of a
-    fresh model (exact comparison with a condensation of a copy)."""
+def test_a_condenser_refuses_another_model_or_an_edited_one():
+    """A condenser belongs to the model it was built for: handed another model (here a truss of
+    other damping, the same shape), or its own model after a matrix was replaced or edited in
+    place, every entry point refuses it with one line naming ``condenser`` instead of
+    condensing the wrong structure. A new condenser of the edited model gives the condensation
+    of a fresh model with the same matrix (exact comparison: the same operations)."""
     model = truss(damping="both")
-    c1 = reduce.condenser(model)
-    assert reduce.condenser(model) is c1
-    model.K = model.K.tocsr(copy=True)
-    model.K.data[0] *= 1.5
-    c2 = reduce.condenser(model)
-    assert c2 is not c1
-    model.K.data[0] *= 2.0  # in place: seen by the fingerprint
-    assert reduce.condenser(model) is not c2
-    red = condense(model, 10.0, [0, 1])
+    cond = exact_condenser(model)
+    condense(model, 10.0, [0, 1], condenser=cond)  # its own model: accepted
+    other = truss(damping="hysteretic")
+    u_loc = np.zeros((2, 12))
+    for call in (lambda m: condense(m, 10.0, [0, 1], condenser=cond),
+                 lambda m: recover(m, 10.0, [0, 1], u_loc, condenser=cond),
+                 lambda m: condense_static(m, condenser=cond)):
+        with pytest.raises(InputError, match="condenser: built for another model") as err:
+            call(other)
+        assert "\n" not in str(err.value)
+    model.K.data[0] *= 1.5  # in place: seen by the fingerprint
+    with pytest.raises(InputError, match="condenser"):
+        condense(model, 10.0, [0, 1], condenser=cond)
+    edited = exact_condenser(model)
+    model.K = model.K.tocsr(copy=True)  # the same values in another matrix: another model
+    with pytest.raises(InputError, match="condenser"):
+        edited.check(model)
+    with pytest.raises(InputError, match="condenser = int object"):
+        condense(model, 10.0, [0, 1], condenser=42)
+    red = condense(model, 10.0, [0, 1], condenser=exact_condenser(model))
     fresh = truss(damping="both")
-    fresh.K = model.K.copy()
+    fresh.K, fresh.loads = model.K.copy(), model.loads  # (truss() draws new random loads)
     ref = condense(fresh, 10.0, [0, 1])
     np.testing.assert_array_equal(red.Z, ref.Z)
+    np.testing.assert_array_equal(red.F, ref.F)
+
+
+def test_exact_condenser_equals_a_dense_schur_complement():
+    """The condensation of one condenser reused across frequencies, harmonics and calls on
+    other models equals eq. 19 written densely from the model's matrices (numpy solves, not
+    the sparse or batched LU of reduce): ``Z_r = R (Z_cc - Z_ci Z_ii^-1 Z_ic) R^T``,
+    ``F_r = R (F_c - Z_ci Z_ii^-1 F_i)``. Tolerance RTOL (module docstring: conditioning up to
+    ~1e3 near a resonance). And a condenser reused is bit for bit a new one per call (the
+    behaviour of the module cache it replaces): the same operations on the same arrays."""
+    model = truss(damping="both")
+    cond = exact_condenser(model)
+    cd = model.contact.dofs.reshape(-1)
+    idofs = np.setdiff1d(model.free_dofs(), cd)
+    R = sla.block_diag(*model.contact.frame)
+    orders = np.array([0, 1, 2, 3])
+    F_all = model.load_harmonics(3)
+    wn = free_eigenfrequencies(model)
+    for f in np.array([0.31 * wn[0], 0.999 * wn[2], 1.7 * wn[4]]) / (2 * np.pi):
+        condense(truss(nx=4, damping="rayleigh"), f, orders)  # another model in between
+        red = condense(model, f, orders, condenser=cond)
+        for b, n in enumerate(orders):
+            Z = dense_Z(model, red.omega, n)
+            X = np.linalg.solve(Z[np.ix_(idofs, idofs)],
+                                np.column_stack([Z[np.ix_(idofs, cd)], F_all[n][idofs]]))
+            S = Z[np.ix_(cd, cd)] - Z[np.ix_(cd, idofs)] @ X[:, :-1]
+            Fr = F_all[n][cd] - Z[np.ix_(cd, idofs)] @ X[:, -1]
+            assert rel(red.Z[b], R @ S @ R.T) < RTOL
+            assert rel(red.F[b], R @ Fr) < RTOL
+        new = condense(model, f, orders)  # a new condenser for this call alone
+        for name in ("Z", "F", "obs_A", "obs_b"):
+            np.testing.assert_array_equal(getattr(red, name), getattr(new, name))
+
+
+def test_loads_are_read_at_each_call():
+    """The loads may change between calls while the structure does not: a condenser reads the
+    model's loads at each call (``F_r`` then equals a new condenser's exactly), and keeps its
+    structure (the same ``Z_r``)."""
+    model = truss(damping="both")
+    cond = exact_condenser(model)
+    before = condense(model, 40.0, [0, 1, 2], condenser=cond)
+    model.loads[1].vector *= 3.0  # the "cos" load, in place
+    model.loads = model.loads[:2]  # and the "sin" and "fourier" loads dropped
+    after = condense(model, 40.0, [0, 1, 2], condenser=cond)
+    ref = condense(model, 40.0, [0, 1, 2])
+    np.testing.assert_array_equal(after.F, ref.F)
+    np.testing.assert_array_equal(after.Z, before.Z)
+    assert rel(after.F[1], before.F[1]) > 0.1
+
+
+@pytest.fixture
+def constructions(monkeypatch):
+    """The number of condensers built (exact or modal) while the test runs."""
+    count = [0]
+    init = reduce.Condenser.__init__
+
+    def counting(self, *args, **kwargs):
+        count[0] += 1
+        init(self, *args, **kwargs)
+
+    monkeypatch.setattr(reduce.Condenser, "__init__", counting)
+    return count
+
+
+def test_one_driver_call_builds_one_condenser(constructions):
+    """Every driver call that condenses builds one condenser for all its condensations (the
+    periodic solve's condensation, its penalty and its static preload; a sweep's penalty
+    samples, points and preload; a wear run's condensation and preload; a condensed FRF's
+    frequencies), and none when one is passed. Counted by a wrapper of Condenser.__init__:
+    with every condensation building its own, the first three build 4, 4 and 3 (measured)."""
+    from fretwear.hb.periodic import solve_periodic
+    from fretwear.hb.sweep import sweep
+    from fretwear.linear import frf
+    from fretwear.wear import BalanceSetup, WearOptions, simulate_wear
+
+    model = oscillator()
+    basis = FourierBasis.up_to(3, 64)
+    wear_model = sliders()
+    wear_opts = WearOptions(max_cycles=2e4, initial_jump=1e4, adaptive=False)
+    runs = {
+        "solve_periodic": lambda c: solve_periodic(model, basis, frequency=10.0, eps="static",
+                                                   condenser=c),
+        "sweep": lambda c: sweep(model, basis, 8.0, 12.0, 3, condenser=c),
+        "simulate_wear": lambda c: simulate_wear(wear_model, basis, quasi_static=True,
+                                                 options=wear_opts,
+                                                 balance=BalanceSetup(condenser=c)),
+        "frf": lambda c: frf(truss(), [10.0, 20.0, 30.0], method="condensed", condenser=c),
+    }
+    for name, run in runs.items():
+        constructions[0] = 0
+        out = run(None)
+        assert getattr(out, "success", True), name
+        assert constructions[0] == 1, name
+    for name, m in (("solve_periodic", model), ("sweep", model),
+                    ("simulate_wear", wear_model)):
+        cond = exact_condenser(m)
+        constructions[0] = 0
+        runs[name](cond)
+        assert constructions[0] == 0, name

@@ -559,7 +559,7 @@ def test_wear_of_a_pair_on_a_stiff_held_body_is_the_rigid_obstacle_wear(tmp_path
     agree to 5 x the stiffness ratio (measured 1.3 x the ratio at ratios 1e-5 and 1e-6:
     linear in the ratio). Resuming from the checkpoint after the run gives the same final
     wear (the fingerprint takes the pair model)."""
-    from fretwear.wear import WearOptions, simulate_wear
+    from fretwear.wear import RunControl, WearOptions, simulate_wear
 
     scale = 1e7 / STEEL.E
     soft = Material(1e7, 0.3, 7800.0 * scale)
@@ -569,7 +569,7 @@ def test_wear_of_a_pair_on_a_stiff_held_body_is_the_rigid_obstacle_wear(tmp_path
     models["rigid"].contact.wear_coefficient = 4e-9  # the sum of both surfaces'
     opts = WearOptions(max_steps=4, tolerance=0.1)
     out = {k: simulate_wear(m, BASIS, frequency=F_HZ, options=opts,
-                            checkpoint=tmp_path / f"{k}.npz")
+                            run=RunControl(checkpoint=tmp_path / f"{k}.npz"))
            for k, m in models.items()}
     wa, wb = out["pair"].history.wear_depth, out["rigid"].history.wear_depth
     assert out["pair"].success and wb[-1].max() > 0
@@ -577,7 +577,7 @@ def test_wear_of_a_pair_on_a_stiff_held_body_is_the_rigid_obstacle_wear(tmp_path
                                rtol=5e-6)
     np.testing.assert_allclose(wa, wb, rtol=0, atol=5e-6 * wb[-1].max())
     again = simulate_wear(models["pair"], BASIS, frequency=F_HZ, options=opts,
-                          checkpoint=tmp_path / "pair.npz", resume=True)
+                          run=RunControl(checkpoint=tmp_path / "pair.npz", resume=True))
     assert again.resumed_from >= 0
     np.testing.assert_array_equal(again.final_wear, out["pair"].final_wear)
 

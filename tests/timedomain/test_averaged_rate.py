@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers.wear_checkpoints import assert_reads_as_format_3
 
 import fretwear.wear.schemes as wear_schemes  # the first balance calls its solve_periodic
 import fretwear.wear.simulate as wear_driver  # the driver calls its advance (balanced steps)
@@ -29,7 +30,14 @@ from fretwear.hb.reduce import condense
 from fretwear.model.build import ContactSpec, Damping, Material, Spring, Traction, from_mesh
 from fretwear.model.mesh import rectangle
 from fretwear.timedomain.averaged_rate import RESPONSE_KINDS, time_averaged_rate
-from fretwear.wear import SlowProblem, WearOptions, wear_coefficients, without_growth
+from fretwear.wear import (
+    Rescue,
+    RunControl,
+    SlowProblem,
+    WearOptions,
+    wear_coefficients,
+    without_growth,
+)
 from fretwear.wear.options import START_JUMP, START_SETTLE
 
 KW = 1e-11
@@ -175,8 +183,8 @@ def test_time_domain_steps_return_to_balanced_solutions(monkeypatch):
     r = simulate_wear(m, BASIS, frequency=F_HZ, options=WearOptions(**OPTS))
     h = r.history
     assert r.success and h.n_steps == 5
-    np.testing.assert_array_equal(h.rescued[:2], [0, 0])
-    assert np.all(h.rescued[2:] == 1)
+    np.testing.assert_array_equal(h.rescued[:2], [Rescue.BALANCED] * 2)
+    assert np.all(h.rescued[2:] == Rescue.TIME_START)
     assert np.all(h.response[2:] == RESPONSE_KINDS.index("periodic"))
     red = condense(m, F_HZ, BASIS.orders)
     spb = SlowProblem(m, red, BASIS, wear_coefficients(m), eps=r.penalty)
@@ -190,18 +198,20 @@ def test_time_domain_steps_return_to_balanced_solutions(monkeypatch):
 @pytest.mark.parametrize("scheme", ["explicit", "rosenbrock"])
 def test_time_averaged_steps_follow_the_time_integration(monkeypatch, tmp_path, scheme):
     """With no balance at all after step 1, the run goes on with time-averaged rates
-    (rescued = 2). Each step's wear is the explicit Euler update (eq. 30) with the previous
-    step's rate, or the linearly implicit one with the slow Jacobian of the last balanced step
-    (recomputed here from the recorded step 1) without its growing modes. Interrupting after
-    step 3 and resuming gives the same history bit for bit (the integration state is in the
-    checkpoint)."""
+    (rescued = Rescue.TIME_AVERAGED). Each step's wear is the explicit Euler update (eq. 30)
+    with the previous step's rate, or the linearly implicit one with the slow Jacobian of the
+    last balanced step (recomputed here from the recorded step 1) without its growing modes.
+    Interrupting after step 3 and resuming gives the same history bit for bit (the
+    integration state is in the checkpoint), from this checkpoint format and from format 3
+    (the same state in its earlier names, written by the format-3 writer kept in
+    tests/helpers)."""
     m = damped_block()
     _forced_failures(monkeypatch, balance_fails=True)
     opts = WearOptions(scheme=scheme, **OPTS)
     full = simulate_wear(m, BASIS, frequency=F_HZ, options=opts)
     h = full.history
     assert full.success and h.n_steps == 5
-    assert np.all(h.rescued[2:] == 2)
+    assert np.all(h.rescued[2:] == Rescue.TIME_AVERAGED)
     # the uncertainty of the averaged rates is recorded; balanced rates are exact (NaN)
     assert np.all(np.isnan(h.rate_scatter[:2]))
     assert np.all((h.rate_scatter[2:] >= 0) & (h.rate_scatter[2:] < 1))
@@ -228,13 +238,20 @@ def test_time_averaged_steps_follow_the_time_integration(monkeypatch, tmp_path, 
             raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
-        simulate_wear(m, BASIS, frequency=F_HZ, options=opts, checkpoint=ck, callback=stop)
-    _forced_failures(monkeypatch, balance_fails=True, first_ok=False)
-    resumed = simulate_wear(m, BASIS, frequency=F_HZ, options=opts, checkpoint=ck, resume=True)
-    assert resumed.resumed_from == 3
-    for name in ("cycles", "wear_depth", "wear_rate", "U", "rescued", "rate_scatter"):
-        np.testing.assert_array_equal(getattr(h, name), getattr(resumed.history, name),
-                                      err_msg=name)
+        simulate_wear(m, BASIS, frequency=F_HZ, options=opts,
+                      run=RunControl(checkpoint=ck, callback=stop))
+    saved = ck.read_bytes()
+    for version in (4, 3):  # this format, and the same state in format 3
+        if version == 3:
+            ck.write_bytes(saved)
+            assert_reads_as_format_3(ck)
+        _forced_failures(monkeypatch, balance_fails=True, first_ok=False)
+        resumed = simulate_wear(m, BASIS, frequency=F_HZ, options=opts,
+                                run=RunControl(checkpoint=ck, resume=True))
+        assert resumed.resumed_from == 3
+        for name in ("cycles", "wear_depth", "wear_rate", "U", "rescued", "rate_scatter"):
+            np.testing.assert_array_equal(getattr(h, name), getattr(resumed.history, name),
+                                          err_msg=f"{name} (format {version})")
 
 
 def test_run_starts_from_a_time_integration_when_the_unworn_balance_fails(monkeypatch):
@@ -256,14 +273,14 @@ def test_run_starts_from_a_time_integration_when_the_unworn_balance_fails(monkey
     opts = WearOptions(**OPTS)
     r = simulate_wear(m, BASIS, frequency=F_HZ, options=opts)
     h = r.history
-    assert r.success and h.n_steps == 5 and h.rescued[0] == 2
+    assert r.success and h.n_steps == 5 and h.rescued[0] == Rescue.TIME_AVERAGED
     ref = time_averaged_rate(m, F_HZ, BASIS, wear_coefficients(m), np.zeros(h.wear_depth.shape[1]),
                              U0=None, V0=None, settle=START_SETTLE, average=64,
                              steps_per_period=512)
     np.testing.assert_array_equal(h.wear_rate[0], ref.g)
     assert h.jump[1] == START_JUMP
     # the response is periodic: the balance converges from it at step 1, then ordinary steps
-    assert h.rescued[1] == 1 and np.all(h.rescued[2:] == 0)
+    assert h.rescued[1] == Rescue.TIME_START and np.all(h.rescued[2:] == Rescue.BALANCED)
     # only the wear module's start was forced
     assert fretwear.hb.periodic.solve_periodic is not failing
 

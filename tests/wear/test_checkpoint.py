@@ -6,6 +6,8 @@ of writes that were killed.
   ``--resume``: ``results.nc`` equals the uninterrupted run's bit for bit (wall times aside);
   SIGTERM saves the state it has reached (exit 143, no traceback);
 * every kind of damaged checkpoint: exit 2, one line naming the file, the file left as it was;
+* a format-3 checkpoint (written by the format-3 writer kept in tests/helpers) resumes to the
+  uninterrupted run's history bit for bit; another version is refused in one line;
 * stale temporary files of :func:`fretwear.files.atomic_write` are removed at the next run,
   nothing else is.
 """
@@ -20,11 +22,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 from helpers.cases import WEAR_BLOCK
+from helpers.wear_checkpoints import assert_reads_as_format_3
 
 from fretwear import cli
 from fretwear.errors import InputError
+from fretwear.examples.builders import stromberg_beam
+from fretwear.hb.fourier import FourierBasis
 from fretwear.io.results import read_results
-from fretwear.wear.checkpoint import load_checkpoint, read_history
+from fretwear.wear import HISTORY_FIELDS, RunControl, WearOptions, simulate_wear
+from fretwear.wear.checkpoint import CHECKPOINT_VERSION, load_checkpoint, read_history
 
 # A quasi-static wear case of ~400 fixed jumps of 1e4 cycles on an 11-node interface (a few
 # seconds). Its first checkpoint is written after step 1, the next one only on an interrupt or
@@ -245,12 +251,56 @@ def test_checkpoint_of_another_model_shape(reference):
     with np.load(ck) as z:
         key = str(z["fingerprint"])
         nc, d, H = z["hist_U"].shape[1:]
-    state, rows = load_checkpoint(ck, key, shape=(nc, d, H))
-    assert int(state["step"]) == N_STEPS and len(rows) == N_STEPS + 1
+    state, records = load_checkpoint(ck, key, shape=(nc, d, H))
+    assert state.step == N_STEPS and len(records) == N_STEPS + 1
     with pytest.raises(InputError, match="different model .*11 contact nodes"):
         load_checkpoint(ck, key, shape=(nc + 1, d, H))
     with pytest.raises(InputError, match="different model"):
         load_checkpoint(ck, "0" * 64, shape=(nc, d, H))
+
+
+# --- earlier formats ---------------------------------------------------------------------------
+def test_format_3_checkpoint_resumes_to_the_uninterrupted_run(tmp_path):
+    """A run interrupted after 3 steps whose checkpoint is then rewritten in format 3 (the
+    state's earlier names, version 3) reads as the same state and resumes to the history of the
+    uninterrupted run, bit for bit (wall times aside; the same deterministic steps from the
+    same state), rewritten in this format as it goes on. Quasi-static Stromberg beam (12 x 2),
+    partial slip."""
+    model, basis = stromberg_beam(nx=12, ny=2), FourierBasis.up_to(3, 32)
+    opts = WearOptions(max_steps=8, tolerance=0.02, checkpoint_every_s=1e9)
+    full = simulate_wear(model, basis, quasi_static=True, options=opts)
+    ck = tmp_path / "wear.npz"
+
+    def stop(step, record):
+        if step == 3:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        simulate_wear(model, basis, quasi_static=True, options=opts,
+                      run=RunControl(checkpoint=ck, callback=stop))
+    assert_reads_as_format_3(ck)
+    assert read_history(ck).n_steps == 4
+    resumed = simulate_wear(model, basis, quasi_static=True, options=opts,
+                            run=RunControl(checkpoint=ck, resume=True))
+    assert resumed.resumed_from == 3 and resumed.stop_reason == full.stop_reason == "max_steps"
+    for name in HISTORY_FIELDS:
+        if name != "wall_time":
+            np.testing.assert_array_equal(getattr(resumed.history, name),
+                                          getattr(full.history, name), err_msg=name)
+    with np.load(ck) as z:
+        assert int(z["version"]) == CHECKPOINT_VERSION == 4
+
+
+@pytest.mark.parametrize("version", [2, 5])
+def test_checkpoint_of_another_version_is_refused_in_one_line(reference, tmp_path, version):
+    with np.load(reference / CKPT) as z:
+        arrays = {k: z[k] for k in z.files}
+    arrays["version"] = np.asarray(version)
+    ck = tmp_path / CKPT
+    np.savez(ck, **arrays)
+    with pytest.raises(InputError, match="has another format version") as err:
+        load_checkpoint(ck, str(arrays["fingerprint"]))
+    assert "\n" not in str(err.value) and str(ck) in str(err.value)
 
 
 # --- temporary files of killed writes ---------------------------------------------------------

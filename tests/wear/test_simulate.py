@@ -38,6 +38,8 @@ from fretwear.hb.solvers import solve_identity_rows
 from fretwear.model.build import ContactSpec, Material, Spring, Traction, from_mesh
 from fretwear.model.mesh import rectangle
 from fretwear.wear import (
+    BalanceSetup,
+    RunControl,
     SlowProblem,
     WearOptions,
     read_history,
@@ -119,7 +121,7 @@ def test_sticking_nodes_do_not_wear(blk, sol_block):
     assert stuck.sum() >= 4 and (~stuck).sum() >= 3  # really partial slip
     assert np.all(dw[stuck] == 0.0)
     m, red, anc = blk
-    r = simulate_wear(m, BASIS, quasi_static=True, reduced=red, anchor=anc,
+    r = simulate_wear(m, BASIS, quasi_static=True, balance=BalanceSetup(reduced=red, anchor=anc),
                       options=WearOptions(max_cycles=3e5, tolerance=0.05))
     h = r.history
     never = np.all(h.state_fraction[:, :, law.STICK] == 1.0, axis=0)
@@ -292,7 +294,7 @@ def explicit_reference(blk):
     """Explicit Euler with fixed jumps of 2e4 cycles (the stability limit 2/rho is ~9e4 at
     the start) up to N = 2e6: 100 steps."""
     m, red, anc = blk
-    r = simulate_wear(m, BASIS, quasi_static=True, reduced=red, anchor=anc,
+    r = simulate_wear(m, BASIS, quasi_static=True, balance=BalanceSetup(reduced=red, anchor=anc),
                       options=WearOptions(scheme="explicit", adaptive=False, initial_jump=2e4,
                                           max_cycles=2e6))
     return r
@@ -313,7 +315,8 @@ def test_implicit_large_jumps_and_adaptive_match_fine_explicit(blk, explicit_ref
 
     def run(**kw):
         o = WearOptions(max_cycles=2e6, **kw)
-        r = simulate_wear(m, BASIS, quasi_static=True, reduced=red, anchor=anc, options=o)
+        r = simulate_wear(m, BASIS, quasi_static=True,
+                          balance=BalanceSetup(reduced=red, anchor=anc), options=o)
         assert r.success and r.history.cycles[-1] == pytest.approx(2e6)
         return np.abs(r.history.wear_depth[-1] - ref).max() / ref.max(), r
 
@@ -336,7 +339,7 @@ def test_plateau_stop_and_history(blk):
     the history is consistent (cycles = cumulative jumps, worn volume = area . W) and every
     recorded step is a converged balance."""
     m, red, anc = blk
-    r = simulate_wear(m, BASIS, quasi_static=True, reduced=red, anchor=anc,
+    r = simulate_wear(m, BASIS, quasi_static=True, balance=BalanceSetup(reduced=red, anchor=anc),
                       options=WearOptions(tolerance=0.05, plateau_rate=0.05))
     h = r.history
     assert r.stop_reason == "plateau" and r.success and h.stop_reason == "plateau"
@@ -363,7 +366,7 @@ def test_failed_solve_stops_cleanly(blk, monkeypatch):
         return U, st
 
     monkeypatch.setattr(SlowProblem, "solve_balance", flaky)
-    r = simulate_wear(m, BASIS, quasi_static=True, reduced=red, anchor=anc,
+    r = simulate_wear(m, BASIS, quasi_static=True, balance=BalanceSetup(reduced=red, anchor=anc),
                       options=WearOptions(scheme="explicit", max_retries=2))
     assert r.stop_reason == "solver_failed" and not r.success
     assert "forced failure" in r.message
@@ -378,7 +381,8 @@ def test_interrupt_and_resume_equals_uninterrupted(blk, tmp_path, every):
     With every = 1e9 s the checkpoint is only written by the interrupt handler."""
     m, red, anc = blk
     opts = WearOptions(max_cycles=1e6, tolerance=0.02, checkpoint_every_s=every)
-    full = simulate_wear(m, BASIS, quasi_static=True, reduced=red, anchor=anc, options=opts)
+    bal = BalanceSetup(reduced=red, anchor=anc)
+    full = simulate_wear(m, BASIS, quasi_static=True, balance=bal, options=opts)
     ck = tmp_path / "wear.npz"
 
     def stop(step, row):
@@ -386,11 +390,11 @@ def test_interrupt_and_resume_equals_uninterrupted(blk, tmp_path, every):
             raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
-        simulate_wear(m, BASIS, quasi_static=True, reduced=red, anchor=anc, options=opts,
-                      checkpoint=ck, callback=stop)
+        simulate_wear(m, BASIS, quasi_static=True, balance=bal, options=opts,
+                      run=RunControl(checkpoint=ck, callback=stop))
     assert ck.is_file() and not list(tmp_path.glob(".*tmp"))
-    resumed = simulate_wear(m, BASIS, quasi_static=True, reduced=red, anchor=anc,
-                            options=opts, checkpoint=ck, resume=True)
+    resumed = simulate_wear(m, BASIS, quasi_static=True, balance=bal, options=opts,
+                            run=RunControl(checkpoint=ck, resume=True))
     assert resumed.resumed_from == 3
     a, b = full.history, resumed.history
     assert a.n_steps == b.n_steps > 4 and a.stop_reason == b.stop_reason
@@ -404,10 +408,11 @@ def test_resume_extends_a_finished_run(blk, tmp_path):
     stop criteria are not part of the checkpoint fingerprint)."""
     m, red, anc = blk
     ck = tmp_path / "wear.npz"
-    a = simulate_wear(m, BASIS, quasi_static=True, reduced=red, anchor=anc, checkpoint=ck,
+    bal, resume = BalanceSetup(reduced=red, anchor=anc), RunControl(checkpoint=ck, resume=True)
+    a = simulate_wear(m, BASIS, quasi_static=True, balance=bal, run=RunControl(checkpoint=ck),
                       options=WearOptions(max_cycles=2e5))
-    b = simulate_wear(m, BASIS, quasi_static=True, reduced=red, anchor=anc, checkpoint=ck,
-                      resume=True, options=WearOptions(max_cycles=6e5))
+    b = simulate_wear(m, BASIS, quasi_static=True, balance=bal, run=resume,
+                      options=WearOptions(max_cycles=6e5))
     n = a.history.n_steps
     assert b.resumed_from == n - 1 and b.history.cycles[-1] == pytest.approx(6e5)
     np.testing.assert_array_equal(b.history.wear_depth[:n], a.history.wear_depth)
@@ -421,8 +426,8 @@ def test_resume_extends_a_finished_run(blk, tmp_path):
         old = {k: z[k] for k in z.files if k != "hist_rate_scatter"}
     np.savez(ck, **old)
     assert np.all(np.isnan(read_history(ck).rate_scatter))
-    c = simulate_wear(m, BASIS, quasi_static=True, reduced=red, anchor=anc, checkpoint=ck,
-                      resume=True, options=WearOptions(max_cycles=8e5))
+    c = simulate_wear(m, BASIS, quasi_static=True, balance=bal, run=resume,
+                      options=WearOptions(max_cycles=8e5))
     assert c.resumed_from == b.history.n_steps - 1 and c.history.cycles[-1] == pytest.approx(8e5)
 
 
@@ -432,11 +437,13 @@ def test_resume_refuses_other_settings(blk, tmp_path):
 
     m, red, anc = blk
     ck = tmp_path / "wear.npz"
-    simulate_wear(m, BASIS, quasi_static=True, reduced=red, anchor=anc, checkpoint=ck,
+    bal = BalanceSetup(reduced=red, anchor=anc)
+    simulate_wear(m, BASIS, quasi_static=True, balance=bal, run=RunControl(checkpoint=ck),
                   options=WearOptions(max_cycles=1e4))
     with pytest.raises(InputError, match="different"):
-        simulate_wear(m, BASIS, quasi_static=True, reduced=red, anchor=anc, checkpoint=ck,
-                      resume=True, options=WearOptions(max_cycles=1e4, tolerance=0.3))
+        simulate_wear(m, BASIS, quasi_static=True, balance=bal,
+                      run=RunControl(checkpoint=ck, resume=True),
+                      options=WearOptions(max_cycles=1e4, tolerance=0.3))
 
 
 # --- the case-file analysis -------------------------------------------------------------------
@@ -448,8 +455,8 @@ def test_frf_worn_uniform_wear_is_a_rigid_shift(blk):
 
     m, _, anc = blk
     grid = (2e3, 3e3, 3)
-    a = frf_worn(m, 0.0, grid, BASIS, anchor=anc)
-    b = frf_worn(m, np.full(m.contact.n_nodes, 1e-9), grid, BASIS, anchor=anc)
+    a = frf_worn(m, BASIS, 0.0, *grid, anchor=anc)
+    b = frf_worn(m, BASIS, np.full(m.contact.n_nodes, 1e-9), *grid, anchor=anc)
     assert a.success and b.success
     np.testing.assert_allclose(b.frequency_hz, a.frequency_hz)
     np.testing.assert_allclose(b.amplitude("Pe", 0), a.amplitude("Pe", 0), rtol=1e-6)
@@ -463,11 +470,34 @@ def test_no_wear_without_slip(tmp_path):
     assert np.all(r.final_wear == 0.0) and math.isfinite(r.wall_time)
 
 
+def test_dynamic_run_needs_a_frequency(monkeypatch):
+    """A dynamic wear run without ``frequency`` (which used to default to 1 Hz) is refused in
+    one line naming it, before anything is computed, at both entry points; settings records of
+    the wrong kind are refused by name."""
+    import fretwear
+    import fretwear.wear.simulate as driver
+    from fretwear.errors import InputError
+
+    def no_condensation(*args, **kwargs):
+        raise AssertionError("condensed before the check")
+
+    monkeypatch.setattr(driver, "condense", no_condensation)
+    m = block()
+    for func in (simulate_wear, fretwear.simulate_wear):
+        with pytest.raises(InputError, match="frequency = None") as err:
+            func(m, BASIS, options=WearOptions(max_steps=1))
+        assert "\n" not in str(err.value) and "quasi_static" in str(err.value)
+    for name, value in (("balance", {"eps": 1e9}), ("run", {"resume": True})):
+        with pytest.raises(TypeError, match=f"{name} = .*: expected a"):
+            simulate_wear(m, BASIS, quasi_static=True, **{name: value})
+
+
 def test_progress_bar_shows_cycles_volume_rate_and_time_left(blk, capsys):
     """The progress bar (stderr) names the cycles reached, the worn volume, the worn-volume
     rate and the time left; its worn volume is the history's (area . W)."""
     m, red, anc = blk
-    r = simulate_wear(m, BASIS, quasi_static=True, reduced=red, anchor=anc, progress=True,
+    r = simulate_wear(m, BASIS, quasi_static=True, balance=BalanceSetup(reduced=red, anchor=anc),
+                      run=RunControl(progress=True),
                       options=WearOptions(max_steps=3, tolerance=0.05))
     err = capsys.readouterr().err
     assert "cycles" in err and "m^3/cycle" in err and "<" in err  # tqdm's [elapsed<left]

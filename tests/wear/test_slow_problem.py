@@ -94,12 +94,12 @@ def test_implicit_schemes_refused_when_the_step_is_iterative(monkeypatch):
     linearly implicit default with one message naming the scheme, instead of running one
     iterative solve per node at every step; the explicit scheme runs."""
     from fretwear.errors import InputError
-    from fretwear.wear import WearOptions, simulate_wear
+    from fretwear.wear import BalanceSetup, WearOptions, simulate_wear
 
     model, basis, red, anchor, U, _ = make_case(2)
     monkeypatch.setattr(periodic, "DENSE_JACOBIAN_MAX", 0)
     monkeypatch.setattr(krylov, "ACTIVE_DENSE_MAX", -1)
-    kw = dict(frequency=2000.0, reduced=red, anchor=anchor, U0=U)
+    kw = dict(frequency=2000.0, balance=BalanceSetup(reduced=red, anchor=anchor, U0=U))
     with pytest.raises(InputError, match="scheme = 'rosenbrock'"):
         simulate_wear(model, basis, options=WearOptions(max_steps=1), **kw)
     res = simulate_wear(model, basis, options=WearOptions(max_steps=1, scheme="explicit"),

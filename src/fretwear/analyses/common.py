@@ -38,16 +38,17 @@ OPEN_ATTRIBUTE = "open_under_preload"
 WARNINGS_ATTRIBUTE = "warnings"
 
 
-def preload_notes(model) -> tuple[list[str], list[str]]:
+def preload_notes(model, condenser=None) -> tuple[list[str], list[str]]:
     """Warnings about interfaces that no node touches under the static loads (the preload),
     and the names of those interfaces (:func:`fretwear.hb.periodic.preload_contact`).
 
     A run on such an interface is kept (a clearance that the vibration closes is a model a
     user may mean), but it is almost always a mistake (a gap of the wrong sign, a load pulling
     the bodies apart, a partner surface that is not the one meant), so the run says it before
-    it starts and the results file records it (:data:`OPEN_ATTRIBUTE`).
+    it starts and the results file records it (:data:`OPEN_ATTRIBUTE`). ``condenser``: the
+    run's condenser of ``model`` (:func:`fretwear.hb.reduce.exact_condenser`; None: a new one).
     """
-    pre = preload_contact(model)
+    pre = preload_contact(model, condenser=condenser)
     if not pre.success:
         return ([f"warning: the static contact problem under the preload did not converge "
                  f"({pre.message}); the contact of the interfaces before the vibration is not "

@@ -28,13 +28,14 @@ from pathlib import Path
 import numpy as np
 from matplotlib.colors import BoundaryNorm, ListedColormap
 
+from fretwear import api
 from fretwear.analyses import figures as plots
 from fretwear.analyses.common import basis_of, cell_edges, interface_abscissa, si_scale
 from fretwear.analyses.run import load_case
 from fretwear.analyses.transient import period_friction_energy, state_fractions
 from fretwear.errors import InputError
-from fretwear.hb.periodic import PeriodicSolution, solve_periodic
-from fretwear.hb.reduce import condense
+from fretwear.hb.periodic import PeriodicSolution
+from fretwear.hb.reduce import condense, exact_condenser
 from fretwear.io.case import build_model
 from fretwear.timedomain.quasistatic import incremental_wear
 from fretwear.timedomain.results import SteadyStateResult
@@ -190,10 +191,12 @@ def compare_periodic(model, analysis: dict, outdir: Path | None, *, steps_per_pe
     basis = basis_of(analysis)
     f_hz = float(analysis["frequency"])
     t0 = time.perf_counter()
-    reduced = condense(model, f_hz, basis.orders)
-    sol = solve_periodic(model, basis, frequency=f_hz, reduced=reduced, eps=analysis["eps"],
-                         solver=analysis["solver"], tol=analysis["tol"],
-                         max_iter=analysis["max_iter"])
+    cond = exact_condenser(model)  # one condensation of the model for the whole solve
+    reduced = condense(model, f_hz, basis.orders, condenser=cond)
+    # the DLFT alone: never started by the time integration it is compared with
+    sol = api.solve_periodic(model, basis, frequency=f_hz, reduced=reduced, eps=analysis["eps"],
+                             solver=analysis["solver"], tol=analysis["tol"],
+                             max_iter=analysis["max_iter"], time_domain=False, condenser=cond)
     stats = sol.stats
     if not sol.success:  # a failed solve is never compared (its last iterate is no result)
         sol = None
@@ -226,18 +229,21 @@ def compare_wear(model, analysis: dict, outdir: Path | None, *, steps_per_cycle:
                  title: str | None = None) -> Comparison:
     """DLFT wear against incremental wear at the DLFT run's final cycle count."""
     from fretwear.analyses.wear import options_from_table, penalty_of
-    from fretwear.wear import simulate_wear
+    from fretwear.wear import BalanceSetup
 
     if not analysis.get("quasi_static"):
         raise InputError("compare: the incremental wear reference is quasi-static; set "
                          "quasi_static = true in the wear case")
     basis = basis_of(analysis)
-    res = simulate_wear(model, basis, quasi_static=True, options=options_from_table(analysis),
-                        **penalty_of(analysis))
+    cond = exact_condenser(model)  # shared by both methods: the same static condensation
+    res = api.simulate_wear(model, basis, quasi_static=True,
+                            options=options_from_table(analysis),
+                            balance=BalanceSetup(condenser=cond, **penalty_of(analysis)),
+                            time_domain=False)
     n = int(round(float(res.history.cycles[-1])))
     jump = _reference_jump(n, res.stability_jump)
     inc = incremental_wear(model, steps_per_cycle=steps_per_cycle, n_cycles=max(n, 1),
-                           cycle_jump=jump)
+                           cycle_jump=jump, condenser=cond)
     w_d, w_t = res.final_wear, inc.wear[-1]
     area = np.asarray(model.contact.area, float)
     rows = [("maximum wear depth [m]", w_d.max(), w_t.max(), relative(w_d.max(), w_t.max())),

@@ -1,8 +1,8 @@
 """The linear analyses of case files: ``"modes"`` and ``"frf"`` (see :mod:`fretwear.linear`).
 
 Each function turns :mod:`fretwear.linear` results into a results dataset (schema in
-``docs/results.md``), figures and ParaView files, and registers itself with
-:mod:`fretwear.analyses.registry`.
+``docs/results.md``), figures and ParaView files; :data:`MODES` and :data:`FRF` are the
+analyses (:mod:`fretwear.analyses.registry` lists them).
 """
 
 from __future__ import annotations
@@ -15,9 +15,10 @@ from tqdm import tqdm
 
 from fretwear import linear
 from fretwear.analyses import figures as plots
+from fretwear.analyses.base import Analysis, RunContext, RunOutput
 from fretwear.analyses.common import AXES, check_points, default_of, figure_path, geometry
-from fretwear.analyses.registry import RunOutput, register
 from fretwear.errors import InputError
+from fretwear.hb.reduce import exact_condenser
 from fretwear.io.results import (
     complex_variables,
     label_coordinate,
@@ -55,13 +56,13 @@ def _pad_points(values_by_point: dict, points: list[str], n_axes: int, shape0) -
 
 
 # --- modes ----------------------------------------------------------------------------------
-def run_modes(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOutput:
+def run_modes(model, analysis: dict, case, context: RunContext) -> RunOutput:
     """Normal modes for each requested interface (:func:`fretwear.linear.modes`)."""
     _need_mass(model)
     interfaces = analysis["interfaces"]
     points = [p.name for p in model.observed]
     results = []
-    for interface in tqdm(interfaces, desc="modes", disable=not progress, leave=False):
+    for interface in tqdm(interfaces, desc="modes", disable=not context.progress, leave=False):
         results.append(linear.modes(model, analysis["n_modes"], interface=interface,
                                     f_max=analysis.get("f_max")))
     nm = max(len(r.frequency_hz) for r in results)
@@ -100,14 +101,14 @@ def run_modes(model, analysis: dict, case, outdir: Path, progress: bool) -> RunO
     figures, files = [], []
     for interface, r in zip(interfaces, results, strict=True):
         if model.mesh is not None and len(r.frequency_hz):
-            p = figure_path(case, outdir, f"modes-{interface}")
+            p = figure_path(case, context.out_dir, f"modes-{interface}")
             if p is not None:
                 figures.append(plots.plot_mode_shapes(
                     model.mesh, r.frequency_hz, r.shapes, p,
                     title=f"{case.title}: modes, {interface} interface"))
             if case.output["vtu"]:
-                files.append(_write_mode_files(model.mesh, r, outdir, interface))
-    p = figure_path(case, outdir, "natural-frequencies")
+                files.append(_write_mode_files(model.mesh, r, context.out_dir, interface))
+    p = figure_path(case, context.out_dir, "natural-frequencies")
     if p is not None:
         figures.append(plots.plot_natural_frequencies(ds, p, title=case.title))
     lines = []
@@ -130,7 +131,7 @@ def _write_mode_files(mesh, r, outdir: Path, interface: str) -> Path:
     return write_pvd(outdir / f"modes-{interface}.pvd", entries)
 
 
-register(
+MODES = Analysis.define(
     "modes",
     {
         "n_modes": Field(Integer(lo=1), "number of lowest modes per interface",
@@ -147,11 +148,14 @@ register(
 
 
 # --- FRF ------------------------------------------------------------------------------------
-def _frf_chunked(model, freqs, interface: str, method: str, bar) -> linear.FRFResult:
-    """:func:`fretwear.linear.frf` in chunks so that the progress bar moves."""
+def _frf_chunked(model, freqs, interface: str, method: str, bar,
+                 condenser=None) -> linear.FRFResult:
+    """:func:`fretwear.linear.frf` in chunks so that the progress bar moves (``condenser``:
+    the run's, for ``method = "condensed"``)."""
     parts = []
     for chunk in np.array_split(freqs, min(len(freqs), 50)):
-        parts.append(linear.frf(model, chunk, interface=interface, method=method))
+        parts.append(linear.frf(model, chunk, interface=interface, method=method,
+                                condenser=condenser))
         bar.update(len(chunk))
     return linear.FRFResult(
         interface, freqs,
@@ -162,19 +166,22 @@ def _frf_chunked(model, freqs, interface: str, method: str, bar) -> linear.FRFRe
     )
 
 
-def run_frf(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOutput:
+def run_frf(model, analysis: dict, case, context: RunContext) -> RunOutput:
     """Frequency response functions for each requested interface."""
     _need_mass(model)
     points = check_points(model, analysis.get("points"))
     freqs = linear.frequency_grid(analysis["f_min"], analysis["f_max"], analysis["n_points"],
                                   analysis["spacing"])
     interfaces = analysis["interfaces"]
+    # the run's condensation of the model, for every chunk and interface (condensed FRFs)
+    cond = exact_condenser(model) if analysis["method"] == "condensed" else None
     results = []
-    with tqdm(total=len(freqs) * len(interfaces), desc="frf", disable=not progress,
+    with tqdm(total=len(freqs) * len(interfaces), desc="frf", disable=not context.progress,
               leave=False, unit="freq") as bar:
         for interface in interfaces:
             bar.set_postfix_str(interface)
-            results.append(_frf_chunked(model, freqs, interface, analysis["method"], bar))
+            results.append(_frf_chunked(model, freqs, interface, analysis["method"], bar,
+                                        cond))
     coords, data = geometry(model, points)
     n_axes = coords["axis"].size
     coords["interface"] = label_coordinate("interface", interfaces)
@@ -194,7 +201,7 @@ def run_frf(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOut
     ds = xr.Dataset(data, coords=coords)
     figures = []
     for point in points:
-        p = figure_path(case, outdir, f"frf-{point}")
+        p = figure_path(case, context.out_dir, f"frf-{point}")
         if p is not None:
             figures.append(plots.plot_frf(ds, p, point, title=f"{case.title}: FRF at {point}"))
     return RunOutput(ds, figures, _frf_summary(results, points, model), True)
@@ -219,7 +226,7 @@ def _frf_summary(results, points, model) -> str:
     return "\n".join(lines)
 
 
-register(
+FRF = Analysis.define(
     "frf",
     {
         "f_min": Field(Number(lo=0, lo_open=True), "lowest frequency", required=True, unit="Hz"),

@@ -1,8 +1,9 @@
 """The ``"periodic"`` analysis of case files: the DLFT periodic response at one frequency.
 
-:func:`run_periodic` calls :func:`fretwear.hb.periodic.solve_periodic`, turns its result into a
-results dataset (schema in ``docs/results.md``), figures and ParaView files, and registers
-itself with :mod:`fretwear.analyses.registry`.
+:func:`run_periodic` calls :func:`fretwear.api.solve_periodic` (the DLFT solve with the public
+API's time-domain fallback), turns its result into a results dataset (schema in
+``docs/results.md``), figures and ParaView files; :data:`PERIODIC` is the analysis
+(:mod:`fretwear.analyses.registry` lists it).
 
 A periodic solve that did not converge is never saved as a result: the run writes a results
 file with the solver diagnostics as attributes and no solution variables, and reports the
@@ -18,6 +19,7 @@ import xarray as xr
 
 from fretwear import api
 from fretwear.analyses import figures as plots
+from fretwear.analyses.base import Analysis, RunContext, RunOutput
 from fretwear.analyses.common import (
     STOP_TOL,
     basis_of,
@@ -34,16 +36,14 @@ from fretwear.analyses.common import (
     solver_attributes,
     titled,
 )
-from fretwear.analyses.registry import RunOutput, register
 from fretwear.errors import InputError
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.penalty import penalty
 from fretwear.hb.periodic import PeriodicSolution, solve_periodic
-from fretwear.hb.reduce import condense, recover
+from fretwear.hb.reduce import condense, exact_condenser, recover
 from fretwear.hb.solvers import SolveStats
 from fretwear.io.results import nodal_vectors, variable, write_pvd, write_vtu
 from fretwear.io.schema import Field, Flag, Integer, Number, join
-from fretwear.timedomain.fallback import FALLBACK
 
 
 # --- dataset -------------------------------------------------------------------------------
@@ -185,13 +185,13 @@ def _periodic_summary(sol: PeriodicSolution, ds: xr.Dataset, analysis: dict, whe
     return "\n".join(lines)
 
 
-def run_periodic(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOutput:
+def run_periodic(model, analysis: dict, case, context: RunContext) -> RunOutput:
     """Periodic response at one frequency (:func:`fretwear.hb.periodic.solve_periodic`).
 
     Parameters
     ----------
     model : the model; analysis : the validated ``[analysis]`` table; case : the case;
-    outdir : results folder; progress : unused (a single solve).
+    context : results folder (progress: unused, a single solve).
 
     Returns
     -------
@@ -200,13 +200,15 @@ def run_periodic(model, analysis: dict, case, outdir: Path, progress: bool) -> R
     basis = basis_of(analysis)
     qs = analysis["quasi_static"]
     f_hz = float(analysis.get("frequency", default_of(solve_periodic, "frequency")))
-    reduced = condense(model, f_hz, basis.orders, quasi_static=qs)
-    eps = penalty(analysis["eps"], model=model, reduced=reduced)
-    sol = solve_periodic(model, basis, frequency=f_hz, quasi_static=qs, reduced=reduced,
-                         eps=eps, solver=analysis["solver"], tol=analysis["tol"],
-                         max_iter=analysis["max_iter"],
-                         time_domain=FALLBACK if analysis["time_domain"] else None,
-                         time_domain_periods=analysis["time_domain_periods"])
+    cond = exact_condenser(model)  # the run's condensation of the model, for every call
+    reduced = condense(model, f_hz, basis.orders, quasi_static=qs, condenser=cond)
+    eps = penalty(analysis["eps"], model=model, reduced=reduced, condenser=cond)
+    sol = api.solve_periodic(model, basis, frequency=f_hz, quasi_static=qs, reduced=reduced,
+                             eps=eps, solver=analysis["solver"], tol=analysis["tol"],
+                             max_iter=analysis["max_iter"],
+                             time_domain=analysis["time_domain"],
+                             time_domain_periods=analysis["time_domain_periods"],
+                             condenser=cond)
     stats = sol.stats
     attrs = {**solver_attributes(stats, analysis, eps), "excitation_frequency": f_hz,
              "quasi_static": int(qs),
@@ -221,10 +223,11 @@ def run_periodic(model, analysis: dict, case, outdir: Path, progress: bool) -> R
     points = [p.name for p in model.observed]
     ds = periodic_dataset(model, sol, points)
     ds.attrs.update(attrs)
-    figures = _periodic_figures(ds, case, outdir, titled(case.title, where))
+    figures = _periodic_figures(ds, case, context.out_dir, titled(case.title, where))
     files = []
     if model.mesh is not None and case.output["vtu"]:
-        files.append(write_period_fields(model, sol, outdir / "periodic.pvd"))
+        files.append(write_period_fields(model, sol, context.out_dir / "periodic.pvd",
+                                         condenser=cond))
     return RunOutput(ds, figures, _periodic_summary(sol, ds, analysis, where), True, files,
                      warnings=list(sol.warnings))
 
@@ -251,7 +254,7 @@ def _periodic_figures(ds: xr.Dataset, case, outdir: Path, title: str) -> list[Pa
     return figures
 
 
-def write_period_fields(model, sol: PeriodicSolution, pvd: Path) -> Path:
+def write_period_fields(model, sol: PeriodicSolution, pvd: Path, *, condenser=None) -> Path:
     """ParaView time series of the whole displacement field over one period.
 
     Every DOF is recovered from the contact solution (:func:`fretwear.hb.reduce.recover`, exact)
@@ -259,7 +262,8 @@ def write_period_fields(model, sol: PeriodicSolution, pvd: Path) -> Path:
     ``pvd.stem`` (point arrays ``displacement`` [m], ``contact_state`` and
     ``contact_pressure`` [Pa] on both surfaces of node-to-node pairs, NaN off the
     interfaces), stepped through by the ``.pvd`` with
-    the time [s] as time step.
+    the time [s] as time step. ``condenser``: the condenser that condensed ``sol``
+    (:func:`fretwear.hb.reduce.exact_condenser`; None: a new exact one).
 
     Returns
     -------
@@ -268,7 +272,8 @@ def write_period_fields(model, sol: PeriodicSolution, pvd: Path) -> Path:
     b = sol.basis
     nc, d, H = sol.U.shape
     u_loc = b.to_complex(sol.U.reshape(nc * d, H))  # (k+1, m), orders [0, h1, ..]
-    full = recover(model, sol.frequency, b.orders, u_loc, quasi_static=sol.quasi_static)
+    full = recover(model, sol.frequency, b.orders, u_loc, quasi_static=sol.quasi_static,
+                   condenser=condenser)
     samples = b.to_time(b.from_complex(full))  # (ndof, N)
     mesh = model.mesh
     nn = mesh.points.shape[0]
@@ -431,7 +436,7 @@ _EPS_RULES = ('"auto": the spectral radius of Z_r over the kept harmonics (the p
               '"top": that of Z_r at the highest kept harmonic; "static": that of the static '
               "reduced stiffness K_r; or a value")
 
-register(
+PERIODIC = Analysis.define(
     "periodic",
     {
         "frequency": Field(Number(lo=0, lo_open=True), "excitation frequency (required unless "

@@ -2,11 +2,14 @@
 build the model, run the analysis, write ``results.nc`` (:mod:`fretwear.io.results`) and print
 a short summary.
 
-Long analyses (wear) that want ``--resume`` save their state in ``outdir`` with
-:func:`fretwear.files.atomic_write` as they go, and read it back when ``case.resume`` is
-true; on Ctrl-C, :func:`run_case` reports the files saved during the run. Before a run, a
-folder standing where a file will be written is refused, and the temporary files of writes
-killed mid-way (:func:`fretwear.files.remove_stale_temporaries`) are removed.
+An analysis is run with the validated case (:class:`~fretwear.io.case.Case`, what the file
+says) and a :class:`~fretwear.analyses.base.RunContext` (how it is run: the results folder,
+``--resume``, progress bars). Long analyses (sweep, wear) that want ``--resume`` save their
+state in the results folder with :func:`fretwear.files.atomic_write` as they go, and read it
+back when ``context.resume`` is true; on Ctrl-C, :func:`run_case` reports the files saved
+during the run. Before a run, a folder standing where a file will be written is refused, and
+the temporary files of writes killed mid-way (:func:`fretwear.files.remove_stale_temporaries`)
+are removed.
 """
 
 from __future__ import annotations
@@ -16,8 +19,9 @@ import time
 from pathlib import Path
 
 from fretwear import __version__
+from fretwear.analyses.base import RunContext, RunOutput
 from fretwear.analyses.common import OPEN_ATTRIBUTE, WARNINGS_ATTRIBUTE, preload_notes
-from fretwear.analyses.registry import RunOutput, analysis_tables, get
+from fretwear.analyses.registry import analysis_tables, get
 from fretwear.errors import InputError, interrupted
 from fretwear.files import remove_stale_temporaries
 from fretwear.io import case as case_files
@@ -129,12 +133,12 @@ def run_case(path: Path | str, outdir: Path | str | None = None, progress: bool 
     progress : show progress bars (stderr).
     resume : skip the run when ``outdir/results.nc`` already holds a converged run of the
         same case text; analyses that checkpoint continue from their checkpoint
-        (``case.resume``).
+        (:attr:`RunContext.resume <fretwear.analyses.base.RunContext.resume>`).
     echo : print the summary (stdout).
 
     Returns
     -------
-    :class:`~fretwear.analyses.registry.RunOutput`: ``success`` (False when some solve did not
+    :class:`~fretwear.analyses.base.RunOutput`: ``success`` (False when some solve did not
     converge; the file's ``converged`` attribute), ``message`` (the summary printed),
     ``dataset``, ``figures``, ``files`` and ``results`` (the NetCDF file written).
 
@@ -147,7 +151,6 @@ def run_case(path: Path | str, outdir: Path | str | None = None, progress: bool 
         saved.
     """
     case = load_case(path)
-    case.resume = resume
     analysis = get(case.analysis["type"])
     out_dir = case.output_dir(outdir)
     results_path = out_dir / RESULTS_FILE
@@ -170,7 +173,8 @@ def run_case(path: Path | str, outdir: Path | str | None = None, progress: bool 
             notes, open_names = preload_notes(model)
             for note in notes:
                 say(note)
-        out = analysis.run(model, case.analysis, case, out_dir, progress)
+        context = RunContext(out_dir, resume=bool(resume), progress=bool(progress))
+        out = analysis.run(model, case.analysis, case, context)
         if open_names is not None:
             out.dataset.attrs[OPEN_ATTRIBUTE] = ", ".join(open_names)
         out.dataset.attrs[WARNINGS_ATTRIBUTE] = "\n".join(out.warnings)

@@ -1,10 +1,11 @@
 """The ``"sweep"`` analysis of case files: the nonlinear FRF (DLFT periodic responses over a
 frequency band).
 
-:func:`run_sweep` calls :func:`fretwear.hb.sweep.sweep`, turns its result into a results dataset
-(schema in ``docs/results.md``) and figures, and registers itself with
-:mod:`fretwear.analyses.registry`. Points that did not converge are kept as NaN with
-``converged = 0`` and the reason in ``flags``.
+:func:`run_sweep` calls :func:`fretwear.api.sweep` (:func:`fretwear.hb.sweep.sweep` with the
+public API's time-domain fallback), turns its result into a results dataset (schema in
+``docs/results.md``) and figures; :data:`SWEEP` is the analysis
+(:mod:`fretwear.analyses.registry` lists it). Points that did not converge are kept as NaN
+with ``converged = 0`` and the reason in ``flags``.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from tqdm import tqdm
 
 from fretwear import api, linear
 from fretwear.analyses import figures as plots
+from fretwear.analyses.base import Analysis, RunContext, RunOutput
 from fretwear.analyses.common import (
     basis_of,
     check_points,
@@ -29,14 +31,13 @@ from fretwear.analyses.common import (
     period_coordinates,
     titled,
 )
-from fretwear.analyses.registry import RunOutput, register
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import PeriodicSolution
+from fretwear.hb.reduce import exact_condenser
 from fretwear.hb.sweep import SweepResult, sweep
 from fretwear.io.results import label_coordinate, variable
 from fretwear.io.schema import Field, Flag, Integer, ListOf, Number, Text, increasing
-from fretwear.timedomain.fallback import FALLBACK
 from fretwear.timedomain.stability import sweep_check
 
 #: the points computed so far, saved after every grid frequency (``--resume`` continues)
@@ -221,13 +222,13 @@ def _sweep_summary(result: SweepResult, ds: xr.Dataset) -> str:
     return "\n".join(lines)
 
 
-def run_sweep(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOutput:
+def run_sweep(model, analysis: dict, case, context: RunContext) -> RunOutput:
     """Nonlinear FRF: periodic solutions over a frequency band (:func:`fretwear.hb.sweep.sweep`).
 
     Parameters
     ----------
     model : the model; analysis : the validated ``[analysis]`` table; case : the case;
-    outdir : results folder; progress : show a progress bar.
+    context : results folder, resume (from ``sweep-checkpoint.npz``), progress bar.
 
     Returns
     -------
@@ -236,23 +237,26 @@ def run_sweep(model, analysis: dict, case, outdir: Path, progress: bool) -> RunO
     points = check_points(model, analysis.get("points"))
     basis = basis_of(analysis)
     n = analysis["n_points"]
-    with tqdm(total=n, desc="sweep", disable=not progress, leave=False, unit="freq") as bar:
+    cond = exact_condenser(model)  # the run's condensation of the model, for every call
+    with tqdm(total=n, desc="sweep", disable=not context.progress, leave=False,
+              unit="freq") as bar:
         def tick(i, total, pt):
             bar.update(1)
             bar.set_postfix_str(f"{plots.format_frequency(pt.frequency_hz)}"
                                 f"{'' if pt.success else ' (not converged)'}")
 
-        result = sweep(model, basis, analysis["f_min"], analysis["f_max"], n,
-                       spacing=analysis["spacing"], eps=analysis["eps"],
-                       eps_band=analysis.get("eps_band"), solver=analysis["solver"],
-                       tol=analysis["tol"], max_iter=analysis["max_iter"],
-                       continuation=analysis["continuation"],
-                       time_domain=FALLBACK if analysis["time_domain"] else None,
-                       time_domain_periods=analysis["time_domain_periods"],
-                       check=(sweep_check(model, max_periods=analysis["time_domain_periods"])
-                              if analysis["check_stability"] else None),
-                       progress=tick, checkpoint=outdir / CHECKPOINT_FILE,
-                       resume=bool(case.resume))
+        result = api.sweep(model, basis, analysis["f_min"], analysis["f_max"], n,
+                           spacing=analysis["spacing"], eps=analysis["eps"],
+                           eps_band=analysis.get("eps_band"), solver=analysis["solver"],
+                           tol=analysis["tol"], max_iter=analysis["max_iter"],
+                           continuation=analysis["continuation"],
+                           time_domain=analysis["time_domain"],
+                           time_domain_periods=analysis["time_domain_periods"],
+                           check=(sweep_check(model, max_periods=analysis["time_domain_periods"],
+                                              condenser=cond)
+                                  if analysis["check_stability"] else None),
+                           progress=tick, checkpoint=context.out_dir / CHECKPOINT_FILE,
+                           resume=context.resume, condenser=cond)
     linear_hz = linear_reference_grid(analysis["f_min"], analysis["f_max"],
                                       analysis["spacing"], result.frequency_hz,
                                       analysis["linear_points"])
@@ -270,10 +274,10 @@ def run_sweep(model, analysis: dict, case, outdir: Path, progress: bool) -> RunO
     })
     figures = []
     for point in points:
-        p = figure_path(case, outdir, f"sweep-{point}")
+        p = figure_path(case, context.out_dir, f"sweep-{point}")
         if p is not None:
             figures.append(plot_sweep(ds, p, point, title=titled(case.title, "nonlinear FRF")))
-    p = figure_path(case, outdir, "sweep-interface")
+    p = figure_path(case, context.out_dir, "sweep-interface")
     if p is not None:
         figures.append(plot_sweep_interface(ds, p, title=titled(case.title,
                                                                   "contact interface")))
@@ -367,7 +371,7 @@ def plot_sweep_interface(ds: xr.Dataset, path: Path, *, title: str | None = None
 
 
 # --- registration ---------------------------------------------------------------------------
-register(
+SWEEP = Analysis.define(
     "sweep",
     {
         "f_min": Field(Number(lo=0, lo_open=True), "lowest frequency", required=True, unit="Hz"),

@@ -21,6 +21,7 @@ import numpy as np
 import xarray as xr
 
 from fretwear.analyses import figures as plots
+from fretwear.analyses.base import Analysis, RunContext, RunOutput
 from fretwear.analyses.common import (
     default_of,
     figure_path,
@@ -30,7 +31,6 @@ from fretwear.analyses.common import (
     si_scale,
     titled,
 )
-from fretwear.analyses.registry import RunOutput, register
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.fourier import FourierBasis, amplitude
 from fretwear.io.results import label_coordinate, variable
@@ -325,13 +325,13 @@ def _transient_summary(ds: xr.Dataset) -> str:
     return "\n".join(lines)
 
 
-def run_transient(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOutput:
+def run_transient(model, analysis: dict, case, context: RunContext) -> RunOutput:
     """Time integration at one frequency (see the module docstring).
 
     Parameters
     ----------
     model : the model; analysis : the validated ``[analysis]`` table; case : the case;
-    outdir : results folder; progress : progress bar (``fixed`` mode).
+    context : results folder, progress bar (``fixed`` mode).
 
     Returns
     -------
@@ -339,12 +339,12 @@ def run_transient(model, analysis: dict, case, outdir: Path, progress: bool) -> 
     ``max_periods``).
     """
     f_hz = float(analysis["frequency"])
-    last, cls, before, info = time_run(model, analysis, f_hz, progress)
+    last, cls, before, info = time_run(model, analysis, f_hz, context.progress)
     points = [p.name for p in model.observed]
     ds = transient_dataset(model, last, points, analysis["harmonics"], before)
     ds.attrs.update(_transient_attributes(ds, cls, info, f_hz, analysis, last))
     title = titled(case.title, plots.format_frequency(f_hz))
-    figures = _transient_figures(ds, case, outdir, title)
+    figures = _transient_figures(ds, case, context.out_dir, title)
     converged = analysis["mode"] == "fixed" or cls.kind != "transient"
     return RunOutput(ds, figures, _transient_summary(ds), converged)
 
@@ -356,7 +356,7 @@ def _check_harmonics(out: dict, path: str) -> None:
              f"more than {2 * out['harmonics']} steps (twice harmonics)")
 
 
-register(
+TRANSIENT = Analysis.define(
     "transient",
     {
         "frequency": Field(Number(lo=0, lo_open=True), "excitation frequency", required=True,
@@ -430,18 +430,17 @@ def plot_incremental_profiles(ds: xr.Dataset, path: Path, *, title: str | None =
     return plots.save(fig, path)
 
 
-def run_incremental_wear(model, analysis: dict, case, outdir: Path, progress: bool
-                         ) -> RunOutput:
+def run_incremental_wear(model, analysis: dict, case, context: RunContext) -> RunOutput:
     """Quasi-static incremental wear (:func:`fretwear.timedomain.quasistatic.incremental_wear`)."""
     r = incremental_wear(model, steps_per_cycle=analysis["steps_per_cycle"],
                          n_cycles=analysis["n_cycles"], cycle_jump=analysis["cycle_jump"],
-                         record_every=analysis["record_every"], progress=progress)
+                         record_every=analysis["record_every"], progress=context.progress)
     ds = incremental_dataset(model, r)
     ds.attrs.update({"computed_cycles": int(r.computed_cycles), "cycle_jump": int(r.cycle_jump),
                      "steps_per_cycle": int(r.steps_per_cycle), "k_w": float(r.k_w),
                      "wall_time": float(r.wall_time)})
     figures = []
-    p = figure_path(case, outdir, "wear-profile")
+    p = figure_path(case, context.out_dir, "wear-profile")
     if p is not None:
         figures.append(plot_incremental_profiles(ds, p, title=titled(case.title, "wear")))
     w = ds["wear_depth"].values[-1]
@@ -451,7 +450,7 @@ def run_incremental_wear(model, analysis: dict, case, outdir: Path, progress: bo
     return RunOutput(ds, figures, summary, True)
 
 
-register(
+INCREMENTAL_WEAR = Analysis.define(
     "incremental-wear",
     {
         "steps_per_cycle": Field(Integer(lo=2), "quasi-static load steps per cycle",

@@ -19,12 +19,13 @@ import xarray as xr
 
 from fretwear import api
 from fretwear.analyses import figures as plots
+from fretwear.analyses.base import Analysis, RunContext, RunOutput
 from fretwear.analyses.common import default_of, interface_labels
-from fretwear.analyses.registry import RunOutput, register
 from fretwear.files import safe_name
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.penalty import RULES
+from fretwear.hb.reduce import exact_condenser
 from fretwear.hb.solvers import SOLVERS
 from fretwear.hb.sweep import frequency_grid
 from fretwear.io.results import label_coordinate, variable, write_pvd, write_vtu
@@ -43,9 +44,18 @@ from fretwear.io.schema import (
     increasing,
 )
 from fretwear.timedomain.averaged_rate import RESPONSE_KINDS
-from fretwear.timedomain.fallback import FALLBACK
-from fretwear.wear import LAWS, SCHEMES, WearOptions, WearResult, frf_worn, simulate_wear
+from fretwear.wear import (
+    LAWS,
+    SCHEMES,
+    BalanceSetup,
+    RunControl,
+    WearOptions,
+    WearResult,
+    frf_worn,
+    simulate_wear,
+)
 from fretwear.wear.laws import side_depths
+from fretwear.wear.simulate import QUASI_STATIC_FREQUENCY
 
 #: the two worn surfaces of a contact node: its own, and its partner's (node-to-node pairs)
 SURFACES = ("contact", "partner")
@@ -365,27 +375,30 @@ def plot_frf_before_after(ds, path: Path, point: str, *, title=None) -> Path:
 
 
 # --- the analysis -----------------------------------------------------------------------------
-def run_wear(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOutput:
+def run_wear(model, analysis: dict, case, context: RunContext) -> RunOutput:
     """Fretting wear to a plateau, a depth or a cycle count (see module docstring)."""
     a = analysis
     opts = options_from_table(a)
     quasi = bool(a["quasi_static"])
-    f_hz = float(a.get("frequency", default_of(simulate_wear, "frequency")))
+    f_hz = float(a.get("frequency", QUASI_STATIC_FREQUENCY))
     basis = FourierBasis.up_to(a["harmonics"], a["n_samples"])
     nc = model.contact.n_nodes
     nodes = a.get("plot_nodes")
     if nodes is not None and any(p >= nc for p in nodes):
         fail("analysis.plot_nodes", nodes, f"contact node numbers from 0 to {nc - 1}")
-    result = simulate_wear(model, basis, frequency=f_hz, quasi_static=quasi,
-                           options=opts, checkpoint=outdir / CHECKPOINT_FILE, **penalty_of(a),
-                           resume=bool(case.resume), progress=progress, time_domain=FALLBACK)
+    # the time-domain rescue: api.simulate_wear's fallback, used as opts.time_domain_rescue says
+    cond = exact_condenser(model)  # the run's condensation of the model: wear run and FRFs
+    result = api.simulate_wear(model, basis, frequency=f_hz, quasi_static=quasi, options=opts,
+                               balance=BalanceSetup(condenser=cond, **penalty_of(a)),
+                               run=RunControl(checkpoint=context.out_dir / CHECKPOINT_FILE,
+                                              resume=context.resume, progress=context.progress))
     frf, frf_note = None, ""
     fb = a.get("frf_before_after")
     if fb is not None and model.observed:
         grid = (fb["f_min"], fb["f_max"], fb["n_points"])
-        sweeps = {name: frf_worn(model, w, grid, basis, solver=a["solver"], **penalty_of(a),
-                                 spacing=fb["spacing"],
-                                 time_domain=FALLBACK if fb["time_domain"] else None)
+        sweeps = {name: api.frf_worn(model, basis, w, *grid, solver=a["solver"],
+                                     **penalty_of(a), spacing=fb["spacing"],
+                                     time_domain=fb["time_domain"], condenser=cond)
                   for name, w in (("unworn", 0.0), ("worn", result.final_wear))}
         frf = _frf_data(model, sweeps, frequency_grid(*grid, fb["spacing"]))
         frf_note = "\n".join(f"FRF {k}: {int(v.point_success.sum())}/{len(v.points)} converged"
@@ -396,10 +409,10 @@ def run_wear(model, analysis: dict, case, outdir: Path, progress: bool) -> RunOu
                       frf=frf, law=opts.law,
                       energy_coefficients=(opts.energy_coefficient,
                                            opts.partner_energy_coefficient))
-    figures = _figures(ds, case, outdir, nodes)
-    files = [outdir / CHECKPOINT_FILE]
+    figures = _figures(ds, case, context.out_dir, nodes)
+    files = [context.out_dir / CHECKPOINT_FILE]
     if model.mesh is not None and case.output["vtu"]:
-        files.append(write_wear_fields(model, ds, outdir / "wear.pvd"))
+        files.append(write_wear_fields(model, ds, context.out_dir / "wear.pvd"))
     h = result.history
     area = np.asarray(model.contact.area, float)
     w = h.wear_depth[-1]
@@ -570,5 +583,5 @@ DOC = (
     "mesh models the ParaView series `wear.pvd` of the worn surfaces."
 )
 
-register("wear", SCHEMA, run_wear, checks=CHECKS, doc=DOC, files=(CHECKPOINT_FILE,),
-         preload_check=True)
+WEAR = Analysis.define("wear", SCHEMA, run_wear, checks=CHECKS, doc=DOC,
+                       files=(CHECKPOINT_FILE,), preload_check=True)

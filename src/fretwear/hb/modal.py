@@ -44,7 +44,6 @@ from fretwear.hb.reduce import (
     _factor,
     _solve,
     _structure,
-    install,
 )
 from fretwear.model.core import Model
 
@@ -59,7 +58,8 @@ PROBES = 4
 class ModalCondenser(Condenser):
     """Craig-Bampton condensation of ``model`` for excitation frequencies up to ``f_max`` [Hz]
     and harmonic orders up to ``max_order`` (module docstring), with the interface of
-    :class:`~fretwear.hb.reduce.Condenser` (``reduced``, ``recover``).
+    :class:`~fretwear.hb.reduce.Condenser` (``reduced``, ``recover``, ``schur`` (exact), and
+    ``check``: it belongs to the model it was built for). Made by :func:`modal_condenser`.
 
     Parameters
     ----------
@@ -294,10 +294,16 @@ def _real_times(A: np.ndarray, x: np.ndarray) -> np.ndarray:
     return A @ x
 
 
-def use_modal(model: Model, f_max: float, max_order: int, **options) -> ModalCondenser:
-    """Build a :class:`ModalCondenser` of ``model`` (error-checked) and make every
-    condensation of this model object (:func:`~fretwear.hb.reduce.condense`, periodic solves,
-    sweeps, wear runs, recovery) use it until the model's matrices change."""
-    cond = ModalCondenser(model, f_max, max_order, **options)
-    install(model, cond)
-    return cond
+def modal_condenser(model: Model, f_max: float, max_order: int, *, modes: int | None = None,
+                    cutoff: float = CUTOFF, tol: float = TOL) -> ModalCondenser:
+    """A :class:`ModalCondenser` of ``model`` for excitation frequencies up to ``f_max`` [Hz]
+    and harmonic orders up to ``max_order``, checked against the exact condensation (an
+    :class:`~fretwear.errors.InputError` when its error exceeds ``tol``; ``modes``, ``cutoff``:
+    see the class).
+
+    Pass it as ``condenser=`` to every condensation of ``model`` that should use it
+    (:func:`~fretwear.hb.reduce.condense`, periodic solves, sweeps, wear runs, recovery), as
+    :func:`~fretwear.hb.reduce.exact_condenser`'s condenser is passed; it refuses another
+    model, or this one after an edit of its matrices.
+    """
+    return ModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff, tol=tol)

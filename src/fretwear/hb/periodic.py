@@ -29,7 +29,14 @@ from fretwear.hb.fallback import TimeDomainFallback
 from fretwear.hb.fourier import FourierBasis, amplitude
 from fretwear.hb.krylov import HarmonicBlocks, KrylovJacobian
 from fretwear.hb.penalty import penalty
-from fretwear.hb.reduce import Reduced, _recover, condense, loads_to_real, to_real_blocks
+from fretwear.hb.reduce import (
+    Reduced,
+    _recover,
+    condense,
+    exact_condenser,
+    loads_to_real,
+    to_real_blocks,
+)
 from fretwear.hb.solvers import SolveStats, solve, vector_norm
 from fretwear.limits import check_range
 from fretwear.model.core import ContactInterface, Model
@@ -668,7 +675,8 @@ class StaticAnchor:
                 "nodes may be wrong")
 
 
-def preload_anchor(model: Model, *, quasi: Reduced | None = None, eps="auto") -> StaticAnchor:
+def preload_anchor(model: Model, *, quasi: Reduced | None = None, eps="auto",
+                   condenser=None) -> StaticAnchor:
     """Tangential positions of the contact nodes after the static loads are applied from rest,
     with whether the static solve converged.
 
@@ -676,29 +684,32 @@ def preload_anchor(model: Model, *, quasi: Reduced | None = None, eps="auto") ->
     every node that touches sticks where it is (anchor 0): the loading history "preload first,
     then vibrate". ``eps``: the penalty of this static solve (the rule or a number, as for
     :class:`DLFTProblem`). When it does not converge the anchors are 0 and the result says so
-    (``success``, ``warning``): the callers put the warning in their results.
+    (``success``, ``warning``): the callers put the warning in their results. ``condenser``:
+    the condenser of ``model`` (:func:`fretwear.hb.reduce.exact_condenser`; None: a new one).
     """
-    prob, x, st = _static_solve(model, quasi, eps)
+    prob, x, st = _static_solve(model, quasi, eps, condenser)
     if not st.success:
         return StaticAnchor(np.zeros((prob.nc, prob.d - 1)), False, st.message)
     U = x.reshape(prob.nc, prob.d, 1)
     return StaticAnchor(U[:, 1:, 0].copy(), True, st.message)
 
 
-def static_anchor(model: Model, *, quasi: Reduced | None = None, eps="auto") -> np.ndarray:
+def static_anchor(model: Model, *, quasi: Reduced | None = None, eps="auto",
+                  condenser=None) -> np.ndarray:
     """The anchors of :func:`preload_anchor` alone, (nc, d-1) [m]; a
     :class:`RuntimeWarning` says when the static solve did not converge (the anchors are then
     0)."""
-    a = preload_anchor(model, quasi=quasi, eps=eps)
+    a = preload_anchor(model, quasi=quasi, eps=eps, condenser=condenser)
     if not a.success:
         warnings.warn(a.warning, RuntimeWarning, stacklevel=2)
     return a.values
 
 
-def _static_solve(model: Model, quasi: Reduced | None, eps):
+def _static_solve(model: Model, quasi: Reduced | None, eps, condenser=None):
     """The static contact problem of :func:`static_anchor`: ``(problem, x, stats)``."""
     basis = FourierBasis((), 1)
-    red = quasi if quasi is not None else condense(model, 0.0, [0], quasi_static=True)
+    red = quasi if quasi is not None else condense(model, 0.0, [0], quasi_static=True,
+                                                   condenser=condenser)
     prob = DLFTProblem(red, model.contact, basis, eps=eps)
     U0 = prob.initial_guess()
 
@@ -738,7 +749,7 @@ class PreloadContact:
         return [n for n, k in zip(self.names, self.closed, strict=True) if k == 0]
 
 
-def preload_contact(model: Model, *, eps="static") -> PreloadContact:
+def preload_contact(model: Model, *, eps="static", condenser=None) -> PreloadContact:
     """Which contact nodes of ``model`` are pressed by its static loads (the preload).
 
     The static contact problem of :func:`static_anchor` (exact contact, Coulomb friction,
@@ -746,6 +757,7 @@ def preload_contact(model: Model, *, eps="static") -> PreloadContact:
     force under the preload (opened by its gap, pulled away, or touching without force) is
     almost always a mistake in a vibration or wear run: its friction can only act where the
     vibration itself closes it. Nodes with a prescribed normal load count as in contact.
+    ``condenser``: the condenser of ``model`` (None: a new exact one).
     """
     c = model.contact
     names = c.names()
@@ -753,7 +765,7 @@ def preload_contact(model: Model, *, eps="static") -> PreloadContact:
     prescribed = np.zeros(c.n_nodes, dtype=bool)
     if c.normal_load is not None:
         prescribed = np.isfinite(np.asarray(c.normal_load.vector, dtype=float))
-    prob, x, st = _static_solve(model, None, eps)
+    prob, x, st = _static_solve(model, None, eps, condenser)
     if not st.success:
         loaded = prescribed
         lam_n = None
@@ -774,7 +786,7 @@ def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
                    eps="auto", anchor=None, U0=None, solver="powell", tol=1e-8, max_iter=200,
                    raise_on_failure=False, strategy=STRATEGY,
                    time_domain: TimeDomainFallback | None = None,
-                   time_domain_periods: int = 3000) -> PeriodicSolution:
+                   time_domain_periods: int = 3000, condenser=None) -> PeriodicSolution:
     """Periodic response of ``model`` at the excitation ``frequency`` [Hz] with the DLFT
     (section 3.1-3.2).
 
@@ -811,6 +823,9 @@ def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
         state to find, or none the integration reached. Not with ``quasi_static``, a ``gap``
         other than the model's, contact springs or prescribed normal loads (the time-domain
         solver models none of these).
+    condenser : the condenser of ``model`` (:func:`fretwear.hb.reduce.exact_condenser` or
+        :func:`fretwear.hb.modal.modal_condenser`) used by every condensation of the solve;
+        None: a new exact one, built once for the solve.
 
     Returns
     -------
@@ -820,13 +835,16 @@ def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
     """
     frequency = check_inputs(model, basis, frequency, quasi_static=quasi_static,
                              anchor=anchor, U0=U0)
+    if condenser is None and (reduced is None or anchor is None):
+        condenser = exact_condenser(model)  # one for the solve's condensations
     if reduced is None:
-        reduced = condense(model, frequency, _orders(basis), quasi_static=quasi_static)
+        reduced = condense(model, frequency, _orders(basis), quasi_static=quasi_static,
+                           condenser=condenser)
     reduced = connect(reduced, model.contact)
-    eps = penalty(eps, model=model, reduced=reduced)
+    eps = penalty(eps, model=model, reduced=reduced, condenser=condenser)
     preload = None
     if anchor is None:
-        preload = preload_anchor(model)
+        preload = preload_anchor(model, condenser=condenser)
         anchor = preload.values
     prob = DLFTProblem(reduced, model.contact, basis, gap=gap, eps=eps, anchor=anchor)
     if U0 is None and basis.k > 3:
@@ -966,14 +984,16 @@ def assemble_solution(prob: DLFTProblem, U, model: Model, stats: SolveStats) -> 
     )
 
 
-def initial_state(model: Model, sol: PeriodicSolution):
-    """Full-field displacement [m] and velocity [m/s] at ``t = 0`` of a periodic solution."""
+def initial_state(model: Model, sol: PeriodicSolution, condenser=None):
+    """Full-field displacement [m] and velocity [m/s] at ``t = 0`` of a periodic solution
+    (recovered by ``condenser``, the solution's; None: a new exact one)."""
     b = sol.basis
     m = sol.U.shape[0] * sol.U.shape[1]
     U = sol.U if sol.U_node is None else sol.U_node  # the structure's contact nodes
     Uc = b.to_complex(U.reshape(m, -1))  # (k+1, m) complex amplitudes
     orders = np.array([0, *b.harmonics])
-    Ufull = _recover(model, sol.omega, orders, Uc, quasi_static=sol.quasi_static)
+    Ufull = _recover(model, sol.omega, orders, Uc, quasi_static=sol.quasi_static,
+                     condenser=condenser)
     U0 = Ufull.real.sum(axis=0)
     V0 = -(orders[:, None] * sol.omega * Ufull.imag).sum(axis=0)
     return U0, V0

@@ -17,14 +17,20 @@ The quasi-static variant drops inertia and damping (``Z_n = K`` for every ``n``)
 time ordering of the friction law over the period; :func:`condense_static` gives the same
 static condensation in real arithmetic with the condensed loads of any load vectors (the
 quasi-static load steps of :mod:`fretwear.timedomain.integrate`). Both use one implementation
-of eq. 19 (:func:`_schur`).
+of eq. 19 (:meth:`Condenser.schur`).
+
+The prepared condensation of a structure is an object the caller owns, as scikit-fem's
+``Basis`` is built once and passed to ``asm``: :func:`exact_condenser` builds a
+:class:`Condenser` (the modal one is :func:`fretwear.hb.modal.modal_condenser`), and every
+function that condenses takes it as ``condenser=`` (None: a new exact one for that call
+alone; build one and pass it for repeated calls). A condenser remembers the model it was
+built for and refuses another one (:meth:`Condenser.check`).
 """
 
 from __future__ import annotations
 
 import math
 import warnings
-import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -100,7 +106,8 @@ class Structure:
     vectors [N]. With node-to-node pairs every field is in the relative coordinates ``U'``
     (``U = P U'``, :func:`fretwear.model.interfaces.relative_model`), ``obs`` holds the
     primed DOFs the observed ones depend on and ``U[obs_out] = S @ U'[obs]``; ``P``, ``S``
-    are None without pairs (``obs_out = obs``).
+    are None without pairs (``obs_out = obs``). fingerprint : what the condensation depends on
+    in the model read (:func:`_fingerprint`; None for the model's own coordinates).
     """
 
     K: sp.csr_matrix
@@ -116,6 +123,7 @@ class Structure:
     P: sp.csr_matrix | None = None
     obs_out: np.ndarray | None = None
     S: sp.csr_matrix | None = None
+    fingerprint: tuple | None = None
 
     @property
     def ndof(self) -> int:
@@ -126,9 +134,12 @@ def _structure(model: Model, relative: bool = True) -> Structure:
     """The structure's matrices, loads, contact DOFs and observed DOFs as the condensation
     sees them: every read of ``model.K/M/C/D``, the loads and the observed DOFs in this module
     goes through here, and the change of coordinates of node-to-node pairs (``U = P U'``)
-    applies here (``relative=False``: the model's own coordinates)."""
+    applies here (``relative=False``: the model's own coordinates). The loads are read by
+    :func:`_read_loads`, the same code that reads them again at each use of a condenser."""
     P = None
+    given, fp = model, None
     if relative:
+        fp = _fingerprint(model)
         model, P = relative_model(model)  # node-to-node pairs: relative coordinates U = P U'
         obs_out, obs, S = observed_map(model, P)  # U[obs_out] = S @ U'[obs]
     else:
@@ -136,16 +147,50 @@ def _structure(model: Model, relative: bool = True) -> Structure:
                                          for p in model.observed])
                          if model.observed else np.zeros(0, dtype=np.int64))
         S = None
-    return Structure(
+    s = Structure(
         K=sp.csr_matrix(model.K), M=sp.csr_matrix(model.M),
         C=None if model.C is None else sp.csr_matrix(model.C),
         D=None if model.D is None else sp.csr_matrix(model.D),
-        load_harmonics=model.load_harmonics,
+        load_harmonics=None,
         fixed=np.asarray(model.fixed_dofs, dtype=np.int64),
         cdofs=np.asarray(model.contact.dofs, dtype=np.int64).reshape(-1),
         frame=np.asarray(model.contact.frame, dtype=float), obs=np.asarray(obs, np.int64),
-        load_vectors=[np.asarray(ld.vector, dtype=float) for ld in model.loads],
-        P=P, obs_out=np.asarray(obs_out, np.int64), S=S)
+        load_vectors=[], P=P, obs_out=np.asarray(obs_out, np.int64), S=S, fingerprint=fp)
+    _read_loads(s, given)
+    return s
+
+
+def _read_loads(s: Structure, model: Model) -> None:
+    """Point ``s`` at the current loads of ``model`` (``P^T F`` in the relative coordinates of
+    node-to-node pairs): ``load_harmonics`` reads them at each call, ``load_vectors`` now."""
+    P = s.P
+    if P is None:
+        s.load_harmonics = model.load_harmonics
+        s.load_vectors = [np.asarray(ld.vector, dtype=float) for ld in model.loads]
+        return
+    Pt = P.T.tocsr()
+    s.load_harmonics = lambda nmax: (Pt @ model.load_harmonics(nmax).T).T
+    s.load_vectors = [Pt @ np.asarray(ld.vector, dtype=float) for ld in model.loads]
+
+
+def _fingerprint(model: Model) -> tuple:
+    """What a :class:`Condenser` depends on: the matrices (identity, pattern size and a sum of
+    their entries, so an edit in place is seen), the fixed DOFs, contact DOFs, partners and
+    frames, and the observed points (not the loads: they are read at each use)."""
+    def mat(A):
+        if A is None:
+            return None
+        data = A.data if sp.issparse(A) else np.asarray(A)
+        return (id(A), getattr(A, "nnz", data.size), float(np.sum(data)),
+                float(np.sum(np.abs(data))))
+
+    c = model.contact
+    return (mat(model.K), mat(model.M), mat(model.C), mat(model.D),
+            np.asarray(model.fixed_dofs).tobytes(), np.asarray(c.dofs).tobytes(),
+            np.asarray(c.frame, float).tobytes(),
+            None if getattr(c, "partner_dofs", None) is None
+            else np.asarray(c.partner_dofs).tobytes(),
+            tuple(tuple(np.asarray(p.dofs).tolist()) for p in model.observed))
 
 
 def _dynamic_stiffness(s: Structure, omega: float, n: int, quasi_static: bool = False):
@@ -287,7 +332,8 @@ class Condenser:
     ``K_ii`` is kept: harmonic 0 at every frequency, quasi-static solves, recovery). Small
     models (``n_i <= DENSE_MAX``) work on dense arrays with LAPACK; large ones use SuperLU
     with blocked multi-right-hand-side solves (``BLOCK`` columns at a time, so the dense
-    ``Z_ii^-1 Z_ic`` is never held whole). Made by :func:`condenser`.
+    ``Z_ii^-1 Z_ic`` is never held whole). Made by :func:`exact_condenser` and owned by the
+    caller, who passes it (``condenser=``) to every condensation of the same model.
     """
 
     def __init__(self, structure: Structure, dense: bool | None = None):
@@ -307,6 +353,27 @@ class Condenser:
         self._lus: dict = {}
         self._static = None
         self._load_cache: dict = {}
+
+    # -- the model it belongs to ---------------------------------------------------------------
+    def check(self, model: Model) -> Condenser:
+        """Refuse ``model`` (:class:`~fretwear.errors.InputError`) unless this condenser was
+        built for it as it is now (the same matrices, unedited, fixed DOFs, contact DOFs and
+        frames, observed points); then read its current loads, which may change between calls
+        (:meth:`read_loads`). Returns the condenser."""
+        if _fingerprint(model) != self.structure.fingerprint:
+            raise InputError(
+                "condenser: built for another model, or for this model before its matrices, "
+                "fixed DOFs, contact DOFs, frames or observed points changed; build one for "
+                "this model (fretwear.exact_condenser(model) or "
+                "fretwear.modal_condenser(model, f_max, max_order))")
+        self.read_loads(model)
+        return self
+
+    def read_loads(self, model: Model) -> None:
+        """Read the loads of ``model`` anew (the condensation of the structure is kept; the
+        loads condensed at the next call are the model's at that call)."""
+        self._load_cache = {}
+        _read_loads(self.structure, model)
 
     # -- the blocks of Z_n ------------------------------------------------------------------
     def _z(self, part: str, omega: float, n: int, quasi_static: bool):
@@ -420,7 +487,7 @@ class Condenser:
 
     def load_harmonics(self, nmax: int) -> np.ndarray:
         """The structure's load amplitudes (nmax+1, ndof) complex [N], kept until
-        :func:`condenser` reads the model's loads again (a sweep condenses the same loads at
+        :meth:`read_loads` reads the model's loads again (a sweep condenses the same loads at
         every frequency)."""
         F = self._load_cache.get(nmax)
         if F is None:
@@ -548,62 +615,26 @@ def _solve(lu, B):
     return lu.solve(np.ascontiguousarray(B.real)) + 1j * lu.solve(np.ascontiguousarray(B.imag))
 
 
-#: condensers of recently condensed models (a sweep, a wear run or an FRF condenses the same
-#: structure at many frequencies): model id -> (weak reference, fingerprint, Condenser)
-_CONDENSERS: dict = {}
-_CONDENSERS_KEEP = 4
+def exact_condenser(model: Model) -> Condenser:
+    """A new exact :class:`Condenser` of ``model`` (eq. 19): build it once and pass it
+    (``condenser=``) to every condensation, solve, sweep or wear run of this model, which then
+    share its prepared blocks and kept factorisations. It refuses another model, or this one
+    after an edit of its matrices (:meth:`Condenser.check`); the loads are read at each use."""
+    return Condenser(_structure(model))
 
 
-def _fingerprint(model: Model):
-    """What a :class:`Condenser` depends on: the matrices (identity, pattern size and a sum of
-    their entries, so an edit in place is seen), the fixed DOFs, contact DOFs and frames."""
-    def mat(A):
-        if A is None:
-            return None
-        data = A.data if sp.issparse(A) else np.asarray(A)
-        return (id(A), getattr(A, "nnz", data.size), float(np.sum(data)),
-                float(np.sum(np.abs(data))))
-
-    c = model.contact
-    return (mat(model.K), mat(model.M), mat(model.C), mat(model.D),
-            np.asarray(model.fixed_dofs).tobytes(), np.asarray(c.dofs).tobytes(),
-            np.asarray(c.frame, float).tobytes(),
-            None if getattr(c, "partner_dofs", None) is None
-            else np.asarray(c.partner_dofs).tobytes(),
-            tuple(tuple(np.asarray(p.dofs).tolist()) for p in model.observed))
-
-
-def condenser(model: Model) -> Condenser:
-    """The :class:`Condenser` of ``model``, reused while the model is unchanged (its matrices,
-    fixed DOFs, contact DOFs, frames and observed points; the loads are read at each call)."""
-    key = id(model)
-    fp = _fingerprint(model)
-    hit = _CONDENSERS.get(key)
-    if hit is not None and hit[0]() is model and hit[1] == fp:
-        cond = hit[2]  # the loads are read anew (in relative coordinates with pairs)
-        cond._load_cache = {}
-        s, P = cond.structure, cond.structure.P
-        if P is None:
-            s.load_harmonics = model.load_harmonics
-            s.load_vectors = [np.asarray(ld.vector, dtype=float) for ld in model.loads]
-        else:
-            Pt = P.T.tocsr()
-            s.load_harmonics = lambda nmax: (Pt @ model.load_harmonics(nmax).T).T
-            s.load_vectors = [Pt @ np.asarray(ld.vector, dtype=float) for ld in model.loads]
-        return cond
-    cond = Condenser(_structure(model))
-    install(model, cond)
-    return cond
-
-
-def install(model: Model, cond: Condenser) -> None:
-    """Make :func:`condenser` return ``cond`` for ``model`` while the model is unchanged (a
-    modal representation, :func:`fretwear.hb.modal.use_modal`)."""
-    key = id(model)
-    _CONDENSERS.pop(key, None)
-    while len(_CONDENSERS) >= _CONDENSERS_KEEP:
-        _CONDENSERS.pop(next(iter(_CONDENSERS)))
-    _CONDENSERS[key] = (weakref.ref(model), _fingerprint(model), cond)
+def condenser_for(model: Model, condenser=None):
+    """The condenser a driver uses for ``model``: ``condenser`` checked against ``model``
+    (:meth:`Condenser.check`, which also reads the model's current loads), or, when None, a
+    new exact one (:func:`exact_condenser`)."""
+    if condenser is None:
+        return exact_condenser(model)
+    if not callable(getattr(condenser, "check", None)):
+        raise InputError(f"condenser = {type(condenser).__name__} object: expected a condenser "
+                         "(fretwear.exact_condenser(model) or fretwear.modal_condenser(model, "
+                         "f_max, max_order)) or None")
+    condenser.check(model)
+    return condenser
 
 
 @dataclass
@@ -654,53 +685,60 @@ class StaticCondensation:
         return U if self._P is None else self._P @ U
 
 
-def condense_static(model: Model) -> StaticCondensation:
+def condense_static(model: Model, *, condenser=None) -> StaticCondensation:
     """Exact static condensation of ``model`` onto its contact DOFs (eq. 19 with ``Z = K``).
 
     The same computation as :func:`condense` (:meth:`Condenser.schur`), in real arithmetic,
     with the condensed loads of any load vectors (e.g. the loads at the phases of a
-    quasi-static cycle) and the exact recovery of every DOF.
+    quasi-static cycle) and the exact recovery of every DOF. ``condenser``: the condenser of
+    ``model`` (:func:`exact_condenser`; None: a new one for this call).
     """
-    cond = condenser(model)
+    cond = condenser_for(model, condenser)
     Kr, lu, Kci, _ = cond.schur(0.0, 0, True)
     return StaticCondensation(np.ascontiguousarray(0.5 * (Kr + Kr.T)), cond, lu, Kci)
 
 
-def condense(model: Model, frequency: float, orders, *, quasi_static: bool = False) -> Reduced:
+def condense(model: Model, frequency: float, orders, *, quasi_static: bool = False,
+             condenser=None) -> Reduced:
     """Condense ``model`` onto its contact DOFs for harmonic ``orders`` (``[0, h1, .., hk]``)
     at the excitation ``frequency`` [Hz] (0 allowed when ``quasi_static``).
 
-    Implements eq. (17)-(19) with one LU of ``Z_ii`` per harmonic (:class:`Condenser`, reused
-    across calls on the same model). Returns a :class:`Reduced` in contact-local coordinates
-    with the observed-DOF recovery rows (``Reduced.omega = 2 pi frequency`` [rad/s],
-    ``Reduced.frequency`` as given).
+    Implements eq. (17)-(19) with one LU of ``Z_ii`` per harmonic. ``condenser``: the
+    condenser of ``model`` (:func:`exact_condenser`, or
+    :func:`fretwear.hb.modal.modal_condenser`), which keeps its prepared blocks and
+    factorisations between calls; None builds a new exact one for this call alone (build one
+    and pass it when condensing the same model more than once). Returns a :class:`Reduced` in
+    contact-local coordinates with the observed-DOF recovery rows
+    (``Reduced.omega = 2 pi frequency`` [rad/s], ``Reduced.frequency`` as given).
     """
     return _condense(model, 2 * np.pi * frequency, orders, quasi_static=quasi_static,
-                     frequency=frequency)
+                     frequency=frequency, condenser=condenser)
 
 
 def _condense(model: Model, omega: float, orders, *, quasi_static: bool = False,
-              frequency: float | None = None) -> Reduced:
+              frequency: float | None = None, condenser=None) -> Reduced:
     """:func:`condense` at the circular frequency ``omega`` [rad/s] (``frequency`` [Hz]:
     recorded in the result, default ``omega / 2 pi``)."""
-    return condenser(model).reduced(omega, orders, quasi_static, frequency)
+    return condenser_for(model, condenser).reduced(omega, orders, quasi_static, frequency)
 
 
 def recover(model: Model, frequency: float, orders, u_loc: np.ndarray, *,
-            quasi_static: bool = False) -> np.ndarray:
+            quasi_static: bool = False, condenser=None) -> np.ndarray:
     """All DOFs ``U_n`` (nb, ndof) complex [m] from the contact-local amplitudes ``u_loc``
     (nb, m) [m] of the harmonic ``orders`` at the excitation ``frequency`` [Hz].
 
     ``U_i = Z_ii^-1 (F_i - Z_ic U_c)`` per harmonic (exact recovery of the condensation);
-    fixed DOFs are zero.
+    fixed DOFs are zero. ``condenser``: as for :func:`condense` (the one that condensed the
+    solution: a modal one recovers through its modes).
     """
-    return _recover(model, 2 * np.pi * frequency, orders, u_loc, quasi_static=quasi_static)
+    return _recover(model, 2 * np.pi * frequency, orders, u_loc, quasi_static=quasi_static,
+                    condenser=condenser)
 
 
 def _recover(model: Model, omega: float, orders, u_loc: np.ndarray, *,
-             quasi_static: bool = False) -> np.ndarray:
+             quasi_static: bool = False, condenser=None) -> np.ndarray:
     """:func:`recover` at the circular frequency ``omega`` [rad/s]."""
-    return condenser(model).recover(omega, orders, u_loc, quasi_static)
+    return condenser_for(model, condenser).recover(omega, orders, u_loc, quasi_static)
 
 
 def to_real_blocks(Zc: np.ndarray, orders: np.ndarray) -> np.ndarray:

@@ -38,7 +38,7 @@ from fretwear.hb.periodic import (
     preload_anchor,
     solve_strategy,
 )
-from fretwear.hb.reduce import _condense, condenser
+from fretwear.hb.reduce import _condense, condenser_for
 from fretwear.hb.solvers import SolveStats, solve
 from fretwear.hb.sweep_checkpoint import (
     WHAT,
@@ -192,7 +192,7 @@ class _Problems:
     most ``cache_size`` reduced models and :data:`CACHE_BYTES` of them (the newest always).
     ``eps``: a number [N/m], or ``"auto"`` (the spectral radius of each frequency's ``Z_r``)."""
 
-    def __init__(self, model, basis, gap, eps, cache_size=CACHE_SIZE):
+    def __init__(self, model, basis, gap, eps, cache_size=CACHE_SIZE, condenser=None):
         self.model, self.basis, self.gap, self.eps = model, basis, gap, eps
         self.orders = np.array([0, *basis.harmonics])
         self.cache: dict = {}
@@ -200,7 +200,7 @@ class _Problems:
         self.last = None  # the last problem handed out
         # the model does not change during a sweep: its condenser (and loads) are read once,
         # the contact springs prepared once, and the problems share their set-up
-        self.condenser = condenser(model)
+        self.condenser = condenser_for(model, condenser)
         self.springs = springs(model.contact)
         self.template = None
 
@@ -238,7 +238,8 @@ class _Problems:
         return prob
 
 
-def rebuild_point(model: Model, basis: FourierBasis, gap, entry: dict) -> SweepPoint:
+def rebuild_point(model: Model, basis: FourierBasis, gap, entry: dict,
+                  condenser=None) -> SweepPoint:
     """A sweep point from a checkpoint entry
     (:func:`fretwear.hb.sweep_checkpoint.load_sweep_checkpoint`): its solution re-assembled
     from its harmonics, anchors and penalty by the code that assembled it first, so it equals
@@ -248,7 +249,8 @@ def rebuild_point(model: Model, basis: FourierBasis, gap, entry: dict) -> SweepP
     sol = None
     if "U" in entry:
         orders = np.array([0, *basis.harmonics])
-        prob = DLFTProblem(_condense(model, entry["omega"], orders), model.contact, basis,
+        prob = DLFTProblem(_condense(model, entry["omega"], orders, condenser=condenser),
+                           model.contact, basis,
                            gap=gap, eps=entry["eps"], anchor=entry["anchor"])
         sol = assemble_solution(prob, np.array(entry["U"], float), model, stats)
     pt = SweepPoint(rec["frequency_hz"], sol, stats, rec["how"], list(rec["flags"]),
@@ -404,7 +406,7 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
           max_bisections: int = 4, check=None,
           time_domain: TimeDomainFallback | None = None, eps_band=None,
           time_domain_periods: int = 3000, progress=None, checkpoint=None,
-          resume: bool = False) -> SweepResult:
+          resume: bool = False, condenser=None) -> SweepResult:
     """Nonlinear FRF: periodic solutions from ``f_min`` to ``f_max`` [Hz].
 
     Parameters
@@ -448,6 +450,9 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
         same sweep: same model, grid and settings); the result equals the uninterrupted
         sweep's bit for bit. A damaged or foreign checkpoint is an
         :class:`~fretwear.errors.InputError`, never silently replaced.
+    condenser : the condenser of ``model`` (:func:`fretwear.hb.reduce.exact_condenser` or
+        :func:`fretwear.hb.modal.modal_condenser`) used by every condensation of the sweep;
+        None: a new exact one, built once for the sweep.
 
     Returns
     -------
@@ -461,11 +466,13 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
     if model.contact.has_connectors:  # the time-domain solver has rigid contacts only
         time_domain = None
     band = (f_min, f_max) if eps_band is None else _band(eps_band)
-    eps = sweep_penalty(eps, model, [0, *basis.harmonics], *band, spacing=spacing)
-    probs = _Problems(model, basis, gap, eps)
+    condenser = condenser_for(model, condenser)  # one for every condensation of the sweep
+    eps = sweep_penalty(eps, model, [0, *basis.harmonics], *band, spacing=spacing,
+                        condenser=condenser)
+    probs = _Problems(model, basis, gap, eps, condenser=condenser)
     warnings = []
     if anchor is None:
-        preload = preload_anchor(model)
+        preload = preload_anchor(model, condenser=condenser)
         anchor = preload.values
         if not preload.success:
             warnings.append(preload.warning)
@@ -486,7 +493,7 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
         if resume and Path(checkpoint).exists():
             first, entries = load_sweep_checkpoint(checkpoint, key, shape)
             for e in entries:
-                pt = rebuild_point(model, basis, gap, e)
+                pt = rebuild_point(model, basis, gap, e, condenser)
                 points.append(pt)
                 if pt.solution is not None:
                     history.append((e["omega"], e["U"]))

@@ -415,7 +415,7 @@ _MODEL_SECTIONS = ("model", "material", "damping", "springs", "fixed", "loads", 
                    "observed", "materials")
 
 
-@dataclass
+@dataclass(frozen=True)
 class Case:
     """A validated case file.
 
@@ -430,7 +430,9 @@ class Case:
         the model kind), with defaults filled in and file paths absolute.
     analysis : the validated ``[analysis]`` table (with ``type``).
     output : the validated ``[output]`` table.
-    resume : set by :func:`fretwear.analyses.run.run_case`: continue from a checkpoint if any.
+
+    How a case is run (results folder, ``--resume``, progress bars) is not part of it: see
+    :class:`fretwear.analyses.base.RunContext`.
     """
 
     path: Path
@@ -440,7 +442,6 @@ class Case:
     model: dict
     analysis: dict
     output: dict
-    resume: bool = False
 
     @property
     def folder(self) -> Path:

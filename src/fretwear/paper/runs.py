@@ -24,11 +24,13 @@ from pathlib import Path
 
 import numpy as np
 
+from fretwear import api
 from fretwear.analyses.run import RunInterrupted, load_case, run_case
 from fretwear.errors import FretwearError, InputError
 from fretwear.examples.builders import stromberg_beam
 from fretwear.files import atomic_write
 from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.reduce import exact_condenser
 from fretwear.io.case import build_model
 from fretwear.paper.catalogue import (
     EXTRA_KEYS,
@@ -43,9 +45,7 @@ from fretwear.paper.catalogue import (
     toml_value,
 )
 from fretwear.paper.report import load, write_report
-from fretwear.timedomain.fallback import FALLBACK
 from fretwear.timedomain.quasistatic import incremental_wear
-from fretwear.wear import frf_worn
 
 
 # --- running ----------------------------------------------------------------------------------
@@ -143,10 +143,11 @@ def _frf_worn(folder: Path, wear_dir: Path, quick: bool) -> str:
         return "up to date"
     model = build_model(load_case(wear_dir / "case.toml"))
     basis = FourierBasis.up_to(h, s)
+    cond = exact_condenser(model)  # one condensation of the beam for both FRFs
     out = {}
     for name, w in (("unworn", np.zeros_like(wear)), ("worn", wear)):
-        r = frf_worn(model, w, (f_min, f_max, n), basis, spacing="linear",
-                     time_domain=FALLBACK)
+        r = api.frf_worn(model, basis, w, f_min, f_max, n, spacing="linear",
+                         time_domain=True, condenser=cond)
         out[f"{name}_summary"] = r.summary()
         out[f"{name}_frequency"] = r.frequency_hz
         out[f"{name}_amplitude"] = r.amplitude("Pe", 0, 1)

@@ -31,9 +31,10 @@ from fretwear.timedomain.results import IncrementalWearResult
 # quasi-static incremental wear
 # --------------------------------------------------------------------------------------------
 def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int = 100,
-                     cycle_jump: int = 1, k_w: float | None = None, record_every: int = 1,
+                     cycle_jump: int = 1, wear_coefficient: float | None = None,
+                     record_every: int = 1,
                      wear0=None, tol: float = 1e-10, progress: bool = False,
-                     raise_on_failure: bool = True) -> IncrementalWearResult:
+                     raise_on_failure: bool = True, condenser=None) -> IncrementalWearResult:
     """Quasi-static fretting wear by load steps (in the spirit of Stromberg 1997).
 
     At every load step ``tau_k = 2 pi k / steps_per_cycle`` the static equilibrium
@@ -56,14 +57,17 @@ def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int =
     steps_per_cycle : load steps per cycle.
     n_cycles : number of load cycles (physical, counting the jumps).
     cycle_jump : cycles represented by each computed cycle.
-    k_w : Archard coefficient [1/Pa]; default ``model.contact.wear_coefficient`` (plus the
-        partners' coefficient at node-to-node pairs: the gap opens by both worn depths).
+    wear_coefficient : Archard coefficient k_w [1/Pa]; default
+        ``model.contact.wear_coefficient`` (plus the partners' coefficient at node-to-node
+        pairs: the gap opens by both worn depths).
     record_every : record every this many computed cycles (and the last).
     wear0 : (nc,) initial wear [m].
     tol : relative tolerance of the contact solver.
     raise_on_failure : raise :class:`~fretwear.errors.ConvergenceError` when the contact
         problem of some load step does not settle (default); False: return the result with
         ``success`` False and the count in ``message``.
+    condenser : the condenser of ``model`` (:func:`fretwear.hb.reduce.exact_condenser`) whose
+        static condensation is used (None: a new exact one).
 
     Returns
     -------
@@ -74,7 +78,7 @@ def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int =
     n_cycles = count(n_cycles, "n_cycles", 1)
     J = count(cycle_jump, "cycle_jump", 1)
     rec_every = count(record_every, "record_every", 1)
-    if k_w is None:  # both surfaces of a pair wear: the gap opens at their summed rate
+    if wear_coefficient is None:  # both surfaces of a pair wear: the gap opens by both
         both = model.contact.wear_nodes() + model.contact.partner_wear_nodes()
         if np.ptp(both) > 0.0:
             raise InputError(f"contact: the Archard coefficients (both surfaces summed) differ "
@@ -82,10 +86,11 @@ def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int =
                              "incremental_wear takes one coefficient k_w")
         kw = both[0]
     else:
-        kw = k_w
+        kw = wear_coefficient
     kw = float(kw)
     if not (math.isfinite(kw) and kw >= 0.0):
-        raise InputError(f"k_w = {k_w!r}; expected an Archard coefficient >= 0 [1/Pa]")
+        raise InputError(f"wear_coefficient = {wear_coefficient!r}; expected an Archard "
+                         "coefficient k_w >= 0 [1/Pa]")
     t0 = time.perf_counter()
     c = model.contact
     nc, d = c.dofs.shape
@@ -93,7 +98,7 @@ def incremental_wear(model: Model, *, steps_per_cycle: int = 64, n_cycles: int =
     if area.shape != (nc,) or np.any(area <= 0):
         raise InputError(f"contact.area must be ({nc},) positive areas [m^2]")
     check_contact(model)
-    cond = condense_static(model)
+    cond = condense_static(model, condenser=condenser)
     A = cond.K
     tau = 2.0 * np.pi * np.arange(N) / N
     Ft = model.load_time(tau) if model.loads else np.zeros((N, model.ndof))

@@ -64,7 +64,7 @@ class StabilityCheck:
 def check_periodic(model: Model, sol: PeriodicSolution, *, max_periods: int = 3000,
                    steps_per_period: int | None = None, perturbation: float = 1e-3,
                    tolerance: float = 0.2, periodicity_tol: float = 1e-4,
-                   seed: int = 0) -> StabilityCheck:
+                   seed: int = 0, condenser=None) -> StabilityCheck:
     """Integrate in time from the periodic solution and say whether the structure stays on it.
 
     Parameters
@@ -81,6 +81,9 @@ def check_periodic(model: Model, sol: PeriodicSolution, *, max_periods: int = 30
         truncation error measured on the paper's beam with 7 harmonics (docs/verification.md).
     periodicity_tol : relative periodicity tolerance of the time integration's classification.
     seed : of the random perturbation.
+    condenser : the condenser that condensed ``sol`` (:func:`fretwear.hb.reduce.exact_condenser`
+        or :func:`fretwear.hb.modal.modal_condenser`): the start of the integration is the full
+        field it recovers; None: a new exact one.
 
     Returns
     -------
@@ -97,7 +100,7 @@ def check_periodic(model: Model, sol: PeriodicSolution, *, max_periods: int = 30
     t0 = time.perf_counter()
     if sol.quasi_static or sol.omega <= 0:
         return StabilityCheck("stable", 0.0, 0, 0.0, "quasi-static: no dynamics to check")
-    U0, V0 = initial_state(model, sol)
+    U0, V0 = initial_state(model, sol, condenser)
     rng = np.random.default_rng(seed)
     vmax = np.abs(V0).max()
     V0 = V0 + perturbation * vmax * rng.standard_normal(V0.shape)

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+from dataclasses import fields
 from pathlib import Path
 
 import numpy as np
@@ -26,11 +27,21 @@ from fretwear.hb.reduce import Reduced
 from fretwear.model.core import Model
 from fretwear.wear.history import HISTORY_FIELDS, LATE_HISTORY_FIELDS, WearHistory
 from fretwear.wear.options import WearOptions
+from fretwear.wear.state import SlowStep, StepRecord, shape_of
 
-#: 3: the fingerprint hashes the reduced model as stored, real for an undamped modal
-#: condensation (complex before), so an earlier checkpoint cannot match it: say so by the
-#: version rather than by "written for a different model"
-CHECKPOINT_VERSION = 3
+#: 4: the state is the fields of :class:`~fretwear.wear.state.SlowStep`, some renamed
+#: (:data:`FORMAT_3_NAMES`); 3: the fingerprint hashes the reduced model as stored, real for an
+#: undamped modal condensation (complex before), so an earlier checkpoint cannot match it: say
+#: so by the version rather than by "written for a different model"
+CHECKPOINT_VERSION = 4
+#: the versions read: this one, and format 3 (its state renamed, :data:`FORMAT_3_NAMES`)
+READ_VERSIONS = (3, 4)
+#: the state of a format-3 checkpoint: its name -> the :class:`SlowStep` field
+FORMAT_3_NAMES = {"vrate": "volume_rate", "vrate0": "volume_rate0", "td_U": "time_U",
+                  "td_V": "time_V", "td_retry_at": "retry_balance_at"}
+#: the fields of the state and of the history (:class:`StepRecord`): shapes, units, meanings
+STATE_FIELDS = fields(SlowStep)
+RECORD_FIELDS = {f.name: f for f in fields(StepRecord)}
 
 
 def _mu_key(mu):
@@ -40,13 +51,13 @@ def _mu_key(mu):
 
 
 def fingerprint(model: Model, reduced: Reduced, basis: FourierBasis, eps: float, coef,
-                options: WearOptions, W0, anchor0) -> str:
+                options: WearOptions, wear0, anchor0) -> str:
     """SHA-256 of everything that determines the trajectory (model data after condensation,
     basis, penalty, wear factors, options, initial state)."""
     h = hashlib.sha256()
     for a in (reduced.Z, reduced.F, np.asarray(model.contact.gap, float),
               np.asarray(model.contact.area, float), np.asarray(coef, float),
-              np.asarray(W0, float), np.asarray(anchor0, float)):
+              np.asarray(wear0, float), np.asarray(anchor0, float)):
         h.update(np.ascontiguousarray(a).tobytes())
     meta = {"basis": [list(basis.harmonics), basis.n_samples], "eps": float(eps),
             "mu": _mu_key(model.contact.mu), "omega": float(reduced.omega),
@@ -55,10 +66,13 @@ def fingerprint(model: Model, reduced: Reduced, basis: FourierBasis, eps: float,
     return h.hexdigest()
 
 
-def save_checkpoint(path: Path | str, state: dict, rows: list[dict], key: str) -> Path:
-    """Write the state and the history so far to ``path`` (``.npz``) atomically."""
-    arrays = {f"state_{k}": np.asarray(v) for k, v in state.items()}
-    hist = WearHistory.from_rows(rows)
+def save_checkpoint(path: Path | str, state: SlowStep, records: list[StepRecord],
+                    key: str) -> Path:
+    """Write the state (every field of :class:`~fretwear.wear.state.SlowStep`, ``state_``
+    and its name) and the history so far (``hist_`` and its column) to ``path`` (``.npz``)
+    atomically."""
+    arrays = {f"state_{f.name}": np.asarray(getattr(state, f.name)) for f in STATE_FIELDS}
+    hist = WearHistory.from_records(records)
     arrays.update({f"hist_{k}": getattr(hist, k) for k in HISTORY_FIELDS})
     arrays["fingerprint"] = np.asarray(key)
     arrays["version"] = np.asarray(CHECKPOINT_VERSION)
@@ -70,22 +84,8 @@ def save_checkpoint(path: Path | str, state: dict, rows: list[dict], key: str) -
     return atomic_write(path, write)
 
 
-#: the state of a checkpoint (:func:`fretwear.wear.schemes.first_state`) and its shape in
-#: the dimensions of the model: nc contact nodes, d components, H Fourier coefficients
-#: (m = nc d; None: any shape, e.g. the time-integration state ``td_U``, ``td_V``)
-STATE_SHAPES = {
-    "step": (), "cycles": (), "W": ("nc",), "U": ("m", "H"), "anchor": ("nc", "d-1"),
-    "g": ("nc",), "jump": (), "vrate": (), "vrate0": (), "stability_jump": (),
-    "stop_reason": (), "td_U": None, "td_V": None, "td_retry_at": (), "Js": None,
-}
-#: the history arrays whose shape is more than (s,) (s = recorded steps)
-HISTORY_SHAPES = {
-    "wear_depth": ("s", "nc"), "wear_rate": ("s", "nc"), "pressure_mean": ("s", "nc"),
-    "pressure_max": ("s", "nc"), "slip_amplitude": ("s", "nc"), "slip_path": ("s", "nc"),
-    "state_fraction": ("s", "nc", 3), "friction_energy": ("s", "nc"),
-    "U": ("s", "nc", "d", "H"), "lam": ("s", "nc", "d", "H"), "anchor": ("s", "nc", "d-1"),
-}
-_TEXT = ("fingerprint", "state_stop_reason")
+#: text arrays (every other one is numeric)
+_TEXT = ("fingerprint", *(f"state_{f.name}" for f in STATE_FIELDS if f.type == "str"))
 
 
 WHAT = "wear checkpoint"
@@ -103,8 +103,9 @@ def check_checkpoint_path(path: Path | str) -> None:
 
 
 def _read_checkpoint(path: Path | str) -> dict:
-    """The arrays of a checkpoint of this format version (:func:`save_checkpoint`), checked
-    for completeness and consistency (:func:`_check_arrays`).
+    """The arrays of a checkpoint of a version read (:data:`READ_VERSIONS`), its state under
+    the names of :class:`~fretwear.wear.state.SlowStep`, checked for completeness and
+    consistency (:func:`_check_arrays`).
 
     Raises
     ------
@@ -115,13 +116,21 @@ def _read_checkpoint(path: Path | str) -> dict:
     version = data.get("version")
     if version is None or version.shape != () or version.dtype.kind not in "iu":
         raise _damaged(path, "no format version")
-    if int(version) != CHECKPOINT_VERSION:
+    if int(version) not in READ_VERSIONS:
         raise InputError(f"wear checkpoint {str(path)!r} has another format version; delete it "
                          "to start again")
+    if int(version) == 3:
+        data = {_format_3_name(k): v for k, v in data.items()}
     why = _check_arrays(data)
     if why:
         raise _damaged(path, why)
     return data
+
+
+def _format_3_name(key: str) -> str:
+    """The name in this format of the array ``key`` of a format-3 checkpoint."""
+    old = key.removeprefix("state_")
+    return f"state_{FORMAT_3_NAMES[old]}" if old != key and old in FORMAT_3_NAMES else key
 
 
 def _dims(data: dict) -> dict:
@@ -133,7 +142,7 @@ def _dims(data: dict) -> dict:
 def _check_arrays(data: dict) -> str:
     """What is wrong with the arrays of a checkpoint ("" if nothing): every key present,
     numeric (text where text is expected), and shapes consistent with one another."""
-    need = ["fingerprint", *(f"state_{k}" for k in STATE_SHAPES),
+    need = ["fingerprint", *(f"state_{f.name}" for f in STATE_FIELDS),
             *(f"hist_{k}" for k in HISTORY_FIELDS if k not in LATE_HISTORY_FIELDS)]
     missing = [k for k in need if k not in data]
     if missing:
@@ -146,13 +155,16 @@ def _check_arrays(data: dict) -> str:
     dims = _dims(data)
     if dims["s"] < 1 or dims["d"] < 2:
         return "an empty history"  # (or fewer than 2 components)
-    wanted = {f"state_{k}": v for k, v in STATE_SHAPES.items() if v is not None}
-    wanted.update({f"hist_{k}": HISTORY_SHAPES.get(k, ("s",)) for k in HISTORY_FIELDS})
-    for k, shape in wanted.items():
-        if k in data and data[k].shape != tuple(dims.get(n, n) for n in shape):
-            return f"{k} has the shape {data[k].shape}"
-    if data["state_Js"].size and data["state_Js"].shape != (dims["nc"], dims["nc"]):
-        return f"state_Js has the shape {data['state_Js'].shape}"
+    wanted = {f"state_{f.name}": f for f in STATE_FIELDS}
+    wanted.update({f"hist_{k}": f for k, f in RECORD_FIELDS.items()})
+    for k, f in wanted.items():
+        shape = shape_of(f, dims)
+        if k.startswith("hist_"):
+            shape = (dims["s"], *shape)
+        a = data.get(k)
+        if (a is not None and shape is not None and a.shape != shape
+                and not (f.metadata["empty"] and a.size == 0)):
+            return f"{k} has the shape {a.shape}"
     if int(data["state_step"]) != dims["s"] - 1:
         return f"state at step {int(data['state_step'])} with a history of {dims['s']} steps"
     return ""
@@ -174,11 +186,11 @@ def read_history(path: Path | str) -> WearHistory:
     return _history(_read_checkpoint(path))
 
 
-def load_checkpoint(path: Path | str, key: str,
-                    shape: tuple[int, int, int] | None = None) -> tuple[dict, list[dict]]:
-    """Read a checkpoint written by :func:`save_checkpoint` for the same trajectory ``key``
-    and, when given, the model's ``shape = (nc, d, H)`` (contact nodes, components, Fourier
-    coefficients).
+def load_checkpoint(path: Path | str, key: str, shape: tuple[int, int, int] | None = None
+                    ) -> tuple[SlowStep, list[StepRecord]]:
+    """Read a checkpoint written by :func:`save_checkpoint` (this format or format 3) for the
+    same trajectory ``key`` and, when given, the model's ``shape = (nc, d, H)`` (contact nodes,
+    components, Fourier coefficients): the state and the records of the history.
 
     Raises
     ------
@@ -197,5 +209,12 @@ def load_checkpoint(path: Path | str, key: str,
                          f"({dims['nc']} contact nodes, {dims['d']} components, {dims['H']} "
                          f"Fourier coefficients instead of {shape[0]}, {shape[1]}, {shape[2]}); "
                          "delete it (or run without --resume) to start again")
-    state = {k[6:]: data[k] for k in data if k.startswith("state_")}
-    return state, _history(data).rows()
+    state = SlowStep(**{f.name: _value(f, data[f"state_{f.name}"]) for f in STATE_FIELDS})
+    return state, _history(data).records()
+
+
+def _value(f, a: np.ndarray):
+    """The value of the state field ``f`` stored as the array ``a``: a Python number or
+    text where the field is one, else the array."""
+    convert = {"int": int, "float": float, "str": str}.get(f.type)
+    return convert(a) if convert is not None else a

@@ -22,13 +22,13 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
 from fretwear.errors import ConvergenceError, InputError
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.solvers import SolveStats
-from fretwear.wear.history import solution_row
 from fretwear.wear.options import (
     GROWTH_LIMIT,
     MIN_JUMP_FRACTION,
@@ -36,27 +36,44 @@ from fretwear.wear.options import (
     WearOptions,
 )
 from fretwear.wear.slow_problem import SlowProblem
+from fretwear.wear.state import SlowStep, StepRecord, StepStats
 from fretwear.wear.step_control import local_error, next_jump
 from fretwear.wear.time_steps import time_domain_start
 
 
-def first_state(sp: SlowProblem, W0, anchor, U0, opts: WearOptions) -> tuple[dict, list[dict]]:
-    """The balanced initial state (step 0)."""
+@dataclass(frozen=True)
+class StepStart:
+    """Where a slow step starts: the wear depths ``W`` (nc,) [m], their balance ``U`` (m, H)
+    [m] and rate ``g`` (nc,) [m/cycle], and the stick anchors ``anchor`` (nc, d-1) [m] of the
+    step's balances."""
+
+    W: np.ndarray
+    U: np.ndarray
+    g: np.ndarray
+    anchor: np.ndarray
+
+
+def first_state(sp: SlowProblem, wear0, anchor, U0, opts: WearOptions
+                ) -> tuple[SlowStep, list[StepRecord]]:
+    """The balanced initial state (step 0) at the wear depths ``wear0`` (nc,) [m], from the
+    stick anchors ``anchor`` (nc, d-1) [m] and the start ``U0`` (or None) of the first solve;
+    from a time integration when that balance fails and the problem has one
+    (:func:`~fretwear.wear.time_steps.time_domain_start`)."""
     t0 = time.perf_counter()
-    sp.set_state(W0, anchor)
+    sp.set_state(wear0, anchor)
     # the first balance goes through solve_periodic (its start strategies for a cold start);
     # the solver alone: a wear run has its own fallback (a start from a time integration),
     # and its examples are validated with it (the further attempts of solve_periodic find a
     # balance of the 79 kHz reduced example that the time-domain start replaces today)
     sol0 = solve_periodic(sp.model, sp.prob.basis, frequency=sp.prob.reduced.frequency,
                           quasi_static=sp.prob.reduced.quasi_static,
-                          reduced=sp.prob.reduced, gap=sp.gap0 + W0, eps=sp.eps,
+                          reduced=sp.prob.reduced, gap=sp.gap0 + wear0, eps=sp.eps,
                           anchor=anchor, U0=U0, solver=opts.solver, tol=opts.tol,
                           max_iter=max(opts.max_iter, 200), strategy=("start",))
     st = sol0.stats
     if not sol0.success:
         if sp.time_domain is not None:
-            return time_domain_start(sp, W0, opts, st, t0)
+            return time_domain_start(sp, wear0, opts, st, t0)
         raise ConvergenceError(
             f"the periodic solve of the unworn interface did not converge ({st.message}, "
             f"relative residual {st.residual:.3g} > {opts.tol:g}): no wear computed"
@@ -79,38 +96,34 @@ def first_state(sp: SlowProblem, W0, anchor, U0, opts: WearOptions) -> tuple[dic
         jump = opts.tolerance * stab if math.isfinite(stab) else 1.0
     else:
         jump = 0.5 * stab if math.isfinite(stab) else 1.0
-    sol = sp.solution(U, W0, anchor, st)
-    row = solution_row(sol, W0, g, 0.0, 0.0, st.iterations, 0, 0.0, time.perf_counter() - t0)
-    state = {
-        "step": 0, "cycles": 0.0, "W": np.array(W0, float), "U": U.copy(),
-        "anchor": np.array(anchor, float), "g": g, "jump": float(jump),
-        "vrate": row["volume_rate"], "vrate0": row["volume_rate"],
-        "stability_jump": float(stab), "stop_reason": np.asarray(""),
-        "td_U": np.zeros(0), "td_V": np.zeros(0), "td_retry_at": 0.0, "Js": np.zeros(0),
-    }
-    return state, [row]
+    sol = sp.solution(U, wear0, anchor, st)
+    record = StepRecord.balanced(sol, wear0, g, StepStats(0.0, 0.0, st.iterations, 0, 0.0,
+                                                          time.perf_counter() - t0))
+    return SlowStep.balanced(record, jump, stability_jump=stab), [record]
 
 
-def advance(sp: SlowProblem, st: dict, opts: WearOptions):
-    """One accepted slow step from state ``st``: ``(new_state, row, failure_message)``.
+def advance(sp: SlowProblem, st: SlowStep, opts: WearOptions):
+    """One accepted slow step from the state ``st``: ``(new_state, record, failure_message)``
+    (``(None, None, message)`` when it failed).
 
     Retries a failed solve with the jump divided by 4 (up to ``max_retries`` times, not below
     ``min_jump``); with ``adaptive``, rejects a step whose error estimate exceeds the
     tolerance and retries with the jump the controller proposes.
     """
     t0 = time.perf_counter()
-    W_k, U_k, g_k = st["W"], st["U"], st["g"]
-    anchor = U_k.reshape(sp.nc, sp.d, sp.H)[:, 1:, 0].copy()  # history rule: previous mean
-    dN = min(float(st["jump"]), opts.max_jump, opts.max_cycles - float(st["cycles"]))
-    floor = max(opts.min_jump, MIN_JUMP_FRACTION * float(st["cycles"]))  # error control
+    # history rule: the stick anchors are the previous mean tangential positions
+    anchor = st.U.reshape(sp.nc, sp.d, sp.H)[:, 1:, 0].copy()
+    start = StepStart(st.W, st.U, st.g, anchor)
+    dN = min(st.jump, opts.max_jump, opts.max_cycles - st.cycles)
+    floor = max(opts.min_jump, MIN_JUMP_FRACTION * st.cycles)  # error control
     rescue = sp.time_domain is not None
     # failed solves: with a time-domain rescue behind, stop cutting where the rescue starts
-    fail_floor = max(floor, RESCUE_START_FRACTION * float(st["cycles"])) if rescue else floor
+    fail_floor = max(floor, RESCUE_START_FRACTION * st.cycles) if rescue else floor
     iters = rejected = failures = 0
     lin = None
     if opts.scheme != "explicit":
-        sp.set_state(W_k, anchor)
-        lin = sp.slow_jacobian(U_k, with_dUdW=True)  # Js, dU/dW at the start of the step
+        sp.set_state(st.W, anchor)
+        lin = sp.slow_jacobian(st.U, with_dUdW=True)  # Js, dU/dW at the start of the step
         iters += 1
         # a growing mode (eigenvalue lam > 0: wear moving load onto a neighbour) is only
         # followed accurately with dN lam small, and I - dN Js is singular at dN lam = 1
@@ -118,51 +131,50 @@ def advance(sp: SlowProblem, st: dict, opts: WearOptions):
         if lam_plus > 0:
             dN = min(dN, GROWTH_LIMIT / lam_plus)
     while True:
-        W1, U1, stats = _attempt(sp, opts, W_k, U_k, g_k, anchor, dN, lin)
+        W1, U1, stats = _attempt(sp, opts, start, dN, lin)
         iters += stats.iterations
         if not stats.success:
             failures += 1
             rejected += 1
             if failures > opts.max_retries or dN <= fail_floor:
-                return None, None, (f"{stats.message} at N = {float(st['cycles']):.4g} with a "
+                return None, None, (f"{stats.message} at N = {st.cycles:.4g} with a "
                                     f"jump of {dN:.3g} cycles after {failures} attempts")
             dN = max(dN / 4.0, fail_floor)
             continue
         sp.set_state(W1, anchor)
         g1 = sp.rate(U1)
-        err = local_error(dN, W1, W_k, g1, g_k)
+        err = local_error(dN, W1, st.W, g1, st.g)
         if opts.adaptive and err > opts.tolerance and dN > floor:
             rejected += 1
             dN = max(dN * max(0.1, 0.9 * math.sqrt(opts.tolerance / err)), floor)
             continue
         break
     # no growth right after a failed solve (stiff ODE practice)
-    jump = next_jump(dN, err, opts, float(st["jump"]), 1.0 if failures else 5.0)
+    jump = next_jump(dN, err, opts, st.jump, 1.0 if failures else 5.0)
     sol = sp.solution(U1, W1, anchor, stats)
-    cycles = float(st["cycles"]) + dN
-    row = solution_row(sol, W1, g1, cycles, dN, iters, rejected, err, time.perf_counter() - t0)
-    new = dict(st)
-    new.update({"step": int(st["step"]) + 1, "cycles": cycles, "W": np.array(W1, float),
-                "U": U1.copy(), "anchor": anchor, "g": g1, "jump": float(jump),
-                "vrate": row["volume_rate"]})
-    return new, row, ""
+    record = StepRecord.balanced(sol, W1, g1, StepStats(st.cycles + dN, dN, iters, rejected,
+                                                        err, time.perf_counter() - t0))
+    return SlowStep.balanced(record, jump, st), record, ""
 
 
-def _attempt(sp: SlowProblem, opts: WearOptions, W_k, U_k, g_k, anchor, dN, lin):
-    """One try of a slow step of ``dN`` cycles: ``(W1, U1, stats)``.
+def _attempt(sp: SlowProblem, opts: WearOptions, start: StepStart, dN: float, lin):
+    """One try of a slow step of ``dN`` cycles from ``start``: ``(W1, U1, stats)``; ``lin``
+    the slow Jacobian ``Js`` (nc, nc) and ``dU~/dW`` (n, nc) at the start (None for the
+    explicit scheme).
 
     explicit (eq. 30): ``W1 = W_k + dN g_k``, then the balance at ``W1``;
     rosenbrock: ``W1 = W_k + dN (I - dN Js)^-1 g_k``, then the balance at ``W1``;
-    implicit: backward Euler from the Rosenbrock predictor (:func:`_backward_euler`, or the
+    implicit: backward Euler from the Rosenbrock predictor (:class:`_BackwardEuler`, or the
     Newton method on the coupled unknowns ``(U~, W1)`` when ``implicit_newton = "coupled"``).
     """
     kw = {"solver": opts.solver, "tol": opts.tol, "max_iter": opts.max_iter}
+    W_k, U_k, anchor = start.W, start.U, start.anchor
     if opts.scheme == "explicit":
-        W1 = W_k + dN * g_k
+        W1 = W_k + dN * start.g
         U1, stats = sp.solve_balance(W1, anchor, sp.shift_guess(U_k, W1 - W_k), **kw)
         return W1, U1, stats
     Js, dUdW = lin
-    dW = dN * np.linalg.solve(np.eye(sp.nc) - dN * Js, g_k)
+    dW = dN * np.linalg.solve(np.eye(sp.nc) - dN * Js, start.g)
     dW = np.maximum(dW, 0.0)  # a node's wear never decreases (g >= 0)
     Wp = W_k + dW
     Up = U_k + (dUdW @ dW).reshape(sp.m, sp.H)
@@ -177,12 +189,12 @@ def _attempt(sp: SlowProblem, opts: WearOptions, W_k, U_k, g_k, anchor, dN, lin)
         kw["max_iter"] = opts.max_iter_coupled
         U1, W1, stats = sp.solve_implicit(W_k, dN, anchor, Up, Wp, **kw)
         return W1, U1, stats
-    return _backward_euler(sp, opts, W_k, U_k, dN, anchor, Up, Wp, Js, dUdW)
+    return _BackwardEuler(sp, opts, start, dN).solve(Wp, Up, lin)
 
 
-def _backward_euler(sp: SlowProblem, opts: WearOptions, W_k, U_start, dN, anchor, U, W, Js,
-                    dUdW):
-    """Backward Euler ``W1 = W_k + dN g(W1)`` by a damped Newton method on ``W``.
+class _BackwardEuler:
+    """Backward Euler ``W1 = W_k + dN g(W1)`` by a damped Newton method on ``W``, for one
+    step of ``dN`` cycles from ``start`` (:class:`StepStart`).
 
     Every iterate is a converged periodic balance at its ``W`` (the ordinary DLFT solve,
     warm-started), so no unbalanced state is ever returned. The BE defect
@@ -194,71 +206,83 @@ def _backward_euler(sp: SlowProblem, opts: WearOptions, W_k, U_start, dN, anchor
     and the iteration can stall at a kink: the best iterate is then returned if
     ``max|r| <= 0.5 tolerance max W``. The step's error estimate (:func:`local_error`) contains
     ``r``, so the error test judges such a step.
-
-    Returns ``(W1, U1, stats)``; ``stats.success`` is False when the balance or the
-    iteration fails.
     """
-    t0 = time.perf_counter()
-    kw = {"solver": opts.solver, "tol": opts.tol, "max_iter": opts.max_iter}
-    its = 0
-    msg = "backward Euler iteration did not converge"
 
-    def evaluate(W, U):
-        nonlocal its
-        U1, st = sp.solve_balance(W, anchor, U, **kw)
-        its += st.iterations
+    def __init__(self, sp: SlowProblem, opts: WearOptions, start: StepStart, dN: float):
+        self.sp, self.opts, self.start, self.dN = sp, opts, start, dN
+        self.kw = {"solver": opts.solver, "tol": opts.tol, "max_iter": opts.max_iter}
+        self.its = 0  # nonlinear iterations, slow Jacobians included
+
+    def evaluate(self, W, U):
+        """The balance at ``W`` from ``U`` and the BE defect there: ``(U, r, max|r|,
+        residual)``, or None when the balance fails (also from the start's balance)."""
+        sp, start = self.sp, self.start
+        U1, st = sp.solve_balance(W, start.anchor, U, **self.kw)
+        self.its += st.iterations
         if not st.success:  # retry from the previous balance, shifted by the wear change
-            U1, st = sp.solve_balance(W, anchor, sp.shift_guess(U_start, W - W_k), **kw)
-            its += st.iterations
+            U1, st = sp.solve_balance(W, start.anchor, sp.shift_guess(start.U, W - start.W),
+                                      **self.kw)
+            self.its += st.iterations
         if not st.success:
             return None
         U = U1
-        r = W - W_k - dN * sp.rate(U)
+        r = W - start.W - self.dN * sp.rate(U)
         return U, r, float(np.max(np.abs(r))), st.residual
 
-    ev = evaluate(W, U)
-    if ev is None:
-        return W, U, SolveStats(False, math.inf, its, 0, 0, time.perf_counter() - t0,
-                                "balance failed at the predictor", opts.solver)
-    U, r, rn, res = ev
-    best = (rn, W, U, res)
-    M = np.eye(sp.nc) - dN * Js
-    fresh = True
-    for _k in range(opts.max_iter_implicit):
-        if rn <= 0.1 * opts.tolerance * max(float(np.max(W)), 1e-300):
-            break
-        dW = -np.linalg.solve(M, r)
-        t, accepted = 1.0, False
+    def matrix(self, U):
+        """The iteration matrix ``I - dN Js`` and ``dU~/dW`` at the balance ``U``."""
+        Js, dUdW = self.sp.slow_jacobian(U, with_dUdW=True)
+        self.its += 1
+        return np.eye(self.sp.nc) - self.dN * Js, dUdW
+
+    def backtrack(self, W, U, dW, dUdW, rn):
+        """The Newton step ``dW`` from ``(W, U)``, halved until ``max|r|`` decreases (at most
+        4 tries): ``(W_try, evaluation)``, or None."""
+        t = 1.0
         for _ls in range(4):
-            W_try = np.maximum(W + t * dW, W_k)  # BE keeps W1 >= W_k since g >= 0
-            ev = evaluate(W_try, U + (dUdW @ (W_try - W)).reshape(sp.m, sp.H))
+            W_try = np.maximum(W + t * dW, self.start.W)  # BE keeps W1 >= W_k since g >= 0
+            ev = self.evaluate(W_try, U + (dUdW @ (W_try - W)).reshape(self.sp.m, self.sp.H))
             if ev is not None and ev[2] < (1.0 - 1e-4 * t) * rn:
-                accepted = True
-                break
+                return W_try, ev
             t *= 0.5
-        if not accepted:
-            if fresh:
-                msg = "backward Euler iteration stalled (no decrease of the defect)"
+        return None
+
+    def solve(self, W, U, lin):
+        """The step from the predictor ``(W, U)`` with the linearization ``lin = (Js, dUdW)``
+        at the start: ``(W1, U1, stats)``; ``stats.success`` is False when the balance or
+        the iteration fails."""
+        t0 = time.perf_counter()
+        opts, sp = self.opts, self.sp
+        msg = "backward Euler iteration did not converge"
+        ev = self.evaluate(W, U)
+        if ev is None:
+            return W, U, SolveStats(False, math.inf, self.its, 0, 0, time.perf_counter() - t0,
+                                    "balance failed at the predictor", opts.solver)
+        U, r, rn, res = ev
+        best = (rn, W, U, res)
+        Js, dUdW = lin
+        M = np.eye(sp.nc) - self.dN * Js
+        fresh = True
+        for _k in range(opts.max_iter_implicit):
+            if rn <= 0.1 * opts.tolerance * max(float(np.max(W)), 1e-300):
                 break
-            Js, dUdW = sp.slow_jacobian(U, with_dUdW=True)  # retry with a fresh Jacobian
-            its += 1
-            M = np.eye(sp.nc) - dN * Js
-            fresh = True
-            continue
-        contraction = ev[2] / rn
-        W, (U, r, rn, res) = W_try, ev
-        if rn < best[0]:
-            best = (rn, W, U, res)
-        if contraction > 0.5:  # poor contraction: Jacobian at the new iterate
-            Js, dUdW = sp.slow_jacobian(U, with_dUdW=True)
-            its += 1
-            M = np.eye(sp.nc) - dN * Js
-            fresh = True
-        else:
-            fresh = False
-    rn, W, U, res = best
-    if rn <= 0.5 * opts.tolerance * max(float(np.max(W)), 1e-300):
-        return W, U, SolveStats(True, res, its, 0, 0, time.perf_counter() - t0, "converged",
+            tried = self.backtrack(W, U, -np.linalg.solve(M, r), dUdW, rn)
+            if tried is None:
+                if fresh:
+                    msg = "backward Euler iteration stalled (no decrease of the defect)"
+                    break
+                M, dUdW = self.matrix(U)  # retry with a fresh Jacobian
+                fresh = True
+                continue
+            contraction = tried[1][2] / rn
+            W, (U, r, rn, res) = tried
+            if rn < best[0]:
+                best = (rn, W, U, res)
+            fresh = contraction > 0.5
+            if fresh:  # poor contraction: Jacobian at the new iterate
+                M, dUdW = self.matrix(U)
+        rn, W, U, res = best
+        ok = rn <= 0.5 * opts.tolerance * max(float(np.max(W)), 1e-300)
+        return W, U, SolveStats(ok, res if ok else math.inf, self.its, 0, 0,
+                                time.perf_counter() - t0, "converged" if ok else msg,
                                 opts.solver)
-    return W, U, SolveStats(False, math.inf, its, 0, 0, time.perf_counter() - t0, msg,
-                            opts.solver)

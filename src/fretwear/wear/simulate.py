@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -28,7 +29,7 @@ from fretwear.errors import InputError, interrupted
 from fretwear.hb.fallback import TimeDomainFallback
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import PeriodicSolution, check_inputs, preload_anchor
-from fretwear.hb.reduce import Reduced, condense
+from fretwear.hb.reduce import Reduced, condense, condenser_for
 from fretwear.hb.solvers import SolveStats
 from fretwear.model.core import Model
 from fretwear.wear.checkpoint import (
@@ -42,14 +43,64 @@ from fretwear.wear.laws import wear_coefficients, worn_volume
 from fretwear.wear.options import WearOptions
 from fretwear.wear.schemes import advance, first_state
 from fretwear.wear.slow_problem import SlowProblem
+from fretwear.wear.state import SlowStep, StepRecord
 from fretwear.wear.time_steps import time_domain_step
 
+#: the frequency of a quasi-static run that gives none [Hz]: it only scales time
+QUASI_STATIC_FREQUENCY = 1.0
 
-def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
+
+@dataclass(frozen=True)
+class BalanceSetup:
+    """How the periodic balances of a wear run are set up (every field optional).
+
+    Attributes
+    ----------
+    reduced : precomputed condensation on ``[0] + basis.harmonics`` (:func:`fretwear.condense`;
+        default: computed by the run).
+    eps : DLFT penalty: ``"auto"`` (default) the spectral radius of ``Z_r`` (the paper),
+        ``"static"`` that of the static ``K_r``, or a positive number [N/m]
+        (:func:`fretwear.hb.penalty.penalty`).
+    anchor : (nc, d-1) stick anchors of the first solve [m] (default: static preload state;
+        0 when that static solve does not converge, and the result's ``warnings`` says so).
+    U0 : (nc, d, H) or (m, H) start of the first periodic solve [m].
+    condenser : the condenser of the model (:func:`fretwear.hb.reduce.exact_condenser` or
+        :func:`fretwear.hb.modal.modal_condenser`), used for every condensation of the run
+        (default: a new exact one, built once for the run).
+    """
+
+    reduced: Reduced | None = None
+    eps: str | float = "auto"
+    anchor: np.ndarray | None = None
+    U0: np.ndarray | None = None
+    condenser: object | None = None
+
+
+@dataclass(frozen=True)
+class RunControl:
+    """How a wear run is kept, shown and watched (every field optional).
+
+    Attributes
+    ----------
+    checkpoint : ``.npz`` file for the state (written atomically as the run goes, every
+        ``WearOptions.checkpoint_every_s``, on Ctrl-C and at the end).
+    resume : continue from ``checkpoint`` when it exists (same model and options; a damaged
+        checkpoint is an InputError, never silently replaced).
+    progress : show a tqdm bar (cycles, worn volume, rate, time left).
+    callback : ``callback(step, record)`` after each accepted step (and after the checkpoint
+        is written), ``record`` its :class:`~fretwear.wear.state.StepRecord`; raising
+        ``KeyboardInterrupt`` there stops the run as Ctrl-C.
+    """
+
+    checkpoint: Path | str | None = None
+    resume: bool = False
+    progress: bool = False
+    callback: Callable | None = None
+
+
+def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float | None = None,
                   quasi_static: bool = False, options: WearOptions | None = None,
-                  reduced: Reduced | None = None, eps: str | float = "auto", anchor=None,
-                  W0=None, U0=None, checkpoint: Path | str | None = None, resume: bool = False,
-                  progress: bool = False, callback: Callable | None = None,
+                  wear0=None, balance: BalanceSetup | None = None, run: RunControl | None = None,
                   time_domain: TimeDomainFallback | None = None) -> WearResult:
     """Integrate fretting wear over the slow time scale (paper Fig. 3, eq. 29-30).
 
@@ -57,27 +108,21 @@ def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
     ----------
     model : the structure (``contact.wear_coefficient`` k_w [1/Pa] for Archard's law).
     basis : Fourier basis of the periodic solutions.
-    frequency : excitation frequency [Hz] (only scales time when ``quasi_static``).
+    frequency : excitation frequency [Hz]; required unless ``quasi_static`` (then it only
+        scales time, default :data:`QUASI_STATIC_FREQUENCY`).
     quasi_static : drop inertia and damping.
     options : :class:`WearOptions` (defaults: adaptive linearly implicit, tolerance 1e-2).
-    reduced : precomputed condensation on ``[0] + basis.harmonics``.
-    eps : DLFT penalty: ``"auto"`` (default) the spectral radius of ``Z_r`` (the paper),
-        ``"static"`` that of the static ``K_r``, or a positive number [N/m]
-        (:func:`fretwear.hb.penalty.penalty`).
-    anchor : (nc, d-1) stick anchors of the first solve [m] (default: static preload state;
-        0 when that static solve does not converge, and the result's ``warnings`` says so).
-    W0 : (nc,) initial wear [m] (default 0).
-    U0 : (nc, d, H) or (m, H) start of the first periodic solve.
-    checkpoint : ``.npz`` file for the state (written atomically as the run goes).
-    resume : continue from ``checkpoint`` when it exists (same model and options; a damaged
-        checkpoint is an InputError, never silently replaced).
-    progress : show a tqdm bar (cycles, worn volume, rate, time left).
-    callback : ``callback(step, history_row)`` after each accepted step (and after the
-        checkpoint is written); raising ``KeyboardInterrupt`` there stops the run as Ctrl-C.
+    wear0 : (nc,) initial wear depths [m] (default 0).
+    balance : :class:`BalanceSetup`: the condensation, the DLFT penalty, the stick anchors and
+        the start of the first periodic solve (default: all computed).
+    run : :class:`RunControl`: checkpoint and resume, progress bar, callback (default: none).
     time_domain : the :class:`~fretwear.hb.fallback.TimeDomainFallback` of the steps whose
         balance fails (``options.time_domain_rescue``, dynamic cases); ``None``: no fallback
         (a failed balance stops the run). :func:`fretwear.simulate_wear` passes
         :data:`fretwear.timedomain.fallback.FALLBACK`.
+    condenser : the condenser of ``model`` (:func:`fretwear.hb.reduce.exact_condenser` or
+        :func:`fretwear.hb.modal.modal_condenser`) used by every condensation and recovery of
+        the run; None: a new exact one, built once for the run.
 
     Returns
     -------
@@ -86,133 +131,193 @@ def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
 
     Raises
     ------
+    InputError
+        Bad input, e.g. a dynamic run without ``frequency``.
     ConvergenceError
         The first periodic solve (unworn interface) did not converge and no time-domain start
         is allowed (quasi-static, or ``time_domain_rescue = False``): nothing to integrate.
     KeyboardInterrupt
         On Ctrl-C (the last accepted state is in the checkpoint first).
     """
-    frequency = check_inputs(model, basis, frequency, quasi_static=quasi_static,
-                             anchor=anchor, U0=U0)
+    balance, run, opts = _settings(balance, run, options)
+    frequency = check_inputs(model, basis, _frequency(frequency, quasi_static),
+                             quasi_static=quasi_static, anchor=balance.anchor, U0=balance.U0)
     if model.contact.prescribed_nodes().any():
         raise InputError("contact normal_load: wear needs the normal contact to come from the "
                          "structure (a prescribed normal load does not move with the worn gap)")
     if model.contact.has_connectors:  # the time-domain solver has rigid contacts only
         time_domain = None
-    if options is not None and not isinstance(options, WearOptions):
-        raise TypeError(f"options = {options!r}: expected a WearOptions")
-    opts = (options or WearOptions()).check()
-    ckpt = Path(checkpoint) if checkpoint is not None else None
-    if ckpt is not None:
-        check_checkpoint_path(ckpt)  # a folder there: refused before anything is computed
+    if run.checkpoint is not None:
+        check_checkpoint_path(run.checkpoint)  # a folder: refused before anything is computed
     t_start = time.perf_counter()
     nc, d = model.contact.dofs.shape
+    condenser = condenser_for(model, balance.condenser)  # one for every condensation of the run
+    reduced = balance.reduced
     if reduced is None:
-        reduced = condense(model, frequency, basis.orders, quasi_static=quasi_static)
+        reduced = condense(model, frequency, basis.orders, quasi_static=quasi_static,
+                           condenser=condenser)
     coef = wear_coefficients(model, opts.law, opts.energy_coefficient,
                              opts.partner_energy_coefficient)
-    W0 = np.zeros(nc) if W0 is None else np.broadcast_to(np.asarray(W0, float), (nc,)).copy()
+    wear0 = np.zeros(nc) if wear0 is None else np.broadcast_to(np.asarray(wear0, float),
+                                                                 (nc,)).copy()
+    anchor, warnings = _first_anchor(model, balance.anchor, condenser)
+    sp = SlowProblem(model, reduced, basis, coef, eps=balance.eps, anchor=anchor,
+                     time_domain=time_domain if opts.time_domain_rescue and not quasi_static
+                     else None, condenser=condenser)
+    saver = _Saver(run.checkpoint, fingerprint(model, reduced, basis, sp.eps, coef, opts, wear0,
+                                               anchor), opts.checkpoint_every_s)
+    if run.resume and saver.exists():  # damaged: an InputError, never ignored
+        state, records = saver.load(shape=(nc, d, sp.H))
+        resumed_from = state.step
+    else:
+        state, records = first_state(sp, wear0, anchor, balance.U0, opts)
+        resumed_from = -1
+    balanced = [r for r in records if r.has_balance]
+    initial = _assemble(sp, balanced[0]) if balanced else None
+    state, reason, extra = _integrate(sp, state, records, opts, run, saver)
+    state.stop_reason = reason
+    saver.save(state, records, now=True)
+    balanced = [r for r in records if r.has_balance]
+    final = _assemble(sp, balanced[-1]) if balanced else None
+    return WearResult(WearHistory.from_records(records, reason), initial, final, reason,
+                      _message(reason, state, opts, extra), reason != "solver_failed",
+                      time.perf_counter() - t_start, state.stability_jump, resumed_from,
+                      penalty=sp.eps, warnings=warnings)
+
+
+def _settings(balance, run, options) -> tuple[BalanceSetup, RunControl, WearOptions]:
+    """The settings records of a run, checked, defaults for those not given."""
+    for name, value, kind in (("balance", balance, BalanceSetup), ("run", run, RunControl),
+                              ("options", options, WearOptions)):
+        if value is not None and not isinstance(value, kind):
+            raise TypeError(f"{name} = {value!r}: expected a {kind.__name__}")
+    return balance or BalanceSetup(), run or RunControl(), (options or WearOptions()).check()
+
+
+def _frequency(frequency, quasi_static: bool):
+    """The excitation frequency [Hz]: required for a dynamic run; a quasi-static run without
+    one gets :data:`QUASI_STATIC_FREQUENCY` (it only scales time)."""
+    if frequency is not None:
+        return frequency
+    if not quasi_static:
+        raise InputError("frequency = None: a dynamic wear run needs the excitation frequency "
+                         "[Hz] (frequency=...), or quasi_static=True")
+    return QUASI_STATIC_FREQUENCY
+
+
+def _first_anchor(model: Model, anchor, condenser) -> tuple[np.ndarray, list]:
+    """The stick anchors (nc, d-1) [m] of the first solve: ``anchor``, or those of the static
+    preload state; and the warnings (the static solve did not converge)."""
     warnings = []
     if anchor is None:
-        preload = preload_anchor(model)
+        preload = preload_anchor(model, condenser=condenser)
         anchor = preload.values
         if not preload.success:
             warnings.append(preload.warning)
-    anchor = np.array(anchor, float).reshape(nc, d - 1)
-    sp = SlowProblem(model, reduced, basis, coef, eps=eps, anchor=anchor,
-                     time_domain=time_domain if opts.time_domain_rescue and not quasi_static
-                     else None)
-    key = fingerprint(model, reduced, basis, sp.eps, coef, opts, W0, anchor)
+    nc, d = model.contact.dofs.shape
+    return np.array(anchor, float).reshape(nc, d - 1), warnings
 
-    state, rows, resumed_from = None, [], -1
-    if resume and ckpt is not None and ckpt.exists():  # damaged: an InputError, never ignored
-        state, rows = load_checkpoint(ckpt, key, shape=(nc, d, sp.H))
-        resumed_from = int(state["step"])
-    if state is None:
-        state, rows = first_state(sp, W0, anchor, U0, opts)
-    balanced = [r for r in rows if int(r["rescued"]) != 2]
-    initial = _assemble(sp, balanced[0]) if balanced else None
 
-    bar = _Bar(progress, opts, model.contact.area)
-    last_ckpt = -math.inf
-    reason = _stop_reason(state, opts)
-    extra = ""
+class _Saver:
+    """The checkpoint of a run (``path`` None: none): written at most every ``every_s``
+    seconds as steps are accepted, and at once on an interrupt and at the end; ``key`` the
+    run's fingerprint (:func:`~fretwear.wear.checkpoint.fingerprint`)."""
+
+    def __init__(self, path: Path | str | None, key: str, every_s: float):
+        self.path = Path(path) if path is not None else None
+        self.key, self.every_s = key, every_s
+        self.last = -math.inf
+
+    def exists(self) -> bool:
+        return self.path is not None and self.path.exists()
+
+    def load(self, shape) -> tuple[SlowStep, list[StepRecord]]:
+        return load_checkpoint(self.path, self.key, shape=shape)
+
+    def save(self, state: SlowStep, records: list[StepRecord], now: bool = False) -> None:
+        if self.path is None or not (now or time.perf_counter() - self.last >= self.every_s):
+            return
+        save_checkpoint(self.path, state, records, self.key)
+        self.last = time.perf_counter()
+
+
+def _integrate(sp: SlowProblem, state: SlowStep, records: list[StepRecord], opts: WearOptions,
+               run: RunControl, saver: _Saver) -> tuple[SlowStep, str, str]:
+    """Slow steps from ``state`` until a stop criterion holds or a step fails, each step's
+    record appended to ``records``: ``(last state, stop reason, what failed)``. On Ctrl-C
+    the last accepted state is saved, then ``KeyboardInterrupt`` raised."""
+    bar = _Bar(run.progress, opts, sp.model.contact.area)
+    reason, extra = _stop_reason(state, opts), ""
     try:
         bar.show(state)
         while not reason:
-            if np.size(state["td_U"]):  # the previous step came from a time integration
-                new_state, row, failure = time_domain_step(sp, state, opts)
-            else:
-                new_state, row, failure = advance(sp, state, opts)
-                if failure and sp.time_domain is not None:
-                    new_state, row, why = time_domain_step(sp, state, opts)
-                    failure = f"{failure}; {why}" if why else ""
+            new_state, record, failure = _step(sp, state, opts)
             if failure:
                 reason, extra = "solver_failed", f": {failure}"
                 break
             state = new_state
-            rows.append(row)
+            records.append(record)
             bar.show(state)
-            if ckpt is not None and (time.perf_counter() - last_ckpt >= opts.checkpoint_every_s):
-                save_checkpoint(ckpt, state, rows, key)
-                last_ckpt = time.perf_counter()
-            if callback is not None:
-                callback(int(state["step"]), row)
+            saver.save(state, records)
+            if run.callback is not None:
+                run.callback(state.step, record)
             reason = _stop_reason(state, opts)
     except (KeyboardInterrupt, SystemError) as exc:
         if not interrupted(exc):
             raise
-        if ckpt is not None:
-            save_checkpoint(ckpt, state, rows, key)
+        saver.save(state, records, now=True)
         bar.close()
         raise KeyboardInterrupt from None
     bar.close()
-    state["stop_reason"] = np.asarray(reason)
-    if ckpt is not None:
-        save_checkpoint(ckpt, state, rows, key)
-    hist = WearHistory.from_rows(rows, reason)
-    last = [r for r in rows if int(r["rescued"]) != 2]
-    final = _assemble(sp, last[-1]) if last else None
-    return WearResult(hist, initial, final, reason, _message(reason, state, opts, extra),
-                      reason != "solver_failed", time.perf_counter() - t_start,
-                      float(state["stability_jump"]), resumed_from, penalty=sp.eps,
-                      warnings=warnings)
+    return state, reason, extra
 
 
-def _assemble(sp: SlowProblem, row: dict) -> PeriodicSolution:
+def _step(sp: SlowProblem, state: SlowStep, opts: WearOptions):
+    """The next slow step: ``(state, record, failure)``. From a time integration while the
+    previous step came from one; else on periodic balances (:func:`advance`), and from a time
+    integration where those fail and the problem has one."""
+    if state.in_time_integration:
+        return time_domain_step(sp, state, opts)
+    new_state, record, failure = advance(sp, state, opts)
+    if failure and sp.time_domain is not None:
+        new_state, record, why = time_domain_step(sp, state, opts)
+        failure = f"{failure}; {why}" if why else ""
+    return new_state, record, failure
+
+
+def _assemble(sp: SlowProblem, record: StepRecord) -> PeriodicSolution:
     """The periodic solution of a recorded step (no solve: ``U`` is converged)."""
-    U = np.asarray(row["U"], float).reshape(sp.m, sp.H)
-    stats = SolveStats(True, 0.0, int(row["newton_iterations"]), 0, 0, float(row["wall_time"]),
+    U = np.asarray(record.U, float).reshape(sp.m, sp.H)
+    stats = SolveStats(True, 0.0, int(record.newton_iterations), 0, 0, float(record.wall_time),
                        "recorded", "")
-    return sp.solution(U, row["wear_depth"], row["anchor"], stats)
+    return sp.solution(U, record.wear_depth, record.anchor, stats)
 
 
-def _stop_reason(st: dict, opts: WearOptions) -> str:
-    if float(st["vrate0"]) <= 0.0:
+def _stop_reason(st: SlowStep, opts: WearOptions) -> str:
+    if st.volume_rate0 <= 0.0:
         return "no_wear"
-    if float(st["cycles"]) >= opts.max_cycles * (1 - 1e-12):
+    if st.cycles >= opts.max_cycles * (1 - 1e-12):
         return "max_cycles"
-    if float(np.max(st["W"])) >= opts.max_depth:
+    if float(np.max(st.W)) >= opts.max_depth:
         return "max_depth"
-    if float(st["vrate"]) <= opts.plateau_rate * float(st["vrate0"]):
+    if st.volume_rate <= opts.plateau_rate * st.volume_rate0:
         return "plateau"
-    if int(st["step"]) >= opts.max_steps:
+    if st.step >= opts.max_steps:
         return "max_steps"
     return ""
 
 
-def _message(reason: str, st: dict, opts: WearOptions, extra: str = "") -> str:
-    n = float(st["cycles"])
+def _message(reason: str, st: SlowStep, opts: WearOptions, extra: str = "") -> str:
     txt = {
         "max_cycles": f"reached max_cycles = {opts.max_cycles:.4g}",
         "max_depth": f"a wear depth reached max_depth = {opts.max_depth:.4g} m",
-        "plateau": (f"plateau: worn-volume rate {float(st['vrate']):.3g} m^3/cycle <= "
-                    f"{opts.plateau_rate:g} x initial {float(st['vrate0']):.3g}"),
+        "plateau": (f"plateau: worn-volume rate {st.volume_rate:.3g} m^3/cycle <= "
+                    f"{opts.plateau_rate:g} x initial {st.volume_rate0:.3g}"),
         "no_wear": "no wear: no contact node slips (worn-volume rate 0)",
         "max_steps": f"reached max_steps = {opts.max_steps}",
         "solver_failed": "stopped: a periodic solve failed even with smaller jumps",
     }[reason]
-    return f"{txt} after {int(st['step'])} steps, N = {n:.4g} cycles{extra}"
+    return f"{txt} after {st.step} steps, N = {st.cycles:.4g} cycles{extra}"
 
 
 def _progress_fraction(cycles, vrate, vrate0, wmax, opts: WearOptions) -> float:
@@ -239,16 +344,16 @@ class _Bar:
                             bar_format="{desc}: {percentage:3.0f}%|{bar}| {postfix} "
                             "[{elapsed}<{remaining}]")
 
-    def show(self, st: dict):
+    def show(self, st: SlowStep):
         if self.bar is None:
             return
-        frac = _progress_fraction(float(st["cycles"]), float(st["vrate"]), float(st["vrate0"]),
-                                  float(np.max(st["W"])), self.opts)
+        frac = _progress_fraction(st.cycles, st.volume_rate, st.volume_rate0,
+                                  float(np.max(st.W)), self.opts)
         self.bar.n = max(self.bar.n, int(1000 * frac))
-        vol = worn_volume(st["W"], self.area)
-        self.bar.set_postfix_str(f"N={float(st['cycles']):.3g} cycles, worn {vol:.3g} m^3, "
-                                 f"rate {float(st['vrate']):.3g} m^3/cycle, "
-                                 f"step {int(st['step'])}", refresh=False)
+        vol = worn_volume(st.W, self.area)
+        self.bar.set_postfix_str(f"N={st.cycles:.3g} cycles, worn {vol:.3g} m^3, "
+                                 f"rate {st.volume_rate:.3g} m^3/cycle, "
+                                 f"step {st.step}", refresh=False)
         self.bar.refresh()
 
     def close(self):

@@ -38,14 +38,19 @@ class SlowProblem:
     eps : DLFT penalty: ``"auto"`` (default, spectral radius of ``Z_r``), ``"static"`` or a
         positive number [N/m] (:func:`fretwear.hb.penalty.penalty`).
     anchor : (nc, d-1) stick anchors [m].
+    time_domain : the fallback of failed balances (None: none).
+    condenser : the condenser of ``model`` that made ``reduced``
+        (:func:`fretwear.hb.reduce.exact_condenser`): the full-field recoveries of the run
+        (the start of a time integration) use it; None: a new exact one at each.
 
     The wear depths ``W`` (nc,) [m] enter the DLFT as the normal gap ``gap0 + W``; ``E_W`` puts
     ``W_p`` into the static coefficient of the normal DOF of node ``p``.
     """
 
     def __init__(self, model: Model, reduced: Reduced, basis: FourierBasis, coef, *, eps="auto",
-                 anchor=None, time_domain: TimeDomainFallback | None = None):
+                 anchor=None, time_domain: TimeDomainFallback | None = None, condenser=None):
         self.model = model
+        self.condenser = condenser
         self.time_domain = time_domain  # fallback of failed balances (None: none)
         self.gap0 = np.broadcast_to(np.asarray(model.contact.gap, float),
                                     (model.contact.n_nodes,)).copy()

@@ -17,7 +17,6 @@ import numpy as np
 from fretwear.errors import ConvergenceError
 from fretwear.hb.periodic import initial_state
 from fretwear.hb.solvers import SolveStats
-from fretwear.wear.history import solution_row, time_row
 from fretwear.wear.options import (
     BALANCE_KINDS,
     MIN_JUMP_FRACTION,
@@ -27,36 +26,33 @@ from fretwear.wear.options import (
     WearOptions,
 )
 from fretwear.wear.slow_problem import SlowProblem
+from fretwear.wear.state import Rescue, SlowStep, StepRecord, StepStats
 from fretwear.wear.step_control import local_error, next_jump
 
 
-def time_domain_start(sp: SlowProblem, W0, opts: WearOptions, st: SolveStats, t0: float):
+def time_domain_start(sp: SlowProblem, wear0, opts: WearOptions, st: SolveStats, t0: float
+                      ) -> tuple[SlowStep, list[StepRecord]]:
     """Step 0 from a time integration when the unworn interface has no periodic balance
     (dynamic cases; e.g. a subharmonic or quasi-periodic response): the structure is integrated
     from rest for ``START_SETTLE`` periods, then its wear rate is averaged as in
     :func:`time_domain_step`, and the run goes on with time-domain steps (which go back to the
     DLFT as soon as a balance converges). The first jump is ``initial_jump``, default
-    ``START_JUMP`` cycles (no slow Jacobian without a balance; the error control adapts it)."""
+    ``START_JUMP`` cycles (no slow Jacobian without a balance; the error control adapts it).
+    ``wear0`` (nc,) [m] the initial wear depths; ``st`` the failed solve; ``t0`` the start
+    time of the step [s]."""
     tr = sp.time_domain.averaged_rate(sp.model, sp.prob.reduced.frequency, sp.prob.basis,
-                                      sp.coef, W0, U0=None, V0=None,
+                                      sp.coef, wear0, U0=None, V0=None,
                                       settle=max(opts.time_domain_settle, START_SETTLE),
                                       average=opts.time_domain_average,
                                       steps_per_period=opts.time_domain_steps)
-    row = time_row(tr, sp.model.contact.area, W0, 0.0, 0.0, st.iterations, 1, 0.0,
-                   time.perf_counter() - t0)
+    record = StepRecord.time_averaged(tr, sp.model.contact.area, wear0, StepStats(
+        0.0, 0.0, st.iterations, 1, 0.0, time.perf_counter() - t0))
     jump = float(opts.initial_jump) if opts.initial_jump is not None else START_JUMP
-    state = {
-        "step": 0, "cycles": 0.0, "W": np.array(W0, float),
-        "U": tr.U.reshape(sp.m, sp.H).copy(), "anchor": np.array(tr.anchor, float), "g": tr.g,
-        "jump": jump, "vrate": row["volume_rate"], "vrate0": row["volume_rate"],
-        "stability_jump": math.nan, "stop_reason": np.asarray(""), "td_U": tr.U_end,
-        "td_V": tr.V_end, "td_retry_at": 0.0, "Js": np.zeros(0),
-    }
-    return state, [row]
+    return SlowStep.time_averaged(record, jump, (tr.U_end, tr.V_end)), [record]
 
 
-def time_domain_step(sp: SlowProblem, st: dict, opts: WearOptions):
-    """A slow step taken from a time integration: ``(state, row, failure)``.
+def time_domain_step(sp: SlowProblem, st: SlowStep, opts: WearOptions):
+    """A slow step taken from a time integration: ``(state, record, failure)``.
 
     Used where the periodic balance fails (dynamic cases). The wear is advanced from the rate at
     the start of the step: by explicit Euler (eq. 30), ``W1 = W_k + dN g_k``, with
@@ -78,25 +74,25 @@ def time_domain_step(sp: SlowProblem, st: dict, opts: WearOptions):
     irregular), the balance at ``W1`` is tried from the harmonics of its last period
     with its mean tangential positions as stick anchors (the history selects where nodes that
     stop slipping stick): if it converges and passes the error test the step is an ordinary
-    balanced step (``rescued = 1``) and the next step goes back to the DLFT. Otherwise the step
-    keeps the time-averaged rate (``rescued = 2``), and so do the next steps until the balance
-    converges again. A balance that failed is not retried before the cycle count has doubled
-    (each try costs up to hundreds of iterations).
+    balanced step (:attr:`Rescue.TIME_START`) and the next step goes back to the DLFT.
+    Otherwise the step keeps the time-averaged rate (:attr:`Rescue.TIME_AVERAGED`), and so do
+    the next steps until the balance converges again. A balance that failed is not retried
+    before the cycle count has doubled (each try costs up to hundreds of iterations).
     """
     t0 = time.perf_counter()
-    W_k, g_k, cycles = st["W"], st["g"], float(st["cycles"])
-    if np.size(st["td_U"]):
-        U0, V0 = st["td_U"], st["td_V"]
+    W_k, g_k, cycles = st.W, st.g, st.cycles
+    if st.in_time_integration:
+        U0, V0 = st.time_U, st.time_V
     else:
-        last = sp.solution(st["U"], W_k, st["anchor"], SolveStats(True, 0.0, 0, 0, 0, 0.0, "", ""))
-        U0, V0 = initial_state(sp.model, last)
-    dN = min(float(st["jump"]), opts.max_jump, opts.max_cycles - cycles)
+        last = sp.solution(st.U, W_k, st.anchor, SolveStats(True, 0.0, 0, 0, 0, 0.0, "", ""))
+        U0, V0 = initial_state(sp.model, last, sp.condenser)
+    dN = min(st.jump, opts.max_jump, opts.max_cycles - cycles)
     floor = max(opts.min_jump, MIN_JUMP_FRACTION * cycles)
     rejected = iters = 0
-    Js = np.asarray(st["Js"], float)
-    if opts.scheme != "explicit" and Js.size == 0 and not np.size(st["td_U"]):
-        sp.set_state(W_k, st["anchor"])  # the last balanced state: its slow Jacobian
-        Js = sp.slow_jacobian(st["U"])
+    Js = np.asarray(st.Js, float)
+    if opts.scheme != "explicit" and Js.size == 0 and not st.in_time_integration:
+        sp.set_state(W_k, st.anchor)  # the last balanced state: its slow Jacobian
+        Js = sp.slow_jacobian(st.U)
         iters += 1
     if Js.size:
         # Js is the Jacobian of an older (balanced) state: its growing modes are not those of
@@ -123,9 +119,8 @@ def time_domain_step(sp: SlowProblem, st: dict, opts: WearOptions):
             continue
         break
     cycles1 = cycles + dN
-    new = dict(st)
-    new.update({"step": int(st["step"]) + 1, "cycles": cycles1, "W": np.array(W1, float)})
-    if tr.kind in BALANCE_KINDS and cycles1 >= float(st["td_retry_at"]):
+    retry_at = st.retry_balance_at
+    if tr.kind in BALANCE_KINDS and cycles1 >= retry_at:
         U1, stats = sp.solve_balance(W1, tr.anchor, tr.U.reshape(sp.m, sp.H),
                                      solver=opts.solver, tol=opts.tol,
                                      max_iter=max(opts.max_iter, RESCUE_MAX_ITER))
@@ -136,22 +131,18 @@ def time_domain_step(sp: SlowProblem, st: dict, opts: WearOptions):
             err_b = local_error(dN, W1, W_k, g1, g_k)
             if not opts.adaptive or err_b <= opts.tolerance:
                 sol = sp.solution(U1, W1, tr.anchor, stats)
-                row = solution_row(sol, W1, g1, cycles1, dN, iters, rejected, err_b,
-                                   time.perf_counter() - t0)
-                row.update({"rescued": 1, "response": tr.kind_code})
-                new.update({"U": U1.copy(), "anchor": np.array(tr.anchor, float), "g": g1,
-                            "jump": next_jump(dN, err_b, opts, float(st["jump"]), 1.0),
-                            "vrate": row["volume_rate"], "td_U": np.zeros(0),
-                            "td_V": np.zeros(0), "td_retry_at": 0.0, "Js": np.zeros(0)})
-                return new, row, ""
-        new["td_retry_at"] = 2.0 * cycles1
-    row = time_row(tr, sp.model.contact.area, W1, cycles1, dN, iters, rejected, err,
-                   time.perf_counter() - t0)
-    new.update({"U": tr.U.reshape(sp.m, sp.H).copy(), "anchor": np.array(tr.anchor, float),
-                "g": tr.g, "jump": next_jump(dN, err, opts, float(st["jump"])),
-                "vrate": row["volume_rate"],
-                "td_U": tr.U_end, "td_V": tr.V_end, "Js": Js})
-    return new, row, ""
+                record = StepRecord.balanced(
+                    sol, W1, g1, StepStats(cycles1, dN, iters, rejected, err_b,
+                                           time.perf_counter() - t0),
+                    rescued=Rescue.TIME_START, response=tr.kind_code)
+                jump = next_jump(dN, err_b, opts, st.jump, 1.0)
+                return SlowStep.balanced(record, jump, st), record, ""
+        retry_at = 2.0 * cycles1
+    record = StepRecord.time_averaged(tr, sp.model.contact.area, W1, StepStats(
+        cycles1, dN, iters, rejected, err, time.perf_counter() - t0))
+    jump = next_jump(dN, err, opts, st.jump)
+    return (SlowStep.time_averaged(record, jump, (tr.U_end, tr.V_end), st, Js=Js,
+                                   retry_balance_at=retry_at), record, "")
 
 
 def without_growth(Js: np.ndarray, max_condition: float = 1e8) -> np.ndarray:

@@ -8,20 +8,26 @@ from fretwear.hb.fourier import FourierBasis
 from fretwear.model.core import Model
 
 
-def frf_worn(model: Model, wear, frequencies_hz, basis: FourierBasis, *, anchor=None,
-             point: str | None = None, solver: str = "powell", spacing: str = "linear",
+def frf_worn(model: Model, basis: FourierBasis, wear, f_min: float, f_max: float,
+             n_points: int, *, anchor=None, spacing: str = "linear", condenser=None,
              **kwargs):
-    """Nonlinear FRF with the worn gap ``gap + wear`` (paper Fig. 24).
+    """Nonlinear FRF with the worn gap ``gap + wear`` (paper Fig. 24): the sweep of
+    :func:`fretwear.hb.sweep.sweep` (same argument order) with the model's gap opened by
+    ``wear``.
 
     Parameters
     ----------
-    model : the structure; wear : (nc,) wear depths [m] (e.g. ``result.final_wear``, or 0).
-    frequencies_hz : ``(f_min, f_max, n_points)`` [Hz].
-    basis : Fourier basis.
-    anchor : stick anchors of the first point (default: static preload).
-    point : unused here (kept for the documented signature); read amplitudes with
+    model, basis : the structure and the Fourier basis.
+    wear : (nc,) wear depths [m] (e.g. ``result.final_wear``, or 0).
+    f_min, f_max, n_points : the frequency band [Hz] and its number of grid frequencies.
+    anchor : (nc, d-1) stick anchors of the first point [m] (default: static preload).
+    spacing : ``"linear"`` (default) or ``"log"``.
+    **kwargs : the other keywords of :func:`fretwear.hb.sweep.sweep` (``eps``, ``solver``,
+        ``time_domain``, ...), with its defaults. Read amplitudes with
         ``SweepResult.amplitude(point, axis)``.
-    solver, spacing, **kwargs : passed to :func:`fretwear.hb.sweep.sweep`.
+    condenser : the condenser of ``model`` (:func:`fretwear.hb.reduce.exact_condenser` or
+        :func:`fretwear.hb.modal.modal_condenser`, e.g. the wear run's); None: a new exact one
+        for the sweep.
 
     Returns
     -------
@@ -29,8 +35,7 @@ def frf_worn(model: Model, wear, frequencies_hz, basis: FourierBasis, *, anchor=
     """
     from fretwear.hb.sweep import sweep
 
-    f_min, f_max, n_points = frequencies_hz
     gap = np.broadcast_to(np.asarray(model.contact.gap, float), (model.contact.n_nodes,))
     gap = gap + np.asarray(wear, float)
     return sweep(model, basis, float(f_min), float(f_max), int(n_points), spacing=spacing,
-                 gap=gap, anchor=anchor, solver=solver, **kwargs)
+                 gap=gap, anchor=anchor, condenser=condenser, **kwargs)

@@ -1,0 +1,115 @@
+"""Nonlinear modes and stability: accuracy against a closed form and the cost of Hill's method.
+
+* The EPMC backbone of a Jenkins oscillator (m = k = kt = 1, mu N = 0.1) with one harmonic
+  against the closed form of the element's describing function (docs/theory.md, "Nonlinear
+  modes"), for 64 to 1024 samples: the error of the stick-slip instants falling between
+  samples, O(N^-2).
+* Hill's method at every point of two frequency sweeps (a forced Jenkins oscillator, 7
+  harmonics; the two-DOF oscillator with a unilateral spring, 15 harmonics): its time against
+  the point's solve (the sum of the attempts' times the sweep records), median and range.
+
+Ends with ``epmc_jenkins_err=<max relative error, one harmonic, 1024 samples>`` and
+``hill_cost_ratio=<stability time / solve time, median over the sweeps>``. Run:
+``python benchmarks/nonlinear_modes.py`` (the JIT warm-up, about a minute on first use, runs
+before the timings).
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from fretwear.hb.dynamics import structure_dynamics
+from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.nonlinear_modes import nonlinear_mode
+from fretwear.hb.stability import stability
+from fretwear.hb.sweep import sweep
+from fretwear.model.core import Load
+from fretwear.model.matrices import from_matrices
+
+M_, K_, KT, FS = 1.0, 1.0, 1.0, 0.1
+
+
+def jenkins(force=None, c=0.0):
+    loads = [Load(np.array([force]), "cos")] if force else []
+    return from_matrices([[K_]], [[M_]], C=[[c]] if c else None, contact_normal_dofs=None,
+                         contact_tangential_dofs=[0], mu=FS, normal_load=1.0, kt=KT,
+                         loads=loads, observed={"x": 0})
+
+
+def two_dof(kn=10.0, gap=0.5, force=0.1):
+    K = np.diag([0.0, 0.0, 1.0])
+    K[:2, :2] = [[1.0, -1.0], [-1.0, 2.0]]
+    C = 0.03 * K
+    C[2, 2] = 1.0
+    return from_matrices(K, np.eye(3), C=C, contact_normal_dofs=[0], contact_tangential_dofs=[2],
+                         gap=gap, mu=0.0, kn=kn, kt=kn,
+                         loads=[Load(np.array([0.0, force, 0.0]), "cos")],
+                         observed={"x1": 0, "x2": 1})
+
+
+def closed_form(a):
+    a_s = FS / KT
+    th = np.arccos(np.clip(1.0 - 2.0 * a_s / a, -1.0, 1.0))
+    K = np.where(a > a_s, KT / np.pi * (th - np.sin(2.0 * th) / 2.0), KT)
+    D = np.where(a > a_s, 4.0 * FS * (a - a_s) / (np.pi * a * a), 0.0)
+    w = np.sqrt((K_ + K) / M_)
+    return w, D / (2.0 * M_ * w * w)
+
+
+def epmc_errors():
+    amps = np.geomspace(0.01, 10.0, 40)
+    out = {}
+    for n in (64, 128, 256, 512, 1024):
+        t0 = time.perf_counter()
+        bb = nonlinear_mode(jenkins(), FourierBasis((1,), n), amps)
+        wall = time.perf_counter() - t0
+        a = bb.array("amplitude") / np.sqrt(M_)
+        w_ref, z_ref = closed_form(a)
+        slip = z_ref > 0
+        ew = float(np.max(np.abs(bb.array("omega") / w_ref - 1.0)))
+        ez = float(np.max(np.abs(bb.array("damping_ratio")[slip] / z_ref[slip] - 1.0)))
+        out[n] = max(ew, ez)
+        print(f"  {n:5d} samples: frequency {ew:.2e}, damping ratio {ez:.2e} (relative), "
+              f"backbone of {len(bb.points)} amplitudes in {wall:.2f} s")
+    return out
+
+
+def hill_ratios(model, basis, f_min, f_max, n_points, label):
+    res = sweep(model, basis, f_min, f_max, n_points, spacing="linear")
+    dyn = structure_dynamics(model)
+    ratios, unstable = [], 0
+    for p in res.points:
+        if p.solution is None:
+            continue
+        solve_t = sum(a.wall_time for a in p.attempts)
+        t0 = time.perf_counter()
+        fl = stability(model, p.solution, dyn=dyn)
+        ratios.append((time.perf_counter() - t0) / max(solve_t, 1e-9))
+        unstable += not fl.stable
+    r = np.array(ratios)
+    print(f"  {label}: {r.size} points ({unstable} unstable), stability / solve: median "
+          f"{np.median(r):.2f}, range {r.min():.2f}-{r.max():.2f}")
+    return r
+
+
+def main():
+    # JIT warm-up
+    nonlinear_mode(jenkins(), FourierBasis((1,), 16), [0.5, 1.0])
+    sol_model = jenkins(0.2, c=0.02)
+    res = sweep(sol_model, FourierBasis.up_to(3, 32), 0.18, 0.2, 3, spacing="linear")
+    stability(sol_model, res.points[-1].solution)
+    print("EPMC of a Jenkins oscillator, one harmonic, against the describing function:")
+    err = epmc_errors()
+    print("Hill's method on sweeps:")
+    r1 = hill_ratios(jenkins(0.2, c=0.02), FourierBasis.up_to(7, 128), 0.15, 0.23, 30,
+                     "Jenkins oscillator, 7 harmonics")
+    r2 = hill_ratios(two_dof(), FourierBasis.up_to(15, 256), 0.56 / (2 * np.pi),
+                     0.8 / (2 * np.pi), 30, "two-DOF unilateral spring, 15 harmonics")
+    print(f"epmc_jenkins_err={err[1024]:.3g}")
+    print(f"hill_cost_ratio={float(np.median(np.concatenate([r1, r2]))):.3g}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,195 @@
+"""The structure's dynamic stiffness at any complex Laplace variable, condensed on the contact.
+
+The harmonic balance needs the condensed dynamic stiffness ``Z_r(n w)`` at the kept harmonics
+of one real frequency (eq. 18-19, :mod:`fretwear.hb.reduce`). Hill's method
+(:mod:`fretwear.hb.stability`) needs it at ``lambda = s + i n w`` for a complex Floquet exponent
+``s``, and the nonlinear modes (:mod:`fretwear.hb.nonlinear_modes`) with a negative
+mass-proportional damping ``-xi M``. Both are the same Schur complement (eq. 19) of
+
+    Z = K + a M + b C + c D
+
+for coefficients ``(a, b, c)``: ``(lambda^2, lambda, +-i)`` for Hill's method (the hysteretic
+``D`` keeps the sign of the harmonic it acts on, as in the balance; it is absent from harmonic
+0, where the balance has ``Z_0 = K``), ``(-(n w)^2 - i n w xi, i n w, i)`` for a mode.
+
+:class:`StructureDynamics` holds the structure in coordinates ``(x, q)``: ``x`` the contact
+points the law acts on, ``q`` everything else. Without contact springs ``x = u_c`` are the
+contact DOFs in their local frames and the interior is ``u_i = Psi u_c + V q``:
+
+* a model with at most :data:`DENSE_INTERIOR_MAX` interior DOFs: ``Psi = -K_ii^-1 K_ic`` and
+  ``V = I`` (``q`` the interior motion relative to the static shape): the transformation is
+  one-to-one, so every ``Z_r(lambda)`` is exact;
+* a model with a modal representation (:func:`fretwear.hb.modal.use_modal`): its projected
+  matrices (``V`` the fixed-interface modes kept and the loads' static responses), with the
+  error that representation was checked for.
+
+A contact spring joins the structure's contact DOF to a massless contact point
+(:mod:`fretwear.hb.connectors`): the point is in ``x``, the structure's DOF moves to ``q``, so
+that the blocks stay quadratic in ``lambda`` (Hill's quadratic problem) and the structure's
+modes with the contact points held are those of ``(K_qq, M_qq)`` (the nonlinear modes' master
+coordinates). The blocks are dense: ``Z_r(lambda) = Z^xx - Z^xq (Z^qq)^-1 Z^qx`` costs a
+``q x q`` solve with ``m`` right-hand sides per value of ``lambda`` (batched), and equals the
+balance's condensation through the springs (tests/hb/test_stability.py).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+
+from fretwear.errors import InputError
+from fretwear.hb.connectors import springs
+from fretwear.hb.modal import ModalCondenser
+from fretwear.hb.reduce import condenser
+from fretwear.model.core import Model
+
+#: at most this many interior DOFs: the exact transformation is formed densely; above, the
+#: model needs a modal representation (:func:`fretwear.hb.modal.use_modal`)
+DENSE_INTERIOR_MAX = 600
+MATRICES = ("K", "M", "C", "D")
+
+
+@dataclass
+class StructureDynamics:
+    """The structure in coordinates ``(x, q)`` (module docstring): ``x`` (m,) the contact
+    points the law acts on (the contact DOFs themselves, or the massless points behind the
+    contact springs), ``q`` the rest (the structure's contact DOFs behind springs, then the
+    interior coordinates).
+
+    blocks : name (``"K"``, ``"M"``, ``"C"``, ``"D"``) -> ``(xx, xq, qx, qq)`` dense blocks in
+        the contact-local frames ([N/m], [kg], [N s/m], [N/m]); ``C``, ``D`` absent when the
+        model has none.
+    load_x, load_q : (m,), (q,) the static loads (harmonic 0) on ``x`` and ``q`` [N].
+    exact : the transformation is exact (no truncated modes).
+    """
+
+    blocks: dict
+    load_x: np.ndarray
+    load_q: np.ndarray
+    exact: bool
+
+    @property
+    def m(self) -> int:
+        return int(self.blocks["K"][0].shape[0])
+
+    @property
+    def q(self) -> int:
+        return int(self.blocks["K"][3].shape[0])
+
+    def assemble(self, mass, visc, hyst):
+        """The blocks ``(xx, xq, qx, qq)`` of ``Z = K + a M + b C + c D`` for the coefficient
+        arrays ``a``, ``b``, ``c`` (nl,): complex arrays (nl, ...)."""
+        mass, visc, hyst = (np.atleast_1d(np.asarray(x, dtype=complex))
+                            for x in (mass, visc, hyst))
+        out = []
+        for i in range(4):
+            Z = mass[:, None, None] * self.blocks["M"][i] + self.blocks["K"][i]
+            if "C" in self.blocks:
+                Z = Z + visc[:, None, None] * self.blocks["C"][i]
+            if "D" in self.blocks:
+                Z = Z + hyst[:, None, None] * self.blocks["D"][i]
+            out.append(Z)
+        return out
+
+    def condensed(self, mass, visc, hyst) -> np.ndarray:
+        """``Z_r`` (nl, m, m) complex seen by the contact law [N/m]: the Schur complement
+        ``Z^xx - Z^xq (Z^qq)^-1 Z^qx`` (eq. 19, and :func:`fretwear.hb.connectors.connect`
+        when there are contact springs)."""
+        xx, xq, qx, qq = self.assemble(mass, visc, hyst)
+        if not self.q:
+            return xx
+        try:
+            return xx - xq @ np.linalg.solve(qq, qx)
+        except np.linalg.LinAlgError:
+            raise InputError("the structure with its contact points held is singular at a "
+                             "value of the Laplace variable (an eigenvalue of the held "
+                             "interface)") from None
+
+
+def _with_springs(blocks: dict, load_c, load_q, contact):
+    """The blocks on ``(x, [u_f, q])`` from those on ``(u, q)``: a contact spring ``k`` joins
+    the structure's contact DOF ``u_f`` to a massless contact point ``x_f``; rigid directions
+    keep ``x_r = u_r`` (:mod:`fretwear.hb.connectors`)."""
+    sp = springs(contact)
+    if sp is None:
+        return blocks, load_c, load_q
+    r, f, kf = sp.r, sp.f, sp.kf
+    m, nf = load_c.size, f.size
+    out = {}
+    for name, (cc, cq, qc, qq) in blocks.items():
+        q = qq.shape[0]
+        xx = np.zeros((m, m), dtype=cc.dtype)
+        xx[np.ix_(r, r)] = cc[np.ix_(r, r)]
+        xq = np.zeros((m, nf + q), dtype=cc.dtype)
+        xq[r, :nf] = cc[np.ix_(r, f)]
+        xq[r, nf:] = cq[r]
+        qx = np.zeros((nf + q, m), dtype=cc.dtype)
+        qx[:nf, r] = cc[np.ix_(f, r)]
+        qx[nf:, r] = qc[:, r]
+        qq2 = np.zeros((nf + q, nf + q), dtype=cc.dtype)
+        qq2[:nf, :nf] = cc[np.ix_(f, f)]
+        qq2[:nf, nf:] = cq[f]
+        qq2[nf:, :nf] = qc[:, f]
+        qq2[nf:, nf:] = qq
+        if name == "K":
+            xx[f, f] += kf
+            xq[f, np.arange(nf)] -= kf
+            qx[np.arange(nf), f] -= kf
+            qq2[np.arange(nf), np.arange(nf)] += kf
+        out[name] = (xx, xq, qx, qq2)
+    lx = np.zeros(m)
+    lx[r] = load_c[r]
+    return out, lx, np.concatenate([load_c[f], load_q])
+
+
+def structure_dynamics(model: Model) -> StructureDynamics:
+    """The :class:`StructureDynamics` of ``model``: its modal representation when one is
+    installed (:func:`fretwear.hb.modal.use_modal`), else the exact transformation (at most
+    :data:`DENSE_INTERIOR_MAX` interior DOFs; an InputError above, saying to install a modal
+    representation)."""
+    cond = condenser(model)
+    if isinstance(cond, ModalCondenser):
+        blocks = {name: tuple(np.asarray(b) for b in cond.proj_local[name])
+                  for name in MATRICES if name in cond.proj_local}
+        F0 = np.asarray(cond.structure.load_harmonics(0)[0].real, dtype=float)
+        Fi = F0[cond.idofs]
+        load_c = cond.R @ (F0[cond.cdofs] + cond.Psi.T @ Fi)
+        load_q = cond.V.T @ Fi
+        return StructureDynamics(*_with_springs(blocks, load_c, load_q, model.contact), False)
+    if cond.ni > DENSE_INTERIOR_MAX:
+        raise InputError(
+            f"the model has {cond.ni} interior DOFs: Hill's method and nonlinear modes form "
+            f"the structure's matrices densely up to {DENSE_INTERIOR_MAX}; install a modal "
+            "representation first (fretwear.hb.modal.use_modal(model, f_max, max_order))")
+    R = np.asarray(cond.R.toarray() if hasattr(cond.R, "toarray") else cond.R, dtype=float)
+
+    def dense(A):
+        return A.toarray() if hasattr(A, "toarray") else np.asarray(A)
+
+    parts = {}
+    for name in MATRICES:
+        B = getattr(cond, name)
+        if B is not None:
+            parts[name] = tuple(dense(getattr(B, p)) for p in ("cc", "ci", "ic", "ii"))
+    Kcc, Kci, Kic, Kii = parts["K"]
+    if cond.ni:
+        try:
+            Psi = -sla.solve(Kii, Kic)
+        except (np.linalg.LinAlgError, sla.LinAlgError):
+            raise InputError("the structure with its contact DOFs held is singular: part of "
+                             "the model can move with nothing to hold it") from None
+    else:
+        Psi = np.zeros((0, cond.m))
+    blocks = {}
+    for name, (cc, ci, ic, ii) in parts.items():
+        # u_c = R^T u_loc, u_i = Psi u_c + q: the blocks of T^T X T, T = [[I, 0], [Psi, I]]
+        xcc = cc + ci @ Psi + Psi.T @ ic + Psi.T @ ii @ Psi
+        xcq = ci + Psi.T @ ii
+        xqc = ic + ii @ Psi
+        blocks[name] = (R @ xcc @ R.T, R @ xcq, xqc @ R.T, ii)
+    F0 = np.asarray(cond.structure.load_harmonics(0)[0].real, dtype=float)
+    Fi = F0[cond.idofs]
+    load_c = R @ (F0[cond.cdofs] + Psi.T @ Fi)
+    return StructureDynamics(*_with_springs(blocks, load_c, Fi.copy(), model.contact), True)

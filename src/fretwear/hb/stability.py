@@ -1,0 +1,696 @@
+"""Stability of a periodic DLFT solution by Hill's method (Floquet exponents in the frequency
+domain), on the balance's own linearisation.
+
+The perturbation and its Floquet form
+-------------------------------------
+A small perturbation of a periodic solution of period ``T = 2 pi / w`` grows or decays as
+``e^{s t} p(t)`` with ``p`` periodic: ``s`` is a Floquet exponent, ``rho = e^{s T}`` the
+multiplier, and the solution is asymptotically stable when every ``|rho| < 1``. Written on the
+balance's unknowns, ``p`` has the kept harmonics and ``T(s) p~ = 0`` with (docs/theory.md,
+"Stability of periodic solutions")
+
+    T(s) = eps I - G(s) (eps I - Z(s))
+
+the DLFT Jacobian (``J = T(0)``, eq. 22-28 differentiated) with two changes:
+
+* ``Z(s)``: harmonic ``n`` of ``e^{st} p`` oscillates at ``lambda = s +- i n w``, so its block
+  is built from ``Z_r(s + i n w)`` and ``Z_r(s - i n w)`` (:mod:`fretwear.hb.dynamics`; at
+  ``s = 0`` they are conjugate and give the real blocks ``[[Zr, Zi], [-Zi, Zr]]`` of the
+  balance). ``Z_r`` is a condensation (a Schur complement), not a quadratic polynomial in
+  ``s``.
+* ``G(s)``: the law's derivative with a memory. Where a node sticks it carries the correction
+  of the previous instant; for the perturbation, ``delta lambda_x(n) = delta lambda_x(n-1)``,
+  i.e. ``r(n) = z r(n-1)`` for the periodic part ``r`` with ``z = e^{-s h}``, ``h = T / N``
+  the sample step (and likewise for the carried part of a 3D slip). :func:`shifted_gain` is
+  the recursion of :func:`fretwear.hb.contact.dlft_jacobian` with that factor; ``G(0)`` is the
+  solve's own ``G``. A frozen ``G`` (``z = 1`` for every ``s``, the usual Hill method for a
+  law without memory) is exact at ``s = 0`` only: a node that sticks from ``t0`` to ``t``
+  remembers ``e^{-s (t - t0)}``, which is far from 1 when ``|s| T`` is not small.
+
+The exponents are thus the roots of a nonlinear eigenvalue problem ``T(s) p~ = 0``, exact for
+the truncated (DLFT-discretised) periodic solution.
+
+How they are computed
+---------------------
+1. **Candidates**: on the structure's coordinates ``(x, q)`` (:mod:`fretwear.hb.dynamics`:
+   the contact points and everything else, nothing condensed) the structure is exactly
+   quadratic in ``s``; with the law's memory frozen (``G(s) = G(0)``) Hill's matrix is the
+   polynomial ``A0 + sigma A1 + sigma^2 A2`` in ``sigma = s / w`` (:meth:`HillProblem.pencil`),
+   whose eigenvalues are computed densely (:func:`quadratic_eigen`: massless coordinates
+   eliminated, a standard eigenvalue problem of twice the size). Where no node sticks (nor
+   slips in 3D) and the structure is exact, they are the exponents.
+2. **Sorting**: the truncated Hill problem has, for every exponent ``s``, copies
+   ``s + i j w`` with the eigenvectors ``p e^{-i j w t}``, accurate only while the shifted
+   eigenvector still fits in the kept harmonics. Each eigenvector has a harmonic centroid
+   ``kappa`` (:func:`centroid`), and a copy shifted by ``j`` has ``kappa - j``: keeping
+   ``|kappa| <= 1/2`` picks one member per family, the one centred on the kept harmonics and
+   therefore the least truncated. The usual alternative (``|Im s| <= w/2``) also picks one
+   member per family but, for a mode far above ``w``, the member whose eigenvector sits
+   ``j`` harmonics off centre, where the truncation acts. At ``Im s = +-w/2`` (a real negative
+   multiplier) the two members tie and count once (:data:`EDGE_TOL`).
+3. **Refinement** (a node sticks: the memory matters): in decreasing order of their real
+   parts, candidates are refined on the exact ``T(s)`` (condensed on the contact points,
+   ``m H`` unknowns) until ``options.refine`` have converged (:func:`_track`: the secant
+   method on the eigenvalue of ``T(s)`` whose eigenvector continues the candidate's). A
+   candidate near which the exact problem has no exponent is an artefact of the frozen memory
+   (:attr:`FloquetResult.spurious`).
+
+Exponents not reported: a node that sticks all period (or a contact point behind a spring that
+sticks all period) holds its contact DOFs, so the modes of the structure with that part of the
+interface held are linear (stable when the structure is damped) and ``T(s)`` does not see them;
+its tangential position is the member of a family of stuck states that the stick anchors
+select (docs/theory.md, "Full stick"), a neutral direction with multiplier exactly 1 that
+:attr:`FloquetResult.neutral` counts.
+
+Cost: one dense eigenvalue problem of ``2 (m' + q) H`` unknowns (``m'`` contact points with
+mass, ``q`` other coordinates) and, with a memory, a few evaluations of ``T(s)`` and ``m H``
+eigenvalue problems per refined exponent. Measured at 13-22 times a warm-started sweep
+point's solve on small models (docs/theory.md, section 9): the whole spectrum at every point
+is what costs; tracking the exponents along a sweep would not. Dense up to
+:data:`DENSE_MAX` unknowns of the balance.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+from numba import njit
+
+from fretwear.errors import InputError
+from fretwear.hb import contact as law
+from fretwear.hb.contact import SEPARATION, STICK
+from fretwear.hb.dynamics import StructureDynamics, structure_dynamics
+from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.periodic import DLFTProblem, PeriodicSolution
+from fretwear.hb.reduce import condense, to_real_blocks
+from fretwear.model.core import Model
+
+#: Hill's matrix is formed and its quadratic eigenvalue problem solved densely up to this
+#: many unknowns ``m H`` (the companion pencil has twice as many)
+DENSE_MAX = 1500
+#: an exponent within this of Im s = +-w/2 (in units of w) is a real negative multiplier: its
+#: conjugate is the other member of its family (the truncated problem puts the two a little
+#: off the line: 1e-4 measured on a two-DOF oscillator near period doubling)
+EDGE_TOL = 1e-3
+#: exponents whose multiplier is below this are not refined (they decay within a period; the
+#: factor e^{-s h} of the law's memory would overflow over a period)
+NEGLIGIBLE = 1e-8
+
+
+@dataclass(frozen=True)
+class HillOptions:
+    """Settings of :func:`hill_stability`.
+
+    refine : when the law has a memory, the candidates are refined on the exact ``T(s)`` in
+        decreasing order of their real parts until this many have converged (each with its
+        conjugate; the rest stay candidates; 0: none refined).
+    step : step of the forward difference of ``T`` in ``s / w`` (Newton's derivative).
+    newton_tol : relative residual ``|T v| / (|T| |v|)`` at which a refinement stops.
+    newton_max_iter : iterations of one refinement.
+    stable_tol : ``|rho| <= 1 + stable_tol`` counts as stable (rounding of a neutral exponent).
+    """
+
+    refine: int = 2
+    step: float = 1e-6
+    newton_tol: float = 1e-10
+    newton_max_iter: int = 20
+    stable_tol: float = 1e-6
+
+    def __post_init__(self):
+        n = self.refine
+        if isinstance(n, bool) or not isinstance(n, int) or n < 0:
+            raise InputError(f"refine = {n!r}: expected a whole number >= 0")
+        for name in ("step", "newton_tol", "stable_tol"):
+            v = getattr(self, name)
+            if not (isinstance(v, int | float) and math.isfinite(v) and 0 < v < 1):
+                raise InputError(f"{name} = {v!r}: expected a number between 0 and 1")
+        n = self.newton_max_iter
+        if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+            raise InputError(f"newton_max_iter = {n!r}: expected a whole number >= 1")
+
+
+@dataclass
+class FloquetResult:
+    """Floquet exponents of a periodic solution by Hill's method (:func:`hill_stability`).
+
+    Attributes
+    ----------
+    exponents : (k,) complex Floquet exponents ``s`` [1/s], sorted by decreasing real part:
+        the member of each family ``s + i j w`` whose eigenvector is centred on the kept
+        harmonics (the one continued from the time-invariant problem).
+    multipliers : (k,) complex ``e^{s T}`` [-].
+    centroid : (k,) harmonic centroid of each eigenvector [-] (:func:`centroid`).
+    residual : (k,) relative residual ``|T(s) v| / (|T(s)| |v|)`` (NaN unless refined).
+    kind : (k,) ``"exact"`` (the law has no memory at this solution: the quadratic problem
+        is exact), ``"refined"`` (refined on the exact ``T(s)``), ``"held"`` (a mode in which
+        the contact points do not move: exact, not coupled to the law) or ``"candidate"`` (an
+        eigenvalue of the quadratic problem with the memory frozen, not refined: its
+        multiplier is below :data:`NEGLIGIBLE`, or ``options.refine`` exponents with larger
+        real parts were refined before it).
+    spurious : candidates of the frozen-memory problem near which the exact ``T(s)`` has no
+        exponent (their refinement did not converge) [1/s]: not exponents, listed for
+        inspection.
+    neutral : tangential directions of nodes that stick all period: multipliers exactly 1
+        (a family of stuck states; the anchors select the member), not in ``exponents``.
+    omega : circular frequency of the solution [rad/s].
+    evaluations : evaluations of ``T(s)``; wall_time : seconds.
+    """
+
+    exponents: np.ndarray
+    multipliers: np.ndarray
+    centroid: np.ndarray
+    residual: np.ndarray
+    kind: np.ndarray
+    neutral: int
+    omega: float
+    spurious: np.ndarray
+    evaluations: int
+    wall_time: float
+    stable_tol: float = 1e-6
+
+    @property
+    def period(self) -> float:
+        return 2.0 * np.pi / self.omega
+
+    @property
+    def max_multiplier(self) -> float:
+        """Largest ``|rho|`` [-] (0 when no exponent was found)."""
+        return float(np.max(np.abs(self.multipliers), initial=0.0))
+
+    @property
+    def stable(self) -> bool:
+        """Every multiplier inside the unit circle (to ``stable_tol``)."""
+        return self.max_multiplier <= 1.0 + self.stable_tol
+
+    @property
+    def reliable(self) -> bool:
+        """Every exponent was refined or is exact, and every eigenvector is centred on the kept
+        harmonics (``|kappa| <= 1/2``): no candidate was left unrefined."""
+        return not bool(np.any((self.kind == "candidate")
+                               & (np.abs(self.multipliers) > NEGLIGIBLE))
+                        or np.any(np.abs(self.centroid) > 0.5 + EDGE_TOL))
+
+    def in_strip(self) -> np.ndarray:
+        """The exponents shifted by multiples of ``i w`` into ``-w/2 < Im s <= w/2`` (the
+        other usual representative; the same multipliers)."""
+        w = self.omega
+        shift = np.round(self.exponents.imag / w)
+        return self.exponents - 1j * w * shift
+
+    def critical(self, count: int = 2) -> np.ndarray:
+        """The ``count`` multipliers of largest modulus."""
+        order = np.argsort(-np.abs(self.multipliers), kind="stable")
+        return self.multipliers[order[:count]]
+
+
+# --------------------------------------------------------------------------------------------
+# the law's derivative with the Floquet factor
+# --------------------------------------------------------------------------------------------
+@njit(cache=True)
+def _shifted_gain(lam_u, lam_x, state, mu, P, Q, z, normal):
+    """``G(s) = d lambda_x~ / d lambda_u~`` (nc, dH, dH) complex for the Floquet-periodic part
+    of a perturbation ``e^{s t}``: the recursion of :func:`fretwear.hb.contact._dlft_jacobian`
+    with every carried derivative multiplied by ``z = e^{-s h}`` (one sample step ``h``), the
+    wrap-around solved for the periodic part. A singular wrap-around (a node that sticks all
+    period at ``z^N = 1``) takes the least-squares seed: zero, as the anchors give."""
+    nc, d, N = lam_u.shape
+    H = P.shape[0]
+    dt = d - 1
+    dH = d * H
+    G = np.zeros((nc, dH, dH), dtype=np.complex128)
+    A0 = np.zeros((d, dH), dtype=np.complex128)
+    S = np.zeros((d, dt), dtype=np.complex128)
+    Abuf = np.empty((d, N, dH), dtype=np.complex128)
+    Sbuf = np.empty((d, N, dt), dtype=np.complex128)
+    tmpA = np.zeros((dt, dH), dtype=np.complex128)
+    tmpS = np.zeros((dt, dt), dtype=np.complex128)
+    that = np.zeros(dt)
+    B = np.zeros((dt, dt))
+    Pc = np.ascontiguousarray(P).astype(np.complex128)
+    for p in range(nc):
+        A0[:, :] = 0.0
+        S[:, :] = 0.0
+        for c in range(dt):
+            S[1 + c, c] = 1.0
+        fixed = not np.isnan(normal[p, 0])
+        dcap = 0.0 if fixed else mu[p]
+        for n in range(N):
+            st = state[p, n]
+            if st == SEPARATION:
+                A0[:, :] = 0.0
+                for c in range(d):
+                    for h in range(H):
+                        A0[c, c * H + h] = Q[n, h]
+                S[:, :] = 0.0
+            elif st == STICK:
+                for c in range(dt):
+                    for j in range(dH):
+                        A0[1 + c, j] *= z
+                    for j in range(dt):
+                        S[1 + c, j] *= z
+                A0[0, :] = 0.0
+                S[0, :] = 0.0
+                if fixed:
+                    for h in range(H):
+                        A0[0, h] = Q[n, h]
+            else:  # slip: as contact.slip_derivative_step, the carried part times z
+                m = n - 1 if n > 0 else N - 1
+                pn = normal[p, n] if fixed else lam_u[p, 0, n]
+                nrm2 = 0.0
+                for c in range(dt):
+                    that[c] = lam_u[p, 1 + c, n] - lam_x[p, 1 + c, n]
+                    nrm2 += that[c] * that[c]
+                lt = np.sqrt(nrm2)
+                for c in range(dt):
+                    that[c] = that[c] / lt if lt > 0.0 else 0.0
+                nrm2 = 0.0
+                for c in range(dt):
+                    v = lam_u[p, 1 + c, n] - lam_x[p, 1 + c, m]
+                    nrm2 += v * v
+                rho = np.sqrt(nrm2)
+                g = mu[p] * pn / rho if rho > 0.0 else 0.0
+                for a in range(dt):
+                    for b in range(dt):
+                        B[a, b] = g * ((1.0 if a == b else 0.0) - that[a] * that[b])
+                for a in range(dt):
+                    for j in range(dH):
+                        acc = 0.0 + 0.0j
+                        for b in range(dt):
+                            acc += B[a, b] * A0[1 + b, j]
+                        tmpA[a, j] = z * acc
+                    for j in range(dt):
+                        acc = 0.0 + 0.0j
+                        for b in range(dt):
+                            acc += B[a, b] * S[1 + b, j]
+                        tmpS[a, j] = z * acc
+                for a in range(dt):
+                    for j in range(dH):
+                        A0[1 + a, j] = tmpA[a, j]
+                    for h in range(H):
+                        qh = Q[n, h]
+                        for b in range(dt):
+                            A0[1 + a, (1 + b) * H + h] += ((1.0 if a == b else 0.0)
+                                                           - B[a, b]) * qh
+                        A0[1 + a, h] += -dcap * that[a] * qh
+                    for j in range(dt):
+                        S[1 + a, j] = tmpS[a, j]
+                A0[0, :] = 0.0
+                S[0, :] = 0.0
+                if fixed:
+                    for h in range(H):
+                        A0[0, h] = Q[n, h]
+            for c in range(d):
+                for j in range(dH):
+                    Abuf[c, n, j] = A0[c, j]
+                for j in range(dt):
+                    Sbuf[c, n, j] = S[c, j]
+        Gp = G[p]
+        PS = np.zeros((dH, dt), dtype=np.complex128)
+        for c in range(d):
+            Gp[c * H:(c + 1) * H, :] = np.dot(Pc, Abuf[c])
+            PS[c * H:(c + 1) * H, :] = np.dot(Pc, Sbuf[c])
+        Mw = np.eye(dt).astype(np.complex128)
+        for a in range(dt):
+            for b in range(dt):
+                Mw[a, b] -= S[1 + a, b]
+        rhs = A0[1:, :].copy()
+        smin = np.linalg.svd(Mw)[1].min()
+        if smin > 1e-8:
+            seed = np.linalg.solve(Mw, rhs)
+        else:
+            seed = np.linalg.lstsq(Mw, rhs)[0]
+        Gp += np.dot(PS, np.ascontiguousarray(seed))
+    return G
+
+
+def shifted_gain(lam_u, lam_x, state, mu, P, Q, z: complex, normal=None) -> np.ndarray:
+    """``G(s)`` (nc, dH, dH) complex for ``z = e^{-s h}`` (module docstring); ``normal``
+    the prescribed normal forces (nc, N) [N] (NaN rows: unilateral), as
+    :func:`fretwear.hb.contact.dlft_jacobian` takes them."""
+    return _shifted_gain(np.ascontiguousarray(lam_u, dtype=float),
+                         np.ascontiguousarray(lam_x, dtype=float), state,
+                         np.ascontiguousarray(mu, dtype=float), np.ascontiguousarray(P),
+                         np.ascontiguousarray(Q), complex(z), law._normal(normal, lam_u))
+
+
+# --------------------------------------------------------------------------------------------
+# Hill's matrix
+# --------------------------------------------------------------------------------------------
+def hill_blocks(Z0: np.ndarray, Zp: np.ndarray, Zm: np.ndarray) -> np.ndarray:
+    """``Z(s)`` (m H, m H) complex, DOF-major as :func:`fretwear.hb.reduce.to_real_blocks`,
+    from ``Z_r(s)`` (m, m) on the static coefficient and ``Z_r(s + i n w)``,
+    ``Z_r(s - i n w)`` (k, m, m) on the cosine/sine pairs of the kept harmonics: with
+    ``a = (U+ + U-)/2``, ``b = i (U+ - U-)/2``, the block of harmonic ``n`` maps ``[a; b]`` by
+    ``[[(Zp + Zm)/2, i (Zm - Zp)/2], [i (Zp - Zm)/2, (Zp + Zm)/2]]`` (the real blocks
+    ``[[Zr, Zi], [-Zi, Zr]]`` when ``Zm`` is the conjugate of ``Zp``)."""
+    k, r, c = Zp.shape
+    H = 1 + 2 * k
+    out = np.zeros((r, H, c, H), dtype=complex)
+    view = out.transpose(1, 3, 0, 2)
+    view[0, 0] = Z0
+    ca = np.arange(1, k + 1)
+    cb = ca + k
+    half = 0.5 * (Zp + Zm)
+    view[ca, ca] = half
+    view[cb, cb] = half
+    view[ca, cb] = 0.5j * (Zm - Zp)
+    view[cb, ca] = 0.5j * (Zp - Zm)
+    return out.reshape(r * H, c * H)
+
+
+def jacobian_form(G: np.ndarray, Z: np.ndarray, eps: float) -> np.ndarray:
+    """``eps I - G (eps I - Z)`` (n, n) for ``G`` (nc, dH, dH) block-diagonal per node and
+    ``Z`` (n, n), as the balance forms its Jacobian (eq. 22-28)."""
+    nc, dH, _ = G.shape
+    n = Z.shape[0]
+    T = np.matmul(G, Z.reshape(nc, dH, n)).reshape(n, n)
+    for p in range(nc):
+        sl = slice(p * dH, (p + 1) * dH)
+        T[sl, sl] -= eps * G[p]
+    T[np.diag_indices(n)] += eps
+    return T
+
+
+class HillProblem:
+    """``T(s)`` of a converged solution ``U`` (m, H) of ``prob`` (module docstring), with the
+    structure ``dyn`` for ``Z_r`` at complex arguments. Evaluated in ``sigma = s / w``."""
+
+    def __init__(self, prob: DLFTProblem, U, dyn: StructureDynamics):
+        if prob.reduced.quasi_static or not prob.reduced.omega > 0:
+            raise InputError("stability of a quasi-static solution: there are no dynamics "
+                             "(expected a solution at a frequency > 0)")
+        n = prob.m * prob.H
+        if n > DENSE_MAX:
+            raise InputError(f"Hill's method forms {n} x {n} matrices densely up to "
+                             f"{DENSE_MAX} unknowns (m H)")
+        if dyn.m != prob.m:
+            raise InputError(f"the structure has {dyn.m} contact DOFs, the problem {prob.m}")
+        self.prob = prob
+        self.U = np.asarray(U, dtype=float).reshape(prob.m, prob.H)
+        self.dyn = dyn
+        self.omega = float(prob.reduced.omega)
+        self.harmonics = np.asarray(prob.basis.harmonics, dtype=float)
+        self.N = prob.basis.n_samples
+        lu, lx, state, _ = prob.time_law(self.U)
+        self.lu = np.ascontiguousarray(lu)
+        self.lx = np.ascontiguousarray(lx)
+        self.state = state
+        self.G0 = law.dlft_jacobian(self.lu, self.lx, self.state, prob.mu, prob.P, prob.Q,
+                                    prob.eps * prob.anchor, prob.tol, prob.max_sweeps,
+                                    prob.normal)
+        self.evaluations = 0
+
+    def gain(self, sigma: complex) -> np.ndarray:
+        """``G(s)`` at ``s = sigma w`` (the solve's own ``G`` at 0)."""
+        p = self.prob
+        if sigma == 0:
+            return self.G0.astype(complex)
+        z = np.exp(-2.0 * np.pi * complex(sigma) / self.N)  # e^{-s h}: h = T / N
+        return shifted_gain(self.lu, self.lx, self.state, p.mu, p.P, p.Q, z, p.normal)
+
+    def stiffness(self, sigma: complex) -> np.ndarray:
+        """``Z(s)`` (m H, m H) at ``s = sigma w``: ``Z_r(s + i n w)`` with the hysteretic
+        damping signed by the frequency ``Im(s) + n w`` of each component."""
+        w = self.omega
+        s = complex(sigma) * w
+        nw = 1j * self.harmonics * w
+        lam = np.concatenate([[s], s + nw, s - nw])
+        k = self.harmonics.size
+        Zr = self.dyn.condensed(lam * lam, lam, 1j * np.sign(lam.imag))
+        return hill_blocks(Zr[0], Zr[1:k + 1], Zr[k + 1:])
+
+    def matrix(self, sigma: complex) -> np.ndarray:
+        """``T(s)`` (m H, m H) complex at ``s = sigma w``."""
+        self.evaluations += 1
+        return jacobian_form(self.gain(sigma), self.stiffness(sigma), self.prob.eps)
+
+    def neutral(self) -> int:
+        """Tangential directions of the nodes that stick all period (multiplier 1)."""
+        stuck = np.all(self.state == STICK, axis=1)
+        return int(stuck.sum()) * (self.prob.d - 1)
+
+    def memoryless(self) -> bool:
+        """No node sticks at any instant nor slips in 3D: ``G(s) = G(0)`` for every ``s``
+        (separation and 2D slip carry nothing from the previous instant)."""
+        return not (np.any(self.state == STICK)
+                    or (self.prob.d > 2 and np.any(self.state == law.SLIP)))
+
+    def pencil(self):
+        """``(A0, A1, A2)``: Hill's matrix on the structure's coordinates ``(x, q)`` (every
+        coordinate with the kept harmonics, ``(m + q) H`` unknowns), a quadratic polynomial
+        ``A0 + sigma A1 + sigma^2 A2`` in ``sigma = s / w`` when the law's memory is frozen
+        (``G(s) = G(0)``): rows of ``x``: ``eps x - G (eps x - Z^xx x - Z^xq q)``, rows of
+        ``q``: ``Z^qx x + Z^qq q``, with ``Z^ab(lambda)`` of ``lambda = w (sigma + i n)``.
+        Exact for a law without memory (:meth:`memoryless`); the hysteretic damping keeps
+        the sign of ``n`` (none on the static coefficient)."""
+        dyn, prob, w = self.dyn, self.prob, self.omega
+        orders = prob.basis.orders
+        nw = orders * w
+        q = dyn.q
+
+        def full(name):
+            if name not in dyn.blocks:
+                return None
+            xx, xq, qx, qq = (np.asarray(b, dtype=float) for b in dyn.blocks[name])
+            return np.block([[xx, xq], [qx, qq]]) if q else xx
+
+        K, M, C, D = (full(nm) for nm in ("K", "M", "C", "D"))
+        nb = orders.size
+        # complex blocks per harmonic of the coefficients of sigma^0, sigma^1, sigma^2 of
+        # Z(lambda), lambda = w (sigma + i n), in the layout of reduce.to_real_blocks
+        Z0 = np.repeat(K[None].astype(complex), nb, axis=0)
+        Z0 -= (nw ** 2)[:, None, None] * M
+        Z1 = np.repeat((2j * w * nw)[:, None, None] * M, 1, axis=0)
+        if C is not None:
+            Z0 += (1j * nw)[:, None, None] * C
+            Z1 = Z1 + w * C
+        if D is not None:
+            Z0[1:] += 1j * D
+        Z2 = np.repeat((w * w * M)[None], nb, axis=0).astype(complex)
+        H = prob.H
+        nx = prob.m * H
+        n = (prob.m + q) * H
+        G = self.G0
+        mats = []
+        for power, Zc in enumerate((Z0, Z1, Z2)):
+            Z = to_real_blocks(Zc, orders)
+            A = np.empty((n, n))
+            # rows of x: eps x - G (eps x - Z^xx x - Z^xq q); rows of q: Z^qx x + Z^qq q
+            A[:nx] = np.matmul(G, Z[:nx].reshape(prob.nc, -1, n)).reshape(nx, n)
+            if power == 0:
+                for p in range(prob.nc):
+                    sl = slice(p * G.shape[1], (p + 1) * G.shape[1])
+                    A[sl, sl] -= prob.eps * G[p]
+                A[np.arange(nx), np.arange(nx)] += prob.eps
+            A[nx:] = Z[nx:]
+            mats.append(A)
+        return tuple(mats)
+
+
+def centroid(p: np.ndarray, k: int) -> np.ndarray:
+    """Harmonic centroid of Hill eigenvectors ``p`` (..., r, 1 + 2k) complex,
+    real-coefficient layout ``[a0, a.., b..]``: ``sum_n n |c_n|^2 / sum |c_n|^2`` over their
+    complex-exponential coefficients ``c_{+n} = (a_n - i b_n)/2``,
+    ``c_{-n} = (a_n + i b_n)/2``, ``c_0 = a0``; harmonic orders are taken as their index
+    among the kept harmonics (``1..k``). A float for one vector, an array (...) otherwise."""
+    a, b = p[..., 1:1 + k], p[..., 1 + k:]
+    wp = np.sum(np.abs(a - 1j * b) ** 2, axis=-2) / 4.0
+    wm = np.sum(np.abs(a + 1j * b) ** 2, axis=-2) / 4.0
+    total = np.sum(np.abs(p[..., 0]) ** 2, axis=-1) + wp.sum(-1) + wm.sum(-1)
+    order = np.arange(1, k + 1)
+    out = np.sum(order * (wp - wm), axis=-1) / np.maximum(total, 1e-300)
+    return float(out) if np.ndim(out) == 0 else out
+
+
+def quadratic_eigen(A0: np.ndarray, A1: np.ndarray, A2: np.ndarray):
+    """Eigenvalues (k,) and eigenvectors (n, k) of ``(A0 + s A1 + s^2 A2) y = 0``.
+
+    Coordinates whose rows and columns of ``A1`` and ``A2`` vanish (massless contact points
+    behind springs, rows the law holds) are algebraic: they are eliminated exactly by the
+    Schur complement of ``A0`` (their blocks do not depend on ``s``). The rest is linearised
+    as ``[[0, I], [-A2^-1 A0, -A2^-1 A1]]`` (a standard real eigenvalue problem) when ``A2``
+    is well conditioned there, else as the generalised problem of the companion pencil
+    (infinite eigenvalues are dropped)."""
+    n = A0.shape[0]
+    dyn_ = np.flatnonzero(np.any(A1 != 0, axis=1) | np.any(A2 != 0, axis=1)
+                          | np.any(A1 != 0, axis=0) | np.any(A2 != 0, axis=0))
+    alg = np.setdiff1d(np.arange(n), dyn_)
+    B0, B1, B2 = (X[np.ix_(dyn_, dyn_)] for X in (A0, A1, A2))
+    back = None
+    if alg.size:
+        try:
+            back = -np.linalg.solve(A0[np.ix_(alg, alg)], A0[np.ix_(alg, dyn_)])
+        except np.linalg.LinAlgError:
+            back = -np.linalg.lstsq(A0[np.ix_(alg, alg)], A0[np.ix_(alg, dyn_)],
+                                    rcond=None)[0]
+        B0 = B0 + A0[np.ix_(dyn_, alg)] @ back
+    nd = dyn_.size
+    if nd == 0:
+        return np.zeros(0, dtype=complex), np.zeros((n, 0), dtype=complex)
+    eye, nil = np.eye(nd), np.zeros((nd, nd))
+    try:
+        cond = np.linalg.cond(B2)
+    except np.linalg.LinAlgError:
+        cond = np.inf
+    if cond < 1e10:
+        top = np.linalg.solve(B2, np.hstack([B0, B1]))
+        vals, Y = np.linalg.eig(np.block([[nil, eye], [-top[:, :nd], -top[:, nd:]]]))
+    else:
+        vals, Y = sla.eig(np.block([[nil, eye], [-B0, -B1]]),
+                          np.block([[eye, nil], [nil, B2]]), check_finite=False)
+        ok = np.isfinite(vals)
+        vals, Y = vals[ok], Y[:, ok]
+    Y = Y[:nd]
+    vecs = np.zeros((n, vals.size), dtype=complex)
+    vecs[dyn_] = Y
+    if alg.size:
+        vecs[alg] = back @ Y
+    return vals, vecs
+
+
+def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions):
+    """The exponent of the exact ``T`` continued from ``sigma`` with eigenvector ``v``: the
+    scalar equation ``mu(sigma) = 0`` for the eigenvalue ``mu`` of the linear problem
+    ``T(sigma) y = mu y`` whose eigenvector continues ``v`` (largest overlap with the previous
+    one), solved by the secant method. Following an eigenvector of ``T(sigma)`` rather than
+    Newton's method on ``T(sigma) v = 0`` keeps to the member of the family that was started
+    (centred): the truncated problem has copies of every exponent one harmonic apart, and
+    Newton's iterate drifts to a near copy whose eigenvector its normalisation does not
+    see. Returns ``(sigma, v, residual, converged)``; the residual is ``|mu| / |T|``."""
+    prev = None
+    res = np.inf
+    start = sigma
+    real = sigma.imag == 0.0  # a real exponent of the real problem stays real (until it
+    # meets another one, which the frozen-memory candidates would show as a pair)
+    for _ in range(opt.newton_max_iter):
+        if abs(sigma - start) > 0.5 or 2.0 * np.pi * sigma.real < np.log(NEGLIGIBLE):
+            break  # left the neighbourhood of the candidate: not its exponent
+        T = hp.matrix(sigma)
+        mus, Y = np.linalg.eig(T)
+        Y = Y / np.linalg.norm(Y, axis=0)
+        overlap = np.abs(np.conj(v) @ Y) / np.linalg.norm(v)
+        j = int(np.argmax(overlap))
+        mu, v = mus[j], Y[:, j]
+        res = float(abs(mu) / np.linalg.norm(T, 2))
+        if res <= opt.newton_tol:
+            return sigma, v, res, True
+        if prev is None:  # first step: the derivative by a forward difference
+            dmu = _mu_derivative(hp, sigma, v, T, opt.step)
+            new = sigma - mu / dmu if dmu != 0 else sigma
+        else:
+            s0, mu0 = prev
+            new = sigma - mu * (sigma - s0) / (mu - mu0) if mu != mu0 else sigma
+        prev = (sigma, mu)
+        if real:
+            new = complex(new.real, 0.0)
+        if not np.isfinite(new) or new == sigma:
+            break
+        sigma = complex(new)
+    return sigma, v, res, res <= opt.newton_tol
+
+
+def _mu_derivative(hp: HillProblem, sigma: complex, v: np.ndarray, T: np.ndarray,
+                   step: float) -> complex:
+    """``d mu / d sigma = w^H T' v / w^H v`` of a simple eigenvalue with right eigenvector
+    ``v`` (left eigenvector ``w`` of ``T``, from the transposed problem), ``T'`` by a forward
+    difference."""
+    mus, W = np.linalg.eig(T.conj().T)
+    Tv = T @ v
+    mu = np.vdot(v, Tv) / np.vdot(v, v)
+    w = W[:, int(np.argmin(np.abs(np.conj(mus) - mu)))]
+    dT = (hp.matrix(sigma + step) - T) / step
+    den = np.vdot(w, v)
+    return complex(np.vdot(w, dT @ v) / den) if den != 0 else 0.0
+
+
+def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
+                   options: HillOptions | None = None) -> FloquetResult:
+    """Floquet exponents and multipliers of the converged solution ``U`` (m, H) of ``prob``
+    by Hill's method (module docstring); ``dyn`` the structure
+    (:func:`fretwear.hb.dynamics.structure_dynamics` of the model)."""
+    opt = HillOptions() if options is None else options
+    t0 = time.perf_counter()
+    hp = HillProblem(prob, U, dyn)
+    m, H, k = prob.m, prob.H, len(prob.basis.harmonics)
+    q = dyn.q
+    vals, vecs = quadratic_eigen(*hp.pencil())
+    finite = np.flatnonzero(np.isfinite(vals) & (np.abs(vals) < 2.0 * (k + 1) + 10.0))
+    kap = np.atleast_1d(centroid(vecs[:, finite].T.reshape(-1, m + q, H), k))
+    keep = np.abs(kap) <= 0.5 + 1e-9
+    idx, kap = finite[keep], kap[keep]
+    half = vals[idx].imag >= -1e-12 * np.maximum(np.abs(vals[idx]), 1.0)
+    idx, kap = idx[half], kap[half]
+    order = np.argsort(-vals[idx].real, kind="stable")
+    idx, kap = idx[order], kap[order]
+    exact = hp.memoryless() and dyn.exact
+    sig, kaps, res, kind, spurious = [], [], [], [], []
+    refined = 0
+    for i, kp in zip(idx, kap, strict=True):
+        s0 = complex(vals[i])
+        y = vecs[:, i]
+        vx = y[:m * H]
+        held = np.linalg.norm(vx) < 1e-8 * np.linalg.norm(y)
+        negligible = 2.0 * np.pi * s0.real < np.log(NEGLIGIBLE)
+        if held or exact or negligible or refined >= opt.refine:  # refined: successes
+            sig.append(s0)
+            kaps.append(kp)
+            res.append(np.nan)
+            kind.append("held" if held else "exact" if exact else "candidate")
+            continue
+        s1, v1, r1, conv = _track(hp, s0, vx, opt)
+        refined += conv
+        if not conv:  # no exponent of the exact problem near it: an artefact of the frozen
+            spurious.append(s0)  # memory (a node that sticks part of the period)
+            continue
+        sig.append(s1)
+        kaps.append(centroid(v1.reshape(m, H), k))
+        res.append(r1)
+        kind.append("refined")
+    sig = np.array(sig, dtype=complex)
+    kaps = np.array(kaps)
+    res = np.array(res)
+    kind = np.array(kind, dtype=object)
+    # one multiplier per family: the conjugate of a complex exponent is another family,
+    # except at Im s = w/2, where s and its conjugate s - i w are the two members of one
+    # family with a real negative multiplier (a period-doubling direction)
+    edge = np.abs(np.abs(sig.imag) - 0.5) <= EDGE_TOL
+    cplx = (np.abs(sig.imag) > 1e-9 * np.maximum(np.abs(sig), 1.0)) & ~edge
+    allsig = np.concatenate([sig, np.conj(sig[cplx])])
+    allkap = np.concatenate([kaps, -kaps[cplx]])
+    allres = np.concatenate([res, res[cplx]])
+    allkind = np.concatenate([kind, kind[cplx]])
+    mult = np.exp(2.0 * np.pi * allsig)
+    redge = np.concatenate([edge, np.zeros(int(cplx.sum()), dtype=bool)])
+    mult[redge] = -np.exp(2.0 * np.pi * allsig[redge].real)
+    chosen = np.argsort(-allsig.real, kind="stable")
+    w = hp.omega
+    return FloquetResult(exponents=allsig[chosen] * w, multipliers=mult[chosen],
+                         centroid=allkap[chosen], residual=allres[chosen],
+                         kind=allkind[chosen], neutral=hp.neutral(), omega=w,
+                         spurious=np.array(spurious, dtype=complex) * w,
+                         evaluations=hp.evaluations, wall_time=time.perf_counter() - t0,
+                         stable_tol=opt.stable_tol)
+
+
+def stability(model: Model, sol: PeriodicSolution, *, options: HillOptions | None = None,
+              dyn: StructureDynamics | None = None) -> FloquetResult:
+    """:func:`hill_stability` of a converged :class:`~fretwear.hb.periodic.PeriodicSolution`
+    of ``model`` (its problem rebuilt from the solution: frequency, basis, gap, eps,
+    anchors); ``dyn``: the model's :func:`fretwear.hb.dynamics.structure_dynamics` if already
+    made (a sweep makes it once)."""
+    if not sol.success:
+        raise InputError(f"stability of a solution that did not converge ({sol.message})")
+    prob = problem_of(model, sol)
+    dyn = structure_dynamics(model) if dyn is None else dyn
+    return hill_stability(prob, sol.U.reshape(prob.m, prob.H), dyn, options=options)
+
+
+def problem_of(model: Model, sol: PeriodicSolution) -> DLFTProblem:
+    """The :class:`~fretwear.hb.periodic.DLFTProblem` a solution was solved on."""
+    basis: FourierBasis = sol.basis
+    red = condense(model, sol.frequency, basis.orders, quasi_static=sol.quasi_static)
+    return DLFTProblem(red, model.contact, basis, gap=sol.gap, eps=sol.eps, anchor=sol.anchor)
