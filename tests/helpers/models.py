@@ -4,6 +4,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from fretwear.model.core import ContactInterface, Load, Model, ObservedPoint
+from fretwear.model.matrices import from_matrices
 
 # --- a braced 2D truss with tilted contact frames (the condensation tests) ------------------
 #: random numbers of tests/hb/test_reduce.py (truss() draws from its own generator)
@@ -154,3 +155,24 @@ def chain(*, n=12, k=100.0, kg=30.0, mu=0.3, gap=0.0, N=5.0, F=2.0, ks_normal=0.
     return Model(K=(K0 + Kn + Kg).tocsr(), M=M, C=C, contact=contact, loads=loads,
                  observed=[ObservedPoint("end", np.array([nd - 1]), np.zeros(1)),
                            ObservedPoint("all", np.arange(nd), np.zeros(1))])
+
+
+# --- two masses with a unilateral spring (the stability and dynamics tests) ---------------
+K2 = np.array([[1.0, -1.0], [-1.0, 2.0]])  # two masses of 1 kg: springs 0, 1, 1 N/m
+C2 = 0.03 * K2
+
+
+def two_dof(kn=10.0, gap=0.5, force=0.1):
+    """NLvib's example-03 family: two masses, damping 0.03 K, a unilateral spring ``kn`` with
+    a ``gap`` on the first mass, a harmonic force on the second. The contact's tangential
+    direction is a separate damped DOF (frictionless: it never couples)."""
+    K = np.zeros((3, 3))
+    K[:2, :2] = K2
+    K[2, 2] = 1.0
+    C = np.zeros((3, 3))
+    C[:2, :2] = C2
+    C[2, 2] = 1.0
+    return from_matrices(K, np.eye(3), C=C, contact_normal_dofs=[0], contact_tangential_dofs=[2],
+                         gap=gap, mu=0.0, kn=kn, kt=kn,
+                         loads=[Load(np.array([0.0, force, 0.0]), "cos")],
+                         observed={"x1": 0, "x2": 1})
