@@ -45,7 +45,6 @@ def test_generated_cases_fast_analyses(generated):
 
 
 @pytest.mark.slow
-@pytest.mark.slow
 @settings(max_examples=200, deadline=None, derandomize=True, database=None,
           suppress_health_check=list(HealthCheck),
           phases=(Phase.explicit, Phase.generate))  # no shrinking: each run costs seconds

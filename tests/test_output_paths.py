@@ -13,8 +13,6 @@ from pathlib import Path
 
 import pytest
 
-from fretwear.files import inside, safe_name
-
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "src" / "fretwear" / "examples" / "beam-linear-frf.toml"
 
@@ -92,18 +90,3 @@ def test_point_names_never_write_outside_the_output_folder(tmp_path, point):
     assert new and all(work / "out" in p.parents or p == work / "out" for p in new), new
     figures = [p for p in (work / "out").iterdir() if p.suffix == ".png"]
     assert figures and all(len(p.name) <= 120 for p in figures)
-
-
-def test_safe_name_rules():
-    assert safe_name("Pe") == "Pe"
-    assert safe_name("../../x") == "_.._x"
-    assert "/" not in safe_name("a/b") and safe_name("a/b") == "a_b"
-    long_a, long_b = safe_name("y" * 300 + "a"), safe_name("y" * 300 + "b")
-    assert len(long_a) == 100 and long_a != long_b
-    assert safe_name("") == "_" and safe_name("...") == "_"
-
-
-def test_inside_guard(tmp_path):
-    assert inside(tmp_path, tmp_path / "a" / "b.png") == (tmp_path / "a" / "b.png").resolve()
-    with pytest.raises(ValueError, match="outside the output folder"):
-        inside(tmp_path / "out", tmp_path / "out" / ".." / "escape.png")

@@ -11,7 +11,6 @@ import pytest
 
 from fretwear.errors import InputError
 from fretwear.hb.fourier import FourierBasis, amplitude
-from fretwear.model.core import Load
 
 RNG = np.random.default_rng(12345)
 TOL = 1e-12  # FFT of O(1) data with N <= 256: rounding ~ 1e-15 * log2(N); margin 100x
@@ -126,15 +125,3 @@ def test_complex_convention():
     ref = np.real(np.exp(1j * np.outer(basis.tau, n)) @ U).T  # (3, N)
     np.testing.assert_allclose(basis.to_time(c), ref, rtol=0, atol=TOL)
     np.testing.assert_allclose(basis.to_complex(c), U, rtol=0, atol=TOL)
-
-
-def test_load_waveforms_consistent_with_transform():
-    """The closed-form Fourier coefficients of the load waveforms (core.Load) vs the DFT of the
-    exact samples. The triangle has all odd harmonics decaying like 1/n^2: with N = 4096 the
-    aliased energy in harmonics <= 7 is ~8/pi^2 * 2/(N-7)^2 ~ 1e-7, hence the tolerance."""
-    basis = FourierBasis.up_to(7, 4096)
-    for wf, tol in (("cos", TOL), ("sin", TOL), ("constant", TOL), ("triangle", 2e-7)):
-        load = Load(np.ones(1), wf)
-        a, b = load.fourier_coefficients(7)
-        c = basis.to_freq(load.waveform_samples(basis.tau))
-        np.testing.assert_allclose(c, np.concatenate([[a[0]], a[1:], b[1:]]), rtol=0, atol=tol)

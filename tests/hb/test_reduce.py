@@ -235,7 +235,7 @@ def test_a_condenser_refuses_another_model_or_an_edited_one():
         condense(model, 10.0, [0, 1], condenser=42)
     red = condense(model, 10.0, [0, 1], condenser=exact_condenser(model))
     fresh = truss(damping="both")
-    fresh.K, fresh.loads = model.K.copy(), model.loads  # (truss() draws new random loads)
+    fresh.K, fresh.loads = model.K.copy(), model.loads  # (truss() gives these loads too)
     ref = condense(fresh, 10.0, [0, 1])
     np.testing.assert_array_equal(red.Z, ref.Z)
     np.testing.assert_array_equal(red.F, ref.F)

@@ -1,5 +1,6 @@
-"""Hill's method on the DLFT linearisation (:mod:`fretwear.hb.stability`) and the structure's
-dynamic stiffness at complex arguments (:mod:`fretwear.hb.dynamics`).
+"""Hill's method on the DLFT linearisation (:mod:`fretwear.hb.stability`); the structure's
+dynamic stiffness at complex arguments (:mod:`fretwear.hb.dynamics`) is tested in
+test_dynamics.py.
 
 Independent references (none calls the code under test):
 
@@ -15,15 +16,14 @@ Independent references (none calls the code under test):
 
 import numpy as np
 import pytest
+from helpers.models import C2, K2, two_dof
 from scipy.integrate import solve_ivp
 from scipy.optimize import root
 
 from fretwear.hb import contact as law
-from fretwear.hb.connectors import connect
 from fretwear.hb.dynamics import structure_dynamics
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import solve_periodic
-from fretwear.hb.reduce import condense
 from fretwear.hb.stability import (
     HillProblem,
     centroid,
@@ -35,28 +35,8 @@ from fretwear.model.build import Damping
 from fretwear.model.core import Load
 from fretwear.model.matrices import ContactDofs, from_matrices
 
+
 # --- models --------------------------------------------------------------------------------
-K2 = np.array([[1.0, -1.0], [-1.0, 2.0]])  # two masses of 1 kg: springs 0, 1, 1 N/m
-C2 = 0.03 * K2
-
-
-def two_dof(kn=10.0, gap=0.5, force=0.1):
-    """NLvib's example-03 family: two masses, damping 0.03 K, a unilateral spring ``kn`` with
-    a ``gap`` on the first mass, a harmonic force on the second. The contact's tangential
-    direction is a separate damped DOF (frictionless: it never couples)."""
-    K = np.zeros((3, 3))
-    K[:2, :2] = K2
-    K[2, 2] = 1.0
-    C = np.zeros((3, 3))
-    C[:2, :2] = C2
-    C[2, 2] = 1.0
-    return from_matrices(K, np.eye(3),
-                         contact=ContactDofs(normal_dofs=[0], tangential_dofs=[2], gap=gap,
-                                             mu=0.0, kn=kn, kt=kn),
-                         damping=Damping(C=C), loads=[Load(np.array([0.0, force, 0.0]), "cos")],
-                         observed={"x1": 0, "x2": 1})
-
-
 def jenkins(force, m=1.0, k=1.0, c=0.02, kt=0.5, slip=0.5):
     """A mass on a spring ``k`` and a Jenkins element (``kt`` in series with a slider of
     threshold ``slip`` = mu N, N prescribed)."""
@@ -145,20 +125,6 @@ def jenkins_flow(omega, force, m=1.0, k=1.0, c=0.02, kt=0.5, slip=0.5, n=1000):
         return np.array([u, v, f])
 
     return flow
-
-
-# --- the structure at complex arguments -----------------------------------------------------
-def test_condensed_stiffness_equals_the_balance_s_condensation_through_springs():
-    """At ``lambda = i n w`` the structure's coordinates ``(x, q)`` with the contact springs as
-    massless points give the reduced model of the balance (eq. 19 then
-    ``connectors.connect``), to rounding: the same Schur complement two ways."""
-    model = two_dof(kn=7.0)
-    basis = FourierBasis.up_to(5, 32)
-    w = 0.61
-    ref = connect(condense(model, w / (2 * np.pi), basis.orders), model.contact).Z
-    lam = 1j * w * basis.orders
-    Z = structure_dynamics(model).condensed(lam * lam, lam, 1j * np.sign(lam.imag))
-    assert np.abs(Z - ref).max() <= 1e-12 * np.abs(ref).max()
 
 
 # --- the law's derivative with its memory ----------------------------------------------------

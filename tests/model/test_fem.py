@@ -1,75 +1,21 @@
-"""Stiffness, mass and consistent loads (fretwear.model.fem, fretwear.model.loads).
+"""Stiffness and mass (fretwear.model.fem); the consistent loads are in test_loads.py.
 
 References independent of the code under test: the exact linear-elastic solution of a
-uniform stress state (patch test), the body's volume, rigid-body motions, the
-Euler-Bernoulli frequencies of a free-free beam, and consistent nodal forces worked out by
-hand for straight edges and flat faces.
+uniform stress state (patch test), the body's volume, rigid-body motions and the
+Euler-Bernoulli frequencies of a free-free beam.
 """
 
 import numpy as np
 import pytest
 import scipy.sparse.linalg as spla
+from helpers.meshes import meshes_2d, meshes_3d
 
 from fretwear.errors import InputError
 from fretwear.model.core import Mesh
 from fretwear.model.fem import assemble
-from fretwear.model.loads import (
-    boundary_load,
-    boundary_measure,
-    nodal_areas,
-    nodal_force,
-    resultant,
-)
-from fretwear.model.mesh import box, rectangle
+from fretwear.model.mesh import rectangle
 
 E, NU, RHO = 210e9, 0.3, 7800.0
-KUHN = [[0, 1, 2, 6], [0, 2, 3, 6], [0, 3, 7, 6], [0, 7, 4, 6], [0, 4, 5, 6], [0, 5, 1, 6]]
-
-
-def distort(mesh, amount, seed=0):
-    """Move interior nodes at random by up to ``amount`` times the smallest cell size (the
-    boundary nodes stay, so the boundary facets stay straight/flat and evenly spaced)."""
-    rng = np.random.default_rng(seed)
-    on_boundary = np.zeros(len(mesh.points), bool)
-    for f in mesh.boundaries.values():
-        on_boundary[np.unique(f)] = True
-    h = min(np.ptp(mesh.points[mesh.cells[0]], axis=0))
-    pts = mesh.points.copy()
-    pts[~on_boundary] += amount * h * rng.uniform(-1, 1, (np.sum(~on_boundary), mesh.dim))
-    return Mesh(pts, mesh.cells, mesh.cell_type, mesh.boundaries, mesh.node_sets)
-
-
-def triangles(mesh):
-    """Split each quad of a 2D mesh along its 0-2 diagonal."""
-    tri = mesh.cells[:, [[0, 1, 2], [0, 2, 3]]].reshape(-1, 3)
-    return Mesh(mesh.points, tri, "triangle", mesh.boundaries, mesh.node_sets)
-
-
-def tetrahedra(mesh):
-    """Split each hexahedron in 6 tetrahedra around its 0-6 diagonal (conforming on a
-    structured grid); the box faces become pairs of triangles along the matching diagonal."""
-    tets = mesh.cells[:, KUHN].reshape(-1, 4)
-    faces = tets[:, [[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]]].reshape(-1, 3)
-    _, inv, count = np.unique(np.sort(faces, axis=1), axis=0, return_inverse=True,
-                              return_counts=True)
-    outer = faces[count[inv.ravel()] == 1]
-    centre = mesh.points[outer].mean(axis=1)
-    lo, hi = mesh.points.min(axis=0), mesh.points.max(axis=0)
-    tris = {}
-    for axis, a in enumerate("xyz"):
-        tris[a + "min"] = outer[np.isclose(centre[:, axis], lo[axis])]
-        tris[a + "max"] = outer[np.isclose(centre[:, axis], hi[axis])]
-    return Mesh(mesh.points, tets, "tetra", tris, mesh.node_sets)
-
-
-def meshes_2d():
-    q = distort(rectangle(0.3, 0.2, 6, 4, origin=(0.1, -0.05)), 0.25)
-    return {"quad": q, "triangle": triangles(q)}
-
-
-def meshes_3d():
-    h = distort(box(0.3, 0.2, 0.1, 3, 2, 2), 0.2)
-    return {"hexahedron": h, "tetra": tetrahedra(box(0.3, 0.2, 0.1, 3, 2, 2))}
 
 
 def lame(E, nu):
@@ -210,87 +156,6 @@ def test_unused_node_is_refused():
         assemble(m, E, NU, RHO)
 
 
-# --------------------------------------------------------------------------------------------
-# consistent loads
-# --------------------------------------------------------------------------------------------
-def test_uniform_pressure_resultant_2d():
-    """Sum of the nodal forces of a pressure p on the top edge = -p x length x thickness
-    along y (the pressure pushes on the body); each interior node carries p x h x t, each
-    end node half of it (hand values). Exact up to rounding."""
-    m = rectangle(0.1, 0.01, 30, 2)
-    f = boundary_load(m, "top", pressure=1e4, thickness=0.01).reshape(-1, 2)
-    np.testing.assert_allclose(f.sum(axis=0), [0.0, -1e4 * 0.1 * 0.01], atol=1e-15)
-    top = m.node_sets["top"]
-    expected = np.full(31, -1e4 * 0.1 / 30 * 0.01)
-    expected[[0, -1]] /= 2
-    np.testing.assert_allclose(f[top, 1], expected, rtol=1e-12)
-    assert np.all(np.delete(f, top, axis=0) == 0.0)
-    np.testing.assert_allclose(resultant(m, "right", traction=(2.0, -3.0), thickness=0.5),
-                               [2.0 * 0.01 * 0.5, -3.0 * 0.01 * 0.5], rtol=1e-12)
-    assert boundary_measure(m, "left") == pytest.approx(0.01, rel=1e-14)
-
-
-def test_linear_traction_exact_nodal_values():
-    """A traction varying linearly along a non-uniformly divided edge: the exact consistent
-    forces of a 2-node edge from x1 to x2 are L/6 (2 t1 + t2) and L/6 (t1 + 2 t2), summed
-    over the edges by hand. Exact up to rounding (1e-12)."""
-    base = rectangle(1.0, 0.5, 5, 1)
-    pts = base.points.copy()
-    xs = np.array([0.0, 0.1, 0.35, 0.5, 0.8, 1.0])
-    pts[:, 0] = np.tile(xs, 2)
-    m = Mesh(pts, base.cells, "quad", base.boundaries, base.node_sets)
-    tx = lambda x: 3.0 + 2.0 * x  # noqa: E731
-    ty = lambda x: -1.0 + 0.5 * x  # noqa: E731
-    f = boundary_load(m, "bottom",
-                      traction=lambda p: np.column_stack([tx(p[:, 0]), ty(p[:, 0])]),
-                      thickness=2.0).reshape(-1, 2)
-    expected = np.zeros((6, 2))
-    for k in range(5):
-        x1, x2 = xs[k], xs[k + 1]
-        for c, t in enumerate((tx, ty)):
-            expected[k, c] += (x2 - x1) / 6 * (2 * t(x1) + t(x2))
-            expected[k + 1, c] += (x2 - x1) / 6 * (t(x1) + 2 * t(x2))
-    np.testing.assert_allclose(f[:6], 2.0 * expected, rtol=1e-12)
-    # the same with a linearly varying pressure on the bottom (outward normal -y)
-    fp = boundary_load(m, "bottom", pressure=lambda p: tx(p[:, 0]), thickness=2.0)
-    np.testing.assert_allclose(fp.reshape(-1, 2)[:6, 1], 2.0 * expected[:, 0], rtol=1e-12)
-
-
-@pytest.mark.parametrize("kind", ["hexahedron", "tetra"])
-def test_pressure_on_a_face_3d(kind):
-    """Pressure p on the zmax face of a 0.3 x 0.2 box: resultant -p x 0.06 along z, and the
-    nodal areas add up to the face area (exact up to rounding)."""
-    m = meshes_3d()[kind]
-    f = resultant(m, "zmax", pressure=5.0)
-    np.testing.assert_allclose(f, [0.0, 0.0, -5.0 * 0.06], atol=1e-14)
-    nodes, area = nodal_areas(m, "zmax")
-    assert area.sum() == pytest.approx(0.06, rel=1e-13)
-    assert np.all(area > 0) and len(nodes) == 4 * 3
-
-
-def test_load_argument_errors():
-    m = rectangle(1.0, 1.0, 2, 2)
-    with pytest.raises(InputError, match="exactly one of pressure"):
-        boundary_load(m, "top")
-    with pytest.raises(InputError, match="exactly one of pressure"):
-        boundary_load(m, "top", pressure=1.0, traction=(1.0, 0.0))
-    with pytest.raises(InputError, match=r"unknown boundary 'up'.*\['bottom', 'left'"):
-        boundary_load(m, "up", pressure=1.0)
-    with pytest.raises(InputError, match="traction"):
-        boundary_load(m, "top", traction=(1.0, 0.0, 0.0))
-    with pytest.raises(InputError, match="returned shape"):
-        boundary_load(m, "top", pressure=lambda x: np.ones(3))
-
-
-def test_nodal_force():
-    m = rectangle(1.0, 1.0, 1, 1)
-    f = nodal_force(m, 3, (1.0, -2.0))
-    assert f.tolist() == [0, 0, 0, 0, 0, 0, 1.0, -2.0]
-    assert nodal_force(9, 1, (0.0, 0.0, 4.0)).tolist() == [0, 0, 0, 0, 0, 4.0, 0, 0, 0]
-    with pytest.raises(InputError, match="node number"):
-        nodal_force(m, 4, (1.0, 0.0))
-
-
 @pytest.mark.parametrize("E", [1e308, 1e-300, 0.5, 2e13])
 def test_youngs_modulus_outside_the_documented_range_is_refused(E):
     """Reference: fretwear.limits.RANGES["modulus"] = [1, 1e13] Pa."""
@@ -311,15 +176,3 @@ def test_density_outside_the_documented_range_is_refused(rho):
                                          r"in \[0.001, 100000\] kg/m\^3"):
         check_material(2e11, 0.3, rho)
     assert check_material(2e11, 0.3, 0.0)[2] == 0.0  # massless stays legal
-
-
-@pytest.mark.parametrize("f", [5e-324, 1e-9, 2e10])
-def test_frequency_outside_the_documented_range_is_refused(f):
-    """Reference: fretwear.limits.RANGES["frequency"] = 0, or [1e-6, 1e10] Hz (5e-324 Hz made
-    the period infinite and the solve fail deep inside LAPACK)."""
-    from fretwear.limits import check_range
-
-    with pytest.raises(InputError, match=r"frequency = .* Hz: expected 0 or a magnitude in "
-                                         r"\[1e-06, 1e\+10\] Hz"):
-        check_range(f, "frequency", "frequency")
-    assert check_range(0.0, "frequency", "frequency") == 0.0

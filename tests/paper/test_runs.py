@@ -1,59 +1,19 @@
-"""``fretwear reproduce``: case-file edits, resumable runs and the comparison report.
+"""``fretwear reproduce``: resumable runs and the comparison report.
 
 The reproduction's numbers come from the shipped examples (their physics is tested in
-tests/test_examples.py); here the driver is checked: the edited case files are what a TOML parser
-reads back, a second call reads finished runs back instead of running them again, a missing
-run is reported as missing, and the report's figures agree with the results files it was
-measured on.
+tests/test_examples.py); here the driver is checked: a second call reads finished runs back
+instead of running them again, a missing run is reported as missing, and the report's figures
+agree with the results files it was measured on. The edited case files are checked in
+test_catalogue.py.
 """
-
-import tomllib
 
 import numpy as np
 import pytest
 
-from fretwear.analyses.run import load_case
 from fretwear.cli import main
 from fretwear.errors import InputError
 from fretwear.io.results import read_results
-from fretwear.paper.catalogue import RUNS, edit_case_text, run_case_text, toml_value
 from fretwear.paper.runs import plan, reproduce
-
-
-@pytest.mark.parametrize("value", [3, 2e8, 1e-12, float("inf"), True, False, "static",
-                                   'a "quoted" \\ path', ["sliding", "stuck"], [0.1, 0.005]])
-def test_toml_values_read_back(value):
-    """Each value written by toml_value is read back equal by Python's TOML parser (an
-    independent implementation of the format)."""
-    assert tomllib.loads(f"k = {toml_value(value)}")["k"] == value
-
-
-def test_edit_replaces_and_appends_keys_of_one_table_only():
-    text = ("title = \"t\"\n[model]\nnx = 30  # comment\nny = 4\n\n[analysis]\n"
-            "type = \"wear\"\nharmonics = 7  # paper\nnx = 1\n")
-    out = edit_case_text(text, "analysis", {"harmonics": 3, "max_cycles": 2e3})
-    parsed = tomllib.loads(out)
-    assert parsed["analysis"] == {"type": "wear", "harmonics": 3, "nx": 1, "max_cycles": 2e3}
-    assert parsed["model"] == {"nx": 30, "ny": 4}
-    out = edit_case_text(out, "model", {"nx": 100})
-    assert tomllib.loads(out)["model"]["nx"] == 100
-    assert tomllib.loads(out)["analysis"]["nx"] == 1
-    with pytest.raises(InputError, match=r"no table \[damping\]"):
-        edit_case_text(text, "damping", {"loss_factor": 0.0})
-
-
-@pytest.mark.parametrize("quick", [False, True], ids=["full", "quick"])
-def test_every_run_is_a_valid_case_with_its_edits(tmp_path, quick):
-    """Every run's case text validates and carries its edits (read back by load_case)."""
-    for run in RUNS:
-        path = tmp_path / f"{run.key}.toml"
-        path.write_text(run_case_text(run, quick))
-        case = load_case(path)
-        edits = {**run.analysis, **(run.quick if quick else {})}
-        for k, v in edits.items():
-            assert case.analysis[k] == v, (run.key, k)
-        for k, v in {**run.model, **(run.quick_model if quick else {})}.items():
-            assert case.model["model"][k] == v, (run.key, k)
 
 
 def test_plan_orders_runs_and_rejects_unknown_keys():

@@ -171,19 +171,3 @@ def test_split_sweep_joins_checked_and_equal_to_the_whole_sweep(tmp_path, client
     b = whole["linear_response_amplitude"].sel(
         linear_frequency=whole["frequency"].values).values  # the same to 1e-14 (above)
     assert np.max(np.abs(a - b)) <= 1e-6 * np.max(np.abs(b))
-
-
-def test_a_join_between_different_solutions_is_flagged():
-    """join_difference on two constructed chunks: the relative difference it reports is the
-    one computed by hand, and a frequency mismatch is NaN."""
-    from fretwear.study.sweep_split import join_difference
-
-    def chunk(freqs, amp_end, amp_start):
-        amp = np.ones((len(freqs), 1, 2, 1))
-        amp[-1, 0, 0, 0], amp[0, 0, 0, 0] = amp_end, amp_start
-        return xr.Dataset({"response_amplitude": (("frequency", "point", "axis", "harmonic"),
-                                                  amp)}, coords={"frequency": freqs})
-
-    f, d = join_difference(chunk([1.0, 2.0], 4.0, 1.0), chunk([2.0, 3.0], 1.0, 3.0))
-    assert f == 2.0 and d == abs(4.0 - 3.0) / 4.0
-    assert np.isnan(join_difference(chunk([1.0, 2.0], 1, 1), chunk([2.5, 3.0], 1, 1))[1])

@@ -1,15 +1,13 @@
-"""Study files: validation (one line naming the study file and the key) and the expansion
-into members (grids, seeded samples, seeded perturbations, chunks of a sweep), compared with
-what each kind means, computed independently here."""
+"""Study files: validation (one line naming the study file and the key), through the command
+line, and the shipped study files. The expansion into members is checked in
+test_members.py."""
 
 from __future__ import annotations
 
-import itertools
 import tomllib
 
-import numpy as np
 import pytest
-from helpers.studies import SWEEP, base_case, study_file
+from helpers.studies import base_case, study_file
 
 from fretwear import cli
 from fretwear.study.members import expand, get_key
@@ -22,88 +20,6 @@ def _members(path):
 
 def _case(member) -> dict:
     return tomllib.loads(member.text)
-
-
-def test_grid_is_every_combination_set_in_the_member_cases(tmp_path):
-    base_case(tmp_path)
-    path = study_file(tmp_path, '[set]\nanalysis.harmonics = 2\n[grid]\ncontact.mu = [0.1, 0.2]\n'
-                      '"loads[2].pressure" = [1e3, 2e3, 3e3]\n')
-    members = _members(path)
-    assert len(members) == 6
-    got = [(_case(m)["contact"]["mu"], _case(m)["loads"][1]["pressure"]) for m in members]
-    assert got == list(itertools.product([0.1, 0.2], [1e3, 2e3, 3e3]))
-    for m in members:
-        case = _case(m)
-        assert case["analysis"]["harmonics"] == 2  # [set] applies to every member
-        assert "directory" not in case.get("output", {})
-        assert case["loads"][0]["pressure"] == 1e4  # the other load is untouched
-
-
-def test_block_by_name_and_file_paths_made_absolute(tmp_path):
-    """A [[loads]] block named in the path; a mesh file named relative to the base case
-    becomes absolute in the member case (which lives in another folder)."""
-    base_case(tmp_path)
-    members = _members(study_file(tmp_path, "[grid]\nloads.Q.pressure = [5.0]\n"))
-    assert _case(members[0])["loads"][1]["pressure"] == 5.0
-
-
-def test_samples_are_seeded_and_follow_their_distributions(tmp_path):
-    base_case(tmp_path)
-    body = ('[samples]\nn = 40\nseed = 7\nmethod = "latin_hypercube"\n[samples.vary]\n'
-            'contact.mu = {distribution = "uniform", low = 0.1, high = 0.5}\n'
-            'damping.loss_factor = {distribution = "loguniform", low = 1e-4, high = 1e-2}\n')
-    a = _members(study_file(tmp_path, body))
-    b = _members(study_file(tmp_path, body, name="again.toml"))
-    mu = np.array([m.values["contact.mu"] for m in a])
-    eta = np.array([m.values["damping.loss_factor"] for m in a])
-    assert [m.values for m in a] == [m.values for m in b]  # same seed, same samples
-    # Latin hypercube: exactly one sample in each of the n equal strata of each key
-    # (the definition of the design, counted here independently of scipy)
-    assert np.array_equal(np.sort(np.floor((mu - 0.1) / 0.4 * 40)), np.arange(40))
-    assert np.array_equal(np.sort(np.floor(np.log(eta / 1e-4) / np.log(100) * 40)),
-                          np.arange(40))
-    assert all(_case(m)["contact"]["mu"] == m.values["contact.mu"] for m in a)
-
-
-def test_normal_samples_have_the_stated_moments(tmp_path):
-    base_case(tmp_path)
-    body = ('[samples]\nn = 500\nseed = 3\n[samples.vary]\n'
-            'contact.mu = {distribution = "normal", mean = 0.3, std = 0.01}\n')
-    mu = np.array([m.values["contact.mu"] for m in _members(study_file(tmp_path, body))])
-    # mean within 4 standard errors (0.01 / sqrt(500)), std within 10 % (3 of its standard
-    # errors, 1 / sqrt(2 x 500) = 3.2 %)
-    assert abs(mu.mean() - 0.3) < 4 * 0.01 / np.sqrt(500)
-    assert abs(mu.std() / 0.01 - 1) < 0.1
-
-
-def test_ensemble_member_zero_is_the_base_and_perturbations_are_seeded(tmp_path):
-    base_case(tmp_path)
-    body = ('[ensemble]\nmembers = 5\nseed = 11\n[ensemble.perturb]\n'
-            'contact.mu = {relative = 1e-6}\ncontact.gap = {absolute = 1e-9, '
-            'distribution = "uniform"}\n')
-    members = _members(study_file(tmp_path, body))
-    assert members[0].values == {}
-    assert _case(members[0])["contact"]["mu"] == 0.3
-    mu = np.array([m.values["contact.mu"] for m in members[1:]])
-    gap = np.array([m.values["contact.gap"] for m in members[1:]])
-    assert np.all(mu != 0.3) and np.all(np.abs(mu / 0.3 - 1) < 1e-5)  # 10 sigma
-    assert np.all(np.abs(gap) <= 1e-9) and np.all(gap != 0.0)  # uniform in [-1e-9, 1e-9]
-    # member i's draws depend on (seed, i) only: a larger ensemble keeps the first members
-    more = _members(study_file(tmp_path, body.replace("members = 5", "members = 8"),
-                               name="more.toml"))
-    assert [m.values for m in more[:5]] == [m.values for m in members]
-
-
-def test_split_chunks_cover_the_band_and_share_their_ends(tmp_path):
-    base_case(tmp_path, SWEEP.replace("n_points = 7", "n_points = 11"))
-    members = _members(study_file(tmp_path, "[split]\nchunks = 3\n"))
-    full = np.linspace(6e3, 8e3, 11)  # the base sweep's own grid
-    freqs = [np.linspace(_case(m)["analysis"]["f_min"], _case(m)["analysis"]["f_max"],
-                         _case(m)["analysis"]["n_points"]) for m in members]
-    for left, right in itertools.pairwise(freqs):
-        assert left[-1] == right[0]
-    joined = np.concatenate([freqs[0]] + [f[1:] for f in freqs[1:]])
-    np.testing.assert_allclose(joined, full, rtol=1e-14)  # linspace rounding only
 
 
 @pytest.mark.parametrize("body, words", [

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
+from helpers.models import chain
 from helpers.pads import F_PAD, MU_PAD, P_PAD, dlft_friction_energy, pad_3d
 from scipy.integrate import solve_ivp
 
@@ -22,7 +22,7 @@ from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import initial_state, solve_periodic
 from fretwear.model.core import ContactInterface, Load, Model, ObservedPoint
 from fretwear.timedomain import integrate as tr
-from fretwear.timedomain import quasistatic, reduction, steady
+from fretwear.timedomain import quasistatic, steady
 from fretwear.timedomain.options import (
     IncrementalWearOptions,
     InitialState,
@@ -66,41 +66,6 @@ def slider3d(*, m=1.0, k=1.0, N=1.0, F0=1.0, mu=0.3):
              Load(np.array([0.0, 0.0, F0]), "sin")]
     return Model(K=K, M=M, contact=contact, loads=loads, dim=3,
                  observed=[ObservedPoint("x", np.array([1, 2]), np.zeros(3))])
-
-
-def chain(*, n=12, k=100.0, kg=30.0, mu=0.3, gap=0.0, N=5.0, F=2.0, ks_normal=0.0, c_a=0.0,
-          c_b=0.0):
-    """A contact node (DOFs 0 = normal, 1 = tangential) on a chain of ``n`` unit masses
-    (DOFs 2..n+1) with springs k, the last mass grounded by ``kg`` (an undamped spring to
-    ground), a force ``F cos(wt)`` on the last mass, and a constant normal load N. Damping
-    ``c_a K0 + c_b M`` with ``K0`` the chain without the ground spring."""
-    nd = n + 2
-    rows, cols, vals = [], [], []
-
-    def spring(i, j, kk):
-        rows.extend([i, j, i, j])
-        cols.extend([i, j, j, i])
-        vals.extend([kk, kk, -kk, -kk])
-
-    spring(1, 2, k)
-    for i in range(2, n + 1):
-        spring(i, i + 1, k)
-    K0 = sp.csr_matrix((vals, (rows, cols)), shape=(nd, nd))
-    Kn = sp.csr_matrix(([ks_normal], ([0], [0])), shape=(nd, nd))
-    Kg = sp.csr_matrix(([kg], ([nd - 1], [nd - 1])), shape=(nd, nd))
-    M = sp.identity(nd, format="csr")
-    C = (c_a * K0 + c_b * M).tocsr() if (c_a or c_b) else None
-    contact = ContactInterface(dofs=np.array([[0, 1]]), frame=np.eye(2)[None],
-                               gap=np.array([gap]), area=np.ones(1), mu=mu,
-                               coords=np.zeros((1, 2)))
-    fN = np.zeros(nd)
-    fN[0] = N
-    fQ = np.zeros(nd)
-    fQ[nd - 1] = F
-    loads = [Load(fN, "constant", name="normal"), Load(fQ, "cos", name="Q")]
-    return Model(K=(K0 + Kn + Kg).tocsr(), M=M, C=C, contact=contact, loads=loads,
-                 observed=[ObservedPoint("end", np.array([nd - 1]), np.zeros(1)),
-                           ObservedPoint("all", np.arange(nd), np.zeros(1))])
 
 
 # --------------------------------------------------------------------------------------------
@@ -468,24 +433,6 @@ def test_low_rank_damping_step_matches_dense():
 # --------------------------------------------------------------------------------------------
 # reduction
 # --------------------------------------------------------------------------------------------
-def test_reduction_is_exact_in_statics():
-    """Craig-Bampton on the contact DOFs plus one static mode per load vector: the static
-    response to any contact force and to the loads is exact. Compared with a direct sparse
-    solve of the full model (round-off, 1e-9), with no fixed-interface mode kept."""
-    model = chain(ks_normal=50.0)
-    red = reduction.reduce_dynamics(model, 1.0, modal_cutoff=None, n_modes=0,
-                                    steps_per_period=64)
-    assert red.basis.shape[1] < model.ndof
-    rng = np.random.default_rng(1)
-    lam = rng.normal(size=2)
-    F = sum(ld.vector for ld in model.loads) - model.contact.local_transform(model.ndof).T @ lam
-    u_full = spla.spsolve(model.K.tocsc(), F)
-    B = red.basis
-    K = B.T @ (model.K @ B)
-    u_red = B @ np.linalg.solve(K, B.T @ F)
-    np.testing.assert_allclose(u_red, u_full, rtol=1e-9, atol=1e-12 * np.abs(u_full).max())
-
-
 def test_linear_limit_against_frequency_domain():
     """Frictionless, permanently closed contact makes the problem linear (the normal DOF is
     held, the tangential one is free). For ``F e^{i w t}`` the two-step trapezoidal rule has

@@ -27,7 +27,6 @@ from helpers.wear_checkpoints import assert_reads_as_format_3
 from fretwear import cli
 from fretwear.errors import InputError
 from fretwear.examples.builders import stromberg_beam
-from fretwear.files import TEMPORARY, atomic_write, remove_stale_temporaries
 from fretwear.hb.fourier import FourierBasis
 from fretwear.io.results import read_results
 from fretwear.wear import HISTORY_FIELDS, RunControl, WearOptions, simulate_wear
@@ -305,50 +304,6 @@ def test_checkpoint_of_another_version_is_refused_in_one_line(reference, tmp_pat
 
 
 # --- temporary files of killed writes ---------------------------------------------------------
-def test_atomic_write_temporaries_match_the_cleanup_pattern(tmp_path):
-    names = []
-
-    def write(tmp: Path):
-        names.append(tmp.name)
-        tmp.write_text("x")
-
-    atomic_write(tmp_path / "results.nc", write)
-    atomic_write(tmp_path / CKPT, write)
-    assert all(TEMPORARY.fullmatch(n) for n in names) and len(names) == 2
-
-
-def test_stale_temporaries_are_removed_and_nothing_else(tmp_path):
-    old = time.time() - 120
-    files = {
-        ".results.nc.abc123.tmp": True,  # stale: removed
-        f".{CKPT}.k2j_9xq1.tmp": True,  # stale: removed
-        ".results.nc.fresh123.tmp": False,  # a write that may be in progress
-        ".results.tmp": False,  # not the pattern (no random part)
-        ".results.nc.abc123.tmp.bak": False,
-        ".results.nc.ABC123.tmp": False,  # mkstemp draws lowercase
-        "results.nc.abc123.tmp": False,  # not hidden
-        "notes.txt": False,
-    }
-    for name in files:
-        (tmp_path / name).write_text(name)
-        if name != ".results.nc.fresh123.tmp":
-            os.utime(tmp_path / name, (old, old))
-    (tmp_path / ".dir.abc123.tmp").mkdir()  # a folder of that name: kept
-    os.utime(tmp_path / ".dir.abc123.tmp", (old, old))
-    (tmp_path / "sub").mkdir()  # only the folder itself is cleaned, not below
-    (tmp_path / "sub" / ".results.nc.abc123.tmp").write_text("x")
-    os.utime(tmp_path / "sub" / ".results.nc.abc123.tmp", (old, old))
-    removed = remove_stale_temporaries(tmp_path)
-    assert sorted(p.name for p in removed) == sorted(n for n, gone in files.items() if gone)
-    for name, gone in files.items():
-        assert (tmp_path / name).exists() is not gone, name
-        if not gone:
-            assert (tmp_path / name).read_text() == name
-    assert (tmp_path / ".dir.abc123.tmp").is_dir()
-    assert (tmp_path / "sub" / ".results.nc.abc123.tmp").is_file()
-    assert remove_stale_temporaries(tmp_path / "missing") == []
-
-
 def test_next_run_removes_a_stale_temporary(case, reference, tmp_path, capsys):
     out = tmp_path / "out"
     out.mkdir()
@@ -370,26 +325,3 @@ def test_next_run_removes_a_stale_temporary(case, reference, tmp_path, capsys):
     assert not stale.exists()
     for name, (data, mtime) in kept.items():
         assert (out / name).read_bytes() == data and (out / name).stat().st_mtime_ns == mtime
-
-
-def test_an_interruption_inside_compiled_code_is_an_interruption():
-    """Ctrl-C or SIGTERM that arrives while a numba function runs surfaces as SystemError
-    ("returned a result with an exception set") caused, through one or more such
-    SystemErrors, by the KeyboardInterrupt (seen on a killed wear run): the run must treat it
-    as the interruption (save, exit 130/143), and anything else as an error."""
-    from fretwear.errors import interrupted
-
-    def nested(depth):
-        exc = KeyboardInterrupt()
-        for _ in range(depth):
-            outer = SystemError("returned a result with an exception set")
-            outer.__cause__ = exc
-            exc = outer
-        return exc
-
-    assert interrupted(KeyboardInterrupt())
-    assert interrupted(nested(1)) and interrupted(nested(2))
-    assert not interrupted(SystemError("something else"))
-    other = SystemError("x")
-    other.__cause__ = ValueError("y")
-    assert not interrupted(other)

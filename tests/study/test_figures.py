@@ -1,0 +1,115 @@
+"""The figures of a study (fretwear.study.figures), drawn from ``study.nc`` alone.
+
+References: study datasets built here with known values; what each figure draws is read back
+from its matplotlib artists (the lines' data, labels and colours) and compared with the
+dataset's values in the figure's units, and the files are checked to be PNG images.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from fretwear.study import figures
+
+PNG = b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.fixture
+def drawn(monkeypatch):
+    """The figures as they are saved: path name -> matplotlib figure."""
+    out = {}
+    save = figures._save
+
+    def keep(fig, path):
+        out[path.name] = fig
+        return save(fig, path)
+
+    monkeypatch.setattr(figures, "_save", keep)
+    return out
+
+
+def wear_study() -> xr.Dataset:
+    """3 members on 5 cycles and 2 nodes; member 2 stops after cycle index 2, so the last
+    cycle every member reached is index 2."""
+    vol = np.array([[0, 1, 2, 3, 4], [0, 2, 3, 4, 5], [0, 1, 5, np.nan, np.nan]], float) * 1e-9
+    depth = np.stack([vol * 1e3, vol * 2e3], axis=-1)  # (member, cycle, node) [m]
+    reached = np.isfinite(vol).sum(axis=0)
+    with np.errstate(all="ignore"):
+        q = np.nanquantile(vol, (0.05, 0.5, 0.95), axis=0)
+        qd = np.nanquantile(depth, (0.05, 0.5, 0.95), axis=0)
+    return xr.Dataset({
+        "worn_volume_on_cycles": (("member", "cycle"), vol),
+        "worn_volume_quantile": (("quantile", "cycle"), q),
+        "worn_volume_mean": ("cycle", np.nanmean(vol, axis=0)),
+        "members_reached": ("cycle", reached),
+        "wear_depth_on_cycles": (("member", "cycle", "contact_node"), depth),
+        "wear_depth_quantile": (("quantile", "cycle", "contact_node"), qd),
+        "contact_position": (("member", "contact_node", "dim"),
+                             np.tile([[0.001, 0.0], [0.002, 0.0]], (3, 1, 1)))},
+        coords={"cycle": np.linspace(0.0, 4e6, 5)}, attrs={"title": "t", "members_ok": 3})
+
+
+def test_wear_figures_draw_the_statistics_in_their_units(tmp_path, drawn):
+    """Fan chart: one thin line per member, the median and the mean of the dataset in mm^3
+    (1e9 x m^3). Profiles: drawn at the last cycle every member reached (index 2, found by
+    hand), x in mm and the median in um. Both files are PNG images."""
+    ds = wear_study()
+    paths = figures.study_figures(ds, tmp_path, ["contact.mu"])
+    assert [p.name for p in paths] == ["study-worn-volume.png", "study-wear-profiles.png"]
+    assert all(p.read_bytes()[:8] == PNG for p in paths)
+    ax = drawn["study-worn-volume.png"].axes[0]
+    lines = {ln.get_label(): ln for ln in ax.get_lines()}
+    assert sum(lb.startswith("_") for lb in lines) == 3  # members, unlabelled
+    np.testing.assert_allclose(lines["median"].get_ydata(),
+                               ds["worn_volume_quantile"].values[1] * 1e9, rtol=1e-15)
+    np.testing.assert_allclose(lines["mean"].get_ydata(),
+                               ds["worn_volume_mean"].values * 1e9, rtol=1e-15)
+    ax = drawn["study-wear-profiles.png"].axes[0]
+    median = next(ln for ln in ax.get_lines() if ln.get_label() == "median")
+    np.testing.assert_allclose(median.get_xdata(), [1.0, 2.0], rtol=1e-15)
+    np.testing.assert_allclose(median.get_ydata(),
+                               ds["wear_depth_quantile"].values[1, 2] * 1e6, rtol=1e-15)
+    assert ax.get_title() == "worn profiles at N = 2e+06"
+
+
+def sweep_study(joined: bool) -> xr.Dataset:
+    f = np.array([1e3, 2e3, 4e3])
+    if joined:
+        amp = np.array([1e-6, 3e-6, 2e-6])[:, None, None, None] * np.array([1, 10])[:, None]
+        return xr.Dataset({"response_amplitude": (("frequency", "point", "axis", "harmonic"),
+                                                  amp),
+                           "join_frequency": ("join", [2e3, np.nan]),
+                           "join_ok": ("join", [0, 0])},
+                          coords={"frequency": f, "point": ["Pe"], "axis": ["x", "y"]})
+    amp = np.array([[1e-6, 2e-6, 1e-6], [2e-6, 5e-6, 3e-6]])[:, :, None, None, None]
+    amp = amp * np.array([1, 10])[:, None]  # axis y larger: the one drawn
+    return xr.Dataset({"response_amplitude": (("member", "frequency", "point", "axis",
+                                               "harmonic"), amp)},
+                      coords={"frequency": f, "point": ["Pe"], "axis": ["x", "y"],
+                              "contact.mu": ("member", [0.1, 0.3])}, attrs={"title": "t"})
+
+
+def test_sweep_family_draws_each_member_on_the_axis_of_largest_response(tmp_path, drawn):
+    """One curve per member labelled with its varied key, on the axis with the largest
+    amplitude (y, 10 x x), in metres."""
+    ds = sweep_study(joined=False)
+    paths = figures.study_figures(ds, tmp_path, ["contact.mu"])
+    assert [p.name for p in paths] == ["study-frf-family.png"]
+    ax = drawn["study-frf-family.png"].axes[0]
+    assert [ln.get_label() for ln in ax.get_lines()] == ["contact.mu = 0.1", "contact.mu = 0.3"]
+    for i, ln in enumerate(ax.get_lines()):
+        np.testing.assert_array_equal(ln.get_ydata(),
+                                      ds["response_amplitude"].values[i, :, 0, 1, 0])
+    assert ax.get_ylabel() == "amplitude Pe y [m]"
+
+
+def test_joined_sweep_marks_its_joins_red_where_the_check_failed(tmp_path, drawn):
+    """The failed join at 2 kHz is a red dotted line; the unjudged one (NaN) is not drawn."""
+    paths = figures.study_figures(sweep_study(joined=True), tmp_path, [])
+    assert [p.name for p in paths] == ["study-frf-joined.png"]
+    ax = drawn["study-frf-joined.png"].axes[0]
+    marks = [ln for ln in ax.get_lines() if ln.get_linestyle() == ":"]
+    assert len(marks) == 1 and marks[0].get_color() == "red"
+    assert list(marks[0].get_xdata()) == [2e3, 2e3]

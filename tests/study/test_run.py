@@ -1,0 +1,103 @@
+"""A study from end to end (fretwear.study.run) without running a member: ``collect`` writes
+``study.nc`` from what the members' folders hold, the summary counts what happened, shipped
+studies are found by name.
+
+References: a member folder prepared here as a finished run leaves it (its status file with
+the hash of its case text, its results file) and the values written into it; the summary's
+counts are those of the records, counted by hand. No cluster is started and no member runs
+(the runs themselves are tested in test_runner.py).
+"""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+import xarray as xr
+from helpers.studies import base_case, study_file
+
+from fretwear.errors import InputError
+from fretwear.examples import EXAMPLES_DIR
+from fretwear.study.members import expand
+from fretwear.study.run import _summary, resolve_study, run_study, shipped_studies
+from fretwear.study.runner import RESULTS_FILE, STATUS_FILE, MemberRecord, case_hash
+from fretwear.study.spec import read_study
+
+
+def test_collect_writes_the_study_of_the_finished_members_only(tmp_path):
+    """Member 0 finished (its status and results as a run leaves them), member 1 never ran:
+    ``collect`` records them as "ok" (finished before) and "not run", writes study.nc with
+    member 0's values stacked unchanged and NaN for member 1, and the study is not a
+    success. study.nc on disk equals the returned dataset."""
+    base_case(tmp_path)
+    path = study_file(tmp_path, "[grid]\ncontact.mu = [0.1, 0.3]\n")
+    members = expand(read_study(path))
+    out = tmp_path / "out"
+    done = out / members[0].folder_name
+    done.mkdir(parents=True)
+    amp = np.array([[1.0, 2.0], [3.0, 4.0]])
+    xr.Dataset({"slip_amplitude": (("contact_node", "harmonic"), amp)}).to_netcdf(
+        done / RESULTS_FILE, engine="h5netcdf")
+    (done / STATUS_FILE).write_text(MemberRecord(0, "ok", "periodic solution",
+                                                 case_sha256=case_hash(members[0].text)
+                                                 ).to_json())
+    res = run_study(path, out, collect=True, progress=False, echo=False)
+    assert [r.status for r in res.records] == ["ok", "not run"]
+    assert not res.success and res.figures == []  # figures = false in the base case
+    assert res.message.splitlines()[0] == ("grid study of 2 members: 1 ok, 0 not converged, "
+                                           "0 failed, 1 not run (1 finished before)")
+    ds = xr.open_dataset(res.results, engine="h5netcdf").load()
+    assert res.results == (out / "study.nc").resolve()
+    np.testing.assert_array_equal(ds["slip_amplitude"].values[0], amp)
+    assert np.all(np.isnan(ds["slip_amplitude"].values[1]))
+    assert ds["contact.mu"].values.tolist() == [0.1, 0.3]
+    xr.testing.assert_identical(ds, res.dataset)
+    assert not (out / members[1].folder_name / RESULTS_FILE).exists()
+
+
+def test_a_finished_member_of_another_case_text_is_not_taken(tmp_path):
+    """A status whose hash is not that of the member's case text (the study was edited
+    since) does not count: the member is "not run"."""
+    base_case(tmp_path)
+    path = study_file(tmp_path, "[grid]\ncontact.mu = [0.1]\n")
+    done = tmp_path / "out" / "member-0000"
+    done.mkdir(parents=True)
+    xr.Dataset({"x": ("a", [1.0])}).to_netcdf(done / RESULTS_FILE, engine="h5netcdf")
+    (done / STATUS_FILE).write_text(MemberRecord(0, "ok", case_sha256="0" * 64).to_json())
+    res = run_study(path, tmp_path / "out", collect=True, progress=False, echo=False)
+    assert [r.status for r in res.records] == ["not run"]
+
+
+def test_summary_of_a_split_sweep_names_each_failed_join():
+    """Counts by status and the joins beyond join_rtol, with their frequencies and
+    differences, make the study fail even when every member is ok."""
+    study = SimpleNamespace(kind="split", split={"join_rtol": 1e-6})
+    records = [MemberRecord(0, "ok"), MemberRecord(1, "ok"), MemberRecord(2, "ok")]
+    ds = xr.Dataset({"join_frequency": ("join", [3.0, 5.0]),
+                     "join_difference": ("join", [0.0, 1e-3]), "join_ok": ("join", [1, 0])})
+    ok, message = _summary(study, records, ds)
+    assert not ok
+    assert message.splitlines() == ["split study of 3 members: 3 ok, 0 not converged, 0 failed",
+                                    "  joins beyond join_rtol = 1e-06: 5 Hz (0.001)"]
+    ds["join_ok"].values[1] = 1
+    assert _summary(study, records, ds) == (True, "split study of 3 members: 3 ok, 0 not "
+                                            "converged, 0 failed\n  every join within "
+                                            "join_rtol = 1e-06")
+
+
+def test_studies_are_found_by_file_or_by_shipped_name(tmp_path):
+    """A path is itself; a shipped study's name is its file in the package's studies folder
+    (listed here with glob); anything else is one InputError naming what exists."""
+    folder = EXAMPLES_DIR / "studies"
+    assert shipped_studies() == {p.stem: p for p in sorted(folder.glob("*.toml"))}
+    name = "salles2011-frf-mu-load"
+    assert resolve_study(name) == folder / f"{name}.toml"
+    path = study_file(tmp_path, "")
+    assert resolve_study(path) == path
+    with pytest.raises(InputError, match=r"no study file 'nope'.*salles2011-frf-mu-load"):
+        resolve_study("nope")
+    with pytest.raises(InputError, match=r"study file '.*missing.toml' does not exist"):
+        resolve_study(tmp_path / "missing.toml")
+    with pytest.raises(InputError, match=r"study file 'nowhere.toml' does not exist"):
+        resolve_study("nowhere.toml")  # a file name, not a shipped study's name
