@@ -79,5 +79,5 @@ def test_a_large_interior_needs_a_modal_representation(monkeypatch):
     """Above DENSE_INTERIOR_MAX interior DOFs the exact transformation is not formed: one
     InputError saying how many and what to do."""
     monkeypatch.setattr(dynamics, "DENSE_INTERIOR_MAX", 20)
-    with pytest.raises(InputError, match=r"21 interior DOFs.*use_modal"):
+    with pytest.raises(InputError, match=r"21 interior DOFs.*modal_condenser"):
         structure_dynamics(truss())

@@ -14,14 +14,25 @@ import numpy as np
 from helpers.models import F0, K_, M_, ZETA, oscillator
 
 from fretwear.hb.fourier import FourierBasis
-from fretwear.timedomain.averaged_rate import time_averaged_rate
+from fretwear.timedomain import fallback
 from fretwear.timedomain.fallback import FALLBACK
 from fretwear.timedomain.stability import time_domain_start
 
 
-def test_the_fallback_is_the_time_integration():
+def test_the_fallback_is_the_time_integration(monkeypatch):
+    """FALLBACK's start is the time integration's; its averaged rate is the adapter that
+    hands the wear driver's keywords to time_averaged_rate as an AveragingOptions record
+    (checked by recording the call)."""
     assert FALLBACK.start is time_domain_start
-    assert FALLBACK.averaged_rate is time_averaged_rate
+    seen = {}
+    monkeypatch.setattr(fallback, "time_averaged_rate",
+                        lambda *a, **kw: seen.update(args=a, **kw) or "rate")
+    out = FALLBACK.averaged_rate("m", 7.0, "b", "c", "w", U0="u", V0="v", settle=3,
+                                 average=4, steps_per_period=64)
+    assert out == "rate" and seen["args"] == ("m", 7.0, "b", "c", "w")
+    assert (seen["U0"], seen["V0"]) == ("u", "v")
+    opts = seen["options"]
+    assert (opts.settle, opts.average, opts.steps_per_period) == (3, 4, 64)
 
 
 def test_start_returns_the_steady_state_in_the_layout_of_the_basis():
