@@ -24,7 +24,8 @@ import scipy.linalg as sla
 
 from fretwear.examples.builders import paper_beam
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import DLFTProblem, solve_periodic
+from fretwear.hb.periodic import solve_periodic
+from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.reduce import condense
 from fretwear.hb.sweep import sweep
 from fretwear.timedomain.fallback import FALLBACK

@@ -116,7 +116,9 @@ def warm_up():
     solve. The 256-node solve takes the dense path, the 1024-node one the operator path:
     without the second part only the latter would pay for loading its kernel."""
     from fretwear.hb.fourier import FourierBasis
-    from fretwear.hb.periodic import DLFTProblem, solve_periodic, static_anchor
+    from fretwear.hb.periodic import solve_periodic
+    from fretwear.hb.preload import static_anchor
+    from fretwear.hb.problem import DLFTProblem
     from fretwear.hb.reduce import condense
 
     small, basis = pad(4), FourierBasis.up_to(H, 128)
@@ -134,7 +136,8 @@ def one(n: int, extras: dict) -> dict:
 
     from fretwear.hb.fourier import FourierBasis
     from fretwear.hb.modal import use_modal
-    from fretwear.hb.periodic import solve_periodic, static_anchor
+    from fretwear.hb.periodic import solve_periodic
+    from fretwear.hb.preload import static_anchor
     from fretwear.hb.reduce import Condenser, _structure
 
     out = {"n": n, "nodes": n * n}
@@ -216,7 +219,8 @@ def alternate(sizes: tuple[int, int], reps: int) -> dict:
     periodic solve on the condensation of the frequency (condensed once per size)."""
     from fretwear.hb.fourier import FourierBasis
     from fretwear.hb.modal import use_modal
-    from fretwear.hb.periodic import solve_periodic, static_anchor
+    from fretwear.hb.periodic import solve_periodic
+    from fretwear.hb.preload import static_anchor
 
     basis = FourierBasis.up_to(H, 128)
     warm_up()  # untimed, as in one()

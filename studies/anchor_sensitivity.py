@@ -18,7 +18,8 @@ import numpy as np
 
 from fretwear.examples.builders import paper_beam
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import solve_periodic, static_anchor
+from fretwear.hb.periodic import solve_periodic
+from fretwear.hb.preload import static_anchor
 from fretwear.hb.reduce import condense
 
 

@@ -88,8 +88,8 @@ def main(argv=None) -> int:
 
     from fretwear.analyses.run import load_case
     from fretwear.hb.fourier import FourierBasis
-    from fretwear.hb.periodic import initial_state
     from fretwear.hb.reduce import condense
+    from fretwear.hb.solution import initial_state
     from fretwear.hb.solvers import SolveStats
     from fretwear.io.case import build_model
     from fretwear.timedomain.averaged_rate import time_averaged_rate

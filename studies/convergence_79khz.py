@@ -179,7 +179,7 @@ class Study:
 
     def model(self, nx):
         from fretwear.examples.builders import paper_beam
-        from fretwear.hb.periodic import static_anchor
+        from fretwear.hb.preload import static_anchor
 
         if nx not in self.models:
             self.models[nx] = paper_beam(nx=nx, ny=4)

@@ -45,7 +45,7 @@ _API = {
     # harmonic balance
     "FourierBasis": "fretwear.hb.fourier", "condense": "fretwear.hb.reduce",
     "Reduced": "fretwear.hb.reduce", "solve_periodic": "fretwear.api",
-    "PeriodicSolution": "fretwear.hb.periodic", "SweepResult": "fretwear.hb.sweep",
+    "PeriodicSolution": "fretwear.hb.solution", "SweepResult": "fretwear.hb.sweep",
     "sweep": "fretwear.api",
     # linear
     "modes": "fretwear.linear", "frf": "fretwear.linear",

@@ -35,7 +35,7 @@ def solve_periodic(model, basis, *, time_domain: bool = True,
 
     Returns
     -------
-    :class:`~fretwear.hb.periodic.PeriodicSolution`: ``success``, ``message``, ``attempts``,
+    :class:`~fretwear.hb.solution.PeriodicSolution`: ``success``, ``message``, ``attempts``,
     the harmonics and time histories of the contact (see its docstring).
     """
     return _periodic.solve_periodic(model, basis, time_domain=_fallback(time_domain), **kwargs)

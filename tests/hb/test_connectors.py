@@ -18,8 +18,9 @@ import pytest
 
 from fretwear.hb.connectors import Connected, connect
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import initial_state, solve_periodic
+from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.reduce import condense
+from fretwear.hb.solution import initial_state
 from fretwear.model.core import Load
 from fretwear.model.matrices import from_matrices
 

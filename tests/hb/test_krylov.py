@@ -21,7 +21,8 @@ from fretwear.hb import contact as law
 from fretwear.hb import krylov
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.krylov import KrylovJacobian
-from fretwear.hb.periodic import DLFTProblem, static_anchor
+from fretwear.hb.preload import static_anchor
+from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.reduce import condense
 from fretwear.hb.solvers import solve
 

@@ -15,7 +15,8 @@ import scipy.sparse as sp
 
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.penalty import penalty
-from fretwear.hb.periodic import DLFTProblem, solve_periodic
+from fretwear.hb.periodic import solve_periodic
+from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.reduce import condense
 from fretwear.hb.sweep import sweep
 from fretwear.model.core import ContactInterface, Load, Model

@@ -16,7 +16,8 @@ import pytest
 
 from fretwear.hb import small
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import DLFTProblem, solve_periodic
+from fretwear.hb.periodic import solve_periodic
+from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.reduce import condense
 from fretwear.hb.sweep import sweep
 from fretwear.model import ContactSpec, Damping, Material, Spring, Traction, from_mesh, rectangle

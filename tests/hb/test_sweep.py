@@ -73,7 +73,7 @@ def test_point_passed_by_eps_continuation_keeps_the_sweep_eps_and_its_attempts()
     says so (``how``), keeps every attempt in order, and its answer is at the sweep's eps (no
     eps jump). Independent check: the residual of a fresh problem at eps = 1 at the point's
     harmonics is below the tolerance."""
-    from fretwear.hb.periodic import DLFTProblem
+    from fretwear.hb.problem import DLFTProblem
     from fretwear.hb.reduce import condense
     from fretwear.model.core import Load
     from fretwear.model.matrices import from_matrices

@@ -24,7 +24,8 @@ import scipy.sparse as sp
 
 from fretwear.errors import InputError
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import DLFTProblem, solve_periodic
+from fretwear.hb.periodic import solve_periodic
+from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.reduce import condense, recover
 from fretwear.linear import frf, modes
 from fretwear.model import (
@@ -483,7 +484,7 @@ def test_interface_open_under_the_preload_is_flagged():
     springs' force is k times the displacement of the spring nodes), to rounding (1e-9: the
     static solve's 1e-10 convergence test)."""
     from fretwear.analyses.common import preload_notes
-    from fretwear.hb.periodic import _static_solve, preload_contact
+    from fretwear.hb.preload import _static_solve, preload_contact
     from fretwear.hb.reduce import condense_static
 
     pulled = pressed_or_pulled_block(-1e6)
@@ -591,7 +592,7 @@ def test_time_integration_of_a_pair_on_a_stiff_held_body_is_the_rigid_obstacle_o
     rest is a shock the contact solve of the first step does not settle); 256 steps per
     period, because at 64 a few contact solves of either model, the rigid one included, do
     not settle."""
-    from fretwear.hb.periodic import initial_state
+    from fretwear.hb.solution import initial_state
     from fretwear.timedomain.integrate import integrate
 
     ratio = 1e-6
@@ -643,7 +644,7 @@ def test_time_integration_takes_a_friction_coefficient_per_interface():
     (a 3-harmonic balance depends on eps, and the default rule gives the joint model another
     one). Tolerance 1e-10 of the largest force: the contact solves settle to 1e-10 of the
     largest force of the model they solve; measured 4e-14."""
-    from fretwear.hb.periodic import initial_state
+    from fretwear.hb.solution import initial_state
     from fretwear.timedomain.integrate import integrate
 
     sizes = {"one": (0.02, 4), "two": (0.015, 3)}

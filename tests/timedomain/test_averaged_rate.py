@@ -24,8 +24,9 @@ import fretwear.wear.schemes as wear_schemes  # the first balance calls its solv
 import fretwear.wear.simulate as wear_driver  # the driver calls its advance (balanced steps)
 from fretwear import simulate_wear  # the public driver: time-domain fallback on
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import initial_state, solve_periodic
+from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.reduce import condense
+from fretwear.hb.solution import initial_state
 from fretwear.model.build import ContactSpec, Damping, Material, Spring, Traction, from_mesh
 from fretwear.model.mesh import rectangle
 from fretwear.timedomain.averaged_rate import RESPONSE_KINDS, time_averaged_rate

@@ -19,7 +19,8 @@ from scipy.integrate import solve_ivp
 
 from fretwear.errors import InputError
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import initial_state, solve_periodic
+from fretwear.hb.periodic import solve_periodic
+from fretwear.hb.solution import initial_state
 from fretwear.model.core import ContactInterface, Load, Model, ObservedPoint
 from fretwear.timedomain import integrate as tr
 from fretwear.timedomain import quasistatic, reduction, steady

@@ -15,7 +15,8 @@ from helpers.models import K_, M_, oscillator
 from helpers.pads import F_PAD, pad_3d
 
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import initial_state, solve_periodic
+from fretwear.hb.periodic import solve_periodic
+from fretwear.hb.solution import initial_state
 from fretwear.timedomain.stability import RESOLVED_STEPS, check_periodic, time_domain_start
 
 F_HZ = 0.7 * np.sqrt(K_ / M_) / (2 * np.pi)  # forcing frequency [Hz], below the resonance

@@ -32,7 +32,8 @@ from helpers.models import sliders
 
 from fretwear.hb import contact as law
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import solve_periodic, static_anchor
+from fretwear.hb.periodic import solve_periodic
+from fretwear.hb.preload import static_anchor
 from fretwear.hb.reduce import condense
 from fretwear.hb.solvers import solve_identity_rows
 from fretwear.model.build import ContactSpec, Material, Spring, Traction, from_mesh

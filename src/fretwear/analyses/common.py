@@ -17,7 +17,7 @@ import xarray as xr
 from fretwear.files import inside, safe_name
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.penalty import RULES
-from fretwear.hb.periodic import preload_contact
+from fretwear.hb.preload import preload_contact
 from fretwear.hb.solvers import SOLVERS, SolveStats
 from fretwear.io.results import label_coordinate, variable
 from fretwear.io.schema import AnyOf, Field, Integer, ListOf, Number, Text, fail, join
@@ -40,7 +40,7 @@ WARNINGS_ATTRIBUTE = "warnings"
 
 def preload_notes(model) -> tuple[list[str], list[str]]:
     """Warnings about interfaces that no node touches under the static loads (the preload),
-    and the names of those interfaces (:func:`fretwear.hb.periodic.preload_contact`).
+    and the names of those interfaces (:func:`fretwear.hb.preload.preload_contact`).
 
     A run on such an interface is kept (a clearance that the vibration closes is a model a
     user may mean), but it is almost always a mistake (a gap of the wrong sign, a load pulling

@@ -33,8 +33,9 @@ from fretwear.analyses.common import basis_of, cell_edges, interface_abscissa, s
 from fretwear.analyses.run import load_case
 from fretwear.analyses.transient import period_friction_energy, state_fractions
 from fretwear.errors import InputError
-from fretwear.hb.periodic import PeriodicSolution, solve_periodic
+from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.reduce import condense
+from fretwear.hb.solution import PeriodicSolution
 from fretwear.io.case import build_model
 from fretwear.timedomain.quasistatic import incremental_wear
 from fretwear.timedomain.results import SteadyStateResult

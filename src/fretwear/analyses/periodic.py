@@ -38,8 +38,9 @@ from fretwear.analyses.registry import RunOutput, register
 from fretwear.errors import InputError
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.penalty import penalty
-from fretwear.hb.periodic import PeriodicSolution, solve_periodic
+from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.reduce import condense, recover
+from fretwear.hb.solution import PeriodicSolution
 from fretwear.hb.solvers import SolveStats
 from fretwear.io.results import nodal_vectors, variable, write_pvd, write_vtu
 from fretwear.io.schema import Field, Flag, Integer, Number, join

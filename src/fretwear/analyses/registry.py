@@ -118,7 +118,7 @@ def register(name: str, schema: Table | Mapping, run: RunFunction, *, doc: str =
     preload_check : the analysis runs the contact law (vibration, wear):
         :func:`fretwear.analyses.run.run_case` first solves the static contact under the
         preload and warns about an interface that no node of touches
-        (:func:`fretwear.hb.periodic.preload_contact`).
+        (:func:`fretwear.hb.preload.preload_contact`).
     """
     table = schema if isinstance(schema, Table) else Table(dict(schema), tuple(checks), doc)
     if "type" in table.fields:

@@ -32,7 +32,7 @@ from fretwear.analyses.common import (
 from fretwear.analyses.registry import RunOutput, register
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import PeriodicSolution
+from fretwear.hb.solution import PeriodicSolution
 from fretwear.hb.sweep import SweepResult, sweep
 from fretwear.io.results import label_coordinate, variable
 from fretwear.io.schema import Field, Flag, Integer, ListOf, Number, Text, increasing

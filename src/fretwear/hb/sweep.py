@@ -8,7 +8,7 @@ point that still does not converge is kept in the result as *not converged*, wit
 and never used as a solution.
 
 Mean tangential position (stick anchors): the sweep follows the loading history; the first
-point starts from the static preload (:func:`fretwear.hb.periodic.static_anchor`) and every later
+point starts from the static preload (:func:`fretwear.hb.preload.static_anchor`) and every later
 point
 takes the mean tangential positions of the previous converged point as its anchors (a node that
 sticks all period stays where it was). See docs/theory.md, "Full stick and the mean position".
@@ -24,21 +24,16 @@ import numpy as np
 
 from fretwear.errors import InputError
 from fretwear.files import check_state_file
+from fretwear.hb.attempts import _first_harmonic_start, solve_strategy
 from fretwear.hb.connectors import connect, springs
 from fretwear.hb.fallback import TimeDomainFallback
 from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.inputs import check_inputs
 from fretwear.hb.penalty import sweep_penalty
-from fretwear.hb.periodic import (
-    Attempt,
-    DLFTProblem,
-    PeriodicSolution,
-    _first_harmonic_start,
-    assemble_solution,
-    check_inputs,
-    preload_anchor,
-    solve_strategy,
-)
+from fretwear.hb.preload import preload_anchor
+from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.reduce import _condense, condenser
+from fretwear.hb.solution import Attempt, PeriodicSolution, assemble_solution
 from fretwear.hb.solvers import SolveStats, solve
 from fretwear.hb.sweep_checkpoint import (
     WHAT,
@@ -60,7 +55,7 @@ class SweepPoint:
     solver statistics of the last solve; how : ``"grid"``, ``"substep"``, ``"retry"``,
     ``"arclength"``, ``"eps-continuation"``, ``"harmonic-continuation"``, ``"fresh-start"``
     or ``"time-start"``; attempts : every attempt made at this frequency, in order
-    (:class:`~fretwear.hb.periodic.Attempt`); flags : reasons for caution
+    (:class:`~fretwear.hb.solution.Attempt`); flags : reasons for caution
     (``"not converged: ..."``, time-domain findings); on_grid : a requested grid frequency
     (False for the intermediate points the sweep added); time_domain : what the time
     integration found at a point whose balance failed (``""`` when none ran).

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fretwear.hb.periodic import PeriodicSolution
+from fretwear.hb.solution import PeriodicSolution
 from fretwear.wear.laws import worn_volume
 
 #: per-step arrays of :class:`WearHistory`: name -> (units, long name)

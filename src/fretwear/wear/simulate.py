@@ -27,8 +27,10 @@ import numpy as np
 from fretwear.errors import InputError, interrupted
 from fretwear.hb.fallback import TimeDomainFallback
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import PeriodicSolution, check_inputs, preload_anchor
+from fretwear.hb.inputs import check_inputs
+from fretwear.hb.preload import preload_anchor
 from fretwear.hb.reduce import Reduced, condense
+from fretwear.hb.solution import PeriodicSolution
 from fretwear.hb.solvers import SolveStats
 from fretwear.model.core import Model
 from fretwear.wear.checkpoint import (

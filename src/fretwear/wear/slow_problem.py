@@ -11,8 +11,9 @@ from fretwear.hb import contact as law
 from fretwear.hb import solvers
 from fretwear.hb.fallback import TimeDomainFallback
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import DLFTProblem, PeriodicSolution, assemble_solution
+from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.reduce import Reduced
+from fretwear.hb.solution import PeriodicSolution, assemble_solution
 from fretwear.hb.solvers import SolveStats, solve, solve_identity_rows
 from fretwear.model.core import Model
 from fretwear.resources import require_memory

@@ -15,7 +15,7 @@ import time
 import numpy as np
 
 from fretwear.errors import ConvergenceError
-from fretwear.hb.periodic import initial_state
+from fretwear.hb.solution import initial_state
 from fretwear.hb.solvers import SolveStats
 from fretwear.wear.history import solution_row, time_row
 from fretwear.wear.options import (
