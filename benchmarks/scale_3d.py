@@ -191,12 +191,13 @@ def one(n: int, extras: dict) -> dict:
     anchor = sol.anchor
     del red, sol  # the sweep condenses each of its frequencies itself
     if extras.get("sweep"):
+        from fretwear.hb.options import SweepOptions
         from fretwear.hb.sweep import sweep
 
         ck = os.path.join(tmp, "sweep-checkpoint.npz")
         with Clock() as c:
-            res = sweep(model, basis, 4000.0, 6000.0, extras["sweep"], spacing="linear",
-                        anchor=anchor, checkpoint=ck)
+            res = sweep(model, basis, 4000.0, 6000.0, extras["sweep"],
+                        options=SweepOptions(spacing="linear", checkpoint=ck), anchor=anchor)
         out.update(sweep_points=extras["sweep"], sweep_cpu=c.cpu, sweep_wall=c.wall,
                    sweep_converged=int(sum(p.success for p in res.points)),
                    sweep_ckpt_mib=os.path.getsize(ck) / 2**20,

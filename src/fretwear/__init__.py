@@ -46,7 +46,8 @@ _API = {
     "FourierBasis": "fretwear.hb.fourier", "condense": "fretwear.hb.reduce",
     "Reduced": "fretwear.hb.reduce", "solve_periodic": "fretwear.api",
     "PeriodicSolution": "fretwear.hb.solution", "SweepResult": "fretwear.hb.sweep",
-    "sweep": "fretwear.api",
+    "sweep": "fretwear.api", "SolveOptions": "fretwear.hb.options",
+    "SweepOptions": "fretwear.hb.options",
     # linear
     "modes": "fretwear.linear", "frf": "fretwear.linear",
     # wear

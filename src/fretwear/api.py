@@ -12,7 +12,9 @@ from __future__ import annotations
 from fretwear import wear as _wear
 from fretwear.hb import periodic as _periodic
 from fretwear.hb import sweep as _sweep
+from fretwear.hb.options import sweep_options
 from fretwear.timedomain.fallback import FALLBACK
+from fretwear.wear.worn_frf import WORN_FRF
 
 
 def _fallback(time_domain: bool):
@@ -23,12 +25,13 @@ def _fallback(time_domain: bool):
 
 def solve_periodic(model, basis, *, time_domain: bool = True,
                    **kwargs) -> _periodic.PeriodicSolution:
-    """Periodic response of ``model`` at the excitation ``frequency`` [Hz] (keyword, default
-    1 Hz) with the DLFT (paper section 3.1-3.2).
+    """Periodic response of ``model`` at the excitation ``frequency`` [Hz] (keyword, required
+    unless ``quasi_static``) with the DLFT (paper section 3.1-3.2).
 
     :func:`fretwear.hb.periodic.solve_periodic` (every other keyword: ``frequency``,
-    ``quasi_static``, ``gap`` [m], ``eps``, ``anchor``, ``U0``, ``solver``, ``tol``,
-    ``max_iter``, ``strategy``, ``time_domain_periods``, ...) with the time-domain fallback
+    ``quasi_static``, ``options`` (:class:`~fretwear.hb.options.SolveOptions`: ``solver``,
+    ``tol``, ``max_iter``, ``strategy``, ``time_domain_periods``, ...), ``gap`` [m], ``eps``,
+    ``anchor``, ``U0``, ``condenser``, ...) with the time-domain fallback
     when every attempt of the solve strategy failed (``time_domain=True``, as the case-file
     key ``time_domain`` of a periodic analysis): a periodic steady state of a time integration
     starts one more solve; any other response is reported (``solution.time_domain``).
@@ -46,11 +49,12 @@ def sweep(model, basis, f_min: float, f_max: float, n_points: int, *, time_domai
     """Nonlinear FRF: periodic solutions of the DLFT from ``f_min`` to ``f_max`` [Hz] on
     ``n_points`` grid frequencies, each starting from its neighbours (continuation).
 
-    :func:`fretwear.hb.sweep.sweep` (every other keyword: ``spacing``, ``gap`` [m], ``eps``
-    [N/m or "static"/"auto"], ``solver``, ``tol``, ``max_iter``, ``continuation``, ``check``,
-    ``time_domain_periods``, ``checkpoint``, ``resume``, ...) with the time-domain fallback at
-    points whose balance fails (``time_domain=True``, as the case-file key ``time_domain`` of a
-    sweep).
+    :func:`fretwear.hb.sweep.sweep` (every other keyword: ``options``
+    (:class:`~fretwear.hb.options.SweepOptions`: ``solve``, ``spacing``, ``eps`` [N/m or
+    "top"/"static"/"auto"], ``continuation``, ``flag``, ``checkpoint``, ``resume``, ...; or a
+    :class:`~fretwear.hb.options.SolveOptions`), ``gap`` [m], ``anchor``, ``condenser``) with
+    the time-domain fallback at points whose balance fails (``time_domain=True``, as the
+    case-file key ``time_domain`` of a sweep; it replaces ``options.time_domain``).
 
     Returns
     -------
@@ -59,8 +63,9 @@ def sweep(model, basis, f_min: float, f_max: float, n_points: int, *, time_domai
     with ``frequency_hz`` [Hz], ``solution`` or None, ``success``, ``message``, ``flags``),
     ``frequency_hz`` [Hz], ``point_success``, ``amplitude(point, axis)`` [m].
     """
+    options = sweep_options(kwargs.pop("options", None))
     return _sweep.sweep(model, basis, f_min, f_max, n_points,
-                        time_domain=_fallback(time_domain), **kwargs)
+                        options=options.replace(time_domain=_fallback(time_domain)), **kwargs)
 
 
 def simulate_wear(model, basis, *, time_domain: bool = True, **kwargs) -> _wear.WearResult:
@@ -87,11 +92,12 @@ def simulate_wear(model, basis, *, time_domain: bool = True, **kwargs) -> _wear.
 def frf_worn(model, wear, frequencies_hz, basis, *, time_domain: bool = True, **kwargs):
     """Nonlinear FRF with the worn gap ``gap + wear`` (paper Fig. 24), ``wear`` (nc,) [m],
     ``frequencies_hz = (f_min, f_max, n_points)`` [Hz]: :func:`fretwear.wear.worn_frf.frf_worn`
-    with the time-domain fallback (``time_domain=True``).
+    with the time-domain fallback (``time_domain=True``; it replaces ``options.time_domain``).
 
     Returns
     -------
     :class:`~fretwear.hb.sweep.SweepResult` (``success``, ``message``, as :func:`sweep`).
     """
+    options = sweep_options(kwargs.pop("options", None), WORN_FRF)
     return _wear.frf_worn(model, wear, frequencies_hz, basis,
-                          time_domain=_fallback(time_domain), **kwargs)
+                          options=options.replace(time_domain=_fallback(time_domain)), **kwargs)

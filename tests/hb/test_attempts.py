@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.options import SolveOptions
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.reduce import condense
@@ -40,7 +41,7 @@ def test_strategy_records_every_attempt_and_ends_at_the_target_eps():
     f, _ = prob.residual(U, jacobian=False)
     assert np.linalg.norm(f) <= 1e-8 * prob.scale(U)
     only = solve_periodic(model, basis, frequency=1.4905405 / (2 * np.pi), eps=1.0,
-                          strategy=("start",))
+                          options=SolveOptions(strategy=("start",)))
     assert not only.success and [a.method for a in only.attempts] == ["start"]
 
 
@@ -56,8 +57,8 @@ def test_time_start_reaches_the_balance_of_the_standard_solve():
 
     model, basis = oscillator(), FourierBasis.up_to(5, 64)
     ref = solve_periodic(model, basis, frequency=15.0)
-    ts = solve_periodic(model, basis, frequency=15.0, strategy=("time-start",),
-                        time_domain=FALLBACK)
+    ts = solve_periodic(model, basis, frequency=15.0,
+                        options=SolveOptions(strategy=("time-start",)), time_domain=FALLBACK)
     assert ref.success and ts.success
     assert [a.method for a in ts.attempts] == ["time-start"] and ts.attempts[0].success
     assert ts.time_domain.startswith("time integration: periodic steady state")
@@ -81,7 +82,8 @@ def test_time_start_reports_a_response_that_is_not_periodic():
 
     fake = TimeDomainFallback(start=start, averaged_rate=None)
     sol = solve_periodic(oscillator(), FourierBasis.up_to(3, 32), frequency=15.0,
-                         strategy=("time-start",), time_domain=fake, time_domain_periods=300)
+                         options=SolveOptions(strategy=("time-start",),
+                                              time_domain_periods=300), time_domain=fake)
     assert not sol.success
     assert calls == [(15.0, None, 300)]
     assert sol.time_domain == msg and msg in sol.flags
@@ -102,8 +104,8 @@ def test_time_start_is_skipped_where_the_time_domain_does_not_apply():
     basis = FourierBasis.up_to(3, 32)
     model = oscillator()
     for kw in ({"quasi_static": True}, {"gap": np.array([1e-9])}):
-        sol = solve_periodic(model, basis, frequency=15.0, strategy=("time-start",),
-                             time_domain=fake, **kw)
+        sol = solve_periodic(model, basis, frequency=15.0,
+                             options=SolveOptions(strategy=("time-start",)), time_domain=fake, **kw)
         assert not sol.success and sol.time_domain == ""
 
 

@@ -39,3 +39,16 @@ def test_objects_of_the_wrong_kind():
         check_inputs("model", BASIS, 15.0)
     with pytest.raises(TypeError, match="expected a fretwear FourierBasis"):
         check_inputs(oscillator(), (1, 2, 3), 15.0)
+
+
+def test_the_frequency_is_required_unless_quasi_static():
+    """No silent 1 Hz: a dynamic solve without a frequency is refused in one line; a
+    quasi-static one runs at QUASI_STATIC_FREQUENCY (it only sets the time scale)."""
+    from fretwear.hb.inputs import QUASI_STATIC_FREQUENCY
+    from fretwear.hb.periodic import solve_periodic
+
+    with pytest.raises(InputError, match="^frequency is missing: expected the excitation "
+                                         r"frequency \[Hz\] > 0") as err:
+        solve_periodic(oscillator(), BASIS)
+    assert "\n" not in str(err.value)
+    assert check_inputs(oscillator(), BASIS, None, quasi_static=True) == QUASI_STATIC_FREQUENCY

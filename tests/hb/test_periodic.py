@@ -26,6 +26,7 @@ from scipy import integrate, optimize
 from fretwear.errors import ConvergenceError
 from fretwear.hb import contact as law
 from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.options import SolveOptions
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.reduce import condense, recover
 from fretwear.model import (
@@ -176,7 +177,8 @@ def test_den_hartog_oscillator(zeta):
     1.5 %, 0.75 % for zeta = 2 %). Asserted: strictly decreasing errors, first-order rate
     0.15 <= err (Nh + 1) <= 0.45 for Nh >= 3, and < 1 % at Nh = 31."""
     model, w, ref = den_hartog_case(zeta)
-    sols = solve_sequence(model, NH_SEQ, frequency=w / (2 * np.pi), tol=1e-10)
+    sols = solve_sequence(model, NH_SEQ, frequency=w / (2 * np.pi),
+                          options=SolveOptions(tol=1e-10))
     err_a, err_e = [], []
     for sol in sols.values():
         k = sol.basis.k
@@ -196,7 +198,8 @@ def test_den_hartog_from_default_initial_guess():
     """Same problem as test_den_hartog_oscillator (zeta = 2 %) solved directly with
     Nh = 15 from solve_periodic's default initial guess."""
     model, w, ref = den_hartog_case(0.02)
-    sol = solve_periodic(model, basis_for(15), frequency=w / (2 * np.pi), tol=1e-10)
+    sol = solve_periodic(model, basis_for(15), frequency=w / (2 * np.pi),
+                         options=SolveOptions(tol=1e-10))
     st = sol.stats
     assert st.success, st.message
 
@@ -264,7 +267,7 @@ def test_jenkins_quasi_static_hysteresis(F0, phase, condensed):
     closed = 4 * R * (F - R) / k
     for nh in (1, 7, 31):
         b = basis_for(nh)
-        sol = solve_periodic(model, b, quasi_static=True, tol=1e-10)
+        sol = solve_periodic(model, b, quasi_static=True, options=SolveOptions(tol=1e-10))
         st = sol.stats
         assert sol.success, st.message
         Fn = F * np.cos(b.tau + phase)
@@ -293,7 +296,7 @@ def test_jenkins_full_stick(condensed):
     model, k, F = jenkins_model(F0, 0.3, condensed)
     for anchor in (None, 4e-6):  # k a = 8 N: 8 + 20 < 30
         b = basis_for(7)
-        sol = solve_periodic(model, b, quasi_static=True, tol=1e-10,
+        sol = solve_periodic(model, b, quasi_static=True, options=SolveOptions(tol=1e-10),
                              anchor=None if anchor is None else np.array([[anchor]]))
         st = sol.stats
         assert sol.success, st.message
@@ -331,7 +334,8 @@ def fe_block(q_ratio=0.8):
 @pytest.fixture(scope="module")
 def block_sequence():
     model = fe_block()
-    sols = solve_sequence(model, NH_SEQ, per=8, frequency=F_B, tol=1e-11)
+    sols = solve_sequence(model, NH_SEQ, per=8, frequency=F_B,
+                          options=SolveOptions(tol=1e-11))
     return model, F_B, sols
 
 
@@ -438,7 +442,7 @@ def test_fe_eps_independence(block_sequence, nh, bound):
         res = []
         for fac in (0.1, 1.0, 10.0):
             sol = solve_periodic(model, b, frequency=f, reduced=red, eps=fac * rho,
-                                 U0=base.U, tol=1e-11)
+                                 U0=base.U, options=SolveOptions(tol=1e-11))
             st = sol.stats
             assert sol.success, st.message
             res.append((sol.U[:, :, [0, 1, 1 + b.k]], sol.friction_energy().sum()))
@@ -461,7 +465,8 @@ def test_solvers_agree(block_sequence):
     red = condense(model, f, [0, *b.harmonics])
     U = {}
     for solver in ("powell", "newton", "hybr"):
-        sol = solve_periodic(model, b, frequency=f, reduced=red, solver=solver, tol=1e-11)
+        sol = solve_periodic(model, b, frequency=f, reduced=red,
+                             options=SolveOptions(solver=solver, tol=1e-11))
         st = sol.stats
         assert sol.success and st.success and st.solver == solver, st.message
         assert st.residual <= 1e-11
@@ -478,14 +483,16 @@ def test_failed_solve_says_so(block_sequence, solver):
     raise_on_failure it raises ConvergenceError instead."""
     model, f, _ = block_sequence
     b = basis_for(7, per=8)
-    sol = solve_periodic(model, b, frequency=f, solver=solver, tol=1e-11, max_iter=1)
+    sol = solve_periodic(model, b, frequency=f, options=SolveOptions(solver=solver, tol=1e-11,
+                                                                     max_iter=1))
     st = sol.stats
     assert sol.success is False and sol.message == st.message
     assert st.success is False
     assert st.residual > 1e-11
     assert isinstance(st.message, str) and st.message and st.message != "converged"
     with pytest.raises(ConvergenceError):
-        solve_periodic(model, b, frequency=f, solver=solver, tol=1e-11, max_iter=1,
+        solve_periodic(model, b, frequency=f,
+                       options=SolveOptions(solver=solver, tol=1e-11, max_iter=1),
                        raise_on_failure=True)
 
 
@@ -533,7 +540,8 @@ def global_friction(sol, model):
 @pytest.fixture(scope="module")
 def block_3d_45():
     model = block_3d(45.0)
-    sol = solve_periodic(model, basis_for(7, per=8), quasi_static=True, tol=1e-11)
+    sol = solve_periodic(model, basis_for(7, per=8), quasi_static=True,
+                         options=SolveOptions(tol=1e-11))
     st = sol.stats
     assert sol.success, st.message
     return model, sol
@@ -585,7 +593,8 @@ def test_3d_gross_slip_follows_load_direction():
     magnitude is mu sum(lambda_N) within 1e-3. A friction law that is not isotropic would
     pull the force towards its preferred directions (45 deg for a square law: 15 deg off)."""
     model = block_3d(30.0)
-    sol = solve_periodic(model, basis_for(7, per=8), quasi_static=True, tol=1e-11)
+    sol = solve_periodic(model, basis_for(7, per=8), quasi_static=True,
+                         options=SolveOptions(tol=1e-11))
     st = sol.stats
     assert sol.success, st.message
     lam = check_cone(sol, MU_B)
@@ -603,7 +612,8 @@ def test_3d_poisson_preload():
     outwards, beyond the cone of their zero anchor. Expected: a converged, symmetric
     solution whose forces lie in the cone (as with nu = 0)."""
     model = block_3d(45.0, nu=0.3)
-    sol = solve_periodic(model, basis_for(3, per=8), quasi_static=True, tol=1e-10)
+    sol = solve_periodic(model, basis_for(3, per=8), quasi_static=True,
+                         options=SolveOptions(tol=1e-10))
     st = sol.stats
     assert sol.success, st.message
     check_cone(sol, MU_B)

@@ -7,6 +7,7 @@ import pytest
 import scipy.sparse as sp
 
 from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.options import SolveOptions
 from fretwear.hb.periodic import solve_periodic
 from fretwear.model.core import Load
 
@@ -41,14 +42,15 @@ def test_a_failed_static_preload_solve_is_reported_not_silent():
                                   "converge (") and "stick anchors are set to 0" in pre.warning
     with pytest.warns(RuntimeWarning, match="did not converge"):
         assert np.array_equal(static_anchor(bad), np.zeros((1, 1)))
-    sol = solve_periodic(bad, basis, frequency=15.0, strategy=("start",))
+    sol = solve_periodic(bad, basis, frequency=15.0, options=SolveOptions(strategy=("start",)))
     assert sol.warnings == [pre.warning]
     # explicit anchors: no static solve, nothing to report
-    assert solve_periodic(bad, basis, frequency=15.0, strategy=("start",),
+    assert solve_periodic(bad, basis, frequency=15.0, options=SolveOptions(strategy=("start",)),
                           anchor=np.zeros((1, 1))).warnings == []
 
     good = _pushed_oscillator(0.5)
     pre = preload_anchor(good)
     assert pre.success and pre.warning == ""
     np.testing.assert_allclose(pre.values, 0.0, atol=1e-12)  # stuck where it touched
-    assert solve_periodic(good, basis, frequency=15.0, strategy=("start",)).warnings == []
+    assert solve_periodic(good, basis, frequency=15.0,
+                          options=SolveOptions(strategy=("start",))).warnings == []

@@ -15,6 +15,7 @@ import pytest
 from helpers.models import oscillator
 
 from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.options import SolveOptions
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.solution import initial_state
 
@@ -25,7 +26,7 @@ TOL = 1e-11
 @pytest.fixture(scope="module")
 def solved():
     model = oscillator()
-    sol = solve_periodic(model, BASIS, frequency=15.0, tol=TOL)
+    sol = solve_periodic(model, BASIS, frequency=15.0, options=SolveOptions(tol=TOL))
     assert sol.success, sol.message
     return model, sol
 

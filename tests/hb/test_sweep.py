@@ -12,6 +12,7 @@ import numpy as np
 
 from fretwear.hb.contact import SEPARATION
 from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.options import SWEEP_POINT, SweepOptions
 from fretwear.hb.sweep import frequency_grid, sweep
 from fretwear.linear import frf
 from fretwear.model import ContactSpec, Damping, Material, Spring, Traction, from_mesh, rectangle
@@ -41,7 +42,8 @@ def test_frequency_grid_is_geomspace_or_linspace():
 
 def test_frictionless_closed_sweep_is_the_linear_frf():
     model = closed_block()
-    res = sweep(model, BASIS, 1e3, 3e3, 3, tol=1e-10)
+    res = sweep(model, BASIS, 1e3, 3e3, 3,
+                options=SweepOptions(solve=SWEEP_POINT.replace(tol=1e-10)))
     assert res.success, res.message
     assert res.point_success.tolist() == [True] * 3
     f = res.frequency_hz
@@ -58,8 +60,9 @@ def test_frictionless_closed_sweep_is_the_linear_frf():
 def test_failed_points_say_so():
     """Slip (a tangential load above the friction capacity), one iteration per point and no
     continuation: points fail, each with its reason."""
-    res = sweep(closed_block(mu=0.3, q=2e6), BASIS, 1e3, 3e3, 2, max_iter=1, continuation=False,
-                max_bisections=0)
+    res = sweep(closed_block(mu=0.3, q=2e6), BASIS, 1e3, 3e3, 2,
+                options=SweepOptions(solve=SWEEP_POINT.replace(max_iter=1), continuation=False,
+                                     max_bisections=0))
     assert not res.point_success.all()
     assert res.success is False or not res.success
     assert isinstance(res.message, str) and res.message
@@ -84,7 +87,7 @@ def test_point_passed_by_eps_continuation_keeps_the_sweep_eps_and_its_attempts()
                           observed={"x": 0})
     basis = FourierBasis.up_to(15, 128)
     f = 1.4905405 / (2 * np.pi)
-    res = sweep(model, basis, f, 1.01 * f, 2, eps=1.0, time_domain=None)
+    res = sweep(model, basis, f, 1.01 * f, 2, options=SweepOptions(eps=1.0, time_domain=None))
     p = res.points[0]
     assert p.success and p.how == "eps-continuation"
     assert [a.method for a in p.attempts][0] == "grid" and not p.attempts[0].success
@@ -102,9 +105,10 @@ def test_reduced_models_kept_within_the_memory_budget(monkeypatch):
     """The sweep's cache of reduced models keeps at most CACHE_SIZE of them and no more bytes
     than CACHE_BYTES, always the newest (counted against the models' own sizes)."""
     from fretwear.hb import sweep as sw
+    from fretwear.hb.reduce import exact_condenser
 
     model = closed_block()
-    probs = sw._Problems(model, BASIS, None, 1e9)
+    probs = sw._Problems(model, BASIS, None, 1e9, exact_condenser(model))
     one = probs.get(2 * np.pi * 1000.0, None).reduced.Z.nbytes
     monkeypatch.setattr(sw, "CACHE_BYTES", int(2.5 * one))
     for f in (1100.0, 1200.0, 1300.0):

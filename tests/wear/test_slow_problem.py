@@ -20,6 +20,7 @@ from helpers.blocks import block
 from fretwear.hb import krylov, problem
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.krylov import KrylovJacobian
+from fretwear.hb.options import SolveOptions
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.preload import static_anchor
 from fretwear.hb.reduce import condense
@@ -32,7 +33,8 @@ def make_case(dim):
     basis = FourierBasis.up_to(3, 32)
     red = condense(model, 2000.0, basis.orders)
     anchor = static_anchor(model)
-    sol = solve_periodic(model, basis, frequency=2000.0, reduced=red, anchor=anchor, tol=1e-12)
+    sol = solve_periodic(model, basis, frequency=2000.0, reduced=red, anchor=anchor,
+                         options=SolveOptions(tol=1e-12))
     assert sol.success
     coef = np.full(model.contact.n_nodes, 1e-15)
     return model, basis, red, anchor, sol.U.reshape(-1, basis.size), coef

@@ -29,10 +29,17 @@ import numpy as np
 from matplotlib.colors import BoundaryNorm, ListedColormap
 
 from fretwear.analyses import figures as plots
-from fretwear.analyses.common import basis_of, cell_edges, interface_abscissa, si_scale
+from fretwear.analyses.common import (
+    basis_of,
+    cell_edges,
+    interface_abscissa,
+    si_scale,
+    solve_options_of,
+)
 from fretwear.analyses.run import load_case
 from fretwear.analyses.transient import period_friction_energy, state_fractions
 from fretwear.errors import InputError
+from fretwear.hb.options import PERIODIC
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.reduce import condense
 from fretwear.hb.solution import PeriodicSolution
@@ -192,9 +199,9 @@ def compare_periodic(model, analysis: dict, outdir: Path | None, *, steps_per_pe
     f_hz = float(analysis["frequency"])
     t0 = time.perf_counter()
     reduced = condense(model, f_hz, basis.orders)
-    sol = solve_periodic(model, basis, frequency=f_hz, reduced=reduced, eps=analysis["eps"],
-                         solver=analysis["solver"], tol=analysis["tol"],
-                         max_iter=analysis["max_iter"])
+    sol = solve_periodic(model, basis, frequency=f_hz,
+                         options=solve_options_of(analysis, PERIODIC), reduced=reduced,
+                         eps=analysis["eps"])
     stats = sol.stats
     if not sol.success:  # a failed solve is never compared (its last iterate is no result)
         sol = None

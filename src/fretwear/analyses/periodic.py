@@ -31,12 +31,15 @@ from fretwear.analyses.common import (
     pad_axes,
     period_coordinates,
     si_scale,
+    solve_options_of,
     solver_attributes,
     titled,
 )
 from fretwear.analyses.registry import RunOutput, register
 from fretwear.errors import InputError
 from fretwear.hb.contact import STATE_NAMES
+from fretwear.hb.inputs import QUASI_STATIC_FREQUENCY
+from fretwear.hb.options import PERIODIC
 from fretwear.hb.penalty import penalty
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.reduce import condense, recover
@@ -200,14 +203,12 @@ def run_periodic(model, analysis: dict, case, outdir: Path, progress: bool) -> R
     """
     basis = basis_of(analysis)
     qs = analysis["quasi_static"]
-    f_hz = float(analysis.get("frequency", default_of(solve_periodic, "frequency")))
+    f_hz = float(analysis.get("frequency", QUASI_STATIC_FREQUENCY))
     reduced = condense(model, f_hz, basis.orders, quasi_static=qs)
     eps = penalty(analysis["eps"], model=model, reduced=reduced)
-    sol = solve_periodic(model, basis, frequency=f_hz, quasi_static=qs, reduced=reduced,
-                         eps=eps, solver=analysis["solver"], tol=analysis["tol"],
-                         max_iter=analysis["max_iter"],
-                         time_domain=FALLBACK if analysis["time_domain"] else None,
-                         time_domain_periods=analysis["time_domain_periods"])
+    sol = solve_periodic(model, basis, frequency=f_hz, quasi_static=qs,
+                         options=solve_options_of(analysis, PERIODIC), reduced=reduced, eps=eps,
+                         time_domain=FALLBACK if analysis["time_domain"] else None)
     stats = sol.stats
     attrs = {**solver_attributes(stats, analysis, eps), "excitation_frequency": f_hz,
              "quasi_static": int(qs),
@@ -447,8 +448,9 @@ register(
                                                                           "time_domain")),
         "time_domain_periods": Field(Integer(lo=10), "forcing periods allowed to the time "
                                      "integration (time_domain)",
-                                     default=default_of(solve_periodic, "time_domain_periods")),
-        **harmonic_balance_fields(solve_periodic, "DLFT penalty: " + _EPS_RULES),
+                                     default=PERIODIC.time_domain_periods),
+        **harmonic_balance_fields(PERIODIC, default_of(solve_periodic, "eps"),
+                                  "DLFT penalty: " + _EPS_RULES),
     },
     run_periodic,
     checks=(_frequency_needed, check_sampling),

@@ -13,7 +13,7 @@ import numpy as np
 
 from fretwear.hb.connectors import Connected
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.options import STRATEGY
+from fretwear.hb.options import PERIODIC, SolveOptions
 from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.solution import Attempt
 from fretwear.hb.solvers import SolveStats, solve, vector_norm
@@ -30,7 +30,7 @@ EPS_MIN_RATIO = 1.02
 EPS_STEP_MAX_ITER = 20
 
 
-def _eps_path(prob, x, st, eps_from, solver, tol, max_iter):
+def _eps_path(prob, x, st, eps_from, options: SolveOptions):
     """From the converged ``x`` at ``eps_from`` back to ``prob.eps`` by geometric steps: a
     step that fails is halved (in log eps) and retried from the last converged answer, a step
     that converges grows by 1.5, until ``prob.eps`` is reached or a step would be below
@@ -46,8 +46,8 @@ def _eps_path(prob, x, st, eps_from, solver, tol, max_iter):
         remaining = np.log(target / cur)
         last = abs(remaining) <= abs(step) * (1.0 + 1e-12)
         e = target if last else float(cur * np.exp(step))
-        xn, stn = _run(prob if last else prob.with_eps(e), x, solver, tol,
-                       min(max_iter, EPS_STEP_MAX_ITER))
+        xn, stn = _run(prob if last else prob.with_eps(e), x,
+                       options.replace(max_iter=min(options.max_iter, EPS_STEP_MAX_ITER)))
         if stn.success:
             cur, x, st = e, xn, stn
             path.append(e)
@@ -60,24 +60,24 @@ def _eps_path(prob, x, st, eps_from, solver, tol, max_iter):
     return x, st, path
 
 
-def _run(prob: DLFTProblem, x0, solver, tol, max_iter):
-    """One solver run on ``prob`` from ``x0`` (m, H): ``(x (m, H), stats)``."""
+def _run(prob: DLFTProblem, x0, options: SolveOptions):
+    """One run of ``options.solver`` on ``prob`` from ``x0`` (m, H): ``(x (m, H), stats)``."""
 
     def fun(x, jac=True):
         return prob.residual(x.reshape(prob.m, prob.H), jac)
 
     t0 = time.perf_counter()
     x, _, st = solve(fun, np.asarray(x0, float).reshape(-1),
-                     lambda x: prob.scale(x.reshape(prob.m, prob.H)), method=solver, tol=tol,
-                     max_iter=max_iter)
+                     lambda x: prob.scale(x.reshape(prob.m, prob.H)), method=options.solver,
+                     tol=options.tol, max_iter=options.max_iter)
     st.wall_time = time.perf_counter() - t0
     return x.reshape(prob.m, prob.H), st
 
 
-def solve_strategy(prob: DLFTProblem, x0, *, solver="powell", tol=1e-8, max_iter=200,
-                   attempts: list | None = None, steps=STRATEGY):
+def solve_strategy(prob: DLFTProblem, x0, *, options: SolveOptions = PERIODIC,
+                   attempts: list | None = None, steps=None):
     """Solve the balance of ``prob`` from ``x0`` (m, H), trying in order until one converges
-    (``steps``, a subset of :data:`STRATEGY`):
+    (``steps``, default ``options.strategy``):
 
     1. ``"start"``: ``solver`` from ``x0``;
     2. ``"best-point"``: the other solver (Newton after Powell, Powell after Newton or hybr)
@@ -95,7 +95,9 @@ def solve_strategy(prob: DLFTProblem, x0, *, solver="powell", tol=1e-8, max_iter
     converged answer, or the iterate with the smallest residual when none converged.
     """
     attempts = [] if attempts is None else attempts
-    other = "newton" if solver != "newton" else "powell"
+    steps = options.strategy if steps is None else steps
+    solver = options.solver
+    other = options.replace(solver=options.other_solver)
     best = None
 
     def keep(x, st):
@@ -106,13 +108,13 @@ def solve_strategy(prob: DLFTProblem, x0, *, solver="powell", tol=1e-8, max_iter
 
     x0 = np.asarray(x0, float).reshape(prob.m, prob.H)
     if "start" in steps:
-        x, st = _run(prob, x0, solver, tol, max_iter)
+        x, st = _run(prob, x0, options)
         attempts.append(Attempt.of("start", prob.eps, st))
         if keep(x, st):
             return best
     if "best-point" in steps:
         start = x0 if best is None else best[0]
-        x, st = _run(prob, start, other, tol, max_iter)
+        x, st = _run(prob, start, other)
         attempts.append(Attempt.of("best-point", prob.eps, st))
         if keep(x, st):
             return best
@@ -120,16 +122,16 @@ def solve_strategy(prob: DLFTProblem, x0, *, solver="powell", tol=1e-8, max_iter
         for factor in EPS_FACTORS:
             t0 = time.perf_counter()
             shifted = prob.with_eps(factor * prob.eps)
-            x, st = _run(shifted, x0, solver, tol, max_iter)
+            x, st = _run(shifted, x0, options)
             if not st.success:  # the other solver at the shifted eps
-                x, st = _run(shifted, x0, other, tol, max_iter)
+                x, st = _run(shifted, x0, other)
             if not st.success and prob.basis.k > 1:  # the first harmonic alone, at that eps
-                U1 = _first_harmonic_start(shifted, solver, tol, max_iter)
+                U1 = _first_harmonic_start(shifted, options)
                 if U1 is not None:
-                    x, st = _run(shifted, U1, solver, tol, max_iter)
+                    x, st = _run(shifted, U1, options)
             path = [factor * prob.eps]
             if st.success:
-                x, st, path = _eps_path(prob, x, st, factor * prob.eps, solver, tol, max_iter)
+                x, st, path = _eps_path(prob, x, st, factor * prob.eps, options)
             st.wall_time = time.perf_counter() - t0
             msg = (f"{st.message} (eps path {', '.join(f'{e:.3g}' for e in path)} N/m)")
             attempts.append(Attempt.of("eps-continuation", prob.eps if st.success else
@@ -139,9 +141,9 @@ def solve_strategy(prob: DLFTProblem, x0, *, solver="powell", tol=1e-8, max_iter
                 return best
     if "harmonic-continuation" in steps and prob.basis.k > 1:
         t0 = time.perf_counter()
-        U1 = _first_harmonic_start(prob, solver, tol, max_iter)
+        U1 = _first_harmonic_start(prob, options)
         if U1 is not None:
-            x, st = _run(prob, U1, solver, tol, max_iter)
+            x, st = _run(prob, U1, options)
             st.wall_time = time.perf_counter() - t0
             attempts.append(Attempt.of("harmonic-continuation", prob.eps, st))
             if keep(x, st):
@@ -170,23 +172,23 @@ def _time_start_applies(model: Model, time_domain, quasi_static: bool, gap, stra
                                          model.contact.gap)
 
 
-def _time_start(model, basis, frequency, reduced, prob, time_domain, periods, solver, tol,
-                max_iter):
+def _time_start(model, basis, frequency, reduced, prob, time_domain, options: SolveOptions):
     """The ``"time-start"`` attempt: ``(message, problem, x, stats)``; ``stats`` None when
     the integration did not settle to a periodic state (the message says what it does)."""
     t0 = time.perf_counter()
-    msg, Ut, anchor = time_domain.start(model, frequency, basis, None, max_periods=periods)
+    msg, Ut, anchor = time_domain.start(model, frequency, basis, None,
+                                        max_periods=options.time_domain_periods)
     if Ut is None:
         return msg, prob, None, None
     prob2 = DLFTProblem(reduced, model.contact, basis, gap=prob.gap, eps=prob.eps,
                         anchor=anchor, jacobian=prob.jacobian)
-    x, st = _run(prob2, np.asarray(Ut, float).reshape(prob2.m, prob2.H), solver, tol,
-                 2 * max_iter)
+    x, st = _run(prob2, np.asarray(Ut, float).reshape(prob2.m, prob2.H),
+                 options.replace(max_iter=2 * options.max_iter))
     st.wall_time = time.perf_counter() - t0
     return msg, prob2, x, st
 
 
-def _first_harmonic_start(prob, solver, tol, max_iter):
+def _first_harmonic_start(prob, options: SolveOptions):
     """:func:`_harmonic_continuation_start` from the problem alone."""
     basis, reduced = prob.basis, prob.reduced
     sub = FourierBasis(basis.harmonics[:1], basis.n_samples)
@@ -202,8 +204,8 @@ def _first_harmonic_start(prob, solver, tol, max_iter):
         return p1.residual(x.reshape(p1.m, p1.H), jac)
 
     x, _, st = solve(fun, p1.initial_guess().reshape(-1),
-                     lambda x: p1.scale(x.reshape(p1.m, p1.H)), method=solver, tol=tol,
-                     max_iter=max_iter)
+                     lambda x: p1.scale(x.reshape(p1.m, p1.H)), method=options.solver,
+                     tol=options.tol, max_iter=options.max_iter)
     if not st.success:
         return None
     U = np.zeros((prob.m, prob.H))

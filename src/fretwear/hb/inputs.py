@@ -12,6 +12,9 @@ from fretwear.hb.fourier import FourierBasis
 from fretwear.limits import check_range
 from fretwear.model.core import Model
 
+#: the frequency of a quasi-static solve that gives none [Hz]: inertia and damping are
+#: dropped, so it only sets the time scale (one load cycle per second); case files use it too
+QUASI_STATIC_FREQUENCY = 1.0
 #: highest harmonic inspected when checking that the loads act on the kept harmonics
 LOAD_CHECK_HARMONICS = 64
 
@@ -20,6 +23,9 @@ def check_inputs(model, basis, frequency, *, quasi_static: bool = False, anchor=
                  U0=None) -> float:
     """Check the arguments of a periodic solve (and of the drivers built on it); return the
     frequency as a float [Hz].
+
+    The frequency is required for a dynamic solve (``frequency=None``: an InputError); a
+    quasi-static solve may omit it and then runs at :data:`QUASI_STATIC_FREQUENCY`.
 
     Raises TypeError for a model or basis of the wrong kind and InputError (a ValueError)
     naming the argument for: a basis with no harmonic; a frequency outside
@@ -35,6 +41,11 @@ def check_inputs(model, basis, frequency, *, quasi_static: bool = False, anchor=
     if not basis.harmonics:
         raise InputError("basis keeps no harmonic: expected at least one (e.g. "
                          "FourierBasis.up_to(7, 128))")
+    if frequency is None:
+        if not quasi_static:
+            raise InputError("frequency is missing: expected the excitation frequency [Hz] "
+                             "> 0 (only a quasi-static solve may omit it)")
+        frequency = QUASI_STATIC_FREQUENCY
     f = check_range(frequency, "frequency", "frequency")
     if not quasi_static and f <= 0.0:
         raise InputError(f"frequency = {frequency!r} Hz: expected > 0 for a dynamic solve "

@@ -41,7 +41,7 @@ import numpy as np
 
 from fretwear.errors import InputError
 from fretwear.hb.connectors import connect, springs, stiffness
-from fretwear.hb.reduce import Reduced, condense, condenser
+from fretwear.hb.reduce import Reduced, condense, exact_condenser
 from fretwear.model.core import Model
 
 #: the rules :func:`penalty` accepts besides a positive number [N/m]
@@ -172,7 +172,7 @@ def check_rule(rule) -> str | float:
 
 def penalty(rule, *, model: Model | None = None, frequency: float = 0.0, orders=None,
             quasi_static: bool = False, reduced: Reduced | None = None,
-            contact=None) -> float:
+            contact=None, condenser=None) -> float:
     """The DLFT penalty [N/m] of ``rule`` (module docstring) at the excitation ``frequency``.
 
     Parameters
@@ -186,6 +186,8 @@ def penalty(rule, *, model: Model | None = None, frequency: float = 0.0, orders=
         ``model`` takes its order-0 block, which is ``K_r`` at every frequency.
     contact : the interface (default ``model.contact``): rows of prescribed normal loads are
         left out.
+    condenser : the condenser of the caller's run for the condensations made here (default:
+        :func:`fretwear.hb.reduce.exact_condenser`).
 
     Returns
     -------
@@ -206,12 +208,13 @@ def penalty(rule, *, model: Model | None = None, frequency: float = 0.0, orders=
             orders = np.asarray(orders)
             if rule == "top":
                 orders = orders[-1:]
-            reduced = connect(condense(model, frequency, orders, quasi_static=quasi_static),
-                              model.contact)
+            reduced = connect(condense(model, frequency, orders, quasi_static=quasi_static,
+                                       condenser=condenser), model.contact)
         rows = _law_rows(contact, reduced.m)
         return radius_max(reduced.Z if rule == "auto" else reduced.Z[-1:], rows)
     if model is not None:
-        red = connect(condense(model, 0.0, [0], quasi_static=True), model.contact)
+        red = connect(condense(model, 0.0, [0], quasi_static=True, condenser=condenser),
+                      model.contact)
         return radius(red.Z[0], _law_rows(contact, red.m))
     if reduced is None or int(reduced.orders[0]) != 0:
         raise ValueError('eps = "static" needs the model or a reduced model with order 0')
@@ -219,11 +222,12 @@ def penalty(rule, *, model: Model | None = None, frequency: float = 0.0, orders=
 
 
 def sweep_penalty(rule, model: Model, orders, f_min: float, f_max: float, *,
-                  spacing: str = "log") -> float | str:
+                  spacing: str = "log", condenser=None) -> float | str:
     """The one eps [N/m] of a sweep over ``[f_min, f_max]`` [Hz]: a number as given;
     ``"static"`` as :func:`penalty`; ``"top"`` the median of :func:`penalty` at
     :data:`SWEEP_SAMPLES` frequencies spread over the band (``spacing`` as the sweep's grid);
-    ``"auto"`` is returned as is (the paper's rule point by point, kept for comparison)."""
+    ``"auto"`` is returned as is (the paper's rule point by point, kept for comparison).
+    ``condenser``: the sweep's (default: :func:`fretwear.hb.reduce.exact_condenser`)."""
     rule = check_rule(rule)
     if not isinstance(rule, str):
         return rule
@@ -232,9 +236,10 @@ def sweep_penalty(rule, model: Model, orders, f_min: float, f_max: float, *,
     if rule == "auto":
         return rule
     if rule == "static":
-        return penalty(rule, model=model)
+        return penalty(rule, model=model, condenser=condenser)
     grid = (np.geomspace if spacing == "log" else np.linspace)(f_min, f_max, SWEEP_SAMPLES)
-    cond, prepared = condenser(model), springs(model.contact)  # prepared once for the band
+    cond = condenser if condenser is not None else exact_condenser(model)
+    prepared = springs(model.contact)  # prepared once for the band
     top = np.asarray(orders)[-1:]
     values = []
     for f in grid:

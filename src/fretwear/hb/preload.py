@@ -47,7 +47,8 @@ class StaticAnchor:
                 "nodes may be wrong")
 
 
-def preload_anchor(model: Model, *, quasi: Reduced | None = None, eps="auto") -> StaticAnchor:
+def preload_anchor(model: Model, *, quasi: Reduced | None = None, eps="auto",
+                   condenser=None) -> StaticAnchor:
     """Tangential positions of the contact nodes after the static loads are applied from rest,
     with whether the static solve converged.
 
@@ -55,29 +56,33 @@ def preload_anchor(model: Model, *, quasi: Reduced | None = None, eps="auto") ->
     every node that touches sticks where it is (anchor 0): the loading history "preload first,
     then vibrate". ``eps``: the penalty of this static solve (the rule or a number, as for
     :class:`DLFTProblem`). When it does not converge the anchors are 0 and the result says so
-    (``success``, ``warning``): the callers put the warning in their results.
+    (``success``, ``warning``): the callers put the warning in their results. ``condenser``:
+    the condenser of the caller's run (default: :func:`fretwear.hb.reduce.exact_condenser`),
+    used for the quasi-static condensation unless ``quasi`` gives it.
     """
-    prob, x, st = _static_solve(model, quasi, eps)
+    prob, x, st = _static_solve(model, quasi, eps, condenser)
     if not st.success:
         return StaticAnchor(np.zeros((prob.nc, prob.d - 1)), False, st.message)
     U = x.reshape(prob.nc, prob.d, 1)
     return StaticAnchor(U[:, 1:, 0].copy(), True, st.message)
 
 
-def static_anchor(model: Model, *, quasi: Reduced | None = None, eps="auto") -> np.ndarray:
+def static_anchor(model: Model, *, quasi: Reduced | None = None, eps="auto",
+                  condenser=None) -> np.ndarray:
     """The anchors of :func:`preload_anchor` alone, (nc, d-1) [m]; a
     :class:`RuntimeWarning` says when the static solve did not converge (the anchors are then
     0)."""
-    a = preload_anchor(model, quasi=quasi, eps=eps)
+    a = preload_anchor(model, quasi=quasi, eps=eps, condenser=condenser)
     if not a.success:
         warnings.warn(a.warning, RuntimeWarning, stacklevel=2)
     return a.values
 
 
-def _static_solve(model: Model, quasi: Reduced | None, eps):
+def _static_solve(model: Model, quasi: Reduced | None, eps, condenser=None):
     """The static contact problem of :func:`static_anchor`: ``(problem, x, stats)``."""
     basis = FourierBasis((), 1)
-    red = quasi if quasi is not None else condense(model, 0.0, [0], quasi_static=True)
+    red = quasi if quasi is not None else condense(model, 0.0, [0], quasi_static=True,
+                                                   condenser=condenser)
     prob = DLFTProblem(red, model.contact, basis, eps=eps)
     U0 = prob.initial_guess()
 
@@ -117,7 +122,7 @@ class PreloadContact:
         return [n for n, k in zip(self.names, self.closed, strict=True) if k == 0]
 
 
-def preload_contact(model: Model, *, eps="static") -> PreloadContact:
+def preload_contact(model: Model, *, eps="static", condenser=None) -> PreloadContact:
     """Which contact nodes of ``model`` are pressed by its static loads (the preload).
 
     The static contact problem of :func:`static_anchor` (exact contact, Coulomb friction,
@@ -125,6 +130,7 @@ def preload_contact(model: Model, *, eps="static") -> PreloadContact:
     force under the preload (opened by its gap, pulled away, or touching without force) is
     almost always a mistake in a vibration or wear run: its friction can only act where the
     vibration itself closes it. Nodes with a prescribed normal load count as in contact.
+    ``condenser``: as for :func:`preload_anchor`.
     """
     c = model.contact
     names = c.names()
@@ -132,7 +138,7 @@ def preload_contact(model: Model, *, eps="static") -> PreloadContact:
     prescribed = np.zeros(c.n_nodes, dtype=bool)
     if c.normal_load is not None:
         prescribed = np.isfinite(np.asarray(c.normal_load.vector, dtype=float))
-    prob, x, st = _static_solve(model, None, eps)
+    prob, x, st = _static_solve(model, None, eps, condenser)
     if not st.success:
         loaded = prescribed
         lam_n = None

@@ -596,6 +596,13 @@ def condenser(model: Model) -> Condenser:
     return cond
 
 
+def exact_condenser(model: Model) -> Condenser:
+    """The exact :class:`Condenser` of ``model`` (eq. 19): what a driver condenses with when
+    its caller passes no condenser, built once per driver call and used for every
+    condensation of that call."""
+    return condenser(model)
+
+
 def install(model: Model, cond: Condenser) -> None:
     """Make :func:`condenser` return ``cond`` for ``model`` while the model is unchanged (a
     modal representation, :func:`fretwear.hb.modal.use_modal`)."""
@@ -654,27 +661,33 @@ class StaticCondensation:
         return U if self._P is None else self._P @ U
 
 
-def condense_static(model: Model) -> StaticCondensation:
+def condense_static(model: Model, *, condenser: Condenser | None = None) -> StaticCondensation:
     """Exact static condensation of ``model`` onto its contact DOFs (eq. 19 with ``Z = K``).
 
     The same computation as :func:`condense` (:meth:`Condenser.schur`), in real arithmetic,
     with the condensed loads of any load vectors (e.g. the loads at the phases of a
-    quasi-static cycle) and the exact recovery of every DOF.
+    quasi-static cycle) and the exact recovery of every DOF. ``condenser``: the model's
+    exact condenser when the caller holds one (default: that of :func:`exact_condenser`).
     """
-    cond = condenser(model)
+    cond = condenser if condenser is not None else exact_condenser(model)
     Kr, lu, Kci, _ = cond.schur(0.0, 0, True)
     return StaticCondensation(np.ascontiguousarray(0.5 * (Kr + Kr.T)), cond, lu, Kci)
 
 
-def condense(model: Model, frequency: float, orders, *, quasi_static: bool = False) -> Reduced:
+def condense(model: Model, frequency: float, orders, *, quasi_static: bool = False,
+             condenser=None) -> Reduced:
     """Condense ``model`` onto its contact DOFs for harmonic ``orders`` (``[0, h1, .., hk]``)
     at the excitation ``frequency`` [Hz] (0 allowed when ``quasi_static``).
 
     Implements eq. (17)-(19) with one LU of ``Z_ii`` per harmonic (:class:`Condenser`, reused
     across calls on the same model). Returns a :class:`Reduced` in contact-local coordinates
     with the observed-DOF recovery rows (``Reduced.omega = 2 pi frequency`` [rad/s],
-    ``Reduced.frequency`` as given).
+    ``Reduced.frequency`` as given). ``condenser``: the condenser of ``model`` (exact or
+    modal, any object with ``reduced(omega, orders, quasi_static, frequency)``) when the
+    caller holds one.
     """
+    if condenser is not None:
+        return condenser.reduced(2 * np.pi * frequency, orders, quasi_static, frequency)
     return _condense(model, 2 * np.pi * frequency, orders, quasi_static=quasi_static,
                      frequency=frequency)
 

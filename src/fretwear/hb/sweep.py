@@ -26,13 +26,19 @@ from fretwear.errors import InputError
 from fretwear.files import check_state_file
 from fretwear.hb.attempts import _first_harmonic_start, solve_strategy
 from fretwear.hb.connectors import connect, springs
-from fretwear.hb.fallback import TimeDomainFallback
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.inputs import check_inputs
+from fretwear.hb.options import (
+    SWEEP,
+    SWEEP_POINT,
+    SolveOptions,
+    SweepOptions,
+    sweep_options,
+)
 from fretwear.hb.penalty import sweep_penalty
 from fretwear.hb.preload import preload_anchor
 from fretwear.hb.problem import DLFTProblem
-from fretwear.hb.reduce import _condense, condenser
+from fretwear.hb.reduce import exact_condenser
 from fretwear.hb.solution import Attempt, PeriodicSolution, assemble_solution
 from fretwear.hb.solvers import SolveStats, solve
 from fretwear.hb.sweep_checkpoint import (
@@ -187,15 +193,16 @@ class _Problems:
     most ``cache_size`` reduced models and :data:`CACHE_BYTES` of them (the newest always).
     ``eps``: a number [N/m], or ``"auto"`` (the spectral radius of each frequency's ``Z_r``)."""
 
-    def __init__(self, model, basis, gap, eps, cache_size=CACHE_SIZE):
+    def __init__(self, model, basis, gap, eps, condenser, jacobian="auto", cache_size=CACHE_SIZE):
         self.model, self.basis, self.gap, self.eps = model, basis, gap, eps
+        self.jacobian = jacobian
         self.orders = np.array([0, *basis.harmonics])
         self.cache: dict = {}
         self.size = cache_size
         self.last = None  # the last problem handed out
         # the model does not change during a sweep: its condenser (and loads) are read once,
         # the contact springs prepared once, and the problems share their set-up
-        self.condenser = condenser(model)
+        self.condenser = condenser
         self.springs = springs(model.contact)
         self.template = None
 
@@ -217,7 +224,7 @@ class _Problems:
             self.cache[key] = red
         if self.template is None:
             prob = DLFTProblem(red, self.model.contact, self.basis, gap=self.gap,
-                               eps=self.eps, anchor=anchor)
+                               eps=self.eps, anchor=anchor, jacobian=self.jacobian)
             # the set-up the other frequencies share (DLFTProblem.at), without this
             # frequency's reduced model and blocks: they are not pinned for the whole sweep
             self.template = object.__new__(DLFTProblem)
@@ -233,7 +240,7 @@ class _Problems:
         return prob
 
 
-def rebuild_point(model: Model, basis: FourierBasis, gap, entry: dict) -> SweepPoint:
+def rebuild_point(probs: _Problems, entry: dict) -> SweepPoint:
     """A sweep point from a checkpoint entry
     (:func:`fretwear.hb.sweep_checkpoint.load_sweep_checkpoint`): its solution re-assembled
     from its harmonics, anchors and penalty by the code that assembled it first, so it equals
@@ -242,9 +249,10 @@ def rebuild_point(model: Model, basis: FourierBasis, gap, entry: dict) -> SweepP
     stats = SolveStats(**rec["stats"])
     sol = None
     if "U" in entry:
-        orders = np.array([0, *basis.harmonics])
-        prob = DLFTProblem(_condense(model, entry["omega"], orders), model.contact, basis,
-                           gap=gap, eps=entry["eps"], anchor=entry["anchor"])
+        model, basis = probs.model, probs.basis
+        prob = DLFTProblem(probs.condenser.reduced(entry["omega"], probs.orders), model.contact,
+                           basis, gap=probs.gap, eps=entry["eps"], anchor=entry["anchor"],
+                           jacobian=probs.jacobian)
         sol = assemble_solution(prob, np.array(entry["U"], float), model, stats)
     pt = SweepPoint(rec["frequency_hz"], sol, stats, rec["how"], list(rec["flags"]),
                     bool(rec["on_grid"]), rec["time_domain"],
@@ -254,7 +262,7 @@ def rebuild_point(model: Model, basis: FourierBasis, gap, entry: dict) -> SweepP
     return pt
 
 
-def _solve_at(probs, omega, anchor, U0, solver, tol, max_iter):
+def _solve_at(probs, omega, anchor, U0, options: SolveOptions):
     prob = probs.get(omega, anchor)
     x0 = prob.initial_guess() if U0 is None else np.asarray(U0, float).reshape(prob.m, prob.H)
 
@@ -262,10 +270,13 @@ def _solve_at(probs, omega, anchor, U0, solver, tol, max_iter):
         return prob.residual(x.reshape(prob.m, prob.H), jac)
 
     x, _, st = solve(fun, x0.reshape(-1), lambda x: prob.scale(x.reshape(prob.m, prob.H)),
-                     method=solver, tol=tol, max_iter=max_iter)
+                     method=options.solver, tol=options.tol, max_iter=options.max_iter)
     return prob, x.reshape(prob.m, prob.H), st
 
 
+#: the settings of the point's solve that a checkpoint fingerprint always holds (the others
+#: only when they differ from :data:`~fretwear.hb.options.SWEEP_POINT`)
+CHECKPOINT_SOLVE_KEYS = ("solver", "tol", "max_iter", "time_domain_periods")
 #: iterations of the last attempt of a sweep point before the time integration (a fresh start
 #: as :func:`fretwear.hb.periodic.solve_periodic` makes it), as a multiple of the sweep's
 #: ``max_iter``: 5 x 40 is the single solve's default of 200
@@ -383,66 +394,53 @@ def _bordered_step(J, f, fw, g, t, sx, sw):
     return np.concatenate([(a - dw * b) / sx, [dw]])
 
 
-def _band(eps_band) -> tuple[float, float]:
-    try:
-        lo, hi = (float(v) for v in eps_band)
-    except (TypeError, ValueError):
-        raise InputError(f"eps_band = {eps_band!r}: expected (f_min, f_max) in Hz") from None
-    if not (0.0 < lo <= hi < np.inf):
-        raise InputError(f"eps_band = {eps_band!r}: expected 0 < f_min <= f_max [Hz]")
-    return lo, hi
-
-
 def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_points: int, *,
-          spacing: str = "log", gap=None, eps="top", anchor=None, solver: str = "powell",
-          tol: float = 1e-8, max_iter: int = 40, continuation: bool = True,
-          max_bisections: int = 4, check=None,
-          time_domain: TimeDomainFallback | None = None, eps_band=None,
-          time_domain_periods: int = 3000, progress=None, checkpoint=None,
-          resume: bool = False) -> SweepResult:
-    """Nonlinear FRF: periodic solutions from ``f_min`` to ``f_max`` [Hz].
+          options: SweepOptions | SolveOptions = SWEEP, gap=None, anchor=None,
+          condenser=None) -> SweepResult:
+    """Nonlinear FRF: periodic solutions from ``f_min`` to ``f_max`` [Hz] on ``n_points`` grid
+    frequencies.
 
     Parameters
     ----------
     model, basis : the structure and the Fourier basis.
-    n_points, spacing : the frequency grid (``"log"`` or ``"linear"``).
+    f_min, f_max, n_points : the frequency grid [Hz] (spacing ``options.spacing``).
+    options : :class:`~fretwear.hb.options.SweepOptions` (default
+        :data:`~fretwear.hb.options.SWEEP`): the solve of one point (``solve``, default
+        :data:`~fretwear.hb.options.SWEEP_POINT`), ``spacing``, the penalty ``eps`` and
+        ``eps_band``, ``continuation``, ``max_bisections``, the time-domain parts ``flag``
+        and ``time_domain``, ``progress``, ``checkpoint`` and ``resume``. A
+        :class:`~fretwear.hb.options.SolveOptions` stands for ``SweepOptions(solve=...)``.
+
+        The penalty is one value for every point (:func:`fretwear.hb.penalty.sweep_penalty`).
+        ``"top"`` (default): the spectral radius of ``Z_r`` at the highest kept harmonic, its
+        median over the band (``eps_band``, default the sweep's own: the chunks of a sweep
+        split across workers, :mod:`fretwear.study`, give the whole band so that they all use
+        the whole sweep's eps and join without an eps jump). ``"static"``: the spectral
+        radius of the static reduced stiffness ``Z_r(0) = K_r``. ``"auto"``: the spectral
+        radius of ``Z_r`` over the kept harmonics at each frequency (the paper's rule applied
+        point by point; kept for comparison: the harmonics of ``Z_r(n w)`` have poles at the
+        clamped-interface resonances, so it jumps by orders of magnitude between
+        neighbouring frequencies, and with 7 harmonics the solution depends measurably on
+        eps, so the FRF is jagged). A positive number [N/m]: that penalty everywhere
+        (docs/theory.md, "The penalty eps").
+
+        ``time_domain`` (e.g. :data:`fretwear.timedomain.fallback.FALLBACK`; None: none): at
+        a point that still did not converge, integrate in time from the neighbour for at most
+        ``solve.time_domain_periods`` periods (not with contact springs or prescribed normal
+        loads, which the time-domain solver does not model): if the structure settles to a
+        periodic state, its harmonics and mean positions start one more solve (``how =
+        "time-start"``); otherwise the point is flagged with what the structure does there
+        (drifting, quasi-periodic...). ``checkpoint``: a ``.npz`` file where the points
+        computed so far are saved after every grid frequency
+        (:mod:`fretwear.hb.sweep_checkpoint`); with ``resume`` the sweep continues from it when
+        it exists (it must have been written by the same sweep: same model, grid and
+        settings) and the result equals the uninterrupted sweep's bit for bit. A damaged or
+        foreign checkpoint is an :class:`~fretwear.errors.InputError`, never silently
+        replaced.
     gap : (nc,) gap + wear [m] (a worn interface); default the model's initial gap.
-    eps : DLFT penalty (:func:`fretwear.hb.penalty.sweep_penalty`), one value for every
-        point. Default ``"top"``: the spectral radius of ``Z_r`` at the highest kept harmonic,
-        its median over the band. ``"static"``: the spectral radius of the static reduced
-        stiffness ``Z_r(0) = K_r``. ``"auto"``: the spectral radius of ``Z_r`` over the kept
-        harmonics at each frequency (the paper's rule applied point by point; kept for
-        comparison: the harmonics of ``Z_r(n w)`` have poles at the clamped-interface
-        resonances, so it jumps by orders of magnitude between neighbouring frequencies, and
-        with 7 harmonics the solution depends measurably on eps, so the FRF is jagged).
-        A positive number [N/m]: that penalty everywhere (docs/theory.md, "The penalty eps").
-    eps_band : ``(f_min, f_max)`` [Hz], the band over which the ``"top"`` rule takes its
-        median (default: the sweep's own band). The chunks of a sweep split across workers
-        (:mod:`fretwear.study`) give the whole band, so that they all use the whole sweep's eps
-        and join without an eps jump.
     anchor : stick anchors of the first point (default: static preload state).
-    solver, tol, max_iter : nonlinear solver settings (:func:`fretwear.hb.solvers.solve`).
-    continuation : use pseudo-arclength continuation when a grid step fails.
-    max_bisections : halvings of a failed frequency step (the intermediate converged
-        points are kept in the result, ``how = "substep"``).
-    check : optional callable ``(PeriodicSolution) -> list[str]`` returning flags (e.g. the
-        time-domain stability check of :mod:`fretwear.timedomain.stability`).
-    time_domain : a :class:`~fretwear.hb.fallback.TimeDomainFallback` (e.g.
-        :data:`fretwear.timedomain.fallback.FALLBACK`; ``None``: none). At a point that still
-        did not converge, integrate in time from the neighbour (not with contact springs or
-        prescribed normal loads, which the time-domain solver does not model): if the
-        structure settles to a periodic
-        state, its harmonics and mean positions start one more solve (``how = "time-start"``);
-        otherwise the point is flagged with what the structure does there (drifting,
-        quasi-periodic...).
-    time_domain_periods : periods allowed to the time integration.
-    progress : optional callable ``(i, n, point)`` called after each grid point.
-    checkpoint : path of a ``.npz`` file where the points computed so far are saved after
-        every grid frequency (:mod:`fretwear.hb.sweep_checkpoint`); ``None``: no checkpoint.
-    resume : continue from ``checkpoint`` when it exists (it must have been written by the
-        same sweep: same model, grid and settings); the result equals the uninterrupted
-        sweep's bit for bit. A damaged or foreign checkpoint is an
-        :class:`~fretwear.errors.InputError`, never silently replaced.
+    condenser : the condenser of ``model`` (exact or modal) for every condensation of the
+        sweep; default: one :func:`~fretwear.hb.reduce.exact_condenser`.
 
     Returns
     -------
@@ -451,16 +449,24 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
     says why in ``flags``).
     """
     t_start = time.perf_counter()
+    opts = sweep_options(options)
+    so = opts.solve
+    spacing, check, checkpoint, resume = opts.spacing, opts.flag, opts.checkpoint, opts.resume
+    continuation, max_bisections = opts.continuation, opts.max_bisections
+    time_domain, progress = opts.time_domain, opts.progress
     grid = frequency_grid(f_min, f_max, n_points, spacing)
     check_inputs(model, basis, f_min, anchor=anchor)
     if model.contact.has_connectors:  # the time-domain solver has rigid contacts only
         time_domain = None
-    band = (f_min, f_max) if eps_band is None else _band(eps_band)
-    eps = sweep_penalty(eps, model, [0, *basis.harmonics], *band, spacing=spacing)
-    probs = _Problems(model, basis, gap, eps)
+    if condenser is None:
+        condenser = exact_condenser(model)
+    band = (f_min, f_max) if opts.eps_band is None else opts.eps_band
+    eps = sweep_penalty(opts.eps, model, [0, *basis.harmonics], *band, spacing=spacing,
+                        condenser=condenser)
+    probs = _Problems(model, basis, gap, eps, condenser, so.jacobian)
     warnings = []
     if anchor is None:
-        preload = preload_anchor(model)
+        preload = preload_anchor(model, condenser=condenser)
         anchor = preload.values
         if not preload.success:
             warnings.append(preload.warning)
@@ -472,21 +478,20 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
     first = 0
     if checkpoint is not None:
         check_state_file(checkpoint, WHAT)
-        settings = {"eps": probs.eps, "gap": gap, "anchor": anchor, "solver": solver,
-                    "tol": tol, "max_iter": max_iter, "continuation": continuation,
-                    "max_bisections": max_bisections, "check": check is not None,
-                    "time_domain": time_domain is not None,
-                    "time_domain_periods": time_domain_periods}
+        settings = {"eps": probs.eps, "gap": gap, "anchor": anchor,
+                    **so.key_changes(SWEEP_POINT, CHECKPOINT_SOLVE_KEYS),
+                    "continuation": continuation, "max_bisections": max_bisections,
+                    "check": check is not None, "time_domain": time_domain is not None}
         key = fingerprint(model, basis, grid, settings)
         if resume and Path(checkpoint).exists():
             first, entries = load_sweep_checkpoint(checkpoint, key, shape)
             for e in entries:
-                pt = rebuild_point(model, basis, gap, e)
+                pt = rebuild_point(probs, e)
                 points.append(pt)
                 if pt.solution is not None:
                     history.append((e["omega"], e["U"]))
                     last_solution[0] = pt.solution
-    other = {"powell": "newton", "newton": "powell", "hybr": "powell"}[solver]
+    other = so.replace(solver=so.other_solver)
 
     def record(omega, prob, U, st, how, flags=()):
         sol = assemble_solution(prob, U, model, st)
@@ -517,8 +522,7 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
         if i < first:
             continue
         omega = 2 * np.pi * f
-        prob, U, st = _solve_at(probs, omega, current_anchor(), predict(omega), solver, tol,
-                                max_iter)
+        prob, U, st = _solve_at(probs, omega, current_anchor(), predict(omega), so)
         how = "grid"
         tried = [Attempt.of("grid", prob.eps, st)]
         if not st.success and history:
@@ -533,8 +537,7 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
                 last = abs(omega - w_try) <= 1e-9 * abs(omega)
                 if last:
                     w_try = omega
-                pb, Ub, stb = _solve_at(probs, w_try, current_anchor(), predict(w_try), solver,
-                                        tol, max_iter)
+                pb, Ub, stb = _solve_at(probs, w_try, current_anchor(), predict(w_try), so)
                 if not stb.success:
                     step *= 0.5
                     continue
@@ -548,20 +551,18 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
                 if abs(step) > abs(omega - w_cur):
                     step = omega - w_cur
         if not st.success and history:
-            prob, U, st = _solve_at(probs, omega, current_anchor(), history[-1][1], other, tol,
-                                    max_iter)
+            prob, U, st = _solve_at(probs, omega, current_anchor(), history[-1][1], other)
             how = "retry"
             tried.append(Attempt.of("retry", prob.eps, st))
         if not st.success and continuation and len(history) >= 2:
             anc = current_anchor()
             t_arc = time.perf_counter()
             branch = _arclength(probs, model, anc, (history[-2][1].reshape(-1), history[-2][0]),
-                                (history[-1][1].reshape(-1), history[-1][0]), omega, tol)
+                                (history[-1][1].reshape(-1), history[-1][0]), omega, so.tol)
             for Ub, wb, stb, pb in branch:
                 points.append(record(wb, pb, Ub.reshape(pb.m, pb.H), stb, "arclength"))
             if branch:
-                prob, U, st = _solve_at(probs, omega, current_anchor(), history[-1][1], solver,
-                                        tol, max_iter)
+                prob, U, st = _solve_at(probs, omega, current_anchor(), history[-1][1], so)
                 how = "arclength"
                 tried.append(Attempt.of("arclength", prob.eps, st))
             else:
@@ -573,8 +574,7 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
             pb = probs.get(omega, current_anchor())
             start = history[-1][1] if history else pb.initial_guess()
             n0 = len(tried)
-            Ub, stb = solve_strategy(pb, start, solver=solver, tol=tol, max_iter=max_iter,
-                                     attempts=tried,
+            Ub, stb = solve_strategy(pb, start, options=so, attempts=tried,
                                      steps=("eps-continuation", "harmonic-continuation"))
             if stb.success:
                 prob, U, st, how = pb, Ub, stb, tried[-1].method
@@ -585,14 +585,14 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
             # the solver and the eps continuation with the single solve's iterations (the
             # neighbour's state can lie on the wrong side of a jump of the mean position)
             pb = probs.get(omega, anchor)
-            U1 = _first_harmonic_start(pb, solver, tol, FRESH_ITER_FACTOR * max_iter)
-            tried.append(Attempt("fresh-start", solver, pb.eps, U1 is not None, float("nan"),
+            fresh = so.replace(max_iter=FRESH_ITER_FACTOR * so.max_iter)
+            U1 = _first_harmonic_start(pb, fresh)
+            tried.append(Attempt("fresh-start", so.solver, pb.eps, U1 is not None, float("nan"),
                                  0, 0.0, "the first harmonic alone" + ("" if U1 is not None
                                                                        else " did not converge")))
             if U1 is not None:
                 n0 = len(tried)
-                Ub, stb = solve_strategy(pb, U1, solver=solver, tol=tol,
-                                         max_iter=FRESH_ITER_FACTOR * max_iter, attempts=tried,
+                Ub, stb = solve_strategy(pb, U1, options=fresh, attempts=tried,
                                          steps=("start", "eps-continuation"))
                 if stb.success:
                     prob, U, st, how = pb, Ub, stb, "fresh-start"
@@ -601,10 +601,10 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
         td_msg = None
         if not st.success and time_domain is not None:
             td_msg, Ut, anc_t = time_domain.start(model, f, basis, last_solution[0],
-                                                  max_periods=time_domain_periods)
+                                                  max_periods=so.time_domain_periods)
             if Ut is not None:
                 prob, U, st = _solve_at(probs, omega, anc_t, Ut.reshape(-1, basis.size),
-                                        solver, tol, 2 * max_iter)
+                                        so.replace(max_iter=2 * so.max_iter))
                 how = "time-start"
                 tried.append(Attempt.of("time-start", prob.eps, st))
         if st.success:

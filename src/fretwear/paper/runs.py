@@ -46,6 +46,7 @@ from fretwear.paper.report import load, write_report
 from fretwear.timedomain.fallback import FALLBACK
 from fretwear.timedomain.quasistatic import incremental_wear
 from fretwear.wear import frf_worn
+from fretwear.wear.worn_frf import WORN_FRF
 
 
 # --- running ----------------------------------------------------------------------------------
@@ -145,8 +146,8 @@ def _frf_worn(folder: Path, wear_dir: Path, quick: bool) -> str:
     basis = FourierBasis.up_to(h, s)
     out = {}
     for name, w in (("unworn", np.zeros_like(wear)), ("worn", wear)):
-        r = frf_worn(model, w, (f_min, f_max, n), basis, spacing="linear",
-                     time_domain=FALLBACK)
+        r = frf_worn(model, w, (f_min, f_max, n), basis,
+                     options=WORN_FRF.replace(time_domain=FALLBACK))
         out[f"{name}_summary"] = r.summary()
         out[f"{name}_frequency"] = r.frequency_hz
         out[f"{name}_amplitude"] = r.amplitude("Pe", 0, 1)

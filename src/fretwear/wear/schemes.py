@@ -45,21 +45,22 @@ def first_state(sp: SlowProblem, W0, anchor, U0, opts: WearOptions) -> tuple[dic
     t0 = time.perf_counter()
     sp.set_state(W0, anchor)
     # the first balance goes through solve_periodic (its start strategies for a cold start);
-    # the solver alone: a wear run has its own fallback (a start from a time integration),
-    # and its examples are validated with it (the further attempts of solve_periodic find a
-    # balance of the 79 kHz reduced example that the time-domain start replaces today)
+    # its attempts are opts.solve.strategy, by default the solver alone (WEAR_STEP): a wear
+    # run has its own fallback (a start from a time integration), and its examples are
+    # validated with it (the further attempts of solve_periodic find a balance of the 79 kHz
+    # reduced example that the time-domain start replaces today)
+    first = opts.solve.replace(max_iter=max(opts.solve.max_iter, 200))
     sol0 = solve_periodic(sp.model, sp.prob.basis, frequency=sp.prob.reduced.frequency,
-                          quasi_static=sp.prob.reduced.quasi_static,
+                          quasi_static=sp.prob.reduced.quasi_static, options=first,
                           reduced=sp.prob.reduced, gap=sp.gap0 + W0, eps=sp.eps,
-                          anchor=anchor, U0=U0, solver=opts.solver, tol=opts.tol,
-                          max_iter=max(opts.max_iter, 200), strategy=("start",))
+                          anchor=anchor, U0=U0)
     st = sol0.stats
     if not sol0.success:
         if sp.time_domain is not None:
             return time_domain_start(sp, W0, opts, st, t0)
         raise ConvergenceError(
             f"the periodic solve of the unworn interface did not converge ({st.message}, "
-            f"relative residual {st.residual:.3g} > {opts.tol:g}): no wear computed"
+            f"relative residual {st.residual:.3g} > {opts.solve.tol:g}): no wear computed"
         )
     U = sol0.U.reshape(sp.m, sp.H)
     if opts.scheme != "explicit" and sp.needs_iterative_solves(U):
@@ -156,7 +157,7 @@ def _attempt(sp: SlowProblem, opts: WearOptions, W_k, U_k, g_k, anchor, dN, lin)
     implicit: backward Euler from the Rosenbrock predictor (:func:`_backward_euler`, or the
     Newton method on the coupled unknowns ``(U~, W1)`` when ``implicit_newton = "coupled"``).
     """
-    kw = {"solver": opts.solver, "tol": opts.tol, "max_iter": opts.max_iter}
+    kw = {"options": opts.solve}
     if opts.scheme == "explicit":
         W1 = W_k + dN * g_k
         U1, stats = sp.solve_balance(W1, anchor, sp.shift_guess(U_k, W1 - W_k), **kw)
@@ -174,7 +175,7 @@ def _attempt(sp: SlowProblem, opts: WearOptions, W_k, U_k, g_k, anchor, dN, lin)
             stats.iterations += its
         return Wp, U1, stats
     if opts.implicit_newton == "coupled":
-        kw["max_iter"] = opts.max_iter_coupled
+        kw["options"] = opts.solve.replace(max_iter=opts.max_iter_coupled)
         U1, W1, stats = sp.solve_implicit(W_k, dN, anchor, Up, Wp, **kw)
         return W1, U1, stats
     return _backward_euler(sp, opts, W_k, U_k, dN, anchor, Up, Wp, Js, dUdW)
@@ -199,7 +200,7 @@ def _backward_euler(sp: SlowProblem, opts: WearOptions, W_k, U_start, dN, anchor
     iteration fails.
     """
     t0 = time.perf_counter()
-    kw = {"solver": opts.solver, "tol": opts.tol, "max_iter": opts.max_iter}
+    kw = {"options": opts.solve}
     its = 0
     msg = "backward Euler iteration did not converge"
 
@@ -219,7 +220,7 @@ def _backward_euler(sp: SlowProblem, opts: WearOptions, W_k, U_start, dN, anchor
     ev = evaluate(W, U)
     if ev is None:
         return W, U, SolveStats(False, math.inf, its, 0, 0, time.perf_counter() - t0,
-                                "balance failed at the predictor", opts.solver)
+                                "balance failed at the predictor", opts.solve.solver)
     U, r, rn, res = ev
     best = (rn, W, U, res)
     M = np.eye(sp.nc) - dN * Js
@@ -259,6 +260,6 @@ def _backward_euler(sp: SlowProblem, opts: WearOptions, W_k, U_start, dN, anchor
     rn, W, U, res = best
     if rn <= 0.5 * opts.tolerance * max(float(np.max(W)), 1e-300):
         return W, U, SolveStats(True, res, its, 0, 0, time.perf_counter() - t0, "converged",
-                                opts.solver)
+                                opts.solve.solver)
     return W, U, SolveStats(False, math.inf, its, 0, 0, time.perf_counter() - t0, msg,
-                            opts.solver)
+                            opts.solve.solver)

@@ -123,7 +123,7 @@ def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float = 1.0,
     anchor = np.array(anchor, float).reshape(nc, d - 1)
     sp = SlowProblem(model, reduced, basis, coef, eps=eps, anchor=anchor,
                      time_domain=time_domain if opts.time_domain_rescue and not quasi_static
-                     else None)
+                     else None, jacobian=opts.solve.jacobian)
     key = fingerprint(model, reduced, basis, sp.eps, coef, opts, W0, anchor)
 
     state, rows, resumed_from = None, [], -1

@@ -127,8 +127,8 @@ def time_domain_step(sp: SlowProblem, st: dict, opts: WearOptions):
     new.update({"step": int(st["step"]) + 1, "cycles": cycles1, "W": np.array(W1, float)})
     if tr.kind in BALANCE_KINDS and cycles1 >= float(st["td_retry_at"]):
         U1, stats = sp.solve_balance(W1, tr.anchor, tr.U.reshape(sp.m, sp.H),
-                                     solver=opts.solver, tol=opts.tol,
-                                     max_iter=max(opts.max_iter, RESCUE_MAX_ITER))
+                                     options=opts.solve.replace(
+                                         max_iter=max(opts.solve.max_iter, RESCUE_MAX_ITER)))
         iters += stats.iterations
         if stats.success:
             sp.set_state(W1, tr.anchor)
