@@ -45,7 +45,7 @@ _API = {
     # harmonic balance
     "FourierBasis": "fretwear.hb.fourier", "condense": "fretwear.hb.reduce",
     "Reduced": "fretwear.hb.reduce", "solve_periodic": "fretwear.api",
-    "PeriodicSolution": "fretwear.hb.solution", "SweepResult": "fretwear.hb.sweep",
+    "PeriodicSolution": "fretwear.hb.solution", "SweepResult": "fretwear.hb.sweep_result",
     "sweep": "fretwear.api", "SolveOptions": "fretwear.hb.options",
     "SweepOptions": "fretwear.hb.options",
     # linear

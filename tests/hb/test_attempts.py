@@ -114,7 +114,8 @@ def test_strategy_without_an_attempt_at_the_target_reports_the_start_residual():
     fail or do not apply), the unconverged answer is the start and its reported relative
     residual is the start's, |f(x0)| / scale(x0) evaluated here with numpy's norm, not inf
     (which the sweeps' messages printed before)."""
-    from fretwear.hb.attempts import solve_strategy
+    from fretwear.hb.attempts import Trial, solve_ladder
+    from fretwear.hb.options import PERIODIC
     from fretwear.model.matrices import from_matrices
 
     model = from_matrices(np.array([[2.0, -1.0], [-1.0, 1.0]]), np.eye(2), C=0.02 * np.eye(2),
@@ -125,7 +126,8 @@ def test_strategy_without_an_attempt_at_the_target_reports_the_start_residual():
     red = condense(model, 1.49 / (2 * np.pi), basis.orders)
     prob = DLFTProblem(red, model.contact, basis, eps=1.0)
     x0 = np.full((prob.m, prob.H), 0.1)
-    x, st = solve_strategy(prob, x0, steps=())
+    best = solve_ladder(Trial(prob, x0, PERIODIC), rungs=())
+    x, st = best.x, best.stats
     f, _ = prob.residual(x0, jacobian=False)
     assert not st.success and np.array_equal(x, x0)
     assert st.residual == pytest.approx(np.linalg.norm(f) / prob.scale(x0), rel=1e-12)

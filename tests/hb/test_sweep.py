@@ -9,28 +9,15 @@ residual test is 1e-10 relative to |Z U| and the kept harmonics are exact for a 
 """
 
 import numpy as np
+from helpers.blocks import closed_block
 
 from fretwear.hb.contact import SEPARATION
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.options import SWEEP_POINT, SweepOptions
 from fretwear.hb.sweep import frequency_grid, sweep
 from fretwear.linear import frf
-from fretwear.model import ContactSpec, Damping, Material, Spring, Traction, from_mesh, rectangle
 
-L, H = 0.02, 0.01  # [m]
 BASIS = FourierBasis.up_to(3, 32)
-
-
-def closed_block(mu=0.0, q=1e5):
-    """Steel block 20 x 10 mm (6 x 2 Q4) pressed by 1 MPa on a rigid flat, held in x by a spring,
-    driven by a cosine pressure ``q`` [Pa] on its right face (0.1 MPa: stays closed)."""
-    return from_mesh(rectangle(L, H, nx=6, ny=2), Material(210e9, 0.3, 7800.0), thickness=0.01,
-                     damping=Damping(rayleigh_stiffness=5e-6),
-                     springs=[Spring(at=(0.0, H / 2), direction="x", stiffness=1e7)],
-                     loads=[Traction("top", pressure=1e6),
-                            Traction("right", pressure=q, waveform="cos")],
-                     contact=ContactSpec("bottom", mu=mu),
-                     observed={"Pe": (L, H / 2)})
 
 
 def test_frequency_grid_is_geomspace_or_linspace():
@@ -99,21 +86,3 @@ def test_point_passed_by_eps_continuation_keeps_the_sweep_eps_and_its_attempts()
     U = p.solution.U.reshape(prob.m, prob.H)
     fres, _ = prob.residual(U, jacobian=False)
     assert np.linalg.norm(fres) <= 1e-8 * prob.scale(U)
-
-
-def test_reduced_models_kept_within_the_memory_budget(monkeypatch):
-    """The sweep's cache of reduced models keeps at most CACHE_SIZE of them and no more bytes
-    than CACHE_BYTES, always the newest (counted against the models' own sizes)."""
-    from fretwear.hb import sweep as sw
-    from fretwear.hb.reduce import exact_condenser
-
-    model = closed_block()
-    probs = sw._Problems(model, BASIS, None, 1e9, exact_condenser(model))
-    one = probs.get(2 * np.pi * 1000.0, None).reduced.Z.nbytes
-    monkeypatch.setattr(sw, "CACHE_BYTES", int(2.5 * one))
-    for f in (1100.0, 1200.0, 1300.0):
-        probs.get(2 * np.pi * f, None)
-    assert list(probs.cache) == [2 * np.pi * 1200.0, 2 * np.pi * 1300.0]
-    monkeypatch.setattr(sw, "CACHE_BYTES", one // 2)  # smaller than one: the newest only
-    probs.get(2 * np.pi * 1400.0, None)
-    assert list(probs.cache) == [2 * np.pi * 1400.0]

@@ -1,7 +1,7 @@
 """The periodic solve of the DLFT harmonic balance at one frequency (paper section 3.1-3.2):
 :func:`solve_periodic` condenses the model, builds the balance (:mod:`fretwear.hb.problem`),
-runs the attempt ladder (:mod:`fretwear.hb.attempts`) and assembles the result
-(:mod:`fretwear.hb.solution`).
+runs the attempt ladder of a single solve (:mod:`fretwear.hb.attempts`) and assembles the
+result (:mod:`fretwear.hb.solution`).
 """
 
 from __future__ import annotations
@@ -10,13 +10,8 @@ import time
 
 import numpy as np
 
-from fretwear.errors import InputError
-from fretwear.hb.attempts import (
-    _first_harmonic_start,
-    _time_start,
-    _time_start_applies,
-    solve_strategy,
-)
+from fretwear.errors import ConvergenceError, InputError
+from fretwear.hb.attempts import TimeStart, Trial, cold_start, solve_ladder
 from fretwear.hb.connectors import connect
 from fretwear.hb.fallback import TimeDomainFallback
 from fretwear.hb.fourier import FourierBasis
@@ -26,12 +21,8 @@ from fretwear.hb.penalty import penalty
 from fretwear.hb.preload import preload_anchor
 from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.reduce import Reduced, condense, exact_condenser
-from fretwear.hb.solution import Attempt, PeriodicSolution, assemble_solution
+from fretwear.hb.solution import PeriodicSolution, assemble_solution
 from fretwear.model.core import Model
-
-
-def _orders(basis):
-    return np.array([0, *basis.harmonics], dtype=np.int64)
 
 
 def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float | None = None,
@@ -94,49 +85,32 @@ def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float | None
     if condenser is None and (reduced is None or anchor is None or eps == "static"):
         condenser = exact_condenser(model)
     if reduced is None:
-        reduced = condense(model, frequency, _orders(basis), quasi_static=quasi_static,
+        reduced = condense(model, frequency, basis.orders, quasi_static=quasi_static,
                            condenser=condenser)
     reduced = connect(reduced, model.contact)
     eps = penalty(eps, model=model, reduced=reduced, condenser=condenser)
-    preload = None
-    if anchor is None:
-        preload = preload_anchor(model, condenser=condenser)
-        anchor = preload.values
-    prob = DLFTProblem(reduced, model.contact, basis, gap=gap, eps=eps, anchor=anchor,
+    preload = preload_anchor(model, condenser=condenser) if anchor is None else None
+    prob = DLFTProblem(reduced, model.contact, basis, gap=gap,
+                       eps=eps, anchor=anchor if preload is None else preload.values,
                        jacobian=options.jacobian)
-    if U0 is None and basis.k > 3:
-        U0 = _harmonic_continuation_start(model, basis, reduced, prob, options)
-    x0 = (prob.initial_guess() if U0 is None else np.asarray(U0, float).reshape(prob.m, prob.H))
-    attempts: list = []
+    trial = Trial(prob, cold_start(prob, U0, options), options,
+                  time_start=_time_start(model, frequency, reduced, time_domain, quasi_static,
+                                         gap))
     t0 = time.perf_counter()
-    x, st = solve_strategy(prob, x0, options=options, attempts=attempts)
-    found = ""
-    if not st.success and _time_start_applies(model, time_domain, quasi_static, gap,
-                                              options.strategy):
-        found, prob2, x2, st2 = _time_start(model, basis, frequency, reduced, prob, time_domain,
-                                            options)
-        if st2 is not None:
-            attempts.append(Attempt.of("time-start", prob2.eps, st2))
-            if st2.success or st2.residual < st.residual:
-                prob, x, st = prob2, x2, st2
-        else:
-            attempts.append(Attempt("time-start", options.solver, prob.eps, False,
-                                    float("nan"), 0, 0.0, found))
+    best = solve_ladder(trial)
+    st = best.stats
     st.wall_time = time.perf_counter() - t0
     if not st.success and raise_on_failure:
-        from fretwear.errors import ConvergenceError
-
         raise ConvergenceError(
             f"periodic solve at f = {reduced.frequency:.6g} Hz did not converge: "
             f"{st.message} (relative residual {st.residual:.3g} > {options.tol:g}; "
-            f"{len(attempts)} attempts: {', '.join(a.method for a in attempts)})"
-        )
-    sol = assemble_solution(prob, x.reshape(prob.m, prob.H), model, st)
-    sol.attempts = attempts
-    if found:
-        sol.time_domain = found
+            f"{len(trial.attempts)} attempts: {', '.join(a.method for a in trial.attempts)})")
+    sol = assemble_solution(best.prob, best.x.reshape(best.prob.m, best.prob.H), model, st)
+    sol.attempts = trial.attempts
+    if trial.found:
+        sol.time_domain = trial.found
         if not sol.success:
-            sol.flags.append(found)
+            sol.flags.append(trial.found)
     if preload is not None and not preload.success:
         sol.warnings.append(preload.warning)
     return sol
@@ -151,10 +125,14 @@ def check_options(options) -> SolveOptions:
     return options
 
 
-def _harmonic_continuation_start(model, basis, reduced, prob, options: SolveOptions):
-    """A starting point for a many-harmonic solve: the solution on the first kept harmonic,
-    embedded in the full basis (None if that fails). From the contact-closed guess, the
-    solvers can stall with 15+ harmonics where the one-harmonic problem converges and then
-    starts the full one within a few iterations (docs/verification.md)."""
-    return _first_harmonic_start(prob, options)
-
+def _time_start(model: Model, frequency: float, reduced: Reduced, time_domain, quasi_static,
+                gap) -> TimeStart | None:
+    """The time-domain start of the ladder, where it answers the same problem: not with
+    ``quasi_static``, a ``gap`` other than the model's, or contact springs (the time-domain
+    solver models none of these)."""
+    if time_domain is None or quasi_static or model.contact.has_connectors:
+        return None
+    if gap is not None and not np.array_equal(
+            np.broadcast_to(np.asarray(gap, float), model.contact.gap.shape), model.contact.gap):
+        return None
+    return TimeStart(time_domain, model, frequency, reduced)

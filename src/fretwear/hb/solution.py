@@ -183,7 +183,7 @@ class PeriodicSolution:
 
 @dataclass
 class Attempt:
-    """One attempt of a periodic solve (:func:`solve_strategy`, the sweeps).
+    """One attempt of a periodic solve (a rung of :mod:`fretwear.hb.attempts`).
 
     method : what was tried: ``"start"`` (the solver from the given start), ``"best-point"``
         (the other solver from the best iterate so far), ``"eps-continuation"`` (converged at
