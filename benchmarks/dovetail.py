@@ -36,6 +36,7 @@ from fretwear import linear
 from fretwear.analyses.run import load_case
 from fretwear.examples import example_path
 from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.options import SweepOptions
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.reduce import condense, exact_condenser
 from fretwear.hb.sweep import sweep
@@ -156,8 +157,8 @@ def main():
             t_sweep[0] = now
 
         res, t = _timed(lambda: sweep(model, basis, a["f_min"], a["f_max"], args.points,
-                                      spacing="linear", eps=a["eps"], progress=show,
-                                      condenser=cond))
+                                      options=SweepOptions(spacing="linear", eps=a["eps"],
+                                                           progress=show), condenser=cond))
         grid = [p for p in res.points if p.on_grid]
         ok = sum(p.success for p in grid)
         print(f"FRF: {args.points} points, {m * basis.size} unknowns each, {t:.1f} s"

@@ -24,7 +24,9 @@ import scipy.linalg as sla
 
 from fretwear.examples.builders import paper_beam
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import DLFTProblem, solve_periodic
+from fretwear.hb.options import SolveOptions, SweepOptions
+from fretwear.hb.periodic import solve_periodic
+from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.reduce import condense
 from fretwear.hb.sweep import sweep
 from fretwear.timedomain.fallback import FALLBACK
@@ -76,7 +78,8 @@ def main():
     # the periodic solve at 79 kHz from the default start (paper's eps: spectral radius of Z_r)
     sol = None
     for solver in ("powell", "newton"):
-        s_ = solve_periodic(model, basis, frequency=f, reduced=red, solver=solver, max_iter=400)
+        s_ = solve_periodic(model, basis, frequency=f, reduced=red,
+                            options=SolveOptions(solver=solver, max_iter=400))
         st = s_.stats
         print(f"periodic_79khz_{solver}_s={st.wall_time:.3f} iterations={st.iterations} "
               f"converged={st.success} residual={st.residual:.2e}")
@@ -100,7 +103,7 @@ def main():
 
     if not args.quick:
         t0 = time.perf_counter()
-        res = sweep(model, basis, 1.0, 1e5, args.points, time_domain=FALLBACK)
+        res = sweep(model, basis, 1.0, 1e5, args.points, options=SweepOptions(time_domain=FALLBACK))
         t_sweep = time.perf_counter() - t0
         print(f"sweep_{args.points}pts_s={t_sweep:.1f} (computed points incl. substeps: "
               f"{len(res.points)})")

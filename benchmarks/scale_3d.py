@@ -116,7 +116,9 @@ def warm_up():
     solve. The 256-node solve takes the dense path, the 1024-node one the operator path:
     without the second part only the latter would pay for loading its kernel."""
     from fretwear.hb.fourier import FourierBasis
-    from fretwear.hb.periodic import DLFTProblem, solve_periodic, static_anchor
+    from fretwear.hb.periodic import solve_periodic
+    from fretwear.hb.preload import static_anchor
+    from fretwear.hb.problem import DLFTProblem
     from fretwear.hb.reduce import condense
 
     small, basis = pad(4), FourierBasis.up_to(H, 128)
@@ -134,7 +136,8 @@ def one(n: int, extras: dict) -> dict:
 
     from fretwear.hb.fourier import FourierBasis
     from fretwear.hb.modal import modal_condenser
-    from fretwear.hb.periodic import solve_periodic, static_anchor
+    from fretwear.hb.periodic import solve_periodic
+    from fretwear.hb.preload import static_anchor
     from fretwear.hb.reduce import exact_condenser
 
     out = {"n": n, "nodes": n * n}
@@ -191,12 +194,14 @@ def one(n: int, extras: dict) -> dict:
     anchor = sol.anchor
     del red, sol  # the sweep condenses each of its frequencies itself (with mc)
     if extras.get("sweep"):
+        from fretwear.hb.options import SweepOptions
         from fretwear.hb.sweep import sweep
 
         ck = os.path.join(tmp, "sweep-checkpoint.npz")
         with Clock() as c:
-            res = sweep(model, basis, 4000.0, 6000.0, extras["sweep"], spacing="linear",
-                        anchor=anchor, checkpoint=ck, condenser=mc)
+            res = sweep(model, basis, 4000.0, 6000.0, extras["sweep"],
+                        options=SweepOptions(spacing="linear", checkpoint=ck), anchor=anchor,
+                        condenser=mc)
         out.update(sweep_points=extras["sweep"], sweep_cpu=c.cpu, sweep_wall=c.wall,
                    sweep_converged=int(sum(p.success for p in res.points)),
                    sweep_ckpt_mib=os.path.getsize(ck) / 2**20,
@@ -219,7 +224,8 @@ def alternate(sizes: tuple[int, int], reps: int) -> dict:
     periodic solve on the condensation of the frequency (condensed once per size)."""
     from fretwear.hb.fourier import FourierBasis
     from fretwear.hb.modal import modal_condenser
-    from fretwear.hb.periodic import solve_periodic, static_anchor
+    from fretwear.hb.periodic import solve_periodic
+    from fretwear.hb.preload import static_anchor
 
     basis = FourierBasis.up_to(H, 128)
     warm_up()  # untimed, as in one()

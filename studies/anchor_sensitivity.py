@@ -18,7 +18,9 @@ import numpy as np
 
 from fretwear.examples.builders import paper_beam
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import solve_periodic, static_anchor
+from fretwear.hb.options import SolveOptions
+from fretwear.hb.periodic import solve_periodic
+from fretwear.hb.preload import static_anchor
 from fretwear.hb.reduce import condense, exact_condenser
 
 
@@ -46,7 +48,7 @@ def main():
               f"{'mean x(Pe) [m]':>15s} {'stuck':>6s} {'d_amp':>8s} {'d_E':>8s}")
         for name, anc in rules.items():
             sol = solve_periodic(model, basis, frequency=f, reduced=red,
-                                 anchor=anc, solver="newton", max_iter=300)
+                                 anchor=anc, options=SolveOptions(solver="newton", max_iter=300))
             st = sol.stats
             if not sol.success:
                 print(f"{name:20s} {'no':>5s}   ({st.message}, residual {st.residual:.1e})")

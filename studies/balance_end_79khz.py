@@ -59,13 +59,15 @@ def continue_in_wear(sp, W0, dW, anchor, U0, *, tol, max_iter=60, ds_min=1e-7):
     """Natural-parameter continuation of the balance along ``W0 + s dW`` from ``s = 0``.
 
     Returns ``(s_reached, U_reached, iterations, failed_attempts, wall)``."""
+    from fretwear.hb.options import SolveOptions
+
     s, U, ds = 0.0, U0, 0.02
     its = fails = 0
     t0 = time.perf_counter()
     while s < 1.0 and ds >= ds_min:
         s1 = min(1.0, s + ds)
         Ux, st = sp.solve_balance(W0 + s1 * dW, anchor, sp.shift_guess(U, (s1 - s) * dW),
-                                  solver="powell", tol=tol, max_iter=max_iter)
+                                  options=SolveOptions(tol=tol, max_iter=max_iter))
         its += st.iterations
         if st.success:
             s, U = s1, Ux
@@ -88,8 +90,9 @@ def main(argv=None) -> int:
 
     from fretwear.analyses.run import load_case
     from fretwear.hb.fourier import FourierBasis
-    from fretwear.hb.periodic import initial_state
+    from fretwear.hb.options import SolveOptions
     from fretwear.hb.reduce import condense
+    from fretwear.hb.solution import initial_state
     from fretwear.hb.solvers import SolveStats
     from fretwear.io.case import build_model
     from fretwear.timedomain.averaged_rate import time_averaged_rate
@@ -143,8 +146,8 @@ def main(argv=None) -> int:
                              coef, eps=a.get("eps", "auto")), tol)):
             Ustart = U0
             if spx is not sp:  # the balance with the finer sampling at N0 first
-                Ustart, st = spx.solve_balance(W0, anchor, U0, solver="powell", tol=tolx,
-                                               max_iter=400)
+                Ustart, st = spx.solve_balance(W0, anchor, U0,
+                                               options=SolveOptions(tol=tolx, max_iter=400))
                 if not st.success:
                     print(f"  {label}: no balance at N0 ({st.message})")
                     continue

@@ -179,7 +179,7 @@ class Study:
 
     def model(self, nx):
         from fretwear.examples.builders import paper_beam
-        from fretwear.hb.periodic import static_anchor
+        from fretwear.hb.preload import static_anchor
 
         if nx not in self.models:
             self.models[nx] = paper_beam(nx=nx, ny=4)
@@ -250,6 +250,7 @@ class Study:
     def unworn(self, v):
         """Unworn periodic solve; returns (record, solution or None, eps)."""
         from fretwear.hb.fourier import FourierBasis
+        from fretwear.hb.options import SolveOptions
         from fretwear.hb.periodic import solve_periodic
 
         model, anchor = self.model(v["nx"])
@@ -268,8 +269,9 @@ class Study:
         for name, start, solver, max_iter in attempts:
             U0 = None if start is None else self.embedded_base(basis, model)
             sol = solve_periodic(model, basis, frequency=FREQ, reduced=red,
-                                 eps=eps, anchor=anchor, U0=U0, solver=solver, tol=1e-9,
-                                 max_iter=max_iter)
+                                 eps=eps, anchor=anchor, U0=U0,
+                                 options=SolveOptions(solver=solver, tol=1e-9,
+                                                      max_iter=max_iter))
             st = sol.stats
             tried.append({"start": name, "converged": bool(st.success),
                           "message": st.message, "residual": float(st.residual),

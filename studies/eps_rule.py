@@ -34,6 +34,7 @@ from peers import curve_peak  # noqa: E402
 import fretwear  # noqa: E402
 from fretwear.examples.builders import paper_beam  # noqa: E402
 from fretwear.hb.fourier import FourierBasis  # noqa: E402
+from fretwear.hb.options import SolveOptions, SweepOptions  # noqa: E402
 from fretwear.hb.periodic import solve_periodic  # noqa: E402
 from fretwear.model.build import Damping  # noqa: E402
 from fretwear.model.core import Load  # noqa: E402
@@ -67,7 +68,8 @@ def part1(harmonics, eps_list):
             for eps in eps_list:
                 t0 = time.perf_counter()
                 res = fretwear.sweep(model, basis, band[0] / (2 * np.pi),
-                                     band[1] / (2 * np.pi), n, spacing="linear", eps=eps,
+                                     band[1] / (2 * np.pi), n,
+                                     options=SweepOptions(spacing="linear", eps=eps),
                                      time_domain=False)
                 grid = [p for p in res.points if p.on_grid]
                 ok = [p for p in grid if p.success]
@@ -89,7 +91,8 @@ def part2(eps_list, freqs):
     for f in freqs:
         for eps in eps_list:
             t0 = time.perf_counter()
-            s = solve_periodic(model, basis, frequency=f, eps=eps, strategy=("start",))
+            s = solve_periodic(model, basis, frequency=f, eps=eps,
+                               options=SolveOptions(strategy=("start",)))
             print(f"{f / 1e3:6.0f} {str(eps):>10s} {s.eps:10.3g} {str(s.success):>5s} "
                   f"{s.stats.residual:9.1e} {s.observed_amplitude('Pe')[0][0]:11.4e} "
                   f"{time.perf_counter() - t0:7.1f}", flush=True)

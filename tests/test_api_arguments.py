@@ -14,6 +14,7 @@ import scipy.sparse as sp
 
 import fretwear as fw
 from fretwear.errors import InputError
+from fretwear.hb.options import SweepOptions
 from fretwear.model import ContactSpec, Material, Spring, Traction, from_mesh, rectangle
 from fretwear.model.core import Load
 from fretwear.timedomain.options import InitialState, IntegrationOptions
@@ -84,7 +85,7 @@ def test_sweep_bad_bands(block, args, match):
 
 def test_sweep_bad_spacing(block):
     with pytest.raises(InputError, match='spacing = .lin.: expected "log" or "linear"'):
-        fw.sweep(block, BASIS, 1e3, 2e3, 3, spacing="lin")
+        fw.sweep(block, BASIS, 1e3, 2e3, 3, options=SweepOptions(spacing="lin"))
 
 
 @pytest.mark.parametrize("harmonics,samples,match", [

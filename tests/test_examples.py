@@ -413,6 +413,7 @@ def test_frf_before_and_after_wear_example(tmp_path):
     worn one differs from it (measured: by 6e-4 to 2.6e-3 of the amplitude; threshold 1e-3,
     far above the solver's reproducibility, which the 1e-12 check above bounds)."""
     from fretwear.hb.fourier import FourierBasis
+    from fretwear.hb.options import SweepOptions
     from fretwear.hb.sweep import sweep
 
     text = (EXAMPLES / "salles2011-79khz-frf-worn.toml").read_text()
@@ -426,7 +427,8 @@ def test_frf_before_and_after_wear_example(tmp_path):
     assert ds["wear_depth"].values[-1].max() > 0.0
     amp = ds["frf_amplitude"].sel(point="Pe").isel(axis=0).values
     model = build_model(load_case(tmp_path / "salles2011-79khz-frf-worn.toml"))
-    ref = sweep(model, FourierBasis.up_to(3, 32), 6e4, 8.2e4, 12, spacing="linear")
+    ref = sweep(model, FourierBasis.up_to(3, 32), 6e4, 8.2e4, 12,
+                options=SweepOptions(spacing="linear"))
     on_grid = [int(np.argmin(np.abs(ref.frequency_hz - f))) for f in ds["frequency"].values]
     np.testing.assert_allclose(amp[0], ref.amplitude("Pe", 0, 1)[on_grid], rtol=1e-12)
     assert np.abs(amp[1] / amp[0] - 1.0).max() > 1e-3

@@ -12,6 +12,7 @@ import pytest
 
 from fretwear.hb.contact import SEPARATION
 from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.options import SolveOptions
 from fretwear.hb.periodic import solve_periodic
 from fretwear.linear import frf
 from fretwear.model import ContactSpec, Damping, Material, Spring, Traction, from_mesh, rectangle
@@ -41,7 +42,8 @@ def test_frictionless_response_is_the_sliding_linear_frf(mu):
     residual test is 1e-10 relative to |Z U|, and the 3 harmonics kept are exact for a
     linear response (only the first is loaded)."""
     model = block(mu)
-    sol = solve_periodic(model, FourierBasis.up_to(3, 32), frequency=F_HZ, tol=1e-10)
+    sol = solve_periodic(model, FourierBasis.up_to(3, 32), frequency=F_HZ,
+                         options=SolveOptions(tol=1e-10))
     assert sol.success, sol.message
     assert not np.any(sol.state == SEPARATION)  # closed all period: the reference applies
     np.testing.assert_allclose(sol.lam[:, 1:, :], 0.0, atol=1e-12 * np.abs(sol.lam).max())
@@ -59,7 +61,8 @@ def test_frictionless_contact_does_no_friction_work_and_no_energy_wear():
     from fretwear.wear import wear_coefficients
 
     model = block(0.0)
-    sol = solve_periodic(model, FourierBasis.up_to(3, 32), frequency=F_HZ, tol=1e-10)
+    sol = solve_periodic(model, FourierBasis.up_to(3, 32), frequency=F_HZ,
+                         options=SolveOptions(tol=1e-10))
     assert sol.success, sol.message
     scale = np.abs(sol.lam_t[:, 0]).max() * np.ptp(sol.x_t[:, 1], axis=-1).max()
     assert scale > 0

@@ -18,6 +18,7 @@ from helpers.models import K_, M_, oscillator, sliders
 
 from fretwear.analyses.run import load_case
 from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.options import SWEEP_POINT, SolveOptions, SweepOptions
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.sweep import sweep
 from fretwear.io.case import build_model
@@ -45,7 +46,7 @@ def test_solve_periodic():
     sol = solve_periodic(model, BASIS, frequency=F_HZ)
     check_shape(sol, True)
     assert sol.message == sol.stats.message
-    bad = solve_periodic(model, BASIS, frequency=F_HZ, max_iter=1, tol=1e-14)
+    bad = solve_periodic(model, BASIS, frequency=F_HZ, options=SolveOptions(max_iter=1, tol=1e-14))
     check_shape(bad, False)
     assert bad.stats.success is False and bad.U.shape == sol.U.shape  # the last iterate
 
@@ -58,8 +59,9 @@ def test_sweep():
     assert res.point_success.tolist() == [True] * 3
     for p in res.points:
         check_shape(p, True)
-    bad = sweep(model, BASIS, 0.9 * F_HZ, 1.1 * F_HZ, 3, max_iter=1, tol=1e-15,
-                continuation=False, max_bisections=1)
+    bad = sweep(model, BASIS, 0.9 * F_HZ, 1.1 * F_HZ, 3,
+                options=SweepOptions(solve=SWEEP_POINT.replace(max_iter=1, tol=1e-15),
+                                     continuation=False, max_bisections=1))
     check_shape(bad, False)
     assert bad.message == "0 of 3 points converged; 3 not converged"
     assert not bad.point_success.any()

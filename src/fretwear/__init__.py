@@ -58,8 +58,9 @@ _API = {
     "FourierBasis": "fretwear.hb.fourier", "condense": "fretwear.hb.reduce",
     "exact_condenser": "fretwear.hb.reduce", "modal_condenser": "fretwear.hb.modal",
     "Reduced": "fretwear.hb.reduce", "solve_periodic": "fretwear.api",
-    "PeriodicSolution": "fretwear.hb.periodic", "SweepResult": "fretwear.hb.sweep",
-    "sweep": "fretwear.api",
+    "PeriodicSolution": "fretwear.hb.solution", "SweepResult": "fretwear.hb.sweep_result",
+    "sweep": "fretwear.api", "SolveOptions": "fretwear.hb.options",
+    "SweepOptions": "fretwear.hb.options",
     # linear
     "modes": "fretwear.linear", "frf": "fretwear.linear",
     # wear

@@ -29,10 +29,12 @@ from fretwear import wear as _wear
 from fretwear.errors import InputError
 from fretwear.hb import periodic as _periodic
 from fretwear.hb import sweep as _sweep
+from fretwear.hb.options import sweep_options
 from fretwear.timedomain import integrate as _integrate
 from fretwear.timedomain import quasistatic as _quasistatic
 from fretwear.timedomain import steady as _steady
 from fretwear.timedomain.fallback import FALLBACK
+from fretwear.wear.worn_frf import WORN_FRF
 
 #: spellings of other entry points -> the public one
 _RENAMED = {"stick_anchor": "anchor", "W0": "wear0", "k_w": "wear_coefficient",
@@ -85,12 +87,14 @@ def solve_periodic(model, basis, frequency: float | None = None, *, quasi_static
     **kwargs : the other keywords of :func:`fretwear.hb.periodic.solve_periodic`, with its
         defaults: ``reduced`` (a :class:`~fretwear.hb.reduce.Reduced` to reuse), ``gap``
         (nc,) [m], ``eps`` (DLFT penalty [N/m] or ``"auto"``/``"top"``/``"static"``),
-        ``anchor`` (nc, d-1) stick anchors [m], ``U0`` (start), ``solver``, ``tol``,
-        ``max_iter``, ``raise_on_failure``, ``strategy``, ``time_domain_periods``.
+        ``anchor`` (nc, d-1) stick anchors [m], ``U0`` (start), ``options``
+        (:class:`~fretwear.hb.options.SolveOptions`: ``solver``, ``tol``, ``max_iter``,
+        ``strategy``, ``jacobian``, ``time_domain_periods``), ``raise_on_failure``,
+        ``condenser``.
 
     Returns
     -------
-    :class:`~fretwear.hb.periodic.PeriodicSolution`: ``success``, ``message``, ``attempts``,
+    :class:`~fretwear.hb.solution.PeriodicSolution`: ``success``, ``message``, ``attempts``,
     the harmonics and time histories of the contact (see its docstring).
     """
     _public_names("solve_periodic", kwargs)
@@ -111,10 +115,12 @@ def sweep(model, basis, f_min: float, f_max: float, n_points: int, *, time_domai
     time_domain : at points whose balance still fails, integrate in time from the neighbour
         (the case-file key ``time_domain`` of a sweep).
     **kwargs : the other keywords of :func:`fretwear.hb.sweep.sweep`, with its defaults:
-        ``spacing`` (``"log"``/``"linear"``), ``gap`` (nc,) [m], ``eps`` [N/m or
-        ``"top"``/``"static"``/``"auto"``], ``eps_band`` [Hz], ``anchor`` (nc, d-1) [m],
-        ``solver``, ``tol``, ``max_iter``, ``continuation``, ``max_bisections``, ``check``,
-        ``time_domain_periods``, ``progress``, ``checkpoint``, ``resume``.
+        ``options`` (:class:`~fretwear.hb.options.SweepOptions`: ``solve`` (a
+        :class:`~fretwear.hb.options.SolveOptions`), ``spacing`` (``"log"``/``"linear"``),
+        ``eps`` [N/m or ``"top"``/``"static"``/``"auto"``], ``eps_band`` [Hz],
+        ``continuation``, ``max_bisections``, ``flag``, ``progress``, ``checkpoint``,
+        ``resume``; or a SolveOptions alone), ``gap`` (nc,) [m], ``anchor`` (nc, d-1) [m],
+        ``condenser``. ``time_domain`` here replaces ``options.time_domain``.
 
     Returns
     -------
@@ -124,8 +130,9 @@ def sweep(model, basis, f_min: float, f_max: float, n_points: int, *, time_domai
     ``frequency_hz`` [Hz], ``point_success``, ``amplitude(point, axis)`` [m].
     """
     _public_names("sweep", kwargs)
+    options = sweep_options(kwargs.pop("options", None))
     return _sweep.sweep(model, basis, f_min, f_max, n_points,
-                        time_domain=_fallback(time_domain), **kwargs)
+                        options=options.replace(time_domain=_fallback(time_domain)), **kwargs)
 
 
 def simulate_wear(model, basis, frequency: float | None = None, *, quasi_static: bool = False,
@@ -183,16 +190,18 @@ def frf_worn(model, basis, wear, f_min: float, f_max: float, n_points: int, *,
     f_min, f_max, n_points : the frequency band [Hz] and its number of grid frequencies.
     time_domain : at points whose balance still fails, integrate in time from the neighbour
         (the key ``time_domain`` of a wear analysis's ``frf_before_after``).
-    **kwargs : the other keywords of :func:`fretwear.wear.worn_frf.frf_worn` (``anchor``,
-        ``spacing``, default ``"linear"``) and of :func:`fretwear.hb.sweep.sweep`.
+    **kwargs : the other keywords of :func:`fretwear.wear.worn_frf.frf_worn`: ``anchor``,
+        ``options`` (:class:`~fretwear.hb.options.SweepOptions`, default
+        :data:`~fretwear.wear.worn_frf.WORN_FRF`: a sweep's on a linear grid), ``condenser``.
 
     Returns
     -------
     :class:`~fretwear.hb.sweep.SweepResult` (``success``, ``message``, as :func:`sweep`).
     """
     _public_names("frf_worn", kwargs)
+    options = sweep_options(kwargs.pop("options", None), WORN_FRF)
     return _wear.frf_worn(model, basis, wear, f_min, f_max, n_points,
-                          time_domain=_fallback(time_domain), **kwargs)
+                          options=options.replace(time_domain=_fallback(time_domain)), **kwargs)
 
 
 def integrate(model, frequency: float, **kwargs):

@@ -199,12 +199,12 @@ def test_a_failed_static_preload_solve_is_a_warning_and_an_attribute(tmp_path, c
     of the results; with the normal iteration limit the attribute is empty (asserted by
     test_periodic_writes_documented_results_figures_and_paraview and the sweep's
     test_sweep_writes_documented_results_and_figures)."""
-    from fretwear.hb import periodic
+    from fretwear.hb import preload
 
     table = PERIODIC if analysis == "periodic" else (
         '[analysis]\ntype = "sweep"\nf_min = 9e3\nf_max = 1e4\nn_points = 2\nharmonics = 1\n'
         "n_samples = 16\n")
-    monkeypatch.setattr(periodic, "STATIC_MAX_ITER", 0)
+    monkeypatch.setattr(preload, "STATIC_MAX_ITER", 0)
     path = tmp_path / "starved.toml"
     path.write_text(small_case(tmp_path, table).read_text()
                     + "[output]\nvtu = false\nfigures = false\n")

@@ -18,8 +18,10 @@ import pytest
 
 from fretwear.hb.connectors import Connected, connect
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import initial_state, solve_periodic
+from fretwear.hb.options import SolveOptions
+from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.reduce import condense
+from fretwear.hb.solution import initial_state
 from fretwear.model.build import Damping
 from fretwear.model.core import Load
 from fretwear.model.matrices import ContactDofs, from_matrices
@@ -57,8 +59,10 @@ def test_jenkins_matches_explicit_spring_dof(w):
     point of the connected model moves as the explicit massless DOF. Frequencies below, at and
     above the frictional resonance (stick-slip at all three: asserted)."""
     f = w / (2 * np.pi)
-    a = solve_periodic(jenkins(0.5, explicit=False), BASIS, frequency=f, eps=1.0, tol=TOL)
-    b = solve_periodic(jenkins(0.5, explicit=True), BASIS, frequency=f, eps=1.0, tol=TOL)
+    a = solve_periodic(jenkins(0.5, explicit=False), BASIS, frequency=f, eps=1.0,
+                       options=SolveOptions(tol=TOL))
+    b = solve_periodic(jenkins(0.5, explicit=True), BASIS, frequency=f, eps=1.0,
+                       options=SolveOptions(tol=TOL))
     assert a.success and b.success
     assert set(np.unique(a.state)) >= {1, 2}
     np.testing.assert_allclose(a.observed["u"], b.observed["u"], rtol=0,
@@ -78,7 +82,7 @@ def test_stuck_jenkins_is_linear_with_springs_in_parallel():
     vanish. Tolerance 1e-9 relative: a linear solve, only the solver tolerance remains."""
     w = 1.1
     s = solve_periodic(jenkins(0.5, explicit=False, mu=1.0, normal=1e3), BASIS,
-                       frequency=w / (2 * np.pi), eps=1.0, tol=TOL)
+                       frequency=w / (2 * np.pi), eps=1.0, options=SolveOptions(tol=TOL))
     assert s.success and np.all(s.state == 1)
     amp = s.observed_amplitude("u")[0]
     ref = 0.2 / abs(1.5 - w * w + 1j * 0.02 * w)
@@ -112,8 +116,8 @@ def test_normal_and_tangential_stiffness_match_explicit_dofs():
                               loads=[Load(ld.vector[:2], ld.waveform) for ld in F],
                               observed={"m": [0, 1]})
     f = 0.9 / (2 * np.pi)
-    b = solve_periodic(explicit, BASIS, frequency=f, eps=1.0, tol=TOL)
-    a = solve_periodic(connected, BASIS, frequency=f, eps=1.0, tol=TOL)
+    b = solve_periodic(explicit, BASIS, frequency=f, eps=1.0, options=SolveOptions(tol=TOL))
+    a = solve_periodic(connected, BASIS, frequency=f, eps=1.0, options=SolveOptions(tol=TOL))
     assert a.success and b.success
     assert set(np.unique(b.state)) == {0, 1, 2}
     scale = np.abs(b.observed["m"]).max()

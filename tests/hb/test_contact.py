@@ -1,7 +1,7 @@
 """Validation of the DLFT contact law in time (paper eq. 24-28) and of its Jacobian.
 
 Code under test: :func:`fretwear.hb.contact.dlft_time`, :func:`fretwear.hb.contact.dlft_jacobian`
-and :meth:`fretwear.hb.periodic.DLFTProblem.residual`.
+and :meth:`fretwear.hb.problem.DLFTProblem.residual`.
 
 Independent references used here (none of them calls the code under test):
 
@@ -27,174 +27,29 @@ step never crosses a kink of this piecewise-smooth map.
 
 import numpy as np
 import pytest
-import scipy.sparse as sp
+from helpers.contact_law import (
+    ATOL_LAW,
+    CASES,
+    EXPECTED,
+    FD_RTOL,
+    FD_STEP,
+    HARM,
+    MIN_MARGIN,
+    NS,
+    P_REF,
+    Q_REF,
+    SWEEPS,
+    TOL_LAW,
+    case,
+    coeffs,
+    margins,
+    pattern,
+    ref_law,
+    ref_sweep,
+    run_law,
+)
 
 from fretwear.hb import contact as law
-from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import DLFTProblem
-from fretwear.hb.reduce import condense
-from fretwear.model.core import ContactInterface, Load, Model
-
-HARM = (1, 2, 3)
-NS = 24  # samples per period (> 2 * 3)
-TOL_LAW = 1e-14  # periodicity tolerance passed to both implementations
-SWEEPS = 2000
-# Two implementations of the same recursion differ by rounding only (~1e-16 per operation,
-# amplified by at most a few hundred operations per instant): 1e-10 of the signal scale is a
-# wide margin, while any wrong branch or sign gives errors of order mu * pN ~ 0.1 of the scale.
-ATOL_LAW = 1e-10
-# Central differences with h = 1e-6 x scale: truncation ~ h^2 |f'''| ~ 1e-12 (the map is
-# smooth between switches; every instant is >= MIN_MARGIN from a switch), rounding
-# ~ 1e-16 / 1e-6 = 1e-10 relative, plus the periodicity tolerance 1e-14 / 1e-6 = 1e-8 in 3D.
-# A missing term of the Jacobian (wrap-around seed, cone projection, mu t dpN, ...) gives
-# errors of order 1e-2..1, so 1e-6 is discriminating with a 100x margin on the noise.
-FD_STEP = 1e-6
-FD_RTOL = 1e-6
-MIN_MARGIN = 1e-3  # relative distance to a switch; >> FD_STEP x (sum of |G| entries ~ 10)
-
-
-# --------------------------------------------------------------------------------------------
-# independent references
-# --------------------------------------------------------------------------------------------
-def trig_matrices(harmonics, n):
-    """``P`` (H, N) and ``Q`` (N, H) of the real basis, by direct evaluation of cos/sin."""
-    tau = 2.0 * np.pi * np.arange(n) / n
-    h = np.asarray(harmonics, dtype=float)
-    q = np.hstack([np.ones((n, 1)), np.cos(np.outer(tau, h)), np.sin(np.outer(tau, h))])
-    p = q.T * (2.0 / n)
-    p[0] *= 0.5
-    return p, q
-
-
-P_REF, Q_REF = trig_matrices(HARM, NS)
-
-
-def ref_sweep(lu, mu, xprev):
-    """One pass of eq. 24-28 over a period for one node. ``lu`` (d, N); ``xprev`` the
-    tangential correction lambda_x,T before the first instant. Returns (lx, state, end)."""
-    d, n_t = lu.shape
-    lx = np.zeros((d, n_t))
-    state = np.zeros(n_t, dtype=int)
-    xp = np.array(xprev, dtype=float)
-    for n in range(n_t):
-        pre_n = lu[0, n]  # eq. 24, normal
-        pre_t = lu[1:, n] - xp  # eq. 24, tangential
-        if pre_n <= 0.0:  # separation (paper: pre_N >= 0 with its opposite sign)
-            lx[:, n] = lu[:, n]  # eq. 26
-            state[n] = law.SEPARATION
-        elif np.linalg.norm(pre_t) < mu * pre_n:  # stick
-            lx[0, n] = 0.0  # eq. 27
-            lx[1:, n] = xp
-            state[n] = law.STICK
-        else:  # slip
-            lx[0, n] = 0.0  # eq. 28
-            lx[1:, n] = xp + pre_t * (1.0 - mu * pre_n / np.linalg.norm(pre_t))
-            state[n] = law.SLIP
-        xp = lx[1:, n].copy()
-    return lx, state, xp
-
-
-def ref_law(lu, mu, x_start, tol=TOL_LAW, max_sweeps=SWEEPS):
-    """Periodic solution of the recursion for every node: sweep the period, each pass starting
-    where the previous one ended, until the start state repeats."""
-    nc, d, n_t = lu.shape
-    lx = np.zeros_like(lu)
-    state = np.zeros((nc, n_t), dtype=int)
-    for p in range(nc):
-        start = np.array(x_start[p], dtype=float)
-        thr = tol * np.abs(lu[p]).max()
-        for _ in range(max_sweeps):
-            lx[p], state[p], end = ref_sweep(lu[p], mu[p], start)
-            done = np.abs(end - start).max() <= thr
-            start = end
-            if done:
-                break
-    return lx, state
-
-
-def margins(lu, lx, mu):
-    """Smallest distance of any instant from a switching threshold, relative to the node's
-    scale: ``|pN|`` (separation/contact) and ``| |pre_T| - mu pN |`` (stick/slip)."""
-    out = []
-    for p in range(lu.shape[0]):
-        pn = lu[p, 0]
-        pre = lu[p, 1:] - np.roll(lx[p, 1:], 1, axis=1)
-        m = np.where(pn <= 0.0, -pn,
-                     np.minimum(pn, np.abs(np.linalg.norm(pre, axis=0) - mu[p] * pn)))
-        out.append(m.min() / np.abs(lu[p]).max())
-    return np.array(out)
-
-
-def coeffs(d, spec):
-    """Real Fourier coefficients (d, H) from {(component, "0" | "cH" | "sH"): value}."""
-    k = len(HARM)
-    c = np.zeros((d, 1 + 2 * k))
-    for (comp, term), v in spec.items():
-        if term == "0":
-            c[comp, 0] = v
-        else:
-            i = HARM.index(int(term[1:]))
-            c[comp, 1 + i if term[0] == "c" else 1 + k + i] = v
-    return c
-
-
-PH = 0.8  # phase putting the maximum of cos(tau + PH) near the end of the period
-# name -> (coefficients, mu, stick anchor x_start); expected state pattern in the comment
-# ("-" separation, "|" stick, "/" slip; 24 instants).
-CASES = {
-    # ------------------------
-    (2, "separation"): ({(0, "0"): -1.0, (0, "c1"): 0.3, (1, "0"): 0.2, (1, "s1"): 0.5},
-                        0.3, [0.1]),
-    # ||||||||||||||||||||||||
-    (2, "stick"): ({(0, "0"): 2.0, (0, "c1"): 0.2, (1, "s1"): 0.1, (1, "c2"): 0.05},
-                   0.3, [0.05]),
-    # //////////////////////// (a sample-to-sample drop > 2 mu pN reverses the slip)
-    (2, "slip"): ({(0, "0"): 1.0, (0, "c1"): 0.2, (1, "s1"): 20.0, (1, "c3"): 2.0},
-                  0.3, [0.0]),
-    # /////////-------//||||||
-    (2, "mixed"): ({(0, "0"): 1.0, (0, "c1"): 1.5, (1, "s1"): 0.8, (1, "c2"): 0.2},
-                   0.3, [0.0]),
-    # ||////////||||////////|| (stick across the end of the period)
-    (2, "wrap"): ({(0, "0"): 1.0, (0, "s2"): 0.1, (1, "c1"): np.cos(PH),
-                   (1, "s1"): -np.sin(PH)}, 0.3, [0.0]),
-    (3, "separation"): ({(0, "0"): -1.0, (0, "c1"): 0.3, (1, "0"): 0.2, (1, "s1"): 0.5,
-                         (2, "c2"): 0.3}, 0.3, [0.1, -0.1]),
-    (3, "stick"): ({(0, "0"): 2.0, (0, "c1"): 0.2, (1, "s1"): 0.1, (2, "c2"): 0.05},
-                   0.3, [0.05, -0.02]),
-    # //////////////////////// (the tangential prediction turns on a circle)
-    (3, "slip"): ({(0, "0"): 1.0, (0, "c2"): 0.2, (1, "c1"): 2.0, (2, "s1"): 2.0},
-                  0.3, [0.0, 0.0]),
-    # /////////-------/|||||||
-    (3, "mixed"): ({(0, "0"): 1.0, (0, "c1"): 1.5, (1, "s1"): 0.8, (2, "c1"): 0.5,
-                    (2, "s2"): 0.3}, 0.3, [0.0, 0.0]),
-    # ||////////||||////////||
-    (3, "wrap"): ({(0, "0"): 1.0, (0, "s2"): 0.1, (1, "c1"): 0.8 * np.cos(PH),
-                   (1, "s1"): -0.8 * np.sin(PH), (2, "c1"): 0.6 * np.cos(PH),
-                   (2, "s1"): -0.6 * np.sin(PH), (2, "c2"): 0.05}, 0.3, [0.0, 0.0]),
-}
-EXPECTED = {
-    "separation": "-" * 24,
-    "stick": "|" * 24,
-    "slip": "/" * 24,
-    "mixed": {2: "/////////-------//||||||", 3: "/////////-------/|||||||"},
-    "wrap": "||////////||||////////||",
-}
-
-
-def case(key):
-    spec, mu, xs = CASES[key]
-    c = coeffs(key[0], spec)[None]  # (1, d, H)
-    return c, np.array([mu]), np.array([xs], dtype=float)
-
-
-def run_law(c, mu, xs):
-    lu = np.ascontiguousarray(c @ Q_REF.T)
-    lx, state, sweeps = law.dlft_time(lu, mu, xs, TOL_LAW, SWEEPS)
-    return lu, lx, state, sweeps
-
-
-def pattern(state):
-    return "".join("-|/"[s] for s in state)
 
 
 # --------------------------------------------------------------------------------------------
@@ -466,124 +321,6 @@ def test_jacobian_3d_static_slip():
     ref[1:, 0] = -mu[0] * t
     G = law.dlft_jacobian(lu, lx, state, mu, np.ones((1, 1)), np.ones((1, 1)))[0]
     np.testing.assert_allclose(G, ref, rtol=0, atol=1e-12)
-
-
-# --------------------------------------------------------------------------------------------
-# 3. the DLFT residual and its full Jacobian on hand-built models
-# --------------------------------------------------------------------------------------------
-def chain_model(d, nc):
-    """``nc`` contact nodes (d DOFs each, frames rotated so that no axis is special) tied by
-    springs to each other and, through an interior mass, to ground; viscous and hysteretic
-    damping so that every harmonic block of Z_r is complex and non-symmetric in real form."""
-    rng = np.random.default_rng(3)
-    nd = nc * d + d  # contact DOFs then d interior DOFs
-    A = rng.standard_normal((nd, nd))
-    K = A @ A.T + nd * np.eye(nd)
-    M = np.diag(rng.uniform(0.5, 1.5, nd))
-    C = 0.01 * K
-    D = 0.02 * K
-    frames = []
-    for _ in range(nc):
-        q, _ = np.linalg.qr(rng.standard_normal((d, d)))
-        frames.append(q)
-    contact = ContactInterface(
-        dofs=np.arange(nc * d).reshape(nc, d), frame=np.array(frames), gap=np.zeros(nc),
-        area=np.ones(nc), mu=0.3, coords=np.zeros((nc, d)))
-    F = np.zeros(nd)
-    F[:nc * d] = 1.0
-    model = Model(K=sp.csr_matrix(K), M=sp.csr_matrix(M), C=sp.csr_matrix(C),
-                  D=sp.csr_matrix(D), contact=contact,
-                  loads=[Load(F, "constant"), Load(0.5 * F, "cos"), Load(0.2 * F, "sin")],
-                  dim=d)
-    return model
-
-
-def real_blocks(Zc, k):
-    """Real operator on [a0, a_h.., b_h..] per DOF from complex blocks, written from
-    ``u = Re(U e^{i h tau})`` with U = a - i b (independent of reduce.to_real_blocks)."""
-    m = Zc.shape[1]
-    H = 1 + 2 * k
-    out = np.zeros((m, H, m, H))
-    out[:, 0, :, 0] = Zc[0].real
-    for i in range(1, k + 1):
-        # Z (a - i b) = (Zr a + Zi b) - i (Zr b - Zi a):  new a = Zr a + Zi b, new b = Zr b - Zi a
-        zr, zi = Zc[i].real, Zc[i].imag
-        out[:, i, :, i] = zr
-        out[:, i, :, k + i] = zi
-        out[:, k + i, :, i] = -zi
-        out[:, k + i, :, k + i] = zr
-    return out.reshape(m * H, m * H)
-
-
-def problem_at(d, keys, frequency=3.0 / (2 * np.pi)):
-    """A DLFTProblem on ``chain_model`` and a point U at which lambda_u of node p equals the
-    test signal ``keys[p]`` (U from (eps I - Z) U = lambda_u - F + eps W, eps = 2 x spectral
-    radius so that eps I - Z is invertible)."""
-    nc = len(keys)
-    model = chain_model(d, nc)
-    basis = FourierBasis(HARM, NS)
-    red = condense(model, frequency, [0, *HARM])
-    eps = 2.0 * red.spectral_radius()
-    scale = 1e3  # forces of order 1e3 N
-    anchors = np.array([case(k)[2][0] for k in keys]) * scale / eps  # eps X_a = x_start
-    prob = DLFTProblem(red, model.contact, basis, eps=eps, anchor=anchors,
-                       periodicity_tol=TOL_LAW, max_sweeps=SWEEPS)
-    target = scale * np.concatenate([case(k)[0][0] for k in keys])  # (nc*d, H): lambda_u
-    n = prob.m * prob.H
-    Z = real_blocks(red.Z, len(HARM))
-    F = np.hstack([red.F[0].real[:, None], red.F[1:].real.T, -red.F[1:].imag.T])
-    rhs = (target - F + eps * prob.W).reshape(-1)
-    U = np.linalg.solve(eps * np.eye(n) - Z, rhs).reshape(prob.m, prob.H)
-    return prob, U, Z, F, target
-
-
-@pytest.mark.parametrize("d, keys", [
-    (2, [(2, "mixed"), (2, "wrap"), (2, "slip"), (2, "stick"), (2, "separation")]),
-    (3, [(3, "mixed"), (3, "wrap"), (3, "slip"), (3, "stick"), (3, "separation")]),
-], ids=["2D", "3D"])
-def test_residual_matches_reference(d, keys):
-    """DLFTProblem.residual vs an independent assembly: lambda_u~ = F~ - Z U~ + eps (U~ - W~)
-    from the complex reduced blocks through ``real_blocks`` (own real form), lambda_u in time
-    with ``trig_matrices``, lambda_x by ``ref_law``, f = eps (U~ - W~) - P lambda_x (eq. 22).
-    Tolerance 1e-10 of eps |U|: rounding of dense products of size ~ 100."""
-    prob, U, Z, F, target = problem_at(d, keys)
-    lu = (F - (Z @ U.reshape(-1)).reshape(prob.m, prob.H) + prob.eps * (U - prob.W))
-    np.testing.assert_allclose(lu, target, rtol=0, atol=1e-9 * np.abs(target).max())
-    lu_t = (lu @ Q_REF.T).reshape(prob.nc, d, NS)
-    lx_ref, state_ref = ref_law(lu_t, prob.mu, prob.eps * prob.anchor)
-    f_ref = prob.eps * (U - prob.W) - (lx_ref.reshape(prob.m, NS) @ P_REF.T)
-    f, _ = prob.residual(U, jacobian=False)
-    np.testing.assert_allclose(f, f_ref.reshape(-1), rtol=0,
-                               atol=1e-10 * prob.eps * np.abs(U).max())
-    _, _, state, _ = prob.time_law(U)
-    np.testing.assert_array_equal(state, state_ref)
-
-
-@pytest.mark.parametrize("d, keys", [
-    (2, [(2, "mixed"), (2, "wrap"), (2, "slip"), (2, "stick"), (2, "separation")]),
-    (3, [(3, "mixed"), (3, "wrap"), (3, "slip"), (3, "stick"), (3, "separation")]),
-], ids=["2D", "3D"])
-def test_residual_jacobian_matches_finite_differences(d, keys):
-    """Full Jacobian ``J = eps I - G (eps I - Z)`` of DLFTProblem.residual vs central
-    differences in U (step 1e-6 x max |U|), on coupled nodes in all state patterns (the
-    coupling through Z mixes the nodes, so an error in the ordering of G's rows/columns or in
-    the chain rule shows). Tolerance FD_RTOL relative to eps (the size of J's entries)."""
-    prob, U, _, _, _ = problem_at(d, keys)
-    lu, lx, _, _ = prob.time_law(U)
-    assert margins(lu, lx, prob.mu).min() > MIN_MARGIN
-    f0, J = prob.residual(U)
-    h = FD_STEP * np.abs(U).max()
-    n = U.size
-    J_fd = np.zeros((n, n))
-    for j in range(n):
-        e = np.zeros(n)
-        e[j] = h
-        fp, _ = prob.residual(U + e.reshape(U.shape), jacobian=False)
-        fm, _ = prob.residual(U - e.reshape(U.shape), jacobian=False)
-        J_fd[:, j] = (fp - fm) / (2 * h)
-    np.testing.assert_allclose(J, J_fd, rtol=0, atol=FD_RTOL * prob.eps)
-    # the nonlinear part is not negligible: the test would see an error in G
-    assert np.abs(J - prob.eps * np.eye(n)).max() > 0.1 * prob.eps
 
 
 # --------------------------------------------------------------------------------------------

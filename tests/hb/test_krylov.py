@@ -21,7 +21,8 @@ from fretwear.hb import contact as law
 from fretwear.hb import krylov
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.krylov import KrylovJacobian
-from fretwear.hb.periodic import DLFTProblem, static_anchor
+from fretwear.hb.preload import static_anchor
+from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.reduce import condense
 from fretwear.hb.solvers import solve
 
@@ -163,7 +164,7 @@ def test_arclength_step_with_the_operator_equals_the_bordered_lu(case):
     """The arclength Newton step of a sweep with the operator Jacobian (block elimination, two
     solves) equals the LU of the formed bordered matrix (numpy.linalg.solve on the dense
     path's Jacobian): 1e-9 relative, the accuracy of the step (test above)."""
-    from fretwear.hb.sweep import _bordered_step
+    from fretwear.hb.arclength import bordered_step
 
     model, x = case
     dense, op = problem(model, "dense"), problem(model, "krylov")
@@ -172,8 +173,8 @@ def test_arclength_step_with_the_operator_equals_the_bordered_lu(case):
     _, Jo = op.residual(x1.reshape(op.m, op.H), True)
     rng = np.random.default_rng(4)
     fw, t = rng.standard_normal(f.size), rng.standard_normal(f.size + 1)
-    ref = _bordered_step(J, f, fw, 0.3, t, 2.0, 5.0)
-    got = _bordered_step(Jo, f, fw, 0.3, t, 2.0, 5.0)
+    ref = bordered_step(J, f, fw, 0.3, t, 2.0, 5.0)
+    got = bordered_step(Jo, f, fw, 0.3, t, 2.0, 5.0)
     assert np.abs(got - ref).max() <= 1e-9 * np.abs(ref).max()
 
 

@@ -14,8 +14,10 @@ import pytest
 import scipy.sparse as sp
 
 from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.options import SolveOptions, SweepOptions
 from fretwear.hb.penalty import penalty
-from fretwear.hb.periodic import DLFTProblem, solve_periodic
+from fretwear.hb.periodic import solve_periodic
+from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.reduce import condense
 from fretwear.hb.sweep import sweep
 from fretwear.model.core import ContactInterface, Load, Model
@@ -133,7 +135,8 @@ def test_the_solvers_take_the_same_words():
     assert DLFTProblem(red, model.contact, basis).eps == penalty("auto", reduced=red)
     for call in (lambda: DLFTProblem(red, model.contact, basis, eps="paper"),
                  lambda: solve_periodic(model, basis, frequency=300.0, eps=-1.0),
-                 lambda: sweep(model, basis, 100.0, 200.0, 2, eps="per-frequency")):
+                 lambda: sweep(model, basis, 100.0, 200.0, 2,
+                               options=SweepOptions(eps="per-frequency"))):
         with pytest.raises(ValueError, match="eps = "):
             call()
 
@@ -147,14 +150,16 @@ def test_sweep_static_and_top_are_one_penalty_and_auto_one_per_frequency():
     # between the resonances of the interior node with the contact held (675 and 1031 Hz),
     # where Z_r(w) outweighs K_r
     f = np.array([700.0, 800.0])
-    top = sweep(model, basis, f[0], f[1], 2, spacing="linear", time_domain=None)
+    top = sweep(model, basis, f[0], f[1], 2, options=SweepOptions(spacing="linear",
+                                                                  time_domain=None))
     ref_top = float(np.median([reference_radius(model, 2 * np.pi * x, [1])
                                for x in np.linspace(f[0], f[1], 5)]))
     assert [p.solution.eps for p in top.points] == pytest.approx([ref_top] * 2, rel=1e-12)
-    static = sweep(model, basis, f[0], f[1], 2, spacing="linear", time_domain=None,
-                   eps="static")
+    static = sweep(model, basis, f[0], f[1], 2,
+                   options=SweepOptions(spacing="linear", time_domain=None, eps="static"))
     default = static
-    auto = sweep(model, basis, f[0], f[1], 2, spacing="linear", time_domain=None, eps="auto")
+    auto = sweep(model, basis, f[0], f[1], 2, options=SweepOptions(spacing="linear",
+                                                                   time_domain=None, eps="auto"))
     for res in (static, top, auto):
         assert res.success, res.message
         np.testing.assert_allclose(res.frequency_hz, f, rtol=1e-15)
@@ -303,7 +308,8 @@ def test_jenkins_eps_is_its_spring_and_equals_the_aft_balance(w, f0):
     scale = np.max(np.abs(ref))
 
     def error(eps):
-        sol = solve_periodic(model, basis, frequency=w / (2 * np.pi), eps=eps, tol=1e-12)
+        sol = solve_periodic(model, basis, frequency=w / (2 * np.pi), eps=eps,
+                             options=SolveOptions(tol=1e-12))
         assert sol.success
         return np.max(np.abs(sol.observed_time("x")[0][0] - ref)) / scale
 

@@ -26,7 +26,8 @@ from scipy import integrate, optimize
 from fretwear.errors import ConvergenceError
 from fretwear.hb import contact as law
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import DLFTProblem, solve_periodic
+from fretwear.hb.options import SolveOptions
+from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.reduce import condense, recover
 from fretwear.model import (
     ContactSpec,
@@ -176,7 +177,8 @@ def test_den_hartog_oscillator(zeta):
     1.5 %, 0.75 % for zeta = 2 %). Asserted: strictly decreasing errors, first-order rate
     0.15 <= err (Nh + 1) <= 0.45 for Nh >= 3, and < 1 % at Nh = 31."""
     model, w, ref = den_hartog_case(zeta)
-    sols = solve_sequence(model, NH_SEQ, frequency=w / (2 * np.pi), tol=1e-10)
+    sols = solve_sequence(model, NH_SEQ, frequency=w / (2 * np.pi),
+                          options=SolveOptions(tol=1e-10))
     err_a, err_e = [], []
     for sol in sols.values():
         k = sol.basis.k
@@ -196,7 +198,8 @@ def test_den_hartog_from_default_initial_guess():
     """Same problem as test_den_hartog_oscillator (zeta = 2 %) solved directly with
     Nh = 15 from solve_periodic's default initial guess."""
     model, w, ref = den_hartog_case(0.02)
-    sol = solve_periodic(model, basis_for(15), frequency=w / (2 * np.pi), tol=1e-10)
+    sol = solve_periodic(model, basis_for(15), frequency=w / (2 * np.pi),
+                         options=SolveOptions(tol=1e-10))
     st = sol.stats
     assert st.success, st.message
 
@@ -264,7 +267,7 @@ def test_jenkins_quasi_static_hysteresis(F0, phase, condensed):
     closed = 4 * R * (F - R) / k
     for nh in (1, 7, 31):
         b = basis_for(nh)
-        sol = solve_periodic(model, b, quasi_static=True, tol=1e-10)
+        sol = solve_periodic(model, b, quasi_static=True, options=SolveOptions(tol=1e-10))
         st = sol.stats
         assert sol.success, st.message
         Fn = F * np.cos(b.tau + phase)
@@ -293,7 +296,7 @@ def test_jenkins_full_stick(condensed):
     model, k, F = jenkins_model(F0, 0.3, condensed)
     for anchor in (None, 4e-6):  # k a = 8 N: 8 + 20 < 30
         b = basis_for(7)
-        sol = solve_periodic(model, b, quasi_static=True, tol=1e-10,
+        sol = solve_periodic(model, b, quasi_static=True, options=SolveOptions(tol=1e-10),
                              anchor=None if anchor is None else np.array([[anchor]]))
         st = sol.stats
         assert sol.success, st.message
@@ -331,7 +334,8 @@ def fe_block(q_ratio=0.8):
 @pytest.fixture(scope="module")
 def block_sequence():
     model = fe_block()
-    sols = solve_sequence(model, NH_SEQ, per=8, frequency=F_B, tol=1e-11)
+    sols = solve_sequence(model, NH_SEQ, per=8, frequency=F_B,
+                          options=SolveOptions(tol=1e-11))
     return model, F_B, sols
 
 
@@ -438,7 +442,7 @@ def test_fe_eps_independence(block_sequence, nh, bound):
         res = []
         for fac in (0.1, 1.0, 10.0):
             sol = solve_periodic(model, b, frequency=f, reduced=red, eps=fac * rho,
-                                 U0=base.U, tol=1e-11)
+                                 U0=base.U, options=SolveOptions(tol=1e-11))
             st = sol.stats
             assert sol.success, st.message
             res.append((sol.U[:, :, [0, 1, 1 + b.k]], sol.friction_energy().sum()))
@@ -461,7 +465,8 @@ def test_solvers_agree(block_sequence):
     red = condense(model, f, [0, *b.harmonics])
     U = {}
     for solver in ("powell", "newton", "hybr"):
-        sol = solve_periodic(model, b, frequency=f, reduced=red, solver=solver, tol=1e-11)
+        sol = solve_periodic(model, b, frequency=f, reduced=red,
+                             options=SolveOptions(solver=solver, tol=1e-11))
         st = sol.stats
         assert sol.success and st.success and st.solver == solver, st.message
         assert st.residual <= 1e-11
@@ -478,14 +483,16 @@ def test_failed_solve_says_so(block_sequence, solver):
     raise_on_failure it raises ConvergenceError instead."""
     model, f, _ = block_sequence
     b = basis_for(7, per=8)
-    sol = solve_periodic(model, b, frequency=f, solver=solver, tol=1e-11, max_iter=1)
+    sol = solve_periodic(model, b, frequency=f, options=SolveOptions(solver=solver, tol=1e-11,
+                                                                     max_iter=1))
     st = sol.stats
     assert sol.success is False and sol.message == st.message
     assert st.success is False
     assert st.residual > 1e-11
     assert isinstance(st.message, str) and st.message and st.message != "converged"
     with pytest.raises(ConvergenceError):
-        solve_periodic(model, b, frequency=f, solver=solver, tol=1e-11, max_iter=1,
+        solve_periodic(model, b, frequency=f,
+                       options=SolveOptions(solver=solver, tol=1e-11, max_iter=1),
                        raise_on_failure=True)
 
 
@@ -533,7 +540,8 @@ def global_friction(sol, model):
 @pytest.fixture(scope="module")
 def block_3d_45():
     model = block_3d(45.0)
-    sol = solve_periodic(model, basis_for(7, per=8), quasi_static=True, tol=1e-11)
+    sol = solve_periodic(model, basis_for(7, per=8), quasi_static=True,
+                         options=SolveOptions(tol=1e-11))
     st = sol.stats
     assert sol.success, st.message
     return model, sol
@@ -585,7 +593,8 @@ def test_3d_gross_slip_follows_load_direction():
     magnitude is mu sum(lambda_N) within 1e-3. A friction law that is not isotropic would
     pull the force towards its preferred directions (45 deg for a square law: 15 deg off)."""
     model = block_3d(30.0)
-    sol = solve_periodic(model, basis_for(7, per=8), quasi_static=True, tol=1e-11)
+    sol = solve_periodic(model, basis_for(7, per=8), quasi_static=True,
+                         options=SolveOptions(tol=1e-11))
     st = sol.stats
     assert sol.success, st.message
     lam = check_cone(sol, MU_B)
@@ -603,172 +612,8 @@ def test_3d_poisson_preload():
     outwards, beyond the cone of their zero anchor. Expected: a converged, symmetric
     solution whose forces lie in the cone (as with nu = 0)."""
     model = block_3d(45.0, nu=0.3)
-    sol = solve_periodic(model, basis_for(3, per=8), quasi_static=True, tol=1e-10)
+    sol = solve_periodic(model, basis_for(3, per=8), quasi_static=True,
+                         options=SolveOptions(tol=1e-10))
     st = sol.stats
     assert sol.success, st.message
     check_cone(sol, MU_B)
-
-
-def test_strategy_records_every_attempt_and_ends_at_the_target_eps():
-    """The issue's two-DOF chain (mass 2 rubbing on the ground under a prescribed normal
-    force) at 15 harmonics with eps = 1 N/m: Powell stalls from the contact-closed start,
-    Newton from its best iterate too, and the eps continuation (10 N/m, then back to 1 N/m)
-    converges. Checked independently of the solver's own test: a fresh problem at eps = 1
-    evaluates the residual of the returned harmonics below the tolerance, and the attempts
-    are recorded in order with only the last one successful."""
-    from fretwear.hb.fourier import FourierBasis as FB
-    from fretwear.model.build import Damping
-    from fretwear.model.matrices import ContactDofs, from_matrices
-
-    model = from_matrices(np.array([[2.0, -1.0], [-1.0, 1.0]]), np.eye(2),
-                          contact=ContactDofs(normal_dofs=None, tangential_dofs=[1], mu=0.5,
-                                              normal_load=1.0),
-                          damping=Damping(C=0.02 * np.eye(2)),
-                          loads=[Load(np.array([0.2, 0.0]), "cos")], observed={"x": 0})
-    basis = FB.up_to(15, 128)
-    sol = solve_periodic(model, basis, frequency=1.4905405 / (2 * np.pi), eps=1.0)
-    assert sol.success and sol.eps == 1.0
-    methods = [a.method for a in sol.attempts]
-    assert methods == ["start", "best-point", "eps-continuation"]
-    assert [a.success for a in sol.attempts] == [False, False, True]
-    assert sol.attempts[-1].eps == 1.0 and "eps path 10, " in sol.attempts[-1].message
-    red = condense(model, sol.frequency, basis.orders)
-    prob = DLFTProblem(red, model.contact, basis, eps=1.0, anchor=sol.anchor)
-    U = sol.U.reshape(prob.m, prob.H)
-    f, _ = prob.residual(U, jacobian=False)
-    assert np.linalg.norm(f) <= 1e-8 * prob.scale(U)
-    only = solve_periodic(model, basis, frequency=1.4905405 / (2 * np.pi), eps=1.0,
-                          strategy=("start",))
-    assert not only.success and [a.method for a in only.attempts] == ["start"]
-
-
-# --- the time-domain start of solve_periodic ------------------------------------------------
-def test_time_start_reaches_the_balance_of_the_standard_solve():
-    """The attempt "time-start" alone (no other attempt) on the friction oscillator (continuous
-    slip: one periodic solution, no stick anchors to choose): the balance started from a time
-    integration's periodic steady state equals the one solved from the contact-closed guess.
-    Two independent paths to one solution of one balance: they agree to the conditioning of
-    the balance times its tolerance 1e-8 (1e-6 relative leaves that margin; measured 1e-13)."""
-    from fretwear.timedomain.fallback import FALLBACK
-    from tests.helpers.models import oscillator
-
-    model, basis = oscillator(), FourierBasis.up_to(5, 64)
-    ref = solve_periodic(model, basis, frequency=15.0)
-    ts = solve_periodic(model, basis, frequency=15.0, strategy=("time-start",),
-                        time_domain=FALLBACK)
-    assert ref.success and ts.success
-    assert [a.method for a in ts.attempts] == ["time-start"] and ts.attempts[0].success
-    assert ts.time_domain.startswith("time integration: periodic steady state")
-    assert not ts.flags
-    assert np.abs(ts.U - ref.U).max() <= 1e-6 * np.abs(ref.U).max()
-
-
-def test_time_start_reports_a_response_that_is_not_periodic():
-    """When the time integration finds no periodic state, the solve fails with what the
-    structure does: in ``time_domain``, in ``flags`` and as the last attempt's message; the
-    integration is asked for the given number of periods, from rest."""
-    from fretwear.hb.fallback import TimeDomainFallback
-    from tests.helpers.models import oscillator
-
-    calls = []
-    msg = "time integration: quasi-periodic over 300 periods: no periodic steady state"
-
-    def start(model, frequency, basis, solution, *, max_periods):
-        calls.append((frequency, solution, max_periods))
-        return msg, None, None
-
-    fake = TimeDomainFallback(start=start, averaged_rate=None)
-    sol = solve_periodic(oscillator(), FourierBasis.up_to(3, 32), frequency=15.0,
-                         strategy=("time-start",), time_domain=fake, time_domain_periods=300)
-    assert not sol.success
-    assert calls == [(15.0, None, 300)]
-    assert sol.time_domain == msg and msg in sol.flags
-    assert [a.method for a in sol.attempts] == ["time-start"]
-    assert sol.attempts[0].message == msg and not sol.attempts[0].success
-
-
-def test_time_start_is_skipped_where_the_time_domain_does_not_apply():
-    """Quasi-static solves, a worn gap and contact springs take no time-domain start (the
-    integration would answer another problem): the fallback is never called."""
-    from fretwear.hb.fallback import TimeDomainFallback
-    from tests.helpers.models import oscillator
-
-    def start(*args, **kwargs):
-        raise AssertionError("the time-domain start ran")
-
-    fake = TimeDomainFallback(start=start, averaged_rate=None)
-    basis = FourierBasis.up_to(3, 32)
-    model = oscillator()
-    for kw in ({"quasi_static": True}, {"gap": np.array([1e-9])}):
-        sol = solve_periodic(model, basis, frequency=15.0, strategy=("time-start",),
-                             time_domain=fake, **kw)
-        assert not sol.success and sol.time_domain == ""
-
-
-# --- the static preload solve that gives the default stick anchors ---------------------------
-def _pushed_oscillator(ratio):
-    """The friction oscillator without its tangential spring, under a constant tangential load
-    ``ratio mu N0``: for ratio > 1 no static equilibrium exists (Coulomb: |T| <= mu N0 and
-    nothing else resists T), for ratio < 1 the node sticks where it is (anchor 0)."""
-    from tests.helpers.models import KN, MU, N0, oscillator
-
-    model = oscillator()
-    model.K = sp.csr_matrix(np.diag([KN, 0.0]))
-    model.loads[0] = Load(np.array([N0, ratio * MU * N0]), "constant")
-    return model
-
-
-def test_a_failed_static_preload_solve_is_reported_not_silent():
-    """The static problem under the preload has no solution (a tangential load of twice the
-    friction limit and no tangential stiffness, Coulomb's law): the anchors fall back to 0 and
-    every result that uses them says so (preload_anchor, static_anchor's RuntimeWarning,
-    solve_periodic's ``warnings``). Below the friction limit (0.5 mu N0) the same model has a
-    static equilibrium and no warning is raised: the report depends on the solve. (Without a
-    tangential spring and with a harmonic load above the friction limit neither model has a
-    periodic state that stays put; only the report is checked here.)"""
-    from fretwear.hb.periodic import preload_anchor, static_anchor
-
-    basis = FourierBasis.up_to(1, 16)
-    bad = _pushed_oscillator(2.0)
-    pre = preload_anchor(bad)
-    assert not pre.success and np.array_equal(pre.values, np.zeros((1, 1)))
-    assert pre.warning.startswith("the static contact problem under the preload did not "
-                                  "converge (") and "stick anchors are set to 0" in pre.warning
-    with pytest.warns(RuntimeWarning, match="did not converge"):
-        assert np.array_equal(static_anchor(bad), np.zeros((1, 1)))
-    sol = solve_periodic(bad, basis, frequency=15.0, strategy=("start",))
-    assert sol.warnings == [pre.warning]
-    # explicit anchors: no static solve, nothing to report
-    assert solve_periodic(bad, basis, frequency=15.0, strategy=("start",),
-                          anchor=np.zeros((1, 1))).warnings == []
-
-    good = _pushed_oscillator(0.5)
-    pre = preload_anchor(good)
-    assert pre.success and pre.warning == ""
-    np.testing.assert_allclose(pre.values, 0.0, atol=1e-12)  # stuck where it touched
-    assert solve_periodic(good, basis, frequency=15.0, strategy=("start",)).warnings == []
-
-
-def test_strategy_without_an_attempt_at_the_target_reports_the_start_residual():
-    """When no attempt runs at the target eps (a sweep passes only its later steps, and they
-    fail or do not apply), the unconverged answer is the start and its reported relative
-    residual is the start's, |f(x0)| / scale(x0) evaluated here with numpy's norm, not inf
-    (which the sweeps' messages printed before)."""
-    from fretwear.hb.periodic import solve_strategy
-    from fretwear.model.build import Damping
-    from fretwear.model.matrices import ContactDofs, from_matrices
-
-    model = from_matrices(np.array([[2.0, -1.0], [-1.0, 1.0]]), np.eye(2),
-                          contact=ContactDofs(normal_dofs=None, tangential_dofs=[1], mu=0.5,
-                                              normal_load=1.0),
-                          damping=Damping(C=0.02 * np.eye(2)),
-                          loads=[Load(np.array([0.2, 0.0]), "cos")], observed={"x": 0})
-    basis = FourierBasis.up_to(3, 32)
-    red = condense(model, 1.49 / (2 * np.pi), basis.orders)
-    prob = DLFTProblem(red, model.contact, basis, eps=1.0)
-    x0 = np.full((prob.m, prob.H), 0.1)
-    x, st = solve_strategy(prob, x0, steps=())
-    f, _ = prob.residual(x0, jacobian=False)
-    assert not st.success and np.array_equal(x, x0)
-    assert st.residual == pytest.approx(np.linalg.norm(f) / prob.scale(x0), rel=1e-12)
-    assert "no attempt converged (none)" in st.message

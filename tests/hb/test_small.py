@@ -16,7 +16,9 @@ import pytest
 
 from fretwear.hb import small
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import DLFTProblem, solve_periodic
+from fretwear.hb.options import SWEEP_POINT, SolveOptions, SweepOptions
+from fretwear.hb.periodic import solve_periodic
+from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.reduce import condense
 from fretwear.hb.sweep import sweep
 from fretwear.model import ContactSpec, Damping, Material, Spring, Traction, from_mesh, rectangle
@@ -80,7 +82,7 @@ def test_residual_and_jacobian_equal_the_general_path(name, monkeypatch):
     Jacobian equal the general path's."""
     model, basis, f, eps, prob = problem(name)
     assert prob.small
-    sol = solve_periodic(model, basis, frequency=f, eps=eps, tol=1e-10)
+    sol = solve_periodic(model, basis, frequency=f, eps=eps, options=SolveOptions(tol=1e-10))
     assert sol.success
     U = sol.U.reshape(prob.m, prob.H)
     U = U + 0.1 * np.abs(U).max() * np.random.default_rng(0).standard_normal(U.shape)
@@ -100,9 +102,9 @@ def test_converged_answers_equal_the_general_path(name, monkeypatch):
     contact forces and the observed point to 1e-10 relative; on the block every contact
     state (separation, stick, slip) occurs."""
     model, basis, f, eps, _ = problem(name)
-    a = solve_periodic(model, basis, frequency=f, eps=eps, tol=1e-12)
+    a = solve_periodic(model, basis, frequency=f, eps=eps, options=SolveOptions(tol=1e-12))
     monkeypatch.setattr(small, "SMALL_MAX", -1)
-    b = solve_periodic(model, basis, frequency=f, eps=eps, tol=1e-12)
+    b = solve_periodic(model, basis, frequency=f, eps=eps, options=SolveOptions(tol=1e-12))
     assert a.success and b.success
     for x, y in ((a.U, b.U), (a.lam, b.lam), (a.observed[list(a.observed)[0]],
                                               b.observed[list(b.observed)[0]])):
@@ -120,8 +122,9 @@ def test_sweeps_equal_the_general_path(name, monkeypatch):
     band = (0.9 * f, 1.1 * f)
 
     def run():
-        res = sweep(make(), FourierBasis.up_to(5, 64), *band, 9, spacing="linear", eps=eps,
-                    tol=1e-12)
+        res = sweep(make(), FourierBasis.up_to(5, 64), *band, 9,
+                    options=SweepOptions(solve=SWEEP_POINT.replace(tol=1e-12), spacing="linear",
+                                         eps=eps))
         assert res.success
         return res.amplitude("x")
 

@@ -9,27 +9,15 @@ residual test is 1e-10 relative to |Z U| and the kept harmonics are exact for a 
 """
 
 import numpy as np
+from helpers.blocks import closed_block
 
 from fretwear.hb.contact import SEPARATION
 from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.options import SWEEP_POINT, SweepOptions
 from fretwear.hb.sweep import frequency_grid, sweep
 from fretwear.linear import frf
-from fretwear.model import ContactSpec, Damping, Material, Spring, Traction, from_mesh, rectangle
 
-L, H = 0.02, 0.01  # [m]
 BASIS = FourierBasis.up_to(3, 32)
-
-
-def closed_block(mu=0.0, q=1e5):
-    """Steel block 20 x 10 mm (6 x 2 Q4) pressed by 1 MPa on a rigid flat, held in x by a spring,
-    driven by a cosine pressure ``q`` [Pa] on its right face (0.1 MPa: stays closed)."""
-    return from_mesh(rectangle(L, H, nx=6, ny=2), Material(210e9, 0.3, 7800.0), thickness=0.01,
-                     damping=Damping(rayleigh_stiffness=5e-6),
-                     supports=[Spring(at=(0.0, H / 2), direction="x", stiffness=1e7)],
-                     loads=[Traction("top", pressure=1e6),
-                            Traction("right", pressure=q, waveform="cos")],
-                     contact=ContactSpec("bottom", mu=mu),
-                     observed={"Pe": (L, H / 2)})
 
 
 def test_frequency_grid_is_geomspace_or_linspace():
@@ -41,7 +29,8 @@ def test_frequency_grid_is_geomspace_or_linspace():
 
 def test_frictionless_closed_sweep_is_the_linear_frf():
     model = closed_block()
-    res = sweep(model, BASIS, 1e3, 3e3, 3, tol=1e-10)
+    res = sweep(model, BASIS, 1e3, 3e3, 3,
+                options=SweepOptions(solve=SWEEP_POINT.replace(tol=1e-10)))
     assert res.success, res.message
     assert res.point_success.tolist() == [True] * 3
     f = res.frequency_hz
@@ -58,8 +47,9 @@ def test_frictionless_closed_sweep_is_the_linear_frf():
 def test_failed_points_say_so():
     """Slip (a tangential load above the friction capacity), one iteration per point and no
     continuation: points fail, each with its reason."""
-    res = sweep(closed_block(mu=0.3, q=2e6), BASIS, 1e3, 3e3, 2, max_iter=1, continuation=False,
-                max_bisections=0)
+    res = sweep(closed_block(mu=0.3, q=2e6), BASIS, 1e3, 3e3, 2,
+                options=SweepOptions(solve=SWEEP_POINT.replace(max_iter=1), continuation=False,
+                                     max_bisections=0))
     assert not res.point_success.all()
     assert res.success is False or not res.success
     assert isinstance(res.message, str) and res.message
@@ -73,7 +63,7 @@ def test_point_passed_by_eps_continuation_keeps_the_sweep_eps_and_its_attempts()
     says so (``how``), keeps every attempt in order, and its answer is at the sweep's eps (no
     eps jump). Independent check: the residual of a fresh problem at eps = 1 at the point's
     harmonics is below the tolerance."""
-    from fretwear.hb.periodic import DLFTProblem
+    from fretwear.hb.problem import DLFTProblem
     from fretwear.hb.reduce import condense
     from fretwear.model.build import Damping
     from fretwear.model.core import Load
@@ -86,7 +76,7 @@ def test_point_passed_by_eps_continuation_keeps_the_sweep_eps_and_its_attempts()
                           loads=[Load(np.array([0.2, 0.0]), "cos")], observed={"x": 0})
     basis = FourierBasis.up_to(15, 128)
     f = 1.4905405 / (2 * np.pi)
-    res = sweep(model, basis, f, 1.01 * f, 2, eps=1.0, time_domain=None)
+    res = sweep(model, basis, f, 1.01 * f, 2, options=SweepOptions(eps=1.0, time_domain=None))
     p = res.points[0]
     assert p.success and p.how == "eps-continuation"
     assert [a.method for a in p.attempts][0] == "grid" and not p.attempts[0].success
@@ -98,20 +88,3 @@ def test_point_passed_by_eps_continuation_keeps_the_sweep_eps_and_its_attempts()
     U = p.solution.U.reshape(prob.m, prob.H)
     fres, _ = prob.residual(U, jacobian=False)
     assert np.linalg.norm(fres) <= 1e-8 * prob.scale(U)
-
-
-def test_reduced_models_kept_within_the_memory_budget(monkeypatch):
-    """The sweep's cache of reduced models keeps at most CACHE_SIZE of them and no more bytes
-    than CACHE_BYTES, always the newest (counted against the models' own sizes)."""
-    from fretwear.hb import sweep as sw
-
-    model = closed_block()
-    probs = sw._Problems(model, BASIS, None, 1e9)
-    one = probs.get(2 * np.pi * 1000.0, None).reduced.Z.nbytes
-    monkeypatch.setattr(sw, "CACHE_BYTES", int(2.5 * one))
-    for f in (1100.0, 1200.0, 1300.0):
-        probs.get(2 * np.pi * f, None)
-    assert list(probs.cache) == [2 * np.pi * 1200.0, 2 * np.pi * 1300.0]
-    monkeypatch.setattr(sw, "CACHE_BYTES", one // 2)  # smaller than one: the newest only
-    probs.get(2 * np.pi * 1400.0, None)
-    assert list(probs.cache) == [2 * np.pi * 1400.0]

@@ -19,6 +19,7 @@ from helpers.cases import small_case
 
 from fretwear.errors import InputError
 from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.options import SweepOptions
 from fretwear.hb.sweep import sweep
 from fretwear.io.results import read_results
 from fretwear.model import ContactSpec, Damping, Material, Spring, Traction, from_mesh, rectangle
@@ -83,14 +84,15 @@ def reference(model):
 def test_interrupted_sweep_resumes_bit_for_bit(model, reference, tmp_path, n_done):
     ckpt = tmp_path / "sweep.npz"
     with pytest.raises(Stop):
-        sweep(model, BASIS, *GRID, checkpoint=ckpt, progress=stop_after(n_done))
-    resumed = sweep(model, BASIS, *GRID, checkpoint=ckpt, resume=True)
+        sweep(model, BASIS, *GRID, options=SweepOptions(checkpoint=ckpt,
+                                                        progress=stop_after(n_done)))
+    resumed = sweep(model, BASIS, *GRID, options=SweepOptions(checkpoint=ckpt, resume=True))
     assert resumed.resumed_from == n_done
     states = {int(s) for p in reference.points if p.solution for s in np.unique(p.solution.state)}
     assert states >= {1, 2}  # stick and slip occur: the continuation state is not trivial
     assert_same_points(resumed, reference)
     # resuming a finished sweep recomputes nothing and gives the same points again
-    again = sweep(model, BASIS, *GRID, checkpoint=ckpt, resume=True)
+    again = sweep(model, BASIS, *GRID, options=SweepOptions(checkpoint=ckpt, resume=True))
     assert again.resumed_from == GRID[2]
     assert_same_points(again, reference)
 
@@ -98,19 +100,20 @@ def test_interrupted_sweep_resumes_bit_for_bit(model, reference, tmp_path, n_don
 def test_foreign_and_damaged_checkpoints_are_refused(model, tmp_path):
     ckpt = tmp_path / "sweep.npz"
     with pytest.raises(Stop):
-        sweep(model, BASIS, *GRID, checkpoint=ckpt, progress=stop_after(2))
+        sweep(model, BASIS, *GRID, options=SweepOptions(checkpoint=ckpt, progress=stop_after(2)))
     with pytest.raises(InputError, match="different model or different sweep settings"):
-        sweep(model, BASIS, GRID[0], GRID[1], GRID[2] + 1, checkpoint=ckpt, resume=True)
+        sweep(model, BASIS, GRID[0], GRID[1], GRID[2] + 1, options=SweepOptions(checkpoint=ckpt,
+                                                                                resume=True))
     data = ckpt.read_bytes()
     ckpt.write_bytes(data[: len(data) // 2])
     with pytest.raises(InputError) as err:
-        sweep(model, BASIS, *GRID, checkpoint=ckpt, resume=True)
+        sweep(model, BASIS, *GRID, options=SweepOptions(checkpoint=ckpt, resume=True))
     msg = str(err.value)
     assert str(ckpt) in msg and "damaged" in msg and "\n" not in msg
     ckpt.unlink()
     ckpt.mkdir()
     with pytest.raises(InputError, match="is a folder"):
-        sweep(model, BASIS, *GRID, checkpoint=ckpt)
+        sweep(model, BASIS, *GRID, options=SweepOptions(checkpoint=ckpt))
 
 
 SWEEP = """[analysis]

@@ -41,3 +41,19 @@ def block(dim, loss_factor=0.0):
                             Traction(top, traction=cyc, waveform="cos"),
                             Traction(top, traction=lift, waveform="sin")],
                      contact=ContactSpec(bottom, mu=MU))
+
+
+CLOSED_L, CLOSED_H = 0.02, 0.01  # [m]
+
+
+def closed_block(mu=0.0, q=1e5):
+    """Steel block 20 x 10 mm (6 x 2 Q4) pressed by 1 MPa on a rigid flat, held in x by a spring,
+    driven by a cosine pressure ``q`` [Pa] on its right face (0.1 MPa: stays closed)."""
+    L, H = CLOSED_L, CLOSED_H
+    return from_mesh(rectangle(L, H, nx=6, ny=2), Material(210e9, 0.3, 7800.0), thickness=0.01,
+                     damping=Damping(rayleigh_stiffness=5e-6),
+                     supports=[Spring(at=(0.0, H / 2), direction="x", stiffness=1e7)],
+                     loads=[Traction("top", pressure=1e6),
+                            Traction("right", pressure=q, waveform="cos")],
+                     contact=ContactSpec("bottom", mu=mu),
+                     observed={"Pe": (L, H / 2)})

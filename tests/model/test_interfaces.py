@@ -24,7 +24,9 @@ import scipy.sparse as sp
 
 from fretwear.errors import InputError
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import DLFTProblem, solve_periodic
+from fretwear.hb.options import SolveOptions
+from fretwear.hb.periodic import solve_periodic
+from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.reduce import condense, recover
 from fretwear.linear import frf, modes
 from fretwear.model import (
@@ -108,8 +110,10 @@ def test_stiff_held_body_is_a_rigid_obstacle():
     assert stiff.contact.has_pairs and not rigid.contact.has_pairs
     np.testing.assert_array_equal(stiff.contact.coords, rigid.contact.coords)
     np.testing.assert_array_equal(stiff.contact.frame, rigid.contact.frame)
-    a = solve_periodic(stiff, BASIS, frequency=F_HZ, tol=1e-12, raise_on_failure=True)
-    b = solve_periodic(rigid, BASIS, frequency=F_HZ, tol=1e-12, raise_on_failure=True)
+    a = solve_periodic(stiff, BASIS, frequency=F_HZ, options=SolveOptions(tol=1e-12),
+                       raise_on_failure=True)
+    b = solve_periodic(rigid, BASIS, frequency=F_HZ, options=SolveOptions(tol=1e-12),
+                       raise_on_failure=True)
     assert np.any(b.state == 2) and np.any(b.state == 1)  # stick-slip: the law is at work
     scale = np.abs(b.lam).max()
     np.testing.assert_allclose(a.lam, b.lam, rtol=0, atol=2 * ratio * scale)
@@ -124,7 +128,8 @@ def test_pair_forces_are_equal_and_opposite():
     Newton's third law, independent of the change of variables). Tolerance: rounding of
     K U at 1e-9 of the largest nodal force."""
     model = block_on_base()
-    sol = solve_periodic(model, BASIS, frequency=F_HZ, tol=1e-12, raise_on_failure=True)
+    sol = solve_periodic(model, BASIS, frequency=F_HZ, options=SolveOptions(tol=1e-12),
+                         raise_on_failure=True)
     orders = np.array([0, *BASIS.harmonics])
     c = model.contact
     nc, d = c.dofs.shape
@@ -223,8 +228,8 @@ def test_cut_body_with_preload_and_friction_vibrates_like_the_uncut_body():
     uncut beam's linear FRF; the tolerance is the balance's convergence test (1e-12
     relative) times conditioning."""
     f = 800.0
-    sol = solve_periodic(cut_beam(True, preload=200e6), BASIS, frequency=f, tol=1e-12,
-                         raise_on_failure=True)
+    sol = solve_periodic(cut_beam(True, preload=200e6), BASIS, frequency=f,
+                         options=SolveOptions(tol=1e-12), raise_on_failure=True)
     assert np.all(sol.state == 1)
     ref = frf(cut_beam(False), [f], interface="free").observed["tip"][0]
     k = BASIS.k
@@ -239,8 +244,10 @@ def test_rotated_model_gives_the_same_contact_forces_wear_and_frf():
     balance's 1e-12 convergence test)."""
     theta = 0.7
     a, b = block_on_base(), block_on_base(theta=theta)
-    sa = solve_periodic(a, BASIS, frequency=F_HZ, tol=1e-12, raise_on_failure=True)
-    sb = solve_periodic(b, BASIS, frequency=F_HZ, tol=1e-12, raise_on_failure=True)
+    sa = solve_periodic(a, BASIS, frequency=F_HZ, options=SolveOptions(tol=1e-12),
+                        raise_on_failure=True)
+    sb = solve_periodic(b, BASIS, frequency=F_HZ, options=SolveOptions(tol=1e-12),
+                        raise_on_failure=True)
     np.testing.assert_allclose(sb.lam, sa.lam, rtol=0, atol=1e-8 * np.abs(sa.lam).max())
     np.testing.assert_array_equal(sb.state, sa.state)
     from fretwear.wear.kernels import slip_work
@@ -271,7 +278,8 @@ def test_two_sided_archard_identity():
     periodicity tolerance."""
     ka, kb = 1e-13, 3e-13
     model = block_on_base(kw=(ka, kb))
-    sol = solve_periodic(model, BASIS, frequency=F_HZ, tol=1e-12, raise_on_failure=True)
+    sol = solve_periodic(model, BASIS, frequency=F_HZ, options=SolveOptions(tol=1e-12),
+                         raise_on_failure=True)
     from fretwear.wear.kernels import slip_work
 
     prob = DLFTProblem(condense(model, F_HZ, [0, *BASIS.harmonics]), model.contact, BASIS,
@@ -295,7 +303,8 @@ def test_two_sided_energy_law_identity():
     identity's."""
     ka, kb = 2e-15, 5e-15
     model = block_on_base()
-    sol = solve_periodic(model, BASIS, frequency=F_HZ, tol=1e-12, raise_on_failure=True)
+    sol = solve_periodic(model, BASIS, frequency=F_HZ, options=SolveOptions(tol=1e-12),
+                         raise_on_failure=True)
     from fretwear.wear.kernels import slip_work
 
     prob = DLFTProblem(condense(model, F_HZ, [0, *BASIS.harmonics]), model.contact, BASIS,
@@ -334,12 +343,14 @@ def test_two_interfaces_on_two_separate_bodies():
     assert c.names() == ["soft", "hard"]
     np.testing.assert_array_equal(c.interface_index(), [0] * 5 + [1] * 5)
     np.testing.assert_array_equal(c.mu_nodes(), [0.3] * 5 + [0.6] * 5)
-    both = solve_periodic(model, BASIS, frequency=F_HZ, tol=1e-12, raise_on_failure=True)
+    both = solve_periodic(model, BASIS, frequency=F_HZ, options=SolveOptions(tol=1e-12),
+                          raise_on_failure=True)
     for k, mu in enumerate((0.3, 0.6)):
         alone = from_mesh(block((0.0, 0.0)), STEEL, damping=Damping(loss_factor=0.02),
                           supports=[Spring("top_left", "x", 1e7)], loads=block_loads(),
                           contact=ContactSpec("bottom", mu=mu))
-        ref = solve_periodic(alone, BASIS, frequency=F_HZ, tol=1e-12, raise_on_failure=True)
+        ref = solve_periodic(alone, BASIS, frequency=F_HZ, options=SolveOptions(tol=1e-12),
+                             raise_on_failure=True)
         got = both.lam[c.interface_index() == k]
         np.testing.assert_allclose(got, ref.lam, rtol=0, atol=1e-8 * np.abs(ref.lam).max())
 
@@ -483,7 +494,7 @@ def test_interface_open_under_the_preload_is_flagged():
     springs' force is k times the displacement of the spring nodes), to rounding (1e-9: the
     static solve's 1e-10 convergence test)."""
     from fretwear.analyses.common import preload_notes
-    from fretwear.hb.periodic import _static_solve, preload_contact
+    from fretwear.hb.preload import _static_solve, preload_contact
     from fretwear.hb.reduce import condense_static
 
     pulled = pressed_or_pulled_block(-1e6)
@@ -592,7 +603,7 @@ def test_time_integration_of_a_pair_on_a_stiff_held_body_is_the_rigid_obstacle_o
     rest is a shock the contact solve of the first step does not settle); 256 steps per
     period, because at 64 a few contact solves of either model, the rigid one included, do
     not settle."""
-    from fretwear.hb.periodic import initial_state
+    from fretwear.hb.solution import initial_state
     from fretwear.timedomain.integrate import integrate
 
     ratio = 1e-6
@@ -602,7 +613,8 @@ def test_time_integration_of_a_pair_on_a_stiff_held_body_is_the_rigid_obstacle_o
     rigid = block_on_rigid(block=soft, scale=scale)
     run = {}
     for key, model in (("pair", pair), ("rigid", rigid)):
-        U0, V0 = initial_state(model, solve_periodic(model, BASIS, frequency=F_HZ, tol=1e-12))
+        U0, V0 = initial_state(model, solve_periodic(model, BASIS, frequency=F_HZ,
+                                                     options=SolveOptions(tol=1e-12)))
         run[key] = integrate(model, F_HZ, options=IntegrationOptions(steps_per_period=256),
                              start=InitialState(U0=U0, V0=V0), n_periods=10, record="last")
     a, b = run["pair"], run["rigid"]
@@ -644,7 +656,7 @@ def test_time_integration_takes_a_friction_coefficient_per_interface():
     (a 3-harmonic balance depends on eps, and the default rule gives the joint model another
     one). Tolerance 1e-10 of the largest force: the contact solves settle to 1e-10 of the
     largest force of the model they solve; measured 4e-14."""
-    from fretwear.hb.periodic import initial_state
+    from fretwear.hb.solution import initial_state
     from fretwear.timedomain.integrate import integrate
 
     sizes = {"one": (0.02, 4), "two": (0.015, 3)}
@@ -654,8 +666,9 @@ def test_time_integration_takes_a_friction_coefficient_per_interface():
         return rectangle(length, 0.01, nx, 2, origin=origin)
 
     def run(model):
-        U0, V0 = initial_state(model, solve_periodic(model, BASIS, frequency=F_HZ, tol=1e-12,
-                                                     eps=1e9, raise_on_failure=True))
+        U0, V0 = initial_state(model, solve_periodic(model, BASIS, frequency=F_HZ,
+                                                     options=SolveOptions(tol=1e-12), eps=1e9,
+                                                     raise_on_failure=True))
         out = integrate(model, F_HZ, options=IntegrationOptions(steps_per_period=256),
                         start=InitialState(U0=U0, V0=V0), n_periods=10, record="last")
         assert out.success
@@ -728,7 +741,8 @@ def test_symmetric_dovetail_gives_symmetric_forces_and_wear():
                        for p in x[west]])
     np.testing.assert_allclose(c.frame[west][:, 0], c.frame[mirror][:, 0] * [-1, 1], atol=1e-15)
     f = 3000.0
-    sol = solve_periodic(model, BASIS, frequency=f, tol=1e-12, raise_on_failure=True)
+    sol = solve_periodic(model, BASIS, frequency=f, options=SolveOptions(tol=1e-12),
+                         raise_on_failure=True)
     assert np.any(sol.state == 2) and np.any(sol.state == 1)
     lam = sol.lam
     scale = np.abs(lam).max()

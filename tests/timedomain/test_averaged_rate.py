@@ -25,8 +25,10 @@ import fretwear.wear.schemes as wear_schemes  # the first balance calls its solv
 import fretwear.wear.simulate as wear_driver  # the driver calls its advance (balanced steps)
 from fretwear import simulate_wear  # the public driver: time-domain fallback on
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import initial_state, solve_periodic
+from fretwear.hb.options import SolveOptions
+from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.reduce import condense
+from fretwear.hb.solution import initial_state
 from fretwear.model.build import ContactSpec, Damping, Material, Spring, Traction, from_mesh
 from fretwear.model.mesh import rectangle
 from fretwear.timedomain.averaged_rate import RESPONSE_KINDS, time_averaged_rate
@@ -67,7 +69,7 @@ def periodic():
     order in the step; with 256 steps the worn volume differs by 5.4 %, with 1024 by 0.8 %)."""
     m = damped_block()
     basis = FourierBasis.up_to(15, 256)
-    sol = solve_periodic(m, basis, frequency=F_HZ, tol=1e-10)
+    sol = solve_periodic(m, basis, frequency=F_HZ, options=SolveOptions(tol=1e-10))
     st = sol.stats
     assert st.success
     coef = wear_coefficients(m)

@@ -19,7 +19,9 @@ from scipy.integrate import solve_ivp
 
 from fretwear.errors import InputError
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import initial_state, solve_periodic
+from fretwear.hb.options import SolveOptions
+from fretwear.hb.periodic import solve_periodic
+from fretwear.hb.solution import initial_state
 from fretwear.model.core import ContactInterface, Load, Model, ObservedPoint
 from fretwear.timedomain import integrate as tr
 from fretwear.timedomain import quasistatic, steady
@@ -284,7 +286,7 @@ def pad_dlft():
     sols = {}
     for H in (6, 12):
         sols[H] = solve_periodic(model, FourierBasis.up_to(H, 16 * H), frequency=F_PAD,
-                                 tol=1e-10)
+                                 options=SolveOptions(tol=1e-10))
         assert sols[H].success, sols[H].message
     return model, sols
 

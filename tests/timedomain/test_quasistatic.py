@@ -17,6 +17,7 @@ import scipy.sparse as sp
 from helpers.pads import MU_PAD, dlft_friction_energy, pad_3d
 
 from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.options import SolveOptions
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.reduce import condense
 from fretwear.model.core import ContactInterface, Load, Model
@@ -31,7 +32,7 @@ def dlft_wear_rate(model, H):
     """Worn volume per cycle [m^3] and friction energy per cycle [J] of the quasi-static DLFT
     solution with H harmonics (16 samples per harmonic)."""
     basis = FourierBasis.up_to(H, 16 * H)
-    sol = solve_periodic(model, basis, quasi_static=True, tol=1e-11)
+    sol = solve_periodic(model, basis, quasi_static=True, options=SolveOptions(tol=1e-11))
     assert sol.success, sol.message
     coef = wear_coefficients(model)
     sp = SlowProblem(model, condense(model, 1.0, basis.orders, quasi_static=True), basis, coef,

@@ -15,7 +15,9 @@ from helpers.models import K_, M_, oscillator
 from helpers.pads import F_PAD, pad_3d
 
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import initial_state, solve_periodic
+from fretwear.hb.options import SolveOptions
+from fretwear.hb.periodic import solve_periodic
+from fretwear.hb.solution import initial_state
 from fretwear.timedomain.stability import RESOLVED_STEPS, check_periodic, time_domain_start
 
 F_HZ = 0.7 * np.sqrt(K_ / M_) / (2 * np.pi)  # forcing frequency [Hz], below the resonance
@@ -74,7 +76,8 @@ def test_3d_pad_is_reported_stable_when_the_step_resolves_the_contact():
     resolves them: more than 1024 x 3 (fewer than one step per highest period at 1024) and
     fewer than 4096 (3.4 steps at 4096); measured 3489."""
     model = pad_3d()
-    sol = solve_periodic(model, FourierBasis.up_to(6, 96), frequency=F_PAD, tol=1e-10)
+    sol = solve_periodic(model, FourierBasis.up_to(6, 96), frequency=F_PAD,
+                         options=SolveOptions(tol=1e-10))
     assert sol.success
     chk = check_periodic(model, sol, max_periods=200, steps_per_period=4096)
     assert chk.verdict == "stable", chk

@@ -12,6 +12,7 @@ import pytest
 from fretwear.analyses.registry import get
 from fretwear.analyses.wear import OPTION_KEYS, options_from_table
 from fretwear.errors import InputError
+from fretwear.hb.options import WEAR_STEP
 from fretwear.io.schema import Context
 from fretwear.wear import WearOptions
 
@@ -33,6 +34,10 @@ def test_case_file_defaults_are_those_of_wear_options():
             assert a[f.name] == getattr(default, f.name), f.name
             assert type(a[f.name]) is type(getattr(default, f.name)), f.name
             compared += 1
+    for k in ("solver", "tol"):  # the keys of its solve record (WearOptions.solve)
+        assert a[k] == getattr(default.solve, k), k
+        assert type(a[k]) is type(getattr(default.solve, k)), k
+        compared += 1
     assert compared == len(OPTION_KEYS) - 5
     assert {k for k in OPTION_KEYS if k not in a} == {
         "energy_coefficient", "partner_energy_coefficient", "initial_jump", "max_depth",
@@ -60,20 +65,23 @@ def test_every_wear_key_of_a_case_file_reaches_wear_options():
     default = WearOptions()
     for f in fields(WearOptions):
         expected = given.get(f.name, getattr(default, f.name))
+        if f.name == "solve":  # the keys of its record: solver and tol
+            expected = WEAR_STEP.replace(solver=given["solver"], tol=given["tol"])
+            assert expected != default.solve
         assert expected != getattr(default, f.name) or f.name not in given, f.name
         assert getattr(opts, f.name) == expected, f.name
 
 
 @pytest.mark.parametrize("name, value", [
-    ("max_steps", 2.5), ("max_steps", 0), ("max_steps", True), ("max_iter", 60.0),
+    ("max_steps", 2.5), ("max_steps", 0), ("max_steps", True), ("solve", {"max_iter": 60}),
     ("max_iter_coupled", 0), ("max_iter_implicit", -1), ("max_retries", 1.5),
     ("time_domain_settle", 300.0), ("time_domain_average", 1), ("time_domain_steps", 4),
     ("time_domain_steps", 256.0), ("adaptive", 1), ("time_domain_rescue", "yes"),
     ("tolerance", 0.0), ("tolerance", "1e-2"), ("max_cycles", math.nan), ("max_jump", -1.0),
-    ("min_jump", 0), ("max_depth", None), ("tol", True), ("plateau_rate", -1e-3),
+    ("min_jump", 0), ("max_depth", None), ("solve", None), ("plateau_rate", -1e-3),
     ("checkpoint_every_s", -1.0), ("initial_jump", 0.0), ("initial_jump", "1e4"),
     ("energy_coefficient", -1e-13), ("partner_energy_coefficient", -1e-13), ("law", "usui"),
-    ("scheme", "rk4"), ("solver", "newton?"), ("implicit_newton", "full"),
+    ("scheme", "rk4"), ("implicit_newton", "full"),
 ])
 def test_wear_options_refuse_bad_values_when_made(name, value):
     """A wrong type or value is refused at construction (and by dataclasses.replace), with an

@@ -32,7 +32,9 @@ from helpers.models import sliders
 
 from fretwear.hb import contact as law
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import solve_periodic, static_anchor
+from fretwear.hb.options import SolveOptions
+from fretwear.hb.periodic import solve_periodic
+from fretwear.hb.preload import static_anchor
 from fretwear.hb.reduce import condense
 from fretwear.hb.solvers import solve_identity_rows
 from fretwear.model.build import ContactSpec, Material, Spring, Traction, from_mesh
@@ -78,7 +80,8 @@ def blk():
 @pytest.fixture(scope="module")
 def sol_block(blk):
     m, red, anc = blk
-    sol = solve_periodic(m, BASIS, quasi_static=True, reduced=red, anchor=anc, tol=1e-12)
+    sol = solve_periodic(m, BASIS, quasi_static=True, reduced=red, anchor=anc,
+                         options=SolveOptions(tol=1e-12))
     st = sol.stats
     assert st.success
     return sol
@@ -145,7 +148,7 @@ def test_uniform_sliding_analytic_rate():
     errors = []
     for nh, eps in ((3, "auto"), (3, 10 * kt), (7, 10 * kt), (31, 10 * kt)):
         b = FourierBasis.up_to(nh, 16 * nh + 16)
-        sol = solve_periodic(m, b, quasi_static=True, tol=1e-12, eps=eps)
+        sol = solve_periodic(m, b, quasi_static=True, options=SolveOptions(tol=1e-12), eps=eps)
         st = sol.stats
         assert st.success
         np.testing.assert_array_equal(sol.pressure_t(), P)  # exact normal force
@@ -223,8 +226,8 @@ def test_coupled_jacobian_vs_finite_differences(blk, sol_block):
     U0 = sol_block.U.reshape(spb.m, spb.H)
     g = spb.rate(U0)
     W = 3e4 * g
-    U, st = spb.solve_balance(W, anc, spb.shift_guess(U0, W), solver="powell", tol=1e-12,
-                              max_iter=100)
+    U, st = spb.solve_balance(W, anc, spb.shift_guess(U0, W),
+                              options=SolveOptions(tol=1e-12, max_iter=100))
     assert st.success
     dN, Wk = 1e5, 0.9 * W
     x = np.concatenate([U.ravel(), W])
@@ -262,8 +265,8 @@ def test_slow_jacobian_vs_finite_differences(blk, sol_block):
     spb = SlowProblem(m, red, BASIS, wear_coefficients(m), anchor=anc)
     U0 = sol_block.U.reshape(spb.m, spb.H)
     W = 3e4 * spb.rate(U0)
-    U, _ = spb.solve_balance(W, anc, spb.shift_guess(U0, W), solver="powell", tol=1e-13,
-                             max_iter=100)
+    U, _ = spb.solve_balance(W, anc, spb.shift_guess(U0, W),
+                             options=SolveOptions(tol=1e-13, max_iter=100))
     spb.set_state(W, anc)
     Js = spb.slow_jacobian(U)
     h = 1e-3 * W.max()
@@ -271,7 +274,7 @@ def test_slow_jacobian_vs_finite_differences(blk, sol_block):
         def g_of(s, q=q):
             Wq = W.copy()
             Wq[q] += s
-            Uq, st = spb.solve_balance(Wq, anc, U, solver="powell", tol=1e-13, max_iter=100)
+            Uq, st = spb.solve_balance(Wq, anc, U, options=SolveOptions(tol=1e-13, max_iter=100))
             assert st.success
             return spb.rate(Uq)
         fd = _fd(g_of, 0.0, h)

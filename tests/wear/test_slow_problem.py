@@ -17,10 +17,12 @@ import numpy as np
 import pytest
 from helpers.blocks import block
 
-from fretwear.hb import krylov, periodic
+from fretwear.hb import krylov, problem
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.krylov import KrylovJacobian
-from fretwear.hb.periodic import solve_periodic, static_anchor
+from fretwear.hb.options import SolveOptions
+from fretwear.hb.periodic import solve_periodic
+from fretwear.hb.preload import static_anchor
 from fretwear.hb.reduce import condense
 from fretwear.wear.slow_problem import SlowProblem
 
@@ -31,7 +33,8 @@ def make_case(dim):
     basis = FourierBasis.up_to(3, 32)
     red = condense(model, 2000.0, basis.orders)
     anchor = static_anchor(model)
-    sol = solve_periodic(model, basis, frequency=2000.0, reduced=red, anchor=anchor, tol=1e-12)
+    sol = solve_periodic(model, basis, frequency=2000.0, reduced=red, anchor=anchor,
+                         options=SolveOptions(tol=1e-12))
     assert sol.success
     coef = np.full(model.contact.n_nodes, 1e-15)
     return model, basis, red, anchor, sol.U.reshape(-1, basis.size), coef
@@ -40,7 +43,7 @@ def make_case(dim):
 def slow(case, monkeypatch, operator):
     model, basis, red, anchor, _, coef = case
     if operator:
-        monkeypatch.setattr(periodic, "DENSE_JACOBIAN_MAX", 0)
+        monkeypatch.setattr(problem, "DENSE_JACOBIAN_MAX", 0)
     sp = SlowProblem(model, red, basis, coef, anchor=anchor)
     assert (sp.prob.jacobian == "krylov") == operator
     return sp
@@ -97,7 +100,7 @@ def test_implicit_schemes_refused_when_the_step_is_iterative(monkeypatch):
     from fretwear.wear import BalanceSetup, WearOptions, simulate_wear
 
     model, basis, red, anchor, U, _ = make_case(2)
-    monkeypatch.setattr(periodic, "DENSE_JACOBIAN_MAX", 0)
+    monkeypatch.setattr(problem, "DENSE_JACOBIAN_MAX", 0)
     monkeypatch.setattr(krylov, "ACTIVE_DENSE_MAX", -1)
     kw = dict(frequency=2000.0, balance=BalanceSetup(reduced=red, anchor=anchor, U0=U))
     with pytest.raises(InputError, match="scheme = 'rosenbrock'"):

@@ -16,8 +16,9 @@ import xarray as xr
 
 from fretwear.files import inside, safe_name
 from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.options import SolveOptions
 from fretwear.hb.penalty import RULES
-from fretwear.hb.periodic import preload_contact
+from fretwear.hb.preload import preload_contact
 from fretwear.hb.solvers import SOLVERS, SolveStats
 from fretwear.io.results import label_coordinate, variable
 from fretwear.io.schema import AnyOf, Field, Integer, ListOf, Number, Text, fail, join
@@ -40,7 +41,7 @@ WARNINGS_ATTRIBUTE = "warnings"
 
 def preload_notes(model, condenser=None) -> tuple[list[str], list[str]]:
     """Warnings about interfaces that no node touches under the static loads (the preload),
-    and the names of those interfaces (:func:`fretwear.hb.periodic.preload_contact`).
+    and the names of those interfaces (:func:`fretwear.hb.preload.preload_contact`).
 
     A run on such an interface is kept (a clearance that the vibration closes is a model a
     user may mean), but it is almost always a mistake (a gap of the wrong sign, a load pulling
@@ -205,25 +206,34 @@ def basis_fields() -> dict:
     }
 
 
-def harmonic_balance_fields(func: Callable, eps_doc: str) -> dict:
+def harmonic_balance_fields(solve: SolveOptions, eps_default, eps_doc: str) -> dict:
     """The keys of the DLFT analyses' tables (``harmonics``, ``n_samples``, ``eps``,
     ``solver``, ``tol``, ``max_iter``) with the ``eps`` description ``eps_doc``; the defaults
-    are those of the keywords of ``func``, the function the analysis calls
-    (:func:`fretwear.hb.periodic.solve_periodic`, :func:`fretwear.hb.sweep.sweep`), and of
+    are those of the solve record the analysis runs with (``solve``:
+    :data:`fretwear.hb.options.PERIODIC`, :data:`fretwear.hb.options.SWEEP_POINT`), of the
+    penalty of the function it calls (``eps_default``) and of
     :meth:`~fretwear.hb.fourier.FourierBasis.up_to`."""
     return {
         **basis_fields(),
         "eps": Field(AnyOf((Text(RULES), Number(lo=0, lo_open=True))), eps_doc,
-                     default=default_of(func, "eps"), unit="N/m"),
+                     default=eps_default, unit="N/m"),
         "solver": Field(Text(SOLVERS), '"powell" (hybrid dog-leg, LAPACK), "newton" (damped '
                         'Newton) or "hybr" (MINPACK hybrj, as in the paper)',
-                        default=default_of(func, "solver")),
+                        default=solve.solver),
         "tol": Field(Number(lo=0, lo_open=True), "relative residual of the convergence test "
-                     "|f(U)| <= tol |Z_r U| (paper section 3.2)", default=default_of(func, "tol"),
+                     "|f(U)| <= tol |Z_r U| (paper section 3.2)", default=solve.tol,
                      unit="-"),
         "max_iter": Field(Integer(lo=1), "maximum solver iterations per frequency",
-                          default=default_of(func, "max_iter")),
+                          default=solve.max_iter),
     }
+
+
+def solve_options_of(analysis: dict, base: SolveOptions) -> SolveOptions:
+    """The :class:`~fretwear.hb.options.SolveOptions` of an ``[analysis]`` table: ``base``
+    with the table's ``solver``, ``tol``, ``max_iter`` and ``time_domain_periods`` (those it
+    has)."""
+    keys = ("solver", "tol", "max_iter", "time_domain_periods")
+    return base.replace(**{k: analysis[k] for k in keys if k in analysis})
 
 
 def solver_attributes(stats: SolveStats, analysis: dict, eps: float) -> dict:

@@ -30,12 +30,19 @@ from matplotlib.colors import BoundaryNorm, ListedColormap
 
 from fretwear import api
 from fretwear.analyses import figures as plots
-from fretwear.analyses.common import basis_of, cell_edges, interface_abscissa, si_scale
+from fretwear.analyses.common import (
+    basis_of,
+    cell_edges,
+    interface_abscissa,
+    si_scale,
+    solve_options_of,
+)
 from fretwear.analyses.run import load_case
 from fretwear.analyses.transient import period_friction_energy, state_fractions
 from fretwear.errors import InputError
-from fretwear.hb.periodic import PeriodicSolution
+from fretwear.hb.options import PERIODIC
 from fretwear.hb.reduce import condense, exact_condenser
+from fretwear.hb.solution import PeriodicSolution
 from fretwear.io.case import build_model
 from fretwear.timedomain.options import (
     IncrementalWearOptions,
@@ -199,9 +206,9 @@ def compare_periodic(model, analysis: dict, outdir: Path | None, *, steps_per_pe
     cond = exact_condenser(model)  # one condensation of the model for the whole solve
     reduced = condense(model, f_hz, basis.orders, condenser=cond)
     # the DLFT alone: never started by the time integration it is compared with
-    sol = api.solve_periodic(model, basis, frequency=f_hz, reduced=reduced, eps=analysis["eps"],
-                             solver=analysis["solver"], tol=analysis["tol"],
-                             max_iter=analysis["max_iter"], time_domain=False, condenser=cond)
+    sol = api.solve_periodic(model, basis, frequency=f_hz,
+                             options=solve_options_of(analysis, PERIODIC), reduced=reduced,
+                             eps=analysis["eps"], time_domain=False, condenser=cond)
     stats = sol.stats
     if not sol.success:  # a failed solve is never compared (its last iterate is no result)
         sol = None

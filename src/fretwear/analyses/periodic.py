@@ -33,14 +33,18 @@ from fretwear.analyses.common import (
     pad_axes,
     period_coordinates,
     si_scale,
+    solve_options_of,
     solver_attributes,
     titled,
 )
 from fretwear.errors import InputError
 from fretwear.hb.contact import STATE_NAMES
+from fretwear.hb.inputs import QUASI_STATIC_FREQUENCY
+from fretwear.hb.options import PERIODIC
 from fretwear.hb.penalty import penalty
-from fretwear.hb.periodic import PeriodicSolution, solve_periodic
+from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.reduce import condense, exact_condenser, recover
+from fretwear.hb.solution import PeriodicSolution
 from fretwear.hb.solvers import SolveStats
 from fretwear.io.results import nodal_vectors, variable, write_pvd, write_vtu
 from fretwear.io.schema import Field, Flag, Integer, Number, join
@@ -199,16 +203,13 @@ def run_periodic(model, analysis: dict, case, context: RunContext) -> RunOutput:
     """
     basis = basis_of(analysis)
     qs = analysis["quasi_static"]
-    f_hz = float(analysis.get("frequency", default_of(solve_periodic, "frequency")))
+    f_hz = float(analysis.get("frequency", QUASI_STATIC_FREQUENCY))
     cond = exact_condenser(model)  # the run's condensation of the model, for every call
     reduced = condense(model, f_hz, basis.orders, quasi_static=qs, condenser=cond)
     eps = penalty(analysis["eps"], model=model, reduced=reduced, condenser=cond)
-    sol = api.solve_periodic(model, basis, frequency=f_hz, quasi_static=qs, reduced=reduced,
-                             eps=eps, solver=analysis["solver"], tol=analysis["tol"],
-                             max_iter=analysis["max_iter"],
-                             time_domain=analysis["time_domain"],
-                             time_domain_periods=analysis["time_domain_periods"],
-                             condenser=cond)
+    sol = api.solve_periodic(model, basis, frequency=f_hz, quasi_static=qs,
+                             options=solve_options_of(analysis, PERIODIC), reduced=reduced,
+                             eps=eps, time_domain=analysis["time_domain"], condenser=cond)
     stats = sol.stats
     attrs = {**solver_attributes(stats, analysis, eps), "excitation_frequency": f_hz,
              "quasi_static": int(qs),
@@ -451,8 +452,9 @@ PERIODIC = Analysis.define(
                                                                           "time_domain")),
         "time_domain_periods": Field(Integer(lo=10), "forcing periods allowed to the time "
                                      "integration (time_domain)",
-                                     default=default_of(solve_periodic, "time_domain_periods")),
-        **harmonic_balance_fields(solve_periodic, "DLFT penalty: " + _EPS_RULES),
+                                     default=PERIODIC.time_domain_periods),
+        **harmonic_balance_fields(PERIODIC, default_of(solve_periodic, "eps"),
+                                  "DLFT penalty: " + _EPS_RULES),
     },
     run_periodic,
     checks=(_frequency_needed, check_sampling),

@@ -29,13 +29,15 @@ from fretwear.analyses.common import (
     harmonic_balance_fields,
     live_axes,
     period_coordinates,
+    solve_options_of,
     titled,
 )
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import PeriodicSolution
+from fretwear.hb.options import SWEEP
 from fretwear.hb.reduce import exact_condenser
-from fretwear.hb.sweep import SweepResult, sweep
+from fretwear.hb.solution import PeriodicSolution
+from fretwear.hb.sweep import SweepResult
 from fretwear.io.results import label_coordinate, variable
 from fretwear.io.schema import Field, Flag, Integer, ListOf, Number, Text, increasing
 from fretwear.timedomain.stability import sweep_check
@@ -245,18 +247,17 @@ def run_sweep(model, analysis: dict, case, context: RunContext) -> RunOutput:
             bar.set_postfix_str(f"{plots.format_frequency(pt.frequency_hz)}"
                                 f"{'' if pt.success else ' (not converged)'}")
 
+        options = SWEEP.replace(
+            solve=solve_options_of(analysis, SWEEP.solve), spacing=analysis["spacing"],
+            eps=analysis["eps"], eps_band=analysis.get("eps_band"),
+            continuation=analysis["continuation"],
+            flag=(sweep_check(model, max_periods=analysis["time_domain_periods"],
+                              condenser=cond)
+                  if analysis["check_stability"] else None),
+            progress=tick, checkpoint=context.out_dir / CHECKPOINT_FILE, resume=context.resume)
         result = api.sweep(model, basis, analysis["f_min"], analysis["f_max"], n,
-                           spacing=analysis["spacing"], eps=analysis["eps"],
-                           eps_band=analysis.get("eps_band"), solver=analysis["solver"],
-                           tol=analysis["tol"], max_iter=analysis["max_iter"],
-                           continuation=analysis["continuation"],
-                           time_domain=analysis["time_domain"],
-                           time_domain_periods=analysis["time_domain_periods"],
-                           check=(sweep_check(model, max_periods=analysis["time_domain_periods"],
-                                              condenser=cond)
-                                  if analysis["check_stability"] else None),
-                           progress=tick, checkpoint=context.out_dir / CHECKPOINT_FILE,
-                           resume=context.resume, condenser=cond)
+                           options=options, time_domain=analysis["time_domain"],
+                           condenser=cond)
     linear_hz = linear_reference_grid(analysis["f_min"], analysis["f_max"],
                                       analysis["spacing"], result.frequency_hz,
                                       analysis["linear_points"])
@@ -379,17 +380,17 @@ SWEEP = Analysis.define(
         "n_points": Field(Integer(lo=2), "number of grid frequencies (the sweep may add "
                           "intermediate points where a step fails)", default=200),
         "spacing": Field(Text(("log", "linear")), "frequency spacing",
-                         default=default_of(sweep, "spacing")),
+                         default=SWEEP.spacing),
         "continuation": Field(Flag(), "pseudo-arclength continuation when a frequency step "
                               "fails (passes folds of the response curve)",
-                              default=default_of(sweep, "continuation")),
+                              default=SWEEP.continuation),
         "time_domain": Field(Flag(), "where a point still fails, integrate in time from the "
                              "neighbour: a periodic steady state starts one more solve, any "
                              "other response (drifting, quasi-periodic) is reported as the "
                              "reason", default=default_of(api.sweep, "time_domain")),
         "time_domain_periods": Field(Integer(lo=10), "forcing periods allowed to each time "
                                      "integration (time_domain, check_stability)",
-                                     default=default_of(sweep, "time_domain_periods")),
+                                     default=SWEEP.solve.time_domain_periods),
         "check_stability": Field(Flag(), "check every converged point in time (does the "
                                  "structure settle to it?); slow", default=False),
         "points": Field(ListOf(Text(), non_empty=True, unique=True),
@@ -408,7 +409,7 @@ SWEEP = Analysis.define(
                                "few sparse solves per resonance however many points",
                                default=default_of(linear_reference_grid, "linear_points")),
         **harmonic_balance_fields(
-            sweep,
+            SWEEP.solve, SWEEP.eps,
             'DLFT penalty, one value for the whole sweep (a smooth FRF): "top": the spectral '
             "radius of Z_r at the highest kept harmonic, its median over the band (chosen "
             'from measurements, docs/studies/eps-rule.md); "static": that of the static '

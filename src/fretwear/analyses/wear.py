@@ -24,6 +24,7 @@ from fretwear.analyses.common import default_of, interface_labels
 from fretwear.files import safe_name
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.options import WEAR_STEP
 from fretwear.hb.penalty import RULES
 from fretwear.hb.reduce import exact_condenser
 from fretwear.hb.solvers import SOLVERS
@@ -51,11 +52,11 @@ from fretwear.wear import (
     RunControl,
     WearOptions,
     WearResult,
-    frf_worn,
     simulate_wear,
 )
 from fretwear.wear.laws import side_depths
 from fretwear.wear.simulate import QUASI_STATIC_FREQUENCY
+from fretwear.wear.worn_frf import WORN_FRF
 
 #: the two worn surfaces of a contact node: its own, and its partner's (node-to-node pairs)
 SURFACES = ("contact", "partner")
@@ -67,8 +68,12 @@ AXES = ("x", "y", "z")
 
 # --- options ----------------------------------------------------------------------------------
 #: the defaults of the wear options: :class:`~fretwear.wear.options.WearOptions` is their one
-#: definition, for case files as for Python
-OPTION_DEFAULTS = {f.name: f.default for f in fields(WearOptions)}
+#: definition, for case files as for Python (the keys of its solve record,
+#: :data:`SOLVE_KEYS`, from :data:`~fretwear.hb.options.WEAR_STEP`)
+OPTION_DEFAULTS = {f.name: f.default for f in fields(WearOptions) if f.name != "solve"}
+#: the keys of the table that set the solve record of the wear options (``WearOptions.solve``)
+SOLVE_KEYS = ("solver", "tol")
+OPTION_DEFAULTS.update({k: getattr(WEAR_STEP, k) for k in SOLVE_KEYS})
 
 
 def option(name: str, spec: Spec, doc: str, unit: str = "", *, fill: bool = True) -> Field:
@@ -83,8 +88,11 @@ def option(name: str, spec: Spec, doc: str, unit: str = "", *, fill: bool = True
 
 def options_from_table(a: dict) -> WearOptions:
     """:class:`~fretwear.wear.options.WearOptions` from the validated ``[analysis]`` table: its
-    wear options (:data:`OPTION_KEYS`) that are there; the others keep their defaults."""
-    return WearOptions(**{k: a[k] for k in OPTION_KEYS if k in a})
+    wear options (:data:`OPTION_KEYS`, those of the solve record into ``solve``) that are
+    there; the others keep their defaults."""
+    given = {k: a[k] for k in OPTION_KEYS if k in a}
+    solve = WEAR_STEP.replace(**{k: given.pop(k) for k in SOLVE_KEYS if k in given})
+    return WearOptions(solve=solve, **given)
 
 
 def penalty_of(a: dict) -> dict:
@@ -396,8 +404,10 @@ def run_wear(model, analysis: dict, case, context: RunContext) -> RunOutput:
     fb = a.get("frf_before_after")
     if fb is not None and model.observed:
         grid = (fb["f_min"], fb["f_max"], fb["n_points"])
-        sweeps = {name: api.frf_worn(model, basis, w, *grid, solver=a["solver"],
-                                     **penalty_of(a), spacing=fb["spacing"],
+        frf_options = WORN_FRF.replace(
+            solve=WORN_FRF.solve.replace(solver=a["solver"]), **penalty_of(a),
+            spacing=fb["spacing"])
+        sweeps = {name: api.frf_worn(model, basis, w, *grid, options=frf_options,
                                      time_domain=fb["time_domain"], condenser=cond)
                   for name, w in (("unworn", 0.0), ("worn", result.final_wear))}
         frf = _frf_data(model, sweeps, frequency_grid(*grid, fb["spacing"]))
@@ -495,7 +505,7 @@ _FRF = Table(
         "f_max": Field(_POS, "highest frequency", required=True, unit="Hz"),
         "n_points": Field(Integer(lo=2), "number of frequencies", default=100),
         "spacing": Field(Text(("linear", "log")), "frequency spacing",
-                         default=default_of(frf_worn, "spacing")),
+                         default=WORN_FRF.spacing),
         "time_domain": Field(Flag(), "where a point's balance fails, integrate in time from "
                              "the neighbour (as in `frf` sweeps)",
                              default=default_of(api.frf_worn, "time_domain")),

@@ -24,7 +24,7 @@ class TimeDomainFallback:
     ----------
     start : ``start(model, frequency, basis, solution | None, *, max_periods) ->
         (message, U0 | None, anchor | None)``: integrate at ``frequency`` [Hz] (from a
-        neighbouring :class:`~fretwear.hb.periodic.PeriodicSolution` when given) until the
+        neighbouring :class:`~fretwear.hb.solution.PeriodicSolution` when given) until the
         response is classified; if it settles to a periodic state, its contact harmonics
         ``U0`` (nc, d, H) [m] and mean tangential positions ``anchor`` (nc, d-1) [m] start a
         balance; ``message`` says what the structure does.

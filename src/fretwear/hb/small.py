@@ -3,7 +3,7 @@
 For a problem of a few contact DOFs (``m H <= SMALL_MAX`` unknowns) the arithmetic of one
 residual is a few thousand operations, and the Python work around it (the FFTs' set-up, the
 reshapes, the Jacobian's per-node products) cost ten times more. This kernel does the same
-computation as :meth:`fretwear.hb.periodic.DLFTProblem.residual` on plain arrays:
+computation as :meth:`fretwear.hb.problem.DLFTProblem.residual` on plain arrays:
 
     lambda_u~ = F~ - Z~ U~ + eps (U~ - W~)                       (eq. 23)
     lambda_u(t_n) = Q lambda_u~,   lambda_x = the DLFT law       (eq. 24-28, :mod:`.contact`)

@@ -4,8 +4,8 @@ same result, bit for bit, as if it had never stopped.
 
 What a point needs to be rebuilt exactly is small: its circular frequency, its harmonics ``U``,
 its stick anchors and penalty, and the solver statistics and flags (its
-:class:`~fretwear.hb.periodic.PeriodicSolution` is re-assembled from them by the same
-deterministic code, :func:`fretwear.hb.sweep.rebuild_point`). The continuation state of the sweep
+:class:`~fretwear.hb.solution.PeriodicSolution` is re-assembled from them by the same
+deterministic code, :func:`fretwear.hb.branch.rebuild_point`). The continuation state of the sweep
 (the last two converged points of the secant predictor, the neighbour of a time-domain start)
 is the sequence of converged points itself.
 

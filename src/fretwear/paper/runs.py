@@ -47,6 +47,7 @@ from fretwear.paper.catalogue import (
 from fretwear.paper.report import load, write_report
 from fretwear.timedomain.options import IncrementalWearOptions
 from fretwear.timedomain.quasistatic import incremental_wear
+from fretwear.wear.worn_frf import WORN_FRF
 
 
 # --- running ----------------------------------------------------------------------------------
@@ -148,7 +149,7 @@ def _frf_worn(folder: Path, wear_dir: Path, quick: bool) -> str:
     cond = exact_condenser(model)  # one condensation of the beam for both FRFs
     out = {}
     for name, w in (("unworn", np.zeros_like(wear)), ("worn", wear)):
-        r = api.frf_worn(model, basis, w, f_min, f_max, n, spacing="linear",
+        r = api.frf_worn(model, basis, w, f_min, f_max, n, options=WORN_FRF,
                          time_domain=True, condenser=cond)
         out[f"{name}_summary"] = r.summary()
         out[f"{name}_frequency"] = r.frequency_hz

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import PeriodicSolution, initial_state
+from fretwear.hb.solution import PeriodicSolution, initial_state
 from fretwear.model.core import Model
 from fretwear.timedomain.options import InitialState, IntegrationOptions, SteadyStateOptions
 from fretwear.timedomain.steady import steady_state, steady_state_at_omega

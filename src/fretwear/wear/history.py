@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fretwear.hb.periodic import PeriodicSolution
+from fretwear.hb.solution import PeriodicSolution
 from fretwear.wear.state import RECORD_COLUMNS, Rescue, StepRecord
 
 #: per-step arrays of :class:`WearHistory`: name -> (units, long name), the columns of

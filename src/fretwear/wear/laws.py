@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from fretwear.errors import InputError
-from fretwear.hb.periodic import PeriodicSolution
+from fretwear.hb.solution import PeriodicSolution
 from fretwear.model.core import Model
 
 LAWS = ("archard", "energy")
@@ -81,10 +81,10 @@ def wear_per_cycle(sol: PeriodicSolution, *, law_name: str = "archard",
     """Wear depth per cycle ``dW1`` per node (nc,) [m] of a converged periodic solution.
 
     Archard (eq. 29 with the corrected slip): ``k_w sum_n p_N(n) |X_T(n) - X_T(n-1)|``, from
-    :meth:`~fretwear.hb.periodic.PeriodicSolution.pressure_t` and
-    :meth:`~fretwear.hb.periodic.PeriodicSolution.slip_t` (zero in stick, so a node that sticks all
+    :meth:`~fretwear.hb.solution.PeriodicSolution.pressure_t` and
+    :meth:`~fretwear.hb.solution.PeriodicSolution.slip_t` (zero in stick, so a node that sticks all
     period does not wear). Energy law (Fouvry et al. 2003): ``k_e E_p / area_p`` with ``E_p``
-    from :meth:`~fretwear.hb.periodic.PeriodicSolution.friction_energy`.
+    from :meth:`~fretwear.hb.solution.PeriodicSolution.friction_energy`.
 
     This is the post-processing route; the integrators use the kernel
     :func:`fretwear.wear.kernels.slip_work`, which gives the same numbers.

@@ -10,7 +10,7 @@ import numbers
 from dataclasses import asdict, dataclass
 
 from fretwear.errors import InputError
-from fretwear.hb.solvers import SOLVERS
+from fretwear.hb.options import WEAR_STEP, SolveOptions
 from fretwear.wear.laws import LAWS
 
 SCHEMES = ("implicit", "rosenbrock", "explicit")
@@ -64,8 +64,11 @@ class WearOptions:
     plateau_rate : stop when the worn-volume rate falls below this fraction of its initial
         value (the plateau of paper Fig. 25).
     max_steps : stop after this many slow steps.
-    solver, tol, max_iter : nonlinear solver (:func:`fretwear.hb.solvers.solve`), its relative
-        residual tolerance ``eps_r`` and iteration cap.
+    solve : :class:`~fretwear.hb.options.SolveOptions` of the periodic balances (default
+        :data:`~fretwear.hb.options.WEAR_STEP`): the nonlinear solver, its relative residual
+        tolerance ``eps_r`` and iteration cap, the Jacobian, and the attempts of the first
+        (unworn) balance (``strategy``; later balances are warm-started and retried by the
+        slow steps themselves).
     max_iter_coupled : iteration cap of the Newton method on the coupled unknowns
         (``implicit_newton = "coupled"``).
     max_iter_implicit : Newton iterations on ``W`` of a backward Euler step
@@ -96,9 +99,7 @@ class WearOptions:
     max_depth: float = math.inf
     plateau_rate: float = 1e-3
     max_steps: int = 10_000
-    solver: str = "powell"
-    tol: float = 1e-9
-    max_iter: int = 60
+    solve: SolveOptions = WEAR_STEP
     max_iter_coupled: int = 20
     max_iter_implicit: int = 8
     implicit_newton: str = "nested"
@@ -115,7 +116,10 @@ class WearOptions:
     def check(self) -> WearOptions:
         """Validate (also done at construction); raise InputError (a ValueError) naming the
         option and the bad value."""
-        for name, choices in (("law", LAWS), ("scheme", SCHEMES), ("solver", SOLVERS),
+        if not isinstance(self.solve, SolveOptions):
+            raise InputError(f"solve = {self.solve!r}: expected a SolveOptions (e.g. "
+                             "WEAR_STEP.replace(tol=1e-10))")
+        for name, choices in (("law", LAWS), ("scheme", SCHEMES),
                               ("implicit_newton", IMPLICIT_NEWTONS)):
             v = getattr(self, name)
             if not (isinstance(v, str) and v in choices):
@@ -124,7 +128,7 @@ class WearOptions:
             v = getattr(self, name)
             if not isinstance(v, bool):
                 raise InputError(f"{name} = {v!r}: expected True or False")
-        for name in ("tolerance", "max_jump", "min_jump", "max_cycles", "max_depth", "tol"):
+        for name in ("tolerance", "max_jump", "min_jump", "max_cycles", "max_depth"):
             v = getattr(self, name)
             if not (_is_number(v) and v > 0):
                 raise InputError(f"{name} = {v!r}: expected a positive number")
@@ -139,7 +143,7 @@ class WearOptions:
             v = getattr(self, name)
             if not (_is_number(v) and v >= 0):
                 raise InputError(f"{name} = {v!r}: expected a number >= 0")
-        for name, lo in (("max_steps", 1), ("max_iter", 1), ("max_iter_coupled", 1),
+        for name, lo in (("max_steps", 1), ("max_iter_coupled", 1),
                          ("max_iter_implicit", 0), ("max_retries", 0)):
             v = getattr(self, name)
             if not (_is_integer(v) and v >= lo):
@@ -158,10 +162,14 @@ class WearOptions:
     def trajectory_key(self) -> dict:
         """The options that change the computed trajectory (for checkpoint matching). The stop
         criteria are not among them: a finished run can be extended (e.g. a larger
-        ``max_cycles``) by resuming from its checkpoint."""
-        d = asdict(self)
+        ``max_cycles``) by resuming from its checkpoint. The solve's part is
+        :meth:`~fretwear.hb.options.SolveOptions.key` (solver, tol, max_iter, and the other
+        settings where they differ from :data:`~fretwear.hb.options.WEAR_STEP`: the keys of
+        the checkpoints written before the record)."""
+        d = {k: v for k, v in asdict(self).items() if k != "solve"}
         for k in ("checkpoint_every_s", "max_cycles", "max_depth", "plateau_rate", "max_steps"):
             d.pop(k)
+        d.update(self.solve.key_changes(WEAR_STEP))
         if d["partner_energy_coefficient"] is None:  # the checkpoints written before it
             d.pop("partner_energy_coefficient")
         return d

@@ -62,21 +62,22 @@ def first_state(sp: SlowProblem, wear0, anchor, U0, opts: WearOptions
     t0 = time.perf_counter()
     sp.set_state(wear0, anchor)
     # the first balance goes through solve_periodic (its start strategies for a cold start);
-    # the solver alone: a wear run has its own fallback (a start from a time integration),
-    # and its examples are validated with it (the further attempts of solve_periodic find a
-    # balance of the 79 kHz reduced example that the time-domain start replaces today)
+    # its attempts are opts.solve.strategy, by default the solver alone (WEAR_STEP): a wear
+    # run has its own fallback (a start from a time integration), and its examples are
+    # validated with it (the further attempts of solve_periodic find a balance of the 79 kHz
+    # reduced example that the time-domain start replaces today)
+    first = opts.solve.replace(max_iter=max(opts.solve.max_iter, 200))
     sol0 = solve_periodic(sp.model, sp.prob.basis, frequency=sp.prob.reduced.frequency,
-                          quasi_static=sp.prob.reduced.quasi_static,
+                          quasi_static=sp.prob.reduced.quasi_static, options=first,
                           reduced=sp.prob.reduced, gap=sp.gap0 + wear0, eps=sp.eps,
-                          anchor=anchor, U0=U0, solver=opts.solver, tol=opts.tol,
-                          max_iter=max(opts.max_iter, 200), strategy=("start",))
+                          anchor=anchor, U0=U0)
     st = sol0.stats
     if not sol0.success:
         if sp.time_domain is not None:
             return time_domain_start(sp, wear0, opts, st, t0)
         raise ConvergenceError(
             f"the periodic solve of the unworn interface did not converge ({st.message}, "
-            f"relative residual {st.residual:.3g} > {opts.tol:g}): no wear computed"
+            f"relative residual {st.residual:.3g} > {opts.solve.tol:g}): no wear computed"
         )
     U = sol0.U.reshape(sp.m, sp.H)
     if opts.scheme != "explicit" and sp.needs_iterative_solves(U):
@@ -167,7 +168,7 @@ def _attempt(sp: SlowProblem, opts: WearOptions, start: StepStart, dN: float, li
     implicit: backward Euler from the Rosenbrock predictor (:class:`_BackwardEuler`, or the
     Newton method on the coupled unknowns ``(U~, W1)`` when ``implicit_newton = "coupled"``).
     """
-    kw = {"solver": opts.solver, "tol": opts.tol, "max_iter": opts.max_iter}
+    kw = {"options": opts.solve}
     W_k, U_k, anchor = start.W, start.U, start.anchor
     if opts.scheme == "explicit":
         W1 = W_k + dN * start.g
@@ -186,7 +187,7 @@ def _attempt(sp: SlowProblem, opts: WearOptions, start: StepStart, dN: float, li
             stats.iterations += its
         return Wp, U1, stats
     if opts.implicit_newton == "coupled":
-        kw["max_iter"] = opts.max_iter_coupled
+        kw["options"] = opts.solve.replace(max_iter=opts.max_iter_coupled)
         U1, W1, stats = sp.solve_implicit(W_k, dN, anchor, Up, Wp, **kw)
         return W1, U1, stats
     return _BackwardEuler(sp, opts, start, dN).solve(Wp, Up, lin)
@@ -210,7 +211,7 @@ class _BackwardEuler:
 
     def __init__(self, sp: SlowProblem, opts: WearOptions, start: StepStart, dN: float):
         self.sp, self.opts, self.start, self.dN = sp, opts, start, dN
-        self.kw = {"solver": opts.solver, "tol": opts.tol, "max_iter": opts.max_iter}
+        self.kw = {"options": opts.solve}
         self.its = 0  # nonlinear iterations, slow Jacobians included
 
     def evaluate(self, W, U):
@@ -257,7 +258,7 @@ class _BackwardEuler:
         ev = self.evaluate(W, U)
         if ev is None:
             return W, U, SolveStats(False, math.inf, self.its, 0, 0, time.perf_counter() - t0,
-                                    "balance failed at the predictor", opts.solver)
+                                    "balance failed at the predictor", opts.solve.solver)
         U, r, rn, res = ev
         best = (rn, W, U, res)
         Js, dUdW = lin
@@ -285,4 +286,4 @@ class _BackwardEuler:
         ok = rn <= 0.5 * opts.tolerance * max(float(np.max(W)), 1e-300)
         return W, U, SolveStats(ok, res if ok else math.inf, self.its, 0, 0,
                                 time.perf_counter() - t0, "converged" if ok else msg,
-                                opts.solver)
+                                opts.solve.solver)

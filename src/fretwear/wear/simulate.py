@@ -28,8 +28,10 @@ import numpy as np
 from fretwear.errors import InputError, interrupted
 from fretwear.hb.fallback import TimeDomainFallback
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import PeriodicSolution, check_inputs, preload_anchor
+from fretwear.hb.inputs import QUASI_STATIC_FREQUENCY, check_inputs
+from fretwear.hb.preload import preload_anchor
 from fretwear.hb.reduce import Reduced, condense, condenser_for
+from fretwear.hb.solution import PeriodicSolution
 from fretwear.hb.solvers import SolveStats
 from fretwear.model.core import Model
 from fretwear.wear.checkpoint import (
@@ -45,9 +47,6 @@ from fretwear.wear.schemes import advance, first_state
 from fretwear.wear.slow_problem import SlowProblem
 from fretwear.wear.state import SlowStep, StepRecord
 from fretwear.wear.time_steps import time_domain_step
-
-#: the frequency of a quasi-static run that gives none [Hz]: it only scales time
-QUASI_STATIC_FREQUENCY = 1.0
 
 
 @dataclass(frozen=True)
@@ -163,7 +162,7 @@ def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float | None 
     anchor, warnings = _first_anchor(model, balance.anchor, condenser)
     sp = SlowProblem(model, reduced, basis, coef, eps=balance.eps, anchor=anchor,
                      time_domain=time_domain if opts.time_domain_rescue and not quasi_static
-                     else None, condenser=condenser)
+                     else None, condenser=condenser, jacobian=opts.solve.jacobian)
     saver = _Saver(run.checkpoint, fingerprint(model, reduced, basis, sp.eps, coef, opts, wear0,
                                                anchor), opts.checkpoint_every_s)
     if run.resume and saver.exists():  # damaged: an InputError, never ignored

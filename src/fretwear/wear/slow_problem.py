@@ -11,8 +11,10 @@ from fretwear.hb import contact as law
 from fretwear.hb import solvers
 from fretwear.hb.fallback import TimeDomainFallback
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import DLFTProblem, PeriodicSolution, assemble_solution
+from fretwear.hb.options import SolveOptions
+from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.reduce import Reduced
+from fretwear.hb.solution import PeriodicSolution, assemble_solution
 from fretwear.hb.solvers import SolveStats, solve, solve_identity_rows
 from fretwear.model.core import Model
 from fretwear.resources import require_memory
@@ -42,20 +44,22 @@ class SlowProblem:
     condenser : the condenser of ``model`` that made ``reduced``
         (:func:`fretwear.hb.reduce.exact_condenser`): the full-field recoveries of the run
         (the start of a time integration) use it; None: a new exact one at each.
+    jacobian : how the Newton step is computed (:data:`fretwear.hb.options.JACOBIANS`).
 
     The wear depths ``W`` (nc,) [m] enter the DLFT as the normal gap ``gap0 + W``; ``E_W`` puts
     ``W_p`` into the static coefficient of the normal DOF of node ``p``.
     """
 
     def __init__(self, model: Model, reduced: Reduced, basis: FourierBasis, coef, *, eps="auto",
-                 anchor=None, time_domain: TimeDomainFallback | None = None, condenser=None):
+                 anchor=None, time_domain: TimeDomainFallback | None = None, condenser=None,
+                 jacobian="auto"):
         self.model = model
         self.condenser = condenser
         self.time_domain = time_domain  # fallback of failed balances (None: none)
         self.gap0 = np.broadcast_to(np.asarray(model.contact.gap, float),
                                     (model.contact.n_nodes,)).copy()
         self.prob = DLFTProblem(reduced, model.contact, basis, gap=self.gap0, eps=eps,
-                                anchor=anchor)
+                                anchor=anchor, jacobian=jacobian)
         p = self.prob
         self.nc, self.d, self.H, self.m = p.nc, p.d, p.H, p.m
         self.n = p.m * p.H
@@ -209,11 +213,12 @@ class SlowProblem:
         return float(np.max(np.abs(lam))) if np.size(lam) else 0.0
 
     # -- solves --------------------------------------------------------------------------
-    def solve_balance(self, W, anchor, U0, *, solver, tol, max_iter, fast=True):
+    def solve_balance(self, W, anchor, U0, *, options: SolveOptions, fast=True):
         """Periodic solution at wear ``W`` from ``U0``: ``(U (m, H), stats)``.
 
         With ``fast``, :func:`newton` first (warm starts converge in a few steps); if it fails,
-        ``solver`` of :mod:`fretwear.hb.solvers` from the same start."""
+        ``options.solver`` of :mod:`fretwear.hb.solvers` from the same start (``options``:
+        its ``tol`` and ``max_iter`` too)."""
         self.set_state(W, anchor)
         p = self.prob
 
@@ -226,15 +231,16 @@ class SlowProblem:
         x0 = np.asarray(U0, float).reshape(-1)
         its = 0
         if fast:
-            x, st = newton(fun, x0, scale, tol=tol, max_iter=min(max_iter, 15))
+            x, st = newton(fun, x0, scale, tol=options.tol, max_iter=min(options.max_iter, 15))
             if st.success:
                 return x.reshape(self.m, self.H), st
             its = st.iterations
-        x, _, st = solve(fun, x0, scale, method=solver, tol=tol, max_iter=max_iter)
+        x, _, st = solve(fun, x0, scale, method=options.solver, tol=options.tol,
+                         max_iter=options.max_iter)
         st.iterations += its
         return x.reshape(self.m, self.H), st
 
-    def solve_implicit(self, W_k, dN, anchor, U0, W0, *, solver, tol, max_iter):
+    def solve_implicit(self, W_k, dN, anchor, U0, W0, *, options: SolveOptions):
         """Backward Euler step: ``(U, W_{k+1}, stats)`` from the guess ``(U0, W0)``."""
         self.set_state(W0, anchor)
         p = self.prob
@@ -245,7 +251,7 @@ class SlowProblem:
 
         x0 = np.concatenate([np.asarray(U0, float).reshape(-1), np.asarray(W0, float)])
         x, _, st = solve(fun, x0, lambda x: p.scale(x[: self.n].reshape(self.m, self.H)),
-                         method=solver, tol=tol, max_iter=max_iter)
+                         method=options.solver, tol=options.tol, max_iter=options.max_iter)
         return x[: self.n].reshape(self.m, self.H), x[self.n :].copy(), st
 
     def solution(self, U, W, anchor, stats) -> PeriodicSolution:

@@ -15,7 +15,7 @@ import time
 import numpy as np
 
 from fretwear.errors import ConvergenceError
-from fretwear.hb.periodic import initial_state
+from fretwear.hb.solution import initial_state
 from fretwear.hb.solvers import SolveStats
 from fretwear.wear.options import (
     BALANCE_KINDS,
@@ -122,8 +122,8 @@ def time_domain_step(sp: SlowProblem, st: SlowStep, opts: WearOptions):
     retry_at = st.retry_balance_at
     if tr.kind in BALANCE_KINDS and cycles1 >= retry_at:
         U1, stats = sp.solve_balance(W1, tr.anchor, tr.U.reshape(sp.m, sp.H),
-                                     solver=opts.solver, tol=opts.tol,
-                                     max_iter=max(opts.max_iter, RESCUE_MAX_ITER))
+                                     options=opts.solve.replace(
+                                         max_iter=max(opts.solve.max_iter, RESCUE_MAX_ITER)))
         iters += stats.iterations
         if stats.success:
             sp.set_state(W1, tr.anchor)

@@ -1,0 +1,124 @@
+"""Pseudo-arclength continuation of the DLFT balance in frequency (the rung ``"arclength"`` of a
+sweep point, :mod:`fretwear.hb.attempts`): from the last two converged points of a sweep along
+the response curve until the frequency passes the target, through folds where frequency is not
+a good parameter."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from fretwear.hb.solvers import SolveStats
+
+#: Newton iterations of an arclength corrector without halving its best residual after which
+#: the step is shortened (rather than spending the rest of ``max_iter`` on a diverging step)
+STALL_ITERATIONS = 5
+
+
+def arclength(probs, anchor, y_prev, y_last, omega_target, solver_tol, max_steps=20,
+              max_iter=20):
+    """Pseudo-arclength continuation from ``y_last`` (secant from ``y_prev``) until the
+    frequency passes ``omega_target``. ``y = (U (m*H,), omega)``. Returns the list of converged
+    ``(U, omega, stats, problem)`` along the branch (the last one is past or at the target) or
+    [] (the problem is the one the point converged on: recording the point needs no new
+    condensation)."""
+    U1, w1 = y_last
+    U0, w0 = y_prev
+    sx = max(np.linalg.norm(U1), 1e-30)
+    sw = max(abs(w1), 1e-30)
+
+    def scaled(U, w):
+        return np.concatenate([U / sx, [w / sw]])
+
+    t = scaled(U1, w1) - scaled(U0, w0)
+    ds = np.linalg.norm(t)
+    if ds == 0:
+        return []
+    t /= ds
+    if t[-1] * (omega_target - w1) < 0:  # march towards the target
+        t = -t
+    out = []
+    yk = scaled(U1, w1)
+    for _ in range(max_steps):
+        converged = False
+        for _shrink in range(4):
+            yp = yk + ds * t
+            y = yp.copy()
+            t0 = time.perf_counter()
+            nit = nf = 0
+            fw = None
+            best = []
+            for _it in range(max_iter):
+                U, w = y[:-1] * sx, y[-1] * sw
+                prob = probs.get(w, anchor)
+                f, J = prob.residual(U.reshape(prob.m, prob.H))
+                nf += 1
+                if fw is None:
+                    # df/dw by a forward difference, once per corrector (a chord: each one
+                    # costs a condensation at w + dw; the residual itself is exact at every
+                    # iterate, so the converged point is the same)
+                    dw = 1e-7 * w
+                    f2, _ = probs.get(w + dw, anchor).residual(U.reshape(prob.m, prob.H),
+                                                               False)
+                    fw = (f2 - f) / dw
+                g = t @ (y - yp)
+                rel = np.linalg.norm(f) / prob.scale(U.reshape(prob.m, prob.H))
+                if rel <= solver_tol:
+                    converged = True
+                    break
+                best.append(rel)
+                if len(best) > STALL_ITERATIONS and min(best[-STALL_ITERATIONS:]) > \
+                        0.5 * min(best[:-STALL_ITERATIONS]):
+                    break  # no progress: a shorter step rather than more iterations
+                try:
+                    dy = bordered_step(J, f, fw, g, t, sx, sw)
+                except np.linalg.LinAlgError:
+                    break
+                if abs(dy[-1] * sw) > abs(omega_target - w1):
+                    # a Newton step of the corrector that moves the frequency by more than
+                    # the whole step to the target is diverging (seen past folds of the
+                    # dovetail's FRF: 70 Hz jumps on an 18 Hz grid): a shorter step at once,
+                    # rather than more iterates, each a condensation at a new frequency
+                    break
+                y = y + dy
+                nit += 1
+            if converged:
+                break
+            ds *= 0.5
+        if not converged:
+            return out
+        U, w = y[:-1] * sx, y[-1] * sw
+        st = SolveStats(True, float(np.linalg.norm(f) / prob.scale(U.reshape(prob.m, prob.H))),
+                        nit, nf * 2, nf, time.perf_counter() - t0, "converged (arclength)",
+                        "arclength")
+        out.append((U, w, st, prob))
+        tn = y - yk
+        tn /= np.linalg.norm(tn)
+        t = tn
+        yk = y
+        if (w - omega_target) * (omega_target - w1) >= 0:  # passed the target frequency
+            break
+        if nit <= 3:
+            ds *= 1.5
+    return out
+
+
+def bordered_step(J, f, fw, g, t, sx, sw):
+    """The Newton step ``dy`` of the arclength system ``[[J sx, fw sw], [t]] dy = -[f, g]``
+    (scaled variables): by LU of the bordered matrix for a formed Jacobian, by block
+    elimination with two solves of ``J`` for the operator of large interfaces
+    (:class:`~fretwear.hb.krylov.KrylovJacobian`)."""
+    n = f.size
+    if isinstance(J, np.ndarray):
+        A = np.zeros((n + 1, n + 1))
+        A[:n, :n] = J * sx
+        A[:n, n] = fw * sw
+        A[n] = t
+        return np.linalg.solve(A, -np.concatenate([f, [g]]))
+    a, b = J.solve(np.column_stack([-f, fw * sw])).T  # J a = -f, J b = fw sw
+    den = t[n] - t[:n] @ b / sx
+    if not np.isfinite(den) or den == 0.0:
+        raise np.linalg.LinAlgError("singular bordered system")
+    dw = (-g - t[:n] @ a / sx) / den
+    return np.concatenate([(a - dw * b) / sx, [dw]])

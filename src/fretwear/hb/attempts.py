@@ -1,0 +1,521 @@
+"""The attempt ladder of the periodic solve: named rungs, each a small function of a context,
+composed into the ladder of a single solve (:func:`solve_ladder`: the attempts of
+:func:`fretwear.hb.periodic.solve_periodic`) and the ladder of one grid frequency of a sweep
+(:func:`point_ladder`: the attempts of :func:`fretwear.hb.sweep.sweep` at each frequency).
+
+A rung tries one way to a converged balance from what its context holds, records each try as
+an :class:`~fretwear.hb.solution.Attempt` (their ``method`` names are those of the results
+files) and says whether it converged; a ladder runs its rungs in order until one has.
+
+Single solve (:class:`Trial`; :data:`~fretwear.hb.options.STRATEGY`, the rungs that
+``SolveOptions.strategy`` names):
+
+1. ``"start"``: the solver from the start;
+2. ``"best-point"``: the other solver (``SolveOptions.other_solver``: Newton after Powell,
+   Powell after Newton or hybr) from the best iterate so far (Newton converges where Powell's
+   trust region stalls, and the reverse, on the paper's beam);
+3. ``"eps-continuation"``: the balance at ``10 eps`` (then ``eps / 10``) from the start (the
+   solver, then the other one, then the solver from the first harmonic alone at that eps),
+   and from there geometric steps back to ``eps`` (:func:`eps_path`: halved where one
+   fails), each starting from the previous answer: the answer is that of the target eps (no
+   eps jump);
+4. ``"harmonic-continuation"``: the first harmonic alone from the contact-closed guess, then
+   all harmonics from it;
+5. ``"time-start"``: a time integration from rest (a :class:`TimeStart`); its periodic
+   steady state starts one more solve with its mean tangential positions as anchors.
+
+Sweep point (:class:`Point`; :data:`POINT_RUNGS`): ``"grid"`` (the solver from the secant
+predictor), ``"substep"`` (bisection of the step from the last converged point),
+``"retry"`` (the other solver from the neighbour), ``"arclength"`` (pseudo-arclength
+continuation past a fold, :mod:`fretwear.hb.arclength`), the rungs 3-4 of a single solve
+from the neighbour, ``"fresh-start"`` (as a single solve from the first harmonic alone with
+the static anchors and five times the iterations: the neighbour's state can lie on the wrong
+side of a jump of the mean position) and ``"time-start"`` (a time integration from the
+neighbour). Single-solve rungs that ``SolveOptions.strategy`` leaves out are left out of a
+sweep point too.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from fretwear.hb.arclength import arclength
+from fretwear.hb.branch import Branch, Problems
+from fretwear.hb.connectors import Connected
+from fretwear.hb.fallback import TimeDomainFallback
+from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.options import STRATEGY, SolveOptions, SweepOptions
+from fretwear.hb.problem import DLFTProblem
+from fretwear.hb.reduce import Reduced
+from fretwear.hb.solution import Attempt
+from fretwear.hb.solvers import SolveStats, solve, vector_norm
+from fretwear.model.core import Model
+
+#: penalties tried by the eps continuation, as factors of the target eps, and the number of
+#: geometric steps back to the target (the first try: a failed step is halved in log eps)
+EPS_FACTORS = (10.0, 0.1)
+EPS_STEPS = 4
+#: the eps continuation gives up when a step would be smaller than this ratio of penalties
+EPS_MIN_RATIO = 1.02
+#: iterations allowed to one step of the eps continuation (it starts from the answer at a
+#: nearby eps: a step that needs more is better halved)
+EPS_STEP_MAX_ITER = 20
+#: iterations of the fresh start of a sweep point (as a single solve makes it), as a multiple
+#: of the sweep's ``max_iter``: 5 x 40 is the single solve's default of 200
+FRESH_ITER_FACTOR = 5
+#: harmonics above which a single solve without a start begins from the first harmonic alone
+COLD_START_HARMONICS = 3
+
+
+# --- solver runs and starts -----------------------------------------------------------------
+def run(prob: DLFTProblem, x0, options: SolveOptions):
+    """One run of ``options.solver`` on ``prob`` from ``x0`` (m, H): ``(x (m, H), stats)``."""
+
+    def fun(x, jac=True):
+        return prob.residual(x.reshape(prob.m, prob.H), jac)
+
+    t0 = time.perf_counter()
+    x, _, st = solve(fun, np.asarray(x0, float).reshape(-1),
+                     lambda x: prob.scale(x.reshape(prob.m, prob.H)), method=options.solver,
+                     tol=options.tol, max_iter=options.max_iter)
+    st.wall_time = time.perf_counter() - t0
+    return x.reshape(prob.m, prob.H), st
+
+
+def first_harmonic_start(prob: DLFTProblem, options: SolveOptions):
+    """A starting point for a many-harmonic solve: the solution on the first kept harmonic
+    from the contact-closed guess, embedded in the full basis (None if that fails). From the
+    contact-closed guess, the solvers can stall with 15+ harmonics where the one-harmonic
+    problem converges and then starts the full one within a few iterations
+    (docs/verification.md)."""
+    basis, reduced = prob.basis, prob.reduced
+    sub = FourierBasis(basis.harmonics[:1], basis.n_samples)
+    cut = {k: getattr(reduced, k)[:2] for k in ("orders", "Z", "F", "obs_A", "obs_b")}
+    if isinstance(reduced, Connected):  # already seen through the contact springs
+        cut.update(node_A=reduced.node_A[:2], node_b=reduced.node_b[:2])
+    red = dataclasses.replace(reduced, **cut)
+    p1 = DLFTProblem(red, prob.contact, sub, gap=prob.gap, eps=prob.eps, anchor=prob.anchor)
+    if p1.jacobian == "krylov":  # the full problem's blocks (and their real copies), shared
+        p1.blocks = prob.blocks.leading(2)
+
+    def fun(x, jac=True):
+        return p1.residual(x.reshape(p1.m, p1.H), jac)
+
+    x, _, st = solve(fun, p1.initial_guess().reshape(-1),
+                     lambda x: p1.scale(x.reshape(p1.m, p1.H)), method=options.solver,
+                     tol=options.tol, max_iter=options.max_iter)
+    if not st.success:
+        return None
+    U = np.zeros((prob.m, prob.H))
+    x = x.reshape(p1.m, p1.H)
+    U[:, 0] = x[:, 0]
+    U[:, 1] = x[:, 1]
+    U[:, 1 + basis.k] = x[:, 2]
+    return U
+
+
+def cold_start(prob: DLFTProblem, U0, options: SolveOptions) -> np.ndarray:
+    """The start (m, H) of a single solve: ``U0`` when given; else, above
+    :data:`COLD_START_HARMONICS` harmonics, the first harmonic alone
+    (:func:`first_harmonic_start`); else the contact-closed guess."""
+    if U0 is None and prob.basis.k > COLD_START_HARMONICS:
+        U0 = first_harmonic_start(prob, options)
+    return prob.initial_guess() if U0 is None else np.asarray(U0, float).reshape(prob.m, prob.H)
+
+
+def eps_path(prob: DLFTProblem, x, st, eps_from, options: SolveOptions):
+    """From the converged ``x`` at ``eps_from`` back to ``prob.eps`` by geometric steps: a
+    step that fails is halved (in log eps) and retried from the last converged answer, a step
+    that converges grows by 1.5, until ``prob.eps`` is reached or a step would be below
+    :data:`EPS_MIN_RATIO`. On the paper's beam at 79.34 kHz the four equal steps from 10 eps
+    failed where steps of 10 % converge in 3-4 iterations each (docs/studies/eps-rule.md).
+    Returns ``(x, stats, path)``: ``path`` the penalties of the converged answers and, last,
+    that of the failed step if it did not reach ``prob.eps``."""
+    target = float(prob.eps)
+    cur = float(eps_from)
+    step = np.log(target / cur) / EPS_STEPS
+    path = [cur]
+    short = options.replace(max_iter=min(options.max_iter, EPS_STEP_MAX_ITER))
+    while cur != target:
+        remaining = np.log(target / cur)
+        last = abs(remaining) <= abs(step) * (1.0 + 1e-12)
+        e = target if last else float(cur * np.exp(step))
+        xn, stn = run(prob if last else prob.with_eps(e), x, short)
+        if stn.success:
+            cur, x, st = e, xn, stn
+            path.append(e)
+            step *= 1.5
+            continue
+        step *= 0.5
+        if abs(step) < np.log(EPS_MIN_RATIO):
+            path.append(e)
+            return xn, stn, path
+    return x, st, path
+
+
+# --- the ladder of a single solve -----------------------------------------------------------
+@dataclass
+class Found:
+    """An answer of a ladder: ``x`` (m, H) of ``prob`` with its statistics (converged or the
+    best iterate)."""
+
+    x: np.ndarray
+    stats: SolveStats
+    prob: DLFTProblem
+
+
+@dataclass
+class TimeStart:
+    """What the rung ``"time-start"`` of a single solve needs: a time integration of ``model``
+    from rest at ``frequency`` [Hz] (``fallback``), and the condensation ``reduced`` of the
+    balance it starts."""
+
+    fallback: TimeDomainFallback
+    model: Model
+    frequency: float
+    reduced: Reduced
+
+
+@dataclass
+class Trial:
+    """The context of the ladder of a single solve: the balance ``prob`` at the target eps,
+    the ``start`` (m, H), the ``options``, the attempts so far (appended to), the best answer
+    so far, and the optional time-domain start (``found``: what its integration found)."""
+
+    prob: DLFTProblem
+    start: np.ndarray
+    options: SolveOptions
+    attempts: list = field(default_factory=list)
+    time_start: TimeStart | None = None
+    best: Found | None = None
+    found: str = ""
+
+    def __post_init__(self):
+        self.start = np.asarray(self.start, float).reshape(self.prob.m, self.prob.H)
+
+    def keep(self, x, st, prob: DLFTProblem | None = None) -> bool:
+        """Keep ``x`` if it converged or has the smallest residual so far; its success."""
+        if self.best is None or st.success or st.residual < self.best.stats.residual:
+            self.best = Found(x, st, self.prob if prob is None else prob)
+        return st.success
+
+    def settle(self) -> Found:
+        """The best answer so far; the start, unconverged, when no rung ran at the target eps
+        (its relative residual as the solvers give it)."""
+        if self.best is None:
+            tried = ", ".join(a.method for a in self.attempts) or "none"
+            x0 = self.start
+            f, _ = self.prob.residual(x0, False)
+            rel = float(vector_norm(f) / max(self.prob.scale(x0), 1e-300))
+            self.best = Found(x0, SolveStats(False, rel, 0, 1, 0, 0.0,
+                                             f"no attempt converged ({tried})",
+                                             self.options.solver), self.prob)
+        return self.best
+
+
+def start(t: Trial) -> bool:
+    """``"start"``: the solver from the start."""
+    x, st = run(t.prob, t.start, t.options)
+    t.attempts.append(Attempt.of("start", t.prob.eps, st))
+    return t.keep(x, st)
+
+
+def best_point(t: Trial) -> bool:
+    """``"best-point"``: the other solver from the best iterate so far (the start before
+    any)."""
+    x0 = t.start if t.best is None else t.best.x
+    x, st = run(t.prob, x0, t.options.replace(solver=t.options.other_solver))
+    t.attempts.append(Attempt.of("best-point", t.prob.eps, st))
+    return t.keep(x, st)
+
+
+def eps_continuation(t: Trial) -> bool:
+    """``"eps-continuation"``: converge at a shifted penalty (:data:`EPS_FACTORS`), then step
+    back to the target one (:func:`eps_path`); one attempt per shifted penalty, its message
+    gives the path. An answer that did not reach the target eps is not kept."""
+    prob, opts = t.prob, t.options
+    other = opts.replace(solver=opts.other_solver)
+    for factor in EPS_FACTORS:
+        t0 = time.perf_counter()
+        shifted = prob.with_eps(factor * prob.eps)
+        x, st = run(shifted, t.start, opts)
+        if not st.success:  # the other solver at the shifted eps
+            x, st = run(shifted, t.start, other)
+        if not st.success and prob.basis.k > 1:  # the first harmonic alone, at that eps
+            U1 = first_harmonic_start(shifted, opts)
+            if U1 is not None:
+                x, st = run(shifted, U1, opts)
+        path = [factor * prob.eps]
+        if st.success:
+            x, st, path = eps_path(prob, x, st, factor * prob.eps, opts)
+        st.wall_time = time.perf_counter() - t0
+        msg = f"{st.message} (eps path {', '.join(f'{e:.3g}' for e in path)} N/m)"
+        t.attempts.append(Attempt.of("eps-continuation", prob.eps if st.success else path[-1],
+                                     st, msg))
+        if st.success and path[-1] == prob.eps:
+            return t.keep(x, st)
+    return False
+
+
+def harmonic_continuation(t: Trial) -> bool:
+    """``"harmonic-continuation"``: the first harmonic alone, then every harmonic from it (not
+    with a single harmonic)."""
+    prob = t.prob
+    if prob.basis.k <= 1:
+        return False
+    t0 = time.perf_counter()
+    U1 = first_harmonic_start(prob, t.options)
+    if U1 is None:
+        t.attempts.append(Attempt("harmonic-continuation", t.options.solver, prob.eps, False,
+                                  float("nan"), 0, time.perf_counter() - t0,
+                                  "the first harmonic alone did not converge"))
+        return False
+    x, st = run(prob, U1, t.options)
+    st.wall_time = time.perf_counter() - t0
+    t.attempts.append(Attempt.of("harmonic-continuation", prob.eps, st))
+    return t.keep(x, st)
+
+
+def time_start(t: Trial) -> bool:
+    """``"time-start"``: integrate in time from rest (``t.time_start``; none: the rung does
+    not apply) for ``options.time_domain_periods`` periods; a periodic steady state starts
+    the solver (twice the iterations) with its mean tangential positions as anchors, and the
+    answer is kept if it converged or beats the best so far; any other response is what
+    ``t.found`` says."""
+    ts = t.time_start
+    if ts is None:
+        return False
+    best = t.settle()
+    opts, prob = t.options, t.prob
+    t0 = time.perf_counter()
+    t.found, Ut, anchor = ts.fallback.start(ts.model, ts.frequency, prob.basis, None,
+                                            max_periods=opts.time_domain_periods)
+    if Ut is None:
+        t.attempts.append(Attempt("time-start", opts.solver, prob.eps, False, float("nan"), 0,
+                                  0.0, t.found))
+        return False
+    prob2 = DLFTProblem(ts.reduced, ts.model.contact, prob.basis, gap=prob.gap, eps=prob.eps,
+                        anchor=anchor, jacobian=prob.jacobian)
+    x, st = run(prob2, np.asarray(Ut, float).reshape(prob2.m, prob2.H),
+                opts.replace(max_iter=2 * opts.max_iter))
+    st.wall_time = time.perf_counter() - t0
+    t.attempts.append(Attempt.of("time-start", prob2.eps, st))
+    if st.success or st.residual < best.stats.residual:
+        t.best = Found(x, st, prob2)
+    return st.success
+
+
+#: the rungs of a single solve, by the names of :data:`~fretwear.hb.options.STRATEGY`
+SOLVE_RUNGS = {"start": start, "best-point": best_point, "eps-continuation": eps_continuation,
+               "harmonic-continuation": harmonic_continuation, "time-start": time_start}
+
+
+def solve_ladder(t: Trial, rungs=None) -> Found:
+    """Run the rungs ``rungs`` (default ``t.options.strategy``) of a single solve, in the order
+    of :data:`~fretwear.hb.options.STRATEGY`, until one converges: the converged answer, or
+    the best iterate (the start when no rung ran at the target eps)."""
+    rungs = t.options.strategy if rungs is None else rungs
+    for name in STRATEGY:
+        if name in rungs and SOLVE_RUNGS[name](t):
+            break
+    return t.settle()
+
+
+# --- the ladder of a sweep point ------------------------------------------------------------
+@dataclass
+class Point:
+    """The context of the ladder of one grid frequency of a sweep: the frequency [Hz] and
+    ``omega`` [rad/s], the sweep's problems per frequency, its branch of converged points and
+    its options; then what the rungs found: the problem, harmonics and statistics of the last
+    solve, how it was made, every attempt, and what a time integration found (None: none
+    ran)."""
+
+    frequency: float
+    probs: Problems
+    branch: Branch
+    options: SweepOptions
+    prob: DLFTProblem | None = None
+    U: np.ndarray | None = None
+    stats: SolveStats | None = None
+    how: str = "grid"
+    tried: list = field(default_factory=list)
+    time_domain: str | None = None
+
+    @property
+    def omega(self) -> float:
+        return 2 * np.pi * self.frequency
+
+    def adopt(self, prob, U, stats, how) -> bool:
+        """The solve of a rung becomes the point's; its success."""
+        self.prob, self.U, self.stats, self.how = prob, U, stats, how
+        return stats.success
+
+
+def solve_at(probs: Problems, omega: float, anchor, U0, options: SolveOptions):
+    """One solver run at ``omega`` [rad/s] with the stick anchors ``anchor`` from ``U0``
+    (None: the contact-closed guess): ``(problem, U (m, H), stats)``."""
+    prob = probs.get(omega, anchor)
+    x0 = prob.initial_guess() if U0 is None else np.asarray(U0, float).reshape(prob.m, prob.H)
+    x, st = _solve(prob, x0, options)
+    return prob, x, st
+
+
+def _solve(prob: DLFTProblem, x0, options: SolveOptions):
+    def fun(x, jac=True):
+        return prob.residual(x.reshape(prob.m, prob.H), jac)
+
+    x, _, st = solve(fun, x0.reshape(-1), lambda x: prob.scale(x.reshape(prob.m, prob.H)),
+                     method=options.solver, tol=options.tol, max_iter=options.max_iter)
+    return x.reshape(prob.m, prob.H), st
+
+
+def grid(p: Point) -> bool:
+    """``"grid"``: the solver from the secant predictor, with the anchors of the history."""
+    b = p.branch
+    prob, U, st = solve_at(p.probs, p.omega, b.anchor(), b.predict(p.omega), p.options.solve)
+    p.tried.append(Attempt.of("grid", prob.eps, st))
+    return p.adopt(prob, U, st, "grid")
+
+
+def substep(p: Point) -> bool:
+    """``"substep"``: from the last converged point, steps halved on failure (at most
+    ``max_bisections`` times) and grown by 1.5 on success, each converged intermediate point
+    kept in the sweep."""
+    b, omega, opts = p.branch, p.omega, p.options
+    if not b.history:
+        return False
+    w_cur = b.history[-1][0]
+    step = 0.5 * (omega - w_cur)
+    min_step = (omega - w_cur) / 2**opts.max_bisections
+    budget = 6 * opts.max_bisections
+    while budget > 0 and abs(step) >= abs(min_step) * (1 - 1e-12):
+        budget -= 1
+        w_try = w_cur + step
+        last = abs(omega - w_try) <= 1e-9 * abs(omega)
+        if last:
+            w_try = omega
+        pb, Ub, stb = solve_at(p.probs, w_try, b.anchor(), b.predict(w_try), opts.solve)
+        if not stb.success:
+            step *= 0.5
+            continue
+        if last:
+            p.tried.append(Attempt.of("substep", pb.eps, stb))
+            return p.adopt(pb, Ub, stb, "substep")
+        b.add(w_try, pb, Ub, stb, "substep")
+        w_cur = w_try
+        step = step * 1.5
+        if abs(step) > abs(omega - w_cur):
+            step = omega - w_cur
+    return False
+
+
+def retry(p: Point) -> bool:
+    """``"retry"``: the other solver from the last converged point."""
+    b, so = p.branch, p.options.solve
+    if not b.history:
+        return False
+    prob, U, st = solve_at(p.probs, p.omega, b.anchor(), b.history[-1][1],
+                           so.replace(solver=so.other_solver))
+    p.tried.append(Attempt.of("retry", prob.eps, st))
+    return p.adopt(prob, U, st, "retry")
+
+
+def arclength_branch(p: Point) -> bool:
+    """``"arclength"``: pseudo-arclength continuation from the last two converged points past
+    this frequency (its points kept in the sweep), then the solver from the last one."""
+    b, opts = p.branch, p.options
+    if not (opts.continuation and len(b.history) >= 2):
+        return False
+    anc = b.anchor()
+    t_arc = time.perf_counter()
+    found = arclength(p.probs, anc, (b.history[-2][1].reshape(-1), b.history[-2][0]),
+                      (b.history[-1][1].reshape(-1), b.history[-1][0]), p.omega,
+                      opts.solve.tol)
+    for Ub, wb, stb, pb in found:
+        b.add(wb, pb, Ub.reshape(pb.m, pb.H), stb, "arclength")
+    if not found:
+        p.tried.append(Attempt("arclength", "arclength", p.probs.get(p.omega, anc).eps, False,
+                               float("nan"), 0, time.perf_counter() - t_arc,
+                               "the continuation did not reach this frequency"))
+        return False
+    prob, U, st = solve_at(p.probs, p.omega, b.anchor(), b.history[-1][1], opts.solve)
+    p.tried.append(Attempt.of("arclength", prob.eps, st))
+    return p.adopt(prob, U, st, "arclength")
+
+
+def _single(p: Point, prob: DLFTProblem, x0, options: SolveOptions, rungs, how) -> bool:
+    """Rungs of a single solve at this point (those ``options.strategy`` names), recorded
+    with the point's attempts: a converged answer is adopted (``how``: its method when None);
+    a failed one gives the point its statistics when a rung ran."""
+    n0 = len(p.tried)
+    best = solve_ladder(Trial(prob, x0, options, p.tried),
+                        [r for r in rungs if r in options.strategy])
+    if best.stats.success:
+        return p.adopt(prob, best.x, best.stats, how or p.tried[-1].method)
+    if len(p.tried) > n0:
+        p.stats = best.stats
+    return False
+
+
+def continuation(p: Point) -> bool:
+    """``"eps-continuation"``, then ``"harmonic-continuation"``, from the last converged
+    point (the contact-closed guess before any), ending at the sweep's eps (no eps jump)."""
+    b = p.branch
+    pb = p.probs.get(p.omega, b.anchor())
+    x0 = b.history[-1][1] if b.history else pb.initial_guess()
+    return _single(p, pb, x0, p.options.solve, ("eps-continuation", "harmonic-continuation"),
+                   None)
+
+
+def fresh_start(p: Point) -> bool:
+    """``"fresh-start"``: as a single solve would, from the first harmonic alone with the
+    sweep's first anchors, then ``"start"`` and ``"eps-continuation"``, with
+    :data:`FRESH_ITER_FACTOR` times the iterations (the neighbour's state can lie on the wrong
+    side of a jump of the mean position)."""
+    so = p.options.solve
+    pb = p.probs.get(p.omega, p.branch.first_anchor)
+    fresh = so.replace(max_iter=FRESH_ITER_FACTOR * so.max_iter)
+    U1 = first_harmonic_start(pb, fresh)
+    p.tried.append(Attempt("fresh-start", so.solver, pb.eps, U1 is not None, float("nan"), 0,
+                           0.0, "the first harmonic alone" + ("" if U1 is not None
+                                                              else " did not converge")))
+    if U1 is None:
+        return False
+    return _single(p, pb, U1, fresh, ("start", "eps-continuation"), "fresh-start")
+
+
+def point_time_start(p: Point) -> bool:
+    """``"time-start"``: integrate in time from the neighbour (``options.time_domain``; none:
+    the rung does not apply); a periodic steady state starts the solver (twice the
+    iterations) with its mean tangential positions as anchors; what the integration found is
+    ``p.time_domain``."""
+    td, so = p.options.time_domain, p.options.solve
+    if td is None or "time-start" not in so.strategy:
+        return False
+    p.time_domain, Ut, anc_t = td.start(p.probs.model, p.frequency, p.probs.basis,
+                                        p.branch.last_solution,
+                                        max_periods=so.time_domain_periods)
+    if Ut is None:
+        return False
+    prob, U, st = solve_at(p.probs, p.omega, anc_t, Ut.reshape(-1, p.probs.basis.size),
+                           so.replace(max_iter=2 * so.max_iter))
+    p.tried.append(Attempt.of("time-start", prob.eps, st))
+    return p.adopt(prob, U, st, "time-start")
+
+
+#: the rungs of a sweep point, in order
+POINT_RUNGS = (("grid", grid), ("substep", substep), ("retry", retry),
+               ("arclength", arclength_branch), ("continuation", continuation),
+               ("fresh-start", fresh_start), ("time-start", point_time_start))
+
+
+def point_ladder(p: Point) -> Point:
+    """Run the rungs of a sweep point (:data:`POINT_RUNGS`) until one converges."""
+    for _, rung in POINT_RUNGS:
+        if rung(p):
+            break
+    return p

@@ -1,0 +1,164 @@
+"""The continuation state of a sweep: its DLFT problems per frequency, condensed once and kept
+within a memory budget (:class:`Problems`), and its converged points with the secant
+predictor and the stick anchors of the loading history (:class:`Branch`).
+
+Mean tangential position (stick anchors): the sweep follows the loading history; the first
+point starts from the static preload (:func:`fretwear.hb.preload.preload_anchor`) and every
+later point takes the mean tangential positions of the previous converged point as its anchors
+(a node that sticks all period stays where it was). See docs/theory.md, "Full stick and the
+mean position".
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fretwear.hb.connectors import connect, springs
+from fretwear.hb.problem import DLFTProblem
+from fretwear.hb.solution import Attempt, assemble_solution
+from fretwear.hb.solvers import SolveStats
+from fretwear.hb.sweep_result import SweepPoint
+
+#: reduced models a sweep keeps (it revisits the last few frequencies: sub-steps, retries,
+#: arclength) at most, and the memory they may take together [bytes]: at 1024 contact nodes
+#: and 7 harmonics one reduced model is 1.2 GB, so two are kept there (docs/theory.md,
+#: "Large interfaces")
+CACHE_SIZE = 8
+CACHE_BYTES = 3 * 2**30
+
+
+class Problems:
+    """DLFT problems per frequency, condensed once and cached (the sweep revisits them): at
+    most ``cache_size`` reduced models and :data:`CACHE_BYTES` of them (the newest always).
+    ``eps``: a number [N/m], or ``"auto"`` (the spectral radius of each frequency's ``Z_r``)."""
+
+    def __init__(self, model, basis, gap, eps, condenser, jacobian="auto", cache_size=CACHE_SIZE):
+        self.model, self.basis, self.gap, self.eps = model, basis, gap, eps
+        self.jacobian = jacobian
+        self.orders = np.array([0, *basis.harmonics])
+        self.cache: dict = {}
+        self.size = cache_size
+        self.last = None  # the last problem handed out
+        # the model does not change during a sweep: its condenser (and loads) are read once,
+        # the contact springs prepared once, and the problems share their set-up
+        self.condenser = condenser
+        self.springs = springs(model.contact)
+        self.template = None
+
+    def get(self, omega: float, anchor) -> DLFTProblem:
+        """The problem at the circular frequency ``omega`` [rad/s] (the continuation
+        variable of the sweep) with the stick anchors ``anchor``."""
+        key = float(omega)
+        red = self.cache.get(key)
+        if red is None:
+            # room is made before the new model is condensed (every frequency's has the
+            # size of the cached ones): at 1024 nodes one model less held at the peak
+            size = next(iter(self.cache.values())).Z.nbytes if self.cache else 0
+            while self.cache and (len(self.cache) >= self.size or size + sum(
+                    r.Z.nbytes for r in self.cache.values()) > CACHE_BYTES):
+                self.cache.pop(next(iter(self.cache)))
+            red = self.condenser.reduced(omega, self.orders)
+            if self.springs is not None:
+                red = connect(red, self.model.contact, self.springs)
+            self.cache[key] = red
+        if self.template is None:
+            prob = DLFTProblem(red, self.model.contact, self.basis, gap=self.gap,
+                               eps=self.eps, anchor=anchor, jacobian=self.jacobian)
+            # the set-up the other frequencies share (DLFTProblem.at), without this
+            # frequency's reduced model and blocks: they are not pinned for the whole sweep
+            self.template = object.__new__(DLFTProblem)
+            self.template.__dict__.update(prob.__dict__)
+            self.template.reduced = self.template.blocks = self.template.F = None
+        else:
+            prob = self.template.at(red, anchor)
+        # the GMRES preconditioner of large interfaces (fretwear.hb.krylov) is carried from
+        # the neighbouring frequency: GMRES still solves each step to its tolerance, and
+        # rebuilds it when it has become slow
+        prob._precond = getattr(self.last, "_precond", None)
+        self.last = prob
+        return prob
+
+
+def rebuild_point(probs: Problems, entry: dict) -> SweepPoint:
+    """A sweep point from a checkpoint entry
+    (:func:`fretwear.hb.sweep_checkpoint.load_sweep_checkpoint`): its solution re-assembled
+    from its harmonics, anchors and penalty by the code that assembled it first, so it equals
+    the original bit for bit."""
+    rec = entry["record"]
+    stats = SolveStats(**rec["stats"])
+    sol = None
+    if "U" in entry:
+        model, basis = probs.model, probs.basis
+        prob = DLFTProblem(probs.condenser.reduced(entry["omega"], probs.orders), model.contact,
+                           basis, gap=probs.gap, eps=entry["eps"], anchor=entry["anchor"],
+                           jacobian=probs.jacobian)
+        sol = assemble_solution(prob, np.array(entry["U"], float), model, stats)
+    pt = SweepPoint(rec["frequency_hz"], sol, stats, rec["how"], list(rec["flags"]),
+                    bool(rec["on_grid"]), rec["time_domain"],
+                    [Attempt(**a) for a in rec.get("attempts", [])])
+    if sol is not None:
+        sol.attempts = pt.attempts
+    return pt
+
+
+class Branch:
+    """The converged points of a sweep so far, in the order computed: the secant predictor in
+    frequency, the stick anchors of the loading history, and the recording of points.
+
+    Parameters
+    ----------
+    model : the structure; anchor : (nc, d-1) stick anchors of the first point [m] (the
+    static preload state unless given); flag : ``(PeriodicSolution) -> list[str]``, reasons
+    for caution about each converged point (None: none).
+    """
+
+    def __init__(self, model, anchor, flag=None):
+        self.model, self.first_anchor, self.flag = model, anchor, flag
+        self.history: list = []  # converged (omega, U (m, H)) in order
+        self.last_solution = None  # the last converged solution (a time start's neighbour)
+        self.points: list = []  # every point computed, intermediate ones included
+
+    def predict(self, omega: float):
+        """Start at ``omega`` [rad/s]: the secant through the last two converged points (the
+        last one alone, None before any)."""
+        if not self.history:
+            return None
+        if len(self.history) == 1:
+            return self.history[-1][1]
+        (w0, U0), (w1, U1) = self.history[-2], self.history[-1]
+        if w1 == w0:
+            return U1
+        return U1 + (U1 - U0) * (omega - w1) / (w1 - w0)
+
+    def anchor(self):
+        """Stick anchors of the next point: the mean tangential positions of the last
+        converged point (the first point's before any)."""
+        if not self.history:
+            return self.first_anchor
+        c = self.model.contact
+        U = self.history[-1][1].reshape(c.n_nodes, c.dim, -1)
+        return U[:, 1:, 0].copy()
+
+    def record(self, omega, prob, U, stats, how) -> SweepPoint:
+        """The converged point ``U`` (m, H) at ``omega`` [rad/s] of ``prob``, added to the
+        history (not to :attr:`points`)."""
+        sol = assemble_solution(prob, U, self.model, stats)
+        pt = SweepPoint(omega / (2 * np.pi), sol, stats, how, [])
+        if self.flag is not None:
+            pt.flags.extend(self.flag(sol))
+        self.history.append((omega, U))
+        self.last_solution = sol
+        return pt
+
+    def add(self, omega, prob, U, stats, how) -> None:
+        """An intermediate converged point (a substep, a point of the arclength branch)."""
+        self.points.append(self.record(omega, prob, U, stats, how))
+
+    def resume(self, probs: Problems, entries) -> None:
+        """The points of a checkpoint (:func:`rebuild_point`), as if computed here."""
+        for e in entries:
+            pt = rebuild_point(probs, e)
+            self.points.append(pt)
+            if pt.solution is not None:
+                self.history.append((e["omega"], e["U"]))
+                self.last_solution = pt.solution

@@ -1,0 +1,58 @@
+"""Pseudo-arclength continuation (:mod:`fretwear.hb.arclength`): the Newton step of the bordered
+system, and the branch from two converged points past a target frequency.
+
+References: the bordered system multiplied out by hand (the step is whatever solves it), and a
+fresh DLFT problem condensed at each returned frequency by :func:`fretwear.hb.reduce.condense`
+(not the sweep's cache), whose residual at the returned harmonics must meet the corrector's
+tolerance."""
+
+import numpy as np
+from helpers.blocks import closed_block
+
+from fretwear.hb.arclength import arclength, bordered_step
+from fretwear.hb.attempts import solve_at
+from fretwear.hb.branch import Problems
+from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.options import SolveOptions
+from fretwear.hb.problem import DLFTProblem
+from fretwear.hb.reduce import condense, exact_condenser
+
+BASIS = FourierBasis.up_to(3, 32)
+EPS = 1e9  # N/m: one penalty at every frequency
+
+
+def test_bordered_step_solves_the_bordered_system():
+    """``[[J sx, fw sw], [t]] dy = -[f, g]`` multiplied out: 1e-12 of the right-hand side
+    (an LU of a well-conditioned 9 x 9 system)."""
+    rng = np.random.default_rng(2)
+    n, sx, sw = 8, 2.0, 5.0
+    J = rng.standard_normal((n, n)) + 4 * np.eye(n)
+    f, fw, t = rng.standard_normal(n), rng.standard_normal(n), rng.standard_normal(n + 1)
+    dy = bordered_step(J, f, fw, 0.3, t, sx, sw)
+    lhs = np.concatenate([J @ dy[:n] * sx + fw * sw * dy[n], [t @ dy]])
+    np.testing.assert_allclose(lhs, -np.concatenate([f, [0.3]]), rtol=0, atol=1e-12 * 10)
+
+
+def test_branch_passes_the_target_with_balanced_points():
+    """A frictionless block held closed (a linear response): from two converged points at
+    1000 and 1100 Hz towards 1300 Hz, the branch reaches past the target and every point on
+    it is a balance of its own frequency (relative residual of a freshly condensed problem
+    below 1e-8, the corrector's 1e-10 plus the rounding of omega -> Hz -> omega)."""
+    model = closed_block()
+    probs = Problems(model, BASIS, None, EPS, exact_condenser(model))
+    anchor = np.zeros((model.contact.n_nodes, 1))
+    opts = SolveOptions(tol=1e-10)
+    w0, w1, target = (2 * np.pi * f for f in (1000.0, 1100.0, 1300.0))
+    _, U0, s0 = solve_at(probs, w0, anchor, None, opts)
+    _, U1, s1 = solve_at(probs, w1, anchor, U0, opts)
+    assert s0.success and s1.success
+    branch = arclength(probs, anchor, (U0.reshape(-1), w0), (U1.reshape(-1), w1), target, 1e-10)
+    assert branch and branch[-1][1] >= target
+    assert all(b[1] > w1 for b in branch)
+    for U, w, st, _ in branch:
+        assert st.success and st.solver == "arclength"
+        red = condense(model, w / (2 * np.pi), BASIS.orders)
+        prob = DLFTProblem(red, model.contact, BASIS, eps=EPS, anchor=anchor)
+        Ux = U.reshape(prob.m, prob.H)
+        f, _ = prob.residual(Ux, jacobian=False)
+        assert np.linalg.norm(f) <= 1e-8 * prob.scale(Ux)
