@@ -13,7 +13,8 @@ import numpy as np
 
 from fretwear.hb.dynamics import structure_dynamics
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import initial_state, solve_periodic
+from fretwear.hb.periodic import solve_periodic
+from fretwear.hb.solution import initial_state
 from fretwear.hb.stability import stability
 from fretwear.model.build import Damping
 from fretwear.model.core import Load

@@ -112,7 +112,7 @@ class Analysis:
     preload_check : the analysis runs the contact law (vibration, wear):
         :func:`fretwear.analyses.run.run_case` first solves the static contact under the
         preload and warns about an interface that no node of touches
-        (:func:`fretwear.hb.periodic.preload_contact`).
+        (:func:`fretwear.hb.preload.preload_contact`).
     """
 
     name: str

@@ -85,8 +85,9 @@ from fretwear.hb import contact as law
 from fretwear.hb.contact import SEPARATION, STICK
 from fretwear.hb.dynamics import StructureDynamics, structure_dynamics
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.periodic import DLFTProblem, PeriodicSolution
+from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.reduce import condense, to_real_blocks
+from fretwear.hb.solution import PeriodicSolution
 from fretwear.model.core import Model
 
 #: Hill's matrix is formed and its quadratic eigenvalue problem solved densely up to this
@@ -678,7 +679,7 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
 
 def stability(model: Model, sol: PeriodicSolution, *, options: HillOptions | None = None,
               dyn: StructureDynamics | None = None) -> FloquetResult:
-    """:func:`hill_stability` of a converged :class:`~fretwear.hb.periodic.PeriodicSolution`
+    """:func:`hill_stability` of a converged :class:`~fretwear.hb.solution.PeriodicSolution`
     of ``model`` (its problem rebuilt from the solution: frequency, basis, gap, eps,
     anchors); ``dyn``: the model's :func:`fretwear.hb.dynamics.structure_dynamics` if already
     made (a sweep makes it once)."""
@@ -690,7 +691,7 @@ def stability(model: Model, sol: PeriodicSolution, *, options: HillOptions | Non
 
 
 def problem_of(model: Model, sol: PeriodicSolution) -> DLFTProblem:
-    """The :class:`~fretwear.hb.periodic.DLFTProblem` a solution was solved on."""
+    """The :class:`~fretwear.hb.problem.DLFTProblem` a solution was solved on."""
     basis: FourierBasis = sol.basis
     red = condense(model, sol.frequency, basis.orders, quasi_static=sol.quasi_static)
     return DLFTProblem(red, model.contact, basis, gap=sol.gap, eps=sol.eps, anchor=sol.anchor)

@@ -9,7 +9,7 @@ the same multipliers as the continuous flow, to the accuracy of the step).
 
 :func:`monodromy` finds the fixed point by Newton's method on ``P(x) - x`` (shooting, the
 Jacobian by forward differences) from a start (e.g. the state at ``t = 0`` of a harmonic-balance
-solution, :func:`fretwear.hb.periodic.initial_state`), so that unstable periodic responses are
+solution, :func:`fretwear.hb.solution.initial_state`), so that unstable periodic responses are
 found too, and then forms ``dP/dx`` by central differences of ``2 r`` periods. The map is
 piecewise smooth (a node's stick/slip/open decision at a step switches where the perturbation
 moves it across a threshold); the differences are small enough (``perturbation`` of the state's
@@ -135,7 +135,7 @@ def monodromy(model: Model, frequency: float, *, start: InitialState,
     ----------
     start : :class:`~fretwear.timedomain.options.InitialState`: the start of the shooting,
         ``U0, V0`` (ndof,) displacement [m] and velocity [m/s] at ``t = 0`` (e.g.
-        :func:`fretwear.hb.periodic.initial_state` of a harmonic-balance solution), and the
+        :func:`fretwear.hb.solution.initial_state` of a harmonic-balance solution), and the
         ``anchor`` (nc, d-1) tangential positions [m] the first step's slip is measured from
         (default: those of ``U0``).
     integration : :class:`~fretwear.timedomain.options.IntegrationOptions` of the period map

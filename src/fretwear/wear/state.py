@@ -21,7 +21,7 @@ from enum import IntEnum
 
 import numpy as np
 
-from fretwear.hb.periodic import PeriodicSolution
+from fretwear.hb.solution import PeriodicSolution
 from fretwear.wear.laws import worn_volume
 
 
