@@ -711,8 +711,6 @@ def condense(model: Model, frequency: float, orders, *, quasi_static: bool = Fal
     contact-local coordinates with the observed-DOF recovery rows
     (``Reduced.omega = 2 pi frequency`` [rad/s], ``Reduced.frequency`` as given).
     """
-    if condenser is not None:
-        return condenser.reduced(2 * np.pi * frequency, orders, quasi_static, frequency)
     return _condense(model, 2 * np.pi * frequency, orders, quasi_static=quasi_static,
                      frequency=frequency, condenser=condenser)
 
