@@ -40,7 +40,7 @@ from fretwear.analyses.common import (
 from fretwear.errors import InputError
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.inputs import QUASI_STATIC_FREQUENCY
-from fretwear.hb.options import PERIODIC
+from fretwear.hb.options import PERIODIC as PERIODIC_SOLVE
 from fretwear.hb.penalty import penalty
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.reduce import condense, exact_condenser, recover
@@ -208,7 +208,7 @@ def run_periodic(model, analysis: dict, case, context: RunContext) -> RunOutput:
     reduced = condense(model, f_hz, basis.orders, quasi_static=qs, condenser=cond)
     eps = penalty(analysis["eps"], model=model, reduced=reduced, condenser=cond)
     sol = api.solve_periodic(model, basis, frequency=f_hz, quasi_static=qs,
-                             options=solve_options_of(analysis, PERIODIC), reduced=reduced,
+                             options=solve_options_of(analysis, PERIODIC_SOLVE), reduced=reduced,
                              eps=eps, time_domain=analysis["time_domain"], condenser=cond)
     stats = sol.stats
     attrs = {**solver_attributes(stats, analysis, eps), "excitation_frequency": f_hz,
@@ -452,8 +452,8 @@ PERIODIC = Analysis.define(
                                                                           "time_domain")),
         "time_domain_periods": Field(Integer(lo=10), "forcing periods allowed to the time "
                                      "integration (time_domain)",
-                                     default=PERIODIC.time_domain_periods),
-        **harmonic_balance_fields(PERIODIC, default_of(solve_periodic, "eps"),
+                                     default=PERIODIC_SOLVE.time_domain_periods),
+        **harmonic_balance_fields(PERIODIC_SOLVE, default_of(solve_periodic, "eps"),
                                   "DLFT penalty: " + _EPS_RULES),
     },
     run_periodic,

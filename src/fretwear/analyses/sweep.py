@@ -34,7 +34,7 @@ from fretwear.analyses.common import (
 )
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.options import SWEEP
+from fretwear.hb.options import SWEEP as SWEEP_OPTIONS
 from fretwear.hb.reduce import exact_condenser
 from fretwear.hb.solution import PeriodicSolution
 from fretwear.hb.sweep import SweepResult
@@ -247,8 +247,8 @@ def run_sweep(model, analysis: dict, case, context: RunContext) -> RunOutput:
             bar.set_postfix_str(f"{plots.format_frequency(pt.frequency_hz)}"
                                 f"{'' if pt.success else ' (not converged)'}")
 
-        options = SWEEP.replace(
-            solve=solve_options_of(analysis, SWEEP.solve), spacing=analysis["spacing"],
+        options = SWEEP_OPTIONS.replace(
+            solve=solve_options_of(analysis, SWEEP_OPTIONS.solve), spacing=analysis["spacing"],
             eps=analysis["eps"], eps_band=analysis.get("eps_band"),
             continuation=analysis["continuation"],
             flag=(sweep_check(model, max_periods=analysis["time_domain_periods"],
@@ -380,17 +380,17 @@ SWEEP = Analysis.define(
         "n_points": Field(Integer(lo=2), "number of grid frequencies (the sweep may add "
                           "intermediate points where a step fails)", default=200),
         "spacing": Field(Text(("log", "linear")), "frequency spacing",
-                         default=SWEEP.spacing),
+                         default=SWEEP_OPTIONS.spacing),
         "continuation": Field(Flag(), "pseudo-arclength continuation when a frequency step "
                               "fails (passes folds of the response curve)",
-                              default=SWEEP.continuation),
+                              default=SWEEP_OPTIONS.continuation),
         "time_domain": Field(Flag(), "where a point still fails, integrate in time from the "
                              "neighbour: a periodic steady state starts one more solve, any "
                              "other response (drifting, quasi-periodic) is reported as the "
                              "reason", default=default_of(api.sweep, "time_domain")),
         "time_domain_periods": Field(Integer(lo=10), "forcing periods allowed to each time "
                                      "integration (time_domain, check_stability)",
-                                     default=SWEEP.solve.time_domain_periods),
+                                     default=SWEEP_OPTIONS.solve.time_domain_periods),
         "check_stability": Field(Flag(), "check every converged point in time (does the "
                                  "structure settle to it?); slow", default=False),
         "points": Field(ListOf(Text(), non_empty=True, unique=True),
@@ -409,7 +409,7 @@ SWEEP = Analysis.define(
                                "few sparse solves per resonance however many points",
                                default=default_of(linear_reference_grid, "linear_points")),
         **harmonic_balance_fields(
-            SWEEP.solve, SWEEP.eps,
+            SWEEP_OPTIONS.solve, SWEEP_OPTIONS.eps,
             'DLFT penalty, one value for the whole sweep (a smooth FRF): "top": the spectral '
             "radius of Z_r at the highest kept harmonic, its median over the band (chosen "
             'from measurements, docs/studies/eps-rule.md); "static": that of the static '
