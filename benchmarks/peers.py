@@ -104,7 +104,9 @@ def model():
 
 def run():
     res = fretwear.sweep(model(), FourierBasis.up_to(H, 128), w0 / (2 * np.pi),
-                         w1 / (2 * np.pi), n, spacing="linear", eps=eps, time_domain=False)
+                         w1 / (2 * np.pi), n,
+                         options=fretwear.SweepOptions(spacing="linear", eps=eps),
+                         time_domain=False)
     pts = [p for p in res.points if p.on_grid]
     w = [2 * np.pi * p.frequency_hz for p in pts if p.success]
     a = [float(p.solution.observed_amplitude("x")[0][0]) for p in pts if p.success]

@@ -170,8 +170,8 @@ def _verdict(kind, dist, n, wall, tolerance, res) -> StabilityCheck:
 
 
 def sweep_check(model: Model, **kwargs):
-    """A ``check`` callable for :func:`fretwear.hb.sweep.sweep`: flags from
-    :func:`check_periodic`."""
+    """The ``flag`` callable of a sweep (:class:`fretwear.hb.options.SweepOptions`): flags
+    from :func:`check_periodic`."""
 
     def check(sol: PeriodicSolution) -> list[str]:
         return check_periodic(model, sol, **kwargs).flags()
