@@ -203,7 +203,8 @@ def test_frf_worn_is_the_sweep_of_the_worn_gap(block):
     gap = np.broadcast_to(np.asarray(block.contact.gap, float), (block.contact.n_nodes,))
     wear = np.linspace(0.0, 2e-9, block.contact.n_nodes)
     a = fw.frf_worn(block, BASIS, wear, 1400.0, 1600.0, 2)
-    b = fw.sweep(block, BASIS, 1400.0, 1600.0, 2, spacing="linear", gap=gap + wear)
+    b = fw.sweep(block, BASIS, 1400.0, 1600.0, 2, options=SweepOptions(spacing="linear"),
+                 gap=gap + wear)
     assert a.success == b.success and a.point_success.any()
     np.testing.assert_array_equal(a.frequency_hz, b.frequency_hz)
     np.testing.assert_array_equal(a.amplitude("Pe", 0), b.amplitude("Pe", 0))

@@ -18,8 +18,11 @@ from helpers.cases import WEAR_BLOCK, small_case
 import fretwear.analyses
 from fretwear import api
 from fretwear.analyses.run import run_case
+from fretwear.hb.fallback import TimeDomainFallback
 
-SENTINEL = object()  # stands for fretwear.timedomain.fallback.FALLBACK inside fretwear.api
+# stands for fretwear.timedomain.fallback.FALLBACK inside fretwear.api (a fallback of its own
+# kind: the option records check what they are given)
+SENTINEL = TimeDomainFallback(start=None, averaged_rate=None)
 
 PERIODIC = '[analysis]\ntype = "periodic"\nfrequency = 1e4\nharmonics = 1\nn_samples = 16\n'
 SWEEP = ('[analysis]\ntype = "sweep"\nf_min = 1e3\nf_max = 2e3\nn_points = 2\nharmonics = 1\n'
@@ -84,8 +87,8 @@ def test_sweep_takes_the_fallback_of_the_api(tmp_path, core, key, expected):
         run_case(small_case(tmp_path, SWEEP + key + NO_FILES), progress=False, echo=False,
                  resume=True)
     ((kw,),) = calls.values()
-    assert kw["time_domain"] is expected
-    assert kw["resume"] is True  # from the run context
+    assert kw["options"].time_domain is expected
+    assert kw["options"].resume is True  # from the run context
 
 
 @pytest.mark.parametrize("key,expected", [("", SENTINEL), ("time_domain = false\n", None)])
@@ -102,7 +105,7 @@ def test_wear_and_its_frfs_take_the_fallback_of_the_api(tmp_path, core, key, exp
     (wear,) = calls["simulate_wear"]
     (frf,) = calls["frf_worn"]  # the unworn interface first; the run stops there
     assert wear["time_domain"] is SENTINEL and wear["quasi_static"] is True
-    assert frf["time_domain"] is expected
+    assert frf["options"].time_domain is expected
 
 
 def test_no_analysis_names_the_fallback_itself():

@@ -250,14 +250,17 @@ def assemble_solution(prob: DLFTProblem, U, model: Model, stats: SolveStats) -> 
     )
 
 
-def initial_state(model: Model, sol: PeriodicSolution):
-    """Full-field displacement [m] and velocity [m/s] at ``t = 0`` of a periodic solution."""
+def initial_state(model: Model, sol: PeriodicSolution, condenser=None):
+    """Full-field displacement [m] and velocity [m/s] at ``t = 0`` of a periodic solution
+    (the exact recovery of the condensation, eq. 19; ``condenser``: the model's, as the solve
+    had it, None a new exact one)."""
     b = sol.basis
     m = sol.U.shape[0] * sol.U.shape[1]
     U = sol.U if sol.U_node is None else sol.U_node  # the structure's contact nodes
     Uc = b.to_complex(U.reshape(m, -1))  # (k+1, m) complex amplitudes
     orders = np.array([0, *b.harmonics])
-    Ufull = _recover(model, sol.omega, orders, Uc, quasi_static=sol.quasi_static)
+    Ufull = _recover(model, sol.omega, orders, Uc, quasi_static=sol.quasi_static,
+                     condenser=condenser)
     U0 = Ufull.real.sum(axis=0)
     V0 = -(orders[:, None] * sol.omega * Ufull.imag).sum(axis=0)
     return U0, V0
