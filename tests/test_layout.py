@@ -25,7 +25,6 @@ PENDING = {
     "wear/time_steps.py",
     "wear/worn_frf.py",
     "analyses/run.py",  # helper "analyses"
-    "timedomain/steady.py",  # helper "model"
 }
 
 
