@@ -24,7 +24,6 @@ PENDING = {
     "wear/step_control.py",
     "wear/time_steps.py",
     "wear/worn_frf.py",
-    "analyses/run.py",  # helper "analyses"
 }
 
 
