@@ -1,6 +1,6 @@
 """The checks of a periodic solve's arguments (:func:`fretwear.hb.inputs.check_inputs`): one
 InputError (or TypeError for an object of the wrong kind) naming the argument, the value and
-what is expected. The public entry points are exercised in tests/test_api_arguments.py."""
+what is expected. The public entry points are exercised in tests/test_api.py."""
 
 import numpy as np
 import pytest

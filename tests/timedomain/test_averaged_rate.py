@@ -249,7 +249,7 @@ def test_time_averaged_steps_follow_the_time_integration(monkeypatch, tmp_path, 
         spb.set_state(h.wear_depth[1], h.anchor[1])
         Js = spb.slow_jacobian(h.U[1].reshape(spb.m, spb.H))
     eye = np.eye(Js.shape[0])
-    Js = without_growth(Js)  # checked against eigen-analysis in test_without_growth_*
+    Js = without_growth(Js)  # checked in tests/wear/test_time_steps.py
     for k in range(2, 5):
         dN = h.jump[k]
         dW = np.maximum(dN * np.linalg.solve(eye - dN * Js, h.wear_rate[k - 1]), 0.0)
@@ -311,33 +311,3 @@ def test_run_starts_from_a_time_integration_when_the_unworn_balance_fails(monkey
     assert h.rescued[1] == Rescue.TIME_START and np.all(h.rescued[2:] == Rescue.BALANCED)
     # only the wear module's start was forced
     assert fretwear.hb.periodic.solve_periodic is not failing
-
-
-def test_without_growth_keeps_decaying_modes_and_makes_growing_ones_explicit():
-    """:func:`without_growth` against a hand-built matrix with known eigenpairs: a growing
-    mode (+2), a neutral one (0), a decaying one (-5) and a decaying oscillatory pair
-    (-1 +- 3i), in a non-orthogonal basis. The predictor ``(I - dN Js+)^-1 g`` must then be,
-    along each eigenvector, explicit Euler (growing: factor 1, even at ``dN mu = 1`` where
-    ``I - dN Js`` is singular), exact for the neutral mode (factor 1) and ``1 / (1 - dN mu)``
-    for the others; the eigenvectors are unchanged. Tolerance: round-off of a 5 x 5 eigen
-    decomposition with condition number ~10."""
-    rng = np.random.default_rng(3)
-    V = np.eye(5) + 0.3 * rng.standard_normal((5, 5))
-    B = np.zeros((5, 5))
-    B[0, 0], B[1, 1], B[2, 2] = 2.0, 0.0, -5.0
-    B[3:, 3:] = [[-1.0, 3.0], [-3.0, -1.0]]  # eigenvalues -1 +- 3i
-    Js = V @ B @ np.linalg.inv(V)
-    Jp = without_growth(Js)
-    assert Jp.dtype == float
-    Bp = B.copy()
-    Bp[0, 0] = 0.0
-    np.testing.assert_allclose(Jp, V @ Bp @ np.linalg.inv(V), atol=1e-12 * np.abs(Js).max())
-    dN = 0.5  # dN mu = 1 for the growing mode
-    for j, factor in ((0, 1.0), (1, 1.0), (2, 1.0 / (1.0 + 5.0 * dN))):
-        step = np.linalg.solve(np.eye(5) - dN * Jp, V[:, j])
-        np.testing.assert_allclose(step, factor * V[:, j], atol=1e-12)
-    # a matrix without growing modes is returned unchanged
-    Bm = B.copy()
-    Bm[0, 0] = -2.0
-    Jm = V @ Bm @ np.linalg.inv(V)
-    np.testing.assert_array_equal(without_growth(Jm), Jm)

@@ -1,18 +1,15 @@
-"""Tests of fretting wear on the slow scale (the fretwear.wear package: laws, kernels, schemes,
-run_wear).
+"""Tests of fretting wear on the slow scale through its driver (:mod:`fretwear.wear.simulate`:
+simulate_wear, with its rates, derivatives, stops and checkpoints). The tests of the wear laws,
+the slow-step schemes and the worn FRF are in tests/wear/test_laws.py, test_schemes.py and
+test_worn_frf.py.
 
 References, each independent of the code under test:
 
-* the friction energy of :func:`fretwear.hb.contact.friction_work` (a separate code path): with
-  Archard's law and Coulomb slip, worn volume per cycle = k_w / mu x friction energy, exactly
-  on the same samples; and the energy law with k_e = k_w / mu gives Archard's wear;
-* the closed-form quasi-static Coulomb oscillator (a contact node on a tangential spring k_t
-  under a constant normal load and a sinusoidal tangential load of amplitude Q > mu P A):
-  slip path 4 (Q - mu P A) / k_t per cycle, so Archard's rate is k_w P x that path;
+* the post-processed Archard rate of eq. 29 (pressure_t x slip_t), a separate code path from
+  the integrators' kernel;
 * contact states of the DLFT (:mod:`fretwear.hb.contact`): a node that sticks all period must
   not wear, to the last bit;
 * finite differences for every derivative of the implicit scheme;
-* a fine-jump explicit Euler run for the slow-scale integrators;
 * an uninterrupted run for interrupt-and-resume (bitwise);
 * statics of the mean state of the paper's beam: mean contact forces = preload, resultant at
   L/2.
@@ -28,17 +25,12 @@ import math
 
 import numpy as np
 import pytest
-from helpers.models import sliders
+from helpers.wear_block import BASIS, KW, block
 
 from fretwear.hb import contact as law
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.options import SolveOptions
-from fretwear.hb.periodic import solve_periodic
-from fretwear.hb.preload import static_anchor
-from fretwear.hb.reduce import condense
 from fretwear.hb.solvers import solve_identity_rows
-from fretwear.model.build import ContactSpec, Material, Spring, Traction, from_mesh
-from fretwear.model.mesh import rectangle
 from fretwear.wear import (
     BalanceSetup,
     RunControl,
@@ -51,60 +43,8 @@ from fretwear.wear import (
 )
 from fretwear.wear.kernels import slip_work, slip_work_gradient
 
-KW = 1e-11  # Archard coefficient [1/Pa] (paper section 4)
-MU = 0.3
-BASIS = FourierBasis.up_to(3, 32)
 
-
-# --- models -------------------------------------------------------------------------------
-def block(q_ratio=0.5):
-    """A steel block 20 x 4 mm (10 x 2 Q4) on a rigid flat, held in x by a spring at the
-    bottom-left corner, pressed by 1 MPa on top, with a sinusoidal pressure on its right face
-    worth ``q_ratio`` of the friction capacity: partial slip next to the loaded end."""
-    q = q_ratio * 1e6 * MU * 0.02 / 0.004
-    return from_mesh(rectangle(0.02, 0.004, 10, 2), Material(210e9, 0.3, 7800), thickness=0.01,
-                     supports=[Spring("bottom_left", "x", 1e5)],
-                     loads=[Traction("top", pressure=1e6),
-                            Traction("right", pressure=q, waveform="sin")],
-                     contact=ContactSpec("bottom", mu=MU, normal=(0, -1), wear_coefficient=KW),
-                     observed={"Pe": (0.02, 0.002)})
-
-
-@pytest.fixture(scope="module")
-def blk():
-    m = block()
-    red = condense(m, 1.0, BASIS.orders, quasi_static=True)
-    return m, red, static_anchor(m)
-
-
-@pytest.fixture(scope="module")
-def sol_block(blk):
-    m, red, anc = blk
-    sol = solve_periodic(m, BASIS, quasi_static=True, reduced=red, anchor=anc,
-                         options=SolveOptions(tol=1e-12))
-    st = sol.stats
-    assert st.success
-    return sol
-
-
-# --- wear laws ---------------------------------------------------------------------------------
-def test_archard_volume_equals_friction_energy_over_mu(sol_block):
-    """Worn volume per cycle = k_w / mu x friction energy per cycle (Coulomb slip: lambda_T is
-    mu lambda_N along the slip increment). Same samples, so only rounding separates them:
-    1e-12 relative."""
-    sol = sol_block
-    dw = wear_per_cycle(sol, wear_coefficient=KW)
-    volume = float(sol.area @ dw)
-    energy = float(sol.friction_energy().sum())
-    assert energy > 0
-    assert volume == pytest.approx(KW / MU * energy, rel=1e-12)
-    # node by node, and the energy law with k_e = k_w / mu gives Archard's wear
-    np.testing.assert_allclose(sol.area * dw, KW / MU * sol.friction_energy(), rtol=1e-12,
-                               atol=1e-30)
-    de = wear_per_cycle(sol, law_name="energy", energy_coefficient=KW / MU)
-    np.testing.assert_allclose(de, dw, rtol=1e-12, atol=1e-30)
-
-
+# --- wear rates ---------------------------------------------------------------------------------
 def test_kernel_matches_post_processing(blk, sol_block):
     """The integrators' kernel (slip work on lambda_u, lambda_x) gives the post-processed
     Archard rate of eq. 29 (pressure_t x slip_t): two code paths, rounding only (1e-12)."""
@@ -132,48 +72,6 @@ def test_sticking_nodes_do_not_wear(blk, sol_block):
     assert np.all(h.wear_depth[-1, never] == 0.0)
     worn = h.wear_depth[-1] > 0
     assert worn.sum() >= 4 and np.all(h.slip_path.max(axis=0)[worn] > 0)
-
-
-def test_uniform_sliding_analytic_rate():
-    """Independent sliders (normal force exactly P A): Archard's rate is k_w P x slip path,
-    uniform, and the path is the closed form 4 (Q - mu P A)/k_t of the quasi-static Coulomb
-    oscillator. With the default penalty eps = k_t, lambda_u = F - k_t U + eps U = F does not
-    depend on U: the DLFT is then exact at the samples whatever the harmonics (1e-12). With
-    eps = 10 k_t the truncated harmonics smooth the stick corners; measured path errors
-    2.8% (3 harmonics), 1.5% (7), 0.36% (15), 0.012% (31): checked to 1e-3 at 31 and
-    decreasing."""
-    P, A, kt, ratio = 1e6, 1e-4, 1e8, 3.0
-    m = sliders(P=P, A=A, kt=kt, ratio=ratio)
-    exact_path = 4 * (ratio - 1) * MU * P * A / kt
-    errors = []
-    for nh, eps in ((3, "auto"), (3, 10 * kt), (7, 10 * kt), (31, 10 * kt)):
-        b = FourierBasis.up_to(nh, 16 * nh + 16)
-        sol = solve_periodic(m, b, quasi_static=True, options=SolveOptions(tol=1e-12), eps=eps)
-        st = sol.stats
-        assert st.success
-        np.testing.assert_array_equal(sol.pressure_t(), P)  # exact normal force
-        rate = wear_per_cycle(sol, wear_coefficient=KW)
-        np.testing.assert_allclose(rate, KW * P * sol.slip_t().sum(axis=1), rtol=1e-13)
-        assert np.ptp(rate) <= 1e-12 * rate.max()  # uniform
-        errors.append(abs(rate[0] / (KW * P * exact_path) - 1))
-    assert errors[0] < 1e-12
-    assert errors[3] < 1e-3
-    assert errors[1] > errors[2] > errors[3]
-
-
-@pytest.mark.parametrize("scheme", ["implicit", "explicit"])
-def test_uniform_sliding_wears_linearly(scheme):
-    """Uniform wear opens a uniform gap, which does not change a load-controlled contact (the
-    normal spring is 1 N/m: the load it takes after 1e5 cycles is 6e-8 of P A), so W(N) is the
-    initial rate x N at every node: checked to 1e-6."""
-    m = sliders()
-    b = FourierBasis.up_to(3, 32)
-    r = simulate_wear(m, b, quasi_static=True,
-                      options=WearOptions(scheme=scheme, max_cycles=1e5, initial_jump=1e4,
-                                          adaptive=False))
-    h = r.history
-    assert r.stop_reason == "max_cycles" and h.cycles[-1] == pytest.approx(1e5)
-    np.testing.assert_allclose(h.wear_depth[-1], h.wear_rate[0] * 1e5, rtol=1e-6)
 
 
 # --- derivatives ------------------------------------------------------------------------------
@@ -292,51 +190,6 @@ def test_identity_row_elimination_is_exact():
 
 
 # --- slow-scale integrators ---------------------------------------------------------------------
-@pytest.fixture(scope="module")
-def explicit_reference(blk):
-    """Explicit Euler with fixed jumps of 2e4 cycles (the stability limit 2/rho is ~9e4 at
-    the start) up to N = 2e6: 100 steps."""
-    m, red, anc = blk
-    r = simulate_wear(m, BASIS, quasi_static=True, balance=BalanceSetup(reduced=red, anchor=anc),
-                      options=WearOptions(scheme="explicit", adaptive=False, initial_jump=2e4,
-                                          max_cycles=2e6))
-    return r
-
-
-def test_implicit_large_jumps_and_adaptive_match_fine_explicit(blk, explicit_reference):
-    """Implicit Euler with jumps of 5e5 cycles (5.5x the explicit stability limit 2/rho) and
-    the adaptive backward Euler, linearly implicit and explicit schemes (tolerance 1e-2) reach
-    the profile of the fine explicit reference at N = 2e6 (max difference relative to the
-    maximum depth). Measured: 3.7% (7 steps: first order with jumps 25x the reference's);
-    1.2%, 1.0% and 0.7% for the adaptive schemes (the global error of first-order steps at a
-    local tolerance of 1e-2, one-sided because the rates decrease as wear grows). The
-    reference itself is 0.2% from jumps of 2e3. Bounds: 8%, 3%, 3%, 3%. Explicit Euler with
-    the same 5e5 jumps is unstable: 76% off (checked > 5x the implicit error)."""
-    m, red, anc = blk
-    ref = explicit_reference.history.wear_depth[-1]
-    assert explicit_reference.stability_jump == pytest.approx(9e4, rel=0.5)
-
-    def run(**kw):
-        o = WearOptions(max_cycles=2e6, **kw)
-        r = simulate_wear(m, BASIS, quasi_static=True,
-                          balance=BalanceSetup(reduced=red, anchor=anc), options=o)
-        assert r.success and r.history.cycles[-1] == pytest.approx(2e6)
-        return np.abs(r.history.wear_depth[-1] - ref).max() / ref.max(), r
-
-    e_big, r_big = run(scheme="implicit", adaptive=False, initial_jump=5e5)
-    # jumps of 5e5 except where a growing mode (eigenvalue > 0 of the slow Jacobian) limits
-    assert r_big.history.n_steps <= 8 and r_big.history.jump.max() == 5e5
-    e_ad, _ = run(scheme="implicit", tolerance=1e-2)
-    e_ro, _ = run(scheme="rosenbrock", tolerance=1e-2)
-    e_ex, _ = run(scheme="explicit", tolerance=1e-2)
-    e_unstable, _ = run(scheme="explicit", adaptive=False, initial_jump=5e5)
-    assert e_big < 0.08
-    assert e_ad < 0.03
-    assert e_ro < 0.03
-    assert e_ex < 0.03
-    assert e_unstable > 5 * e_big
-
-
 def test_plateau_stop_and_history(blk):
     """The run stops at the plateau (worn-volume rate below plateau_rate x the initial one),
     the history is consistent (cycles = cumulative jumps, worn volume = area . W) and every
@@ -450,21 +303,6 @@ def test_resume_refuses_other_settings(blk, tmp_path):
 
 
 # --- the case-file analysis -------------------------------------------------------------------
-def test_frf_worn_uniform_wear_is_a_rigid_shift(blk):
-    """The block is held vertically by the contact only: a uniform wear depth translates it
-    without changing any force, so the nonlinear FRF (fretwear.hb.sweep with the worn gap) is
-    that of the unworn interface, to the solver tolerance (1e-6 relative)."""
-    from fretwear.wear import frf_worn
-
-    m, _, anc = blk
-    grid = (2e3, 3e3, 3)
-    a = frf_worn(m, BASIS, 0.0, *grid, anchor=anc)
-    b = frf_worn(m, BASIS, np.full(m.contact.n_nodes, 1e-9), *grid, anchor=anc)
-    assert a.success and b.success
-    np.testing.assert_allclose(b.frequency_hz, a.frequency_hz)
-    np.testing.assert_allclose(b.amplitude("Pe", 0), a.amplitude("Pe", 0), rtol=1e-6)
-
-
 def test_no_wear_without_slip(tmp_path):
     """A fully stuck interface: zero rate at the start, stop reason "no_wear" at once."""
     m = block(q_ratio=0.01)
@@ -505,17 +343,6 @@ def test_progress_bar_shows_cycles_volume_rate_and_time_left(blk, capsys):
     err = capsys.readouterr().err
     assert "cycles" in err and "m^3/cycle" in err and "<" in err  # tqdm's [elapsed<left]
     assert f"worn {r.history.worn_volume[-1]:.3g} m^3" in err
-
-
-def test_zero_wear_zones_are_runs_of_unworn_nodes():
-    """Hand-made profile (unordered x): the zones are the runs of nodes at most 1 % of the
-    deepest, in x order, ends included."""
-    from fretwear.wear import zero_wear_zones
-
-    x = np.array([0.5, 0.0, 0.1, 0.2, 0.3, 0.4, 0.6])
-    w = np.array([0.0, 0.0, 0.005, 1.0, 0.0, 0.3, 0.02])
-    assert zero_wear_zones(x, w) == [[0.0, 0.1], [0.3, 0.3], [0.5, 0.5]]
-    assert zero_wear_zones(x, w, fraction=0.03) == [[0.0, 0.1], [0.3, 0.3], [0.5, 0.6]]
 
 
 def test_mean_normal_force_balances_the_preload_on_the_paper_beam():

@@ -18,16 +18,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers.wear_runs import short_run
 
-from fretwear.examples.builders import stromberg_beam
-from fretwear.hb.fourier import FourierBasis
-from fretwear.wear import (
-    HISTORY_FIELDS,
-    RunControl,
-    WearHistory,
-    WearOptions,
-    simulate_wear,
-)
+from fretwear.wear import HISTORY_FIELDS
 from fretwear.wear.state import Rescue, SlowStep, StepRecord, shape_of
 
 DOCS = Path(__file__).resolve().parents[2] / "docs"
@@ -35,15 +28,8 @@ DOCS = Path(__file__).resolve().parents[2] / "docs"
 
 @pytest.fixture(scope="module")
 def run():
-    """Six steps of a quasi-static wear run (12 x 2 Stromberg beam, 3 harmonics), with every
-    accepted step's record as the callback got it."""
-    model, basis = stromberg_beam(nx=12, ny=2), FourierBasis.up_to(3, 32)
-    seen = []
-    res = simulate_wear(model, basis, quasi_static=True, options=WearOptions(max_steps=6),
-                        run=RunControl(callback=lambda step, record: seen.append(record)))
-    nc, d = model.contact.dofs.shape
-    dims = {"nc": nc, "d": d, "d-1": d - 1, "m": nc * d, "H": basis.size}
-    return res, seen, dims
+    """The short run of :func:`helpers.wear_runs.short_run` (result, records, dimensions)."""
+    return short_run()
 
 
 def test_rescue_codes_are_the_documented_ones():
@@ -100,20 +86,3 @@ def test_state_after_a_step_holds_its_record(run):
     assert after.cycles == seen[1].cycles and after.volume_rate == seen[1].volume_rate
     assert after.Js.size == after.time_U.size == after.time_V.size == 0
     assert after.retry_balance_at == 0.0 and after.stop_reason == ""
-
-
-def test_history_of_records_and_back(run):
-    """The history is the records stacked step by step; its records are the same numbers,
-    with the rescue as a :class:`Rescue`."""
-    res, seen, _ = run
-    h = res.history
-    again = WearHistory.from_records(h.records(), h.stop_reason)
-    for name in HISTORY_FIELDS:
-        a, b = getattr(h, name), getattr(again, name)
-        assert a.dtype == b.dtype, name
-        np.testing.assert_array_equal(a, b, err_msg=name)
-    assert h.rescued.dtype.kind == "i"
-    for k, record in enumerate(seen, start=1):
-        np.testing.assert_array_equal(h.wear_depth[k], record.wear_depth)
-        assert h.cycles[k] == record.cycles
-    assert all(isinstance(r.rescued, Rescue) for r in h.records())

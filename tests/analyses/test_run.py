@@ -1,4 +1,5 @@
-"""Output paths a hostile user gives: every one gets one clear message before anything is
+"""The output folder of a run (fretwear.analyses.run: run_case, check_output). Output paths a
+hostile user gives: every one gets one clear message before anything is
 computed (exit 2, no traceback), and no run ever writes outside its output folder.
 
 Reference: the rules of the command line (docs: README "Using it"): an output folder that
@@ -13,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "src" / "fretwear" / "examples" / "beam-linear-frf.toml"
 
 

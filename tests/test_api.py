@@ -1,7 +1,7 @@
-"""The Python API refuses wrong shapes, types and values at its entry points with a
-ValueError (InputError) or TypeError that names the argument, instead of a traceback from
-deep inside (an AttributeError on None, an IndexError in the balance, a geomspace error) or
-a silent answer (complex K cut to its real part, a zero response reported as converged).
+"""The Python API (fretwear.api) refuses wrong shapes, types and values at its entry points
+with a ValueError (InputError) or TypeError that names the argument, instead of a traceback
+from deep inside (an AttributeError on None, an IndexError in the balance, a geomspace
+error) or a silent answer (complex K cut to its real part, a zero response reported as converged).
 
 Reference: the documented signatures (docstrings) of each entry point.
 """
