@@ -45,7 +45,7 @@ SHORTEN = {
 }
 
 #: attributes that record when, how long or with what, not what
-VOLATILE = ("time", "seconds", "version", "created", "host", "elapsed", "date", "wall",
+VOLATILE = ("time", "seconds", "version", "created", "host", "elapsed", "date", "wall", "path",
             "case_file", "cpu")
 
 
