@@ -93,6 +93,10 @@ from fretwear.model.core import Model
 #: Hill's matrix is formed and its quadratic eigenvalue problem solved densely up to this
 #: many unknowns ``m H`` (the companion pencil has twice as many)
 DENSE_MAX = 1500
+#: the candidates' quadratic problem on the structure's coordinates is solved densely up to
+#: this many unknowns ``(m + q) H`` (its companion form has twice as many; beyond, a dense
+#: eigensolve takes minutes)
+PENCIL_MAX = 1500
 #: an exponent within this of Im s = +-w/2 (in units of w) is a real negative multiplier: its
 #: conjugate is the other member of its family (the truncated problem puts the two a little
 #: off the line: 1e-4 measured on a two-DOF oscillator near period doubling)
@@ -393,6 +397,11 @@ class HillProblem:
                              f"{DENSE_MAX} unknowns (m H)")
         if dyn.m != prob.m:
             raise InputError(f"the structure has {dyn.m} contact DOFs, the problem {prob.m}")
+        if (dyn.m + dyn.q) * prob.H > PENCIL_MAX:
+            raise InputError(f"Hill's method solves its quadratic eigenvalue problem densely "
+                             f"up to {PENCIL_MAX} unknowns (structure coordinates x kept "
+                             f"harmonics); this one has {(dyn.m + dyn.q) * prob.H}: use fewer "
+                             "harmonics or a modal condenser with fewer modes")
         self.prob = prob
         self.U = np.asarray(U, dtype=float).reshape(prob.m, prob.H)
         self.dyn = dyn

@@ -52,22 +52,26 @@ class BranchEvent:
     ``"period-doubling"``, ``"Neimark-Sacker"`` or ``"real multiplier through +1"`` (a
     stability change by a real positive multiplier without a sign change of ``det J``: two
     crossed, or a branch point). f_lo, f_hi : the neighbours' frequencies [Hz]; multiplier :
-    the critical multiplier of the unstable neighbour (NaN for a fold between two stable
-    points); stable_to_unstable : the stability is lost with increasing frequency.
+    the critical multiplier of the unstable neighbour (NaN where the stability does not
+    change); change : ``"stable -> unstable"``, ``"unstable -> stable"`` (with increasing
+    frequency) or ``""`` (the stability does not change: a fold between two unstable
+    points, or between two stable ones that another multiplier separates).
     """
 
     kind: str
     f_lo: float
     f_hi: float
     multiplier: complex
-    stable_to_unstable: bool
+    change: str = ""
 
     def line(self) -> str:
         m = self.multiplier
-        text = ("" if not np.isfinite(abs(m)) else
-                f", critical multiplier {m.real:.4g}{m.imag:+.4g}j (|rho| = {abs(m):.4g})")
-        change = ("stable -> unstable" if self.stable_to_unstable else "unstable -> stable")
-        return f"{self.kind} between {self.f_lo:.6g} and {self.f_hi:.6g} Hz ({change}{text})"
+        text = [self.change] if self.change else []
+        if np.isfinite(abs(m)):
+            text.append(f"critical multiplier {m.real:.4g}{m.imag:+.4g}j "
+                        f"(|rho| = {abs(m):.4g})")
+        more = f" ({', '.join(text)})" if text else ""
+        return f"{self.kind} between {self.f_lo:.6g} and {self.f_hi:.6g} Hz{more}"
 
 
 @dataclass
@@ -153,14 +157,15 @@ def branch_events(freqs, st: SweepStability) -> list:
     for a, b in zip(done[:-1], done[1:], strict=True):
         fa, fb = float(freqs[a]), float(freqs[b])
         changed = st.stable[a] != st.stable[b]
-        lost = bool(st.stable[a] == 1 and st.stable[b] == 0)
+        change = ("" if not changed else "stable -> unstable" if st.stable[a] == 1
+                  else "unstable -> stable")
         unstable = a if st.stable[a] == 0 else b
         crit = _critical(st.floquet[unstable]) if changed else complex(np.nan)
         if st.det_sign[a] * st.det_sign[b] < 0:
-            events.append(BranchEvent("fold", fa, fb, crit, lost))
+            events.append(BranchEvent("fold", fa, fb, crit, change))
         elif changed:
             real = abs(crit.imag) <= REAL_TOL * max(abs(crit), 1e-300)
             kind = ("Neimark-Sacker" if not real else
                     "period-doubling" if crit.real < 0 else "real multiplier through +1")
-            events.append(BranchEvent(kind, fa, fb, crit, lost))
+            events.append(BranchEvent(kind, fa, fb, crit, change))
     return events
