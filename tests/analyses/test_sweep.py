@@ -85,8 +85,9 @@ def test_sweep_with_hill_stability(tmp_path, capsys):
     """``hill_stability = true`` adds the documented stability variables: every converged point
     classified (this beam is small enough for the dense Hill problem), its largest
     multiplier consistent with ``stable``, ``det J`` signed, the events and notes as
-    attributes; the figure is still written (one harmonic, three frequencies: seconds). The reference for the classification itself is
-    tests/hb/test_stability.py (shooting) and tests/hb/test_sweep_stability.py."""
+    attributes; the figure is still written (one harmonic, three frequencies: seconds). The
+    reference for the classification itself is tests/hb/test_stability.py (shooting) and
+    tests/hb/test_sweep_stability.py."""
     case = SWEEP
     for line in ("hill_stability = true", "n_points = 3", "harmonics = 1", "n_samples = 16"):
         case = with_key(case, line)
