@@ -43,6 +43,9 @@ from fretwear.io.results import variable
 from fretwear.io.schema import Field, Integer, ListOf, Number, Text, increasing
 
 AMPLITUDE_UNIT = "m kg^0.5"
+#: modal amplitudes accepted: a displacement of 1e-9 to 1e5 m (fretwear.limits) times the
+#: square root of a mass of 1e-12 to 1e12 kg, with margin
+_AMPLITUDE = Number(lo=1e-20, hi=1e12)
 
 
 # --- dataset -------------------------------------------------------------------------------
@@ -229,13 +232,14 @@ NONLINEAR_MODES = Analysis.define(
                            'branch\'s low-amplitude end); "sliding": the frictionless '
                            "structure's, whose nearest stuck mode is followed",
                            default=default_of(api.nonlinear_mode, "interface")),
-        "amplitude_min": Field(Number(lo=0, lo_open=True), "smallest modal amplitude (mass "
-                               "norm of the fundamental harmonic of the motion)",
-                               required=True, unit=AMPLITUDE_UNIT),
-        "amplitude_max": Field(Number(lo=0, lo_open=True), "largest modal amplitude",
-                               required=True, unit=AMPLITUDE_UNIT),
-        "n_amplitudes": Field(Integer(lo=2), "modal amplitudes of the result, log-spaced (the "
-                              "continuation adds steps where one fails)", default=30),
+        "amplitude_min": Field(_AMPLITUDE, "smallest modal amplitude (mass norm of the "
+                               "fundamental harmonic of the motion)", required=True,
+                               unit=AMPLITUDE_UNIT),
+        "amplitude_max": Field(_AMPLITUDE, "largest modal amplitude", required=True,
+                               unit=AMPLITUDE_UNIT),
+        "n_amplitudes": Field(Integer(lo=2, hi=10_000), "modal amplitudes of the result, "
+                              "log-spaced (the continuation adds steps where one fails)",
+                              default=30),
         "masters": Field(Integer(lo=1), "modes of the structure with its contact points held "
                          "kept as unknowns (the rest condensed exactly)",
                          default=default_of(_core, "masters")),
