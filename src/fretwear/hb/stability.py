@@ -51,7 +51,8 @@ How they are computed
 3. **Refinement** (a node sticks: the memory matters): in decreasing order of their real
    parts, candidates are refined on the exact ``T(s)`` (condensed on the contact points,
    ``m H`` unknowns) until ``options.refine`` have converged (:func:`_track`: the secant
-   method on the eigenvalue of ``T(s)`` whose eigenvector continues the candidate's). A
+   method on the eigenvalue of ``T(s)`` whose eigenvector continues the candidate's,
+   followed by inverse iteration on one LU per evaluation, :func:`_pair`). A
    candidate near which the exact problem has no exponent is an artefact of the frozen memory
    (:attr:`FloquetResult.spurious`).
 
@@ -63,11 +64,13 @@ select (docs/theory.md, "Full stick"), a neutral direction with multiplier exact
 :attr:`FloquetResult.neutral` counts.
 
 Cost: one dense eigenvalue problem of ``2 (m' + q) H`` unknowns (``m'`` contact points with
-mass, ``q`` other coordinates) and, with a memory, a few evaluations of ``T(s)`` and ``m H``
-eigenvalue problems per refined exponent. Measured at 13-22 times a warm-started sweep
-point's solve on small models (docs/theory.md, section 9): the whole spectrum at every point
-is what costs; tracking the exponents along a sweep would not. Dense up to
-:data:`DENSE_MAX` unknowns of the balance.
+mass, ``q`` other coordinates; at most :data:`PENCIL_MAX` before the companion form) and,
+with a memory, a few evaluations of ``T(s)`` and ``m H`` LU factorisations per refined
+exponent. Measured at 10-30 ms of CPU a point on the benchmark's small models, tens of times
+a warm-started sweep point's solve (docs/theory.md, section 9): the whole spectrum at every
+point and the evaluations of ``T(s)`` are what cost; tracking the exponents along a sweep
+would not. Dense up to :data:`DENSE_MAX` unknowns of the balance. The sign of ``det J``
+(``J = T(0)``) is reported with the exponents (:attr:`FloquetResult.det_sign`).
 """
 
 from __future__ import annotations
