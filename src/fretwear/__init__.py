@@ -11,6 +11,8 @@ The public API, stage by stage (data flows one way; each stage returns a plain d
     red   = fretwear.condense(model, frequency, basis.orders, condenser=cond)  # Reduced (Z_r)
     sol   = fretwear.solve_periodic(model, basis, frequency, condenser=cond)   # PeriodicSolution
     frf   = fretwear.sweep(model, basis, f_min, f_max, n, condenser=cond)     # SweepResult
+    hill  = fretwear.sweep_stability(model, frf, condenser=cond)         # SweepStability
+    nm    = fretwear.nonlinear_mode(model, basis, amplitudes)           # Backbone (EPMC)
     wear  = fretwear.simulate_wear(model, basis, frequency, condenser=cond)   # WearResult
     worn  = fretwear.frf_worn(model, basis, wear.final_wear, f_min, f_max, n)  # SweepResult
     run   = fretwear.integrate(model, frequency, n_periods=...)   # TransientResult
@@ -61,6 +63,7 @@ _API = {
     "PeriodicSolution": "fretwear.hb.solution", "SweepResult": "fretwear.hb.sweep_result",
     "sweep": "fretwear.api", "SolveOptions": "fretwear.hb.options",
     "SweepOptions": "fretwear.hb.options",
+    "nonlinear_mode": "fretwear.api", "sweep_stability": "fretwear.hb.sweep_stability",
     # linear
     "modes": "fretwear.linear", "frf": "fretwear.linear",
     # wear
