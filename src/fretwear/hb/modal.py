@@ -70,6 +70,11 @@ def next_mode_count(n_modes: int, n_interior: int) -> int | None:
     return min(max(2 * n_modes, MIN_RAISE), top)
 
 
+class CheckFailed(InputError):
+    """The modal condensation's error check failed (its message says by how much): the
+    automatic choice (:func:`fretwear.hb.condensers.condenser`) then condenses exactly."""
+
+
 class ModalCondenser(Condenser):
     """Craig-Bampton condensation of ``model`` for excitation frequencies up to ``f_max`` [Hz]
     and harmonic orders up to ``max_order`` (module docstring), with the interface of
@@ -142,7 +147,7 @@ class ModalCondenser(Condenser):
                 break
             self._basis(*self._modes(lu, k, f_cut), np.column_stack(extra))
         if self.error > self.tol:
-            raise InputError(
+            raise CheckFailed(
                 f"modal condensation with {self.n_modes} modes (up to "
                 f"{(self.mode_frequencies.max() if self.n_modes else 0.0):.6g} Hz): relative "
                 f"error {self.error:.3g} of Z_r at harmonic {self.max_order} of {f_max:.6g} Hz"
