@@ -163,6 +163,8 @@ def condenser(model: Model, method: str = "auto", *, f_max: float | None = None,
         :data:`~fretwear.hb.modal.MAX_MODES` modes).
     """
     _check(method, f_max, max_order, modes, cutoff, tol)
+    if residual is not None and not isinstance(residual, bool):
+        raise InputError(f"residual = {residual!r}: expected True, False or None")
     if method == "exact":
         return _with(exact_condenser(model), CondensationChoice("exact", "exact", "asked"))
     reason = "asked"
@@ -172,8 +174,6 @@ def condenser(model: Model, method: str = "auto", *, f_max: float | None = None,
             return _with(exact_condenser(model), CondensationChoice("auto", "exact", reason))
     if residual is None:
         residual = sizes(model)[0] <= RESIDUAL_MAX
-    elif not isinstance(residual, bool):
-        raise InputError(f"residual = {residual!r}: expected True, False or None")
     try:
         mc = ModalCondenser(model, float(f_max), int(max_order), modes=modes, cutoff=cutoff,
                             tol=float(tol), raise_modes=modes is None, residual=residual)
