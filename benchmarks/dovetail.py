@@ -182,7 +182,7 @@ def _frf(model, m, args):
         return cond, res
 
     out, cpu = {}, {}
-    for name, make in (("exact at every frequency", lambda: exact_condenser(model)),
+    for name, make in (("exact at every frequency", lambda: condenser(model, "exact")),
                        ("auto (one modal basis)",
                         lambda: condenser(model, "auto", f_max=a["f_max"],
                                           max_order=max(basis.harmonics)))):
