@@ -20,7 +20,12 @@ modes, which grows with frequency. :class:`ModalCondenser` therefore checks itse
 highest frequency it is built for: ``Z_r`` and ``F_r`` applied to random probe vectors
 against the exact condensation (one sparse LU of ``Z_ii`` there and a few solves); the
 relative error is stored (``error``) and an :class:`~fretwear.errors.InputError` is raised
-when it exceeds ``tol`` (keep more modes, or condense exactly).
+when it exceeds ``tol`` (keep more modes, or condense exactly); with ``raise_modes`` the
+modes are first raised until it passes (:func:`next_mode_count`). With ``residual`` the basis
+also holds the static responses to the constraint modes' inertia loads (the residual
+flexibility of the omitted modes: one basis accurate over a whole band,
+:meth:`ModalCondenser._residual_vectors`). :func:`fretwear.hb.condensers.condenser` chooses
+between this and the exact condensation.
 
 Cost: one real LU of ``K_ii`` and ``m`` real solves (``Psi``), a shift-invert Lanczos for the
 modes, and projections; then ``O(m^2 q)`` per harmonic and frequency, against one complex
