@@ -20,10 +20,11 @@ The public API, stage by stage (data flows one way; each stage returns a plain d
     ds    = fretwear.read_results("out/results.nc")               # an xarray Dataset
     st    = fretwear.run_study("study.toml", "out/")              # members on Dask (study.nc)
 
-The condensation of a model is an object its caller owns (``exact_condenser``, or the
-Craig-Bampton ``modal_condenser`` for large interfaces): build it once and pass it as
-``condenser=`` to every driver that condenses the same model; without it each call builds
-its own exact one.
+The condensation of a model is an object its caller owns (``exact_condenser``, the
+Craig-Bampton ``modal_condenser`` for large interfaces, or ``condenser(model, method, f_max=,
+max_order=)``: ``"exact"``, ``"modal"`` or ``"auto"``, the modal one where it is cheaper, with
+modes raised until its error check passes): build it once and pass it as ``condenser=`` to
+every driver that condenses the same model; without it each call builds its own exact one.
 
 One vocabulary and argument order at every entry point (:mod:`fretwear.api`): ``model, basis``
 first, then the frequency or the band; the stick anchors are ``anchor``, the initial wear
@@ -59,6 +60,7 @@ _API = {
     # harmonic balance
     "FourierBasis": "fretwear.hb.fourier", "condense": "fretwear.hb.reduce",
     "exact_condenser": "fretwear.hb.reduce", "modal_condenser": "fretwear.hb.modal",
+    "condenser": "fretwear.hb.condensers",
     "Reduced": "fretwear.hb.reduce", "solve_periodic": "fretwear.api",
     "PeriodicSolution": "fretwear.hb.solution", "SweepResult": "fretwear.hb.sweep_result",
     "sweep": "fretwear.api", "SolveOptions": "fretwear.hb.options",

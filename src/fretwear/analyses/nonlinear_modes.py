@@ -23,6 +23,7 @@ from fretwear.analyses.common import (
     basis_of,
     check_points,
     check_sampling,
+    condensation_fields,
     default_of,
     figure_path,
     geometry,
@@ -245,11 +246,13 @@ NONLINEAR_MODES = Analysis.define(
                          default=default_of(_core, "masters")),
         "points": Field(ListOf(Text(), non_empty=True, unique=True),
                         "observed points to report (default: all)"),
-        **harmonic_balance_fields(
+        # the condensation keys are not among them: the mode's structure is reduced on its
+        # own modes (``masters``), exactly, with no frequency band to build a modal one for
+        **{k: f for k, f in harmonic_balance_fields(
             SolveOptions(), default_of(_core, "eps"),
             'DLFT penalty: "top" (the contact springs themselves where there are some: the '
             "exact value; else the spectral radius of Z_r at the highest kept harmonic), "
-            '"static", "auto" or a value'),
+            '"static", "auto" or a value').items() if k not in condensation_fields()},
     },
     run_nonlinear_modes,
     checks=(increasing("amplitude_min", "amplitude_max", AMPLITUDE_UNIT), check_sampling),

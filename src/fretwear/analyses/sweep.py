@@ -23,6 +23,7 @@ from fretwear.analyses.common import (
     basis_of,
     check_points,
     check_sampling,
+    condenser_of,
     default_of,
     figure_path,
     geometry,
@@ -35,7 +36,6 @@ from fretwear.analyses.common import (
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.options import SWEEP as SWEEP_OPTIONS
-from fretwear.hb.reduce import exact_condenser
 from fretwear.hb.solution import PeriodicSolution
 from fretwear.hb.sweep import SweepResult
 from fretwear.hb.sweep_stability import SweepStability, sweep_stability
@@ -264,7 +264,9 @@ def run_sweep(model, analysis: dict, case, context: RunContext) -> RunOutput:
     points = check_points(model, analysis.get("points"))
     basis = basis_of(analysis)
     n = analysis["n_points"]
-    cond = exact_condenser(model)  # the run's condensation of the model, for every call
+    # the run's condensation of the model (the case file's choice: one modal basis for the
+    # whole band where chosen), for every call
+    cond = condenser_of(model, analysis, analysis["f_max"], max(basis.harmonics))
     with tqdm(total=n, desc="sweep", disable=not context.progress, leave=False,
               unit="freq") as bar:
         def tick(i, total, pt):
@@ -303,6 +305,7 @@ def run_sweep(model, analysis: dict, case, context: RunContext) -> RunOutput:
         "eps_rule": str(analysis["eps"]),
         "harmonics": ", ".join(str(h) for h in basis.harmonics),
         "n_samples": int(basis.n_samples),
+        **cond.choice.attributes(),
     })
     figures = []
     for point in points:
@@ -314,7 +317,7 @@ def run_sweep(model, analysis: dict, case, context: RunContext) -> RunOutput:
         figures.append(plot_sweep_interface(ds, p, title=titled(case.title,
                                                                   "contact interface")))
     grid_ok = all(p.success for p in result.points if p.on_grid)
-    summary = "\n".join([_sweep_summary(result, ds), *events])
+    summary = "\n".join([_sweep_summary(result, ds), *events, cond.choice.summary()])
     return RunOutput(ds, figures, summary, grid_ok, warnings=list(result.warnings))
 
 
