@@ -14,12 +14,13 @@ from fretwear.model.mesh import rectangle
 R_IN, R_OUT = 0.1, 0.2
 
 
-def annulus_sector(n_sectors: int, nr: int = 3, nt: int = 3) -> Mesh:
+def annulus_sector(n_sectors: int, nr: int = 3, nt: int = 4) -> Mesh:
     """Quads on ``R_IN <= r <= R_OUT``, ``0 <= theta <= 2 pi / n_sectors``: boundaries
     ``hub`` (r = R_IN), ``tip`` (r = R_OUT, its two end edges left out so that no contact
     node lies on a cyclic boundary), node sets ``left`` (theta = 0), ``right`` (theta = 2 pi
-    / N), ``tip_mid`` (one tip node). The inner nodes are skewed so that the sector has no
-    mirror symmetry and the disk no symmetry beyond its N sectors."""
+    / N), ``tip_mid`` (one tip node), ``load`` (an inner node near the tip). The inner nodes
+    are skewed so that the sector has no mirror symmetry and the disk no symmetry beyond its
+    N sectors."""
     m = rectangle(R_OUT - R_IN, 2 * np.pi / n_sectors, nr, nt, origin=(R_IN, 0.0))
     r, t = m.points[:, 0].copy(), m.points[:, 1].copy()
     inner = (t > 1e-12) & (t < 2 * np.pi / n_sectors - 1e-12)  # not on a cyclic boundary
@@ -28,7 +29,8 @@ def annulus_sector(n_sectors: int, nr: int = 3, nt: int = 3) -> Mesh:
     tip = m.boundaries["right"]  # r = R_OUT, ordered by increasing theta
     bounds = {"hub": m.boundaries["left"], "tip": tip[1:-1]}
     sets = {"left": m.node_sets["bottom"], "right": m.node_sets["top"],
-            "hub": m.node_sets["left"], "tip_mid": m.node_sets["right"][[nt // 2]]}
+            "hub": m.node_sets["left"], "tip_mid": m.node_sets["right"][[nt // 2]],
+            "load": np.array([nr - 1 + (nr + 1) * (nt // 2)])}
     return Mesh(pts, m.cells, "quad", bounds, sets)
 
 
@@ -36,15 +38,15 @@ def sector_model(n_sectors: int = 8, *, damping=True, mu: float = 0.3, press: fl
                  force: float = 5e3, contact: bool = True):
     """``(sector, model)``: the annulus sector with ``n_sectors`` sectors."""
     mesh = annulus_sector(n_sectors)
-    mid = mesh.points[mesh.node_sets["tip_mid"][0]]
+    mid = mesh.points[mesh.node_sets["load"][0]]
     e_r = mid / np.linalg.norm(mid)
     e_t = np.array([-e_r[1], e_r[0]])
-    loads = [NodalForce("tip_mid", tuple(press * e_r), "constant", name="press"),
-             NodalForce("tip_mid", tuple(force * e_t), "cos", name="excitation")]
+    loads = [NodalForce("load", tuple(press * e_r), "constant", name="press"),
+             NodalForce("load", tuple(force * e_t), "cos", name="excitation")]
     spec = ContactSpec("tip", mu=mu, name="casing") if contact else ContactSpec(
         "tip", mu=mu, name="casing", gap=1.0)
     model = from_mesh(mesh, Material(2e11, 0.3, 7800.0), thickness=0.01,
                       damping=Damping(loss_factor=0.01, rayleigh_mass=5.0) if damping else None,
                       supports=[("hub", "all")], loads=loads, contact=spec,
-                      observed={"tip": "tip_mid"}, name="annulus sector")
+                      observed={"tip": "load"}, name="annulus sector")
     return cyclic_sector(model, n_sectors, "left", "right"), model

@@ -13,6 +13,7 @@ import dataclasses
 
 import numpy as np
 import pytest
+from helpers.cyclic import sector_model
 
 from fretwear.errors import InputError
 from fretwear.model.core import Mesh
@@ -25,7 +26,6 @@ from fretwear.model.cyclic import (
     transform,
     whole_disk,
 )
-from tests.helpers.cyclic import sector_model
 
 
 def test_boundaries_match_by_the_rotation():

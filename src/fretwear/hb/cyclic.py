@@ -28,8 +28,8 @@ import scipy.sparse.linalg as spla
 
 from fretwear.errors import InputError
 from fretwear.hb.reduce import Condenser, Reduced, Structure, _fingerprint
-from fretwear.model.cyclic import CyclicSector, harmonic_index, harmonic_model
 from fretwear.model.core import Model
+from fretwear.model.cyclic import CyclicSector, harmonic_index, harmonic_model
 from fretwear.model.interfaces import observed_map, relative_model
 
 #: at most this many kept DOFs: cyclic modes by a dense Hermitian eigensolver

@@ -393,7 +393,7 @@ def whole_disk(sector: CyclicSector, engine_order: int = 0) -> Model:
 def _disk_contact(sector: CyclicSector, c: ContactInterface, maps) -> ContactInterface:
     """Every sector's copy of the contact record: DOFs renumbered, frames and positions
     turned into the disk's axes, per-node values repeated."""
-    n, nc, d = sector.n_sectors, c.n_nodes, c.dim
+    n, d = sector.n_sectors, c.dim
     if c.normal_load is not None:
         raise InputError("whole_disk: a prescribed normal load is not phased per sector; "
                          "the disk reference takes unilateral contacts")
