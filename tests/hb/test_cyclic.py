@@ -153,3 +153,41 @@ def test_condenser_refuses_another_model(sector):
     other = sector_model(N)[1]
     with pytest.raises(InputError, match="another sector"):
         cyclic_condenser(sector, 1).check(other)
+
+
+def test_real_blocks_of_a_complex_hermitian_block():
+    """The balance's real cos/sin operator of a complex non-symmetric (Hermitian, k != 0,
+    N/2) block is the complex product itself: ``to_real_blocks(Z) x = real(Z U)`` for random
+    ``Z``, ``U`` (reference: complex arithmetic; rounding only)."""
+    from fretwear.hb.reduce import loads_to_real, to_real_blocks
+
+    rng = np.random.default_rng(1)
+    m, nb = 4, 3
+    Z = rng.normal(size=(nb, m, m)) + 1j * rng.normal(size=(nb, m, m))
+    Z = Z + Z.conj().transpose(0, 2, 1)  # Hermitian, complex off the diagonal
+    Z[0] = Z[0].real  # harmonic 0 lives in index 0: real
+    U = rng.normal(size=(nb, m)) + 1j * rng.normal(size=(nb, m))
+    U[0] = U[0].real
+    x = loads_to_real(U).reshape(-1)  # DOF-major [a0, a.., b..] per DOF
+    want = loads_to_real(np.einsum("bij,bj->bi", Z, U)).reshape(-1)
+    assert np.allclose(to_real_blocks(Z, np.arange(nb)) @ x, want, rtol=0, atol=1e-12)
+
+
+def test_short_sweep_equals_the_disk(sector):
+    """A 4-point nonlinear sweep across the index-3 resonance (12.3 kHz) on the sector and on
+    the disk, same eps: every point's contact harmonics to 1e-8 relative."""
+    from fretwear.hb.options import SweepOptions
+    from fretwear.hb.sweep import sweep
+
+    eo = 3
+    basis = FourierBasis((1, 2, 3), 32)
+    opts = SweepOptions(solve=SolveOptions(tol=1e-13, max_iter=200), eps=3e9,
+                        spacing="linear")
+    res = sweep(sector.model, basis, 11500.0, 13000.0, 4, options=opts,
+                condenser=cyclic_condenser(sector, eo))
+    res_d = sweep(whole_disk(sector, eo), basis, 11500.0, 13000.0, 4, options=opts)
+    assert res.success and res_d.success
+    nc = sector.model.contact.n_nodes
+    for p, p_d in zip(res.points, res_d.points, strict=True):
+        U, U_d = p.solution.U, p_d.solution.U[:nc]
+        assert np.max(np.abs(U - U_d)) < 1e-8 * np.abs(U_d).max()
