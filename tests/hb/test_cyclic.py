@@ -191,3 +191,26 @@ def test_short_sweep_equals_the_disk(sector):
     for p, p_d in zip(res.points, res_d.points, strict=True):
         U, U_d = p.solution.U, p_d.solution.U[:nc]
         assert np.max(np.abs(U - U_d)) < 1e-8 * np.abs(U_d).max()
+
+
+@pytest.mark.parametrize("eo", [3, 4, 0])
+def test_inter_blade_contact_equals_the_disk(eo):
+    """Friction between neighbouring sectors (sector j's face A against sector j+1's face B,
+    interference 0.2 um) and at the tip: one periodic solve on the sector (the partner's
+    harmonic n phased by ``e^{+i n EO 2 pi / N}``) equals the disk's, in which A of every
+    sector is paired with B of the next, to 1e-8 relative; the inter-blade nodes separate,
+    stick and slip within the period. (With the phase's sign flipped the difference is 0.6.)"""
+    sector, model = sector_model(N, slit=True)
+    basis = FourierBasis((1, 2, 3), 32)
+    f, eps = 9000.0, 3e9
+    sol = solve_periodic(model, basis, frequency=f, eps=eps, options=TIGHT,
+                         condenser=cyclic_condenser(sector, eo))
+    sol_d = solve_periodic(whole_disk(sector, eo), basis, frequency=f, eps=eps, options=TIGHT)
+    assert sol.success and sol_d.success
+    nc = model.contact.n_nodes
+    between = model.contact.interface_index() == 1
+    # the inter-blade nodes change state within the period (EO 3 and 0: they separate,
+    # stick and slip; EO 4: separate and stick)
+    assert np.unique(sol.state[between]).size == (2 if eo == 4 else 3)
+    assert np.max(np.abs(sol.U - sol_d.U[:nc])) < 1e-8 * np.abs(sol_d.U[:nc]).max()
+    assert np.max(np.abs(sol.lam - sol_d.lam[:nc])) < 1e-8 * np.abs(sol_d.lam[:nc]).max()

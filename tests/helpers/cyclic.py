@@ -8,19 +8,22 @@ import numpy as np
 
 from fretwear.model.build import ContactSpec, Damping, Material, NodalForce, from_mesh
 from fretwear.model.core import Mesh
-from fretwear.model.cyclic import cyclic_sector
+from fretwear.model.cyclic import cyclic_sector, neighbour_contact
 from fretwear.model.mesh import rectangle
 
 R_IN, R_OUT = 0.1, 0.2
 
 
-def annulus_sector(n_sectors: int, nr: int = 3, nt: int = 4) -> Mesh:
+def annulus_sector(n_sectors: int, nr: int = 3, nt: int = 4, slit: float | None = None) -> Mesh:
     """Quads on ``R_IN <= r <= R_OUT``, ``0 <= theta <= 2 pi / n_sectors``: boundaries
     ``hub`` (r = R_IN), ``tip`` (r = R_OUT, its two end edges left out so that no contact
     node lies on a cyclic boundary), node sets ``left`` (theta = 0), ``right`` (theta = 2 pi
     / N), ``tip_mid`` (one tip node), ``load`` (an inner node near the tip). The inner nodes
     are skewed so that the sector has no mirror symmetry and the disk no symmetry beyond its
-    N sectors."""
+    N sectors. ``slit`` [m]: the sectors are joined below this radius only (``left``,
+    ``right``); above it their faces are boundaries ``slit_b`` (theta = 0) and ``slit_a``
+    (theta = 2 pi / N), the next sector's ``slit_b`` touching ``slit_a`` (an inter-blade
+    contact)."""
     m = rectangle(R_OUT - R_IN, 2 * np.pi / n_sectors, nr, nt, origin=(R_IN, 0.0))
     r, t = m.points[:, 0].copy(), m.points[:, 1].copy()
     inner = (t > 1e-12) & (t < 2 * np.pi / n_sectors - 1e-12)  # not on a cyclic boundary
@@ -31,13 +34,21 @@ def annulus_sector(n_sectors: int, nr: int = 3, nt: int = 4) -> Mesh:
     sets = {"left": m.node_sets["bottom"], "right": m.node_sets["top"],
             "hub": m.node_sets["left"], "tip_mid": m.node_sets["right"][[nt // 2]],
             "load": np.array([nr - 1 + (nr + 1) * (nt // 2)])}
+    if slit is not None:
+        x = m.points[:, 0]
+        for side, name, face in (("bottom", "left", "slit_b"), ("top", "right", "slit_a")):
+            sets[name] = sets[name][x[sets[name]] < slit]
+            edges = m.boundaries[side]
+            bounds[face] = edges[np.all(x[edges] > slit, axis=1)]
     return Mesh(pts, m.cells, "quad", bounds, sets)
 
 
 def sector_model(n_sectors: int = 8, *, damping=True, mu: float = 0.3, press: float = 2e4,
-                 force: float = 5e3, contact: bool = True):
-    """``(sector, model)``: the annulus sector with ``n_sectors`` sectors."""
-    mesh = annulus_sector(n_sectors)
+                 force: float = 5e3, contact: bool = True, slit: bool = False):
+    """``(sector, model)``: the annulus sector with ``n_sectors`` sectors; ``slit``: the
+    sectors joined below r = 0.14 m only, with a friction contact between neighbours above
+    (an interference of 0.2 um presses them together)."""
+    mesh = annulus_sector(n_sectors, nr=4 if slit else 3, slit=0.14 if slit else None)
     mid = mesh.points[mesh.node_sets["load"][0]]
     e_r = mid / np.linalg.norm(mid)
     e_t = np.array([-e_r[1], e_r[0]])
@@ -49,4 +60,9 @@ def sector_model(n_sectors: int = 8, *, damping=True, mu: float = 0.3, press: fl
                       damping=Damping(loss_factor=0.01, rayleigh_mass=5.0) if damping else None,
                       supports=[("hub", "all")], loads=loads, contact=spec,
                       observed={"tip": "load"}, name="annulus sector")
-    return cyclic_sector(model, n_sectors, "left", "right"), model
+    sector = cyclic_sector(model, n_sectors, "left", "right")
+    if slit:
+        sector = neighbour_contact(sector, ContactSpec("slit_a", mu=mu, partner="slit_b",
+                                                       gap=-2e-7, name="neighbours"))
+        model = sector.model
+    return sector, model

@@ -137,3 +137,35 @@ def test_bad_inputs_are_refused_in_one_line():
         cyclic_sector(model, 8, "lft", "right")
     with pytest.raises(InputError, match="both the left and the right"):
         cyclic_sector(model, 8, "left", "left")
+
+
+def test_neighbour_contact_pairs_a_face_with_the_next_sectors_face():
+    """Each node of face A is paired with the node of face B that lands on it turned by
+    2 pi / N; in the disk its partner is the next sector's node (same position)."""
+    sector, model = sector_model(8, slit=True)
+    c = model.contact
+    nb = sector.neighbour_nodes()
+    assert nb.sum() == 3 and not nb[~(c.interface_index() == 1)].any()
+    pts = model.mesh.points
+    b = np.asarray(c.partner_ids)[nb]
+    turned = pts[b] @ sector.rotation.T
+    assert np.allclose(turned, c.coords[nb], rtol=0, atol=1e-15)
+    disk = whole_disk(sector, 1)
+    A, _ = sector_maps(sector)
+    first = np.flatnonzero(nb)[0]
+    y = np.zeros(model.ndof)
+    y[c.partner_dofs[first]] = 1.0  # the partner's image in sector 0, put in sector 1
+    assert set(np.flatnonzero(A[1] @ y)) == set(disk.contact.partner_dofs[first])
+    assert set(np.flatnonzero(A[1] @ y)).isdisjoint(np.flatnonzero(A[0] @ y))
+
+
+def test_neighbour_contact_refuses_a_face_paired_with_itself():
+    """A damper pairing a boundary with itself, or faces that do not match: one line."""
+    from fretwear.model.build import ContactSpec
+    from fretwear.model.cyclic import neighbour_contact
+
+    base, _ = sector_model(8, slit=True)
+    with pytest.raises(InputError, match="pairs a boundary with another"):
+        neighbour_contact(base, ContactSpec("slit_a", mu=0.3, partner="slit_a", name="x"))
+    with pytest.raises(InputError, match="swap left and right|from the nearest"):
+        neighbour_contact(base, ContactSpec("slit_b", mu=0.3, partner="slit_a", name="x"))

@@ -29,8 +29,13 @@ import scipy.sparse.linalg as spla
 from fretwear.errors import InputError
 from fretwear.hb.reduce import Condenser, Reduced, Structure, _fingerprint
 from fretwear.model.core import Model
-from fretwear.model.cyclic import CyclicSector, harmonic_index, harmonic_model
-from fretwear.model.interfaces import observed_map, relative_model
+from fretwear.model.cyclic import (
+    CyclicSector,
+    harmonic_index,
+    harmonic_model,
+    relative_harmonic_model,
+)
+from fretwear.model.interfaces import observed_map
 
 #: at most this many kept DOFs: cyclic modes by a dense Hermitian eigensolver
 DENSE_MODES = 600
@@ -43,10 +48,11 @@ def _engine_order(engine_order) -> int:
     return int(engine_order)
 
 
-def _structure_k(red: Model, T: sp.csr_matrix) -> Structure:
-    """The :class:`~fretwear.hb.reduce.Structure` of the harmonic-index model ``red``
-    (complex matrices allowed), its loads set by :meth:`CyclicCondenser.read_loads`."""
-    rel, P = relative_model(red)
+def _structure_k(sector: CyclicSector, k: int) -> tuple[Structure, sp.csr_matrix]:
+    """The :class:`~fretwear.hb.reduce.Structure` of harmonic index ``k`` (complex matrices
+    allowed, in the relative coordinates of its pairs, inter-blade ones phased) and its
+    ``T_k``; the loads are set by :meth:`CyclicCondenser.read_loads`."""
+    rel, T, P = relative_harmonic_model(sector, k)
     obs_out, obs, S = observed_map(rel, P)
     return Structure(
         K=sp.csr_matrix(rel.K), M=sp.csr_matrix(rel.M),
@@ -55,7 +61,8 @@ def _structure_k(red: Model, T: sp.csr_matrix) -> Structure:
         load_harmonics=None, fixed=np.asarray(rel.fixed_dofs, dtype=np.int64),
         cdofs=np.asarray(rel.contact.dofs, dtype=np.int64).reshape(-1),
         frame=np.asarray(rel.contact.frame, dtype=float), obs=np.asarray(obs, np.int64),
-        load_vectors=[], P=P, obs_out=np.asarray(obs_out, np.int64), S=S, fingerprint=None)
+        load_vectors=[], P=P, obs_out=np.asarray(obs_out, np.int64), S=S,
+        fingerprint=None), T
 
 
 class CyclicCondenser(Condenser):
@@ -72,8 +79,8 @@ class CyclicCondenser(Condenser):
         self._dense = dense
         self._fp = _fingerprint(sector.model)
         self._subs: dict[int, tuple[Condenser, sp.csr_matrix]] = {}
-        red, T = harmonic_model(sector, 0)
-        super().__init__(_structure_k(red, T), dense)
+        structure, T = _structure_k(sector, 0)
+        super().__init__(structure, dense)
         self._subs[0] = (self, T)
         self.read_loads(sector.model)
 
@@ -83,8 +90,8 @@ class CyclicCondenser(Condenser):
 
     def _sub(self, k: int) -> tuple[Condenser, sp.csr_matrix]:
         if k not in self._subs:
-            red, T = harmonic_model(self.sector, k)
-            cond = Condenser(_structure_k(red, T), self._dense)
+            structure, T = _structure_k(self.sector, k)
+            cond = Condenser(structure, self._dense)
             self._subs[k] = (cond, T)
             self._set_loads(cond, T)
         return self._subs[k]
@@ -93,7 +100,7 @@ class CyclicCondenser(Condenser):
         model = self.sector.model
         Th = T.conj().T.tocsr()
         P = cond.structure.P
-        Pt = None if P is None else P.T.tocsr()
+        Pt = None if P is None else P.conj().T.tocsr()  # P^H: complex for inter-blade pairs
 
         def harmonics(nmax):
             F = (Th @ model.load_harmonics(nmax).T)

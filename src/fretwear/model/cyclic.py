@@ -45,6 +45,9 @@ class CyclicSector:
     node_dofs : (nn, d) int, every group of DOFs that turns as a vector (a node's components);
         used to turn a sector into the disk's axes (:func:`whole_disk`).
     rotation : (d, d) the rotation by ``2 pi / N`` of a vector's components.
+    neighbour : (nc,) bool, the contact nodes whose partner is in the *next* sector (an
+        inter-blade contact, :func:`neighbour_contact`; ``partner_dofs`` then holds the DOFs
+        of the partner's image in this sector), or None: every partner in the sector.
     """
 
     model: Model
@@ -57,6 +60,13 @@ class CyclicSector:
     right_coords: np.ndarray
     node_dofs: np.ndarray
     rotation: np.ndarray
+    neighbour: np.ndarray | None = None
+
+    def neighbour_nodes(self) -> np.ndarray:
+        """(nc,) bool: the contact nodes paired with a node of the next sector."""
+        if self.neighbour is None:
+            return np.zeros(self.model.contact.n_nodes, dtype=bool)
+        return np.asarray(self.neighbour, dtype=bool)
 
     @property
     def angle(self) -> float:
@@ -267,6 +277,52 @@ def _positions(sector: CyclicSector, dofs, what: str) -> np.ndarray:
     return out
 
 
+def neighbour_contact(sector: CyclicSector, spec) -> CyclicSector:
+    """The sector with an inter-blade contact added (a damper, a shroud): ``spec`` a
+    :class:`~fretwear.model.build.ContactSpec` whose ``boundary`` A touches the *next*
+    sector's copy of the boundary ``spec.partner`` B (B turned by ``+2 pi / N`` lands on A,
+    node by node within ``spec.tolerance``). The contact law acts on ``U_A - U_B(next
+    sector)``, which in the sector's own coordinates is, harmonic by harmonic (Petrov 2004),
+
+        U_rel,n = U_A,n - e^{+i n EO 2 pi / N} R U_B,n
+
+    (:func:`relative_harmonic_model`); the normal default is A's outward normal."""
+    from fretwear.model.build import _contact
+    from fretwear.model.interfaces import check_distinct, combine
+
+    model = sector.model
+    mesh = model.mesh
+    if mesh is None:
+        raise InputError("neighbour_contact: the sector model has no mesh")
+    if spec.partner is None or spec.partner == spec.boundary:
+        raise InputError(f"contact {spec.name!r}: partner = {spec.partner!r}; an inter-blade "
+                         "contact pairs a boundary with another boundary of the sector (the "
+                         "next sector's copy of it)")
+    if spec.partner not in mesh.boundaries:
+        raise InputError(f"contact {spec.name!r}: unknown partner boundary {spec.partner!r}")
+    c = _contact(mesh, dataclasses.replace(spec, partner=None), model.thickness)
+    d = mesh.dim
+    b_nodes = np.unique(np.asarray(mesh.boundaries[spec.partner]).reshape(-1))
+    tol = spec.tolerance if spec.tolerance is not None else \
+        1e-6 * float(np.ptp(mesh.points, axis=0).max())
+    order = match_boundaries(mesh.points[b_nodes], c.coords, sector.axis, sector.point,
+                             sector.n_sectors, tol) if b_nodes.size == c.n_nodes else None
+    if order is None:
+        raise InputError(f"contact {spec.name!r}: boundary {spec.boundary!r} has {c.n_nodes} "
+                         f"nodes, its partner {spec.partner!r} {b_nodes.size}; expected the "
+                         "partner turned by 2 pi / N onto the boundary node by node")
+    partner = np.empty(c.n_nodes, dtype=np.int64)
+    partner[order] = b_nodes  # A node order[b] is B node b turned
+    c = dataclasses.replace(c, partner_dofs=d * partner[:, None] + np.arange(d),
+                            partner_ids=partner,
+                            partner_wear_coefficient=spec.partner_wear_coefficient)
+    contact = combine([model.contact, c])
+    check_distinct(contact)
+    neighbour = np.concatenate([sector.neighbour_nodes(), np.ones(c.n_nodes, dtype=bool)])
+    return dataclasses.replace(sector, model=dataclasses.replace(model, contact=contact),
+                               neighbour=neighbour)
+
+
 def harmonic_model(sector: CyclicSector, k: int) -> tuple[Model, sp.csr_matrix]:
     """The sector reduced to harmonic index ``k`` and its ``T_k``: a :class:`Model` on the
     kept DOFs ``q`` with the complex Hermitian ``T_k^H K T_k`` (and ``M``, ``C``, ``D``), the
@@ -297,6 +353,45 @@ def harmonic_model(sector: CyclicSector, k: int) -> tuple[Model, sp.csr_matrix]:
                               loads=[], contact=contact, observed=observed, fixed_dofs=fixed_q,
                               mesh=None, name=f"{model.name} (harmonic index {k})")
     return red, T
+
+
+def relative_harmonic_model(sector: CyclicSector, k: int):
+    """``(rel, T_k, P_k)``: :func:`harmonic_model` in the relative coordinates of its pairs,
+    ``q = P_k q'`` with ``q_a = q'_a + c R^s q'_b`` for a pair ``(a, b)``: ``c = 1``, ``s = 0``
+    inside the sector, ``c = e^{i k 2 pi / N}``, ``s = 1`` for a partner in the next sector
+    (:func:`neighbour_contact`). ``rel`` has ``P_k^H A P_k`` for every matrix and the pairs
+    dropped (node-to-rigid on the relative DOFs); ``P_k`` is None without pairs. The
+    observed DOFs keep their numbers: their displacement is ``(P_k q')[dofs]``."""
+    red, T = harmonic_model(sector, k)
+    c = red.contact
+    if not c.has_pairs:
+        return red, T, None
+    nq = red.ndof
+    if np.intersect1d(np.asarray(red.fixed_dofs), np.asarray(c.dofs).reshape(-1)).size:
+        raise InputError("contact DOFs cannot also be fixed (Dirichlet) DOFs")
+    pd = np.asarray(c.partner_dofs, dtype=np.int64)
+    dofs = np.asarray(c.dofs, dtype=np.int64)
+    nb = sector.neighbour_nodes()
+    phase = np.exp(1j * k * sector.angle)
+    rows, cols, vals = [np.arange(nq)], [np.arange(nq)], [np.ones(nq, dtype=complex)]
+    d = sector.dim
+    for p in np.flatnonzero(pd[:, 0] >= 0):
+        B = phase * sector.rotation if nb[p] else np.eye(d)
+        rows.append(np.repeat(dofs[p], d))
+        cols.append(np.tile(pd[p], d))
+        vals.append(B.reshape(-1).astype(complex))
+    P = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                      shape=(nq, nq))
+    if k % sector.n_sectors == 0 or 2 * k == sector.n_sectors:
+        P = P.real.tocsr()
+    Ph = P.conj().T.tocsr()
+
+    def tr(A):
+        return None if A is None else (Ph @ A @ P).tocsr()
+
+    rel = dataclasses.replace(red, K=tr(red.K), M=tr(red.M), C=tr(red.C), D=tr(red.D),
+                              contact=dataclasses.replace(c, partner_dofs=None))
+    return rel, T, P
 
 
 # --------------------------------------------------------------------------------------------
@@ -405,6 +500,7 @@ def _disk_contact(sector: CyclicSector, c: ContactInterface, maps) -> ContactInt
         return np.concatenate([np.asarray(v)] * n)
 
     dofs, frames, coords, partners = [], [], [], []
+    nb = sector.neighbour_nodes()
     for j in range(n):
         Q = sector.turn(j)
         dofs.append(maps[j, c.dofs])
@@ -412,7 +508,9 @@ def _disk_contact(sector: CyclicSector, c: ContactInterface, maps) -> ContactInt
         coords.append(pt + (np.asarray(c.coords, float) - pt) @ Q.T)
         if c.partner_dofs is not None:
             pdofs = np.asarray(c.partner_dofs)
-            partners.append(np.where(pdofs >= 0, maps[j, np.maximum(pdofs, 0)], -1))
+            where = np.where(nb[:, None], maps[(j + 1) % n, np.maximum(pdofs, 0)],
+                             maps[j, np.maximum(pdofs, 0)])
+            partners.append(np.where(pdofs >= 0, where, -1))
     return dataclasses.replace(
         c, dofs=np.concatenate(dofs), frame=np.concatenate(frames), gap=tile(c.gap),
         area=tile(c.area), mu=tile(c.mu), coords=np.concatenate(coords),
