@@ -214,3 +214,42 @@ def test_inter_blade_contact_equals_the_disk(eo):
     assert np.unique(sol.state[between]).size == (2 if eo == 4 else 3)
     assert np.max(np.abs(sol.U - sol_d.U[:nc])) < 1e-8 * np.abs(sol_d.U[:nc]).max()
     assert np.max(np.abs(sol.lam - sol_d.lam[:nc])) < 1e-8 * np.abs(sol_d.lam[:nc]).max()
+
+
+def test_krylov_operator_path_takes_the_complex_hermitian_blocks():
+    """The large-interface path (Jacobian as an operator, ``jacobian="krylov"``) on the
+    sector with its inter-blade contact (Z_r complex and non-symmetric for EO 3) gives the
+    dense path's disk answer to 1e-8 relative."""
+    sector, model = sector_model(N, slit=True)
+    basis = FourierBasis((1, 2, 3), 32)
+    opts = SolveOptions(tol=1e-13, max_iter=200, jacobian="krylov")
+    sol = solve_periodic(model, basis, frequency=9000.0, eps=3e9, options=opts,
+                         condenser=cyclic_condenser(sector, 3))
+    sol_d = solve_periodic(whole_disk(sector, 3), basis, frequency=9000.0, eps=3e9,
+                           options=TIGHT)
+    assert sol.success and sol_d.success
+    nc = model.contact.n_nodes
+    assert np.max(np.abs(sol.U - sol_d.U[:nc])) < 1e-8 * np.abs(sol_d.U[:nc]).max()
+
+
+def test_wear_steps_equal_the_disk():
+    """Three explicit wear steps of 1e6 cycles (Archard at the tip and between neighbours, both
+    surfaces of the pair wearing) on the sector and on the disk: sector 0's wear depths to
+    1e-8 relative, and every sector of the disk wears as sector 0 (the tuned assumption)."""
+    from fretwear.wear.options import WearOptions
+    from fretwear.wear.simulate import BalanceSetup, simulate_wear
+
+    sector, model = sector_model(N, slit=True, wear=1e-14)
+    basis = FourierBasis((1, 2, 3), 32)
+    opts = WearOptions(scheme="explicit", adaptive=False, initial_jump=1e6, max_steps=3,
+                       max_cycles=1e9, solve=SolveOptions(tol=1e-13, max_iter=100,
+                                                          strategy=("start",)))
+    r = simulate_wear(model, basis, frequency=9000.0, options=opts,
+                      balance=BalanceSetup(eps=3e9, condenser=cyclic_condenser(sector, 3)))
+    r_d = simulate_wear(whole_disk(sector, 3), basis, frequency=9000.0, options=opts,
+                        balance=BalanceSetup(eps=3e9))
+    assert r.success and r_d.success and r.history.cycles[-1] == 3e6
+    nc = model.contact.n_nodes
+    W, W_d = r.history.wear_depth, r_d.history.wear_depth.reshape(-1, N, nc)
+    assert W[-1].max() > 1e-7  # it wears
+    assert np.max(np.abs(W[:, None, :] - W_d)) < 1e-8 * W.max()

@@ -44,7 +44,8 @@ def annulus_sector(n_sectors: int, nr: int = 3, nt: int = 4, slit: float | None 
 
 
 def sector_model(n_sectors: int = 8, *, damping=True, mu: float = 0.3, press: float = 2e4,
-                 force: float = 5e3, contact: bool = True, slit: bool = False):
+                 force: float = 5e3, contact: bool = True, slit: bool = False,
+                 wear: float = 0.0):
     """``(sector, model)``: the annulus sector with ``n_sectors`` sectors; ``slit``: the
     sectors joined below r = 0.14 m only, with a friction contact between neighbours above
     (an interference of 0.2 um presses them together)."""
@@ -54,8 +55,8 @@ def sector_model(n_sectors: int = 8, *, damping=True, mu: float = 0.3, press: fl
     e_t = np.array([-e_r[1], e_r[0]])
     loads = [NodalForce("load", tuple(press * e_r), "constant", name="press"),
              NodalForce("load", tuple(force * e_t), "cos", name="excitation")]
-    spec = ContactSpec("tip", mu=mu, name="casing") if contact else ContactSpec(
-        "tip", mu=mu, name="casing", gap=1.0)
+    spec = ContactSpec("tip", mu=mu, name="casing", wear_coefficient=wear,
+                       gap=0.0 if contact else 1.0)
     model = from_mesh(mesh, Material(2e11, 0.3, 7800.0), thickness=0.01,
                       damping=Damping(loss_factor=0.01, rayleigh_mass=5.0) if damping else None,
                       supports=[("hub", "all")], loads=loads, contact=spec,
@@ -63,6 +64,8 @@ def sector_model(n_sectors: int = 8, *, damping=True, mu: float = 0.3, press: fl
     sector = cyclic_sector(model, n_sectors, "left", "right")
     if slit:
         sector = neighbour_contact(sector, ContactSpec("slit_a", mu=mu, partner="slit_b",
-                                                       gap=-2e-7, name="neighbours"))
+                                                       gap=-2e-7, name="neighbours",
+                                                       wear_coefficient=wear,
+                                                       partner_wear_coefficient=wear))
         model = sector.model
     return sector, model
