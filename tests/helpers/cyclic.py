@@ -69,3 +69,37 @@ def sector_model(n_sectors: int = 8, *, damping=True, mu: float = 0.3, press: fl
                                                        partner_wear_coefficient=wear))
         model = sector.model
     return sector, model
+
+
+def sector_model_3d(n_sectors: int = 6, force: float = 3e4):
+    """``(sector, model)``: a coarse 3D annular sector (3 x 3 x 2 hexahedra, 20 mm wide) about
+    z, hub clamped, the tip facets off the cyclic boundaries against a rigid casing, a
+    static radial press and a harmonic tangential and axial force near the tip (large enough
+    for every tip node to separate or slip twice per period, where the periodic state is
+    unique)."""
+    from fretwear.model.mesh import box
+
+    alpha = 2 * np.pi / n_sectors
+    nr, nt, nz = 3, 3, 2
+    m = box(R_OUT - R_IN, alpha, 0.02, nr, nt, nz, origin=(R_IN, 0.0, 0.0))
+    r, t, z = m.points.T
+    pts = np.column_stack([r * np.cos(t), r * np.sin(t), z])
+    side = (t < 1e-12) | (t > alpha - 1e-12)
+    tip = m.boundaries["xmax"]
+    tip = tip[~np.any(side[tip], axis=1)]
+    load = np.flatnonzero((np.abs(r - (R_IN + (nr - 1) * (R_OUT - R_IN) / nr)) < 1e-12)
+                          & ~side & (z < 1e-12))[:1]
+    mesh = Mesh(pts, m.cells, "hexahedron", {"tip": tip, "hub": m.boundaries["xmin"]},
+                {"left": m.node_sets["ymin"], "right": m.node_sets["ymax"],
+                 "hub": m.node_sets["xmin"], "load": load})
+    x = pts[load[0]]
+    e_r = np.array([x[0], x[1], 0.0]) / np.hypot(x[0], x[1])
+    e_t = np.array([-e_r[1], e_r[0], 0.0])
+    loads = [NodalForce("load", tuple(2e4 * e_r), "constant", name="press"),
+             NodalForce("load", tuple(force * e_t + force / 3 * np.array([0, 0, 1.0])), "cos",
+                        name="excitation")]
+    model = from_mesh(mesh, Material(2e11, 0.3, 7800.0), supports=[("hub", "all")],
+                      loads=loads, contact=ContactSpec("tip", mu=0.3, name="casing"),
+                      damping=Damping(loss_factor=0.01), observed={"load": "load"},
+                      name="3D sector")
+    return cyclic_sector(model, n_sectors, "left", "right"), model
