@@ -169,3 +169,17 @@ def test_neighbour_contact_refuses_a_face_paired_with_itself():
         neighbour_contact(base, ContactSpec("slit_a", mu=0.3, partner="slit_a", name="x"))
     with pytest.raises(InputError, match="swap left and right|from the nearest"):
         neighbour_contact(base, ContactSpec("slit_b", mu=0.3, partner="slit_a", name="x"))
+
+
+def test_sector_of_user_matrices_from_dofs():
+    """The entry for models without a mesh (DOFs and positions of the boundary nodes, any
+    order) gives the same matched sector as the mesh entry."""
+    from fretwear.model.cyclic import cyclic_sector_from_dofs
+
+    sector, model = sector_model(8)
+    flip = np.arange(sector.left_dofs.shape[0])[::-1]  # the right nodes listed backwards
+    other = cyclic_sector_from_dofs(
+        model, 8, (sector.left_dofs, sector.left_coords),
+        (sector.right_dofs[flip], sector.right_coords[flip]), tolerance=1e-9)
+    assert np.array_equal(other.right_dofs, sector.right_dofs)
+    assert np.allclose(transform(other, 3).toarray(), transform(sector, 3).toarray())

@@ -167,10 +167,6 @@ def cyclic_condenser(sector: CyclicSector, engine_order: int) -> CyclicCondenser
     return CyclicCondenser(sector, engine_order)
 
 
-def _kept(model: Model) -> np.ndarray:
-    return model.free_dofs()
-
-
 def cyclic_modes(sector: CyclicSector, k: int, n_modes: int = 6) -> tuple[np.ndarray,
                                                                           np.ndarray]:
     """The ``n_modes`` lowest modes of harmonic index (nodal diameter) ``k`` of the disk,
@@ -182,7 +178,7 @@ def cyclic_modes(sector: CyclicSector, k: int, n_modes: int = 6) -> tuple[np.nda
             0 <= k < sector.n_sectors:
         raise InputError(f"k = {k!r}: expected a harmonic index 0..{sector.n_sectors - 1}")
     red, T = harmonic_model(sector, int(k))
-    free = _kept(red)
+    free = red.free_dofs()
     K = red.K.tocsr()[free][:, free]
     M = red.M.tocsr()[free][:, free]
     n_modes = min(int(n_modes), free.size)
@@ -204,7 +200,7 @@ def cyclic_frf(sector: CyclicSector, engine_order: int, frequencies) -> np.ndarr
     eo = _engine_order(engine_order)
     k = int(harmonic_index(1, eo, sector.n_sectors))
     red, T = harmonic_model(sector, k)
-    free = _kept(red)
+    free = red.free_dofs()
     F = (T.conj().T @ sector.model.load_harmonics(1)[1])[free]
     K, M = red.K.tocsc()[free][:, free], red.M.tocsc()[free][:, free]
     C = None if red.C is None else red.C.tocsc()[free][:, free]

@@ -29,7 +29,9 @@ import numpy as np
 import scipy.sparse as sp
 
 from fretwear.errors import InputError
+from fretwear.model.build import _contact
 from fretwear.model.core import ContactInterface, Load, Model, ObservedPoint
+from fretwear.model.interfaces import check_distinct, combine
 
 
 @dataclass
@@ -192,18 +194,20 @@ def cyclic_sector(model: Model, n_sectors: int, left, right, *, axis=(0.0, 0.0, 
     dofs = np.arange(model.ndof, dtype=np.int64).reshape(-1, d)
     if tolerance is None:
         tolerance = 1e-6 * float(np.ptp(mesh.points, axis=0).max())
-    return cyclic_sector_from_dofs(model, n_sectors, dofs[ln], mesh.points[ln], dofs[rn],
-                                   mesh.points[rn], axis=axis, point=point, tolerance=tolerance,
-                                   node_dofs=dofs)
+    return cyclic_sector_from_dofs(model, n_sectors, (dofs[ln], mesh.points[ln]),
+                                   (dofs[rn], mesh.points[rn]), axis=axis, point=point,
+                                   tolerance=tolerance, node_dofs=dofs)
 
 
-def cyclic_sector_from_dofs(model: Model, n_sectors: int, left_dofs, left_coords, right_dofs,
-                            right_coords, *, axis=(0.0, 0.0, 1.0), point=(0.0, 0.0, 0.0),
+def cyclic_sector_from_dofs(model: Model, n_sectors: int, left, right, *,
+                            axis=(0.0, 0.0, 1.0), point=(0.0, 0.0, 0.0),
                             tolerance: float = 1e-9, node_dofs=None) -> CyclicSector:
     """The sector ``model`` (any model, user matrices included) with its cyclic boundaries
-    given as the DOFs (nb, d) and positions (nb, d) [m] of their nodes; ``node_dofs`` (nn, d):
-    the DOF groups that turn as vectors (default: ``d i + c``, every DOF in a node)."""
+    ``left``, ``right`` each given as ``(dofs, coords)``: the DOFs (nb, d) and positions
+    (nb, d) [m] of their nodes, in any order (matched here); ``node_dofs`` (nn, d): the DOF
+    groups that turn as vectors (default: ``d i + c``, every DOF in a node)."""
     n = _count(n_sectors)
+    (left_dofs, left_coords), (right_dofs, right_coords) = left, right
     d = int(model.dim)
     a, p = _axis(axis, point, d)
     ld = np.asarray(left_dofs, dtype=np.int64).reshape(-1, d)
@@ -287,9 +291,6 @@ def neighbour_contact(sector: CyclicSector, spec) -> CyclicSector:
         U_rel,n = U_A,n - e^{+i n EO 2 pi / N} R U_B,n
 
     (:func:`relative_harmonic_model`); the normal default is A's outward normal."""
-    from fretwear.model.build import _contact
-    from fretwear.model.interfaces import check_distinct, combine
-
     model = sector.model
     mesh = model.mesh
     if mesh is None:
