@@ -285,3 +285,15 @@ def test_3d_sector_periodic_solve_and_frf_equal_the_disk():
         assert np.max(np.abs(sol.U - sol_d.U[:nc])) < 1e-8 * np.abs(sol_d.U[:nc]).max()
         assert np.max(np.abs(sol.observed["load"] - sol_d.observed["load"])) < \
             1e-8 * np.abs(sol_d.observed["load"]).max()
+
+
+def test_static_condensation_of_load_vectors_is_refused(sector):
+    """condense_static would apply the sector's load vectors to harmonic index 0's DOFs: a
+    one-line InputError instead of a wrong answer; the drivers drop the time-domain fallback
+    (it would integrate the sector without its cyclic boundaries)."""
+    from fretwear.hb.reduce import condense_static
+
+    cond = cyclic_condenser(sector, 1)
+    assert cond.models_in_time is False
+    with pytest.raises(InputError, match="not available on a sector"):
+        condense_static(sector.model, condenser=cond).loads(np.zeros(sector.model.ndof))

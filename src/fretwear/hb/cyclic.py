@@ -71,7 +71,15 @@ class CyclicCondenser(Condenser):
     blocks are those of harmonic index 0 (the static condensation, the preload); harmonic
     ``n`` is condensed by the condenser of ``k = n EO mod N``. Contact and observed nodes
     must not lie on the right cyclic boundary (it is the next sector's left one). Recovery
-    gives the sector's DOFs (right boundary included). Made by :func:`cyclic_condenser`."""
+    gives the sector's DOFs (right boundary included). Made by :func:`cyclic_condenser`.
+
+    The time-domain fallback integrates the model it is given, which for a sector lacks its
+    cyclic boundaries: ``models_in_time = False`` tells the periodic solve, the sweep and the
+    wear run to go without it. The static condensation with load vectors
+    (:func:`~fretwear.hb.reduce.condense_static`: quasi-static time stepping) is refused."""
+
+    #: the drivers' time-domain fallback does not model the sector's cyclic boundaries
+    models_in_time = False
 
     def __init__(self, sector: CyclicSector, engine_order: int, dense: bool | None = None):
         self.sector = sector
@@ -112,8 +120,17 @@ class CyclicCondenser(Condenser):
         cond._load_cache = {}
 
     # -- the Condenser interface --------------------------------------------------------------
+    def loads(self, F, lu, Zci):
+        """Eq. 19's loads on harmonic index 0's DOFs; load vectors of the sector's own DOFs
+        (:func:`~fretwear.hb.reduce.condense_static`) are refused."""
+        if np.shape(F)[0] != self.structure.ndof:
+            raise InputError("cyclic condenser: the static condensation of load vectors "
+                             "(condense_static, quasi-static time stepping, incremental wear) "
+                             "is not available on a sector; use condense / solve_periodic")
+        return super().loads(F, lu, Zci)
+
     def check(self, model: Model) -> CyclicCondenser:
-        if model is not self.sector.model or _fingerprint(model) != self._fp:
+        if _fingerprint(model) != self._fp:  # the matrices (by identity), DOFs, frames
             raise InputError("condenser: this cyclic condenser was built for another sector "
                              "model, or for this one before its matrices, fixed DOFs, contact "
                              "DOFs, frames or observed points changed; build one for it "
