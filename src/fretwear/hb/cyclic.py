@@ -105,7 +105,7 @@ class CyclicCondenser(Condenser):
         return self._subs[k]
 
     def _set_loads(self, cond: Condenser, T: sp.csr_matrix) -> None:
-        model = self.sector.model
+        model = self._loads_of  # the loads of the model last checked (read at each use)
         Th = T.conj().T.tocsr()
         P = cond.structure.P
         Pt = None if P is None else P.conj().T.tocsr()  # P^H: complex for inter-blade pairs
@@ -139,6 +139,8 @@ class CyclicCondenser(Condenser):
         return self
 
     def read_loads(self, model: Model) -> None:
+        """Read the loads of ``model`` (the sector's, same matrices) for every index."""
+        self._loads_of = model
         for cond, T in self._subs.values():
             self._set_loads(cond, T)
 
