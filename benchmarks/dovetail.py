@@ -15,7 +15,12 @@ Prints, on this machine and in this run, with the number of unknowns of each sta
   solves counted), against the direct FRF (one sparse solve per frequency) at 10 of them,
   timed in the same run, with the largest relative difference;
 - a nonlinear FRF of ``--points`` (default 50) points from 1.9 to 2.8 kHz with the example's
-  settings (1 harmonic), and how many converged.
+  settings (1 harmonic), and how many converged, twice in the same run: with the exact
+  condensation at every frequency, and with the case file's default (``condensation =
+  "auto"``: one modal basis with residual vectors for the whole band, its error check
+  printed); the largest relative difference of the points converged in both. The last lines
+  are ``frf50_cpu_s=`` (processor seconds of the new path, its condenser's build included)
+  and ``frf50_speedup=`` (the exact path's processor time over the new path's).
 
 Run: ``python benchmarks/dovetail.py [--points 50] [--quick] [--verbose]`` (``--quick``
 skips the nonlinear FRF, ``--verbose`` prints one line per FRF point: how it converged and
@@ -35,6 +40,7 @@ import scipy.linalg as sla
 from fretwear import linear
 from fretwear.analyses.run import load_case
 from fretwear.examples import example_path
+from fretwear.hb.condensers import condenser
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.options import SweepOptions
 from fretwear.hb.periodic import solve_periodic
@@ -143,29 +149,85 @@ def main():
               f"frequency; largest relative difference at {some.size} frequencies {diff:.1e}")
 
     if not args.quick:
-        case = load_case(example_path("dovetail-frf"))
-        a = case.analysis
-        basis = FourierBasis.up_to(a["harmonics"], a["n_samples"])
-        t_sweep = [time.perf_counter()]
+        _frf(model, m, args)
+    else:
+        print(f"load average at the end: {os.getloadavg()[0]:.2f}")
 
-        def show(i, n, pt):
-            now = time.perf_counter()
-            if args.verbose:
-                print(f"  {i + 1:3d}/{n} {pt.frequency_hz:8.1f} Hz {pt.how:22s} "
-                      f"{pt.stats.iterations:3d} it, {len(pt.attempts)} attempts, "
-                      f"{now - t_sweep[0]:6.1f} s, success={pt.success}", flush=True)
-            t_sweep[0] = now
 
-        res, t = _timed(lambda: sweep(model, basis, a["f_min"], a["f_max"], args.points,
-                                      options=SweepOptions(spacing="linear", eps=a["eps"],
-                                                           progress=show), condenser=cond))
+def _frf(model, m, args):
+    """The nonlinear FRF of the example's settings twice in this run: with the exact
+    condensation at every frequency (one exact condenser, as before) and with the case file's
+    default condensation (``fretwear.condenser(model, "auto", f_max=, max_order=)``: one modal
+    basis with residual vectors for the whole band, its build timed with it); the largest
+    relative difference of the points converged in both, on the observed responses and on the
+    contact displacements and forces."""
+    case = load_case(example_path("dovetail-frf"))
+    a = case.analysis
+    basis = FourierBasis.up_to(a["harmonics"], a["n_samples"])
+    t_sweep = [time.perf_counter()]
+
+    def show(i, n, pt):
+        now = time.perf_counter()
+        if args.verbose:
+            print(f"  {i + 1:3d}/{n} {pt.frequency_hz:8.1f} Hz {pt.how:22s} "
+                  f"{pt.stats.iterations:3d} it, {len(pt.attempts)} attempts, "
+                  f"{now - t_sweep[0]:6.1f} s, success={pt.success}", flush=True)
+        t_sweep[0] = now
+
+    def run(make):
+        cond = make()
+        res = sweep(model, basis, a["f_min"], a["f_max"], args.points,
+                    options=SweepOptions(spacing="linear", eps=a["eps"], progress=show),
+                    condenser=cond)
+        return cond, res
+
+    out, cpu = {}, {}
+    for name, make in (("exact at every frequency", lambda: condenser(model, "exact")),
+                       ("auto (one modal basis)",
+                        lambda: condenser(model, "auto", f_max=a["f_max"],
+                                          max_order=max(basis.harmonics)))):
+        print(f"load average before the FRF, {name}: {os.getloadavg()[0]:.2f}")
+        (cond, res), t = _timed(lambda mk=make: run(mk))
+        cpu[name] = CPU[0]
+        out[name] = res
         grid = [p for p in res.points if p.on_grid]
         ok = sum(p.success for p in grid)
-        print(f"FRF: {args.points} points, {m * basis.size} unknowns each, {t:.1f} s"
-              f"{_cpu()}, {t / args.points:.2f} s per point; sweep_converged={ok}/{len(grid)} "
-              f"({len(res.points) - len(grid)} intermediate points)")
+        print(f"FRF, condensation {name}: {args.points} points, {m * basis.size} unknowns "
+              f"each, {t:.1f} s{_cpu()}, {t / args.points:.2f} s per point; "
+              f"sweep_converged={ok}/{len(grid)} ({len(res.points) - len(grid)} intermediate "
+              f"points)")
+        print(f"  {cond.choice.summary()}")
+    ref, new = out.values()
+    d_obs, d_u, d_lam, both = _differences(ref, new)
+    print(f"converged in both: {both} grid points; largest relative difference: observed "
+          f"responses {d_obs:.2e}, contact displacements {d_u:.2e}, contact forces "
+          f"{d_lam:.2e}")
     print(f"load average at the end: {os.getloadavg()[0]:.2f}")
+    c_ref, c_new = cpu.values()
+    print(f"frf50_cpu_s={c_new:.2f}")
+    print(f"frf50_speedup={c_ref / c_new:.1f}")
 
+
+def _differences(ref, new):
+    """Largest relative differences (observed harmonics, contact ``U``, contact ``lam``: each
+    ``max |new - ref| / max |ref|`` per point) over the grid points converged in both."""
+    pr = {p.frequency_hz: p for p in ref.points if p.on_grid and p.success}
+    d_obs = d_u = d_lam = 0.0
+    both = 0
+    for p in new.points:
+        q = pr.get(p.frequency_hz)
+        if q is None or not (p.on_grid and p.success):
+            continue
+        both += 1
+        for k, c in q.solution.observed.items():
+            d_obs = max(d_obs, _rel(p.solution.observed[k], c))
+        d_u = max(d_u, _rel(p.solution.U, q.solution.U))
+        d_lam = max(d_lam, _rel(p.solution.lam, q.solution.lam))
+    return d_obs, d_u, d_lam, both
+
+
+def _rel(a, b) -> float:
+    return float(np.abs(np.asarray(a) - b).max() / max(np.abs(b).max(), 1e-300))
 
 if __name__ == "__main__":
     main()

@@ -16,6 +16,7 @@ before the timings).
 
 from __future__ import annotations
 
+import os
 import time
 
 import numpy as np
@@ -23,6 +24,8 @@ import numpy as np
 from fretwear.hb.dynamics import structure_dynamics
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.nonlinear_modes import nonlinear_mode
+from fretwear.hb.options import SweepOptions
+from fretwear.hb.reduce import exact_condenser
 from fretwear.hb.stability import stability
 from fretwear.hb.sweep import sweep
 from fretwear.model.build import Damping
@@ -81,28 +84,40 @@ def epmc_errors():
 
 
 def hill_ratios(model, basis, f_min, f_max, n_points, label):
-    res = sweep(model, basis, f_min, f_max, n_points, spacing="linear")
-    dyn = structure_dynamics(model)
-    ratios, unstable = [], 0
+    """Hill's time at every converged point over the point's solve time (wall seconds, as the
+    sweep records its attempts; the machine may be loaded, so the CPU seconds of Hill's
+    method are printed too)."""
+    cond = exact_condenser(model)
+    res = sweep(model, basis, f_min, f_max, n_points, options=SweepOptions(spacing="linear"),
+                condenser=cond)
+    dyn = structure_dynamics(model, cond)
+    ratios, unstable, cpu, evals = [], 0, 0.0, 0
     for p in res.points:
         if p.solution is None:
             continue
         solve_t = sum(a.wall_time for a in p.attempts)
-        t0 = time.perf_counter()
-        fl = stability(model, p.solution, dyn=dyn)
+        t0, c0 = time.perf_counter(), time.process_time()
+        fl = stability(model, p.solution, dyn=dyn, condenser=cond)
         ratios.append((time.perf_counter() - t0) / max(solve_t, 1e-9))
+        cpu += time.process_time() - c0
+        evals += fl.evaluations
         unstable += not fl.stable
     r = np.array(ratios)
     print(f"  {label}: {r.size} points ({unstable} unstable), stability / solve: median "
-          f"{np.median(r):.2f}, range {r.min():.2f}-{r.max():.2f}")
+          f"{np.median(r):.2f}, range {r.min():.2f}-{r.max():.2f}; Hill CPU "
+          f"{1e3 * cpu / max(r.size, 1):.1f} ms and {evals / max(r.size, 1):.1f} evaluations "
+          "of T(s) per point")
     return r
 
 
 def main():
+    print(f"load average before: {os.getloadavg()[0]:.1f}")
+    c0 = time.process_time()
     # JIT warm-up
     nonlinear_mode(jenkins(), FourierBasis((1,), 16), [0.5, 1.0])
     sol_model = jenkins(0.2, c=0.02)
-    res = sweep(sol_model, FourierBasis.up_to(3, 32), 0.18, 0.2, 3, spacing="linear")
+    res = sweep(sol_model, FourierBasis.up_to(3, 32), 0.18, 0.2, 3,
+                options=SweepOptions(spacing="linear"))
     stability(sol_model, res.points[-1].solution)
     print("EPMC of a Jenkins oscillator, one harmonic, against the describing function:")
     err = epmc_errors()
@@ -111,6 +126,7 @@ def main():
                      "Jenkins oscillator, 7 harmonics")
     r2 = hill_ratios(two_dof(), FourierBasis.up_to(15, 256), 0.56 / (2 * np.pi),
                      0.8 / (2 * np.pi), 30, "two-DOF unilateral spring, 15 harmonics")
+    print(f"load average after: {os.getloadavg()[0]:.1f}; CPU {time.process_time() - c0:.1f} s")
     print(f"epmc_jenkins_err={err[1024]:.3g}")
     print(f"hill_cost_ratio={float(np.median(np.concatenate([r1, r2]))):.3g}")
 

@@ -11,6 +11,8 @@ The public API, stage by stage (data flows one way; each stage returns a plain d
     red   = fretwear.condense(model, frequency, basis.orders, condenser=cond)  # Reduced (Z_r)
     sol   = fretwear.solve_periodic(model, basis, frequency, condenser=cond)   # PeriodicSolution
     frf   = fretwear.sweep(model, basis, f_min, f_max, n, condenser=cond)     # SweepResult
+    hill  = fretwear.sweep_stability(model, frf, condenser=cond)         # SweepStability
+    nm    = fretwear.nonlinear_mode(model, basis, amplitudes)           # Backbone (EPMC)
     wear  = fretwear.simulate_wear(model, basis, frequency, condenser=cond)   # WearResult
     worn  = fretwear.frf_worn(model, basis, wear.final_wear, f_min, f_max, n)  # SweepResult
     run   = fretwear.integrate(model, frequency, n_periods=...)   # TransientResult
@@ -18,10 +20,11 @@ The public API, stage by stage (data flows one way; each stage returns a plain d
     ds    = fretwear.read_results("out/results.nc")               # an xarray Dataset
     st    = fretwear.run_study("study.toml", "out/")              # members on Dask (study.nc)
 
-The condensation of a model is an object its caller owns (``exact_condenser``, or the
-Craig-Bampton ``modal_condenser`` for large interfaces): build it once and pass it as
-``condenser=`` to every driver that condenses the same model; without it each call builds
-its own exact one.
+The condensation of a model is an object its caller owns (``exact_condenser``, the
+Craig-Bampton ``modal_condenser`` for large interfaces, or ``condenser(model, method, f_max=,
+max_order=)``: ``"exact"``, ``"modal"`` or ``"auto"``, the modal one where it is cheaper, with
+modes raised until its error check passes): build it once and pass it as ``condenser=`` to
+every driver that condenses the same model; without it each call builds its own exact one.
 
 One vocabulary and argument order at every entry point (:mod:`fretwear.api`): ``model, basis``
 first, then the frequency or the band; the stick anchors are ``anchor``, the initial wear
@@ -57,10 +60,12 @@ _API = {
     # harmonic balance
     "FourierBasis": "fretwear.hb.fourier", "condense": "fretwear.hb.reduce",
     "exact_condenser": "fretwear.hb.reduce", "modal_condenser": "fretwear.hb.modal",
+    "condenser": "fretwear.hb.condensers",
     "Reduced": "fretwear.hb.reduce", "solve_periodic": "fretwear.api",
     "PeriodicSolution": "fretwear.hb.solution", "SweepResult": "fretwear.hb.sweep_result",
     "sweep": "fretwear.api", "SolveOptions": "fretwear.hb.options",
     "SweepOptions": "fretwear.hb.options",
+    "nonlinear_mode": "fretwear.api", "sweep_stability": "fretwear.hb.sweep_stability",
     # linear
     "modes": "fretwear.linear", "frf": "fretwear.linear",
     # one sector of a tuned bladed disk (cyclic symmetry)

@@ -24,11 +24,15 @@ built once by the caller and passed to every driver that condenses the same mode
 from __future__ import annotations
 
 import dataclasses
+import math
 
+from fretwear import linear as _linear
 from fretwear import wear as _wear
 from fretwear.errors import InputError
+from fretwear.hb import nonlinear_modes as _modes
 from fretwear.hb import periodic as _periodic
 from fretwear.hb import sweep as _sweep
+from fretwear.hb.dynamics import structure_dynamics
 from fretwear.hb.options import sweep_options
 from fretwear.timedomain import integrate as _integrate
 from fretwear.timedomain import quasistatic as _quasistatic
@@ -202,6 +206,71 @@ def frf_worn(model, basis, wear, f_min: float, f_max: float, n_points: int, *,
     options = sweep_options(kwargs.pop("options", None), WORN_FRF)
     return _wear.frf_worn(model, basis, wear, f_min, f_max, n_points,
                           options=options.replace(time_domain=_fallback(time_domain)), **kwargs)
+
+
+#: linear interfaces a nonlinear mode may be chosen on (:func:`nonlinear_mode`)
+MODE_INTERFACES = ("stuck", "sliding")
+
+
+def mode_target(model, mode: int = 1, interface: str = "stuck", dyn=None) -> float:
+    """The circular frequency [rad/s] that picks the linear mode a nonlinear mode starts from:
+    mode number ``mode`` (from 1, by increasing frequency) of the structure with its contact
+    points held (``interface = "stuck"``: the EPMC's own start, contact springs included), or
+    of the frictionless structure (``"sliding"``: :func:`fretwear.linear.modes`), whose
+    nearest stuck mode is then followed. ``dyn``: the model's
+    :func:`fretwear.hb.dynamics.structure_dynamics` if already made."""
+    if isinstance(mode, bool) or not isinstance(mode, int) or mode < 1:
+        raise InputError(f"mode = {mode!r}: expected a mode number >= 1")
+    if interface not in MODE_INTERFACES:
+        raise InputError(f"interface = {interface!r}: expected one of "
+                         f"{', '.join(MODE_INTERFACES)}")
+    if interface == "stuck":
+        held = _modes.mode_system(model, None, dyn=dyn).omega_held
+        if mode > held.size:
+            raise InputError(f"mode = {mode}: the structure with its contact points held has "
+                             f"{held.size} modes")
+        return float(held[mode - 1])
+    r = _linear.modes(model, mode, interface="sliding")
+    if mode > len(r.frequency_hz):
+        raise InputError(f"mode = {mode}: the structure with a sliding interface has "
+                         f"{len(r.frequency_hz)} modes")
+    return float(2.0 * math.pi * r.frequency_hz[mode - 1])
+
+
+def nonlinear_mode(model, basis, amplitudes, *, mode: int = 1, interface: str = "stuck",
+                   **kwargs) -> _modes.Backbone:
+    """Nonlinear mode of ``model`` over the modal ``amplitudes`` by the Extended Periodic
+    Motion Concept (:func:`fretwear.hb.nonlinear_modes.nonlinear_mode`): natural frequency
+    [Hz] and damping ratio against amplitude, from the stuck to the sliding interface.
+
+    Parameters
+    ----------
+    model, basis : the structure and the Fourier basis (the fundamental kept).
+    amplitudes : (k,) increasing modal amplitudes [m sqrt(kg)]: the mass norm of the
+        fundamental harmonic of the whole structure's motion.
+    mode, interface : which linear mode the branch starts from (:func:`mode_target`):
+        number ``mode`` from 1 of the structure with its interface ``"stuck"`` (contact points
+        held) or ``"sliding"`` (frictionless).
+    **kwargs : the other keywords of :func:`fretwear.hb.nonlinear_modes.nonlinear_mode`,
+        with its defaults: ``masters``, ``eps`` (a rule or [N/m]), ``options``
+        (:class:`~fretwear.hb.options.SolveOptions`), ``dyn``; or ``condenser`` (a modal
+        condenser for a large model: the structure's matrices are then its projection).
+
+    Returns
+    -------
+    :class:`~fretwear.hb.nonlinear_modes.Backbone`: ``success``, ``message``, ``points``
+    (each with ``amplitude``, ``frequency`` [Hz], ``damping_ratio``, ``energy`` [J],
+    ``state``, ``observed``), ``array(name)``.
+    """
+    _public_names("nonlinear_mode", kwargs)
+    if "omega_target" in kwargs:
+        raise TypeError("nonlinear_mode() takes mode and interface, not omega_target")
+    dyn = kwargs.pop("dyn", None)
+    if dyn is None:
+        dyn = structure_dynamics(model, kwargs.pop("condenser", None))
+    target = mode_target(model, mode, interface, dyn=dyn)
+    return _modes.nonlinear_mode(model, basis, amplitudes, omega_target=target, dyn=dyn,
+                                 **kwargs)
 
 
 def integrate(model, frequency: float, **kwargs):

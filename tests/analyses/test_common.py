@@ -22,7 +22,8 @@ from fretwear import api, linear
 from fretwear.analyses.registry import analysis_tables
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.inputs import QUASI_STATIC_FREQUENCY
-from fretwear.hb.options import PERIODIC, SWEEP, WEAR_STEP
+from fretwear.hb.nonlinear_modes import nonlinear_mode
+from fretwear.hb.options import PERIODIC, SWEEP, WEAR_STEP, SolveOptions
 from fretwear.hb.periodic import solve_periodic
 from fretwear.io.case import validate
 from fretwear.timedomain.integrate import integrate
@@ -54,6 +55,11 @@ CASES = {
         **BASIS, **{k: (SWEEP, k) for k in ("spacing", "continuation", "eps")},
         **{k: (SWEEP.solve, k) for k in ("time_domain_periods", "solver", "tol", "max_iter")},
         "time_domain": (api.sweep, "time_domain")}),
+    "nonlinear-modes": ({"amplitude_min": 1e-6, "amplitude_max": 1e-3}, {
+        **BASIS, "mode": (api.nonlinear_mode, "mode"),
+        "interface": (api.nonlinear_mode, "interface"),
+        **{k: (nonlinear_mode, k) for k in ("masters", "eps")},
+        **{k: (SolveOptions, k) for k in ("solver", "tol", "max_iter")}}),
     "transient": ({"frequency": 10.0}, {
         "steps_per_period": (IntegrationOptions, "steps_per_period"),
         **{k: (SteadyStateOptions, k) for k in ("max_periods", "tol", "harmonics")}}),

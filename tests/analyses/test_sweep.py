@@ -79,3 +79,27 @@ def test_sweep_rejects_a_reversed_band_and_aliasing(tmp_path, capsys):
     assert run(small_case(tmp_path, bad), capsys)[2] == (
         "error: analysis.n_samples = 32: expected more than 32 samples per period "
         "(twice the highest harmonic, 16)\n")
+
+
+def test_sweep_with_hill_stability(tmp_path, capsys):
+    """``hill_stability = true`` adds the documented stability variables: every converged point
+    classified (this beam is small enough for the dense Hill problem), its largest
+    multiplier consistent with ``stable``, ``det J`` signed, the events and notes as
+    attributes; the figure is still written (one harmonic, three frequencies: seconds). The
+    reference for the classification itself is tests/hb/test_stability.py (shooting) and
+    tests/hb/test_sweep_stability.py."""
+    case = SWEEP
+    for line in ("hill_stability = true", "n_points = 3", "harmonics = 1", "n_samples = 16"):
+        case = with_key(case, line)
+    status, out, err = run(small_case(tmp_path, case), capsys)
+    res = tmp_path / "beam-results"
+    ds = read_results(res / "results.nc")
+    check_documented(ds, "sweep")
+    conv = ds["converged"].values == 1
+    stable = ds["stable"].values
+    assert np.all(stable[conv] >= 0) and np.all(stable[~conv] == -1), ds.attrs["stability_notes"]
+    rho = ds["floquet_multiplier_max"].values[conv]
+    np.testing.assert_array_equal(stable[conv] == 1, rho <= 1 + 1e-6)
+    assert np.all(np.abs(ds["jacobian_sign"].values[conv]) == 1)
+    assert "branch_events" in ds.attrs and ds.attrs["stability_notes"] == ""
+    assert (res / "sweep-Pe.png").stat().st_size > 10_000

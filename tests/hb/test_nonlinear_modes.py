@@ -148,3 +148,30 @@ def test_rigid_contact_mode_with_a_master_coordinate():
     w_ref, z_ref = closed_form(bb.array("amplitude") / np.sqrt(M_))
     assert np.max(np.abs(bb.array("omega") / w_ref - 1)) < 2e-3
     assert np.max(np.abs(bb.array("damping_ratio") - z_ref)) < 2e-3
+
+
+
+def test_observed_harmonics_are_recovered_from_the_condensed_coordinates():
+    """The observed points' harmonics (``ModePoint.observed``) against the modal amplitude's
+    definition: while the light node sticks it does not move, so the whole motion is the
+    mass's and its first harmonic has the amplitude ``a / sqrt(m)`` exactly (rounding); the
+    mass is an interior DOF behind the contact, recovered through ``Psi u_c + q``. On the
+    Jenkins model (the mass behind a contact spring, a coordinate of ``q``) the same holds at
+    every amplitude (the massless contact point carries no mass)."""
+    ms, kz = 1e-3, 10.0
+    K = np.array([[K_ + KT, -KT, 0], [-KT, KT, 0], [0, 0, kz]])
+    model = from_matrices(K, np.diag([M_, ms, ms]),
+                          contact=ContactDofs(normal_dofs=[2], tangential_dofs=[1], gap=0.0,
+                                              mu=FS),
+                          loads=[Load(np.array([0, 0, 1.0]), "constant")], observed={"x": 0})
+    basis = FourierBasis((1,), 256)
+    bb = nonlinear_mode(model, basis, np.geomspace(0.01, 0.05, 3), eps=KT)
+    assert bb.success
+    for p in bb.points:
+        assert np.all(p.state == 1)  # below the stick limit a_s sqrt(m) = 0.1
+        amp = np.hypot(p.observed[0, 1], p.observed[0, 2])
+        assert amp == pytest.approx(p.amplitude / np.sqrt(M_), rel=1e-10)
+    bb = nonlinear_mode(jenkins_model(), basis, np.geomspace(0.01, 10.0, 7))
+    for p in bb.points:
+        amp = np.hypot(p.observed[0, 1], p.observed[0, 2])
+        assert amp == pytest.approx(p.amplitude / np.sqrt(M_), rel=1e-10)

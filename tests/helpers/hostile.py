@@ -83,6 +83,8 @@ ANALYSES = {
     "periodic": 'type = "periodic"\nfrequency = 1500.0\nharmonics = 3\nn_samples = 16\n',
     "sweep": ('type = "sweep"\nf_min = 1000.0\nf_max = 1200.0\nn_points = 3\nharmonics = 1\n'
               'n_samples = 16\ntime_domain_periods = 10\n'),
+    "nonlinear-modes": ('type = "nonlinear-modes"\namplitude_min = 1e-10\namplitude_max = 1e-9\n'
+                        'n_amplitudes = 2\nharmonics = 1\nn_samples = 16\n'),
     "transient": ('type = "transient"\nfrequency = 1500.0\nmode = "fixed"\nn_periods = 5\n'
                   'steps_per_period = 64\nmax_periods = 20\n'),
     "wear": ('type = "wear"\nquasi_static = true\nharmonics = 1\nn_samples = 16\n'

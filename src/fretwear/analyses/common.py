@@ -15,6 +15,7 @@ import numpy as np
 import xarray as xr
 
 from fretwear.files import inside, safe_name
+from fretwear.hb.condensers import METHODS, condenser
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.options import SolveOptions
 from fretwear.hb.penalty import RULES
@@ -206,6 +207,43 @@ def basis_fields() -> dict:
     }
 
 
+def condensation_fields() -> dict:
+    """The keys of the condensation (``condensation``, ``condensation_modes``,
+    ``condensation_cutoff``, ``condensation_tol``), with the defaults of
+    :func:`fretwear.hb.condensers.condenser` (docs/case-files.md, "Condensation")."""
+    return {
+        "condensation": Field(
+            Text(METHODS), 'condensation on the contact DOFs: "exact" (eq. 19 at every '
+            'harmonic and frequency), "modal" (one Craig-Bampton basis for every frequency, '
+            'with its error check) or "auto" (the modal one for large models where its check '
+            "passes, else exact; see Condensation below)",
+            default=default_of(condenser, "method")),
+        "condensation_modes": Field(
+            Integer(lo=0), "modal: the number of fixed-interface modes kept (checked, not "
+            "raised; default: those below condensation_cutoff, raised until the check "
+            "passes)"),
+        "condensation_cutoff": Field(
+            Number(lo=0, lo_open=True), "modal: keep the modes below this multiple of the "
+            "highest harmonic frequency (then raised until the check passes)",
+            default=default_of(condenser, "cutoff"), unit="-"),
+        "condensation_tol": Field(
+            Number(lo=0, lo_open=True), "modal: bound on the relative error of the check "
+            "against the exact condensation at the highest harmonic frequency",
+            default=default_of(condenser, "tol"), unit="-"),
+    }
+
+
+def condenser_of(model, analysis: dict, f_max: float | None, max_order: int):
+    """The run's condenser of ``model`` as the ``[analysis]`` table asks
+    (:func:`condensation_fields`; :func:`fretwear.hb.condensers.condenser`) for excitation
+    frequencies up to ``f_max`` [Hz] (None: a quasi-static run, exact) and harmonic orders
+    up to ``max_order``; its ``choice`` goes to the run summary and the results attributes."""
+    return condenser(model, analysis.get("condensation", "auto"), f_max=f_max,
+                     max_order=int(max_order), modes=analysis.get("condensation_modes"),
+                     cutoff=analysis.get("condensation_cutoff", default_of(condenser, "cutoff")),
+                     tol=analysis.get("condensation_tol", default_of(condenser, "tol")))
+
+
 def harmonic_balance_fields(solve: SolveOptions, eps_default, eps_doc: str) -> dict:
     """The keys of the DLFT analyses' tables (``harmonics``, ``n_samples``, ``eps``,
     ``solver``, ``tol``, ``max_iter``) with the ``eps`` description ``eps_doc``; the defaults
@@ -215,6 +253,7 @@ def harmonic_balance_fields(solve: SolveOptions, eps_default, eps_doc: str) -> d
     :meth:`~fretwear.hb.fourier.FourierBasis.up_to`."""
     return {
         **basis_fields(),
+        **condensation_fields(),
         "eps": Field(AnyOf((Text(RULES), Number(lo=0, lo_open=True))), eps_doc,
                      default=eps_default, unit="N/m"),
         "solver": Field(Text(SOLVERS), '"powell" (hybrid dog-leg, LAPACK), "newton" (damped '

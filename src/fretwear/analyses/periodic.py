@@ -24,6 +24,7 @@ from fretwear.analyses.common import (
     STOP_TOL,
     basis_of,
     check_sampling,
+    condenser_of,
     default_of,
     figure_path,
     geometry,
@@ -43,7 +44,7 @@ from fretwear.hb.inputs import QUASI_STATIC_FREQUENCY
 from fretwear.hb.options import PERIODIC as PERIODIC_SOLVE
 from fretwear.hb.penalty import penalty
 from fretwear.hb.periodic import solve_periodic
-from fretwear.hb.reduce import condense, exact_condenser, recover
+from fretwear.hb.reduce import condense, recover
 from fretwear.hb.solution import PeriodicSolution
 from fretwear.hb.solvers import SolveStats
 from fretwear.io.results import nodal_vectors, variable, write_pvd, write_vtu
@@ -204,7 +205,8 @@ def run_periodic(model, analysis: dict, case, context: RunContext) -> RunOutput:
     basis = basis_of(analysis)
     qs = analysis["quasi_static"]
     f_hz = float(analysis.get("frequency", QUASI_STATIC_FREQUENCY))
-    cond = exact_condenser(model)  # the run's condensation of the model, for every call
+    # the run's condensation of the model (the case file's choice), for every call
+    cond = condenser_of(model, analysis, None if qs else f_hz, max(basis.harmonics))
     reduced = condense(model, f_hz, basis.orders, quasi_static=qs, condenser=cond)
     eps = penalty(analysis["eps"], model=model, reduced=reduced, condenser=cond)
     sol = api.solve_periodic(model, basis, frequency=f_hz, quasi_static=qs,
@@ -215,7 +217,7 @@ def run_periodic(model, analysis: dict, case, context: RunContext) -> RunOutput:
              "quasi_static": int(qs),
              "attempts": "; ".join(f"{a.method}/{a.solver}/{'yes' if a.success else 'no'}/"
                                    f"{a.residual:.1e}" for a in sol.attempts),
-             "time_domain": sol.time_domain}
+             "time_domain": sol.time_domain, **cond.choice.attributes()}
     where = _frequency_text(f_hz, qs)
     if not sol.success:  # never saved as a result: the diagnostics only
         return RunOutput(xr.Dataset(attrs=attrs), [],
@@ -229,8 +231,8 @@ def run_periodic(model, analysis: dict, case, context: RunContext) -> RunOutput:
     if model.mesh is not None and case.output["vtu"]:
         files.append(write_period_fields(model, sol, context.out_dir / "periodic.pvd",
                                          condenser=cond))
-    return RunOutput(ds, figures, _periodic_summary(sol, ds, analysis, where), True, files,
-                     warnings=list(sol.warnings))
+    return RunOutput(ds, figures, _periodic_summary(sol, ds, analysis, where) + "\n"
+                     + cond.choice.summary(), True, files, warnings=list(sol.warnings))
 
 
 def _periodic_figures(ds: xr.Dataset, case, outdir: Path, title: str) -> list[Path]:

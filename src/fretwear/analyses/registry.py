@@ -16,6 +16,7 @@ from types import MappingProxyType
 
 from fretwear.analyses.base import Analysis
 from fretwear.analyses.linear import FRF, MODES
+from fretwear.analyses.nonlinear_modes import NONLINEAR_MODES
 from fretwear.analyses.periodic import PERIODIC
 from fretwear.analyses.sweep import SWEEP
 from fretwear.analyses.transient import INCREMENTAL_WEAR, TRANSIENT
@@ -24,8 +25,8 @@ from fretwear.errors import InputError
 from fretwear.io.schema import Table
 
 #: every analysis, in the order of ``docs/case-files.md``
-ANALYSES: tuple[Analysis, ...] = (MODES, FRF, PERIODIC, SWEEP, TRANSIENT, INCREMENTAL_WEAR,
-                                  WEAR)
+ANALYSES: tuple[Analysis, ...] = (MODES, FRF, PERIODIC, SWEEP, NONLINEAR_MODES, TRANSIENT,
+                                  INCREMENTAL_WEAR, WEAR)
 
 
 def by_name(analyses: Iterable[Analysis]) -> Mapping[str, Analysis]:

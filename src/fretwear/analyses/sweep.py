@@ -23,6 +23,7 @@ from fretwear.analyses.common import (
     basis_of,
     check_points,
     check_sampling,
+    condenser_of,
     default_of,
     figure_path,
     geometry,
@@ -35,9 +36,9 @@ from fretwear.analyses.common import (
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.options import SWEEP as SWEEP_OPTIONS
-from fretwear.hb.reduce import exact_condenser
 from fretwear.hb.solution import PeriodicSolution
 from fretwear.hb.sweep import SweepResult
+from fretwear.hb.sweep_stability import SweepStability, sweep_stability
 from fretwear.io.results import label_coordinate, variable
 from fretwear.io.schema import Field, Flag, Integer, ListOf, Number, Text, increasing
 from fretwear.timedomain.stability import sweep_check
@@ -205,6 +206,30 @@ def sweep_dataset(model, result: SweepResult, basis: FourierBasis, points: list[
     return xr.Dataset(data, coords=coords)
 
 
+# --- stability (Hill's method; issue 31) ----------------------------------------------------
+def stability_variables(st: SweepStability) -> dict:
+    """``stable``, ``floquet_multiplier_max`` and ``jacobian_sign`` per sweep point."""
+    f = "frequency"
+    return {
+        "stable": variable(f, st.stable, "1", "stability of the periodic solution by Hill's "
+                           "method: 1 stable, 0 unstable, -1 not computed",
+                           flag_values=np.array([-1, 0, 1], dtype=np.int8),
+                           flag_meanings="unknown unstable stable"),
+        "floquet_multiplier_max": variable(f, st.max_multiplier, "1",
+                                           "largest modulus of the Floquet multipliers"),
+        "jacobian_sign": variable(f, st.det_sign, "1", "sign of the determinant of the "
+                                  "balance's Jacobian (0: not computed); a change between "
+                                  "neighbours is a fold or a branch point"),
+    }
+
+
+def stability_attributes(st: SweepStability) -> dict:
+    """``branch_events`` (one line per event) and ``stability_notes``."""
+    return {"branch_events": "\n".join(e.line() for e in st.events),
+            "stability_notes": "\n".join(st.notes),
+            "stability_wall_time": float(np.sum(st.wall_time))}
+
+
 # --- run -----------------------------------------------------------------------------------
 def _sweep_summary(result: SweepResult, ds: xr.Dataset) -> str:
     lines = [result.summary()]
@@ -239,7 +264,9 @@ def run_sweep(model, analysis: dict, case, context: RunContext) -> RunOutput:
     points = check_points(model, analysis.get("points"))
     basis = basis_of(analysis)
     n = analysis["n_points"]
-    cond = exact_condenser(model)  # the run's condensation of the model, for every call
+    # the run's condensation of the model (the case file's choice: one modal basis for the
+    # whole band where chosen), for every call
+    cond = condenser_of(model, analysis, analysis["f_max"], max(basis.harmonics))
     with tqdm(total=n, desc="sweep", disable=not context.progress, leave=False,
               unit="freq") as bar:
         def tick(i, total, pt):
@@ -262,6 +289,12 @@ def run_sweep(model, analysis: dict, case, context: RunContext) -> RunOutput:
                                       analysis["spacing"], result.frequency_hz,
                                       analysis["linear_points"])
     ds = sweep_dataset(model, result, basis, points, analysis["linear_references"], linear_hz)
+    events = []
+    if analysis["hill_stability"]:
+        st = sweep_stability(model, result, condenser=cond)
+        ds = ds.assign(stability_variables(st))
+        ds.attrs.update(stability_attributes(st))
+        events = [e.line() for e in st.events]
     flagged = [f"{p.frequency_hz:.6g} Hz: " + "; ".join(p.flags)
                for p in result.points if p.flags]
     ds.attrs.update({
@@ -272,6 +305,7 @@ def run_sweep(model, analysis: dict, case, context: RunContext) -> RunOutput:
         "eps_rule": str(analysis["eps"]),
         "harmonics": ", ".join(str(h) for h in basis.harmonics),
         "n_samples": int(basis.n_samples),
+        **cond.choice.attributes(),
     })
     figures = []
     for point in points:
@@ -283,8 +317,8 @@ def run_sweep(model, analysis: dict, case, context: RunContext) -> RunOutput:
         figures.append(plot_sweep_interface(ds, p, title=titled(case.title,
                                                                   "contact interface")))
     grid_ok = all(p.success for p in result.points if p.on_grid)
-    return RunOutput(ds, figures, _sweep_summary(result, ds), grid_ok,
-                     warnings=list(result.warnings))
+    summary = "\n".join([_sweep_summary(result, ds), *events, cond.choice.summary()])
+    return RunOutput(ds, figures, summary, grid_ok, warnings=list(result.warnings))
 
 
 # --- figures -------------------------------------------------------------------------------
@@ -299,6 +333,22 @@ def _mark_failures(ax, f: np.ndarray, converged: np.ndarray, flagged: np.ndarray
     if ring.any():
         ax.plot(f[ring], y[ring], "o", mfc="none", color="tab:orange", ms=7,
                 label=f"flagged ({ring.sum()})")
+
+
+def _plot_branch(ax, f: np.ndarray, y: np.ndarray, stable, *, label: str) -> None:
+    """The nonlinear FRF: solid where stable or not classified, dashed along the stretches
+    where Hill's method found the solution unstable (each dashed stretch joins its
+    neighbours, so the curve stays continuous)."""
+    if stable is None or not np.any(stable == 0):
+        ax.plot(f, y, color="k", marker=".", ms=3, label=label)
+        return
+    bad = stable == 0
+    near = bad | np.r_[bad[1:], False] | np.r_[False, bad[:-1]]
+    solid = np.where(bad, np.nan, y)
+    ax.plot(f, solid, color="k", marker=".", ms=3, label=label)
+    ax.plot(f, np.where(near, y, np.nan), color="k", linestyle="--", lw=1.0)
+    ax.plot(f[bad], y[bad], "o", mfc="none", color="k", ms=3, ls="none",
+            label=f"unstable (Hill, {int(bad.sum())})")
 
 
 def plot_sweep(ds: xr.Dataset, path: Path, point: str, *, title: str | None = None) -> Path:
@@ -320,8 +370,9 @@ def plot_sweep(ds: xr.Dataset, path: Path, point: str, *, title: str | None = No
                 ax.plot(fl, np.where(y > 0, y, np.nan), label=f"linear, {interface}",
                         **plots.INTERFACE_STYLE.get(str(interface), {}))
         y = ds["response_amplitude"].sel(point=point, axis=axis, harmonic=h).values
-        ax.plot(f, np.where(y > 0, y, np.nan), color="k", marker=".", ms=3,
-                label=f"friction, harmonic {h}")
+        _plot_branch(ax, f, np.where(y > 0, y, np.nan),
+                     ds["stable"].values if "stable" in ds else None,
+                     label=f"friction, harmonic {h}")
         half = 0.5 * ds["response_peak_to_peak"].sel(point=point, axis=axis).values
         ax.plot(f, np.where(half > 0, half, np.nan), color="0.5", lw=0.8, linestyle=":",
                 label="friction, half peak-to-peak")
@@ -393,6 +444,14 @@ SWEEP = Analysis.define(
                                      default=SWEEP_OPTIONS.solve.time_domain_periods),
         "check_stability": Field(Flag(), "check every converged point in time (does the "
                                  "structure settle to it?); slow", default=False),
+        "hill_stability": Field(Flag(), "Floquet multipliers of every converged point by "
+                                "Hill's method on the balance's Jacobian: `stable`, the "
+                                "largest multiplier, the sign of det J, and the folds, "
+                                "period-doubling and Neimark-Sacker points between "
+                                "neighbours; unstable stretches dashed in the figure. Dense: "
+                                "small models (a few hundred DOFs); a point it cannot treat "
+                                "is left unknown with the reason in `stability_notes`",
+                                default=False),
         "points": Field(ListOf(Text(), non_empty=True, unique=True),
                         "observed points to report (default: all)"),
         "eps_band": Field(ListOf(Number(lo=0, lo_open=True), sizes=(2,)),

@@ -20,13 +20,17 @@ import xarray as xr
 from fretwear import api
 from fretwear.analyses import figures as plots
 from fretwear.analyses.base import Analysis, RunContext, RunOutput
-from fretwear.analyses.common import default_of, interface_labels
+from fretwear.analyses.common import (
+    condensation_fields,
+    condenser_of,
+    default_of,
+    interface_labels,
+)
 from fretwear.files import safe_name
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.options import WEAR_STEP
 from fretwear.hb.penalty import RULES
-from fretwear.hb.reduce import exact_condenser
 from fretwear.hb.solvers import SOLVERS
 from fretwear.hb.sweep import frequency_grid
 from fretwear.io.results import label_coordinate, variable, write_pvd, write_vtu
@@ -395,13 +399,15 @@ def run_wear(model, analysis: dict, case, context: RunContext) -> RunOutput:
     if nodes is not None and any(p >= nc for p in nodes):
         fail("analysis.plot_nodes", nodes, f"contact node numbers from 0 to {nc - 1}")
     # the time-domain rescue: api.simulate_wear's fallback, used as opts.time_domain_rescue says
-    cond = exact_condenser(model)  # the run's condensation of the model: wear run and FRFs
+    # the run's condensation of the model (the case file's choice), for the wear run and FRFs
+    fb = a.get("frf_before_after")
+    top = None if quasi else max(f_hz, fb["f_max"] if fb is not None else 0.0)
+    cond = condenser_of(model, a, top, max(basis.harmonics))
     result = api.simulate_wear(model, basis, frequency=f_hz, quasi_static=quasi, options=opts,
                                balance=BalanceSetup(condenser=cond, **penalty_of(a)),
                                run=RunControl(checkpoint=context.out_dir / CHECKPOINT_FILE,
                                               resume=context.resume, progress=context.progress))
     frf, frf_note = None, ""
-    fb = a.get("frf_before_after")
     if fb is not None and model.observed:
         grid = (fb["f_min"], fb["f_max"], fb["n_points"])
         frf_options = WORN_FRF.replace(
@@ -419,6 +425,7 @@ def run_wear(model, analysis: dict, case, context: RunContext) -> RunOutput:
                       frf=frf, law=opts.law,
                       energy_coefficients=(opts.energy_coefficient,
                                            opts.partner_energy_coefficient))
+    ds.attrs.update(cond.choice.attributes())
     figures = _figures(ds, case, context.out_dir, nodes)
     files = [context.out_dir / CHECKPOINT_FILE]
     if model.mesh is not None and case.output["vtu"]:
@@ -437,6 +444,7 @@ def run_wear(model, analysis: dict, case, context: RunContext) -> RunOutput:
     ]
     if frf_note:
         lines.append(frf_note)
+    lines.append(cond.choice.summary())
     warnings = list(result.warnings)
     for name, sw in (sweeps.items() if frf is not None else ()):
         warnings += [f"FRF {name}: {w}" for w in sw.warnings]
@@ -524,6 +532,7 @@ SCHEMA = {
                        default=default_of(FourierBasis.up_to, "nh")),
     "n_samples": Field(Integer(lo=3), "time samples per period",
                        default=default_of(FourierBasis.up_to, "n_samples")),
+    **condensation_fields(),
     "eps": Field(AnyOf((Text(RULES), _POS)), 'DLFT penalty: "auto" (the spectral radius of '
                  'Z_r over the kept harmonics, the paper), "top" (that of Z_r at the highest kept '
                  'harmonic), "static" (that of the static K_r) or a value; default: "auto" for '

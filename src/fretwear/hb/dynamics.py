@@ -63,12 +63,16 @@ class StructureDynamics:
         model has none.
     load_x, load_q : (m,), (q,) the static loads (harmonic 0) on ``x`` and ``q`` [N].
     exact : the transformation is exact (no truncated modes).
+    observe : (no, m + q) the displacements of the observed DOFs (global frame, in the order
+        of ``model.observed`` and of their DOFs, as ``Reduced.obs_dofs``) from ``(x, q)``:
+        ``u_o = observe @ [x; q]`` [m] (None: not formed).
     """
 
     blocks: dict
     load_x: np.ndarray
     load_q: np.ndarray
     exact: bool
+    observe: np.ndarray | None = None
 
     @property
     def m(self) -> int:
@@ -106,6 +110,39 @@ class StructureDynamics:
             raise InputError("the structure with its contact points held is singular at a "
                              "value of the Laplace variable (an eigenvalue of the held "
                              "interface)") from None
+
+
+def _observation(cond, Psi_loc: np.ndarray, V: np.ndarray | None) -> np.ndarray:
+    """``(no, m + q)``: the observed DOFs from the contact DOFs in their local frames ``u`` and
+    the interior coordinates ``q`` (``U_c = R^T u``, ``U_i = Psi_loc u + V q``; ``V`` None:
+    the identity), mapped back from the relative coordinates of node-to-node pairs
+    (``U[obs_out] = S U'[obs]``, :class:`fretwear.hb.reduce.Structure`)."""
+    m = cond.m
+    R = np.asarray(cond.R.toarray() if hasattr(cond.R, "toarray") else cond.R, dtype=float)
+    nq = cond.ni if V is None else V.shape[1]
+    O = np.zeros((cond.structure.obs.size, m + nq))
+    for j, c in cond.obs_c:
+        O[j, :m] = R[:, c]
+    for j, i in cond.obs_i:
+        O[j, :m] = Psi_loc[i]
+        if V is None:
+            O[j, m + i] = 1.0
+        else:
+            O[j, m:] = V[i]
+    S = cond.structure.S
+    return O if S is None else np.asarray(S.toarray() @ O)
+
+
+def _observation_with_springs(O: np.ndarray, m: int, contact) -> np.ndarray:
+    """The rows of :func:`_observation` (``m`` contact DOFs) on ``(x, [u_f, q])``
+    (:func:`_with_springs`)."""
+    sp = springs(contact)
+    if sp is None:
+        return O
+    Oc, Oq = O[:, :m], O[:, m:]
+    Ox = np.zeros_like(Oc)
+    Ox[:, sp.r] = Oc[:, sp.r]
+    return np.hstack([Ox, Oc[:, sp.f], Oq])
 
 
 def _with_springs(blocks: dict, load_c, load_q, contact):
@@ -157,7 +194,12 @@ def structure_dynamics(model: Model, condenser=None) -> StructureDynamics:
         Fi = F0[cond.idofs]
         load_c = cond.R @ (F0[cond.cdofs] + cond.Psi.T @ Fi)
         load_q = cond.V.T @ Fi
-        return StructureDynamics(*_with_springs(blocks, load_c, load_q, model.contact), False)
+        obs = _observation_with_springs(
+            _observation(cond, cond.Psi @ np.asarray(
+                cond.R.toarray() if hasattr(cond.R, "toarray") else cond.R).T, cond.V),
+            cond.m, model.contact)
+        return StructureDynamics(*_with_springs(blocks, load_c, load_q, model.contact), False,
+                                 obs)
     if cond.ni > DENSE_INTERIOR_MAX:
         raise InputError(
             f"the model has {cond.ni} interior DOFs: Hill's method and nonlinear modes form "
@@ -192,4 +234,7 @@ def structure_dynamics(model: Model, condenser=None) -> StructureDynamics:
     F0 = np.asarray(cond.structure.load_harmonics(0)[0].real, dtype=float)
     Fi = F0[cond.idofs]
     load_c = R @ (F0[cond.cdofs] + Psi.T @ Fi)
-    return StructureDynamics(*_with_springs(blocks, load_c, Fi.copy(), model.contact), True)
+    obs = _observation_with_springs(_observation(cond, Psi @ R.T, None), cond.m,
+                                   model.contact)
+    return StructureDynamics(*_with_springs(blocks, load_c, Fi.copy(), model.contact), True,
+                             obs)

@@ -20,7 +20,12 @@ modes, which grows with frequency. :class:`ModalCondenser` therefore checks itse
 highest frequency it is built for: ``Z_r`` and ``F_r`` applied to random probe vectors
 against the exact condensation (one sparse LU of ``Z_ii`` there and a few solves); the
 relative error is stored (``error``) and an :class:`~fretwear.errors.InputError` is raised
-when it exceeds ``tol`` (keep more modes, or condense exactly).
+when it exceeds ``tol`` (keep more modes, or condense exactly); with ``raise_modes`` the
+modes are first raised until it passes (:func:`next_mode_count`). With ``residual`` the basis
+also holds the static responses to the constraint modes' inertia loads (the residual
+flexibility of the omitted modes: one basis accurate over a whole band,
+:meth:`ModalCondenser._residual_vectors`). :func:`fretwear.hb.condensers.condenser` chooses
+between this and the exact condensation.
 
 Cost: one real LU of ``K_ii`` and ``m`` real solves (``Psi``), a shift-invert Lanczos for the
 modes, and projections; then ``O(m^2 q)`` per harmonic and frequency, against one complex
@@ -53,6 +58,26 @@ CUTOFF = 3.0
 TOL = 1e-3
 #: random probe vectors of the error check
 PROBES = 4
+#: raising the number of modes (``raise_modes``): at least this many after none
+MIN_RAISE = 8
+#: ... and at most this many (beyond, the interior is not well represented by modes: the
+#: exact condensation is the better choice)
+MAX_MODES = 512
+
+
+def next_mode_count(n_modes: int, n_interior: int) -> int | None:
+    """The number of modes to try after ``n_modes`` failed the error check: twice as many, at
+    least :data:`MIN_RAISE`, at most :data:`MAX_MODES` and ``n_interior - 2`` (the
+    Lanczos limit); None when ``n_modes`` already is the most."""
+    top = min(MAX_MODES, n_interior - 2)
+    if n_modes >= top:
+        return None
+    return min(max(2 * n_modes, MIN_RAISE), top)
+
+
+class CheckFailed(InputError):
+    """The modal condensation's error check failed (its message says by how much): the
+    automatic choice (:func:`fretwear.hb.condensers.condenser`) then condenses exactly."""
 
 
 class ModalCondenser(Condenser):
@@ -70,20 +95,32 @@ class ModalCondenser(Condenser):
         times ``max_order * f_max``.
     cutoff : see ``modes``.
     tol : largest relative error of ``Z_r``/``F_r`` accepted at ``max_order * f_max``.
+    raise_modes : when the check fails, keep more modes (:func:`next_mode_count`: doubled,
+        at least :data:`MIN_RAISE`, at most :data:`MAX_MODES`) until it passes, instead of
+        raising at once; an InputError only when :data:`MAX_MODES` modes do not pass.
+    residual : add the static responses of the interior to the constraint modes' inertia
+        loads (``m`` vectors, :meth:`_residual_vectors`): the omitted modes' error falls from
+        ``(w / w_k)^2`` to ``(w / w_k)^4``; ``q`` grows by ``m``.
 
     Attributes
     ----------
     n_modes : fixed-interface modes kept; q : reduced interior coordinates (modes + load
-    responses); mode_frequencies : (n_modes,) [Hz]; error : relative error of the check.
+    responses (+ residual vectors)); mode_frequencies : (n_modes,) [Hz]; error : relative error
+    of the check; residual : whether the residual vectors are in the basis.
     """
 
     def __init__(self, model: Model, f_max: float, max_order: int, *, modes: int | None = None,
-                 cutoff: float = CUTOFF, tol: float = TOL):
+                 cutoff: float = CUTOFF, tol: float = TOL, raise_modes: bool = False,
+                 residual: bool = False):
         if not (isinstance(f_max, int | float) and math.isfinite(f_max) and f_max > 0):
             raise InputError(f"f_max = {f_max!r}: expected a positive frequency [Hz]")
         if modes is not None and (isinstance(modes, bool) or not isinstance(modes, int)
                                   or modes < 0):
             raise InputError(f"modes = {modes!r}: expected a number of modes >= 0")
+        for name, value in (("cutoff", cutoff), ("tol", tol)):
+            if (isinstance(value, bool) or not isinstance(value, int | float)
+                    or not math.isfinite(value) or value <= 0):
+                raise InputError(f"{name} = {value!r}: expected a positive number")
         super().__init__(_structure(model), dense=False)
         if not self.ni:
             raise InputError("the model has no interior DOFs: nothing to represent by modes")
@@ -95,16 +132,40 @@ class ModalCondenser(Condenser):
             cols = slice(j0, min(j0 + BLOCK, self.m))
             Psi[:, cols] = -lu.solve(self.K.ic[:, cols].toarray())
         self.Psi = Psi
-        # fixed-interface modes up to the cutoff, by shift-invert Lanczos on the kept LU
-        f_cut = cutoff * self.max_order * self.f_max
-        self.mode_frequencies, Phi = self._modes(lu, modes, f_cut)
-        self.n_modes = Phi.shape[1]
-        # + static responses of the loads' interior parts, orthonormalised
+        # + static responses of the loads' interior parts (and, with ``residual``, of the
+        # constraint modes' inertia loads): the modes' companions in the basis
         vecs = self.structure.load_vectors
         Fl = (np.column_stack([v[self.idofs] for v in vecs]) if vecs
               else np.zeros((self.ni, 0)))
-        Xl = lu.solve(Fl) if Fl.shape[1] else Fl
-        V = np.column_stack([Phi, Xl])
+        extra = [lu.solve(Fl) if Fl.shape[1] else Fl]
+        if residual:
+            extra.append(self._residual_vectors(lu))
+        self.residual = bool(residual)
+        self._exact = None  # the exact side of the error check, computed once
+        # fixed-interface modes up to the cutoff, by shift-invert Lanczos on the kept LU;
+        # with raise_modes, more of them until the error check passes (next_mode_count)
+        f_cut = cutoff * self.max_order * self.f_max
+        self._basis(*self._modes(lu, modes, f_cut), np.column_stack(extra))
+        while raise_modes and self.error > self.tol:
+            k = next_mode_count(self.n_modes, self.ni)
+            if k is None:
+                break
+            self._basis(*self._modes(lu, k, f_cut), np.column_stack(extra))
+        if self.error > self.tol:
+            raise CheckFailed(
+                f"modal condensation with {self.n_modes} modes (up to "
+                f"{(self.mode_frequencies.max() if self.n_modes else 0.0):.6g} Hz): relative "
+                f"error {self.error:.3g} of Z_r at harmonic {self.max_order} of {f_max:.6g} Hz"
+                f" > tol = {tol:g}; keep more modes (modes=, cutoff=), add the residual "
+                "vectors (residual=True) or condense exactly")
+
+    # -- construction -------------------------------------------------------------------------
+    def _basis(self, mode_frequencies, Phi, extra):
+        """Interior basis ``V``: the modes ``Phi`` and the static vectors ``extra``, scaled and
+        orthonormalised (pivoted QR, dependent columns dropped); then the projections and the
+        error check."""
+        self.mode_frequencies, self.n_modes = mode_frequencies, Phi.shape[1]
+        V = np.column_stack([Phi, extra])
         if V.shape[1]:
             V = V / np.maximum(np.linalg.norm(V, axis=0), 1e-300)  # modes ~ 1/sqrt(kg), loads ~ m
             Q, r, _ = sla.qr(V, mode="economic", pivoting=True)
@@ -114,14 +175,24 @@ class ModalCondenser(Condenser):
         self._static = {}  # the frequency-independent blocks of reduced(): harmonic 0
         self._project()
         self.error = self._check()
-        if self.error > self.tol:
-            raise InputError(
-                f"modal condensation with {self.n_modes} modes (up to "
-                f"{(self.mode_frequencies.max() if self.n_modes else 0.0):.6g} Hz): relative "
-                f"error {self.error:.3g} of Z_r at harmonic {self.max_order} of {f_max:.6g} Hz"
-                f" > tol = {tol:g}; keep more modes (modes=, cutoff=) or condense exactly")
 
-    # -- construction -------------------------------------------------------------------------
+    def _residual_vectors(self, lu) -> np.ndarray:
+        """``K_ii^-1 (M_ii Psi + M_ic)`` (n_i, m): the static response of the interior to the
+        inertia loads of the constraint modes' motion. The exact interior motion is
+        ``u_i = Psi u_c + w^2 Z_ii^-1 (M_ii Psi + M_ic) u_c``; with these vectors in the basis
+        the omitted modes enter through their residual flexibility (the first term of
+        ``Z_ii^-1 = K_ii^-1 + w^2 K_ii^-1 M_ii K_ii^-1 + ..``), and their error falls from
+        ``(w / w_k)^2`` to ``(w / w_k)^4`` of the first omitted mode ``w_k`` (docs/theory.md,
+        "Large interfaces")."""
+        X = np.empty((self.ni, self.m))
+        Mic = self.M.ic
+        for j0 in range(0, self.m, BLOCK):
+            cols = slice(j0, min(j0 + BLOCK, self.m))
+            B = self.M.ii @ self.Psi[:, cols]
+            B += Mic[:, cols] if isinstance(Mic, np.ndarray) else Mic[:, cols].toarray()
+            X[:, cols] = lu.solve(B)
+        return X
+
     def _modes(self, lu, modes, f_cut):
         Kii, Mii = self.K.ii, self.M.ii
         n = self.ni
@@ -202,23 +273,24 @@ class ModalCondenser(Condenser):
         interior DOFs' response to them and of ``F_r``, at the highest harmonic of ``f_max``,
         against the exact condensation (eq. 19)."""
         n, omega = self.max_order, 2 * np.pi * self.f_max
-        rng = np.random.default_rng(0)
-        P = rng.standard_normal((self.m, PROBES))
         F = self.structure.load_harmonics(n)[n]
+        if self._exact is None:  # one LU of Z_ii and a few solves, however many bases tried
+            P = np.random.default_rng(0).standard_normal((self.m, PROBES))
+            lu = _factor(self._z("ii", omega, n, False), n, omega)
+            Zci, Zic = self._z("ci", omega, n, False), self._z("ic", omega, n, False)
+            X = _solve(lu, Zic @ P)  # Z_ii^-1 Z_ic P: the interior response to the probes
+            exact = self._z("cc", omega, n, False) @ P - Zci @ X
+            Fe = F[self.cdofs] - Zci @ _solve(lu, F[self.idofs]) if np.any(F) else None
+            self._exact = (P, X, exact, Fe)
+        P, X, exact, Fe = self._exact
         S, Y, Fr, _ = self._parts(omega, n, False, F)
-        Zii = self._z("ii", omega, n, False)
-        lu = _factor(Zii, n, omega)
-        Zci, Zic = self._z("ci", omega, n, False), self._z("ic", omega, n, False)
-        X = _solve(lu, Zic @ P)  # Z_ii^-1 Z_ic P: the interior response to the probes
-        exact = self._z("cc", omega, n, False) @ P - Zci @ X
         err = np.linalg.norm(S @ P - exact, axis=0) / np.linalg.norm(exact, axis=0)
         e = float(err.max())
         rows = np.array([i for _, i in self.obs_i], dtype=np.int64)
         if rows.size:  # recovery of the observed interior DOFs: -(Psi - V Y) P vs -X
             mod = (self.Psi[rows] - self.V[rows] @ Y) @ P
             e = max(e, float(np.linalg.norm(mod + X[rows]) / np.linalg.norm(X[rows])))
-        if np.any(F):
-            Fe = F[self.cdofs] - Zci @ _solve(lu, F[self.idofs])
+        if Fe is not None:
             e = max(e, float(np.linalg.norm(Fr - Fe) / max(np.linalg.norm(Fe), 1e-300)))
         return e
 
@@ -295,15 +367,18 @@ def _real_times(A: np.ndarray, x: np.ndarray) -> np.ndarray:
 
 
 def modal_condenser(model: Model, f_max: float, max_order: int, *, modes: int | None = None,
-                    cutoff: float = CUTOFF, tol: float = TOL) -> ModalCondenser:
+                    cutoff: float = CUTOFF, tol: float = TOL, raise_modes: bool = False,
+                    residual: bool = False) -> ModalCondenser:
     """A :class:`ModalCondenser` of ``model`` for excitation frequencies up to ``f_max`` [Hz]
     and harmonic orders up to ``max_order``, checked against the exact condensation (an
-    :class:`~fretwear.errors.InputError` when its error exceeds ``tol``; ``modes``, ``cutoff``:
-    see the class).
+    :class:`~fretwear.errors.InputError` when its error exceeds ``tol``; ``modes``, ``cutoff``,
+    ``raise_modes``, ``residual``: see the class; :func:`fretwear.hb.condensers.condenser`
+    chooses them, and between this and the exact condensation).
 
     Pass it as ``condenser=`` to every condensation of ``model`` that should use it
     (:func:`~fretwear.hb.reduce.condense`, periodic solves, sweeps, wear runs, recovery), as
     :func:`~fretwear.hb.reduce.exact_condenser`'s condenser is passed; it refuses another
     model, or this one after an edit of its matrices.
     """
-    return ModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff, tol=tol)
+    return ModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff, tol=tol,
+                          raise_modes=raise_modes, residual=residual)

@@ -125,6 +125,36 @@ class ModeSystem:
         xx, xe, ex, ee = self._blocks("K")
         return np.block([[xx, xe], [ex, ee]]) if self.phi.shape[1] else xx
 
+    def coordinates(self, Y: np.ndarray, omega: float, xi: float,
+                    basis: FourierBasis) -> np.ndarray:
+        """Real harmonics (m + q, H) of the structure's coordinates ``(x, q)`` of the mode
+        ``Y`` (n, H) at ``(omega, xi)``: the condensed master coordinates recovered harmonic
+        by harmonic (:meth:`stiffness`; harmonic 0 with the static loads), ``q = phi eta``."""
+        m, q = self.m, self.phi.shape[1]
+        orders = basis.orders
+        Yc = basis.to_complex(Y)  # (nb, n)
+        keep = np.concatenate([np.arange(m), m + self.masters])
+        rest = np.setdiff1d(np.arange(m + q), keep)
+        full = np.zeros((orders.size, m + q), dtype=complex)
+        full[:, keep] = Yc
+        if rest.size:
+            _, S = self.stiffness(omega, xi, orders)
+            full[:, rest] = np.einsum("brn,bn->br", S, Yc)
+            if 0 in orders:  # the static loads on the condensed coordinates
+                K = self._full_static()
+                F = np.concatenate([self.dyn.load_x, self.phi.T @ self.dyn.load_q])
+                b0 = int(np.flatnonzero(orders == 0)[0])
+                full[b0, rest] += np.linalg.solve(K[np.ix_(rest, rest)], F[rest])
+        full[:, m:] = full[:, m:] @ self.phi.T
+        return basis.from_complex(full)
+
+    def observed(self, Y: np.ndarray, omega: float, xi: float,
+                 basis: FourierBasis) -> np.ndarray | None:
+        """Real harmonics (no, H) of the observed DOFs [m] (``dyn.observe``; None without)."""
+        if self.dyn.observe is None:
+            return None
+        return self.dyn.observe @ self.coordinates(Y, omega, xi, basis)
+
     def mass(self, S1: np.ndarray) -> np.ndarray:
         """``T^H M T`` (n, n) at harmonic 1 for the recovery ``eta_rest = S1 y``: the
         structure's mass seen by the kept coordinates (the modal amplitude's norm)."""
@@ -172,7 +202,10 @@ class ModePoint:
     mass-proportional damping [1/s]; damping_ratio : ``xi / (2 omega)`` [-].
     Y : (n, H) harmonics of the contact points [m] and master coordinates [m sqrt(kg)].
     state : (nc, N) contact states (0 separation, 1 stick, 2 slip); energy : friction
-    energy dissipated per cycle [J]. success, residual, iterations : of the corrector.
+    energy dissipated per cycle [J]; node_energy : (nc,) its share per contact node [J].
+    success, residual, iterations : of the corrector.
+    observed : (no, H) real harmonics of the observed DOFs [m], in the order of
+    ``model.observed`` (:meth:`ModeSystem.observed`; None when the structure has no map).
     """
 
     amplitude: float
@@ -184,6 +217,8 @@ class ModePoint:
     success: bool
     residual: float
     iterations: int
+    node_energy: np.ndarray | None = None
+    observed: np.ndarray | None = None
 
     @property
     def frequency(self) -> float:
@@ -337,9 +372,11 @@ class ModeProblem:
         Zt, _ = self.operator(float(z[-2]), float(z[-1]))
         lu, lx, state, _ = self.law(Y, Zt)
         lam = lu - lx
-        energy = float(law.friction_work(lam, lx / self.eps, state).sum())
-        return ModePoint(self.amplitude, float(z[-2]), float(z[-1]), Y.copy(), state, energy,
-                         bool(st.success), float(st.residual), int(st.iterations))
+        node = np.asarray(law.friction_work(lam, lx / self.eps, state), dtype=float)
+        omega, xi = float(z[-2]), float(z[-1])
+        return ModePoint(self.amplitude, omega, xi, Y.copy(), state, float(node.sum()),
+                         bool(st.success), float(st.residual), int(st.iterations), node,
+                         self.sys.observed(Y, omega, xi, self.basis))
 
 
 def _static_start(problem: ModeProblem, omega0: float):

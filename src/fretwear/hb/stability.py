@@ -51,7 +51,8 @@ How they are computed
 3. **Refinement** (a node sticks: the memory matters): in decreasing order of their real
    parts, candidates are refined on the exact ``T(s)`` (condensed on the contact points,
    ``m H`` unknowns) until ``options.refine`` have converged (:func:`_track`: the secant
-   method on the eigenvalue of ``T(s)`` whose eigenvector continues the candidate's). A
+   method on the eigenvalue of ``T(s)`` whose eigenvector continues the candidate's,
+   followed by inverse iteration on one LU per evaluation, :func:`_pair`). A
    candidate near which the exact problem has no exponent is an artefact of the frozen memory
    (:attr:`FloquetResult.spurious`).
 
@@ -63,11 +64,13 @@ select (docs/theory.md, "Full stick"), a neutral direction with multiplier exact
 :attr:`FloquetResult.neutral` counts.
 
 Cost: one dense eigenvalue problem of ``2 (m' + q) H`` unknowns (``m'`` contact points with
-mass, ``q`` other coordinates) and, with a memory, a few evaluations of ``T(s)`` and ``m H``
-eigenvalue problems per refined exponent. Measured at 13-22 times a warm-started sweep
-point's solve on small models (docs/theory.md, section 9): the whole spectrum at every point
-is what costs; tracking the exponents along a sweep would not. Dense up to
-:data:`DENSE_MAX` unknowns of the balance.
+mass, ``q`` other coordinates; at most :data:`PENCIL_MAX` before the companion form) and,
+with a memory, a few evaluations of ``T(s)`` and ``m H`` LU factorisations per refined
+exponent. Measured at 10-30 ms of CPU a point on the benchmark's small models, tens of times
+a warm-started sweep point's solve (docs/theory.md, section 9): the whole spectrum at every
+point and the evaluations of ``T(s)`` are what cost; tracking the exponents along a sweep
+would not. Dense up to :data:`DENSE_MAX` unknowns of the balance. The sign of ``det J``
+(``J = T(0)``) is reported with the exponents (:attr:`FloquetResult.det_sign`).
 """
 
 from __future__ import annotations
@@ -93,6 +96,10 @@ from fretwear.model.core import Model
 #: Hill's matrix is formed and its quadratic eigenvalue problem solved densely up to this
 #: many unknowns ``m H`` (the companion pencil has twice as many)
 DENSE_MAX = 1500
+#: the candidates' quadratic problem on the structure's coordinates is solved densely up to
+#: this many unknowns ``(m + q) H`` (its companion form has twice as many; beyond, a dense
+#: eigensolve takes minutes)
+PENCIL_MAX = 1500
 #: an exponent within this of Im s = +-w/2 (in units of w) is a real negative multiplier: its
 #: conjugate is the other member of its family (the truncated problem puts the two a little
 #: off the line: 1e-4 measured on a two-DOF oscillator near period doubling)
@@ -159,6 +166,8 @@ class FloquetResult:
         (a family of stuck states; the anchors select the member), not in ``exponents``.
     omega : circular frequency of the solution [rad/s].
     evaluations : evaluations of ``T(s)``; wall_time : seconds.
+    det_sign : sign of ``det J``, ``J = T(0)`` the balance's Jacobian (a change between
+        neighbours of a branch: a fold or a branch point, :mod:`fretwear.hb.sweep_stability`).
     """
 
     exponents: np.ndarray
@@ -172,6 +181,7 @@ class FloquetResult:
     evaluations: int
     wall_time: float
     stable_tol: float = 1e-6
+    det_sign: int = 0
 
     @property
     def period(self) -> float:
@@ -390,6 +400,11 @@ class HillProblem:
                              f"{DENSE_MAX} unknowns (m H)")
         if dyn.m != prob.m:
             raise InputError(f"the structure has {dyn.m} contact DOFs, the problem {prob.m}")
+        if (dyn.m + dyn.q) * prob.H > PENCIL_MAX:
+            raise InputError(f"Hill's method solves its quadratic eigenvalue problem densely "
+                             f"up to {PENCIL_MAX} unknowns (structure coordinates x kept "
+                             f"harmonics); this one has {(dyn.m + dyn.q) * prob.H}: use fewer "
+                             "harmonics or a modal condenser with fewer modes")
         self.prob = prob
         self.U = np.asarray(U, dtype=float).reshape(prob.m, prob.H)
         self.dyn = dyn
@@ -553,39 +568,60 @@ def quadratic_eigen(A0: np.ndarray, A1: np.ndarray, A2: np.ndarray):
     return vals, vecs
 
 
+def _pair(T: np.ndarray, v: np.ndarray, mu0: complex, steps: int = 2):
+    """The eigenpair ``(mu, y)`` of ``T`` nearest ``mu0`` that continues ``v``: inverse
+    iteration from ``v`` with the shift ``mu0`` (one LU of ``T - mu0 I``, ``steps`` solves),
+    ``mu`` the Rayleigh quotient of ``y``; also the LU (for the left vector). From a start
+    close to the eigenvector (the previous iterate of :func:`_track`) each solve reduces its
+    error by ``|mu - mu0| / |mu' - mu0|`` over the next eigenvalue ``mu'``: the pair tracked
+    stays the one started, as a full eigendecomposition with the largest overlap picks it,
+    at the cost of one LU instead of a dense nonsymmetric eigensolve."""
+    n = T.shape[0]
+    A = T - mu0 * np.eye(n)
+    lu = sla.lu_factor(A, check_finite=False)
+    y = v / np.linalg.norm(v)
+    for _ in range(steps):
+        y = sla.lu_solve(lu, y, check_finite=False)
+        y = y / np.linalg.norm(y)
+    mu = complex(np.vdot(y, T @ y))
+    return mu, y, lu
+
+
 def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions):
     """The exponent of the exact ``T`` continued from ``sigma`` with eigenvector ``v``: the
     scalar equation ``mu(sigma) = 0`` for the eigenvalue ``mu`` of the linear problem
-    ``T(sigma) y = mu y`` whose eigenvector continues ``v`` (largest overlap with the previous
-    one), solved by the secant method. Following an eigenvector of ``T(sigma)`` rather than
-    Newton's method on ``T(sigma) v = 0`` keeps to the member of the family that was started
-    (centred): the truncated problem has copies of every exponent one harmonic apart, and
-    Newton's iterate drifts to a near copy whose eigenvector its normalisation does not
-    see. Returns ``(sigma, v, residual, converged)``; the residual is ``|mu| / |T|``."""
+    ``T(sigma) y = mu y`` whose eigenvector continues ``v`` (:func:`_pair`: inverse iteration
+    from the previous eigenvector, shifted by the previous eigenvalue), solved by the secant
+    method. Following an eigenvector of ``T(sigma)`` rather than Newton's method on
+    ``T(sigma) v = 0`` keeps to the member of the family that was started (centred): the
+    truncated problem has copies of every exponent one harmonic apart, and Newton's iterate
+    drifts to a near copy whose eigenvector its normalisation does not see. Returns
+    ``(sigma, v, residual, converged)``; the residual is ``|mu| / |T|`` (with ``|T v - mu v|
+    / |T|`` below the same tolerance: an eigenpair)."""
     prev = None
     res = np.inf
     start = sigma
     real = sigma.imag == 0.0  # a real exponent of the real problem stays real (until it
     # meets another one, which the frozen-memory candidates would show as a pair)
+    mu0 = 0.0
     for _ in range(opt.newton_max_iter):
         if abs(sigma - start) > 0.5 or 2.0 * np.pi * sigma.real < np.log(NEGLIGIBLE):
             break  # left the neighbourhood of the candidate: not its exponent
         T = hp.matrix(sigma)
-        mus, Y = np.linalg.eig(T)
-        Y = Y / np.linalg.norm(Y, axis=0)
-        overlap = np.abs(np.conj(v) @ Y) / np.linalg.norm(v)
-        j = int(np.argmax(overlap))
-        mu, v = mus[j], Y[:, j]
-        res = float(abs(mu) / np.linalg.norm(T, 2))
+        scale = np.linalg.norm(T, 1)
+        mu, v, lu = _pair(T, v, mu0)
+        pair = float(np.linalg.norm(T @ v - mu * v) / scale)
+        res = max(float(abs(mu) / scale), pair)
         if res <= opt.newton_tol:
             return sigma, v, res, True
         if prev is None:  # first step: the derivative by a forward difference
-            dmu = _mu_derivative(hp, sigma, v, T, opt.step)
+            dmu = _mu_derivative(hp, sigma, v, T, lu, opt.step)
             new = sigma - mu / dmu if dmu != 0 else sigma
         else:
-            s0, mu0 = prev
-            new = sigma - mu * (sigma - s0) / (mu - mu0) if mu != mu0 else sigma
+            s0, m0 = prev
+            new = sigma - mu * (sigma - s0) / (mu - m0) if mu != m0 else sigma
         prev = (sigma, mu)
+        mu0 = 0.0 if pair < 1e-3 else mu  # near the root, the eigenvalue nearest 0
         if real:
             new = complex(new.real, 0.0)
         if not np.isfinite(new) or new == sigma:
@@ -594,15 +630,13 @@ def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions):
     return sigma, v, res, res <= opt.newton_tol
 
 
-def _mu_derivative(hp: HillProblem, sigma: complex, v: np.ndarray, T: np.ndarray,
+def _mu_derivative(hp: HillProblem, sigma: complex, v: np.ndarray, T: np.ndarray, lu,
                    step: float) -> complex:
     """``d mu / d sigma = w^H T' v / w^H v`` of a simple eigenvalue with right eigenvector
-    ``v`` (left eigenvector ``w`` of ``T``, from the transposed problem), ``T'`` by a forward
-    difference."""
-    mus, W = np.linalg.eig(T.conj().T)
-    Tv = T @ v
-    mu = np.vdot(v, Tv) / np.vdot(v, v)
-    w = W[:, int(np.argmin(np.abs(np.conj(mus) - mu)))]
+    ``v`` (left eigenvector ``w`` of ``T`` by inverse iteration on ``T^H`` with the LU of
+    :func:`_pair`), ``T'`` by a forward difference."""
+    w = sla.lu_solve(lu, v, trans=2, check_finite=False)
+    w = sla.lu_solve(lu, w / np.linalg.norm(w), trans=2, check_finite=False)
     dT = (hp.matrix(sigma + step) - T) / step
     den = np.vdot(w, v)
     return complex(np.vdot(w, dT @ v) / den) if den != 0 else 0.0
@@ -616,6 +650,7 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
     opt = HillOptions() if options is None else options
     t0 = time.perf_counter()
     hp = HillProblem(prob, U, dyn)
+    det_sign = int(np.sign(np.linalg.slogdet(np.real(hp.matrix(0.0)))[0]))
     m, H, k = prob.m, prob.H, len(prob.basis.harmonics)
     q = dyn.q
     vals, vecs = quadratic_eigen(*hp.pencil())
@@ -674,24 +709,26 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
                          kind=allkind[chosen], neutral=hp.neutral(), omega=w,
                          spurious=np.array(spurious, dtype=complex) * w,
                          evaluations=hp.evaluations, wall_time=time.perf_counter() - t0,
-                         stable_tol=opt.stable_tol)
+                         stable_tol=opt.stable_tol, det_sign=det_sign)
 
 
 def stability(model: Model, sol: PeriodicSolution, *, options: HillOptions | None = None,
-              dyn: StructureDynamics | None = None) -> FloquetResult:
+              dyn: StructureDynamics | None = None, condenser=None) -> FloquetResult:
     """:func:`hill_stability` of a converged :class:`~fretwear.hb.solution.PeriodicSolution`
     of ``model`` (its problem rebuilt from the solution: frequency, basis, gap, eps,
     anchors); ``dyn``: the model's :func:`fretwear.hb.dynamics.structure_dynamics` if already
-    made (a sweep makes it once)."""
+    made (a sweep makes it once); ``condenser``: the model's condenser, as the solve had it."""
     if not sol.success:
         raise InputError(f"stability of a solution that did not converge ({sol.message})")
-    prob = problem_of(model, sol)
-    dyn = structure_dynamics(model) if dyn is None else dyn
+    prob = problem_of(model, sol, condenser=condenser)
+    dyn = structure_dynamics(model, condenser) if dyn is None else dyn
     return hill_stability(prob, sol.U.reshape(prob.m, prob.H), dyn, options=options)
 
 
-def problem_of(model: Model, sol: PeriodicSolution) -> DLFTProblem:
-    """The :class:`~fretwear.hb.problem.DLFTProblem` a solution was solved on."""
+def problem_of(model: Model, sol: PeriodicSolution, *, condenser=None) -> DLFTProblem:
+    """The :class:`~fretwear.hb.problem.DLFTProblem` a solution was solved on (``condenser``:
+    the model's, None a new exact one)."""
     basis: FourierBasis = sol.basis
-    red = condense(model, sol.frequency, basis.orders, quasi_static=sol.quasi_static)
+    red = condense(model, sol.frequency, basis.orders, quasi_static=sol.quasi_static,
+                   condenser=condenser)
     return DLFTProblem(red, model.contact, basis, gap=sol.gap, eps=sol.eps, anchor=sol.anchor)

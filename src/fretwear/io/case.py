@@ -829,6 +829,37 @@ differ between the two; `[material]`, `[[springs]]` and `[[fixed]]` exist for me
 """
 
 
+_DOC_CONDENSATION = """\
+### Condensation (`periodic`, `sweep`, `wear`)
+
+The structure is condensed on its contact DOFs (paper eq. 19) by the method of the key
+`condensation` (Python: `fretwear.condenser`, docs/api.md):
+
+- `"exact"`: one complex LU and one solve per contact DOF at every harmonic and frequency.
+- `"modal"`: one Craig-Bampton basis for every frequency up to the analysis' highest (the
+  sweep's `f_max`, the solve's `frequency`, the wear run's frequency or its FRFs' `f_max`)
+  and every kept harmonic: the fixed-interface modes below `condensation_cutoff` times the
+  highest harmonic frequency (or `condensation_modes` of them), the static responses of the
+  loads and, up to 1024 contact DOFs, the residual vectors (the static correction of the
+  omitted modes; docs/theory.md, "Large interfaces"). A sweep or a wear run then condenses
+  nothing again at each frequency or step.
+- `"auto"` (default): the modal condensation for a large model (at least 2000 interior DOFs
+  and 8 per contact DOF) with a frequency, else the exact one (quasi-static runs are exact).
+
+**Error check** of the modal condensation: at the highest harmonic of the highest frequency,
+`Z_r` applied to four random vectors, the condensed loads and the recovery of the observed
+points inside the structure are compared with the exact condensation (one complex LU); the
+largest relative error must be at most `condensation_tol` (default 1e-3). Without
+`condensation_modes` the number of modes is raised (doubled, at least 8, at most 512) until
+the check passes; `"auto"` falls back to the exact condensation where 512 modes do not pass,
+`"modal"` stops with an error. The method used, why, the modes kept and the check's error are
+printed in the run summary (`condensation: ...`) and stored as results attributes
+(`condensation`, `condensation_asked`, `condensation_reason`, `condensation_modes`,
+`condensation_residual_vectors`, `condensation_error`, `condensation_tol`,
+`condensation_f_max`, `condensation_max_order`).
+"""
+
+
 def case_docs(analyses: Mapping[str, Table]) -> str:
     """The Markdown of ``docs/case-files.md``, generated from the schemas (``analyses``: the
     schema of each analysis type, as for :func:`validate`)."""
@@ -854,6 +885,7 @@ def case_docs(analyses: Mapping[str, Table]) -> str:
                  "in this version).\n")
     for kind, table in analyses.items():
         parts.append(render_table(table, f'### type = "{kind}"'))
+    parts.append(_DOC_CONDENSATION)
     parts.append(render_table(OUTPUT, "## [output]"))
     return "\n".join(parts)
 

@@ -45,6 +45,7 @@ DIMENSIONS = {
     "tau": ("angle tau = omega t over one period", "rad"),
     "step": ("slow-scale (wear) step", "1"),
     "harmonic": ("kept harmonic number", "1"),
+    "modal_amplitude": ("modal amplitude of a nonlinear mode", "m kg^0.5"),
     "point": ("observed point, by name", "1"),
     "axis": ("component in the structure's axes: x, y(, z)", "1"),
     "contact_node": ("contact node, from 0", "1"),

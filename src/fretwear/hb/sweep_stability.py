@@ -1,0 +1,171 @@
+"""Stability along a frequency sweep: Hill's method (:mod:`fretwear.hb.stability`) at every
+converged point, and the points where the branch changes its character between neighbours.
+
+Along a branch of periodic solutions the Floquet multipliers move continuously; the
+solution changes stability where one leaves the unit circle:
+
+* a real multiplier through ``+1``: a turning point (fold) of the response curve, or a branch
+  point. There the Jacobian of the balance ``J = T(0)`` (the solve's own, eq. 22-28) is
+  singular: its determinant changes sign between the two neighbours (``det J`` is the
+  product of the ``T(0)`` eigenvalues, and an exponent through 0 is an eigenvalue of ``T(0)``
+  through 0). A sweep in increasing frequency that passes a fold jumps to another branch,
+  which the sign change of ``det J`` shows too;
+* a real multiplier through ``-1``: a period-doubling point;
+* a complex pair through the unit circle: a Neimark-Sacker point (a quasi-periodic
+  response is born).
+
+:func:`sweep_stability` computes the multipliers and ``sign det J`` of every converged point
+and :func:`branch_events` lists these changes between neighbouring converged points (the
+event lies between the two frequencies; its kind is read from the multipliers of the
+unstable neighbour, nearest the unit circle's crossing).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from fretwear.errors import InputError
+from fretwear.hb.dynamics import StructureDynamics, structure_dynamics
+from fretwear.hb.stability import (
+    FloquetResult,
+    HillOptions,
+    HillProblem,
+    hill_stability,
+    problem_of,
+)
+from fretwear.hb.sweep_result import SweepResult
+from fretwear.model.core import Model
+
+#: |Im rho| / |rho| below this: the multiplier is real (period doubling / fold, not
+#: Neimark-Sacker)
+REAL_TOL = 1e-6
+
+
+@dataclass
+class BranchEvent:
+    """A change along the branch between two neighbouring converged points.
+
+    kind : ``"fold"`` (``det J`` changes sign: a turning point or a branch point),
+    ``"period-doubling"``, ``"Neimark-Sacker"`` or ``"real multiplier through +1"`` (a
+    stability change by a real positive multiplier without a sign change of ``det J``: two
+    crossed, or a branch point). f_lo, f_hi : the neighbours' frequencies [Hz]; multiplier :
+    the critical multiplier of the unstable neighbour (NaN where the stability does not
+    change); change : ``"stable -> unstable"``, ``"unstable -> stable"`` (with increasing
+    frequency) or ``""`` (the stability does not change: a fold between two unstable
+    points, or between two stable ones that another multiplier separates).
+    """
+
+    kind: str
+    f_lo: float
+    f_hi: float
+    multiplier: complex
+    change: str = ""
+
+    def line(self) -> str:
+        m = self.multiplier
+        text = [self.change] if self.change else []
+        if np.isfinite(abs(m)):
+            text.append(f"critical multiplier {m.real:.4g}{m.imag:+.4g}j "
+                        f"(|rho| = {abs(m):.4g})")
+        more = f" ({', '.join(text)})" if text else ""
+        return f"{self.kind} between {self.f_lo:.6g} and {self.f_hi:.6g} Hz{more}"
+
+
+@dataclass
+class SweepStability:
+    """Stability of the points of a sweep (:func:`sweep_stability`), in the sweep's order.
+
+    stable : (n,) int8: 1 stable, 0 unstable, -1 not computed (not converged, or Hill's
+    method refused the point: ``notes``). max_multiplier : (n,) largest ``|rho|`` [-] (NaN
+    where not computed). det_sign : (n,) int8 sign of ``det J`` (0: not computed).
+    floquet : (n,) the :class:`~fretwear.hb.stability.FloquetResult` or None. events : the
+    :class:`BranchEvent` list. wall_time : (n,) seconds of Hill's method per point. notes :
+    reasons a point was not computed, one line each.
+    """
+
+    stable: np.ndarray
+    max_multiplier: np.ndarray
+    det_sign: np.ndarray
+    floquet: list
+    events: list = field(default_factory=list)
+    wall_time: np.ndarray | None = None
+    notes: list = field(default_factory=list)
+
+
+def jacobian_sign(hp: HillProblem) -> int:
+    """Sign of ``det J``, ``J = T(0)`` the balance's Jacobian (real at ``s = 0``)."""
+    sign, _ = np.linalg.slogdet(np.real(hp.matrix(0.0)))
+    return int(np.sign(sign))
+
+
+def sweep_stability(model: Model, result: SweepResult, *, options: HillOptions | None = None,
+                    dyn: StructureDynamics | None = None, condenser=None) -> SweepStability:
+    """Hill's method at every converged point of ``result`` (a sweep of ``model``) and the
+    branch events between them (module docstring). ``dyn``: the model's
+    :func:`~fretwear.hb.dynamics.structure_dynamics` if already made; ``condenser``: the
+    model's condenser as the sweep had it (for the problems rebuilt from the solutions)."""
+    n = len(result.points)
+    stable = np.full(n, -1, dtype=np.int8)
+    rho = np.full(n, np.nan)
+    det = np.zeros(n, dtype=np.int8)
+    wall = np.zeros(n)
+    floquet: list = [None] * n
+    notes: list = []
+    if dyn is None:
+        try:
+            dyn = structure_dynamics(model, condenser)
+        except InputError as exc:
+            notes.append(f"stability not computed: {exc}")
+            return SweepStability(stable, rho, det, floquet, [], wall, notes)
+    for i, p in enumerate(result.points):
+        if not p.success:
+            continue
+        t0 = time.perf_counter()
+        try:
+            prob = problem_of(model, p.solution, condenser=condenser)
+            fl = hill_stability(prob, p.solution.U.reshape(prob.m, prob.H), dyn,
+                                options=options)
+            det[i] = fl.det_sign
+        except InputError as exc:
+            notes.append(f"{p.frequency_hz:.6g} Hz: stability not computed: {exc}")
+            continue
+        finally:
+            wall[i] = time.perf_counter() - t0
+        floquet[i] = fl
+        stable[i] = 1 if fl.stable else 0
+        rho[i] = fl.max_multiplier
+    out = SweepStability(stable, rho, det, floquet, [], wall, notes)
+    out.events = branch_events(result.frequency_hz, out)
+    return out
+
+
+def _critical(fl: FloquetResult | None) -> complex:
+    if fl is None or fl.multipliers.size == 0:
+        return complex(np.nan)
+    return complex(fl.critical(1)[0])
+
+
+def branch_events(freqs, st: SweepStability) -> list:
+    """The :class:`BranchEvent` list between neighbouring points where both were computed:
+    a sign change of ``det J`` (a fold), or a change of stability (classified by the critical
+    multiplier of the unstable neighbour)."""
+    done = np.flatnonzero(st.stable >= 0)
+    events = []
+    for a, b in zip(done[:-1], done[1:], strict=True):
+        fa, fb = float(freqs[a]), float(freqs[b])
+        changed = st.stable[a] != st.stable[b]
+        change = ("" if not changed else "stable -> unstable" if st.stable[a] == 1
+                  else "unstable -> stable")
+        unstable = a if st.stable[a] == 0 else b
+        crit = _critical(st.floquet[unstable]) if changed else complex(np.nan)
+        if st.det_sign[a] * st.det_sign[b] < 0:
+            events.append(BranchEvent("fold", fa, fb, crit, change))
+        elif changed:
+            real = abs(crit.imag) <= REAL_TOL * max(abs(crit), 1e-300)
+            kind = ("Neimark-Sacker" if not real else
+                    "period-doubling" if crit.real < 0 else "real multiplier through +1")
+            events.append(BranchEvent(kind, fa, fb, crit, change))
+    return events

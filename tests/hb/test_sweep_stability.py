@@ -1,0 +1,72 @@
+"""Stability along a sweep (:mod:`fretwear.hb.sweep_stability`) on the two-DOF oscillator with
+a unilateral spring (NLvib's example-03 family), whose forced response folds.
+
+References (none is the code under test's own bookkeeping):
+
+* the determinant of the balance's Jacobian ``J = T(0)`` has the sign
+  ``(-1)^(number of real Floquet multipliers above 1)``: an eigenvalue of ``T(0)`` passes
+  through 0 exactly where a real exponent does (``T(s) p = 0`` at ``s = 0``), starting from
+  ``det J > 0`` on the stable branch below the resonance. The sign comes from an LU of ``J``,
+  the multipliers from the eigenvalues of the quadratic Hill problem refined on ``T(s)``: two
+  computations that share only ``T``;
+* the events listed are exactly where the neighbours' signs or stabilities differ (the
+  definition, counted here independently).
+"""
+
+import numpy as np
+import pytest
+from helpers.models import two_dof
+
+from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.options import SweepOptions
+from fretwear.hb.reduce import exact_condenser
+from fretwear.hb.sweep import sweep
+from fretwear.hb.sweep_stability import branch_events, sweep_stability
+
+
+@pytest.fixture(scope="module")
+def folded():
+    model = two_dof()
+    cond = exact_condenser(model)
+    res = sweep(model, FourierBasis.up_to(15, 256), 0.56 / (2 * np.pi), 0.8 / (2 * np.pi), 30,
+                options=SweepOptions(spacing="linear"), condenser=cond)
+    return res, sweep_stability(model, res, condenser=cond)
+
+
+def test_det_sign_is_the_parity_of_real_multipliers_above_one(folded):
+    """At every point: sign det J = (-1)^(real multipliers > 1); and the band has unstable
+    points (the fold's middle branch or a period doubling) and stable ones, so the check is
+    not vacuous. Real: |Im rho| <= 1e-6 |rho| (the problem is real: a real exponent stays
+    real, :func:`fretwear.hb.stability._track`); above 1: by 1e-6 (the stability margin)."""
+    res, st = folded
+    done = st.stable >= 0
+    assert done.sum() == res.point_success.sum() and done.any()
+    assert (st.stable[done] == 0).any() and (st.stable[done] == 1).any()
+    assert (st.det_sign[done] == -1).any()
+    for i in np.flatnonzero(done):
+        rho = st.floquet[i].multipliers
+        real = np.abs(rho.imag) <= 1e-6 * np.abs(rho)
+        count = int(np.sum(real & (rho.real > 1 + 1e-6)))
+        assert st.det_sign[i] == (-1) ** count, (i, rho)
+        assert st.stable[i] == (st.max_multiplier[i] <= 1 + 1e-6)
+
+
+def test_events_are_where_neighbours_differ(folded):
+    """One event between two neighbouring computed points where ``det J`` changes sign (a
+    fold) or the stability changes (classified by the critical multiplier), none elsewhere;
+    a fold between a stable and an unstable neighbour has its real multiplier above 1."""
+    res, st = folded
+    f = res.frequency_hz
+    done = np.flatnonzero(st.stable >= 0)
+    expected = [(f[a], f[b]) for a, b in zip(done[:-1], done[1:], strict=True)
+                if st.det_sign[a] != st.det_sign[b] or st.stable[a] != st.stable[b]]
+    events = branch_events(f, st)
+    assert [(e.f_lo, e.f_hi) for e in events] == expected and events
+    for e in events:
+        assert e.kind in ("fold", "period-doubling", "Neimark-Sacker",
+                          "real multiplier through +1")
+        if e.kind == "fold" and e.change:
+            assert abs(e.multiplier.imag) < 1e-6 and e.multiplier.real > 1
+        if e.kind == "period-doubling":
+            assert e.multiplier.real < -1
+        assert f"{e.f_lo:.6g}" in e.line()
