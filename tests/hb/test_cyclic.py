@@ -297,3 +297,12 @@ def test_static_condensation_of_load_vectors_is_refused(sector):
     assert cond.models_in_time is False
     with pytest.raises(InputError, match="not available on a sector"):
         condense_static(sector.model, condenser=cond).loads(np.zeros(sector.model.ndof))
+
+
+def test_hill_dynamics_of_a_sector_are_refused(sector):
+    """Hill's method and nonlinear modes build Z(lambda) from the condenser's own (index 0)
+    matrices, which is not the sector's at k != 0: refused in one line."""
+    from fretwear.hb.dynamics import structure_dynamics
+
+    with pytest.raises(InputError, match="not available on one sector"):
+        structure_dynamics(sector.model, cyclic_condenser(sector, 1))
