@@ -68,6 +68,10 @@ _API = {
     "nonlinear_mode": "fretwear.api", "sweep_stability": "fretwear.hb.sweep_stability",
     # linear
     "modes": "fretwear.linear", "frf": "fretwear.linear",
+    # one sector of a tuned bladed disk (cyclic symmetry)
+    "cyclic_sector": "fretwear.model.cyclic", "neighbour_contact": "fretwear.model.cyclic",
+    "whole_disk": "fretwear.model.cyclic", "cyclic_condenser": "fretwear.hb.cyclic",
+    "cyclic_modes": "fretwear.hb.cyclic", "cyclic_frf": "fretwear.hb.cyclic",
     # wear
     "simulate_wear": "fretwear.api", "frf_worn": "fretwear.api",
     "WearOptions": "fretwear.wear", "WearResult": "fretwear.wear",

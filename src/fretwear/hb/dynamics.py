@@ -187,6 +187,11 @@ def structure_dynamics(model: Model, condenser=None) -> StructureDynamics:
     transformation (at most :data:`DENSE_INTERIOR_MAX` interior DOFs; an InputError above,
     saying to pass a modal condenser)."""
     cond = condenser_for(model, condenser)
+    if not getattr(cond, "models_in_time", True):  # a sector (hb/cyclic.py): Z(lambda) would
+        raise InputError(  # be harmonic index 0's at every harmonic
+            "condenser: Hill's method and nonlinear modes are not available on one sector "
+            "with cyclic symmetry (fretwear.hb.cyclic) yet; use the whole disk "
+            "(fretwear.model.cyclic.whole_disk)")
     if isinstance(cond, ModalCondenser):
         blocks = {name: tuple(np.asarray(b) for b in cond.proj_local[name])
                   for name in MATRICES if name in cond.proj_local}

@@ -84,6 +84,8 @@ def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float | None
                              anchor=anchor, U0=U0)
     if condenser is not None or reduced is None or anchor is None or eps == "static":
         condenser = condenser_for(model, condenser)  # checked against the model
+    if not getattr(condenser, "models_in_time", True):  # a sector (hb/cyclic.py): the time
+        time_domain = None  # integration would not see its cyclic boundaries
     if reduced is None:
         reduced = condense(model, frequency, basis.orders, quasi_static=quasi_static,
                            condenser=condenser)

@@ -129,6 +129,8 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
     if model.contact.has_connectors:  # the time-domain solver has rigid contacts only
         opts = opts.replace(time_domain=None)
     condenser = condenser_for(model, condenser)  # one for every condensation of the sweep
+    if not getattr(condenser, "models_in_time", True):  # a sector (hb/cyclic.py)
+        opts = opts.replace(time_domain=None)
     band = (f_min, f_max) if opts.eps_band is None else opts.eps_band
     eps = sweep_penalty(opts.eps, model, [0, *basis.harmonics], *band, spacing=opts.spacing,
                         condenser=condenser)

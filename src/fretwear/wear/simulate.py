@@ -146,6 +146,8 @@ def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float | None 
                          "structure (a prescribed normal load does not move with the worn gap)")
     if model.contact.has_connectors:  # the time-domain solver has rigid contacts only
         time_domain = None
+    if not getattr(balance.condenser, "models_in_time", True):  # a sector (hb/cyclic.py)
+        time_domain = None
     if run.checkpoint is not None:
         check_checkpoint_path(run.checkpoint)  # a folder: refused before anything is computed
     t_start = time.perf_counter()
