@@ -210,3 +210,82 @@ def test_frf_worn_is_the_sweep_of_the_worn_gap(block):
     np.testing.assert_array_equal(a.amplitude("Pe", 0), b.amplitude("Pe", 0))
     with pytest.raises(TypeError):
         fw.frf_worn(block, wear, (1400.0, 1600.0, 2), BASIS)
+
+
+def test_sweep_progress_bar_and_callable(block, capsys):
+    """fw.sweep(..., progress=True) draws a bar (it raised "'bool' object is not callable");
+    the bar only reports, so the answer is the same bit for bit as without it; a callable is
+    called once per grid frequency with (i, n, point); anything else, or a progress given both
+    as the keyword and in the options, is one InputError."""
+    a = fw.sweep(block, BASIS, 1400.0, 1600.0, 3, progress=True)
+    assert "sweep" in capsys.readouterr().err
+    b = fw.sweep(block, BASIS, 1400.0, 1600.0, 3)
+    np.testing.assert_array_equal(a.amplitude("Pe", 0), b.amplitude("Pe", 0))
+    calls = []
+    fw.sweep(block, BASIS, 1400.0, 1600.0, 3, progress=lambda i, n, p: calls.append((i, n)))
+    assert calls == [(0, 3), (1, 3), (2, 3)]
+    with pytest.raises(InputError, match="progress = 'yes': expected True, False or a callable"):
+        fw.sweep(block, BASIS, 1400.0, 1600.0, 3, progress="yes")
+    with pytest.raises(InputError, match="progress given twice"):
+        fw.sweep(block, BASIS, 1400.0, 1600.0, 3, progress=True,
+                 options=SweepOptions(progress=lambda *a: None))
+
+
+def test_sweep_amplitude_names_its_axes_and_points(block):
+    """res.amplitude takes "x"/"y" as count_resonances does (it raised a raw IndexError):
+    the named axis is the same component as its index, bit for bit; an unknown axis, point or
+    harmonic is one InputError naming what there is."""
+    res = fw.sweep(block, BASIS, 1400.0, 1600.0, 2)
+    np.testing.assert_array_equal(res.amplitude("Pe", "x"), res.amplitude("Pe", 0))
+    np.testing.assert_array_equal(res.amplitude("Pe", "Y"), res.amplitude("Pe", 1))
+    with pytest.raises(InputError, match=r"axis = 'z': expected 'x', 'y' or an index 0\.\.1"):
+        res.amplitude("Pe", "z")
+    with pytest.raises(InputError, match="axis = 2"):
+        res.amplitude("Pe", 2)
+    with pytest.raises(InputError, match="no observed point 'tip'; the model observes: 'Pe'"):
+        res.amplitude("tip", "x")
+    with pytest.raises(InputError, match="harmonic = 5 is not kept"):
+        res.amplitude("Pe", "x", harmonic=5)
+
+
+def test_drivers_run_with_one_blas_thread_from_python(block):
+    """From Python, as from the command line, the drivers run with one BLAS thread (a sweep
+    was 3-16x slower from a notebook than from the CLI on a loaded 2-core machine): the BLAS
+    thread count seen by threadpoolctl (independent of fretwear) inside the sweep is 1, the
+    caller's setting is back after it, and set_blas_threads changes the count."""
+    threadpoolctl = pytest.importorskip("threadpoolctl")
+
+    def blas():
+        return {i["num_threads"] for i in threadpoolctl.threadpool_info()
+                if i["user_api"] == "blas"}
+
+    seen = []
+    before = blas()
+    with threadpoolctl.threadpool_limits(limits=2, user_api="blas"):
+        outside = blas()
+        fw.sweep(block, BASIS, 1400.0, 1600.0, 2, progress=lambda *a: seen.append(blas()))
+        assert blas() == outside
+        try:
+            fw.set_blas_threads(2)
+            fw.sweep(block, BASIS, 1400.0, 1600.0, 2,
+                     progress=lambda *a: seen.append(blas()))
+        finally:
+            fw.set_blas_threads(1)
+    assert seen[:2] == [{1}, {1}] and seen[2:] == [outside, outside]
+    assert blas() == before
+    with pytest.raises(InputError, match=r"set_blas_threads\(0\)"):
+        fw.set_blas_threads(0)
+
+
+def test_subpackages_are_attributes_in_a_fresh_interpreter():
+    """``fw.model.join``, ``fw.hb`` and ``fw.linear`` work right after ``import fretwear``
+    (they raised AttributeError unless another name had loaded the submodule first): checked
+    in a fresh interpreter, where nothing else has been imported."""
+    import subprocess
+    import sys
+
+    code = ("import fretwear as fw; fw.model.join; fw.hb.__name__; fw.linear.frf; "
+            "fw.wear.simulate_wear; print('ok')")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=120)
+    assert out.returncode == 0 and out.stdout.strip() == "ok", out.stderr

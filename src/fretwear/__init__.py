@@ -34,8 +34,10 @@ matters (a quasi-static solve can do without). Every frequency argument is in Hz
 ``omega = 2 pi frequency`` [rad/s] where the equations use it. Every
 result has ``success`` (bool) and ``message`` (str), as :class:`scipy.optimize.OptimizeResult`.
 
-Names are loaded on first use, so ``import fretwear`` stays light (the command line sets its
-BLAS threads before numpy loads). ``docs/api.md`` has runnable examples.
+Names are loaded on first use, so ``import fretwear`` stays light. The drivers run with one
+BLAS thread, from Python as from the command line (:mod:`fretwear.threads`; change it with
+``fretwear.set_blas_threads(n)`` or the environment variable ``FRETWEAR_THREADS``).
+``docs/api.md`` has runnable examples.
 """
 
 from __future__ import annotations
@@ -88,6 +90,8 @@ _API = {
     "run_case": "fretwear.analyses.run", "load_case": "fretwear.analyses.run",
     "read_results": "fretwear.io.results",
     "run_study": "fretwear.study.run", "read_study": "fretwear.study.spec",
+    # BLAS threads of the drivers
+    "blas_threads": "fretwear.threads", "set_blas_threads": "fretwear.threads",
     # errors
     "FretwearError": "fretwear.errors", "InputError": "fretwear.errors",
     "ConvergenceError": "fretwear.errors",
@@ -96,7 +100,17 @@ _API = {
 __all__ = ["__version__", *_API]
 
 
+#: the subpackages, reachable as attributes (``fw.model.join``, ``fw.hb``, ``fw.linear``) as
+#: after ``import fretwear.model``, loaded on first use like the names above
+_SUBPACKAGES = ("model", "hb", "linear", "wear", "timedomain", "io", "analyses", "study",
+                "paper", "examples", "api", "errors", "limits", "files", "threads")
+
+
 def __getattr__(name: str):
+    if name in _SUBPACKAGES:
+        value = importlib.import_module(f"fretwear.{name}")
+        globals()[name] = value
+        return value
     module = _API.get(name)
     if module is None:
         raise AttributeError(f"module 'fretwear' has no attribute {name!r}")
@@ -106,4 +120,4 @@ def __getattr__(name: str):
 
 
 def __dir__():
-    return sorted(set(globals()) | set(_API))
+    return sorted(set(globals()) | set(_API) | set(_SUBPACKAGES))

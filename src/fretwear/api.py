@@ -23,6 +23,7 @@ built once by the caller and passed to every driver that condenses the same mode
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 
@@ -34,6 +35,7 @@ from fretwear.hb import periodic as _periodic
 from fretwear.hb import sweep as _sweep
 from fretwear.hb.dynamics import structure_dynamics
 from fretwear.hb.options import sweep_options
+from fretwear.threads import limited
 from fretwear.timedomain import integrate as _integrate
 from fretwear.timedomain import quasistatic as _quasistatic
 from fretwear.timedomain import steady as _steady
@@ -74,6 +76,34 @@ def _frequency(frequency, quasi_static: bool) -> dict:
     return {"frequency": frequency}
 
 
+@contextlib.contextmanager
+def _sweep_progress(progress, options, n_points):
+    """The sweep's ``progress`` callable: ``True`` draws a tqdm bar over the grid frequencies
+    (stderr), a callable is used as it is, ``False``/``None`` shows nothing. Yields the
+    options with it."""
+    if progress is None or progress is False:
+        yield options
+        return
+    if options.progress is not None:
+        raise InputError("progress given twice (progress= and options.progress); give one")
+    if callable(progress) and not isinstance(progress, bool):
+        yield options.replace(progress=progress)
+        return
+    if progress is not True:
+        raise InputError(f"progress = {progress!r}: expected True, False or a callable "
+                         "(i, n, point) called after each grid frequency")
+    from tqdm import tqdm
+
+    with tqdm(total=n_points, desc="sweep", leave=False, unit="freq") as bar:
+        def tick(i, total, point):
+            bar.update(1)
+            bar.set_postfix_str(f"{point.frequency_hz:.6g} Hz"
+                                f"{'' if point.success else ' (not converged)'}")
+
+        yield options.replace(progress=tick)
+
+
+@limited
 def solve_periodic(model, basis, frequency: float | None = None, *, quasi_static: bool = False,
                    time_domain: bool = True, **kwargs) -> _periodic.PeriodicSolution:
     """Periodic response of ``model`` at the excitation ``frequency`` [Hz] with the DLFT (paper
@@ -107,8 +137,9 @@ def solve_periodic(model, basis, frequency: float | None = None, *, quasi_static
                                     time_domain=_fallback(time_domain), **kwargs)
 
 
+@limited
 def sweep(model, basis, f_min: float, f_max: float, n_points: int, *, time_domain: bool = True,
-          **kwargs) -> _sweep.SweepResult:
+          progress=False, **kwargs) -> _sweep.SweepResult:
     """Nonlinear FRF: periodic solutions of the DLFT from ``f_min`` to ``f_max`` [Hz] on
     ``n_points`` grid frequencies, each starting from its neighbours (continuation).
 
@@ -118,6 +149,8 @@ def sweep(model, basis, f_min: float, f_max: float, n_points: int, *, time_domai
     f_min, f_max, n_points : the frequency band [Hz] and its number of grid frequencies.
     time_domain : at points whose balance still fails, integrate in time from the neighbour
         (the case-file key ``time_domain`` of a sweep).
+    progress : True draws a progress bar over the grid frequencies (stderr); a callable
+        ``(i, n, point)`` is called after each grid frequency instead; False: nothing.
     **kwargs : the other keywords of :func:`fretwear.hb.sweep.sweep`, with its defaults:
         ``options`` (:class:`~fretwear.hb.options.SweepOptions`: ``solve`` (a
         :class:`~fretwear.hb.options.SolveOptions`), ``spacing`` (``"log"``/``"linear"``),
@@ -135,10 +168,13 @@ def sweep(model, basis, f_min: float, f_max: float, n_points: int, *, time_domai
     """
     _public_names("sweep", kwargs)
     options = sweep_options(kwargs.pop("options", None))
-    return _sweep.sweep(model, basis, f_min, f_max, n_points,
-                        options=options.replace(time_domain=_fallback(time_domain)), **kwargs)
+    with _sweep_progress(progress, options, n_points) as options:
+        return _sweep.sweep(model, basis, f_min, f_max, n_points,
+                            options=options.replace(time_domain=_fallback(time_domain)),
+                            **kwargs)
 
 
+@limited
 def simulate_wear(model, basis, frequency: float | None = None, *, quasi_static: bool = False,
                   wear0=None, time_domain: bool = True, condenser=None,
                   **kwargs) -> _wear.WearResult:
@@ -182,8 +218,9 @@ def simulate_wear(model, basis, frequency: float | None = None, *, quasi_static:
                                time_domain=_fallback(time_domain), **kwargs)
 
 
+@limited
 def frf_worn(model, basis, wear, f_min: float, f_max: float, n_points: int, *,
-             time_domain: bool = True, **kwargs) -> _sweep.SweepResult:
+             time_domain: bool = True, progress=False, **kwargs) -> _sweep.SweepResult:
     """Nonlinear FRF with the worn gap ``gap + wear`` (paper Fig. 24) from ``f_min`` to
     ``f_max`` [Hz] on ``n_points`` grid frequencies, as :func:`sweep`.
 
@@ -194,6 +231,7 @@ def frf_worn(model, basis, wear, f_min: float, f_max: float, n_points: int, *,
     f_min, f_max, n_points : the frequency band [Hz] and its number of grid frequencies.
     time_domain : at points whose balance still fails, integrate in time from the neighbour
         (the key ``time_domain`` of a wear analysis's ``frf_before_after``).
+    progress : as :func:`sweep`.
     **kwargs : the other keywords of :func:`fretwear.wear.worn_frf.frf_worn`: ``anchor``,
         ``options`` (:class:`~fretwear.hb.options.SweepOptions`, default
         :data:`~fretwear.wear.worn_frf.WORN_FRF`: a sweep's on a linear grid), ``condenser``.
@@ -204,8 +242,10 @@ def frf_worn(model, basis, wear, f_min: float, f_max: float, n_points: int, *,
     """
     _public_names("frf_worn", kwargs)
     options = sweep_options(kwargs.pop("options", None), WORN_FRF)
-    return _wear.frf_worn(model, basis, wear, f_min, f_max, n_points,
-                          options=options.replace(time_domain=_fallback(time_domain)), **kwargs)
+    with _sweep_progress(progress, options, n_points) as options:
+        return _wear.frf_worn(model, basis, wear, f_min, f_max, n_points,
+                              options=options.replace(time_domain=_fallback(time_domain)),
+                              **kwargs)
 
 
 #: linear interfaces a nonlinear mode may be chosen on (:func:`nonlinear_mode`)
@@ -237,6 +277,7 @@ def mode_target(model, mode: int = 1, interface: str = "stuck", dyn=None) -> flo
     return float(2.0 * math.pi * r.frequency_hz[mode - 1])
 
 
+@limited
 def nonlinear_mode(model, basis, amplitudes, *, mode: int = 1, interface: str = "stuck",
                    **kwargs) -> _modes.Backbone:
     """Nonlinear mode of ``model`` over the modal ``amplitudes`` by the Extended Periodic
@@ -273,6 +314,7 @@ def nonlinear_mode(model, basis, amplitudes, *, mode: int = 1, interface: str = 
                                  **kwargs)
 
 
+@limited
 def integrate(model, frequency: float, **kwargs):
     """Integrate the forced response at ``frequency`` [Hz] in time with exact contact and
     friction.
@@ -299,6 +341,7 @@ def integrate(model, frequency: float, **kwargs):
     return _integrate.integrate(model, frequency, **kwargs)
 
 
+@limited
 def steady_state(model, frequency: float, **kwargs):
     """Integrate at ``frequency`` [Hz] until the response is periodic (or classified
     otherwise).
@@ -324,6 +367,7 @@ def steady_state(model, frequency: float, **kwargs):
     return _steady.steady_state(model, frequency, **kwargs)
 
 
+@limited
 def incremental_wear(model, *, wear_coefficient: float | None = None, wear0=None, **kwargs):
     """Quasi-static fretting wear by load steps (in the spirit of Stromberg 1997).
 

@@ -152,6 +152,41 @@ def damaged(path: Path | str, what: str, why: str) -> InputError:
                       "over (a run without --resume also starts over and replaces it)")
 
 
+#: the array of a state file that holds the SHA-256 of all its other arrays (:func:`seal`)
+SEAL = "content_sha256"
+
+
+def content_digest(arrays: dict) -> str:
+    """SHA-256 of the arrays of a state file (every key but :data:`SEAL`, in sorted order:
+    name, dtype, shape and bytes of each)."""
+    h = hashlib.sha256()
+    for k in sorted(arrays):
+        if k == SEAL:
+            continue
+        a = np.ascontiguousarray(arrays[k])
+        h.update(f"{k}|{a.dtype.str}|{a.shape}|".encode())
+        h.update(a.tobytes())
+    return h.hexdigest()
+
+
+def seal(arrays: dict) -> dict:
+    """``arrays`` with :data:`SEAL`: the checksum of their content, checked on reading
+    (:func:`check_seal`), so that a state file edited by hand or corrupted in a way its CRCs
+    do not catch (a value changed and the archive rewritten) is refused, never resumed."""
+    return {**arrays, SEAL: np.asarray(content_digest(arrays))}
+
+
+def check_seal(data: dict, path: Path | str, what: str) -> None:
+    """Refuse (:func:`damaged`) a state file whose :data:`SEAL` is missing or does not match
+    its content."""
+    stored = data.get(SEAL)
+    if stored is None or stored.dtype.kind != "U" or stored.shape != ():
+        raise damaged(path, what, "no content checksum")
+    if str(stored) != content_digest(data):
+        raise damaged(path, what, "its content does not match its checksum: it was edited or "
+                      "corrupted after it was written")
+
+
 def read_archive(path: Path | str, what: str) -> dict:
     """Every array of a ``.npz`` state file (``what``, e.g. ``"wear checkpoint"``), read whole
     so that every member's CRC is checked, with no pickled objects.

@@ -116,6 +116,46 @@ def test_foreign_and_damaged_checkpoints_are_refused(model, tmp_path):
         sweep(model, BASIS, *GRID, options=SweepOptions(checkpoint=ckpt))
 
 
+def _edited(src, dst, edit):
+    """Copy the checkpoint ``src`` to ``dst`` with ``edit(arrays)`` applied and the archive
+    rewritten whole (so every member's CRC is right again: only the content checksum can
+    tell)."""
+    with np.load(src) as z:
+        arrays = {k: z[k] for k in z.files}
+    edit(arrays)
+    with open(dst, "wb") as fh:
+        np.savez(fh, **arrays)
+
+
+@pytest.mark.parametrize("edit", [
+    lambda a: a["U"].__setitem__(Ellipsis, np.nan),                 # harmonics set to NaN
+    lambda a: (a["converged"].__setitem__(Ellipsis, True),          # every point converged
+               a["U"].__setitem__(Ellipsis, 0.0)),                  # ... with U = 0
+    lambda a: a.__setitem__("records", np.asarray(                  # a frequency changed
+        str(a["records"]).replace('"frequency_hz": ', '"frequency_hz": 1', 1))),
+    lambda a: a.__setitem__("next_index", np.asarray(-1)),          # a negative next index
+    lambda a: a["omega"].__setitem__(0, a["omega"][0] * (1 + 1e-15)),  # one value, one ulp
+], ids=["U-nan", "all-converged", "frequency", "next-index", "one-ulp"])
+def test_edited_checkpoint_with_a_matching_fingerprint_is_refused(model, tmp_path, edit):
+    """A checkpoint edited by hand so that its fingerprint still matches (the variants a
+    hostile survey resumed silently into a different results file) is refused in one line
+    naming the file: the checksum of its content, computed here independently of the
+    archive's CRCs, no longer matches. The unedited copy still resumes (the check does not
+    refuse good files)."""
+    ckpt = tmp_path / "sweep.npz"
+    with pytest.raises(Stop):
+        sweep(model, BASIS, *GRID, options=SweepOptions(checkpoint=ckpt, progress=stop_after(3)))
+    bad = tmp_path / "edited.npz"
+    _edited(ckpt, bad, edit)
+    with pytest.raises(InputError) as err:
+        sweep(model, BASIS, *GRID, options=SweepOptions(checkpoint=bad, resume=True))
+    msg = str(err.value)
+    assert str(bad) in msg and "damaged" in msg and "\n" not in msg
+    assert "does not match its checksum" in msg
+    good = sweep(model, BASIS, *GRID, options=SweepOptions(checkpoint=ckpt, resume=True))
+    assert good.resumed_from == 3
+
+
 SWEEP = """[analysis]
 type = "sweep"
 f_min = 1e3

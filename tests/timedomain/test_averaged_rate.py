@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from helpers.wear_checkpoints import assert_reads_as_format_3
+from helpers.wear_checkpoints import assert_format_3_is_refused
 
 import fretwear.wear.schemes as wear_schemes  # the first balance calls its solve_periodic
 import fretwear.wear.simulate as wear_driver  # the driver calls its advance (balanced steps)
@@ -229,9 +229,9 @@ def test_time_averaged_steps_follow_the_time_integration(monkeypatch, tmp_path, 
     with the previous step's rate, or the linearly implicit one with the slow Jacobian of the
     last balanced step (recomputed here from the recorded step 1) without its growing modes.
     Interrupting after step 3 and resuming gives the same history bit for bit (the
-    integration state is in the checkpoint), from this checkpoint format and from format 3
-    (the same state in its earlier names, written by the format-3 writer kept in
-    tests/helpers)."""
+    integration state is in the checkpoint); the same state in format 3 (its earlier names,
+    written by the format-3 writer kept in tests/helpers, with no content checksum) is
+    refused, never resumed."""
     m = damped_block()
     _forced_failures(monkeypatch, balance_fails=True)
     opts = WearOptions(scheme=scheme, **OPTS)
@@ -268,17 +268,15 @@ def test_time_averaged_steps_follow_the_time_integration(monkeypatch, tmp_path, 
         simulate_wear(m, BASIS, frequency=F_HZ, options=opts,
                       run=RunControl(checkpoint=ck, callback=stop))
     saved = ck.read_bytes()
-    for version in (4, 3):  # this format, and the same state in format 3
-        if version == 3:
-            ck.write_bytes(saved)
-            assert_reads_as_format_3(ck)
-        _forced_failures(monkeypatch, balance_fails=True, first_ok=False)
-        resumed = simulate_wear(m, BASIS, frequency=F_HZ, options=opts,
-                                run=RunControl(checkpoint=ck, resume=True))
-        assert resumed.resumed_from == 3
-        for name in ("cycles", "wear_depth", "wear_rate", "U", "rescued", "rate_scatter"):
-            np.testing.assert_array_equal(getattr(h, name), getattr(resumed.history, name),
-                                          err_msg=f"{name} (format {version})")
+    _forced_failures(monkeypatch, balance_fails=True, first_ok=False)
+    resumed = simulate_wear(m, BASIS, frequency=F_HZ, options=opts,
+                            run=RunControl(checkpoint=ck, resume=True))
+    assert resumed.resumed_from == 3
+    for name in ("cycles", "wear_depth", "wear_rate", "U", "rescued", "rate_scatter"):
+        np.testing.assert_array_equal(getattr(h, name), getattr(resumed.history, name),
+                                      err_msg=name)
+    ck.write_bytes(saved)
+    assert_format_3_is_refused(ck)
 
 
 def test_run_starts_from_a_time_integration_when_the_unworn_balance_fails(monkeypatch):

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from helpers.cases import WEAR_BLOCK
-from helpers.wear_checkpoints import assert_reads_as_format_3
+from helpers.wear_checkpoints import assert_format_3_is_refused
 
 from fretwear import cli
 from fretwear.errors import InputError
@@ -182,8 +182,23 @@ def _short_history(ok: bytes, path: Path):
         np.savez(fh, **arrays)
 
 
+def _edited_depth(ok: bytes, path: Path):
+    """One wear depth made negative and the archive rewritten whole (every CRC right): only
+    the checksum of the content can tell."""
+    tmp = path.with_name("ok.npz")
+    tmp.write_bytes(ok)
+    with np.load(tmp) as z:
+        arrays = {k: z[k] for k in z.files}
+    tmp.unlink()
+    arrays["state_W"] = arrays["state_W"].copy()
+    arrays["state_W"].flat[0] = -1e-6
+    with open(path, "wb") as fh:
+        np.savez(fh, **arrays)
+
+
 DAMAGES = {"truncated": _truncated, "flipped": _flipped, "text": _text, "empty": _empty,
-           "missing-key": _missing_key, "short-history": _short_history}
+           "missing-key": _missing_key, "short-history": _short_history,
+           "edited-depth": _edited_depth}
 
 
 @pytest.mark.parametrize("kind", list(DAMAGES))
@@ -260,12 +275,12 @@ def test_checkpoint_of_another_model_shape(reference):
 
 
 # --- earlier formats ---------------------------------------------------------------------------
-def test_format_3_checkpoint_resumes_to_the_uninterrupted_run(tmp_path):
-    """A run interrupted after 3 steps whose checkpoint is then rewritten in format 3 (the
-    state's earlier names, version 3) reads as the same state and resumes to the history of the
+def test_interrupted_run_resumes_and_format_3_is_refused(tmp_path):
+    """A run interrupted after 3 steps resumes from its checkpoint to the history of the
     uninterrupted run, bit for bit (wall times aside; the same deterministic steps from the
-    same state), rewritten in this format as it goes on. Quasi-static Stromberg beam (12 x 2),
-    partial slip."""
+    same state); the same state written in format 3 (the state's earlier names, version 3, no
+    content checksum) is refused with a message saying why. Quasi-static Stromberg beam
+    (12 x 2), partial slip."""
     model, basis = stromberg_beam(nx=12, ny=2), FourierBasis.up_to(3, 32)
     opts = WearOptions(max_steps=8, tolerance=0.02, checkpoint_every_s=1e9)
     full = simulate_wear(model, basis, quasi_static=True, options=opts)
@@ -278,7 +293,9 @@ def test_format_3_checkpoint_resumes_to_the_uninterrupted_run(tmp_path):
     with pytest.raises(KeyboardInterrupt):
         simulate_wear(model, basis, quasi_static=True, options=opts,
                       run=RunControl(checkpoint=ck, callback=stop))
-    assert_reads_as_format_3(ck)
+    saved = ck.read_bytes()
+    assert_format_3_is_refused(ck)
+    ck.write_bytes(saved)
     assert read_history(ck).n_steps == 4
     resumed = simulate_wear(model, basis, quasi_static=True, options=opts,
                             run=RunControl(checkpoint=ck, resume=True))
@@ -288,10 +305,10 @@ def test_format_3_checkpoint_resumes_to_the_uninterrupted_run(tmp_path):
             np.testing.assert_array_equal(getattr(resumed.history, name),
                                           getattr(full.history, name), err_msg=name)
     with np.load(ck) as z:
-        assert int(z["version"]) == CHECKPOINT_VERSION == 4
+        assert int(z["version"]) == CHECKPOINT_VERSION == 5
 
 
-@pytest.mark.parametrize("version", [2, 5])
+@pytest.mark.parametrize("version", [2, 6])
 def test_checkpoint_of_another_version_is_refused_in_one_line(reference, tmp_path, version):
     with np.load(reference / CKPT) as z:
         arrays = {k: z[k] for k in z.files}

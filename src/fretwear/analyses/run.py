@@ -27,6 +27,7 @@ from fretwear.files import remove_stale_temporaries
 from fretwear.io import case as case_files
 from fretwear.io.case import Case, build_model, observed_notes
 from fretwear.io.results import read_results, write_results
+from fretwear.threads import limited
 
 RESULTS_FILE = "results.nc"
 
@@ -121,6 +122,7 @@ def _interrupted_message(outdir: Path, start: float) -> str:
             "run again with --resume to continue where it can)")
 
 
+@limited
 def run_case(path: Path | str, outdir: Path | str | None = None, progress: bool = True,
              resume: bool = False, echo: bool = True) -> RunOutput:
     """Load, validate, build, run and save a case file.

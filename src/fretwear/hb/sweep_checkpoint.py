@@ -10,7 +10,8 @@ deterministic code, :func:`fretwear.hb.branch.rebuild_point`). The continuation 
 is the sequence of converged points itself.
 
 A checkpoint is read whole and checked before use (:func:`fretwear.files.read_archive`: every
-member's CRC; then keys, types and shapes): a damaged one is one
+member's CRC; the checksum of its whole content, :func:`fretwear.files.check_seal`, so that a
+file edited by hand is refused; then keys, types, shapes and finite values): a damaged one is one
 :class:`~fretwear.errors.InputError` naming the file, never a traceback, never a silent start
 from zero. It is matched to its sweep by a fingerprint of everything that determines the points
 (:func:`fingerprint`).
@@ -27,14 +28,15 @@ import numpy as np
 import scipy.sparse as sp
 
 from fretwear.errors import InputError
-from fretwear.files import atomic_write, damaged, read_archive
+from fretwear.files import SEAL, atomic_write, check_seal, damaged, read_archive, seal
 
-SWEEP_CHECKPOINT_VERSION = 1
+#: 2: sealed with the checksum of its content (:func:`fretwear.files.seal`)
+SWEEP_CHECKPOINT_VERSION = 2
 WHAT = "sweep checkpoint"
 #: the arrays of a checkpoint and their shapes (p points, m contact unknowns, H coefficients)
 SHAPES = {"omega": ("p",), "converged": ("p",), "U": ("p", "m", "H"), "eps": ("p",),
           "anchor": ("p", "nc", "d-1"), "next_index": ()}
-_TEXT = ("fingerprint", "records")
+_TEXT = ("fingerprint", "records", SEAL)
 
 
 def _digest(h, obj) -> None:
@@ -106,7 +108,7 @@ def save_sweep_checkpoint(path: Path | str, key: str, next_index: int, points: l
 
     def write(tmp: Path):
         with open(tmp, "wb") as fh:
-            np.savez(fh, **arrays)
+            np.savez(fh, **seal(arrays))
 
     return atomic_write(path, write)
 
@@ -133,6 +135,12 @@ def _check(data: dict) -> str:
         return "unreadable point records"
     if not isinstance(records, list) or len(records) != p:
         return "point records inconsistent with the arrays"
+    if int(data["next_index"]) < 0:
+        return f"a negative next grid index ({int(data['next_index'])})"
+    conv = data["converged"].astype(bool)
+    for k in ("U", "anchor", "omega", "eps"):
+        if not np.isfinite(data[k][conv]).all():
+            return f"non-finite {k} at a converged point"
     return ""
 
 
@@ -156,8 +164,9 @@ def load_sweep_checkpoint(path: Path | str, key: str, shape: tuple[int, int, int
     if version is None or version.shape != () or version.dtype.kind not in "iu":
         raise damaged(path, WHAT, "no format version")
     if int(version) != SWEEP_CHECKPOINT_VERSION:
-        raise InputError(f"{WHAT} {str(path)!r} has another format version; delete it to "
-                         "start again")
+        raise InputError(f"{WHAT} {str(path)!r} has another format version (written by "
+                         "another version of fretwear); delete it to start again")
+    check_seal(data, path, WHAT)
     why = _check(data)
     if why:
         raise damaged(path, WHAT, why)

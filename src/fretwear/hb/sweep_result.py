@@ -7,8 +7,26 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from fretwear.errors import InputError
 from fretwear.hb.solution import PeriodicSolution
 from fretwear.hb.solvers import SolveStats
+
+_AXES = {"x": 0, "y": 1, "z": 2}
+
+
+def _axis_index(axis, d: int) -> int:
+    """Component index of ``axis`` (``"x"``/``"y"``/``"z"`` or an index) for a point with
+    ``d`` components; an InputError names the axes there are."""
+    names = "'x', 'y'" + (", 'z'" if d == 3 else "")
+    if isinstance(axis, str):
+        k = _AXES.get(axis.strip().lower())
+    elif isinstance(axis, int | np.integer) and not isinstance(axis, bool):
+        k = int(axis)
+    else:
+        k = None
+    if k is None or not 0 <= k < d:
+        raise InputError(f"amplitude: axis = {axis!r}: expected {names} or an index 0..{d - 1}")
+    return k
 
 
 @dataclass
@@ -90,15 +108,32 @@ class SweepResult:
                 text += f" ({timed} flagged by the time integration)"
         return text
 
-    def amplitude(self, point: str, axis: int = 0, harmonic: int | None = 1) -> np.ndarray:
+    def amplitude(self, point: str, axis: int | str = 0,
+                  harmonic: int | None = 1) -> np.ndarray:
         """Amplitude of an observed point [m] per sweep point (nan where not converged):
-        of one harmonic, or (``harmonic=None``) half the peak-to-peak range over the period."""
+        of one harmonic, or (``harmonic=None``) half the peak-to-peak range over the period.
+
+        point : the name of an observed point; axis : ``"x"``, ``"y"``, ``"z"`` or a component
+        index (0, 1, 2) in the model's global frame; harmonic : a kept harmonic order, or
+        None."""
+        solved = [p.solution for p in self.points if p.solution is not None]
+        if not solved:
+            return np.full(len(self.points), np.nan)
+        first = solved[0]
+        if point not in first.observed:
+            names = ", ".join(repr(n) for n in first.observed) or "none"
+            raise InputError(f"amplitude: no observed point {point!r}; the model observes: "
+                             f"{names}")
+        k = _axis_index(axis, first.observed[point].shape[0])
+        if harmonic is not None and harmonic not in first.basis.harmonics:
+            raise InputError(f"amplitude: harmonic = {harmonic!r} is not kept; expected one "
+                             f"of {list(first.basis.harmonics)} or None (peak-to-peak)")
         out = np.full(len(self.points), np.nan)
         for i, p in enumerate(self.points):
             s = p.solution
             if s is None:
                 continue
-            c = s.observed[point][axis]
+            c = s.observed[point][k]
             if harmonic is None:
                 u = s.basis.to_time(c)
                 out[i] = 0.5 * (u.max() - u.min())

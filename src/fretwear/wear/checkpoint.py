@@ -21,7 +21,15 @@ from pathlib import Path
 import numpy as np
 
 from fretwear.errors import InputError
-from fretwear.files import atomic_write, check_state_file, damaged, read_archive
+from fretwear.files import (
+    SEAL,
+    atomic_write,
+    check_seal,
+    check_state_file,
+    damaged,
+    read_archive,
+    seal,
+)
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.reduce import Reduced
 from fretwear.model.core import Model
@@ -29,16 +37,15 @@ from fretwear.wear.history import HISTORY_FIELDS, LATE_HISTORY_FIELDS, WearHisto
 from fretwear.wear.options import WearOptions
 from fretwear.wear.state import SlowStep, StepRecord, shape_of
 
-#: 4: the state is the fields of :class:`~fretwear.wear.state.SlowStep`, some renamed
-#: (:data:`FORMAT_3_NAMES`); 3: the fingerprint hashes the reduced model as stored, real for an
-#: undamped modal condensation (complex before), so an earlier checkpoint cannot match it: say
-#: so by the version rather than by "written for a different model"
-CHECKPOINT_VERSION = 4
-#: the versions read: this one, and format 3 (its state renamed, :data:`FORMAT_3_NAMES`)
-READ_VERSIONS = (3, 4)
-#: the state of a format-3 checkpoint: its name -> the :class:`SlowStep` field
-FORMAT_3_NAMES = {"vrate": "volume_rate", "vrate0": "volume_rate0", "td_U": "time_U",
-                  "td_V": "time_V", "td_retry_at": "retry_balance_at"}
+#: 5: sealed with the checksum of its content (:func:`fretwear.files.seal`); 4: the state is
+#: the fields of :class:`~fretwear.wear.state.SlowStep`, some renamed;
+#: 3: the fingerprint hashes the reduced model as stored, real for an undamped modal
+#: condensation (complex before), so an earlier checkpoint cannot match it: say so by the
+#: version rather than by "written for a different model"
+CHECKPOINT_VERSION = 5
+#: the versions read: only sealed ones (an unsealed checkpoint cannot be told from one edited
+#: by hand, so formats 3 and 4 are refused with a message that says why)
+READ_VERSIONS = (5,)
 #: the fields of the state and of the history (:class:`StepRecord`): shapes, units, meanings
 STATE_FIELDS = fields(SlowStep)
 RECORD_FIELDS = {f.name: f for f in fields(StepRecord)}
@@ -79,13 +86,13 @@ def save_checkpoint(path: Path | str, state: SlowStep, records: list[StepRecord]
 
     def write(tmp: Path):
         with open(tmp, "wb") as fh:
-            np.savez(fh, **arrays)
+            np.savez(fh, **seal(arrays))
 
     return atomic_write(path, write)
 
 
 #: text arrays (every other one is numeric)
-_TEXT = ("fingerprint", *(f"state_{f.name}" for f in STATE_FIELDS if f.type == "str"))
+_TEXT = ("fingerprint", SEAL, *(f"state_{f.name}" for f in STATE_FIELDS if f.type == "str"))
 
 
 WHAT = "wear checkpoint"
@@ -116,21 +123,18 @@ def _read_checkpoint(path: Path | str) -> dict:
     version = data.get("version")
     if version is None or version.shape != () or version.dtype.kind not in "iu":
         raise _damaged(path, "no format version")
+    if int(version) in (3, 4):
+        raise InputError(f"wear checkpoint {str(path)!r} was written by an earlier fretwear "
+                         "whose checkpoints carry no content checksum (this one cannot tell it "
+                         "from a file edited by hand); delete it to start again")
     if int(version) not in READ_VERSIONS:
         raise InputError(f"wear checkpoint {str(path)!r} has another format version; delete it "
                          "to start again")
-    if int(version) == 3:
-        data = {_format_3_name(k): v for k, v in data.items()}
+    check_seal(data, path, WHAT)
     why = _check_arrays(data)
     if why:
         raise _damaged(path, why)
     return data
-
-
-def _format_3_name(key: str) -> str:
-    """The name in this format of the array ``key`` of a format-3 checkpoint."""
-    old = key.removeprefix("state_")
-    return f"state_{FORMAT_3_NAMES[old]}" if old != key and old in FORMAT_3_NAMES else key
 
 
 def _dims(data: dict) -> dict:
