@@ -91,3 +91,56 @@ def test_identity_rows_against_a_dense_solve(k):
     b = RNG.standard_normal(4)
     np.testing.assert_allclose(solve_identity_rows(full, b), np.linalg.solve(full, b),
                                rtol=1e-12)
+
+
+@pytest.mark.parametrize("method", ["powell", "newton"])
+def test_progress_test_stops_a_solve_without_progress(method):
+    """``max_slow`` (MINPACK hybrj's "not making good progress" test): on ``x^2 + 1 = 0`` (no
+    real root, |f| >= 1 everywhere, so no iteration can decrease |f|^2 by 10 % for long) the
+    solve stops unconverged after ``max_slow`` Jacobians in a row without such an iteration,
+    and says so; without the test it goes on until another stop (82 Powell iterations
+    measured, 11 Newton ones). The count is checked against the definition: at most
+    ``max_slow`` + 1 Jacobian evaluations after the last iteration with 10 % decrease."""
+    def fun(x, need_jacobian):
+        return np.array([x[0] ** 2 + 1.0]), (np.array([[2 * x[0]]]) if need_jacobian else None)
+
+    _, _, free = solve(fun, [0.3], lambda x: 1.0, method=method, tol=1e-12, max_iter=200)
+    norms = []
+    x, _, st = solve(fun, [0.3], lambda x: 1.0, method=method, tol=1e-12, max_iter=200,
+                     max_slow=3, callback=lambda it, x, fn: norms.append(fn))
+    assert not st.success and st.message.startswith("not making good progress")
+    assert st.iterations < free.iterations
+    good = [i for i in range(1, len(norms)) if norms[i] ** 2 <= 0.9 * norms[i - 1] ** 2]
+    last = good[-1] if good else 0
+    accepted = sum(1 for i in range(last + 1, len(norms)) if norms[i] < norms[i - 1])
+    assert accepted <= 3
+
+
+@pytest.mark.parametrize("method", ["powell", "newton"])
+def test_progress_test_leaves_a_converging_solve_unchanged(method):
+    """A solve that converges makes good progress: the same iterates, bit for bit, with and
+    without ``max_slow``."""
+    fun, x_star, scale = monotone()
+    x0 = np.zeros_like(x_star)
+    a, _, sa = solve(fun, x0, lambda x: scale, method=method, tol=1e-12)
+    b, _, sb = solve(fun, x0, lambda x: scale, method=method, tol=1e-12, max_slow=5)
+    assert sa.success and sb.success and sa.iterations == sb.iterations
+    np.testing.assert_array_equal(a, b)
+
+
+def test_powell_solves_once_per_jacobian(monkeypatch):
+    """A rejected step keeps the iterate, its Jacobian and residual: Powell's next iteration
+    reuses the Newton step (one linear solve per Jacobian, not per iteration; the solve of a
+    large interface is a GMRES run). Counted on the problem without a root, where steps are
+    rejected (82 iterations, 18 Jacobians)."""
+    from fretwear.hb import solvers
+
+    calls = []
+    step = solvers._lu_step
+    monkeypatch.setattr(solvers, "_lu_step", lambda J, f: calls.append(1) or step(J, f))
+
+    def fun(x, need_jacobian):
+        return np.array([x[0] ** 2 + 1.0]), (np.array([[2 * x[0]]]) if need_jacobian else None)
+
+    _, _, st = solve(fun, [0.3], lambda x: 1.0, method="powell", tol=1e-12, max_iter=200)
+    assert st.iterations > st.njev and len(calls) <= st.njev

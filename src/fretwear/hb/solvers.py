@@ -111,12 +111,22 @@ def _column_norms(J):
     return J.column_norms()
 
 
-def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None):
+#: a decrease of ``|f|^2`` by less than this fraction in an iteration is slow progress
+#: (MINPACK ``hybrj``'s test on its ``actred``)
+SLOW_DECREASE = 0.1
+
+
+def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=None):
     """Powell's hybrid dog-leg trust region on ``f(x) = 0`` with analytic Jacobian.
 
     As MINPACK ``hybrj``: the variables are scaled by the running maximum of the Jacobian's
     column norms, the trust region is halved on a poor step and doubled on a good one; the
-    Newton step comes from a LAPACK LU. Returns ``(x, f, stats)``.
+    Newton step comes from a LAPACK LU (computed once per Jacobian: a rejected step keeps
+    the iterate, and the next iteration reuses its Newton step with a smaller trust
+    region). ``max_slow``: stop (unconverged) after that many iterations on a new Jacobian
+    in a row without one that decreased ``|f|^2`` by :data:`SLOW_DECREASE` (MINPACK's "not
+    making good progress" test, ``info = 4`` of ``hybrj`` with 5); None: no such test.
+    Returns ``(x, f, stats)``.
     """
     t0 = time.perf_counter()
     x = np.array(x0, dtype=float)
@@ -133,17 +143,25 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None):
     ok = False
     stall = 0
     nsuc = 0
+    slow = 0  # iterations on a new Jacobian since one decreased |f|^2 by SLOW_DECREASE
+    sn = None  # the Newton step at x (one per Jacobian)
     while True:
         if fn <= tol * scale(x):
             ok, msg = True, "converged"
             break
         if it >= max_iter:
             break
+        if max_slow is not None and slow >= max_slow:
+            msg = (f"not making good progress: {slow} Jacobians in a row without an iteration "
+                   f"that decreased |f|^2 by {SLOW_DECREASE:g}")
+            break
         it += 1
         if dscale is None:
             dscale = _column_norms(J)
             dscale[dscale == 0] = 1.0
-        sn = _lu_step(J, f)
+        if sn is None:  # an iteration on a new Jacobian
+            sn = _lu_step(J, f)
+            slow += 1
         snd = vector_norm(dscale * sn)
         if delta is None:
             delta = snd
@@ -182,10 +200,13 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None):
                 delta = max(delta, 2.0 * pnorm)
             if abs(ratio - 1.0) <= 0.1:
                 delta = 2.0 * pnorm
+        if actual >= SLOW_DECREASE * fn * fn:
+            slow = 0
         if fnn < fn:  # accept any decrease (non-smooth residual: ratios are noisy)
             x, f, fn = xn, fnew, fnn
             _, J = fun(x, True)
             njev += 1
+            sn = None
             dscale = np.maximum(dscale, _column_norms(J))
             stall = 0
         else:
@@ -200,8 +221,10 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None):
     return x, f, st
 
 
-def newton(fun, x0, scale, *, tol=1e-8, max_iter=100, callback=None):
-    """Newton's method with a backtracking line search on ``|f|^2``. Returns ``(x, f, stats)``."""
+def newton(fun, x0, scale, *, tol=1e-8, max_iter=100, callback=None, max_slow=None):
+    """Newton's method with a backtracking line search on ``|f|^2``. ``max_slow``: stop
+    (unconverged) after that many iterations in a row that decreased ``|f|^2`` by less than
+    :data:`SLOW_DECREASE` (as :func:`powell`). Returns ``(x, f, stats)``."""
     t0 = time.perf_counter()
     x = np.array(x0, dtype=float)
     f, J = fun(x, True)
@@ -210,11 +233,16 @@ def newton(fun, x0, scale, *, tol=1e-8, max_iter=100, callback=None):
     it = 0
     ok = False
     msg = "maximum number of iterations reached"
+    slow = 0
     while True:
         if fn <= tol * scale(x):
             ok, msg = True, "converged"
             break
         if it >= max_iter:
+            break
+        if max_slow is not None and slow >= max_slow:
+            msg = (f"not making good progress: {slow} iterations in a row without a decrease "
+                   f"of |f|^2 by {SLOW_DECREASE:g}")
             break
         it += 1
         s = _lu_step(J, f)
@@ -231,6 +259,7 @@ def newton(fun, x0, scale, *, tol=1e-8, max_iter=100, callback=None):
         if not accepted:
             msg = "line search failed: no decrease of |f| along the Newton direction"
             break
+        slow = 0 if fnn * fnn <= (1.0 - SLOW_DECREASE) * fn * fn else slow + 1
         x, f, fn = x + t * s, fnew, fnn
         _, J = fun(x, True)
         njev += 1
@@ -263,11 +292,15 @@ def hybr(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None):
     return sol.x, f, st
 
 
-def solve(fun, x0, scale, *, method="powell", tol=1e-8, max_iter=200, callback=None):
-    """Dispatch to one of :data:`SOLVERS`."""
+def solve(fun, x0, scale, *, method="powell", tol=1e-8, max_iter=200, callback=None,
+          max_slow=None):
+    """Dispatch to one of :data:`SOLVERS`. ``max_slow``: the progress test of
+    :func:`powell` and :func:`newton` (``"hybr"`` has MINPACK's own)."""
     table = {"powell": powell, "newton": newton, "hybr": hybr}
     if method not in table:
         from fretwear.errors import InputError
 
         raise InputError(f"solver = {method!r}: expected one of {SOLVERS}")
-    return table[method](fun, x0, scale, tol=tol, max_iter=max_iter, callback=callback)
+    extra = {} if max_slow is None or method == "hybr" else {"max_slow": max_slow}
+    return table[method](fun, x0, scale, tol=tol, max_iter=max_iter, callback=callback,
+                         **extra)
