@@ -137,10 +137,84 @@ def test_powell_solves_once_per_jacobian(monkeypatch):
 
     calls = []
     step = solvers._lu_step
-    monkeypatch.setattr(solvers, "_lu_step", lambda J, f: calls.append(1) or step(J, f))
+    monkeypatch.setattr(solvers, "_lu_step", lambda J, f, *a: calls.append(1) or step(J, f, *a))
 
     def fun(x, need_jacobian):
         return np.array([x[0] ** 2 + 1.0]), (np.array([[2 * x[0]]]) if need_jacobian else None)
 
     _, _, st = solve(fun, [0.3], lambda x: 1.0, method="powell", tol=1e-12, max_iter=200)
     assert st.iterations > st.njev and len(calls) <= st.njev
+
+
+class InexactOperator:
+    """A formed Jacobian seen as an operator (as fretwear.hb.krylov.KrylovJacobian): its
+    ``solve(b, rtol)`` returns the exact solution plus an error whose residual is ``rtol``
+    times ``|b|`` (the most an iterative solver to that tolerance leaves), and records the
+    tolerances asked for."""
+
+    def __init__(self, J, asked):
+        self.J, self.asked = J, asked
+        self.shape = J.shape
+
+    def __matmul__(self, x):
+        return self.J @ x
+
+    @property
+    def T(self):
+        return self.J.T
+
+    def column_norms(self):
+        return np.linalg.norm(self.J, axis=0)
+
+    def solve(self, b, rtol=None):
+        self.asked.append(rtol)
+        x = np.linalg.solve(self.J, b)
+        if rtol is None:
+            return x
+        e = np.linalg.solve(self.J, np.ones_like(b))  # residual along (1, .., 1)
+        return x + rtol * np.linalg.norm(b) / np.linalg.norm(self.J @ e) * e
+
+
+def test_powell_inexact_newton_steps_reach_the_same_root():
+    """With an operator Jacobian, Powell asks for inexact Newton steps (Eisenstat-Walker
+    forcing terms: FORCING_MAX first, then at most FORCING_GAMMA (|f_k|/|f_k-1|)^2) and still
+    converges to the root of the smooth monotone problem (closed form: the x* it was built
+    from; 1e-9 relative as above); the tolerances it asks for decrease as |f| does."""
+    from fretwear.hb import solvers
+
+    fun, x_star, scale = monotone()
+    asked = []
+
+    def op(x, need_jacobian):
+        f, J = fun(x, need_jacobian)
+        return f, (InexactOperator(J, asked) if need_jacobian else None)
+
+    x, _, st = solve(op, np.zeros_like(x_star), lambda x: scale, tol=1e-12)
+    assert st.success, st.message
+    np.testing.assert_allclose(x, x_star, rtol=1e-9, atol=1e-9 * np.abs(x_star).max())
+    loose = [a for a in asked if a is not None]
+    assert loose and loose[0] == solvers.FORCING_MAX and loose[-1] < 1e-3
+
+
+def test_powell_redoes_a_poor_inexact_step_exactly():
+    """An inexact step that the model served poorly (ratio of actual to predicted decrease
+    below 0.1) and that did not decrease |f| is redone on the same Jacobian to the full
+    accuracy (``rtol`` None) before the next iteration: on x^2 + 1 = 0 (no root) every
+    first step on a new Jacobian fails, so every loose request is followed by an exact one
+    with the same Jacobian (the iterate unchanged in between)."""
+    asked, at = [], []
+
+    class Recording(InexactOperator):
+        def solve(self, b, rtol=None):
+            at.append(self.J[0, 0])
+            return super().solve(b, rtol)
+
+    def op(x, need_jacobian):
+        f = np.array([x[0] ** 2 + 1.0])
+        return f, (Recording(np.array([[2 * x[0]]]), asked) if need_jacobian else None)
+
+    _, _, st = solve(op, [0.3], lambda x: 1.0, tol=1e-12, max_iter=30)
+    assert not st.success and len(asked) > 4
+    for i, a in enumerate(asked[:-1]):
+        if a is not None:
+            assert asked[i + 1] is None and at[i + 1] == at[i]

@@ -152,7 +152,10 @@ class HarmonicBlocks:
         return out
 
     def sub(self, dofs: np.ndarray) -> HarmonicBlocks:
-        """The blocks restricted to the rows and columns ``dofs`` (real when these are)."""
+        """The blocks restricted to the rows and columns ``dofs`` (real when these are); this
+        object itself when ``dofs`` are all its DOFs in order (every node active: no copy)."""
+        if dofs.size == self.m and np.array_equal(dofs, np.arange(self.m)):
+            return self
         src = self.Zr if self.real else self.Zc
         out = np.empty((self.nb, dofs.size, dofs.size), dtype=src.dtype)
         for b in range(self.nb):  # rows then columns: 40 % faster than z[np.ix_(...)]
@@ -516,14 +519,16 @@ class KrylovJacobian:
         ``eps I``)."""
         return np.flatnonzero(np.any(self.G.reshape(self.nc, -1) != 0.0, axis=1))
 
-    def solve(self, b) -> np.ndarray:
+    def solve(self, b, rtol: float | None = None) -> np.ndarray:
         """``J^-1 b``, exact on the stuck nodes and reduced to the active ones
         (:meth:`active_nodes`): with ``s`` the stuck unknowns, ``x_s = b_s / eps`` and
 
             (eps I + G_a (Z_aa - eps I)) x_a = b_a - G_a Z_as x_s,
 
         solved by a LAPACK LU when it has at most :data:`ACTIVE_DENSE_MAX` unknowns, else by
-        right-preconditioned GMRES on that active system to :data:`GMRES_RTOL` (the
+        right-preconditioned GMRES on that active system to the relative residual
+        ``rtol`` (default :data:`GMRES_RTOL`; Powell's inexact Newton steps ask for less
+        far from the solution, :func:`fretwear.hb.solvers.powell`) (the
         preconditioner, restricted to the active nodes, is rebuilt when the active set
         changes, when the kept one needs more than :data:`REBUILD_AFTER` iterations or
         fails). ``b`` (n,) or (n, r)."""
@@ -531,9 +536,12 @@ class KrylovJacobian:
         act = self.active_nodes()
         x, rhs, dofs = self._reduce(b, act)
         if act.size:
-            solver = (self._lu_active if act.size * self.dH <= ACTIVE_DENSE_MAX
-                      else self._gmres_active)
-            x[act] = solver(rhs, act, dofs)
+            if act.size * self.dH <= ACTIVE_DENSE_MAX:
+                x[act] = self._lu_active(rhs, act, dofs)
+            else:
+                x[act] = self._gmres_active(rhs, act, dofs,
+                                            GMRES_RTOL if rtol is None else max(rtol,
+                                                                                GMRES_RTOL))
         return x.reshape(b.shape)
 
     def _reduce(self, b, act):
@@ -592,11 +600,11 @@ class KrylovJacobian:
             pc = MeanGainPreconditioner(gbar, Za, self.eps, share=not rebuild, gosc=gosc)
             pc.oscillating = gosc is not gbar
             pc.nodes = act
-            pc.first_iterations = None  # GMRES iterations of its first run
+            pc.first_iterations = None  # GMRES iterations per decade, first run
             owner._precond = pc
         return pc
 
-    def _gmres_active(self, rhs, act, dofs) -> np.ndarray:
+    def _gmres_active(self, rhs, act, dofs, rtol=GMRES_RTOL) -> np.ndarray:
         """GMRES on the active system, one right-hand side at a time."""
         eps, dH = self.eps, self.dH
         Za = self._active_blocks(dofs)
@@ -612,10 +620,11 @@ class KrylovJacobian:
         A = spla.LinearOperator((n, n), matvec=matvec, dtype=float)
         out = np.empty_like(rhs)
         for c in range(rhs.shape[2]):
-            out[:, :, c] = self._gmres(A, rhs[:, :, c].reshape(-1), act, Za).reshape(na, dH)
+            out[:, :, c] = self._gmres(A, rhs[:, :, c].reshape(-1), act, Za,
+                                       rtol).reshape(na, dH)
         return out
 
-    def _gmres(self, A, b, act, Za) -> np.ndarray:
+    def _gmres(self, A, b, act, Za, rtol=GMRES_RTOL) -> np.ndarray:
         """GMRES on one right-hand side. When it fails with a preconditioner kept from an
         earlier Jacobian or with shared factors, one more run from its last iterate with a
         preconditioner rebuilt from this Jacobian without sharing; when a fresh unshared one
@@ -623,8 +632,8 @@ class KrylovJacobian:
         gain from then on and one more run follows with it; a fresh unshared one with the
         mean gain is the best at hand (GMRES's last iterate is returned). A kept
         preconditioner that needs more than :data:`REBUILD_AFTER` iterations and more than
-        :data:`REBUILD_GROWTH` times those of its first run is rebuilt at the next
-        Jacobian."""
+        :data:`REBUILD_GROWTH` times those of its first run (per decade of the residual:
+        ``rtol`` varies) is rebuilt at the next Jacobian."""
         x = None
         for attempt in range(3):
             pc0 = getattr(self.owner, "_precond", None)
@@ -637,14 +646,16 @@ class KrylovJacobian:
             def cb(_r, count=count):
                 count[0] += 1
 
-            x, info = spla.gmres(A, b, x0=x, rtol=GMRES_RTOL, atol=0.0,
+            x, info = spla.gmres(A, b, x0=x, rtol=rtol, atol=0.0,
                                  restart=GMRES_RESTART, maxiter=GMRES_MAXITER, M=M,
                                  callback=cb, callback_type="pr_norm")
             self.gmres_iterations += count[0]
             if info == 0:
+                rate = count[0] / max(-np.log10(rtol), 1.0)  # iterations per decade
                 if pc.first_iterations is None:
-                    pc.first_iterations = count[0]
-                elif count[0] > max(REBUILD_AFTER, REBUILD_GROWTH * pc.first_iterations):
+                    pc.first_iterations = rate
+                elif (count[0] > REBUILD_AFTER
+                      and rate > REBUILD_GROWTH * pc.first_iterations):
                     self.owner._precond = None  # slow: rebuild at the next Jacobian
                 break
             if fresh and not pc.shared:

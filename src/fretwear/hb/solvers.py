@@ -89,12 +89,15 @@ def _dense_solve(A, B):
     return np.linalg.lstsq(A, B, rcond=None)[0]
 
 
-def _lu_step(J, f):
-    """The Newton step ``-J^-1 f``: LAPACK LU of a formed Jacobian, or the operator's own
-    solve (:class:`fretwear.hb.krylov.KrylovJacobian`: GMRES)."""
+def _lu_step(J, f, rtol=None):
+    """The Newton step ``-J^-1 f``: LAPACK LU of a formed Jacobian (exact), or the operator's
+    own solve (:class:`fretwear.hb.krylov.KrylovJacobian`: GMRES, to the relative residual
+    ``rtol`` if given)."""
     if isinstance(J, np.ndarray):
         return -solve_identity_rows(J, f)
-    return -J.solve(f)
+    if rtol is None:
+        return -J.solve(f)
+    return -J.solve(f, rtol=rtol)
 
 
 def vector_norm(x):
@@ -114,6 +117,12 @@ def _column_norms(J):
 #: a decrease of ``|f|^2`` by less than this fraction in an iteration is slow progress
 #: (MINPACK ``hybrj``'s test on its ``actred``)
 SLOW_DECREASE = 0.1
+#: inexact Newton steps of an operator Jacobian (Eisenstat and Walker 1996, their choice 2):
+#: the step's linear system is solved to the relative residual ``eta_k = FORCING_GAMMA
+#: (|f_k| / |f_k-1|)^2``, at most FORCING_MAX (the first step), at least ``gamma
+#: eta_k-1^2`` when that exceeds 0.1, and no tighter than a tenth of the convergence test
+FORCING_MAX = 1e-2
+FORCING_GAMMA = 0.9
 
 
 def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=None):
@@ -123,7 +132,13 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
     column norms, the trust region is halved on a poor step and doubled on a good one; the
     Newton step comes from a LAPACK LU (computed once per Jacobian: a rejected step keeps
     the iterate, and the next iteration reuses its Newton step with a smaller trust
-    region). ``max_slow``: stop (unconverged) after that many iterations on a new Jacobian
+    region), or for an operator Jacobian (:class:`fretwear.hb.krylov.KrylovJacobian`) from
+    GMRES to the relative residual of the forcing terms :data:`FORCING_MAX`,
+    :data:`FORCING_GAMMA` (an inexact Newton step far from the solution, tighter as
+    ``|f|`` decreases: the dog-leg's predicted reduction is taken with the operator
+    itself, and the converged answer is that of the residual test; after a step that the
+    model served poorly, steps to the full accuracy until it serves well again).
+    ``max_slow``: stop (unconverged) after that many iterations on a new Jacobian
     in a row without one that decreased ``|f|^2`` by :data:`SLOW_DECREASE` (MINPACK's "not
     making good progress" test, ``info = 4`` of ``hybrj`` with 5); None: no such test.
     Returns ``(x, f, stats)``.
@@ -145,8 +160,12 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
     nsuc = 0
     slow = 0  # iterations on a new Jacobian since one decreased |f|^2 by SLOW_DECREASE
     sn = None  # the Newton step at x (one per Jacobian)
+    exact = isinstance(J, np.ndarray)  # a formed Jacobian: exact LU steps
+    eta = FORCING_MAX  # the forcing term of an inexact step (operator Jacobians)
+    tight = False  # after a poor step: Newton steps to the full accuracy
     while True:
-        if fn <= tol * scale(x):
+        target = tol * scale(x)
+        if fn <= target:
             ok, msg = True, "converged"
             break
         if it >= max_iter:
@@ -159,8 +178,9 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
         if dscale is None:
             dscale = _column_norms(J)
             dscale[dscale == 0] = 1.0
-        if sn is None:  # an iteration on a new Jacobian
-            sn = _lu_step(J, f)
+        if sn is None:  # an iteration on a new Jacobian (or an inexact step redone)
+            loose = not (exact or tight)
+            sn = _lu_step(J, f, max(eta, 0.1 * target / fn) if loose else None)
             slow += 1
         snd = vector_norm(dscale * sn)
         if delta is None:
@@ -194,7 +214,11 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
         if ratio < 0.1:
             nsuc = 0
             delta = 0.5 * min(delta, pnorm)
+            if loose and fnn >= fn:  # a poor inexact step: redo it to the full accuracy
+                sn, slow = None, slow - 1
+            tight = True  # the model served poorly: full accuracy until it serves well
         else:
+            tight = False
             nsuc += 1
             if ratio >= 0.5 or nsuc > 1:
                 delta = max(delta, 2.0 * pnorm)
@@ -203,6 +227,9 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
         if actual >= SLOW_DECREASE * fn * fn:
             slow = 0
         if fnn < fn:  # accept any decrease (non-smooth residual: ratios are noisy)
+            floor = FORCING_GAMMA * eta * eta
+            eta = FORCING_GAMMA * (fnn / fn) ** 2
+            eta = min(FORCING_MAX, max(eta, floor) if floor > 0.1 else eta)
             x, f, fn = xn, fnew, fnn
             _, J = fun(x, True)
             njev += 1
