@@ -130,8 +130,12 @@ def first_harmonic_start(prob: DLFTProblem, options: SolveOptions):
 def cold_start(prob: DLFTProblem, U0, options: SolveOptions) -> np.ndarray:
     """The start (m, H) of a single solve: ``U0`` when given; else, above
     :data:`COLD_START_HARMONICS` harmonics, the first harmonic alone
-    (:func:`first_harmonic_start`); else the contact-closed guess."""
-    if U0 is None and prob.basis.k > COLD_START_HARMONICS:
+    (:func:`first_harmonic_start`), except on the operator path (large interfaces, where
+    fretting puts the interface in partial slip: there the one-harmonic balance stalled on
+    256 contact nodes or led the full one through 31 Powell iterations where the
+    contact-closed guess needs 11 on 576; docs/studies/large-interface-solve.md; the rung
+    ``"harmonic-continuation"`` remains if the solve fails); else the contact-closed guess."""
+    if U0 is None and prob.basis.k > COLD_START_HARMONICS and prob.jacobian != "krylov":
         U0 = first_harmonic_start(prob, options)
     return prob.initial_guess() if U0 is None else np.asarray(U0, float).reshape(prob.m, prob.H)
 
