@@ -136,3 +136,37 @@ def test_strategy_without_an_attempt_at_the_target_reports_the_start_residual():
     assert not st.success and np.array_equal(x, x0)
     assert st.residual == pytest.approx(np.linalg.norm(f) / prob.scale(x0), rel=1e-12)
     assert "no attempt converged (none)" in st.message
+
+
+# --- the cold start of a single solve -------------------------------------------------------
+def test_cold_start_on_the_operator_path_is_the_contact_closed_guess(monkeypatch):
+    """Above 3 harmonics a single solve on the dense path starts from the first harmonic
+    alone; on the operator path (large interfaces, in partial slip where fretting happens) it
+    starts from the contact-closed guess, and converges from there to the dense path's answer.
+    The reference is independent of the start: the dense path's converged harmonics (formed
+    Jacobian, LU). Both solves stop at a relative residual of 1e-12, where two converged
+    answers of this 3D block (separation, stick and slip in its period) agree to ~1e-11; 1e-8
+    of the largest coefficient would catch a start that led to another solution."""
+    from helpers.blocks import block
+
+    from fretwear.hb import attempts
+
+    calls = []
+    real = attempts.first_harmonic_start
+
+    def counted(prob, options):
+        calls.append(prob.jacobian)
+        return real(prob, options)
+
+    monkeypatch.setattr(attempts, "first_harmonic_start", counted)
+    model = block(3)
+    basis = FourierBasis.up_to(5, 32)
+    sols = {}
+    for jac in ("dense", "krylov"):
+        sols[jac] = solve_periodic(model, basis, frequency=2000.0,
+                                   options=SolveOptions(tol=1e-12, jacobian=jac,
+                                                        strategy=("start",)))
+        assert sols[jac].success, sols[jac].message
+    assert calls == ["dense"]
+    U, V = sols["dense"].U, sols["krylov"].U
+    assert np.abs(U - V).max() <= 1e-8 * np.abs(U).max()

@@ -164,6 +164,70 @@ def test_non_repeating_start_is_flagged():
     assert 2 < sweeps[0] <= SWEEPS
 
 
+# A 3D node slipping a little at both ends of a tangential load on a line (amplitude 0.302
+# against mu pN = 0.3, 2 slip instants of 24), with a small load across it: plain passes
+# contract its start state across the slip direction by ~0.97 per pass (951 passes to
+# repeat within TOL_LAW; after the 200 that DLFTProblem allows by default it still changes by
+# 4e-6 of the scale); the kernel's Newton step on the start state (contact._newton_start)
+# reaches the same fixed point in 10.
+SLOW_3D = ({(0, "0"): 1.0, (1, "c1"): 0.302, (2, "0"): 0.02, (2, "s1"): 0.01}, 0.3,
+           [0.0, 0.1])
+
+
+def slow_case():
+    spec, mu, xs = SLOW_3D
+    return coeffs(3, spec)[None], np.array([mu]), np.array([xs], dtype=float)
+
+
+def test_slowly_contracting_start_state_reaches_the_periodic_state():
+    """The SLOW_3D node: ``ref_law`` (plain passes in pure Python, eq. 24-28) needs more than
+    200 passes for its start state to repeat; the kernel with its default-size budget (200)
+    takes at most 12 and gives the reference's corrections and states (tolerance ATOL_LAW:
+    rounding and the periodicity tolerance). Instants at least MIN_MARGIN from a switch."""
+    c, mu, xs = slow_case()
+    lu = np.ascontiguousarray(c @ Q_REF.T)
+    lx, state, sweeps = law.dlft_time(lu, mu, xs, TOL_LAW, 200)
+    start, passes = xs[0].copy(), 0
+    while passes < 100000:
+        passes += 1
+        _, _, end = ref_sweep(lu[0], mu[0], start)
+        if np.abs(end - start).max() <= TOL_LAW * np.abs(lu).max():
+            break
+        start = end
+    assert passes > 200
+    lx_ref, state_ref = ref_law(lu, mu, xs, max_sweeps=100000)
+    assert margins(lu, lx_ref, mu).min() > MIN_MARGIN
+    assert 0 < np.count_nonzero(state_ref == law.SLIP) < NS // 2
+    np.testing.assert_array_equal(state, state_ref)
+    np.testing.assert_allclose(lx, lx_ref, rtol=0, atol=ATOL_LAW * np.abs(lu).max())
+    assert sweeps[0] <= 12
+
+
+def test_pass_derivative_with_respect_to_start_state():
+    """The derivative ``S = d end / d start`` of one pass that :func:`contact._sweep`
+    returns (what the Newton step on the start state uses) against central differences of
+    ``ref_sweep`` (step 1e-7 of the scale: the pass is smooth there, every instant
+    MIN_MARGIN from a switch; tolerance 1e-6 of max |S|, as FD_RTOL), on the SLOW_3D node,
+    the 3D wrap case and a pass through separation (S = 0)."""
+    for c, mu, xs in (slow_case(), case((3, "wrap")), case((3, "mixed"))):
+        lu = np.ascontiguousarray(c @ Q_REF.T)
+        lx, _, _ = law.dlft_time(lu, mu, xs, TOL_LAW, SWEEPS)
+        x0 = lx[0, 1:, -1] + np.array([0.003, -0.002])  # near the periodic state
+        S = np.eye(2)
+        law._sweep(lu[0], mu[0], x0.copy(), np.empty((3, NS)), np.empty(NS, np.int8),
+                   np.full(NS, np.nan), S)
+        h = 1e-7 * np.abs(lu).max()
+        S_fd = np.zeros((2, 2))
+        for j in range(2):
+            e = np.zeros(2)
+            e[j] = h
+            S_fd[:, j] = (ref_sweep(lu[0], mu[0], x0 + e)[2]
+                          - ref_sweep(lu[0], mu[0], x0 - e)[2]) / (2 * h)
+        np.testing.assert_allclose(S, S_fd, rtol=0, atol=1e-6 * max(np.abs(S_fd).max(), 1.0))
+        if np.any(law.dlft_time(lu, mu, xs, TOL_LAW, SWEEPS)[1] == law.SEPARATION):
+            np.testing.assert_array_equal(S, 0.0)
+
+
 # --------------------------------------------------------------------------------------------
 # 2. the quasi-analytic Jacobian of the law against finite differences
 # --------------------------------------------------------------------------------------------
@@ -299,6 +363,36 @@ def test_jacobian_3d_shakedown_node(name):
     lu, lx, state, _ = run_law(c, mu, xs)
     G_fd = fd_jacobian(c, mu, xs)
     G = law.dlft_jacobian(lu, lx, state, mu, P_REF, Q_REF, xs, TOL_LAW, SWEEPS)[0]
+    np.testing.assert_allclose(G, G_fd, rtol=0, atol=FD_RTOL * max(np.abs(G_fd).max(), 1.0))
+
+
+def test_jacobian_of_slowly_contracting_node():
+    """dlft_jacobian vs central differences of the time law (tolerance FD_RTOL, as above) on
+    the SLOW_3D node, whose periodic state the kernel now reaches by Newton's step on the
+    start state: the Jacobian (the derivative of the periodic fixed point, wrap-around seed
+    solved exactly) is that of the law the residual evaluates, with the 200 passes that
+    DLFTProblem allows by default. Before, the kernel stopped after those 200 plain passes
+    short of the fixed point, and the two disagreed (by ~0.97^200 = 2e-3 of the start
+    state's sensitivity: above FD_RTOL)."""
+    c, mu, xs = slow_case()
+    d, H = c.shape[1:]
+
+    def law_coeffs(cc):
+        lu = np.ascontiguousarray(cc @ Q_REF.T)
+        lx, state, _ = law.dlft_time(lu, mu, xs, TOL_LAW, 200)
+        return lu, lx, state
+
+    lu, lx, state = law_coeffs(c)
+    assert margins(lu, lx, mu).min() > MIN_MARGIN
+    G = law.dlft_jacobian(lu, lx, state, mu, P_REF, Q_REF, xs, TOL_LAW, 200)[0]
+    h = FD_STEP * np.abs(lu).max()
+    G_fd = np.zeros((d * H, d * H))
+    for j in range(d * H):
+        e = np.zeros(d * H)
+        e[j] = h
+        plus = law_coeffs(c + e.reshape(1, d, H))[1][0] @ P_REF.T
+        minus = law_coeffs(c - e.reshape(1, d, H))[1][0] @ P_REF.T
+        G_fd[:, j] = (plus - minus).reshape(-1) / (2 * h)
     np.testing.assert_allclose(G, G_fd, rtol=0, atol=FD_RTOL * max(np.abs(G_fd).max(), 1.0))
 
 

@@ -91,3 +91,130 @@ def test_identity_rows_against_a_dense_solve(k):
     b = RNG.standard_normal(4)
     np.testing.assert_allclose(solve_identity_rows(full, b), np.linalg.solve(full, b),
                                rtol=1e-12)
+
+
+@pytest.mark.parametrize("method", ["powell", "newton"])
+def test_progress_test_stops_a_solve_without_progress(method):
+    """``max_slow`` (MINPACK hybrj's "not making good progress" test): on ``x^2 + 1 = 0`` (no
+    real root, |f| >= 1 everywhere, so no iteration can decrease |f|^2 by 10 % for long) the
+    solve stops unconverged after ``max_slow`` Jacobians in a row without such an iteration,
+    and says so; without the test it goes on until another stop (82 Powell iterations
+    measured, 11 Newton ones). The count is checked against the definition: at most
+    ``max_slow`` + 1 Jacobian evaluations after the last iteration with 10 % decrease."""
+    def fun(x, need_jacobian):
+        return np.array([x[0] ** 2 + 1.0]), (np.array([[2 * x[0]]]) if need_jacobian else None)
+
+    _, _, free = solve(fun, [0.3], lambda x: 1.0, method=method, tol=1e-12, max_iter=200)
+    norms = []
+    x, _, st = solve(fun, [0.3], lambda x: 1.0, method=method, tol=1e-12, max_iter=200,
+                     max_slow=3, callback=lambda it, x, fn: norms.append(fn))
+    assert not st.success and st.message.startswith("not making good progress")
+    assert st.iterations < free.iterations
+    good = [i for i in range(1, len(norms)) if norms[i] ** 2 <= 0.9 * norms[i - 1] ** 2]
+    last = good[-1] if good else 0
+    accepted = sum(1 for i in range(last + 1, len(norms)) if norms[i] < norms[i - 1])
+    assert accepted <= 3
+
+
+@pytest.mark.parametrize("method", ["powell", "newton"])
+def test_progress_test_leaves_a_converging_solve_unchanged(method):
+    """A solve that converges makes good progress: the same iterates, bit for bit, with and
+    without ``max_slow``."""
+    fun, x_star, scale = monotone()
+    x0 = np.zeros_like(x_star)
+    a, _, sa = solve(fun, x0, lambda x: scale, method=method, tol=1e-12)
+    b, _, sb = solve(fun, x0, lambda x: scale, method=method, tol=1e-12, max_slow=5)
+    assert sa.success and sb.success and sa.iterations == sb.iterations
+    np.testing.assert_array_equal(a, b)
+
+
+def test_powell_solves_once_per_jacobian(monkeypatch):
+    """A rejected step keeps the iterate, its Jacobian and residual: Powell's next iteration
+    reuses the Newton step (one linear solve per Jacobian, not per iteration; the solve of a
+    large interface is a GMRES run). Counted on the problem without a root, where steps are
+    rejected (82 iterations, 18 Jacobians)."""
+    from fretwear.hb import solvers
+
+    calls = []
+    step = solvers._lu_step
+    monkeypatch.setattr(solvers, "_lu_step", lambda J, f, *a: calls.append(1) or step(J, f, *a))
+
+    def fun(x, need_jacobian):
+        return np.array([x[0] ** 2 + 1.0]), (np.array([[2 * x[0]]]) if need_jacobian else None)
+
+    _, _, st = solve(fun, [0.3], lambda x: 1.0, method="powell", tol=1e-12, max_iter=200)
+    assert st.iterations > st.njev and len(calls) <= st.njev
+
+
+class InexactOperator:
+    """A formed Jacobian seen as an operator (as fretwear.hb.krylov.KrylovJacobian): its
+    ``solve(b, rtol)`` returns the exact solution plus an error whose residual is ``rtol``
+    times ``|b|`` (the most an iterative solver to that tolerance leaves), and records the
+    tolerances asked for."""
+
+    def __init__(self, J, asked):
+        self.J, self.asked = J, asked
+        self.shape = J.shape
+
+    def __matmul__(self, x):
+        return self.J @ x
+
+    @property
+    def T(self):
+        return self.J.T
+
+    def column_norms(self):
+        return np.linalg.norm(self.J, axis=0)
+
+    def solve(self, b, rtol=None):
+        self.asked.append(rtol)
+        x = np.linalg.solve(self.J, b)
+        if rtol is None:
+            return x
+        e = np.linalg.solve(self.J, np.ones_like(b))  # residual along (1, .., 1)
+        return x + rtol * np.linalg.norm(b) / np.linalg.norm(self.J @ e) * e
+
+
+def test_powell_inexact_newton_steps_reach_the_same_root():
+    """With an operator Jacobian, Powell asks for inexact Newton steps (Eisenstat-Walker
+    forcing terms: FORCING_MAX first, then at most FORCING_GAMMA (|f_k|/|f_k-1|)^2) and still
+    converges to the root of the smooth monotone problem (closed form: the x* it was built
+    from; 1e-9 relative as above); the tolerances it asks for decrease as |f| does."""
+    from fretwear.hb import solvers
+
+    fun, x_star, scale = monotone()
+    asked = []
+
+    def op(x, need_jacobian):
+        f, J = fun(x, need_jacobian)
+        return f, (InexactOperator(J, asked) if need_jacobian else None)
+
+    x, _, st = solve(op, np.zeros_like(x_star), lambda x: scale, tol=1e-12)
+    assert st.success, st.message
+    np.testing.assert_allclose(x, x_star, rtol=1e-9, atol=1e-9 * np.abs(x_star).max())
+    loose = [a for a in asked if a is not None]
+    assert loose and loose[0] == solvers.FORCING_MAX and loose[-1] < 1e-3
+
+
+def test_powell_redoes_a_poor_inexact_step_exactly():
+    """An inexact step that the model served poorly (ratio of actual to predicted decrease
+    below 0.1) and that did not decrease |f| is redone on the same Jacobian to the full
+    accuracy (``rtol`` None) before the next iteration: on x^2 + 1 = 0 (no root) every
+    first step on a new Jacobian fails, so every loose request is followed by an exact one
+    with the same Jacobian (the iterate unchanged in between)."""
+    asked, at = [], []
+
+    class Recording(InexactOperator):
+        def solve(self, b, rtol=None):
+            at.append(self.J[0, 0])
+            return super().solve(b, rtol)
+
+    def op(x, need_jacobian):
+        f = np.array([x[0] ** 2 + 1.0])
+        return f, (Recording(np.array([[2 * x[0]]]), asked) if need_jacobian else None)
+
+    _, _, st = solve(op, [0.3], lambda x: 1.0, tol=1e-12, max_iter=30)
+    assert not st.success and len(asked) > 4
+    for i, a in enumerate(asked[:-1]):
+        if a is not None:
+            assert asked[i + 1] is None and at[i + 1] == at[i]

@@ -69,6 +69,14 @@ EPS_STEP_MAX_ITER = 20
 FRESH_ITER_FACTOR = 5
 #: harmonics above which a single solve without a start begins from the first harmonic alone
 COLD_START_HARMONICS = 3
+#: on the operator path (large interfaces) the first-harmonic start gives up after this many
+#: Jacobians in a row without an iteration that decreased ``|f|^2`` by 10 % (MINPACK's
+#: progress test, fretwear.hb.solvers.powell): it is a start, and a stalled one is not used
+#: (measured: the pad in partial slip crawled through its 200 iterations at a relative
+#: residual of 1e-5, 55 % of the solve; docs/studies/large-interface-solve.md). Not on the
+#: dense path: the paper's beam at 79.34 kHz (salles2011-79khz-periodic) progresses slowly
+#: in its start and then needs 185 iterations; cut short there, 215
+START_MAX_SLOW = 5
 
 
 # --- solver runs and starts -----------------------------------------------------------------
@@ -107,7 +115,8 @@ def first_harmonic_start(prob: DLFTProblem, options: SolveOptions):
 
     x, _, st = solve(fun, p1.initial_guess().reshape(-1),
                      lambda x: p1.scale(x.reshape(p1.m, p1.H)), method=options.solver,
-                     tol=options.tol, max_iter=options.max_iter)
+                     tol=options.tol, max_iter=options.max_iter,
+                     max_slow=START_MAX_SLOW if prob.jacobian == "krylov" else None)
     if not st.success:
         return None
     U = np.zeros((prob.m, prob.H))
@@ -121,8 +130,12 @@ def first_harmonic_start(prob: DLFTProblem, options: SolveOptions):
 def cold_start(prob: DLFTProblem, U0, options: SolveOptions) -> np.ndarray:
     """The start (m, H) of a single solve: ``U0`` when given; else, above
     :data:`COLD_START_HARMONICS` harmonics, the first harmonic alone
-    (:func:`first_harmonic_start`); else the contact-closed guess."""
-    if U0 is None and prob.basis.k > COLD_START_HARMONICS:
+    (:func:`first_harmonic_start`), except on the operator path (large interfaces, where
+    fretting puts the interface in partial slip: there the one-harmonic balance stalled on
+    256 contact nodes or led the full one through 31 Powell iterations where the
+    contact-closed guess needs 11 on 576; docs/studies/large-interface-solve.md; the rung
+    ``"harmonic-continuation"`` remains if the solve fails); else the contact-closed guess."""
+    if U0 is None and prob.basis.k > COLD_START_HARMONICS and prob.jacobian != "krylov":
         U0 = first_harmonic_start(prob, options)
     return prob.initial_guess() if U0 is None else np.asarray(U0, float).reshape(prob.m, prob.H)
 

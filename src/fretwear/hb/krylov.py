@@ -40,8 +40,12 @@ SHARE_BELOW = 0.25
 #: Krylov vectors kept before a restart, and restarts allowed
 GMRES_RESTART = 60
 GMRES_MAXITER = 4
-#: GMRES iterations above which the preconditioner is rebuilt from the current Jacobian
+#: a kept preconditioner is rebuilt from the current Jacobian when GMRES needs more than
+#: REBUILD_AFTER iterations and more than REBUILD_GROWTH times those of its first run (in
+#: partial slip a fresh one needs 30-45 iterations, and one kept over the Newton steps of a
+#: solve about as many: docs/studies/large-interface-solve.md)
 REBUILD_AFTER = 25
+REBUILD_GROWTH = 2.0
 #: the step is solved by a LAPACK LU of the active block up to this many unknowns (slipping
 #: or separating nodes x d x H), by GMRES above (docs/theory.md, "Large interfaces")
 ACTIVE_DENSE_MAX = 3000
@@ -148,7 +152,10 @@ class HarmonicBlocks:
         return out
 
     def sub(self, dofs: np.ndarray) -> HarmonicBlocks:
-        """The blocks restricted to the rows and columns ``dofs`` (real when these are)."""
+        """The blocks restricted to the rows and columns ``dofs`` (real when these are); this
+        object itself when ``dofs`` are all its DOFs in order (every node active: no copy)."""
+        if dofs.size == self.m and np.array_equal(dofs, np.arange(self.m)):
+            return self
         src = self.Zr if self.real else self.Zc
         out = np.empty((self.nb, dofs.size, dofs.size), dtype=src.dtype)
         for b in range(self.nb):  # rows then columns: 40 % faster than z[np.ix_(...)]
@@ -250,31 +257,69 @@ class HarmonicBlocks:
         return to_real_blocks(self.Zc, np.arange(self.nb))
 
 
-class MeanGainPreconditioner:
-    """``P^-1`` with ``P_n = eps I + gbar (Z_n - eps I)`` per harmonic (module docstring).
+def harmonic_gains(G: np.ndarray, d: int, oscillating: bool = True):
+    """The gains of :class:`MeanGainPreconditioner` from the node blocks ``G`` (nc, dH, dH):
+    ``gbar`` (nc, d, d), the (0, 0) coefficient block (the response of the mean correction to
+    the mean of ``lambda_u``), the gain of harmonic 0; and ``gosc`` (nc, d, d), the gain of
+    the harmonics ``n >= 1``: the mean over them of the diagonal blocks
+    ``(G_p[a_n, a_n] + G_p[b_n, b_n]) / 2`` (the response of harmonic ``n`` to itself), or
+    ``gbar`` itself unless ``oscillating``.
 
-    gbar : (nc, d, d) mean gain of each node over the period; Z : :class:`HarmonicBlocks`;
-    share : let a harmonic use the factors of the last factored one when they precondition
-    it well (:meth:`_close`): below the structure's first resonances ``Z_n`` hardly differs
-    from ``Z_0`` (``-(n w)^2 M_r`` against the stiffness) and one LU serves several
-    harmonics. A rebuild after a GMRES failure does not share.
+    The two differ where a node slips during part of the period only (partial slip, the
+    fretting case): the derivative of the law (eq. 27-28) is then a sample and hold,
+    ``lambda_x,T`` following ``lambda_u,T`` at the slip instants and keeping its value while
+    the node sticks. A constant change of ``lambda_u,T`` passes whole (``gbar`` = 1 in the
+    slip direction), an oscillating one only through its samples at the slip instants (the
+    diagonal blocks well below 1): the mean gain alone treats the oscillating harmonics of
+    such nodes as if they slipped all period. Measured (docs/studies/
+    large-interface-solve.md): GMRES iterations from 214 to 41 on the 256-node pad in partial
+    slip, from 35 to 2 on the benchmark's mostly stuck pad. Where the whole interface slides
+    or lifts (a 25-node block in gross slip and separation) the mean gain served better (280
+    iterations against no convergence in 480): :meth:`KrylovJacobian._gmres` falls back to
+    it when GMRES fails with the oscillating gains."""
+    nc, dH, _ = G.shape
+    H = dH // d
+    k = (H - 1) // 2
+    Gr = G.reshape(nc, d, H, d, H)
+    gbar = np.ascontiguousarray(Gr[:, :, 0, :, 0])
+    if not k or not oscillating:
+        return gbar, gbar
+    gosc = np.zeros_like(gbar)
+    for b in range(1, 2 * k + 1):
+        gosc += Gr[:, :, b, :, b]
+    return gbar, gosc / (2 * k)
+
+
+class MeanGainPreconditioner:
+    """``P^-1`` with ``P_n = eps I + g_n (Z_n - eps I)`` per harmonic (module docstring).
+
+    gbar : (nc, d, d) mean gain of each node over the period (the (0, 0) coefficient block of
+    ``G_p``), the gain ``g_0`` of harmonic 0; gosc : (nc, d, d) the gain ``g_n`` of the
+    harmonics ``n >= 1`` (:func:`harmonic_gains`; default ``gbar``); Z :
+    :class:`HarmonicBlocks`; share : let a harmonic use the factors of the last factored one
+    when they precondition it well (:meth:`_close`): below the structure's first resonances
+    ``Z_n`` hardly differs from ``Z_0`` (``-(n w)^2 M_r`` against the stiffness) and one LU
+    serves several harmonics. A rebuild after a GMRES failure does not share.
     """
 
-    def __init__(self, gbar: np.ndarray, Z: HarmonicBlocks, eps: float, share: bool = True):
+    def __init__(self, gbar: np.ndarray, Z: HarmonicBlocks, eps: float, share: bool = True,
+                 gosc: np.ndarray | None = None):
         self.k, self.m, self.H = Z.k, Z.m, Z.H  # (no reference to Z: kept across sweeps)
+        gosc = gbar if gosc is None else gosc
         self.factors = []  # per harmonic block: LAPACK LU of P_n or of a close P_b
         self.shared = 0
-        last = None  # (Z_b, its LU) of the last factored harmonic
+        last = None  # (Z_b, g_b, its LU) of the last factored harmonic
         for b in range(Z.nb):
             Zb = Z.Z0 if b == 0 else Z.block(b)
-            if share and last is not None and self._close(gbar, Zb, last, eps):
-                self.factors.append(last[1])
+            g = gbar if b == 0 else gosc
+            if share and last is not None and self._close(g, Zb, last, eps):
+                self.factors.append(last[2])
                 self.shared += 1
                 continue
-            lu = sla.lu_factor(self._block(gbar, Zb, eps), overwrite_a=True,
+            lu = sla.lu_factor(self._block(g, Zb, eps), overwrite_a=True,
                                check_finite=False)
             self.factors.append(lu)
-            last = (Zb, lu)
+            last = (Zb, g, lu)
         # the harmonics of each set of factors, solved together by apply()
         groups: dict = {}
         for b, lu in enumerate(self.factors):
@@ -303,22 +348,27 @@ class MeanGainPreconditioner:
         return sla.lu_solve(lu, b, check_finite=False)
 
     @classmethod
-    def _close(cls, gbar, Zn, last, eps) -> bool:
-        """Whether the factors of ``P_b`` (``last`` = ``(Z_b, LU)``) precondition ``P_n``
-        well: ``P_b^-1 P_n = I + E`` with ``E = P_b^-1 gbar (Z_n - Z_b)``, and GMRES on it
+    def _close(cls, gn, Zn, last, eps) -> bool:
+        """Whether the factors of ``P_b`` (``last`` = ``(Z_b, g_b, LU)``) precondition ``P_n``
+        (gain ``gn``) well: ``P_b^-1 P_n = I + E`` with ``E = P_b^-1 (P_n - P_b)``, which is
+        ``P_b^-1 g (Z_n - Z_b)`` when both take the same gain ``g``, and GMRES on it
         converges about as fast as on ``I`` when ``E`` is small. Its size is estimated by
         :data:`SHARE_PROBES` steps of the power iteration from a fixed random vector
         (``2 SHARE_PROBES`` products and solves of ``m^2`` operations, against the ``m^3``
         of an LU): shared when below :data:`SHARE_BELOW`. An isolated large eigenvalue of
         ``E`` that the probe misses costs GMRES about one iteration."""
-        Zb, lu = last
-        nc, d, _ = gbar.shape
+        Zb, gb, lu = last
+        nc, d, _ = gn.shape
         m = Zn.shape[0]
         v = np.random.default_rng(0).standard_normal(m)
         size = 0.0
         for _ in range(SHARE_PROBES):
-            y = (Zn @ v - Zb @ v).reshape(nc, d)
-            w = cls._solve(lu, np.matmul(gbar, y[:, :, None])[:, :, 0].reshape(-1))
+            if gn is gb:
+                y = np.matmul(gn, (Zn @ v - Zb @ v).reshape(nc, d, 1))
+            else:
+                y = (np.matmul(gn, (Zn @ v - eps * v).reshape(nc, d, 1))
+                     - np.matmul(gb, (Zb @ v - eps * v).reshape(nc, d, 1)))
+            w = cls._solve(lu, y[:, :, 0].reshape(-1))
             size = float(np.linalg.norm(w) / np.linalg.norm(v))
             v = w
             if not np.isfinite(size) or size == 0.0:
@@ -350,7 +400,8 @@ class KrylovJacobian:
 
     G : (nc, dH, dH) node blocks (:func:`fretwear.hb.contact.dlft_jacobian`);
     Z : :class:`HarmonicBlocks`; owner : the object that keeps the preconditioner across
-    Jacobians (its attribute ``_precond``).
+    Jacobians (its attribute ``_precond``, and ``_mean_gain`` once the oscillating gains of
+    :func:`harmonic_gains` failed on it).
     """
 
     def __init__(self, G: np.ndarray, Z: HarmonicBlocks, eps: float, d: int, owner=None):
@@ -468,14 +519,16 @@ class KrylovJacobian:
         ``eps I``)."""
         return np.flatnonzero(np.any(self.G.reshape(self.nc, -1) != 0.0, axis=1))
 
-    def solve(self, b) -> np.ndarray:
+    def solve(self, b, rtol: float | None = None) -> np.ndarray:
         """``J^-1 b``, exact on the stuck nodes and reduced to the active ones
         (:meth:`active_nodes`): with ``s`` the stuck unknowns, ``x_s = b_s / eps`` and
 
             (eps I + G_a (Z_aa - eps I)) x_a = b_a - G_a Z_as x_s,
 
         solved by a LAPACK LU when it has at most :data:`ACTIVE_DENSE_MAX` unknowns, else by
-        right-preconditioned GMRES on that active system to :data:`GMRES_RTOL` (the
+        right-preconditioned GMRES on that active system to the relative residual
+        ``rtol`` (default :data:`GMRES_RTOL`; Powell's inexact Newton steps ask for less
+        far from the solution, :func:`fretwear.hb.solvers.powell`) (the
         preconditioner, restricted to the active nodes, is rebuilt when the active set
         changes, when the kept one needs more than :data:`REBUILD_AFTER` iterations or
         fails). ``b`` (n,) or (n, r)."""
@@ -483,9 +536,12 @@ class KrylovJacobian:
         act = self.active_nodes()
         x, rhs, dofs = self._reduce(b, act)
         if act.size:
-            solver = (self._lu_active if act.size * self.dH <= ACTIVE_DENSE_MAX
-                      else self._gmres_active)
-            x[act] = solver(rhs, act, dofs)
+            if act.size * self.dH <= ACTIVE_DENSE_MAX:
+                x[act] = self._lu_active(rhs, act, dofs)
+            else:
+                x[act] = self._gmres_active(rhs, act, dofs,
+                                            GMRES_RTOL if rtol is None else max(rtol,
+                                                                                GMRES_RTOL))
         return x.reshape(b.shape)
 
     def _reduce(self, b, act):
@@ -534,22 +590,21 @@ class KrylovJacobian:
 
     def _preconditioner(self, act, Za, rebuild=False):
         """The kept preconditioner, or a new one for the active nodes ``act``: sharing
-        factors between harmonics unless ``rebuild`` (GMRES failed with the kept one) or
-        shared factors made GMRES slow before on this owner."""
+        factors between harmonics unless ``rebuild`` (GMRES failed with the kept one)."""
         owner = self.owner
         pc = getattr(owner, "_precond", None)
         if (pc is None or rebuild or pc.m != Za.m
                 or not np.array_equal(getattr(pc, "nodes", None), act)):
-            H = self.Z.H
-            Gr = self.G[act].reshape(act.size, self.d, H, self.d, H)
-            share = not (rebuild or getattr(owner, "_no_share", False))
-            pc = MeanGainPreconditioner(np.ascontiguousarray(Gr[:, :, 0, :, 0]), Za, self.eps,
-                                        share=share)
+            gbar, gosc = harmonic_gains(self.G[act], self.d,
+                                        not getattr(owner, "_mean_gain", False))
+            pc = MeanGainPreconditioner(gbar, Za, self.eps, share=not rebuild, gosc=gosc)
+            pc.oscillating = gosc is not gbar
             pc.nodes = act
+            pc.first_iterations = None  # GMRES iterations per decade, first run
             owner._precond = pc
         return pc
 
-    def _gmres_active(self, rhs, act, dofs) -> np.ndarray:
+    def _gmres_active(self, rhs, act, dofs, rtol=GMRES_RTOL) -> np.ndarray:
         """GMRES on the active system, one right-hand side at a time."""
         eps, dH = self.eps, self.dH
         Za = self._active_blocks(dofs)
@@ -565,18 +620,22 @@ class KrylovJacobian:
         A = spla.LinearOperator((n, n), matvec=matvec, dtype=float)
         out = np.empty_like(rhs)
         for c in range(rhs.shape[2]):
-            out[:, :, c] = self._gmres(A, rhs[:, :, c].reshape(-1), act, Za).reshape(na, dH)
+            out[:, :, c] = self._gmres(A, rhs[:, :, c].reshape(-1), act, Za,
+                                       rtol).reshape(na, dH)
         return out
 
-    def _gmres(self, A, b, act, Za) -> np.ndarray:
+    def _gmres(self, A, b, act, Za, rtol=GMRES_RTOL) -> np.ndarray:
         """GMRES on one right-hand side. When it fails with a preconditioner kept from an
         earlier Jacobian or with shared factors, one more run from its last iterate with a
-        preconditioner rebuilt from this Jacobian without sharing; a fresh unshared one is
-        the best at hand (GMRES's last iterate is returned). When shared factors converge
-        slowly, the owner stops sharing and keeps an unshared preconditioner of this
-        Jacobian."""
+        preconditioner rebuilt from this Jacobian without sharing; when a fresh unshared one
+        with the oscillating gains of :func:`harmonic_gains` fails, the owner takes the mean
+        gain from then on and one more run follows with it; a fresh unshared one with the
+        mean gain is the best at hand (GMRES's last iterate is returned). A kept
+        preconditioner that needs more than :data:`REBUILD_AFTER` iterations and more than
+        :data:`REBUILD_GROWTH` times those of its first run (per decade of the residual:
+        ``rtol`` varies) is rebuilt at the next Jacobian."""
         x = None
-        for attempt in range(2):
+        for attempt in range(3):
             pc0 = getattr(self.owner, "_precond", None)
             fresh = attempt > 0 or pc0 is None or not np.array_equal(
                 getattr(pc0, "nodes", None), act)
@@ -587,19 +646,22 @@ class KrylovJacobian:
             def cb(_r, count=count):
                 count[0] += 1
 
-            x, info = spla.gmres(A, b, x0=x, rtol=GMRES_RTOL, atol=0.0,
+            x, info = spla.gmres(A, b, x0=x, rtol=rtol, atol=0.0,
                                  restart=GMRES_RESTART, maxiter=GMRES_MAXITER, M=M,
                                  callback=cb, callback_type="pr_norm")
             self.gmres_iterations += count[0]
             if info == 0:
-                if count[0] > REBUILD_AFTER and pc.shared:
-                    self.owner._no_share = True  # shared factors served badly here
-                    self._preconditioner(act, Za, rebuild=True)  # kept for what follows
-                elif count[0] > REBUILD_AFTER and not fresh:
+                rate = count[0] / max(-np.log10(rtol), 1.0)  # iterations per decade
+                if pc.first_iterations is None:
+                    pc.first_iterations = rate
+                elif (count[0] > REBUILD_AFTER
+                      and rate > REBUILD_GROWTH * pc.first_iterations):
                     self.owner._precond = None  # slow: rebuild at the next Jacobian
                 break
             if fresh and not pc.shared:
-                break  # the best preconditioner at hand: GMRES's last iterate
+                if not pc.oscillating:
+                    break  # the best preconditioner at hand: GMRES's last iterate
+                self.owner._mean_gain = True  # the oscillating gains failed here
         return x
 
 

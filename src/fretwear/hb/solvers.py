@@ -89,12 +89,15 @@ def _dense_solve(A, B):
     return np.linalg.lstsq(A, B, rcond=None)[0]
 
 
-def _lu_step(J, f):
-    """The Newton step ``-J^-1 f``: LAPACK LU of a formed Jacobian, or the operator's own
-    solve (:class:`fretwear.hb.krylov.KrylovJacobian`: GMRES)."""
+def _lu_step(J, f, rtol=None):
+    """The Newton step ``-J^-1 f``: LAPACK LU of a formed Jacobian (exact), or the operator's
+    own solve (:class:`fretwear.hb.krylov.KrylovJacobian`: GMRES, to the relative residual
+    ``rtol`` if given)."""
     if isinstance(J, np.ndarray):
         return -solve_identity_rows(J, f)
-    return -J.solve(f)
+    if rtol is None:
+        return -J.solve(f)
+    return -J.solve(f, rtol=rtol)
 
 
 def vector_norm(x):
@@ -111,12 +114,34 @@ def _column_norms(J):
     return J.column_norms()
 
 
-def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None):
+#: a decrease of ``|f|^2`` by less than this fraction in an iteration is slow progress
+#: (MINPACK ``hybrj``'s test on its ``actred``)
+SLOW_DECREASE = 0.1
+#: inexact Newton steps of an operator Jacobian (Eisenstat and Walker 1996, their choice 2):
+#: the step's linear system is solved to the relative residual ``eta_k = FORCING_GAMMA
+#: (|f_k| / |f_k-1|)^2``, at most FORCING_MAX (the first step), at least ``gamma
+#: eta_k-1^2`` when that exceeds 0.1, and no tighter than a tenth of the convergence test
+FORCING_MAX = 1e-2
+FORCING_GAMMA = 0.9
+
+
+def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=None):
     """Powell's hybrid dog-leg trust region on ``f(x) = 0`` with analytic Jacobian.
 
     As MINPACK ``hybrj``: the variables are scaled by the running maximum of the Jacobian's
     column norms, the trust region is halved on a poor step and doubled on a good one; the
-    Newton step comes from a LAPACK LU. Returns ``(x, f, stats)``.
+    Newton step comes from a LAPACK LU (computed once per Jacobian: a rejected step keeps
+    the iterate, and the next iteration reuses its Newton step with a smaller trust
+    region), or for an operator Jacobian (:class:`fretwear.hb.krylov.KrylovJacobian`) from
+    GMRES to the relative residual of the forcing terms :data:`FORCING_MAX`,
+    :data:`FORCING_GAMMA` (an inexact Newton step far from the solution, tighter as
+    ``|f|`` decreases: the dog-leg's predicted reduction is taken with the operator
+    itself, and the converged answer is that of the residual test; after a step that the
+    model served poorly, steps to the full accuracy until it serves well again).
+    ``max_slow``: stop (unconverged) after that many iterations on a new Jacobian
+    in a row without one that decreased ``|f|^2`` by :data:`SLOW_DECREASE` (MINPACK's "not
+    making good progress" test, ``info = 4`` of ``hybrj`` with 5); None: no such test.
+    Returns ``(x, f, stats)``.
     """
     t0 = time.perf_counter()
     x = np.array(x0, dtype=float)
@@ -133,17 +158,30 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None):
     ok = False
     stall = 0
     nsuc = 0
+    slow = 0  # iterations on a new Jacobian since one decreased |f|^2 by SLOW_DECREASE
+    sn = None  # the Newton step at x (one per Jacobian)
+    exact = isinstance(J, np.ndarray)  # a formed Jacobian: exact LU steps
+    eta = FORCING_MAX  # the forcing term of an inexact step (operator Jacobians)
+    tight = False  # after a poor step: Newton steps to the full accuracy
     while True:
-        if fn <= tol * scale(x):
+        target = tol * scale(x)
+        if fn <= target:
             ok, msg = True, "converged"
             break
         if it >= max_iter:
+            break
+        if max_slow is not None and slow >= max_slow:
+            msg = (f"not making good progress: {slow} Jacobians in a row without an iteration "
+                   f"that decreased |f|^2 by {SLOW_DECREASE:g}")
             break
         it += 1
         if dscale is None:
             dscale = _column_norms(J)
             dscale[dscale == 0] = 1.0
-        sn = _lu_step(J, f)
+        if sn is None:  # an iteration on a new Jacobian (or an inexact step redone)
+            loose = not (exact or tight)
+            sn = _lu_step(J, f, max(eta, 0.1 * target / fn) if loose else None)
+            slow += 1
         snd = vector_norm(dscale * sn)
         if delta is None:
             delta = snd
@@ -176,16 +214,26 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None):
         if ratio < 0.1:
             nsuc = 0
             delta = 0.5 * min(delta, pnorm)
+            if loose and fnn >= fn:  # a poor inexact step: redo it to the full accuracy
+                sn, slow = None, slow - 1
+            tight = True  # the model served poorly: full accuracy until it serves well
         else:
+            tight = False
             nsuc += 1
             if ratio >= 0.5 or nsuc > 1:
                 delta = max(delta, 2.0 * pnorm)
             if abs(ratio - 1.0) <= 0.1:
                 delta = 2.0 * pnorm
+        if actual >= SLOW_DECREASE * fn * fn:
+            slow = 0
         if fnn < fn:  # accept any decrease (non-smooth residual: ratios are noisy)
+            floor = FORCING_GAMMA * eta * eta
+            eta = FORCING_GAMMA * (fnn / fn) ** 2
+            eta = min(FORCING_MAX, max(eta, floor) if floor > 0.1 else eta)
             x, f, fn = xn, fnew, fnn
             _, J = fun(x, True)
             njev += 1
+            sn = None
             dscale = np.maximum(dscale, _column_norms(J))
             stall = 0
         else:
@@ -200,8 +248,10 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None):
     return x, f, st
 
 
-def newton(fun, x0, scale, *, tol=1e-8, max_iter=100, callback=None):
-    """Newton's method with a backtracking line search on ``|f|^2``. Returns ``(x, f, stats)``."""
+def newton(fun, x0, scale, *, tol=1e-8, max_iter=100, callback=None, max_slow=None):
+    """Newton's method with a backtracking line search on ``|f|^2``. ``max_slow``: stop
+    (unconverged) after that many iterations in a row that decreased ``|f|^2`` by less than
+    :data:`SLOW_DECREASE` (as :func:`powell`). Returns ``(x, f, stats)``."""
     t0 = time.perf_counter()
     x = np.array(x0, dtype=float)
     f, J = fun(x, True)
@@ -210,11 +260,16 @@ def newton(fun, x0, scale, *, tol=1e-8, max_iter=100, callback=None):
     it = 0
     ok = False
     msg = "maximum number of iterations reached"
+    slow = 0
     while True:
         if fn <= tol * scale(x):
             ok, msg = True, "converged"
             break
         if it >= max_iter:
+            break
+        if max_slow is not None and slow >= max_slow:
+            msg = (f"not making good progress: {slow} iterations in a row without a decrease "
+                   f"of |f|^2 by {SLOW_DECREASE:g}")
             break
         it += 1
         s = _lu_step(J, f)
@@ -231,6 +286,7 @@ def newton(fun, x0, scale, *, tol=1e-8, max_iter=100, callback=None):
         if not accepted:
             msg = "line search failed: no decrease of |f| along the Newton direction"
             break
+        slow = 0 if fnn * fnn <= (1.0 - SLOW_DECREASE) * fn * fn else slow + 1
         x, f, fn = x + t * s, fnew, fnn
         _, J = fun(x, True)
         njev += 1
@@ -263,11 +319,15 @@ def hybr(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None):
     return sol.x, f, st
 
 
-def solve(fun, x0, scale, *, method="powell", tol=1e-8, max_iter=200, callback=None):
-    """Dispatch to one of :data:`SOLVERS`."""
+def solve(fun, x0, scale, *, method="powell", tol=1e-8, max_iter=200, callback=None,
+          max_slow=None):
+    """Dispatch to one of :data:`SOLVERS`. ``max_slow``: the progress test of
+    :func:`powell` and :func:`newton` (``"hybr"`` has MINPACK's own)."""
     table = {"powell": powell, "newton": newton, "hybr": hybr}
     if method not in table:
         from fretwear.errors import InputError
 
         raise InputError(f"solver = {method!r}: expected one of {SOLVERS}")
-    return table[method](fun, x0, scale, tol=tol, max_iter=max_iter, callback=callback)
+    extra = {} if max_slow is None or method == "hybr" else {"max_slow": max_slow}
+    return table[method](fun, x0, scale, tol=tol, max_iter=max_iter, callback=callback,
+                         **extra)
