@@ -247,3 +247,24 @@ def test_a_failed_static_preload_solve_is_a_warning_and_an_attribute(tmp_path, c
     assert ds.attrs["warnings"].startswith(expected), ds.attrs["warnings"]
     assert "stick anchors are set to 0" in ds.attrs["warnings"]
     assert f"warning: {ds.attrs['warnings']}" in out
+
+
+def test_a_model_without_observed_points_runs(tmp_path, capsys):
+    """A periodic run of a model that observes no point writes its results (it failed while
+    writing them, on the observed variables' dimensions): the contact results are there and
+    equal those of the same case with an observed point (the observed point does not enter
+    the balance: bit for bit)."""
+    with_point = small_case(tmp_path, PERIODIC, "with.toml")
+    text = with_point.read_text()
+    start = text.index("[observed]")
+    end = text.index("\n[", start + 1)
+    without = tmp_path / "without.toml"
+    without.write_text(text[:start] + text[end + 1:])
+    assert "[observed]" not in without.read_text()
+    for path in (with_point, without):
+        status, out, err = run(path, capsys)
+        assert status == 0, err
+    a = read_results(tmp_path / "with-results" / "results.nc")
+    b = read_results(tmp_path / "without-results" / "results.nc")
+    assert "displacement" in a and "displacement" not in b
+    np.testing.assert_array_equal(a["contact_force"].values, b["contact_force"].values)

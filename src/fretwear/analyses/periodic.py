@@ -53,7 +53,10 @@ from fretwear.io.schema import Field, Flag, Integer, Number, join
 
 # --- dataset -------------------------------------------------------------------------------
 def _observed_variables(sol: PeriodicSolution, points: list[str], n_axes: int) -> dict:
-    """Displacement and velocity of the observed points over a period, per harmonic."""
+    """Displacement and velocity of the observed points over a period, per harmonic (none
+    when the model observes no point)."""
+    if not points:
+        return {}
     coeffs, disp, vel, amp, stops = [], [], [], [], []
     for name in points:
         u, v = sol.observed_time(name)
