@@ -305,5 +305,28 @@ def modal_condenser(model: Model, f_max: float, max_order: int, *, modes: int | 
     (:func:`~fretwear.hb.reduce.condense`, periodic solves, sweeps, wear runs, recovery), as
     :func:`~fretwear.hb.reduce.exact_condenser`'s condenser is passed; it refuses another
     model, or this one after an edit of its matrices.
+
+    Where the dense storage (:func:`dense_storage_gib`) exceeds :data:`DENSE_STORAGE_GIB`
+    it is a :class:`~fretwear.hb.modal_blocked.BlockedModalCondenser` (the same condensation
+    without ``Psi`` or dense blocks per harmonic).
     """
+    if dense_storage_gib(model, max_order) > DENSE_STORAGE_GIB:
+        from fretwear.hb.modal_blocked import BlockedModalCondenser
+
+        return BlockedModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff,
+                                     tol=tol)
     return ModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff, tol=tol)
+
+
+#: above this estimated storage [GiB] :func:`modal_condenser` builds the blocked condenser
+#: (1024 contact nodes of benchmarks/scale_3d.py: 1.1 GiB, dense; 4096: 22.5 GiB, blocked)
+DENSE_STORAGE_GIB = 6.0
+
+
+def dense_storage_gib(model: Model, max_order: int) -> float:
+    """The arrays of :class:`ModalCondenser` that grow with the interface [GiB]: ``Psi``
+    (``n_i x m``), the projected ``K^cc, M^cc`` in both frames and the ``max_order + 1``
+    real blocks of ``Z_r`` (``m x m`` each), ``m`` the contact DOFs."""
+    m = int(np.asarray(model.contact.dofs).size)
+    ni = max(int(model.ndof) - m, 0)
+    return 8.0 * (ni * m + (max_order + 5) * m * m) / 2**30
