@@ -54,6 +54,9 @@ def main():
     ap.add_argument("--limit-gib", type=float, default=20.0, help="address-space limit")
     args = ap.parse_args()
     cap = int(args.limit_gib * 2**30)
+    hard = resource.getrlimit(resource.RLIMIT_AS)[1]
+    if hard != resource.RLIM_INFINITY:  # only lowered (e.g. under ulimit -v)
+        cap = min(cap, hard)
     resource.setrlimit(resource.RLIMIT_AS, (cap, cap))
 
     from fretwear.hb.fourier import FourierBasis

@@ -131,7 +131,7 @@ def test_periodic_solve_in_partial_slip_equals_dense_modal_path():
     """The periodic solve through the blocked condenser (operator Jacobian) reaches the
     solution of the dense modal condenser with the formed Jacobian, in partial slip."""
     model = block(traction=4.5e5)
-    basis = FourierBasis.up_to(7, 64)
+    basis = FourierBasis.up_to(3, 64)  # 27 % of area x period slips, 6.5 % separates
     out = []
     for cond, jac in ((ModalCondenser(model, F_MAX, 7, tol=1e-2), "dense"),
                       (BlockedModalCondenser(model, F_MAX, 7, tol=1e-2), "krylov")):
