@@ -142,3 +142,38 @@ def test_periodic_solve_in_partial_slip_equals_dense_modal_path():
     slip = out[1].state_fractions().mean(axis=0)[2]
     assert 0.02 < slip < 0.98  # partial slip
     assert rel(out[1].U, out[0].U) < 1e-8
+
+
+def test_bounded_preconditioner_factors_give_the_same_step(monkeypatch):
+    """The GMRES step on operator blocks with the preconditioner's factors bounded to one
+    factorisation (every harmonic shares it) equals the dense solve of the formed Jacobian
+    (GMRES_RTOL 1e-10: asserted 1e-8), in partial slip."""
+    from fretwear.hb import krylov, modal_operator
+
+    monkeypatch.setattr(krylov, "ACTIVE_DENSE_MAX", 0)  # GMRES whatever the size
+    monkeypatch.setattr(modal_operator.OperatorBlocks, "factor_budget", 1)  # one LU
+    model = block(traction=4.5e5)
+    bc = BlockedModalCondenser(model, F_MAX, 7, tol=1e-2)
+    basis = FourierBasis.up_to(3, 64)
+    sol = solve_periodic(model, basis, frequency=12e3, condenser=bc,
+                         anchor=static_anchor(model, condenser=bc))
+    red = bc.reduced(2 * np.pi * 12e3, basis.orders)
+    kw = dict(eps=sol.eps, anchor=sol.anchor)
+    pk = DLFTProblem(red, model.contact, basis, jacobian="krylov", **kw)
+    pd = DLFTProblem(red, model.contact, basis, jacobian="dense", **kw)
+    U = sol.U.reshape(pk.m, pk.H)
+    _, J = pk.residual(U)
+    _, Jd = pd.residual(U)
+    v = np.random.default_rng(5).standard_normal(pk.m * pk.H)
+    assert rel(J.solve(v), np.linalg.solve(Jd, v)) < 1e-8
+    # without sharing by closeness, only the bound makes the harmonics share one LU
+    act = J.active_nodes()
+    dofs = (act[:, None] * 3 + np.arange(3)).reshape(-1)
+    gbar = J.G[act].reshape(act.size, 3, basis.size, 3, basis.size)[:, :, 0, :, 0]
+    pc = krylov.MeanGainPreconditioner(np.ascontiguousarray(gbar), J.Z.sub(dofs), J.eps,
+                                       share=False)
+    assert len(pc.factors) == basis.k + 1 and len({id(f) for f in pc.factors}) == 1
+    monkeypatch.undo()
+    pc = krylov.MeanGainPreconditioner(np.ascontiguousarray(gbar), J.Z.sub(dofs), J.eps,
+                                       share=False)
+    assert len({id(f) for f in pc.factors}) == basis.k + 1

@@ -147,12 +147,22 @@ class ReducedOperator:
         return out
 
 
+#: bytes of LU factors the mean-gain preconditioner (hb/krylov.py) may hold for operator
+#: blocks: one factorisation of all 4096 contact nodes' DOFs of benchmarks/scale_3d.py
+#: (1.1 GiB) fits, not eight
+FACTOR_BUDGET = 2 * 2**30
+
+
 class OperatorBlocks(HarmonicBlocks):
     """:class:`~fretwear.hb.krylov.HarmonicBlocks` of a :class:`ReducedOperator`: the same
     products on the real Fourier basis (DOF-major ``(m, H)`` arrays), through
     :meth:`ReducedOperator.matmat` instead of stored blocks; a block is formed (dense) only
     where :meth:`block` is asked for one (the column norms and the preconditioner, one block
-    at a time, on the active DOFs for the latter)."""
+    at a time, on the active DOFs for the latter). The preconditioner's factors are bounded
+    by :data:`FACTOR_BUDGET` bytes (``factor_budget``): past it the harmonics share the
+    last factors."""
+
+    factor_budget = FACTOR_BUDGET
 
     def __init__(self, op: ReducedOperator):  # no super().__init__: no (nb, m, m) array
         self.op = op
