@@ -77,7 +77,7 @@ def estimate_gib(n: int) -> dict:
     the kept harmonic 0, the active sub-blocks and the preconditioner's factors; calibrated
     on the 2.2 GiB measured at 1024 nodes) and 0.4 GiB of Python, NumPy, SciPy and numba.
 
-    Where it builds the blocked one (fretwear.hb.modal_blocked, 4096 nodes; not yet
+    Where it builds the blocked one (fretwear.hb.modal, 4096 nodes; not yet
     measured at that size): the shared ``K^cc, M^cc`` (two real m x m), the sparse LU of
     ``K_ii`` (8.9e6 non-zeros measured at 1024 nodes, 12 bytes each, grown as n_i^(4/3)),
     work arrays: the active sub-blocks (two m x m at most), one formed block and the

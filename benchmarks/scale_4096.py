@@ -1,4 +1,4 @@
-"""Memory and time of the blocked modal condensation (fretwear.hb.modal_blocked) and the
+"""Memory and time of the blocked modal condensation (fretwear.hb.modal) and the
 periodic solve on the pad of benchmarks/scale_3d.py (its model and load, imported) at n x n
 contact nodes: 64 x 64 (4096 contact nodes, 7 harmonics, 172 032 unknowns) by default.
 
@@ -60,8 +60,7 @@ def main():
     resource.setrlimit(resource.RLIMIT_AS, (cap, cap))
 
     from fretwear.hb.fourier import FourierBasis
-    from fretwear.hb.modal import ModalCondenser
-    from fretwear.hb.modal_blocked import BlockedModalCondenser
+    from fretwear.hb.modal import BlockedModalCondenser, ModalCondenser
     from fretwear.hb.periodic import solve_periodic
     from fretwear.hb.preload import static_anchor
 

@@ -1,4 +1,4 @@
-"""The blocked modal condensation (fretwear.hb.modal_blocked: no Psi held, Z_r as a
+"""The blocked modal condensation (fretwear.hb.modal: no Psi held, Z_r as a
 ReducedOperator of shared matrices and a low-rank term per harmonic) against the dense modal
 condensation of fretwear.hb.modal (itself checked against the exact condensation in
 test_modal.py), the exact condensation, the dense Jacobian and finite differences.
@@ -15,9 +15,9 @@ import pytest
 
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.krylov import HarmonicBlocks, KrylovJacobian
-from fretwear.hb.modal import ModalCondenser
-from fretwear.hb.modal_blocked import BlockedModalCondenser
-from fretwear.hb.modal_operator import OperatorBlocks, ReducedOperator
+from fretwear.hb.modal import BlockedModalCondenser, ModalCondenser
+from fretwear.hb.modal_operator import ReducedOperator
+from fretwear.hb.operator_blocks import OperatorBlocks
 from fretwear.hb.options import SolveOptions
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.preload import static_anchor
@@ -148,10 +148,10 @@ def test_bounded_preconditioner_factors_give_the_same_step(monkeypatch):
     """The GMRES step on operator blocks with the preconditioner's factors bounded to one
     factorisation (every harmonic shares it) equals the dense solve of the formed Jacobian
     (GMRES_RTOL 1e-10: asserted 1e-8), in partial slip."""
-    from fretwear.hb import krylov, modal_operator
+    from fretwear.hb import krylov, operator_blocks
 
     monkeypatch.setattr(krylov, "ACTIVE_DENSE_MAX", 0)  # GMRES whatever the size
-    monkeypatch.setattr(modal_operator.OperatorBlocks, "factor_budget", 1)  # one LU
+    monkeypatch.setattr(operator_blocks.OperatorBlocks, "factor_budget", 1)  # one LU
     model = block(traction=4.5e5)
     bc = BlockedModalCondenser(model, F_MAX, 7, tol=1e-2)
     basis = FourierBasis.up_to(3, 64)

@@ -265,7 +265,7 @@ class MeanGainPreconditioner:
         self.factors = []  # per harmonic block: LAPACK LU of P_n or of a close P_b
         self.shared = 0
         last = None  # (Z_b, its LU) of the last factored harmonic
-        # blocks held as an operator (hb/modal_operator.py) bound the factors' memory: past
+        # blocks held as an operator (hb/operator_blocks.py) bound the factors' memory: past
         # the bound every further harmonic shares the last factors
         budget = getattr(Z, "factor_budget", None)
         most = Z.nb if budget is None else max(1, int(budget // (8 * Z.m * Z.m)))

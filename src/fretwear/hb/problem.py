@@ -23,7 +23,7 @@ from fretwear.hb import small
 from fretwear.hb.connectors import connect, springs
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.krylov import KrylovJacobian
-from fretwear.hb.modal_operator import harmonic_blocks
+from fretwear.hb.operator_blocks import harmonic_blocks
 from fretwear.hb.options import JACOBIANS
 from fretwear.hb.penalty import penalty
 from fretwear.hb.reduce import Reduced, loads_to_real, to_real_blocks
