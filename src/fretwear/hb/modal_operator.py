@@ -83,6 +83,14 @@ class ReducedOperator:
                    + sum(u.nbytes + y.nbytes for u, y in zip(self.U, self.Y, strict=True)
                          if u is not None))
 
+    def arrays(self) -> list:
+        """Every array that determines the operator (for a fingerprint: hashing the formed
+        blocks would form them all)."""
+        out = [*self.mats, np.ascontiguousarray(self.coef)]
+        for u, y in zip(self.U, self.Y, strict=True):
+            out += [] if u is None else [u, y]
+        return out
+
     def __len__(self) -> int:
         return self.nb
 
