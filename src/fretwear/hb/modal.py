@@ -514,12 +514,15 @@ class BlockedModalCondenser(ModalCondenser):
                                [p[2] for p in parts], symmetric=self._symmetric())
 
     def _symmetric(self) -> bool:
-        """Whether ``K, M, C, D`` are symmetric (then so is every ``Z_r(n)``)."""
+        """Whether ``K, M, C, D`` are symmetric (then so is every ``Z_r(n)``), found once."""
+        if getattr(self, "_sym", None) is not None:
+            return self._sym
         out = True
         for nm in self.proj_local:
             A = getattr(self.structure, nm)
             out = out and abs(A - A.T).max() <= 1e-12 * abs(A).max()
-        return bool(out)
+        self._sym = bool(out)
+        return self._sym
 
     def _check(self) -> float:
         """As :meth:`ModalCondenser._check`, with ``Z_r`` applied as the operator."""
