@@ -105,19 +105,31 @@ def layers(n: int) -> int:
 
 def estimate_gib(n: int, damped: bool = False) -> dict:
     """Peak memory [GiB] of one size, estimated from the arrays that grow with it (the sizes
-    measured at 32 x 32 check it, docs/theory.md): the reduced model ``Z_r`` (H + 1 real
-    m x m blocks when the pad is undamped, as fretwear.hb.modal stores them; complex when
-    ``damped``), the
-    static constraint modes ``Psi`` (n_i x m reals) with one product of their size while
-    they are projected, and work arrays: ten real m x m (the projected stiffness and mass in
-    both frames, a harmonic's condensation, the kept harmonic 0, the active sub-blocks and
-    the preconditioner's factors; calibrated on the 2.2 GiB measured at 1024 nodes) and
-    0.4 GiB of Python, NumPy, SciPy and numba."""
+    measured at 32 x 32 check it, docs/theory.md).
+
+    Where fretwear.hb.modal.modal_condenser builds the dense condenser (up to 1024 nodes):
+    the reduced model ``Z_r`` (H + 1 real m x m blocks when the pad is undamped, as
+    fretwear.hb.modal stores them; complex when ``damped``), the static constraint modes
+    ``Psi`` (n_i x m reals) with one product of their size while they are projected, and work
+    arrays: ten real m x m (the projected stiffness and mass in both frames, a harmonic's
+    condensation, the kept harmonic 0, the active sub-blocks and the preconditioner's
+    factors; calibrated on the 2.2 GiB measured at 1024 nodes) and 0.4 GiB of Python, NumPy,
+    SciPy and numba.
+
+    Where it builds the blocked one (fretwear.hb.modal, 4096 nodes; not yet
+    measured at that size): the shared ``K^cc, M^cc`` (two real m x m; four complex-sized
+    when ``damped``), the sparse LU of ``K_ii`` (8.9e6 non-zeros measured at 1024 nodes, 12
+    bytes each, grown as n_i^(4/3)), work arrays: the active sub-blocks (two m x m at most),
+    one formed block and the preconditioner's factors (at most 2 GiB), and the same base."""
     m = 3 * n * n
     ni = 3 * n * n * (layers(n) + 1) - m
-    parts = {"Z_r": (H + 1) * m * m * (16 if damped else 8), "Psi": 2 * ni * m * 8,
-             "work": 10 * m * m * (16 if damped else 8),
-             "base": 0.4 * 2**30}
+    w = 16 if damped else 8
+    if 8.0 * (ni * m + (H + 5) * m * m) / 2**30 <= 6.0:  # modal.DENSE_STORAGE_GIB
+        parts = {"Z_r": (H + 1) * m * m * w, "Psi": 2 * ni * m * 8, "work": 10 * m * m * w,
+                 "base": 0.4 * 2**30}
+    else:
+        parts = {"K^cc, M^cc": 2 * m * m * w, "LU K_ii": 12 * 8.9e6 * (ni / 12288) ** (4 / 3),
+                 "work": 3 * m * m * w + 2 * 2**30, "base": 0.4 * 2**30}
     parts = {k: v / 2**30 for k, v in parts.items()}
     parts["total"] = sum(parts.values())
     return parts

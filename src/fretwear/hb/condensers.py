@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fretwear.errors import InputError
-from fretwear.hb.modal import CUTOFF, TOL, CheckFailed, ModalCondenser
+from fretwear.hb.modal import CUTOFF, TOL, CheckFailed, modal_condenser
 from fretwear.hb.reduce import exact_condenser
 from fretwear.model.core import Model
 
@@ -175,15 +175,16 @@ def condenser(model: Model, method: str = "auto", *, f_max: float | None = None,
     if residual is None:
         residual = sizes(model)[0] <= RESIDUAL_MAX
     try:
-        mc = ModalCondenser(model, float(f_max), int(max_order), modes=modes, cutoff=cutoff,
-                            tol=float(tol), raise_modes=modes is None, residual=residual)
+        mc = modal_condenser(model, float(f_max), int(max_order), modes=modes, cutoff=cutoff,
+                             tol=float(tol), raise_modes=modes is None, residual=residual)
     except CheckFailed as exc:
         if method == "modal":
             raise
         return _with(exact_condenser(model),
                      CondensationChoice("auto", "exact", f"the modal check failed: {exc}"))
     return _with(mc, CondensationChoice(method, "modal", reason, float(f_max), int(max_order),
-                                        mc.n_modes, mc.q, residual, float(mc.error),
+                                        mc.n_modes, mc.q, bool(getattr(mc, "residual", False)),
+                                        float(mc.error),
                                         float(tol)))
 
 

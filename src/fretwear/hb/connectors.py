@@ -116,6 +116,8 @@ def connect(reduced: Reduced, contact: ContactInterface,
         raise InputError(f"contact stiffness has {sp.k.size} entries for {m} reduced DOFs")
     kf, nr = sp.kf, sp.r.size
     Z, F = reduced.Z, reduced.F
+    if not isinstance(Z, np.ndarray):  # a ReducedOperator (hb/modal_operator.py): formed
+        Z = np.stack(list(Z))
     if sp.perm is not None:  # rigid directions first: the blocks are then slices
         Z, F = Z[:, sp.perm[:, None], sp.perm], F[:, sp.perm]
     nb = Z.shape[0]

@@ -309,10 +309,15 @@ class MeanGainPreconditioner:
         self.factors = []  # per harmonic block: LAPACK LU of P_n or of a close P_b
         self.shared = 0
         last = None  # (Z_b, g_b, its LU) of the last factored harmonic
+        # blocks held as an operator (hb/operator_blocks.py) bound the factors' memory: past
+        # the bound every further harmonic shares the last factors
+        budget = getattr(Z, "factor_budget", None)
+        most = Z.nb if budget is None else max(1, int(budget // (8 * Z.m * Z.m)))
         for b in range(Z.nb):
             Zb = Z.Z0 if b == 0 else Z.block(b)
             g = gbar if b == 0 else gosc
-            if share and last is not None and self._close(g, Zb, last, eps):
+            full = last is not None and len({id(f) for f in self.factors}) >= most
+            if full or (share and last is not None and self._close(g, Zb, last, eps)):
                 self.factors.append(last[2])
                 self.shared += 1
                 continue

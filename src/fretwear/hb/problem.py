@@ -22,7 +22,8 @@ from fretwear.hb import contact as law
 from fretwear.hb import small
 from fretwear.hb.connectors import connect, springs
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.krylov import HarmonicBlocks, KrylovJacobian
+from fretwear.hb.krylov import KrylovJacobian
+from fretwear.hb.operator_blocks import harmonic_blocks
 from fretwear.hb.options import JACOBIANS
 from fretwear.hb.penalty import penalty
 from fretwear.hb.reduce import Reduced, loads_to_real, to_real_blocks
@@ -73,7 +74,7 @@ class DLFTProblem:
             reduced = connect(reduced, contact, self._springs)
         self.reduced = reduced
         self.contact = contact
-        self.blocks = HarmonicBlocks(reduced.Z)
+        self.blocks = harmonic_blocks(reduced.Z)
         self._Z = None
         self._zu = None
         if jacobian not in JACOBIANS:
@@ -112,7 +113,7 @@ class DLFTProblem:
         if self._springs is not None:
             reduced = connect(reduced, self.contact, self._springs)
         new.reduced = reduced
-        new.blocks = HarmonicBlocks(reduced.Z)
+        new.blocks = harmonic_blocks(reduced.Z)
         new._Z = new._zu = None
         new.F = loads_to_real(reduced.F)
         new._Fnorm = None
@@ -139,7 +140,10 @@ class DLFTProblem:
         """The real block operator ``Z~`` (m*H, m*H), DOF-major
         (:func:`~fretwear.hb.reduce.to_real_blocks`), formed on first use."""
         if self._Z is None:
-            self._Z = to_real_blocks(self.reduced.Z, self.reduced.orders)
+            Z = self.reduced.Z
+            if not isinstance(Z, np.ndarray):  # a ReducedOperator (hb/modal_operator.py)
+                Z = np.stack(list(Z))
+            self._Z = to_real_blocks(Z, self.reduced.orders)
         return self._Z
 
     def apply_Z(self, U) -> np.ndarray:

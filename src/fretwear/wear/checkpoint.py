@@ -62,7 +62,8 @@ def fingerprint(model: Model, reduced: Reduced, basis: FourierBasis, eps: float,
     """SHA-256 of everything that determines the trajectory (model data after condensation,
     basis, penalty, wear factors, options, initial state)."""
     h = hashlib.sha256()
-    for a in (reduced.Z, reduced.F, np.asarray(model.contact.gap, float),
+    Z = reduced.Z.arrays() if hasattr(reduced.Z, "arrays") else [reduced.Z]  # an operator
+    for a in (*Z, reduced.F, np.asarray(model.contact.gap, float),
               np.asarray(model.contact.area, float), np.asarray(coef, float),
               np.asarray(wear0, float), np.asarray(anchor0, float)):
         h.update(np.ascontiguousarray(a).tobytes())

@@ -1,0 +1,154 @@
+"""The condensed dynamic stiffness ``Z_r`` of the modal (Craig-Bampton) condensation held as a
+few shared matrices and a low-rank term per harmonic, not as dense ``m x m`` blocks per
+harmonic (docs/theory.md, "Large interfaces").
+
+On the reduced coordinates ``(u_c, q)`` of :mod:`fretwear.hb.modal` every matrix ``X`` of
+``K, M, C, D`` projects to ``X^cc`` (m, m), ``X^cq`` (m, q), ``X^qc`` (q, m), ``X^qq`` (q, q),
+and harmonic ``n`` (``w_n = n w``) of the condensation is
+
+    Z_r(n) = sum_X c_X(n) X^cc - Z^cq(n) Z^qq(n)^-1 Z^qc(n),
+    c_K = 1, c_M = -w_n^2, c_C = i w_n, c_D = i       (harmonic 0 and quasi-static: K alone),
+
+with ``Z^cq(n) = sum_X c_X(n) X^cq`` etc. (eq. 18 on the reduced coordinates). The ``m x m``
+matrices ``X^cc`` do not depend on the frequency: they are stored once (two for an undamped
+structure: the static condensation ``K_r`` and the projected mass), shared by every harmonic,
+frequency, sweep point and the active sub-blocks; each harmonic adds ``U_n = Z^cq(n)``
+(m, q) and ``Y_n = Z^qq(n)^-1 Z^qc(n)`` (q, m). A product ``Z_r(n) x`` is then one product
+per stored matrix (all harmonics' columns at once) and ``U_n (Y_n x)``: the same
+``O(m^2)`` per column as a dense block, with ``2 m^2`` numbers stored instead of
+``(H + 1) m^2``. A dense block is formed only where a caller asks for one (:meth:`block`).
+The solver's products on the real Fourier basis are in :mod:`fretwear.hb.operator_blocks`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def _times(A: np.ndarray, X: np.ndarray) -> np.ndarray:
+    """``A @ X`` for a real ``A`` and a real or complex ``X`` without a complex copy of
+    ``A``."""
+    if np.iscomplexobj(X) and not np.iscomplexobj(A):
+        return A @ X.real + 1j * (A @ X.imag)
+    return A @ X
+
+
+class ReducedOperator:
+    """``Z_r`` on ``nb`` harmonic orders (module docstring), in place of the (nb, m, m) array
+    of :class:`~fretwear.hb.reduce.Reduced`.
+
+    Parameters
+    ----------
+    mats : the shared (m, m) real matrices ``X^cc`` (contact-local frames).
+    coef : (nb, len(mats)) their coefficients ``c_X(n)`` per block.
+    U, Y : per block the low-rank factors ``Z^cq(n)`` (m, q) and ``Z^qq(n)^-1 Z^qc(n)``
+        (q, m), or None for a block without a modal term (harmonic 0).
+    symmetric : whether every ``X^cc`` is symmetric and ``U_n Y_n`` is (symmetric ``K, M, C,
+        D``): then ``Z_r(n)^T = Z_r(n)``.
+
+    It has the array interface the solvers use: ``shape``, ``dtype``, ``ndim``, ``nbytes``,
+    ``len``; an integer index forms that block (dense, (m, m)), a slice gives the operator of
+    those blocks (sharing the matrices), iteration forms the blocks one at a time.
+    """
+
+    ndim = 3
+
+    def __init__(self, mats, coef, U, Y, symmetric: bool = True):
+        self.mats = list(mats)
+        self.coef = np.asarray(coef)
+        self.U, self.Y = list(U), list(Y)
+        self.nb = self.coef.shape[0]
+        self.m = self.mats[0].shape[0]
+        self.symmetric = bool(symmetric)
+        cplx = (np.iscomplexobj(self.coef) and np.any(self.coef.imag)) or any(
+            u is not None and (np.iscomplexobj(u) or np.iscomplexobj(y))
+            for u, y in zip(self.U, self.Y, strict=True))
+        self.dtype = np.dtype(complex if cplx else float)
+        if not cplx:
+            self.coef = self.coef.real
+
+    @property
+    def shape(self) -> tuple:
+        return (self.nb, self.m, self.m)
+
+    @property
+    def real(self) -> bool:
+        """Whether every block is real (an undamped structure)."""
+        return self.dtype.kind == "f"
+
+    @property
+    def nbytes(self) -> int:
+        """Bytes held: the shared matrices and the low-rank factors."""
+        return int(sum(a.nbytes for a in self.mats)
+                   + sum(u.nbytes + y.nbytes for u, y in zip(self.U, self.Y, strict=True)
+                         if u is not None))
+
+    def arrays(self) -> list:
+        """Every array that determines the operator (for a fingerprint: hashing the formed
+        blocks would form them all)."""
+        out = [*self.mats, np.ascontiguousarray(self.coef)]
+        for u, y in zip(self.U, self.Y, strict=True):
+            out += [] if u is None else [u, y]
+        return out
+
+    def __len__(self) -> int:
+        return self.nb
+
+    def __getitem__(self, key):
+        if isinstance(key, slice):
+            idx = range(self.nb)[key]
+            return ReducedOperator(self.mats, self.coef[list(idx)].reshape(len(idx), -1),
+                                   [self.U[b] for b in idx], [self.Y[b] for b in idx],
+                                   self.symmetric)
+        return self.block(int(key))
+
+    def __iter__(self):
+        for b in range(self.nb):
+            yield self.block(b)
+
+    def block(self, b: int, rows=None, cols=None) -> np.ndarray:
+        """Block ``b`` formed densely (m, m), or its rows ``rows`` and columns ``cols``."""
+        sub = rows is not None or cols is not None
+        rows = np.arange(self.m) if rows is None else np.asarray(rows)
+        cols = np.arange(self.m) if cols is None else np.asarray(cols)
+        out = np.zeros((rows.size, cols.size), dtype=self.dtype)
+        for c, A in zip(self.coef[b], self.mats, strict=True):
+            if c != 0:
+                out += c * (A[np.ix_(rows, cols)] if sub else A)
+        if self.U[b] is not None:
+            out -= self.U[b][rows] @ self.Y[b][:, cols]
+        return out
+
+    def sub(self, dofs: np.ndarray) -> ReducedOperator:
+        """The operator restricted to the rows and columns ``dofs``."""
+        ix = np.ix_(dofs, dofs)
+        return ReducedOperator(
+            [np.ascontiguousarray(A[ix]) for A in self.mats], self.coef,
+            [None if u is None else np.ascontiguousarray(u[dofs]) for u in self.U],
+            [None if y is None else np.ascontiguousarray(y[:, dofs]) for y in self.Y],
+            self.symmetric)
+
+    def matmat(self, blocks, X: np.ndarray, transpose: bool = False) -> np.ndarray:
+        """``Z_r(n_b) X[:, j]`` for the column ``j`` of ``X`` (m, r) on block ``blocks[j]``
+        (r,): each stored matrix is read once for all columns. ``transpose``: with
+        ``Z_r(n_b)^T`` (``Z_r(n_b)^H`` of a conjugated ``X`` for a damped structure is the
+        caller's)."""
+        blocks = np.asarray(blocks, dtype=np.int64)
+        cplx = np.iscomplexobj(X) or not self.real
+        rows = self.mats[0].shape[1 if transpose else 0]  # a sub-block may be rectangular
+        out = np.zeros((rows, X.shape[1]), dtype=complex if cplx else float)
+        for t, A in enumerate(self.mats):
+            c = self.coef[blocks, t]
+            if not np.any(c):
+                continue
+            At = A.T if transpose and not self.symmetric else A
+            out += _times(At, X * c[None, :])
+        for b in np.unique(blocks):
+            if self.U[b] is None:
+                continue
+            j = np.flatnonzero(blocks == b)
+            U, Y = self.U[b], self.Y[b]
+            if transpose and not self.symmetric:
+                U, Y = Y.T, U.T
+            out[:, j] -= U @ (Y @ X[:, j])
+        return out
