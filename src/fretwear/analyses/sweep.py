@@ -396,9 +396,9 @@ SWEEP = Analysis.define(
         "points": Field(ListOf(Text(), non_empty=True, unique=True),
                         "observed points to report (default: all)"),
         "eps_band": Field(ListOf(Number(lo=0, lo_open=True), sizes=(2,)),
-                          'the band [f_min, f_max] over which eps = "top" takes its median '
-                          "(default: the sweep's band; the chunks of a split sweep give the "
-                          "whole band, so that they share the whole sweep's eps)", unit="Hz"),
+                          'the band [f_min, f_max] over which eps = "stiff" or "top" takes its '
+                          "median (default: the sweep's band; the chunks of a split sweep give "
+                          "the whole band, so that they share the whole sweep's eps)", unit="Hz"),
         "linear_references": Field(
             ListOf(Text(linear.INTERFACES), unique=True),
             'linear FRFs drawn with the nonlinear one: "sliding" (frictionless), "stuck", '
@@ -410,11 +410,11 @@ SWEEP = Analysis.define(
                                default=default_of(linear_reference_grid, "linear_points")),
         **harmonic_balance_fields(
             SWEEP_OPTIONS.solve, SWEEP_OPTIONS.eps,
-            'DLFT penalty, one value for the whole sweep (a smooth FRF): "top": the spectral '
-            "radius of Z_r at the highest kept harmonic, its median over the band (chosen "
-            'from measurements, docs/studies/eps-rule.md); "static": that of the static '
-            'reduced stiffness K_r; or a value. "auto": the paper\'s rule (spectral radius of '
-            "Z_r over the kept harmonics) at each frequency"),
+            'DLFT penalty, one value for the whole sweep (a smooth FRF): "stiff": ten times '
+            '"top", "top" being the spectral radius of Z_r at the highest kept harmonic, its '
+            "median over the band (chosen from measurements, docs/studies/eps-rule.md); "
+            '"static": that of the static reduced stiffness K_r; or a value. "auto": the '
+            "paper's rule (spectral radius of Z_r over the kept harmonics) at each frequency"),
     },
     run_sweep,
     checks=(increasing("f_min", "f_max", "Hz"), check_sampling),
