@@ -7,6 +7,11 @@ pyHarm is installed in the benchmark's own environment, never as a fretwear depe
 then, from the repository root (with fretwear importable, e.g. ``PYTHONPATH=src``)::
 
     python benchmarks/peers.py [--pyharm /tmp/pyharm-venv/bin/python] [--harmonics 7 15]
+        [--problems a b] [--default-only] [--recorded-references]
+
+(``--problems``: which problems; ``--default-only``: on (b) only fretwear's default rule and
+pyHarm; ``--recorded-references``: the references of :data:`RECORDED`, as this script
+computes them, instead of computing them again: for a loaded machine.)
 
 Problems (benchmarks/reference_oscillators.py):
 
@@ -64,6 +69,10 @@ sys.path.insert(0, str(HERE))
 import reference_oscillators as ref  # noqa: E402
 
 BAND = {"a": (0.7, 1.3), "b": (1.0, 1.8)}  # rad/s
+#: the references (w [rad/s], A1) as this script computes them (``ref.peak``, golden section to
+#: 1e-8), for ``--recorded-references``: recomputing them takes a minute on a quiet machine
+#: and 13 minutes at a load of 19 on 2 cores
+RECORDED = {"a": (1.1802562, 1.3630690), "b": (1.4905405, 0.7686448)}
 #: pyHarm's continuation stops at this many solutions if it has not left the band (without it,
 #: on (b) at H = 7, it was still running after 39 min, 12 min of CPU; 300 solutions end at
 #: w = 1.53 rad/s, past the peak)
@@ -295,6 +304,12 @@ def main(argv=None):
     ap.add_argument("--harmonics", type=int, nargs="+", default=[7, 15])
     ap.add_argument("--first-ever", action="store_true",
                     help="also time a first run with empty numba and bytecode caches")
+    ap.add_argument("--problems", nargs="+", choices=sorted(BAND), default=sorted(BAND),
+                    help="problems to run (default: both)")
+    ap.add_argument("--default-only", action="store_true",
+                    help='on (b), leave out the rows of "top" and of eps = 1000 N/m')
+    ap.add_argument("--recorded-references", action="store_true",
+                    help="take the references from RECORDED instead of computing them")
     args = ap.parse_args(argv)
     have_pyharm = Path(args.pyharm).exists()
     if not have_pyharm:
@@ -303,22 +318,28 @@ def main(argv=None):
               "pyharm-os==1.2.2")
 
     t0 = time.perf_counter()
-    refs = {"a": ref.peak(ref.Jenkins(), 1.1, 1.3), "b": ref.peak(ref.Chain(), 1.4, 1.6)}
-    print(f"# references (event-driven + shooting, {time.perf_counter() - t0:.0f} s): "
-          + ", ".join(f"({k}) A1 = {v[1]:.7f} at w = {v[0]:.7f}" for k, v in refs.items()))
+    if args.recorded_references:
+        refs, how = {k: RECORDED[k] for k in args.problems}, "recorded"
+    else:
+        systems = {"a": (ref.Jenkins(), 1.1, 1.3), "b": (ref.Chain(), 1.4, 1.6)}
+        refs = {k: ref.peak(*systems[k]) for k in args.problems}
+        how = f"event-driven + shooting, {time.perf_counter() - t0:.0f} s"
+    print(f"# references ({how}): "
+          + ", ".join(f"({k}) A1 = {v[1]:.7f} at w = {v[0]:.7f}" for k, v in refs.items()),
+          flush=True)
     env = dict(os.environ, OPENBLAS_NUM_THREADS="1")
     print(f"# machine load at the start (uptime): {os.getloadavg()[0]:.2f} "
           f"{os.getloadavg()[1]:.2f} {os.getloadavg()[2]:.2f} on {os.cpu_count()} cores")
     print(f"{'code':9s} {'prob':4s} {'H':>3s} {'points':>6s} {'conv':>5s} {'warm_s':>8s} "
           f"{'cold_s':>8s} {'warm_cpu':>8s} {'peak_err':>10s} {'freq_err':>10s}  notes")
     ratios, err_ratios = [], []
-    for prob in ("a", "b"):
+    for prob in args.problems:
         w_ref, a_ref = refs[prob]
         for H in args.harmonics:
             rows = {"fretwear": child(sys.executable, FRETWEAR_CHILD,
                                       [prob, H, N_POINTS[prob], *BAND[prob], "default"], env)}
-            if prob == "b":  # the rule "top" (the default before "stiff"), and the penalty
-                # pyHarm is given, for a like-for-like accuracy
+            if prob == "b" and not args.default_only:  # the rule "top" (the default before
+                # "stiff"), and the penalty that pyHarm is given, for a like-for-like accuracy
                 for code, eps in (("fretwear^", "top"), ("fretwear*", 1000.0)):
                     rows[code] = child(sys.executable, FRETWEAR_CHILD,
                                        [prob, H, N_POINTS[prob], *BAND[prob], eps], env)
@@ -339,7 +360,7 @@ def main(argv=None):
                 print(f"{code:9s} {prob:4s} {H:3d} {r['points']:6d} {r['converged']:5d} "
                       f"{r['warm']:8.2f} {r['cold']:8.2f} {r['warm_cpu']:8.2f} "
                       f"{errors[code]:+10.2e} "
-                      f"{wp / w_ref - 1:+10.2e}  {note}")
+                      f"{wp / w_ref - 1:+10.2e}  {note}", flush=True)
             if prob == "b" and all(c in errors for c in ("fretwear", "pyHarm")):
                 err_ratios.append(abs(errors["fretwear"]) / abs(errors["pyHarm"]))
             if all(c in rows and "error" not in rows[c] for c in ("fretwear", "pyHarm")):
