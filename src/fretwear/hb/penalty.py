@@ -31,9 +31,9 @@ files and in Python:
   the highest harmonic of a contact behind a mass (``Z_r ~ -(hk w)^2 m``, ``eps = |Z_r|``);
   ten times it, 1/1.1, and ``(n / hk)^2 / 10`` of the stiffness at a lower harmonic ``n``.
   Measured against the event-driven reference of the two-DOF chain on a rigid contact
-  (docs/studies/eps-rule.md): the peak error falls from -7.9 % to -5.0 % at 7 harmonics and
-  from -4.0 % to -2.9 % at 15, where the truncation's own error is about -3.4 % / -2 %; the
-  paper's beam converges with it (sweeps at 1 Hz-100 kHz and at 76-82 kHz).
+  (docs/studies/eps-rule.md): the peak error falls from -7.9 % to -5.0 % at 7 harmonics (the
+  truncation's own is -3.4 %) and from -4.0 % to -2.1 % at 15; pyHarm 1.2.2 with the eps its
+  user gives has -5.15 % and -3.55 %. A larger factor costs robustness on the paper's beam.
 * a positive number [N/m], used as given.
 
 Rows of nodes with a prescribed normal load (no unilateral normal contact) are left out: their
