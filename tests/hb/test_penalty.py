@@ -142,10 +142,10 @@ def test_the_solvers_take_the_same_words():
 
 
 def test_sweep_static_and_top_are_one_penalty_and_auto_one_per_frequency():
-    """``"top"`` in a sweep is one eps for every point: the median over 5 frequencies of the
-    band of the spectral radius of Z_r at the highest kept harmonic, compared with
-    ``reference_radius`` (dense matrices, module docstring) to rounding; the default,
-    ``"stiff"``, is ten times that (``STIFF_FACTOR``)."""
+    """``"top"`` (the default) in a sweep is one eps for every point: the median over 5
+    frequencies of the band of the spectral radius of Z_r at the highest kept harmonic,
+    compared with ``reference_radius`` (dense matrices, module docstring) to rounding;
+    ``"stiff"`` is ten times that (``STIFF_FACTOR``)."""
     model = tiny_model()
     basis = FourierBasis((1,), 16)
     # between the resonances of the interior node with the contact held (675 and 1031 Hz),
@@ -160,16 +160,19 @@ def test_sweep_static_and_top_are_one_penalty_and_auto_one_per_frequency():
                    options=SweepOptions(spacing="linear", time_domain=None, eps="static"))
     default = sweep(model, basis, f[0], f[1], 2, options=SweepOptions(spacing="linear",
                                                                       time_domain=None))
+    stiff = sweep(model, basis, f[0], f[1], 2,
+                  options=SweepOptions(spacing="linear", time_domain=None, eps="stiff"))
     auto = sweep(model, basis, f[0], f[1], 2, options=SweepOptions(spacing="linear",
                                                                    time_domain=None, eps="auto"))
-    for res in (static, top, default, auto):
+    for res in (static, top, default, stiff, auto):
         assert res.success, res.message
         np.testing.assert_allclose(res.frequency_hz, f, rtol=1e-15)
     k_r = penalty("static", model=model)
     assert [p.solution.eps for p in static.points] == [k_r, k_r]
     assert STIFF_FACTOR == 10.0
-    assert [p.solution.eps for p in default.points] == pytest.approx([10.0 * ref_top] * 2,
-                                                                     rel=1e-12)
+    assert [p.solution.eps for p in default.points] == pytest.approx([ref_top] * 2, rel=1e-12)
+    assert [p.solution.eps for p in stiff.points] == pytest.approx([10.0 * ref_top] * 2,
+                                                                   rel=1e-12)
     per_point = [penalty("auto", model=model, frequency=x, orders=basis.orders)
                  for x in f]
     assert [p.solution.eps for p in auto.points] == per_point

@@ -410,9 +410,9 @@ SWEEP = Analysis.define(
                                default=default_of(linear_reference_grid, "linear_points")),
         **harmonic_balance_fields(
             SWEEP_OPTIONS.solve, SWEEP_OPTIONS.eps,
-            'DLFT penalty, one value for the whole sweep (a smooth FRF): "stiff": ten times '
-            '"top", "top" being the spectral radius of Z_r at the highest kept harmonic, its '
-            "median over the band (chosen from measurements, docs/studies/eps-rule.md); "
+            'DLFT penalty, one value for the whole sweep (a smooth FRF): "top": the spectral '
+            "radius of Z_r at the highest kept harmonic, its median over the band (chosen from "
+            'measurements, docs/studies/eps-rule.md); "stiff": ten times "top"; '
             '"static": that of the static reduced stiffness K_r; or a value. "auto": the '
             "paper's rule (spectral radius of Z_r over the kept harmonics) at each frequency"),
     },
