@@ -7,6 +7,12 @@ pyHarm is installed in the benchmark's own environment, never as a fretwear depe
 then, from the repository root (with fretwear importable, e.g. ``PYTHONPATH=src``)::
 
     python benchmarks/peers.py [--pyharm /tmp/pyharm-venv/bin/python] [--harmonics 7 15]
+        [--problems a b] [--default-only] [--recorded-references]
+
+(``--problems``: which problems; ``--default-only``: on (b) only fretwear's default rule and
+pyHarm, without the rows of "stiff" and eps = 1000 N/m; ``--recorded-references``: the
+references of :data:`RECORDED`, as this script computes them, instead of computing them
+again: for a loaded machine.)
 
 Problems (benchmarks/reference_oscillators.py):
 
@@ -24,7 +30,8 @@ References: event-driven integration with exact stick/slip switching plus Newton
 Each code runs in a fresh process of its own interpreter (``cold``: first run in that process,
 imports and just-in-time compilation included) and runs the same analysis again in that
 process (``warm``). fretwear: 121 (a) / 137 (b) linearly spaced frequencies (``fretwear.sweep``,
-default eps rule "top"; on (b) also with pyHarm's eps = 1000, row ``fretwear*``); pyHarm: its
+default eps rule, "top"; on (b) also with the rule "stiff", ten times "top", row
+``fretwear^``, and with pyHarm's eps = 1000, row ``fretwear*``); pyHarm: its
 arclength continuation over the same band (step ``ds = 0.05``:
 its default continuation did not end on (b)), stopped after ``PYHARM_MAX_SOLUTIONS`` solutions
 if it has not left the band by then. The peak of each curve is the largest A1 of its
@@ -32,9 +39,11 @@ points refined by a parabola through the three points around it, then refined by
 code on grids 10, 100, 1000 and 10000 times finer around it
 (:func:`refined_peak`, untimed; the same estimator for both codes).
 
-Prints per code, problem and H: points, converged, warm and cold wall time [s], peak amplitude
-and frequency errors (relative); then the machine load; the last line is
-``speedup_vs_pyharm_warm=<geometric mean over problems and H of pyHarm warm / fretwear warm>``.
+Prints per code, problem and H: points, converged, warm and cold wall time [s], CPU time of the
+warm run [s], peak amplitude and frequency errors (relative); then the machine load; the last
+lines are ``peak_err_ratio_b=<|peak error of fretwear's default| / |pyHarm's| on (b), the
+largest over the H run>`` and ``speedup_vs_pyharm_warm=<geometric mean over problems and H
+of pyHarm warm / fretwear warm>`` (wall times: the machine's load is printed beside them).
 
 ``--first-ever`` adds, per code, the cold run of problem (a) at the first H in a process whose
 caches are empty: numba's on-disk cache of compiled kernels (``NUMBA_CACHE_DIR``) and Python's
@@ -61,6 +70,10 @@ sys.path.insert(0, str(HERE))
 import reference_oscillators as ref  # noqa: E402
 
 BAND = {"a": (0.7, 1.3), "b": (1.0, 1.8)}  # rad/s
+#: the references (w [rad/s], A1) as this script computes them (``ref.peak``, golden section to
+#: 1e-8), for ``--recorded-references``: recomputing them takes a minute on a quiet machine
+#: and 13 minutes at a load of 19 on 2 cores
+RECORDED = {"a": (1.1802562, 1.3630690), "b": (1.4905405, 0.7686448)}
 #: pyHarm's continuation stops at this many solutions if it has not left the band (without it,
 #: on (b) at H = 7, it was still running after 39 min, 12 min of CPU; 300 solutions end at
 #: w = 1.53 rad/s, past the peak)
@@ -78,6 +91,7 @@ import json, sys, time
 t0 = time.perf_counter()
 import numpy as np
 import fretwear
+import fretwear.hb.penalty
 from fretwear.hb.fourier import FourierBasis
 from fretwear.model.core import Load
 from fretwear.model.build import Damping
@@ -85,7 +99,8 @@ from fretwear.model.matrices import ContactDofs, from_matrices
 
 prob, H, n, w0, w1 = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), float(sys.argv[4]), \
     float(sys.argv[5])
-eps = sys.argv[6] if sys.argv[6] in ("top", "auto", "static") else float(sys.argv[6])
+eps = sys.argv[6] if sys.argv[6] in ("default", *fretwear.hb.penalty.RULES) else \
+    float(sys.argv[6])
 
 
 def model():
@@ -103,9 +118,10 @@ def model():
 
 
 def run():
+    given = {} if eps == "default" else {"eps": eps}  # "default": the sweep's own rule
     res = fretwear.sweep(model(), FourierBasis.up_to(H, 128), w0 / (2 * np.pi),
                          w1 / (2 * np.pi), n,
-                         options=fretwear.SweepOptions(spacing="linear", eps=eps),
+                         options=fretwear.SweepOptions(spacing="linear", **given),
                          time_domain=False)
     pts = [p for p in res.points if p.on_grid]
     w = [2 * np.pi * p.frequency_hz for p in pts if p.success]
@@ -117,9 +133,9 @@ def run():
 out = run()
 out["cold"] = time.perf_counter() - t0
 if sys.argv[7:] != ["once"]:
-    t1 = time.perf_counter()
+    t1, c1 = time.perf_counter(), time.process_time()
     run()
-    out["warm"] = time.perf_counter() - t1
+    out["warm"], out["warm_cpu"] = time.perf_counter() - t1, time.process_time() - c1
 print("RESULT " + json.dumps(out))
 '''
 
@@ -203,9 +219,9 @@ if sys.argv[7:8] == ["at"]:  # A1 at the given frequencies only
 out = run()
 out["cold"] = time.perf_counter() - t0
 if sys.argv[7:] != ["once"]:
-    t1 = time.perf_counter()
+    t1, c1 = time.perf_counter(), time.process_time()
     run()
-    out["warm"] = time.perf_counter() - t1
+    out["warm"], out["warm_cpu"] = time.perf_counter() - t1, time.process_time() - c1
 print("RESULT " + json.dumps(out))
 '''
 
@@ -289,6 +305,12 @@ def main(argv=None):
     ap.add_argument("--harmonics", type=int, nargs="+", default=[7, 15])
     ap.add_argument("--first-ever", action="store_true",
                     help="also time a first run with empty numba and bytecode caches")
+    ap.add_argument("--problems", nargs="+", choices=sorted(BAND), default=sorted(BAND),
+                    help="problems to run (default: both)")
+    ap.add_argument("--default-only", action="store_true",
+                    help='on (b), leave out the rows of "stiff" and of eps = 1000 N/m')
+    ap.add_argument("--recorded-references", action="store_true",
+                    help="take the references from RECORDED instead of computing them")
     args = ap.parse_args(argv)
     have_pyharm = Path(args.pyharm).exists()
     if not have_pyharm:
@@ -297,21 +319,33 @@ def main(argv=None):
               "pyharm-os==1.2.2")
 
     t0 = time.perf_counter()
-    refs = {"a": ref.peak(ref.Jenkins(), 1.1, 1.3), "b": ref.peak(ref.Chain(), 1.4, 1.6)}
-    print(f"# references (event-driven + shooting, {time.perf_counter() - t0:.0f} s): "
-          + ", ".join(f"({k}) A1 = {v[1]:.7f} at w = {v[0]:.7f}" for k, v in refs.items()))
+    if args.recorded_references:
+        refs, how = {k: RECORDED[k] for k in args.problems}, "recorded"
+    else:
+        systems = {"a": (ref.Jenkins(), 1.1, 1.3), "b": (ref.Chain(), 1.4, 1.6)}
+        refs = {k: ref.peak(*systems[k]) for k in args.problems}
+        how = f"event-driven + shooting, {time.perf_counter() - t0:.0f} s"
+    print(f"# references ({how}): "
+          + ", ".join(f"({k}) A1 = {v[1]:.7f} at w = {v[0]:.7f}" for k, v in refs.items()),
+          flush=True)
     env = dict(os.environ, OPENBLAS_NUM_THREADS="1")
+    print(f"# machine load at the start (uptime): {os.getloadavg()[0]:.2f} "
+          f"{os.getloadavg()[1]:.2f} {os.getloadavg()[2]:.2f} on {os.cpu_count()} cores")
     print(f"{'code':9s} {'prob':4s} {'H':>3s} {'points':>6s} {'conv':>5s} {'warm_s':>8s} "
-          f"{'cold_s':>8s} {'peak_err':>10s} {'freq_err':>10s}  notes")
-    ratios = []
-    for prob in ("a", "b"):
+          f"{'cold_s':>8s} {'warm_cpu':>8s} {'peak_err':>10s} {'freq_err':>10s}  notes")
+    ratios, err_ratios = [], []
+    for prob in args.problems:
         w_ref, a_ref = refs[prob]
         for H in args.harmonics:
             rows = {"fretwear": child(sys.executable, FRETWEAR_CHILD,
-                                      [prob, H, N_POINTS[prob], *BAND[prob], "top"], env)}
-            if prob == "b":  # the penalty pyHarm is given, for a like-for-like accuracy
-                rows["fretwear*"] = child(sys.executable, FRETWEAR_CHILD,
-                                          [prob, H, N_POINTS[prob], *BAND[prob], 1000.0], env)
+                                      [prob, H, N_POINTS[prob], *BAND[prob], "default"], env)}
+            if prob == "b" and not args.default_only:  # the rule "stiff" (ten times the
+                # default "top"), and the penalty that pyHarm is given, for a like-for-like
+                # accuracy
+                for code, eps in (("fretwear^", "stiff"), ("fretwear*", 1000.0)):
+                    rows[code] = child(sys.executable, FRETWEAR_CHILD,
+                                       [prob, H, N_POINTS[prob], *BAND[prob], eps], env)
+            errors = {}
             if have_pyharm:
                 rows["pyHarm"] = child(args.pyharm, PYHARM_CHILD,
                                        [prob, H, *BAND[prob], PYHARM_MAX_SOLUTIONS, PYHARM_DS],
@@ -324,16 +358,20 @@ def main(argv=None):
                 note = f"eps = {r['eps']:.3g} N/m" if "eps" in r else ""
                 if not refined:
                     note += " peak not refined (coarse parabola)"
+                errors[code] = ap_ / a_ref - 1
                 print(f"{code:9s} {prob:4s} {H:3d} {r['points']:6d} {r['converged']:5d} "
-                      f"{r['warm']:8.2f} {r['cold']:8.2f} {ap_ / a_ref - 1:+10.2e} "
-                      f"{wp / w_ref - 1:+10.2e}  {note}")
+                      f"{r['warm']:8.2f} {r['cold']:8.2f} {r['warm_cpu']:8.2f} "
+                      f"{errors[code]:+10.2e} "
+                      f"{wp / w_ref - 1:+10.2e}  {note}", flush=True)
+            if prob == "b" and all(c in errors for c in ("fretwear", "pyHarm")):
+                err_ratios.append(abs(errors["fretwear"]) / abs(errors["pyHarm"]))
             if all(c in rows and "error" not in rows[c] for c in ("fretwear", "pyHarm")):
                 ratios.append(rows["pyHarm"]["warm"] / rows["fretwear"]["warm"])
     if args.first_ever:
         H = args.harmonics[0]
         for code, python, src, cargs in (
                 ("fretwear", sys.executable, FRETWEAR_CHILD,
-                 ["a", H, N_POINTS["a"], *BAND["a"], "top"]),
+                 ["a", H, N_POINTS["a"], *BAND["a"], "default"]),
                 ("pyHarm", args.pyharm if have_pyharm else None, PYHARM_CHILD,
                  ["a", H, *BAND["a"], PYHARM_MAX_SOLUTIONS, PYHARM_DS])):
             if python is None:
@@ -352,6 +390,7 @@ def main(argv=None):
     print(f"# machine load (uptime): {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f} "
           f"{os.getloadavg()[2]:.2f} on {os.cpu_count()} cores")
     gm = math.exp(sum(map(math.log, ratios)) / len(ratios)) if ratios else math.nan
+    print(f"peak_err_ratio_b={max(err_ratios) if err_ratios else math.nan:.3g}")
     print(f"speedup_vs_pyharm_warm={gm:.3g}")
 
 

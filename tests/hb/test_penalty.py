@@ -15,7 +15,7 @@ import scipy.sparse as sp
 
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.options import SolveOptions, SweepOptions
-from fretwear.hb.penalty import penalty
+from fretwear.hb.penalty import STIFF_FACTOR, penalty
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.reduce import condense
@@ -142,30 +142,37 @@ def test_the_solvers_take_the_same_words():
 
 
 def test_sweep_static_and_top_are_one_penalty_and_auto_one_per_frequency():
-    """The default ``"top"`` of a sweep is one eps for every point: the median over 5
+    """``"top"`` (the default) in a sweep is one eps for every point: the median over 5
     frequencies of the band of the spectral radius of Z_r at the highest kept harmonic,
-    compared with ``reference_radius`` (dense matrices, module docstring) to rounding."""
+    compared with ``reference_radius`` (dense matrices, module docstring) to rounding;
+    ``"stiff"`` is ten times that (``STIFF_FACTOR``)."""
     model = tiny_model()
     basis = FourierBasis((1,), 16)
     # between the resonances of the interior node with the contact held (675 and 1031 Hz),
     # where Z_r(w) outweighs K_r
     f = np.array([700.0, 800.0])
     top = sweep(model, basis, f[0], f[1], 2, options=SweepOptions(spacing="linear",
-                                                                  time_domain=None))
+                                                                  time_domain=None, eps="top"))
     ref_top = float(np.median([reference_radius(model, 2 * np.pi * x, [1])
                                for x in np.linspace(f[0], f[1], 5)]))
     assert [p.solution.eps for p in top.points] == pytest.approx([ref_top] * 2, rel=1e-12)
     static = sweep(model, basis, f[0], f[1], 2,
                    options=SweepOptions(spacing="linear", time_domain=None, eps="static"))
-    default = static
+    default = sweep(model, basis, f[0], f[1], 2, options=SweepOptions(spacing="linear",
+                                                                      time_domain=None))
+    stiff = sweep(model, basis, f[0], f[1], 2,
+                  options=SweepOptions(spacing="linear", time_domain=None, eps="stiff"))
     auto = sweep(model, basis, f[0], f[1], 2, options=SweepOptions(spacing="linear",
                                                                    time_domain=None, eps="auto"))
-    for res in (static, top, auto):
+    for res in (static, top, default, stiff, auto):
         assert res.success, res.message
         np.testing.assert_allclose(res.frequency_hz, f, rtol=1e-15)
     k_r = penalty("static", model=model)
     assert [p.solution.eps for p in static.points] == [k_r, k_r]
-    assert [p.solution.eps for p in default.points] == [k_r, k_r]
+    assert STIFF_FACTOR == 10.0
+    assert [p.solution.eps for p in default.points] == pytest.approx([ref_top] * 2, rel=1e-12)
+    assert [p.solution.eps for p in stiff.points] == pytest.approx([10.0 * ref_top] * 2,
+                                                                   rel=1e-12)
     per_point = [penalty("auto", model=model, frequency=x, orders=basis.orders)
                  for x in f]
     assert [p.solution.eps for p in auto.points] == per_point
@@ -173,12 +180,15 @@ def test_sweep_static_and_top_are_one_penalty_and_auto_one_per_frequency():
 
 
 def test_top_is_the_spectral_radius_at_the_highest_kept_harmonic():
-    """``"top"`` vs ``reference_radius`` on the highest kept order alone (dense matrices)."""
+    """``"top"`` vs ``reference_radius`` on the highest kept order alone (dense matrices);
+    ``"stiff"`` ten times it."""
     model = tiny_model()
     for f in (300.0, 2000.0):
         ref = reference_radius(model, 2 * np.pi * f, [ORDERS[-1]])
         assert penalty("top", model=model, frequency=f, orders=ORDERS) == pytest.approx(
             ref, rel=1e-12)
+        assert penalty("stiff", model=model, frequency=f, orders=ORDERS) == pytest.approx(
+            10.0 * ref, rel=1e-12)
 
 
 def test_radius_estimate_of_large_blocks():

@@ -455,9 +455,9 @@ SWEEP = Analysis.define(
         "points": Field(ListOf(Text(), non_empty=True, unique=True),
                         "observed points to report (default: all)"),
         "eps_band": Field(ListOf(Number(lo=0, lo_open=True), sizes=(2,)),
-                          'the band [f_min, f_max] over which eps = "top" takes its median '
-                          "(default: the sweep's band; the chunks of a split sweep give the "
-                          "whole band, so that they share the whole sweep's eps)", unit="Hz"),
+                          'the band [f_min, f_max] over which eps = "stiff" or "top" takes its '
+                          "median (default: the sweep's band; the chunks of a split sweep give "
+                          "the whole band, so that they share the whole sweep's eps)", unit="Hz"),
         "linear_references": Field(
             ListOf(Text(linear.INTERFACES), unique=True),
             'linear FRFs drawn with the nonlinear one: "sliding" (frictionless), "stuck", '
@@ -470,10 +470,10 @@ SWEEP = Analysis.define(
         **harmonic_balance_fields(
             SWEEP_OPTIONS.solve, SWEEP_OPTIONS.eps,
             'DLFT penalty, one value for the whole sweep (a smooth FRF): "top": the spectral '
-            "radius of Z_r at the highest kept harmonic, its median over the band (chosen "
-            'from measurements, docs/studies/eps-rule.md); "static": that of the static '
-            'reduced stiffness K_r; or a value. "auto": the paper\'s rule (spectral radius of '
-            "Z_r over the kept harmonics) at each frequency"),
+            "radius of Z_r at the highest kept harmonic, its median over the band (chosen from "
+            'measurements, docs/studies/eps-rule.md); "stiff": ten times "top"; '
+            '"static": that of the static reduced stiffness K_r; or a value. "auto": the '
+            "paper's rule (spectral radius of Z_r over the kept harmonics) at each frequency"),
     },
     run_sweep,
     checks=(increasing("f_min", "f_max", "Hz"), check_sampling),

@@ -535,9 +535,9 @@ SCHEMA = {
     **condensation_fields(),
     "eps": Field(AnyOf((Text(RULES), _POS)), 'DLFT penalty: "auto" (the spectral radius of '
                  'Z_r over the kept harmonics, the paper), "top" (that of Z_r at the highest kept '
-                 'harmonic), "static" (that of the static K_r) or a value; default: "auto" for '
-                 'the wear run (simulate_wear), "top" for the FRFs of frf_before_after (as '
-                 "sweeps)", unit="N/m"),
+                 'harmonic), "stiff" (ten times "top"), "static" (that of the static K_r) or a '
+                 'value; default: "auto" for the wear run (simulate_wear), "top" for the FRFs '
+                 'of frf_before_after (as sweeps)', unit="N/m"),
     # wear options: option() takes the default of WearOptions
     "solver": option("solver", Text(SOLVERS), "nonlinear solver of the first periodic solve "
                      "and the fallback of the slow steps"),

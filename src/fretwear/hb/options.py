@@ -151,9 +151,10 @@ class SweepOptions:
     spacing : ``"log"`` or ``"linear"`` grid.
     eps : DLFT penalty, one value for every point (:func:`fretwear.hb.penalty.sweep_penalty`):
         ``"top"`` (default: the spectral radius of ``Z_r`` at the highest kept harmonic, its
-        median over the band), ``"static"``, ``"auto"`` (the paper's rule at each frequency) or
-        a positive number [N/m].
-    eps_band : ``(f_min, f_max)`` [Hz] over which ``"top"`` takes its median (default: the
+        median over the band), ``"stiff"`` (ten times ``"top"``), ``"static"``, ``"auto"`` (the
+        paper's rule at each frequency) or a positive number [N/m].
+    eps_band : ``(f_min, f_max)`` [Hz] over which ``"stiff"`` and ``"top"`` take their median
+        (default: the
         sweep's band; the chunks of a split sweep give the whole band).
     continuation : pseudo-arclength continuation when a grid step fails.
     max_bisections : halvings of a failed frequency step.

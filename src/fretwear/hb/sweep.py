@@ -86,10 +86,14 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
         :class:`~fretwear.hb.options.SolveOptions` stands for ``SweepOptions(solve=...)``.
 
         The penalty is one value for every point (:func:`fretwear.hb.penalty.sweep_penalty`).
-        ``"top"`` (default): the spectral radius of ``Z_r`` at the highest kept harmonic, its
-        median over the band (``eps_band``, default the sweep's own: the chunks of a sweep
-        split across workers, :mod:`fretwear.study`, give the whole band so that they all use
-        the whole sweep's eps and join without an eps jump). ``"static"``: the spectral
+        ``"top"`` (default) and ``"stiff"`` (ten times ``"top"``): the spectral radius of
+        ``Z_r`` at the
+        highest kept harmonic, its median over the band (``eps_band``, default the sweep's
+        own: the chunks of a sweep split across workers, :mod:`fretwear.study`, give the whole
+        band so that they all use the whole sweep's eps and join without an eps jump);
+        ``"stiff"`` is more accurate on a rigid contact behind a mass and less robust on the
+        paper's beam at 76-82 kHz (docs/theory.md, "The penalty eps"). ``"static"``: the
+        spectral
         radius of the static reduced stiffness ``Z_r(0) = K_r``. ``"auto"``: the spectral
         radius of ``Z_r`` over the kept harmonics at each frequency (the paper's rule applied
         point by point; kept for comparison: the harmonics of ``Z_r(n w)`` have poles at the
