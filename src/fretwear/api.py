@@ -254,7 +254,8 @@ def nonlinear_mode(model, basis, amplitudes, *, mode: int = 1, interface: str = 
         held) or ``"sliding"`` (frictionless).
     **kwargs : the other keywords of :func:`fretwear.hb.nonlinear_modes.nonlinear_mode`,
         with its defaults: ``masters``, ``eps`` (a rule or [N/m]), ``options``
-        (:class:`~fretwear.hb.options.SolveOptions`), ``dyn``; or ``condenser`` (a modal
+        (:class:`~fretwear.hb.options.SolveOptions`), ``dyn``, ``wear0`` (wear depths [m]:
+        the mode of the worn interface, gap ``gap + wear0``); or ``condenser`` (a modal
         condenser for a large model: the structure's matrices are then its projection).
 
     Returns
