@@ -37,7 +37,7 @@ from fretwear.errors import InputError
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.dynamics import structure_dynamics
 from fretwear.hb.fourier import FourierBasis, amplitude
-from fretwear.hb.mode_synthesis import DAMPING
+from fretwear.hb.mode_synthesis import DAMPING, modal_forces, synthesize
 from fretwear.hb.nonlinear_modes import Backbone
 from fretwear.hb.nonlinear_modes import nonlinear_mode as _core
 from fretwear.hb.options import SolveOptions
@@ -159,11 +159,12 @@ def synthesis_dataset(model, bb: Backbone, analysis: dict, dyn, points: list[str
     na, n_axes = shape
     if not bb.points:
         raise InputError("synthesis: the nonlinear mode has no converged amplitude")
-    syn = api.mode_frf(model, bb, damping=analysis["synthesis_damping"], dyn=dyn)
-    if not np.all(syn.modal_force > 0):
+    forces = modal_forces(model, bb, dyn=dyn)
+    if not np.all(forces > 0):
         raise InputError("synthesis_f_min/synthesis_f_max: the synthesised forced response "
                          "needs a periodic load ([[loads]] with a cos or sin waveform) that "
                          "the mode's shape does not leave unexcited")
+    syn = synthesize(bb, forces, damping=analysis["synthesis_damping"])
     res = api.sweep(model, bb.basis, analysis["synthesis_f_min"], analysis["synthesis_f_max"],
                     analysis["synthesis_points"])
     done = len(bb.points)

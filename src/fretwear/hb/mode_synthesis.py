@@ -141,8 +141,11 @@ def synthesize(backbone: Backbone, modal_force, *, damping: str = "viscous") -> 
     a = backbone.array("amplitude")
     f = np.broadcast_to(np.asarray(modal_force, dtype=float), a.shape).copy()
     if np.any(~np.isfinite(f)) or np.any(f <= 0):
-        raise InputError(f"modal_force = {modal_force!r}: expected positive values "
-                         f"(a number or {a.size} values, one per backbone point)")
+        bad = f[~(np.isfinite(f) & (f > 0))]
+        raise InputError(f"modal_force: {bad.size} of {f.size} values not positive (e.g. "
+                         f"{bad[0]!r}): expected positive values, a number or one per "
+                         "backbone point (no periodic load, or one the mode leaves "
+                         "unexcited?)")
     lo, hi = excitation_frequencies(backbone.array("omega"), backbone.array("xi"), a, f,
                                     damping)
     obs = None
