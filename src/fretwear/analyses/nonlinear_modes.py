@@ -306,6 +306,22 @@ def plot_mode_frf(ds: xr.Dataset, path: Path, *, title: str | None = None) -> Pa
     return plots.save(fig, path)
 
 
+#: the keys of the synthesised forced response (docs/theory.md section 11)
+SYNTHESIS_FIELDS = {
+    "synthesis_f_min": Field(Number(lo=0, lo_open=True), "with `synthesis_f_max`: also "
+                             "the forced response to the case's loads synthesised from "
+                             "the mode (single-nonlinear-mode theory), beside a direct "
+                             "sweep over this band", unit="Hz"),
+    "synthesis_f_max": Field(Number(lo=0, lo_open=True), "upper end of the direct "
+                             "sweep's band", unit="Hz"),
+    "synthesis_points": Field(Integer(lo=2, hi=10_000), "frequencies of the direct "
+                              "sweep", default=41),
+    "synthesis_damping": Field(Text(DAMPING), 'the mode\'s damping in the synthesis: '
+                               '"viscous" (xi W, the EPMC\'s reading) or "hysteretic" '
+                               "(xi w, rate-independent)", default="viscous"),
+}
+
+
 # --- registration ---------------------------------------------------------------------------
 NONLINEAR_MODES = Analysis.define(
     "nonlinear-modes",
@@ -323,6 +339,7 @@ NONLINEAR_MODES = Analysis.define(
                                unit=AMPLITUDE_UNIT),
         "amplitude_max": Field(_AMPLITUDE, "largest modal amplitude", required=True,
                                unit=AMPLITUDE_UNIT),
+        **SYNTHESIS_FIELDS,
         "n_amplitudes": Field(Integer(lo=2, hi=10_000), "modal amplitudes of the result, "
                               "log-spaced (the continuation adds steps where one fails)",
                               default=30),
@@ -331,17 +348,6 @@ NONLINEAR_MODES = Analysis.define(
                          default=default_of(_core, "masters")),
         "points": Field(ListOf(Text(), non_empty=True, unique=True),
                         "observed points to report (default: all)"),
-        "synthesis_f_min": Field(Number(lo=0, lo_open=True), "with `synthesis_f_max`: also "
-                                 "the forced response to the case's loads synthesised from "
-                                 "the mode (single-nonlinear-mode theory), beside a direct "
-                                 "sweep over this band", unit="Hz"),
-        "synthesis_f_max": Field(Number(lo=0, lo_open=True), "upper end of the direct "
-                                 "sweep's band", unit="Hz"),
-        "synthesis_points": Field(Integer(lo=2, hi=10_000), "frequencies of the direct "
-                                  "sweep", default=41),
-        "synthesis_damping": Field(Text(DAMPING), 'the mode\'s damping in the synthesis: '
-                                   '"viscous" (xi W, the EPMC\'s reading) or "hysteretic" '
-                                   "(xi w, rate-independent)", default="viscous"),
         **harmonic_balance_fields(
             SolveOptions(), default_of(_core, "eps"),
             'DLFT penalty: "top" (the contact springs themselves where there are some: the '
