@@ -13,6 +13,7 @@ The public API, stage by stage (data flows one way; each stage returns a plain d
     frf   = fretwear.sweep(model, basis, f_min, f_max, n, condenser=cond)     # SweepResult
     hill  = fretwear.sweep_stability(model, frf, condenser=cond)         # SweepStability
     nm    = fretwear.nonlinear_mode(model, basis, amplitudes)           # Backbone (EPMC)
+    syn   = fretwear.mode_frf(model, nm)                  # ModalFRF (single-mode theory)
     wear  = fretwear.simulate_wear(model, basis, frequency, condenser=cond)   # WearResult
     worn  = fretwear.frf_worn(model, basis, wear.final_wear, f_min, f_max, n)  # SweepResult
     run   = fretwear.integrate(model, frequency, n_periods=...)   # TransientResult
@@ -68,6 +69,7 @@ _API = {
     "sweep": "fretwear.api", "SolveOptions": "fretwear.hb.options",
     "SweepOptions": "fretwear.hb.options",
     "nonlinear_mode": "fretwear.api", "sweep_stability": "fretwear.hb.sweep_stability",
+    "mode_frf": "fretwear.api",
     # linear
     "modes": "fretwear.linear", "frf": "fretwear.linear",
     # one sector of a tuned bladed disk (cyclic symmetry)

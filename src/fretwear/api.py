@@ -30,6 +30,7 @@ import math
 from fretwear import linear as _linear
 from fretwear import wear as _wear
 from fretwear.errors import InputError
+from fretwear.hb import mode_synthesis as _synth
 from fretwear.hb import nonlinear_modes as _modes
 from fretwear.hb import periodic as _periodic
 from fretwear.hb import sweep as _sweep
@@ -294,7 +295,8 @@ def nonlinear_mode(model, basis, amplitudes, *, mode: int = 1, interface: str = 
         held) or ``"sliding"`` (frictionless).
     **kwargs : the other keywords of :func:`fretwear.hb.nonlinear_modes.nonlinear_mode`,
         with its defaults: ``masters``, ``eps`` (a rule or [N/m]), ``options``
-        (:class:`~fretwear.hb.options.SolveOptions`), ``dyn``; or ``condenser`` (a modal
+        (:class:`~fretwear.hb.options.SolveOptions`), ``dyn``, ``wear0`` (wear depths [m]:
+        the mode of the worn interface, gap ``gap + wear0``); or ``condenser`` (a modal
         condenser for a large model: the structure's matrices are then its projection).
 
     Returns
@@ -312,6 +314,31 @@ def nonlinear_mode(model, basis, amplitudes, *, mode: int = 1, interface: str = 
     target = mode_target(model, mode, interface, dyn=dyn)
     return _modes.nonlinear_mode(model, basis, amplitudes, omega_target=target, dyn=dyn,
                                  **kwargs)
+
+
+@limited
+def mode_frf(model, backbone: _modes.Backbone, *, damping: str = "viscous", condenser=None,
+             dyn=None):
+    """Forced response of ``model`` (its loads) synthesised from one nonlinear mode
+    (:mod:`fretwear.hb.mode_synthesis`; single-nonlinear-mode theory): at every point of
+    ``backbone`` (:func:`nonlinear_mode` of the same model) the two excitation frequencies
+    at which the forced response reaches that amplitude.
+
+    Parameters
+    ----------
+    damping : ``"viscous"`` (the EPMC's reading: the compensated damping acts as ``xi W``)
+        or ``"hysteretic"`` (``xi w``, rate-independent: exact for a single-DOF joint).
+    condenser, dyn : the condenser (or structure) the backbone was computed with.
+
+    Returns
+    -------
+    :class:`~fretwear.hb.mode_synthesis.ModalFRF`: ``amplitude``, ``modal_force``,
+    ``omega_lo``, ``omega_hi`` [rad/s], ``observed``, ``peak``, ``curve()``.
+    """
+    if dyn is None:
+        dyn = structure_dynamics(model, condenser)
+    return _synth.synthesize(backbone, _synth.modal_forces(model, backbone, dyn=dyn),
+                             damping=damping)
 
 
 @limited

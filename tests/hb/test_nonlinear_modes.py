@@ -175,3 +175,33 @@ def test_observed_harmonics_are_recovered_from_the_condensed_coordinates():
     for p in bb.points:
         amp = np.hypot(p.observed[0, 1], p.observed[0, 2])
         assert amp == pytest.approx(p.amplitude / np.sqrt(M_), rel=1e-10)
+
+
+def test_worn_gap_is_the_preload_it_releases():
+    """The mode on a worn interface (``wear0``: the gap ``gap + wear``) against an
+    independent model: the light node of the rigid-contact Jenkins element above is pressed
+    by a static load P through the spring kz to its own ground; opening its gap by a uniform
+    wear w lets it move w further, releasing ``kz w`` of the normal force, so the worn
+    backbone equals the new interface's under the load ``P - kz w``, whose slip threshold
+    the closed form shows (one harmonic, 256 samples: the two runs share the sampling,
+    only the corrector's tolerance separates them, 1e-6 asserted)."""
+    ms, kz, P, w = 1e-3, 10.0, 1.0, 0.05
+    K = np.array([[K_ + KT, -KT, 0], [-KT, KT, 0], [0, 0, kz]])
+
+    def model(load):
+        return from_matrices(K, np.diag([M_, ms, ms]),
+                             contact=ContactDofs(normal_dofs=[2], tangential_dofs=[1],
+                                                 gap=0.0, mu=FS),
+                             loads=[Load(np.array([0, 0, load]), "constant")],
+                             observed={"x": 0})
+
+    amps = np.geomspace(0.01, 2.0, 9)
+    basis = FourierBasis((1,), 256)
+    worn = nonlinear_mode(model(P), basis, amps, eps=KT, wear0=w)
+    ref = nonlinear_mode(model(P - kz * w), basis, amps, eps=KT)
+    new = nonlinear_mode(model(P), basis, amps, eps=KT)
+    assert worn.success and ref.success and new.success
+    for name in ("omega", "damping_ratio"):
+        np.testing.assert_allclose(worn.array(name), ref.array(name), rtol=1e-6, atol=1e-9)
+    # and the wear matters: the new interface's threshold is twice the worn one's
+    assert np.max(np.abs(new.array("omega") / worn.array("omega") - 1)) > 1e-2

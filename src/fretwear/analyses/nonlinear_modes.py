@@ -34,14 +34,16 @@ from fretwear.analyses.common import (
     solve_options_of,
     titled,
 )
+from fretwear.errors import InputError
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.dynamics import structure_dynamics
 from fretwear.hb.fourier import FourierBasis, amplitude
+from fretwear.hb.mode_synthesis import DAMPING, modal_forces, synthesize
 from fretwear.hb.nonlinear_modes import Backbone
 from fretwear.hb.nonlinear_modes import nonlinear_mode as _core
 from fretwear.hb.options import SolveOptions
 from fretwear.io.results import variable
-from fretwear.io.schema import Field, Integer, ListOf, Number, Text, increasing
+from fretwear.io.schema import Field, Integer, ListOf, Number, Text, increasing, requires
 
 AMPLITUDE_UNIT = "m kg^0.5"
 #: modal amplitudes accepted: a displacement of 1e-9 to 1e5 m (fretwear.limits) times the
@@ -148,6 +150,55 @@ def _summary(bb: Backbone, ds: xr.Dataset) -> str:
     return "\n".join(lines)
 
 
+def synthesis_dataset(model, bb: Backbone, analysis: dict, dyn, points: list[str],
+                      shape: tuple[int, int]) -> tuple[xr.Dataset, object]:
+    """The forced response to the model's loads synthesised from the mode
+    (:func:`fretwear.api.mode_frf`) and the direct sweep beside it (:func:`fretwear.api.sweep`,
+    same basis): variables on ``modal_amplitude`` and ``sweep_frequency``; ``shape``: the
+    sizes of the modes dataset's ``modal_amplitude`` and ``axis``; also the
+    :class:`~fretwear.hb.mode_synthesis.ModalFRF`."""
+    na, n_axes = shape
+    if not bb.points:
+        raise InputError("synthesis: the nonlinear mode has no converged amplitude")
+    forces = modal_forces(model, bb, dyn=dyn)
+    if not np.all(forces > 0):
+        raise InputError("synthesis_f_min/synthesis_f_max: the synthesised forced response "
+                         "needs a periodic load ([[loads]] with a cos or sin waveform) that "
+                         "the mode's shape does not leave unexcited")
+    syn = synthesize(bb, forces, damping=analysis["synthesis_damping"])
+    res = api.sweep(model, bb.basis, analysis["synthesis_f_min"], analysis["synthesis_f_max"],
+                    analysis["synthesis_points"])
+    done = len(bb.points)
+
+    def per_amp(x):
+        out = np.full(na, np.nan)
+        out[:done] = x
+        return out
+
+    a = "modal_amplitude"
+    amp = np.full((len(res.points), len(points), n_axes), np.nan)
+    for j, name in enumerate(points):
+        for ax in range(len(model.observed_point(name).dofs)):
+            amp[:, j, ax] = res.amplitude(name, ax)
+    data = {
+        "synthesis_frequency_low": variable(a, per_amp(syn.omega_lo / (2 * np.pi)), "Hz",
+                                            "lower excitation frequency at which the "
+                                            "synthesised forced response has this amplitude"),
+        "synthesis_frequency_high": variable(a, per_amp(syn.omega_hi / (2 * np.pi)), "Hz",
+                                             "upper excitation frequency at which the "
+                                             "synthesised forced response has this amplitude"),
+        "modal_force": variable(a, per_amp(syn.modal_force), "N kg^-0.5",
+                                "the loads' first harmonic projected on the mass-normalised "
+                                "mode, |phi^H F_1|"),
+        "sweep_response_amplitude": variable(("sweep_frequency", "point", "axis"), amp, "m",
+                                             "amplitude of harmonic 1 of the observed "
+                                             "displacement in the direct sweep"),
+    }
+    coords = {"sweep_frequency": variable("sweep_frequency", res.frequency_hz, "Hz",
+                                          "excitation frequency of the direct sweep")}
+    return xr.Dataset(data, coords=coords), syn
+
+
 # --- run -----------------------------------------------------------------------------------
 def run_nonlinear_modes(model, analysis: dict, case, context: RunContext) -> RunOutput:
     """A nonlinear mode over an amplitude range (:func:`fretwear.api.nonlinear_mode`).
@@ -171,6 +222,11 @@ def run_nonlinear_modes(model, analysis: dict, case, context: RunContext) -> Run
                             eps=analysis["eps"],
                             options=solve_options_of(analysis, SolveOptions()), dyn=dyn)
     ds = modes_dataset(model, bb, amps, points)
+    synthesis = analysis.get("synthesis_f_min") is not None
+    if synthesis:
+        extra, _ = synthesis_dataset(model, bb, analysis, dyn, points,
+                                     (amps.size, ds.sizes["axis"]))
+        ds = xr.merge([ds, extra], combine_attrs="override")
     ds.attrs.update({
         "message": bb.message, "notes": "\n".join(bb.notes),
         "total_wall_time": float(bb.wall_time), "eps": float(bb.eps),
@@ -183,6 +239,9 @@ def run_nonlinear_modes(model, analysis: dict, case, context: RunContext) -> Run
     p = figure_path(case, context.out_dir, "backbone")
     if p is not None:
         figures.append(plot_backbone(ds, p, title=titled(case.title, "nonlinear mode")))
+    p = figure_path(case, context.out_dir, "mode-frf") if synthesis else None
+    if p is not None:
+        figures.append(plot_mode_frf(ds, p, title=titled(case.title, "single-mode FRF")))
     return RunOutput(ds, figures, _summary(bb, ds), bb.success, warnings=list(bb.notes))
 
 
@@ -221,6 +280,49 @@ def plot_backbone(ds: xr.Dataset, path: Path, *, title: str | None = None) -> Pa
     return plots.save(fig, path)
 
 
+def plot_mode_frf(ds: xr.Dataset, path: Path, *, title: str | None = None) -> Path:
+    """The forced response synthesised from the mode (harmonic 1 of each observed point
+    against the excitation frequency, both frequencies of every amplitude) beside the
+    direct sweep."""
+    fig, axes = plots.new_figure(1, 1, title=title, panel_size=(7.5, 4.0))
+    ax = axes[0, 0]
+    h = int(ds["harmonic"].values[0])
+    lo, hi = ds["synthesis_frequency_low"].values, ds["synthesis_frequency_high"].values
+    for k, point in enumerate(ds["point"].values):
+        for axis in live_axes(ds, str(point)) or [str(ds["axis"].values[0])]:
+            y = ds["response_amplitude"].sel(point=point, axis=axis, harmonic=h).values
+            f = np.concatenate([lo, hi[::-1]])
+            yy = np.concatenate([y, y[::-1]])
+            ok = np.isfinite(f) & np.isfinite(yy)
+            color = f"C{k}"
+            ax.plot(f[ok], yy[ok], color=color, label=f"{point} {axis}: single mode")
+            ys = ds["sweep_response_amplitude"].sel(point=point, axis=axis).values
+            ax.plot(ds["sweep_frequency"].values, ys, "o", color=color, ms=3, mfc="none",
+                    label=f"{point} {axis}: direct sweep")
+    ax.set_xlabel("excitation frequency [Hz]")
+    ax.set_ylabel(f"|u_{h}| [m]")
+    ax.grid(True, alpha=0.3)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize="small")
+    return plots.save(fig, path)
+
+
+#: the keys of the synthesised forced response (docs/theory.md section 11)
+SYNTHESIS_FIELDS = {
+    "synthesis_f_min": Field(Number(lo=0, lo_open=True), "with `synthesis_f_max`: also "
+                             "the forced response to the case's loads synthesised from "
+                             "the mode (single-nonlinear-mode theory), beside a direct "
+                             "sweep over this band", unit="Hz"),
+    "synthesis_f_max": Field(Number(lo=0, lo_open=True), "upper end of the direct "
+                             "sweep's band", unit="Hz"),
+    "synthesis_points": Field(Integer(lo=2, hi=10_000), "frequencies of the direct "
+                              "sweep", default=41),
+    "synthesis_damping": Field(Text(DAMPING), 'the mode\'s damping in the synthesis: '
+                               '"viscous" (xi W, the EPMC\'s reading) or "hysteretic" '
+                               "(xi w, rate-independent)", default="viscous"),
+}
+
+
 # --- registration ---------------------------------------------------------------------------
 NONLINEAR_MODES = Analysis.define(
     "nonlinear-modes",
@@ -238,6 +340,7 @@ NONLINEAR_MODES = Analysis.define(
                                unit=AMPLITUDE_UNIT),
         "amplitude_max": Field(_AMPLITUDE, "largest modal amplitude", required=True,
                                unit=AMPLITUDE_UNIT),
+        **SYNTHESIS_FIELDS,
         "n_amplitudes": Field(Integer(lo=2, hi=10_000), "modal amplitudes of the result, "
                               "log-spaced (the continuation adds steps where one fails)",
                               default=30),
@@ -255,14 +358,19 @@ NONLINEAR_MODES = Analysis.define(
             '"static", "auto" or a value').items() if k not in condensation_fields()},
     },
     run_nonlinear_modes,
-    checks=(increasing("amplitude_min", "amplitude_max", AMPLITUDE_UNIT), check_sampling),
+    checks=(increasing("amplitude_min", "amplitude_max", AMPLITUDE_UNIT), check_sampling,
+            requires("synthesis_f_min", "synthesis_f_max"),
+            requires("synthesis_f_max", "synthesis_f_min"),
+            increasing("synthesis_f_min", "synthesis_f_max", "Hz")),
     doc="Nonlinear mode by the Extended Periodic Motion Concept (Krack 2015; docs/theory.md, "
     '"Nonlinear modes"): the periodic motion of the structure without its periodic loads '
     "(the static ones stay: the preload) with a negative mass-proportional damping that makes "
     "it periodic, over a range of modal amplitudes, on the exact DLFT law. Results: natural "
     "frequency, damping ratio, observed harmonics, contact states and friction energy per "
     "amplitude. Writes `backbone.png` (frequency, damping ratio and observed amplitude "
-    "against the modal amplitude). The run exits with status 1 when the continuation "
+    "against the modal amplitude); with `synthesis_f_min`/`synthesis_f_max`, the forced "
+    "response to the loads synthesised from the mode beside a direct sweep (`mode-frf.png`)."
+    " The run exits with status 1 when the continuation "
     "stops before `amplitude_max`.",
     preload_check=True,
 )

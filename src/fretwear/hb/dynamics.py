@@ -66,6 +66,9 @@ class StructureDynamics:
     observe : (no, m + q) the displacements of the observed DOFs (global frame, in the order
         of ``model.observed`` and of their DOFs, as ``Reduced.obs_dofs``) from ``(x, q)``:
         ``u_o = observe @ [x; q]`` [m] (None: not formed).
+    load1_x, load1_q : (m,), (q,) complex amplitudes of the loads' first harmonic on ``x`` and
+        ``q`` [N] (``F(t) = Re(F_1 e^{i w t})``, as ``Model.load_harmonics``; the generalised
+        forces of the same transformation as the static loads; None: not formed).
     """
 
     blocks: dict
@@ -73,6 +76,8 @@ class StructureDynamics:
     load_q: np.ndarray
     exact: bool
     observe: np.ndarray | None = None
+    load1_x: np.ndarray | None = None
+    load1_q: np.ndarray | None = None
 
     @property
     def m(self) -> int:
@@ -176,9 +181,18 @@ def _with_springs(blocks: dict, load_c, load_q, contact):
             qx[np.arange(nf), f] -= kf
             qq2[np.arange(nf), np.arange(nf)] += kf
         out[name] = (xx, xq, qx, qq2)
-    lx = np.zeros(m)
-    lx[r] = load_c[r]
-    return out, lx, np.concatenate([load_c[f], load_q])
+    return (out, *_loads_with_springs(load_c, load_q, contact))
+
+
+def _loads_with_springs(load_c, load_q, contact):
+    """Loads ``(on x, on [u_f, q])`` from those on ``(u, q)`` (:func:`_with_springs`): a
+    massless contact point carries no load."""
+    sp = springs(contact)
+    if sp is None:
+        return load_c, load_q
+    lx = np.zeros(load_c.size, dtype=np.result_type(load_c, load_q))
+    lx[sp.r] = load_c[sp.r]
+    return lx, np.concatenate([load_c[sp.f], load_q])
 
 
 def structure_dynamics(model: Model, condenser=None) -> StructureDynamics:
@@ -203,8 +217,11 @@ def structure_dynamics(model: Model, condenser=None) -> StructureDynamics:
             _observation(cond, cond.Psi @ np.asarray(
                 cond.R.toarray() if hasattr(cond.R, "toarray") else cond.R).T, cond.V),
             cond.m, model.contact)
+        F1 = cond.structure.load_harmonics(1)[1]
+        l1 = _loads_with_springs(cond.R @ (F1[cond.cdofs] + cond.Psi.T @ F1[cond.idofs]),
+                                 cond.V.T @ F1[cond.idofs], model.contact)
         return StructureDynamics(*_with_springs(blocks, load_c, load_q, model.contact), False,
-                                 obs)
+                                 obs, *l1)
     if cond.ni > DENSE_INTERIOR_MAX:
         raise InputError(
             f"the model has {cond.ni} interior DOFs: Hill's method and nonlinear modes form "
@@ -241,5 +258,8 @@ def structure_dynamics(model: Model, condenser=None) -> StructureDynamics:
     load_c = R @ (F0[cond.cdofs] + Psi.T @ Fi)
     obs = _observation_with_springs(_observation(cond, Psi @ R.T, None), cond.m,
                                    model.contact)
+    F1 = cond.structure.load_harmonics(1)[1]
+    l1 = _loads_with_springs(R @ (F1[cond.cdofs] + Psi.T @ F1[cond.idofs]),
+                             F1[cond.idofs].copy(), model.contact)
     return StructureDynamics(*_with_springs(blocks, load_c, Fi.copy(), model.contact), True,
-                             obs)
+                             obs, *l1)

@@ -416,7 +416,7 @@ def _static_start(problem: ModeProblem, omega0: float):
 
 def nonlinear_mode(model: Model, basis: FourierBasis, amplitudes, *, omega_target=None,
                    masters: int = 1, eps="top", options: SolveOptions | None = None,
-                   dyn: StructureDynamics | None = None) -> Backbone:
+                   dyn: StructureDynamics | None = None, wear0=None) -> Backbone:
     """The nonlinear mode of ``model`` over the modal ``amplitudes`` (increasing, [m sqrt(kg)])
     by the EPMC (module docstring), from the linear mode of the structure with its contact
     points stuck nearest ``omega_target`` [rad/s] (default: the lowest).
@@ -431,6 +431,9 @@ def nonlinear_mode(model: Model, basis: FourierBasis, amplitudes, *, omega_targe
         contact spring itself where there is one, the exact value) or a number [N/m].
     options : the corrector's solver, tolerance and iteration cap
         (:class:`~fretwear.hb.options.SolveOptions`; ``strategy`` and ``jacobian`` unused).
+    wear0 : (nc,) or a number: wear depths [m]; the mode of the worn interface, whose gap is
+        ``gap + wear0`` (as :func:`fretwear.wear.worn_frf.frf_worn`; the static preload
+        solved on it). None: the new interface.
     """
     t0 = time.perf_counter()
     opt = SolveOptions() if options is None else options
@@ -448,7 +451,13 @@ def nonlinear_mode(model: Model, basis: FourierBasis, amplitudes, *, omega_targe
     eps_value = (float(eps) if not isinstance(eps, str)
                  else penalty(eps, model=model, frequency=w0 / (2 * np.pi),
                               orders=basis.orders))
-    gap = np.asarray(c.gap, dtype=float)
+    gap = np.broadcast_to(np.asarray(c.gap, dtype=float), (c.n_nodes,)).copy()
+    if wear0 is not None:
+        w = np.asarray(wear0, dtype=float)
+        if w.ndim > 1 or w.size not in (1, c.n_nodes) or not np.all(np.isfinite(w)):
+            raise InputError(f"wear0 = {wear0!r}: expected a finite number or {c.n_nodes} "
+                             "wear depths [m], one per contact node")
+        gap = gap + w
     prob = ModeProblem(system, c, basis, eps_value, np.zeros((c.n_nodes, c.dim - 1)), gap)
     xs, st0 = _static_start(prob, w0)
     notes = []

@@ -68,9 +68,11 @@ mass, ``q`` other coordinates; at most :data:`PENCIL_MAX` before the companion f
 with a memory, a few evaluations of ``T(s)`` and ``m H`` LU factorisations per refined
 exponent. Measured at 10-30 ms of CPU a point on the benchmark's small models, tens of times
 a warm-started sweep point's solve (docs/theory.md, section 9): the whole spectrum at every
-point and the evaluations of ``T(s)`` are what cost; tracking the exponents along a sweep
-would not. Dense up to :data:`DENSE_MAX` unknowns of the balance. The sign of ``det J``
-(``J = T(0)``) is reported with the exponents (:attr:`FloquetResult.det_sign`).
+point and the evaluations of ``T(s)`` are what cost (tracking the candidates from the
+previous point by Rayleigh-quotient iteration was measured slower on the two-DOF sweep and
+not kept: docs/theory.md, section 9). Dense up to :data:`DENSE_MAX` unknowns of the
+balance. The sign of ``det J`` (``J = T(0)``) is reported with the exponents
+(:attr:`FloquetResult.det_sign`).
 """
 
 from __future__ import annotations
