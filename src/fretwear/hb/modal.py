@@ -208,6 +208,7 @@ class ModalCondenser(Condenser):
         S, Y, Fr, _ = self._parts(omega, n, False, F)
         Zii = self._z("ii", omega, n, False)
         lu = _factor(Zii, n, omega)
+        self._used(lu)
         Zci, Zic = self._z("ci", omega, n, False), self._z("ic", omega, n, False)
         X = _solve(lu, Zic @ P)  # Z_ii^-1 Z_ic P: the interior response to the probes
         exact = self._z("cc", omega, n, False) @ P - Zci @ X
