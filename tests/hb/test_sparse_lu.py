@@ -128,3 +128,32 @@ def test_nonsymmetric_real_matrix_is_not_given_to_cholesky():
     assert f.name == "superlu"
     X = _dense(U, B)
     assert np.abs(f.solve(B) - X).max() <= TOL * np.abs(X).max()
+
+
+def test_undamped_condensation_in_real_arithmetic(monkeypatch):
+    """An undamped structure's ``Z_ii = K_ii - (n w)^2 M_ii`` is real: the sparse path
+    factorises it in real arithmetic (the backend recorded on the condenser) and its ``Z_r``
+    equals eq. 19 written densely with numpy's complex solve (independent) to 1e-9, the
+    tolerance of tests/hb/test_reduce.py (conditioning up to ~1e3)."""
+    import scipy.linalg as sla
+    from helpers.models import truss
+
+    monkeypatch.setattr(reduce, "DENSE_MAX", -1)  # the sparse path on a small model
+    model = truss(damping="none")
+    cond = reduce.exact_condenser(model)
+    cd = model.contact.dofs.reshape(-1)
+    idofs = np.setdiff1d(model.free_dofs(), cd)
+    R = sla.block_diag(*model.contact.frame)
+    K, M = model.K.toarray(), model.M.toarray()
+    f, orders = 37.0, np.array([0, 1, 2])
+    red = reduce.condense(model, f, orders, condenser=cond)
+    w = 2 * np.pi * f
+    for b, n in enumerate(orders):
+        Z = (K - (n * w) ** 2 * M).astype(complex)
+        S = Z[np.ix_(cd, cd)] - Z[np.ix_(cd, idofs)] @ np.linalg.solve(
+            Z[np.ix_(idofs, idofs)], Z[np.ix_(idofs, cd)])
+        ref = R @ S @ R.T
+        assert np.abs(red.Z[b] - ref).max() <= 1e-9 * np.abs(ref).max()
+    lu = cond.factor(w, 2)
+    assert not lu.complex  # real arithmetic
+    assert cond.lu_backends <= {"cholmod", "superlu"} and cond.lu_backends
