@@ -164,7 +164,7 @@ def run(name: str, mats: dict, rhs: int | None = None, only=()) -> None:
         if only and not any(o in label for o in only):
             continue
         for kind, A, rhs, sg in (("spd", Kii, B, singles),
-                                 ("symmetric", Zii, B.astype(complex), csingles)):
+                                 ("general", Zii, B.astype(complex), csingles)):
             try:
                 r = time_one(label, make, A, kind, rhs, sg)
             except Exception as exc:  # a backend that cannot do this kind: say so, go on
