@@ -278,6 +278,7 @@ class ModalCondenser(Condenser):
         if self._exact is None:  # one LU of Z_ii and a few solves, however many bases tried
             P = np.random.default_rng(0).standard_normal((self.m, PROBES))
             lu = _factor(self._z("ii", omega, n, False), n, omega)
+            self._used(lu)
             Zci, Zic = self._z("ci", omega, n, False), self._z("ic", omega, n, False)
             X = _solve(lu, Zic @ P)  # Z_ii^-1 Z_ic P: the interior response to the probes
             exact = self._z("cc", omega, n, False) @ P - Zci @ X

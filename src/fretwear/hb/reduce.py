@@ -36,9 +36,9 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from fretwear.errors import InputError
+from fretwear.hb import sparse_lu
 from fretwear.model.core import Model
 from fretwear.model.interfaces import observed_map, relative_model
 
@@ -252,6 +252,8 @@ def _singular(n: int, omega: float, near: bool) -> InputError:
 class _DenseLU:
     """LAPACK LU of a small dense ``Z_ii`` with the interface of SuperLU's ``solve``."""
 
+    name = "lapack"
+
     def __init__(self, A, n, omega):
         try:
             with warnings.catch_warnings():  # singular: the message below says why
@@ -268,18 +270,31 @@ class _DenseLU:
 
 
 def _factor(Zii, n: int, omega: float):
-    """LU of ``Z_ii`` (sparse SuperLU, or LAPACK for a dense array); a singular matrix
-    becomes an InputError naming the cause."""
+    """LU of ``Z_ii`` (sparse: :func:`fretwear.hb.sparse_lu.factor`, CHOLMOD's Cholesky for a
+    real symmetric one where installed, else SuperLU; LAPACK for a dense array); a singular
+    matrix becomes an InputError naming the cause. The factorisation's ``name`` says which
+    backend made it."""
     if isinstance(Zii, np.ndarray):
         return _DenseLU(Zii, n, omega)
+    Zii = Zii.tocsc()
+    if Zii.dtype.kind == "c" and not np.any(Zii.data.imag):
+        # an undamped structure: Z_ii = K_ii - (n w)^2 M_ii is real; a real factorisation
+        # costs a quarter of the complex one and solves complex right-hand sides by parts
+        Zii = sp.csc_matrix((np.ascontiguousarray(Zii.data.real), Zii.indices, Zii.indptr),
+                            shape=Zii.shape)
     try:
-        lu = spla.splu(Zii.tocsc())
-    except RuntimeError as exc:
-        raise _singular(n, omega, False) from exc
-    diag = np.abs(lu.U.diagonal())
-    if diag.size and diag.min() <= 1e-13 * diag.max():
-        raise _singular(n, omega, True)
-    return lu
+        return sparse_lu.factor(Zii, "spd" if _real_symmetric(Zii) else "general")
+    except sparse_lu.SingularError as exc:
+        raise _singular(n, omega, exc.near) from exc
+
+
+def _real_symmetric(A) -> bool:
+    """True for a real sparse ``A`` equal to its transpose to rounding (the interior
+    stiffness ``K_ii``): the only kind a Cholesky factorisation may take."""
+    if A.dtype.kind == "c":
+        return False
+    scale = abs(A).max() if A.nnz else 0.0
+    return A.nnz == 0 or abs(A - A.T).max() <= 1e-12 * scale
 
 
 #: at most this many interior DOFs: the condensation works on dense arrays (LAPACK). Below it
@@ -353,6 +368,16 @@ class Condenser:
         self._lus: dict = {}
         self._static = None
         self._load_cache: dict = {}
+        #: the sparse (or dense) solvers that factorised ``Z_ii`` so far (``"cholmod"``,
+        #: ``"superlu"``, ``"lapack"``: :mod:`fretwear.hb.sparse_lu`)
+        self.lu_backends: set[str] = set()
+
+    def _used(self, lu) -> None:
+        """Record (and log, the first time) the backend that made the factorisation ``lu``."""
+        name = getattr(lu, "name", "superlu")
+        if name not in self.lu_backends:
+            self.lu_backends.add(name)
+            sparse_lu.log.info("condensation: interior matrices factorised by %s", name)
 
     # -- the model it belongs to ---------------------------------------------------------------
     def check(self, model: Model) -> Condenser:
@@ -402,8 +427,8 @@ class Condenser:
         lu = self._lus.get(key)
         if lu is None:
             lu = _factor(self._z("ii", omega, n, quasi_static), n, omega)
-            size = (16 * self.ni**2 if self.dense
-                    else 16 * (lu.L.nnz + lu.U.nnz))
+            self._used(lu)
+            size = 16 * self.ni**2 if self.dense else lu.nbytes
             if size <= LU_BUDGET:
                 if key != ("static",):  # keep the static LU and the latest frequency only
                     for k in [k for k in self._lus if k != ("static",) and k[0] != key[0]]:
@@ -607,7 +632,9 @@ class Condenser:
 def _solve(lu, B):
     """``Z_ii^-1 B`` with a factorisation of :func:`_factor`; a real LU (the static one)
     solves a complex ``B`` by its real and imaginary parts."""
-    cplx = (lu.lu[0] if isinstance(lu, _DenseLU) else lu.U).dtype.kind == "c"
+    if not isinstance(lu, _DenseLU):
+        return lu.solve(B)  # sparse_lu: a real factorisation solves a complex B by parts
+    cplx = lu.lu[0].dtype.kind == "c"
     if cplx or B.dtype.kind != "c":
         return lu.solve(B)
     if not np.any(B.imag):
