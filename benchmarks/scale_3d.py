@@ -231,12 +231,17 @@ class Counts:
 
 
 class Clock:
+    """CPU seconds of the process (``cpu``) and wall seconds (``wall``) of a ``with`` block."""
+
     def __enter__(self):
         self.c, self.w = time.process_time(), time.perf_counter()
         return self
 
     def __exit__(self, *exc):
         self.cpu, self.wall = time.process_time() - self.c, time.perf_counter() - self.w
+
+    def __str__(self):
+        return f"{self.cpu:.1f} s CPU, {self.wall:.1f} s wall"
 
 
 def peak_gib() -> float:

@@ -1,5 +1,6 @@
 """Memory and time of the blocked modal condensation (fretwear.hb.modal) and the
-periodic solve on the pad of benchmarks/scale_3d.py (its model and load, imported) at n x n
+periodic solve on the pad of benchmarks/scale_3d.py (its model and loads, imported: the
+partial-slip load by default, ``--load stuck`` the earlier one) at n x n
 contact nodes: 64 x 64 (4096 contact nodes, 7 harmonics, 172 032 unknowns) by default.
 
 It prints, in one process run under an address-space limit (``--limit-gib``, default 20):
@@ -23,28 +24,11 @@ import argparse
 import os
 import resource
 import sys
-import time
 
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from scale_3d import FREQ, H, pad  # noqa: E402
-
-
-class Clock:
-    def __enter__(self):
-        self.c, self.w = time.process_time(), time.perf_counter()
-        return self
-
-    def __exit__(self, *exc):
-        self.cpu, self.wall = time.process_time() - self.c, time.perf_counter() - self.w
-
-    def __str__(self):
-        return f"{self.cpu:.1f} s CPU, {self.wall:.1f} s wall"
-
-
-def peak_gib() -> float:
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20
+from scale_3d import LOADS, Clock, H, pad, peak_gib  # noqa: E402
 
 
 def main():
@@ -52,6 +36,8 @@ def main():
     ap.add_argument("--n", type=int, default=64, help="contact nodes per side")
     ap.add_argument("--dense", action="store_true", help="the dense ModalCondenser instead")
     ap.add_argument("--limit-gib", type=float, default=20.0, help="address-space limit")
+    ap.add_argument("--load", choices=sorted(LOADS), default="slip",
+                    help="the load case of scale_3d.py (default: partial slip)")
     args = ap.parse_args()
     cap = int(args.limit_gib * 2**30)
     hard = resource.getrlimit(resource.RLIMIT_AS)[1]
@@ -65,22 +51,24 @@ def main():
     from fretwear.hb.preload import static_anchor
 
     n = args.n
+    load = LOADS[args.load]
+    FREQ = load.freq
     print(f"load: {os.getloadavg()}; OPENBLAS_NUM_THREADS="
           f"{os.environ.get('OPENBLAS_NUM_THREADS')}", flush=True)
     with Clock() as c:
-        model = pad(n)
+        model = pad(n, load)
     print(f"{n * n} contact nodes, {model.ndof} DOFs: model built in {c} (not counted)",
           flush=True)
     basis = FourierBasis.up_to(H, 128)
     cls = ModalCondenser if args.dense else BlockedModalCondenser
     with Clock() as cc:
-        mc = cls(model, FREQ * 1.2, H)
+        mc = cls(model, FREQ * 1.2, H, modes=load.modes)
         red = mc.reduced(2 * np.pi * FREQ, basis.orders, frequency=FREQ)
     m = mc.m
     print(f"condensation ({cls.__name__}, {mc.n_modes} modes, q = {mc.q}, checked error "
           f"{mc.error:.2g}): {cc}; peak {peak_gib():.2f} GiB", flush=True)
     lu = mc._lus.get(("static",))
-    lu_gib = (12 * (lu.L.nnz + lu.U.nnz) / 2**30) if hasattr(lu, "L") else float("nan")
+    lu_gib = getattr(lu, "nbytes", float("nan") * 2**30) / 2**30
     if args.dense:
         parts = {"Z_r blocks": red.Z.nbytes, "Psi": mc.Psi.nbytes,
                  "proj (both frames)": sum(x.nbytes for p in (mc.proj, mc.proj_local)
