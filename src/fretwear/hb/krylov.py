@@ -231,13 +231,13 @@ class HarmonicBlocks:
             # row (r, a_n) of Z~ is [Re Z_n, Im Z_n], row (r, b_n) is [-Im Z_n, Re Z_n]:
             # (V_a + i V_b) Z_n gives the a-columns in its real part, the b-columns in its
             # imaginary part
+            # (:meth:`block`: a stored block, or one formed in turn by an operator's blocks)
+            Zb = self.block(b).reshape(nc, d, m)
             if self.real:
-                Zb = self.Zr[b].reshape(nc, d, m)
                 out[:, :, b] = np.einsum("pi,pij->pj", V[:, :, b], Zb)
                 out[:, :, k + b] = np.einsum("pi,pij->pj", V[:, :, k + b], Zb)
                 continue
-            w = V[:, :, b] + 1j * V[:, :, k + b]
-            y = np.einsum("pi,pij->pj", w, self.Zc[b].reshape(nc, d, m))
+            y = np.einsum("pi,pij->pj", V[:, :, b] + 1j * V[:, :, k + b], Zb)
             out[:, :, b], out[:, :, k + b] = y.real, y.imag
         return out.reshape(nc, m * H)
 

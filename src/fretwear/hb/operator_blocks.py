@@ -121,24 +121,6 @@ class OperatorBlocks(HarmonicBlocks):
         out[:, k + 1 :] = -y[:, :, 1:].imag.transpose(0, 2, 1)
         return out
 
-    def node_rows(self, V: np.ndarray) -> np.ndarray:
-        """As :meth:`HarmonicBlocks.node_rows`, with each block formed in turn."""
-        m, H, k = self.m, self.H, self.k
-        nc = V.shape[0]
-        d = m // nc
-        V = V.reshape(nc, d, H)
-        out = np.empty((nc, m, H))
-        out[:, :, 0] = np.einsum("pi,pij->pj", V[:, :, 0], self.Z0.reshape(nc, d, m))
-        for b in range(1, k + 1):
-            Zb = self.block(b).reshape(nc, d, m)
-            if self.real:
-                out[:, :, b] = np.einsum("pi,pij->pj", V[:, :, b], Zb)
-                out[:, :, k + b] = np.einsum("pi,pij->pj", V[:, :, k + b], Zb)
-                continue
-            y = np.einsum("pi,pij->pj", V[:, :, b] + 1j * V[:, :, k + b], Zb)
-            out[:, :, b], out[:, :, k + b] = y.real, y.imag
-        return out.reshape(nc, m * H)
-
     def dense(self) -> np.ndarray:
         from fretwear.hb.reduce import to_real_blocks
 
