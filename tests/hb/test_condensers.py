@@ -83,8 +83,13 @@ def test_auto_rule(pad, monkeypatch):
     c = condenser(pad, f_max=F_MAX, max_order=ORDER)
     assert c.choice.method == "exact" and "interior DOFs <" in c.choice.reason  # 972 < 2000
     monkeypatch.setattr(condensers, "AUTO_MIN_INTERIOR", 500)
-    c = condenser(pad, f_max=F_MAX, max_order=ORDER)
+    c = condenser(pad, f_max=F_MAX, max_order=2)
     assert c.choice.method == "exact" and "8 x 243" in c.choice.reason  # 972 < 8 x 243
+    # 7 harmonics: the exact condensation's 7 complex LUs per frequency cost more than the
+    # modal one's solves, whatever the ratio
+    c = condenser(pad, f_max=F_MAX, max_order=ORDER)
+    assert c.choice.method == "modal" and "7 harmonics >= 3" in c.choice.reason
+    assert c.choice.error <= TOL
     monkeypatch.setattr(condensers, "AUTO_RATIO", 2)
     c = condenser(pad, f_max=F_MAX, max_order=ORDER)
     assert c.choice.method == "modal" and c.choice.error <= TOL

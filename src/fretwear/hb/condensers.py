@@ -10,9 +10,13 @@ condensation costs, per harmonic and frequency, one complex sparse LU of ``Z_ii`
 complex solves (``m`` contact DOFs); the modal one costs, once, one real LU of ``K_ii``, ``m``
 real solves (``Psi``, and as many for the residual vectors), a shift-invert Lanczos and one
 complex LU for its check, then only dense ``O(m^2 q)`` products per harmonic and frequency. It
-pays off when the interior is large against the contact DOFs (:data:`AUTO_MIN_INTERIOR`,
-:data:`AUTO_RATIO`: below them the exact condensation is a few dense or small sparse solves
-and has no error) and there is a frequency band to build it for. The modal condenser then
+pays off when the interior is large (:data:`AUTO_MIN_INTERIOR`: below, the exact condensation
+is a few dense or small sparse solves and has no error), there is a frequency band to build it
+for, and either the interior is large against the contact DOFs (:data:`AUTO_RATIO`) or the
+balance keeps :data:`AUTO_HARMONICS` harmonics or more: one frequency of the exact
+condensation then costs ``max_order`` complex LUs and ``max_order m`` complex solves, several
+times the modal one's ``m`` to ``2 m`` real solves, whatever the ratio (a 3D pad with 1024
+contact nodes, 4 interior DOFs per contact DOF, 7 harmonics). The modal condenser then
 raises its number of modes until its error check passes (:data:`fretwear.hb.modal.MAX_MODES`
 at most); if even that fails, the choice falls back to the exact condensation and says so.
 """
@@ -38,6 +42,9 @@ AUTO_MIN_INTERIOR = 2000
 #: (the modal one's ``m`` solves at the start and its ``O(m^2 q)`` products per harmonic
 #: gain nothing unless the interior solves they replace are much larger)
 AUTO_RATIO = 8
+#: ``auto``: from this many harmonics on, the modal condensation is chosen for any interior
+#: of at least :data:`AUTO_MIN_INTERIOR` DOFs (module docstring)
+AUTO_HARMONICS = 3
 #: the residual vectors (the static correction of the omitted modes) are added up to this
 #: many contact DOFs: they double the ``m`` solves of ``Psi`` and add ``m`` coordinates
 RESIDUAL_MAX = 1024
@@ -94,16 +101,20 @@ def sizes(model: Model) -> tuple[int, int]:
     return m, int(model.ndof) - fixed - m
 
 
-def auto_method(model: Model, f_max: float | None) -> tuple[str, str]:
+def auto_method(model: Model, f_max: float | None, max_order: int = 1) -> tuple[str, str]:
     """``(method, reason)`` of the automatic rule before its error check (module docstring)."""
     m, ni = sizes(model)
     if f_max is None:
         return "exact", "no frequency band (quasi-static)"
     if ni < AUTO_MIN_INTERIOR:
         return "exact", f"{ni} interior DOFs < {AUTO_MIN_INTERIOR}"
-    if ni < AUTO_RATIO * m:
-        return "exact", f"{ni} interior DOFs < {AUTO_RATIO} x {m} contact DOFs"
-    return "modal", f"{ni} interior DOFs >= {AUTO_RATIO} x {m} contact DOFs"
+    if ni >= AUTO_RATIO * m:
+        return "modal", f"{ni} interior DOFs >= {AUTO_RATIO} x {m} contact DOFs"
+    if max_order >= AUTO_HARMONICS:
+        return "modal", (f"{max_order} harmonics >= {AUTO_HARMONICS} on {ni} interior DOFs "
+                         f"(exact: {max_order} complex LUs per frequency)")
+    return "exact", (f"{ni} interior DOFs < {AUTO_RATIO} x {m} contact DOFs and "
+                     f"{max_order} harmonics < {AUTO_HARMONICS}")
 
 
 def _check(method, f_max, max_order, modes, cutoff, tol) -> None:
@@ -169,7 +180,7 @@ def condenser(model: Model, method: str = "auto", *, f_max: float | None = None,
         return _with(exact_condenser(model), CondensationChoice("exact", "exact", "asked"))
     reason = "asked"
     if method == "auto":
-        chosen, reason = auto_method(model, f_max)
+        chosen, reason = auto_method(model, f_max, int(max_order))
         if chosen == "exact":
             return _with(exact_condenser(model), CondensationChoice("auto", "exact", reason))
     if residual is None:

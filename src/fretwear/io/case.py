@@ -843,8 +843,9 @@ The structure is condensed on its contact DOFs (paper eq. 19) by the method of t
   loads and, up to 1024 contact DOFs, the residual vectors (the static correction of the
   omitted modes; docs/theory.md, "Large interfaces"). A sweep or a wear run then condenses
   nothing again at each frequency or step.
-- `"auto"` (default): the modal condensation for a large model (at least 2000 interior DOFs
-  and 8 per contact DOF) with a frequency, else the exact one (quasi-static runs are exact).
+- `"auto"` (default): the modal condensation for a large model (at least 2000 interior DOFs,
+  and 8 per contact DOF or 3 harmonics or more) with a frequency, else the exact one
+  (quasi-static runs are exact).
 
 **Error check** of the modal condensation: at the highest harmonic of the highest frequency,
 `Z_r` applied to four random vectors, the condensed loads and the recovery of the observed
