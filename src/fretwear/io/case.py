@@ -43,6 +43,7 @@ from fretwear.io.schema import (
     Vector,
     exactly_one,
     fail,
+    join,
     non_zero,
     render_table,
     requires,
@@ -279,6 +280,50 @@ CONTACT_MESH = Table(
 )
 OBSERVED_MESH = Dict(AnyOf((Vector(), Text())), key_doc="point names")
 
+
+def _cyclic_rules(out: dict, path: str) -> None:
+    """Rules of ``[cyclic]``: a unit axis, ``|engine_order| < sectors``, two boundaries."""
+    axis = out.get("axis")
+    if axis is not None and (len(axis) != 3 or abs(math.hypot(*axis) - 1.0) > 1e-9):
+        fail(join(path, "axis"), axis, "a unit vector of 3 components (e.g. [0, 0, 1])")
+    n, eo = out["sectors"], out["engine_order"]
+    if abs(eo) >= n:
+        fail(join(path, "engine_order"), eo,
+             f"an integer with |engine_order| < sectors = {n} (engine order EO + {n} gives "
+             f"the same sector response as EO: give it modulo {n})")
+    if out["left"] == out["right"]:
+        fail(join(path, "right"), out["right"], "a boundary other than left")
+
+
+CYCLIC = Table(
+    {
+        "sectors": Field(Integer(lo=2), "number N of identical sectors of the disk",
+                         required=True),
+        "engine_order": Field(Integer(), "engine order EO of the travelling-wave excitation "
+                              "(sector j lags sector j-1 by EO 2 pi / N; negative: the wave "
+                              "travels the other way); |EO| < N", required=True),
+        "axis": Field(Vector((3,)), "unit vector of the rotation axis (right-hand rule; 2D: "
+                      "[0, 0, 1] or [0, 0, -1])", default=[0.0, 0.0, 1.0]),
+        "point": Field(Vector(), "a point of the rotation axis", default=[0.0, 0.0, 0.0],
+                       unit="m"),
+        "left": Field(Text(), "boundary or node set of the left cyclic boundary (theta = 0)",
+                      required=True),
+        "right": Field(Text(), "boundary or node set of the right cyclic boundary: left turned "
+                       "by +2 pi / N, node by node", required=True),
+        "tolerance": Field(_NON_NEG, "largest distance between a turned left node and its "
+                           "right node (default 1e-6 times the model size)", unit="m"),
+        "neighbour": Field(Text(), "name of the `[[contact]]` block between neighbouring "
+                           "sectors (a damper, a shroud): its `boundary` A touches the next "
+                           "sector's copy of its `partner` B (B turned by +2 pi / N lands on "
+                           "A)"),
+    },
+    checks=(_cyclic_rules,),
+    doc="One sector of a cyclically symmetric disk of N sectors under a travelling wave of "
+    "engine order EO (docs/theory.md, Cyclic symmetry): harmonic n lives in the harmonic "
+    "index k = n EO mod N and the right boundary is the left one turned and phased. Mesh "
+    "models only. The results record N, EO and the harmonic index of every harmonic.",
+)
+
 # --- matrices models ------------------------------------------------------------------
 def _normal_dofs_or_load(out: dict, path: str) -> None:
     """Rule: ``normal_dofs`` is given unless ``normal_load`` is (friction under a known load)."""
@@ -383,6 +428,7 @@ def _case_table(model_kind: str, analyses: Mapping[str, Table]) -> Table:
                                "holds a body (e.g. a Gmsh physical volume); a cell with all "
                                "its nodes in such a set takes its material, the others take "
                                "[material]", default={}),
+            "cyclic": Field(CYCLIC, "cyclic symmetry: the model is one sector of a disk"),
         }
     fields["analysis"] = Field(Variant(dict(analyses), key_doc="analysis type"),
                                "what to compute", required=True)
@@ -412,7 +458,7 @@ def validate(raw: Mapping, analyses: Mapping[str, Table], base_dir: Path | str =
 
 # --- loading ----------------------------------------------------------------------------
 _MODEL_SECTIONS = ("model", "material", "damping", "springs", "fixed", "loads", "contact",
-                   "observed", "materials")
+                   "observed", "materials", "cyclic")
 
 
 @dataclass(frozen=True)
@@ -654,7 +700,18 @@ def _build_from_mesh(m: dict, title: str, given: Mapping):
                for c in m["contact"]]
     observed = {k: _at(v) for k, v in m.get("observed", {}).items()} or None
     thickness = m["model"].get("thickness", 1.0) if mesh.dim == 2 else 1.0
-    return build.from_mesh(
+    cyc = m.get("cyclic")
+    neighbour = cyc.get("neighbour") if cyc else None
+    if neighbour is not None:
+        names = [c.name for c in contact]
+        _check_name(neighbour, "cyclic.neighbour", names)
+        spec = contact[names.index(neighbour)]
+        if spec.partner is None or spec.partner == spec.boundary:
+            fail("cyclic.neighbour", neighbour, "a [[contact]] block with a partner boundary "
+                 f"other than its boundary {spec.boundary!r} (the damper pairs a boundary "
+                 "with the next sector's copy of another one)")
+        contact = [c for c in contact if c.name != neighbour]
+    model = build.from_mesh(
         mesh,
         material,
         thickness=thickness,
@@ -666,6 +723,32 @@ def _build_from_mesh(m: dict, title: str, given: Mapping):
         observed=observed,
         name=title,
     )
+    return model if cyc is None else _sector(model, cyc, spec if neighbour else None)
+
+
+def _sector(model, cyc: dict, neighbour):
+    """The sector model of ``[cyclic]``, its :class:`~fretwear.model.cyclic.CyclicSector` in
+    ``model.meta["cyclic"]`` and its engine order in ``model.meta["engine_order"]`` (read by
+    :func:`fretwear.analyses.common.condenser_of`); mistakes name the ``cyclic`` keys."""
+    from fretwear.model.cyclic import cyclic_sector, neighbour_contact
+
+    mesh = model.mesh
+    anywhere = sorted(set(mesh.boundaries) | set(mesh.node_sets))
+    for key in ("left", "right"):
+        _check_name(cyc[key], f"cyclic.{key}", anywhere)
+    if mesh.dim == 2 and (cyc["axis"][0] != 0 or cyc["axis"][1] != 0):
+        fail("cyclic.axis", cyc["axis"], "[0, 0, 1] or [0, 0, -1] for a 2D model")
+    try:
+        sector = cyclic_sector(model, cyc["sectors"], cyc["left"], cyc["right"],
+                               axis=cyc["axis"], point=cyc["point"],
+                               tolerance=cyc.get("tolerance"))
+        if neighbour is not None:
+            sector = neighbour_contact(sector, neighbour)
+    except InputError as exc:
+        raise InputError(f"cyclic: {exc}") from None
+    sector.model.meta["cyclic"] = sector
+    sector.model.meta["engine_order"] = int(cyc["engine_order"])
+    return sector.model
 
 
 def _at(value):
