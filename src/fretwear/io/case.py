@@ -321,7 +321,11 @@ CYCLIC = Table(
     doc="One sector of a cyclically symmetric disk of N sectors under a travelling wave of "
     "engine order EO (docs/theory.md, Cyclic symmetry): harmonic n lives in the harmonic "
     "index k = n EO mod N and the right boundary is the left one turned and phased. Mesh "
-    "models only. The results record N, EO and the harmonic index of every harmonic.",
+    "models only. Contact and observed nodes lie off the right boundary (it is the next "
+    "sector's left one). The condensation is exact, one per harmonic index (`condensation` "
+    "is not used). The results attributes `cyclic_sectors` (N), `engine_order` (EO) and "
+    "`harmonic_index` (the index k of harmonics 0, 1, .., the highest kept) say which family "
+    "each harmonic lives in; the wear is that of every sector (a tuned disk).",
 )
 
 # --- matrices models ------------------------------------------------------------------
@@ -964,6 +968,7 @@ def case_docs(analyses: Mapping[str, Table]) -> str:
         '"set"`, a node set of one node. Matrices: `name = dof` or `name = [dofs]`. '
         "Results and figures use these names.\n"
     )
+    parts.append(render_table(CYCLIC, "## [cyclic] (meshes)"))
     parts.append("## [analysis]\n\n`type` selects one of the analyses below (those registered "
                  "in this version).\n")
     for kind, table in analyses.items():
