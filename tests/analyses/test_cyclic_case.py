@@ -82,3 +82,24 @@ def test_bad_cyclic_keys(tmp_path, what, lines, message):
         build_model(load_case(path))
     assert str(err.value).startswith(message), str(err.value)
     assert len(str(err.value).splitlines()) == 1
+
+
+def test_centrifugal_table(tmp_path):
+    """``[centrifugal]`` adds the load of fretwear.model.rotation.centrifugal_load (tested
+    against closed forms in tests/model/test_rotation.py) about the ``[cyclic]`` axis by
+    default, bit for bit; a bad axis names its key."""
+    from fretwear.model.rotation import centrifugal_load
+
+    path, _ = write_sector_case(tmp_path, N, EO, analysis=PERIODIC)
+    text = path.read_text()
+    path.write_text(text + "[centrifugal]\nspeed = 1500.0\n")
+    model = build_model(load_case(path))
+    _, ref = sector_model(N)
+    want = centrifugal_load(ref, 1500.0).vector
+    assert model.loads[-1].name == "centrifugal" and model.loads[-1].waveform == "constant"
+    np.testing.assert_array_equal(model.loads[-1].vector, want)
+    assert len(model.loads) == len(ref.loads) + 1
+    path.write_text(text + "[centrifugal]\nspeed = 1500.0\naxis = [0.0, 1.0, 0.0]\n")
+    with pytest.raises(InputError) as err:
+        build_model(load_case(path))
+    assert str(err.value).startswith("centrifugal: axis = [0.0, 1.0, 0.0]: a 2D sector turns")

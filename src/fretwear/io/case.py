@@ -16,6 +16,7 @@ The documentation ``docs/case-files.md`` is generated from these schemas
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import tomllib
 from collections.abc import Mapping
@@ -295,6 +296,22 @@ def _cyclic_rules(out: dict, path: str) -> None:
         fail(join(path, "right"), out["right"], "a boundary other than left")
 
 
+CENTRIFUGAL = Table(
+    {
+        "speed": Field(_NON_NEG, "rotation speed Omega", required=True, unit="rad/s"),
+        "axis": Field(Vector((3,)), "unit vector of the rotation axis (default: that of "
+                      "[cyclic], else [0, 0, 1]; 2D: [0, 0, 1] or [0, 0, -1])"),
+        "point": Field(Vector(), "a point of the rotation axis (default: that of [cyclic], "
+                       "else the origin)", unit="m"),
+        "name": Field(Text(), "label of the load in output", default="centrifugal"),
+    },
+    checks=(non_zero("axis"),),
+    doc="Centrifugal loading: the body force rho Omega^2 r (r: the distance vector from the "
+    "axis) as a static load (waveform constant) added to the loads, on the undeformed "
+    "geometry; spin softening, stress stiffening and Coriolis forces are left out "
+    "(docs/theory.md, Centrifugal loading). Mesh models only.",
+)
+
 CYCLIC = Table(
     {
         "sectors": Field(Integer(lo=2), "number N of identical sectors of the disk",
@@ -433,6 +450,7 @@ def _case_table(model_kind: str, analyses: Mapping[str, Table]) -> Table:
                                "its nodes in such a set takes its material, the others take "
                                "[material]", default={}),
             "cyclic": Field(CYCLIC, "cyclic symmetry: the model is one sector of a disk"),
+            "centrifugal": Field(CENTRIFUGAL, "centrifugal loading at a rotation speed"),
         }
     fields["analysis"] = Field(Variant(dict(analyses), key_doc="analysis type"),
                                "what to compute", required=True)
@@ -462,7 +480,7 @@ def validate(raw: Mapping, analyses: Mapping[str, Table], base_dir: Path | str =
 
 # --- loading ----------------------------------------------------------------------------
 _MODEL_SECTIONS = ("model", "material", "damping", "springs", "fixed", "loads", "contact",
-                   "observed", "materials", "cyclic")
+                   "observed", "materials", "cyclic", "centrifugal")
 
 
 @dataclass(frozen=True)
@@ -727,7 +745,24 @@ def _build_from_mesh(m: dict, title: str, given: Mapping):
         observed=observed,
         name=title,
     )
+    if m.get("centrifugal"):
+        model = _spin(model, m["centrifugal"], cyc or {})
     return model if cyc is None else _sector(model, cyc, spec if neighbour else None)
+
+
+def _spin(model, spin: dict, cyc: dict):
+    """``model`` with the ``[centrifugal]`` load added (axis and point: those of ``spin``,
+    else of ``[cyclic]``, else z through the origin)."""
+    from fretwear.model.rotation import centrifugal_load
+
+    axis = spin.get("axis", cyc.get("axis", [0.0, 0.0, 1.0]))
+    point = spin.get("point", cyc.get("point", [0.0, 0.0, 0.0]))
+    try:
+        load = centrifugal_load(model, spin["speed"], axis=axis, point=point,
+                                name=spin["name"])
+    except InputError as exc:
+        raise InputError(f"centrifugal: {exc}") from None
+    return dataclasses.replace(model, loads=[*model.loads, load])
 
 
 def _sector(model, cyc: dict, neighbour):
@@ -969,6 +1004,7 @@ def case_docs(analyses: Mapping[str, Table]) -> str:
         "Results and figures use these names.\n"
     )
     parts.append(render_table(CYCLIC, "## [cyclic] (meshes)"))
+    parts.append(render_table(CENTRIFUGAL, "## [centrifugal] (meshes)"))
     parts.append("## [analysis]\n\n`type` selects one of the analyses below (those registered "
                  "in this version).\n")
     for kind, table in analyses.items():
