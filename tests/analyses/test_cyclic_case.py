@@ -17,6 +17,7 @@ from fretwear.hb.periodic import solve_periodic
 from fretwear.io.case import build_model
 from fretwear.io.results import read_results
 from fretwear.model.cyclic import whole_disk
+from tests.helpers.cases import check_documented
 from tests.helpers.cyclic import sector_model, write_sector_case
 
 N, EO = 8, 3
@@ -120,6 +121,7 @@ def test_cyclic_modes_analysis_gives_disk_frequencies(tmp_path):
     ds = read_results(out.results)
     f = ds["natural_frequency"].values
     assert f.shape == (N // 2 + 1, 2) and np.all(np.isfinite(f))
+    check_documented(ds, "cyclic-modes")
     assert (tmp_path / "sector-results" / "nodal-diameter-diagram.png").is_file()
     sector, _ = sector_model(N)
     disk = whole_disk(sector)
