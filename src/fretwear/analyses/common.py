@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from fretwear.errors import InputError
 from fretwear.files import inside, safe_name
 from fretwear.hb.condensers import METHODS, CondensationChoice, condenser
 from fretwear.hb.cyclic import cyclic_condenser
@@ -260,6 +261,25 @@ def condenser_of(model, analysis: dict, f_max: float | None, max_order: int):
                      max_order=int(max_order), modes=analysis.get("condensation_modes"),
                      cutoff=analysis.get("condensation_cutoff", default_of(condenser, "cutoff")),
                      tol=analysis.get("condensation_tol", default_of(condenser, "tol")))
+
+
+#: the analyses that run on a sector of a case file's ``[cyclic]`` table
+SECTOR_ANALYSES = ("cyclic-modes", "periodic", "sweep", "wear")
+
+
+def check_sector_analysis(model, name: str, analysis: dict) -> None:
+    """Refuse, in one line, an analysis that would treat a sector (``model.meta["cyclic"]``)
+    as a structure with free cyclic boundaries: those not in :data:`SECTOR_ANALYSES`, and a
+    sweep's linear references (contact-law-free FRFs of the whole model)."""
+    if model.meta.get("cyclic") is None:
+        return
+    if name not in SECTOR_ANALYSES:
+        raise InputError(f'analysis.type = "{name}": not available on a sector ([cyclic]); '
+                         f"expected one of {', '.join(SECTOR_ANALYSES)}")
+    if analysis.get("linear_references"):
+        fail("analysis.linear_references", analysis["linear_references"],
+             "none on a sector ([cyclic]): the linear FRFs would leave its cyclic boundaries "
+             "free")
 
 
 @dataclass(frozen=True)
