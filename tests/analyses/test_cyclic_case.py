@@ -135,3 +135,19 @@ def test_cyclic_modes_analysis_gives_disk_frequencies(tmp_path):
     path.write_text(text.replace(text[text.index("[cyclic]"):text.index("[analysis]")], ""))
     with pytest.raises(InputError, match=r'^analysis.type = "cyclic-modes": the case has no '):
         run_case(path, progress=False, echo=False)
+
+
+@pytest.mark.parametrize("analysis, message", [
+    ('[analysis]\ntype = "modes"\n', 'analysis.type = "modes": not available on a sector'),
+    ('[analysis]\ntype = "sweep"\nf_min = 1e4\nf_max = 1.2e4\nlinear_references = ["free"]\n',
+     'analysis.linear_references = ["free"]: expected none on a sector'),
+])
+def test_analyses_that_would_free_the_boundaries_are_refused(tmp_path, analysis, message):
+    """Analyses that would treat the sector as a structure with free cyclic boundaries (the
+    modes of the sector alone, a sweep's linear FRFs of the sector alone) are refused in one
+    line before anything runs."""
+    path, _ = write_sector_case(tmp_path, N, EO, analysis=analysis)
+    with pytest.raises(InputError) as err:
+        run_case(path, progress=False, echo=False)
+    assert str(err.value).startswith(message), str(err.value)
+    assert len(str(err.value).splitlines()) == 1

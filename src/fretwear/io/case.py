@@ -342,7 +342,9 @@ CYCLIC = Table(
     "sector's left one). The condensation is exact, one per harmonic index (`condensation` "
     "is not used). The results attributes `cyclic_sectors` (N), `engine_order` (EO) and "
     "`harmonic_index` (the index k of harmonics 0, 1, .., the highest kept) say which family "
-    "each harmonic lives in; the wear is that of every sector (a tuned disk).",
+    "each harmonic lives in; the wear is that of every sector (a tuned disk). Analyses: "
+    "`cyclic-modes`, `periodic`, `sweep` (without `linear_references`) and `wear`; the others "
+    "would leave the cyclic boundaries free and are refused.",
 )
 
 # --- matrices models ------------------------------------------------------------------
