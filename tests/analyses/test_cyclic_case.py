@@ -6,6 +6,8 @@ Reference: the disk of N turned copies of the Python sector of tests/helpers/cyc
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -119,3 +121,28 @@ def test_analyses_that_would_free_the_boundaries_are_refused(tmp_path, analysis,
         run_case(path, progress=False, echo=False)
     assert str(err.value).startswith(message), str(err.value)
     assert len(str(err.value).splitlines()) == 1
+
+
+def test_sweep_checkpoint_is_not_reused_for_another_engine_order(tmp_path):
+    """A sector sweep resumed with another engine order is refused as a checkpoint of another
+    sweep (its key holds N and EO: the model alone is the same sector, and without them the
+    stale points of EO 3 were taken for EO 2); with the same one it resumes (the sweep's own
+    report ``resumed_from``)."""
+    from fretwear.hb.cyclic import cyclic_condenser
+    from fretwear.hb.options import SweepOptions
+    from fretwear.hb.sweep import sweep
+
+    sector, model = sector_model(N)
+    basis = FourierBasis((1,), 16)
+    ck = tmp_path / "sweep.ckpt.npz"
+    opts = SweepOptions(eps=3e9, checkpoint=ck)
+    first = sweep(model, basis, 9000.0, 9500.0, 2, options=opts,
+                  condenser=cyclic_condenser(sector, 3))
+    assert first.success and ck.is_file()
+    resume = dataclasses.replace(opts, resume=True)
+    again = sweep(model, basis, 9000.0, 9500.0, 2, options=resume,
+                  condenser=cyclic_condenser(sector, 3))
+    assert again.resumed_from == 2
+    with pytest.raises(InputError, match="was written for a different model or different"):
+        sweep(model, basis, 9000.0, 9500.0, 2, options=resume,
+              condenser=cyclic_condenser(sector, 2))
