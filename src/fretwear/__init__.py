@@ -76,6 +76,7 @@ _API = {
     "cyclic_sector": "fretwear.model.cyclic", "neighbour_contact": "fretwear.model.cyclic",
     "whole_disk": "fretwear.model.cyclic", "cyclic_condenser": "fretwear.hb.cyclic",
     "cyclic_modes": "fretwear.hb.cyclic", "cyclic_frf": "fretwear.hb.cyclic",
+    "centrifugal_load": "fretwear.model.rotation",
     # wear
     "simulate_wear": "fretwear.api", "frf_worn": "fretwear.api",
     "WearOptions": "fretwear.wear", "WearResult": "fretwear.wear",

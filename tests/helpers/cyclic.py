@@ -103,3 +103,90 @@ def sector_model_3d(n_sectors: int = 6, force: float = 3e4):
                       damping=Damping(loss_factor=0.01), observed={"load": "load"},
                       name="3D sector")
     return cyclic_sector(model, n_sectors, "left", "right"), model
+
+
+def write_sector_case(folder, n_sectors: int = 8, engine_order: int = 3, *, slit: bool = False,
+                      analysis: str = "", cyclic: str = "") -> tuple:
+    """``(path, mesh_path)``: the sector of :func:`sector_model` as a case file
+    (``sector.toml``) and a Gmsh 2.2 mesh file (``sector.msh``) in ``folder``: the same
+    nodes (in the same order), material, hub, loads, contacts and observed point. The cyclic
+    boundaries are the mesh's ``left`` and ``right`` edges (below r = 0.14 m with ``slit``,
+    where ``[[contact]] neighbours`` pairs ``slit_a`` with the next sector's ``slit_b``).
+    ``analysis``: the ``[analysis]`` table; ``cyclic``: extra lines of ``[cyclic]``."""
+    import meshio
+
+    from fretwear.model.mesh import rectangle as rect
+
+    nr, nt = (4 if slit else 3), 4
+    mesh = annulus_sector(n_sectors, nr=nr, slit=0.14 if slit else None)
+    r = rect(R_OUT - R_IN, 2 * np.pi / n_sectors, nr, nt, origin=(R_IN, 0.0))
+    bounds = dict(mesh.boundaries)
+    for side, name in (("bottom", "left"), ("top", "right")):
+        edges = r.boundaries[side]
+        bounds[name] = edges[np.all(r.points[edges, 0] < 0.14, axis=1)] if slit else edges
+    pts = np.column_stack([mesh.points, np.zeros(len(mesh.points))])
+    cells, phys, field = [("quad", mesh.cells)], [np.ones(len(mesh.cells), int)], {}
+    field["body"] = np.array([1, 2])
+    for k, (name, facets) in enumerate(bounds.items()):
+        cells.append(("line", np.asarray(facets)))
+        phys.append(np.full(len(facets), 10 + k))
+        field[name] = np.array([10 + k, 1])
+    load = mesh.node_sets["load"]
+    cells.append(("vertex", load[:, None]))
+    phys.append(np.full(len(load), 100))
+    field["load"] = np.array([100, 0])
+    mesh_path = folder / "sector.msh"
+    meshio.write(mesh_path, meshio.Mesh(pts, cells, cell_data={"gmsh:physical": phys,
+                                                               "gmsh:geometrical": phys},
+                                        field_data=field), file_format="gmsh22", binary=False)
+    mid = mesh.points[load[0]]
+    e_r = mid / np.linalg.norm(mid)
+    e_t = np.array([-e_r[1], e_r[0]])
+    press, force = [float(v) for v in 2e4 * e_r], [float(v) for v in 5e3 * e_t]
+    neighbours = ('[[contact]]\nboundary = "slit_a"\npartner = "slit_b"\nmu = 0.3\n'
+                  'gap = -2e-7\nname = "neighbours"\n') if slit else ""
+    text = f"""title = "annulus sector"
+[model]
+type = "mesh"
+file = "sector.msh"
+thickness = 0.01
+[material]
+E = 2e11
+nu = 0.3
+rho = 7800.0
+[damping]
+loss_factor = 0.01
+rayleigh_mass = 5.0
+[[fixed]]
+at = "hub"
+[[loads]]
+at = "load"
+force = [{press[0]!r}, {press[1]!r}]
+waveform = "constant"
+name = "press"
+[[loads]]
+at = "load"
+force = [{force[0]!r}, {force[1]!r}]
+waveform = "cos"
+name = "excitation"
+[[contact]]
+boundary = "tip"
+mu = 0.3
+name = "casing"
+{neighbours}[observed]
+tip = "load"
+[cyclic]
+sectors = {n_sectors}
+engine_order = {engine_order}
+left = "left"
+right = "right"
+{'neighbour = "neighbours"' if slit else ""}
+{cyclic}
+{analysis}
+[output]
+vtu = false
+figures = false
+"""
+    path = folder / "sector.toml"
+    path.write_text(text)
+    return path, mesh_path

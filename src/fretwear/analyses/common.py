@@ -9,13 +9,16 @@ from __future__ import annotations
 
 import inspect
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
+from fretwear.errors import InputError
 from fretwear.files import inside, safe_name
-from fretwear.hb.condensers import METHODS, condenser
+from fretwear.hb.condensers import METHODS, CondensationChoice, condenser
+from fretwear.hb.cyclic import cyclic_condenser
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.options import SolveOptions
 from fretwear.hb.penalty import RULES
@@ -23,6 +26,7 @@ from fretwear.hb.preload import preload_contact
 from fretwear.hb.solvers import SOLVERS, SolveStats
 from fretwear.io.results import label_coordinate, variable
 from fretwear.io.schema import AnyOf, Field, Integer, ListOf, Number, Text, fail, join
+from fretwear.model.cyclic import harmonic_index
 
 #: contact-local components of the contact nodes (normal, tangents)
 COMPONENTS = ("N", "T1", "T2")
@@ -237,11 +241,71 @@ def condenser_of(model, analysis: dict, f_max: float | None, max_order: int):
     """The run's condenser of ``model`` as the ``[analysis]`` table asks
     (:func:`condensation_fields`; :func:`fretwear.hb.condensers.condenser`) for excitation
     frequencies up to ``f_max`` [Hz] (None: a quasi-static run, exact) and harmonic orders
-    up to ``max_order``; its ``choice`` goes to the run summary and the results attributes."""
+    up to ``max_order``; its ``choice`` goes to the run summary and the results attributes.
+
+    A sector of a case file's ``[cyclic]`` table (``model.meta["cyclic"]``, set by
+    :func:`fretwear.io.case.build_model`) gets the exact
+    :class:`~fretwear.hb.cyclic.CyclicCondenser` of its engine order, whatever the table asks
+    (a modal condensation per harmonic index is not available); its choice adds ``N``,
+    ``EO`` and the harmonic index of each harmonic up to ``max_order``
+    (:class:`CyclicChoice`)."""
+    sector = model.meta.get("cyclic")
+    if sector is not None:
+        cond = cyclic_condenser(sector, model.meta["engine_order"])
+        asked = analysis.get("condensation", "auto")
+        reason = "one exact condensation per harmonic index (a sector of a disk)"
+        cond.choice = CyclicChoice(CondensationChoice(asked, "exact", reason),
+                                   sector.n_sectors, cond.engine_order, int(max_order))
+        return cond
     return condenser(model, analysis.get("condensation", "auto"), f_max=f_max,
                      max_order=int(max_order), modes=analysis.get("condensation_modes"),
                      cutoff=analysis.get("condensation_cutoff", default_of(condenser, "cutoff")),
                      tol=analysis.get("condensation_tol", default_of(condenser, "tol")))
+
+
+#: the analyses that run on a sector of a case file's ``[cyclic]`` table
+SECTOR_ANALYSES = ("cyclic-modes", "periodic", "sweep", "wear")
+
+
+def check_sector_analysis(model, name: str, analysis: dict) -> None:
+    """Refuse, in one line, an analysis that would treat a sector (``model.meta["cyclic"]``)
+    as a structure with free cyclic boundaries: those not in :data:`SECTOR_ANALYSES`, and a
+    sweep's linear references (contact-law-free FRFs of the whole model)."""
+    if model.meta.get("cyclic") is None:
+        return
+    if name not in SECTOR_ANALYSES:
+        raise InputError(f'analysis.type = "{name}": not available on a sector ([cyclic]); '
+                         f"expected one of {', '.join(SECTOR_ANALYSES)}")
+    if analysis.get("linear_references"):
+        fail("analysis.linear_references", analysis["linear_references"],
+             "none on a sector ([cyclic]): the linear FRFs would leave its cyclic boundaries "
+             "free")
+
+
+@dataclass(frozen=True)
+class CyclicChoice:
+    """The condensation choice of a sector (:func:`condenser_of`): ``base``'s, with the
+    number of sectors ``n_sectors``, the ``engine_order`` and the harmonic index ``k = n EO
+    mod N`` of every harmonic ``n = 0 .. max_order`` in the summary and attributes."""
+
+    base: CondensationChoice
+    n_sectors: int
+    engine_order: int
+    max_order: int
+
+    def indices(self) -> np.ndarray:
+        """(max_order + 1,) the harmonic index of harmonics 0 .. max_order."""
+        return harmonic_index(np.arange(self.max_order + 1), self.engine_order, self.n_sectors)
+
+    def summary(self) -> str:
+        pairs = ", ".join(f"{n}: {k}" for n, k in enumerate(self.indices()))
+        return (f"{self.base.summary()}\ncyclic sector: N = {self.n_sectors}, engine order "
+                f"{self.engine_order}, harmonic index of each harmonic {{{pairs}}}")
+
+    def attributes(self) -> dict:
+        return {**self.base.attributes(), "cyclic_sectors": int(self.n_sectors),
+                "engine_order": int(self.engine_order),
+                "harmonic_index": self.indices().astype(np.int64)}
 
 
 def harmonic_balance_fields(solve: SolveOptions, eps_default, eps_doc: str) -> dict:

@@ -15,6 +15,7 @@ from collections.abc import Iterable, Mapping
 from types import MappingProxyType
 
 from fretwear.analyses.base import Analysis
+from fretwear.analyses.cyclic_modes import CYCLIC_MODES
 from fretwear.analyses.linear import FRF, MODES
 from fretwear.analyses.nonlinear_modes import NONLINEAR_MODES
 from fretwear.analyses.periodic import PERIODIC
@@ -25,8 +26,8 @@ from fretwear.errors import InputError
 from fretwear.io.schema import Table
 
 #: every analysis, in the order of ``docs/case-files.md``
-ANALYSES: tuple[Analysis, ...] = (MODES, FRF, PERIODIC, SWEEP, NONLINEAR_MODES, TRANSIENT,
-                                  INCREMENTAL_WEAR, WEAR)
+ANALYSES: tuple[Analysis, ...] = (MODES, FRF, CYCLIC_MODES, PERIODIC, SWEEP, NONLINEAR_MODES,
+                                  TRANSIENT, INCREMENTAL_WEAR, WEAR)
 
 
 def by_name(analyses: Iterable[Analysis]) -> Mapping[str, Analysis]:

@@ -20,7 +20,12 @@ from pathlib import Path
 
 from fretwear import __version__
 from fretwear.analyses.base import RunContext, RunOutput
-from fretwear.analyses.common import OPEN_ATTRIBUTE, WARNINGS_ATTRIBUTE, preload_notes
+from fretwear.analyses.common import (
+    OPEN_ATTRIBUTE,
+    WARNINGS_ATTRIBUTE,
+    check_sector_analysis,
+    preload_notes,
+)
 from fretwear.analyses.registry import analysis_tables, get
 from fretwear.errors import InputError, interrupted
 from fretwear.files import remove_stale_temporaries
@@ -168,6 +173,7 @@ def run_case(path: Path | str, outdir: Path | str | None = None, progress: bool 
     start = time.time()
     try:
         model = build_model(case)
+        check_sector_analysis(model, analysis.name, case.analysis)
         for note in observed_notes(case, model):
             say(note)
         open_names = None

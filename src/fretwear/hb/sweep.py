@@ -174,6 +174,11 @@ def _checkpoint_key(probs: Problems, grid, opts: SweepOptions, anchor) -> str | 
                 **opts.solve.key_changes(SWEEP_POINT, CHECKPOINT_SOLVE_KEYS),
                 "continuation": opts.continuation, "max_bisections": opts.max_bisections,
                 "check": opts.flag is not None, "time_domain": opts.time_domain is not None}
+    sector = getattr(probs.condenser, "sector", None)
+    if sector is not None:  # a sector (hb/cyclic.py): its symmetry and the engine order
+        settings["cyclic"] = [sector.n_sectors, probs.condenser.engine_order, sector.axis,
+                              sector.point, sector.left_dofs, sector.right_dofs,
+                              sector.neighbour]
     return fingerprint(probs.model, probs.basis, grid, settings)
 
 

@@ -16,6 +16,7 @@ The documentation ``docs/case-files.md`` is generated from these schemas
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import tomllib
 from collections.abc import Mapping
@@ -43,6 +44,7 @@ from fretwear.io.schema import (
     Vector,
     exactly_one,
     fail,
+    join,
     non_zero,
     render_table,
     requires,
@@ -279,6 +281,72 @@ CONTACT_MESH = Table(
 )
 OBSERVED_MESH = Dict(AnyOf((Vector(), Text())), key_doc="point names")
 
+
+def _cyclic_rules(out: dict, path: str) -> None:
+    """Rules of ``[cyclic]``: a unit axis, ``|engine_order| < sectors``, two boundaries."""
+    axis = out.get("axis")
+    if axis is not None and (len(axis) != 3 or abs(math.hypot(*axis) - 1.0) > 1e-9):
+        fail(join(path, "axis"), axis, "a unit vector of 3 components (e.g. [0, 0, 1])")
+    n, eo = out["sectors"], out["engine_order"]
+    if abs(eo) >= n:
+        fail(join(path, "engine_order"), eo,
+             f"an integer with |engine_order| < sectors = {n} (engine order EO + {n} gives "
+             f"the same sector response as EO: give it modulo {n})")
+    if out["left"] == out["right"]:
+        fail(join(path, "right"), out["right"], "a boundary other than left")
+
+
+CENTRIFUGAL = Table(
+    {
+        "speed": Field(_NON_NEG, "rotation speed Omega", required=True, unit="rad/s"),
+        "axis": Field(Vector((3,)), "unit vector of the rotation axis (default: that of "
+                      "[cyclic], else [0, 0, 1]; 2D: [0, 0, 1] or [0, 0, -1])"),
+        "point": Field(Vector(), "a point of the rotation axis (default: that of [cyclic], "
+                       "else the origin)", unit="m"),
+        "name": Field(Text(), "label of the load in output", default="centrifugal"),
+    },
+    checks=(non_zero("axis"),),
+    doc="Centrifugal loading: the body force rho Omega^2 r (r: the distance vector from the "
+    "axis) as a static load (waveform constant) added to the loads, on the undeformed "
+    "geometry; spin softening, stress stiffening and Coriolis forces are left out "
+    "(docs/theory.md, Centrifugal loading). Mesh models only.",
+)
+
+CYCLIC = Table(
+    {
+        "sectors": Field(Integer(lo=2), "number N of identical sectors of the disk",
+                         required=True),
+        "engine_order": Field(Integer(), "engine order EO of the travelling-wave excitation "
+                              "(sector j lags sector j-1 by EO 2 pi / N; negative: the wave "
+                              "travels the other way); |EO| < N", required=True),
+        "axis": Field(Vector((3,)), "unit vector of the rotation axis (right-hand rule; 2D: "
+                      "[0, 0, 1] or [0, 0, -1])", default=[0.0, 0.0, 1.0]),
+        "point": Field(Vector(), "a point of the rotation axis", default=[0.0, 0.0, 0.0],
+                       unit="m"),
+        "left": Field(Text(), "boundary or node set of the left cyclic boundary (theta = 0)",
+                      required=True),
+        "right": Field(Text(), "boundary or node set of the right cyclic boundary: left turned "
+                       "by +2 pi / N, node by node", required=True),
+        "tolerance": Field(_NON_NEG, "largest distance between a turned left node and its "
+                           "right node (default 1e-6 times the model size)", unit="m"),
+        "neighbour": Field(Text(), "name of the `[[contact]]` block between neighbouring "
+                           "sectors (a damper, a shroud): its `boundary` A touches the next "
+                           "sector's copy of its `partner` B (B turned by +2 pi / N lands on "
+                           "A)"),
+    },
+    checks=(_cyclic_rules,),
+    doc="One sector of a cyclically symmetric disk of N sectors under a travelling wave of "
+    "engine order EO (docs/theory.md, Cyclic symmetry): harmonic n lives in the harmonic "
+    "index k = n EO mod N and the right boundary is the left one turned and phased. Mesh "
+    "models only. Contact and observed nodes lie off the right boundary (it is the next "
+    "sector's left one). The condensation is exact, one per harmonic index (`condensation` "
+    "is not used). The results attributes `cyclic_sectors` (N), `engine_order` (EO) and "
+    "`harmonic_index` (the index k of harmonics 0, 1, .., the highest kept) say which family "
+    "each harmonic lives in; the wear is that of every sector (a tuned disk). Analyses: "
+    "`cyclic-modes`, `periodic`, `sweep` (without `linear_references`) and `wear`; the others "
+    "would leave the cyclic boundaries free and are refused.",
+)
+
 # --- matrices models ------------------------------------------------------------------
 def _normal_dofs_or_load(out: dict, path: str) -> None:
     """Rule: ``normal_dofs`` is given unless ``normal_load`` is (friction under a known load)."""
@@ -383,6 +451,8 @@ def _case_table(model_kind: str, analyses: Mapping[str, Table]) -> Table:
                                "holds a body (e.g. a Gmsh physical volume); a cell with all "
                                "its nodes in such a set takes its material, the others take "
                                "[material]", default={}),
+            "cyclic": Field(CYCLIC, "cyclic symmetry: the model is one sector of a disk"),
+            "centrifugal": Field(CENTRIFUGAL, "centrifugal loading at a rotation speed"),
         }
     fields["analysis"] = Field(Variant(dict(analyses), key_doc="analysis type"),
                                "what to compute", required=True)
@@ -412,7 +482,7 @@ def validate(raw: Mapping, analyses: Mapping[str, Table], base_dir: Path | str =
 
 # --- loading ----------------------------------------------------------------------------
 _MODEL_SECTIONS = ("model", "material", "damping", "springs", "fixed", "loads", "contact",
-                   "observed", "materials")
+                   "observed", "materials", "cyclic", "centrifugal")
 
 
 @dataclass(frozen=True)
@@ -654,7 +724,18 @@ def _build_from_mesh(m: dict, title: str, given: Mapping):
                for c in m["contact"]]
     observed = {k: _at(v) for k, v in m.get("observed", {}).items()} or None
     thickness = m["model"].get("thickness", 1.0) if mesh.dim == 2 else 1.0
-    return build.from_mesh(
+    cyc = m.get("cyclic")
+    neighbour = cyc.get("neighbour") if cyc else None
+    if neighbour is not None:
+        names = [c.name for c in contact]
+        _check_name(neighbour, "cyclic.neighbour", names)
+        spec = contact[names.index(neighbour)]
+        if spec.partner is None or spec.partner == spec.boundary:
+            fail("cyclic.neighbour", neighbour, "a [[contact]] block with a partner boundary "
+                 f"other than its boundary {spec.boundary!r} (the damper pairs a boundary "
+                 "with the next sector's copy of another one)")
+        contact = [c for c in contact if c.name != neighbour]
+    model = build.from_mesh(
         mesh,
         material,
         thickness=thickness,
@@ -666,6 +747,49 @@ def _build_from_mesh(m: dict, title: str, given: Mapping):
         observed=observed,
         name=title,
     )
+    if m.get("centrifugal"):
+        model = _spin(model, m["centrifugal"], cyc or {})
+    return model if cyc is None else _sector(model, cyc, spec if neighbour else None)
+
+
+def _spin(model, spin: dict, cyc: dict):
+    """``model`` with the ``[centrifugal]`` load added (axis and point: those of ``spin``,
+    else of ``[cyclic]``, else z through the origin)."""
+    from fretwear.model.rotation import centrifugal_load
+
+    axis = spin.get("axis", cyc.get("axis", [0.0, 0.0, 1.0]))
+    point = spin.get("point", cyc.get("point", [0.0, 0.0, 0.0]))
+    try:
+        load = centrifugal_load(model, spin["speed"], axis=axis, point=point,
+                                name=spin["name"])
+    except InputError as exc:
+        raise InputError(f"centrifugal: {exc}") from None
+    return dataclasses.replace(model, loads=[*model.loads, load])
+
+
+def _sector(model, cyc: dict, neighbour):
+    """The sector model of ``[cyclic]``, its :class:`~fretwear.model.cyclic.CyclicSector` in
+    ``model.meta["cyclic"]`` and its engine order in ``model.meta["engine_order"]`` (read by
+    :func:`fretwear.analyses.common.condenser_of`); mistakes name the ``cyclic`` keys."""
+    from fretwear.model.cyclic import cyclic_sector, neighbour_contact
+
+    mesh = model.mesh
+    anywhere = sorted(set(mesh.boundaries) | set(mesh.node_sets))
+    for key in ("left", "right"):
+        _check_name(cyc[key], f"cyclic.{key}", anywhere)
+    if mesh.dim == 2 and (cyc["axis"][0] != 0 or cyc["axis"][1] != 0):
+        fail("cyclic.axis", cyc["axis"], "[0, 0, 1] or [0, 0, -1] for a 2D model")
+    try:
+        sector = cyclic_sector(model, cyc["sectors"], cyc["left"], cyc["right"],
+                               axis=cyc["axis"], point=cyc["point"],
+                               tolerance=cyc.get("tolerance"))
+        if neighbour is not None:
+            sector = neighbour_contact(sector, neighbour)
+    except InputError as exc:
+        raise InputError(f"cyclic: {exc}") from None
+    sector.model.meta["cyclic"] = sector
+    sector.model.meta["engine_order"] = int(cyc["engine_order"])
+    return sector.model
 
 
 def _at(value):
@@ -882,6 +1006,8 @@ def case_docs(analyses: Mapping[str, Table]) -> str:
         '"set"`, a node set of one node. Matrices: `name = dof` or `name = [dofs]`. '
         "Results and figures use these names.\n"
     )
+    parts.append(render_table(CYCLIC, "## [cyclic] (meshes)"))
+    parts.append(render_table(CENTRIFUGAL, "## [centrifugal] (meshes)"))
     parts.append("## [analysis]\n\n`type` selects one of the analyses below (those registered "
                  "in this version).\n")
     for kind, table in analyses.items():

@@ -1,0 +1,148 @@
+"""A sector described by a case file ([cyclic]): the run equals the whole disk, and the bad
+inputs of the new keys are one-line messages naming the key.
+
+Reference: the disk of N turned copies of the Python sector of tests/helpers/cyclic.py
+(fretwear.model.cyclic.whole_disk), which the case file reproduces node by node."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from fretwear.analyses.run import load_case, run_case
+from fretwear.errors import InputError
+from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.options import SolveOptions
+from fretwear.hb.periodic import solve_periodic
+from fretwear.io.case import build_model
+from fretwear.io.results import read_results
+from fretwear.model.cyclic import whole_disk
+from tests.helpers.cyclic import sector_model, write_sector_case
+
+N, EO = 8, 3
+PERIODIC = ('[analysis]\ntype = "periodic"\nfrequency = 9000.0\nharmonics = 3\n'
+            'n_samples = 32\neps = 3e9\ntol = 1e-13\nmax_iter = 200\n')
+
+
+def test_case_file_sector_equals_the_disk(tmp_path):
+    """The periodic analysis of the case-file sector (tip friction and an inter-blade
+    contact between neighbours, EO 3 of N = 8: harmonics 1-3 in indices 3, 6, 1) equals one
+    DLFT solve of the whole disk assembled from the Python sector at the same eps: sector
+    0's contact harmonics to 1e-8 relative (the agreement of the exact reduction, tests/hb/
+    test_cyclic.py; the results file adds only its write). The results record N, EO and
+    the harmonic index of every harmonic."""
+    path, _ = write_sector_case(tmp_path, N, EO, slit=True, analysis=PERIODIC)
+    out = run_case(path, progress=False, echo=False)
+    assert out.success
+    ds = read_results(out.results)
+    sector, model = sector_model(N, slit=True)
+    sol_d = solve_periodic(whole_disk(sector, EO), FourierBasis((1, 2, 3), 32),
+                           frequency=9000.0, eps=3e9,
+                           options=SolveOptions(tol=1e-13, max_iter=200))
+    assert sol_d.success
+    nc = model.contact.n_nodes
+    U = ds["contact_displacement_coefficients"].values
+    U_d = sol_d.U[:nc]
+    assert U.shape == U_d.shape
+    assert np.max(np.abs(U - U_d)) < 1e-8 * np.abs(U_d).max()
+    assert int(ds.attrs["cyclic_sectors"]) == N and int(ds.attrs["engine_order"]) == EO
+    np.testing.assert_array_equal(np.atleast_1d(ds.attrs["harmonic_index"]), [0, 3, 6, 1])
+    assert ds.attrs["condensation"] == "exact"
+
+
+BAD = [
+    ("match", "point = [0.001, 0.0, 0.0]", "cyclic: cyclic boundaries: left node 0 at "),
+    ("engine order", "engine_order = 8", "cyclic.engine_order = 8: expected an integer with "
+     "|engine_order| < sectors = 8"),
+    ("axis", "axis = [0.0, 0.0, 2.0]", "cyclic.axis = [0.0, 0.0, 2.0]: expected a unit vector"),
+    ("self-pairing", "", 'cyclic.neighbour = "neighbours": expected a [[contact]] block with a '
+     "partner boundary other than its boundary"),
+]
+
+
+@pytest.mark.parametrize("what, lines, message", BAD, ids=[b[0] for b in BAD])
+def test_bad_cyclic_keys(tmp_path, what, lines, message):
+    """Boundaries that do not match under the rotation, an engine order out of range, an
+    axis that is not a unit vector, a damper pairing a boundary with itself: one line
+    naming the key (the case file is otherwise valid: the good one builds)."""
+    path, _ = write_sector_case(tmp_path, N, EO, slit=True, analysis=PERIODIC)
+    build_model(load_case(path))  # the unchanged case is good
+    text = path.read_text()
+    if what == "self-pairing":
+        text = text.replace('partner = "slit_b"', 'partner = "slit_a"')
+    else:
+        table = text[text.index("[cyclic]"):]
+        keys = {line.split("=")[0].strip() for line in lines.splitlines()}
+        kept = "\n".join(line for line in table.splitlines()
+                         if line.split("=")[0].strip() not in keys)
+        text = text[:text.index("[cyclic]")] + kept.replace("[cyclic]", "[cyclic]\n" + lines,
+                                                            1)
+    path.write_text(text)
+    with pytest.raises(InputError) as err:
+        build_model(load_case(path))
+    assert str(err.value).startswith(message), str(err.value)
+    assert len(str(err.value).splitlines()) == 1
+
+
+def test_centrifugal_table(tmp_path):
+    """``[centrifugal]`` adds the load of fretwear.model.rotation.centrifugal_load (tested
+    against closed forms in tests/model/test_rotation.py) about the ``[cyclic]`` axis by
+    default, bit for bit; a bad axis names its key."""
+    from fretwear.model.rotation import centrifugal_load
+
+    path, _ = write_sector_case(tmp_path, N, EO, analysis=PERIODIC)
+    text = path.read_text()
+    path.write_text(text + "[centrifugal]\nspeed = 1500.0\n")
+    model = build_model(load_case(path))
+    _, ref = sector_model(N)
+    want = centrifugal_load(ref, 1500.0).vector
+    assert model.loads[-1].name == "centrifugal" and model.loads[-1].waveform == "constant"
+    np.testing.assert_array_equal(model.loads[-1].vector, want)
+    assert len(model.loads) == len(ref.loads) + 1
+    path.write_text(text + "[centrifugal]\nspeed = 1500.0\naxis = [0.0, 1.0, 0.0]\n")
+    with pytest.raises(InputError) as err:
+        build_model(load_case(path))
+    assert str(err.value).startswith("centrifugal: axis = [0.0, 1.0, 0.0]: a 2D sector turns")
+
+
+@pytest.mark.parametrize("analysis, message", [
+    ('[analysis]\ntype = "modes"\n', 'analysis.type = "modes": not available on a sector'),
+    ('[analysis]\ntype = "sweep"\nf_min = 1e4\nf_max = 1.2e4\nlinear_references = ["free"]\n',
+     'analysis.linear_references = ["free"]: expected none on a sector'),
+])
+def test_analyses_that_would_free_the_boundaries_are_refused(tmp_path, analysis, message):
+    """Analyses that would treat the sector as a structure with free cyclic boundaries (the
+    modes of the sector alone, a sweep's linear FRFs of the sector alone) are refused in one
+    line before anything runs."""
+    path, _ = write_sector_case(tmp_path, N, EO, analysis=analysis)
+    with pytest.raises(InputError) as err:
+        run_case(path, progress=False, echo=False)
+    assert str(err.value).startswith(message), str(err.value)
+    assert len(str(err.value).splitlines()) == 1
+
+
+def test_sweep_checkpoint_is_not_reused_for_another_engine_order(tmp_path):
+    """A sector sweep resumed with another engine order is refused as a checkpoint of another
+    sweep (its key holds N and EO: the model alone is the same sector, and without them the
+    stale points of EO 3 were taken for EO 2); with the same one it resumes (the sweep's own
+    report ``resumed_from``)."""
+    from fretwear.hb.cyclic import cyclic_condenser
+    from fretwear.hb.options import SweepOptions
+    from fretwear.hb.sweep import sweep
+
+    sector, model = sector_model(N)
+    basis = FourierBasis((1,), 16)
+    ck = tmp_path / "sweep.ckpt.npz"
+    opts = SweepOptions(eps=3e9, checkpoint=ck)
+    first = sweep(model, basis, 9000.0, 9500.0, 2, options=opts,
+                  condenser=cyclic_condenser(sector, 3))
+    assert first.success and ck.is_file()
+    resume = dataclasses.replace(opts, resume=True)
+    again = sweep(model, basis, 9000.0, 9500.0, 2, options=resume,
+                  condenser=cyclic_condenser(sector, 3))
+    assert again.resumed_from == 2
+    with pytest.raises(InputError, match="was written for a different model or different"):
+        sweep(model, basis, 9000.0, 9500.0, 2, options=resume,
+              condenser=cyclic_condenser(sector, 2))
