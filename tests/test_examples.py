@@ -476,7 +476,7 @@ def test_jenkins_nonlinear_modes_example_is_the_describing_function(tmp_path):
     test_nonlinear_modes.py derives it): ``w^2 = (k + K_eq(a)) / m``, ``zeta = D_eq(a) / (2 m
     w^2)``, the friction energy ``4 mu N (a - mu N / kt)`` per cycle (Masing) and the stick
     part of the period ``theta* / pi``, ``cos theta* = 1 - 2 mu N / (kt a)``, with ``a`` the
-    displacement amplitude read from the results (``mode_shape``), which must be the modal
+    displacement amplitude read from the results (``mode_harmonics``), which must be the modal
     amplitude over sqrt(m) (the definition of the modal amplitude of a one-mass structure:
     rounding). Tolerances: the sampling error of the stick-slip instants, O(N^-2): measured
     2.8e-7 (frequency) and 5.2e-6 (damping ratio), asserted 1e-4 (the issue's target);
@@ -495,7 +495,7 @@ def test_jenkins_nonlinear_modes_example_is_the_describing_function(tmp_path):
     m, k = 0.5, 2e5  # jenkins-M.mtx, jenkins-K.mtx
     kt, fs = spec["contact"]["kt"], spec["contact"]["mu"] * spec["contact"]["normal_load"]
     assert ds["converged"].values.all()
-    c = ds["mode_shape"].sel(point="mass", axis="x")
+    c = ds["mode_harmonics"].sel(point="mass", axis="x")
     a = np.hypot(c.sel(harmonic_coefficient="c1"), c.sel(harmonic_coefficient="s1")).values
     np.testing.assert_allclose(a * np.sqrt(m), ds["modal_amplitude"].values, rtol=1e-12)
     a_s = fs / kt
@@ -506,7 +506,7 @@ def test_jenkins_nonlinear_modes_example_is_the_describing_function(tmp_path):
     w = np.sqrt((k + K) / m)
     zeta = D / (2.0 * m * w * w)
     assert 0 < slip.sum() < slip.size  # from stuck to sliding
-    np.testing.assert_allclose(2 * np.pi * ds["natural_frequency"].values, w, rtol=1e-4)
+    np.testing.assert_allclose(2 * np.pi * ds["backbone_frequency"].values, w, rtol=1e-4)
     np.testing.assert_allclose(ds["damping_ratio"].values[slip], zeta[slip], rtol=1e-4)
     assert np.all(ds["damping_ratio"].values[~slip] == 0.0)
     np.testing.assert_allclose(ds["friction_energy"].values,

@@ -31,7 +31,7 @@ def test_cyclic_modes_analysis_gives_disk_frequencies(tmp_path):
     path.write_text(text)
     out = run_case(path, progress=False, echo=False)
     ds = read_results(out.results)
-    f = ds["natural_frequency"].values
+    f = ds["cyclic_frequency"].values
     assert f.shape == (N // 2 + 1, 2) and np.all(np.isfinite(f))
     check_documented(ds, "cyclic-modes")
     assert (tmp_path / "sector-results" / "nodal-diameter-diagram.png").is_file()

@@ -36,7 +36,7 @@ def run_cyclic_modes(model, analysis: dict, case, context: RunContext) -> RunOut
                                          "their frequencies)"),
               "mode": variable("mode", np.arange(1, freq.shape[1] + 1), "1",
                                "mode number within the family")}
-    ds = xr.Dataset({"natural_frequency": variable(("nodal_diameter", "mode"), freq, "Hz",
+    ds = xr.Dataset({"cyclic_frequency": variable(("nodal_diameter", "mode"), freq, "Hz",
                                                    "natural frequency of the disk, contact "
                                                    "free")}, coords=coords)
     ds.attrs.update({"cyclic_sectors": int(n)})
@@ -56,7 +56,7 @@ def plot_nodal_diameters(ds: xr.Dataset, path: Path | str, *, title: str | None 
     ax = axes[0, 0]
     nd = ds["nodal_diameter"].values
     for m in ds["mode"].values:
-        f = ds["natural_frequency"].sel(mode=m).values
+        f = ds["cyclic_frequency"].sel(mode=m).values
         ax.plot(nd, f, marker="o", label=f"family {m}")
     ax.set_xlabel("nodal diameter")
     ax.set_ylabel("natural frequency [Hz]")

@@ -104,7 +104,7 @@ def modes_dataset(model, bb: Backbone, amplitudes: np.ndarray, points: list[str]
     conv = np.zeros(na, dtype=np.int8)
     conv[:done] = [p.success for p in bb.points]
     data.update({
-        "natural_frequency": variable(a, field("frequency"), "Hz",
+        "backbone_frequency": variable(a, field("frequency"), "Hz",
                                       "natural frequency of the nonlinear mode"),
         "damping_ratio": variable(a, field("damping_ratio"), "1",
                                   "damping ratio of the nonlinear mode, xi / (2 omega)"),
@@ -117,7 +117,7 @@ def modes_dataset(model, bb: Backbone, amplitudes: np.ndarray, points: list[str]
                                     "energy dissipated by friction per period"),
         "dissipated_energy": variable((a, "contact_node"), node_e, "J",
                                       "energy dissipated by friction per period at the node"),
-        "mode_shape": variable((a, "point", "axis", "harmonic_coefficient"), coef, "m",
+        "mode_harmonics": variable((a, "point", "axis", "harmonic_coefficient"), coef, "m",
                                "real Fourier coefficients of the observed displacement"),
         "response_amplitude": variable((a, "point", "axis", "harmonic"), amp, "m",
                                        "amplitude of each kept harmonic of the observed "
@@ -141,7 +141,7 @@ def _summary(bb: Backbone, ds: xr.Dataset) -> str:
     if bb.message:
         lines.append(bb.message)
     if n:
-        f, z = ds["natural_frequency"].values, ds["damping_ratio"].values
+        f, z = ds["backbone_frequency"].values, ds["damping_ratio"].values
         a = ds["modal_amplitude"].values
         j = int(np.nanargmax(z))
         lines.append(f"frequency {plots.format_frequency(f[0])} at {a[0]:.3g} {AMPLITUDE_UNIT}"
@@ -250,7 +250,7 @@ def plot_backbone(ds: xr.Dataset, path: Path, *, title: str | None = None) -> Pa
     """Natural frequency and damping ratio against the modal amplitude (log x), and the
     amplitude of harmonic 1 of the observed points (the backbone)."""
     a = ds["modal_amplitude"].values
-    f = ds["natural_frequency"].values
+    f = ds["backbone_frequency"].values
     z = ds["damping_ratio"].values
     rows = 3 if ds.sizes.get("point", 0) else 2
     fig, axes = plots.new_figure(rows, 1, title=title, panel_size=(7.5, 3.0), sharex=True)
