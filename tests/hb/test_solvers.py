@@ -196,12 +196,15 @@ def test_powell_inexact_newton_steps_reach_the_same_root():
     assert loose and loose[0] == solvers.FORCING_MAX and loose[-1] < 1e-3
 
 
-def test_powell_redoes_a_poor_inexact_step_exactly():
-    """An inexact step that the model served poorly (ratio of actual to predicted decrease
-    below 0.1) and that did not decrease |f| is redone on the same Jacobian to the full
-    accuracy (``rtol`` None) before the next iteration: on x^2 + 1 = 0 (no root) every
-    first step on a new Jacobian fails, so every loose request is followed by an exact one
-    with the same Jacobian (the iterate unchanged in between)."""
+def test_powell_redoes_a_poor_inexact_step_exactly(monkeypatch):
+    """With ``POOR_STEP_FULL_ACCURACY``, an inexact step that the model served poorly (ratio
+    of actual to predicted decrease below 0.1) and that did not decrease |f| is redone on
+    the same Jacobian to the full accuracy (``rtol`` None) before the next iteration: on
+    x^2 + 1 = 0 (no root) every first step on a new Jacobian fails, so every loose request
+    is followed by an exact one with the same Jacobian (the iterate unchanged in between)."""
+    from fretwear.hb import solvers
+
+    monkeypatch.setattr(solvers, "POOR_STEP_FULL_ACCURACY", True)
     asked, at = [], []
 
     class Recording(InexactOperator):
@@ -218,3 +221,28 @@ def test_powell_redoes_a_poor_inexact_step_exactly():
     for i, a in enumerate(asked[:-1]):
         if a is not None:
             assert asked[i + 1] is None and at[i + 1] == at[i]
+
+
+def test_powell_keeps_inexact_steps_after_a_poor_step_by_default():
+    """By default (``POOR_STEP_FULL_ACCURACY`` False) a poor inexact step is neither redone
+    nor followed by full-accuracy steps: on x^2 + 1 = 0 (no root: every step is poor, the
+    case where the other setting asks for an exact step after each loose one) every request
+    is loose (``rtol`` given) and no Jacobian is solved twice."""
+    from fretwear.hb import solvers
+
+    assert solvers.POOR_STEP_FULL_ACCURACY is False
+    asked, at = [], []
+
+    class Recording(InexactOperator):
+        def solve(self, b, rtol=None):
+            at.append(self.J[0, 0])
+            return super().solve(b, rtol)
+
+    def op(x, need_jacobian):
+        f = np.array([x[0] ** 2 + 1.0])
+        return f, (Recording(np.array([[2 * x[0]]]), asked) if need_jacobian else None)
+
+    _, _, st = solve(op, [0.3], lambda x: 1.0, tol=1e-12, max_iter=30)
+    assert not st.success and len(asked) > 4
+    assert all(a is not None for a in asked)
+    assert all(at[i + 1] != at[i] for i in range(len(at) - 1))
