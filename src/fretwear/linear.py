@@ -201,7 +201,10 @@ def _eig_dense(K, M, sigma: float):
 def _eig_sparse(K, M, k: int, sigma: float):
     """The ``k`` eigenpairs nearest ``sigma`` by shift-invert Lanczos (M may be singular)."""
     try:
-        lam, X = spla.eigsh(K, k=k, M=M, sigma=sigma, which="LM")
+        # a fixed start vector (SciPy's default draws fresh entropy: degenerate modes would
+        # differ by rounding from run to run)
+        lam, X = spla.eigsh(K, k=k, M=M, sigma=sigma, which="LM",
+                            v0=np.random.default_rng(0).standard_normal(K.shape[0]))
     except RuntimeError as exc:  # singular K - sigma M
         raise InputError(
             "the constrained structure has a motion with neither stiffness nor mass "

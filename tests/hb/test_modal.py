@@ -147,3 +147,33 @@ def test_undamped_blocks_are_stored_real(loss_factor):
     assert rel(red.Z[1], exact.Z[1]) < 1e-5
     if loss_factor:  # the damping is in the imaginary part: K (1 + i eta) on harmonic 1
         assert np.abs(red.Z[1].imag).max() > 1e-3 * np.abs(red.Z[1].real).max()
+
+
+REPRODUCE = """
+import hashlib, sys
+import numpy as np
+from fretwear.hb.modal import ModalCondenser
+from fretwear.model import ContactSpec, Material, Spring, Traction, box, from_mesh
+m = from_mesh(box(0.01, 0.01, 0.005, 4, 4, 2), Material(210e9, 0.3, 7800.0),
+              supports=[Spring("zmax", "x", 1e7), Spring("zmax", "y", 1e7)],
+              loads=[Traction("zmax", pressure=1e6)], contact=ContactSpec("zmin", mu=0.5))
+c = ModalCondenser(m, 20e3, 3, modes=12)
+red = c.reduced(2 * np.pi * 15e3, np.arange(4))
+print(hashlib.sha256(np.ascontiguousarray(red.Z).tobytes()).hexdigest())
+"""
+
+
+def test_modal_condensation_is_the_same_in_every_process():
+    """The modal condensation of the square block (whose fixed-interface modes come in
+    degenerate pairs by its symmetry) gives the same Z_r bit for bit in two fresh processes:
+    the Lanczos run starts from a fixed vector. SciPy's default start is drawn from fresh
+    entropy, and the basis of a degenerate eigenspace, hence Z_r to rounding, and a large
+    partial-slip solve's path with it, changed from run to run (a resumed wear run rebuilds
+    its condenser in a new process and must continue the same trajectory)."""
+    import subprocess
+    import sys
+
+    out = [subprocess.run([sys.executable, "-c", REPRODUCE], capture_output=True, text=True,
+                          timeout=300) for _ in range(2)]
+    assert all(o.returncode == 0 for o in out), out[0].stderr
+    assert out[0].stdout == out[1].stdout and len(out[0].stdout.strip()) == 64

@@ -204,7 +204,8 @@ def cyclic_modes(sector: CyclicSector, k: int, n_modes: int = 6) -> tuple[np.nda
     if free.size <= DENSE_MODES:
         w2, X = sla.eigh(K.toarray(), M.toarray(), subset_by_index=[0, n_modes - 1])
     else:
-        w2, X = spla.eigsh(K.tocsc(), n_modes, M.tocsc(), sigma=0.0, which="LM")
+        w2, X = spla.eigsh(K.tocsc(), n_modes, M.tocsc(), sigma=0.0, which="LM",
+                           v0=np.random.default_rng(0).standard_normal(K.shape[0]))
         order = np.argsort(w2)
         w2, X = w2[order], X[:, order]
     q = np.zeros((red.ndof, n_modes), dtype=complex)

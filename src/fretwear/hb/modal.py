@@ -203,7 +203,11 @@ class ModalCondenser(Condenser):
             return np.zeros(0), np.zeros((n, 0))
         k = min(modes if modes is not None else 20, n - 2)
         while True:
-            lam, Phi = spla.eigsh(Kii, k=k, M=Mii, sigma=0.0, which="LM", OPinv=op)
+            # a fixed start vector: SciPy's default is drawn from fresh entropy, and the modes
+            # of a degenerate eigenspace (a square pad) then differ by rounding from run to
+            # run, and with them every result computed from the condensation
+            lam, Phi = spla.eigsh(Kii, k=k, M=Mii, sigma=0.0, which="LM", OPinv=op,
+                                  v0=np.random.default_rng(0).standard_normal(n))
             order = np.argsort(lam)
             lam, Phi = lam[order], Phi[:, order]
             f = np.sqrt(np.maximum(lam, 0.0)) / (2 * np.pi)

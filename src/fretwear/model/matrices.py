@@ -77,7 +77,8 @@ def _most_negative_eigenvalue(S: sp.csr_matrix) -> float:
         return float(np.linalg.eigvalsh(S.toarray())[0])
     import scipy.sparse.linalg as spla
 
-    return float(spla.eigsh(S.tocsc(), k=1, which="SA", return_eigenvectors=False)[0])
+    return float(spla.eigsh(S.tocsc(), k=1, which="SA", return_eigenvectors=False,
+                            v0=np.random.default_rng(0).standard_normal(S.shape[0]))[0])
 
 
 def negative_eigenvalues(S: sp.csr_matrix, shift: float) -> int | None:

@@ -222,7 +222,8 @@ def rigid_motion_check(K, held_dofs, *, dense_limit: int = 600) -> None:
         lam, V = sla.eigh(S.toarray())
         lam, V = lam[:6], V[:, :6]
     else:
-        lam, V = spla.eigsh(S.tocsc(), k=6, sigma=-1e-6 * scale, which="LM")
+        lam, V = spla.eigsh(S.tocsc(), k=6, sigma=-1e-6 * scale, which="LM",
+                            v0=np.random.default_rng(0).standard_normal(S.shape[0]))
     bad = lam < 1e-12 * scale
     if not np.any(bad):
         return

@@ -70,7 +70,8 @@ def fixed_interface_modes(Kii, Mii, w_cut: float | None, n_modes: int | None):
     k = n_modes if n_modes is not None else 20
     while True:
         k = min(k, ni - 2)
-        w2, V = spla.eigsh(Kii.tocsc(), k=k, M=Mii.tocsc(), sigma=0.0, which="LM")
+        w2, V = spla.eigsh(Kii.tocsc(), k=k, M=Mii.tocsc(), sigma=0.0, which="LM",
+                           v0=np.random.default_rng(0).standard_normal(Kii.shape[0]))
         order = np.argsort(w2)
         w2, V = w2[order], V[:, order]
         if n_modes is not None:
