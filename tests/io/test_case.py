@@ -463,3 +463,23 @@ def test_matrices_contact_needs_normal_dofs_or_a_normal_load(tmp_path):
     assert msg.startswith("[contact]: missing 'normal_dofs'")
     msg = error_of(folder, MATRICES.replace("mu = 0.2", "mu = 0.2\nkt = 0.0"))
     assert msg.startswith("contact.kt = 0.0: expected")
+
+
+@pytest.mark.parametrize("line, message", [
+    ("normal_load = -1.0", "contact.normal_load = -1.0: expected a number >= 0"),
+    ("normal_load = [1.0, -2.0]", "contact.normal_load"),
+])
+def test_prescribed_normal_load_in_tension_is_refused(tmp_path, line, message):
+    """A prescribed normal load is compressive: a negative one (tension, a slip threshold
+    mu N < 0 that the friction law cannot mean) was accepted silently; now one InputError
+    names the key (the same rule holds for a mesh contact's normal_pressure)."""
+    folder = tmp_path / "m"
+    folder.mkdir()
+    scipy.io.mmwrite(folder / "K.mtx", sp.coo_matrix(np.eye(2)))
+    scipy.io.mmwrite(folder / "M.mtx", sp.coo_matrix(np.eye(2)))
+    text = ('[model]\ntype = "matrices"\nK = "K.mtx"\nM = "M.mtx"\n'
+            f'[contact]\ntangential_dofs = [0, 1]\nmu = 0.5\n{line}\nkt = 0.5\n'
+            '[analysis]\ntype = "modes"\n')
+    with pytest.raises(InputError, match=message.replace("[", r"\[")) as err:
+        load_case(write(folder, text))
+    assert "\n" not in str(err.value)

@@ -266,10 +266,11 @@ CONTACT_MESH = Table(
         "tangential_stiffness": Field(_CONTACT_K, "tangential contact stiffness per unit area "
                                       "(a finite value makes each node a Jenkins element; "
                                       "inf: rigid)", default=math.inf, unit="Pa/m"),
-        "normal_pressure": Field(Number(), "friction under a prescribed normal load: the "
-                                 "normal pressure p (each node carries p x its area x "
-                                 "g(omega t), whatever its normal motion; slip threshold mu "
-                                 "times that); absent: unilateral contact", unit="Pa"),
+        "normal_pressure": Field(_NON_NEG, "friction under a prescribed normal load: the "
+                                 "normal pressure p >= 0, compressive (each node carries p x "
+                                 "its area x g(omega t), whatever its normal motion; slip "
+                                 "threshold mu times that); absent: unilateral contact",
+                                 unit="Pa"),
         "normal_waveform": _NORMAL_WAVEFORM,
     },
     checks=(non_zero("normal", "tangent"),
@@ -396,10 +397,11 @@ CONTACT_MATRICES = Table(
                     "tangential contact stiffness, one value or one per node (a finite value "
                     "makes each node a Jenkins element; inf: rigid)", default=math.inf,
                     unit="N/m"),
-        "normal_load": Field(AnyOf((Number(), ListOf(Number(), non_empty=True))),
+        "normal_load": Field(AnyOf((_NON_NEG, ListOf(_NON_NEG, non_empty=True))),
                              "friction under a prescribed normal load: each node's normal force "
-                             "N, one value or one per node (N x g(omega t), whatever the normal "
-                             "motion; slip threshold mu N); absent: unilateral contact",
+                             "N >= 0 (compressive), one value or one per node (N x g(omega t), "
+                             "whatever the normal motion; slip threshold mu N); absent: "
+                             "unilateral contact",
                              unit="N"),
         "normal_waveform": _NORMAL_WAVEFORM,
     },
