@@ -196,15 +196,10 @@ def test_powell_inexact_newton_steps_reach_the_same_root():
     assert loose and loose[0] == solvers.FORCING_MAX and loose[-1] < 1e-3
 
 
-def test_powell_redoes_a_poor_inexact_step_exactly(monkeypatch):
-    """With ``POOR_STEP_FULL_ACCURACY``, an inexact step that the model served poorly (ratio
-    of actual to predicted decrease below 0.1) and that did not decrease |f| is redone on
-    the same Jacobian to the full accuracy (``rtol`` None) before the next iteration: on
-    x^2 + 1 = 0 (no root) every first step on a new Jacobian fails, so every loose request
-    is followed by an exact one with the same Jacobian (the iterate unchanged in between)."""
-    from fretwear.hb import solvers
-
-    monkeypatch.setattr(solvers, "POOR_STEP_FULL_ACCURACY", True)
+def _powell_without_root():
+    """Powell on x^2 + 1 = 0 (no root: every step is poor) from x = 0.3 with an inexact
+    operator Jacobian: ``(stats, asked, at)``, the ``rtol`` of every solve request (None:
+    full accuracy) and the Jacobian each was made with."""
     asked, at = [], []
 
     class Recording(InexactOperator):
@@ -217,6 +212,19 @@ def test_powell_redoes_a_poor_inexact_step_exactly(monkeypatch):
         return f, (Recording(np.array([[2 * x[0]]]), asked) if need_jacobian else None)
 
     _, _, st = solve(op, [0.3], lambda x: 1.0, tol=1e-12, max_iter=30)
+    return st, asked, at
+
+
+def test_powell_redoes_a_poor_inexact_step_exactly(monkeypatch):
+    """With ``POOR_STEP_FULL_ACCURACY``, an inexact step that the model served poorly (ratio
+    of actual to predicted decrease below 0.1) and that did not decrease |f| is redone on
+    the same Jacobian to the full accuracy (``rtol`` None) before the next iteration: on
+    x^2 + 1 = 0 (no root) every first step on a new Jacobian fails, so every loose request
+    is followed by an exact one with the same Jacobian (the iterate unchanged in between)."""
+    from fretwear.hb import solvers
+
+    monkeypatch.setattr(solvers, "POOR_STEP_FULL_ACCURACY", True)
+    st, asked, at = _powell_without_root()
     assert not st.success and len(asked) > 4
     for i, a in enumerate(asked[:-1]):
         if a is not None:
@@ -231,18 +239,7 @@ def test_powell_keeps_inexact_steps_after_a_poor_step_by_default():
     from fretwear.hb import solvers
 
     assert solvers.POOR_STEP_FULL_ACCURACY is False
-    asked, at = [], []
-
-    class Recording(InexactOperator):
-        def solve(self, b, rtol=None):
-            at.append(self.J[0, 0])
-            return super().solve(b, rtol)
-
-    def op(x, need_jacobian):
-        f = np.array([x[0] ** 2 + 1.0])
-        return f, (Recording(np.array([[2 * x[0]]]), asked) if need_jacobian else None)
-
-    _, _, st = solve(op, [0.3], lambda x: 1.0, tol=1e-12, max_iter=30)
+    st, asked, at = _powell_without_root()
     assert not st.success and len(asked) > 4
     assert all(a is not None for a in asked)
     assert all(at[i + 1] != at[i] for i in range(len(at) - 1))
