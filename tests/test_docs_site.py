@@ -52,3 +52,13 @@ def test_every_docs_page_is_in_the_site_navigation():
     assert pages
     missing = [p for p in pages if p not in nav]
     assert not missing, f"pages missing from mkdocs.yml nav: {missing}"
+
+
+def test_the_api_reference_lists_every_public_name():
+    """docs/reference/python.md (scripts/write_api_reference.py) has an entry for every name
+    of fretwear's public table: a name added without its reference entry fails here."""
+    import fretwear
+
+    page = (ROOT / "docs" / "reference" / "python.md").read_text()
+    missing = [n for n, m in fretwear._API.items() if f"::: {m}.{n}\n" not in page]
+    assert not missing, f"run scripts/write_api_reference.py; missing: {missing}"
