@@ -30,9 +30,9 @@ predictor), ``"substep"`` (bisection of the step from the last converged point),
 continuation past a fold, :mod:`fretwear.hb.arclength`), the rungs 3-4 of a single solve
 from the neighbour (at the first point of a branch, which has none, from the contact-closed
 guess with a single solve's iterations), ``"fresh-start"`` (as a single solve from the first
-harmonic alone with the static anchors and five times the iterations: the neighbour's state can lie on the wrong
-side of a jump of the mean position) and ``"time-start"`` (a time integration from the
-neighbour). Single-solve rungs that ``SolveOptions.strategy`` leaves out are left out of a
+harmonic alone with the static anchors and five times the iterations: the neighbour's state
+can lie on the wrong side of a jump of the mean position) and ``"time-start"`` (a time
+integration from the neighbour). Single-solve rungs that ``SolveOptions.strategy`` leaves out are left out of a
 sweep point too.
 """
 
