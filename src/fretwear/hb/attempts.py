@@ -32,8 +32,8 @@ from the neighbour (at the first point of a branch, which has none, from the con
 guess with a single solve's iterations), ``"fresh-start"`` (as a single solve from the first
 harmonic alone with the static anchors and five times the iterations: the neighbour's state
 can lie on the wrong side of a jump of the mean position) and ``"time-start"`` (a time
-integration from the neighbour). Single-solve rungs that ``SolveOptions.strategy`` leaves out are left out of a
-sweep point too.
+integration from the neighbour). Single-solve rungs that ``SolveOptions.strategy`` leaves
+out are left out of a sweep point too.
 """
 
 from __future__ import annotations
