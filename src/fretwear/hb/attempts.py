@@ -28,11 +28,12 @@ Sweep point (:class:`Point`; :data:`POINT_RUNGS`): ``"grid"`` (the solver from t
 predictor), ``"substep"`` (bisection of the step from the last converged point),
 ``"retry"`` (the other solver from the neighbour), ``"arclength"`` (pseudo-arclength
 continuation past a fold, :mod:`fretwear.hb.arclength`), the rungs 3-4 of a single solve
-from the neighbour, ``"fresh-start"`` (as a single solve from the first harmonic alone with
-the static anchors and five times the iterations: the neighbour's state can lie on the wrong
-side of a jump of the mean position) and ``"time-start"`` (a time integration from the
-neighbour). Single-solve rungs that ``SolveOptions.strategy`` leaves out are left out of a
-sweep point too.
+from the neighbour (at the first point of a branch, which has none, from the contact-closed
+guess with a single solve's iterations), ``"fresh-start"`` (as a single solve from the first
+harmonic alone with the static anchors and five times the iterations: the neighbour's state
+can lie on the wrong side of a jump of the mean position) and ``"time-start"`` (a time
+integration from the neighbour). Single-solve rungs that ``SolveOptions.strategy`` leaves
+out are left out of a sweep point too.
 """
 
 from __future__ import annotations
@@ -48,7 +49,7 @@ from fretwear.hb.branch import Branch, Problems
 from fretwear.hb.connectors import Connected
 from fretwear.hb.fallback import TimeDomainFallback
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.options import STRATEGY, SolveOptions, SweepOptions
+from fretwear.hb.options import PERIODIC, STRATEGY, SolveOptions, SweepOptions
 from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.reduce import Reduced
 from fretwear.hb.solution import Attempt
@@ -477,11 +478,16 @@ def _single(p: Point, prob: DLFTProblem, x0, options: SolveOptions, rungs, how) 
 def continuation(p: Point) -> bool:
     """``"eps-continuation"``, then ``"harmonic-continuation"``, from the last converged
     point (the contact-closed guess before any), ending at the sweep's eps (no eps jump)."""
-    b = p.branch
+    b, so = p.branch, p.options.solve
     pb = p.probs.get(p.omega, b.anchor())
-    x0 = b.history[-1][1] if b.history else pb.initial_guess()
-    return _single(p, pb, x0, p.options.solve, ("eps-continuation", "harmonic-continuation"),
-                   None)
+    if b.history:
+        return _single(p, pb, b.history[-1][1], so,
+                       ("eps-continuation", "harmonic-continuation"), None)
+    # the first point of a branch has no neighbour to start from: it gets the iterations of a
+    # single solve (PERIODIC), not the few of a warm-started point
+    first = so.replace(max_iter=max(so.max_iter, PERIODIC.max_iter))
+    return _single(p, pb, pb.initial_guess(), first,
+                   ("eps-continuation", "harmonic-continuation"), None)
 
 
 def fresh_start(p: Point) -> bool:
