@@ -118,6 +118,8 @@ def read_dmig(path) -> dict[str, tuple[DofMap, DofMap, sp.coo_matrix, int]]:
         gj, cj = _int(f[1], where), _int(f[2], where)
         entries = f[4:]
         n_groups = len(entries) // 4
+        if not any(e.strip() for e in entries):
+            raise InputError(f"{where}: column ({gj}, {cj}) has no terms (a truncated card?)")
         for g in range(n_groups):
             gi, ci, a = entries[4 * g:4 * g + 3]
             if not gi and not ci and not a:
