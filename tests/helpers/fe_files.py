@@ -80,7 +80,7 @@ def write_dmig(path, matrices: dict, dofs: DofMap) -> None:
             if rows.size == 0:
                 continue
             fields = [name, str(dofs.node[j]), str(dofs.component[j]), ""]
-            for r, v in zip(rows, vals):
+            for r, v in zip(rows, vals, strict=True):
                 fields += [str(dofs.node[r]), str(dofs.component[r]),
                            f"{v:.9E}".replace("E", "D"), ""]
             lines += _large(fields)
@@ -132,7 +132,7 @@ def write_abaqus_matrix_input(path, A, dofs: DofMap) -> None:
     """``row node, row DOF, column node, column DOF, value`` lines (lower triangle)."""
     L = sp.tril(sp.coo_matrix(A)).tocoo()
     lines = [f"{dofs.node[i]},{dofs.component[i]}, {dofs.node[j]},{dofs.component[j]}, {v:.16E}"
-             for i, j, v in zip(L.row, L.col, L.data)]
+             for i, j, v in zip(L.row, L.col, L.data, strict=True)]
     path.write_text("\n".join(lines) + "\n")
 
 

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-np.in1d = np.isin  # removed in NumPy 2.4, still used by pyNastran 1.4.1
+np.in1d = np.isin  # noqa: NPY201  (removed in NumPy 2.4, still used by pyNastran 1.4.1)
 import scipy.sparse as sp  # noqa: E402
 from pyNastran.bdf.bdf import BDF  # noqa: E402
 from pyNastran.op4.op4 import OP4  # noqa: E402

@@ -6,10 +6,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 import scipy.sparse as sp
+from helpers import fe_files
 
 from fretwear.errors import InputError
 from fretwear.model.readers import DofMap, read_fe
-from helpers import fe_files
 
 
 def _samples():

@@ -8,14 +8,14 @@ import dataclasses
 import numpy as np
 import pytest
 import scipy.sparse as sp
+from helpers import fe_files as ff
+from helpers.blocks import block
 
 from fretwear import simulate_wear, solve_periodic
 from fretwear.errors import InputError
 from fretwear.hb.fourier import FourierBasis
 from fretwear.model.readers import FEMatrices, NodeContact, from_fe, read_fe, write_dofmap
 from fretwear.wear import WearOptions
-from helpers import fe_files as ff
-from helpers.blocks import block
 
 BASIS = FourierBasis.up_to(3, 32)
 F_HZ = 2000.0

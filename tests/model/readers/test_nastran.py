@@ -6,11 +6,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 import scipy.sparse as sp
+from helpers import fe_files
 
 from fretwear.errors import InputError
 from fretwear.model.readers import read_fe, write_dofmap
 from fretwear.model.readers.nastran import nastran_real, read_dmig, read_op4
-from helpers import fe_files
 
 DATA = Path(__file__).resolve().parents[2] / "data" / "fe"
 

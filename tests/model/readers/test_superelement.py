@@ -6,6 +6,8 @@ scalar points (as Nastran's EXTSEOUT punches it) reads back as a model."""
 
 import numpy as np
 import pytest
+from helpers import fe_files as ff
+from helpers.blocks import block
 
 from fretwear import simulate_wear, solve_periodic
 from fretwear.errors import InputError
@@ -14,8 +16,6 @@ from fretwear.linear import modes
 from fretwear.model.core import Load
 from fretwear.model.readers import FEMatrices, craig_bampton, from_fe, read_fe
 from fretwear.wear import WearOptions
-from helpers import fe_files as ff
-from helpers.blocks import block
 
 BASIS = FourierBasis.up_to(3, 32)
 F_HZ = 2000.0

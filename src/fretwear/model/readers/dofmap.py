@@ -79,7 +79,8 @@ class DofMap:
                                and np.all(nodes == np.round(nodes))):
             raise InputError(f"{what} = {nodes[:4].tolist()!r}...; expected integer node ids")
         nodes = nodes.astype(np.int64)
-        lookup = {(int(n), int(c)): i for i, (n, c) in enumerate(zip(self.node, self.component))}
+        pairs = zip(self.node.tolist(), self.component.tolist(), strict=True)
+        lookup = {(n, c): i for i, (n, c) in enumerate(pairs)}
         known = set(self.node.tolist())
         out = np.empty((nodes.size, len(components)), dtype=np.int64)
         for i, n in enumerate(nodes.tolist()):
@@ -170,5 +171,5 @@ def read_dofmap(path) -> DofMap:
 def write_dofmap(path, dofs: DofMap) -> None:
     """Write ``dofs`` as a text file that :func:`read_dofmap` reads."""
     lines = ["# node component (one line per row of the matrices)"]
-    lines += [f"{n} {c}" for n, c in zip(dofs.node.tolist(), dofs.component.tolist())]
+    lines += [f"{n} {c}" for n, c in zip(dofs.node.tolist(), dofs.component.tolist(), strict=True)]
     Path(path).write_text("\n".join(lines) + "\n")

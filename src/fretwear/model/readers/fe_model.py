@@ -16,7 +16,7 @@ import numpy as np
 
 from fretwear.errors import InputError
 from fretwear.model.build import Damping
-from fretwear.model.core import Load, Model, ObservedPoint
+from fretwear.model.core import Load, Model
 from fretwear.model.matrices import ContactDofs, from_matrices
 from fretwear.model.readers.dofmap import FEMatrices
 from fretwear.model.readers.nodes import NodeTable
@@ -128,7 +128,7 @@ def _contact_dofs(contacts, fe: FEMatrices, table, dim: int) -> tuple[ContactDof
         parts.append((c, ids, rows, prow, frames))
     nc = [p[1].size for p in parts]
     per = lambda f: np.concatenate([np.broadcast_to(np.asarray(f(p[0]), dtype=float),  # noqa: E731
-                                                    (n,)) for p, n in zip(parts, nc)])
+                                                    (n,)) for p, n in zip(parts, nc, strict=True)])
     rows = np.concatenate([p[2] for p in parts])
     paired = [p[3] is not None for p in parts]
     if any(paired) and not all(paired):

@@ -119,9 +119,8 @@ def _abaqus_nodes(text: str, src: str) -> NodeTable:
 def _ansys_nodes(text: str, src: str) -> NodeTable:
     ids, xyz, sets = [], [], {}
     lines = text.splitlines()
-    k = 0
     try:
-        _ansys_blocks(lines, ids, xyz, sets)
+        _ansys_blocks(lines, ids, xyz, sets, src)
     except (ValueError, IndexError):
         raise InputError(f"{src}: cannot read its NBLOCK or CMBLOCK (a truncated or malformed "
                          "file?)") from None
@@ -129,9 +128,8 @@ def _ansys_nodes(text: str, src: str) -> NodeTable:
                      sets)
 
 
-def _ansys_blocks(lines, ids, xyz, sets) -> None:
+def _ansys_blocks(lines, ids, xyz, sets, src: str) -> None:
     k = 0
-    src = "cdb"
     while k < len(lines):
         head = lines[k].strip().upper()
         if head.startswith("NBLOCK"):
