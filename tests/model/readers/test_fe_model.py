@@ -183,3 +183,22 @@ def test_normals_give_frames(mesh_model):
     np.testing.assert_allclose(np.abs(m1.contact.frame[:, 1]), np.abs(m0.contact.frame[:, 1]),
                                atol=1e-15)
     assert sp.issparse(m1.K)
+
+
+def test_partners_from_a_node_set_are_paired_by_position():
+    """Partners given as a node set are matched to the contact nodes at their positions (the
+    set lists them in another order); a partner face that does not match is one line."""
+    from fretwear.model.readers import DofMap, NodeTable
+
+    dofs = DofMap(np.repeat([1, 2, 3, 4], 2), np.tile([1, 2], 4))
+    fe = FEMatrices(sp.identity(8, format="csr") * 1e6, sp.identity(8, format="csr"), dofs)
+    xyz = np.array([[0.0, 0, 0], [1, 0, 0], [1, 0, 0], [0, 0, 0]])
+    table = NodeTable(np.array([1, 2, 3, 4]), xyz, {"upper": np.array([1, 2]),
+                                                    "lower": np.array([3, 4])})
+    pair = NodeContact(nodes="upper", partners="lower", mu=0.3, normal=[0.0, -1.0])
+    model = from_fe(fe, contact=pair, nodes=table)
+    np.testing.assert_array_equal(model.contact.partner_ids, [4, 3])
+    np.testing.assert_array_equal(model.contact.partner_dofs, [[6, 7], [4, 5]])
+    table.xyz[3] = [0.5, 0.0, 0.0]
+    with pytest.raises(InputError, match="node 1 has no partner at its position"):
+        from_fe(fe, contact=pair, nodes=table)

@@ -117,6 +117,8 @@ def _contact_dofs(contacts, fe: FEMatrices, table, dim: int) -> tuple[ContactDof
         prow = None
         if c.partners is not None:
             pids = _ids(c.partners, table, f"{label} partners")
+            if isinstance(c.partners, str):  # a node set: each node's coincident partner
+                pids = _coincident(ids, pids, table, dim, f"{label} partners")
             if pids.size != ids.size:
                 raise InputError(f"{label}: {pids.size} partners for {ids.size} nodes; expected "
                                  "one partner per node")
@@ -125,7 +127,7 @@ def _contact_dofs(contacts, fe: FEMatrices, table, dim: int) -> tuple[ContactDof
             raise InputError(f"{label}: give either normal or frames (the contact directions)")
         frames = (frames_from_normals(c.normal, ids.size, dim, f"{label} normal")
                   if c.frames is None else np.asarray(c.frames, dtype=float))
-        parts.append((c, ids, rows, prow, frames))
+        parts.append((c, ids, rows, prow, frames, None if c.partners is None else pids))
     nc = [p[1].size for p in parts]
     per = lambda f: np.concatenate([np.broadcast_to(np.asarray(f(p[0]), dtype=float),  # noqa: E731
                                                     (n,)) for p, n in zip(parts, nc, strict=True)])
@@ -148,11 +150,27 @@ def _contact_dofs(contacts, fe: FEMatrices, table, dim: int) -> tuple[ContactDof
         kn=stiff["kn"], kt=stiff["kt"])
     extra = {"mu": per(lambda c: c.mu), "wear": per(lambda c: c.wear_coefficient),
              "pwear": per(lambda c: c.partner_wear_coefficient), "ids": ids,
-             "pids": (np.concatenate([_ids(p[0].partners, table, "partners") for p in parts])
-                      if all(paired) else None),
+             "pids": np.concatenate([p[5] for p in parts]) if all(paired) else None,
              "interface": np.repeat(np.arange(len(parts)), nc),
              "names": tuple(str(p[0].name) for p in parts)}
     return contact, extra
+
+
+def _coincident(ids, pool, table: NodeTable, dim: int, what: str, rtol=1e-6) -> np.ndarray:
+    """For each node of ``ids`` the node of ``pool`` at its position (within ``rtol`` times
+    the size of the nodes' extent)."""
+    from scipy.spatial import cKDTree
+
+    a = table.coordinates(ids, dim, what)
+    b = table.coordinates(pool, dim, what)
+    size = float(np.linalg.norm(np.ptp(np.vstack([a, b]), axis=0))) or 1.0
+    dist, k = cKDTree(b).query(a)
+    far = np.flatnonzero(dist > rtol * size)
+    if far.size:
+        raise InputError(f"{what}: node {int(ids[far[0]])} has no partner at its position "
+                         f"(nearest {dist[far[0]]:.3g} m away, tolerance {rtol * size:.3g} m); "
+                         "expected coincident nodes on the two faces")
+    return np.asarray(pool, dtype=np.int64)[k]
 
 
 def _loads(loads, fe: FEMatrices, table, dim: int) -> list[Load]:
