@@ -463,8 +463,9 @@ CONTACT_FE = Table(
     {
         "nodes": Field(_NODES, "contact node ids, or the name of a node set of the `nodes` "
                        "file", required=True),
-        "partners": Field(_NODES, "node-to-node pairs: each node's partner on the other body "
-                          "(same order), ids or a node set"),
+        "partners": Field(_NODES, "node-to-node pairs: each node's partner on the other body, "
+                          "ids in the order of `nodes`, or a node set (each node paired with "
+                          "the set's node at its position)"),
         "normal": Field(Vector(), "the normal of every node, pointing from its body into the "
                         "obstacle (or the partner's body); the tangents are chosen from it",
                         required=True),
@@ -1045,7 +1046,9 @@ Items of arrays of tables are numbered from 1 in messages: `loads[2]` is the sec
 
 A model is either a finite element mesh (`model.type` = `"rectangle"`, `"box"` or `"mesh"`)
 or user matrices (`"matrices"`). The sections `[contact]`, `[[loads]]` and `[observed]`
-differ between the two; `[material]`, `[[springs]]` and `[[fixed]]` exist for meshes only.
+differ between the two; `[material]` and `[[springs]]` exist for meshes only, `[[fixed]]` for
+meshes and for matrices exported by an FE code (`format` or `dofmap` in `[model]`: the
+sections then name nodes by id, see "Exporting matrices from an FE code").
 
 ## Top level
 
@@ -1056,7 +1059,7 @@ differ between the two; `[material]`, `[[springs]]` and `[[fixed]]` exist for me
 | `[material]` | elastic material (meshes, required) |
 | `[damping]` | structural damping (optional) |
 | `[[springs]]` | grounded springs (meshes, optional) |
-| `[[fixed]]` | held displacement components (meshes, optional) |
+| `[[fixed]]` | held displacement components (meshes, FE matrices; optional) |
 | `[[loads]]` | loads (optional) |
 | `[contact]` | the frictional interface, or `[[contact]]` blocks for several (required) |
 | `[observed]` | points (meshes) or DOFs (matrices) whose motion is reported (optional) |
@@ -1108,9 +1111,10 @@ names. Give the code's input file as `nodes` for coordinates and node sets.
 
 - **Nastran**: a superelement with `EXTSEOUT(ASMBULK, EXTID=1, DMIGPCH)` (boundary grids on
   `ASET`/`BSET`, modes on `QSET` scalar points, `SPOINT`s) punches `KAAX`, `MAAX` (`BAAX`,
-  `K4AX` with damping) as DMIG cards: `format = "dmig"`, `K = "model.pch"`. Full matrices:
-  `PARAM,EXTOUT,DMIGPCH` or a DMAP `OUTPUT4` of `KGG`/`MGG` (`format = "op4"`, ASCII
-  `FORMATTED`, with a `dofmap` file; `names` gives other matrix names).
+  `K4AX` with damping) as DMIG cards (so does the older `PARAM,EXTOUT,DMIGPCH`):
+  `format = "dmig"`, `K = "model.pch"`. Full matrices: a DMAP `OUTPUT4` of `KGG`/`MGG`
+  (`format = "op4"`, ASCII `FORMATTED`, with a `dofmap` file; `names = {K = "KGG", M =
+  "MGG"}`).
 - **Abaqus**: `*SUBSTRUCTURE GENERATE` with `*RETAINED NODAL DOFS` (contact and observed
   nodes) and `*SUBSTRUCTURE MATRIX OUTPUT, STIFFNESS=YES, MASS=YES` writes one `.mtx` file:
   `format = "abaqus"`. Full matrices: `*MATRIX GENERATE, STIFFNESS, MASS` then `*MATRIX OUTPUT,
