@@ -109,7 +109,7 @@ def _abaqus_nodes(text: str, src: str) -> NodeTable:
                     sets[current].extend(range(a, b + 1, step))
                 else:
                     sets[current].extend(int(t) for t in tok)
-        except ValueError:
+        except (ValueError, IndexError):
             raise InputError(f"{src}, line {k}: {line[:60]!r}; expected numbers (a node set "
                              "given by name inside *NSET is not read)") from None
     return NodeTable(np.array(ids, dtype=np.int64), np.array(xyz, dtype=float).reshape(-1, 3),
