@@ -107,6 +107,32 @@ _THICKNESS = Field(
 )
 
 # --- [model] --------------------------------------------------------------------------
+FE_FORMATS = ("dmig", "op4", "abaqus", "abaqus-matrix-input", "ansys-full", "matrix-market",
+              "harwell-boeing")
+_ONE_FILE = ("dmig", "op4", "abaqus", "ansys-full")
+
+
+def fe_mode(model: Mapping) -> bool:
+    """A ``matrices`` model whose rows are named by node id (``format`` or ``dofmap`` given)."""
+    return model.get("type") == "matrices" and ("format" in model or "dofmap" in model)
+
+
+def _matrices_files(out: dict, path: str) -> None:
+    """Rules: M is given unless one file holds every matrix; DOF-numbering keys only without
+    node ids."""
+    fmt = out.get("format", "matrix-market")
+    if fmt in _ONE_FILE:
+        for key in ("M", "C", "D"):
+            if key in out:
+                raise InputError(f"{join(path, key)}: format {fmt!r} holds every matrix in "
+                                 "`K`; remove this key")
+    elif "M" not in out:
+        raise InputError(f"missing required key {join(path, 'M')!r} (mass matrix file)")
+    if ("format" in out or "dofmap" in out) and out.get("fixed_dofs"):
+        raise InputError(f"{join(path, 'fixed_dofs')}: the rows are named by node ids "
+                         "(format/dofmap given): hold nodes with [[fixed]] blocks")
+
+
 MODEL_TYPES = {
     "rectangle": Table(
         {
@@ -144,20 +170,41 @@ MODEL_TYPES = {
     ),
     "matrices": Table(
         {
-            "K": Field(FilePath(), "stiffness matrix (Matrix Market .mtx)", required=True,
-                       unit="N/m"),
-            "M": Field(FilePath(), "mass matrix (Matrix Market .mtx)", required=True,
-                       unit="kg"),
+            "K": Field(FilePath(), "stiffness matrix (Matrix Market .mtx by default), or the "
+                       "one file holding every matrix (`format` dmig, op4, abaqus, ansys-full)",
+                       required=True, unit="N/m"),
+            "M": Field(FilePath(), "mass matrix (Matrix Market .mtx by default); not with a "
+                       "one-file `format`", unit="kg"),
             "C": Field(FilePath(), "viscous damping matrix (Matrix Market .mtx)", unit="N s/m"),
             "D": Field(FilePath(), "hysteretic damping matrix (Matrix Market .mtx): adds i D "
                        "to the dynamic stiffness of harmonics n >= 1", unit="N/m"),
-            "fixed_dofs": Field(ListOf(_DOF, unique=True), "DOFs held at zero (Dirichlet)",
+            "fixed_dofs": Field(ListOf(_DOF, unique=True), "DOFs held at zero (Dirichlet; "
+                                "DOF numbering only: with node ids use `[[fixed]]`)",
                                 default=[]),
             "first_dof": Field(Choice((0, 1)), "number of the first DOF in every DOF list "
                                "of this case file: 0 (Python) or 1 (Matlab, Matrix Market rows)",
                                default=0),
+            "format": Field(Text(FE_FORMATS), "the FE code's file format; given (or with "
+                            "`dofmap`), every section names nodes by their ids: "
+                            '"dmig" (Nastran punch or bulk data), "op4" (ASCII), "abaqus" '
+                            '(*SUBSTRUCTURE MATRIX OUTPUT .mtx), "abaqus-matrix-input" '
+                            '(*MATRIX GENERATE files), "ansys-full" (needs fretwear[ansys]), '
+                            '"harwell-boeing" (ANSYS HBMAT), "matrix-market"'),
+            "dofmap": Field(FilePath(), "the node id and component (1-6; 0 a scalar point) of "
+                            "each row, one `node component` line a row, or ANSYS's .mapping "
+                            "file: for op4, matrix-market and harwell-boeing"),
+            "nodes": Field(FilePath(), "the mesh the matrices came from (.bdf, .inp, .cdb): "
+                           "node coordinates (output) and node sets (names in sections)"),
+            "names": Field(Dict(Text(), key_ok=lambda k: k in ("K", "M", "C", "D"),
+                                key_doc='"K", "M", "C", "D"'),
+                           "DMIG or OP4 matrix names, e.g. {K = \"KGG\", M = \"MGG\"} "
+                           "(default KAAX, MAAX, BAAX, K4AX as EXTSEOUT punches them)"),
         },
-        doc="User matrices: DOF numbers are row numbers of K (counted from `first_dof`).",
+        checks=(_matrices_files,),
+        doc="User matrices: DOF numbers are row numbers of K (counted from `first_dof`), or, "
+        "with `format` or `dofmap`, matrices exported by an FE code whose rows are named by "
+        "node id and component: then `[[contact]]`, `[[loads]]`, `[[fixed]]` and `[observed]` "
+        "name nodes by id or node set (the `(FE matrices)` sections below).",
     ),
 }
 MODEL = Variant(MODEL_TYPES, key_doc="kind of model")
@@ -410,6 +457,53 @@ CONTACT_MATRICES = Table(
 )
 OBSERVED_MATRICES = Dict(AnyOf((_DOF, ListOf(_DOF, non_empty=True))), key_doc="point names")
 
+# --- matrices exported by an FE code: everything named by node ids -------------------------
+_NODES = AnyOf((ListOf(Integer(lo=0), non_empty=True, unique=True), Text()))
+CONTACT_FE = Table(
+    {
+        "nodes": Field(_NODES, "contact node ids, or the name of a node set of the `nodes` "
+                       "file", required=True),
+        "partners": Field(_NODES, "node-to-node pairs: each node's partner on the other body, "
+                          "ids in the order of `nodes`, or a node set (each node paired with "
+                          "the set's node at its position)"),
+        "normal": Field(Vector(), "the normal of every node, pointing from its body into the "
+                        "obstacle (or the partner's body); the tangents are chosen from it",
+                        required=True),
+        "mu": _MU,
+        "gap": Field(Number(), "initial normal gap (>= 0 open, < 0 interference)", default=0.0,
+                     unit="m"),
+        "area": Field(AnyOf((_POSITIVE, ListOf(_POSITIVE, non_empty=True))),
+                      "tributary area, one value or one per node", default=1.0, unit="m^2"),
+        "wear_coefficient": _WEAR,
+        "partner_wear_coefficient": Field(_NON_NEG, "Archard coefficient of the partners' "
+                                          "surface", default=0.0, unit="1/Pa"),
+        "name": _CONTACT_NAME,
+    },
+    doc="A frictional interface on nodes of the exported matrices, one `[[contact]]` block "
+    "each (all node-to-rigid, or all with `partners`).",
+)
+LOAD_FE = Table(
+    {
+        "nodes": Field(_NODES, "loaded node ids, or a node set", required=True),
+        "force": Field(Vector(), "force vector on every node of `nodes`", required=True,
+                       unit="N"),
+        "waveform": _WAVEFORM,
+        "coefficients": _COEFFICIENTS,
+        "name": _LOAD_NAME,
+    },
+    checks=(_fourier_coefficients,),
+    doc="Nodal forces `F(t) = force * g(omega t)` on each node, one `[[loads]]` block each.",
+)
+FIXED_FE = Table(
+    {
+        "nodes": Field(_NODES, "held node ids, or a node set", required=True),
+        "direction": Field(Text(AXES + ("all",)), 'the component held at zero ("all": every '
+                           "component of the nodes in the matrices)", default="all"),
+    },
+    doc="Held components of nodes, one `[[fixed]]` block each.",
+)
+OBSERVED_FE = Dict(AnyOf((Integer(lo=0), Text())), key_doc="point names")
+
 # --- [output] and the whole file --------------------------------------------------------
 OUTPUT = Table(
     {
@@ -428,7 +522,19 @@ _TITLE = Field(Text(), "one line describing the case (used in figures and result
 
 
 def _case_table(model_kind: str, analyses: Mapping[str, Table]) -> Table:
-    if model_kind == "matrices":
+    if model_kind == "fe":
+        fields = {
+            "title": _TITLE,
+            "model": Field(MODEL, "the structure", required=True),
+            "damping": Field(DAMPING, "structural damping"),
+            "fixed": Field(TableList(FIXED_FE), "held node components", default=[]),
+            "loads": Field(TableList(LOAD_FE), "nodal forces", default=[]),
+            "contact": Field(TableList(CONTACT_FE), "the frictional interfaces",
+                             required=True),
+            "observed": Field(OBSERVED_FE, "nodes (id or one-node set) whose motion is "
+                              "reported", default={}),
+        }
+    elif model_kind == "matrices":
         fields = {
             "title": _TITLE,
             "model": Field(MODEL, "the structure", required=True),
@@ -476,8 +582,10 @@ def validate(raw: Mapping, analyses: Mapping[str, Table], base_dir: Path | str =
     """
     model = raw.get("model")
     kind = model.get("type") if isinstance(model, Mapping) else None
+    if kind == "matrices" and fe_mode(model):
+        kind = "fe"
     raw = {"damping": {}, "output": {}, **raw}  # absent tables get their defaults
-    return _case_table("matrices" if kind == "matrices" else "mesh", analyses).check(
+    return _case_table(kind if kind in ("matrices", "fe") else "mesh", analyses).check(
         raw, "", Context(Path(base_dir))
     )
 
@@ -596,6 +704,10 @@ def build_model(case: Case):
     Names (boundaries, node sets, observed points) and vector sizes are checked against
     the mesh here so that the message names the case-file key.
     """
+    if case.model_kind == "matrices" and fe_mode(case.model["model"]):
+        from fretwear.io.fe_case import build_from_fe
+
+        return build_from_fe(case.model, case.title)
     if case.model_kind == "matrices":
         return _build_from_matrices(case.model, case.title)
     return _build_from_mesh(case.model, case.title, given=case.raw["model"])
@@ -934,7 +1046,9 @@ Items of arrays of tables are numbered from 1 in messages: `loads[2]` is the sec
 
 A model is either a finite element mesh (`model.type` = `"rectangle"`, `"box"` or `"mesh"`)
 or user matrices (`"matrices"`). The sections `[contact]`, `[[loads]]` and `[observed]`
-differ between the two; `[material]`, `[[springs]]` and `[[fixed]]` exist for meshes only.
+differ between the two; `[material]` and `[[springs]]` exist for meshes only, `[[fixed]]` for
+meshes and for matrices exported by an FE code (`format` or `dofmap` in `[model]`: the
+sections then name nodes by id, see "Exporting matrices from an FE code").
 
 ## Top level
 
@@ -945,7 +1059,7 @@ differ between the two; `[material]`, `[[springs]]` and `[[fixed]]` exist for me
 | `[material]` | elastic material (meshes, required) |
 | `[damping]` | structural damping (optional) |
 | `[[springs]]` | grounded springs (meshes, optional) |
-| `[[fixed]]` | held displacement components (meshes, optional) |
+| `[[fixed]]` | held displacement components (meshes, FE matrices; optional) |
 | `[[loads]]` | loads (optional) |
 | `[contact]` | the frictional interface, or `[[contact]]` blocks for several (required) |
 | `[observed]` | points (meshes) or DOFs (matrices) whose motion is reported (optional) |
@@ -987,6 +1101,34 @@ printed in the run summary (`condensation: ...`) and stored as results attribute
 """
 
 
+_DOC_FE = """\
+## Exporting matrices from an FE code
+
+With `format` (or `dofmap`) in `[model]`, the rows of the matrices are named by node id and
+component, and a Craig-Bampton superelement is read like any matrices: its contact and observed
+nodes must be boundary (retained) nodes, its modal coordinates are scalar points that nothing
+names. Give the code's input file as `nodes` for coordinates and node sets.
+
+- **Nastran**: a superelement with `EXTSEOUT(ASMBULK, EXTID=1, DMIGPCH)` (boundary grids on
+  `ASET`/`BSET`, modes on `QSET` scalar points, `SPOINT`s) punches `KAAX`, `MAAX` (`BAAX`,
+  `K4AX` with damping) as DMIG cards (so does the older `PARAM,EXTOUT,DMIGPCH`):
+  `format = "dmig"`, `K = "model.pch"`. Full matrices: a DMAP `OUTPUT4` of `KGG`/`MGG`
+  (`format = "op4"`, ASCII `FORMATTED`, with a `dofmap` file; `names = {K = "KGG", M =
+  "MGG"}`).
+- **Abaqus**: `*SUBSTRUCTURE GENERATE` with `*RETAINED NODAL DOFS` (contact and observed
+  nodes) and `*SUBSTRUCTURE MATRIX OUTPUT, STIFFNESS=YES, MASS=YES` writes one `.mtx` file:
+  `format = "abaqus"`. Full matrices: `*MATRIX GENERATE, STIFFNESS, MASS` then `*MATRIX OUTPUT,
+  STIFFNESS=YES, MASS=YES, FORMAT=MATRIX INPUT`: `format = "abaqus-matrix-input"`, `K` and `M`
+  the `_STIF1.mtx` and `_MASS1.mtx` files.
+- **ANSYS**: a substructure (`ANTYPE,SUBSTR` with `SEOPT` and master DOFs `M` on the contact
+  and observed nodes, `CMSOPT` for component modes) or a full model leaves `file.full`
+  (`WRFULL,1` stops after writing it): `format = "ansys-full"` (needs `pip install
+  'fretwear[ansys]'`). Without that package: `HBMAT,K,txt,,ASCII,STIFF,NO,YES` and
+  `HBMAT,M,txt,,ASCII,MASS,NO,YES` write Harwell-Boeing files and `K.mapping`:
+  `format = "harwell-boeing"`, `dofmap = "K.mapping"`.
+"""
+
+
 def case_docs(analyses: Mapping[str, Table]) -> str:
     """The Markdown of ``docs/case-files.md``, generated from the schemas (``analyses``: the
     schema of each analysis type, as for :func:`validate`)."""
@@ -1002,11 +1144,15 @@ def case_docs(analyses: Mapping[str, Table]) -> str:
     parts.append(render_table(LOAD_MATRICES, "## [[loads]] (matrices)"))
     parts.append(render_table(CONTACT_MESH, "## [contact] (meshes)"))
     parts.append(render_table(CONTACT_MATRICES, "## [contact] (matrices)"))
+    parts.append(render_table(CONTACT_FE, "## [[contact]] (FE matrices)"))
+    parts.append(render_table(LOAD_FE, "## [[loads]] (FE matrices)"))
+    parts.append(render_table(FIXED_FE, "## [[fixed]] (FE matrices)"))
+    parts.append(_DOC_FE)
     parts.append(
         "## [observed]\n\nOne key per point. Meshes: `name = [x, y(, z)]`, the node nearest "
         "to these coordinates [m] (its exact position is in the results), or `name = "
-        '"set"`, a node set of one node. Matrices: `name = dof` or `name = [dofs]`. '
-        "Results and figures use these names.\n"
+        '"set"`, a node set of one node. Matrices: `name = dof` or `name = [dofs]`; FE '
+        "matrices: `name = node id` or a one-node set. Results and figures use these names.\n"
     )
     parts.append(render_table(CYCLIC, "## [cyclic] (meshes)"))
     parts.append(render_table(CENTRIFUGAL, "## [centrifugal] (meshes)"))

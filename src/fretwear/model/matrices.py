@@ -301,13 +301,25 @@ def from_matrices(K, M, *, contact: ContactDofs, damping: Damping | None = None,
         name=str(name),
         meta={"source": "matrices"},
     )
-    # the DOF nearest to each normal is held; for pairs in the relative coordinates, where
-    # it holds n . (U_a - U_b)
-    frame = interface.frame
-    held = np.union1d(dofs[np.arange(dofs.shape[0]), np.argmax(np.abs(frame[:, 0, :]), axis=1)],
-                      fixed)
-    rigid_motion_check(relative_model(model)[0].K, held)
+    # each node's normal displacement is held: in the axes of its frame (for pairs in the
+    # relative coordinates, where it holds n . (U_a - U_b))
+    K_rel = relative_model(model)[0].K
+    R = _frame_rotation(dofs, interface.frame, K_rel.shape[0])
+    rigid_motion_check((R.T @ K_rel @ R).tocsr(), np.union1d(dofs[:, 0], fixed))
     return model
+
+
+def _frame_rotation(dofs: np.ndarray, frame: np.ndarray, n: int) -> sp.csr_matrix:
+    """``R`` (n, n) with ``U = R V``: on each contact node's DOFs ``V`` holds its local
+    displacement ``[u_N, u_T..] = frame @ U[dofs]`` (normal first), elsewhere ``V = U``."""
+    nc, d = dofs.shape
+    keep = np.ones(n, dtype=bool)
+    keep[dofs.ravel()] = False
+    rows = np.concatenate([np.flatnonzero(keep), np.repeat(dofs, d, axis=1).ravel()])
+    cols = np.concatenate([np.flatnonzero(keep), np.tile(dofs, (1, d)).ravel()])
+    # R[dofs_i[a], dofs_i[b]] = frame_i[b, a]: U[dofs_i] = frame_i^T u_loc
+    vals = np.concatenate([np.ones(keep.sum()), np.swapaxes(frame, 1, 2).reshape(-1)])
+    return sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
 
 
 def _contact_dofs(contact: ContactDofs, K, M):

@@ -1,0 +1,188 @@
+"""Node coordinates and node sets of the mesh that exported matrices came from, read from the
+FE code's input file: Nastran bulk data (``GRID`` cards, basic coordinates), Abaqus ``.inp``
+(``*NODE``, ``*NSET``) and ANSYS ``.cdb`` (``NBLOCK``, node components ``CMBLOCK``).
+
+Only the positions are read (frames, pairing, output); the matrices carry the mechanics.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from fretwear.errors import InputError
+from fretwear.model.readers.nastran import _fields, nastran_real
+
+
+@dataclass
+class NodeTable:
+    """Node ids, their coordinates [m] (n, 3) and named node sets (name -> ids)."""
+
+    ids: np.ndarray
+    xyz: np.ndarray
+    node_sets: dict[str, np.ndarray] = field(default_factory=dict)
+
+    def coordinates(self, ids, dim: int, what: str) -> np.ndarray:
+        """Coordinates (len(ids), dim) of the given node ids."""
+        ids = np.asarray(ids, dtype=np.int64).reshape(-1)
+        order = np.argsort(self.ids)
+        pos = np.searchsorted(self.ids[order], ids).clip(0, max(self.ids.size - 1, 0))
+        bad = (self.ids.size == 0) | (self.ids[order][pos] != ids)
+        if np.any(bad):
+            raise InputError(f"{what}: node {int(ids[np.flatnonzero(bad)[0]])} is not in the "
+                             "node file; expected nodes of the mesh the matrices came from")
+        return self.xyz[order[pos], :dim]
+
+
+def read_nodes(path) -> NodeTable:
+    """The nodes of a Nastran (``.bdf``, ``.dat``, ``.nas``, ``.blk``), Abaqus (``.inp``) or
+    ANSYS (``.cdb``) input file."""
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"node file {str(path)!r} does not exist")
+    suffix = path.suffix.lower()
+    text = path.read_text(errors="replace")
+    if suffix == ".inp":
+        table = _abaqus_nodes(text, str(path))
+    elif suffix == ".cdb":
+        table = _ansys_nodes(text, str(path))
+    elif suffix in (".bdf", ".dat", ".nas", ".blk", ".pch", ".fem"):
+        table = _nastran_nodes(text, str(path))
+    else:
+        raise InputError(f"node file {str(path)!r}: unknown suffix {suffix!r}; expected .bdf "
+                         "(.dat, .nas), .inp or .cdb")
+    if table.ids.size == 0:
+        raise InputError(f"node file {str(path)!r} defines no node")
+    return table
+
+
+def _nastran_nodes(text: str, src: str) -> NodeTable:
+    ids, xyz = [], []
+    lines = text.splitlines()
+    for k, raw in enumerate(lines):
+        line = raw.split("$")[0].expandtabs(8)
+        first, data = _fields(line)
+        if first.upper().rstrip("*") != "GRID":
+            continue
+        if first.endswith("*"):  # large field: x, y on this line, z on the continuation
+            data = data + _fields(lines[k + 1].expandtabs(8))[1] if k + 1 < len(lines) else data
+        where = f"{src}, line {k + 1} (GRID)"
+        if data[1].strip() not in ("", "0"):
+            raise InputError(f"{where}: coordinate system CP = {data[1]}; expected positions "
+                             "in the basic system (CP blank or 0)")
+        try:
+            ids.append(int(data[0]))
+        except ValueError:
+            raise InputError(f"{where}: node id {data[0]!r}; expected an integer") from None
+        xyz.append([nastran_real(v or "0", where) for v in data[2:5]])
+    return NodeTable(np.array(ids, dtype=np.int64), np.array(xyz, dtype=float).reshape(-1, 3))
+
+
+def _abaqus_nodes(text: str, src: str) -> NodeTable:
+    ids, xyz, sets = [], [], {}
+    state, current, generate = None, None, False
+    for k, raw in enumerate(text.splitlines(), start=1):
+        line = raw.strip()
+        if not line or line.startswith("**"):
+            continue
+        if line.startswith("*"):
+            parts = [p.strip() for p in line[1:].split(",")]
+            key = parts[0].upper()
+            params = {p.partition("=")[0].strip().upper(): p.partition("=")[2].strip()
+                      for p in parts[1:]}
+            state = key if key in ("NODE", "NSET") else None
+            if key == "NSET":
+                current = params.get("NSET", "")
+                generate = "GENERATE" in params
+                sets.setdefault(current, [])
+            continue
+        tok = [t for t in line.rstrip(",").split(",") if t.strip()]
+        try:
+            if state == "NODE":
+                ids.append(int(tok[0]))
+                xyz.append(([float(t) for t in tok[1:4]] + [0.0, 0.0])[:3])
+            elif state == "NSET":
+                if generate:
+                    a, b, step = (int(t) for t in (tok + ["1"])[:3])
+                    sets[current].extend(range(a, b + 1, step))
+                else:
+                    sets[current].extend(int(t) for t in tok)
+        except (ValueError, IndexError):
+            raise InputError(f"{src}, line {k}: {line[:60]!r}; expected numbers (a node set "
+                             "given by name inside *NSET is not read)") from None
+    return NodeTable(np.array(ids, dtype=np.int64), np.array(xyz, dtype=float).reshape(-1, 3),
+                     {name: np.array(v, dtype=np.int64) for name, v in sets.items()})
+
+
+def _ansys_nodes(text: str, src: str) -> NodeTable:
+    ids, xyz, sets = [], [], {}
+    lines = text.splitlines()
+    try:
+        _ansys_blocks(lines, ids, xyz, sets, src)
+    except (ValueError, IndexError):
+        raise InputError(f"{src}: cannot read its NBLOCK or CMBLOCK (a truncated or malformed "
+                         "file?)") from None
+    return NodeTable(np.array(ids, dtype=np.int64), np.array(xyz, dtype=float).reshape(-1, 3),
+                     sets)
+
+
+def _ansys_blocks(lines, ids, xyz, sets, src: str) -> None:
+    k = 0
+    while k < len(lines):
+        head = lines[k].strip().upper()
+        if head.startswith("NBLOCK"):
+            fmt = lines[k + 1]
+            widths = _fortran_widths(fmt, src, k + 2)
+            k += 2
+            while k < len(lines) and not lines[k].strip().startswith(("N,", "-1")):
+                vals = _fixed_columns(lines[k], widths)
+                ids.append(int(vals[0]))
+                coords = [float(v) if v.strip() else 0.0 for v in vals[3:6]]
+                xyz.append((coords + [0.0, 0.0, 0.0])[:3])
+                k += 1
+        elif head.startswith("CMBLOCK"):
+            parts = [p.strip() for p in lines[k].split("!")[0].split(",")]
+            name, kind, count = parts[1], parts[2].upper(), int(parts[3])
+            k += 2
+            items = []
+            while len(items) < count and k < len(lines):
+                items.extend(int(t) for t in lines[k].split())
+                k += 1
+            if kind == "NODE":
+                sets[name] = _expand_ranges(items)
+            continue
+        k += 1
+
+
+def _fortran_widths(fmt: str, src: str, line: int) -> list[int]:
+    """Field widths of a format like ``(3i9,6e21.13e3)``."""
+    import re
+
+    widths = []
+    for count, _kind, width in re.findall(r"(\d*)([ie])(\d+)(?:\.\d+)?(?:e\d+)?",
+                                          fmt.lower()):
+        widths.extend([int(width)] * int(count or 1))
+    if len(widths) < 4:
+        raise InputError(f"{src}, line {line}: NBLOCK format {fmt.strip()!r} not understood")
+    return widths
+
+
+def _fixed_columns(line: str, widths: list[int]) -> list[str]:
+    out, pos = [], 0
+    for w in widths:
+        out.append(line[pos:pos + w])
+        pos += w
+    return out
+
+
+def _expand_ranges(items: list[int]) -> np.ndarray:
+    """ANSYS component lists: a negative entry ``-b`` after ``a`` means ``a..b``."""
+    out = []
+    for i, v in enumerate(items):
+        if v < 0:
+            out.extend(range(items[i - 1] + 1, -v + 1))
+        else:
+            out.append(v)
+    return np.array(out, dtype=np.int64)
