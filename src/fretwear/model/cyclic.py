@@ -342,6 +342,10 @@ def harmonic_model(sector: CyclicSector, k: int) -> tuple[Model, sp.csr_matrix]:
         return B.real.tocsr() if real else B
 
     c = model.contact
+    if c.segments is not None:
+        raise InputError("contact: node-to-segment pairs (non-matching interface meshes) in a "
+                         "cyclic sector are not supported; expected node-to-node pairs "
+                         '(pairing = "node-to-node", matching nodes)')
     contact = dataclasses.replace(
         c, dofs=_positions(sector, c.dofs, "contact"),
         partner_dofs=None if c.partner_dofs is None
