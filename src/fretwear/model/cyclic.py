@@ -301,7 +301,8 @@ def neighbour_contact(sector: CyclicSector, spec) -> CyclicSector:
                          "next sector's copy of it)")
     if spec.partner not in mesh.boundaries:
         raise InputError(f"contact {spec.name!r}: unknown partner boundary {spec.partner!r}")
-    c = _contact(mesh, dataclasses.replace(spec, partner=None, partner_wear_coefficient=0.0),
+    c = _contact(mesh, dataclasses.replace(spec, partner=None, partner_wear_coefficient=0.0,
+                                           pairing="auto"),
                  model.thickness)
     d = mesh.dim
     b_nodes = np.unique(np.asarray(mesh.boundaries[spec.partner]).reshape(-1))
