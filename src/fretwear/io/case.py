@@ -326,12 +326,14 @@ CONTACT_MESH = Table(
                                  "threshold mu times that); absent: unilateral contact",
                                  unit="Pa"),
         "normal_waveform": _NORMAL_WAVEFORM,
-        "pairing": Field(Text(("auto", "node-to-node", "node-to-segment")),
+        "pairing": Field(Text(("auto", "node-to-node", "mortar", "node-to-segment")),
                          "how the nodes of `boundary` meet the `partner` boundary: "
-                         '"node-to-node" (matching nodes), "node-to-segment" (each node '
-                         "against the closest point of a partner facet: non-matching meshes) "
-                         'or "auto": node-to-node when every node has a partner node within '
-                         "`tolerance`, else node-to-segment", default="auto"),
+                         '"node-to-node" (matching nodes), "mortar" (non-matching meshes: '
+                         "each node's area-weighted relative displacement, exact for a "
+                         'uniform pressure and slip), "node-to-segment" (each node against '
+                         'the closest point of a partner facet) or "auto": node-to-node when '
+                         "every node has a partner node within `tolerance`, else mortar",
+                         default="auto"),
         "region": REGION,
     },
     checks=(non_zero("normal", "tangent"), _ranges,

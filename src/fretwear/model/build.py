@@ -229,7 +229,7 @@ class ContactSpec:
         ``1e-6`` times the model size (node-to-node), a tenth of the partner's longest facet
         edge (node-to-segment).
     pairing : ``"auto"`` (default: node-to-node when the nodes match within the tolerance,
-        else node-to-segment), ``"node-to-node"`` or ``"node-to-segment"``
+        else mortar), ``"node-to-node"``, ``"mortar"`` or ``"node-to-segment"``
         (:mod:`fretwear.model.pairing`).
     region : part of ``boundary`` in contact: coordinate ranges ``{"x": (x0, x1), ...}`` [m]
         (:mod:`fretwear.model.regions`; a facet is in contact when all its nodes lie in the
@@ -539,8 +539,8 @@ def _contact(mesh: Mesh, spec: ContactSpec, thickness: float) -> ContactInterfac
         gap = np.full(nc, float(spec.gap))
     partner = dict(partner_dofs=None, partner_ids=None)
     if spec.partner is not None:
-        found = pair(mesh, nodes, frames[:, 0], spec.partner, tolerance=spec.tolerance,
-                     pairing=spec.pairing, what=what)
+        found = pair(mesh, nodes, frames[:, 0], spec.partner, face=facets,
+                     tolerance=spec.tolerance, pairing=spec.pairing, what=what)
         partner = dict(partner_dofs=found.partner_dofs, partner_ids=found.partner_ids,
                        segments=found.segments)
         if found.segments is not None:

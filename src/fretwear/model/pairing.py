@@ -8,9 +8,19 @@
   boundary (:mod:`fretwear.model.projection`), within ``tolerance`` (default a tenth of the
   partner's longest facet edge); the signed distance to that point along the node's normal
   is added to its initial gap (0 on flat faces).
+* ``"mortar"``: each contact node's relative displacement is the average over its
+  tributary area, weighted by its dual shape function, of the slave face's displacement
+  relative to the master face's (:mod:`fretwear.model.mortar`); every node's area must be
+  covered by the partner face (at least ``MIN_COVERAGE`` of it). It passes the patch test
+  (uniform pressure and slip across any two meshes) exactly; node-to-segment does not
+  when the meshes are not nested.
 * ``"auto"`` (default): node-to-node when every contact node has a partner node within the
   node-to-node tolerance (so matching meshes keep their pairs and answers exactly), else
-  node-to-segment.
+  mortar.
+
+Node-to-segment and mortar pairs hold, for each contact node, the partner nodes and their
+weights (:class:`fretwear.model.core.Segments`); a weight within ``1e-10`` of 1 is exactly 1
+and the others 0, so that coincident nodes pair exactly as node-to-node.
 
 When some nodes have no partner, the error lists them, and when most of them lie outside
 the partner face it suggests restricting the contact to the overlap (``region``).
@@ -26,10 +36,13 @@ from fretwear.errors import InputError
 from fretwear.model.core import Mesh, Segments
 from fretwear.model.mesh import boundary as _boundary
 from fretwear.model.mesh import model_size
+from fretwear.model.mortar import mortar
 from fretwear.model.projection import project
 from fretwear.model.regions import bounding_region
 
-PAIRINGS = ("auto", "node-to-node", "node-to-segment")
+PAIRINGS = ("auto", "node-to-node", "mortar", "node-to-segment")
+#: the smallest fraction of a contact node's area that the partner face must cover (mortar)
+MIN_COVERAGE = 0.99
 
 
 @dataclass
@@ -50,10 +63,11 @@ def check_pairing(pairing, what: str) -> str:
 
 
 def pair(mesh: Mesh, nodes: np.ndarray, normals: np.ndarray, partner: str, *,
-         tolerance: float | None = None, pairing: str = "auto",
-         what: str = "contact") -> Partners:
+         face: np.ndarray | None = None, tolerance: float | None = None,
+         pairing: str = "auto", what: str = "contact") -> Partners:
     """The partners of the contact ``nodes`` (nc,) on boundary ``partner``; ``normals``
-    (nc, d) are their contact normals (module docstring)."""
+    (nc, d) are their contact normals and ``face`` the facets of the contact face (needed by
+    the mortar pairing) (module docstring)."""
     from scipy.spatial import cKDTree  # lazy: scipy.spatial is slow to import
 
     check_pairing(pairing, what)
@@ -78,16 +92,25 @@ def pair(mesh: Mesh, nodes: np.ndarray, normals: np.ndarray, partner: str, *,
     far = np.flatnonzero(proj.distance > tol)
     if far.size:
         _no_partner(mesh, nodes, far, proj.distance, cand, partner, tol, what,
-                    "node-to-segment: the partner face must cover the contact nodes")
-    ids = proj.nodes
+                    "node-to-segment and mortar: the partner face must cover the contact "
+                    "nodes")
+    ids, weights, point = proj.nodes, proj.weights, proj.point
+    if pairing != "node-to-segment":
+        mo = mortar(mesh.points, nodes, face, facets)
+        low = np.flatnonzero(mo.coverage < MIN_COVERAGE)
+        if low.size:
+            _no_partner(mesh, nodes, low, 1.0 - mo.coverage, cand, partner, 1 - MIN_COVERAGE,
+                        what, "mortar: the partner face must cover the area of every contact "
+                        "node (the distance shown is the uncovered fraction of its area)")
+        ids, weights, point = mo.nodes, mo.weights, mo.point
     same = np.intersect1d(ids[ids >= 0], nodes)
     if same.size:
         raise InputError(f"{what}: node {int(same[0])} is on both boundaries of the pair; the "
                          "two bodies need their own nodes at the interface")
-    primary = ids[np.arange(nodes.size), np.argmax(proj.weights, axis=1)]
+    primary = ids[np.arange(nodes.size), np.argmax(weights, axis=1)]
     seg = Segments(dofs=np.where(ids[..., None] >= 0, d * ids[..., None] + np.arange(d), -1),
-                   weights=proj.weights, ids=ids)
-    gap = np.einsum("nd,nd->n", normals, proj.point - mesh.points[nodes])
+                   weights=weights, ids=ids)
+    gap = np.einsum("nd,nd->n", normals, point - mesh.points[nodes])
     return Partners(d * primary[:, None] + np.arange(d), primary, seg, gap)
 
 
