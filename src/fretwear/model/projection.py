@@ -13,9 +13,10 @@ weights ``(1, 0, ...)`` exactly, so that matching meshes give the node-to-node p
 below ``1e-10`` are dropped and the others scaled to add up to 1.
 
 The wear of the master surface is computed at each slave node (the worn depth of the master
-at the projection point); on the master's own nodes, for output, it is the average of the
-slave values weighted by the same shape functions (:func:`partner_node_values`), so that a
-uniform worn depth stays uniform.
+at the projection point, which opens that node's gap with the slave's own); on the master's
+own nodes, for output, it is the average of the slave values weighted by the same weights
+times the slave areas (:func:`partner_node_values`), so that a uniform worn depth stays
+uniform.
 """
 
 from __future__ import annotations
@@ -168,18 +169,22 @@ def _on_quad(x, p):
 def partner_node_values(contact: ContactInterface, values: np.ndarray):
     """``(ids, v)``: a per-contact-node quantity of the partner surface (e.g. its worn depth)
     on the partner's own mesh nodes. Node-to-node: each pair's value on its partner node;
-    node-to-segment: on each facet node, the average of the values of the contact nodes
-    projected onto its facets, weighted by the shape functions of those projections."""
+    node-to-segment and mortar: on each partner node ``m``, the average of the contact nodes'
+    values weighted by their weights times their areas, ``sum_s w_sm a_s v_s / sum_s w_sm
+    a_s`` (for the mortar weights the denominator is the partner node's own area, so a
+    uniform value stays uniform); nodes whose total weight is not positive are left out."""
     values = np.asarray(values, dtype=float)
     pair = contact.paired()
     if contact.segments is None:
         return np.asarray(contact.partner_ids)[pair], values[pair]
     ids = np.asarray(contact.segments.ids, dtype=np.int64)
-    w = np.asarray(contact.segments.weights, dtype=float)
-    keep = (ids >= 0) & (w > 0.0)
+    w = np.asarray(contact.segments.weights, dtype=float) \
+        * np.asarray(contact.area, dtype=float)[:, None]
+    keep = (ids >= 0) & (w != 0.0)
     nodes, where = np.unique(ids[keep], return_inverse=True)
     total = np.zeros(nodes.size)
     weight = np.zeros(nodes.size)
     np.add.at(total, where, (w * values[:, None])[keep])
     np.add.at(weight, where, w[keep])
-    return nodes, total / weight
+    good = weight > 0.0
+    return nodes[good], total[good] / weight[good]
