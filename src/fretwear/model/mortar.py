@@ -3,7 +3,7 @@
 The relative displacement of contact node ``s`` (slave face: the contact boundary) is the
 weighted average ``r_s = (1 / D_s) int Phi_s (u_slave - u_master) dA`` over the slave face,
 with the *dual* shape functions ``Phi_s`` (biorthogonal to the slave's ``N_t``: ``int Phi_s
-N_t dA = delta_st D_s``, Wohlmuth 2000; ``Phi = 2 N_1 - N_2`` on a segment, ``3 N_i - 1`` on a
+N_t dA = delta_st D_s``, Wohlmuth 2000; ``Phi = 2 N_1 - N_2`` on a segment, ``4 N_i - 1`` on a
 triangle, the tensor product of the segment's on a quadrilateral). Then
 ``r_s = u_s - sum_m w_sm u_m`` with ``w_sm = M_sm / D_s``, ``M_sm = int Phi_s N_m dA``: the
 form of a node-to-node or node-to-segment pair (:mod:`fretwear.model.interfaces`), with the
@@ -186,11 +186,11 @@ def _rule(region: np.ndarray):
 
 def _dual(N: np.ndarray, k: int, x: np.ndarray, p: np.ndarray) -> np.ndarray:
     """Dual shape functions of a facet of ``k`` nodes at the point whose shape functions are
-    ``N`` (segment ``2 N_i - N_j``, triangle ``3 N_i - 1``, quadrilateral: tensor product)."""
+    ``N`` (segment ``2 N_i - N_j``, triangle ``4 N_i - 1``, quadrilateral: tensor product)."""
     if k == 2:
         return 2.0 * N - N[::-1]
     if k == 3:
-        return 3.0 * N - 1.0
+        return 4.0 * N - 1.0
     # bilinear: recover (xi, eta) from N = (1 -+ xi)(1 -+ eta) / 4
     xi = (N[1] + N[2]) - (N[0] + N[3])
     eta = (N[2] + N[3]) - (N[0] + N[1])
