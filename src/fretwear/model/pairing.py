@@ -7,7 +7,8 @@
 * ``"node-to-segment"``: each contact node faces the closest point of a facet of the partner
   boundary (:mod:`fretwear.model.projection`), within ``tolerance`` (default a tenth of the
   partner's longest facet edge); the signed distance to that point along the node's normal
-  is added to its initial gap (0 on flat faces).
+  is added to its initial gap (0 on flat faces; below ``1e-12`` times the model size it is
+  rounding, and taken as 0).
 * ``"mortar"``: each contact node's relative displacement is the average over its
   tributary area, weighted by its dual shape function, of the slave face's displacement
   relative to the master face's (:mod:`fretwear.model.mortar`); every node's area must be
@@ -111,6 +112,7 @@ def pair(mesh: Mesh, nodes: np.ndarray, normals: np.ndarray, partner: str, *,
     seg = Segments(dofs=np.where(ids[..., None] >= 0, d * ids[..., None] + np.arange(d), -1),
                    weights=weights, ids=ids)
     gap = np.einsum("nd,nd->n", normals, point - mesh.points[nodes])
+    gap[np.abs(gap) <= 1e-12 * model_size(mesh)] = 0.0  # rounding of the weighted points
     return Partners(d * primary[:, None] + np.arange(d), primary, seg, gap)
 
 
