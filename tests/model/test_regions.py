@@ -10,8 +10,7 @@ import numpy as np
 import pytest
 
 from fretwear.errors import InputError
-from fretwear.model import ContactSpec, Material, NodalForce, Spring, Traction, from_mesh
-from fretwear.model import rectangle
+from fretwear.model import ContactSpec, Material, NodalForce, Spring, Traction, from_mesh, rectangle
 from fretwear.model.regions import bounding_region, check_region, inside, restricted
 
 STEEL = Material(210e9, 0.3, 7800.0)
