@@ -155,8 +155,8 @@ def test_wrong_choice_suggests(tmp_path):
     assert msg == ('springs[1].direction = "X": expected one of "x", "y", "z" or a list of '
                    '2 or 3 numbers (did you mean "x"?)')
     msg = error_of(tmp_path, BASE.replace('type = "rectangle"', 'type = "rectangel"'))
-    assert msg == ('model.type = "rectangel": expected one of "rectangle", "box", "mesh", '
-                   '"matrices" (did you mean "rectangle"?)')
+    assert msg == ('model.type = "rectangel": expected one of "rectangle", "box", "blocks", '
+                   '"mesh", "matrices" (did you mean "rectangle"?)')
 
 
 def test_unknown_boundary_is_reported_with_its_key(tmp_path):
