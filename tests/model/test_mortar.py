@@ -61,7 +61,7 @@ def test_dual_shape_functions_are_biorthogonal(k):
     mass = np.zeros(k)
     for p, wq in pts:
         N = closest_on_facet(facet, p)[0]
-        G += wq * np.outer(_dual(N, k, facet, p), N)
+        G += wq * np.outer(_dual(N[None], k)[0], N)
         mass += wq * N
     np.testing.assert_allclose(G, np.diag(mass), rtol=0, atol=1e-14)
 
@@ -119,10 +119,11 @@ def test_patch_test_3d():
     assert pressure_error(blocks_3d("node-to-segment")) > 0.05
 
 
-def test_mortar_on_matching_meshes_is_node_to_node():
-    """4 | 4 elements with friction under a harmonic tangential load: the mortar weights are
-    exactly one-hot, ``P`` is the node-to-node one, and the periodic solution (stick and
-    slip) is the node-to-node one bit for bit."""
+@pytest.mark.parametrize("pairing", ["mortar", "node-to-segment"])
+def test_mortar_on_matching_meshes_is_node_to_node(pairing):
+    """4 | 4 elements with friction under a harmonic tangential load: the mortar (and the
+    node-to-segment) weights are exactly one-hot, ``P`` is the node-to-node one, and the
+    periodic solution (stick and slip) is the node-to-node one bit for bit."""
     def model(pairing):
         mesh = join(("upper", rectangle(0.02, 0.01, 4, 2, origin=(0.0, 0.005))),
                     ("base", rectangle(0.02, 0.005, 4, 1)))
@@ -132,7 +133,7 @@ def test_mortar_on_matching_meshes_is_node_to_node():
             loads=[Traction("upper.top", pressure=P, waveform="constant"),
                    Traction("upper.right", traction=(-1e7, 0.0), waveform="cos")],
             contact=ContactSpec("upper.bottom", mu=0.3, partner="base.top", pairing=pairing))
-    nn, mo = model("node-to-node"), model("mortar")
+    nn, mo = model("node-to-node"), model(pairing)
     w = mo.contact.segments.weights
     np.testing.assert_array_equal(np.sort(w, axis=1)[:, ::-1][:, 0], 1.0)
     np.testing.assert_array_equal(np.sort(w, axis=1)[:, :-1], 0.0)
@@ -155,3 +156,27 @@ def test_coverage_of_a_node_half_off_the_master_face():
     pts = np.array([[0.0, 0.0], [2.0, 0.0], [1.0, 0.0], [3.0, 0.0]])
     mo = mortar(pts, np.array([0, 1]), np.array([[0, 1]]), np.array([[2, 3]]))
     np.testing.assert_allclose(mo.coverage, [-0.25, 1.25], rtol=1e-14)
+
+
+@pytest.mark.parametrize("k", [2, 3, 4])
+def test_shape_functions_of_points_on_a_facet(k):
+    """The batch shape functions at points of a (non-parallelogram) facet, made from known
+    facet coordinates, are those coordinates' shape functions (to 1e-13; the quadrilateral's
+    are found by Gauss-Newton)."""
+    from fretwear.model.mortar import shape_functions
+
+    rng = np.random.default_rng(5)
+    if k == 2:
+        x = np.array([[0.0, 0.0, 0.0], [1.0, 0.3, 0.2]])
+        t = rng.uniform(0, 1, 20)
+        N = np.column_stack([1 - t, t])
+    elif k == 3:
+        x = np.array([[0.0, 0.0, 0.0], [1.0, 0.1, 0.0], [0.2, 0.9, 0.1]])
+        u = rng.dirichlet(np.ones(3), 20)
+        N = u
+    else:
+        x = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.2, 1.0, 0.0], [0.1, 0.8, 0.0]])
+        xi, eta = rng.uniform(-1, 1, (2, 20))
+        N = 0.25 * np.column_stack([(1 - xi) * (1 - eta), (1 + xi) * (1 - eta),
+                                    (1 + xi) * (1 + eta), (1 - xi) * (1 + eta)])
+    np.testing.assert_allclose(shape_functions(x, N @ x), N, rtol=0, atol=1e-13)

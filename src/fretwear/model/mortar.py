@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fretwear.model.projection import closest_on_facet, snapped
+from fretwear.model.projection import snapped
 
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(3)
 _A1, _B1, _A2, _B2 = 0.059715871789770, 0.470142064105115, 0.797426985353087, 0.101286507323456
@@ -73,23 +73,25 @@ def mortar(points: np.ndarray, slaves: np.ndarray, slave_facets: np.ndarray,
         c = xs.mean(axis=0)
         rs = float(np.linalg.norm(xs - c, axis=1).max())
         rows = [pos[int(n)] for n in f]
-        for q, w in _rule(ps):  # the slave facet itself: int N_s
-            area[rows] += w * closest_on_facet(xs, origin + q @ axes)[0]
+        lo, hi = ps.min(axis=0), ps.max(axis=0)
+        q, w = _rule(ps)  # the slave facet itself: int N_s
+        area[rows] += w @ shape_functions(xs, origin + q @ axes)
         for m in tree.query_ball_point(c, rs + rm + 1e-9 * (rs + rm)):
             pm = (xm[m] - origin) @ axes.T
+            if np.any(pm.max(axis=0) <= lo) or np.any(pm.min(axis=0) >= hi):
+                continue  # the boxes do not overlap
             clip = _clip(ps, pm)
             if clip is None:
                 continue
-            for q, w in _rule(clip):
-                x = origin + q @ axes
-                phi = _dual(closest_on_facet(xs, x)[0], xs.shape[0], xs, x)
-                nm = closest_on_facet(xm[m], x)[0]
-                for a, r in enumerate(rows):
-                    cover[r] += w * phi[a]
-                    for b, node in enumerate(mf[m]):
-                        if nm[b] != 0.0:
-                            coupling[r][int(node)] = coupling[r].get(int(node), 0.0) \
-                                + w * phi[a] * nm[b]
+            q, w = _rule(clip)
+            x = origin + q @ axes
+            phi = _dual(shape_functions(xs, x), xs.shape[0])  # (nq, ks)
+            M = (w[:, None] * phi).T @ shape_functions(xm[m], x)  # (ks, km)
+            cover[rows] += w @ phi
+            for a, r in enumerate(rows):
+                for b, node in enumerate(mf[m]):
+                    if M[a, b] != 0.0:
+                        coupling[r][int(node)] = coupling[r].get(int(node), 0.0) + M[a, b]
     k = max(1, max(len(cp) for cp in coupling))
     nodes = np.full((slaves.size, k), -1, dtype=np.int64)
     weights = np.zeros((slaves.size, k))
@@ -168,32 +170,71 @@ def _cut(poly: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.array(out) if out else np.zeros((0, 2))
 
 
-def _rule(region: np.ndarray):
-    """Quadrature points (local coordinates) and weights [m or m^2] on an interval (2, 1) or
-    a convex polygon (n, 2) (fan of triangles)."""
+def _rule(region: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Quadrature points (nq, d-1) in local coordinates and weights (nq,) [m or m^2] on an
+    interval (2, 1) or a convex polygon (n, 2) (fan of triangles)."""
     if region.shape[1] == 1:
         lo, hi = float(region.min()), float(region.max())
         half = 0.5 * (hi - lo)
-        for x, w in zip(_GAUSS_X, _GAUSS_W, strict=True):
-            yield np.array([0.5 * (lo + hi) + half * x]), w * half
-        return
+        return (0.5 * (lo + hi) + half * _GAUSS_X)[:, None], half * _GAUSS_W
     p0 = region[0]
+    pts, wts = [], []
     for p1, p2 in zip(region[1:-1], region[2:], strict=True):
         a = 0.5 * abs((p1[0] - p0[0]) * (p2[1] - p0[1]) - (p1[1] - p0[1]) * (p2[0] - p0[0]))
-        for bary, w in zip(_TRI_P, _TRI_W, strict=True):
-            yield bary @ np.vstack([p0, p1, p2]), w * a
+        pts.append(_TRI_P @ np.vstack([p0, p1, p2]))
+        wts.append(_TRI_W * a)
+    return np.vstack(pts), np.concatenate(wts)
 
 
-def _dual(N: np.ndarray, k: int, x: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """Dual shape functions of a facet of ``k`` nodes at the point whose shape functions are
-    ``N`` (segment ``2 N_i - N_j``, triangle ``4 N_i - 1``, quadrilateral: tensor product)."""
+def shape_functions(x: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """Shape functions (n, k) of facet ``x`` (k, d) at the feet of the normals from the
+    points ``p`` (n, d), their facet coordinates clamped to the facet (exact for points on a
+    flat facet; the closest point's for points off a gently curved one)."""
+    k = x.shape[0]
     if k == 2:
-        return 2.0 * N - N[::-1]
+        ab = x[1] - x[0]
+        t = np.clip((p - x[0]) @ ab / (ab @ ab), 0.0, 1.0)
+        return np.column_stack([1.0 - t, t])
+    if k == 3:
+        e1, e2 = x[1] - x[0], x[2] - x[0]
+        G = np.array([[e1 @ e1, e1 @ e2], [e1 @ e2, e2 @ e2]])
+        st = np.linalg.solve(G, np.column_stack([(p - x[0]) @ e1, (p - x[0]) @ e2]).T).T
+        N = np.clip(np.column_stack([1.0 - st.sum(axis=1), st]), 0.0, None)
+        return N / N.sum(axis=1, keepdims=True)
+    xi = np.zeros(p.shape[0])
+    eta = np.zeros(p.shape[0])
+    for _ in range(20):
+        N = 0.25 * np.column_stack([(1 - xi) * (1 - eta), (1 + xi) * (1 - eta),
+                                    (1 + xi) * (1 + eta), (1 - xi) * (1 + eta)])
+        dxi = 0.25 * np.column_stack([-(1 - eta), 1 - eta, 1 + eta, -(1 + eta)]) @ x
+        deta = 0.25 * np.column_stack([-(1 - xi), -(1 + xi), 1 + xi, 1 - xi]) @ x
+        r = p - N @ x
+        a11 = np.einsum("nd,nd->n", dxi, dxi)
+        a12 = np.einsum("nd,nd->n", dxi, deta)
+        a22 = np.einsum("nd,nd->n", deta, deta)
+        b1 = np.einsum("nd,nd->n", dxi, r)
+        b2 = np.einsum("nd,nd->n", deta, r)
+        det = a11 * a22 - a12 * a12
+        s1, s2 = (a22 * b1 - a12 * b2) / det, (a11 * b2 - a12 * b1) / det
+        xi, eta = xi + s1, eta + s2
+        if max(np.abs(s1).max(), np.abs(s2).max()) < 1e-14:
+            break
+    xi, eta = np.clip(xi, -1.0, 1.0), np.clip(eta, -1.0, 1.0)
+    return 0.25 * np.column_stack([(1 - xi) * (1 - eta), (1 + xi) * (1 - eta),
+                                   (1 + xi) * (1 + eta), (1 - xi) * (1 + eta)])
+
+
+def _dual(N: np.ndarray, k: int) -> np.ndarray:
+    """Dual shape functions (n, k) of a facet of ``k`` nodes at points whose shape functions
+    are ``N`` (n, k) (segment ``2 N_i - N_j``, triangle ``4 N_i - 1``, quadrilateral: the
+    tensor product of the segment's)."""
+    if k == 2:
+        return 2.0 * N - N[:, ::-1]
     if k == 3:
         return 4.0 * N - 1.0
     # bilinear: recover (xi, eta) from N = (1 -+ xi)(1 -+ eta) / 4
-    xi = (N[1] + N[2]) - (N[0] + N[3])
-    eta = (N[2] + N[3]) - (N[0] + N[1])
+    xi = (N[:, 1] + N[:, 2]) - (N[:, 0] + N[:, 3])
+    eta = (N[:, 2] + N[:, 3]) - (N[:, 0] + N[:, 1])
     a, b = 0.5 * (1 - 3 * xi), 0.5 * (1 + 3 * xi)
     c, d = 0.5 * (1 - 3 * eta), 0.5 * (1 + 3 * eta)
-    return np.array([a * c, b * c, b * d, a * d])
+    return np.column_stack([a * c, b * c, b * d, a * d])
