@@ -305,11 +305,14 @@ CONTACT_MESH = Table(
                      unit="m"),
         "wear_coefficient": _WEAR,
         "name": _CONTACT_NAME,
-        "partner": Field(Text(), "node-to-node contact: the boundary of the second body whose "
-                         "nodes face those of `boundary` (same positions, within `tolerance`); "
-                         "the contact law acts on their relative displacement"),
-        "tolerance": Field(_NON_NEG, "largest distance between paired nodes (default 1e-6 "
-                           "times the model size)", unit="m"),
+        "partner": Field(Text(), "two-body contact: the boundary of the second body that "
+                         "`boundary` touches (its nodes at the same positions, within "
+                         "`tolerance`, or its facets: `pairing`); the contact law acts on "
+                         "their relative displacement"),
+        "tolerance": Field(_NON_NEG, "largest distance between a node and its partner "
+                           "(default 1e-6 times the model size between paired nodes; a tenth "
+                           "of the partner's longest facet edge to the partner face for "
+                           "mortar and node-to-segment pairs)", unit="m"),
         "partner_wear_coefficient": Field(_NON_NEG, "Archard wear coefficient of the "
                                           "partner's surface (the gap opens by the sum of both "
                                           "worn depths; default 0)", unit="1/Pa"),
