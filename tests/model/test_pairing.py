@@ -237,3 +237,27 @@ def test_mortar_refuses_a_node_whose_area_is_not_covered():
     uncovered fraction."""
     with pytest.raises(InputError, match=r"lie outside the partner face|uncovered fraction"):
         lap(region={"x": (0.02, 0.0434)}, pairing="mortar", tolerance=0.01)
+
+
+def test_mortar_and_rigid_interfaces_combine():
+    """A mortar interface and a node-to-rigid one in one model: each interface's rows of the
+    local transform are those of the model with that interface alone (the combined record
+    pads the weights; the rigid nodes have none)."""
+    mesh = join(("block", rectangle(0.02, 0.01, 4, 2, origin=(0.0, 0.005))),
+                ("base", rectangle(0.02, 0.005, 5, 1)))
+    held = [Spring("block.top_left", "x", 1e7), Spring("block.top", "y", 1e7),
+            ("base.bottom", "all")]
+    specs = [ContactSpec("block.bottom", mu=MU, partner="base.top", name="joint"),
+             ContactSpec("block.right", mu=MU, name="wall", gap=1e-3,
+                         region={"y": (0.0075, 0.015)})]  # not the corner of the joint
+    both = from_mesh(mesh, STEEL, supports=held, contact=specs).contact
+    assert both.names() == ["joint", "wall"] and both.segments is not None
+    T = both.local_transform(2 * mesh.points.shape[0]).toarray()
+    rows = 0
+    for spec in specs:
+        one = from_mesh(mesh, STEEL, supports=held, contact=spec).contact
+        Ti = one.local_transform(2 * mesh.points.shape[0]).toarray()
+        np.testing.assert_array_equal(T[rows:rows + Ti.shape[0]], Ti)
+        rows += Ti.shape[0]
+    assert rows == T.shape[0]
+    np.testing.assert_array_equal(both.segments.weights[both.interface_index() == 1], 0.0)
