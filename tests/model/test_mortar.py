@@ -180,3 +180,68 @@ def test_shape_functions_of_points_on_a_facet(k):
         N = 0.25 * np.column_stack([(1 - xi) * (1 - eta), (1 + xi) * (1 - eta),
                                     (1 + xi) * (1 + eta), (1 - xi) * (1 + eta)])
     np.testing.assert_allclose(shape_functions(x, N @ x), N, rtol=0, atol=1e-13)
+
+
+def tet_block(lx, ly, lz, n, origin):
+    """A box of n = (nx, ny, nz) cubes, each cut into 6 tetrahedra along its main diagonal
+    (Kuhn: conforming across cubes), with triangle boundaries "xmin" ... "zmax" cut along the
+    same diagonals."""
+    from itertools import permutations
+
+    from fretwear.model.core import Mesh
+
+    nx, ny, nz = n
+    g = np.stack(np.meshgrid(*(np.linspace(0, s, m + 1) for s, m in
+                               ((lx, nx), (ly, ny), (lz, nz))), indexing="ij"), axis=-1)
+    points = g.reshape(-1, 3) + np.asarray(origin, float)
+
+    def at(i, j, k):
+        return (i * (ny + 1) + j) * (nz + 1) + k
+
+    cells = []
+    for i in range(nx):
+        for j in range(ny):
+            for k in range(nz):
+                for perm in permutations(range(3)):
+                    c = np.array([i, j, k])
+                    path = [at(*c)]
+                    for axis in perm:
+                        c[axis] += 1
+                        path.append(at(*c))
+                    x = points[path]
+                    if np.linalg.det(x[1:] - x[0]) < 0:
+                        path[1], path[2] = path[2], path[1]
+                    cells.append(path)
+    boundaries = {}
+    for axis, name in enumerate("xyz"):
+        for side, end in (("min", 0), ("max", (nx, ny, nz)[axis])):
+            tri = []
+            others = [a for a in range(3) if a != axis]
+            for u in range((nx, ny, nz)[others[0]]):
+                for v in range((nx, ny, nz)[others[1]]):
+                    corner = {}
+                    for du in (0, 1):
+                        for dv in (0, 1):
+                            c = [0, 0, 0]
+                            c[axis], c[others[0]], c[others[1]] = end, u + du, v + dv
+                            corner[du, dv] = at(*c)
+                    lo, hi = corner[0, 0], corner[1, 1]
+                    tri += [[lo, corner[1, 0], hi], [lo, corner[0, 1], hi]]
+            boundaries[name + side] = np.array(tri)
+    return Mesh(points, np.array(cells), "tetra", boundaries, {})
+
+
+def test_patch_test_3d_tetrahedra():
+    """Uniform pressure across triangle faces of 3 x 2 | 2 x 3 cubes cut into tetrahedra
+    (clipped triangles, the triangle's dual functions): p x area at every node, to 1e-10 as
+    on hexahedra."""
+    mesh = join(("upper", tet_block(0.01, 0.01, 0.004, (3, 2, 1), (0, 0, 0.004))),
+                ("base", tet_block(0.01, 0.01, 0.004, (2, 3, 1), (0, 0, 0))))
+    corner = [Spring((0, 0, 0.008), "x", 1e3), Spring((0, 0, 0.008), "y", 1e3),
+              Spring((0.01, 0, 0.008), "y", 1e3)]
+    model = from_mesh(mesh, STEEL, supports=[*corner, ("base.zmin", "z"), ("base.xmin", "x"),
+                                             ("base.ymin", "y")],
+                      loads=[Traction("upper.zmax", pressure=P, waveform="constant")],
+                      contact=ContactSpec("upper.zmin", mu=0.0, partner="base.zmax"))
+    assert model.contact.segments is not None
+    assert pressure_error(model) < 1e-10
