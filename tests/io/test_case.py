@@ -155,8 +155,8 @@ def test_wrong_choice_suggests(tmp_path):
     assert msg == ('springs[1].direction = "X": expected one of "x", "y", "z" or a list of '
                    '2 or 3 numbers (did you mean "x"?)')
     msg = error_of(tmp_path, BASE.replace('type = "rectangle"', 'type = "rectangel"'))
-    assert msg == ('model.type = "rectangel": expected one of "rectangle", "box", "mesh", '
-                   '"matrices" (did you mean "rectangle"?)')
+    assert msg == ('model.type = "rectangel": expected one of "rectangle", "box", "blocks", '
+                   '"mesh", "matrices" (did you mean "rectangle"?)')
 
 
 def test_unknown_boundary_is_reported_with_its_key(tmp_path):
@@ -483,3 +483,103 @@ def test_prescribed_normal_load_in_tension_is_refused(tmp_path, line, message):
     with pytest.raises(InputError, match=message.replace("[", r"\[")) as err:
         load_case(write(folder, text))
     assert "\n" not in str(err.value)
+
+
+LAP = """
+title = "2D lap joint of two plates meshed apart"
+
+[model]
+type = "blocks"
+thickness = 0.01
+
+[[model.blocks]]
+name = "lower"
+size = [0.04, 0.004]
+elements = [16, 2]
+
+[[model.blocks]]
+name = "upper"
+size = [0.04, 0.004]
+elements = [12, 2]
+origin = [0.02, 0.004]
+
+[material]
+E = 210e9
+nu = 0.3
+rho = 7800.0
+
+[materials.upper]
+E = 70e9
+nu = 0.33
+rho = 2700.0
+
+[[fixed]]
+at = "lower.bottom"
+
+[[springs]]
+at = "upper.right"
+direction = "x"
+stiffness = 1e7
+
+[[springs]]
+at = "upper.right"
+direction = "y"
+stiffness = 1e8
+
+[[loads]]
+boundary = "upper.top"
+region = {x = [0.02, 0.04]}
+pressure = 2e7
+
+[[contact]]
+boundary = "upper.bottom"
+region = {x = [0.02, 0.04]}
+partner = "lower.top"
+mu = 0.3
+
+[analysis]
+type = "periodic"
+frequency = 500.0
+"""
+
+
+def test_two_block_lap_joint_in_a_case_file(tmp_path):
+    """`type = "blocks"`: two structured plates placed apart and joined, the upper one in its
+    own material; the contact and the pressure on the overlap only (`region`), paired by
+    mortar (the nodes do not match). Checked against closed forms: the node count of the
+    overlap (7 nodes of 3.33 mm elements), its area (20 mm x 10 mm), the pressure's resultant
+    (p x that area) and the mass of the upper plate (its own density: 2700 / 7800 of the
+    steel plate's)."""
+    model = build_model(load_case(write(tmp_path, LAP)))
+    c = model.contact
+    assert c.n_nodes == 7 and c.segments is not None
+    np.testing.assert_allclose(c.area.sum(), 0.02 * 0.01, rtol=1e-14)
+    f = model.loads[0].vector.reshape(-1, 2)
+    np.testing.assert_allclose(f[:, 1].sum(), -2e7 * 0.02 * 0.01, rtol=1e-14)
+    assert {"lower", "upper", "upper.top_left"} <= set(model.mesh.node_sets)
+    steel = build_model(load_case(write(tmp_path, LAP.replace("rho = 2700.0",
+                                                              "rho = 7800.0"))))
+    upper = np.asarray(model.mesh.node_sets["upper"])
+    dofs = (2 * upper[:, None] + np.arange(2)).ravel()
+    np.testing.assert_allclose(model.M[dofs].sum() / steel.M[dofs].sum(), 2700 / 7800,
+                               rtol=1e-14)
+
+
+@pytest.mark.parametrize("change, message", [
+    (("elements = [12, 2]", "elements = [12, 2, 1]"),
+     "model.blocks[2].elements = [12, 2, 1]: expected 2 components, like size"),
+    (('size = [0.04, 0.004]\nelements = [12, 2]\norigin = [0.02, 0.004]',
+      'size = [0.04, 0.004, 0.01]\nelements = [12, 2, 1]\norigin = [0.02, 0.004, 0.0]'),
+     "model.blocks = [\"lower\", \"upper\"]: expected blocks of one dimension (all 2D sizes "
+     "or all 3D)"),
+    (("region = {x = [0.02, 0.04]}\npartner", "region = {x = [0.04, 0.02]}\npartner"),
+     "contact[1].region.x = [0.04, 0.02]: expected a range [lo, hi] with lo <= hi"),
+    (("region = {x = [0.02, 0.04]}\npartner", "region = {w = [0.02, 0.04]}\npartner"),
+     "contact[1].region: key 'w' is not valid; expected axes \"x\", \"y\", \"z\""),
+    (('partner = "lower.top"', 'partner = "lower.top"\npairing = "mortar-ish"'),
+     "contact[1].pairing = \"mortar-ish\": expected one of \"auto\", \"node-to-node\", "
+     "\"mortar\", \"node-to-segment\" (did you mean \"mortar\"?)"),
+])
+def test_bad_joint_keys_get_one_line(tmp_path, change, message):
+    assert LAP.replace(*change) != LAP
+    assert error_of(tmp_path, LAP.replace(*change), build=True) == message

@@ -443,10 +443,12 @@ def test_unmatched_pair_names_the_node_and_its_distance():
     block = rectangle(0.02, 0.01, 4, 2, origin=(0.0, 0.005))
     base = rectangle(0.02, 0.005, 5, 1)  # 5 elements: nodes do not match the block's 4
     mesh = join(("block", block), ("base", base))
-    with pytest.raises(InputError, match=r"node \d+ at \(.*\) has no node of boundary "
-                                         r"'base.top' within .* m away"):
+    with pytest.raises(InputError, match=r"contact nodes have no partner on boundary "
+                                         r"'base.top' within .* m: nodes \d+.* \(farthest: "
+                                         r"node \d+ at \(.*\), .* m away\)"):
         from_mesh(mesh, STEEL, supports=[("base.bottom", "all")],
-                  contact=ContactSpec("block.bottom", mu=MU, partner="base.top"))
+                  contact=ContactSpec("block.bottom", mu=MU, partner="base.top",
+                                      pairing="node-to-node"))
 
 
 def test_node_in_two_interfaces_is_refused():

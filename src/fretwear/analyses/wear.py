@@ -48,6 +48,7 @@ from fretwear.io.schema import (
     fail,
     increasing,
 )
+from fretwear.model.projection import partner_node_values
 from fretwear.timedomain.averaged_rate import RESPONSE_KINDS
 from fretwear.wear import (
     LAWS,
@@ -456,20 +457,21 @@ def write_wear_fields(model, ds, pvd: Path) -> Path:
     """ParaView series of the worn surfaces: one ``.vtu`` per recorded step in the folder
     ``pvd.stem`` with the point array ``worn_depth`` [m] (each surface's own depth on its
     own nodes: the contact nodes and, at node-to-node pairs, their partners; NaN off the
-    interfaces), stepped through by the ``.pvd`` with the cycle count as time."""
+    interfaces; :func:`fretwear.model.projection.partner_node_values` for
+    node-to-segment partners), stepped through by the ``.pvd`` with the cycle count as time."""
     mesh = model.mesh
     c = model.contact
     nn = mesh.points.shape[0]
     ids = np.asarray(c.node_ids)
-    pair = c.paired()
-    partner = np.asarray(c.partner_ids)[pair] if c.has_pairs else np.zeros(0, dtype=int)
     worn = ds["worn_depth_surface"].values
     folder = pvd.parent / pvd.stem
     entries = []
     for k, cycles in enumerate(ds["cycles"].values):
         w = np.full(nn, np.nan)
         w[ids] = worn[k, :, 0]
-        w[partner] = worn[k, pair, 1]
+        if c.has_pairs:  # node-to-segment: shape-function average on the facet nodes
+            partner, depth = partner_node_values(c, worn[k, :, 1])
+            w[partner] = depth
         path = write_vtu(folder / f"step-{k:04d}.vtu", mesh, {"worn_depth": w},
                          {"cycles": float(cycles)})
         entries.append((float(cycles), path))

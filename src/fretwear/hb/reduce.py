@@ -190,6 +190,9 @@ def _fingerprint(model: Model) -> tuple:
             np.asarray(c.frame, float).tobytes(),
             None if getattr(c, "partner_dofs", None) is None
             else np.asarray(c.partner_dofs).tobytes(),
+            None if getattr(c, "segments", None) is None
+            else np.asarray(c.segments.weights, float).tobytes()
+            + np.asarray(c.segments.dofs).tobytes(),
             tuple(tuple(np.asarray(p.dofs).tolist()) for p in model.observed))
 
 

@@ -133,6 +133,31 @@ def _matrices_files(out: dict, path: str) -> None:
                          "(format/dofmap given): hold nodes with [[fixed]] blocks")
 
 
+BLOCK = Table(
+    {
+        "name": Field(Text(), "the body's name (prefix of its boundaries and node sets)",
+                      required=True),
+        "size": Field(ListOf(_POSITIVE, sizes=(2, 3)), "[length, height] of a 2D rectangle "
+                      "of 4-node quadrilaterals, or [lx, ly, lz] of a 3D box of 8-node "
+                      "hexahedra", required=True, unit="m"),
+        "elements": Field(ListOf(Integer(lo=1), sizes=(2, 3)), "number of elements along "
+                          "each axis", required=True),
+        "origin": Field(Vector(), "position of the corner of least coordinates", unit="m"),
+    },
+    checks=(lambda out, path: _block_sizes(out, path),),
+    doc="A structured block: a rectangle (2D) or a box (3D) with the boundaries of "
+    "`type = \"rectangle\"` or `\"box\"`, placed at `origin`.",
+)
+
+
+def _block_sizes(out, path):
+    """Rule: ``size``, ``elements`` and ``origin`` have one component per axis."""
+    d = len(out["size"])
+    for key in ("elements", "origin"):
+        if key in out and len(out[key]) != d:
+            fail(join(path, key), out[key], f"{d} components, like size")
+
+
 MODEL_TYPES = {
     "rectangle": Table(
         {
@@ -157,6 +182,18 @@ MODEL_TYPES = {
         },
         doc="A 3D box [0, lx] x [0, ly] x [0, lz] of 8-node hexahedra. Boundaries (and node "
         'sets): "xmin", "xmax", "ymin", "ymax", "zmin", "zmax".',
+    ),
+    "blocks": Table(
+        {
+            "blocks": Field(TableList(BLOCK), "the bodies, one `[[model.blocks]]` each",
+                            required=True),
+            "thickness": _THICKNESS,
+        },
+        doc="Several structured bodies placed side by side, each meshed on its own (the nodes "
+        "of two faces that touch need not match: `[[contact]]` `pairing`). Boundaries and "
+        'node sets are named "<block>.<name>" (e.g. "upper.bottom", "upper.top_left"), and '
+        "each block's nodes form a node set named after it, so `[materials.<block>]` gives "
+        "a block its own material.",
     ),
     "mesh": Table(
         {
@@ -237,6 +274,20 @@ DAMPING = Table(
     "Rayleigh part is added to the matrix C and the loss factor to the matrix D.",
 )
 _AT = AnyOf((Text(), Vector()))
+REGION = Field(Dict(ListOf(Number(), sizes=(2,)), key_ok=lambda k: k in AXES,
+                    key_doc='axes "x", "y", "z"'),
+               "part of the boundary or node set: coordinate ranges, e.g. {x = [0.0, 0.01]} "
+               "(a facet belongs when all its nodes lie in the ranges; unnamed axes are "
+               "unbounded)", unit="m")
+
+
+def _ranges(out, path):
+    """Rule: each range of ``region`` is ``[lo, hi]`` with ``lo <= hi``."""
+    for axis, (lo, hi) in (out.get("region") or {}).items():
+        if lo > hi:
+            fail(join(join(path, "region"), axis), [lo, hi], "a range [lo, hi] with lo <= hi")
+
+
 SPRING = Table(
     {
         "at": Field(_AT, "node set or boundary name, or the coordinates [x, y(, z)] of a node",
@@ -248,8 +299,9 @@ SPRING = Table(
                            "inf holds them (Dirichlet; axis directions only); finite values up "
                            "to 1e20 (beyond, use inf: the matrices would lose all precision)",
                            required=True, unit="N/m"),
+        "region": REGION,
     },
-    checks=(non_zero("direction"),),
+    checks=(non_zero("direction"), _ranges),
     doc="Grounded springs, one `[[springs]]` block each.",
 )
 FIXED = Table(
@@ -272,8 +324,10 @@ LOAD_MESH = Table(
         "waveform": _WAVEFORM,
         "coefficients": _COEFFICIENTS,
         "name": _LOAD_NAME,
+        "region": REGION,
     },
     checks=(
+        _ranges,
         exactly_one("pressure", "traction", "force"),
         requires("pressure", "boundary", excludes="at"),
         requires("traction", "boundary", excludes="at"),
@@ -298,11 +352,14 @@ CONTACT_MESH = Table(
                      unit="m"),
         "wear_coefficient": _WEAR,
         "name": _CONTACT_NAME,
-        "partner": Field(Text(), "node-to-node contact: the boundary of the second body whose "
-                         "nodes face those of `boundary` (same positions, within `tolerance`); "
-                         "the contact law acts on their relative displacement"),
-        "tolerance": Field(_NON_NEG, "largest distance between paired nodes (default 1e-6 "
-                           "times the model size)", unit="m"),
+        "partner": Field(Text(), "two-body contact: the boundary of the second body that "
+                         "`boundary` touches (its nodes at the same positions, within "
+                         "`tolerance`, or its facets: `pairing`); the contact law acts on "
+                         "their relative displacement"),
+        "tolerance": Field(_NON_NEG, "largest distance between a node and its partner "
+                           "(default 1e-6 times the model size between paired nodes; a tenth "
+                           "of the partner's longest facet edge to the partner face for "
+                           "mortar and node-to-segment pairs)", unit="m"),
         "partner_wear_coefficient": Field(_NON_NEG, "Archard wear coefficient of the "
                                           "partner's surface (the gap opens by the sum of both "
                                           "worn depths; default 0)", unit="1/Pa"),
@@ -319,13 +376,23 @@ CONTACT_MESH = Table(
                                  "threshold mu times that); absent: unilateral contact",
                                  unit="Pa"),
         "normal_waveform": _NORMAL_WAVEFORM,
+        "pairing": Field(Text(("auto", "node-to-node", "mortar", "node-to-segment")),
+                         "how the nodes of `boundary` meet the `partner` boundary: "
+                         '"node-to-node" (matching nodes), "mortar" (non-matching meshes: '
+                         "each node's area-weighted relative displacement, exact for a "
+                         'uniform pressure and slip), "node-to-segment" (each node against '
+                         'the closest point of a partner facet) or "auto": node-to-node when '
+                         "every node has a partner node within `tolerance`, else mortar",
+                         default="auto"),
+        "region": REGION,
     },
-    checks=(non_zero("normal", "tangent"),
+    checks=(non_zero("normal", "tangent"), _ranges,
             requires("partner_wear_coefficient", "partner"),
             requires("tolerance", "partner")),
-    doc="A frictional interface: the nodes of one boundary against a rigid obstacle, or "
-    "against the matching nodes of a second body (`partner`). Several interfaces: one "
-    "`[[contact]]` block each, with distinct names (a node belongs to one interface).",
+    doc="A frictional interface: the nodes of one boundary (or of its `region`) against a "
+    "rigid obstacle, or against a second body (`partner`): its matching nodes, or its facets "
+    "when the meshes do not match (`pairing`). Several interfaces: one `[[contact]]` block "
+    "each, with distinct names (a node belongs to one interface).",
 )
 OBSERVED_MESH = Dict(AnyOf((Vector(), Text())), key_doc="point names")
 
@@ -742,7 +809,29 @@ def _make_mesh(spec: dict):
         return meshes.rectangle(spec["length"], spec["height"], spec["nx"], spec["ny"])
     if kind == "box":
         return meshes.box(spec["lx"], spec["ly"], spec["lz"], spec["nx"], spec["ny"], spec["nz"])
+    if kind == "blocks":
+        return _blocks(spec["blocks"])
     return meshes.read(spec["file"])
+
+
+def _blocks(blocks: list):
+    """One mesh of the structured ``[[model.blocks]]``
+    (:func:`fretwear.model.mesh.join`)."""
+    from fretwear.model import mesh as meshes
+
+    dims = {len(b["size"]) for b in blocks}
+    if len(dims) > 1:
+        fail("model.blocks", [b["name"] for b in blocks],
+             "blocks of one dimension (all 2D sizes or all 3D)")
+    parts = []
+    for b in blocks:
+        origin = b.get("origin", [0.0] * len(b["size"]))
+        if len(b["size"]) == 2:
+            m = meshes.rectangle(*b["size"], *b["elements"], origin=origin)
+        else:
+            m = meshes.box(*b["size"], *b["elements"], origin=origin)
+        parts.append((b["name"], m))
+    return meshes.join(*parts)
 
 
 def _check_name(name: str, path: str, names) -> None:
@@ -794,7 +883,7 @@ def _check_against_mesh(m: dict, mesh, given: Mapping) -> None:
             _check_name(where, f"observed.{name}", mesh.node_sets)
         _check_vector(where, f"observed.{name}", dim)
     spec = m["model"]
-    if spec["type"] == "mesh" and dim == 3 and "thickness" in given:
+    if spec["type"] in ("mesh", "blocks") and dim == 3 and "thickness" in given:
         fail("model.thickness", spec["thickness"], "no thickness for a 3D mesh")
 
 
@@ -811,7 +900,8 @@ def _build_from_mesh(m: dict, title: str, given: Mapping):
         material = {**{body: build.Material(v["E"], v["nu"], v["rho"])
                        for body, v in m["materials"].items()}, None: material}
     damp = m["damping"]
-    springs = [build.Spring(_at(s["at"]), s["direction"], s["stiffness"])
+    springs = [build.Spring(_at(s["at"]), s["direction"], s["stiffness"],
+                            region=s.get("region"))
                for s in m.get("springs", [])]
     fixed = [(_at(f["at"]), f["direction"]) for f in m.get("fixed", [])]
     loads = []
@@ -820,11 +910,11 @@ def _build_from_mesh(m: dict, title: str, given: Mapping):
         coefficients = _coefficients(ld.get("coefficients"))
         if "force" in ld:
             loads.append(build.NodalForce(_at(ld["at"]), ld["force"], waveform=ld["waveform"],
-                                          name=name, **coefficients))
+                                          name=name, region=ld.get("region"), **coefficients))
         else:
             loads.append(build.Traction(ld["boundary"], pressure=ld.get("pressure"),
                                         traction=ld.get("traction"), waveform=ld["waveform"],
-                                        name=name, **coefficients))
+                                        name=name, region=ld.get("region"), **coefficients))
     contact = [build.ContactSpec(c["boundary"], c["mu"], normal=c.get("normal"),
                                  tangent=c.get("tangent"), gap=c["gap"],
                                  wear_coefficient=c["wear_coefficient"],
@@ -834,7 +924,8 @@ def _build_from_mesh(m: dict, title: str, given: Mapping):
                                  normal_stiffness=c["normal_stiffness"],
                                  tangential_stiffness=c["tangential_stiffness"],
                                  normal_pressure=c.get("normal_pressure"),
-                                 normal_waveform=c["normal_waveform"])
+                                 normal_waveform=c["normal_waveform"],
+                                 pairing=c["pairing"], region=c.get("region"))
                for c in m["contact"]]
     observed = {k: _at(v) for k, v in m.get("observed", {}).items()} or None
     thickness = m["model"].get("thickness", 1.0) if mesh.dim == 2 else 1.0

@@ -29,8 +29,10 @@ from fretwear.model.fem import assemble, check_material, check_thickness
 from fretwear.model.interfaces import combine
 from fretwear.model.loads import boundary_load, nodal_areas
 from fretwear.model.mesh import boundary as _boundary
-from fretwear.model.mesh import check_cells, facet_normals, model_size, orient_facets
+from fretwear.model.mesh import check_cells, facet_normals, orient_facets
+from fretwear.model.pairing import check_pairing, pair
 from fretwear.model.places import AXES, axis_index, find_node, nodes_at, unit_direction
+from fretwear.model.regions import region_nodes, restricted
 from fretwear.model.supports import check_supported
 
 
@@ -128,11 +130,14 @@ class Spring:
         each gets ``stiffness / n_nodes`` along ``direction``, so that a rigid translation of
         the set along ``direction`` is resisted by ``stiffness``. ``math.inf`` holds the DOF
         (Dirichlet condition on every node of ``at``); only axis directions are allowed then.
+    region : only the nodes of ``at`` in these coordinate ranges ``{"x": (x0, x1), ...}`` [m]
+        (:mod:`fretwear.model.regions`). None: all of them.
     """
 
     at: str | tuple
     direction: str | tuple
     stiffness: float
+    region: dict | None = None
 
     def __post_init__(self):
         self.stiffness = _finite(self.stiffness, f"spring at {self.at!r}: stiffness",
@@ -149,6 +154,8 @@ class Traction:
     waveform : one of :data:`fretwear.model.core.WAVEFORMS`; ``"constant"`` is a static load.
     coefficients : ``{n: (a_n, b_n)}`` for ``waveform="fourier"``.
     name : label (default ``"traction on <boundary>"``).
+    region : only the facets of ``boundary`` in these coordinate ranges
+        ``{"x": (x0, x1), ...}`` [m] (:mod:`fretwear.model.regions`). None: all of them.
     """
 
     boundary: str
@@ -157,6 +164,7 @@ class Traction:
     waveform: str = "constant"
     name: str | None = None
     coefficients: dict | None = None
+    region: dict | None = None
 
     def __post_init__(self):
         what = f"traction on {self.boundary!r}"
@@ -175,7 +183,8 @@ class NodalForce:
 
     at : node-set or boundary name, or coordinates of a node [m]. force : vector [N] in
     global axes; it is the *total* force, shared equally by the nodes of ``at``.
-    waveform, coefficients, name : as for :class:`Traction`.
+    waveform, coefficients, name, region : as for :class:`Traction` (``region``: only the
+    nodes of ``at`` in the ranges share the force).
     """
 
     at: str | tuple
@@ -183,6 +192,7 @@ class NodalForce:
     waveform: str = "constant"
     name: str | None = None
     coefficients: dict | None = None
+    region: dict | None = None
 
     def __post_init__(self):
         _check_waveform(self.waveform, self.coefficients, f"nodal force at {self.at!r}")
@@ -210,12 +220,20 @@ class ContactSpec:
         function of the contact node coordinates (nc, d) -> (nc,).
     wear_coefficient : Archard coefficient k_w [1/Pa], >= 0, of the boundary's surface.
     name : label (interfaces of one model have distinct names).
-    partner : the boundary of the second body (node-to-node): every contact node is paired
-        with the partner node at the same position (within ``tolerance``); the contact law
+    partner : the boundary of the second body: every contact node is paired with the
+        partner node at the same position (node-to-node), or with the closest point of a
+        partner facet (node-to-segment, non-matching meshes; ``pairing``); the contact law
         acts on their relative displacement, with equal and opposite forces. None:
         node-to-rigid.
-    tolerance : largest distance [m] between paired nodes; default ``1e-6`` times the model
-        size.
+    tolerance : largest distance [m] between a contact node and its partner; default
+        ``1e-6`` times the model size (node-to-node), a tenth of the partner's longest facet
+        edge (node-to-segment).
+    pairing : ``"auto"`` (default: node-to-node when the nodes match within the tolerance,
+        else mortar), ``"node-to-node"``, ``"mortar"`` or ``"node-to-segment"``
+        (:mod:`fretwear.model.pairing`).
+    region : part of ``boundary`` in contact: coordinate ranges ``{"x": (x0, x1), ...}`` [m]
+        (:mod:`fretwear.model.regions`; a facet is in contact when all its nodes lie in the
+        ranges), e.g. the overlap of a lap joint. None: the whole boundary.
     partner_wear_coefficient : Archard coefficient k_w [1/Pa], >= 0, of the partner's
         surface; the gap opens by the sum of the two worn depths.
     normal_stiffness, tangential_stiffness : contact stiffness per unit area [Pa/m] in series
@@ -245,9 +263,15 @@ class ContactSpec:
     tangential_stiffness: float = np.inf
     normal_pressure: float | None = None
     normal_waveform: str = "constant"
+    pairing: str = "auto"
+    region: dict | None = None
 
     def __post_init__(self):
         what = f"contact {self.name!r}"
+        check_pairing(self.pairing, what)
+        if self.pairing != "auto" and self.partner is None:
+            raise InputError(f"{what}: pairing = {self.pairing!r} without a partner boundary "
+                             "(pairing is for two-body contact)")
         self.mu = _finite(self.mu, f"{what}: friction coefficient mu", minimum=0.0)
         self.wear_coefficient = _finite(self.wear_coefficient, f"{what}: wear_coefficient",
                                         minimum=0.0)
@@ -297,8 +321,10 @@ def _supports(mesh: Mesh, supports) -> tuple[sp.csr_matrix, np.ndarray]:
 def _spring_place(mesh: Mesh, s: Spring) -> tuple[np.ndarray, np.ndarray]:
     """The nodes of a spring and its unit direction."""
     what = f"spring at {s.at!r}"
-    return (nodes_at(mesh, s.at, f"{what}: at"),
-            unit_direction(s.direction, mesh.dim, f"{what}: direction"))
+    nodes = nodes_at(mesh, s.at, f"{what}: at")
+    if s.region is not None:
+        nodes = region_nodes(mesh, nodes, s.region, what)
+    return nodes, unit_direction(s.direction, mesh.dim, f"{what}: direction")
 
 
 def _spring_axis(s: Spring, n: np.ndarray, d: int) -> int:
@@ -336,11 +362,15 @@ def _loads(mesh: Mesh, loads, thickness: float) -> list[Load]:
     out = []
     for item in loads:
         if isinstance(item, Traction):
-            vec = boundary_load(mesh, item.boundary, pressure=item.pressure,
+            part, face = (mesh, item.boundary) if item.region is None else \
+                restricted(mesh, item.boundary, item.region, f"traction on {item.boundary!r}")
+            vec = boundary_load(part, face, pressure=item.pressure,
                                 traction=item.traction, thickness=thickness)
             name = item.name or f"traction on {item.boundary}"
         elif isinstance(item, NodalForce):
             nodes = nodes_at(mesh, item.at, f"nodal force at {item.at!r}")
+            if item.region is not None:
+                nodes = region_nodes(mesh, nodes, item.region, f"nodal force at {item.at!r}")
             f = np.asarray(item.force, dtype=float).reshape(-1)
             if f.size != d or not np.all(np.isfinite(f)):
                 raise InputError(f"nodal force at {item.at!r}: force = {item.force!r}; "
@@ -444,46 +474,6 @@ def mesh_facet_vectors(mesh: Mesh, facets: np.ndarray) -> np.ndarray:
     return n * size[:, None]
 
 
-def match_nodes(mesh: Mesh, nodes: np.ndarray, partner: str, tolerance: float | None,
-                what: str) -> np.ndarray:
-    """The node of boundary ``partner`` at the position of each of ``nodes`` (n,).
-
-    Raises InputError naming the first node without a partner within ``tolerance`` [m]
-    (default ``1e-6`` times the model size), its position and the distance to the nearest
-    partner node, and a partner node matched twice.
-    """
-    from scipy.spatial import cKDTree  # lazy: scipy.spatial is slow to import
-
-    if partner not in mesh.boundaries:
-        raise InputError(f"{what}: unknown partner boundary {partner!r}; the mesh has "
-                         f"boundaries {sorted(mesh.boundaries)}")
-    cand = np.unique(_boundary(mesh, partner))
-    if cand.size == 0:
-        raise InputError(f"{what}: partner boundary {partner!r} is empty")
-    tol = 1e-6 * model_size(mesh) if tolerance is None else tolerance
-    dist, idx = cKDTree(mesh.points[cand]).query(mesh.points[nodes])
-    far = np.flatnonzero(dist > tol)
-    if far.size:
-        i = int(far[np.argmax(dist[far])])
-        raise InputError(
-            f"{what}: node {int(nodes[i])} at {tuple(np.round(mesh.points[nodes[i]], 12).tolist())}"
-            f" has no node of boundary {partner!r} within {tol:.3g} m (nearest: node "
-            f"{int(cand[idx[i]])}, {dist[i]:.3g} m away; {far.size} such nodes): the two "
-            "boundaries need matching nodes (or a larger tolerance)"
-        )
-    out = cand[idx]
-    same = np.intersect1d(out, nodes)
-    if same.size:
-        raise InputError(f"{what}: node {int(same[0])} is on both boundaries of the pair; the "
-                         "two bodies need their own nodes at the interface")
-    values, counts = np.unique(out, return_counts=True)
-    if np.any(counts > 1):
-        j = int(values[counts > 1][0])
-        raise InputError(f"{what}: node {j} of boundary {partner!r} is the partner of "
-                         f"{int(counts.max())} contact nodes; expected one-to-one pairs")
-    return out
-
-
 def _contact(mesh: Mesh, spec: ContactSpec, thickness: float) -> ContactInterface:
     if not isinstance(spec, ContactSpec):
         raise InputError(f"contact: {spec!r} is not a ContactSpec")
@@ -496,11 +486,15 @@ def _contact(mesh: Mesh, spec: ContactSpec, thickness: float) -> ContactInterfac
     facets = _boundary(mesh, spec.boundary)
     if facets.shape[0] == 0:
         raise InputError(f"{what}: boundary {spec.boundary!r} is empty: no contact nodes")
+    face = spec.boundary
+    if spec.region is not None:  # part of the face
+        mesh, face = restricted(mesh, spec.boundary, spec.region, what)
+        facets = _boundary(mesh, face)
     facets = orient_facets(mesh, facets, f"boundary {spec.boundary!r}")
     outward = facet_normals(mesh, facets)
     mean = outward.mean(axis=0)
     mean /= np.linalg.norm(mean)
-    nodes, area = nodal_areas(mesh, spec.boundary, thickness)
+    nodes, area = nodal_areas(mesh, face, thickness)
     if np.any(~(area > 0.0)):
         i = int(np.flatnonzero(~(area > 0.0))[0])
         raise InputError(f"{what}: node {int(nodes[i])} at "
@@ -545,8 +539,12 @@ def _contact(mesh: Mesh, spec: ContactSpec, thickness: float) -> ContactInterfac
         gap = np.full(nc, float(spec.gap))
     partner = dict(partner_dofs=None, partner_ids=None)
     if spec.partner is not None:
-        other = match_nodes(mesh, nodes, spec.partner, spec.tolerance, what)
-        partner = dict(partner_dofs=d * other[:, None] + np.arange(d), partner_ids=other)
+        found = pair(mesh, nodes, frames[:, 0], spec.partner, face=facets,
+                     tolerance=spec.tolerance, pairing=spec.pairing, what=what)
+        partner = dict(partner_dofs=found.partner_dofs, partner_ids=found.partner_ids,
+                       segments=found.segments)
+        if found.segments is not None:
+            gap = gap + found.gap  # the facet's distance along the normal (0 if flat)
     return ContactInterface(
         dofs=d * nodes[:, None] + np.arange(d),
         frame=frames,

@@ -108,6 +108,23 @@ class Load:
 
 
 @dataclass
+class Segments:
+    """Node-to-segment partners of the contact nodes (non-matching interface meshes).
+
+    dofs : (nc, k, d) int, the DOFs of the ``k`` nodes of the facet each contact node faces
+        (``-1`` pads shorter facets and node-to-rigid nodes).
+    weights : (nc, k) float, the facet's shape functions ``N_k(xi)`` at the projection of
+        the contact node (they add up to 1; 0 for padding): the partner displacement is
+        ``sum_k N_k U[dofs[:, k]]``.
+    ids : (nc, k) int, mesh node numbers of the facet nodes (``-1``: padding).
+    """
+
+    dofs: np.ndarray
+    weights: np.ndarray
+    ids: np.ndarray
+
+
+@dataclass
 class ContactInterface:
     """The contact nodes of a model: one per-node record for all its interfaces.
 
@@ -152,6 +169,10 @@ class ContactInterface:
         of the interface in series with the contact law (:mod:`fretwear.hb.connectors`):
         ``inf`` is a rigid contact (default), a finite ``kt`` with a rigid normal is a
         Jenkins element. None: rigid everywhere.
+    segments : node-to-segment pairs (non-matching meshes, :class:`Segments`): node ``a``
+        faces a point of a facet of the other body, whose displacement is the facet nodes'
+        interpolated by the weights ``N_k``; ``partner_dofs`` then holds the facet node of the
+        largest weight (for output). None: every pair is node-to-node.
     """
 
     dofs: np.ndarray
@@ -171,6 +192,7 @@ class ContactInterface:
     normal_load: Load | None = None
     kn: np.ndarray | None = None
     kt: np.ndarray | None = None
+    segments: Segments | None = None
 
     @property
     def n_nodes(self) -> int:
@@ -194,6 +216,20 @@ class ContactInterface:
     def partner_wear_nodes(self) -> np.ndarray:
         """Archard coefficient of every partner's surface (nc,) [1/Pa] (0 without partner)."""
         return np.where(self.paired(), self._per_node(self.partner_wear_coefficient), 0.0)
+
+    def partner_terms(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(dofs, weights)``, (nc, k, d) int and (nc, k) float: the partner displacement
+        of node ``p`` is ``sum_k weights[p, k] U[dofs[p, k]]`` (``-1`` DOFs and zero weights
+        pad a node with fewer terms; a node-to-node pair is one term of weight 1; a
+        node-to-rigid node none)."""
+        if self.segments is not None:
+            return (np.asarray(self.segments.dofs, dtype=np.int64),
+                    np.asarray(self.segments.weights, dtype=float))
+        nc, d = self.dofs.shape
+        if self.partner_dofs is None:
+            return np.full((nc, 1, d), -1, dtype=np.int64), np.zeros((nc, 1))
+        pd = np.asarray(self.partner_dofs, dtype=np.int64)
+        return pd[:, None, :], (pd[:, :1] >= 0).astype(float)
 
     def paired(self) -> np.ndarray:
         """(nc,) bool: which nodes are node ``a`` of a node-to-node pair."""
@@ -249,10 +285,15 @@ class ContactInterface:
         vals = self.frame.reshape(-1)
         T = sp.csr_matrix((vals, (rows, cols)), shape=(nc * d, ndof))
         if self.has_pairs:
-            pd = np.asarray(self.partner_dofs)
-            keep = np.broadcast_to(pd[:, None, :] >= 0, (nc, d, d)).reshape(-1)
-            pcols = np.broadcast_to(pd[:, None, :], (nc, d, d)).reshape(-1)
-            T = T - sp.csr_matrix((vals[keep], (rows[keep], pcols[keep])), shape=(nc * d, ndof))
+            pdofs, weights = self.partner_terms()
+            for k in range(weights.shape[1]):
+                pd = np.where(weights[:, k, None] != 0.0, pdofs[:, k], -1)
+                keep = np.broadcast_to(pd[:, None, :] >= 0, (nc, d, d)).reshape(-1)
+                pcols = np.broadcast_to(pd[:, None, :], (nc, d, d)).reshape(-1)
+                w = vals if self.segments is None else \
+                    vals * np.repeat(weights[:, k], d * d)
+                T = T - sp.csr_matrix((w[keep], (rows[keep], pcols[keep])),
+                                      shape=(nc * d, ndof))
         return T.tocsr()
 
 

@@ -301,7 +301,8 @@ def neighbour_contact(sector: CyclicSector, spec) -> CyclicSector:
                          "next sector's copy of it)")
     if spec.partner not in mesh.boundaries:
         raise InputError(f"contact {spec.name!r}: unknown partner boundary {spec.partner!r}")
-    c = _contact(mesh, dataclasses.replace(spec, partner=None, partner_wear_coefficient=0.0),
+    c = _contact(mesh, dataclasses.replace(spec, partner=None, partner_wear_coefficient=0.0,
+                                           pairing="auto"),
                  model.thickness)
     d = mesh.dim
     b_nodes = np.unique(np.asarray(mesh.boundaries[spec.partner]).reshape(-1))
@@ -342,6 +343,10 @@ def harmonic_model(sector: CyclicSector, k: int) -> tuple[Model, sp.csr_matrix]:
         return B.real.tocsr() if real else B
 
     c = model.contact
+    if c.segments is not None:
+        raise InputError("contact: node-to-segment pairs (non-matching interface meshes) in a "
+                         "cyclic sector are not supported; expected node-to-node pairs "
+                         '(pairing = "node-to-node", matching nodes)')
     contact = dataclasses.replace(
         c, dofs=_positions(sector, c.dofs, "contact"),
         partner_dofs=None if c.partner_dofs is None

@@ -25,7 +25,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from fretwear.errors import InputError
-from fretwear.model.core import ContactInterface, Load, Model, ObservedPoint
+from fretwear.model.core import ContactInterface, Load, Model, ObservedPoint, Segments
 
 
 def combine(interfaces) -> ContactInterface:
@@ -94,6 +94,7 @@ def combine(interfaces) -> ContactInterface:
         normal_load=_combined_normal_load(items),
         kn=_combined_stiffness(items, "kn"),
         kt=_combined_stiffness(items, "kt"),
+        segments=_combined_segments(items, d),
     )
     check_distinct(out)
     for key in ("mu", "wear_coefficient", "partner_wear_coefficient"):
@@ -101,8 +102,29 @@ def combine(interfaces) -> ContactInterface:
         if v.size and np.all(v == v[0]):  # one number for every node stays one number
             setattr(out, key, float(v[0]))
     if not out.has_pairs:
-        out.partner_dofs = out.partner_ids = None
+        out.partner_dofs = out.partner_ids = out.segments = None
     return out
+
+
+def _combined_segments(items, d: int) -> Segments | None:
+    """The node-to-segment partners of several interfaces (node-to-node pairs become one
+    term of weight 1); None when no interface has node-to-segment pairs."""
+    if all(c.segments is None for c in items):
+        return None
+    terms = [c.partner_terms() for c in items]
+    k = max(w.shape[1] for _, w in terms)
+
+    def pad(a, fill):
+        return np.concatenate([a, np.full((a.shape[0], k - a.shape[1], *a.shape[2:]), fill,
+                                          dtype=a.dtype)], axis=1)
+
+    ids = [pad(np.asarray(c.segments.ids, np.int64), -1) if c.segments is not None
+           else np.where(w > 0, (np.full(c.n_nodes, -1) if c.partner_ids is None
+                                  else np.asarray(c.partner_ids))[:, None], -1)
+           for c, (_, w) in zip(items, terms, strict=True)]
+    return Segments(dofs=np.concatenate([pad(p, -1) for p, _ in terms]),
+                    weights=np.concatenate([pad(w, 0.0) for _, w in terms]),
+                    ids=np.concatenate([pad(i, -1) for i in ids]))
 
 
 def _combined_stiffness(items, field: str):
@@ -152,7 +174,7 @@ def check_distinct(c: ContactInterface) -> None:
             "interface only"
         )
     if c.partner_dofs is not None:
-        pd = np.asarray(c.partner_dofs, dtype=np.int64)
+        pd = c.partner_terms()[0].reshape(c.n_nodes, -1)
         clash = np.intersect1d(pd[pd >= 0], flat)
         if clash.size:
             p = int(np.flatnonzero(np.any(pd == clash[0], axis=1))[0])
@@ -168,13 +190,23 @@ def pair_transform(contact: ContactInterface, ndof: int) -> sp.csr_matrix | None
     """``P`` (ndof, ndof) with ``U = P U'`` (module docstring), or None without pairs."""
     if not contact.has_pairs:
         return None
-    pd = np.asarray(contact.partner_dofs, dtype=np.int64)
-    keep = pd >= 0
-    rows = np.asarray(contact.dofs, dtype=np.int64)[keep]
-    cols = pd[keep]
     eye = np.arange(ndof)
+    if contact.segments is None:
+        pd = np.asarray(contact.partner_dofs, dtype=np.int64)
+        keep = pd >= 0
+        rows = np.asarray(contact.dofs, dtype=np.int64)[keep]
+        cols = pd[keep]
+        vals = np.ones(rows.size)
+    else:  # node-to-segment: U_a = r + sum_k N_k U_k (one block N_k I per facet node)
+        pdofs, weights = contact.partner_terms()
+        w = np.broadcast_to(weights[:, :, None], pdofs.shape)
+        keep = (pdofs >= 0) & (w != 0.0)
+        rows = np.broadcast_to(np.asarray(contact.dofs, dtype=np.int64)[:, None, :],
+                               pdofs.shape)[keep]
+        cols, vals = pdofs[keep], w[keep]
     return sp.csr_matrix(
-        (np.ones(ndof + rows.size), (np.concatenate([eye, rows]), np.concatenate([eye, cols]))),
+        (np.concatenate([np.ones(ndof), vals]),
+         (np.concatenate([eye, rows]), np.concatenate([eye, cols]))),
         shape=(ndof, ndof),
     )
 
@@ -200,7 +232,7 @@ def relative_model(model: Model) -> tuple[Model, sp.csr_matrix | None]:
 
     loads = [dataclasses.replace(ld, vector=Pt @ np.asarray(ld.vector, dtype=float))
              for ld in model.loads]
-    contact = dataclasses.replace(model.contact, partner_dofs=None)
+    contact = dataclasses.replace(model.contact, partner_dofs=None, segments=None)
     rel = dataclasses.replace(model, K=tr(model.K), M=tr(model.M), C=tr(model.C), D=tr(model.D),
                               loads=loads, contact=contact,
                               observed=[ObservedPoint(p.name, p.dofs, p.coords)

@@ -133,8 +133,11 @@ def check_supported(model: Model) -> None:
     springs = springs / np.linalg.norm(springs, axis=1, keepdims=True)
     Rrel = R[c.dofs]
     if c.has_pairs:  # a pair holds the relative normal displacement n . (U_a - U_b)
-        pd = np.asarray(c.partner_dofs)
-        Rrel = Rrel - np.where(pd[..., None] >= 0, R[np.maximum(pd, 0)], 0.0)
+        pdofs, weights = c.partner_terms()  # U_b = sum_k N_k U_k (node-to-segment)
+        for k in range(weights.shape[1]):
+            pd = pdofs[:, k]
+            Rrel = Rrel - np.where(pd[..., None] >= 0, weights[:, k, None, None]
+                                   * R[np.maximum(pd, 0)], 0.0)
     A = np.vstack([
         np.einsum("nd,ndr->nr", c.frame[:, 0, :], Rrel),
         R[np.asarray(model.fixed_dofs, dtype=np.int64)],
