@@ -101,3 +101,67 @@ def test_studies_are_found_by_file_or_by_shipped_name(tmp_path):
         resolve_study(tmp_path / "missing.toml")
     with pytest.raises(InputError, match=r"study file 'nowhere.toml' does not exist"):
         resolve_study("nowhere.toml")  # a file name, not a shipped study's name
+
+
+def _run_members_here(path, out):
+    """Run every member of the study ``path`` in this process (run_case into its folder, the
+    status file a worker writes), as the Dask tasks do, without starting a cluster."""
+    from fretwear.analyses.run import run_case
+
+    members = expand(read_study(path))
+    for m in members:
+        folder = out / m.folder_name
+        folder.mkdir(parents=True)
+        (folder / "case.toml").write_text(m.text)
+        res = run_case(folder / "case.toml", folder, progress=False, echo=False)
+        (folder / STATUS_FILE).write_text(MemberRecord(
+            m.index, "ok" if res.success else "not converged", res.summary,
+            case_sha256=case_hash(m.text)).to_json())
+    return members
+
+
+def test_sweep_members_on_different_frequencies_give_a_study_and_its_figure(tmp_path):
+    """Two sweep members whose frequencies differ (4 and 6 grid points over the same band:
+    the case of a continuation that adds points where each member needs them) and whose kept
+    harmonics differ (1 and 1, 2, 3; the two keys tied): study.nc holds their responses on the
+    union of their frequencies and harmonics, equal bit for bit to each member's own results.nc at its own
+    points and harmonics, NaN for a harmonic it did not keep, linear in frequency in between
+    (checked at one midpoint by the formula); member_response_amplitude keeps each member's
+    own points; the summary and the attribute common_grid say so, and the FRF family figure
+    is written."""
+    from helpers.studies import SWEEP
+
+    base_case(tmp_path, SWEEP.replace("n_points = 7", "n_points = 4"))
+    path = study_file(tmp_path, "[grid]\n[[grid.tied]]\n\"analysis.n_points\" = [4, 6]\n"
+                      "\"analysis.harmonics\" = [1, 3]\n")
+    out = tmp_path / "out"
+    members = _run_members_here(path, out)
+    res = run_study(path, out, collect=True, progress=False, echo=False)
+    ds = res.dataset
+    assert "response_amplitude" in ds and "common_grid" in ds.attrs
+    assert "interpolated" in res.message
+    assert [p.name for p in res.figures] == ["study-frf-family.png"]
+    own = [xr.open_dataset(out / m.folder_name / RESULTS_FILE, engine="h5netcdf").load()
+           for m in members]
+    grid = np.unique(np.concatenate([o["frequency"].values for o in own]))
+    np.testing.assert_array_equal(ds["frequency"].values, grid)
+    np.testing.assert_array_equal(ds["harmonic"].values, [1, 2, 3])
+    assert ds["analysis.n_points"].values.tolist() == [4, 6]
+    for i, o in enumerate(own):
+        on = ds["response_amplitude"].isel(member=i).sel(frequency=o["frequency"].values)
+        for h in ds["harmonic"].values:
+            if h in o["harmonic"].values:
+                np.testing.assert_array_equal(on.sel(harmonic=h).values,
+                                              o["response_amplitude"].sel(harmonic=h).values)
+            else:
+                assert np.all(np.isnan(on.sel(harmonic=h).values))
+        m = ds["member_response_amplitude"].isel(member=i).sel(harmonic=1).values
+        n = o.sizes["frequency"]
+        np.testing.assert_array_equal(m[:n], o["response_amplitude"].sel(harmonic=1).values)
+        assert np.all(np.isnan(m[n:]))
+    # member 0 (4 points) between its first two points, at a frequency of member 1
+    f0, a0 = own[0]["frequency"].values, own[0]["response_amplitude"].sel(harmonic=1).values
+    x = grid[(grid > f0[0]) & (grid < f0[1])][0]
+    t = (x - f0[0]) / (f0[1] - f0[0])
+    np.testing.assert_allclose(ds["response_amplitude"].isel(member=0).sel(
+        frequency=x, harmonic=1).values, (1 - t) * a0[0] + t * a0[1], rtol=1e-14)
