@@ -121,14 +121,14 @@ def _run_members_here(path, out):
 
 
 def test_sweep_members_on_different_frequencies_give_a_study_and_its_figure(tmp_path):
-    """Two sweep members whose frequencies differ (4 and 6 grid points over the same band:
-    the case of a continuation that adds points where each member needs them) and whose kept
+    """Two sweep members whose frequencies differ (4 and 6 grid points over the same band: the
+    case of a continuation that adds points where each member needs them) and whose kept
     harmonics differ (1 and 1, 2, 3; the two keys tied): study.nc holds their responses on the
-    union of their frequencies and harmonics, equal bit for bit to each member's own results.nc at its own
-    points and harmonics, NaN for a harmonic it did not keep, linear in frequency in between
-    (checked at one midpoint by the formula); member_response_amplitude keeps each member's
-    own points; the summary and the attribute common_grid say so, and the FRF family figure
-    is written."""
+    union of their frequencies and harmonics, equal bit for bit to each member's own results.nc
+    at its own points and harmonics, NaN for a harmonic it did not keep, linear in frequency in
+    between (checked at one midpoint by the formula); member_response_amplitude keeps each
+    member's own points; the summary and the attribute common_grid say so, and the FRF family
+    figure is written."""
     from helpers.studies import SWEEP
 
     base_case(tmp_path, SWEEP.replace("n_points = 7", "n_points = 4"))
@@ -165,3 +165,31 @@ def test_sweep_members_on_different_frequencies_give_a_study_and_its_figure(tmp_
     t = (x - f0[0]) / (f0[1] - f0[0])
     np.testing.assert_allclose(ds["response_amplitude"].isel(member=0).sel(
         frequency=x, harmonic=1).values, (1 - t) * a0[0] + t * a0[1], rtol=1e-14)
+
+
+def test_summary_wraps_between_words_and_prints_worker_warnings_in_one_line():
+    """A failed member's long message is printed whole, in lines of at most 100 characters
+    broken between words (the words of the lines, joined, are the message's words: none is
+    cut); a member's Python warnings are one line each, ``Category: message``, once each,
+    without the file name and source line Python prints by default."""
+    import warnings
+
+    from fretwear.study.runner import warning_lines
+
+    words = [f"word{i:03d}" for i in range(60)] + ["x" * 120]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        for _ in range(2):
+            warnings.warn("the preload solve\n  did not converge", RuntimeWarning,
+                          stacklevel=1)
+    lines = warning_lines(caught)
+    assert lines == "RuntimeWarning: the preload solve did not converge"
+    records = [MemberRecord(0, "failed", " ".join(words)), MemberRecord(1, "ok",
+                                                                        warnings=lines)]
+    ok, message = _summary(SimpleNamespace(kind="grid"), records, xr.Dataset())
+    body = message.splitlines()[1:]
+    assert not ok and all(len(x) <= 100 or x.strip() == "x" * 120 for x in body)
+    assert " ".join(body[:-1]).split() == ["member", "0:", "failed:", *words]
+    assert body[-1] == ("  member 1: warning: RuntimeWarning: the preload solve did not "
+                        "converge")
+    assert "test_run.py" not in message

@@ -77,6 +77,9 @@ def _summary(study: Study, records, ds) -> tuple[bool, str]:
     for r in records:
         if r.status not in ("ok", "not run"):
             lines.append(_wrap(f"member {r.index}: {r.status}: {r.message}"))
+    for r in records:
+        for w in filter(None, r.warnings.splitlines()):
+            lines.append(_wrap(f"member {r.index}: warning: {w}"))
     if ds.attrs.get("common_grid"):
         lines.append(_wrap(ds.attrs["common_grid"]))
     ok = count["ok"] == n
