@@ -249,6 +249,22 @@ def _sweep_summary(result: SweepResult, ds: xr.Dataset) -> str:
     return "\n".join(lines)
 
 
+def sweep_figures(ds: xr.Dataset, case, outdir: Path) -> list[Path]:
+    """The figures of a sweep (``case.output``: whether and in which format): the FRF of
+    each observed point and the interface's energy and states."""
+    figures = []
+    for point in ds["point"].values:
+        p = figure_path(case, outdir, f"sweep-{point}")
+        if p is not None:
+            figures.append(plot_sweep(ds, p, str(point),
+                                      title=titled(case.title, "nonlinear FRF")))
+    p = figure_path(case, outdir, "sweep-interface")
+    if p is not None:
+        figures.append(plot_sweep_interface(ds, p, title=titled(case.title,
+                                                                  "contact interface")))
+    return figures
+
+
 def run_sweep(model, analysis: dict, case, context: RunContext) -> RunOutput:
     """Nonlinear FRF: periodic solutions over a frequency band (:func:`fretwear.hb.sweep.sweep`).
 
@@ -307,15 +323,7 @@ def run_sweep(model, analysis: dict, case, context: RunContext) -> RunOutput:
         "n_samples": int(basis.n_samples),
         **cond.choice.attributes(),
     })
-    figures = []
-    for point in points:
-        p = figure_path(case, context.out_dir, f"sweep-{point}")
-        if p is not None:
-            figures.append(plot_sweep(ds, p, point, title=titled(case.title, "nonlinear FRF")))
-    p = figure_path(case, context.out_dir, "sweep-interface")
-    if p is not None:
-        figures.append(plot_sweep_interface(ds, p, title=titled(case.title,
-                                                                  "contact interface")))
+    figures = sweep_figures(ds, case, context.out_dir)
     grid_ok = all(p.success for p in result.points if p.on_grid)
     summary = "\n".join([_sweep_summary(result, ds), *events, cond.choice.summary()])
     return RunOutput(ds, figures, summary, grid_ok, warnings=list(result.warnings))

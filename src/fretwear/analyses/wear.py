@@ -426,7 +426,7 @@ def run_wear(model, analysis: dict, case, context: RunContext) -> RunOutput:
                       energy_coefficients=(opts.energy_coefficient,
                                            opts.partner_energy_coefficient))
     ds.attrs.update(cond.choice.attributes())
-    figures = _figures(ds, case, context.out_dir, nodes)
+    figures = wear_figures(ds, case, context.out_dir, nodes)
     files = [context.out_dir / CHECKPOINT_FILE]
     if model.mesh is not None and case.output["vtu"]:
         files.append(write_wear_fields(model, ds, context.out_dir / "wear.pvd"))
@@ -476,7 +476,9 @@ def write_wear_fields(model, ds, pvd: Path) -> Path:
     return write_pvd(pvd, entries)
 
 
-def _figures(ds, case, outdir: Path, nodes) -> list[Path]:
+def wear_figures(ds, case, outdir: Path, nodes) -> list[Path]:
+    """The figures of a wear run (``case.output``: whether and in which format; ``nodes``:
+    those of the wear kinetics, default :func:`default_nodes`)."""
     out = case.output
     if not out["figures"]:
         return []
