@@ -52,9 +52,10 @@ def wear_study() -> xr.Dataset:
 
 
 def test_wear_figures_draw_the_statistics_in_their_units(tmp_path, drawn):
-    """Fan chart: one thin line per member, the median and the mean of the dataset in mm^3
-    (1e9 x m^3). Profiles: drawn at the last cycle every member reached (index 2, found by
-    hand), x in mm and the median in um. Both files are PNG images."""
+    """Fan chart: one thin line per member, the median and the mean of the dataset in m^3,
+    the axis labelled in mm³ by the figure style (ticks 1e9 x m^3). Profiles: drawn at the
+    last cycle every member reached (index 2, found by hand), x in m labelled mm, the median
+    in m labelled µm. Both files are PNG images."""
     ds = wear_study()
     paths = figures.study_figures(ds, tmp_path, ["contact.mu"])
     assert [p.name for p in paths] == ["study-worn-volume.png", "study-wear-profiles.png"]
@@ -62,15 +63,16 @@ def test_wear_figures_draw_the_statistics_in_their_units(tmp_path, drawn):
     ax = drawn["study-worn-volume.png"].axes[0]
     lines = {ln.get_label(): ln for ln in ax.get_lines()}
     assert sum(lb.startswith("_") for lb in lines) == 3  # members, unlabelled
-    np.testing.assert_allclose(lines["median"].get_ydata(),
-                               ds["worn_volume_quantile"].values[1] * 1e9, rtol=1e-15)
-    np.testing.assert_allclose(lines["mean"].get_ydata(),
-                               ds["worn_volume_mean"].values * 1e9, rtol=1e-15)
+    np.testing.assert_array_equal(lines["median"].get_ydata(),
+                                  ds["worn_volume_quantile"].values[1])
+    np.testing.assert_array_equal(lines["mean"].get_ydata(), ds["worn_volume_mean"].values)
+    assert ax.get_ylabel() == "worn volume [mm³]"
+    assert ax.yaxis.get_major_formatter()(4e-9, 0) == "4"
     ax = drawn["study-wear-profiles.png"].axes[0]
     median = next(ln for ln in ax.get_lines() if ln.get_label() == "median")
-    np.testing.assert_allclose(median.get_xdata(), [1.0, 2.0], rtol=1e-15)
-    np.testing.assert_allclose(median.get_ydata(),
-                               ds["wear_depth_quantile"].values[1, 2] * 1e6, rtol=1e-15)
+    np.testing.assert_array_equal(median.get_xdata(), [0.001, 0.002])
+    np.testing.assert_array_equal(median.get_ydata(), ds["wear_depth_quantile"].values[1, 2])
+    assert ax.get_xlabel() == "x [mm]" and ax.get_ylabel() == "wear depth [µm]"
     assert ax.get_title() == "worn profiles at N = 2e+06"
 
 

@@ -13,11 +13,14 @@ from pathlib import Path
 
 import numpy as np
 
+from fretwear.analyses.figure_style import apply_style
 from fretwear.files import atomic_write
 
 
 def _save(fig, path: Path) -> Path:
     import matplotlib.pyplot as plt
+
+    apply_style(fig)
 
     def write(tmp: Path) -> None:
         fig.savefig(tmp, format=path.suffix.lstrip("."), dpi=130, bbox_inches="tight")
@@ -42,13 +45,13 @@ def fan_chart(ds, path: Path) -> Path:
     fig, ax = _figure(figsize=(7, 4.5))
     n = ds["cycle"].values
     for v in ds["worn_volume_on_cycles"].values:
-        ax.plot(n, v * 1e9, color="0.6", lw=0.6)
-    q = ds["worn_volume_quantile"].values * 1e9
+        ax.plot(n, v, color="0.6", lw=0.6)
+    q = ds["worn_volume_quantile"].values
     ax.fill_between(n, q[0], q[2], color="C0", alpha=0.3, label="5-95 % of the members")
     ax.plot(n, q[1], color="C0", lw=2, label="median")
-    ax.plot(n, ds["worn_volume_mean"].values * 1e9, color="C1", ls="--", label="mean")
+    ax.plot(n, ds["worn_volume_mean"].values, color="C1", ls="--", label="mean")
     ax.set_xlabel("cycles N")
-    ax.set_ylabel("worn volume [mm^3]")
+    ax.set_ylabel("worn volume [m^3]")
     ax.set_title(f"{ds.attrs.get('title', '')}: {int(ds.attrs.get('members_ok', 0))} members",
                  fontsize=9)
     ax.legend(fontsize=8)
@@ -64,15 +67,15 @@ def profile_band(ds, path: Path) -> Path:
     x = ds["contact_position"].values[..., 0] if "contact_position" in ds else \
         np.arange(ds.sizes["contact_node"])
     x = np.nanmean(x, axis=0) if x.ndim == 2 else x
-    xs = x * 1e3 if "contact_position" in ds else x
+    xs = x
     fig, ax = _figure(figsize=(7, 4.5))
     for w in ds["wear_depth_on_cycles"].values[:, k]:
-        ax.plot(xs, w * 1e6, color="0.6", lw=0.6)
-    q = ds["wear_depth_quantile"].values[:, k] * 1e6
+        ax.plot(xs, w, color="0.6", lw=0.6)
+    q = ds["wear_depth_quantile"].values[:, k]
     ax.fill_between(xs, q[0], q[2], color="C0", alpha=0.3, label="5-95 % of the members")
     ax.plot(xs, q[1], color="C0", lw=2, label="median")
-    ax.set_xlabel("x [mm]" if "contact_position" in ds else "contact node")
-    ax.set_ylabel("wear depth [um]")
+    ax.set_xlabel("x [m]" if "contact_position" in ds else "contact node")
+    ax.set_ylabel("wear depth [m]")
     ax.set_title(f"worn profiles at N = {float(ds['cycle'].values[k]):.3g}", fontsize=9)
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
