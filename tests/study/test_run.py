@@ -193,3 +193,62 @@ def test_summary_wraps_between_words_and_prints_worker_warnings_in_one_line():
     assert body[-1] == ("  member 1: warning: RuntimeWarning: the preload solve did not "
                         "converge")
     assert "test_run.py" not in message
+
+
+JENKINS = """title = "Jenkins oscillator"
+[model]
+type = "matrices"
+K = "{K}"
+M = "{M}"
+[contact]
+tangential_dofs = [0]
+normal_load = 10.0
+mu = 0.3
+kt = 2e5
+[[loads]]
+name = "shake"
+file = "shake.txt"
+waveform = "cos"
+[observed]
+mass = 0
+[analysis]
+type = "sweep"
+f_min = 50.0
+f_max = 90.0
+n_points = 5
+spacing = "linear"
+harmonics = 1
+n_samples = 64
+linear_references = []
+[output]
+figures = false
+vtu = false
+"""
+
+
+def test_a_study_of_the_excitation_level_gives_the_family_of_frfs_and_its_peaks(tmp_path):
+    """The shipped Jenkins oscillator (k = kt = 2e5 N/m, m = 0.5 kg, mu N = 3 N) shaken by
+    1 N x excitation_scale over 50-90 Hz, below its stuck resonance (142 Hz): at levels 0.5
+    and 1 the element stays stuck (response below mu N / kt = 15 um), so the peak is at
+    90 Hz and equals level / (k + kt - m w^2) in closed form to the balance's tolerance
+    (1e-8); at level 10 it slips and the peak per unit level is larger (softer). The summary
+    gives one line per level and the load-level figure is written."""
+    (tmp_path / "shake.txt").write_text("1.0\n")
+    (tmp_path / "beam.toml").write_text(JENKINS.format(K=EXAMPLES_DIR / "jenkins-K.mtx",
+                                                       M=EXAMPLES_DIR / "jenkins-M.mtx"))
+    path = study_file(tmp_path, '[grid]\n"analysis.excitation_scale" = [1.0, 0.5, 10.0]\n')
+    out = tmp_path / "out"
+    _run_members_here(path, out)
+    res = run_study(path, out, collect=True, progress=False, echo=False)
+    assert res.success, res.message
+    ds = res.dataset
+    w = 2 * np.pi * 90.0
+    stuck = 1.0 / (2e5 + 2e5 - 0.5 * w**2)
+    np.testing.assert_allclose(ds["peak_response_amplitude"].values[:2], [stuck, 0.5 * stuck],
+                               rtol=1e-8)
+    np.testing.assert_array_equal(ds["peak_frequency"].values, [90.0, 90.0, 90.0])
+    assert ds["peak_response_amplitude"].values[2] / 10.0 > 1.05 * stuck
+    assert [p.name for p in res.figures] == ["study-frf-family.png", "study-load-levels.png"]
+    levels = [x.strip() for x in res.message.splitlines() if x.strip().startswith("level ")]
+    assert [x.split(":")[0] for x in levels] == ["level 0.5", "level 1", "level 10"]
+    assert levels[1].startswith(f"level 1: peak {stuck:.4g} m at 90 Hz")

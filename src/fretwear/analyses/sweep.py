@@ -41,6 +41,7 @@ from fretwear.hb.sweep import SweepResult
 from fretwear.hb.sweep_stability import SweepStability, sweep_stability
 from fretwear.io.results import label_coordinate, variable
 from fretwear.io.schema import Field, Flag, Integer, ListOf, Number, Text, increasing
+from fretwear.load_levels import excitation_scaled
 from fretwear.timedomain.stability import sweep_check
 
 #: the points computed so far, saved after every grid frequency (``--resume`` continues)
@@ -280,6 +281,7 @@ def run_sweep(model, analysis: dict, case, context: RunContext) -> RunOutput:
     points = check_points(model, analysis.get("points"))
     basis = basis_of(analysis)
     n = analysis["n_points"]
+    model = excitation_scaled(model, analysis["excitation_scale"])
     # the run's condensation of the model (the case file's choice: one modal basis for the
     # whole band where chosen), for every call
     cond = condenser_of(model, analysis, analysis["f_max"], max(basis.harmonics))
@@ -462,6 +464,10 @@ SWEEP = Analysis.define(
                                 default=False),
         "points": Field(ListOf(Text(), non_empty=True, unique=True),
                         "observed points to report (default: all)"),
+        "excitation_scale": Field(Number(lo=0, lo_open=True), "factor on every load that "
+                                  "varies in time (the constant ones, a preload, kept): one "
+                                  "excitation level; a study varying it gives the family of "
+                                  "FRFs over the level (docs/study.md)", default=1.0),
         "eps_band": Field(ListOf(Number(lo=0, lo_open=True), sizes=(2,)),
                           'the band [f_min, f_max] over which eps = "stiff" or "top" takes its '
                           "median (default: the sweep's band; the chunks of a split sweep give "

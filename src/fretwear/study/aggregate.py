@@ -10,8 +10,10 @@ solve is never a result). Two kinds get more:
   the longest run, NaN past a member's last step; their mean and 5/50/95 % quantiles over the
   members that reached each cycle (``members_reached``), and each member's final state;
 * sweep members: the envelope (min, max) of the response amplitude over the members (the band
-  of FRFs); for a split sweep (:mod:`fretwear.study.sweep_split`) the chunks joined into one
-  sweep instead.
+  of FRFs) and each member's peak (``peak_response_amplitude``, ``peak_frequency``: of the
+  family of FRFs over the excitation level, ``analysis.excitation_scale``, the curves a
+  joint engineer reads first); for a split sweep (:mod:`fretwear.study.sweep_split`) the
+  chunks joined into one sweep instead.
 
 Members whose frequencies differ (continuation adds points where each member needs them) or
 whose kept harmonics differ cannot be stacked as they are. Their variables along a frequency
@@ -299,6 +301,35 @@ def _wear(members: list[Member], done: dict) -> tuple[dict, dict]:
     return coords, data
 
 
+def _peaks(stacked: dict, coords: dict) -> dict:
+    """Each member's largest amplitude of harmonic 1 of the first observed point (the
+    largest over its axes) over the band, and its frequency (``peak_response_amplitude``,
+    ``peak_frequency``): the curve of the peak against a varied key (e.g. the excitation
+    level)."""
+    if "response_amplitude" not in stacked or "frequency" not in coords:
+        return {}
+    dims, arr, attrs = stacked["response_amplitude"]
+    if dims[:2] != ("member", "frequency"):
+        return {}
+    sel = arr
+    with np.errstate(all="ignore"), _quiet():
+        for d in dims[2:]:  # point, axis, harmonic: the first point, the largest axis, the
+            sel = np.nanmax(sel, axis=2) if d == "axis" else sel[:, :, 0]  # first harmonic
+        ok = np.any(np.isfinite(sel), axis=1)
+        j = np.argmax(np.where(np.isfinite(sel), sel, -np.inf), axis=1)
+    rows = np.arange(sel.shape[0])
+    f = np.asarray(coords["frequency"][1], float)
+    return {
+        "peak_response_amplitude": ("member", np.where(ok, sel[rows, j], np.nan),
+                                    {"units": attrs.get("units", "m"), "long_name":
+                                     "largest amplitude of harmonic 1 of the first observed "
+                                     "point (largest over its axes) over the band"}),
+        "peak_frequency": ("member", np.where(ok, f[j], np.nan),
+                           {"units": "Hz", "long_name": "frequency of the member's "
+                            "peak_response_amplitude"}),
+    }
+
+
 def _frf_band(stacked: dict) -> dict:
     if "response_amplitude" not in stacked:
         return {}
@@ -357,6 +388,7 @@ def aggregate(study, members: list[Member], records: list[MemberRecord], outdir)
     else:
         data.update(_frf_band(stacked))
         data.update(_own_variables(members, own))
+        data.update(_peaks(stacked, coords))
     ds = xr.Dataset(data, coords=coords)
     if note:
         ds.attrs["common_grid"] = note

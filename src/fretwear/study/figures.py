@@ -4,16 +4,19 @@
   the mean and every member thin) and the band of worn profiles at the last cycle every
   member reached;
 * sweep studies: the family of FRFs (one curve per member, labelled with its varied keys)
-  and their envelope; a split sweep: the joined FRF with the joins marked.
+  and their envelope; a split sweep: the joined FRF with the joins marked; a study of the
+  excitation level alone (``analysis.excitation_scale``): the FRFs divided by the level on
+  one axis and the peak amplitude and frequency against the level.
 """
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import numpy as np
 
-from fretwear.analyses.figure_style import apply_style
+from fretwear.analyses.figure_style import apply_style, frequency_scale
 from fretwear.files import atomic_write
 
 
@@ -94,7 +97,10 @@ def _main_response(ds):
     amp = amp.isel(sel)
     label = f"{str(ds['point'].values[0]) if 'point' in ds else ''}"
     if "axis" in amp.dims:
-        axis = int(np.nanargmax(np.nanmax(amp.values.reshape(-1, amp.sizes["axis"]), axis=0)))
+        with warnings.catch_warnings():  # an axis the point does not have is all NaN
+            warnings.simplefilter("ignore", RuntimeWarning)
+            largest = np.nanmax(amp.values.reshape(-1, amp.sizes["axis"]), axis=0)
+        axis = int(np.nanargmax(np.where(np.isnan(largest), -np.inf, largest)))
         label += f" {str(ds['axis'].values[axis])}"
         amp = amp.isel(axis=axis)
     return amp, label.strip()
@@ -109,10 +115,10 @@ def frf_family(ds, path: Path, varied: list[str]) -> Path:
         text = ", ".join(f"{k} = {ds[k].values[i]:.3g}" if ds[k].dtype.kind == "f"
                          else f"{k} = {ds[k].values[i]}" for k in varied if k in ds.coords
                          and ds[k].dims == ("member",))
-        ax.plot(f, amp.values[i], lw=1, label=text or f"member {i}")
+        ax.plot(f, amp.values[i], lw=1, marker="." if f.size <= 80 else None, ms=3,
+                alpha=0.85, label=text or f"member {i}")
     ax.set_yscale("log")
-    if f.min() > 0 and f.max() / f.min() > 20:
-        ax.set_xscale("log")
+    ax.set_xscale(frequency_scale(f.min(), f.max()))
     ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel(f"amplitude {label} [m]")
     ax.set_title(ds.attrs.get("title", ""), fontsize=9)
@@ -132,12 +138,57 @@ def joined_frf(ds, path: Path) -> Path:
         if np.isfinite(fj):
             ax.axvline(fj, color="0.5" if ok else "red", lw=0.8, ls=":")
     ax.set_yscale("log")
-    if f.size and f.min() > 0 and f.max() / f.min() > 20:
-        ax.set_xscale("log")
+    if f.size:
+        ax.set_xscale(frequency_scale(f.min(), f.max()))
     ax.set_xlabel("frequency [Hz] (dotted: joins of chunks; red: join check failed)")
     ax.set_ylabel(f"amplitude {label} [m]")
     ax.set_title(ds.attrs.get("title", ""), fontsize=9)
     ax.grid(alpha=0.3, which="both")
+    return _save(fig, path)
+
+
+LEVEL_KEY = "analysis.excitation_scale"
+
+
+def load_levels(ds, path: Path) -> Path:
+    """The family of FRFs over the excitation level: every level's FRF divided by the level
+    on one axis (they coincide where the joint is linear: stuck or sliding throughout), and
+    the peak amplitude and its frequency against the level."""
+    import matplotlib
+
+    amp, label = _main_response(ds)
+    levels = ds[LEVEL_KEY].values.astype(float)
+    order = np.argsort(levels)
+    f = ds["frequency"].values
+    fig, axes = _figure(1, 3, figsize=(14, 4.2))
+    colours = matplotlib.colormaps["viridis"](np.linspace(0.0, 0.9, max(len(levels), 1)))
+    styles = ("-", "--", "-.", ":")
+    for k, (c, i) in enumerate(zip(colours, order, strict=False)):
+        # coinciding curves (linear levels) stay visible: thinner and dashed on top
+        axes[0].plot(f, amp.values[i] / levels[i], color=c, ls=styles[k % 4],
+                     lw=max(2.8 - 0.5 * k, 0.8), marker=".", ms=3, zorder=2 + k,
+                     label=f"level {levels[i]:.3g}")
+    axes[0].set_yscale("log")
+    axes[0].set_xscale(frequency_scale(f.min(), f.max()))
+    axes[0].set_xlabel("frequency [Hz]")
+    axes[0].set_ylabel(f"amplitude {label} / level [m]")
+    axes[0].legend(fontsize=7, title="excitation_scale", title_fontsize=7)
+    lv, peak = levels[order], ds["peak_response_amplitude"].values[order]
+    axes[1].loglog(lv, peak, marker="o", label="peak")
+    ok = np.isfinite(peak)
+    if ok.any():
+        k = int(np.flatnonzero(ok)[0])
+        axes[1].loglog(lv, peak[k] * lv / lv[k], color="0.5", ls="--", lw=0.8,
+                       label="proportional to the level (linear)")
+    axes[1].set_xlabel("excitation level (excitation_scale)")
+    axes[1].set_ylabel(f"peak amplitude {label} [m]")
+    axes[1].legend(fontsize=7)
+    axes[2].semilogx(lv, ds["peak_frequency"].values[order], marker="o")
+    axes[2].set_xlabel("excitation level (excitation_scale)")
+    axes[2].set_ylabel("peak frequency [Hz]")
+    for ax in axes:
+        ax.grid(alpha=0.3, which="both")
+    fig.suptitle(ds.attrs.get("title", ""), fontsize=9)
     return _save(fig, path)
 
 
@@ -151,4 +202,6 @@ def study_figures(ds, outdir: Path, varied: list[str], fmt: str = "png") -> list
         out.append(profile_band(ds, outdir / f"study-wear-profiles.{fmt}"))
     elif "response_amplitude" in ds and "member" in ds["response_amplitude"].dims:
         out.append(frf_family(ds, outdir / f"study-frf-family.{fmt}", varied))
+        if varied == [LEVEL_KEY] and "peak_frequency" in ds:
+            out.append(load_levels(ds, outdir / f"study-load-levels.{fmt}"))
     return out

@@ -8,12 +8,14 @@ import textwrap
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
+
 from fretwear import __version__
 from fretwear.analyses.run import check_output
 from fretwear.errors import InputError, interrupted
 from fretwear.files import atomic_write, remove_stale_temporaries
 from fretwear.study.aggregate import aggregate
-from fretwear.study.figures import study_figures
+from fretwear.study.figures import LEVEL_KEY, study_figures
 from fretwear.study.members import expand
 from fretwear.study.runner import check_scheduler_address, dask_client, run_members
 from fretwear.study.spec import Study, read_study
@@ -80,6 +82,11 @@ def _summary(study: Study, records, ds) -> tuple[bool, str]:
     for r in records:
         for w in filter(None, r.warnings.splitlines()):
             lines.append(_wrap(f"member {r.index}: warning: {w}"))
+    if "peak_frequency" in ds and LEVEL_KEY in ds.coords:
+        for lv, a, f in sorted(zip(ds[LEVEL_KEY].values, ds["peak_response_amplitude"].values,
+                                   ds["peak_frequency"].values, strict=True)):
+            lines.append(f"  level {lv:.4g}: peak {a:.4g} m at {f:.6g} Hz"
+                         + (f", {a / lv:.4g} m per unit level" if np.isfinite(a) else ""))
     if ds.attrs.get("common_grid"):
         lines.append(_wrap(ds.attrs["common_grid"]))
     ok = count["ok"] == n
