@@ -11,6 +11,7 @@ The public API, stage by stage (data flows one way; each stage returns a plain d
     red   = fretwear.condense(model, frequency, basis.orders, condenser=cond)  # Reduced (Z_r)
     sol   = fretwear.solve_periodic(model, basis, frequency, condenser=cond)   # PeriodicSolution
     frf   = fretwear.sweep(model, basis, f_min, f_max, n, condenser=cond)     # SweepResult
+    fam   = fretwear.load_levels(model, basis, f_min, f_max, n, levels)  # FRFs over the level
     hill  = fretwear.sweep_stability(model, frf, condenser=cond)         # SweepStability
     nm    = fretwear.nonlinear_mode(model, basis, amplitudes)           # Backbone (EPMC)
     syn   = fretwear.mode_frf(model, nm)                  # ModalFRF (single-mode theory)
@@ -95,6 +96,7 @@ _API = {
     # case files and results
     "run_case": "fretwear.analyses.run", "load_case": "fretwear.analyses.run",
     "read_results": "fretwear.io.results",
+    "load_levels": "fretwear.levels", "LoadLevels": "fretwear.levels",
     "run": "fretwear.analyses.python_run", "write_results": "fretwear.analyses.python_run",
     "plot": "fretwear.analyses.python_run",
     "run_study": "fretwear.study.run", "read_study": "fretwear.study.spec",

@@ -41,7 +41,7 @@ from fretwear.hb.sweep import SweepResult
 from fretwear.hb.sweep_stability import SweepStability, sweep_stability
 from fretwear.io.results import label_coordinate, variable
 from fretwear.io.schema import Field, Flag, Integer, ListOf, Number, Text, increasing
-from fretwear.load_levels import excitation_scaled
+from fretwear.levels import excitation_scaled
 from fretwear.timedomain.stability import sweep_check
 
 #: the points computed so far, saved after every grid frequency (``--resume`` continues)

@@ -1,4 +1,4 @@
-"""The family of FRFs over the excitation level (fretwear.load_levels) and the sweep key
+"""The family of FRFs over the excitation level (fretwear.levels) and the sweep key
 ``excitation_scale``.
 
 References: a Jenkins oscillator (mass m on a spring k, tied to the ground through a
@@ -16,7 +16,7 @@ import pytest
 
 import fretwear as fw
 from fretwear.errors import InputError
-from fretwear.load_levels import excitation_scaled, load_levels
+from fretwear.levels import excitation_scaled, load_levels
 from fretwear.model.core import Load
 from fretwear.model.matrices import ContactDofs, from_matrices
 
