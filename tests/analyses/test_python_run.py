@@ -69,10 +69,10 @@ def test_python_run_keys_are_checked_as_in_a_case_file(tmp_path):
 
 
 def test_python_results_are_written_and_drawn_as_the_case_files_do(tmp_path):
-    """fw.sweep and fw.solve_periodic on the beam, then fw.write_results and fw.plot: the
-    results read back hold the drivers' own amplitudes (SweepResult.amplitude; the periodic
-    solution's first harmonic) and the figure and ParaView files are those the sweep and
-    periodic analyses write."""
+    """fw.sweep, fw.solve_periodic and fw.integrate on the beam, then fw.write_results and
+    fw.plot: the results read back hold the drivers' own values (SweepResult.amplitude, the
+    integration's last period) and the figure and ParaView files are those the sweep,
+    periodic and transient analyses write."""
     case = load_case(base_case(tmp_path, SWEEP.replace("n_points = 7", "n_points = 3")))
     model, basis = build_model(case), basis_of(case.analysis)
     frf = fw.sweep(model, basis, 6e3, 8e3, 3)
@@ -89,5 +89,11 @@ def test_python_results_are_written_and_drawn_as_the_case_files_do(tmp_path):
     assert ds.attrs["analysis_type"] == "periodic" and int(ds.attrs["converged"]) == 1
     files = {p.name for p in fw.plot(sol, tmp_path / "periodic", model, basis)}
     assert f"periodic-{point}.png" in files and "periodic.pvd" in files
+    run = fw.integrate(model, 7e3, n_periods=3)
+    ds = fw.read_results(fw.write_results(run, tmp_path / "transient", model))
+    np.testing.assert_array_equal(ds["displacement"].sel(point=point).values,
+                                  run.observed[point].T)
+    files = {p.name for p in fw.plot(run, tmp_path / "transient", model)}
+    assert files == {f"transient-{point}.png", f"poincare-{point}.png", "contact-state.png"}
     with pytest.raises(InputError, match="expected the result of fw.sweep"):
         fw.write_results(object(), tmp_path / "x", model, basis)

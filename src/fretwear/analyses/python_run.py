@@ -11,9 +11,10 @@ file's ``case_file`` attribute holds the ``[analysis]`` and ``[output]`` tables 
 TOML, under a comment saying that the model was built in Python.
 
 :func:`write_results` and :func:`plot` take a result of :func:`fretwear.sweep`,
-:func:`fretwear.solve_periodic` or :func:`fretwear.simulate_wear` with the model and basis it
-was computed with, and write what the analysis of that kind writes: the results dataset
-(``docs/results.md``) through :func:`fretwear.io.results.write_results`, and its figures.
+:func:`fretwear.solve_periodic`, :func:`fretwear.simulate_wear` or :func:`fretwear.integrate`
+with the model and basis it was computed with, and write what the analysis of that kind writes:
+the results dataset (``docs/results.md``) through :func:`fretwear.io.results.write_results`, and
+its figures.
 """
 
 from __future__ import annotations
@@ -33,6 +34,8 @@ from fretwear.io.schema import Context, Variant, show
 
 #: the file name a Python run stands for in messages and in ``case_path``
 PYTHON_CASE = "python-model.toml"
+#: harmonics of the last period reported for a time integration (``basis`` None)
+TRANSIENT_HARMONICS = 5
 
 
 def _plain(value):
@@ -114,14 +117,15 @@ def run(model, analysis, output, *, title: str = "", progress: bool = False,
 def _kind(result) -> str:
     from fretwear.hb.solution import PeriodicSolution
     from fretwear.hb.sweep_result import SweepResult
+    from fretwear.timedomain.results import TransientResult
     from fretwear.wear import WearResult
 
     for kind, cls in (("sweep", SweepResult), ("periodic", PeriodicSolution),
-                      ("wear", WearResult)):
+                      ("wear", WearResult), ("transient", TransientResult)):
         if isinstance(result, cls):
             return kind
     raise InputError(f"result = {type(result).__name__}: expected the result of fw.sweep, "
-                     "fw.frf_worn, fw.solve_periodic or fw.simulate_wear")
+                     "fw.frf_worn, fw.solve_periodic, fw.simulate_wear or fw.integrate")
 
 
 def results_dataset(result, model, basis, points=None, frequency=None):
@@ -140,6 +144,15 @@ def results_dataset(result, model, basis, points=None, frequency=None):
         from fretwear.analyses.periodic import periodic_dataset
 
         return kind, periodic_dataset(model, result, names)
+    if kind == "transient":
+        from fretwear.analyses.transient import transient_dataset
+
+        if result.t.size > 1.5 * result.steps_per_period:
+            raise InputError(f"result: a time integration recording {result.t.size} samples; "
+                             "its results report the last period: integrate with "
+                             "record='last' (the default)")
+        nh = basis if isinstance(basis, int) else TRANSIENT_HARMONICS
+        return kind, transient_dataset(model, result, names, nh, 0)
     from fretwear.analyses.wear import wear_dataset
 
     if frequency is None:
@@ -148,17 +161,18 @@ def results_dataset(result, model, basis, points=None, frequency=None):
     return kind, wear_dataset(model, result, basis, frequency_hz=float(frequency))
 
 
-def write_results(result, output, model, basis, *, title: str = "", points=None,
+def write_results(result, output, model, basis=None, *, title: str = "", points=None,
                   frequency=None) -> Path:
     """Write ``output/results.nc`` for a result obtained in Python, in the format of the
     case-file route (``docs/results.md``; read it back with :func:`fretwear.read_results`).
 
     Parameters
     ----------
-    result : what :func:`fretwear.sweep` (or ``frf_worn``), :func:`fretwear.solve_periodic` or
-        :func:`fretwear.simulate_wear` returned.
+    result : what :func:`fretwear.sweep` (or ``frf_worn``), :func:`fretwear.solve_periodic`,
+        :func:`fretwear.simulate_wear` or :func:`fretwear.integrate` returned.
     output : the results folder (made if needed).
-    model, basis : the model and Fourier basis the result was computed with.
+    model, basis : the model and Fourier basis the result was computed with (for a time
+        integration, the number of harmonics of the last period to report, default 5).
     title : the title recorded in the file.
     points : observed points to report (default: every one of the model).
     frequency : a wear run's excitation frequency [Hz] (default: that of its first balanced
@@ -179,7 +193,7 @@ def write_results(result, output, model, basis, *, title: str = "", points=None,
                  case_path="", analysis={"type": kind})
 
 
-def plot(result, output, model, basis, *, title: str = "", fmt: str = "png",
+def plot(result, output, model, basis=None, *, title: str = "", fmt: str = "png",
          vtu: bool = True) -> list[Path]:
     """The figures (and, for a model with a mesh and ``vtu``, the ParaView files) the analysis
     of ``result``'s kind writes, into ``output``, for a result obtained in Python.
@@ -211,6 +225,10 @@ def plot(result, output, model, basis, *, title: str = "", fmt: str = "png",
         files += periodic_figures(ds, case, out_dir, name)
         if vtu and model.mesh is not None:
             files.append(write_period_fields(model, result, out_dir / "periodic.pvd"))
+    elif kind == "transient":
+        from fretwear.analyses.transient import transient_figures
+
+        files += transient_figures(ds, case, out_dir, name)
     else:
         from fretwear.analyses.wear import wear_figures, write_wear_fields
 
