@@ -115,3 +115,23 @@ def test_joined_sweep_marks_its_joins_red_where_the_check_failed(tmp_path, drawn
     marks = [ln for ln in ax.get_lines() if ln.get_linestyle() == ":"]
     assert len(marks) == 1 and marks[0].get_color() == "red"
     assert list(marks[0].get_xdata()) == [2e3, 2e3]
+
+
+def test_periodic_members_draw_their_response_against_the_varied_key(tmp_path, drawn):
+    """Members without a frequency axis: one marker per member at its varied value (sorted
+    by it), the harmonic-1 amplitude of the first point on its axis of largest response (y,
+    10 x x here), in metres; the harmonic-3 values are not drawn."""
+    amp = np.array([3e-6, 1e-6, 2e-6])[:, None, None, None] * np.array([1, 10])[:, None]
+    amp = amp * np.array([1.0, 0.1])  # harmonics 1, 3
+    ds = xr.Dataset({"displacement_harmonic_amplitude": (("member", "point", "axis",
+                                                          "harmonic"), amp)},
+                    coords={"point": ["Pe"], "axis": ["x", "y"], "harmonic": [1, 3],
+                            "contact.mu": ("member", [0.3, 0.1, 0.2])}, attrs={"title": "t"})
+    paths = figures.study_figures(ds, tmp_path, ["contact.mu"])
+    assert [p.name for p in paths] == ["study-response.png"]
+    ax = drawn["study-response.png"].axes[0]
+    (line,) = ax.get_lines()
+    np.testing.assert_array_equal(line.get_xdata(), [0.1, 0.2, 0.3])
+    np.testing.assert_array_equal(line.get_ydata(), amp[[1, 2, 0], 0, 1, 0])
+    assert ax.get_xlabel() == "contact.mu" and ax.get_ylabel() == \
+        "amplitude Pe y (harmonic 1) [µm]"

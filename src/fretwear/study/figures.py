@@ -6,7 +6,9 @@
 * sweep studies: the family of FRFs (one curve per member, labelled with its varied keys)
   and their envelope; a split sweep: the joined FRF with the joins marked; a study of the
   excitation level alone (``analysis.excitation_scale``): the FRFs divided by the level on
-  one axis and the peak amplitude and frequency against the level.
+  one axis and the peak amplitude and frequency against the level;
+* periodic studies: the response amplitude of each member against the first varied numeric
+  key.
 """
 
 from __future__ import annotations
@@ -192,6 +194,49 @@ def load_levels(ds, path: Path) -> Path:
     return _save(fig, path)
 
 
+#: the amplitude of each harmonic of the observed points in a periodic (or transient) result
+PERIODIC_RESPONSE = "displacement_harmonic_amplitude"
+
+
+def _numeric_key(ds, varied: list[str]):
+    """The first varied key with one number per member (None: none)."""
+    for k in varied:
+        if k in ds.coords and ds[k].dims == ("member",) and ds[k].dtype.kind in "fi":
+            return k
+    return None
+
+
+def response_per_member(ds, path: Path, varied: list[str]) -> Path:
+    """Members without a frequency axis (periodic or transient responses): the amplitude of
+    harmonic 1 of
+    the first observed point (on its axis of largest response) against the first varied numeric
+    key (the member number when none), one marker per member."""
+    amp = ds[PERIODIC_RESPONSE]
+    sel = {d: 0 for d in ("point", "harmonic") if d in amp.dims}
+    amp = amp.isel(sel)
+    label = str(ds["point"].values[0]) if "point" in ds else ""
+    y = amp.values.reshape(ds.sizes["member"], -1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        largest = np.nanmax(y, axis=0)
+    if "axis" in amp.dims and np.any(np.isfinite(largest)):
+        a = int(np.nanargmax(np.where(np.isnan(largest), -np.inf, largest)))
+        y = y[:, a]
+        label += f" {str(ds['axis'].values[a])}"
+    else:
+        y = y[:, 0]
+    key = _numeric_key(ds, varied)
+    x = ds[key].values if key else ds["member"].values
+    fig, ax = _figure(figsize=(7, 4.5))
+    order = np.argsort(x, kind="stable")
+    ax.plot(x[order], y[order], marker="o", lw=0.8)
+    ax.set_xlabel(key or "member")
+    ax.set_ylabel(f"amplitude {label.strip()} (harmonic 1) [m]")
+    ax.set_title(ds.attrs.get("title", ""), fontsize=9)
+    ax.grid(alpha=0.3)
+    return _save(fig, path)
+
+
 def study_figures(ds, outdir: Path, varied: list[str], fmt: str = "png") -> list[Path]:
     """Every figure that applies to the dataset; returns the files written."""
     out = []
@@ -200,6 +245,8 @@ def study_figures(ds, outdir: Path, varied: list[str], fmt: str = "png") -> list
     elif "worn_volume_on_cycles" in ds:
         out.append(fan_chart(ds, outdir / f"study-worn-volume.{fmt}"))
         out.append(profile_band(ds, outdir / f"study-wear-profiles.{fmt}"))
+    elif PERIODIC_RESPONSE in ds and "member" in ds[PERIODIC_RESPONSE].dims:
+        out.append(response_per_member(ds, outdir / f"study-response.{fmt}", varied))
     elif "response_amplitude" in ds and "member" in ds["response_amplitude"].dims:
         out.append(frf_family(ds, outdir / f"study-frf-family.{fmt}", varied))
         if varied == [LEVEL_KEY] and "peak_frequency" in ds:
