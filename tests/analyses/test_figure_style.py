@@ -68,8 +68,8 @@ def test_labels_and_ticks_read_without_exponents():
 def test_a_narrow_sweep_is_drawn_on_a_linear_axis_in_khz_and_microns():
     """A 6-8 kHz band (less than a decade, as the issue's 900-1100 Hz) drawn loglog with
     amplitudes of a few microns: the frequency axis turns linear and reads kHz; the log
-    amplitude axis keeps its scale and its unit; a linear displacement axis reads µm with
-    plain ticks."""
+    amplitude axis keeps its scale and reads µm (every tick: less than a decade); a linear
+    displacement axis reads µm with plain ticks."""
     fig = Figure()
     ax, bx = fig.subplots(1, 2)
     ax.loglog([6e3, 7e3, 8e3], [1e-6, 3e-6, 2e-6])
@@ -80,7 +80,34 @@ def test_a_narrow_sweep_is_drawn_on_a_linear_axis_in_khz_and_microns():
     apply_style(fig)
     assert ax.get_xscale() == "linear" and ax.get_xlabel() == "frequency [kHz]"
     assert ax.xaxis.get_major_formatter()(7e3, 0) == "7"
-    assert ax.get_yscale() == "log" and ax.get_ylabel() == "amplitude [m]"
+    assert ax.get_yscale() == "log" and ax.get_ylabel() == "amplitude [µm]"
+    assert ax.yaxis.get_minor_formatter()(2e-6, 0) == "2"
     assert bx.get_ylabel() == "u [µm]" and bx.yaxis.get_major_formatter()(1.5e-6, 0) == "1.5"
     fig.canvas.draw()
     assert all("e" not in t.get_text() for t in bx.get_yticklabels())
+
+
+def test_shared_axes_name_the_unit_their_ticks_are_in():
+    """Two panels sharing x, only the lower labelled (x in m up to 0.1 m): the shared ticks
+    read millimetres and the label says mm (a label never names a unit its ticks are not
+    in); a log axis over less than a decade reads its prefixed unit on every tick; an axis
+    with a formatter of its own keeps its label's unit."""
+    from matplotlib import ticker
+
+    fig = Figure()
+    top, low = fig.subplots(2, 1, sharex=True)
+    for ax in (top, low):
+        ax.plot([0.0, 0.1], [1.0, 2.0])
+    low.set_xlabel("x [m]")
+    right = fig.add_axes((0.7, 0.7, 0.2, 0.2))
+    right.semilogy([1.0, 2.0], [7.8e-10, 7.9e-10])
+    right.set_ylabel("|u| [m]")
+    right.xaxis.set_major_formatter(ticker.FormatStrFormatter("%.1f"))
+    right.set_xlabel("t [s]")
+    apply_style(fig)
+    assert low.get_xlabel() == "x [mm]" and top.get_xlabel() == ""
+    assert low.xaxis.get_major_formatter()(0.1, 0) == "100"
+    assert top.xaxis.get_major_formatter()(0.05, 0) == "50"
+    assert right.get_ylabel() == "|u| [pm]"
+    assert right.yaxis.get_minor_formatter()(7.85e-10, 0) == "785"
+    assert right.get_xlabel() == "t [s]" and right.xaxis.get_major_formatter()(2.0, 0) == "2.0"

@@ -95,7 +95,7 @@ def sweep_study(joined: bool) -> xr.Dataset:
 
 def test_sweep_family_draws_each_member_on_the_axis_of_largest_response(tmp_path, drawn):
     """One curve per member labelled with its varied key, on the axis with the largest
-    amplitude (y, 10 x x), in metres."""
+    amplitude (y, 10 x x), in metres, the axis labelled in µm."""
     ds = sweep_study(joined=False)
     paths = figures.study_figures(ds, tmp_path, ["contact.mu"])
     assert [p.name for p in paths] == ["study-frf-family.png"]
@@ -104,7 +104,7 @@ def test_sweep_family_draws_each_member_on_the_axis_of_largest_response(tmp_path
     for i, ln in enumerate(ax.get_lines()):
         np.testing.assert_array_equal(ln.get_ydata(),
                                       ds["response_amplitude"].values[i, :, 0, 1, 0])
-    assert ax.get_ylabel() == "amplitude Pe y [m]"
+    assert ax.get_ylabel() == "amplitude Pe y [µm]"  # the figure style's prefix
 
 
 def test_joined_sweep_marks_its_joins_red_where_the_check_failed(tmp_path, drawn):

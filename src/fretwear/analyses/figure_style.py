@@ -83,28 +83,45 @@ def relabel(label: str, largest: float) -> tuple[float, str]:
 
 
 def _style_axis(ax, which: str) -> None:
+    """One axis: a linear scale for a narrow frequency band, then the unit of its label with
+    its prefix and tick labels in it. The label's unit changes only where the tick labels
+    change with it (a formatter of matplotlib's own, or one set here: shared axes share it),
+    so that a label never names a unit the ticks are not in."""
     from matplotlib import ticker
 
     axis = getattr(ax, f"{which}axis")
     label = axis.get_label_text()
     lo, hi = getattr(ax, f"get_{which}lim")()
-    if getattr(ax, f"get_{which}scale")() == "log":
-        if "frequency" in label.lower() and frequency_scale(min(lo, hi), max(lo, hi)) \
-                == "linear":
-            getattr(ax, f"set_{which}scale")("linear")
-            getattr(ax, f"set_{which}lim")(lo, hi)
-        else:
-            axis.set_label_text(relabel(label, 0.0)[1])
-            return
+    log = getattr(ax, f"get_{which}scale")() == "log"
+    if log and "frequency" in label.lower() and frequency_scale(min(lo, hi), max(lo, hi)) \
+            == "linear":
+        getattr(ax, f"set_{which}scale")("linear")
+        getattr(ax, f"set_{which}lim")(lo, hi)
+        log = False
     factor, new = relabel(label, max(abs(lo), abs(hi)))
+    fmt = axis.get_major_formatter()
+    ours = getattr(fmt, "fretwear_factor", None)
+    theirs = isinstance(fmt, ticker.LogFormatter if log else ticker.ScalarFormatter)
+    if not _UNIT.search(new) or not (theirs or ours is not None):
+        if isinstance(fmt, ticker.ScalarFormatter):
+            fmt.set_useOffset(False)
+        axis.set_label_text(relabel(label, 0.0)[1])  # "um" -> "µm", powers, no prefix
+        return
+    if ours is not None and ours != factor:  # a shared axis styled with another label
+        return
+    text = ticker.FuncFormatter(lambda v, _pos: tick_text(v * factor))
+    text.fretwear_factor = factor
+    axis.set_major_formatter(text)
+    if log:
+        narrow = 0 < min(lo, hi) and max(lo, hi) / min(lo, hi) < 10.0
+        minor = ticker.FuncFormatter(lambda v, _pos: tick_text(v * factor))
+        axis.set_minor_formatter(minor if narrow else ticker.NullFormatter())
     axis.set_label_text(new)
-    if isinstance(axis.get_major_formatter(), ticker.ScalarFormatter):
-        axis.set_major_formatter(ticker.FuncFormatter(lambda v, _pos: tick_text(v * factor)))
 
 
 def apply_style(fig) -> None:
     """The figure style (module docstring) on every axes of ``fig``: prefixed units and
-    plain tick labels on linear axes, linear frequency axes for bands of a decade or less."""
+    plain tick labels, linear frequency axes for bands of a decade or less."""
     for ax in fig.axes:
         if not ax.get_visible() or ax.get_label() == "<colorbar>":
             continue
