@@ -299,9 +299,9 @@ def plot_wear_profiles(ds, path: Path, *, title=None) -> Path:
     ax = axes[0, 0]
     cyc = ds["cycles"].values
     for i in selected_steps(cyc):
-        _profile(ax, x, ds["wear_depth"].values[i] * 1e6, label=f"N = {cyc[i]:.3g}")
+        _profile(ax, x, ds["wear_depth"].values[i], label=f"N = {cyc[i]:.3g}")
     ax.set_xlabel(xl)
-    ax.set_ylabel("wear depth [um]")
+    ax.set_ylabel("wear depth [m]")  # in SI: the figure style writes it in µm or nm
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize="small")
     return plots.save(fig, path)
@@ -329,10 +329,10 @@ def plot_wear_kinetics(ds, path: Path, nodes, *, title=None) -> Path:
     ax = axes[0, 0]
     cyc = ds["cycles"].values
     for p in nodes:
-        ax.semilogx(cyc[1:], ds["wear_depth"].values[1:, p] * 1e6, marker=".",
+        ax.semilogx(cyc[1:], ds["wear_depth"].values[1:, p], marker=".",
                     label=f"node {p} ({xl[0]} = {x[p]:.4g} m)")
     ax.set_xlabel("cycles N")
-    ax.set_ylabel("wear depth [um]")
+    ax.set_ylabel("wear depth [m]")  # in SI: the figure style writes it in µm or nm
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize="small")
     return plots.save(fig, path)
