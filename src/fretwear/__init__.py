@@ -11,6 +11,7 @@ The public API, stage by stage (data flows one way; each stage returns a plain d
     red   = fretwear.condense(model, frequency, basis.orders, condenser=cond)  # Reduced (Z_r)
     sol   = fretwear.solve_periodic(model, basis, frequency, condenser=cond)   # PeriodicSolution
     frf   = fretwear.sweep(model, basis, f_min, f_max, n, condenser=cond)     # SweepResult
+    fam   = fretwear.load_levels(model, basis, f_min, f_max, n, levels)  # FRFs over the level
     hill  = fretwear.sweep_stability(model, frf, condenser=cond)         # SweepStability
     nm    = fretwear.nonlinear_mode(model, basis, amplitudes)           # Backbone (EPMC)
     syn   = fretwear.mode_frf(model, nm)                  # ModalFRF (single-mode theory)
@@ -18,6 +19,9 @@ The public API, stage by stage (data flows one way; each stage returns a plain d
     worn  = fretwear.frf_worn(model, basis, wear.final_wear, f_min, f_max, n)  # SweepResult
     run   = fretwear.integrate(model, frequency, n_periods=...)   # TransientResult
     out   = fretwear.run_case("case.toml", "out/")                # a case file end to end
+    out   = fretwear.run(model, "sweep", "out/", f_min=..., ...)  # a Python model, the same way
+    path  = fretwear.write_results(frf, "out/", model, basis)     # results.nc of a Python result
+    files = fretwear.plot(frf, "out/", model, basis)              # its figures (and ParaView)
     ds    = fretwear.read_results("out/results.nc")               # an xarray Dataset
     st    = fretwear.run_study("study.toml", "out/")              # members on Dask (study.nc)
 
@@ -92,6 +96,9 @@ _API = {
     # case files and results
     "run_case": "fretwear.analyses.run", "load_case": "fretwear.analyses.run",
     "read_results": "fretwear.io.results",
+    "load_levels": "fretwear.levels", "LoadLevels": "fretwear.levels",
+    "run": "fretwear.analyses.python_run", "write_results": "fretwear.analyses.python_run",
+    "plot": "fretwear.analyses.python_run",
     "run_study": "fretwear.study.run", "read_study": "fretwear.study.spec",
     # BLAS threads of the drivers
     "blas_threads": "fretwear.threads", "set_blas_threads": "fretwear.threads",

@@ -52,9 +52,10 @@ def wear_study() -> xr.Dataset:
 
 
 def test_wear_figures_draw_the_statistics_in_their_units(tmp_path, drawn):
-    """Fan chart: one thin line per member, the median and the mean of the dataset in mm^3
-    (1e9 x m^3). Profiles: drawn at the last cycle every member reached (index 2, found by
-    hand), x in mm and the median in um. Both files are PNG images."""
+    """Fan chart: one thin line per member, the median and the mean of the dataset in m^3,
+    the axis labelled in mm³ by the figure style (ticks 1e9 x m^3). Profiles: drawn at the
+    last cycle every member reached (index 2, found by hand), x in m labelled mm, the median
+    in m labelled µm. Both files are PNG images."""
     ds = wear_study()
     paths = figures.study_figures(ds, tmp_path, ["contact.mu"])
     assert [p.name for p in paths] == ["study-worn-volume.png", "study-wear-profiles.png"]
@@ -62,15 +63,16 @@ def test_wear_figures_draw_the_statistics_in_their_units(tmp_path, drawn):
     ax = drawn["study-worn-volume.png"].axes[0]
     lines = {ln.get_label(): ln for ln in ax.get_lines()}
     assert sum(lb.startswith("_") for lb in lines) == 3  # members, unlabelled
-    np.testing.assert_allclose(lines["median"].get_ydata(),
-                               ds["worn_volume_quantile"].values[1] * 1e9, rtol=1e-15)
-    np.testing.assert_allclose(lines["mean"].get_ydata(),
-                               ds["worn_volume_mean"].values * 1e9, rtol=1e-15)
+    np.testing.assert_array_equal(lines["median"].get_ydata(),
+                                  ds["worn_volume_quantile"].values[1])
+    np.testing.assert_array_equal(lines["mean"].get_ydata(), ds["worn_volume_mean"].values)
+    assert ax.get_ylabel() == "worn volume [mm³]"
+    assert ax.yaxis.get_major_formatter()(4e-9, 0) == "4"
     ax = drawn["study-wear-profiles.png"].axes[0]
     median = next(ln for ln in ax.get_lines() if ln.get_label() == "median")
-    np.testing.assert_allclose(median.get_xdata(), [1.0, 2.0], rtol=1e-15)
-    np.testing.assert_allclose(median.get_ydata(),
-                               ds["wear_depth_quantile"].values[1, 2] * 1e6, rtol=1e-15)
+    np.testing.assert_array_equal(median.get_xdata(), [0.001, 0.002])
+    np.testing.assert_array_equal(median.get_ydata(), ds["wear_depth_quantile"].values[1, 2])
+    assert ax.get_xlabel() == "x [mm]" and ax.get_ylabel() == "wear depth [µm]"
     assert ax.get_title() == "worn profiles at N = 2e+06"
 
 
@@ -93,7 +95,7 @@ def sweep_study(joined: bool) -> xr.Dataset:
 
 def test_sweep_family_draws_each_member_on_the_axis_of_largest_response(tmp_path, drawn):
     """One curve per member labelled with its varied key, on the axis with the largest
-    amplitude (y, 10 x x), in metres."""
+    amplitude (y, 10 x x), in metres, the axis labelled in µm."""
     ds = sweep_study(joined=False)
     paths = figures.study_figures(ds, tmp_path, ["contact.mu"])
     assert [p.name for p in paths] == ["study-frf-family.png"]
@@ -102,7 +104,7 @@ def test_sweep_family_draws_each_member_on_the_axis_of_largest_response(tmp_path
     for i, ln in enumerate(ax.get_lines()):
         np.testing.assert_array_equal(ln.get_ydata(),
                                       ds["response_amplitude"].values[i, :, 0, 1, 0])
-    assert ax.get_ylabel() == "amplitude Pe y [m]"
+    assert ax.get_ylabel() == "amplitude Pe y [µm]"  # the figure style's prefix
 
 
 def test_joined_sweep_marks_its_joins_red_where_the_check_failed(tmp_path, drawn):
@@ -113,3 +115,23 @@ def test_joined_sweep_marks_its_joins_red_where_the_check_failed(tmp_path, drawn
     marks = [ln for ln in ax.get_lines() if ln.get_linestyle() == ":"]
     assert len(marks) == 1 and marks[0].get_color() == "red"
     assert list(marks[0].get_xdata()) == [2e3, 2e3]
+
+
+def test_periodic_members_draw_their_response_against_the_varied_key(tmp_path, drawn):
+    """Members without a frequency axis: one marker per member at its varied value (sorted
+    by it), the harmonic-1 amplitude of the first point on its axis of largest response (y,
+    10 x x here), in metres; the harmonic-3 values are not drawn."""
+    amp = np.array([3e-6, 1e-6, 2e-6])[:, None, None, None] * np.array([1, 10])[:, None]
+    amp = amp * np.array([1.0, 0.1])  # harmonics 1, 3
+    ds = xr.Dataset({"displacement_harmonic_amplitude": (("member", "point", "axis",
+                                                          "harmonic"), amp)},
+                    coords={"point": ["Pe"], "axis": ["x", "y"], "harmonic": [1, 3],
+                            "contact.mu": ("member", [0.3, 0.1, 0.2])}, attrs={"title": "t"})
+    paths = figures.study_figures(ds, tmp_path, ["contact.mu"])
+    assert [p.name for p in paths] == ["study-response.png"]
+    ax = drawn["study-response.png"].axes[0]
+    (line,) = ax.get_lines()
+    np.testing.assert_array_equal(line.get_xdata(), [0.1, 0.2, 0.3])
+    np.testing.assert_array_equal(line.get_ydata(), amp[[1, 2, 0], 0, 1, 0])
+    assert ax.get_xlabel() == "contact.mu" and ax.get_ylabel() == \
+        "amplitude Pe y (harmonic 1) [µm]"

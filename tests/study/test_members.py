@@ -113,7 +113,8 @@ def test_split_chunks_cover_the_band_and_share_their_ends(tmp_path):
 
 
 CASE = {"contact": {"mu": 0.3},
-        "loads": [{"name": "P", "pressure": 1e4}, {"name": "Q", "pressure": 2e4}]}
+        "loads": [{"name": "P", "pressure": 1e4}, {"name": "Q", "pressure": 2e4},
+                  {"name": "T", "traction": [0.0, 1e4, 0.0]}]}
 
 
 def test_key_paths_address_tables_and_blocks_by_name_or_number():
@@ -131,9 +132,41 @@ def test_key_paths_address_tables_and_blocks_by_name_or_number():
     assert raw == expected
 
 
+def test_a_vector_and_one_of_its_components_are_keys():
+    """``loads.T.traction`` is the whole vector; ``loads.T.traction.2`` its second
+    component (counted from 1, as blocks are); setting a component changes only it (the rest
+    compared with a deep copy)."""
+    raw = copy.deepcopy(CASE)
+    assert get_key(raw, "loads.T.traction") == [0.0, 1e4, 0.0]
+    assert get_key(raw, "loads.T.traction.2") == 1e4
+    set_key(raw, "loads.T.traction.3", -5.0)
+    expected = copy.deepcopy(CASE)
+    expected["loads"][2]["traction"] = [0.0, 1e4, -5.0]
+    assert raw == expected
+
+
+def test_tied_keys_vary_together_as_one_axis_of_the_grid(tmp_path):
+    """``[[grid.tied]]``: the i-th values of the tied keys go to the same member, and the
+    group is one axis of the combinations with the other grid keys (itertools.product over
+    the axes, the tied pairs zipped); a vector value is set whole."""
+    base_case(tmp_path)
+    path = study_file(tmp_path, '[grid]\ncontact.mu = [0.1, 0.2]\n[[grid.tied]]\n'
+                      '"loads[2].pressure" = [1e3, 2e3]\n"analysis.harmonics" = [1, 3]\n')
+    members = _members(path)
+    got = [(_case(m)["contact"]["mu"], _case(m)["loads"][1]["pressure"],
+            _case(m)["analysis"]["harmonics"]) for m in members]
+    assert got == [(mu, p, h) for mu, (p, h) in itertools.product(
+        [0.1, 0.2], zip([1e3, 2e3], [1, 3], strict=True))]
+    path = study_file(tmp_path, '[grid]\n"loads[1].pressure" = [1.0]\n')
+    assert len(_members(path)) == 1
+
+
 @pytest.mark.parametrize("key, words", [
-    ("loads[3].pressure", "has 2 [[loads]] blocks; expected a number from 1 to 2"),
-    ("loads.X.pressure", "no [[loads]] block named 'X' (names: P, Q)"),
+    ("loads[4].pressure", "has 3 [[loads]] blocks; expected a number from 1 to 3"),
+    ("loads.X.pressure", "no [[loads]] block named 'X' (names: P, Q, T)"),
+    ("loads.T.traction.4", "is a vector of 3 components; expected loads.T.traction (the whole "
+     "vector) or loads.T.traction.N, N a component number from 1 to 3"),
+    ("loads.T.traction.x", "component number from 1 to 3"),
     ("loads.pressure", "is an array of tables; name a block and a key"),
     ("contact.mu.value", "contact.mu = 0.3 is a value, not a table"),
 ])

@@ -101,3 +101,154 @@ def test_studies_are_found_by_file_or_by_shipped_name(tmp_path):
         resolve_study(tmp_path / "missing.toml")
     with pytest.raises(InputError, match=r"study file 'nowhere.toml' does not exist"):
         resolve_study("nowhere.toml")  # a file name, not a shipped study's name
+
+
+def _run_members_here(path, out):
+    """Run every member of the study ``path`` in this process (run_case into its folder, the
+    status file a worker writes), as the Dask tasks do, without starting a cluster."""
+    from fretwear.analyses.run import run_case
+
+    members = expand(read_study(path))
+    for m in members:
+        folder = out / m.folder_name
+        folder.mkdir(parents=True)
+        (folder / "case.toml").write_text(m.text)
+        res = run_case(folder / "case.toml", folder, progress=False, echo=False)
+        (folder / STATUS_FILE).write_text(MemberRecord(
+            m.index, "ok" if res.success else "not converged", res.summary,
+            case_sha256=case_hash(m.text)).to_json())
+    return members
+
+
+def test_sweep_members_on_different_frequencies_give_a_study_and_its_figure(tmp_path):
+    """Two sweep members whose frequencies differ (4 and 6 grid points over the same band: the
+    case of a continuation that adds points where each member needs them) and whose kept
+    harmonics differ (1 and 1, 2, 3; the two keys tied): study.nc holds their responses on the
+    union of their frequencies and harmonics, equal bit for bit to each member's own results.nc
+    at its own points and harmonics, NaN for a harmonic it did not keep, linear in frequency in
+    between (checked at one midpoint by the formula); member_response_amplitude keeps each
+    member's own points; the summary and the attribute common_grid say so, and the FRF family
+    figure is written."""
+    from helpers.studies import SWEEP
+
+    base_case(tmp_path, SWEEP.replace("n_points = 7", "n_points = 4"))
+    path = study_file(tmp_path, "[grid]\n[[grid.tied]]\n\"analysis.n_points\" = [4, 6]\n"
+                      "\"analysis.harmonics\" = [1, 3]\n")
+    out = tmp_path / "out"
+    members = _run_members_here(path, out)
+    res = run_study(path, out, collect=True, progress=False, echo=False)
+    ds = res.dataset
+    assert "response_amplitude" in ds and "common_grid" in ds.attrs
+    assert "interpolated" in res.message
+    assert [p.name for p in res.figures] == ["study-frf-family.png"]
+    own = [xr.open_dataset(out / m.folder_name / RESULTS_FILE, engine="h5netcdf").load()
+           for m in members]
+    grid = np.unique(np.concatenate([o["frequency"].values for o in own]))
+    np.testing.assert_array_equal(ds["frequency"].values, grid)
+    np.testing.assert_array_equal(ds["harmonic"].values, [1, 2, 3])
+    assert ds["analysis.n_points"].values.tolist() == [4, 6]
+    for i, o in enumerate(own):
+        on = ds["response_amplitude"].isel(member=i).sel(frequency=o["frequency"].values)
+        for h in ds["harmonic"].values:
+            if h in o["harmonic"].values:
+                np.testing.assert_array_equal(on.sel(harmonic=h).values,
+                                              o["response_amplitude"].sel(harmonic=h).values)
+            else:
+                assert np.all(np.isnan(on.sel(harmonic=h).values))
+        m = ds["member_response_amplitude"].isel(member=i).sel(harmonic=1).values
+        n = o.sizes["frequency"]
+        np.testing.assert_array_equal(m[:n], o["response_amplitude"].sel(harmonic=1).values)
+        assert np.all(np.isnan(m[n:]))
+    # member 0 (4 points) between its first two points, at a frequency of member 1
+    f0, a0 = own[0]["frequency"].values, own[0]["response_amplitude"].sel(harmonic=1).values
+    x = grid[(grid > f0[0]) & (grid < f0[1])][0]
+    t = (x - f0[0]) / (f0[1] - f0[0])
+    np.testing.assert_allclose(ds["response_amplitude"].isel(member=0).sel(
+        frequency=x, harmonic=1).values, (1 - t) * a0[0] + t * a0[1], rtol=1e-14)
+
+
+def test_summary_wraps_between_words_and_prints_worker_warnings_in_one_line():
+    """A failed member's long message is printed whole, in lines of at most 100 characters
+    broken between words (the words of the lines, joined, are the message's words: none is
+    cut); a member's Python warnings are one line each, ``Category: message``, once each,
+    without the file name and source line Python prints by default."""
+    import warnings
+
+    from fretwear.study.runner import warning_lines
+
+    words = [f"word{i:03d}" for i in range(60)] + ["x" * 120]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        for _ in range(2):
+            warnings.warn("the preload solve\n  did not converge", RuntimeWarning,
+                          stacklevel=1)
+    lines = warning_lines(caught)
+    assert lines == "RuntimeWarning: the preload solve did not converge"
+    records = [MemberRecord(0, "failed", " ".join(words)), MemberRecord(1, "ok",
+                                                                        warnings=lines)]
+    ok, message = _summary(SimpleNamespace(kind="grid"), records, xr.Dataset())
+    body = message.splitlines()[1:]
+    assert not ok and all(len(x) <= 100 or x.strip() == "x" * 120 for x in body)
+    assert " ".join(body[:-1]).split() == ["member", "0:", "failed:", *words]
+    assert body[-1] == ("  member 1: warning: RuntimeWarning: the preload solve did not "
+                        "converge")
+    assert "test_run.py" not in message
+
+
+JENKINS = """title = "Jenkins oscillator"
+[model]
+type = "matrices"
+K = "{K}"
+M = "{M}"
+[contact]
+tangential_dofs = [0]
+normal_load = 10.0
+mu = 0.3
+kt = 2e5
+[[loads]]
+name = "shake"
+file = "shake.txt"
+waveform = "cos"
+[observed]
+mass = 0
+[analysis]
+type = "sweep"
+f_min = 50.0
+f_max = 90.0
+n_points = 5
+spacing = "linear"
+harmonics = 1
+n_samples = 64
+linear_references = []
+[output]
+figures = false
+vtu = false
+"""
+
+
+def test_a_study_of_the_excitation_level_gives_the_family_of_frfs_and_its_peaks(tmp_path):
+    """The shipped Jenkins oscillator (k = kt = 2e5 N/m, m = 0.5 kg, mu N = 3 N) shaken by
+    1 N x excitation_scale over 50-90 Hz, below its stuck resonance (142 Hz): at levels 0.5
+    and 1 the element stays stuck (response below mu N / kt = 15 um), so the peak is at
+    90 Hz and equals level / (k + kt - m w^2) in closed form to the balance's tolerance
+    (1e-8); at level 10 it slips and the peak per unit level is larger (softer). The summary
+    gives one line per level and the load-level figure is written."""
+    (tmp_path / "shake.txt").write_text("1.0\n")
+    (tmp_path / "beam.toml").write_text(JENKINS.format(K=EXAMPLES_DIR / "jenkins-K.mtx",
+                                                       M=EXAMPLES_DIR / "jenkins-M.mtx"))
+    path = study_file(tmp_path, '[grid]\n"analysis.excitation_scale" = [1.0, 0.5, 10.0]\n')
+    out = tmp_path / "out"
+    _run_members_here(path, out)
+    res = run_study(path, out, collect=True, progress=False, echo=False)
+    assert res.success, res.message
+    ds = res.dataset
+    w = 2 * np.pi * 90.0
+    stuck = 1.0 / (2e5 + 2e5 - 0.5 * w**2)
+    np.testing.assert_allclose(ds["peak_response_amplitude"].values[:2], [stuck, 0.5 * stuck],
+                               rtol=1e-8)
+    np.testing.assert_array_equal(ds["peak_frequency"].values, [90.0, 90.0, 90.0])
+    assert ds["peak_response_amplitude"].values[2] / 10.0 > 1.05 * stuck
+    assert [p.name for p in res.figures] == ["study-frf-family.png", "study-load-levels.png"]
+    levels = [x.strip() for x in res.message.splitlines() if x.strip().startswith("level ")]
+    assert [x.split(":")[0] for x in levels] == ["level 0.5", "level 1", "level 10"]
+    assert levels[1].startswith(f"level 1: peak {stuck:.4g} m at 90 Hz")

@@ -36,6 +36,13 @@ def _case(member) -> dict:
      ["study.toml", "[set]", "analysis.harmonics = 0"]),
     ("[split]\nchunks = 2\n", ["study.toml", "sweep", "periodic"]),
     ("[grid\n", ["study.toml", "invalid TOML"]),
+    ("[grid]\n[[grid.tied]]\ncontact.mu = [0.1, 0.2]\n\"loads[1].pressure\" = [1.0]\n",
+     ["study.toml", "[[grid.tied]] block 1", "differ in length", "contact.mu: 2"]),
+    ("[grid]\ncontact.mu = [0.1]\n[[grid.tied]]\ncontact.mu = [0.1]\n",
+     ["study.toml", "contact.mu varied twice"]),
+    ("[grid]\ncontact.mu = [[0.1, 'a']]\n", ["study.toml", "grid.contact.mu", "vectors"]),
+    ("[grid]\n\"loads[1].pressure.2\" = [1.0]\n", ["study.toml", "member 0",
+                                                    "is a value, not a table"]),
 ])
 def test_malformed_study_gets_one_line_and_status_2(tmp_path, capsys, body, words):
     base_case(tmp_path)

@@ -1,8 +1,10 @@
 """Figures of computed results (matplotlib, files only, no screen).
 
 Each function takes result objects or a results dataset and the path of the figure file,
-writes it and returns the path. Common style: :func:`new_figure` and :func:`save`; one curve
-per interface with the colours of :data:`INTERFACE_STYLE`; axis labels carry units.
+writes it and returns the path. Common style: :func:`new_figure` and :func:`save` (which
+applies :func:`fretwear.analyses.figure_style.apply_style`: SI prefixes in the units, no offset
+or multiplier in an axis corner, a linear frequency axis for a band of a decade or less); one
+curve per interface with the colours of :data:`INTERFACE_STYLE`; axis labels carry units.
 Figures are made with :class:`matplotlib.figure.Figure` directly (rendered by Agg), not
 with ``pyplot``: no window, no global backend switch, nothing left open.
 """
@@ -19,6 +21,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 
 from fretwear.analyses.common import cell_edges, interface_abscissa
+from fretwear.analyses.figure_style import apply_style
 from fretwear.hb.contact import STATE_NAMES
 
 #: line style of each linear interface, shared by all figures
@@ -73,6 +76,7 @@ def save(fig, path: Path | str, dpi: int = 150) -> Path:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     _guard_log_axes(fig)
+    apply_style(fig)
     fig.tight_layout()
     fig.savefig(path, dpi=dpi)
     return path

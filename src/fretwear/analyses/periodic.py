@@ -229,7 +229,7 @@ def run_periodic(model, analysis: dict, case, context: RunContext) -> RunOutput:
     points = [p.name for p in model.observed]
     ds = periodic_dataset(model, sol, points)
     ds.attrs.update(attrs)
-    figures = _periodic_figures(ds, case, context.out_dir, titled(case.title, where))
+    figures = periodic_figures(ds, case, context.out_dir, titled(case.title, where))
     files = []
     if model.mesh is not None and case.output["vtu"]:
         files.append(write_period_fields(model, sol, context.out_dir / "periodic.pvd",
@@ -238,7 +238,8 @@ def run_periodic(model, analysis: dict, case, context: RunContext) -> RunOutput:
                      + cond.choice.summary(), True, files, warnings=list(sol.warnings))
 
 
-def _periodic_figures(ds: xr.Dataset, case, outdir: Path, title: str) -> list[Path]:
+def periodic_figures(ds: xr.Dataset, case, outdir: Path, title: str) -> list[Path]:
+    """The figures of a periodic run (``case.output``: whether and in which format)."""
     figures = []
     for point in ds["point"].values:
         p = figure_path(case, outdir, f"periodic-{point}")

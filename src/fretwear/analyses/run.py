@@ -158,30 +158,41 @@ def run_case(path: Path | str, outdir: Path | str | None = None, progress: bool 
         saved.
     """
     case = load_case(path)
+    return run_built(None, case, case.output_dir(outdir),
+                     RunContext(Path("."), resume=bool(resume), progress=bool(progress)),
+                     echo=echo)
+
+
+def run_built(model, case, out_dir: Path, how: RunContext, echo: bool = True) -> RunOutput:
+    """The run of :func:`run_case` from the validated ``case`` on: build the model (unless
+    ``model`` is given: a model built in Python, :func:`fretwear.run`), run the analysis into
+    ``out_dir``, write ``results.nc`` and print the summary. ``how``: ``resume`` and
+    ``progress`` (its ``out_dir`` is replaced by ``out_dir``)."""
     analysis = get(case.analysis["type"])
-    out_dir = case.output_dir(outdir)
     results_path = out_dir / RESULTS_FILE
     made = check_output(out_dir, [RESULTS_FILE, *analysis.files])
     say = print if echo else (lambda *a, **k: None)
     say(f"fretwear {__version__}: {case.title} ({case.path.name}, analysis {analysis.name})")
     for p in remove_stale_temporaries(out_dir):
         say(f"removed {p.name}: temporary file of a write that was killed")
-    if resume and _up_to_date(results_path, case):
+    if how.resume and _up_to_date(results_path, case):
         ds = read_results(results_path)
         say(f"results are up to date: {results_path}")
         return RunOutput(ds, summary="up to date", results=results_path)
     start = time.time()
     try:
-        model = build_model(case)
+        built = model is None
+        if built:
+            model = build_model(case)
         check_sector_analysis(model, analysis.name, case.analysis)
-        for note in observed_notes(case, model):
+        for note in observed_notes(case, model) if built else ():
             say(note)
         open_names = None
         if analysis.preload_check:
             notes, open_names = preload_notes(model)
             for note in notes:
                 say(note)
-        context = RunContext(out_dir, resume=bool(resume), progress=bool(progress))
+        context = RunContext(out_dir, resume=bool(how.resume), progress=bool(how.progress))
         out = analysis.run(model, case.analysis, case, context)
         if open_names is not None:
             out.dataset.attrs[OPEN_ATTRIBUTE] = ", ".join(open_names)

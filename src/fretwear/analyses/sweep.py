@@ -41,6 +41,7 @@ from fretwear.hb.sweep import SweepResult
 from fretwear.hb.sweep_stability import SweepStability, sweep_stability
 from fretwear.io.results import label_coordinate, variable
 from fretwear.io.schema import Field, Flag, Integer, ListOf, Number, Text, increasing
+from fretwear.levels import excitation_scaled
 from fretwear.timedomain.stability import sweep_check
 
 #: the points computed so far, saved after every grid frequency (``--resume`` continues)
@@ -249,6 +250,22 @@ def _sweep_summary(result: SweepResult, ds: xr.Dataset) -> str:
     return "\n".join(lines)
 
 
+def sweep_figures(ds: xr.Dataset, case, outdir: Path) -> list[Path]:
+    """The figures of a sweep (``case.output``: whether and in which format): the FRF of
+    each observed point and the interface's energy and states."""
+    figures = []
+    for point in ds["point"].values:
+        p = figure_path(case, outdir, f"sweep-{point}")
+        if p is not None:
+            figures.append(plot_sweep(ds, p, str(point),
+                                      title=titled(case.title, "nonlinear FRF")))
+    p = figure_path(case, outdir, "sweep-interface")
+    if p is not None:
+        figures.append(plot_sweep_interface(ds, p, title=titled(case.title,
+                                                                  "contact interface")))
+    return figures
+
+
 def run_sweep(model, analysis: dict, case, context: RunContext) -> RunOutput:
     """Nonlinear FRF: periodic solutions over a frequency band (:func:`fretwear.hb.sweep.sweep`).
 
@@ -264,6 +281,7 @@ def run_sweep(model, analysis: dict, case, context: RunContext) -> RunOutput:
     points = check_points(model, analysis.get("points"))
     basis = basis_of(analysis)
     n = analysis["n_points"]
+    model = excitation_scaled(model, analysis["excitation_scale"])
     # the run's condensation of the model (the case file's choice: one modal basis for the
     # whole band where chosen), for every call
     cond = condenser_of(model, analysis, analysis["f_max"], max(basis.harmonics))
@@ -307,15 +325,7 @@ def run_sweep(model, analysis: dict, case, context: RunContext) -> RunOutput:
         "n_samples": int(basis.n_samples),
         **cond.choice.attributes(),
     })
-    figures = []
-    for point in points:
-        p = figure_path(case, context.out_dir, f"sweep-{point}")
-        if p is not None:
-            figures.append(plot_sweep(ds, p, point, title=titled(case.title, "nonlinear FRF")))
-    p = figure_path(case, context.out_dir, "sweep-interface")
-    if p is not None:
-        figures.append(plot_sweep_interface(ds, p, title=titled(case.title,
-                                                                  "contact interface")))
+    figures = sweep_figures(ds, case, context.out_dir)
     grid_ok = all(p.success for p in result.points if p.on_grid)
     summary = "\n".join([_sweep_summary(result, ds), *events, cond.choice.summary()])
     return RunOutput(ds, figures, summary, grid_ok, warnings=list(result.warnings))
@@ -454,6 +464,10 @@ SWEEP = Analysis.define(
                                 default=False),
         "points": Field(ListOf(Text(), non_empty=True, unique=True),
                         "observed points to report (default: all)"),
+        "excitation_scale": Field(Number(lo=0, lo_open=True), "factor on every load that "
+                                  "varies in time (the constant ones, a preload, kept): one "
+                                  "excitation level; a study varying it gives the family of "
+                                  "FRFs over the level (docs/study.md)", default=1.0),
         "eps_band": Field(ListOf(Number(lo=0, lo_open=True), sizes=(2,)),
                           'the band [f_min, f_max] over which eps = "stiff" or "top" takes its '
                           "median (default: the sweep's band; the chunks of a split sweep give "

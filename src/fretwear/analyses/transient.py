@@ -302,7 +302,8 @@ def plot_poincare(ds: xr.Dataset, path: Path, point: str, *, title: str | None =
     return plots.save(fig, path)
 
 
-def _transient_figures(ds: xr.Dataset, case, outdir: Path, title: str) -> list[Path]:
+def transient_figures(ds: xr.Dataset, case, outdir: Path, title: str) -> list[Path]:
+    """The figures of a transient run (``case.output``: whether and in which format)."""
     figures = []
     for point in ds["point"].values:
         for stem, plot in (("transient", plot_last_period), ("poincare", plot_poincare)):
@@ -354,7 +355,7 @@ def run_transient(model, analysis: dict, case, context: RunContext) -> RunOutput
     ds = transient_dataset(model, last, points, analysis["harmonics"], before)
     ds.attrs.update(_transient_attributes(ds, cls, info, f_hz, analysis, last))
     title = titled(case.title, plots.format_frequency(f_hz))
-    figures = _transient_figures(ds, case, context.out_dir, title)
+    figures = transient_figures(ds, case, context.out_dir, title)
     converged = analysis["mode"] == "fixed" or cls.kind != "transient"
     return RunOutput(ds, figures, _transient_summary(ds), converged)
 

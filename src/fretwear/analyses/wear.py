@@ -300,9 +300,9 @@ def plot_wear_profiles(ds, path: Path, *, title=None) -> Path:
     ax = axes[0, 0]
     cyc = ds["cycles"].values
     for i in selected_steps(cyc):
-        _profile(ax, x, ds["wear_depth"].values[i] * 1e6, label=f"N = {cyc[i]:.3g}")
+        _profile(ax, x, ds["wear_depth"].values[i], label=f"N = {cyc[i]:.3g}")
     ax.set_xlabel(xl)
-    ax.set_ylabel("wear depth [um]")
+    ax.set_ylabel("wear depth [m]")  # in SI: the figure style writes it in µm or nm
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize="small")
     return plots.save(fig, path)
@@ -330,10 +330,10 @@ def plot_wear_kinetics(ds, path: Path, nodes, *, title=None) -> Path:
     ax = axes[0, 0]
     cyc = ds["cycles"].values
     for p in nodes:
-        ax.semilogx(cyc[1:], ds["wear_depth"].values[1:, p] * 1e6, marker=".",
+        ax.semilogx(cyc[1:], ds["wear_depth"].values[1:, p], marker=".",
                     label=f"node {p} ({xl[0]} = {x[p]:.4g} m)")
     ax.set_xlabel("cycles N")
-    ax.set_ylabel("wear depth [um]")
+    ax.set_ylabel("wear depth [m]")  # in SI: the figure style writes it in µm or nm
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize="small")
     return plots.save(fig, path)
@@ -427,7 +427,7 @@ def run_wear(model, analysis: dict, case, context: RunContext) -> RunOutput:
                       energy_coefficients=(opts.energy_coefficient,
                                            opts.partner_energy_coefficient))
     ds.attrs.update(cond.choice.attributes())
-    figures = _figures(ds, case, context.out_dir, nodes)
+    figures = wear_figures(ds, case, context.out_dir, nodes)
     files = [context.out_dir / CHECKPOINT_FILE]
     if model.mesh is not None and case.output["vtu"]:
         files.append(write_wear_fields(model, ds, context.out_dir / "wear.pvd"))
@@ -478,7 +478,9 @@ def write_wear_fields(model, ds, pvd: Path) -> Path:
     return write_pvd(pvd, entries)
 
 
-def _figures(ds, case, outdir: Path, nodes) -> list[Path]:
+def wear_figures(ds, case, outdir: Path, nodes) -> list[Path]:
+    """The figures of a wear run (``case.output``: whether and in which format; ``nodes``:
+    those of the wear kinetics, default :func:`default_nodes`)."""
     out = case.output
     if not out["figures"]:
         return []

@@ -10,8 +10,20 @@ solve is never a result). Two kinds get more:
   the longest run, NaN past a member's last step; their mean and 5/50/95 % quantiles over the
   members that reached each cycle (``members_reached``), and each member's final state;
 * sweep members: the envelope (min, max) of the response amplitude over the members (the band
-  of FRFs); for a split sweep (:mod:`fretwear.study.sweep_split`) the chunks joined into one
-  sweep instead.
+  of FRFs) and each member's peak (``peak_response_amplitude``, ``peak_frequency``: of the
+  family of FRFs over the excitation level, ``analysis.excitation_scale``, the curves a
+  joint engineer reads first); for a split sweep (:mod:`fretwear.study.sweep_split`) the
+  chunks joined into one sweep instead.
+
+Members whose frequencies differ (continuation adds points where each member needs them) or
+whose kept harmonics differ cannot be stacked as they are. Their variables along a frequency
+dimension (``frequency``, ``linear_frequency``) are then interpolated, linearly in frequency,
+onto the union of the members' frequencies (so each member's own points keep their values
+exactly; NaN outside a member's band and next to its points that did not converge), and the
+harmonics are the union of the members' (NaN for a harmonic a member did not keep). The
+attribute ``common_grid`` says so, and each member's own response is kept as well with its own
+coordinate: ``member_frequency`` and ``member_response_amplitude`` along ``member_point``
+(NaN-padded to the longest member).
 """
 
 from __future__ import annotations
@@ -96,6 +108,110 @@ def _shared_coords(done: dict, variables: dict) -> dict:
                 for ds in done.values()):
             out[d] = (d, first[d].values, dict(first[d].attrs))
     return out
+
+
+FREQUENCY_DIMS = ("frequency", "linear_frequency")
+LABEL_DIMS = ("harmonic",)
+COMMON_GRID = ("the members' {dims} differ: their responses are interpolated linearly in "
+               "frequency onto the union of the members' frequencies ({n} points; each "
+               "member's own points exact, NaN outside its band), harmonics not kept by a "
+               "member are NaN; member_response_amplitude keeps each member's own points")
+
+
+def _differing(done: dict, dims) -> list[str]:
+    """The dims among ``dims`` whose coordinate is not the same in every member."""
+    first = next(iter(done.values()))
+    out = []
+    for d in dims:
+        have = [ds for ds in done.values() if d in ds.coords]
+        if have and any(d not in ds.coords or not np.array_equal(ds[d].values, first[d].values)
+                        for ds in done.values()):
+            out.append(d)
+    return out
+
+
+def _on_grid(var: xr.DataArray, dim: str, grid: np.ndarray) -> xr.DataArray:
+    """``var`` at the frequencies ``grid`` (which holds every frequency of ``var``), linear in
+    ``var[dim]`` (sorted, the first of equal frequencies kept: a fold is seen as one branch
+    here, ``member_response_amplitude`` keeps it whole); NaN outside the member's band or
+    between a point and a NaN neighbour. Integer variables (flags) keep their values at the
+    member's own frequencies only."""
+    f = var[dim].values.astype(float)
+    order = np.unique(f, return_index=True)[1]
+    xp, fp = f[order], np.moveaxis(var.values[order], var.dims.index(dim), 0)
+    new = np.full((grid.size, *fp.shape[1:]), np.nan)
+    if var.dtype.kind == "f" and xp.size > 1:
+        new = _interp(grid, xp, fp.astype(float))
+    new[np.searchsorted(grid, xp)] = fp  # exact at its own points, even beside a NaN
+    coords = {d: var[d] for d in var.dims if d != dim and d in var.coords}
+    return xr.DataArray(np.moveaxis(new, 0, var.dims.index(dim)), dims=var.dims,
+                        coords={**coords, dim: grid}, attrs=var.attrs)
+
+
+def _regrid(done: dict) -> tuple[dict, dict, str]:
+    """The members' datasets on common frequency grids and harmonics (see the module
+    docstring), each member's own response, and the note (empty: nothing to do)."""
+    freq = _differing(done, FREQUENCY_DIMS)
+    labels = _differing(done, LABEL_DIMS)
+    if not freq and not labels:
+        return done, {}, ""
+    grids = {d: np.unique(np.concatenate([ds[d].values.astype(float) for ds in done.values()
+                                          if d in ds.coords])) for d in freq}
+    union = {d: np.unique(np.concatenate([ds[d].values for ds in done.values()
+                                          if d in ds.coords])) for d in labels}
+    out = {}
+    for key, ds in done.items():
+        new = {}
+        for name, var in ds.data_vars.items():
+            if var.dtype.kind not in "fiub":
+                continue
+            for d in labels:
+                if d in var.dims:
+                    var = var.astype(float).reindex({d: union[d]})
+            for d in freq:
+                if d in var.dims:
+                    var = _on_grid(var, d, grids[d])
+            new[name] = var
+        coords = {k: v for k, v in ds.coords.items() if not set(v.dims) & {*freq, *labels}}
+        regridded = xr.Dataset(new).assign_coords(coords)
+        for d in (*freq, *labels):
+            if d in ds.coords and d in regridded.dims:
+                regridded[d].attrs.update(ds[d].attrs)
+        out[key] = regridded
+    own = _own_responses(done) if "frequency" in freq else {}
+    n = grids["frequency"].size if "frequency" in grids else 0
+    what = " and ".join(["frequencies"] * bool(freq) + ["harmonics"] * bool(labels))
+    return out, own, COMMON_GRID.format(dims=what, n=n)
+
+
+def _own_responses(done: dict) -> dict:
+    """Each member's frequencies and response amplitude on its own points (NaN-padded)."""
+    have = {k: ds for k, ds in done.items() if "response_amplitude" in ds}
+    if not have:
+        return {}
+    n = max(ds.sizes["frequency"] for ds in have.values())
+    first = next(iter(have.values()))["response_amplitude"]
+    rest = [d for d in first.dims if d != "frequency"]
+    if any(ds["response_amplitude"].dims != first.dims for ds in have.values()):
+        return {}
+    union = {d: np.unique(np.concatenate([ds[d].values for ds in have.values()]))
+             if d in LABEL_DIMS else first[d].values for d in rest if d in first.coords}
+    shape = [union[d].size if d in union else first.sizes[d] for d in rest]
+    keys = sorted(done)
+    freq = np.full((len(keys), n), np.nan)
+    amp = np.full((len(keys), n, *shape), np.nan)
+    for i, k in enumerate(keys):
+        if k not in have:
+            continue
+        var = have[k]["response_amplitude"]
+        for d in LABEL_DIMS:
+            if d in var.dims:
+                var = var.astype(float).reindex({d: union[d]})
+        m = var.sizes["frequency"]
+        freq[i, :m] = have[k]["frequency"].values
+        amp[i, :m] = var.transpose("frequency", *rest).values
+    return {"keys": keys, "frequency": freq, "amplitude": amp, "dims": rest,
+            "attrs": dict(first.attrs)}
 
 
 def _interp(x: np.ndarray, xp: np.ndarray, fp: np.ndarray) -> np.ndarray:
@@ -185,6 +301,35 @@ def _wear(members: list[Member], done: dict) -> tuple[dict, dict]:
     return coords, data
 
 
+def _peaks(stacked: dict, coords: dict) -> dict:
+    """Each member's largest amplitude of harmonic 1 of the first observed point (the
+    largest over its axes) over the band, and its frequency (``peak_response_amplitude``,
+    ``peak_frequency``): the curve of the peak against a varied key (e.g. the excitation
+    level)."""
+    if "response_amplitude" not in stacked or "frequency" not in coords:
+        return {}
+    dims, arr, attrs = stacked["response_amplitude"]
+    if dims[:2] != ("member", "frequency"):
+        return {}
+    sel = arr
+    with np.errstate(all="ignore"), _quiet():
+        for d in dims[2:]:  # point, axis, harmonic: the first point, the largest axis, the
+            sel = np.nanmax(sel, axis=2) if d == "axis" else sel[:, :, 0]  # first harmonic
+        ok = np.any(np.isfinite(sel), axis=1)
+        j = np.argmax(np.where(np.isfinite(sel), sel, -np.inf), axis=1)
+    rows = np.arange(sel.shape[0])
+    f = np.asarray(coords["frequency"][1], float)
+    return {
+        "peak_response_amplitude": ("member", np.where(ok, sel[rows, j], np.nan),
+                                    {"units": attrs.get("units", "m"), "long_name":
+                                     "largest amplitude of harmonic 1 of the first observed "
+                                     "point (largest over its axes) over the band"}),
+        "peak_frequency": ("member", np.where(ok, f[j], np.nan),
+                           {"units": "Hz", "long_name": "frequency of the member's "
+                            "peak_response_amplitude"}),
+    }
+
+
 def _frf_band(stacked: dict) -> dict:
     if "response_amplitude" not in stacked:
         return {}
@@ -197,9 +342,31 @@ def _frf_band(stacked: dict) -> dict:
                                                       "response amplitude over the members"})}
 
 
+def _own_variables(members: list[Member], own: dict) -> dict:
+    """``member_frequency`` and ``member_response_amplitude`` (see the module docstring)."""
+    if not own:
+        return {}
+    row = {k: i for i, k in enumerate(own["keys"])}
+    n = own["frequency"].shape[1]
+    freq = np.full((len(members), n), np.nan)
+    amp = np.full((len(members), *own["amplitude"].shape[1:]), np.nan)
+    for i, m in enumerate(members):
+        if m.index in row:
+            freq[i], amp[i] = own["frequency"][row[m.index]], own["amplitude"][row[m.index]]
+    return {
+        "member_frequency": (("member", "member_point"), freq,
+                             {"units": "Hz", "long_name": "the member's own frequencies "
+                              "(NaN past its last point)"}),
+        "member_response_amplitude": (("member", "member_point", *own["dims"]), amp,
+                                      {**own["attrs"], "long_name": "the member's response "
+                                       "amplitude at its own frequencies"}),
+    }
+
+
 def aggregate(study, members: list[Member], records: list[MemberRecord], outdir) -> xr.Dataset:
     """The study's dataset (see the module docstring)."""
     done = _open(outdir, members, records)
+    done, own, note = _regrid(done) if done else (done, {}, "")
     coords = _member_coords(members)
     data = {
         "member_status": ("member", np.array([r.status for r in records]),
@@ -220,7 +387,11 @@ def aggregate(study, members: list[Member], records: list[MemberRecord], outdir)
         data.update(d)
     else:
         data.update(_frf_band(stacked))
+        data.update(_own_variables(members, own))
+        data.update(_peaks(stacked, coords))
     ds = xr.Dataset(data, coords=coords)
+    if note:
+        ds.attrs["common_grid"] = note
     ds.attrs.update({
         "title": study.title, "study_kind": study.kind, "study_file": study.text,
         "base_case": str(study.base), "members": len(members),

@@ -4,20 +4,28 @@
   the mean and every member thin) and the band of worn profiles at the last cycle every
   member reached;
 * sweep studies: the family of FRFs (one curve per member, labelled with its varied keys)
-  and their envelope; a split sweep: the joined FRF with the joins marked.
+  and their envelope; a split sweep: the joined FRF with the joins marked; a study of the
+  excitation level alone (``analysis.excitation_scale``): the FRFs divided by the level on
+  one axis and the peak amplitude and frequency against the level;
+* periodic studies: the response amplitude of each member against the first varied numeric
+  key.
 """
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import numpy as np
 
+from fretwear.analyses.figure_style import apply_style, frequency_scale
 from fretwear.files import atomic_write
 
 
 def _save(fig, path: Path) -> Path:
     import matplotlib.pyplot as plt
+
+    apply_style(fig)
 
     def write(tmp: Path) -> None:
         fig.savefig(tmp, format=path.suffix.lstrip("."), dpi=130, bbox_inches="tight")
@@ -42,13 +50,13 @@ def fan_chart(ds, path: Path) -> Path:
     fig, ax = _figure(figsize=(7, 4.5))
     n = ds["cycle"].values
     for v in ds["worn_volume_on_cycles"].values:
-        ax.plot(n, v * 1e9, color="0.6", lw=0.6)
-    q = ds["worn_volume_quantile"].values * 1e9
+        ax.plot(n, v, color="0.6", lw=0.6)
+    q = ds["worn_volume_quantile"].values
     ax.fill_between(n, q[0], q[2], color="C0", alpha=0.3, label="5-95 % of the members")
     ax.plot(n, q[1], color="C0", lw=2, label="median")
-    ax.plot(n, ds["worn_volume_mean"].values * 1e9, color="C1", ls="--", label="mean")
+    ax.plot(n, ds["worn_volume_mean"].values, color="C1", ls="--", label="mean")
     ax.set_xlabel("cycles N")
-    ax.set_ylabel("worn volume [mm^3]")
+    ax.set_ylabel("worn volume [m^3]")
     ax.set_title(f"{ds.attrs.get('title', '')}: {int(ds.attrs.get('members_ok', 0))} members",
                  fontsize=9)
     ax.legend(fontsize=8)
@@ -64,15 +72,15 @@ def profile_band(ds, path: Path) -> Path:
     x = ds["contact_position"].values[..., 0] if "contact_position" in ds else \
         np.arange(ds.sizes["contact_node"])
     x = np.nanmean(x, axis=0) if x.ndim == 2 else x
-    xs = x * 1e3 if "contact_position" in ds else x
+    xs = x
     fig, ax = _figure(figsize=(7, 4.5))
     for w in ds["wear_depth_on_cycles"].values[:, k]:
-        ax.plot(xs, w * 1e6, color="0.6", lw=0.6)
-    q = ds["wear_depth_quantile"].values[:, k] * 1e6
+        ax.plot(xs, w, color="0.6", lw=0.6)
+    q = ds["wear_depth_quantile"].values[:, k]
     ax.fill_between(xs, q[0], q[2], color="C0", alpha=0.3, label="5-95 % of the members")
     ax.plot(xs, q[1], color="C0", lw=2, label="median")
-    ax.set_xlabel("x [mm]" if "contact_position" in ds else "contact node")
-    ax.set_ylabel("wear depth [um]")
+    ax.set_xlabel("x [m]" if "contact_position" in ds else "contact node")
+    ax.set_ylabel("wear depth [m]")
     ax.set_title(f"worn profiles at N = {float(ds['cycle'].values[k]):.3g}", fontsize=9)
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
@@ -91,7 +99,10 @@ def _main_response(ds):
     amp = amp.isel(sel)
     label = f"{str(ds['point'].values[0]) if 'point' in ds else ''}"
     if "axis" in amp.dims:
-        axis = int(np.nanargmax(np.nanmax(amp.values.reshape(-1, amp.sizes["axis"]), axis=0)))
+        with warnings.catch_warnings():  # an axis the point does not have is all NaN
+            warnings.simplefilter("ignore", RuntimeWarning)
+            largest = np.nanmax(amp.values.reshape(-1, amp.sizes["axis"]), axis=0)
+        axis = int(np.nanargmax(np.where(np.isnan(largest), -np.inf, largest)))
         label += f" {str(ds['axis'].values[axis])}"
         amp = amp.isel(axis=axis)
     return amp, label.strip()
@@ -106,10 +117,10 @@ def frf_family(ds, path: Path, varied: list[str]) -> Path:
         text = ", ".join(f"{k} = {ds[k].values[i]:.3g}" if ds[k].dtype.kind == "f"
                          else f"{k} = {ds[k].values[i]}" for k in varied if k in ds.coords
                          and ds[k].dims == ("member",))
-        ax.plot(f, amp.values[i], lw=1, label=text or f"member {i}")
+        ax.plot(f, amp.values[i], lw=1, marker="." if f.size <= 80 else None, ms=3,
+                alpha=0.85, label=text or f"member {i}")
     ax.set_yscale("log")
-    if f.min() > 0 and f.max() / f.min() > 20:
-        ax.set_xscale("log")
+    ax.set_xscale(frequency_scale(f.min(), f.max()))
     ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel(f"amplitude {label} [m]")
     ax.set_title(ds.attrs.get("title", ""), fontsize=9)
@@ -129,12 +140,100 @@ def joined_frf(ds, path: Path) -> Path:
         if np.isfinite(fj):
             ax.axvline(fj, color="0.5" if ok else "red", lw=0.8, ls=":")
     ax.set_yscale("log")
-    if f.size and f.min() > 0 and f.max() / f.min() > 20:
-        ax.set_xscale("log")
+    if f.size:
+        ax.set_xscale(frequency_scale(f.min(), f.max()))
     ax.set_xlabel("frequency [Hz] (dotted: joins of chunks; red: join check failed)")
     ax.set_ylabel(f"amplitude {label} [m]")
     ax.set_title(ds.attrs.get("title", ""), fontsize=9)
     ax.grid(alpha=0.3, which="both")
+    return _save(fig, path)
+
+
+LEVEL_KEY = "analysis.excitation_scale"
+
+
+def load_levels(ds, path: Path) -> Path:
+    """The family of FRFs over the excitation level: every level's FRF divided by the level
+    on one axis (they coincide where the joint is linear: stuck or sliding throughout), and
+    the peak amplitude and its frequency against the level."""
+    import matplotlib
+
+    amp, label = _main_response(ds)
+    levels = ds[LEVEL_KEY].values.astype(float)
+    order = np.argsort(levels)
+    f = ds["frequency"].values
+    fig, axes = _figure(1, 3, figsize=(14, 4.2))
+    colours = matplotlib.colormaps["viridis"](np.linspace(0.0, 0.9, max(len(levels), 1)))
+    styles = ("-", "--", "-.", ":")
+    for k, (c, i) in enumerate(zip(colours, order, strict=False)):
+        # coinciding curves (linear levels) stay visible: thinner and dashed on top
+        axes[0].plot(f, amp.values[i] / levels[i], color=c, ls=styles[k % 4],
+                     lw=max(2.8 - 0.5 * k, 0.8), marker=".", ms=3, zorder=2 + k,
+                     label=f"level {levels[i]:.3g}")
+    axes[0].set_yscale("log")
+    axes[0].set_xscale(frequency_scale(f.min(), f.max()))
+    axes[0].set_xlabel("frequency [Hz]")
+    axes[0].set_ylabel(f"amplitude {label} / level [m]")
+    axes[0].legend(fontsize=7, title="excitation_scale", title_fontsize=7)
+    lv, peak = levels[order], ds["peak_response_amplitude"].values[order]
+    axes[1].loglog(lv, peak, marker="o", label="peak")
+    ok = np.isfinite(peak)
+    if ok.any():
+        k = int(np.flatnonzero(ok)[0])
+        axes[1].loglog(lv, peak[k] * lv / lv[k], color="0.5", ls="--", lw=0.8,
+                       label="proportional to the level (linear)")
+    axes[1].set_xlabel("excitation level (excitation_scale)")
+    axes[1].set_ylabel(f"peak amplitude {label} [m]")
+    axes[1].legend(fontsize=7)
+    axes[2].semilogx(lv, ds["peak_frequency"].values[order], marker="o")
+    axes[2].set_xlabel("excitation level (excitation_scale)")
+    axes[2].set_ylabel("peak frequency [Hz]")
+    for ax in axes:
+        ax.grid(alpha=0.3, which="both")
+    fig.suptitle(ds.attrs.get("title", ""), fontsize=9)
+    return _save(fig, path)
+
+
+#: the amplitude of each harmonic of the observed points in a periodic (or transient) result
+PERIODIC_RESPONSE = "displacement_harmonic_amplitude"
+
+
+def _numeric_key(ds, varied: list[str]):
+    """The first varied key with one number per member (None: none)."""
+    for k in varied:
+        if k in ds.coords and ds[k].dims == ("member",) and ds[k].dtype.kind in "fi":
+            return k
+    return None
+
+
+def response_per_member(ds, path: Path, varied: list[str]) -> Path:
+    """Members without a frequency axis (periodic or transient responses): the amplitude of
+    harmonic 1 of
+    the first observed point (on its axis of largest response) against the first varied numeric
+    key (the member number when none), one marker per member."""
+    amp = ds[PERIODIC_RESPONSE]
+    sel = {d: 0 for d in ("point", "harmonic") if d in amp.dims}
+    amp = amp.isel(sel)
+    label = str(ds["point"].values[0]) if "point" in ds else ""
+    y = amp.values.reshape(ds.sizes["member"], -1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        largest = np.nanmax(y, axis=0)
+    if "axis" in amp.dims and np.any(np.isfinite(largest)):
+        a = int(np.nanargmax(np.where(np.isnan(largest), -np.inf, largest)))
+        y = y[:, a]
+        label += f" {str(ds['axis'].values[a])}"
+    else:
+        y = y[:, 0]
+    key = _numeric_key(ds, varied)
+    x = ds[key].values if key else ds["member"].values
+    fig, ax = _figure(figsize=(7, 4.5))
+    order = np.argsort(x, kind="stable")
+    ax.plot(x[order], y[order], marker="o", lw=0.8)
+    ax.set_xlabel(key or "member")
+    ax.set_ylabel(f"amplitude {label.strip()} (harmonic 1) [m]")
+    ax.set_title(ds.attrs.get("title", ""), fontsize=9)
+    ax.grid(alpha=0.3)
     return _save(fig, path)
 
 
@@ -146,6 +245,10 @@ def study_figures(ds, outdir: Path, varied: list[str], fmt: str = "png") -> list
     elif "worn_volume_on_cycles" in ds:
         out.append(fan_chart(ds, outdir / f"study-worn-volume.{fmt}"))
         out.append(profile_band(ds, outdir / f"study-wear-profiles.{fmt}"))
+    elif PERIODIC_RESPONSE in ds and "member" in ds[PERIODIC_RESPONSE].dims:
+        out.append(response_per_member(ds, outdir / f"study-response.{fmt}", varied))
     elif "response_amplitude" in ds and "member" in ds["response_amplitude"].dims:
         out.append(frf_family(ds, outdir / f"study-frf-family.{fmt}", varied))
+        if varied == [LEVEL_KEY] and "peak_frequency" in ds:
+            out.append(load_levels(ds, outdir / f"study-load-levels.{fmt}"))
     return out

@@ -54,6 +54,8 @@ def _locate(raw: dict, parts: list[str], key: str):
     while i < len(parts) - 1:
         part, here = parts[i], ".".join(parts[: i + 1])
         child = node.get(part)
+        if isinstance(child, list) and not all(isinstance(b, Mapping) for b in child):
+            return _component(child, parts, i, key)
         if isinstance(child, list):  # an array of tables: a block by name or number from 1
             if i + 2 > len(parts) - 1:
                 raise InputError(f"{key}: {part} is an array of tables; name a block and a "
@@ -81,9 +83,24 @@ def _locate(raw: dict, parts: list[str], key: str):
     return node, parts[-1]
 
 
+def _component(vector: list, parts: list[str], i: int, key: str):
+    """The vector ``parts[i]`` and the index of its component ``parts[i + 1]`` (counted from
+    1), the last part of ``key``."""
+    here = ".".join(parts[: i + 1])
+    rest = parts[i + 1:]
+    n = len(vector)
+    if len(rest) != 1 or not rest[0].isdigit() or not 1 <= int(rest[0]) <= n:
+        raise InputError(f"{key}: {here} = {show(vector)} is a vector of {n} components; "
+                         f"expected {here} (the whole vector) or {here}.N, N a component "
+                         f"number from 1 to {n}")
+    return vector, int(rest[0]) - 1
+
+
 def get_key(raw: dict, key: str):
     """The value of ``key`` (a dotted path) in the parsed case ``raw`` (None if absent)."""
     table, last = _locate(copy.deepcopy(raw), split_key(key), key)
+    if isinstance(table, list):
+        return table[last]
     return table.get(last)
 
 
@@ -95,9 +112,13 @@ def set_key(raw: dict, key: str, value) -> None:
 
 # --- expanding a study ------------------------------------------------------------------------
 def _grid(study: Study) -> list[dict]:
-    keys = list(study.grid)
-    return [dict(zip(keys, combo, strict=True))
-            for combo in itertools.product(*(study.grid[k] for k in keys))]
+    """Every combination of the axes: each ``[grid]`` key alone, each tied group together."""
+    axes = [[{k: v} for v in values] for k, values in study.grid.items()]
+    for group in getattr(study, "tied", []):
+        n = len(next(iter(group.values())))
+        axes.append([{k: group[k][i] for k in group} for i in range(n)])
+    return [{k: v for part in combo for k, v in part.items()}
+            for combo in itertools.product(*axes)]
 
 
 def _uniform_draws(n: int, d: int, seed: int, method: str) -> np.ndarray:

@@ -4,15 +4,18 @@ write ``study.nc`` and the figures (``fretwear study STUDY.toml`` and
 
 from __future__ import annotations
 
+import textwrap
 from dataclasses import dataclass, field
 from pathlib import Path
+
+import numpy as np
 
 from fretwear import __version__
 from fretwear.analyses.run import check_output
 from fretwear.errors import InputError, interrupted
 from fretwear.files import atomic_write, remove_stale_temporaries
 from fretwear.study.aggregate import aggregate
-from fretwear.study.figures import study_figures
+from fretwear.study.figures import LEVEL_KEY, study_figures
 from fretwear.study.members import expand
 from fretwear.study.runner import check_scheduler_address, dask_client, run_members
 from fretwear.study.spec import Study, read_study
@@ -50,6 +53,20 @@ def _write_dataset(path: Path, ds) -> Path:
     return atomic_write(path, write)
 
 
+def _wrap(text: str, width: int = 100, limit: int = 12) -> str:
+    """``text`` as lines of at most ``width`` characters indented by two, broken between
+    words (never inside one), at most ``limit`` lines per paragraph (the rest said as
+    "...")."""
+    out = []
+    for para in str(text).splitlines() or [""]:
+        lines = textwrap.wrap(para, width - 4, break_long_words=False,
+                              break_on_hyphens=False) or [""]
+        if len(lines) > limit:
+            lines = [*lines[: limit - 1], "..."]
+        out += ["  " + lines[0], *("    " + x for x in lines[1:])]
+    return "\n".join(out)
+
+
 def _summary(study: Study, records, ds) -> tuple[bool, str]:
     n = len(records)
     count = {s: sum(r.status == s for r in records)
@@ -61,7 +78,17 @@ def _summary(study: Study, records, ds) -> tuple[bool, str]:
              + (f" ({skipped} finished before)" if skipped else "")]
     for r in records:
         if r.status not in ("ok", "not run"):
-            lines.append(f"  member {r.index}: {r.status}: {r.message[:200]}")
+            lines.append(_wrap(f"member {r.index}: {r.status}: {r.message}"))
+    for r in records:
+        for w in filter(None, r.warnings.splitlines()):
+            lines.append(_wrap(f"member {r.index}: warning: {w}"))
+    if "peak_frequency" in ds and LEVEL_KEY in ds.coords:
+        for lv, a, f in sorted(zip(ds[LEVEL_KEY].values, ds["peak_response_amplitude"].values,
+                                   ds["peak_frequency"].values, strict=True)):
+            lines.append(f"  level {lv:.4g}: peak {a:.4g} m at {f:.6g} Hz"
+                         + (f", {a / lv:.4g} m per unit level" if np.isfinite(a) else ""))
+    if ds.attrs.get("common_grid"):
+        lines.append(_wrap(ds.attrs["common_grid"]))
     ok = count["ok"] == n
     if study.kind == "split" and "join_ok" in ds:
         bad = [f"{f:.6g} Hz ({d:.2g})" for f, d, j in zip(

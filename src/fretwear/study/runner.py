@@ -23,6 +23,7 @@ import os
 import socket
 import sys
 import time
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -49,10 +50,11 @@ class MemberRecord:
     worker: str = ""
     skipped: bool = False
     case_sha256: str = ""
+    warnings: str = ""
 
     def to_json(self) -> str:
-        d = {k: getattr(self, k)
-             for k in ("index", "status", "message", "seconds", "worker", "case_sha256")}
+        d = {k: getattr(self, k) for k in ("index", "status", "message", "seconds", "worker",
+                                           "case_sha256", "warnings")}
         return json.dumps(d, indent=1) + "\n"
 
 
@@ -99,7 +101,8 @@ def read_status(folder: Path) -> MemberRecord | None:
         d = json.loads((folder / STATUS_FILE).read_text(encoding="utf-8"))
         return MemberRecord(int(d["index"]), str(d["status"]), str(d.get("message", "")),
                             float(d.get("seconds", 0.0)), str(d.get("worker", "")),
-                            case_sha256=str(d.get("case_sha256", "")))
+                            case_sha256=str(d.get("case_sha256", "")),
+                            warnings=str(d.get("warnings", "")))
     except (OSError, ValueError, KeyError, TypeError):
         return None
 
@@ -121,6 +124,13 @@ def finished(folder: Path, text: str) -> MemberRecord | None:
     return rec
 
 
+def warning_lines(caught) -> str:
+    """Python warnings raised during a member's run as one line each, ``Category: message``
+    (no file name and source line, which mean nothing to the user of a study), each once."""
+    lines = [f"{w.category.__name__}: {' '.join(str(w.message).split())}" for w in caught]
+    return "\n".join(dict.fromkeys(lines))
+
+
 def run_member(index: int, text: str, folder: str) -> MemberPayload:
     """Run one member (on a worker): write its case file, run it into ``folder`` with
     ``resume = True``, record its status. Never raises for a failed run: the failure is the
@@ -131,18 +141,20 @@ def run_member(index: int, text: str, folder: str) -> MemberPayload:
     start = time.perf_counter()
     worker = f"{socket.gethostname()}:{os.getpid()}"
     results = None
-    try:
-        case = write_case(folder_path, text)
-        out = run_case(case, folder_path, progress=False, resume=True, echo=False)
-        status = "ok" if out.success else "not converged"
-        message = " ".join(str(out.summary or "").split())
-        results = Path(out.results).read_bytes() if out.results else None
-    except FretwearError as exc:
-        status, message = "failed", " ".join(str(exc).split())
-    except Exception as exc:  # recorded with its message, never dropped
-        status, message = "failed", f"{type(exc).__name__}: {' '.join(str(exc).split())}"
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("default")
+        try:
+            case = write_case(folder_path, text)
+            out = run_case(case, folder_path, progress=False, resume=True, echo=False)
+            status = "ok" if out.success else "not converged"
+            message = " ".join(str(out.summary or "").split())
+            results = Path(out.results).read_bytes() if out.results else None
+        except FretwearError as exc:
+            status, message = "failed", " ".join(str(exc).split())
+        except Exception as exc:  # recorded with its message, never dropped
+            status, message = "failed", f"{type(exc).__name__}: {' '.join(str(exc).split())}"
     rec = MemberRecord(index, status, message, time.perf_counter() - start, worker,
-                       case_sha256=case_hash(text))
+                       case_sha256=case_hash(text), warnings=warning_lines(caught))
     with contextlib.suppress(OSError):
         _write_text(folder_path / STATUS_FILE, rec.to_json())
     return MemberPayload(rec, results)

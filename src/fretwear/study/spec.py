@@ -7,6 +7,11 @@ A study is one of four kinds, chosen by the table it has (exactly one of them)::
     [ensemble]   n members that differ from the base case by a stated, seeded perturbation
     [split]      a frequency sweep split into chunks of its band, one member each
 
+``[grid]`` may tie keys together: each ``[[grid.tied]]`` block lists keys whose values vary
+together (the i-th value of each in one member), one axis of the combinations. A value may be
+a vector (``loads.shake.traction = [[0, 1e6, 0], [0, 2e6, 0]]``), and one component of a
+vector is named by its number counted from 1 (``loads.shake.traction.2``).
+
 Case keys are written as dotted paths into the case file's tables, exactly as TOML nests them:
 ``contact.mu``, ``analysis.frequency``, ``damping.loss_factor``; a block of an array of tables
 is named by its ``name`` (``loads.Q.pressure``) or by its number counted from 1 as in the
@@ -135,6 +140,7 @@ class Study:
     kind : "grid", "samples", "ensemble" or "split".
     set : key path -> value, set in every member.
     grid : key path -> list of values (kind "grid").
+    tied : groups of key paths -> lists of values varied together (``[[grid.tied]]``).
     samples : the [samples] table and ``vary`` (key path -> distribution table).
     ensemble : the [ensemble] table and ``perturb`` (key path -> perturbation table).
     split : the [split] table.
@@ -149,6 +155,7 @@ class Study:
     text: str
     set: dict = field(default_factory=dict)
     grid: dict = field(default_factory=dict)
+    tied: list = field(default_factory=list)
     samples: dict = field(default_factory=dict)
     ensemble: dict = field(default_factory=dict)
     split: dict = field(default_factory=dict)
@@ -208,14 +215,44 @@ def _prefix(study_path: Path, where: str, exc: InputError) -> InputError:
     return InputError(f"{study_path.name}: {where}{exc}")
 
 
+def _is_vector(v) -> bool:
+    return isinstance(v, list) and bool(v) and all(
+        isinstance(x, int | float) and not isinstance(x, bool) for x in v)
+
+
 def _check_values(values, label: str) -> list:
     if not isinstance(values, list) or not values:
         raise InputError(f"{label} = {show(values)}: expected a non-empty list of values")
     for v in values:
-        if isinstance(v, Mapping | list):
-            raise InputError(f"{label} = {show(values)}: expected a list of numbers, strings "
-                             "or booleans")
+        if isinstance(v, Mapping) or (isinstance(v, list) and not _is_vector(v)):
+            raise InputError(f"{label} = {show(values)}: expected a list of numbers, strings, "
+                             "booleans or vectors (lists of numbers, e.g. tractions "
+                             "[[0, 1e6, 0], [0, 2e6, 0]])")
     return values
+
+
+def _tied(groups, ctx_label: str = "grid.tied") -> list[dict]:
+    """``[[grid.tied]]``: groups of keys whose lists of values vary together (the i-th value
+    of each key in one member); each group is one axis of the grid's combinations."""
+    if not isinstance(groups, list) or not all(isinstance(g, Mapping) for g in groups):
+        raise InputError(f"{ctx_label} = {show(groups)}: expected an array of tables "
+                         "([[grid.tied]]), each key path = [values] of the same length")
+    out = []
+    for j, group in enumerate(groups, start=1):
+        label = f"[[grid.tied]] block {j}"
+        flat = _flatten(group, "", lambda v: False)
+        if len(flat) < 1:
+            raise InputError(f"{label}: expected key path = [values] for at least one key")
+        flat = {k: _check_values(v, f"{label}: {k}") for k, v in flat.items()}
+        sizes = {k: len(v) for k, v in flat.items()}
+        if len(set(sizes.values())) > 1:
+            raise InputError(f"{label}: the lists differ in length ("
+                             + ", ".join(f"{k}: {n}" for k, n in sizes.items())
+                             + "); expected one value of each key per member")
+        for key in flat:
+            split_key(key)
+        out.append(flat)
+    return out
 
 
 def _number(v, label: str) -> float:
@@ -278,12 +315,21 @@ def read_study(path: Path | str) -> Study:
             split_key(key)
         study.output = OUTPUT.check(top.get("output", {}), "output", ctx)
         if kind == "grid":
-            grid = _flatten(top["grid"], "", lambda v: False)
-            if not grid:
-                raise InputError("[grid]: expected at least one key path = [values]")
+            table = dict(top["grid"])
+            study.tied = _tied(table.pop("tied")) if "tied" in table else []
+            grid = _flatten(table, "", lambda v: False)
+            if not grid and not study.tied:
+                raise InputError("[grid]: expected at least one key path = [values] (or a "
+                                 "[[grid.tied]] group)")
             study.grid = {k: _check_values(v, f"grid.{k}") for k, v in grid.items()}
             for key in grid:
                 split_key(key)
+            both = set(grid).intersection(*[set(g) for g in study.tied]) if study.tied else ()
+            keys = [k for g in study.tied for k in g] + list(grid)
+            twice = sorted({k for k in keys if keys.count(k) > 1} | set(both))
+            if twice:
+                raise InputError(f"[grid]: {', '.join(twice)} varied twice (in [grid] and "
+                                 "[[grid.tied]], or in two groups); expected each key once")
         elif kind == "samples":
             s = dict(top["samples"])
             vary = s.pop("vary", None)

@@ -1,0 +1,113 @@
+"""The figure style (fretwear.analyses.figure_style): SI prefixes in axis units, plain tick
+labels, a log frequency axis only for bands over a decade.
+
+References: the SI prefixes by their definition (µ = 1e-6, k = 1e3, mm³ = 1e-9 m³), the
+issue's cases (a 900-1100 Hz sweep, micrometre wear depths, "um"), and the tick labels of a
+figure drawn here read back from matplotlib.
+"""
+
+from __future__ import annotations
+
+import pytest
+from matplotlib.figure import Figure
+
+from fretwear.analyses.figure_style import (
+    apply_style,
+    frequency_scale,
+    relabel,
+    si_prefix,
+    tick_text,
+)
+
+
+@pytest.mark.parametrize("largest, unit, factor, shown", [
+    (2.5e-6, "m", 1e6, "µm"),
+    (7e3, "Hz", 1e-3, "kHz"),
+    (79e3, "Hz", 1e-3, "kHz"),
+    (900.0, "Hz", 1.0, "Hz"),
+    (3e-10, "m^3", 1e9, "mm³"),
+    (4e-3, "m", 1e3, "mm"),
+    (0.5, "m", 1e3, "mm"),
+    (2e8, "Pa", 1e-6, "MPa"),
+    (12.0, "N", 1.0, "N"),
+    (3e-4, "J", 1e6, "µJ"),
+    (5e4, "m", 1.0, "m"),            # no km for a structure
+    (1e-3, "Hz", 1.0, "Hz"),         # no mHz
+    (0.0, "m", 1.0, "m"),            # nothing to scale
+    (3.0, "1", 1.0, "1"),            # no prefix for a ratio
+    (1.0, "um", 1.0, "µm"),
+])
+def test_si_prefix_gives_numbers_from_1_to_1000(largest, unit, factor, shown):
+    """The factor is a power of 1000 (of its cube for m^3) and brings the largest value into
+    [1, 1000) where a prefix applies (a volume: the nearest prefix, 3e-10 m³ = 0.3 mm³); the
+    unit is written with its prefix."""
+    f, u = si_prefix(largest, unit)
+    assert f == pytest.approx(factor, rel=1e-12) and u == shown
+    if f != 1.0 and "^" not in unit:
+        assert 1.0 <= largest * f < 1000.0
+
+
+def test_frequency_axis_is_log_only_beyond_a_decade():
+    assert frequency_scale(900.0, 1100.0) == "linear"
+    assert frequency_scale(1e3, 1e4) == "linear"
+    assert frequency_scale(1e3, 1.0001e4) == "log"
+    assert frequency_scale(0.0, 10.0) == "linear"
+
+
+def test_labels_and_ticks_read_without_exponents():
+    """The unit in brackets takes its prefix, "um" becomes "µm", a label without unit is
+    left alone; ticks are plain numbers (no offset, no multiplier)."""
+    assert relabel("wear depth [m]", 3e-6) == (pytest.approx(1e6), "wear depth [µm]")
+    assert relabel("depth [um]", 3.0) == (1.0, "depth [µm]")
+    assert relabel("cycles N", 1e7) == (1.0, "cycles N")
+    assert [tick_text(v) for v in (2.5, 0.0, 1200.0, 0.001, 1e-5, 2e7)] == \
+        ["2.5", "0", "1200", "0.001", "1e-05", "2e+07"]
+    assert tick_text(2.4999999999999996) == "2.5"
+
+
+def test_a_narrow_sweep_is_drawn_on_a_linear_axis_in_khz_and_microns():
+    """A 6-8 kHz band (less than a decade, as the issue's 900-1100 Hz) drawn loglog with
+    amplitudes of a few microns: the frequency axis turns linear and reads kHz; the log
+    amplitude axis keeps its scale and reads µm (every tick: less than a decade); a linear
+    displacement axis reads µm with plain ticks."""
+    fig = Figure()
+    ax, bx = fig.subplots(1, 2)
+    ax.loglog([6e3, 7e3, 8e3], [1e-6, 3e-6, 2e-6])
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel("amplitude [m]")
+    bx.plot([0.0, 1.0], [-2e-6, 2e-6])
+    bx.set_ylabel("u [m]")
+    apply_style(fig)
+    assert ax.get_xscale() == "linear" and ax.get_xlabel() == "frequency [kHz]"
+    assert ax.xaxis.get_major_formatter()(7e3, 0) == "7"
+    assert ax.get_yscale() == "log" and ax.get_ylabel() == "amplitude [µm]"
+    assert ax.yaxis.get_minor_formatter()(2e-6, 0) == "2"
+    assert bx.get_ylabel() == "u [µm]" and bx.yaxis.get_major_formatter()(1.5e-6, 0) == "1.5"
+    fig.canvas.draw()
+    assert all("e" not in t.get_text() for t in bx.get_yticklabels())
+
+
+def test_shared_axes_name_the_unit_their_ticks_are_in():
+    """Two panels sharing x, only the lower labelled (x in m up to 0.1 m): the shared ticks
+    read millimetres and the label says mm (a label never names a unit its ticks are not
+    in); a log axis over less than a decade reads its prefixed unit on every tick; an axis
+    with a formatter of its own keeps its label's unit."""
+    from matplotlib import ticker
+
+    fig = Figure()
+    top, low = fig.subplots(2, 1, sharex=True)
+    for ax in (top, low):
+        ax.plot([0.0, 0.1], [1.0, 2.0])
+    low.set_xlabel("x [m]")
+    right = fig.add_axes((0.7, 0.7, 0.2, 0.2))
+    right.semilogy([1.0, 2.0], [7.8e-10, 7.9e-10])
+    right.set_ylabel("|u| [m]")
+    right.xaxis.set_major_formatter(ticker.FormatStrFormatter("%.1f"))
+    right.set_xlabel("t [s]")
+    apply_style(fig)
+    assert low.get_xlabel() == "x [mm]" and top.get_xlabel() == ""
+    assert low.xaxis.get_major_formatter()(0.1, 0) == "100"
+    assert top.xaxis.get_major_formatter()(0.05, 0) == "50"
+    assert right.get_ylabel() == "|u| [pm]"
+    assert right.yaxis.get_minor_formatter()(7.85e-10, 0) == "785"
+    assert right.get_xlabel() == "t [s]" and right.xaxis.get_major_formatter()(2.0, 0) == "2.0"
