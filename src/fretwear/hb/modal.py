@@ -38,6 +38,7 @@ import math
 
 import numpy as np
 import scipy.linalg as sla
+import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from fretwear.errors import InputError
@@ -231,7 +232,7 @@ class ModalCondenser(Condenser):
             if name == "K":  # K_ii Psi = -K_ic: the static condensation K_r
                 cc = B.cc + B.ci @ Psi
             else:
-                cc = B.cc + B.ci @ Psi + (B.ic.T @ Psi).T + Psi.T @ XiiPsi
+                cc = B.cc + B.ci @ Psi + (B.ic.T @ Psi).T + _gram(Psi, XiiPsi, B.ii)
             cq = (B.ci @ V) + Psi.T @ (B.ii @ V)
             qc = (B.ic.T @ V).T + V.T @ XiiPsi
             qq = V.T @ (B.ii @ V)
@@ -362,6 +363,24 @@ class ModalCondenser(Condenser):
                                                                           qF - Y @ Uc)
         P = self.structure.P
         return out if P is None else (P @ out.T).T
+
+
+def _gram(Psi: np.ndarray, X: np.ndarray, Bii) -> np.ndarray:
+    """``Psi^T X`` for ``X = B_ii Psi``: where ``B_ii`` is exactly symmetric, so is the
+    product, and only its upper triangle is computed (``BLOCK`` columns at a time, then
+    mirrored): half the ``2 n_i m^2`` flops of the largest product of the condensation (the
+    projected mass at 1024 contact nodes: 2.3e11)."""
+    m = Psi.shape[1]
+    symmetric = (not (Bii != Bii.T).nnz if sp.issparse(Bii)
+                 else np.array_equal(Bii, np.transpose(Bii)))
+    if not symmetric:
+        return Psi.T @ X
+    out = np.empty((m, m))
+    for j0 in range(0, m, BLOCK):
+        js = slice(j0, min(j0 + BLOCK, m))
+        out[:js.stop, js] = Psi[:, :js.stop].T @ X[:, js]  # rows up to the block's end
+        out[js, :j0] = out[:j0, js].T  # the mirror of the rows above the block
+    return out
 
 
 def _real_times(A: np.ndarray, x: np.ndarray) -> np.ndarray:
