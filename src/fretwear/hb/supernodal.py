@@ -78,6 +78,8 @@ class SupernodalFactor:
         # LAPACK's trtrs directly: SciPy's solve_triangular's checks cost more than the solve
         # of a narrow supernode (2 s of 6 at 1024 contact nodes)
         for c0, c1, R, D, Bs in self.panels:  # L y = b
+            if not Y[c0:c1].any():  # a zero block stays zero (sparse right-hand sides,
+                continue  # as K_ic's: the forward solve skips most of the supernodes)
             y, _ = dtrtrs(D, Y[c0:c1], lower=1)
             Y[c0:c1] = y
             if R.size:
