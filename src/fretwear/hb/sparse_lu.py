@@ -220,8 +220,12 @@ class _Cholmod(_Factor):
         finally:
             cholmod.options.clear()
             cholmod.options.update(saved)
-        idx = (np.array(Lk.I, dtype=np.int64).ravel(), np.array(Lk.J, dtype=np.int64).ravel())
-        L = sp.csc_matrix((np.array(Lk.V, dtype=float).ravel(), idx), shape=self._A.shape)
+        ptr, rows, vals = Lk.CCS  # compressed columns as they are (no triplets: 4096
+        del Lk, F  # contact nodes' factor holds 1e8 entries)
+        L = sp.csc_matrix((np.asarray(vals, dtype=float).ravel(),
+                           np.asarray(rows, dtype=np.int64).ravel(),
+                           np.asarray(ptr, dtype=np.int64).ravel()), shape=self._A.shape)
+        del ptr, rows, vals
         x = np.random.default_rng(0).standard_normal(self.n)
         Ax = self._A[p][:, p] @ x
         if not np.linalg.norm(L @ (L.T @ x) - Ax) <= 1e-10 * np.linalg.norm(Ax):

@@ -55,7 +55,16 @@ class SupernodalFactor:
         for c0, c1 in zip(starts.tolist(), ends.tolist(), strict=True):
             rows = ix[ip[c0]:ip[c0 + 1]]
             w = c1 - c0
-            dense = L[:, c0:c1][rows].toarray()  # (w + r, w): the pattern of column c0
+            dense = np.zeros((rows.size, w))  # (w + r, w): the pattern of column c0
+            for j in range(w):  # column c0 + j holds the rows of c0 from its j-th on
+                if np.array_equal(ix[ip[c0 + j]:ip[c0 + j + 1]], rows[j:]):
+                    dense[j:, j] = L.data[ip[c0 + j]:ip[c0 + j + 1]]
+                else:  # a pattern without some of its zeros: placed row by row
+                    mine = ix[ip[c0 + j]:ip[c0 + j + 1]]
+                    if not np.all(np.isin(mine, rows)):
+                        raise ValueError("L is not a Cholesky factor: the pattern of "
+                                         f"column {c0 + j} is not in that of {c0}")
+                    dense[:, j] = L[:, c0 + j][rows].toarray()[:, 0]
             self.panels.append((c0, c1, rows[w:].copy(), np.tril(dense[:w]),
                                 np.ascontiguousarray(dense[w:])))
         self.supernodes = len(self.panels)
