@@ -416,3 +416,27 @@ def test_failed_oscillating_gains_fall_back_to_the_mean_gain(case, monkeypatch):
     ref = np.linalg.solve(J, f)
     assert np.abs(Jo.solve(f) - ref).max() <= 1e-9 * np.abs(ref).max()
     assert used[0] and not used[-1] and op._mean_gain
+
+
+def test_tiled_symmetry_check_equals_allclose():
+    """The tiled symmetry test of the harmonic blocks (krylov._symmetric) answers as NumPy's
+    allclose(z, z.T, rtol=0, atol=1e-13 max|z|) (independent code) on blocks larger than a
+    tile, real and complex, with an asymmetry above or below the bound in an off-diagonal
+    tile, and says no for a NaN or an infinity anywhere."""
+    from fretwear.hb.krylov import TILE, _symmetric
+
+    rng = np.random.default_rng(8)
+    m = TILE + 70
+    A = rng.standard_normal((m, m))
+    A = A + A.T
+    for z in (A, A + 0.5j * A):
+        for i, j, e in ((3, m - 2, 0.0), (3, m - 2, 1e-10), (m - 1, 4, 1e-15),
+                        (TILE + 1, TILE + 5, 1e-9)):
+            w = z.copy()
+            w[i, j] += e
+            ref = np.allclose(w, w.T, rtol=0.0, atol=1e-13 * np.abs(w).max())
+            assert _symmetric(w) == ref
+        for bad in (np.nan, np.inf):
+            w = z.copy()
+            w[m - 1, m - 1] = bad
+            assert not _symmetric(w)

@@ -177,3 +177,29 @@ def test_modal_condensation_is_the_same_in_every_process():
                           timeout=300) for _ in range(2)]
     assert all(o.returncode == 0 for o in out), out[0].stderr
     assert out[0].stdout == out[1].stdout and len(out[0].stdout.strip()) == 64
+
+
+def test_gram_upper_triangle_mirrored():
+    """The projected mass's Gram product ``Psi^T B Psi`` computed on its upper triangle and
+    mirrored (fretwear.hb.modal._gram) equals the whole product to rounding (1e-13 relative:
+    the same dot products, summed in the same order above the diagonal) over more than one
+    block of columns, and is exactly symmetric; a non-symmetric B gets the whole product."""
+    import scipy.sparse as sp
+
+    from fretwear.hb.modal import _gram
+    from fretwear.hb.reduce import BLOCK
+
+    rng = np.random.default_rng(5)
+    n, m = 400, BLOCK + 60
+    P = rng.standard_normal((n, m))
+    B = sp.random(n, n, density=0.02, random_state=6)
+    B = (B + B.T + sp.eye(n)).tocsr()
+    X = B @ P
+    G = _gram(P, X, B)
+    full = P.T @ X
+    assert np.abs(G - full).max() <= 1e-13 * np.abs(full).max()
+    lower = np.tril_indices(m, -BLOCK)  # entries set only by the mirror
+    assert np.array_equal(G[lower], G.T[lower])
+    Bn = (B + sp.random(n, n, density=0.002, random_state=7)).tocsr()
+    Xn = Bn @ P
+    assert np.array_equal(_gram(P, Xn, Bn), P.T @ Xn)

@@ -176,3 +176,25 @@ def test_density_outside_the_documented_range_is_refused(rho):
                                          r"in \[0.001, 100000\] kg/m\^3"):
         check_material(2e11, 0.3, rho)
     assert check_material(2e11, 0.3, 0.0)[2] == 0.0  # massless stays legal
+
+
+def test_stiffness_equals_scikit_fem_linear_elasticity():
+    """The elasticity form written out (2 mu eps(u) : eps(v) + lam div u div v) assembles the
+    stiffness of scikit-fem's own linear_elasticity form (an independent implementation of
+    the same form) to 1e-14 relative (rounding: the same quadrature, other sums) on a
+    hexahedral and a quadrilateral (plane strain) mesh."""
+    import skfem
+    from skfem.models.elasticity import lame_parameters, linear_elasticity
+
+    from fretwear.model import box, rectangle
+    from fretwear.model.fem import _symmetric, assemble, node_major, skfem_mesh
+
+    for mesh, nu in ((box(0.01, 0.012, 0.003, 4, 3, 2), 0.3), (rectangle(0.01, 0.004, 5, 3),
+                                                               0.25)):
+        K, _ = assemble(mesh, 210e9, nu, 7800.0)
+        m, elem = skfem_mesh(mesh)
+        basis = skfem.Basis(m, skfem.ElementVector(elem))
+        p = node_major(basis)
+        ref = skfem.asm(linear_elasticity(*lame_parameters(210e9, nu)), basis).tocsr()
+        ref = _symmetric(ref[p][:, p])
+        assert abs(K - ref).max() <= 1e-14 * abs(ref).max()

@@ -38,6 +38,7 @@ import math
 
 import numpy as np
 import scipy.linalg as sla
+import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from fretwear.errors import InputError
@@ -227,13 +228,16 @@ class ModalCondenser(Condenser):
             B = getattr(self, name)
             if B is None:
                 continue
-            XiiPsi = B.ii @ Psi
-            if name == "K":  # K_ii Psi = -K_ic: the static condensation K_r
-                cc = B.cc + B.ci @ Psi
-            else:
-                cc = B.cc + B.ci @ Psi + (B.ic.T @ Psi).T + Psi.T @ XiiPsi
             cq = (B.ci @ V) + Psi.T @ (B.ii @ V)
-            qc = (B.ic.T @ V).T + V.T @ XiiPsi
+            if name == "K":  # K_ii Psi = -K_ic: the static condensation K_r, and
+                # K^qc = V^T (K_ic + K_ii Psi) = 0 (not formed: K_ii Psi is the second
+                # largest product of the condensation, 2 s CPU at 1024 contact nodes)
+                cc = B.cc + B.ci @ Psi
+                qc = np.zeros((V.shape[1], Psi.shape[1]))
+            else:
+                XiiPsi = B.ii @ Psi
+                cc = B.cc + B.ci @ Psi + (B.ic.T @ Psi).T + _gram(Psi, XiiPsi, B.ii)
+                qc = (B.ic.T @ V).T + V.T @ XiiPsi
             qq = V.T @ (B.ii @ V)
             self.proj[name] = (cc, cq, qc, qq)
         # the same in the contact-local frames (R X^cc R^T, R X^cq, X^qc R^T, X^qq), rotated
@@ -254,7 +258,9 @@ class ModalCondenser(Condenser):
         for name, c in (("M", -(w * w)), ("D", 1j), ("C", 1j * w)):
             if name in proj:
                 for i, x in enumerate(proj[name]):
-                    out[i] = out[i] + c * x
+                    t = np.multiply(x, c)  # one new array per term (m x m for Z^cc)
+                    t += out[i]
+                    out[i] = t
         return out
 
     def _parts(self, omega, n, quasi_static, F, local=False):
@@ -270,7 +276,9 @@ class ModalCondenser(Condenser):
         Fq = _real_times(self.V.T, Fi)
         if self.q:
             Y, qF = np.linalg.solve(qq, qc), np.linalg.solve(qq, Fq)
-            return cc - cq @ Y, Y, Fc - cq @ qF, qF
+            S = cq @ Y
+            np.subtract(cc, S, out=S)  # cc - cq Y in the product's array (m x m)
+            return S, Y, Fc - cq @ qF, qF
         return cc, np.zeros((0, self.m)), Fc, np.zeros(0)
 
     def _check(self) -> float:
@@ -362,6 +370,24 @@ class ModalCondenser(Condenser):
                                                                           qF - Y @ Uc)
         P = self.structure.P
         return out if P is None else (P @ out.T).T
+
+
+def _gram(Psi: np.ndarray, X: np.ndarray, Bii) -> np.ndarray:
+    """``Psi^T X`` for ``X = B_ii Psi``: where ``B_ii`` is exactly symmetric, so is the
+    product, and only its upper triangle is computed (``BLOCK`` columns at a time, then
+    mirrored): half the ``2 n_i m^2`` flops of the largest product of the condensation (the
+    projected mass at 1024 contact nodes: 2.3e11)."""
+    m = Psi.shape[1]
+    symmetric = (not (Bii != Bii.T).nnz if sp.issparse(Bii)
+                 else np.array_equal(Bii, np.transpose(Bii)))
+    if not symmetric:
+        return Psi.T @ X
+    out = np.empty((m, m))
+    for j0 in range(0, m, BLOCK):
+        js = slice(j0, min(j0 + BLOCK, m))
+        out[:js.stop, js] = Psi[:, :js.stop].T @ X[:, js]  # rows up to the block's end
+        out[js, :j0] = out[:j0, js].T  # the mirror of the rows above the block
+    return out
 
 
 def _real_times(A: np.ndarray, x: np.ndarray) -> np.ndarray:

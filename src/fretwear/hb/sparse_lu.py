@@ -11,8 +11,10 @@ complex) and the ``name`` of the backend that made it:
 - ``"cholmod"``: the supernodal Cholesky factorisation of CHOLMOD (SuiteSparse) for the real
   symmetric positive definite matrices, from the optional extra ``fretwear[fast]`` (package
   kvxopt, whose wheels bundle SuiteSparse and OpenBLAS: no system library needed). Its
-  solves of many right-hand sides are blocked (BLAS 3), where SuperLU's go column by column;
-  benchmarks/sparse_solvers.py measures both.
+  solves of many right-hand sides (:data:`MANY` or more) go supernode by supernode through
+  NumPy's BLAS 3 (:mod:`fretwear.hb.supernodal`: 4-5 x faster than CHOLMOD's own solve as
+  kvxopt links it), where SuperLU's go column by column; benchmarks/sparse_solvers.py
+  measures both.
 - ``"superlu"``: SciPy's SuperLU, always there: every complex matrix (kvxopt's UMFPACK solved
   these 4-8 x slower than SuperLU, measured on the scale_3d pad), and every matrix when
   kvxopt is not installed. Its default column ordering (COLAMD) was measured best on these
@@ -35,6 +37,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from fretwear.errors import InputError
+from fretwear.hb.supernodal import SupernodalFactor
 
 log = logging.getLogger(__name__)
 
@@ -45,6 +48,9 @@ BACKENDS = ("cholmod", "superlu")
 KINDS = ("spd", "general")
 #: the environment variable that forces a backend (``superlu``)
 ENV = "FRETWEAR_SPARSE_LU"
+#: right-hand sides from which a CHOLMOD factorisation solves through NumPy's BLAS
+#: (:mod:`fretwear.hb.supernodal`) instead of CHOLMOD's own solve
+MANY = 8
 #: pivots spanning more than this ratio: a nearly singular matrix (as reduce's dense check)
 NEAR_SINGULAR = 1e-13
 
@@ -179,10 +185,51 @@ class _Cholmod(_Factor):
             raise SingularError(bool(d.min() > 0))
         self.n = A.shape[0]
         self.nbytes = 8 * A.nnz * 8  # an estimate: kvxopt does not report the factor's size
+        self._A, self._sn = A, None
 
     def _solve(self, B):
         one = B.ndim == 1
+        if not one and B.shape[1] >= MANY:
+            return self._supernodal().solve(B)
         X = self._kvx.matrix(np.asfortranarray(B.reshape(self.n, -1)))
         self._cholmod.solve(self.F, X)
         X = np.array(X)
         return X[:, 0] if one else X
+
+    def _supernodal(self) -> SupernodalFactor:
+        """The factor's solves with NumPy's BLAS (:mod:`fretwear.hb.supernodal`), made at the
+        first solve of :data:`MANY` right-hand sides or more: a second factorisation with
+        CHOLMOD's AMD ordering given explicitly and no postordering, so that the permutation
+        of ``P A P^T = L L^T`` is known (``F`` stays for the solves of few columns: reading
+        ``L`` out of a CHOLMOD factor consumes it), checked on a probe vector."""
+        if self._sn is not None:
+            return self._sn
+        kvx, cholmod = self._kvx, self._cholmod
+        amd = importlib.import_module("kvxopt.amd")
+        C = self._A.tocoo()
+        Ak = kvx.spmatrix(kvx.matrix(np.ascontiguousarray(C.data, dtype=float)),
+                          kvx.matrix(C.row.astype(np.int64)),
+                          kvx.matrix(C.col.astype(np.int64)), self._A.shape)
+        p = np.array(amd.order(Ak), dtype=np.int64).ravel()
+        saved = dict(cholmod.options)
+        cholmod.options["postorder"] = False  # kvxopt's options are global: restored below
+        try:
+            F = cholmod.symbolic(Ak, p=kvx.matrix(p))
+            cholmod.numeric(Ak, F)
+            Lk = cholmod.getfactor(F)
+        finally:
+            cholmod.options.clear()
+            cholmod.options.update(saved)
+        ptr, rows, vals = Lk.CCS  # compressed columns as they are (no triplets: 4096
+        del Lk, F  # contact nodes' factor holds 1e8 entries)
+        L = sp.csc_matrix((np.asarray(vals, dtype=float).ravel(),
+                           np.asarray(rows, dtype=np.int64).ravel(),
+                           np.asarray(ptr, dtype=np.int64).ravel()), shape=self._A.shape)
+        del ptr, rows, vals
+        x = np.random.default_rng(0).standard_normal(self.n)
+        Ax = self._A[p][:, p] @ x
+        if not np.linalg.norm(L @ (L.T @ x) - Ax) <= 1e-10 * np.linalg.norm(Ax):
+            raise RuntimeError("CHOLMOD's factor does not have the permutation it was given")
+        self._sn = SupernodalFactor(L, p)
+        self._A = None
+        return self._sn
