@@ -108,8 +108,11 @@ DENSE_MAX = 1500
 PENCIL_MAX = 1500
 #: an exponent within this of Im s = +-w/2 (in units of w) is a real negative multiplier: its
 #: conjugate is the other member of its family (the truncated problem puts the two a little
-#: off the line: 1e-4 measured on a two-DOF oscillator near period doubling)
-EDGE_TOL = 1e-3
+#: off the line: 1e-4 and 2.1e-3 measured on two two-DOF oscillators near period doubling)
+EDGE_TOL = 1e-2
+#: a member of a period-doubling family whose centroid the truncation puts up to this above
+#: 1/2, within this of Im s = w/2, is kept when no other member is (:func:`_edge_members`)
+EDGE_KAPPA = 0.05
 #: entries of the quadratic problem below this times the largest of their matrix are taken as
 #: zeros when it is split into the blocks it decouples into (:func:`_components`): rounding of
 #: the law's time-invariant parts (``P Q = I`` to 1e-16), whose dropping moves the exponents
@@ -628,6 +631,26 @@ def _companion_eigen(B0: np.ndarray, B1: np.ndarray, B2: np.ndarray):
     return vals, Y[:nd]
 
 
+def _edge_members(vals: np.ndarray, kap: np.ndarray, keep: np.ndarray) -> np.ndarray:
+    """Members of a period-doubling family that the centroid rule drops: at ``Im s = w/2``
+    the family's two members ``s`` and ``conj(s) = s - i w`` tie at ``|kappa| = 1/2``, and the
+    truncation can put both a little above it (0.507 on the unilateral oscillator with 15
+    harmonics, where the pair carried a multiplier of -1.23 that the time integration finds
+    too). Such a member (``|Im s / w - 1/2| <= EDGE_KAPPA``, ``|kappa| <= 1/2 + EDGE_KAPPA``,
+    ``Im s >= 0``) is kept when neither it nor its conjugate is near a kept exponent."""
+    sig = vals
+    near_edge = ((np.abs(np.abs(sig.imag) - 0.5) <= EDGE_KAPPA)
+                 & (np.abs(kap) <= 0.5 + EDGE_KAPPA) & ~keep & (sig.imag >= 0))
+    out = np.zeros_like(keep)
+    kept = sig[keep]
+    for i in np.flatnonzero(near_edge):
+        d = np.minimum(np.abs(kept - sig[i]), np.abs(kept - np.conj(sig[i])))
+        if not np.any(d <= EDGE_KAPPA):
+            out[i] = True
+            kept = np.append(kept, sig[i])
+    return out
+
+
 def _pair(T: np.ndarray, v: np.ndarray, mu0: complex, steps: int = 2):
     """The eigenpair ``(mu, y)`` of ``T`` nearest ``mu0`` that continues ``v``: inverse
     iteration from ``v`` with the shift ``mu0`` (one LU of ``T - mu0 I``, ``steps`` solves),
@@ -717,6 +740,7 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
     finite = np.flatnonzero(np.isfinite(vals) & (np.abs(vals) < 2.0 * (k + 1) + 10.0))
     kap = np.atleast_1d(centroid(vecs[:, finite].T.reshape(-1, m + q, H), k))
     keep = np.abs(kap) <= 0.5 + 1e-9
+    keep |= _edge_members(vals[finite], kap, keep)
     idx, kap = finite[keep], kap[keep]
     half = vals[idx].imag >= -1e-12 * np.maximum(np.abs(vals[idx]), 1.0)
     idx, kap = idx[half], kap[half]
