@@ -249,7 +249,8 @@ def run_periodic(model, analysis: dict, case, context: RunContext) -> RunOutput:
 def hill_verdict(model, sol: PeriodicSolution, cond) -> tuple[str, dict]:
     """What the converged periodic state is, by Hill's method
     (:func:`fretwear.hb.stability.stability`): one summary line and the attributes
-    ``hill_stable`` (1 stable, 0 unstable, -1 not computed), ``floquet_multipliers`` (the
+    ``hill_stable`` (1 stable, 0 unstable, -1 not computed or undecided: the largest
+    multiplier an unrefined candidate), ``floquet_multipliers`` (the
     largest few, text), ``neutral_directions`` (tangential directions of nodes that stick all
     period: the state is then one member of a family of stuck states, which the anchors
     select and a time integration need not reach) and ``stability_notes`` (why not
@@ -270,7 +271,15 @@ def hill_verdict(model, sol: PeriodicSolution, cond) -> tuple[str, dict]:
                      for r in crit)
     attrs.update(hill_stable=int(fl.stable), floquet_multipliers=text,
                  neutral_directions=int(fl.neutral))
-    if not fl.stable:
+    top = int(np.argmax(np.abs(fl.multipliers))) if fl.multipliers.size else -1
+    confirmed = top < 0 or fl.kind[top] != "candidate"
+    if not fl.stable and not confirmed:
+        line = (f"stability UNDECIDED by Hill's method: the largest multiplier, |rho| = "
+                f"{fl.max_multiplier:.4g}, is an unrefined candidate of the frozen-memory "
+                "problem (raise the refinement, fretwear.hb.stability.HillOptions(refine=), "
+                "or integrate in time from the state: fretwear.timedomain.check_periodic)")
+        attrs["hill_stable"] = -1
+    elif not fl.stable:
         r = crit[0]
         how = ("a real multiplier above 1 (a fold's middle branch)" if r.real > 0 and
                abs(r.imag) <= 1e-6 * abs(r) else "a real multiplier below -1 (period "
