@@ -273,3 +273,25 @@ def test_a_model_without_observed_points_runs(tmp_path, capsys):
     b = read_results(tmp_path / "without-results" / "results.nc")
     assert "displacement" in a and "displacement" not in b
     np.testing.assert_array_equal(a["contact_force"].values, b["contact_force"].values)
+
+
+def test_hill_stability_says_what_the_state_is(tmp_path, capsys):
+    """``hill_stability = true``: the summary says whether the state is stable, and the
+    attributes record it. References independent of Hill's method: the neutral directions are
+    the nodes whose ``contact_state`` is stick over the whole period (one tangential direction
+    each in 2D: a family of stuck states), and the verdict is that of the largest multiplier
+    recorded (above 1: unstable). One harmonic keeps Hill's dense problem small."""
+    analysis = with_key(with_key(PERIODIC, "harmonics = 1"), "hill_stability = true")
+    path = small_case(tmp_path, analysis + "[output]\nvtu = false\nfigures = false\n")
+    status, out, err = run(path, capsys)
+    assert status == 0, err
+    ds = read_results(tmp_path / "beam-results" / "results.nc")
+    stuck = int(np.all(ds["contact_state"].values == 1, axis=-1).sum())
+    assert stuck > 0 and ds.attrs["neutral_directions"] == stuck
+    text = ds.attrs["floquet_multipliers"]  # empty: no exponent above NEGLIGIBLE
+    top = float(text.split(",")[0].split()[0]) if text else 0.0
+    assert ds.attrs["hill_stable"] in ((1,) if top <= 1 + 1e-6 else (0, -1))
+    assert ds.attrs["stability_notes"] == ""
+    word = ("stable by Hill's method" if top <= 1 else "UNSTABLE by Hill's method"
+            if ds.attrs["hill_stable"] == 0 else "stability UNDECIDED by Hill's method")
+    assert word in out and f"{stuck} tangential direction(s)" in out

@@ -26,8 +26,11 @@ from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.stability import (
     HillProblem,
+    _companion_eigen,
+    _components,
     centroid,
     problem_of,
+    quadratic_eigen,
     shifted_gain,
     stability,
 )
@@ -290,3 +293,33 @@ def test_centroid_of_shifted_eigenvectors():
     base = centroid(real_layout(c), k)
     assert centroid(real_layout(np.roll(c, 2, axis=1)), k) == pytest.approx(base + 2, abs=1e-12)
     assert centroid(real_layout(np.roll(c, -3, axis=1)), k) == pytest.approx(base - 3, abs=1e-12)
+
+
+def test_quadratic_problem_split_into_its_blocks_keeps_every_eigenpair():
+    """A quadratic problem that decouples into a 60-unknown block and 40 single unknowns
+    (scattered by a permutation, with rounding-size couplings of 1e-17 between them, as the
+    law's ``P Q = I`` leaves) against the dense companion eigensolve of the whole: the same
+    eigenvalues (1e-10 relative, the conditioning of a random companion matrix: rounding is
+    1e-14) and every eigenvector a null vector of its ``A0 + s A1 + s^2 A2`` (1e-9)."""
+    rng = np.random.default_rng(3)
+    n = 100
+    mats = [np.zeros((n, n)) for _ in range(3)]
+    for X, scale in zip(mats, (10.0, 0.1, 1.0), strict=True):
+        X[:60, :60] = scale * rng.standard_normal((60, 60))
+        X[60:, 60:] = np.diag(scale * (1.0 + rng.random(40)))
+        X += 1e-17 * rng.standard_normal((n, n))
+    mats[2][:60, :60] += 10 * np.eye(60)
+    perm = rng.permutation(n)
+    A0, A1, A2 = (X[np.ix_(perm, perm)] for X in mats)
+    assert sorted(map(len, _components(A0, A1, A2))) == [40, 60]
+    vals, vecs = quadratic_eigen(A0, A1, A2)
+    ref, _ = _companion_eigen(A0, A1, A2)
+    assert vals.size == ref.size == 2 * n
+    a = vals[np.lexsort((vals.imag, vals.real))]
+    b = ref[np.lexsort((ref.imag, ref.real))]
+    np.testing.assert_allclose(a, b, rtol=1e-10, atol=1e-10 * np.abs(b).max())
+    for s, y in zip(vals, vecs.T, strict=True):
+        r = (A0 + s * A1 + s * s * A2) @ y
+        scale = (np.linalg.norm(A0) + abs(s) * np.linalg.norm(A1)
+                 + abs(s) ** 2 * np.linalg.norm(A2)) * np.linalg.norm(y)
+        assert np.linalg.norm(r) < 1e-9 * scale

@@ -125,3 +125,56 @@ def test_friction_hill_agrees_with_the_time_integration():
     for r in main:
         assert np.min(np.abs(mono.multipliers[:2] - r)) < 1e-2
     assert abs(mono.multipliers[2]) < 1e-2
+
+
+def test_fold_and_period_doubling_of_the_unilateral_sweep_agree_with_the_time_integration():
+    """The turning points of the unilateral oscillator's folded response (15 harmonics, 256
+    samples, 30 points from 0.56 to 0.8 rad/s: the sweep passes the fold near 0.74-0.77 rad/s
+    by arclength): at every converged point where Hill's method is clear about it (its largest
+    real positive multiplier above 1.05 or below 0.95), the monodromy of the exact integration
+    (1024 steps) has a real multiplier above 1 exactly where Hill's has (the middle branch,
+    where ``det J < 0``), the two within 0.12 of each other (measured up to 0.083 there: the
+    balance's truncation of the contact's kink, which the steep unstable branch magnifies).
+    Points within 0.05 of 1 are the turning points themselves, where the two discretisations
+    put the fold a point apart. Period doubling: where Hill's method has a real multiplier
+    below -1.2 (the upper branch next to the fold, -1.23 to -1.55), the integration has one
+    below -1 (measured -1.09 to -1.47); nearer -1 the two differ by the truncation (Hill's
+    -1.10 at 0.684 and 0.709 rad/s against the integration's -0.97 and -0.95: docs/theory.md,
+    section 9)."""
+    from fretwear.hb.options import SweepOptions
+    from fretwear.hb.reduce import exact_condenser
+    from fretwear.hb.sweep import sweep
+    from fretwear.hb.sweep_stability import sweep_stability
+
+    model = unilateral()
+    cond = exact_condenser(model)
+    res = sweep(model, FourierBasis.up_to(15, 256), 0.56 / (2 * np.pi), 0.8 / (2 * np.pi), 30,
+                options=SweepOptions(spacing="linear"), condenser=cond)
+    st = sweep_stability(model, res, condenser=cond)
+    compared, middle, doubled = 0, 0, 0
+    for i, p in enumerate(res.points):
+        fl = st.floquet[i]
+        if fl is None:
+            continue
+        rho = fl.multipliers
+        pos = rho[(np.abs(rho.imag) <= 1e-6 * np.abs(rho)) & (rho.real > 0)].real
+        top = pos.max(initial=0.0)
+        if 0.95 <= top <= 1.05:
+            continue
+        U0, V0 = initial_state(model, p.solution, cond)
+        mono = monodromy(model, p.frequency_hz, start=InitialState(U0=U0, V0=V0),
+                         integration=SHOOTING.replace(steps_per_period=1024))
+        assert mono.success
+        r = mono.multipliers
+        td = r[(np.abs(r.imag) <= 1e-6 * np.abs(r)) & (r.real > 0)].real.max(initial=0.0)
+        assert (top > 1) == (td > 1) == (fl.det_sign < 0), (p.frequency_hz, top, td)
+        if top > 1:
+            assert abs(top - td) < 0.12
+            middle += 1
+        compared += 1
+        neg = rho[(np.abs(rho.imag) <= 1e-6 * np.abs(rho)) & (rho.real < 0)].real
+        if neg.min(initial=0.0) < -1.2:  # a clear period doubling by Hill's method
+            assert r[(np.abs(r.imag) <= 1e-6 * np.abs(r)) & (r.real < 0)].real.min() < -1
+            doubled += 1
+    assert middle >= 10 and compared >= 40  # both branches are compared
+    assert doubled >= 5

@@ -47,6 +47,7 @@ from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.reduce import condense, recover
 from fretwear.hb.solution import PeriodicSolution
 from fretwear.hb.solvers import SolveStats
+from fretwear.hb.stability import stability
 from fretwear.io.results import nodal_vectors, variable, write_pvd, write_vtu
 from fretwear.io.schema import Field, Flag, Integer, Number, join
 
@@ -222,6 +223,10 @@ def run_periodic(model, analysis: dict, case, context: RunContext) -> RunOutput:
                                    f"{a.residual:.1e}" for a in sol.attempts),
              "time_domain": sol.time_domain, **cond.choice.attributes()}
     where = _frequency_text(f_hz, qs)
+    verdict = ""
+    if sol.success and analysis["hill_stability"] and not qs:
+        verdict, hill_attrs = hill_verdict(model, sol, cond)
+        attrs.update(hill_attrs)
     if not sol.success:  # never saved as a result: the diagnostics only
         return RunOutput(xr.Dataset(attrs=attrs), [],
                          _failure_summary(stats, analysis, where, sol), False,
@@ -234,8 +239,64 @@ def run_periodic(model, analysis: dict, case, context: RunContext) -> RunOutput:
     if model.mesh is not None and case.output["vtu"]:
         files.append(write_period_fields(model, sol, context.out_dir / "periodic.pvd",
                                          condenser=cond))
-    return RunOutput(ds, figures, _periodic_summary(sol, ds, analysis, where) + "\n"
-                     + cond.choice.summary(), True, files, warnings=list(sol.warnings))
+    summary = _periodic_summary(sol, ds, analysis, where)
+    if verdict:
+        summary += "\n" + verdict
+    return RunOutput(ds, figures, summary + "\n" + cond.choice.summary(), True, files,
+                     warnings=list(sol.warnings))
+
+
+def hill_verdict(model, sol: PeriodicSolution, cond) -> tuple[str, dict]:
+    """What the converged periodic state is, by Hill's method
+    (:func:`fretwear.hb.stability.stability`): one summary line and the attributes
+    ``hill_stable`` (1 stable, 0 unstable, -1 not computed or undecided: the largest
+    multiplier an unrefined candidate), ``floquet_multipliers`` (the
+    largest few, text), ``neutral_directions`` (tangential directions of nodes that stick all
+    period: the state is then one member of a family of stuck states, which the anchors
+    select and a time integration need not reach) and ``stability_notes`` (why not
+    computed)."""
+    attrs = {"hill_stable": -1, "floquet_multipliers": "", "neutral_directions": -1,
+             "stability_notes": ""}
+    try:
+        fl = stability(model, sol, condenser=cond)
+    except InputError as exc:
+        attrs["stability_notes"] = str(exc)
+        return (f"stability by Hill's method not computed: {exc}. The state is a periodic "
+                "solution of the truncated balance; whether the structure settles to it is "
+                "not known (a time integration from it: fretwear.timedomain.check_periodic)",
+                attrs)
+    crit = fl.critical(3)
+    text = ", ".join(f"{abs(r):.4g}" + ("" if abs(r.imag) <= 1e-6 * abs(r) else
+                                         f" (arg {np.degrees(np.angle(r)):.1f} deg)")
+                     for r in crit)
+    attrs.update(hill_stable=int(fl.stable), floquet_multipliers=text,
+                 neutral_directions=int(fl.neutral))
+    top = int(np.argmax(np.abs(fl.multipliers))) if fl.multipliers.size else -1
+    confirmed = top < 0 or fl.kind[top] != "candidate"
+    if not fl.stable and not confirmed:
+        line = (f"stability UNDECIDED by Hill's method: the largest multiplier, |rho| = "
+                f"{fl.max_multiplier:.4g}, is an unrefined candidate of the frozen-memory "
+                "problem (raise the refinement, fretwear.hb.stability.HillOptions(refine=), "
+                "or integrate in time from the state: fretwear.timedomain.check_periodic)")
+        attrs["hill_stable"] = -1
+    elif not fl.stable:
+        r = crit[0]
+        how = ("a real multiplier above 1 (a fold's middle branch)" if r.real > 0 and
+               abs(r.imag) <= 1e-6 * abs(r) else "a real multiplier below -1 (period "
+               "doubling)" if abs(r.imag) <= 1e-6 * abs(r) else "a complex pair outside the "
+               "unit circle (Neimark-Sacker: a quasi-periodic response)")
+        line = (f"UNSTABLE by Hill's method: {how}, |rho| = {abs(r):.4g}; the structure "
+                "does not stay on this state, a time integration leaves it")
+    else:
+        line = f"stable by Hill's method (largest |rho| {fl.max_multiplier:.4g})"
+    if fl.neutral:
+        line += (f"; {fl.neutral} tangential direction(s) of nodes that stick all period are "
+                 "neutral (multiplier 1): the state is one member of a family of stuck states "
+                 "(the static anchors select it), and a time integration may settle on "
+                 "another member")
+    if not fl.reliable:
+        line += "; some exponents were not refined (Floquet candidates only)"
+    return line, attrs
 
 
 def periodic_figures(ds: xr.Dataset, case, outdir: Path, title: str) -> list[Path]:
@@ -460,6 +521,13 @@ PERIODIC = Analysis.define(
         "time_domain_periods": Field(Integer(lo=10), "forcing periods allowed to the time "
                                      "integration (time_domain)",
                                      default=PERIODIC_SOLVE.time_domain_periods),
+        "hill_stability": Field(Flag(), "what the converged state is, by Hill's method on the "
+                                "balance's Jacobian: stable, unstable (and how), or one member "
+                                "of a family of stuck states; in the summary and the "
+                                "attributes `hill_stable`, `floquet_multipliers`, "
+                                "`neutral_directions`, `stability_notes`. Dense: small models "
+                                "(a few hundred DOFs, or a modal condensation)",
+                                default=False),
         **harmonic_balance_fields(PERIODIC_SOLVE, default_of(solve_periodic, "eps"),
                                   "DLFT penalty: " + _EPS_RULES),
     },

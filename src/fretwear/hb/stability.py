@@ -37,7 +37,8 @@ How they are computed
    quadratic in ``s``; with the law's memory frozen (``G(s) = G(0)``) Hill's matrix is the
    polynomial ``A0 + sigma A1 + sigma^2 A2`` in ``sigma = s / w`` (:meth:`HillProblem.pencil`),
    whose eigenvalues are computed densely (:func:`quadratic_eigen`: massless coordinates
-   eliminated, a standard eigenvalue problem of twice the size). Where no node sticks (nor
+   eliminated, the blocks the problem decouples into solved apart, a standard eigenvalue
+   problem of twice each block's size). Where no node sticks (nor
    slips in 3D) and the structure is exact, they are the exponents.
 2. **Sorting**: the truncated Hill problem has, for every exponent ``s``, copies
    ``s + i j w`` with the eigenvectors ``p e^{-i j w t}``, accurate only while the shifted
@@ -64,7 +65,9 @@ select (docs/theory.md, "Full stick"), a neutral direction with multiplier exact
 :attr:`FloquetResult.neutral` counts.
 
 Cost: one dense eigenvalue problem of ``2 (m' + q) H`` unknowns (``m'`` contact points with
-mass, ``q`` other coordinates; at most :data:`PENCIL_MAX` before the companion form) and,
+mass, ``q`` other coordinates; at most :data:`PENCIL_MAX` before the companion form; less
+where coordinates whose law does not vary over the period split off, harmonic by harmonic,
+:func:`_components`) and,
 with a memory, a few evaluations of ``T(s)`` and ``m H`` LU factorisations per refined
 exponent. Measured at 10-30 ms of CPU a point on the benchmark's small models, tens of times
 a warm-started sweep point's solve (docs/theory.md, section 9): the whole spectrum at every
@@ -84,6 +87,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 from numba import njit
+from scipy.sparse.csgraph import connected_components
 
 from fretwear.errors import InputError
 from fretwear.hb import contact as law
@@ -104,8 +108,19 @@ DENSE_MAX = 1500
 PENCIL_MAX = 1500
 #: an exponent within this of Im s = +-w/2 (in units of w) is a real negative multiplier: its
 #: conjugate is the other member of its family (the truncated problem puts the two a little
-#: off the line: 1e-4 measured on a two-DOF oscillator near period doubling)
-EDGE_TOL = 1e-3
+#: off the line: 1e-4 and 2.1e-3 measured on two two-DOF oscillators near period doubling)
+EDGE_TOL = 1e-2
+#: a member of a period-doubling family whose centroid the truncation puts up to this above
+#: 1/2, within this of Im s = w/2, is kept when no other member is (:func:`_edge_members`)
+EDGE_KAPPA = 0.05
+#: entries of the quadratic problem below this times the largest of their matrix are taken as
+#: zeros when it is split into the blocks it decouples into (:func:`_components`): rounding of
+#: the law's time-invariant parts (``P Q = I`` to 1e-16), whose dropping moves the exponents
+#: by about as much
+DECOUPLED_TOL = 1e-13
+#: decoupled blocks of the quadratic problem are gathered up to at least this many unknowns
+#: per dense eigensolve (below, the call's overhead exceeds the flops saved)
+MIN_BLOCK = 48
 #: exponents whose multiplier is below this are not refined (they decay within a period; the
 #: factor e^{-s h} of the law's memory would overflow over a period)
 NEGLIGIBLE = 1e-8
@@ -549,6 +564,57 @@ def quadratic_eigen(A0: np.ndarray, A1: np.ndarray, A2: np.ndarray):
     nd = dyn_.size
     if nd == 0:
         return np.zeros(0, dtype=complex), np.zeros((n, 0), dtype=complex)
+    parts = []
+    for comp in _components(B0, B1, B2):
+        ix = np.ix_(comp, comp)
+        v, Yc = _companion_eigen(B0[ix], B1[ix], B2[ix])
+        Y = np.zeros((nd, v.size), dtype=complex)
+        Y[comp] = Yc
+        parts.append((v, Y))
+    vals = np.concatenate([v for v, _ in parts])
+    Y = np.hstack([y for _, y in parts])
+    vecs = np.zeros((n, vals.size), dtype=complex)
+    vecs[dyn_] = Y
+    if alg.size:
+        vecs[alg] = back @ Y
+    return vals, vecs
+
+
+def _components(B0: np.ndarray, B1: np.ndarray, B2: np.ndarray) -> list:
+    """The index sets of the blocks into which ``B0 + s B1 + s^2 B2`` decouples (the connected
+    components of its pattern; entries below :data:`DECOUPLED_TOL` times the largest of their
+    matrix are rounding, e.g. of ``P Q = I`` where a coordinate's law is time-invariant). A
+    coordinate whose law does not vary over the period (a contact point open, sliding without
+    memory, or a held structure) couples no harmonics, so its harmonics decouple: the dense
+    eigensolve, ``O(n^3)``, runs on the blocks (those smaller than :data:`MIN_BLOCK` together)."""
+    if B0.shape[0] <= MIN_BLOCK:
+        return [np.arange(B0.shape[0])]
+    pattern = np.zeros(B0.shape, dtype=bool)
+    for X in (B0, B1, B2):
+        big = np.abs(X).max(initial=0.0)
+        if big > 0:
+            pattern |= np.abs(X) > DECOUPLED_TOL * big
+    count, label = connected_components(pattern, directed=False)
+    blocks, group, size = [], [], 0
+    for c in range(count):  # small blocks are solved together, up to MIN_BLOCK unknowns (a
+        idx = np.flatnonzero(label == c)  # call costs more than the flops saved)
+        if idx.size >= MIN_BLOCK:
+            blocks.append(idx)
+            continue
+        if size + idx.size > MIN_BLOCK:
+            blocks.append(np.concatenate(group))
+            group, size = [], 0
+        group.append(idx)
+        size += idx.size
+    if group:
+        blocks.append(np.concatenate(group))
+    return blocks
+
+
+def _companion_eigen(B0: np.ndarray, B1: np.ndarray, B2: np.ndarray):
+    """Eigenvalues and eigenvectors of ``(B0 + s B1 + s^2 B2) y = 0`` (every coordinate with
+    a mass): the companion linearisation (:func:`quadratic_eigen`)."""
+    nd = B0.shape[0]
     eye, nil = np.eye(nd), np.zeros((nd, nd))
     try:
         cond = np.linalg.cond(B2)
@@ -562,12 +628,27 @@ def quadratic_eigen(A0: np.ndarray, A1: np.ndarray, A2: np.ndarray):
                           np.block([[eye, nil], [nil, B2]]), check_finite=False)
         ok = np.isfinite(vals)
         vals, Y = vals[ok], Y[:, ok]
-    Y = Y[:nd]
-    vecs = np.zeros((n, vals.size), dtype=complex)
-    vecs[dyn_] = Y
-    if alg.size:
-        vecs[alg] = back @ Y
-    return vals, vecs
+    return vals, Y[:nd]
+
+
+def _edge_members(vals: np.ndarray, kap: np.ndarray, keep: np.ndarray) -> np.ndarray:
+    """Members of a period-doubling family that the centroid rule drops: at ``Im s = w/2``
+    the family's two members ``s`` and ``conj(s) = s - i w`` tie at ``|kappa| = 1/2``, and the
+    truncation can put both a little above it (0.507 on the unilateral oscillator with 15
+    harmonics, where the pair carried a multiplier of -1.23 that the time integration finds
+    too). Such a member (``|Im s / w - 1/2| <= EDGE_KAPPA``, ``|kappa| <= 1/2 + EDGE_KAPPA``,
+    ``Im s >= 0``) is kept when neither it nor its conjugate is near a kept exponent."""
+    sig = vals
+    near_edge = ((np.abs(np.abs(sig.imag) - 0.5) <= EDGE_KAPPA)
+                 & (np.abs(kap) <= 0.5 + EDGE_KAPPA) & ~keep & (sig.imag >= 0))
+    out = np.zeros_like(keep)
+    kept = sig[keep]
+    for i in np.flatnonzero(near_edge):
+        d = np.minimum(np.abs(kept - sig[i]), np.abs(kept - np.conj(sig[i])))
+        if not np.any(d <= EDGE_KAPPA):
+            out[i] = True
+            kept = np.append(kept, sig[i])
+    return out
 
 
 def _pair(T: np.ndarray, v: np.ndarray, mu0: complex, steps: int = 2):
@@ -659,6 +740,7 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
     finite = np.flatnonzero(np.isfinite(vals) & (np.abs(vals) < 2.0 * (k + 1) + 10.0))
     kap = np.atleast_1d(centroid(vecs[:, finite].T.reshape(-1, m + q, H), k))
     keep = np.abs(kap) <= 0.5 + 1e-9
+    keep |= _edge_members(vals[finite], kap, keep)
     idx, kap = finite[keep], kap[keep]
     half = vals[idx].imag >= -1e-12 * np.maximum(np.abs(vals[idx]), 1.0)
     idx, kap = idx[half], kap[half]
