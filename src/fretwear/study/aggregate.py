@@ -11,7 +11,9 @@ solve is never a result). Two kinds get more:
   members that reached each cycle (``members_reached``), and each member's final state;
 * sweep members: the envelope (min, max) of the response amplitude over the members (the band
   of FRFs); for a split sweep (:mod:`fretwear.study.sweep_split`) the chunks joined into one
-  sweep instead.
+  sweep instead;
+* mistuned disks (``[cyclic.mistuning]``): each member's blade responses and amplification
+  factor against Whitehead's bound (:mod:`fretwear.study.mistuning`).
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ import xarray as xr
 
 from fretwear.io.results import read_results
 from fretwear.study.members import Member
+from fretwear.study.mistuning import amplification
 from fretwear.study.runner import RESULTS_FILE, MemberRecord
 
 QUANTILES = (0.05, 0.5, 0.95)
@@ -220,7 +223,10 @@ def aggregate(study, members: list[Member], records: list[MemberRecord], outdir)
         data.update(d)
     else:
         data.update(_frf_band(stacked))
+    amp_data, amp_attrs = amplification(members, done)
+    data.update(amp_data)
     ds = xr.Dataset(data, coords=coords)
+    ds.attrs.update(amp_attrs)
     ds.attrs.update({
         "title": study.title, "study_kind": study.kind, "study_file": study.text,
         "base_case": str(study.base), "members": len(members),
