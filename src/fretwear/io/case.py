@@ -462,6 +462,10 @@ OUTPUT = Table(
         "figure_format": Field(Text(FIGURE_FORMATS), "figure file format", default="png"),
         "vtu": Field(Flag(), "write ParaView files (.vtu/.pvd) of fields when the model has a "
                      "mesh", default=True),
+        "whole_disk": Field(Flag(), "a sector ([cyclic]) of a periodic analysis: also "
+                            "`periodic-disk.pvd`, the whole disk rebuilt from the sector (every "
+                            "sector turned, each harmonic n phased by e^{i n EO j 2 pi / N})",
+                            default=False),
     },
     doc="Where and what to write. `fretwear run -o DIR` overrides `directory`.",
 )
