@@ -464,8 +464,8 @@ OUTPUT = Table(
                      "mesh", default=True),
         "whole_disk": Field(Flag(), "a sector ([cyclic]) of a periodic analysis: also "
                             "`periodic-disk.pvd`, the whole disk rebuilt from the sector (every "
-                            "sector turned, each harmonic n phased by e^{i n EO j 2 pi / N})",
-                            default=False),
+                            "sector turned, each harmonic n phased by e^{i n EO j 2 pi / N}); "
+                            "default false"),
     },
     doc="Where and what to write. `fretwear run -o DIR` overrides `directory`.",
 )
