@@ -97,3 +97,32 @@ def test_an_ensemble_perturbs_every_sectors_factor(tmp_path):
     for y in young[1:]:
         assert len(y) == 8 and len(set(y)) == 8 and max(abs(np.array(y) - 1)) < 0.1
     assert young[1] != young[2]
+
+
+def test_wear_members_get_each_sectors_deepest_wear(tmp_path):
+    """Wear members of a disk of N = 4 sectors of 2 contact nodes each (sector-major, as the
+    disk numbers them): each sector's deepest final wear, and the member's deepest over the
+    tuned member's (3 um over 2 um: 1.5); no FRF, so no amplification factor (NaN) and the
+    summary says the wear only."""
+    members = [Member(0, {}), Member(1, {})]
+    finals = [np.array([1, 2, 2, 1, 0.5, 2, 1, 1]) * 1e-6,
+              np.array([1, 3, 2, 1, 0.5, 1, 1, 1]) * 1e-6]
+    for m, w, young in zip(members, finals, ([1.0] * N, [1.0, 1.01, 0.99, 1.0]),
+                           strict=True):
+        ds = xr.Dataset({"wear_depth": (("step", "contact_node"), np.vstack([0 * w, w])),
+                         "cycles": ("step", [0.0, 1e5]),
+                         "worn_volume": ("step", [0.0, w.sum() * 1e-6]),
+                         "contact_position": (("contact_node", "dim"), np.zeros((8, 2)))},
+                        attrs={"mistuned_sectors": N, "mistuning_young": np.array(young),
+                               "mistuning_mu": np.ones(N), "mistuning_wear": np.ones(N)})
+        (tmp_path / m.folder_name).mkdir()
+        ds.to_netcdf(tmp_path / m.folder_name / RESULTS_FILE, engine="h5netcdf")
+    records = [MemberRecord(0, "ok"), MemberRecord(1, "ok")]
+    out = aggregate(STUDY, members, records, tmp_path)
+    np.testing.assert_array_equal(out["sector_wear_depth"].values[1],
+                                  np.array([3, 2, 1, 1]) * 1e-6)
+    np.testing.assert_allclose(out["wear_amplification"].values, [1.0, 1.5], rtol=1e-15)
+    assert np.isnan(out["amplification_factor"].values).all()
+    _, text = _summary(STUDY, records, out)
+    assert "deepest wear over the tuned disk's: largest 1.5" in text
+    assert "amplification factor" not in text
