@@ -514,3 +514,36 @@ def test_jenkins_nonlinear_modes_example_is_the_describing_function(tmp_path):
     n = ds.sizes["tau"]
     np.testing.assert_allclose(ds["stick_fraction"].values, np.where(slip, th / np.pi, 1.0),
                                atol=2.0 / n)
+
+
+def test_bladed_disk_frf_example_sector(tmp_path):
+    """The 3D bladed-disk sector (24 sectors, EO 3, root flanks and an under-platform damper
+    between neighbouring platforms), reduced to two frequencies below the resonance of the
+    family: both converge, the results say N, EO and the harmonic index of each harmonic
+    (0 and EO mod N = 3), the root and both damper seats are in contact and every one of the
+    four interfaces dissipates (friction energy > 0: the damper seat on the next blade works
+    through the phase of the travelling wave)."""
+    shutil.copy(EXAMPLES / "bladed-disk.msh", tmp_path)
+    ds = run_reduced("bladed-disk-frf.toml", tmp_path,
+                     numerics={"n_points": 2, "f_min": 2300.0, "f_max": 2400.0})
+    assert ds["converged"].values.all()
+    assert int(ds.attrs["cyclic_sectors"]) == 24 and int(ds.attrs["engine_order"]) == 3
+    np.testing.assert_array_equal(np.atleast_1d(ds.attrs["harmonic_index"]), [0, 3])
+    e = ds["interface_friction_energy"]
+    assert ds["contact_name"].values.tolist() == ["flank_left", "flank_right",
+                                                  "damper_right_seat", "damper_next_blade"]
+    assert (e.values > 0).all()
+
+
+def test_bladed_disk_wear_example_wears_the_root_only(tmp_path):
+    """The bladed-disk wear example, reduced to three slow steps: the root flanks (Archard
+    coefficients given) wear, the damper seats (none given) do not, and the worn volume
+    grows step by step."""
+    shutil.copy(EXAMPLES / "bladed-disk.msh", tmp_path)
+    ds = run_reduced("bladed-disk-wear.toml", tmp_path,
+                     numerics={"max_steps": 3, "max_cycles": 2e5})
+    w = ds["wear_depth"].values[-1]
+    where = ds["contact_interface"].values
+    root = np.isin(where, ["flank_left", "flank_right"])
+    assert w[root].max() > 0 and np.all(w[~root] == 0)
+    assert np.all(np.diff(ds["worn_volume"].values) > 0)

@@ -81,6 +81,12 @@ _API = {
     "whole_disk": "fretwear.model.cyclic", "cyclic_condenser": "fretwear.hb.cyclic",
     "cyclic_modes": "fretwear.hb.cyclic", "cyclic_frf": "fretwear.hb.cyclic",
     "centrifugal_load": "fretwear.model.rotation",
+    # a mistuned disk: the N sectors made to differ
+    "mistuning": "fretwear.model.mistuning", "random_mistuning": "fretwear.model.mistuning",
+    "mistuned_disk": "fretwear.model.mistuning", "whitehead_bound": "fretwear.model.mistuning",
+    "blade_amplitudes": "fretwear.model.mistuning",
+    "amplification_factor": "fretwear.model.mistuning",
+    "sector_responses": "fretwear.model.mistuning", "lumped_blisk": "fretwear.examples.blisk",
     # wear
     "simulate_wear": "fretwear.api", "frf_worn": "fretwear.api",
     "WearOptions": "fretwear.wear", "WearResult": "fretwear.wear",

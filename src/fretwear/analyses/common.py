@@ -263,6 +263,20 @@ def condenser_of(model, analysis: dict, f_max: float | None, max_order: int):
                      tol=analysis.get("condensation_tol", default_of(condenser, "tol")))
 
 
+def mistuning_attributes(model) -> dict:
+    """The results attributes of a mistuned disk (``model.meta["mistuning"]``, a case file's
+    ``[cyclic.mistuning]``): ``mistuned_sectors`` (N), ``engine_order`` and the factors
+    ``mistuning_young``, ``mistuning_mu``, ``mistuning_wear`` (N each); ``{}`` otherwise."""
+    mt = model.meta.get("mistuning")
+    if mt is None:
+        return {}
+    return {"mistuned_sectors": int(mt.n_sectors),
+            "engine_order": int(model.meta["engine_order"]),
+            "mistuning_young": np.asarray(mt.young, float),
+            "mistuning_mu": np.asarray(mt.mu, float),
+            "mistuning_wear": np.asarray(mt.wear, float)}
+
+
 #: the analyses that run on a sector of a case file's ``[cyclic]`` table
 SECTOR_ANALYSES = ("cyclic-modes", "periodic", "sweep", "wear")
 

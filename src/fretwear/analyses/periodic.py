@@ -239,6 +239,9 @@ def run_periodic(model, analysis: dict, case, context: RunContext) -> RunOutput:
     if model.mesh is not None and case.output["vtu"]:
         files.append(write_period_fields(model, sol, context.out_dir / "periodic.pvd",
                                          condenser=cond))
+    if model.meta.get("cyclic") is not None and case.output.get("whole_disk"):
+        files.append(write_disk_fields(model, sol, context.out_dir / "periodic-disk.pvd",
+                                       condenser=cond))
     summary = _periodic_summary(sol, ds, analysis, where)
     if verdict:
         summary += "\n" + verdict
@@ -361,6 +364,42 @@ def write_period_fields(model, sol: PeriodicSolution, pvd: Path, *, condenser=No
         path = write_vtu(folder / f"period-{j:03d}.vtu", mesh,
                          {"displacement": nodal_vectors(mesh, samples[:, j]),
                           "contact_state": state[:, j], "contact_pressure": pressure[:, j]},
+                         {"time": t, "tau": b.tau[j]})
+        entries.append((t, path))
+    return write_pvd(pvd, entries)
+
+
+def write_disk_fields(model, sol: PeriodicSolution, pvd: Path, *, condenser) -> Path:
+    """ParaView time series of the whole tuned disk over one period, rebuilt from the
+    sector's solution (``model.meta["cyclic"]``, its engine order ``model.meta
+    ["engine_order"]``; :func:`fretwear.model.cyclic.disk_harmonics` on the sector's DOFs
+    recovered by ``condenser``): one ``.vtu`` per instant on the mesh of
+    :func:`fretwear.model.cyclic.disk_mesh`, with the point arrays ``displacement`` [m] (the
+    disk's axes) and ``sector`` (the sector number of each node), stepped through by the
+    ``.pvd`` with the time [s] as time step.
+
+    Returns
+    -------
+    The ``.pvd`` file.
+    """
+    from fretwear.model.cyclic import disk_harmonics, disk_mesh
+
+    sector = model.meta["cyclic"]
+    b = sol.basis
+    nc, d, H = sol.U.shape
+    u_loc = b.to_complex(sol.U.reshape(nc * d, H))
+    full = recover(model, sol.frequency, b.orders, u_loc, quasi_static=sol.quasi_static,
+                   condenser=condenser)  # (k+1, ndof) of sector 0
+    per = disk_harmonics(sector, model.meta["engine_order"], b.orders, full)
+    mesh = disk_mesh(sector)
+    nn = model.mesh.points.shape[0]
+    samples = np.concatenate([b.to_time(b.from_complex(u)) for u in per])  # (N ndof, ns)
+    which = np.repeat(np.arange(sector.n_sectors), nn).astype(float)
+    folder = pvd.parent / pvd.stem
+    entries = []
+    for j, t in enumerate(sol.time):
+        path = write_vtu(folder / f"disk-{j:03d}.vtu", mesh,
+                         {"displacement": nodal_vectors(mesh, samples[:, j]), "sector": which},
                          {"time": t, "tau": b.tau[j]})
         entries.append((t, path))
     return write_pvd(pvd, entries)
@@ -540,7 +579,9 @@ PERIODIC = Analysis.define(
     "point stops), `contact-state.png` (separation/stick/slip along the interface over the "
     "period), `contact-profiles.png` (pressure, slip, friction energy along the interface), "
     "`hysteresis.png` (tangential force against slip for a few nodes) and, for meshes, "
-    "`periodic.pvd` (the displacement field over the period; ParaView's time slider plays it).",
+    "`periodic.pvd` (the displacement field over the period; ParaView's time slider plays it); "
+    "for a sector with `[output] whole_disk = true`, `periodic-disk.pvd` (the whole disk "
+    "rebuilt from the sector).",
     preload_check=True,
 )
 

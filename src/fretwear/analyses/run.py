@@ -24,6 +24,7 @@ from fretwear.analyses.common import (
     OPEN_ATTRIBUTE,
     WARNINGS_ATTRIBUTE,
     check_sector_analysis,
+    mistuning_attributes,
     preload_notes,
 )
 from fretwear.analyses.registry import analysis_tables, get
@@ -197,6 +198,7 @@ def run_built(model, case, out_dir: Path, how: RunContext, echo: bool = True) ->
         if open_names is not None:
             out.dataset.attrs[OPEN_ATTRIBUTE] = ", ".join(open_names)
         out.dataset.attrs[WARNINGS_ATTRIBUTE] = "\n".join(out.warnings)
+        out.dataset.attrs.update(mistuning_attributes(model))
         out.results = write_results(
             results_path, out.dataset, title=case.title, analysis_type=analysis.name,
             converged=out.success, case_text=case.text, case_path=str(case.path),

@@ -397,6 +397,47 @@ CONTACT_MESH = Table(
 OBSERVED_MESH = Dict(AnyOf((Vector(), Text())), key_doc="point names")
 
 
+def _mistuning_rules(out: dict, path: str) -> None:
+    """Rules of ``[cyclic.mistuning]``: a draw has ``std`` and ``seed``; a kind is listed or
+    drawn, not both."""
+    if ("std" in out) != ("seed" in out):
+        have, miss = ("std", "seed") if "std" in out else ("seed", "std")
+        raise InputError(f"{table_label(path)}: {have} without {miss}; a random draw takes "
+                         "both (std, seed)")
+    drawn = out.get("draw", ["young"]) if "std" in out else []
+    for kind in drawn:
+        if kind in out:
+            fail(join(path, kind), out[kind], f"no list: {kind} is drawn (draw = "
+                 f"{drawn}); give its factors or draw it, not both")
+
+
+MISTUNING = Table(
+    {
+        "young": Field(ListOf(_POSITIVE, non_empty=True), "factor on the stiffness (Young's "
+                       "modulus) of each sector, sector 0 first: N numbers (1 = tuned)"),
+        "mu": Field(ListOf(_POSITIVE, non_empty=True), "factor on the friction coefficients "
+                    "of each sector's contact nodes: N numbers"),
+        "wear": Field(ListOf(_POSITIVE, non_empty=True), "factor on the wear coefficients of "
+                      "each sector's contact nodes (and of their partners): N numbers"),
+        "std": Field(Number(lo=0, hi=0.5, hi_open=True), "a seeded random draw instead: "
+                     "factors 1 + std z, z standard normal, of the kinds in `draw`", unit="-"),
+        "seed": Field(Integer(lo=0), "seed of the random draw"),
+        "draw": Field(ListOf(Text(("young", "mu", "wear")), non_empty=True, unique=True),
+                      "the kinds drawn (with std and seed)", default=["young"]),
+    },
+    checks=(_mistuning_rules,),
+    doc="A mistuned disk: the N sectors differ by a factor each on their stiffness, friction "
+    "and wear coefficients (listed, or drawn with a seed). The analysis then runs on the whole "
+    "disk assembled from the N sectors (fretwear.model.mistuning; the cyclic reduction no "
+    "longer holds), every analysis type allowed, with every observed point on every sector "
+    "(`<name>@<j>`, sector j). The results attributes `mistuned_sectors` (N), "
+    "`engine_order` and `mistuning_young`, `mistuning_mu`, `mistuning_wear` (the factors) "
+    "say which disk ran; a study over mistuning patterns (`[ensemble.perturb] "
+    "\"cyclic.mistuning.young\" = {absolute = 0.02}` on a base of N ones) reports the "
+    "amplification factor of each member and Whitehead's bound (docs/study.md).",
+)
+
+
 def _cyclic_rules(out: dict, path: str) -> None:
     """Rules of ``[cyclic]``: a unit axis, ``|engine_order| < sectors``, two boundaries."""
     axis = out.get("axis")
@@ -444,6 +485,8 @@ CYCLIC = Table(
                        "by +2 pi / N, node by node", required=True),
         "tolerance": Field(_NON_NEG, "largest distance between a turned left node and its "
                            "right node (default 1e-6 times the model size)", unit="m"),
+        "mistuning": Field(MISTUNING, "the sectors made to differ (`[cyclic.mistuning]`): the "
+                           "whole disk is assembled and run"),
         "neighbour": Field(Text(), "name of the `[[contact]]` block between neighbouring "
                            "sectors (a damper, a shroud): its `boundary` A touches the next "
                            "sector's copy of its `partner` B (B turned by +2 pi / N lands on "
@@ -580,6 +623,10 @@ OUTPUT = Table(
         "figure_format": Field(Text(FIGURE_FORMATS), "figure file format", default="png"),
         "vtu": Field(Flag(), "write ParaView files (.vtu/.pvd) of fields when the model has a "
                      "mesh", default=True),
+        "whole_disk": Field(Flag(), "a sector ([cyclic]) of a periodic analysis: also "
+                            "`periodic-disk.pvd`, the whole disk rebuilt from the sector (every "
+                            "sector turned, each harmonic n phased by e^{i n EO j 2 pi / N}); "
+                            "default false"),
     },
     doc="Where and what to write. `fretwear run -o DIR` overrides `directory`.",
 )
@@ -994,7 +1041,28 @@ def _sector(model, cyc: dict, neighbour):
         raise InputError(f"cyclic: {exc}") from None
     sector.model.meta["cyclic"] = sector
     sector.model.meta["engine_order"] = int(cyc["engine_order"])
+    if cyc.get("mistuning") is not None:
+        return _mistuned(sector, cyc)
     return sector.model
+
+
+def _mistuned(sector, cyc: dict):
+    """The whole disk of ``[cyclic.mistuning]`` (its factors listed or drawn)."""
+    from fretwear.model.mistuning import KINDS, mistuned_disk, mistuning, random_mistuning
+
+    mt = cyc["mistuning"]
+    n = sector.n_sectors
+    factors = {}
+    if "std" in mt:
+        drawn = random_mistuning(n, mt["std"], mt["seed"], tuple(mt["draw"]))
+        factors = {k: getattr(drawn, k) for k in mt["draw"]}
+    for kind in KINDS:
+        if kind in mt:
+            if len(mt[kind]) != n:
+                fail(f"cyclic.mistuning.{kind}", mt[kind], f"{n} factors (one per sector; "
+                     f"sectors = {n})")
+            factors[kind] = mt[kind]
+    return mistuned_disk(sector, int(cyc["engine_order"]), mistuning(n, **factors))
 
 
 def _at(value):
@@ -1246,6 +1314,7 @@ def case_docs(analyses: Mapping[str, Table]) -> str:
         "matrices: `name = node id` or a one-node set. Results and figures use these names.\n"
     )
     parts.append(render_table(CYCLIC, "## [cyclic] (meshes)"))
+    parts.append(render_table(MISTUNING, "## [cyclic.mistuning] (meshes)"))
     parts.append(render_table(CENTRIFUGAL, "## [centrifugal] (meshes)"))
     parts.append("## [analysis]\n\n`type` selects one of the analyses below (those registered "
                  "in this version).\n")

@@ -526,3 +526,38 @@ def _disk_contact(sector: CyclicSector, c: ContactInterface, maps) -> ContactInt
         partner_ids=tile(c.partner_ids),
         partner_wear_coefficient=tile(c.partner_wear_coefficient),
         interface=tile(c.interface), kn=tile(c.kn), kt=tile(c.kt))
+
+
+# --------------------------------------------------------------------------------------------
+# the whole disk rebuilt from a sector's response (output)
+# --------------------------------------------------------------------------------------------
+def disk_harmonics(sector: CyclicSector, engine_order: int, orders, U) -> np.ndarray:
+    """The harmonics of every sector of the tuned disk in the disk's axes, from the sector's:
+    ``U`` (nb, ndof) complex, harmonic ``orders[b]`` of sector 0 (its DOFs, right boundary
+    included); returns (N, nb, ndof): sector ``j``'s harmonic ``n`` is
+    ``Q_j U_n e^{i n EO j 2 pi / N}`` (``Q_j`` the turn by ``j 2 pi / N`` of each node's
+    components), the travelling wave of the module docstring."""
+    U = np.asarray(U, dtype=complex)
+    orders = np.asarray(orders, dtype=np.int64)
+    out = np.empty((sector.n_sectors, *U.shape), dtype=complex)
+    for j in range(sector.n_sectors):
+        phase = np.exp(1j * orders * int(engine_order) * j * sector.angle)
+        out[j] = (_turn_dofs(sector, j) @ (U * phase[:, None]).T).T
+    return out
+
+
+def disk_mesh(sector: CyclicSector):
+    """The mesh of the whole disk for output: ``N`` copies of the sector's mesh, copy ``j``
+    turned by ``j 2 pi / N`` about the axis (nodes ``j nn .. (j + 1) nn - 1``; the nodes of
+    the cyclic boundaries are repeated, once per sector that has them)."""
+    from fretwear.model.core import Mesh
+
+    mesh = sector.model.mesh
+    if mesh is None:
+        raise InputError("disk_mesh: the sector model has no mesh")
+    nn, d = mesh.points.shape
+    pt = sector.point[:d]
+    points = np.concatenate([pt + (mesh.points - pt) @ sector.turn(j).T
+                             for j in range(sector.n_sectors)])
+    cells = np.concatenate([np.asarray(mesh.cells) + j * nn for j in range(sector.n_sectors)])
+    return Mesh(points, cells, mesh.cell_type)

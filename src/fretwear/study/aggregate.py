@@ -13,7 +13,9 @@ solve is never a result). Two kinds get more:
   of FRFs) and each member's peak (``peak_response_amplitude``, ``peak_frequency``: of the
   family of FRFs over the excitation level, ``analysis.excitation_scale``, the curves a
   joint engineer reads first); for a split sweep (:mod:`fretwear.study.sweep_split`) the
-  chunks joined into one sweep instead.
+  chunks joined into one sweep instead;
+* mistuned disks (``[cyclic.mistuning]``): each member's blade responses and amplification
+  factor against Whitehead's bound (:mod:`fretwear.study.mistuning`).
 
 Members whose frequencies differ (continuation adds points where each member needs them) or
 whose kept harmonics differ cannot be stacked as they are. Their variables along a frequency
@@ -36,6 +38,7 @@ import xarray as xr
 
 from fretwear.io.results import read_results
 from fretwear.study.members import Member
+from fretwear.study.mistuning import amplification
 from fretwear.study.runner import RESULTS_FILE, MemberRecord
 
 QUANTILES = (0.05, 0.5, 0.95)
@@ -389,9 +392,12 @@ def aggregate(study, members: list[Member], records: list[MemberRecord], outdir)
         data.update(_frf_band(stacked))
         data.update(_own_variables(members, own))
         data.update(_peaks(stacked, coords))
+    amp_data, amp_attrs = amplification(members, done)
+    data.update(amp_data)
     ds = xr.Dataset(data, coords=coords)
     if note:
         ds.attrs["common_grid"] = note
+    ds.attrs.update(amp_attrs)
     ds.attrs.update({
         "title": study.title, "study_kind": study.kind, "study_file": study.text,
         "base_case": str(study.base), "members": len(members),

@@ -17,6 +17,7 @@ from fretwear.files import atomic_write, remove_stale_temporaries
 from fretwear.study.aggregate import aggregate
 from fretwear.study.figures import LEVEL_KEY, study_figures
 from fretwear.study.members import expand
+from fretwear.study.mistuning import summary_line
 from fretwear.study.runner import check_scheduler_address, dask_client, run_members
 from fretwear.study.spec import Study, read_study
 from fretwear.study.sweep_split import join_chunks
@@ -107,6 +108,9 @@ def _summary(study: Study, records, ds) -> tuple[bool, str]:
         lines.append(f"  worn volume at N = {float(ds['cycle'].values[k]):.3g}: median "
                      f"{q[1]:.3g} m^3, 5-95 % [{q[0]:.3g}, {q[2]:.3g}] over "
                      f"{int(last[k])} members")
+    amp = summary_line(ds)
+    if amp:
+        lines.append(amp)
     return ok, "\n".join(lines)
 
 
