@@ -53,6 +53,10 @@ class FourierBasis:
             raise InputError(
                 f"harmonics must be strictly increasing integers >= 1, got {list(h)}"
             )
+        if not h and self.n_samples != 1:
+            raise InputError("harmonics = (): expected at least one harmonic >= 1 (e.g. "
+                             "FourierBasis.up_to(7, 128)); the basis of the static part alone "
+                             "is FourierBasis.static()")
         hmax = max(h) if h else 0
         if self.n_samples <= 2 * hmax:
             raise InputError(
@@ -67,7 +71,15 @@ class FourierBasis:
     def up_to(cls, nh: int = 7, n_samples: int = 128) -> FourierBasis:
         """All harmonics ``1..nh`` with ``n_samples`` samples per period (default: the
         paper's 7 harmonics and 128 samples, section 4.2)."""
+        if isinstance(nh, bool) or not isinstance(nh, int | np.integer) or nh < 1:
+            raise InputError(f"nh = {nh!r}: expected a whole number of harmonics >= 1")
         return cls(tuple(range(1, nh + 1)), n_samples)
+
+    @classmethod
+    def static(cls) -> FourierBasis:
+        """The basis of the static part alone (no harmonic, one sample): static contact
+        solves."""
+        return cls((), 1)
 
     @property
     def k(self) -> int:

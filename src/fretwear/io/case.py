@@ -94,6 +94,21 @@ _MU = Field(_NON_NEG, "Coulomb friction coefficient", required=True, unit="-")
 _WEAR = Field(_NON_NEG, "Archard wear coefficient k_w (paper eq. 29)", default=0.0, unit="1/Pa")
 _CONTACT_NAME = Field(Text(), "label of the interface in output", default="contact")
 _CONTACT_K = Number(lo=0, lo_open=True, hi=1e20, allow_inf=True)
+
+
+def _waveform_needs(load_key: str):
+    """Rule: a ``normal_waveform`` other than the default shapes ``load_key`` only: without it,
+    the waveform would be ignored."""
+
+    def rule(out: dict, path: str) -> None:
+        if out.get("normal_waveform", "constant") != "constant" and load_key not in out:
+            raise InputError(f"{table_label(path)}: 'normal_waveform' = "
+                             f"{out['normal_waveform']!r} needs {load_key!r} (the waveform "
+                             "shapes a prescribed normal load; without it it would be ignored)")
+
+    return rule
+
+
 _NORMAL_WAVEFORM = Field(Text(tuple(w for w in WAVEFORMS if w != "fourier")),
                          "time history g(omega t) of the prescribed normal load"
                          ' (as loads\' `waveform`; "fourier" is not offered here)',
@@ -275,7 +290,7 @@ CONTACT_MESH = Table(
     },
     checks=(non_zero("normal", "tangent"),
             requires("partner_wear_coefficient", "partner"),
-            requires("tolerance", "partner")),
+            requires("tolerance", "partner"), _waveform_needs("normal_pressure")),
     doc="A frictional interface: the nodes of one boundary against a rigid obstacle, or "
     "against the matching nodes of a second body (`partner`). Several interfaces: one "
     "`[[contact]]` block each, with distinct names (a node belongs to one interface).",
@@ -405,7 +420,7 @@ CONTACT_MATRICES = Table(
                              unit="N"),
         "normal_waveform": _NORMAL_WAVEFORM,
     },
-    checks=(_normal_dofs_or_load,),
+    checks=(_normal_dofs_or_load, _waveform_needs("normal_load")),
     doc="The frictional interface: DOFs of the contact nodes against a rigid obstacle.",
 )
 OBSERVED_MATRICES = Dict(AnyOf((_DOF, ListOf(_DOF, non_empty=True))), key_doc="point names")
@@ -873,6 +888,11 @@ def _build_from_matrices(m: dict, title: str):
                                  base).tolist()
                 for name, d in m.get("observed", {}).items()}
     gap, area = c["gap"], c["area"]
+    for key in ("normal_load", "gap", "area", "kn", "kt"):
+        if isinstance(c.get(key), list) and len(c[key]) not in (1, len(tangential)):
+            raise InputError(f"model.contact.{key} has {len(c[key])} values; expected one, or "
+                             f"one per contact node ({len(tangential)}, the rows of "
+                             "tangential_dofs)")
     contact = ContactDofs(
         normal_dofs=normal,
         tangential_dofs=tangential,

@@ -32,21 +32,14 @@ from fretwear.model.mesh import boundary as _boundary
 from fretwear.model.mesh import check_cells, facet_normals, model_size, orient_facets
 from fretwear.model.places import AXES, axis_index, find_node, nodes_at, unit_direction
 from fretwear.model.supports import check_supported
+from fretwear.validate import number
 
 
 # --------------------------------------------------------------------------------------------
 # input dataclasses
 # --------------------------------------------------------------------------------------------
 def _finite(value, what: str, *, minimum=None, allow_inf=False) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise InputError(f"{what} = {value!r} is not a number") from None
-    if math.isnan(v) or (math.isinf(v) and not allow_inf):
-        raise InputError(f"{what} = {value!r}; expected a finite number")
-    if minimum is not None and v < minimum:
-        raise InputError(f"{what} = {value!r}; expected a value >= {minimum}")
-    return v
+    return number(value, what, low=minimum, allow_inf=allow_inf)
 
 
 def _check_waveform(waveform, coefficients, what: str) -> None:
@@ -261,6 +254,21 @@ class ContactSpec:
             self.tolerance = _finite(self.tolerance, f"{what}: tolerance", minimum=0.0)
         if not callable(self.gap):
             self.gap = _finite(self.gap, f"{what}: gap")
+        for key in ("normal_stiffness", "tangential_stiffness"):
+            v = number(getattr(self, key), f"{what}: {key}", low=0.0, open_low=True,
+                       allow_inf=True, unit="Pa/m")
+            setattr(self, key, v)
+        if self.normal_pressure is not None:
+            self.normal_pressure = number(self.normal_pressure, f"{what}: normal_pressure",
+                                          low=0.0, unit="Pa")
+        waveforms = [w for w in WAVEFORMS if w != "fourier"]
+        if self.normal_waveform not in waveforms:
+            raise InputError(f"{what}: normal_waveform = {self.normal_waveform!r}; expected one "
+                             f"of {waveforms}")
+        if self.normal_pressure is None and self.normal_waveform != "constant":
+            raise InputError(f"{what}: normal_waveform = {self.normal_waveform!r} without "
+                             "normal_pressure: the waveform only shapes a prescribed normal "
+                             "pressure (give normal_pressure, or leave the waveform out)")
 
 
 # --------------------------------------------------------------------------------------------
@@ -750,6 +758,10 @@ def _assemble_bodies(mesh: Mesh, materials: dict, thickness: float):
             inside = np.zeros(nn, dtype=bool)
             inside[np.asarray(mesh.node_sets[body], dtype=np.int64)] = True
             mine = np.flatnonzero(np.all(inside[cells], axis=1))
+            if mine.size == 0:
+                raise InputError(f"material[{body!r}]: the node set {body!r} holds no whole "
+                                 "cell (a boundary or a few nodes, not a body): the material "
+                                 "would apply to nothing; name a body (a volume group)")
         twice = mine[owner[mine] >= 0]
         if twice.size:
             raise InputError(f"material: cell {int(twice[0])} belongs to two bodies "

@@ -21,6 +21,7 @@ from fretwear.model.core import WAVEFORMS, ContactInterface, Load, Model, Observ
 from fretwear.model.interfaces import relative_model
 from fretwear.model.supports import rigid_motion_check
 from fretwear.resources import require_memory
+from fretwear.validate import is_real
 
 SYMMETRY_TOL = 1e-9  # max |A - A^T| relative to max |A|
 
@@ -141,6 +142,8 @@ def _dofs(values, ndof: int, what: str) -> np.ndarray:
 
 def _per_node(value, nc: int, what: str, *, positive=False, signs=False) -> np.ndarray:
     try:
+        if isinstance(value, str | bytes) or np.asarray(value).dtype.kind not in "iuf":
+            raise ValueError(value)
         a = np.broadcast_to(np.asarray(value, dtype=float), (nc,)).copy()
     except (TypeError, ValueError):
         raise InputError(f"{what} = {value!r}; expected a number or {nc} numbers (one per "
@@ -155,6 +158,8 @@ def _per_node(value, nc: int, what: str, *, positive=False, signs=False) -> np.n
 
 
 def _nonnegative(value, what: str) -> float:
+    if not is_real(value):
+        raise InputError(f"{what} = {value!r} is not a number")
     try:
         v = float(value)
     except (TypeError, ValueError):

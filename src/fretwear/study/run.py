@@ -14,7 +14,13 @@ from fretwear.files import atomic_write, remove_stale_temporaries
 from fretwear.study.aggregate import aggregate
 from fretwear.study.figures import study_figures
 from fretwear.study.members import expand
-from fretwear.study.runner import check_scheduler_address, dask_client, run_members
+from fretwear.study.runner import (
+    check_scheduler,
+    check_scheduler_address,
+    check_workers,
+    dask_client,
+    run_members,
+)
 from fretwear.study.spec import Study, read_study
 from fretwear.study.sweep_split import join_chunks
 
@@ -117,6 +123,8 @@ def run_study(path, outdir=None, *, scheduler=None, workers: int | None = None,
     StudyInterrupted
         On Ctrl-C: finished members are kept; run again to do the rest.
     """
+    check_scheduler(scheduler)
+    check_workers(workers)
     study = read_study(resolve_study(path))
     members = expand(study)
     address = scheduler if scheduler is not None else study.scheduler

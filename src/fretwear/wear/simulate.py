@@ -34,6 +34,7 @@ from fretwear.hb.reduce import Reduced, condense, condenser_for
 from fretwear.hb.solution import PeriodicSolution
 from fretwear.hb.solvers import SolveStats
 from fretwear.model.core import Model
+from fretwear.validate import reals
 from fretwear.wear.checkpoint import (
     check_checkpoint_path,
     fingerprint,
@@ -150,8 +151,17 @@ def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float | None 
         time_domain = None
     if run.checkpoint is not None:
         check_checkpoint_path(run.checkpoint)  # a folder: refused before anything is computed
+    if opts.partner_energy_coefficient is not None and not np.any(model.contact.paired()):
+        raise InputError(f"partner_energy_coefficient = {opts.partner_energy_coefficient!r}, "
+                         "but the model has no node-to-node pair (a rigid obstacle does not "
+                         "wear): leave it out, or give the contact a partner")
     t_start = time.perf_counter()
     nc, d = model.contact.dofs.shape
+    if wear0 is not None:
+        wear0 = reals(wear0, "wear0", low=0.0)
+        if wear0.size != 1 and wear0.shape != (nc,):
+            raise InputError(f"wear0 has shape {wear0.shape}; expected one depth or {nc} "
+                             "(one per contact node) [m]")
     condenser = condenser_for(model, balance.condenser)  # one for every condensation of the run
     reduced = balance.reduced
     if reduced is None:
