@@ -198,9 +198,30 @@ def _edited_depth(ok: bytes, path: Path):
         np.savez(fh, **arrays)
 
 
+def _resealed(value: float):
+    """One wear depth set to ``value`` and the checksum recomputed (as someone who read the
+    code would): the seal passes, the check of the values must not."""
+
+    def damage(ok: bytes, path: Path):
+        from fretwear.files import SEAL, seal
+
+        tmp = path.with_name("ok.npz")
+        tmp.write_bytes(ok)
+        with np.load(tmp) as z:
+            arrays = {k: z[k] for k in z.files if k != SEAL}
+        tmp.unlink()
+        arrays["state_W"] = arrays["state_W"].copy()
+        arrays["state_W"].flat[0] = value
+        with open(path, "wb") as fh:
+            np.savez(fh, **seal(arrays))
+
+    return damage
+
+
 DAMAGES = {"truncated": _truncated, "flipped": _flipped, "text": _text, "empty": _empty,
            "missing-key": _missing_key, "short-history": _short_history,
-           "edited-depth": _edited_depth}
+           "edited-depth": _edited_depth, "resealed-nan-depth": _resealed(np.nan),
+           "resealed-negative-depth": _resealed(-1e-6)}
 
 
 @pytest.mark.parametrize("kind", list(DAMAGES))
