@@ -229,6 +229,35 @@ def test_failed_solve_stops_cleanly(blk, monkeypatch):
     assert 1 <= r.history.n_steps <= 4
 
 
+def test_non_finite_step_stops_the_run_naming_the_column(blk, monkeypatch):
+    """A step whose wear rate comes out NaN (as an overflowing law would give) is a failure
+    naming the column, and no non-finite value reaches the history; without the check the
+    NaN rate was recorded and the run went on (the reference: the issue's silent accepts)."""
+    import dataclasses
+
+    import fretwear.wear.simulate as simulate
+
+    m, red, anc = blk
+    real = simulate.advance
+    calls = {"n": 0}
+
+    def poisoned(sp, state, opts):
+        new_state, record, failure = real(sp, state, opts)
+        calls["n"] += 1
+        if calls["n"] == 2 and not failure:
+            record = dataclasses.replace(record, wear_rate=np.full_like(record.wear_rate,
+                                                                        np.nan))
+        return new_state, record, failure
+
+    monkeypatch.setattr(simulate, "advance", poisoned)
+    r = simulate_wear(m, BASIS, quasi_static=True, balance=BalanceSetup(reduced=red, anchor=anc),
+                      options=WearOptions(tolerance=0.05, max_steps=4))
+    assert r.stop_reason == "solver_failed" and not r.success
+    assert "non-finite values (NaN or inf) in wear_rate" in r.message
+    assert r.history.n_steps == 2  # the initial state and the first step
+    assert np.all(np.isfinite(r.history.wear_rate))
+
+
 # --- checkpoints ------------------------------------------------------------------------------
 @pytest.mark.parametrize("every", [0.0, 1e9])
 def test_interrupt_and_resume_equals_uninterrupted(blk, tmp_path, every):

@@ -263,6 +263,10 @@ def _integrate(sp: SlowProblem, state: SlowStep, records: list[StepRecord], opts
         bar.show(state)
         while not reason:
             new_state, record, failure = _step(sp, state, opts)
+            bad = "" if failure else record.non_finite()
+            if bad:
+                failure = (f"step {state.step + 1} produced non-finite values (NaN or inf) in "
+                           f"{bad}; the last finite state is kept")
             if failure:
                 reason, extra = "solver_failed", f": {failure}"
                 break
