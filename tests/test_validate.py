@@ -210,3 +210,11 @@ def test_material_of_a_set_without_a_whole_cell(tmp_path):
         fw.from_mesh(mesh, {"top": fw.Material(210e9, 0.3, 7800.0),
                             None: fw.Material(210e9, 0.3, 7800.0)}, thickness=0.01,
                      supports=[("top", "all")], contact=fw.ContactSpec("bottom", mu=0.3))
+
+
+def test_unusual_material_and_friction_warn_in_python():
+    """The Python records say what a case file says (fretwear.limits.unusual)."""
+    with pytest.warns(UserWarning, match="Material: E = 210 Pa is below the usual range"):
+        fw.Material(210.0, 0.3, 7800.0)
+    with pytest.warns(UserWarning, match="contact 'contact': mu = 5 is above the usual"):
+        fw.ContactSpec("bottom", mu=5.0)

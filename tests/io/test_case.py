@@ -483,3 +483,27 @@ def test_prescribed_normal_load_in_tension_is_refused(tmp_path, line, message):
     with pytest.raises(InputError, match=message.replace("[", r"\[")) as err:
         load_case(write(folder, text))
     assert "\n" not in str(err.value)
+
+
+def test_legal_but_unusual_magnitudes_are_named(tmp_path):
+    """E = 210 (Pa: steel's modulus in GPa written as Pa), a density in g/cm^3 and mu = 5 run,
+    each with one warning naming the key; the shipped beam's values give none (the ranges
+    of fretwear.limits.USUAL hold every shipped example)."""
+    from fretwear.io.case import unusual_notes
+
+    assert unusual_notes(load_case(write(tmp_path, BASE))) == []
+    text = (BASE.replace("E = 210e9", "E = 210").replace("rho = 7800.0", "rho = 7.8")
+            .replace("mu = 0.3", "mu = 5.0"))
+    notes = unusual_notes(load_case(write(tmp_path, text)))
+    assert [n.split(" = ")[0] for n in notes] == ["warning: material.E", "warning: material.rho",
+                                                "warning: contact.mu"]
+    assert notes[0].startswith("warning: material.E = 210 Pa is below the usual range")
+    assert notes[0].endswith("a unit mistake?")
+
+
+def test_shipped_examples_have_no_unusual_magnitudes():
+    from fretwear.examples import EXAMPLES_DIR
+    from fretwear.io.case import unusual_notes
+
+    for path in sorted(EXAMPLES_DIR.glob("*.toml")):
+        assert unusual_notes(load_case(path)) == [], path.name

@@ -30,7 +30,7 @@ from fretwear.analyses.registry import analysis_tables, get
 from fretwear.errors import InputError, interrupted
 from fretwear.files import remove_stale_temporaries
 from fretwear.io import case as case_files
-from fretwear.io.case import Case, build_model, observed_notes
+from fretwear.io.case import Case, build_model, observed_notes, unusual_notes
 from fretwear.io.results import read_results, write_results
 from fretwear.threads import limited
 
@@ -174,7 +174,7 @@ def run_case(path: Path | str, outdir: Path | str | None = None, progress: bool 
     try:
         model = build_model(case)
         check_sector_analysis(model, analysis.name, case.analysis)
-        for note in observed_notes(case, model):
+        for note in (*unusual_notes(case), *observed_notes(case, model)):
             say(note)
         open_names = None
         if analysis.preload_check:

@@ -52,7 +52,7 @@ from fretwear.io.schema import (
     suggest,
     table_label,
 )
-from fretwear.limits import LOSS_FACTOR_MAX
+from fretwear.limits import LOSS_FACTOR_MAX, unusual
 from fretwear.model.core import WAVEFORMS
 
 AXES = ("x", "y", "z")
@@ -614,6 +614,36 @@ def build_model(case: Case):
     if case.model_kind == "matrices":
         return _build_from_matrices(case.model, case.title)
     return _build_from_mesh(case.model, case.title, given=case.raw["model"])
+
+
+#: case-file key -> kind of :data:`fretwear.limits.USUAL` it is checked against
+_USUAL_KEYS = {"E": "modulus", "rho": "density", "mu": "friction",
+               "wear_coefficient": "wear_coefficient",
+               "partner_wear_coefficient": "wear_coefficient", "pressure": "pressure",
+               "normal_pressure": "pressure"}
+
+
+def unusual_notes(case: Case) -> list[str]:
+    """Lines for legal values that are almost surely a unit mistake (``E = 210`` [Pa], a
+    density in g/cm^3, ``mu = 5``...), named by their key: :func:`fretwear.limits.unusual`."""
+    notes = []
+
+    def walk(value, path: str):
+        if isinstance(value, Mapping):
+            for k, v in value.items():
+                sub = f"{path}.{k}" if path else str(k)
+                if k in _USUAL_KEYS and not isinstance(v, Mapping | list | bool):
+                    note = unusual(v, _USUAL_KEYS[k], sub)
+                    if note:
+                        notes.append(f"warning: {note}")
+                else:
+                    walk(v, sub)
+        elif isinstance(value, list):
+            for i, v in enumerate(value):  # one block: named as the file names it
+                walk(v, f"{path}[{i + 1}]" if len(value) > 1 else path)
+
+    walk({k: v for k, v in case.model.items() if k != "analysis"}, "")
+    return notes
 
 
 def observed_notes(case: Case, model, rtol: float = 1e-6) -> list[str]:

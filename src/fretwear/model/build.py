@@ -16,6 +16,7 @@ The model is refused when the contact alone cannot hold it
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
@@ -23,7 +24,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from fretwear.errors import InputError
-from fretwear.limits import check_loss_factor
+from fretwear.limits import check_loss_factor, unusual
 from fretwear.model.core import WAVEFORMS, ContactInterface, Load, Mesh, Model, ObservedPoint
 from fretwear.model.fem import assemble, check_material, check_thickness
 from fretwear.model.interfaces import combine
@@ -40,6 +41,15 @@ from fretwear.validate import number
 # --------------------------------------------------------------------------------------------
 def _finite(value, what: str, *, minimum=None, allow_inf=False) -> float:
     return number(value, what, low=minimum, allow_inf=allow_inf)
+
+
+def _warn_unusual(*checks) -> None:
+    """A UserWarning for each ``(value, kind, what)`` that is legal but almost surely a unit
+    mistake (:func:`fretwear.limits.unusual`)."""
+    for value, kind, what in checks:
+        note = unusual(value, kind, what)
+        if note:
+            warnings.warn(note, UserWarning, stacklevel=4)
 
 
 def _check_waveform(waveform, coefficients, what: str) -> None:
@@ -81,6 +91,7 @@ class Material:
 
     def __post_init__(self):
         self.E, self.nu, self.rho = check_material(self.E, self.nu, self.rho)
+        _warn_unusual((self.E, "modulus", "Material: E"), (self.rho, "density", "Material: rho"))
 
 
 @dataclass
@@ -254,6 +265,8 @@ class ContactSpec:
             self.tolerance = _finite(self.tolerance, f"{what}: tolerance", minimum=0.0)
         if not callable(self.gap):
             self.gap = _finite(self.gap, f"{what}: gap")
+        _warn_unusual((self.mu, "friction", f"{what}: mu"),
+                      (self.wear_coefficient, "wear_coefficient", f"{what}: wear_coefficient"))
         for key in ("normal_stiffness", "tangential_stiffness"):
             v = number(getattr(self, key), f"{what}: {key}", low=0.0, open_low=True,
                        allow_inf=True, unit="Pa/m")

@@ -31,10 +31,9 @@ def check_material(E, nu, rho) -> tuple[float, float, float]:
     vals = []
     for value, what in ((E, "Young's modulus E"), (nu, "Poisson's ratio nu"),
                         (rho, "density rho")):
-        try:
-            v = float(value)
-        except (TypeError, ValueError):
-            raise InputError(f"{what} = {value!r} is not a number") from None
+        if not is_real(value):
+            raise InputError(f"{what} = {value!r} is not a number")
+        v = float(value)
         if not np.isfinite(v):
             raise InputError(f"{what} = {value!r}; expected a finite number")
         vals.append(v)
