@@ -54,6 +54,7 @@ from fretwear.io.schema import (
 )
 from fretwear.limits import LOSS_FACTOR_MAX, unusual
 from fretwear.model.core import WAVEFORMS
+from fretwear.model.supports import Unsupported
 
 AXES = ("x", "y", "z")
 FIGURE_FORMATS = ("png", "pdf", "svg")
@@ -782,18 +783,21 @@ def _build_from_mesh(m: dict, title: str, given: Mapping):
                  f"other than its boundary {spec.boundary!r} (the damper pairs a boundary "
                  "with the next sector's copy of another one)")
         contact = [c for c in contact if c.name != neighbour]
-    model = build.from_mesh(
-        mesh,
-        material,
-        thickness=thickness,
-        damping=build.Damping(damp["loss_factor"], damp["rayleigh_mass"],
-                              damp["rayleigh_stiffness"]),
-        supports=[*springs, *fixed],
-        loads=loads,
-        contact=contact,
-        observed=observed,
-        name=title,
-    )
+    try:
+        model = build.from_mesh(
+            mesh,
+            material,
+            thickness=thickness,
+            damping=build.Damping(damp["loss_factor"], damp["rayleigh_mass"],
+                                  damp["rayleigh_stiffness"]),
+            supports=[*springs, *fixed],
+            loads=loads,
+            contact=contact,
+            observed=observed,
+            name=title,
+        )
+    except Unsupported as exc:  # the remedy as case-file blocks, not Python
+        raise exc.in_case_file() from None
     if m.get("centrifugal"):
         model = _spin(model, m["centrifugal"], cyc or {})
     return model if cyc is None else _sector(model, cyc, spec if neighbour else None)
