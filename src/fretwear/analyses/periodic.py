@@ -39,6 +39,7 @@ from fretwear.analyses.common import (
     titled,
 )
 from fretwear.errors import InputError
+from fretwear.hb import fallbacks
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.inputs import QUASI_STATIC_FREQUENCY
 from fretwear.hb.options import PERIODIC as PERIODIC_SOLVE
@@ -234,8 +235,11 @@ def run_periodic(model, analysis: dict, case, context: RunContext) -> RunOutput:
     if model.mesh is not None and case.output["vtu"]:
         files.append(write_period_fields(model, sol, context.out_dir / "periodic.pvd",
                                          condenser=cond))
+    fallback = fallbacks.of_solutions([sol], sol.stats.wall_time).line(
+        "solves", fallbacks.eps_hint("eps" in analysis))
     return RunOutput(ds, figures, _periodic_summary(sol, ds, analysis, where) + "\n"
-                     + cond.choice.summary(), True, files, warnings=list(sol.warnings))
+                     + (fallback + "\n" if fallback else "") + cond.choice.summary(), True,
+                     files, warnings=list(sol.warnings))
 
 
 def _periodic_figures(ds: xr.Dataset, case, outdir: Path, title: str) -> list[Path]:

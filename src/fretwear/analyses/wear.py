@@ -27,6 +27,7 @@ from fretwear.analyses.common import (
     interface_labels,
 )
 from fretwear.files import safe_name
+from fretwear.hb import fallbacks
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.options import WEAR_STEP
@@ -444,6 +445,10 @@ def run_wear(model, analysis: dict, case, context: RunContext) -> RunOutput:
     ]
     if frf_note:
         lines.append(frf_note)
+    fallback = fallbacks.of_wear(h.rescued[1:], h.wall_time[1:], result.wall_time).line(
+        "slow steps", fallbacks.eps_hint("eps" in a))
+    if fallback:
+        lines.append(fallback)
     lines.append(cond.choice.summary())
     warnings = list(result.warnings)
     for name, sw in (sweeps.items() if frf is not None else ()):

@@ -27,6 +27,7 @@ import numpy as np
 
 from fretwear.errors import InputError, interrupted
 from fretwear.hb.fallback import TimeDomainFallback
+from fretwear.hb.fallbacks import said
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.inputs import QUASI_STATIC_FREQUENCY, check_inputs
 from fretwear.hb.preload import preload_anchor
@@ -295,6 +296,9 @@ def _step(sp: SlowProblem, state: SlowStep, opts: WearOptions):
         return time_domain_step(sp, state, opts)
     new_state, record, failure = advance(sp, state, opts)
     if failure and sp.time_domain is not None:
+        said(f"wear step {state.step + 1} (N = {state.cycles:.4g} cycles): {failure}; taking "
+             "the step from a time integration (each can take minutes; the next steps too, "
+             "until a balance converges again)")
         new_state, record, why = time_domain_step(sp, state, opts)
         failure = f"{failure}; {why}" if why else ""
     return new_state, record, failure
