@@ -264,6 +264,8 @@ class _SayHandler(logging.Handler):
     :mod:`fretwear.hb.fallbacks`) printed as notes on stdout, above any progress bar."""
 
     def emit(self, record: logging.LogRecord) -> None:
+        if record.name != "fretwear":  # not the modules' own loggers (fretwear.hb.sparse_lu)
+            return
         from tqdm import tqdm
 
         tqdm.write(f"note: {record.getMessage()}", file=sys.stdout)

@@ -39,9 +39,9 @@ def test_each_rung_is_said_as_it_starts_and_its_time_counted(caplog):
         "start", "best-point", "eps-continuation"]
     said = [r.getMessage() for r in caplog.records if r.name == "fretwear"]
     assert len(said) == 2
-    assert said[0].startswith("periodic solve at 0.237227 Hz: start did not converge")
+    assert said[0].startswith("periodic solve at 0.237227 Hz: start failed")
     assert said[0].endswith("trying best-point")
-    assert said[1].endswith("best-point did not converge (best residual "
+    assert said[1].endswith("best-point failed (best residual "
                             f"{min(a.residual for a in sol.attempts[:2]):.2e}); trying "
                             "eps-continuation")
     assert 0.0 < sol.fallback_seconds < sol.stats.wall_time

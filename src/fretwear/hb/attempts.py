@@ -342,7 +342,7 @@ def solve_ladder(t: Trial, rungs=None) -> Found:
             continue
         if done:
             t_first = time.perf_counter() if t_first is None else t_first
-            said(f"{_where(t.prob)}: {done} did not converge (best residual "
+            said(f"{_where(t.prob)}: {done} failed (best residual "
                  f"{t.best.stats.residual if t.best else float('nan'):.2e}); trying {name}")
         if SOLVE_RUNGS[name](t):
             break
@@ -561,7 +561,7 @@ def point_ladder(p: Point) -> Point:
         if i == 1:
             t_first = time.perf_counter()
         if name in SAID_RUNGS:
-            said(f"sweep at {p.frequency:.6g} Hz: the continuation did not converge; trying "
+            said(f"sweep at {p.frequency:.6g} Hz: the continuation failed; trying "
                  f"{name}" + (" (a time integration can take minutes)"
                               if name == "time-start" else ""))
         if rung(p):
