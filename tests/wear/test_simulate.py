@@ -401,3 +401,22 @@ def test_mean_normal_force_balances_the_preload_on_the_paper_beam():
         force = float(area @ p)
         np.testing.assert_allclose(force, P * L * width, rtol=1e-6)
         np.testing.assert_allclose(float((area * p) @ x) / force, L / 2, rtol=1e-6)
+
+
+def test_wear_bar_counts_steps_not_log_cycles():
+    """The bar's fraction is in slow steps: with jumps doubling from 1 cycle, 3 steps are left
+    to 7 more cycles (1 + 2 + 4, by hand), so after 3 steps the bar is at 3 / 6; with
+    constant jumps it is steps / (steps + cycles left / jump). The old measure,
+    log(1 + cycles) / log(1 + max_cycles), said 0.81 here whatever the steps left."""
+    from types import SimpleNamespace
+
+    from fretwear.wear.simulate import _progress_fraction, steps_left
+
+    assert steps_left(9.0, 1.0, 2.0, 16.0) == pytest.approx(3.0, rel=1e-12)
+    assert steps_left(10.0, 2.0, 1.0, 16.0) == pytest.approx(3.0, rel=1e-12)
+    assert steps_left(16.0, 2.0, 1.0, 16.0) == 0.0
+    assert steps_left(0.0, 1.0, 100.0, 1.0 + 4.0 + 16.0) == pytest.approx(3.0)  # q clipped
+    opts = WearOptions(max_cycles=16.0, max_steps=1000)
+    st = SimpleNamespace(step=3, cycles=9.0, jump=1.0, volume_rate=1.0, volume_rate0=1.0,
+                         W=np.zeros(2))
+    assert _progress_fraction(st, 2.0, opts) == pytest.approx(0.5, rel=1e-12)

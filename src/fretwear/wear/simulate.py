@@ -339,13 +339,38 @@ def _message(reason: str, st: SlowStep, opts: WearOptions, extra: str = "") -> s
     return f"{txt} after {st.step} steps, N = {st.cycles:.4g} cycles{extra}"
 
 
-def _progress_fraction(cycles, vrate, vrate0, wmax, opts: WearOptions) -> float:
-    """How far the run is towards its nearest stop criterion, in [0, 1]."""
-    fr = [math.log1p(cycles) / math.log1p(opts.max_cycles)]
+#: the largest growth of the jump per step assumed when counting the steps left
+JUMP_GROWTH_MAX = 4.0
+
+
+def steps_left(cycles: float, jump: float, growth: float, max_cycles: float) -> float:
+    """The slow steps left to reach ``max_cycles`` from ``cycles`` with the next ``jump``
+    [cycles] growing by ``growth`` per step (clipped to [1, :data:`JUMP_GROWTH_MAX`]): the
+    ``k`` with ``jump (1 + q + ... + q^(k-1)) = max_cycles - cycles``."""
+    left = max(0.0, max_cycles - cycles)
+    if left <= 0.0:
+        return 0.0
+    if not (jump > 0 and math.isfinite(jump)):
+        return math.inf
+    q = min(max(growth, 1.0), JUMP_GROWTH_MAX) if math.isfinite(growth) else 1.0
+    if q < 1.0 + 1e-6:
+        return left / jump
+    return math.log1p(left * (q - 1.0) / jump) / math.log(q)
+
+
+def _progress_fraction(st: SlowStep, growth: float, opts: WearOptions) -> float:
+    """How far the run is towards its nearest stop criterion, in [0, 1], measured in what the
+    run does (so that the bar's time left means something): the slow steps taken against
+    those left to ``max_cycles`` at the current jump and its growth (:func:`steps_left`),
+    the worn depth against ``max_depth``, the steps against ``max_steps``, and the worn-volume
+    rate's fall towards the plateau (in log)."""
+    k = steps_left(st.cycles, st.jump, growth, opts.max_cycles)
+    fr = [st.step / (st.step + k) if st.step + k > 0 else 1.0, st.step / opts.max_steps]
+    vrate, vrate0 = st.volume_rate, st.volume_rate0
     if vrate0 > 0 and opts.plateau_rate > 0 and vrate > 0:
         fr.append(math.log(vrate / vrate0) / math.log(opts.plateau_rate))
     if math.isfinite(opts.max_depth):
-        fr.append(wmax / opts.max_depth)
+        fr.append(float(np.max(st.W)) / opts.max_depth)
     return min(1.0, max(0.0, max(fr)))
 
 
@@ -356,6 +381,7 @@ class _Bar:
         self.opts = opts
         self.area = np.asarray(area, float)
         self.bar = None
+        self.last_jump = math.nan  # the jump proposed at the previous step, for its growth
         if enabled:
             from tqdm import tqdm
 
@@ -366,8 +392,8 @@ class _Bar:
     def show(self, st: SlowStep):
         if self.bar is None:
             return
-        frac = _progress_fraction(st.cycles, st.volume_rate, st.volume_rate0,
-                                  float(np.max(st.W)), self.opts)
+        frac = _progress_fraction(st, st.jump / self.last_jump, self.opts)
+        self.last_jump = st.jump
         self.bar.n = max(self.bar.n, int(1000 * frac))
         vol = worn_volume(st.W, self.area)
         self.bar.set_postfix_str(f"N={st.cycles:.3g} cycles, worn {vol:.3g} m^3, "
