@@ -45,6 +45,11 @@ USUAL = {
 }
 
 
+class UnusualValueWarning(UserWarning):
+    """A legal value outside :data:`USUAL` (from the Python records; a case run says it as a
+    line naming the key instead)."""
+
+
 def unusual(value, kind: str, what: str) -> str:
     """A note when ``value`` is legal but outside ``USUAL[kind]`` ("" otherwise, and for 0)."""
     lo, hi, unit, why = USUAL[kind]

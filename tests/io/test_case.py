@@ -507,3 +507,10 @@ def test_shipped_examples_have_no_unusual_magnitudes():
 
     for path in sorted(EXAMPLES_DIR.glob("*.toml")):
         assert unusual_notes(load_case(path)) == [], path.name
+
+
+def test_unusual_values_of_a_case_are_said_once(tmp_path, recwarn):
+    """A case file's unusual value is a line naming its key (above), not also a Python
+    warning with a source line."""
+    build_model(load_case(write(tmp_path, BASE.replace("E = 210e9", "E = 210"))))
+    assert not [w for w in recwarn if "usual range" in str(w.message)]

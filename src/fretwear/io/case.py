@@ -19,6 +19,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import tomllib
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -52,7 +53,7 @@ from fretwear.io.schema import (
     suggest,
     table_label,
 )
-from fretwear.limits import LOSS_FACTOR_MAX, unusual
+from fretwear.limits import LOSS_FACTOR_MAX, UnusualValueWarning, unusual
 from fretwear.model.core import WAVEFORMS
 from fretwear.model.supports import Unsupported
 
@@ -614,7 +615,9 @@ def build_model(case: Case):
     """
     if case.model_kind == "matrices":
         return _build_from_matrices(case.model, case.title)
-    return _build_from_mesh(case.model, case.title, given=case.raw["model"])
+    with warnings.catch_warnings():  # said by key instead (unusual_notes)
+        warnings.simplefilter("ignore", UnusualValueWarning)
+        return _build_from_mesh(case.model, case.title, given=case.raw["model"])
 
 
 #: case-file key -> kind of :data:`fretwear.limits.USUAL` it is checked against

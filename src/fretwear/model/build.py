@@ -24,7 +24,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from fretwear.errors import InputError
-from fretwear.limits import check_loss_factor, unusual
+from fretwear.limits import UnusualValueWarning, check_loss_factor, unusual
 from fretwear.model.core import WAVEFORMS, ContactInterface, Load, Mesh, Model, ObservedPoint
 from fretwear.model.fem import assemble, check_material, check_thickness
 from fretwear.model.interfaces import combine
@@ -49,7 +49,7 @@ def _warn_unusual(*checks) -> None:
     for value, kind, what in checks:
         note = unusual(value, kind, what)
         if note:
-            warnings.warn(note, UserWarning, stacklevel=4)
+            warnings.warn(note, UnusualValueWarning, stacklevel=4)
 
 
 def _check_waveform(waveform, coefficients, what: str) -> None:
