@@ -179,10 +179,11 @@ class Integer(Number):
     def check(self, value, path, ctx):
         if not self.matches(value):
             self._type_error(value, path)
-        if abs(value) > INTEGER_MAX:  # numpy's int64 would overflow (an OverflowError)
+        out = int(super().check(value, path, ctx))
+        if abs(out) > INTEGER_MAX:  # numpy's int64 would overflow (an OverflowError)
             fail(path, value, f"{self.expected()} of magnitude at most 2^62 (no count or "
                  "index of a model comes near it)")
-        return int(super().check(value, path, ctx))
+        return out
 
 
 @dataclass
