@@ -218,3 +218,14 @@ def test_unusual_material_and_friction_warn_in_python():
         fw.Material(210.0, 0.3, 7800.0)
     with pytest.warns(UserWarning, match="contact 'contact': mu = 5 is above the usual"):
         fw.ContactSpec("bottom", mu=5.0)
+
+
+def test_hostile_api_calls_never_end_in_a_deep_error():
+    """Every argument of the survey's targets (tests/helpers/hostile_api.py) replaced by each
+    wrong value: an InputError (or Python's own TypeError for a wrong call) or a legal value
+    accepted, never another exception (the issue counted 7 + 6 deep errors)."""
+    from helpers import hostile_api
+
+    deep = [f"{label} -> {out}" for label, thunk in hostile_api.calls()
+            if (out := hostile_api.outcome(thunk)).startswith("deep")]
+    assert deep == []

@@ -33,6 +33,7 @@ import scipy.sparse.linalg as spla
 
 from fretwear.errors import InputError
 from fretwear.hb.reduce import condenser_for
+from fretwear.limits import RANGES
 from fretwear.model.core import Model
 from fretwear.model.interfaces import pair_transform
 from fretwear.resources import require_memory
@@ -277,7 +278,7 @@ def modes(model: Model, n_modes: int = 10, *, interface: str = "sliding",
     if f_max is None:
         whole(n_modes, "n_modes", low=1)
     else:
-        number(f_max, "f_max", low=0.0, open_low=True, unit="Hz")
+        number(f_max, "f_max", low=0.0, open_low=True, high=RANGES["frequency"][1], unit="Hz")
     _, Tf, _ = _reduced_basis(model, interface)
     if Tf.shape[1] == 0:
         raise InputError(f"interface {interface!r} holds every DOF: the structure cannot move")

@@ -41,8 +41,12 @@ class FourierBasis:
         except TypeError:
             raise InputError(f"harmonics = {self.harmonics!r}: expected a sequence of "
                              "integers >= 1") from None
-        if any(isinstance(x, bool) or int(x) != x for x in h):
-            raise InputError(f"harmonics = {list(h)}: expected integers >= 1")
+        try:
+            bad = any(isinstance(x, bool) or int(x) != x for x in h)
+        except (TypeError, ValueError, OverflowError):
+            bad = True
+        if bad:
+            raise InputError(f"harmonics = {list(h)[:8]}: expected integers >= 1")
         h = tuple(int(x) for x in h)
         object.__setattr__(self, "harmonics", h)
         n = self.n_samples
@@ -73,6 +77,10 @@ class FourierBasis:
         paper's 7 harmonics and 128 samples, section 4.2)."""
         if isinstance(nh, bool) or not isinstance(nh, int | np.integer) or nh < 1:
             raise InputError(f"nh = {nh!r}: expected a whole number of harmonics >= 1")
+        if isinstance(n_samples, int | np.integer) and not isinstance(n_samples, bool) \
+                and n_samples <= 2 * nh:
+            raise InputError(f"n_samples = {n_samples} is too small for harmonic {nh}: "
+                             f"expected more than {2 * nh} samples per period")
         return cls(tuple(range(1, nh + 1)), n_samples)
 
     @classmethod

@@ -252,6 +252,9 @@ class ContactSpec:
 
     def __post_init__(self):
         what = f"contact {self.name!r}"
+        if not isinstance(self.boundary, str) or not self.boundary:
+            raise InputError(f"{what}: boundary = {self.boundary!r}; expected the name of a "
+                             "boundary of the mesh")
         self.mu = _finite(self.mu, f"{what}: friction coefficient mu", minimum=0.0)
         self.wear_coefficient = _finite(self.wear_coefficient, f"{what}: wear_coefficient",
                                         minimum=0.0)
@@ -694,6 +697,9 @@ def from_mesh(mesh: Mesh, material: Material, *, thickness=1.0, damping: Damping
         raise InputError(f"material = {material!r} is not a Material(E, nu, rho)")
     else:
         K0, M = assemble(mesh, material.E, material.nu, material.rho, thickness)
+    if isinstance(supports, str) or not isinstance(supports, Sequence):
+        raise InputError(f"supports = {supports!r}; expected a list of Spring(...) and "
+                         "(at, direction) items")
     Ks, fixed_dofs = _supports(mesh, supports)
     specs = [contact] if isinstance(contact, ContactSpec) else list(contact) \
         if isinstance(contact, Sequence) and not isinstance(contact, str) else [contact]

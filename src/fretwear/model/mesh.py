@@ -21,7 +21,7 @@ from fretwear.errors import InputError
 from fretwear.limits import RANGES, check_range
 from fretwear.model.core import Mesh
 from fretwear.resources import require_memory
-from fretwear.validate import instance, reals
+from fretwear.validate import instance, is_real, reals
 from fretwear.validate import path as check_path
 
 CELL_DIM = {"quad": 2, "triangle": 2, "hexahedron": 3, "tetra": 3}
@@ -43,6 +43,8 @@ _LOCAL_FACETS = {
 # structured meshes
 # --------------------------------------------------------------------------------------------
 def _positive(value, what: str) -> float:
+    if not is_real(value):
+        raise InputError(f"{what} = {value!r} is not a number; expected a length > 0 [m]")
     try:
         v = float(value)
     except (TypeError, ValueError):
