@@ -68,8 +68,6 @@ def unusual(value, kind: str, what: str) -> str:
 def check_loss_factor(value, what: str = "loss_factor") -> float:
     """The loss factor ``value`` as a float, after checking it is a number in
     ``[0, LOSS_FACTOR_MAX]``."""
-    if isinstance(value, str | bool) or value is None:
-        raise InputError(f"{what} = {value!r} is not a number")
     try:
         v = float(value)
     except (TypeError, ValueError, OverflowError):

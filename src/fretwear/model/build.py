@@ -33,7 +33,7 @@ from fretwear.model.mesh import boundary as _boundary
 from fretwear.model.mesh import check_cells, facet_normals, model_size, orient_facets
 from fretwear.model.places import AXES, axis_index, find_node, nodes_at, unit_direction
 from fretwear.model.supports import check_supported
-from fretwear.validate import number
+from fretwear.validate import is_real, number
 
 
 # --------------------------------------------------------------------------------------------
@@ -114,6 +114,8 @@ class Damping:
     D: object = field(default=None, repr=False, compare=False)
 
     def __post_init__(self):
+        if not is_real(self.loss_factor):  # not "1" or True, as a case file could not write
+            raise InputError(f"damping loss_factor = {self.loss_factor!r} is not a number")
         self.loss_factor = check_loss_factor(self.loss_factor, "damping loss_factor")
         self.rayleigh_mass = _finite(self.rayleigh_mass, "damping rayleigh_mass", minimum=0.0)
         self.rayleigh_stiffness = _finite(self.rayleigh_stiffness,
