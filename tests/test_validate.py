@@ -229,3 +229,13 @@ def test_hostile_api_calls_never_end_in_a_deep_error():
     deep = [f"{label} -> {out}" for label, thunk in hostile_api.calls()
             if (out := hostile_api.outcome(thunk)).startswith("deep")]
     assert deep == []
+
+
+def test_gap_larger_than_any_structure_is_refused():
+    """gap = 1e308 m (the survey's one case whose solves overflowed with warnings on stderr):
+    one InputError, on both routes; a gap of 1 mm still passes."""
+    with pytest.raises(InputError, match="gap = 1e.308 m; expected a value >= -100000"):
+        fw.ContactSpec("bottom", mu=0.3, gap=1e308)
+    with pytest.raises(InputError, match="gap .m.: 1e.300; expected magnitudes <= 100000"):
+        _contact_dofs(gap=1e300)
+    assert fw.ContactSpec("bottom", mu=0.3, gap=1e-3).gap == 1e-3

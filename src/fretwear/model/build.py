@@ -24,7 +24,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from fretwear.errors import InputError
-from fretwear.limits import UnusualValueWarning, check_loss_factor, unusual
+from fretwear.limits import RANGES, UnusualValueWarning, check_loss_factor, unusual
 from fretwear.model.core import WAVEFORMS, ContactInterface, Load, Mesh, Model, ObservedPoint
 from fretwear.model.fem import assemble, check_material, check_thickness
 from fretwear.model.interfaces import combine
@@ -269,7 +269,8 @@ class ContactSpec:
         if self.tolerance is not None:
             self.tolerance = _finite(self.tolerance, f"{what}: tolerance", minimum=0.0)
         if not callable(self.gap):
-            self.gap = _finite(self.gap, f"{what}: gap")
+            size = RANGES["length"][1]  # a gap larger than any structure means no contact
+            self.gap = number(self.gap, f"{what}: gap", low=-size, high=size, unit="m")
         _warn_unusual((self.mu, "friction", f"{what}: mu"),
                       (self.wear_coefficient, "wear_coefficient", f"{what}: wear_coefficient"))
         for key in ("normal_stiffness", "tangential_stiffness"):

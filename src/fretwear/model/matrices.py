@@ -16,6 +16,7 @@ import scipy.io
 import scipy.sparse as sp
 
 from fretwear.errors import InputError
+from fretwear.limits import RANGES
 from fretwear.model.build import Damping
 from fretwear.model.core import WAVEFORMS, ContactInterface, Load, Model, ObservedPoint
 from fretwear.model.interfaces import relative_model
@@ -154,6 +155,14 @@ def _per_node(value, nc: int, what: str, *, positive=False, signs=False) -> np.n
         raise InputError(f"{what}: {float(a[a <= 0][0]):g}; expected values > 0")
     if signs and not np.all(np.isin(a, (-1.0, 1.0))):
         raise InputError(f"{what} = {value!r}; expected +1 or -1 (scalar or per node)")
+    return a
+
+
+def _bounded(a: np.ndarray, bound: float, what: str) -> np.ndarray:
+    """``a`` after checking every magnitude is at most ``bound``."""
+    if np.any(np.abs(a) > bound):
+        raise InputError(f"{what}: {float(a[np.abs(a) > bound][0]):g}; expected magnitudes <= "
+                         f"{bound:g} (larger than any structure)")
     return a
 
 
@@ -377,7 +386,7 @@ def _interface(contact: ContactDofs, dofs: np.ndarray, n: int) -> ContactInterfa
     interface = ContactInterface(
         dofs=dofs,
         frame=frame,
-        gap=_per_node(contact.gap, nc, "gap"),
+        gap=_bounded(_per_node(contact.gap, nc, "gap"), RANGES["length"][1], "gap [m]"),
         area=_per_node(contact.area, nc, "area", positive=True),
         mu=_nonnegative(contact.mu, "friction coefficient mu"),
         coords=xyz,
