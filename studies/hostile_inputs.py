@@ -8,6 +8,7 @@ results file), clean message (exit 2, one line), traceback (an exception escaped
 examples of each failure kind.
 
     python studies/hostile_inputs.py --n 500 --seed 1
+    python studies/hostile_inputs.py --api   # the API calls of tests/helpers/hostile_api.py
 """
 
 from __future__ import annotations
@@ -29,7 +30,11 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=500, help="generated cases")
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--api", action="store_true", help="survey the Python API calls instead")
     a = ap.parse_args()
+    if a.api:
+        api_survey()
+        return
     counts: Counter = Counter()
     examples: dict[str, list[str]] = {}
 
@@ -68,6 +73,25 @@ def main() -> None:
         print(f"\nfirst {min(5, len(ex))} of {kind}:")
         for e in ex[:5]:
             print("  " + e)
+
+
+def api_survey() -> None:
+    """Each hostile call of tests/helpers/hostile_api.py: counts of each outcome and every call
+    that did not end in a message."""
+    from helpers import hostile_api
+
+    counts: Counter = Counter()
+    others = []
+    for label, thunk in hostile_api.calls():
+        out = hostile_api.outcome(thunk)
+        counts[out.split(":")[0]] += 1
+        if out != "message":
+            others.append(f"{label} -> {out}")
+    print(f"API calls: {sum(counts.values())}")
+    for kind, n in counts.most_common():
+        print(f"  {kind}: {n}")
+    for line in others:
+        print("  " + line)
 
 
 if __name__ == "__main__":

@@ -52,7 +52,7 @@ def test_solve_periodic_bad_types(block):
     with pytest.raises(TypeError, match="basis = 3: expected a fretwear FourierBasis"):
         fw.solve_periodic(block, 3, frequency=1500.0)
     with pytest.raises(InputError, match="basis keeps no harmonic"):
-        fw.solve_periodic(block, fw.FourierBasis((), 8), frequency=1500.0)
+        fw.solve_periodic(block, fw.FourierBasis.static(), frequency=1500.0)
 
 
 def test_load_on_a_harmonic_that_is_not_kept_is_refused():

@@ -11,6 +11,8 @@ line says what was saved).
 from __future__ import annotations
 
 import argparse
+import contextlib
+import logging
 import os
 import signal
 import sys
@@ -257,12 +259,38 @@ class TerminateAsInterrupt:
         return False
 
 
+class _SayHandler(logging.Handler):
+    """The lines of the ``"fretwear"`` logger (fallbacks as they happen,
+    :mod:`fretwear.hb.fallbacks`) printed as notes on stdout, above any progress bar."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        if record.name != "fretwear":  # not the modules' own loggers (fretwear.hb.sparse_lu)
+            return
+        from tqdm import tqdm
+
+        tqdm.write(f"note: {record.getMessage()}", file=sys.stdout)
+
+
+@contextlib.contextmanager
+def _said_lines():
+    """Print the ``"fretwear"`` logger's INFO lines while the command runs."""
+    logger, handler = logging.getLogger("fretwear"), _SayHandler(logging.INFO)
+    level = logger.level
+    logger.addHandler(handler)
+    logger.setLevel(logging.INFO)
+    try:
+        yield
+    finally:
+        logger.removeHandler(handler)
+        logger.setLevel(level)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``fretwear`` command; returns the exit status."""
     args = _parser().parse_args(argv)
     term = TerminateAsInterrupt()
     try:
-        with term:
+        with term, _said_lines():
             return args.func(args)
     except FretwearError as exc:
         print(f"error: {' '.join(str(exc).split())}", file=sys.stderr)

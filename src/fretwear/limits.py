@@ -31,6 +31,40 @@ ZERO_ALLOWED = ("density", "frequency")
 LOSS_FACTOR_MAX = 10.0
 
 
+#: kind -> (lowest, highest, unit, what is usual): legal values outside these are almost surely a
+#: unit mistake (a modulus in GPa or MPa given as Pa, a density in kg/mm^3 or g/cm^3); they are
+#: run, with a note (:func:`unusual`). 0 (a massless model, no wear) is never unusual.
+USUAL = {
+    "modulus": (1e5, 2e12, "Pa", "from soft rubbers (1e6 Pa) to diamond (1.1e12 Pa); steel "
+                "is 2.1e11 Pa"),
+    "density": (10.0, 3e4, "kg/m^3", "from foams to osmium; steel is 7800 kg/m^3"),
+    "friction": (0.0, 2.0, "-", "dry metal contacts stay below about 1.5"),
+    "wear_coefficient": (0.0, 1e-9, "1/Pa", "Archard coefficients of metals are 1e-17 to "
+                         "1e-12 1/Pa"),
+    "pressure": (0.0, 1e10, "Pa", "ten times the strength of the hardest steels"),
+}
+
+
+class UnusualValueWarning(UserWarning):
+    """A legal value outside :data:`USUAL` (from the Python records; a case run says it as a
+    line naming the key instead)."""
+
+
+def unusual(value, kind: str, what: str) -> str:
+    """A note when ``value`` is legal but outside ``USUAL[kind]`` ("" otherwise, and for 0)."""
+    lo, hi, unit, why = USUAL[kind]
+    try:
+        v = abs(float(value))
+    except (TypeError, ValueError):
+        return ""
+    if v == 0.0 or not math.isfinite(v) or lo <= v <= hi:
+        return ""
+    u = "" if unit == "-" else f" {unit}"
+    side = "below" if v < lo else "above"
+    return (f"{what} = {float(value):g}{u} is {side} the usual range [{lo:g}, {hi:g}]{u} ({why}):"
+            " a unit mistake?")
+
+
 def check_loss_factor(value, what: str = "loss_factor") -> float:
     """The loss factor ``value`` as a float, after checking it is a number in
     ``[0, LOSS_FACTOR_MAX]``."""

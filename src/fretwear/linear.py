@@ -33,8 +33,11 @@ import scipy.sparse.linalg as spla
 
 from fretwear.errors import InputError
 from fretwear.hb.reduce import condenser_for
+from fretwear.limits import RANGES
 from fretwear.model.core import Model
 from fretwear.model.interfaces import pair_transform
+from fretwear.resources import require_memory
+from fretwear.validate import instance, number, reals, whole
 
 INTERFACES = ("free", "sliding", "stuck")
 FRF_METHODS = ("direct", "condensed", "projected")
@@ -269,9 +272,13 @@ def modes(model: Model, n_modes: int = 10, *, interface: str = "sliding",
     ModesResult: ``interface``, ``frequency_hz`` (nm,) natural frequencies [Hz], ``shapes``
     (nm, ndof) mass-normalised mode shapes (a linear computation: no ``success`` to report).
     """
+    instance(model, Model, "model", "a fretwear Model (fretwear.from_mesh, "
+             "fretwear.from_matrices)")
     _check_interface(interface)
-    if f_max is None and n_modes < 1:
-        raise InputError(f"n_modes must be >= 1, got {n_modes}")
+    if f_max is None:
+        whole(n_modes, "n_modes", low=1)
+    else:
+        number(f_max, "f_max", low=0.0, open_low=True, high=RANGES["frequency"][1], unit="Hz")
     _, Tf, _ = _reduced_basis(model, interface)
     if Tf.shape[1] == 0:
         raise InputError(f"interface {interface!r} holds every DOF: the structure cannot move")
@@ -329,8 +336,8 @@ def _harmonic_load(model: Model) -> np.ndarray:
 
 
 def _check_frequencies(frequencies_hz) -> np.ndarray:
-    f = np.atleast_1d(np.asarray(frequencies_hz, dtype=float))
-    if f.ndim != 1 or f.size == 0 or not np.all(np.isfinite(f)) or np.any(f <= 0):
+    f = np.atleast_1d(reals(frequencies_hz, "frequencies_hz", low=0.0, open_low=True))
+    if f.ndim != 1:
         raise InputError("frequencies_hz must be a non-empty 1D array of positive values [Hz]")
     return f
 
@@ -590,10 +597,13 @@ def frf(model: Model, frequencies_hz, *, interface: str = "sliding",
     FRFResult: ``interface``, ``frequency_hz`` (nf,) [Hz], ``observed``: name -> (nf, d)
     complex displacement amplitudes [m], contact displacements [m] and reactions [N].
     """
+    instance(model, Model, "model", "a fretwear Model (fretwear.from_mesh, "
+             "fretwear.from_matrices)")
     _check_interface(interface)
     if method not in FRF_METHODS:
         raise InputError(f"unknown FRF method {method!r}: expected one of {FRF_METHODS}")
     freqs = _check_frequencies(frequencies_hz)
+    check_frf_size(model, freqs.size, method)
     F = _harmonic_load(model)
     _check_contact(model)
     if method in ("direct", "projected"):
@@ -602,6 +612,16 @@ def frf(model: Model, frequencies_hz, *, interface: str = "sliding",
     else:
         observed, con, rea = _frf_condensed(model, freqs, interface, condenser)
     return FRFResult(interface, freqs, observed, con, rea, method)
+
+
+def check_frf_size(model: Model, n_frequencies: int, method: str = "direct") -> None:
+    """Refuse an FRF whose responses cannot fit in memory, before anything is allocated: at
+    every frequency, complex values on the free DOFs (``"direct"``, ``"projected"``), the
+    observed DOFs, the contact displacements and reactions."""
+    per_f = (model.ndof if method != "condensed" else 0) + 2 * model.contact.dofs.size \
+        + sum(len(p.dofs) for p in model.observed)
+    require_memory(16.0 * n_frequencies * per_f, f"an FRF of {model.ndof:,} DOFs at "
+                   f"{n_frequencies:,} frequencies")
 
 
 def frequency_grid(f_min: float, f_max: float, n: int, spacing: str = "log") -> np.ndarray:
@@ -619,6 +639,7 @@ def frequency_grid(f_min: float, f_max: float, n: int, spacing: str = "log") -> 
         raise InputError(f"expected 0 < f_min < f_max, got f_min = {f_min}, f_max = {f_max}")
     if int(n) < 2:
         raise InputError(f"a frequency grid needs n >= 2 points, got {n}")
+    require_memory(8.0 * int(n), f"a grid of {int(n):,} frequencies")
     if spacing == "log":
         return np.geomspace(f_min, f_max, int(n))
     return np.linspace(f_min, f_max, int(n))

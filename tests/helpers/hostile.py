@@ -158,6 +158,26 @@ def _tables(case: dict) -> list[tuple[tuple, Table]]:
     return out
 
 
+#: changes aimed at the keys of materials per body and connectors, whose meaning depends on
+#: other keys (a set holding no whole cell, a waveform without its load, a partner that is the
+#: boundary itself): (key path, value)
+MEANINGS = (
+    (("materials", "top"), {"E": 210e9, "nu": 0.3, "rho": 7800.0}),
+    (("materials", "bottom_left"), {"E": 210e9, "nu": 0.3, "rho": 7800.0}),
+    (("materials", "nowhere"), {"E": 210e9, "nu": 0.3, "rho": 7800.0}),
+    (("contact", "normal_waveform"), "cos"),
+    (("contact", "normal_pressure"), -1e6),
+    (("contact", "normal_pressure"), math.nan),
+    (("contact", "partner"), "bottom"),
+    (("contact", "partner"), "top"),
+    (("contact", "tolerance"), 1e-3),
+    (("contact", "normal_stiffness"), 0.0),
+    (("contact", "tangential_stiffness"), -1.0),
+    (("contact", "partner_wear_coefficient"), 1e-13),
+    (("material", "E"), 210.0),
+)
+
+
 def _get(case: dict, path: tuple):
     node = case
     for k in path:
@@ -184,6 +204,10 @@ def hostile_cases(draw, analyses=tuple(ANALYSES)) -> tuple[dict, list[str]]:
         value = _spec_values(table.fields[key].spec, data)
         _get(case, path)[key] = value
         changes.append(f"{'.'.join(map(str, path))}.{key} = {value!r}"[:120])
+    if draw(st.integers(0, 3)) == 0:  # one in four: a key whose meaning depends on others
+        path, value = draw(st.sampled_from(MEANINGS))
+        _get(case, path[:-1])[path[-1]] = value
+        changes.append(f"{'.'.join(path)} = {value!r}")
     return case, changes
 
 

@@ -583,3 +583,34 @@ def test_two_block_lap_joint_in_a_case_file(tmp_path):
 def test_bad_joint_keys_get_one_line(tmp_path, change, message):
     assert LAP.replace(*change) != LAP
     assert error_of(tmp_path, LAP.replace(*change), build=True) == message
+
+
+def test_legal_but_unusual_magnitudes_are_named(tmp_path):
+    """E = 210 (Pa: steel's modulus in GPa written as Pa), a density in g/cm^3 and mu = 5 run,
+    each with one warning naming the key; the shipped beam's values give none (the ranges
+    of fretwear.limits.USUAL hold every shipped example)."""
+    from fretwear.io.case import unusual_notes
+
+    assert unusual_notes(load_case(write(tmp_path, BASE))) == []
+    text = (BASE.replace("E = 210e9", "E = 210").replace("rho = 7800.0", "rho = 7.8")
+            .replace("mu = 0.3", "mu = 5.0"))
+    notes = unusual_notes(load_case(write(tmp_path, text)))
+    assert [n.split(" = ")[0] for n in notes] == ["warning: material.E", "warning: material.rho",
+                                                "warning: contact.mu"]
+    assert notes[0].startswith("warning: material.E = 210 Pa is below the usual range")
+    assert notes[0].endswith("a unit mistake?")
+
+
+def test_shipped_examples_have_no_unusual_magnitudes():
+    from fretwear.examples import EXAMPLES_DIR
+    from fretwear.io.case import unusual_notes
+
+    for path in sorted(EXAMPLES_DIR.glob("*.toml")):
+        assert unusual_notes(load_case(path)) == [], path.name
+
+
+def test_unusual_values_of_a_case_are_said_once(tmp_path, recwarn):
+    """A case file's unusual value is a line naming its key (above), not also a Python
+    warning with a source line."""
+    build_model(load_case(write(tmp_path, BASE.replace("E = 210e9", "E = 210"))))
+    assert not [w for w in recwarn if "usual range" in str(w.message)]

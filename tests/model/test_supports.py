@@ -91,3 +91,47 @@ def test_bodies_are_the_connected_pieces_of_a_mesh():
     n1 = one.points.shape[0]
     assert set(body[:n1].tolist()) == {0} and set(body[n1:].tolist()) == {1}
     assert bodies(one).tolist() == [0] * n1
+
+
+def test_two_bodies_without_the_spring_name_the_body():
+    """A block on a held base, node-to-node, without the block's tangential spring: the
+    block (its node set from join) can slide along x; the message names it, not a node."""
+    from fretwear.model.build import Material
+
+    block = rectangle(0.02, 0.01, 4, 2, origin=(0.0, 0.005))
+    mesh = join(("block", block), ("base", rectangle(0.02, 0.005, 4, 1)))
+    with pytest.raises(InputError, match=r"body 'block' can translate along x with nothing "
+                                         r"to hold it but friction: add a spring") as err:
+        from_mesh(mesh, Material(210e9, 0.3, 7800.0), supports=[("base.bottom", "all")],
+                  contact=ContactSpec("block.bottom", mu=0.3, partner="base.top"))
+    assert "Spring(at, 'x', stiffness)" in str(err.value)
+
+
+def test_unsupported_case_file_speaks_toml(tmp_path):
+    """The same refusal from a case file gives the remedy as case-file blocks."""
+    from fretwear.analyses.run import load_case
+    from fretwear.io.case import build_model
+
+    text = """\
+[model]
+type = "rectangle"
+length = 0.1
+height = 0.01
+nx = 4
+ny = 1
+thickness = 0.01
+[material]
+E = 210e9
+nu = 0.3
+rho = 7800.0
+[contact]
+boundary = "bottom"
+mu = 0.3
+[analysis]
+type = "modes"
+"""
+    (tmp_path / "case.toml").write_text(text)
+    with pytest.raises(InputError, match=r"can translate along x with nothing to hold it but "
+                                         r"friction: add a \[\[springs\]\] block") as err:
+        build_model(load_case(tmp_path / "case.toml"))
+    assert "Spring(" not in str(err.value) and "\n" not in str(err.value)

@@ -120,8 +120,11 @@ def test_killed_run_resumes_to_the_uninterrupted_results(case, reference, tmp_pa
     if sig == signal.SIGTERM:  # handled as Ctrl-C: the state reached is saved, and said so
         assert code == 143, err
         assert saved > 1  # written by the interrupt, not only the first checkpoint
-        assert err.startswith(f"terminated (SIGTERM): saved in {out}: {CKPT}")
+        assert err.startswith(f"terminated (SIGTERM): saved in {out}: {CKPT}, wear-partial.nc")
         assert err.count("\n") == 1
+        partial = read_results(out / "wear-partial.nc")  # the steps of the checkpoint
+        assert partial.attrs["complete"] == 0 and partial.attrs["converged"] == 0
+        assert partial.sizes["step"] == saved + 1
     else:
         assert code == -signal.SIGKILL and saved == 1
 
@@ -198,9 +201,30 @@ def _edited_depth(ok: bytes, path: Path):
         np.savez(fh, **arrays)
 
 
+def _resealed(value: float):
+    """One wear depth set to ``value`` and the checksum recomputed (as someone who read the
+    code would): the seal passes, the check of the values must not."""
+
+    def damage(ok: bytes, path: Path):
+        from fretwear.files import SEAL, seal
+
+        tmp = path.with_name("ok.npz")
+        tmp.write_bytes(ok)
+        with np.load(tmp) as z:
+            arrays = {k: z[k] for k in z.files if k != SEAL}
+        tmp.unlink()
+        arrays["state_W"] = arrays["state_W"].copy()
+        arrays["state_W"].flat[0] = value
+        with open(path, "wb") as fh:
+            np.savez(fh, **seal(arrays))
+
+    return damage
+
+
 DAMAGES = {"truncated": _truncated, "flipped": _flipped, "text": _text, "empty": _empty,
            "missing-key": _missing_key, "short-history": _short_history,
-           "edited-depth": _edited_depth}
+           "edited-depth": _edited_depth, "resealed-nan-depth": _resealed(np.nan),
+           "resealed-negative-depth": _resealed(-1e-6)}
 
 
 @pytest.mark.parametrize("kind", list(DAMAGES))
@@ -259,6 +283,29 @@ def test_output_folder_that_is_a_file_is_refused(case, tmp_path, capsys):
     assert cli.main(["run", str(case), "-o", str(out), "--no-progress"]) == 2
     assert capsys.readouterr().err.startswith(f"error: the output folder '{out}' is a file")
     assert out.read_text() == "not a folder"
+
+
+def test_partial_results_are_the_steps_of_the_checkpoint(case, reference, tmp_path):
+    """What an interrupted run writes beside its checkpoint: the checkpoint's history as a
+    results file marked complete = 0 (here from the finished run's checkpoint: every step),
+    its depths those of the history read back from the checkpoint, bit for bit."""
+    import shutil
+
+    from fretwear.analyses.run import load_case
+    from fretwear.analyses.wear import write_partial
+    from fretwear.io.case import build_model
+
+    shutil.copy(reference / CKPT, tmp_path / CKPT)
+    c = load_case(case)
+    a = c.analysis
+    path = write_partial(build_model(c), FourierBasis.up_to(a["harmonics"], a["n_samples"]),
+                         a, c, tmp_path)
+    ds = read_results(path)
+    h = read_history(tmp_path / CKPT)
+    assert ds.attrs["complete"] == 0 and ds.attrs["converged"] == 0
+    assert ds.attrs["message"].startswith(f"interrupted after {h.n_steps - 1} slow steps")
+    np.testing.assert_array_equal(ds["wear_depth"].values[-1], h.wear_depth[-1])
+    assert write_partial(None, None, a, c, tmp_path / "nowhere") is None  # no checkpoint
 
 
 def test_checkpoint_of_another_model_shape(reference):

@@ -229,6 +229,35 @@ def test_failed_solve_stops_cleanly(blk, monkeypatch):
     assert 1 <= r.history.n_steps <= 4
 
 
+def test_non_finite_step_stops_the_run_naming_the_column(blk, monkeypatch):
+    """A step whose wear rate comes out NaN (as an overflowing law would give) is a failure
+    naming the column, and no non-finite value reaches the history; without the check the
+    NaN rate was recorded and the run went on (the reference: the issue's silent accepts)."""
+    import dataclasses
+
+    import fretwear.wear.simulate as simulate
+
+    m, red, anc = blk
+    real = simulate.advance
+    calls = {"n": 0}
+
+    def poisoned(sp, state, opts):
+        new_state, record, failure = real(sp, state, opts)
+        calls["n"] += 1
+        if calls["n"] == 2 and not failure:
+            record = dataclasses.replace(record, wear_rate=np.full_like(record.wear_rate,
+                                                                        np.nan))
+        return new_state, record, failure
+
+    monkeypatch.setattr(simulate, "advance", poisoned)
+    r = simulate_wear(m, BASIS, quasi_static=True, balance=BalanceSetup(reduced=red, anchor=anc),
+                      options=WearOptions(tolerance=0.05, max_steps=4))
+    assert r.stop_reason == "solver_failed" and not r.success
+    assert "non-finite values (NaN or inf) in wear_rate" in r.message
+    assert r.history.n_steps == 2  # the initial state and the first step
+    assert np.all(np.isfinite(r.history.wear_rate))
+
+
 # --- checkpoints ------------------------------------------------------------------------------
 @pytest.mark.parametrize("every", [0.0, 1e9])
 def test_interrupt_and_resume_equals_uninterrupted(blk, tmp_path, every):
@@ -372,3 +401,22 @@ def test_mean_normal_force_balances_the_preload_on_the_paper_beam():
         force = float(area @ p)
         np.testing.assert_allclose(force, P * L * width, rtol=1e-6)
         np.testing.assert_allclose(float((area * p) @ x) / force, L / 2, rtol=1e-6)
+
+
+def test_wear_bar_counts_steps_not_log_cycles():
+    """The bar's fraction is in slow steps: with jumps doubling from 1 cycle, 3 steps are left
+    to 7 more cycles (1 + 2 + 4, by hand), so after 3 steps the bar is at 3 / 6; with
+    constant jumps it is steps / (steps + cycles left / jump). The old measure,
+    log(1 + cycles) / log(1 + max_cycles), said 0.81 here whatever the steps left."""
+    from types import SimpleNamespace
+
+    from fretwear.wear.simulate import _progress_fraction, steps_left
+
+    assert steps_left(9.0, 1.0, 2.0, 16.0) == pytest.approx(3.0, rel=1e-12)
+    assert steps_left(10.0, 2.0, 1.0, 16.0) == pytest.approx(3.0, rel=1e-12)
+    assert steps_left(16.0, 2.0, 1.0, 16.0) == 0.0
+    assert steps_left(0.0, 1.0, 100.0, 1.0 + 4.0 + 16.0) == pytest.approx(3.0)  # q clipped
+    opts = WearOptions(max_cycles=16.0, max_steps=1000)
+    st = SimpleNamespace(step=3, cycles=9.0, jump=1.0, volume_rate=1.0, volume_rate0=1.0,
+                         W=np.zeros(2))
+    assert _progress_fraction(st, 2.0, opts) == pytest.approx(0.5, rel=1e-12)

@@ -170,6 +170,7 @@ def run_frf(model, analysis: dict, case, context: RunContext) -> RunOutput:
     """Frequency response functions for each requested interface."""
     _need_mass(model)
     points = check_points(model, analysis.get("points"))
+    linear.check_frf_size(model, analysis["n_points"], analysis["method"])
     freqs = linear.frequency_grid(analysis["f_min"], analysis["f_max"], analysis["n_points"],
                                   analysis["spacing"])
     interfaces = analysis["interfaces"]

@@ -39,6 +39,7 @@ from fretwear.analyses.common import (
     titled,
 )
 from fretwear.errors import InputError
+from fretwear.hb import fallbacks
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.inputs import QUASI_STATIC_FREQUENCY
 from fretwear.hb.options import PERIODIC as PERIODIC_SOLVE
@@ -245,6 +246,10 @@ def run_periodic(model, analysis: dict, case, context: RunContext) -> RunOutput:
     summary = _periodic_summary(sol, ds, analysis, where)
     if verdict:
         summary += "\n" + verdict
+    fallback = fallbacks.of_solutions([sol], sol.stats.wall_time).line(
+        "solves", fallbacks.eps_hint("eps" in analysis))
+    if fallback:
+        summary += "\n" + fallback
     return RunOutput(ds, figures, summary + "\n" + cond.choice.summary(), True, files,
                      warnings=list(sol.warnings))
 

@@ -31,7 +31,7 @@ from fretwear.analyses.registry import analysis_tables, get
 from fretwear.errors import InputError, interrupted
 from fretwear.files import remove_stale_temporaries
 from fretwear.io import case as case_files
-from fretwear.io.case import Case, build_model, observed_notes
+from fretwear.io.case import Case, build_model, observed_notes, unusual_notes
 from fretwear.io.results import read_results, write_results
 from fretwear.threads import limited
 
@@ -186,7 +186,7 @@ def run_built(model, case, out_dir: Path, how: RunContext, echo: bool = True) ->
         if built:
             model = build_model(case)
         check_sector_analysis(model, analysis.name, case.analysis)
-        for note in observed_notes(case, model) if built else ():
+        for note in (*unusual_notes(case), *(observed_notes(case, model) if built else ())):
             say(note)
         open_names = None
         if analysis.preload_check:

@@ -33,6 +33,7 @@ from fretwear.analyses.common import (
     solve_options_of,
     titled,
 )
+from fretwear.hb import fallbacks
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.options import SWEEP as SWEEP_OPTIONS
@@ -327,7 +328,10 @@ def run_sweep(model, analysis: dict, case, context: RunContext) -> RunOutput:
     })
     figures = sweep_figures(ds, case, context.out_dir)
     grid_ok = all(p.success for p in result.points if p.on_grid)
-    summary = "\n".join([_sweep_summary(result, ds), *events, cond.choice.summary()])
+    fallback = fallbacks.of_solutions(result.points, result.wall_time).line(
+        "frequencies", fallbacks.eps_hint("eps" in analysis))
+    summary = "\n".join([_sweep_summary(result, ds), *events, *([fallback] if fallback else []),
+                         cond.choice.summary()])
     return RunOutput(ds, figures, summary, grid_ok, warnings=list(result.warnings))
 
 

@@ -11,6 +11,7 @@ FRFs before and after wear (paper Fig. 24).
 
 from __future__ import annotations
 
+import math
 from dataclasses import fields
 from pathlib import Path
 
@@ -26,14 +27,22 @@ from fretwear.analyses.common import (
     default_of,
     interface_labels,
 )
+from fretwear.errors import InputError, interrupted
 from fretwear.files import safe_name
+from fretwear.hb import fallbacks
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.options import WEAR_STEP
 from fretwear.hb.penalty import RULES
 from fretwear.hb.solvers import SOLVERS
 from fretwear.hb.sweep import frequency_grid
-from fretwear.io.results import label_coordinate, variable, write_pvd, write_vtu
+from fretwear.io.results import (
+    label_coordinate,
+    variable,
+    write_pvd,
+    write_results,
+    write_vtu,
+)
 from fretwear.io.schema import (
     MISSING,
     AnyOf,
@@ -59,6 +68,7 @@ from fretwear.wear import (
     WearResult,
     simulate_wear,
 )
+from fretwear.wear.checkpoint import read_history
 from fretwear.wear.laws import side_depths
 from fretwear.wear.simulate import QUASI_STATIC_FREQUENCY
 from fretwear.wear.worn_frf import WORN_FRF
@@ -404,10 +414,18 @@ def run_wear(model, analysis: dict, case, context: RunContext) -> RunOutput:
     fb = a.get("frf_before_after")
     top = None if quasi else max(f_hz, fb["f_max"] if fb is not None else 0.0)
     cond = condenser_of(model, a, top, max(basis.harmonics))
-    result = api.simulate_wear(model, basis, frequency=f_hz, quasi_static=quasi, options=opts,
-                               balance=BalanceSetup(condenser=cond, **penalty_of(a)),
-                               run=RunControl(checkpoint=context.out_dir / CHECKPOINT_FILE,
-                                              resume=context.resume, progress=context.progress))
+    try:
+        result = api.simulate_wear(model, basis, frequency=f_hz, quasi_static=quasi,
+                                   options=opts,
+                                   balance=BalanceSetup(condenser=cond, **penalty_of(a)),
+                                   run=RunControl(checkpoint=context.out_dir / CHECKPOINT_FILE,
+                                                  resume=context.resume,
+                                                  progress=context.progress))
+    except (KeyboardInterrupt, SystemError) as exc:
+        if not interrupted(exc):
+            raise
+        write_partial(model, basis, analysis, case, context.out_dir)
+        raise KeyboardInterrupt from None
     frf, frf_note = None, ""
     if fb is not None and model.observed:
         grid = (fb["f_min"], fb["f_max"], fb["n_points"])
@@ -445,12 +463,46 @@ def run_wear(model, analysis: dict, case, context: RunContext) -> RunOutput:
     ]
     if frf_note:
         lines.append(frf_note)
+    fallback = fallbacks.of_wear(h.rescued[1:], h.wall_time[1:], result.wall_time).line(
+        "slow steps", fallbacks.eps_hint("eps" in a))
+    if fallback:
+        lines.append(fallback)
     lines.append(cond.choice.summary())
     warnings = list(result.warnings)
     for name, sw in (sweeps.items() if frf is not None else ()):
         warnings += [f"FRF {name}: {w}" for w in sw.warnings]
     return RunOutput(ds, figures, "\n".join(lines), result.success, files,
                      warnings=warnings)
+
+
+#: the results of an interrupted wear run, beside its checkpoint (attribute ``complete = 0``)
+PARTIAL_FILE = "wear-partial.nc"
+
+
+def write_partial(model, basis: FourierBasis, analysis: dict, case, out_dir: Path):
+    """The steps saved in the checkpoint of an interrupted run as a results file
+    (:data:`PARTIAL_FILE`, the variables of ``results.nc``, ``complete = 0`` and
+    ``converged = 0``) to look at while the run is not finished; None without a readable
+    checkpoint. ``--resume`` continues from the checkpoint and writes ``results.nc``."""
+    ck = out_dir / CHECKPOINT_FILE
+    try:
+        history = read_history(ck)
+    except (InputError, OSError):
+        return None
+    opts = options_from_table(analysis)
+    n = history.n_steps - 1
+    message = (f"interrupted after {n} slow steps, N = {float(history.cycles[-1]):.4g} cycles:"
+               " partial results (run again with --resume to continue)")
+    result = WearResult(history, None, None, "", message, False, math.nan)
+    ds = wear_dataset(model, result, basis,
+                      frequency_hz=float(analysis.get("frequency", QUASI_STATIC_FREQUENCY)),
+                      record_every=analysis["record_every"], law=opts.law,
+                      energy_coefficients=(opts.energy_coefficient,
+                                           opts.partner_energy_coefficient))
+    ds.attrs.update({"complete": 0, "message": message})
+    return write_results(out_dir / PARTIAL_FILE, ds, title=case.title, analysis_type="wear",
+                         converged=False, case_text=case.text, case_path=str(case.path),
+                         analysis=analysis)
 
 
 def write_wear_fields(model, ds, pvd: Path) -> Path:

@@ -48,6 +48,7 @@ from fretwear.hb.arclength import arclength
 from fretwear.hb.branch import Branch, Problems
 from fretwear.hb.connectors import Connected
 from fretwear.hb.fallback import TimeDomainFallback
+from fretwear.hb.fallbacks import said
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.options import PERIODIC, STRATEGY, SolveOptions, SweepOptions
 from fretwear.hb.problem import DLFTProblem
@@ -207,6 +208,7 @@ class Trial:
     time_start: TimeStart | None = None
     best: Found | None = None
     found: str = ""
+    fallback_seconds: float = 0.0
 
     def __post_init__(self):
         self.start = np.asarray(self.start, float).reshape(self.prob.m, self.prob.H)
@@ -305,6 +307,8 @@ def time_start(t: Trial) -> bool:
         return False
     best = t.settle()
     opts, prob = t.options, t.prob
+    said(f"{_where(prob)}: integrating in time from rest for up to "
+         f"{opts.time_domain_periods} periods (a time integration can take minutes)")
     t0 = time.perf_counter()
     t.found, Ut, anchor = ts.fallback.start(ts.model, ts.frequency, prob.basis, None,
                                             max_periods=opts.time_domain_periods)
@@ -333,10 +337,26 @@ def solve_ladder(t: Trial, rungs=None) -> Found:
     of :data:`~fretwear.hb.options.STRATEGY`, until one converges: the converged answer, or
     the best iterate (the start when no rung ran at the target eps)."""
     rungs = t.options.strategy if rungs is None else rungs
+    done, t_first = "", None
     for name in STRATEGY:
-        if name in rungs and SOLVE_RUNGS[name](t):
+        if name not in rungs or (name == "time-start" and t.time_start is None):
+            continue
+        if done:
+            t_first = time.perf_counter() if t_first is None else t_first
+            said(f"{_where(t.prob)}: {done} failed (best residual "
+                 f"{t.best.stats.residual if t.best else float('nan'):.2e}); trying {name}")
+        if SOLVE_RUNGS[name](t):
             break
+        done = name
+    if t_first is not None:
+        t.fallback_seconds = time.perf_counter() - t_first
     return t.settle()
+
+
+def _where(prob: DLFTProblem) -> str:
+    red = prob.reduced
+    return ("quasi-static periodic solve" if red.quasi_static
+            else f"periodic solve at {red.frequency:.6g} Hz")
 
 
 # --- the ladder of a sweep point ------------------------------------------------------------
@@ -358,6 +378,7 @@ class Point:
     how: str = "grid"
     tried: list = field(default_factory=list)
     time_domain: str | None = None
+    fallback_seconds: float = 0.0
 
     @property
     def omega(self) -> float:
@@ -532,9 +553,25 @@ POINT_RUNGS = (("grid", grid), ("substep", substep), ("retry", retry),
                ("fresh-start", fresh_start), ("time-start", point_time_start))
 
 
+#: the rungs of a sweep point said as they start (the costly ones; the first four are the
+#: continuation's own steps)
+SAID_RUNGS = ("continuation", "fresh-start", "time-start")
+
+
 def point_ladder(p: Point) -> Point:
-    """Run the rungs of a sweep point (:data:`POINT_RUNGS`) until one converges."""
-    for _, rung in POINT_RUNGS:
+    """Run the rungs of a sweep point (:data:`POINT_RUNGS`) until one converges; the wall time
+    after the first rung is ``p.fallback_seconds``, the costly rungs are said as they start
+    (:func:`~fretwear.hb.fallbacks.said`)."""
+    t_first = None
+    for i, (name, rung) in enumerate(POINT_RUNGS):
+        if i == 1:
+            t_first = time.perf_counter()
+        if name in SAID_RUNGS:
+            said(f"sweep at {p.frequency:.6g} Hz: the continuation failed; trying "
+                 f"{name}" + (" (a time integration can take minutes)"
+                              if name == "time-start" else ""))
         if rung(p):
             break
+    if t_first is not None:
+        p.fallback_seconds = time.perf_counter() - t_first
     return p

@@ -41,8 +41,12 @@ class FourierBasis:
         except TypeError:
             raise InputError(f"harmonics = {self.harmonics!r}: expected a sequence of "
                              "integers >= 1") from None
-        if any(isinstance(x, bool) or int(x) != x for x in h):
-            raise InputError(f"harmonics = {list(h)}: expected integers >= 1")
+        try:
+            bad = any(isinstance(x, bool) or int(x) != x for x in h)
+        except (TypeError, ValueError, OverflowError):
+            bad = True
+        if bad:
+            raise InputError(f"harmonics = {list(h)[:8]}: expected integers >= 1")
         h = tuple(int(x) for x in h)
         object.__setattr__(self, "harmonics", h)
         n = self.n_samples
@@ -53,6 +57,10 @@ class FourierBasis:
             raise InputError(
                 f"harmonics must be strictly increasing integers >= 1, got {list(h)}"
             )
+        if not h and self.n_samples != 1:
+            raise InputError("harmonics = (): expected at least one harmonic >= 1 (e.g. "
+                             "FourierBasis.up_to(7, 128)); the basis of the static part alone "
+                             "is FourierBasis.static()")
         hmax = max(h) if h else 0
         if self.n_samples <= 2 * hmax:
             raise InputError(
@@ -67,7 +75,19 @@ class FourierBasis:
     def up_to(cls, nh: int = 7, n_samples: int = 128) -> FourierBasis:
         """All harmonics ``1..nh`` with ``n_samples`` samples per period (default: the
         paper's 7 harmonics and 128 samples, section 4.2)."""
+        if isinstance(nh, bool) or not isinstance(nh, int | np.integer) or nh < 1:
+            raise InputError(f"nh = {nh!r}: expected a whole number of harmonics >= 1")
+        if isinstance(n_samples, int | np.integer) and not isinstance(n_samples, bool) \
+                and n_samples <= 2 * nh:
+            raise InputError(f"n_samples = {n_samples} is too small for harmonic {nh}: "
+                             f"expected more than {2 * nh} samples per period")
         return cls(tuple(range(1, nh + 1)), n_samples)
+
+    @classmethod
+    def static(cls) -> FourierBasis:
+        """The basis of the static part alone (no harmonic, one sample): static contact
+        solves."""
+        return cls((), 1)
 
     @property
     def k(self) -> int:

@@ -382,7 +382,7 @@ class ModeProblem:
 def _static_start(problem: ModeProblem, omega0: float):
     """The preload state: the balance at harmonic 0 alone (the static contact problem from a
     stress-free state, anchors 0), as the periodic solves take it."""
-    basis0 = FourierBasis((), 1)
+    basis0 = FourierBasis.static()
     p0 = ModeProblem(problem.sys, problem.contact, basis0, problem.eps,
                      np.zeros_like(problem.anchor), problem.W[0::problem.d, 0])
     n = p0.n

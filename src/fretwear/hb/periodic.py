@@ -109,6 +109,7 @@ def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float | None
             f"{len(trial.attempts)} attempts: {', '.join(a.method for a in trial.attempts)})")
     sol = assemble_solution(best.prob, best.x.reshape(best.prob.m, best.prob.H), model, st)
     sol.attempts = trial.attempts
+    sol.fallback_seconds = trial.fallback_seconds
     if trial.found:
         sol.time_domain = trial.found
         if not sol.success:

@@ -80,7 +80,7 @@ def static_anchor(model: Model, *, quasi: Reduced | None = None, eps="auto",
 
 def _static_solve(model: Model, quasi: Reduced | None, eps, condenser=None):
     """The static contact problem of :func:`static_anchor`: ``(problem, x, stats)``."""
-    basis = FourierBasis((), 1)
+    basis = FourierBasis.static()
     red = quasi if quasi is not None else condense(model, 0.0, [0], quasi_static=True,
                                                    condenser=condenser)
     prob = DLFTProblem(red, model.contact, basis, eps=eps)

@@ -60,6 +60,8 @@ class PeriodicSolution:
         when none ran.
     warnings : reasons for caution about the inputs of the solve, one line each (e.g. the
         static preload solve that gives the default stick anchors did not converge).
+    fallback_seconds : wall time [s] of the attempts after the first one
+        (:mod:`fretwear.hb.fallbacks`).
     """
 
     frequency: float
@@ -84,6 +86,7 @@ class PeriodicSolution:
     attempts: list = field(default_factory=list)
     time_domain: str = ""
     warnings: list = field(default_factory=list)
+    fallback_seconds: float = 0.0
 
     @property
     def success(self) -> bool:

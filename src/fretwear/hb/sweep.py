@@ -198,4 +198,5 @@ def _grid_point(p: Point) -> SweepPoint:
             pt.time_domain = p.time_domain
     pt.on_grid = True
     pt.attempts = p.tried
+    pt.fallback_seconds = p.fallback_seconds
     return pt

@@ -41,7 +41,9 @@ class SweepPoint:
     (:class:`~fretwear.hb.solution.Attempt`); flags : reasons for caution
     (``"not converged: ..."``, time-domain findings); on_grid : a requested grid frequency
     (False for the intermediate points the sweep added); time_domain : what the time
-    integration found at a point whose balance failed (``""`` when none ran).
+    integration found at a point whose balance failed (``""`` when none ran);
+    fallback_seconds : wall time [s] spent after the first attempt
+    (:mod:`fretwear.hb.fallbacks`).
     """
 
     frequency_hz: float
@@ -52,6 +54,7 @@ class SweepPoint:
     on_grid: bool = False
     time_domain: str = ""
     attempts: list = field(default_factory=list)
+    fallback_seconds: float = 0.0
 
     @property
     def success(self) -> bool:

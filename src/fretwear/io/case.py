@@ -19,6 +19,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import tomllib
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -52,8 +53,9 @@ from fretwear.io.schema import (
     suggest,
     table_label,
 )
-from fretwear.limits import LOSS_FACTOR_MAX
+from fretwear.limits import LOSS_FACTOR_MAX, UnusualValueWarning, unusual
 from fretwear.model.core import WAVEFORMS
+from fretwear.model.supports import Unsupported
 
 AXES = ("x", "y", "z")
 FIGURE_FORMATS = ("png", "pdf", "svg")
@@ -94,6 +96,21 @@ _MU = Field(_NON_NEG, "Coulomb friction coefficient", required=True, unit="-")
 _WEAR = Field(_NON_NEG, "Archard wear coefficient k_w (paper eq. 29)", default=0.0, unit="1/Pa")
 _CONTACT_NAME = Field(Text(), "label of the interface in output", default="contact")
 _CONTACT_K = Number(lo=0, lo_open=True, hi=1e20, allow_inf=True)
+
+
+def _waveform_needs(load_key: str):
+    """Rule: a ``normal_waveform`` other than the default shapes ``load_key`` only: without it,
+    the waveform would be ignored."""
+
+    def rule(out: dict, path: str) -> None:
+        if out.get("normal_waveform", "constant") != "constant" and load_key not in out:
+            raise InputError(f"{table_label(path)}: 'normal_waveform' = "
+                             f"{out['normal_waveform']!r} needs {load_key!r} (the waveform "
+                             "shapes a prescribed normal load; without it it would be ignored)")
+
+    return rule
+
+
 _NORMAL_WAVEFORM = Field(Text(tuple(w for w in WAVEFORMS if w != "fourier")),
                          "time history g(omega t) of the prescribed normal load"
                          ' (as loads\' `waveform`; "fourier" is not offered here)',
@@ -388,7 +405,7 @@ CONTACT_MESH = Table(
     },
     checks=(non_zero("normal", "tangent"), _ranges,
             requires("partner_wear_coefficient", "partner"),
-            requires("tolerance", "partner")),
+            requires("tolerance", "partner"), _waveform_needs("normal_pressure")),
     doc="A frictional interface: the nodes of one boundary (or of its `region`) against a "
     "rigid obstacle, or against a second body (`partner`): its matching nodes, or its facets "
     "when the meshes do not match (`pairing`). Several interfaces: one `[[contact]]` block "
@@ -562,7 +579,7 @@ CONTACT_MATRICES = Table(
                              unit="N"),
         "normal_waveform": _NORMAL_WAVEFORM,
     },
-    checks=(_normal_dofs_or_load,),
+    checks=(_normal_dofs_or_load, _waveform_needs("normal_load")),
     doc="The frictional interface: DOFs of the contact nodes against a rigid obstacle.",
 )
 OBSERVED_MATRICES = Dict(AnyOf((_DOF, ListOf(_DOF, non_empty=True))), key_doc="point names")
@@ -824,7 +841,39 @@ def build_model(case: Case):
         return build_from_fe(case.model, case.title)
     if case.model_kind == "matrices":
         return _build_from_matrices(case.model, case.title)
-    return _build_from_mesh(case.model, case.title, given=case.raw["model"])
+    with warnings.catch_warnings():  # said by key instead (unusual_notes)
+        warnings.simplefilter("ignore", UnusualValueWarning)
+        return _build_from_mesh(case.model, case.title, given=case.raw["model"])
+
+
+#: case-file key -> kind of :data:`fretwear.limits.USUAL` it is checked against
+_USUAL_KEYS = {"E": "modulus", "rho": "density", "mu": "friction",
+               "wear_coefficient": "wear_coefficient",
+               "partner_wear_coefficient": "wear_coefficient", "pressure": "pressure",
+               "normal_pressure": "pressure"}
+
+
+def unusual_notes(case: Case) -> list[str]:
+    """Lines for legal values that are almost surely a unit mistake (``E = 210`` [Pa], a
+    density in g/cm^3, ``mu = 5``...), named by their key: :func:`fretwear.limits.unusual`."""
+    notes = []
+
+    def walk(value, path: str):
+        if isinstance(value, Mapping):
+            for k, v in value.items():
+                sub = f"{path}.{k}" if path else str(k)
+                if k in _USUAL_KEYS and not isinstance(v, Mapping | list | bool):
+                    note = unusual(v, _USUAL_KEYS[k], sub)
+                    if note:
+                        notes.append(f"warning: {note}")
+                else:
+                    walk(v, sub)
+        elif isinstance(value, list):
+            for i, v in enumerate(value):  # one block: named as the file names it
+                walk(v, f"{path}[{i + 1}]" if len(value) > 1 else path)
+
+    walk({k: v for k, v in case.model.items() if k != "analysis"}, "")
+    return notes
 
 
 def observed_notes(case: Case, model, rtol: float = 1e-6) -> list[str]:
@@ -987,18 +1036,21 @@ def _build_from_mesh(m: dict, title: str, given: Mapping):
                  f"other than its boundary {spec.boundary!r} (the damper pairs a boundary "
                  "with the next sector's copy of another one)")
         contact = [c for c in contact if c.name != neighbour]
-    model = build.from_mesh(
-        mesh,
-        material,
-        thickness=thickness,
-        damping=build.Damping(damp["loss_factor"], damp["rayleigh_mass"],
-                              damp["rayleigh_stiffness"]),
-        supports=[*springs, *fixed],
-        loads=loads,
-        contact=contact,
-        observed=observed,
-        name=title,
-    )
+    try:
+        model = build.from_mesh(
+            mesh,
+            material,
+            thickness=thickness,
+            damping=build.Damping(damp["loss_factor"], damp["rayleigh_mass"],
+                                  damp["rayleigh_stiffness"]),
+            supports=[*springs, *fixed],
+            loads=loads,
+            contact=contact,
+            observed=observed,
+            name=title,
+        )
+    except Unsupported as exc:  # the remedy as case-file blocks, not Python
+        raise exc.in_case_file() from None
     if m.get("centrifugal"):
         model = _spin(model, m["centrifugal"], cyc or {})
     return model if cyc is None else _sector(model, cyc, spec if neighbour else None)
@@ -1144,6 +1196,11 @@ def _build_from_matrices(m: dict, title: str):
                                  base).tolist()
                 for name, d in m.get("observed", {}).items()}
     gap, area = c["gap"], c["area"]
+    for key in ("normal_load", "gap", "area", "kn", "kt"):
+        if isinstance(c.get(key), list) and len(c[key]) not in (1, len(tangential)):
+            raise InputError(f"model.contact.{key} has {len(c[key])} values; expected one, or "
+                             f"one per contact node ({len(tangential)}, the rows of "
+                             "tangential_dofs)")
     contact = ContactDofs(
         normal_dofs=normal,
         tangential_dofs=tangential,

@@ -162,6 +162,11 @@ class Number(Spec):
         return value
 
 
+#: the largest magnitude of an integer key: below numpy's int64 limit (2^63 - 1), far above any
+#: count or index a model can have
+INTEGER_MAX = 2**62
+
+
 @dataclass
 class Integer(Number):
     """An integer, optionally bounded (a float such as ``3.0`` is refused: a likely typo)."""
@@ -174,7 +179,11 @@ class Integer(Number):
     def check(self, value, path, ctx):
         if not self.matches(value):
             self._type_error(value, path)
-        return int(super().check(value, path, ctx))
+        out = int(super().check(value, path, ctx))
+        if abs(out) > INTEGER_MAX:  # numpy's int64 would overflow (an OverflowError)
+            fail(path, value, f"{self.expected()} of magnitude at most 2^62 (no count or "
+                 "index of a model comes near it)")
+        return out
 
 
 @dataclass

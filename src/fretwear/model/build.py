@@ -16,6 +16,7 @@ The model is refused when the contact alone cannot hold it
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
@@ -23,7 +24,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from fretwear.errors import InputError
-from fretwear.limits import check_loss_factor
+from fretwear.limits import RANGES, UnusualValueWarning, check_loss_factor, unusual
 from fretwear.model.core import WAVEFORMS, ContactInterface, Load, Mesh, Model, ObservedPoint
 from fretwear.model.fem import assemble, check_material, check_thickness
 from fretwear.model.interfaces import combine
@@ -34,21 +35,23 @@ from fretwear.model.pairing import check_pairing, pair
 from fretwear.model.places import AXES, axis_index, find_node, nodes_at, unit_direction
 from fretwear.model.regions import region_nodes, restricted
 from fretwear.model.supports import check_supported
+from fretwear.validate import is_real, number
 
 
 # --------------------------------------------------------------------------------------------
 # input dataclasses
 # --------------------------------------------------------------------------------------------
 def _finite(value, what: str, *, minimum=None, allow_inf=False) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise InputError(f"{what} = {value!r} is not a number") from None
-    if math.isnan(v) or (math.isinf(v) and not allow_inf):
-        raise InputError(f"{what} = {value!r}; expected a finite number")
-    if minimum is not None and v < minimum:
-        raise InputError(f"{what} = {value!r}; expected a value >= {minimum}")
-    return v
+    return number(value, what, low=minimum, allow_inf=allow_inf)
+
+
+def _warn_unusual(*checks) -> None:
+    """A UserWarning for each ``(value, kind, what)`` that is legal but almost surely a unit
+    mistake (:func:`fretwear.limits.unusual`)."""
+    for value, kind, what in checks:
+        note = unusual(value, kind, what)
+        if note:
+            warnings.warn(note, UnusualValueWarning, stacklevel=4)
 
 
 def _check_waveform(waveform, coefficients, what: str) -> None:
@@ -90,6 +93,7 @@ class Material:
 
     def __post_init__(self):
         self.E, self.nu, self.rho = check_material(self.E, self.nu, self.rho)
+        _warn_unusual((self.E, "modulus", "Material: E"), (self.rho, "density", "Material: rho"))
 
 
 @dataclass
@@ -112,6 +116,8 @@ class Damping:
     D: object = field(default=None, repr=False, compare=False)
 
     def __post_init__(self):
+        if not is_real(self.loss_factor):  # not "1" or True, as a case file could not write
+            raise InputError(f"damping loss_factor = {self.loss_factor!r} is not a number")
         self.loss_factor = check_loss_factor(self.loss_factor, "damping loss_factor")
         self.rayleigh_mass = _finite(self.rayleigh_mass, "damping rayleigh_mass", minimum=0.0)
         self.rayleigh_stiffness = _finite(self.rayleigh_stiffness,
@@ -268,6 +274,9 @@ class ContactSpec:
 
     def __post_init__(self):
         what = f"contact {self.name!r}"
+        if not isinstance(self.boundary, str) or not self.boundary:
+            raise InputError(f"{what}: boundary = {self.boundary!r}; expected the name of a "
+                             "boundary of the mesh")
         check_pairing(self.pairing, what)
         if self.pairing != "auto" and self.partner is None:
             raise InputError(f"{what}: pairing = {self.pairing!r} without a partner boundary "
@@ -284,7 +293,25 @@ class ContactSpec:
         if self.tolerance is not None:
             self.tolerance = _finite(self.tolerance, f"{what}: tolerance", minimum=0.0)
         if not callable(self.gap):
-            self.gap = _finite(self.gap, f"{what}: gap")
+            size = RANGES["length"][1]  # a gap larger than any structure means no contact
+            self.gap = number(self.gap, f"{what}: gap", low=-size, high=size, unit="m")
+        _warn_unusual((self.mu, "friction", f"{what}: mu"),
+                      (self.wear_coefficient, "wear_coefficient", f"{what}: wear_coefficient"))
+        for key in ("normal_stiffness", "tangential_stiffness"):
+            v = number(getattr(self, key), f"{what}: {key}", low=0.0, open_low=True,
+                       allow_inf=True, unit="Pa/m")
+            setattr(self, key, v)
+        if self.normal_pressure is not None:
+            self.normal_pressure = number(self.normal_pressure, f"{what}: normal_pressure",
+                                          low=0.0, unit="Pa")
+        waveforms = [w for w in WAVEFORMS if w != "fourier"]
+        if self.normal_waveform not in waveforms:
+            raise InputError(f"{what}: normal_waveform = {self.normal_waveform!r}; expected one "
+                             f"of {waveforms}")
+        if self.normal_pressure is None and self.normal_waveform != "constant":
+            raise InputError(f"{what}: normal_waveform = {self.normal_waveform!r} without "
+                             "normal_pressure: the waveform only shapes a prescribed normal "
+                             "pressure (give normal_pressure, or leave the waveform out)")
 
 
 # --------------------------------------------------------------------------------------------
@@ -671,6 +698,9 @@ def from_mesh(mesh: Mesh, material: Material, *, thickness=1.0, damping: Damping
         raise InputError(f"material = {material!r} is not a Material(E, nu, rho)")
     else:
         K0, M = assemble(mesh, material.E, material.nu, material.rho, thickness)
+    if isinstance(supports, str) or not isinstance(supports, Sequence):
+        raise InputError(f"supports = {supports!r}; expected a list of Spring(...) and "
+                         "(at, direction) items")
     Ks, fixed_dofs = _supports(mesh, supports)
     specs = [contact] if isinstance(contact, ContactSpec) else list(contact) \
         if isinstance(contact, Sequence) and not isinstance(contact, str) else [contact]
@@ -748,6 +778,10 @@ def _assemble_bodies(mesh: Mesh, materials: dict, thickness: float):
             inside = np.zeros(nn, dtype=bool)
             inside[np.asarray(mesh.node_sets[body], dtype=np.int64)] = True
             mine = np.flatnonzero(np.all(inside[cells], axis=1))
+            if mine.size == 0:
+                raise InputError(f"material[{body!r}]: the node set {body!r} holds no whole "
+                                 "cell (a boundary or a few nodes, not a body): the material "
+                                 "would apply to nothing; name a body (a volume group)")
         twice = mine[owner[mine] >= 0]
         if twice.size:
             raise InputError(f"material: cell {int(twice[0])} belongs to two bodies "

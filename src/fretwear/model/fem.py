@@ -13,6 +13,7 @@ import scipy.sparse as sp
 from fretwear.errors import InputError
 from fretwear.limits import check_range
 from fretwear.model.core import Mesh
+from fretwear.validate import is_real
 
 # meshio/VTK hexahedron node k is scikit-fem's local node _HEX_TO_SKFEM.index(k): scikit-fem
 # local node j sits at the VTK node _HEX_TO_SKFEM[j].
@@ -30,10 +31,9 @@ def check_material(E, nu, rho) -> tuple[float, float, float]:
     vals = []
     for value, what in ((E, "Young's modulus E"), (nu, "Poisson's ratio nu"),
                         (rho, "density rho")):
-        try:
-            v = float(value)
-        except (TypeError, ValueError):
-            raise InputError(f"{what} = {value!r} is not a number") from None
+        if not is_real(value):
+            raise InputError(f"{what} = {value!r} is not a number")
+        v = float(value)
         if not np.isfinite(v):
             raise InputError(f"{what} = {value!r}; expected a finite number")
         vals.append(v)
@@ -54,10 +54,9 @@ def check_material(E, nu, rho) -> tuple[float, float, float]:
 
 def check_thickness(thickness, dim: int) -> float:
     """Validate the out-of-plane width [m] (2D) or require 1 (3D)."""
-    try:
-        t = float(thickness)
-    except (TypeError, ValueError):
-        raise InputError(f"thickness = {thickness!r} is not a number") from None
+    if not is_real(thickness):
+        raise InputError(f"thickness = {thickness!r} is not a number [m]")
+    t = float(thickness)
     if not np.isfinite(t) or t <= 0.0:
         raise InputError(f"thickness = {thickness!r}; expected an out-of-plane width > 0 [m]")
     if dim == 2:

@@ -16,11 +16,13 @@ import scipy.io
 import scipy.sparse as sp
 
 from fretwear.errors import InputError
+from fretwear.limits import RANGES
 from fretwear.model.build import Damping
 from fretwear.model.core import WAVEFORMS, ContactInterface, Load, Model, ObservedPoint
 from fretwear.model.interfaces import relative_model
 from fretwear.model.supports import rigid_motion_check
 from fretwear.resources import require_memory
+from fretwear.validate import is_real
 
 SYMMETRY_TOL = 1e-9  # max |A - A^T| relative to max |A|
 
@@ -141,6 +143,8 @@ def _dofs(values, ndof: int, what: str) -> np.ndarray:
 
 def _per_node(value, nc: int, what: str, *, positive=False, signs=False) -> np.ndarray:
     try:
+        if isinstance(value, str | bytes) or np.asarray(value).dtype.kind not in "iuf":
+            raise ValueError(value)
         a = np.broadcast_to(np.asarray(value, dtype=float), (nc,)).copy()
     except (TypeError, ValueError):
         raise InputError(f"{what} = {value!r}; expected a number or {nc} numbers (one per "
@@ -154,7 +158,17 @@ def _per_node(value, nc: int, what: str, *, positive=False, signs=False) -> np.n
     return a
 
 
+def _bounded(a: np.ndarray, bound: float, what: str) -> np.ndarray:
+    """``a`` after checking every magnitude is at most ``bound``."""
+    if np.any(np.abs(a) > bound):
+        raise InputError(f"{what}: {float(a[np.abs(a) > bound][0]):g}; expected magnitudes <= "
+                         f"{bound:g} (larger than any structure)")
+    return a
+
+
 def _nonnegative(value, what: str) -> float:
+    if not is_real(value):
+        raise InputError(f"{what} = {value!r} is not a number")
     try:
         v = float(value)
     except (TypeError, ValueError):
@@ -384,7 +398,7 @@ def _interface(contact: ContactDofs, dofs: np.ndarray, n: int) -> ContactInterfa
     interface = ContactInterface(
         dofs=dofs,
         frame=frame,
-        gap=_per_node(contact.gap, nc, "gap"),
+        gap=_bounded(_per_node(contact.gap, nc, "gap"), RANGES["length"][1], "gap [m]"),
         area=_per_node(contact.area, nc, "area", positive=True),
         mu=_nonnegative(contact.mu, "friction coefficient mu"),
         coords=xyz,

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import contextlib
 import io
-from pathlib import Path
 
 import numpy as np
 
@@ -22,6 +21,8 @@ from fretwear.errors import InputError
 from fretwear.limits import RANGES, check_range
 from fretwear.model.core import Mesh
 from fretwear.resources import require_memory
+from fretwear.validate import instance, is_real, reals
+from fretwear.validate import path as check_path
 
 CELL_DIM = {"quad": 2, "triangle": 2, "hexahedron": 3, "tetra": 3}
 FACET_TYPE = {"quad": "line", "triangle": "line", "hexahedron": "quad", "tetra": "triangle"}
@@ -42,6 +43,8 @@ _LOCAL_FACETS = {
 # structured meshes
 # --------------------------------------------------------------------------------------------
 def _positive(value, what: str) -> float:
+    if not is_real(value):
+        raise InputError(f"{what} = {value!r} is not a number; expected a length > 0 [m]")
     try:
         v = float(value)
     except (TypeError, ValueError):
@@ -222,12 +225,15 @@ def join(*parts: tuple[str, Mesh]) -> Mesh:
 def transformed(mesh: Mesh, rotation, shift=None) -> Mesh:
     """The mesh moved rigidly: ``x -> rotation @ x + shift`` (``rotation`` (d, d)
     orthogonal with determinant 1, ``shift`` (d,) [m])."""
-    R = np.asarray(rotation, dtype=float)
+    instance(mesh, Mesh, "mesh", "a fretwear Mesh (fretwear.rectangle, box, read_mesh)")
+    R = reals(rotation, "rotation", ndim=2)
     d = mesh.dim
     if R.shape != (d, d) or not np.allclose(R @ R.T, np.eye(d), atol=1e-12) \
             or np.linalg.det(R) <= 0:
         raise InputError(f"rotation has shape {R.shape}; expected a ({d}, {d}) rotation matrix")
-    t = np.zeros(d) if shift is None else np.asarray(shift, dtype=float).reshape(d)
+    t = np.zeros(d) if shift is None else reals(shift, "shift")
+    if t.shape != (d,):
+        raise InputError(f"shift has shape {t.shape}; expected ({d},) [m]")
     return Mesh(mesh.points @ R.T + t, mesh.cells.copy(), mesh.cell_type,
                 {k: v.copy() for k, v in mesh.boundaries.items()},
                 {k: v.copy() for k, v in mesh.node_sets.items()})
@@ -356,7 +362,7 @@ def read(path) -> Mesh:
     """
     import meshio
 
-    path = Path(path)
+    path = check_path(path, "path")
     if not path.is_file():
         raise InputError(f"mesh file {str(path)!r} does not exist")
     chatter = io.StringIO()

@@ -157,17 +157,42 @@ def check_supported(model: Model) -> None:
         if nb > 1:
             others = [j for j in range(nb) if j != k and np.abs(a[j * nr:(j + 1) * nr]).max()
                       > 1e-8]
-            who = f"the body of node {first}" + (" (with others)" if others else "")
-            words = f"{who} can {words}"
+            who = _body_name(model.mesh, np.flatnonzero(body == k), first)
+            words = f"{who}{' (with others)' if others else ''} can {words}"
         motions.append(words)
-    hint = ", ".join(f"Spring(at, {AXES[i]!r}, stiffness)" for i in range(d))
     lead = "the structure can " if nb == 1 else ""
-    raise InputError(
+    raise Unsupported(
         "with the contact held only along its normal (frictionless), " + lead
         + (", ".join(motions[:-1]) + " and " if len(motions) > 1 else "") + motions[-1]
-        + " with nothing to hold it but friction: add a spring or a fixed DOF (springs = ["
-        + hint + "] or fixed = [(at, direction)]) at a node off the contact boundary"
-    )
+        + " with nothing to hold it but friction", d)
+
+
+class Unsupported(InputError):
+    """A model that only friction could hold: the message says how it can move and, in the
+    words of the Python API, what would hold it; :meth:`in_case_file` says it in those of a
+    case file."""
+
+    def __init__(self, what: str, dim: int):
+        self.what, self.dim = what, dim
+        hint = ", ".join(f"Spring(at, {AXES[i]!r}, stiffness)" for i in range(dim))
+        super().__init__(f"{what}: add a spring or a fixed DOF (supports = [{hint}] or "
+                         "(at, direction)) at a node off the contact boundary")
+
+    def in_case_file(self) -> InputError:
+        """The same refusal, with the remedy as case-file blocks."""
+        return InputError(f"{self.what}: add a [[springs]] block (at = \"<node set>\" or "
+                          "[x, y(, z)], direction = \"x\", stiffness = ... N/m) or a [[fixed]] "
+                          "block at a node off the contact boundary")
+
+
+def _body_name(mesh: Mesh, nodes: np.ndarray, first: int) -> str:
+    """``"body 'blade'"`` when a node set holds exactly the nodes of the body (as
+    :func:`fretwear.model.join` names each body), else ``"the body of node <first>"``."""
+    for name, members in mesh.node_sets.items():
+        m = np.asarray(members)
+        if m.size == nodes.size and np.array_equal(np.sort(m), nodes):
+            return f"body {name!r}"
+    return f"the body of node {first}"
 
 
 def bodies(mesh: Mesh) -> np.ndarray:

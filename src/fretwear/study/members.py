@@ -24,6 +24,7 @@ from fretwear.analyses.registry import analysis_tables
 from fretwear.errors import InputError
 from fretwear.io.case import read_toml, validate
 from fretwear.io.schema import show
+from fretwear.resources import require_memory
 from fretwear.study.spec import Study, split_key, value_label
 
 CASE_FILE = "case.toml"
@@ -224,11 +225,41 @@ def member_case(base: dict, values: dict, base_dir: Path):
     return _absolute_paths(raw, checked), checked
 
 
+#: the most members a study may have: each is a folder, a case text, a Dask task and a row of
+#: study.nc; a million already takes hours of bookkeeping alone
+MAX_MEMBERS = 1_000_000
+#: memory the client holds per member (its case text, record, task and row of study.nc) [bytes]
+MEMBER_BYTES = 64 * 1024
+
+
+def member_count(study: Study) -> int:
+    """The number of members ``study`` expands to, without expanding it."""
+    if study.kind == "grid":
+        return int(np.prod([len(v) for v in study.grid.values()], dtype=object))
+    if study.kind == "samples":
+        return int(study.samples["n"])
+    if study.kind == "ensemble":
+        return int(study.ensemble["members"])
+    return int(study.split["chunks"])
+
+
+def check_size(study: Study) -> int:
+    """The member count of ``study``, after refusing (before anything is allocated) a study of
+    more than :data:`MAX_MEMBERS` members or whose bookkeeping cannot fit in memory."""
+    n = member_count(study)
+    if n > MAX_MEMBERS:
+        raise InputError(f"{study.path.name}: {n:.3g} members; expected at most "
+                         f"{MAX_MEMBERS:,} (split the study, or vary fewer values)")
+    require_memory(n * MEMBER_BYTES, f"{study.path.name}: a study of {n:,} members")
+    return n
+
+
 def expand(study: Study) -> list[Member]:
     """The members of ``study``, each with its case text; every bad key or value is one
     InputError naming the study file, the member and the key."""
     _, base = read_toml(study.base)
     name = study.path.name
+    check_size(study)
     try:
         fixed, _ = member_case(base, study.set, study.base.parent)
     except InputError as exc:

@@ -18,7 +18,13 @@ from fretwear.study.aggregate import aggregate
 from fretwear.study.figures import LEVEL_KEY, study_figures
 from fretwear.study.members import expand
 from fretwear.study.mistuning import summary_line
-from fretwear.study.runner import check_scheduler_address, dask_client, run_members
+from fretwear.study.runner import (
+    check_scheduler,
+    check_scheduler_address,
+    check_workers,
+    dask_client,
+    run_members,
+)
 from fretwear.study.spec import Study, read_study
 from fretwear.study.sweep_split import join_chunks
 
@@ -148,6 +154,8 @@ def run_study(path, outdir=None, *, scheduler=None, workers: int | None = None,
     StudyInterrupted
         On Ctrl-C: finished members are kept; run again to do the rest.
     """
+    check_scheduler(scheduler)
+    check_workers(workers)
     study = read_study(resolve_study(path))
     members = expand(study)
     address = scheduler if scheduler is not None else study.scheduler

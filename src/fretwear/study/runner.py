@@ -30,7 +30,9 @@ from pathlib import Path
 
 from fretwear.errors import FretwearError, InputError
 from fretwear.files import atomic_write
+from fretwear.resources import require_memory
 from fretwear.study.members import CASE_FILE, Member
+from fretwear.validate import ArgumentTypeError, whole
 
 STATUS_FILE = "status.json"
 RESULTS_FILE = "results.nc"
@@ -241,6 +243,35 @@ def dask_client(scheduler=None, workers: int | None = None):
 WORKER_ENVIRON = {"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}
 
 
+#: memory of one idle worker process of a LocalCluster (Python, numpy, scipy, numba, dask)
+WORKER_BYTES = 300 * 2**20
+#: the most worker processes per core of a LocalCluster
+WORKERS_PER_CORE = 8
+
+
+def check_workers(workers) -> int | None:
+    """``workers`` (None: the default) after checking it is a whole number >= 1 that this
+    machine can start: at most :data:`WORKERS_PER_CORE` per core, and their memory."""
+    if workers is None:
+        return None
+    cores = os.cpu_count() or 1
+    n = whole(workers, "workers", low=1, high=WORKERS_PER_CORE * cores)
+    require_memory(n * WORKER_BYTES, f"workers = {n} (worker processes of about "
+                   f"{WORKER_BYTES / 2**20:.0f} MiB each)")
+    return n
+
+
+def check_scheduler(scheduler) -> None:
+    """``scheduler`` is None, an address (str) or a ``distributed.Client``."""
+    if scheduler is None or isinstance(scheduler, str):
+        return
+    from distributed import Client
+
+    if not isinstance(scheduler, Client):
+        raise ArgumentTypeError(f"scheduler = {scheduler!r}; expected None, a scheduler address "
+                                "(e.g. 'tcp://host:8786') or a distributed.Client")
+
+
 def local_cluster(n: int):
     """A LocalCluster of ``n`` worker processes with one thread each (numpy and numba run
     single-threaded in them) and glibc's default memory trimming (:data:`WORKER_ENVIRON`)."""
@@ -249,6 +280,7 @@ def local_cluster(n: int):
     import dask
     from distributed import LocalCluster
 
+    check_workers(n)
     with dask.config.set(WORKER_ENVIRON):
         return LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                             dashboard_address=":0", silence_logs=logging.ERROR)

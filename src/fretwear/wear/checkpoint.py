@@ -172,6 +172,28 @@ def _check_arrays(data: dict) -> str:
             return f"{k} has the shape {a.shape}"
     if int(data["state_step"]) != dims["s"] - 1:
         return f"state at step {int(data['state_step'])} with a history of {dims['s']} steps"
+    return _check_values(data)
+
+
+#: arrays of a checkpoint whose values must be finite, and those that must also be >= 0 (a
+#: worn depth, a cycle count, a jump)
+_FINITE = ("state_U", "state_anchor", "state_g", "hist_U")
+_NON_NEGATIVE = ("state_W", "state_cycles", "state_jump", "hist_wear_depth", "hist_cycles")
+
+
+def _check_values(data: dict) -> str:
+    """What is wrong with the values of a checkpoint ("" if nothing): the resumed state and
+    the history are finite, depths and cycle counts >= 0 and the cycles never decrease (a
+    file rewritten with its checksum recomputed passes the seal, not this)."""
+    for k in (*_FINITE, *_NON_NEGATIVE):
+        a = np.asarray(data[k], dtype=float)
+        if not np.all(np.isfinite(a)):
+            return f"{k} holds non-finite values"
+        if k in _NON_NEGATIVE and np.any(a < 0):
+            return f"{k} holds a negative value ({float(a.min()):g})"
+    if np.any(np.diff(data["hist_cycles"]) < 0) \
+            or float(data["state_cycles"]) != float(data["hist_cycles"][-1]):
+        return "its cycle counts are not those of one run (they decrease or disagree)"
     return ""
 
 

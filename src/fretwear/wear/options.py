@@ -139,6 +139,14 @@ class WearOptions:
             ke = getattr(self, name)
             if ke is not None and not (_is_number(ke) and ke >= 0):
                 raise InputError(f"{name} = {ke!r}: expected k_e >= 0 [m^3/J] or None")
+        if self.law == "energy" and self.energy_coefficient is None:
+            raise InputError("energy_coefficient = None with law = 'energy': expected k_e "
+                             "[m^3/J], the worn volume per unit friction energy")
+        if self.law != "energy" and self.partner_energy_coefficient is not None:
+            raise InputError(f"partner_energy_coefficient = {self.partner_energy_coefficient!r}"
+                             f" with law = {self.law!r}: only the energy law uses it (the "
+                             "partner's Archard coefficient is the contact's "
+                             "partner_wear_coefficient)")
         for name in ("plateau_rate", "checkpoint_every_s"):
             v = getattr(self, name)
             if not (_is_number(v) and v >= 0):

@@ -27,6 +27,7 @@ import numpy as np
 
 from fretwear.errors import InputError, interrupted
 from fretwear.hb.fallback import TimeDomainFallback
+from fretwear.hb.fallbacks import said
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.inputs import QUASI_STATIC_FREQUENCY, check_inputs
 from fretwear.hb.preload import preload_anchor
@@ -34,6 +35,7 @@ from fretwear.hb.reduce import Reduced, condense, condenser_for
 from fretwear.hb.solution import PeriodicSolution
 from fretwear.hb.solvers import SolveStats
 from fretwear.model.core import Model
+from fretwear.validate import reals
 from fretwear.wear.checkpoint import (
     check_checkpoint_path,
     fingerprint,
@@ -150,8 +152,17 @@ def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float | None 
         time_domain = None
     if run.checkpoint is not None:
         check_checkpoint_path(run.checkpoint)  # a folder: refused before anything is computed
+    if opts.partner_energy_coefficient is not None and not np.any(model.contact.paired()):
+        raise InputError(f"partner_energy_coefficient = {opts.partner_energy_coefficient!r}, "
+                         "but the model has no node-to-node pair (a rigid obstacle does not "
+                         "wear): leave it out, or give the contact a partner")
     t_start = time.perf_counter()
     nc, d = model.contact.dofs.shape
+    if wear0 is not None:
+        wear0 = reals(wear0, "wear0", low=0.0)
+        if wear0.size != 1 and wear0.shape != (nc,):
+            raise InputError(f"wear0 has shape {wear0.shape}; expected one depth or {nc} "
+                             "(one per contact node) [m]")
     condenser = condenser_for(model, balance.condenser)  # one for every condensation of the run
     reduced = balance.reduced
     if reduced is None:
@@ -253,6 +264,10 @@ def _integrate(sp: SlowProblem, state: SlowStep, records: list[StepRecord], opts
         bar.show(state)
         while not reason:
             new_state, record, failure = _step(sp, state, opts)
+            bad = "" if failure else record.non_finite()
+            if bad:
+                failure = (f"step {state.step + 1} produced non-finite values (NaN or inf) in "
+                           f"{bad}; the last finite state is kept")
             if failure:
                 reason, extra = "solver_failed", f": {failure}"
                 break
@@ -281,6 +296,9 @@ def _step(sp: SlowProblem, state: SlowStep, opts: WearOptions):
         return time_domain_step(sp, state, opts)
     new_state, record, failure = advance(sp, state, opts)
     if failure and sp.time_domain is not None:
+        said(f"wear step {state.step + 1} (N = {state.cycles:.4g} cycles): {failure}; taking "
+             "the step from a time integration (each can take minutes; the next steps too, "
+             "until a balance converges again)")
         new_state, record, why = time_domain_step(sp, state, opts)
         failure = f"{failure}; {why}" if why else ""
     return new_state, record, failure
@@ -321,13 +339,38 @@ def _message(reason: str, st: SlowStep, opts: WearOptions, extra: str = "") -> s
     return f"{txt} after {st.step} steps, N = {st.cycles:.4g} cycles{extra}"
 
 
-def _progress_fraction(cycles, vrate, vrate0, wmax, opts: WearOptions) -> float:
-    """How far the run is towards its nearest stop criterion, in [0, 1]."""
-    fr = [math.log1p(cycles) / math.log1p(opts.max_cycles)]
+#: the largest growth of the jump per step assumed when counting the steps left
+JUMP_GROWTH_MAX = 4.0
+
+
+def steps_left(cycles: float, jump: float, growth: float, max_cycles: float) -> float:
+    """The slow steps left to reach ``max_cycles`` from ``cycles`` with the next ``jump``
+    [cycles] growing by ``growth`` per step (clipped to [1, :data:`JUMP_GROWTH_MAX`]): the
+    ``k`` with ``jump (1 + q + ... + q^(k-1)) = max_cycles - cycles``."""
+    left = max(0.0, max_cycles - cycles)
+    if left <= 0.0:
+        return 0.0
+    if not (jump > 0 and math.isfinite(jump)):
+        return math.inf
+    q = min(max(growth, 1.0), JUMP_GROWTH_MAX) if math.isfinite(growth) else 1.0
+    if q < 1.0 + 1e-6:
+        return left / jump
+    return math.log1p(left * (q - 1.0) / jump) / math.log(q)
+
+
+def _progress_fraction(st: SlowStep, growth: float, opts: WearOptions) -> float:
+    """How far the run is towards its nearest stop criterion, in [0, 1], measured in what the
+    run does (so that the bar's time left means something): the slow steps taken against
+    those left to ``max_cycles`` at the current jump and its growth (:func:`steps_left`),
+    the worn depth against ``max_depth``, the steps against ``max_steps``, and the worn-volume
+    rate's fall towards the plateau (in log)."""
+    k = steps_left(st.cycles, st.jump, growth, opts.max_cycles)
+    fr = [st.step / (st.step + k) if st.step + k > 0 else 1.0, st.step / opts.max_steps]
+    vrate, vrate0 = st.volume_rate, st.volume_rate0
     if vrate0 > 0 and opts.plateau_rate > 0 and vrate > 0:
         fr.append(math.log(vrate / vrate0) / math.log(opts.plateau_rate))
     if math.isfinite(opts.max_depth):
-        fr.append(wmax / opts.max_depth)
+        fr.append(float(np.max(st.W)) / opts.max_depth)
     return min(1.0, max(0.0, max(fr)))
 
 
@@ -338,6 +381,7 @@ class _Bar:
         self.opts = opts
         self.area = np.asarray(area, float)
         self.bar = None
+        self.last_jump = math.nan  # the jump proposed at the previous step, for its growth
         if enabled:
             from tqdm import tqdm
 
@@ -348,8 +392,8 @@ class _Bar:
     def show(self, st: SlowStep):
         if self.bar is None:
             return
-        frac = _progress_fraction(st.cycles, st.volume_rate, st.volume_rate0,
-                                  float(np.max(st.W)), self.opts)
+        frac = _progress_fraction(st, st.jump / self.last_jump, self.opts)
+        self.last_jump = st.jump
         self.bar.n = max(self.bar.n, int(1000 * frac))
         vol = worn_volume(st.W, self.area)
         self.bar.set_postfix_str(f"N={st.cycles:.3g} cycles, worn {vol:.3g} m^3, "

@@ -147,6 +147,23 @@ class StepRecord:
         solution)."""
         return self.rescued != Rescue.TIME_AVERAGED
 
+    def non_finite(self) -> str:
+        """The first column of the record that holds NaN or inf where a value is due ("" if
+        none): every physical column, and ``rate_scatter`` on time-averaged steps (NaN on
+        balanced steps by definition)."""
+        for name in FINITE_COLUMNS:
+            if not np.all(np.isfinite(np.asarray(getattr(self, name), dtype=float))):
+                return name
+        if not self.has_balance and not math.isfinite(self.rate_scatter):
+            return "rate_scatter"
+        return ""
+
+
+#: the columns of a step record that are finite whenever the step succeeded
+FINITE_COLUMNS = ("cycles", "jump", "wear_depth", "wear_rate", "pressure_mean", "pressure_max",
+                  "slip_amplitude", "slip_path", "state_fraction", "friction_energy",
+                  "worn_volume", "volume_rate", "U", "lam", "anchor")
+
 
 #: the columns of the history: name -> (units, long name)
 RECORD_COLUMNS = {f.name: (f.metadata["units"], f.metadata["doc"]) for f in fields(StepRecord)}

@@ -1,0 +1,74 @@
+"""Fallbacks said as they happen and summed up with their cost (fretwear.hb.fallbacks).
+
+References: the two-DOF chain of tests/hb/test_attempts.py, whose ladder is known to run
+"start", "best-point" and "eps-continuation" (so two lines must be said, in that order, and
+the fallback time is the ladder's time after the first attempt, below the solve's wall time);
+the cost of hand-made histories and points counted by hand.
+"""
+
+import logging
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from fretwear.hb import fallbacks
+from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.periodic import solve_periodic
+from fretwear.hb.solution import Attempt
+
+
+def _chain():
+    from fretwear.model.build import Damping
+    from fretwear.model.core import Load
+    from fretwear.model.matrices import ContactDofs, from_matrices
+
+    return from_matrices(np.array([[2.0, -1.0], [-1.0, 1.0]]), np.eye(2),
+                         contact=ContactDofs(normal_dofs=None, tangential_dofs=[1], mu=0.5,
+                                             normal_load=1.0),
+                         damping=Damping(C=0.02 * np.eye(2)),
+                         loads=[Load(np.array([0.2, 0.0]), "cos")], observed={"x": 0})
+
+
+def test_each_rung_is_said_as_it_starts_and_its_time_counted(caplog):
+    model = _chain()
+    with caplog.at_level(logging.INFO, logger="fretwear"):
+        sol = solve_periodic(model, FourierBasis.up_to(15, 128),
+                             frequency=1.4905405 / (2 * np.pi), eps=1.0)
+    assert sol.success and [a.method for a in sol.attempts] == [
+        "start", "best-point", "eps-continuation"]
+    said = [r.getMessage() for r in caplog.records if r.name == "fretwear"]
+    assert len(said) == 2
+    assert said[0].startswith("periodic solve at 0.237227 Hz: start failed")
+    assert said[0].endswith("trying best-point")
+    assert said[1].endswith("best-point failed (best residual "
+                            f"{min(a.residual for a in sol.attempts[:2]):.2e}); trying "
+                            "eps-continuation")
+    assert 0.0 < sol.fallback_seconds < sol.stats.wall_time
+    cost = fallbacks.of_solutions([sol], sol.stats.wall_time)
+    assert cost.count == 1 and cost.time_domain == 0
+    assert cost.seconds == pytest.approx(sol.fallback_seconds)
+
+
+def _attempts(*methods):
+    return [Attempt(m, "powell", 1.0, i == len(methods) - 1, 0.0, 1, 0.1, "")
+            for i, m in enumerate(methods)]
+
+
+def test_cost_of_points_and_of_a_wear_history():
+    points = [SimpleNamespace(attempts=_attempts("grid"), fallback_seconds=0.0),
+              SimpleNamespace(attempts=_attempts("grid", "retry"), fallback_seconds=2.0),
+              SimpleNamespace(attempts=_attempts("grid", "time-start"), fallback_seconds=5.0)]
+    cost = fallbacks.of_solutions(points, total=10.0)
+    assert (cost.count, cost.time_domain, cost.seconds) == (2, 1, 7.0)
+    hint = fallbacks.eps_hint(False)
+    assert cost.line("frequencies", hint) == (
+        "fallbacks: 2 frequencies needed more than their first attempt, 1 from a time "
+        f"integration: 7.0 s (70 % of 10.0 s); {hint}")
+    assert fallbacks.eps_hint(True) == ""
+    wear = fallbacks.of_wear([0, 2, 2, 1, 0], [1.0, 30.0, 40.0, 5.0, 1.0], total=80.0)
+    assert (wear.count, wear.seconds) == (3, 75.0)
+    assert "eps =" not in wear.line("slow steps", "")
+    small = fallbacks.of_wear([0, 1], [9.0, 1.0], total=100.0)
+    assert small.line("slow steps", hint).endswith("1.0 s (1 % of 100.0 s)")  # no hint < 20 %
+    assert fallbacks.FallbackCost().line() == ""
