@@ -79,6 +79,7 @@ _API = {
     "centrifugal_load": "fretwear.model.rotation",
     # wear
     "simulate_wear": "fretwear.api", "frf_worn": "fretwear.api",
+    "worn_state": "fretwear.api", "WornStateOptions": "fretwear.wear.worn_state",
     "WearOptions": "fretwear.wear", "WearResult": "fretwear.wear",
     "BalanceSetup": "fretwear.wear", "RunControl": "fretwear.wear",
     # time domain
