@@ -23,6 +23,7 @@ quasi_static = true
 harmonics = 3
 n_samples = 32
 checkpoint_every_s = 0.0
+residual_tolerance = 1e-3
 """
 
 
@@ -38,11 +39,12 @@ def test_case_file_gives_the_python_state_and_the_documented_results(tmp_path):
     check_documented(ds, "worn-state")
     assert ds.attrs["analysis_type"] == "worn-state" and ds.attrs["converged"] == 1
     assert ds.attrs["worn_state_kind"] == "null_wear_rate"
-    assert float(ds["null_wear_rate_residual"]) <= 1e-6
+    assert float(ds["null_wear_rate_residual"]) <= 1e-3
     assert float(ds["cycles_to_state_estimate"]) > 0
     c = load_case(case)
     model = build_model(c)
-    ref = fw.worn_state(model, fw.FourierBasis.up_to(3, 32), quasi_static=True)
+    ref = fw.worn_state(model, fw.FourierBasis.up_to(3, 32), quasi_static=True,
+                        options=fw.WornStateOptions(tolerance=1e-3))
     np.testing.assert_allclose(ds["wear_depth"].values[-1], ref.wear, rtol=1e-9, atol=0)
     np.testing.assert_allclose(ds["worn_depth_surface"].values[-1, :, 0], ref.wear, rtol=1e-9)
     res = tmp_path / "w-results"

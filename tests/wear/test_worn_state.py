@@ -10,8 +10,8 @@ References, each independent of the code under test:
   wear stops once the slip zone is unloaded). The same bed under a punch loaded by a force
   (all nodes in gross slip) wears on at the steady rate ``k_w/A N 4 (T - mu N) / k_t`` per
   node (``N = P / n``, the slip path of a spring-friction element per cycle);
-* the march of :func:`fretwear.wear.simulate.simulate_wear` to its plateau (Stromberg's
-  beam, the shipped example): a separate integration of the same slow equation.
+* the march of :func:`fretwear.wear.simulate.simulate_wear` to its plateau (reduced copies
+  of the shipped quasi-static examples): a separate integration of the same slow equation.
 """
 
 from __future__ import annotations
@@ -143,32 +143,43 @@ def test_options_are_checked():
         WornStateOptions(wear=1)
 
 
-def test_stromberg_direct_state_is_the_march_plateau():
-    """Stromberg's beam (the shipped stromberg1997 example, 30 x 4 Q4, 7 harmonics): the
-    direct state equals the state the march reaches at its plateau (default options:
-    worn-volume rate 1e-3 of the initial one): the worn profile within 1 % of the deepest
-    wear, the same stuck nodes (carrying load and sticking all period) and the mean pressure
-    within 1 % of the largest (issue 29). The tolerance is the issue's: the march stops on
-    its plateau, a little short of the asymptote (0.3 % of the deepest wear here)."""
+@pytest.mark.parametrize("name, nx", [("salles2011-quasistatic", 15), ("stromberg1997", 30),
+                                      ("stromberg1997-triangle", 30)])
+def test_direct_state_is_the_march_plateau(name, nx, tmp_path):
+    """Reduced copies of the shipped quasi-static examples (the paper's beam, Stromberg's
+    beam with sinusoidal and triangular loads: ``nx`` x 2 Q4, 3 harmonics, 32 samples; the
+    full ones run in benchmarks/worn_state.py): the direct state equals the state the march
+    reaches at its plateau: the worn profile within 1 % of the deepest wear, the same stuck
+    nodes (carrying load and not wearing) and the mean pressure within 1 % of the
+    largest (issue 29's tolerances; measured 0.43 %, 0.016 % and 0.22 %). The march runs to a
+    worn-volume rate of 1e-8 of the initial one: at its default plateau (1e-3) it has not
+    reached the state yet on Stromberg's full beam (a loaded node next to the pillar wears
+    later, by 8.8 % of the deepest wear; docs/theory.md)."""
     from fretwear.analyses.run import load_case
     from fretwear.examples import example_path
     from fretwear.io.case import build_model
 
-    case = load_case(example_path("stromberg1997"))
-    model = build_model(case)
-    a = case.analysis
-    basis = FourierBasis.up_to(a["harmonics"], a["n_samples"])
-    march = simulate_wear(model, basis, quasi_static=True, options=WearOptions())
+    text = example_path(name).read_text()
+    for old, new in (("nx = 30 ", f"nx = {nx} "), ("ny = 4 ", "ny = 2 ")):
+        assert old in text
+        text = text.replace(old, new)
+    path = tmp_path / "case.toml"
+    path.write_text(text)
+    model = build_model(load_case(path))
+    basis = FourierBasis.up_to(3, 32)
+    march = simulate_wear(model, basis, quasi_static=True,
+                          options=WearOptions(plateau_rate=1e-8, max_steps=300))
     direct = worn_state(model, basis, quasi_static=True)
     assert march.stop_reason == "plateau" and direct.success, direct.message
     h = march.history
     top = h.wear_depth[-1].max()
     assert np.max(np.abs(direct.wear - h.wear_depth[-1])) <= 0.01 * top
     pm, pd = h.pressure_mean[-1], direct.history.pressure_mean[-1]
+    g0 = h.wear_rate[0].max()
 
-    def stuck(p, frac):
-        return (p > 1e-3 * p.max()) & (frac[:, 1] == 1.0)
+    def stuck(p, g):  # carries load, does not wear (a sample on the cone may read "slip")
+        return (p > 1e-3 * p.max()) & (g <= 1e-9 * g0)
 
-    np.testing.assert_array_equal(stuck(pd, direct.history.state_fraction[-1]),
-                                  stuck(pm, h.state_fraction[-1]))
+    np.testing.assert_array_equal(stuck(pd, direct.rate), stuck(pm, h.wear_rate[-1]))
+    assert np.any(stuck(pm, h.wear_rate[-1]))
     assert np.max(np.abs(pd - pm)) <= 0.01 * pm.max()
