@@ -12,6 +12,10 @@ counts them), the largest profile difference over the largest depth, whether the
 nodes agree, the null-wear-rate residual and the direct solve's estimate of the cycles a
 march needs to get within 1 %. A warm-up solve first compiles the numba kernels (not timed).
 
+Then ``--steps-79khz`` steps of the direct solve on the 79 kHz beam (salles2011-79khz),
+with the time-domain rescue of the march: it must report the state not reached, with its
+residual (the path is chaotic, docs/wear.md "Limits").
+
 The last lines are ``worn_state_speedup=<geometric mean of march / direct processor time>``
 and ``worn_state_diff=<largest profile difference / largest depth>``.
 
@@ -30,6 +34,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from fretwear import api
 from fretwear.analyses.common import condenser_of
 from fretwear.analyses.run import load_case
 from fretwear.analyses.wear import options_from_table, penalty_of
@@ -106,10 +111,24 @@ def run_case(name: str, steps: int) -> tuple[float, float]:
     return c_m / c_d, diff
 
 
+def not_reached(steps: int) -> None:
+    """The 79 kHz beam (salles2011-79khz), whose wear path is chaotic: the direct solve
+    must say that it did not reach a state, with the residual."""
+    model, basis, f_hz, quasi, opts, balance = _setup("salles2011-79khz", steps)
+    res, c, w = _timed(lambda: api.worn_state(
+        model, basis, frequency=f_hz, options=WornStateOptions(wear=opts, max_steps=steps),
+        balance=balance))
+    print(f"salles2011-79khz: {res.message}")
+    print(f"  kind {res.kind}, success {res.success}, residual {res.residual:.3g}; processor "
+          f"{c:.1f} s, wall {w:.1f} s")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cases", default=",".join(CASES), help="examples, comma-separated")
     ap.add_argument("--steps", type=int, default=300, help="slow steps of the march at most")
+    ap.add_argument("--steps-79khz", type=int, default=20,
+                    help="steps of the direct solve on the 79 kHz beam (0: skip it)")
     args = ap.parse_args()
     print("load before:", os.getloadavg())
     # warm-up: compiles the numba kernels (not timed)
@@ -121,6 +140,8 @@ def main():
         s, d = run_case(name.strip(), args.steps)
         speed.append(s)
         diffs.append(d)
+    if args.steps_79khz > 0:
+        not_reached(args.steps_79khz)
     print("load after:", os.getloadavg())
     print(f"worn_state_speedup={math.exp(np.mean(np.log(speed))):.3g}")
     print(f"worn_state_diff={max(diffs):.3g}")
