@@ -229,8 +229,9 @@ def worn_state(model, basis, frequency: float | None = None, *, quasi_static: bo
 
     Parameters
     ----------
-    model, basis, frequency, quasi_static, wear0, time_domain, condenser : as
-        :func:`simulate_wear`.
+    model, basis : the structure and the Fourier basis.
+    frequency : excitation frequency [Hz]; required unless ``quasi_static``.
+    quasi_static, wear0, time_domain, condenser : as :func:`simulate_wear`.
     **kwargs : the other keywords of :func:`fretwear.wear.worn_state.worn_state`:
         ``options`` (:class:`~fretwear.wear.worn_state.WornStateOptions`: the wear options,
         the tolerances of the null-wear-rate residual and of the last correction, the steps
