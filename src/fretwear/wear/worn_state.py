@@ -10,12 +10,15 @@ pseudo-transient continuation (Kelley and Keyes, SIAM J. Numer. Anal. 35, 1998):
     W_{k+1} = W_k + dN_k (I - dN_k Js_k)^-1 g(W_k),      then the DLFT balance at W_{k+1}
 
 the linearly implicit Euler step of the march (:mod:`fretwear.wear.schemes`, ``Js = dg/dW``
-along balanced solutions), but with the step ``dN_k`` set by switched evolution relaxation
-(SER) instead of an error tolerance: ``dN_{k+1} = dN_k |g(W_k)| / |g(W_{k+1})|`` (growth
-capped at ``max_growth``). As the rate falls, the step grows without bound and the iteration
-turns into Newton's method on ``g(W) = 0`` (``dW -> -Js^-1 g``), the direct solve of the
-null-wear-rate condition. Early steps, still small, follow the physical path (which nodes
-stick first decides where the state ends: it is not unique).
+along balanced solutions). While the set of slipping nodes changes, ``dN_k`` comes from the
+march's error control (``path_tolerance``): the state is not unique, it depends on the path
+(which nodes stick, and when), so that part is followed. Once the slipping set has settled
+and the rate decays, the step is set by switched evolution relaxation (SER),
+``dN_{k+1} = dN_k min_growth V'_k / V'_{k+1}`` (``V'`` the worn-volume rate, growth capped at
+``max_growth``): it grows without bound as the rate falls, and the iteration turns into
+Newton's method on ``g(W) = 0`` (``dW -> -Js^-1 g``), the direct solve of the null-wear-rate
+condition. A step that wears a node into separation for the whole period (past its lift-off,
+where the rate is 0 too) is pulled back to the lift-off (:func:`_pull_back`).
 
 Honesty (issue 29): the state is reported reached only when the null-wear-rate residual
 
@@ -31,10 +34,8 @@ Wear that goes on (gross slip) has no null-rate state; when the rate stops chang
 (``kind = "steady_wear"``) with the steady rate profile.
 
 The number of cycles a march needs to get within 1 % of the state is estimated (it is an
-estimate) from the pseudo-time path: a linearly implicit step of ``dN`` reduces a decaying
-linear mode by ``1 / (1 + dN mu)`` where the exact flow reduces it by ``exp(-dN mu)``, so a
-step that reduced the rate by the factor ``q < 1`` stands for ``dN ln(1/q) / (1/q - 1)``
-physical cycles (``dN`` when the rate did not fall).
+estimate, :func:`cycles_to_one_percent`): each step's worn volume over the log-mean of the
+worn-volume rates at its ends (the time an exponentially decaying rate takes to wear it).
 """
 
 from __future__ import annotations
