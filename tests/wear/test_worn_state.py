@@ -88,6 +88,38 @@ def test_winkler_punch_reaches_the_analytic_state():
     assert 0 < res.cycles_to_1pc < math.inf
 
 
+def test_node_to_node_winkler_reaches_the_analytic_state():
+    """The same bed between two elastic bodies: every contact node has a partner (3 DOFs on
+    springs ``k_n``, ``k_t`` to the ground), both surfaces wear (``k_w`` each). In series the
+    normal stiffness is ``k_n / 2`` and a stuck pair passes half the tangential load, so with
+    ``2 T`` the same nodes slip and they wear to ``W = 2 F / k_n`` (the gap opens by both
+    surfaces, half each). Tolerance as the node-to-rigid case."""
+    nc = F.size
+    n = 6 * nc
+    K = np.zeros((n, n))
+    fn, ft = np.zeros(n), np.zeros(n)
+    normal = 3 * np.arange(nc)
+    tang = np.stack([normal + 1, normal + 2], axis=1)
+    partner = 3 * nc + np.stack([normal, normal + 1, normal + 2], axis=1)
+    for p in range(nc):
+        for i, k in zip((normal[p], *tang[p]), (KN, KT, KT), strict=True):
+            K[i, i] = k
+        for i, k in zip(partner[p], (KN, KT, KT), strict=True):
+            K[i, i] = k
+        fn[normal[p]] = F[p]
+        ft[tang[p, 0]] = 2 * T
+    contact = ContactDofs(normal_dofs=normal, tangential_dofs=tang, mu=MU, gap=0.0, area=AREA,
+                          wear_coefficient=KW, partner_dofs=partner,
+                          partner_wear_coefficient=KW)
+    model = from_matrices(K, np.eye(n), contact=contact,
+                          loads=[Load(fn, "constant"), Load(ft, "sin")])
+    res = worn_state(model, BASIS, quasi_static=True)
+    assert res.success and res.kind == "null_wear_rate", res.message
+    exact = np.where(MU * F / 2 < T, F / KN, 0.0)
+    assert np.count_nonzero(exact) == 4
+    assert np.max(np.abs(res.wear - exact)) <= 1e-3 * exact.max()
+
+
 def test_gross_slip_is_steady_wear_at_the_analytic_rate():
     """A punch loaded by a force P whose every node slips (mu P / n < T) wears on: no
     null-wear-rate state; the result says steady wear, with every node's rate that of a
