@@ -89,6 +89,7 @@ _API = {
     "sector_responses": "fretwear.model.mistuning", "lumped_blisk": "fretwear.examples.blisk",
     # wear
     "simulate_wear": "fretwear.api", "frf_worn": "fretwear.api",
+    "worn_state": "fretwear.api", "WornStateOptions": "fretwear.wear.worn_state",
     "WearOptions": "fretwear.wear", "WearResult": "fretwear.wear",
     "BalanceSetup": "fretwear.wear", "RunControl": "fretwear.wear",
     # time domain

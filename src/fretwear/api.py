@@ -42,6 +42,7 @@ from fretwear.timedomain import quasistatic as _quasistatic
 from fretwear.timedomain import steady as _steady
 from fretwear.timedomain.fallback import FALLBACK
 from fretwear.wear.worn_frf import WORN_FRF
+from fretwear.wear.worn_state import worn_state as _worn_state
 
 #: spellings of other entry points -> the public one
 _RENAMED = {"stick_anchor": "anchor", "W0": "wear0", "k_w": "wear_coefficient",
@@ -217,6 +218,43 @@ def simulate_wear(model, basis, frequency: float | None = None, *, quasi_static:
     return _wear.simulate_wear(model, basis, **_frequency(frequency, quasi_static),
                                quasi_static=quasi_static, wear0=wear0,
                                time_domain=_fallback(time_domain), **kwargs)
+
+
+@limited
+def worn_state(model, basis, frequency: float | None = None, *, quasi_static: bool = False,
+               wear0=None, time_domain: bool = True, condenser=None, **kwargs):
+    """The worn state directly: where fretting wear stops (the wear depths at which the wear
+    rate of eq. 29 vanishes), by pseudo-transient continuation on the slow equation with the
+    DLFT balance inside (docs/theory.md, "The worn state directly").
+
+    Parameters
+    ----------
+    model, basis : the structure and the Fourier basis.
+    frequency : excitation frequency [Hz]; required unless ``quasi_static``.
+    quasi_static, wear0, time_domain, condenser : as :func:`simulate_wear`.
+    **kwargs : the other keywords of :func:`fretwear.wear.worn_state.worn_state`:
+        ``options`` (:class:`~fretwear.wear.worn_state.WornStateOptions`: the wear options,
+        the tolerances of the null-wear-rate residual and of the last correction, the steps
+        allowed), ``balance``, ``run`` (checkpoint and resume, callback).
+
+    Returns
+    -------
+    :class:`~fretwear.wear.worn_state.WornStateResult`: ``success`` (False, with the
+    ``residual``, when not reached), ``kind`` (``"null_wear_rate"``, ``"steady_wear"``,
+    ``"not_reached"``, ``"no_wear"``), ``wear`` [m], ``rate`` [m/cycle], ``cycles_to_1pc``
+    (an estimate), ``history`` of the pseudo-time steps, ``initial`` and ``final``
+    periodic solutions.
+    """
+    _public_names("worn_state", kwargs)
+    if condenser is not None:
+        balance = kwargs.pop("balance", None) or _wear.BalanceSetup()
+        if balance.condenser is not None:
+            raise InputError("worn_state: condenser given twice (condenser= and "
+                             "balance.condenser); give one")
+        kwargs["balance"] = dataclasses.replace(balance, condenser=condenser)
+    return _worn_state(model, basis, **_frequency(frequency, quasi_static),
+                       quasi_static=quasi_static, wear0=wear0,
+                       time_domain=_fallback(time_domain), **kwargs)
 
 
 @limited

@@ -19,7 +19,7 @@ from fretwear.errors import InputError
 from fretwear.io.schema import Field, Integer, Table
 
 EXPECTED = ["modes", "frf", "cyclic-modes", "periodic", "sweep", "nonlinear-modes", "transient",
-            "incremental-wear", "wear"]
+            "incremental-wear", "wear", "worn-state"]
 
 
 def test_every_analysis_is_listed_in_order():

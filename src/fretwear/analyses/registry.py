@@ -22,12 +22,13 @@ from fretwear.analyses.periodic import PERIODIC
 from fretwear.analyses.sweep import SWEEP
 from fretwear.analyses.transient import INCREMENTAL_WEAR, TRANSIENT
 from fretwear.analyses.wear import WEAR
+from fretwear.analyses.worn_state import WORN_STATE
 from fretwear.errors import InputError
 from fretwear.io.schema import Table
 
 #: every analysis, in the order of ``docs/case-files.md``
 ANALYSES: tuple[Analysis, ...] = (MODES, FRF, CYCLIC_MODES, PERIODIC, SWEEP, NONLINEAR_MODES,
-                                  TRANSIENT, INCREMENTAL_WEAR, WEAR)
+                                  TRANSIENT, INCREMENTAL_WEAR, WEAR, WORN_STATE)
 
 
 def by_name(analyses: Iterable[Analysis]) -> Mapping[str, Analysis]:

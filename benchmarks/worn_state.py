@@ -1,0 +1,164 @@
+"""The worn state directly (fretwear.worn_state) against the march to the plateau
+(fretwear.simulate_wear), in one run, on the quasi-static beam of Salles et al. 2011
+(salles2011-quasistatic), the Stromberg beam (stromberg1997) and the shipped dovetail
+(dovetail-wear).
+
+For each case: the march with the case file's wear options, run to its final plateau (a
+worn-volume rate of 1e-8 of the initial one, PLATEAU: the default 1e-3 stops short of the
+final state on Stromberg's beam, and where the march passed it is printed too; the
+dovetail's ``max_cycles`` and ``max_depth`` are lifted so that it can get there; ``--steps``
+caps its slow steps), then the direct solve with the same wear law and solves; both on the
+same condensation (built once, not timed). Printed: processor and wall seconds of each, the
+number of DLFT solves (Newton iterations of the balances and slow Jacobians, as the march
+counts them), the largest profile difference over the largest depth, whether the stuck
+nodes agree, the null-wear-rate residual and the direct solve's estimate of the cycles a
+march needs to get within 1 %. A warm-up solve first compiles the numba kernels (not timed).
+
+Then ``--steps-79khz`` steps of the direct solve on the 79 kHz beam (salles2011-79khz),
+with the time-domain rescue of the march: it must report the state not reached, with its
+residual (the path is chaotic, docs/wear.md "Limits").
+
+The last lines are ``worn_state_speedup=<geometric mean of march / direct processor time>``
+and ``worn_state_diff=<largest profile difference / largest depth>``.
+
+Run: ``python benchmarks/worn_state.py [--cases salles2011-quasistatic,stromberg1997]
+[--steps 200]``. Quote the figures with the machine load (``uptime``: printed before and
+after).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import time
+from dataclasses import replace
+
+import numpy as np
+
+from fretwear import api
+from fretwear.analyses.common import condenser_of
+from fretwear.analyses.run import load_case
+from fretwear.analyses.wear import options_from_table, penalty_of
+from fretwear.examples import example_path
+from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.reduce import condense
+from fretwear.io.case import build_model
+from fretwear.wear import BalanceSetup, simulate_wear
+from fretwear.wear.worn_state import WornStateOptions, worn_state
+
+CASES = ("salles2011-quasistatic", "stromberg1997", "dovetail-wear")
+#: the march runs to this worn-volume rate (relative to the initial one): its default plateau
+#: (1e-3) is not the final state on Stromberg's beam (docs/examples.md); where it passed the
+#: default plateau is reported too
+PLATEAU = 1e-8
+
+
+def _timed(fn):
+    """``(fn(), processor seconds, wall seconds)``."""
+    t0, c0 = time.perf_counter(), time.process_time()
+    out = fn()
+    return out, time.process_time() - c0, time.perf_counter() - t0
+
+
+def _setup(name: str, steps: int):
+    """Model, basis, frequency, the wear options (stop criteria of a march to the plateau)
+    and the balance setup (a condensation shared by both runs) of the example ``name``."""
+    case = load_case(example_path(name))
+    model = build_model(case)
+    a = case.analysis
+    basis = FourierBasis.up_to(a["harmonics"], a["n_samples"])
+    quasi = bool(a["quasi_static"])
+    f_hz = float(a.get("frequency", 1.0))
+    opts = replace(options_from_table(a), max_cycles=1e13, max_depth=math.inf,
+                   max_steps=steps, checkpoint_every_s=1e9, plateau_rate=PLATEAU)
+    cond = condenser_of(model, a, None if quasi else f_hz, max(basis.harmonics))
+    reduced = condense(model, f_hz, basis.orders, quasi_static=quasi, condenser=cond)
+    balance = BalanceSetup(reduced=reduced, condenser=cond, **penalty_of(a))
+    return model, basis, f_hz, quasi, opts, balance
+
+
+def _stuck(rate, pressure, rate0):
+    """Nodes that carry load and do not wear at a state: pressure > 1e-3 of the largest,
+    rate <= 1e-9 of the largest initial one ``rate0``."""
+    return (pressure > 1e-3 * pressure.max()) & (rate <= 1e-9 * rate0)
+
+
+def run_case(name: str, steps: int) -> tuple[float, float]:
+    """March and direct solve of one example: ``(speedup, profile difference)``."""
+    model, basis, f_hz, quasi, opts, balance = _setup(name, steps)
+    kw = {"frequency": f_hz, "quasi_static": quasi, "balance": balance}
+    march, c_m, w_m = _timed(lambda: simulate_wear(model, basis, options=opts, **kw))
+    direct, c_d, w_d = _timed(lambda: worn_state(
+        model, basis, options=WornStateOptions(wear=opts), **kw))
+    h = march.history
+    Wm, Wd = h.wear_depth[-1], direct.wear
+    top = float(np.max(Wm))
+    diff = float(np.max(np.abs(Wd - Wm))) / top if top > 0 else 0.0
+    pm = h.pressure_mean[-1]
+    pd = direct.history.pressure_mean[-1]
+    g0 = float(h.wear_rate[0].max())
+    same_stuck = bool(np.array_equal(_stuck(h.wear_rate[-1], pm, g0),
+                                     _stuck(direct.rate, pd, g0)))
+    pdiff = float(np.max(np.abs(pd - pm))) / float(np.max(pm))
+    n_march = int(h.newton_iterations.sum())
+    print(f"{name}: {model.contact.n_nodes} contact nodes; march to a worn-volume rate "
+          f"{PLATEAU:g} x initial (or {steps} steps)")
+    print(f"  march : {march.message}")
+    print(f"          processor {c_m:.2f} s, wall {w_m:.2f} s, {h.n_steps - 1} slow steps, "
+          f"{n_march} DLFT solves, max depth {top:.4g} m")
+    print(f"  direct: {direct.message}")
+    print(f"          processor {c_d:.2f} s, wall {w_d:.2f} s, "
+          f"{direct.history.n_steps - 1} pseudo-time steps, {direct.dlft_solves} DLFT solves, "
+          f"max depth {float(np.max(Wd)):.4g} m; estimated cycles to 1 %: "
+          f"{direct.cycles_to_1pc:.3g} (march reached its plateau at {h.cycles[-1]:.3g})")
+    k = int(np.argmax(h.volume_rate <= 1e-3 * h.volume_rate[0])) if np.any(
+        h.volume_rate <= 1e-3 * h.volume_rate[0]) else h.n_steps - 1
+    d3 = float(np.max(np.abs(Wd - h.wear_depth[k]))) / top if top > 0 else 0.0
+    print(f"  the march passed its default plateau (1e-3) at step {k}, N = {h.cycles[k]:.3g} "
+          f"({int(h.newton_iterations[:k + 1].sum())} DLFT solves): {d3:.3g} of the largest "
+          "depth from the direct state")
+    print(f"  profile difference {diff:.3g} of the largest depth, same stuck nodes "
+          f"{same_stuck}, mean pressure difference {pdiff:.3g} of the largest; "
+          f"speedup (processor) {c_m / c_d:.3g}, (wall) {w_m / w_d:.3g}")
+    return c_m / c_d, diff
+
+
+def not_reached(steps: int) -> None:
+    """The 79 kHz beam (salles2011-79khz), whose wear path is chaotic: the direct solve
+    must say that it did not reach a state, with the residual."""
+    model, basis, f_hz, quasi, opts, balance = _setup("salles2011-79khz", steps)
+    res, c, w = _timed(lambda: api.worn_state(
+        model, basis, frequency=f_hz, options=WornStateOptions(wear=opts, max_steps=steps),
+        balance=balance))
+    print(f"salles2011-79khz: {res.message}")
+    print(f"  kind {res.kind}, success {res.success}, residual {res.residual:.3g}; processor "
+          f"{c:.1f} s, wall {w:.1f} s")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--cases", default=",".join(CASES), help="examples, comma-separated")
+    ap.add_argument("--steps", type=int, default=300, help="slow steps of the march at most")
+    ap.add_argument("--steps-79khz", type=int, default=20,
+                    help="steps of the direct solve on the 79 kHz beam (0: skip it)")
+    args = ap.parse_args()
+    print("load before:", os.getloadavg())
+    # warm-up: compiles the numba kernels (not timed)
+    model, basis, f_hz, quasi, opts, balance = _setup("stromberg1997", 2)
+    worn_state(model, basis, quasi_static=True, balance=balance,
+               options=WornStateOptions(wear=opts, max_steps=1))
+    speed, diffs = [], []
+    for name in args.cases.split(","):
+        s, d = run_case(name.strip(), args.steps)
+        speed.append(s)
+        diffs.append(d)
+    if args.steps_79khz > 0:
+        not_reached(args.steps_79khz)
+    print("load after:", os.getloadavg())
+    print(f"worn_state_speedup={math.exp(np.mean(np.log(speed))):.3g}")
+    print(f"worn_state_diff={max(diffs):.3g}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,453 @@
+"""The worn state directly: where fretting wear stops, without marching through every cycle.
+
+The slow-scale equation of a wear run (paper eq. 29) is ``dW/dN = g(W)``, ``g_p >= 0`` the wear
+depth per cycle of contact node ``p`` on the DLFT balance at the worn gap ``gap + W``. Its
+asymptotic (worn) state ``W*`` has a null wear rate, ``g(W*) = 0``: every node that still
+carries load sticks, every node that slipped has worn until it no longer carries load (the
+Ciavarella-Hills result for a partial-slip punch). :func:`worn_state` finds it by
+pseudo-transient continuation (Kelley and Keyes, SIAM J. Numer. Anal. 35, 1998):
+
+    W_{k+1} = W_k + dN_k (I - dN_k Js_k)^-1 g(W_k),      then the DLFT balance at W_{k+1}
+
+the linearly implicit Euler step of the march (:mod:`fretwear.wear.schemes`, ``Js = dg/dW``
+along balanced solutions). While the set of slipping nodes changes, ``dN_k`` comes from the
+march's error control (``path_tolerance``): the state is not unique, it depends on the path
+(which nodes stick, and when), so that part is followed. Once the slipping set has settled
+and the rate decays, the step is set by switched evolution relaxation (SER),
+``dN_{k+1} = dN_k min_growth V'_k / V'_{k+1}`` (``V'`` the worn-volume rate, growth capped at
+``max_growth``): it grows without bound as the rate falls, and the iteration turns into
+Newton's method on ``g(W) = 0`` (``dW -> -Js^-1 g``), the direct solve of the null-wear-rate
+condition. A step that wears a node into separation for the whole period (past its lift-off,
+where the rate is 0 too) is pulled back to the lift-off (:func:`_pull_back`).
+
+Honesty (issue 29): the state is reported reached only when the null-wear-rate residual
+
+    r = max_p g_p(W) / max_p g_p(W0)
+
+(the wear rate left, relative to the initial one) is at most ``tolerance`` AND the last
+correction is at most ``depth_tolerance`` of the deepest wear (a small rate with a slow mode
+that would still carry the profile far is not a state). Otherwise ``success`` is False with
+the residual and the steps tried; the state is never claimed from a plateau of the march.
+
+Wear that goes on (gross slip) has no null-rate state; when the rate stops changing (``max
+|g_{k+1} - g_k| <= tolerance max g``) while the residual stays large, the result says so
+(``kind = "steady_wear"``) with the steady rate profile.
+
+The number of cycles a march needs to get within 1 % of the state is estimated (it is an
+estimate, :func:`cycles_to_one_percent`): each step's worn volume over the log-mean of the
+worn-volume rates at its ends (the time an exponentially decaying rate takes to wear it).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from fretwear.errors import InputError, interrupted
+from fretwear.hb.fallback import TimeDomainFallback
+from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.inputs import check_inputs
+from fretwear.hb.reduce import condense, condenser_for
+from fretwear.hb.solution import PeriodicSolution
+from fretwear.model.core import Model
+from fretwear.wear.checkpoint import check_checkpoint_path, fingerprint
+from fretwear.wear.history import WearHistory
+from fretwear.wear.laws import wear_coefficients, worn_volume
+from fretwear.wear.options import WearOptions
+from fretwear.wear.schemes import first_state
+from fretwear.wear.simulate import (
+    BalanceSetup,
+    RunControl,
+    _assemble,
+    _first_anchor,
+    _frequency,
+    _Saver,
+    _step,
+)
+from fretwear.wear.slow_problem import SlowProblem
+from fretwear.wear.state import SlowStep, StepRecord, StepStats
+
+#: what a worn-state result found: the null-wear-rate state, steady wear (gross slip), none
+KINDS = ("null_wear_rate", "steady_wear", "not_reached", "no_wear")
+
+
+@dataclass(frozen=True)
+class WornStateOptions:
+    """Options of :func:`worn_state`.
+
+    Attributes
+    ----------
+    wear : :class:`~fretwear.wear.options.WearOptions`: the wear law and its coefficients,
+        the periodic solves (``solve``), the retries of a failed step (``max_retries``) and
+        the time-domain rescue; its scheme, error control and stop criteria are not used.
+    tolerance : the null-wear-rate residual ``max g / max g0`` at which the state is reached.
+    depth_tolerance : the largest last correction, relative to the deepest wear, of a
+        reached state.
+    max_steps : pseudo-time steps before giving up.
+    initial_jump : first step [cycles]; None: the march's (``path_tolerance x 2 / rho``,
+        rho the spectral radius of ``Js`` at the start).
+    path_tolerance : the local error per step (relative to the deepest wear) of the steps
+        that follow the path while the set of slipping nodes changes (the march's error
+        control, :mod:`fretwear.wear.step_control`).
+    max_growth : largest growth of the step from one step to the next.
+    min_growth : the SER factor ``|g_k| / |g_{k+1}|`` (worn-volume rates) is multiplied by
+        this: the step grows by it while the rate stays, faster as it falls; a step that
+        changed the set of slipping nodes is not followed by a larger one (the stick
+        events decide where the state ends).
+    """
+
+    wear: WearOptions = field(default_factory=WearOptions)
+    tolerance: float = 1e-6
+    depth_tolerance: float = 1e-3
+    max_steps: int = 200
+    initial_jump: float | None = None
+    max_growth: float = 100.0
+    min_growth: float = 5.0
+    path_tolerance: float = 1e-2
+
+    def __post_init__(self):
+        if not isinstance(self.wear, WearOptions):
+            raise InputError(f"wear = {self.wear!r}: expected a WearOptions")
+        for name in ("tolerance", "depth_tolerance"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and not isinstance(v, bool) and 0 < v < 1):
+                raise InputError(f"{name} = {v!r}: expected a number in (0, 1)")
+        if not (isinstance(self.max_steps, int) and not isinstance(self.max_steps, bool)
+                and self.max_steps >= 1):
+            raise InputError(f"max_steps = {self.max_steps!r}: expected a whole number >= 1")
+        j = self.initial_jump
+        if j is not None and not (isinstance(j, (int, float)) and j > 0):
+            raise InputError(f"initial_jump = {j!r}: expected > 0 cycles or None")
+        if not (isinstance(self.max_growth, (int, float)) and self.max_growth > 1):
+            raise InputError(f"max_growth = {self.max_growth!r}: expected a number > 1")
+
+    def march_options(self, path: bool = False) -> WearOptions:
+        """The wear options of the steps: linearly implicit, no stop criterion of the march;
+        with ``path`` the march's error control at ``path_tolerance``, else none (the step
+        is set by SER)."""
+        return replace(self.wear, scheme="rosenbrock", adaptive=path,
+                       tolerance=self.path_tolerance, initial_jump=self.initial_jump,
+                       max_cycles=math.inf, max_depth=math.inf, plateau_rate=0.0,
+                       max_steps=10**9)
+
+    def key(self) -> dict:
+        """What changes the path (the checkpoint's fingerprint)."""
+        return {"initial_jump": self.initial_jump, "max_growth": self.max_growth,
+                "min_growth": self.min_growth, "path_tolerance": self.path_tolerance}
+
+
+@dataclass
+class WornStateResult:
+    """What :func:`worn_state` found.
+
+    Attributes
+    ----------
+    success : the null-wear-rate state (or steady wear) was reached within the tolerances.
+    kind : one of :data:`KINDS`.
+    message : what was found or tried, with the residual.
+    wear : (nc,) worn depths ``W`` [m] of the last iterate (the state when ``success``).
+    rate : (nc,) wear depth per cycle there [m].
+    residual : the null-wear-rate residual ``max g / max g0`` of the last iterate.
+    correction : the last correction ``max |W_{k+1} - W_k| / max W``.
+    cycles_to_1pc : an ESTIMATE of the cycles a march needs to get within 1 % of the
+        deepest wear of the state (module docstring); NaN when not reached.
+    worn_volume : sum ``area W`` [m^3].
+    history : the pseudo-time steps (:class:`~fretwear.wear.history.WearHistory`; its
+        ``cycles`` are pseudo-time, not physical cycles).
+    initial, final : periodic solutions at the start and at the last iterate.
+    penalty : DLFT penalty [N/m]; dlft_solves : periodic balances solved (Newton iterations
+        and slow Jacobians, as counted by the march); wall_time : [s].
+    resumed_from : step of the checkpoint it resumed from (-1: a fresh run).
+    warnings : reasons for caution.
+    """
+
+    success: bool
+    kind: str
+    message: str
+    wear: np.ndarray
+    rate: np.ndarray
+    residual: float
+    correction: float
+    cycles_to_1pc: float
+    worn_volume: float
+    history: WearHistory
+    initial: PeriodicSolution | None
+    final: PeriodicSolution | None
+    penalty: float
+    dlft_solves: int
+    wall_time: float
+    resumed_from: int = -1
+    warnings: list = field(default_factory=list)
+
+
+def worn_state(model: Model, basis: FourierBasis, *, frequency: float | None = None,
+               quasi_static: bool = False, options: WornStateOptions | None = None,
+               wear0=None, balance: BalanceSetup | None = None, run: RunControl | None = None,
+               time_domain: TimeDomainFallback | None = None) -> WornStateResult:
+    """The asymptotic worn state ``g(W*) = 0`` by pseudo-transient continuation on the slow
+    equation ``dW/dN = g(W)`` (eq. 29; module docstring), with the DLFT balance (eq. 22)
+    solved at every iterate.
+
+    Parameters are those of :func:`fretwear.wear.simulate.simulate_wear` (``run.checkpoint``
+    keeps the pseudo-time state, ``run.resume`` continues it), with ``options`` a
+    :class:`WornStateOptions`.
+
+    Returns
+    -------
+    :class:`WornStateResult`; ``success`` False (with the residual) when the state was not
+    reached in ``options.max_steps`` steps or a step failed.
+    """
+    if options is None:
+        options = WornStateOptions()
+    if not isinstance(options, WornStateOptions):
+        raise InputError(f"options = {options!r}: expected a WornStateOptions")
+    balance = balance or BalanceSetup()
+    run = run or RunControl()
+    opts = options.march_options()
+    frequency = check_inputs(model, basis, _frequency(frequency, quasi_static),
+                             quasi_static=quasi_static, anchor=balance.anchor, U0=balance.U0)
+    if model.contact.prescribed_nodes().any():
+        raise InputError("contact normal_load: the worn state needs the normal contact to come "
+                         "from the structure (a prescribed normal load does not move with the "
+                         "worn gap)")
+    if model.contact.has_connectors or not getattr(balance.condenser, "models_in_time", True):
+        time_domain = None
+    if run.checkpoint is not None:
+        check_checkpoint_path(run.checkpoint)
+    t_start = time.perf_counter()
+    nc, d = model.contact.dofs.shape
+    condenser = condenser_for(model, balance.condenser)
+    reduced = balance.reduced
+    if reduced is None:
+        reduced = condense(model, frequency, basis.orders, quasi_static=quasi_static,
+                           condenser=condenser)
+    coef = wear_coefficients(model, opts.law, opts.energy_coefficient,
+                             opts.partner_energy_coefficient)
+    wear0 = np.zeros(nc) if wear0 is None else np.broadcast_to(np.asarray(wear0, float),
+                                                                 (nc,)).copy()
+    anchor, warnings = _first_anchor(model, balance.anchor, condenser)
+    sp = SlowProblem(model, reduced, basis, coef, eps=balance.eps, anchor=anchor,
+                     time_domain=time_domain if opts.time_domain_rescue and not quasi_static
+                     else None, condenser=condenser, jacobian=opts.solve.jacobian)
+    key = fingerprint(model, reduced, basis, sp.eps, coef,
+                      replace(opts, initial_jump=options.initial_jump), wear0, anchor)
+    key = f"worn-state {options.key()} {key}"
+    saver = _Saver(run.checkpoint, key, opts.checkpoint_every_s)
+    if run.resume and saver.exists():
+        state, records = saver.load(shape=(nc, d, sp.H))
+        resumed_from = state.step
+    else:
+        state, records = first_state(sp, wear0, anchor, balance.U0,
+                                     options.march_options(path=True))
+        resumed_from = -1
+    state, found = _continue(sp, state, records, options, opts, run, saver)
+    saver.save(state, records, now=True)
+    hist = WearHistory.from_records(records, found.kind)
+    balanced = [r for r in records if r.has_balance]
+    area = np.asarray(model.contact.area, float)
+    return WornStateResult(
+        found.success, found.kind, found.message, state.W.copy(), state.g.copy(),
+        found.residual, found.correction,
+        cycles_to_one_percent(records) if found.kind == "null_wear_rate" else math.nan,
+        worn_volume(state.W, area), hist,
+        _assemble(sp, balanced[0]) if balanced else None,
+        _assemble(sp, balanced[-1]) if balanced else None, sp.eps,
+        int(hist.newton_iterations.sum()), time.perf_counter() - t_start, resumed_from,
+        warnings)
+
+
+@dataclass(frozen=True)
+class _Found:
+    success: bool
+    kind: str
+    message: str
+    residual: float
+    correction: float
+
+
+def rate_residual(records: list[StepRecord]) -> float:
+    """The null-wear-rate residual ``max g / max g0`` of the last record (0 with no wear)."""
+    g0 = float(np.max(records[0].wear_rate))
+    return float(np.max(records[-1].wear_rate)) / g0 if g0 > 0 else 0.0
+
+
+def _correction(records: list[StepRecord]) -> float:
+    """The last step's ``max |W_{k+1} - W_k| / max W_{k+1}`` (inf before any step)."""
+    if len(records) < 2:
+        return math.inf
+    W1, W0 = records[-1].wear_depth, records[-2].wear_depth
+    top = float(np.max(W1))
+    return float(np.max(np.abs(W1 - W0))) / top if top > 0 else 0.0
+
+
+def _rate_change(records: list[StepRecord]) -> float:
+    """``max |g_{k+1} - g_k| / max g_{k+1}`` over the last step (inf before any step)."""
+    if len(records) < 2:
+        return math.inf
+    g1, g0 = records[-1].wear_rate, records[-2].wear_rate
+    top = float(np.max(g1))
+    return float(np.max(np.abs(g1 - g0))) / top if top > 0 else math.inf
+
+
+def _judge(records: list[StepRecord], options: WornStateOptions) -> _Found | None:
+    """The verdict on the last iterate, or None to go on."""
+    r, c = rate_residual(records), _correction(records)
+    n = len(records) - 1
+    if float(np.max(records[0].wear_rate)) <= 0:
+        return _Found(True, "no_wear", "no wear: no contact node slips at the start (wear rate "
+                      "0); the worn state is the initial one", 0.0, 0.0)
+    if r <= options.tolerance and c <= options.depth_tolerance:
+        return _Found(True, "null_wear_rate",
+                      f"worn state reached after {n} pseudo-time steps: null-wear-rate "
+                      f"residual max g / max g0 = {r:.3g} <= {options.tolerance:g}, last "
+                      f"correction {c:.3g} of the deepest wear <= {options.depth_tolerance:g}",
+                      r, c)
+    if n >= 3 and _rate_change(records) <= options.tolerance and r > 0.1:
+        return _Found(True, "steady_wear",
+                      f"no null-wear-rate state: the wear goes on at a steady rate (residual "
+                      f"{r:.3g}, the rate profile changed by {_rate_change(records):.3g} over "
+                      "the last step); the rate profile is the steady one", r, c)
+    return None
+
+
+def _continue(sp: SlowProblem, state: SlowStep, records: list[StepRecord],
+              options: WornStateOptions, opts: WearOptions, run: RunControl, saver: _Saver
+              ) -> tuple[SlowStep, _Found]:
+    """Steps from ``state`` until :func:`_judge` decides or ``max_steps``: error-controlled
+    (the march's steps) while the set of slipping nodes changes, with SER once it has
+    settled (:func:`_settled`)."""
+    path = options.march_options(path=True)
+    while True:
+        found = _judge(records, options)
+        if found is not None:
+            return state, found
+        if state.step >= options.max_steps:
+            r, c = rate_residual(records), _correction(records)
+            return state, _Found(False, "not_reached",
+                                 f"worn state NOT reached after {state.step} pseudo-time steps "
+                                 f"(SER from {records[1].jump if len(records) > 1 else 0:.3g} "
+                                 f"to {state.jump:.3g} cycles): null-wear-rate residual max g "
+                                 f"/ max g0 = {r:.3g} (tolerance {options.tolerance:g}), last "
+                                 f"correction {c:.3g} of the deepest wear", r, c)
+        try:
+            settled = _settled(records)
+            new, record, msg = _step(sp, state, opts if settled else path)
+            if new is not None and not new.in_time_integration:
+                new, record = _pull_back(sp, state, new, record, opts)
+                msg = msg or "the balance after pulling back over-worn nodes failed"
+            if new is None:
+                r, c = rate_residual(records), _correction(records)
+                return state, _Found(False, "not_reached",
+                                     f"worn state NOT reached: a pseudo-time step failed "
+                                     f"({msg}); null-wear-rate residual {r:.3g} after "
+                                     f"{state.step} steps", r, c)
+            if settled:  # SER; else the jump the error control proposed
+                new.jump = record.jump * _growth(state, new, records[-1], record, options)
+            records.append(record)
+            state = new
+            saver.save(state, records)
+            if run.callback is not None:
+                run.callback(state.step, record)
+        except (KeyboardInterrupt, SystemError) as exc:
+            if not interrupted(exc):
+                raise
+            saver.save(state, records, now=True)
+            raise KeyboardInterrupt from None
+
+
+def _settled(records: list[StepRecord]) -> bool:
+    """Whether the path has settled: the same slipping nodes over the last three records and
+    a worn-volume rate that fell over both steps. Then only the decay to the state is left,
+    and the steps may grow as fast as SER lets them."""
+    if len(records) < 3:
+        return False
+    last = records[-3:]
+    same = all(np.array_equal(state_slip(last[0]), state_slip(r)) for r in last[1:])
+    return same and last[0].volume_rate > last[1].volume_rate > last[2].volume_rate
+
+
+def _growth(old: SlowStep, new: SlowStep, old_record: StepRecord, record: StepRecord,
+            options: WornStateOptions) -> float:
+    """The factor from this step to the next: SER on the worn-volume rate (smoother than the
+    largest node's rate, which rises where the load moves) times ``min_growth``, within
+    ``[0.5, max_growth]``; at most 1 after a step that changed the set of slipping nodes."""
+    ratio = old.volume_rate / new.volume_rate if new.volume_rate > 0 else options.max_growth
+    grow = min(options.max_growth, max(ratio * options.min_growth, 0.5))
+    if not np.array_equal(state_slip(old_record), state_slip(record)):
+        grow = min(grow, 1.0)
+    return grow
+
+
+def separation(sp: SlowProblem, U) -> np.ndarray:
+    """(nc,) the smallest normal separation over the period [m] of every node separated all
+    period at the balance ``U`` (current gap), 0 for the others: ``-lambda_u,N / eps``
+    (eq. 23: a separated node has ``lambda = 0``, so ``lambda_u = eps (U - W~)``)."""
+    lu, _, st, _ = sp.prob.time_law(U)
+    sep = np.min(-lu[:, 0, :], axis=1) / sp.eps
+    return np.where(np.all(st == 0, axis=1), np.maximum(sep, 0.0), 0.0)
+
+
+def _pull_back(sp: SlowProblem, before: SlowStep, new: SlowStep, record: StepRecord,
+               opts: WearOptions) -> tuple[SlowStep | None, StepRecord | None]:
+    """A node can only wear while it touches: one that the step wore into separation for
+    the whole period (a Newton-like step overshoots the lift-off, where the rate is 0) is
+    pulled back by its separation, no further than where the step started, and the balance
+    solved again. ``(state, record)`` unchanged when no node overshot; ``(None, None)`` when
+    the new balance fails."""
+    sp.set_state(new.W, new.anchor)
+    sep = separation(sp, new.U)
+    worn = new.W > before.W
+    if not np.any(sep[worn] > 0):
+        return new, record
+    t0 = time.perf_counter()
+    W = np.where(worn, np.maximum(new.W - sep, before.W), new.W)
+    U, st = sp.solve_balance(W, new.anchor, sp.shift_guess(new.U, W - new.W),
+                             options=opts.solve)
+    if not st.success:
+        return None, None
+    sp.set_state(W, new.anchor)
+    g = sp.rate(U)
+    sol = sp.solution(U, W, new.anchor, st)
+    stats = StepStats(record.cycles, record.jump, record.newton_iterations + st.iterations,
+                      record.rejected, record.error_estimate,
+                      record.wall_time + time.perf_counter() - t0)
+    rec = StepRecord.balanced(sol, W, g, stats)
+    return SlowStep.balanced(rec, new.jump, before), rec
+
+
+def state_slip(record: StepRecord) -> np.ndarray:
+    """The nodes that slip during the period of a record."""
+    return record.state_fraction[:, 2] > 0
+
+
+def cycles_to_one_percent(records: list[StepRecord]) -> float:
+    """An ESTIMATE of the physical cycles a march needs to get within 1 % of the deepest
+    wear of the last record (module docstring): each pseudo-time step's worn volume ``dV``
+    over the log-mean of the volume rates ``r0, r1`` at its ends (the time an exponential
+    decay of the rate takes to wear ``dV``), summed up to the first step within 1 %, of which
+    only the part that brings the distance to the state down to 1 % (same decay)."""
+    Wf = records[-1].wear_depth
+    top = float(np.max(Wf))
+    if top <= 0:
+        return 0.0
+    n = 0.0
+    for k in range(1, len(records)):
+        r0, r1 = records[k - 1].volume_rate, records[k].volume_rate
+        dV = records[k].worn_volume - records[k - 1].worn_volume
+        d0 = float(np.max(np.abs(records[k - 1].wear_depth - Wf)))
+        d1 = float(np.max(np.abs(records[k].wear_depth - Wf)))
+        decays = dV > 0 and r0 > r1 >= 0
+        if d1 <= 0.01 * top:
+            if d0 > 0.01 * top and decays:
+                n += math.log(d0 / (0.01 * top)) * dV / (r0 - r1)  # 1/mu = dV / (r0 - r1)
+            elif d0 > 0.01 * top and r0 > 0:
+                n += dV / r0
+            return n
+        if decays and r1 > 0:
+            n += dV * math.log(r0 / r1) / (r0 - r1)
+        elif r0 + r1 > 0:
+            n += max(dV, 0.0) / (0.5 * (r0 + r1))
+    return n
