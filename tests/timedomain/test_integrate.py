@@ -524,3 +524,17 @@ def test_energy_is_cumulative_across_kernel_chunks(monkeypatch):
     e = {key: val[-1] - val[0] for key, val in cut.energy.items()}  # five chunk boundaries
     assert e["external"] > 0 and e["friction"] > 0
     assert cut.energy_residual() < 1e-9 * e["external"]
+
+
+def test_kept_periods_that_cannot_fit_are_refused_before_allocation():
+    """A fixed-length run keeps the once-per-period samples of every period: 1e9 periods of a
+    one-DOF slider need 3 x 1e9 x 2 x 8 bytes = 48 GB, more than this machine's memory (24
+    GiB); the run is refused in one line naming what would not fit, before numpy is asked
+    for the arrays (it raised numpy's ArrayMemoryError, a traceback in a case file)."""
+    from fretwear.resources import machine_memory
+
+    n = 10**9
+    assert 3 * n * 2 * 8 > machine_memory()
+    with pytest.raises(InputError, match="once-per-period samples of 1000000000 periods"):
+        tr.integrate(slider(m=1.0, k=1.0, N=1.0, F0=1.0, mu=0.3), hz(1.0), n_periods=n,
+                     keep_poincare=n)

@@ -398,6 +398,10 @@ def integrate(model: Model, frequency: float, *, n_periods: int,
     require_memory(8.0 * n_rec * steps * width,
                    f"recording {n_rec} periods of {steps} time steps")
     integ = Integrator(model, omega, options, start)
+    # once-per-period monitors of the kept periods: start, mean and range of the observed and
+    # contact coordinates [8 bytes each]
+    require_memory(8.0 * 3 * n_keep * (integ.red.obs.shape[0] + integ.m),
+                   f"keeping the once-per-period samples of {n_keep} periods")
     t0 = time.perf_counter()
     raw = integ.run(n_periods, n_rec, n_keep, progress=progress)
     wall = time.perf_counter() - t0
