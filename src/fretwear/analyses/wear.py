@@ -546,19 +546,30 @@ def wear_figures(ds, case, outdir: Path, nodes) -> list[Path]:
                            title=f"{t}: pressure and slip"),
         plot_worn_volume(ds, outdir / f"worn-volume.{fmt}", title=f"{t}: worn volume"),
     ]
+    return figs + maps_and_frf_figures(ds, outdir / f"wear-maps.{fmt}", f"{t}: worn surfaces",
+                                       "last step", (outdir, "frf-worn", fmt,
+                                                     f"{t}: FRF before / after wear"))
+
+
+def maps_and_frf_figures(ds: xr.Dataset, maps: Path, maps_title: str, when: str,
+                         frf: tuple) -> list[Path]:
+    """The figures a wear run and a worn state share: maps of the worn surfaces and of the
+    mean pressure at the last record (``when`` says which: "last step", "at the state"; 3D or
+    several interfaces only) into ``maps``, and each observed point's FRF before and after
+    wear when the run computed them: ``frf = (folder, file stem, format, title)``."""
+    figs = []
     if plots.wants_interface_maps(ds):
         last = ds["worn_depth_surface"].values[-1]
         fields = [("worn depth, contact surface", last[:, 0], "m")]
         if np.any(last[:, 1] > 0):
             fields.append(("worn depth, partner surface", last[:, 1], "m"))
-        fields.append(("mean pressure (last step)", ds["pressure_mean"].values[-1], "Pa"))
-        figs.append(plots.plot_interface_maps(ds, fields, outdir / f"wear-maps.{fmt}",
-                                              title=f"{t}: worn surfaces"))
+        fields.append((f"mean pressure ({when})", ds["pressure_mean"].values[-1], "Pa"))
+        figs.append(plots.plot_interface_maps(ds, fields, maps, title=maps_title))
     if "frf_amplitude" in ds:
+        folder, stem, fmt, title = frf
         for p in ds["point"].values:
-            path = outdir / f"frf-worn-{safe_name(str(p))}.{fmt}"
-            figs.append(plot_frf_before_after(ds, path, str(p),
-                                              title=f"{t}: FRF before / after wear"))
+            path = folder / f"{stem}-{safe_name(str(p))}.{fmt}"
+            figs.append(plot_frf_before_after(ds, path, str(p), title=title))
     return figs
 
 

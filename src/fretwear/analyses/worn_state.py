@@ -30,12 +30,11 @@ from fretwear.analyses.wear import (
     _frf_data,
     _profile,
     _x_along,
+    maps_and_frf_figures,
     options_from_table,
     penalty_of,
-    plot_frf_before_after,
     wear_dataset,
 )
-from fretwear.files import safe_name
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.sweep import frequency_grid
 from fretwear.io.results import variable
@@ -129,20 +128,9 @@ def _figures(ds, case, outdir: Path) -> list[Path]:
     figs = [plot_worn_state(ds, outdir / f"worn-state.{fmt}", title=f"{t}: worn state"),
             plot_residual(ds, outdir / f"worn-state-residual.{fmt}",
                           title=f"{t}: null-wear-rate residual")]
-    if plots.wants_interface_maps(ds):
-        last = ds["worn_depth_surface"].values[-1]
-        fields = [("worn depth, contact surface", last[:, 0], "m")]
-        if np.any(last[:, 1] > 0):
-            fields.append(("worn depth, partner surface", last[:, 1], "m"))
-        fields.append(("mean pressure at the state", ds["pressure_mean"].values[-1], "Pa"))
-        figs.append(plots.plot_interface_maps(ds, fields, outdir / f"worn-state-maps.{fmt}",
-                                              title=f"{t}: worn state"))
-    if "frf_amplitude" in ds:
-        for p in ds["point"].values:
-            path = outdir / f"frf-worn-state-{safe_name(str(p))}.{fmt}"
-            figs.append(plot_frf_before_after(ds, path, str(p),
-                                              title=f"{t}: FRF before wear / at the worn state"))
-    return figs
+    return figs + maps_and_frf_figures(
+        ds, outdir / f"worn-state-maps.{fmt}", f"{t}: worn state", "at the state",
+        (outdir, "frf-worn-state", fmt, f"{t}: FRF before wear / at the worn state"))
 
 
 def run_worn_state(model, analysis: dict, case, context: RunContext) -> RunOutput:

@@ -22,6 +22,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -99,6 +100,49 @@ class RunControl:
     callback: Callable | None = None
 
 
+
+class SlowSetup(NamedTuple):
+    """What a slow-scale run starts from (:func:`slow_setup`)."""
+
+    condenser: object
+    reduced: object
+    coef: object
+    wear0: np.ndarray
+    anchor: np.ndarray
+    warnings: list
+    sp: SlowProblem
+
+
+def slow_setup(model, basis, frequency, quasi_static: bool, balance, opts, wear0,
+               time_domain) -> SlowSetup:
+    """The pieces every run on the slow scale starts from, the march
+    (:func:`simulate_wear`) and the worn state directly
+    (:func:`fretwear.wear.worn_state.worn_state`): the initial wear checked (one depth or one
+    per contact node [m], >= 0), one condenser for every condensation of the run, the reduced
+    model, the wear coefficients of eq. (29), the stick anchors of the first balance and the
+    slow problem (the time-domain rescue only for a dynamic run that asks for it)."""
+    nc = model.contact.dofs.shape[0]
+    if wear0 is not None:
+        wear0 = reals(wear0, "wear0", low=0.0)
+        if wear0.size != 1 and wear0.shape != (nc,):
+            raise InputError(f"wear0 has shape {wear0.shape}; expected one depth or {nc} "
+                             "(one per contact node) [m]")
+    condenser = condenser_for(model, balance.condenser)
+    reduced = balance.reduced
+    if reduced is None:
+        reduced = condense(model, frequency, basis.orders, quasi_static=quasi_static,
+                           condenser=condenser)
+    coef = wear_coefficients(model, opts.law, opts.energy_coefficient,
+                             opts.partner_energy_coefficient)
+    wear0 = np.zeros(nc) if wear0 is None else np.broadcast_to(np.asarray(wear0, float),
+                                                                 (nc,)).copy()
+    anchor, warnings = _first_anchor(model, balance.anchor, condenser)
+    sp = SlowProblem(model, reduced, basis, coef, eps=balance.eps, anchor=anchor,
+                     time_domain=time_domain if opts.time_domain_rescue and not quasi_static
+                     else None, condenser=condenser, jacobian=opts.solve.jacobian)
+    return SlowSetup(condenser, reduced, coef, wear0, anchor, warnings, sp)
+
+
 def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float | None = None,
                   quasi_static: bool = False, options: WearOptions | None = None,
                   wear0=None, balance: BalanceSetup | None = None, run: RunControl | None = None,
@@ -158,24 +202,8 @@ def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float | None 
                          "wear): leave it out, or give the contact a partner")
     t_start = time.perf_counter()
     nc, d = model.contact.dofs.shape
-    if wear0 is not None:
-        wear0 = reals(wear0, "wear0", low=0.0)
-        if wear0.size != 1 and wear0.shape != (nc,):
-            raise InputError(f"wear0 has shape {wear0.shape}; expected one depth or {nc} "
-                             "(one per contact node) [m]")
-    condenser = condenser_for(model, balance.condenser)  # one for every condensation of the run
-    reduced = balance.reduced
-    if reduced is None:
-        reduced = condense(model, frequency, basis.orders, quasi_static=quasi_static,
-                           condenser=condenser)
-    coef = wear_coefficients(model, opts.law, opts.energy_coefficient,
-                             opts.partner_energy_coefficient)
-    wear0 = np.zeros(nc) if wear0 is None else np.broadcast_to(np.asarray(wear0, float),
-                                                                 (nc,)).copy()
-    anchor, warnings = _first_anchor(model, balance.anchor, condenser)
-    sp = SlowProblem(model, reduced, basis, coef, eps=balance.eps, anchor=anchor,
-                     time_domain=time_domain if opts.time_domain_rescue and not quasi_static
-                     else None, condenser=condenser, jacobian=opts.solve.jacobian)
+    condenser, reduced, coef, wear0, anchor, warnings, sp = slow_setup(
+        model, basis, frequency, quasi_static, balance, opts, wear0, time_domain)
     saver = _Saver(run.checkpoint, fingerprint(model, reduced, basis, sp.eps, coef, opts, wear0,
                                                anchor), opts.checkpoint_every_s)
     if run.resume and saver.exists():  # damaged: an InputError, never ignored

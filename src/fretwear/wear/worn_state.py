@@ -50,22 +50,21 @@ from fretwear.errors import InputError, interrupted
 from fretwear.hb.fallback import TimeDomainFallback
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.inputs import check_inputs
-from fretwear.hb.reduce import condense, condenser_for
 from fretwear.hb.solution import PeriodicSolution
 from fretwear.model.core import Model
 from fretwear.wear.checkpoint import check_checkpoint_path, fingerprint
 from fretwear.wear.history import WearHistory
-from fretwear.wear.laws import wear_coefficients, worn_volume
+from fretwear.wear.laws import worn_volume
 from fretwear.wear.options import WearOptions
 from fretwear.wear.schemes import first_state
 from fretwear.wear.simulate import (
     BalanceSetup,
     RunControl,
     _assemble,
-    _first_anchor,
     _frequency,
     _Saver,
     _step,
+    slow_setup,
 )
 from fretwear.wear.slow_problem import SlowProblem
 from fretwear.wear.state import SlowStep, StepRecord, StepStats
@@ -219,19 +218,8 @@ def worn_state(model: Model, basis: FourierBasis, *, frequency: float | None = N
         check_checkpoint_path(run.checkpoint)
     t_start = time.perf_counter()
     nc, d = model.contact.dofs.shape
-    condenser = condenser_for(model, balance.condenser)
-    reduced = balance.reduced
-    if reduced is None:
-        reduced = condense(model, frequency, basis.orders, quasi_static=quasi_static,
-                           condenser=condenser)
-    coef = wear_coefficients(model, opts.law, opts.energy_coefficient,
-                             opts.partner_energy_coefficient)
-    wear0 = np.zeros(nc) if wear0 is None else np.broadcast_to(np.asarray(wear0, float),
-                                                                 (nc,)).copy()
-    anchor, warnings = _first_anchor(model, balance.anchor, condenser)
-    sp = SlowProblem(model, reduced, basis, coef, eps=balance.eps, anchor=anchor,
-                     time_domain=time_domain if opts.time_domain_rescue and not quasi_static
-                     else None, condenser=condenser, jacobian=opts.solve.jacobian)
+    condenser, reduced, coef, wear0, anchor, warnings, sp = slow_setup(
+        model, basis, frequency, quasi_static, balance, opts, wear0, time_domain)
     key = fingerprint(model, reduced, basis, sp.eps, coef,
                       replace(opts, initial_jump=options.initial_jump), wear0, anchor)
     key = f"worn-state {options.key()} {key}"
