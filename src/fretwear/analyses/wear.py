@@ -242,6 +242,28 @@ def wear_dataset(model, result: WearResult, basis: FourierBasis, *, frequency_hz
     return ds
 
 
+
+def before_after_frf(model, basis, a: dict, fb: dict | None, cond, worn) -> tuple:
+    """The FRFs before and after wear (the paper's Fig. 24) that ``frf_before_after`` (``fb``)
+    asks for, with the worn gap ``worn`` (nc,) [m]: ``(frf data or None, summary note,
+    {"unworn": SweepResult, "worn": SweepResult})``; the sweeps use the analysis's solver and
+    penalty (``a``) and the run's condenser."""
+    if fb is None:
+        return None, "", {}
+    if not model.observed:
+        return None, "FRF before/after skipped: the model has no observed point", {}
+    grid = (fb["f_min"], fb["f_max"], fb["n_points"])
+    frf_options = WORN_FRF.replace(solve=WORN_FRF.solve.replace(solver=a["solver"]),
+                                   **penalty_of(a), spacing=fb["spacing"])
+    sweeps = {name: api.frf_worn(model, basis, w, *grid, options=frf_options,
+                                 time_domain=fb["time_domain"], condenser=cond)
+              for name, w in (("unworn", 0.0), ("worn", worn))}
+    frf = _frf_data(model, sweeps, frequency_grid(*grid, fb["spacing"]))
+    note = "\n".join(f"FRF {k}: {int(v.point_success.sum())}/{len(v.points)} converged"
+                     for k, v in sweeps.items())
+    return frf, note, sweeps
+
+
 def _frf_data(model, sweeps: dict, freqs: np.ndarray) -> dict:
     """FRF variables (wear_state, frequency, point, axis) on the requested grid."""
     points = [p.name for p in model.observed]
@@ -426,20 +448,7 @@ def run_wear(model, analysis: dict, case, context: RunContext) -> RunOutput:
             raise
         write_partial(model, basis, analysis, case, context.out_dir)
         raise KeyboardInterrupt from None
-    frf, frf_note = None, ""
-    if fb is not None and model.observed:
-        grid = (fb["f_min"], fb["f_max"], fb["n_points"])
-        frf_options = WORN_FRF.replace(
-            solve=WORN_FRF.solve.replace(solver=a["solver"]), **penalty_of(a),
-            spacing=fb["spacing"])
-        sweeps = {name: api.frf_worn(model, basis, w, *grid, options=frf_options,
-                                     time_domain=fb["time_domain"], condenser=cond)
-                  for name, w in (("unworn", 0.0), ("worn", result.final_wear))}
-        frf = _frf_data(model, sweeps, frequency_grid(*grid, fb["spacing"]))
-        frf_note = "\n".join(f"FRF {k}: {int(v.point_success.sum())}/{len(v.points)} converged"
-                             for k, v in sweeps.items())
-    elif fb is not None:
-        frf_note = "FRF before/after skipped: the model has no observed point"
+    frf, frf_note, sweeps = before_after_frf(model, basis, a, fb, cond, result.final_wear)
     ds = wear_dataset(model, result, basis, frequency_hz=f_hz, record_every=a["record_every"],
                       frf=frf, law=opts.law,
                       energy_coefficients=(opts.energy_coefficient,

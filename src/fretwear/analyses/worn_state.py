@@ -27,21 +27,19 @@ from fretwear.analyses.wear import (
     SCHEMA as WEAR_SCHEMA,
 )
 from fretwear.analyses.wear import (
-    _frf_data,
     _profile,
     _x_along,
+    before_after_frf,
     maps_and_frf_figures,
     options_from_table,
     penalty_of,
     wear_dataset,
 )
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.sweep import frequency_grid
 from fretwear.io.results import variable
 from fretwear.io.schema import Field, Integer, Number, fail
 from fretwear.wear import BalanceSetup, RunControl, WearResult
 from fretwear.wear.simulate import QUASI_STATIC_FREQUENCY
-from fretwear.wear.worn_frf import WORN_FRF
 from fretwear.wear.worn_state import WornStateOptions, WornStateResult
 
 CHECKPOINT_FILE = "worn-state-checkpoint.npz"
@@ -147,20 +145,7 @@ def run_worn_state(model, analysis: dict, case, context: RunContext) -> RunOutpu
                          balance=BalanceSetup(condenser=cond, **penalty_of(a)),
                          run=RunControl(checkpoint=context.out_dir / CHECKPOINT_FILE,
                                         resume=context.resume, progress=context.progress))
-    frf, frf_note, sweeps = None, "", {}
-    if fb is not None and model.observed:
-        grid = (fb["f_min"], fb["f_max"], fb["n_points"])
-        frf_options = WORN_FRF.replace(
-            solve=WORN_FRF.solve.replace(solver=a["solver"]), **penalty_of(a),
-            spacing=fb["spacing"])
-        sweeps = {name: api.frf_worn(model, basis, w, *grid, options=frf_options,
-                                     time_domain=fb["time_domain"], condenser=cond)
-                  for name, w in (("unworn", 0.0), ("worn", res.wear))}
-        frf = _frf_data(model, sweeps, frequency_grid(*grid, fb["spacing"]))
-        frf_note = "\n".join(f"FRF {k}: {int(v.point_success.sum())}/{len(v.points)} converged"
-                             for k, v in sweeps.items())
-    elif fb is not None:
-        frf_note = "FRF before/after skipped: the model has no observed point"
+    frf, frf_note, sweeps = before_after_frf(model, basis, a, fb, cond, res.wear)
     ds = worn_state_dataset(model, res, basis, frequency_hz=f_hz, frf=frf, opts=opts)
     ds.attrs.update(cond.choice.attributes())
     figures = _figures(ds, case, context.out_dir)
