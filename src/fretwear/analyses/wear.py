@@ -420,22 +420,28 @@ def plot_frf_before_after(ds, path: Path, point: str, *, title=None) -> Path:
 
 
 # --- the analysis -----------------------------------------------------------------------------
+def slow_run_setup(model, a: dict) -> tuple:
+    """What a wear run and a worn state read from their ``[analysis]`` table ``a``:
+    ``(quasi_static, frequency [Hz], FourierBasis, frf_before_after table or None, condenser)``;
+    the condenser is the case file's choice of condensation for the run and its FRFs before
+    and after wear (up to the higher of the frequency and the FRF band)."""
+    quasi = bool(a["quasi_static"])
+    f_hz = float(a.get("frequency", QUASI_STATIC_FREQUENCY))
+    basis = FourierBasis.up_to(a["harmonics"], a["n_samples"])
+    fb = a.get("frf_before_after")
+    top = None if quasi else max(f_hz, fb["f_max"] if fb is not None else 0.0)
+    return quasi, f_hz, basis, fb, condenser_of(model, a, top, max(basis.harmonics))
+
+
 def run_wear(model, analysis: dict, case, context: RunContext) -> RunOutput:
     """Fretting wear to a plateau, a depth or a cycle count (see module docstring)."""
     a = analysis
     opts = options_from_table(a)
-    quasi = bool(a["quasi_static"])
-    f_hz = float(a.get("frequency", QUASI_STATIC_FREQUENCY))
-    basis = FourierBasis.up_to(a["harmonics"], a["n_samples"])
     nc = model.contact.n_nodes
     nodes = a.get("plot_nodes")
     if nodes is not None and any(p >= nc for p in nodes):
         fail("analysis.plot_nodes", nodes, f"contact node numbers from 0 to {nc - 1}")
-    # the time-domain rescue: api.simulate_wear's fallback, used as opts.time_domain_rescue says
-    # the run's condensation of the model (the case file's choice), for the wear run and FRFs
-    fb = a.get("frf_before_after")
-    top = None if quasi else max(f_hz, fb["f_max"] if fb is not None else 0.0)
-    cond = condenser_of(model, a, top, max(basis.harmonics))
+    quasi, f_hz, basis, fb, cond = slow_run_setup(model, a)
     try:
         result = api.simulate_wear(model, basis, frequency=f_hz, quasi_static=quasi,
                                    options=opts,

@@ -22,7 +22,6 @@ import numpy as np
 from fretwear import api
 from fretwear.analyses import figures as plots
 from fretwear.analyses.base import Analysis, RunContext, RunOutput
-from fretwear.analyses.common import condenser_of
 from fretwear.analyses.wear import (
     SCHEMA as WEAR_SCHEMA,
 )
@@ -33,13 +32,13 @@ from fretwear.analyses.wear import (
     maps_and_frf_figures,
     options_from_table,
     penalty_of,
+    slow_run_setup,
     wear_dataset,
 )
 from fretwear.hb.fourier import FourierBasis
 from fretwear.io.results import variable
 from fretwear.io.schema import Field, Integer, Number, fail
 from fretwear.wear import BalanceSetup, RunControl, WearResult
-from fretwear.wear.simulate import QUASI_STATIC_FREQUENCY
 from fretwear.wear.worn_state import WornStateOptions, WornStateResult
 
 CHECKPOINT_FILE = "worn-state-checkpoint.npz"
@@ -135,12 +134,7 @@ def run_worn_state(model, analysis: dict, case, context: RunContext) -> RunOutpu
     """The worn state directly (module docstring)."""
     a = analysis
     opts = options_of(a)
-    quasi = bool(a["quasi_static"])
-    f_hz = float(a.get("frequency", QUASI_STATIC_FREQUENCY))
-    basis = FourierBasis.up_to(a["harmonics"], a["n_samples"])
-    fb = a.get("frf_before_after")
-    top = None if quasi else max(f_hz, fb["f_max"] if fb is not None else 0.0)
-    cond = condenser_of(model, a, top, max(basis.harmonics))
+    quasi, f_hz, basis, fb, cond = slow_run_setup(model, a)
     res = api.worn_state(model, basis, frequency=f_hz, quasi_static=quasi, options=opts,
                          balance=BalanceSetup(condenser=cond, **penalty_of(a)),
                          run=RunControl(checkpoint=context.out_dir / CHECKPOINT_FILE,
