@@ -640,10 +640,12 @@ OUTPUT = Table(
         "figure_format": Field(Text(FIGURE_FORMATS), "figure file format", default="png"),
         "vtu": Field(Flag(), "write ParaView files (.vtu/.pvd) of fields when the model has a "
                      "mesh", default=True),
-        "whole_disk": Field(Flag(), "a sector ([cyclic]) of a periodic analysis: also "
-                            "`periodic-disk.pvd`, the whole disk rebuilt from the sector (every "
-                            "sector turned, each harmonic n phased by e^{i n EO j 2 pi / N}); "
-                            "default false"),
+        "whole_disk": Field(Flag(), "a sector ([cyclic]): also the whole disk rebuilt from "
+                            "the sector in ParaView, every sector turned: `periodic-disk.pvd` "
+                            "of a periodic analysis (each harmonic n phased by "
+                            "e^{i n EO j 2 pi / N}), `wear-disk.pvd` of a wear run (every "
+                            "sector with the sector's wear: the tuned assumption); a sweep "
+                            "writes no ParaView fields; default false"),
     },
     doc="Where and what to write. `fretwear run -o DIR` overrides `directory`.",
 )
