@@ -519,13 +519,15 @@ def test_jenkins_nonlinear_modes_example_is_the_describing_function(tmp_path):
 def test_bladed_disk_frf_example_sector(tmp_path):
     """The 3D bladed-disk sector (24 sectors, EO 3, root flanks and an under-platform damper
     between neighbouring platforms), reduced to two frequencies below the resonance of the
-    family: both converge, the results say N, EO and the harmonic index of each harmonic
-    (0 and EO mod N = 3), the root and both damper seats are in contact and every one of the
+    family with 16 samples per period (the shipped 32 are needed near the peak only): both
+    converge, the results say N, EO and the harmonic index of each harmonic (0 and
+    EO mod N = 3), the root and both damper seats are in contact and every one of the
     four interfaces dissipates (friction energy > 0: the damper seat on the next blade works
     through the phase of the travelling wave)."""
     shutil.copy(EXAMPLES / "bladed-disk.msh", tmp_path)
     ds = run_reduced("bladed-disk-frf.toml", tmp_path,
-                     numerics={"n_points": 2, "f_min": 2300.0, "f_max": 2400.0})
+                     numerics={"n_points": 2, "f_min": 2600.0, "f_max": 2650.0,
+                               "n_samples": 16})
     assert ds["converged"].values.all()
     assert int(ds.attrs["cyclic_sectors"]) == 24 and int(ds.attrs["engine_order"]) == 3
     np.testing.assert_array_equal(np.atleast_1d(ds.attrs["harmonic_index"]), [0, 3])

@@ -247,3 +247,60 @@ def test_whole_disk_paraview_equals_the_disk_solution(tmp_path):
         got = meshio.read(files[j]).point_data["displacement"][:, :2]
         want = np.concatenate([samples[maps[s], j] for s in range(N)]).reshape(N * nn, 2)
         assert np.max(np.abs(got - want)) < 1e-8 * np.abs(samples).max()
+
+
+def test_whole_disk_wear_paraview_equals_the_disk_wear(tmp_path):
+    """``[output] whole_disk = true`` in a wear run: the worn surfaces of the disk rebuilt from
+    the sector (every sector with the sector's wear, the tuned assumption) equal, node by
+    node and step by step, the wear of the whole disk assembled from N copies
+    (fretwear.model.cyclic.whole_disk) run through the same two explicit steps of 1e6
+    cycles (one harmonic, 16 samples: a few seconds), both surfaces of the tip contact and
+    of the pair between neighbours (whose partner is the next sector's node) wearing; to
+    1e-12 of the deepest wear: the two exact balances are solved to 1e-13 (the sector and
+    the disk agree to rounding, tests/hb/test_cyclic.py::test_wear_steps_equal_the_disk)."""
+    import meshio
+
+    from fretwear.wear.laws import side_depths
+    from fretwear.wear.options import WearOptions
+    from fretwear.wear.simulate import BalanceSetup, simulate_wear
+
+    wear = ('[analysis]\ntype = "wear"\nfrequency = 9000.0\nharmonics = 1\nn_samples = 16\n'
+            'eps = 3e9\ntol = 1e-13\nscheme = "explicit"\nadaptive = false\n'
+            'initial_jump = 1e6\nmax_steps = 2\nmax_cycles = 1e9\n')
+    path, _ = write_sector_case(tmp_path, N, EO, slit=True, analysis=wear)
+    text = path.read_text().replace("[output]\n", "[output]\nwhole_disk = true\n")
+    text = text.replace('name = "casing"\n', 'name = "casing"\nwear_coefficient = 1e-14\n')
+    text = text.replace('name = "neighbours"\n', 'name = "neighbours"\nwear_coefficient = '
+                        '1e-14\npartner_wear_coefficient = 2e-14\n')
+    path.write_text(text)
+    out = run_case(path, tmp_path / "out", progress=False, echo=False)
+    assert out.success and any(p.name == "wear-disk.pvd" for p in out.files)
+    sector, model = sector_model(N, slit=True, wear=1e-14)
+    sector = dataclasses.replace(sector, model=dataclasses.replace(model, contact=dataclasses
+                                 .replace(model.contact, partner_wear_coefficient=np.where(
+                                     sector.neighbour_nodes(), 2e-14, 0.0))))
+    opts = WearOptions(scheme="explicit", adaptive=False, initial_jump=1e6, max_steps=2,
+                       max_cycles=1e9, solve=SolveOptions(tol=1e-13, max_iter=100,
+                                                          strategy=("start",)))
+    disk = whole_disk(sector, EO)
+    r_d = simulate_wear(disk, FourierBasis((1,), 16), frequency=9000.0, options=opts,
+                        balance=BalanceSetup(eps=3e9))
+    assert r_d.success and r_d.history.cycles[-1] == 2e6
+    c, nn = disk.contact, model.mesh.points.shape[0]
+    nc = model.contact.n_nodes
+    j = np.repeat(np.arange(N), nc)  # the sector of every disk contact node
+    nb = np.tile(sector.neighbour_nodes(), N)
+    files = sorted((tmp_path / "out" / "wear-disk").glob("disk-*.vtu"))
+    assert len(files) == 3  # the start and two steps
+    deepest = r_d.history.wear_depth.max()
+    assert deepest > 1e-7  # it wears
+    for k, f in enumerate(files):
+        got = meshio.read(f).point_data["worn_depth"]
+        wa, wb = side_depths(disk, r_d.history.wear_depth[k])
+        want = np.full(N * nn, np.nan)
+        want[j * nn + np.asarray(c.node_ids)] = wa
+        pair = np.asarray(c.partner_ids) >= 0
+        want[(np.where(nb, j + 1, j) % N * nn + np.asarray(c.partner_ids))[pair]] = wb[pair]
+        assert np.array_equal(np.isnan(got), np.isnan(want))
+        ok = ~np.isnan(want)
+        assert np.max(np.abs(got[ok] - want[ok])) <= 1e-12 * deepest

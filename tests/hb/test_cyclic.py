@@ -306,3 +306,69 @@ def test_hill_dynamics_of_a_sector_are_refused(sector):
 
     with pytest.raises(InputError, match="not available on one sector"):
         structure_dynamics(sector.model, cyclic_condenser(sector, 1))
+
+
+def test_3d_cyclic_modes_are_the_disk_eigenvalues():
+    """The coarse 3D sector (N = 6, hexahedra, axis z): the lowest modes of every harmonic
+    index together are the lowest eigenvalues of the disk assembled from 6 turned copies
+    (dense generalized eigenproblem of its free DOFs, contact free), to 1e-8 relative: the
+    check of the 2D sector's modes on a 3D one, where the turn mixes x and y."""
+    from helpers.cyclic import sector_model_3d
+
+    sector, _ = sector_model_3d(6)
+    per_k = [cyclic_modes(sector, k, 3)[0] for k in range(6)]
+    union = np.sort(np.concatenate(per_k))
+    union = union[union <= min(f[-1] for f in per_k)]
+    disk = whole_disk(sector)
+    free = disk.free_dofs()
+    K, M = disk.K.toarray()[np.ix_(free, free)], disk.M.toarray()[np.ix_(free, free)]
+    w2 = sla.eigh(K, M, eigvals_only=True, subset_by_index=[0, union.size - 1])
+    f_disk = np.sqrt(w2) / (2 * np.pi)
+    assert union.size >= 6
+    assert np.max(np.abs(union - f_disk) / f_disk) < 1e-8
+
+
+def test_3d_short_sweep_and_wear_steps_equal_the_disk():
+    """The coarse 3D sector (N = 6, EO 1, tip friction against a casing, every tip node
+    separating or slipping): a 3-point sweep and two explicit wear steps of 1e6 cycles on
+    the sector equal those of the disk of 6 turned copies (fretwear.model.cyclic.whole_disk),
+    contact harmonics and wear depths of sector 0 to 1e-8 relative, and every sector of the
+    disk wears as sector 0 (the tuned assumption). One harmonic, 12 samples (a multiple of
+    N: the disk's sampled law sees every sector at the same instants, as in
+    test_3d_sector_periodic_solve_and_frf_equal_the_disk): the two exact balances agree to
+    their tolerance 1e-13."""
+    import dataclasses
+
+    from helpers.cyclic import sector_model_3d
+
+    from fretwear.hb.options import SweepOptions
+    from fretwear.hb.sweep import sweep
+    from fretwear.wear.options import WearOptions
+    from fretwear.wear.simulate import BalanceSetup, simulate_wear
+
+    sector, model = sector_model_3d(6)
+    model = dataclasses.replace(model, contact=dataclasses.replace(model.contact,
+                                                                   wear_coefficient=1e-13))
+    sector = dataclasses.replace(sector, model=model)
+    basis = FourierBasis((1,), 12)
+    nc = model.contact.n_nodes
+    opts = SweepOptions(solve=SolveOptions(tol=1e-13, max_iter=200), eps=1e9,
+                        spacing="linear")
+    res = sweep(model, basis, 2300.0, 2700.0, 3, options=opts,
+                condenser=cyclic_condenser(sector, 1))
+    res_d = sweep(whole_disk(sector, 1), basis, 2300.0, 2700.0, 3, options=opts)
+    assert res.success and res_d.success and len(res.points) == len(res_d.points)
+    for p, p_d in zip(res.points, res_d.points, strict=True):
+        U, U_d = p.solution.U, p_d.solution.U[:nc]
+        assert np.max(np.abs(U - U_d)) < 1e-8 * np.abs(U_d).max()
+    wopts = WearOptions(scheme="explicit", adaptive=False, initial_jump=1e6, max_steps=2,
+                        max_cycles=1e9, solve=SolveOptions(tol=1e-13, max_iter=100,
+                                                           strategy=("start",)))
+    r = simulate_wear(model, basis, frequency=2500.0, options=wopts,
+                      balance=BalanceSetup(eps=1e9, condenser=cyclic_condenser(sector, 1)))
+    r_d = simulate_wear(whole_disk(sector, 1), basis, frequency=2500.0, options=wopts,
+                        balance=BalanceSetup(eps=1e9))
+    assert r.success and r_d.success and r.history.cycles[-1] == 2e6
+    W, W_d = r.history.wear_depth, r_d.history.wear_depth.reshape(-1, 6, nc)
+    assert W[-1].max() > 1e-9  # it wears
+    assert np.max(np.abs(W[:, None, :] - W_d)) < 1e-8 * W.max()

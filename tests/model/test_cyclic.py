@@ -183,3 +183,106 @@ def test_sector_of_user_matrices_from_dofs():
         (sector.right_dofs[flip], sector.right_coords[flip]), tolerance=1e-9)
     assert np.array_equal(other.right_dofs, sector.right_dofs)
     assert np.allclose(transform(other, 3).toarray(), transform(sector, 3).toarray())
+
+
+def _wedge_damper_sector(n_sectors: int = 8, seat: bool = True):
+    """``(mesh, seat spec, neighbour spec)``: a 2D annulus sector (0.1 <= r <= 0.2 m, hub
+    held) with a tooth (0.2 <= r <= 0.22 m, 0 <= theta <= alpha / 4) and a separate block
+    (the damper, 0.2 <= r <= 0.22 m, alpha / 2 <= theta <= 5 alpha / 4) that sits on the
+    disk's rim (one edge, node to node) and whose far face touches the next sector's tooth.
+    Nothing but these two contacts holds the block: a wedge damper between two platforms.
+    Without ``seat`` the rim touches a rigid casing instead and the block lies on nothing."""
+    from fretwear.model.build import ContactSpec
+    from fretwear.model.mesh import join, rectangle
+
+    a = 2 * np.pi / n_sectors
+
+    def polar(p):
+        return np.column_stack([p[:, 0] * np.cos(p[:, 1]), p[:, 0] * np.sin(p[:, 1])])
+
+    r = rectangle(0.12, a, 6, 4, origin=(0.1, 0.0))  # node i + 7 j: r index i, theta j
+    keep = [c for c, cell in enumerate(r.cells) if c % 6 < 5 or c // 6 == 0]
+    cells = r.cells[keep]
+    used = np.unique(cells)
+    new = np.full(r.points.shape[0], -1)
+    new[used] = np.arange(used.size)
+    rr, tt = r.points[:, 0], r.points[:, 1]
+
+    def node(i, j):
+        return int(new[i + 7 * j])
+
+    disk = Mesh(polar(r.points[used]), new[cells], "quad",
+                {"hub": new[r.boundaries["left"]], "seat": np.array([[node(5, 2), node(5, 3)]]),
+                 "tooth": np.array([[node(5, 1), node(6, 1)]])},
+                {"left": new[np.flatnonzero((tt < 1e-12) & (rr < 0.2 + 1e-12))],
+                 "right": new[np.flatnonzero((tt > a - 1e-12) & (rr < 0.2 + 1e-12))],
+                 "hub": new[np.flatnonzero(rr < 0.1 + 1e-12)]})
+    d = rectangle(0.02, 0.75 * a, 1, 3, origin=(0.2, 0.5 * a))  # node i + 2 j
+    damper = Mesh(polar(d.points), d.cells, "quad",
+                  {"seat": np.array([[2, 0]]), "face": np.array([[6, 7]])}, {})
+    mesh = join(("disk", disk), ("damper", damper))
+    specs = [ContactSpec("damper.seat", mu=0.3, partner="disk.seat", name="seat") if seat
+             else ContactSpec("disk.seat", mu=0.3, name="rim")]  # the block on nothing
+    return mesh, specs, ContactSpec("damper.face", mu=0.3, partner="disk.tooth", name="next")
+
+
+def _disk_free_motions(sector) -> int:
+    """The zero-energy motions of the whole disk assembled from ``sector``
+    (:func:`whole_disk`) with every contact held along its normal (in the relative
+    coordinates of its pairs, fretwear.model.interfaces.relative_model) and the fixed DOFs
+    held: the dimension of the null space of ``K`` on the DOFs that satisfy those
+    constraints (dense; the eigenvalues below 1e-9 of the largest)."""
+    import scipy.linalg as sla
+
+    from fretwear.model.interfaces import relative_model
+
+    disk = whole_disk(sector)
+    rel, _ = relative_model(disk)
+    c = rel.contact
+    G = np.zeros((c.n_nodes + len(rel.fixed_dofs), rel.ndof))
+    for n in range(c.n_nodes):
+        G[n, c.dofs[n]] = c.frame[n, 0]
+    G[c.n_nodes + np.arange(len(rel.fixed_dofs)), rel.fixed_dofs] = 1.0
+    Z = sla.null_space(G)
+    lam = np.linalg.eigvalsh(Z.T @ rel.K.toarray() @ Z)
+    return int(np.sum(lam < 1e-9 * lam.max()))
+
+
+@pytest.mark.parametrize("seat", [True, False])
+def test_a_damper_held_by_its_neighbour_contact_needs_no_spring(seat):
+    """The support check sees the contact with the next sector: a block held by its seat
+    on this sector and its face on the next one is held (no spring); without its seat it is
+    refused. Reference: the whole disk assembled from the 8 sectors with every contact held
+    along its normal has no zero-energy motion exactly when the sector check passes (one
+    free motion per damper without the seat). ``from_mesh``, which checks before the
+    neighbour contact exists, refuses the block."""
+    from fretwear.model.build import Material, from_mesh, unchecked_from_mesh
+    from fretwear.model.cyclic import neighbour_contact
+    from fretwear.model.supports import Unsupported
+
+    mesh, specs, nb = _wedge_damper_sector(8, seat)
+    args = dict(supports=[("disk.hub", "all")], contact=specs, thickness=0.01)
+    steel = Material(2e11, 0.3, 7800.0)
+    with pytest.raises(Unsupported, match="body 'damper' can"):
+        from_mesh(mesh, steel, **args)
+    sector = cyclic_sector(unchecked_from_mesh(mesh, steel, **args), 8, "disk.left",
+                           "disk.right")
+    if seat:
+        assert _disk_free_motions(neighbour_contact(sector, nb)) == 0
+    else:
+        with pytest.raises(Unsupported, match="body 'damper' can"):
+            neighbour_contact(sector, nb)
+        assert _disk_free_motions(_neighbour_unchecked(sector, nb)) == 8
+
+
+def _neighbour_unchecked(sector, spec):
+    """``neighbour_contact`` without its support check (the disk reference of a sector that
+    the check refuses)."""
+    import fretwear.model.cyclic as cyc
+
+    keep = cyc.check_supported
+    cyc.check_supported = lambda *a, **k: None
+    try:
+        return cyc.neighbour_contact(sector, spec)
+    finally:
+        cyc.check_supported = keep

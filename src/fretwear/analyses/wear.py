@@ -464,6 +464,8 @@ def run_wear(model, analysis: dict, case, context: RunContext) -> RunOutput:
     files = [context.out_dir / CHECKPOINT_FILE]
     if model.mesh is not None and case.output["vtu"]:
         files.append(write_wear_fields(model, ds, context.out_dir / "wear.pvd"))
+    if model.meta.get("cyclic") is not None and case.output.get("whole_disk"):
+        files.append(write_wear_disk_fields(model, ds, context.out_dir / "wear-disk.pvd"))
     h = result.history
     area = np.asarray(model.contact.area, float)
     w = h.wear_depth[-1]
@@ -526,21 +528,49 @@ def write_wear_fields(model, ds, pvd: Path) -> Path:
     own nodes: the contact nodes and, at node-to-node pairs, their partners; NaN off the
     interfaces; :func:`fretwear.model.projection.partner_node_values` for
     node-to-segment partners), stepped through by the ``.pvd`` with the cycle count as time."""
-    mesh = model.mesh
-    c = model.contact
-    nn = mesh.points.shape[0]
-    ids = np.asarray(c.node_ids)
-    worn = ds["worn_depth_surface"].values
     folder = pvd.parent / pvd.stem
     entries = []
     for k, cycles in enumerate(ds["cycles"].values):
-        w = np.full(nn, np.nan)
-        w[ids] = worn[k, :, 0]
-        if c.has_pairs:  # node-to-segment: shape-function average on the facet nodes
-            partner, depth = partner_node_values(c, worn[k, :, 1])
-            w[partner] = depth
-        path = write_vtu(folder / f"step-{k:04d}.vtu", mesh, {"worn_depth": w},
-                         {"cycles": float(cycles)})
+        path = write_vtu(folder / f"step-{k:04d}.vtu", model.mesh,
+                         {"worn_depth": _node_depths(model, ds, k)}, {"cycles": float(cycles)})
+        entries.append((float(cycles), path))
+    return write_pvd(pvd, entries)
+
+
+def _node_depths(model, ds, k: int) -> np.ndarray:
+    """(nn,) the worn depth [m] of every mesh node at recorded step ``k`` (NaN off the
+    interfaces; :func:`write_wear_fields`)."""
+    c = model.contact
+    worn = ds["worn_depth_surface"].values
+    w = np.full(model.mesh.points.shape[0], np.nan)
+    w[np.asarray(c.node_ids)] = worn[k, :, 0]
+    if c.has_pairs:  # node-to-segment: shape-function average on the facet nodes
+        partner, depth = partner_node_values(c, worn[k, :, 1])
+        w[partner] = depth
+    return w
+
+
+def write_wear_disk_fields(model, ds, pvd: Path) -> Path:
+    """ParaView series of the worn surfaces of the whole tuned disk rebuilt from the sector
+    (``model.meta["cyclic"]``; ``[output] whole_disk``): the sector's worn depths of
+    :func:`write_wear_fields` on every sector of the mesh of
+    :func:`fretwear.model.cyclic.disk_mesh` (the tuned assumption: every sector wears as the
+    sector; a partner surface in the next sector, as a damper's seat on the next blade, is
+    that sector's copy of the partner nodes), with the point array ``sector`` (each node's
+    sector), one ``.vtu`` per recorded step, the cycle count as time."""
+    from fretwear.model.cyclic import disk_mesh
+
+    sector = model.meta["cyclic"]
+    mesh = disk_mesh(sector)
+    nn = model.mesh.points.shape[0]
+    which = np.repeat(np.arange(sector.n_sectors), nn).astype(float)
+    folder = pvd.parent / pvd.stem
+    entries = []
+    for k, cycles in enumerate(ds["cycles"].values):
+        w = np.tile(_node_depths(model, ds, k), sector.n_sectors)
+        path = write_vtu(folder / f"disk-{k:04d}.vtu", mesh,
+                         {"worn_depth": w, "sector": which},
+                         {"cycles": float(cycles), "tuned_assumption": 1.0})
         entries.append((float(cycles), path))
     return write_pvd(pvd, entries)
 
@@ -681,7 +711,9 @@ DOC = (
     "result. Writes `wear-profile.png`, `wear-kinetics.png`, `pressure-slip.png`, "
     "`worn-volume.png`, with several or 3D interfaces `wear-maps.png` (worn depth of each "
     "surface over each interface), with `frf_before_after` `frf-worn-<point>.png`, and for "
-    "mesh models the ParaView series `wear.pvd` of the worn surfaces."
+    "mesh models the ParaView series `wear.pvd` of the worn surfaces; for a sector with "
+    "`[output] whole_disk = true`, `wear-disk.pvd`: the worn surfaces of the whole disk, every "
+    "sector with the sector's wear (the tuned assumption)."
 )
 
 WEAR = Analysis.define("wear", SCHEMA, run_wear, checks=CHECKS, doc=DOC,

@@ -640,10 +640,12 @@ OUTPUT = Table(
         "figure_format": Field(Text(FIGURE_FORMATS), "figure file format", default="png"),
         "vtu": Field(Flag(), "write ParaView files (.vtu/.pvd) of fields when the model has a "
                      "mesh", default=True),
-        "whole_disk": Field(Flag(), "a sector ([cyclic]) of a periodic analysis: also "
-                            "`periodic-disk.pvd`, the whole disk rebuilt from the sector (every "
-                            "sector turned, each harmonic n phased by e^{i n EO j 2 pi / N}); "
-                            "default false"),
+        "whole_disk": Field(Flag(), "a sector ([cyclic]): also the whole disk rebuilt from "
+                            "the sector in ParaView, every sector turned: `periodic-disk.pvd` "
+                            "of a periodic analysis (each harmonic n phased by "
+                            "e^{i n EO j 2 pi / N}), `wear-disk.pvd` of a wear run (every "
+                            "sector with the sector's wear: the tuned assumption); a sweep "
+                            "writes no ParaView fields; default false"),
     },
     doc="Where and what to write. `fretwear run -o DIR` overrides `directory`.",
 )
@@ -1036,8 +1038,11 @@ def _build_from_mesh(m: dict, title: str, given: Mapping):
                  f"other than its boundary {spec.boundary!r} (the damper pairs a boundary "
                  "with the next sector's copy of another one)")
         contact = [c for c in contact if c.name != neighbour]
+    # a body held only by its contacts, one with the next sector (a damper between two
+    # platforms), is checked once that contact is added (model.cyclic.neighbour_contact)
+    make = build.from_mesh if neighbour is None else build.unchecked_from_mesh
     try:
-        model = build.from_mesh(
+        model = make(
             mesh,
             material,
             thickness=thickness,
@@ -1089,6 +1094,8 @@ def _sector(model, cyc: dict, neighbour):
                                tolerance=cyc.get("tolerance"))
         if neighbour is not None:
             sector = neighbour_contact(sector, neighbour)
+    except Unsupported as exc:  # the remedy as case-file blocks, not Python
+        raise InputError(f"cyclic: {exc.in_case_file()}") from None
     except InputError as exc:
         raise InputError(f"cyclic: {exc}") from None
     sector.model.meta["cyclic"] = sector

@@ -682,6 +682,21 @@ def from_mesh(mesh: Mesh, material: Material, *, thickness=1.0, damping: Damping
         For any bad input, a contact node with a fixed DOF, or a structure that only
         friction could hold (:func:`fretwear.model.supports.check_supported`).
     """
+    model = unchecked_from_mesh(mesh, material, thickness=thickness, damping=damping,
+                                supports=supports, loads=loads, contact=contact,
+                                observed=observed, name=name)
+    check_supported(model)
+    return model
+
+
+def unchecked_from_mesh(mesh: Mesh, material: Material, *, thickness=1.0,
+                        damping: Damping | None = None, supports=(), loads=(), contact,
+                        observed=None, name: str = "model") -> Model:
+    """:func:`from_mesh` without its last check, that the structure is held
+    (:func:`~fretwear.model.supports.check_supported`): for one sector of a disk whose body
+    is held by a contact with the next sector (a wedge damper between two platforms), added
+    by :func:`fretwear.model.cyclic.neighbour_contact`, which then checks the sector with
+    it. Any other use should call :func:`from_mesh`."""
     if not isinstance(mesh, Mesh):
         raise InputError(f"mesh = {mesh!r} is not a fretwear Mesh")
     check_cells(mesh)
@@ -723,7 +738,6 @@ def from_mesh(mesh: Mesh, material: Material, *, thickness=1.0, damping: Damping
         meta={"source": "mesh", "material": {"E": material.E, "nu": material.nu,
                                               "rho": material.rho}},
     )
-    check_supported(model)
     return model
 
 

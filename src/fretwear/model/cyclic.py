@@ -32,6 +32,7 @@ from fretwear.errors import InputError
 from fretwear.model.build import _contact
 from fretwear.model.core import ContactInterface, Load, Model, ObservedPoint
 from fretwear.model.interfaces import check_distinct, combine
+from fretwear.model.supports import Neighbours, check_supported
 
 
 @dataclass
@@ -290,7 +291,14 @@ def neighbour_contact(sector: CyclicSector, spec) -> CyclicSector:
 
         U_rel,n = U_A,n - e^{+i n EO 2 pi / N} R U_B,n
 
-    (:func:`relative_harmonic_model`); the normal default is A's outward normal."""
+    (:func:`relative_harmonic_model`); the normal default is A's outward normal.
+
+    The sector is then checked to be held with this contact in every family
+    (:func:`~fretwear.model.supports.check_supported` with the pairs to the next sector): a
+    body held only by its contacts, one of them with the next sector (a wedge damper between
+    two platforms), needs no spring; build such a sector with
+    :func:`~fretwear.model.build.unchecked_from_mesh` (:func:`~fretwear.model.build.from_mesh`
+    would refuse it before this contact is known)."""
     model = sector.model
     mesh = model.mesh
     if mesh is None:
@@ -322,8 +330,10 @@ def neighbour_contact(sector: CyclicSector, spec) -> CyclicSector:
     contact = combine([model.contact, c])
     check_distinct(contact)
     neighbour = np.concatenate([sector.neighbour_nodes(), np.ones(c.n_nodes, dtype=bool)])
-    return dataclasses.replace(sector, model=dataclasses.replace(model, contact=contact),
-                               neighbour=neighbour)
+    out = dataclasses.replace(sector, model=dataclasses.replace(model, contact=contact),
+                              neighbour=neighbour)
+    check_supported(out.model, Neighbours(neighbour, sector.rotation, sector.n_sectors))
+    return out
 
 
 def harmonic_model(sector: CyclicSector, k: int) -> tuple[Model, sp.csr_matrix]:

@@ -10,6 +10,8 @@ smallest eigenvalues.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
@@ -89,13 +91,20 @@ def _describe(a: np.ndarray, d: int, centre: np.ndarray, size: float) -> str:
     return f"rotate about an axis along {_fmt_vec(w)} through {pt(p)}{extra}"
 
 
-def check_supported(model: Model) -> None:
+def check_supported(model: Model, neighbour: Neighbours | None = None) -> None:
     """Refuse a model that only friction could hold.
 
     With every contact node held in its normal direction and every fixed DOF held, ``K``
     must be non-singular. For a model with a mesh, the rigid-body modes of the nodes are
     tested exactly (a mode is free if it moves no held direction and costs no strain or
     spring energy); for a model from matrices :func:`rigid_motion_check` is used.
+
+    ``neighbour``: for one sector of a cyclically symmetric structure, the contact nodes
+    whose partner is the *next* sector's copy of a node (an under-platform damper between
+    two blades, :func:`fretwear.model.cyclic.neighbour_contact`). Such a pair holds
+    ``n . (U_a - e^{i k 2 pi / N} Q U_b)`` (``Q`` the turn by ``2 pi / N``) in the family
+    of harmonic index ``k``; the structure must be held in every family ``k = 0 .. N / 2``
+    (a body held only by contacts, one of them with the next sector, is held).
 
     Raises
     ------
@@ -131,21 +140,15 @@ def check_supported(model: Model) -> None:
     KR[np.abs(KR) <= 64 * np.finfo(float).eps * (abs(model.K) @ np.abs(R))] = 0.0
     springs = KR[np.any(KR != 0.0, axis=1)]
     springs = springs / np.linalg.norm(springs, axis=1, keepdims=True)
-    Rrel = R[c.dofs]
-    if c.has_pairs:  # a pair holds the relative normal displacement n . (U_a - U_b)
-        pdofs, weights = c.partner_terms()  # U_b = sum_k N_k U_k (node-to-segment)
-        for k in range(weights.shape[1]):
-            pd = pdofs[:, k]
-            Rrel = Rrel - np.where(pd[..., None] >= 0, weights[:, k, None, None]
-                                   * R[np.maximum(pd, 0)], 0.0)
-    A = np.vstack([
-        np.einsum("nd,ndr->nr", c.frame[:, 0, :], Rrel),
-        R[np.asarray(model.fixed_dofs, dtype=np.int64)],
-        springs,
-    ])
-    _, s, Vt = np.linalg.svd(A)
-    rank = int(np.sum(s > 1e-8 * max(1.0, s.max(initial=0.0))))
-    free = Vt[rank:].T  # rigid motions that move no held direction and strain no spring
+    held = np.vstack([R[np.asarray(model.fixed_dofs, dtype=np.int64)], springs])
+    free = np.zeros((R.shape[1], 0))
+    for phase in (_family_phases(neighbour) if neighbour is not None else [1.0]):
+        A = np.vstack([_normal_rows(c, R, neighbour, phase), held])
+        _, s, Vt = np.linalg.svd(A)
+        rank = int(np.sum(s > 1e-8 * max(1.0, s.max(initial=0.0))))
+        if rank < Vt.shape[0]:  # rigid motions that move no held direction, strain no spring
+            free = _real_motions(Vt[rank:])
+            break
     if free.shape[1] == 0:
         return
     nr = parts[0][0].shape[1]
@@ -165,6 +168,55 @@ def check_supported(model: Model) -> None:
         "with the contact held only along its normal (frictionless), " + lead
         + (", ".join(motions[:-1]) + " and " if len(motions) > 1 else "") + motions[-1]
         + " with nothing to hold it but friction", d)
+
+
+@dataclass(frozen=True)
+class Neighbours:
+    """The pairs of a sector with the next sector (:func:`check_supported`).
+
+    nodes : (nc,) bool, the contact nodes whose partner is in the next sector.
+    rotation : (d, d) the turn by ``2 pi / N`` of a vector's components.
+    n_sectors : ``N``.
+    """
+
+    nodes: np.ndarray
+    rotation: np.ndarray
+    n_sectors: int
+
+
+def _family_phases(neighbour: Neighbours) -> list[complex]:
+    """``e^{i k 2 pi / N}`` of the families ``k = 0 .. N / 2`` (``N - k``: the conjugate)."""
+    n = int(neighbour.n_sectors)
+    return [np.exp(2j * np.pi * k / n) for k in range(n // 2 + 1)]
+
+
+def _normal_rows(c, R: np.ndarray, neighbour: Neighbours | None, phase: complex) -> np.ndarray:
+    """(nc, nr) the normal relative displacement ``n . (U_a - U_b)`` of every contact node
+    under each rigid mode (a partner in the next sector: ``e^{i k alpha} Q U_b``)."""
+    Rrel = R[c.dofs]
+    if c.has_pairs:  # a pair holds the relative normal displacement n . (U_a - U_b)
+        pdofs, weights = c.partner_terms()  # U_b = sum_k N_k U_k (node-to-segment)
+        if neighbour is not None:
+            Rrel = Rrel.astype(complex)
+        for k in range(weights.shape[1]):
+            pd = pdofs[:, k]
+            Rb = weights[:, k, None, None] * R[np.maximum(pd, 0)]
+            if neighbour is not None:
+                nb = np.asarray(neighbour.nodes, dtype=bool)
+                turned = phase * np.einsum("ij,njr->nir", neighbour.rotation, Rb)
+                Rb = np.where(nb[:, None, None], turned, Rb)
+            Rrel = Rrel - np.where(pd[..., None] >= 0, Rb, 0.0)
+    return np.einsum("nd,ndr->nr", c.frame[:, 0, :], Rrel)
+
+
+def _real_motions(V: np.ndarray) -> np.ndarray:
+    """(nr, m) a real basis of the rigid motions spanned by the rows of ``V`` (complex in a
+    family ``k != 0``: its real and imaginary parts, the standing waves)."""
+    if not np.iscomplexobj(V):
+        return V.T
+    W = np.vstack([V.real, V.imag])
+    _, s, Vt = np.linalg.svd(W)
+    return Vt[: int(np.sum(s > 1e-8 * max(1.0, s.max(initial=0.0))))].T
 
 
 class Unsupported(InputError):
