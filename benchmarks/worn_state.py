@@ -151,7 +151,7 @@ def run_case(name: str, steps: int) -> tuple[float, float] | None:
     d3 = float(np.max(np.abs(Wd - h.wear_depth[k]))) / top if top > 0 else 0.0
     passed = bool(np.any(h.volume_rate <= 1e-3 * h.volume_rate[0]))
     print(f"  the march {'passed' if passed else 'did NOT pass'} its default plateau (1e-3)"
-          f"{'' if passed else ' by'} at step {k}, N = {h.cycles[k]:.3g} "
+          f" {'at' if passed else 'by'} step {k}, N = {h.cycles[k]:.3g} "
           f"({int(h.newton_iterations[:k + 1].sum())} DLFT solves): {d3:.3g} of the largest "
           "depth from the direct state")
     print(f"  profile difference {diff:.3g} of the largest depth, same stuck nodes "
