@@ -14,6 +14,17 @@ counts them), the largest profile difference over the largest depth, whether the
 nodes agree, the null-wear-rate residual and the direct solve's estimate of the cycles a
 march needs to get within 1 %. A warm-up solve first compiles the numba kernels (not timed).
 
+Then, for each case, the stick-set jump (fretwear.wear.stick_set: the nodes that wear
+unloaded until they just touch, every other node sticking; a few DLFT balances) from the
+unworn state and from the state where the march passed its default plateau, and the direct
+solve with ``stick_set = True``: how far each is from the march's final state (the worn state
+depends on the path, which the jump does not follow).
+
+The dovetail (dynamic, 1024-odd DOFs condensed on its interface) is attempted with a step
+budget, ``--dovetail-steps`` (each of its steps costs seconds); a case where the march or the
+direct solve reaches no state within its budget is reported so and left out of the two last
+lines.
+
 Then ``--steps-79khz`` steps of the direct solve on the 79 kHz beam (salles2011-79khz),
 with the time-domain rescue of the march: it must report the state not reached, with its
 residual (the path is chaotic, docs/wear.md "Limits").
@@ -22,8 +33,8 @@ The last lines are ``worn_state_speedup=<geometric mean of march / direct proces
 and ``worn_state_diff=<largest profile difference / largest depth>``.
 
 Run: ``python benchmarks/worn_state.py [--cases salles2011-quasistatic,stromberg1997]
-[--steps 200]``. Quote the figures with the machine load (``uptime``: printed before and
-after).
+[--steps 200] [--dovetail-steps 60]``. Quote the figures with the machine load (``uptime``:
+printed before and after).
 """
 
 from __future__ import annotations
@@ -45,9 +56,11 @@ from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.reduce import condense
 from fretwear.io.case import build_model
 from fretwear.wear import BalanceSetup, simulate_wear
+from fretwear.wear.simulate import slow_setup
+from fretwear.wear.stick_set import stick_set_state
 from fretwear.wear.worn_state import WornStateOptions, worn_state
 
-CASES = ("salles2011-quasistatic", "stromberg1997", "dovetail-wear")
+CASES = ("salles2011-quasistatic", "stromberg1997", "stromberg1997-triangle", "dovetail-wear")
 #: the march runs to this worn-volume rate (relative to the initial one): its default plateau
 #: (1e-3) is not the final state on Stromberg's beam (docs/examples.md); where it passed the
 #: default plateau is reported too
@@ -84,13 +97,34 @@ def _stuck(rate, pressure, rate0):
     return (pressure > 1e-3 * pressure.max()) & (rate <= 1e-9 * rate0)
 
 
-def run_case(name: str, steps: int) -> tuple[float, float]:
-    """March and direct solve of one example: ``(speedup, profile difference)``."""
+def jumps(model, basis, f_hz, quasi, opts, balance, h, k: int) -> None:
+    """The stick-set jump from the unworn state and from the march's step ``k`` (where it
+    passed its default plateau): its distance to the march's final state, printed."""
+    *_, sp = slow_setup(model, basis, f_hz, quasi, balance, opts, None, None)
+    Wm = h.wear_depth[-1]
+    top, g0 = float(np.max(Wm)), float(np.max(h.wear_rate[0]))
+    for j in (0, k):
+        U = np.asarray(h.U[j], float).reshape(sp.m, sp.H)
+        (jump, its), c, w = _timed(lambda U=U, j=j: stick_set_state(
+            sp, h.wear_depth[j], U, h.anchor[j], h.wear_rate[j], g0=g0, options=opts.solve))
+        where = "unworn state" if j == 0 else f"march step {j}"
+        if jump is None:
+            print(f"  stick-set jump from the {where}: none ({its} DLFT solves)")
+            continue
+        print(f"  stick-set jump from the {where}: {jump.rounds} rounds, {its} DLFT solves, "
+              f"processor {c:.2f} s; {int(jump.worn.sum())} nodes unloaded; "
+              f"{float(np.max(np.abs(jump.W - Wm))) / top:.3g} of the largest depth from the "
+              "march's final state")
+
+
+def run_case(name: str, steps: int) -> tuple[float, float] | None:
+    """March and direct solve of one example: ``(speedup, profile difference)``, None when
+    either reached no state within ``steps``."""
     model, basis, f_hz, quasi, opts, balance = _setup(name, steps)
     kw = {"frequency": f_hz, "quasi_static": quasi, "balance": balance}
     march, c_m, w_m = _timed(lambda: simulate_wear(model, basis, options=opts, **kw))
     direct, c_d, w_d = _timed(lambda: worn_state(
-        model, basis, options=WornStateOptions(wear=opts), **kw))
+        model, basis, options=WornStateOptions(wear=opts, max_steps=steps), **kw))
     h = march.history
     Wm, Wd = h.wear_depth[-1], direct.wear
     top = float(np.max(Wm))
@@ -115,12 +149,26 @@ def run_case(name: str, steps: int) -> tuple[float, float]:
     k = int(np.argmax(h.volume_rate <= 1e-3 * h.volume_rate[0])) if np.any(
         h.volume_rate <= 1e-3 * h.volume_rate[0]) else h.n_steps - 1
     d3 = float(np.max(np.abs(Wd - h.wear_depth[k]))) / top if top > 0 else 0.0
-    print(f"  the march passed its default plateau (1e-3) at step {k}, N = {h.cycles[k]:.3g} "
+    passed = bool(np.any(h.volume_rate <= 1e-3 * h.volume_rate[0]))
+    print(f"  the march {'passed' if passed else 'did NOT pass'} its default plateau (1e-3)"
+          f" {'at' if passed else 'by'} step {k}, N = {h.cycles[k]:.3g} "
           f"({int(h.newton_iterations[:k + 1].sum())} DLFT solves): {d3:.3g} of the largest "
           "depth from the direct state")
     print(f"  profile difference {diff:.3g} of the largest depth, same stuck nodes "
           f"{same_stuck}, mean pressure difference {pdiff:.3g} of the largest; "
           f"speedup (processor) {c_m / c_d:.3g}, (wall) {w_m / w_d:.3g}")
+    jumps(model, basis, f_hz, quasi, opts, balance, h, k)
+    fast, c_j, w_j = _timed(lambda: worn_state(
+        model, basis, options=WornStateOptions(wear=opts, max_steps=steps, stick_set=True),
+        **kw))
+    print(f"  direct, stick_set = True: {fast.message}")
+    print(f"          processor {c_j:.2f} s, wall {w_j:.2f} s, {fast.dlft_solves} DLFT solves; "
+          f"{float(np.max(np.abs(fast.wear - Wm))) / top:.3g} of the largest depth from the "
+          f"march's final state; speedup (processor) {c_m / c_j:.3g}")
+    if march.stop_reason != "plateau" or not direct.success:
+        print(f"  {name}: no state reached within {steps} steps (march: {march.stop_reason}, "
+              f"direct: {direct.kind}); left out of the summary")
+        return None
     return c_m / c_d, diff
 
 
@@ -140,6 +188,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cases", default=",".join(CASES), help="examples, comma-separated")
     ap.add_argument("--steps", type=int, default=300, help="slow steps of the march at most")
+    ap.add_argument("--dovetail-steps", type=int, default=60,
+                    help="slow steps of the dovetail's march and direct solve at most")
     ap.add_argument("--steps-79khz", type=int, default=20,
                     help="steps of the direct solve on the 79 kHz beam (0: skip it)")
     args = ap.parse_args()
@@ -150,12 +200,17 @@ def main():
                options=WornStateOptions(wear=opts, max_steps=1))
     speed, diffs = [], []
     for name in args.cases.split(","):
-        s, d = run_case(name.strip(), args.steps)
-        speed.append(s)
-        diffs.append(d)
+        name = name.strip()
+        out = run_case(name, args.dovetail_steps if name == "dovetail-wear" else args.steps)
+        if out is not None:
+            speed.append(out[0])
+            diffs.append(out[1])
     if args.steps_79khz > 0:
         not_reached(args.steps_79khz)
     print("load after:", os.getloadavg())
+    if not speed:
+        print("no case reached a state: no summary")
+        return
     print(f"worn_state_speedup={math.exp(np.mean(np.log(speed))):.3g}")
     print(f"worn_state_diff={max(diffs):.3g}")
 

@@ -29,6 +29,13 @@ correction is at most ``depth_tolerance`` of the deepest wear (a small rate with
 that would still carry the profile far is not a state). Otherwise ``success`` is False with
 the residual and the steps tried; the state is never claimed from a plateau of the march.
 
+The stick-set jump (``stick_set``, :mod:`fretwear.wear.stick_set`) characterises the state
+by its stick set instead: the nodes that wear unloaded until they just touch, every other
+node sticking, one balance. From the settled states of the path it is tried, and the run ends
+there when the jumps from two successive states give the same state. It is off by default:
+the state depends on the path, and the jump, which does not follow it, can land on another
+null-wear-rate state than the march (measured in docs/theory.md).
+
 Wear that goes on (gross slip) has no null-rate state; when the rate stops changing (``max
 |g_{k+1} - g_k| <= tolerance max g``) while the residual stays large, the result says so
 (``kind = "steady_wear"``) with the steady rate profile.
@@ -51,6 +58,7 @@ from fretwear.hb.fallback import TimeDomainFallback
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.inputs import check_inputs
 from fretwear.hb.solution import PeriodicSolution
+from fretwear.hb.solvers import SolveStats
 from fretwear.model.core import Model
 from fretwear.wear.checkpoint import check_checkpoint_path, fingerprint
 from fretwear.wear.history import WearHistory
@@ -68,6 +76,7 @@ from fretwear.wear.simulate import (
 )
 from fretwear.wear.slow_problem import SlowProblem
 from fretwear.wear.state import SlowStep, StepRecord, StepStats
+from fretwear.wear.stick_set import separation, stick_set_state
 
 #: what a worn-state result found: the null-wear-rate state, steady wear (gross slip), none
 KINDS = ("null_wear_rate", "steady_wear", "not_reached", "no_wear")
@@ -96,6 +105,11 @@ class WornStateOptions:
         this: the step grows by it while the rate stays, faster as it falls; a step that
         changed the set of slipping nodes is not followed by a larger one (the stick
         events decide where the state ends).
+    stick_set : try the stick-set jump (:mod:`fretwear.wear.stick_set`) from the states
+        where the path has settled, and end there when the jumps from two successive states
+        are the same state (module docstring). Off by default: the jump lands on a
+        null-wear-rate state, but not always on the one the march reaches (Stromberg's beam:
+        8.8 % of the deepest wear away, docs/theory.md); the result then warns.
     """
 
     wear: WearOptions = field(default_factory=WearOptions)
@@ -106,6 +120,7 @@ class WornStateOptions:
     max_growth: float = 100.0
     min_growth: float = 5.0
     path_tolerance: float = 1e-2
+    stick_set: bool = False
 
     def __post_init__(self):
         if not isinstance(self.wear, WearOptions):
@@ -120,6 +135,8 @@ class WornStateOptions:
         j = self.initial_jump
         if j is not None and not (isinstance(j, (int, float)) and j > 0):
             raise InputError(f"initial_jump = {j!r}: expected > 0 cycles or None")
+        if not isinstance(self.stick_set, bool):
+            raise InputError(f"stick_set = {self.stick_set!r}: expected true or false")
         if not (isinstance(self.max_growth, (int, float)) and self.max_growth > 1):
             raise InputError(f"max_growth = {self.max_growth!r}: expected a number > 1")
 
@@ -135,7 +152,8 @@ class WornStateOptions:
     def key(self) -> dict:
         """What changes the path (the checkpoint's fingerprint)."""
         return {"initial_jump": self.initial_jump, "max_growth": self.max_growth,
-                "min_growth": self.min_growth, "path_tolerance": self.path_tolerance}
+                "min_growth": self.min_growth, "path_tolerance": self.path_tolerance,
+                "stick_set": self.stick_set}
 
 
 @dataclass
@@ -232,6 +250,11 @@ def worn_state(model: Model, basis: FourierBasis, *, frequency: float | None = N
                                      options.march_options(path=True))
         resumed_from = -1
     state, found = _continue(sp, state, records, options, opts, run, saver)
+    if found.by_jump:
+        warnings.append("the state is a stick-set jump's (stick_set = True): a null-wear-rate "
+                        "state, but the jump does not follow the path, and the march may reach "
+                        "another (Stromberg's beam: 8.8 % of the deepest wear away, "
+                        "docs/theory.md); stick_set = False follows the path")
     saver.save(state, records, now=True)
     hist = WearHistory.from_records(records, found.kind)
     balanced = [r for r in records if r.has_balance]
@@ -243,8 +266,8 @@ def worn_state(model: Model, basis: FourierBasis, *, frequency: float | None = N
         worn_volume(state.W, area), hist,
         _assemble(sp, balanced[0]) if balanced else None,
         _assemble(sp, balanced[-1]) if balanced else None, sp.eps,
-        int(hist.newton_iterations.sum()), time.perf_counter() - t_start, resumed_from,
-        warnings)
+        int(hist.newton_iterations.sum()) + found.jump_iterations,
+        time.perf_counter() - t_start, resumed_from, warnings)
 
 
 @dataclass(frozen=True)
@@ -254,6 +277,8 @@ class _Found:
     message: str
     residual: float
     correction: float
+    jump_iterations: int = 0  # Newton iterations of the stick-set jumps tried
+    by_jump: bool = False  # the state is a stick-set jump's
 
 
 def rate_residual(records: list[StepRecord]) -> float:
@@ -306,12 +331,14 @@ def _continue(sp: SlowProblem, state: SlowStep, records: list[StepRecord],
               ) -> tuple[SlowStep, _Found]:
     """Steps from ``state`` until :func:`_judge` decides or ``max_steps``: error-controlled
     (the march's steps) while the set of slipping nodes changes, with SER once it has
-    settled (:func:`_settled`)."""
+    settled (:func:`_settled`); from the settled states, the stick-set jump
+    (:class:`_Jumps`)."""
     path = options.march_options(path=True)
+    jumps = _Jumps(sp, options, opts)
     while True:
         found = _judge(records, options)
         if found is not None:
-            return state, found
+            return state, replace(found, jump_iterations=jumps.iterations)
         if state.step >= options.max_steps:
             r, c = rate_residual(records), _correction(records)
             return state, _Found(False, "not_reached",
@@ -319,7 +346,16 @@ def _continue(sp: SlowProblem, state: SlowStep, records: list[StepRecord],
                                  f"(SER from {records[1].jump if len(records) > 1 else 0:.3g} "
                                  f"to {state.jump:.3g} cycles): null-wear-rate residual max g "
                                  f"/ max g0 = {r:.3g} (tolerance {options.tolerance:g}), last "
-                                 f"correction {c:.3g} of the deepest wear", r, c)
+                                 f"correction {c:.3g} of the deepest wear", r, c,
+                                 jumps.iterations)
+        if options.stick_set and _settled(records):
+            hit = jumps.accept(state, records)
+            if hit is not None:
+                state = hit[0]
+                saver.save(state, records)
+                if run.callback is not None:
+                    run.callback(state.step, records[-1])
+                return hit
         try:
             settled = _settled(records)
             new, record, msg = _step(sp, state, opts if settled else path)
@@ -331,7 +367,7 @@ def _continue(sp: SlowProblem, state: SlowStep, records: list[StepRecord],
                 return state, _Found(False, "not_reached",
                                      f"worn state NOT reached: a pseudo-time step failed "
                                      f"({msg}); null-wear-rate residual {r:.3g} after "
-                                     f"{state.step} steps", r, c)
+                                     f"{state.step} steps", r, c, jumps.iterations)
             if settled:  # SER; else the jump the error control proposed
                 new.jump = record.jump * _growth(state, new, records[-1], record, options)
             records.append(record)
@@ -344,6 +380,69 @@ def _continue(sp: SlowProblem, state: SlowStep, records: list[StepRecord],
                 raise
             saver.save(state, records, now=True)
             raise KeyboardInterrupt from None
+
+
+class _Jumps:
+    """The stick-set jumps (:func:`~fretwear.wear.stick_set.stick_set_state`) from the
+    recorded states, each taken once (by record index: a resumed run takes the same ones).
+
+    A jump is kept only when it needs no active-set round beyond the first (the nodes that
+    wear at the state unloaded give a state where all others stick: the path has shed its
+    load where it will); it ends the run when the jump from the state before gives the same
+    state, to ``depth_tolerance`` of the deepest wear (the path from the one state to the
+    next moved nothing the state depends on; a jump from an early state lands elsewhere, as
+    the wear of nodes that slip for a while before they stick is still to come)."""
+
+    def __init__(self, sp: SlowProblem, options: WornStateOptions, opts: WearOptions):
+        self.sp, self.options, self.opts = sp, options, opts
+        self.found: dict[int, object] = {}
+        self.iterations = 0  # Newton iterations of every jump tried
+
+    def of(self, records: list[StepRecord], k: int):
+        """The jump from record ``k`` (None: none kept)."""
+        if k not in self.found:
+            r = records[k]
+            jump, its = stick_set_state(
+                self.sp, r.wear_depth, np.asarray(r.U, float).reshape(self.sp.m, self.sp.H),
+                r.anchor, r.wear_rate, g0=float(np.max(records[0].wear_rate)),
+                options=self.opts.solve, tolerance=self.options.tolerance, max_rounds=1)
+            self.iterations += its
+            self.found[k] = jump
+        return self.found[k]
+
+    def accept(self, state: SlowStep, records: list[StepRecord]
+               ) -> tuple[SlowStep, _Found] | None:
+        """The state of the jump from the last record when the one from the record
+        before agrees (its record appended to ``records``), else None."""
+        k = len(records) - 1
+        if k < 1 or not records[k].has_balance or not records[k - 1].has_balance:
+            return None
+        t0 = time.perf_counter()
+        last = self.of(records, k)
+        if last is None:
+            return None
+        before = self.of(records, k - 1)
+        if before is None:
+            return None
+        top = float(np.max(last.W))
+        c = float(np.max(np.abs(last.W - before.W))) / top if top > 0 else 0.0
+        if c > self.options.depth_tolerance:
+            return None
+        sp, r = self.sp, records[k]
+        st = SolveStats(True, 0.0, 0, 0, 0, time.perf_counter() - t0, "stick-set jump", "")
+        sol = sp.solution(last.U, last.W, r.anchor, st)
+        rec = StepRecord.balanced(sol, last.W, last.g, StepStats(
+            r.cycles, 0.0, 0, 0, 0.0, time.perf_counter() - t0))
+        records.append(rec)
+        res = rate_residual(records)
+        return SlowStep.balanced(rec, state.jump, state), _Found(
+            True, "null_wear_rate",
+            f"worn state reached after {k} pseudo-time steps and a stick-set jump (the "
+            f"{int(np.count_nonzero(last.worn))} nodes that wear unloaded until they just "
+            f"touch, every other node sticking): null-wear-rate residual max g / max g0 = "
+            f"{res:.3g} <= {self.options.tolerance:g}; the jumps from steps {k - 1} and {k} "
+            f"agree within {c:.3g} of the deepest wear <= {self.options.depth_tolerance:g}",
+            res, c, self.iterations, True)
 
 
 def _settled(records: list[StepRecord]) -> bool:
@@ -367,15 +466,6 @@ def _growth(old: SlowStep, new: SlowStep, old_record: StepRecord, record: StepRe
     if not np.array_equal(state_slip(old_record), state_slip(record)):
         grow = min(grow, 1.0)
     return grow
-
-
-def separation(sp: SlowProblem, U) -> np.ndarray:
-    """(nc,) the smallest normal separation over the period [m] of every node separated all
-    period at the balance ``U`` (current gap), 0 for the others: ``-lambda_u,N / eps``
-    (eq. 23: a separated node has ``lambda = 0``, so ``lambda_u = eps (U - W~)``)."""
-    lu, _, st, _ = sp.prob.time_law(U)
-    sep = np.min(-lu[:, 0, :], axis=1) / sp.eps
-    return np.where(np.all(st == 0, axis=1), np.maximum(sep, 0.0), 0.0)
 
 
 def _pull_back(sp: SlowProblem, before: SlowStep, new: SlowStep, record: StepRecord,
