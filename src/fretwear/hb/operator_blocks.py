@@ -57,6 +57,17 @@ class OperatorBlocks(HarmonicBlocks):
             return self.Z0
         return self.op.block(b)
 
+    def row_block(self, b: int, dofs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        if b == 0:  # held formed
+            return self.Z0, np.asarray(dofs)
+        return self.op.block(b, rows=np.asarray(dofs)), np.arange(np.size(dofs))
+
+    def node_diagonal(self, b: int, d: int) -> np.ndarray:
+        if b == 0:
+            return super().node_diagonal(0, d)
+        out = self.op.node_diagonal(b, d)
+        return out.real if self.real else out
+
     def leading(self, nb: int) -> OperatorBlocks:
         return OperatorBlocks(self.op[:nb])
 
