@@ -381,7 +381,7 @@ class ModalCondenser(Condenser):
         names = list(proj)
         coef = np.zeros(len(names), dtype=complex)
         coef[0] = 1.0
-        _, cq, qc, qq = (x.astype(complex) for x in proj["K"])
+        cq, qc, qq = (x.astype(complex) for x in proj["K"][1:])  # not X^cc: m x m
         if not (n == 0 or quasi_static):
             w = n * omega
             for i, nm in enumerate(names):
