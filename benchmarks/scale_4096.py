@@ -71,7 +71,7 @@ def main():
     lu_gib = getattr(lu, "nbytes", float("nan") * 2**30) / 2**30
     if args.dense:
         parts = {"Z_r blocks": red.Z.nbytes, "Psi": mc.Psi.nbytes,
-                 "proj (both frames)": sum(x.nbytes for p in (mc.proj, mc.proj_local)
+                 "proj (local frames)": sum(x.nbytes for p in (mc.proj_local,)
                                            for v in p.values() for x in v)}
     else:
         Z = red.Z

@@ -67,3 +67,45 @@ def test_periodic_solve_in_partial_slip_equals_dense_modal_path():
     slip = out[1].state_fractions().mean(axis=0)[2]
     assert 0.02 < slip < 0.98  # partial slip
     assert rel(out[1].U, out[0].U) < 1e-8
+
+
+@pytest.mark.parametrize("damping", [None, Damping(loss_factor=0.02, rayleigh_mass=100.0,
+                                                   rayleigh_stiffness=1e-7)])
+def test_dense_condenser_as_operator_equals_its_blocks(damping):
+    """ModalCondenser with ``representation="operator"`` (what "auto" takes on large
+    interfaces) against the same condenser's dense blocks: the same projections summed in
+    another order, so equal to rounding (1e-12, as above); "auto" keeps the blocks on this
+    small model; a periodic solve in partial slip through the operator reaches the dense
+    path's solution (1e-8: both stop at the solver's tolerance)."""
+    model = block(damping)
+    mc = ModalCondenser(model, F_MAX, 7, tol=1e-2)
+    oc = ModalCondenser(model, F_MAX, 7, tol=1e-2, representation="operator")
+    w = 2 * np.pi * 15e3
+    a, b = mc.reduced(w, ORDERS), oc.reduced(w, ORDERS)
+    assert isinstance(a.Z, np.ndarray) and isinstance(b.Z, ReducedOperator)
+    assert len(b.Z.mats) == (2 if damping is None else 4)
+    for n in range(ORDERS.size):
+        assert rel(b.Z[n], a.Z[n]) < 1e-12, n
+    for name in ("F", "obs_A", "obs_b"):
+        assert rel(getattr(b, name), getattr(a, name)) < 1e-12, name
+    if damping is not None:
+        return
+    model = block(traction=4.5e5)
+    basis = FourierBasis.up_to(3, 64)
+    out = []
+    for rep in ("dense", "operator"):
+        c = ModalCondenser(model, F_MAX, 7, tol=1e-2, representation=rep)
+        sol = solve_periodic(model, basis, frequency=12e3, condenser=c,
+                             anchor=static_anchor(model, condenser=c))
+        assert sol.success
+        out.append(sol)
+    assert 0.02 < out[1].state_fractions().mean(axis=0)[2] < 0.98  # partial slip
+    assert rel(out[1].U, out[0].U) < 1e-8
+
+
+def test_representation_is_checked():
+    """A representation that is not one of the three is one InputError naming it."""
+    from fretwear.errors import InputError
+
+    with pytest.raises(InputError, match="representation = 'sparse'"):
+        ModalCondenser(block(None), F_MAX, 3, tol=1e-2, representation="sparse")

@@ -15,3 +15,37 @@ def test_operator_arrays_determine_it():
     assert all(np.array_equal(x, y) for x, y in zip(a, b, strict=True))
     assert not all(np.array_equal(x, y) for x, y in zip(a, c, strict=True))
 
+
+
+def _random_operator(rng, m, q, complex_):
+    """An operator of two shared matrices and a rank-q term per block, random."""
+    from fretwear.hb.modal_operator import ReducedOperator
+
+    mats = [rng.standard_normal((m, m)) for _ in range(2)]
+    coef = rng.standard_normal((3, 2)) + (1j * rng.standard_normal((3, 2)) if complex_ else 0)
+    cplx = (lambda a: a + 1j * rng.standard_normal(a.shape)) if complex_ else (lambda a: a)
+    U = [None] + [cplx(rng.standard_normal((m, q))) for _ in range(2)]
+    Y = [None] + [cplx(rng.standard_normal((q, m))) for _ in range(2)]
+    return ReducedOperator(mats, coef, U, Y, symmetric=False), mats, coef, U, Y
+
+
+def test_formed_rows_columns_and_node_diagonal_equal_the_sum_written_out():
+    """``block(b, rows, cols)`` (BLAS axpy and gemm in place) and ``node_diagonal`` against
+    ``sum_t c_t X_t - U Y`` written out with NumPy and sliced: the same sums in another
+    order, equal to rounding (1e-13 of the entries' size 10)."""
+    rng = np.random.default_rng(3)
+    m, q, d = 12, 3, 3
+    rows, cols = np.array([7, 0, 5, 11]), np.array([2, 3, 9])
+    for complex_ in (False, True):
+        op, mats, coef, U, Y = _random_operator(rng, m, q, complex_)
+        for b in range(3):
+            full = coef[b, 0] * mats[0] + coef[b, 1] * mats[1]
+            if U[b] is not None:
+                full = full - U[b] @ Y[b]
+            for r, c in ((None, None), (rows, None), (None, cols), (rows, cols)):
+                want = full[(slice(None) if r is None else r)][:, (slice(None) if c is None
+                                                                    else c)]
+                assert np.abs(op.block(b, r, c) - want).max() < 1e-13 * 10, (b, r, c)
+            diag = np.stack([full[p * d:(p + 1) * d, p * d:(p + 1) * d]
+                             for p in range(m // d)])
+            assert np.abs(op.node_diagonal(b, d) - diag).max() < 1e-13 * 10

@@ -37,6 +37,14 @@ def test_operator_blocks_products_equal_stored_blocks(damping):
     assert rel(ob.node_rows(V), hb.node_rows(V)) < 1e-13
     assert rel(ob.sub(rows).dense(), hb.sub(rows).dense()) < 1e-13
     assert rel(ob.leading(2).dense(), hb.leading(2).dense()) < 1e-13
+    # the rows the column norms read (kept per set of rows) and the node diagonals, for
+    # two sets of rows in turn and the first again: the kept rows follow the set
+    for r in (rows, cols, rows):
+        for b in range(ob.nb):
+            A, ra = ob.row_block(b, r)
+            B, rb = hb.row_block(b, r)
+            assert rel(A[ra], B[rb]) < 1e-13, b
+            assert rel(ob.node_diagonal(b, 3), hb.node_diagonal(b, 3)) < 1e-13, b
 
 
 def test_operator_jacobian_against_dense_and_finite_differences():

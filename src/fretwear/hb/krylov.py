@@ -142,6 +142,19 @@ class HarmonicBlocks:
         """Block ``b`` as the products use it: real (:attr:`Zr`) when :attr:`real`."""
         return self.Zr[b] if self.real else self.Zc[b]
 
+    def row_block(self, b: int, dofs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(A, r)`` with row ``r[i]`` of ``A`` the row ``dofs[i]`` of block ``b`` (as
+        :meth:`block`): the stored block and ``dofs`` themselves here; an operator forms
+        only those rows."""
+        return (self.Z0 if b == 0 else self.block(b)), np.asarray(dofs)
+
+    def node_diagonal(self, b: int, d: int) -> np.ndarray:
+        """The (m / d, d, d) diagonal node blocks of block ``b`` (as :meth:`block`)."""
+        Zb = self.Z0 if b == 0 else self.block(b)
+        nc = self.m // d
+        idx = np.arange(nc)
+        return Zb.reshape(nc, d, nc, d)[idx, :, idx, :]
+
     def leading(self, nb: int) -> HarmonicBlocks:
         """The blocks of the first ``nb`` harmonics, sharing this object's arrays (and its
         real copies)."""
@@ -475,7 +488,6 @@ class KrylovJacobian:
         act = self.active_nodes()  # the Gram matrices of the stuck nodes vanish
         na = act.size
         rows = np.ascontiguousarray(act[:, None] * d + np.arange(d))  # (na, d)
-        idx = np.arange(nc)
 
         for b in range(Z.nb):
             cs = [0] if b == 0 else [b, Z.k + b]
@@ -483,7 +495,11 @@ class KrylovJacobian:
             Gs = np.ascontiguousarray(Gr[:, :, :, cs].reshape(nc, dH, d * nl))
             Ga = Gs[act]
             gram = np.matmul(np.transpose(Ga, (0, 2, 1)), Ga)  # (na, d nl, d nl)
-            Zb = Z.Z0 if b == 0 else Z.block(b)
+            # the block's rows of the active nodes (an operator forms only these) and every
+            # node's own d x d block
+            Zb, lrows = Z.row_block(b, rows.reshape(-1))
+            lrows = np.ascontiguousarray(lrows.reshape(na, d))
+            diag = Z.node_diagonal(b, d)  # (nc, d, d)
             if b == 0:
                 M = gram[None]
             elif Z.real:
@@ -501,14 +517,13 @@ class KrylovJacobian:
                               np.block([[D, np.transpose(B, (0, 2, 1))], [B, A]])])
             M = np.ascontiguousarray(M)
             Are, Aim = (Zb.real, Zb.imag) if np.iscomplexobj(Zb) else (Zb, Zb)
-            diag = Zb.reshape(nc, d, nc, d)[idx, :, idx, :]  # (nc, d, d) own-node blocks
             for j0 in range(0, m, chunk):
                 sl = slice(j0, min(j0 + chunk, m))
                 js = np.arange(sl.start, sl.stop)
                 if d == 3 and not np.iscomplexobj(Zb):
-                    sq = _gram_quad_real3(Zb, rows, M, sl.start, sl.stop).T  # (ncol, nl)
+                    sq = _gram_quad_real3(Zb, lrows, M, sl.start, sl.stop).T  # (ncol, nl)
                 else:
-                    sq = _gram_quad(Are, Aim, rows, M, sl.start, sl.stop).T
+                    sq = _gram_quad(Are, Aim, lrows, M, sl.start, sl.stop).T
                 # + eps (I - G) on the owner's block: column (j, c) -> node j // d, row j%d, c
                 q = js // d
                 ci = np.arange(js.size)

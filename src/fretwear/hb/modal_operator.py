@@ -23,6 +23,7 @@ The solver's products on the real Fourier basis are in :mod:`fretwear.hb.operato
 from __future__ import annotations
 
 import numpy as np
+import scipy.linalg as sla
 
 
 def _times(A: np.ndarray, X: np.ndarray) -> np.ndarray:
@@ -31,6 +32,43 @@ def _times(A: np.ndarray, X: np.ndarray) -> np.ndarray:
     if np.iscomplexobj(X) and not np.iscomplexobj(A):
         return A @ X.real + 1j * (A @ X.imag)
     return A @ X
+
+
+def _select(A: np.ndarray, rows, cols) -> np.ndarray:
+    """``A[rows][:, cols]`` (None: all), a view when both are None."""
+    if rows is None and cols is None:
+        return A
+    if cols is None:
+        return np.take(A, rows, axis=0)
+    if rows is None:
+        return np.take(A, cols, axis=1)
+    return np.take(np.take(A, rows, axis=0), cols, axis=1)
+
+
+def _axpy(c, A: np.ndarray, out: np.ndarray) -> None:
+    """``out += c A`` in place: BLAS ``axpy`` on contiguous arrays of one kind, NumPy
+    otherwise."""
+    if (out.flags.c_contiguous and A.flags.c_contiguous and out.dtype == np.float64
+            and A.dtype == np.float64 and np.isrealobj(c)):
+        sla.blas.daxpy(A.ravel(), out.ravel(), a=float(c))
+    else:
+        out += c * A
+
+
+def _gemm_sub(U: np.ndarray, Y: np.ndarray, out: np.ndarray) -> None:
+    """``out -= U Y`` in place (one BLAS ``gemm`` on ``out^T``, F-ordered, for a contiguous
+    float64 or complex128 ``out``; NumPy otherwise)."""
+    kind = {np.dtype(np.float64): sla.blas.dgemm, np.dtype(np.complex128): sla.blas.zgemm}
+    gemm = kind.get(out.dtype)
+    if gemm is not None and out.flags.c_contiguous and (
+            out.dtype == np.complex128 or not (np.iscomplexobj(U) or np.iscomplexobj(Y))):
+        r = gemm(-1.0, np.asarray(Y, out.dtype).T, np.asarray(U, out.dtype).T, beta=1.0,
+                 c=out.T, overwrite_c=True)
+        if np.shares_memory(r, out):
+            return
+        out[...] = r.T
+        return
+    out -= U @ Y
 
 
 class ReducedOperator:
@@ -107,16 +145,40 @@ class ReducedOperator:
             yield self.block(b)
 
     def block(self, b: int, rows=None, cols=None) -> np.ndarray:
-        """Block ``b`` formed densely (m, m), or its rows ``rows`` and columns ``cols``."""
-        sub = rows is not None or cols is not None
-        rows = np.arange(self.m) if rows is None else np.asarray(rows)
-        cols = np.arange(self.m) if cols is None else np.asarray(cols)
-        out = np.zeros((rows.size, cols.size), dtype=self.dtype)
+        """Block ``b`` formed densely (m, m), or its rows ``rows`` and columns ``cols``
+        (either may be None: all). Each stored matrix is read once, added in place (BLAS
+        ``axpy``), and the low-rank term subtracted by one ``gemm`` into the result: no
+        ``m x m`` temporaries."""
+        out = None
+        for c, A in zip(self.coef[b], self.mats, strict=True):
+            if c == 0:
+                continue
+            As = _select(A, rows, cols)
+            if out is None:
+                out = np.multiply(As, c, dtype=self.dtype)
+            else:
+                _axpy(c, As, out)
+        if out is None:
+            out = np.zeros(_select(self.mats[0], rows, cols).shape, dtype=self.dtype)
+        if self.U[b] is not None:
+            U = self.U[b] if rows is None else self.U[b][rows]
+            Y = self.Y[b] if cols is None else self.Y[b][:, cols]
+            _gemm_sub(U, Y, out)
+        return out
+
+    def node_diagonal(self, b: int, d: int) -> np.ndarray:
+        """The (nc, d, d) blocks of block ``b`` on the diagonal (each node's own ``d x d``
+        block, ``nc = m / d``) without forming the block: ``O(m d (len(mats) + q))``."""
+        nc = self.m // d
+        idx = np.arange(nc)
+        out = np.zeros((nc, d, d), dtype=self.dtype)
         for c, A in zip(self.coef[b], self.mats, strict=True):
             if c != 0:
-                out += c * (A[np.ix_(rows, cols)] if sub else A)
+                out += c * A.reshape(nc, d, nc, d)[idx, :, idx, :]
         if self.U[b] is not None:
-            out -= self.U[b][rows] @ self.Y[b][:, cols]
+            q = self.U[b].shape[1]
+            out -= np.matmul(self.U[b].reshape(nc, d, q),
+                             self.Y[b].reshape(q, nc, d).transpose(1, 0, 2))
         return out
 
     def sub(self, dofs: np.ndarray) -> ReducedOperator:

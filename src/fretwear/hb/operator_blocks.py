@@ -36,6 +36,7 @@ class OperatorBlocks(HarmonicBlocks):
         plain = op.U[0] is None and c0[0] == 1 and not np.any(c0[1:])
         self.Z0 = op.mats[0] if plain else np.ascontiguousarray(op.block(0).real)
         self._ZcH = None
+        self._rows = None  # (dofs, the operator of those rows): row_block
         self._symmetric = op.symmetric
         self._real = op.real
 
@@ -56,6 +57,29 @@ class OperatorBlocks(HarmonicBlocks):
         if b == 0:
             return self.Z0
         return self.op.block(b)
+
+    def row_block(self, b: int, dofs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """As :meth:`HarmonicBlocks.row_block`: the rows ``dofs`` of the stored matrices
+        are taken once for every harmonic (and kept while ``dofs`` do not change: Powell's
+        successive Jacobians near a solution share them), then each block's rows are formed
+        from them."""
+        dofs = np.asarray(dofs)
+        if b == 0:  # held formed
+            return self.Z0, dofs
+        key = dofs.tobytes()
+        if self._rows is None or self._rows[0] != key:
+            op = self.op
+            self._rows = None  # release the last rows before taking new ones
+            self._rows = (key, ReducedOperator(
+                [np.take(A, dofs, axis=0) for A in op.mats], op.coef,
+                [None if u is None else u[dofs] for u in op.U], op.Y, False))
+        return self._rows[1].block(b), np.arange(dofs.size)
+
+    def node_diagonal(self, b: int, d: int) -> np.ndarray:
+        if b == 0:
+            return super().node_diagonal(0, d)
+        out = self.op.node_diagonal(b, d)
+        return out.real if self.real else out
 
     def leading(self, nb: int) -> OperatorBlocks:
         return OperatorBlocks(self.op[:nb])
