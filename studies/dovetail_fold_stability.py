@@ -22,6 +22,7 @@ import time
 import numpy as np
 
 from fretwear.analyses.run import load_case
+from fretwear.errors import InputError
 from fretwear.examples import example_path
 from fretwear.hb.condensers import condenser
 from fretwear.hb.dynamics import structure_dynamics
@@ -66,14 +67,20 @@ def main():
         picks.append(("middle branch (det J < 0)", unstable_pick[len(unstable_pick) // 2]))
     if stable_pick:  # the largest-amplitude point with det J > 0 near the fold
         picks.append(("det J > 0", max(stable_pick, key=lambda r: r[4])))
-    for label, (p, prob, U, sign, amp) in picks:
+    for label, (p, prob, U, sign, _amp) in picks:
         c0 = time.process_time()
-        fl = hill_stability(prob, U, dyn)
-        crit = fl.critical(2)
-        stamp(f"{label}: {p.frequency_hz:.3f} Hz, Hill: {'stable' if fl.stable else 'unstable'}, "
-              f"largest |rho| {fl.max_multiplier:.4f}, critical {np.round(crit, 4)}, kinds "
-              f"{list(fl.kind[:4])}, reliable {fl.reliable}, neutral {fl.neutral}, "
-              f"{time.process_time() - c0:.1f} s CPU")
+        try:
+            fl = hill_stability(prob, U, dyn)
+            crit = fl.critical(2)
+            stamp(f"{label}: {p.frequency_hz:.3f} Hz, Hill: "
+                  f"{'stable' if fl.stable else 'unstable'}, largest |rho| "
+                  f"{fl.max_multiplier:.4f}, critical {np.round(crit, 4)}, kinds "
+                  f"{list(fl.kind[:4])}, reliable {fl.reliable}, neutral {fl.neutral}, "
+                  f"{time.process_time() - c0:.1f} s CPU")
+        except InputError as exc:  # the dense quadratic problem is too large: det J only
+            stamp(f"{label}: {p.frequency_hz:.3f} Hz, Hill's spectrum not computed ({exc}); "
+                  f"sign det J {sign:+d}"
+                  + (": a real multiplier above 1, unstable" if sign < 0 else ""))
         c0 = time.process_time()
         chk = check_periodic(model, p.solution, max_periods=max_periods, condenser=cond)
         stamp(f"{label}: {p.frequency_hz:.3f} Hz, time integration: {chk.verdict} "

@@ -449,11 +449,6 @@ class HillProblem:
                              f"{DENSE_MAX} unknowns (m H)")
         if dyn.m != prob.m:
             raise InputError(f"the structure has {dyn.m} contact DOFs, the problem {prob.m}")
-        if (dyn.m + dyn.q) * prob.H > PENCIL_MAX:
-            raise InputError(f"Hill's method solves its quadratic eigenvalue problem densely "
-                             f"up to {PENCIL_MAX} unknowns (structure coordinates x kept "
-                             f"harmonics); this one has {(dyn.m + dyn.q) * prob.H}: use fewer "
-                             "harmonics or a modal condenser with fewer modes")
         self.prob = prob
         self.U = np.asarray(U, dtype=float).reshape(prob.m, prob.H)
         self.dyn = dyn
@@ -513,6 +508,11 @@ class HillProblem:
         Exact for a law without memory (:meth:`memoryless`); the hysteretic damping keeps
         the sign of ``n`` (none on the static coefficient)."""
         dyn, prob, w = self.dyn, self.prob, self.omega
+        if (dyn.m + dyn.q) * prob.H > PENCIL_MAX:
+            raise InputError(f"Hill's method solves its quadratic eigenvalue problem densely "
+                             f"up to {PENCIL_MAX} unknowns (structure coordinates x kept "
+                             f"harmonics); this one has {(dyn.m + dyn.q) * prob.H}: use fewer "
+                             "harmonics or a modal condenser with fewer modes")
         orders = prob.basis.orders
         nw = orders * w
         q = dyn.q
