@@ -56,6 +56,13 @@ How they are computed
    followed by inverse iteration on one LU per evaluation, :func:`_pair`). A
    candidate near which the exact problem has no exponent is an artefact of the frozen memory
    (:attr:`FloquetResult.spurious`).
+4. **Along a sweep** (``previous``: the neighbouring point's result), the candidates of step 1
+   are continued from the neighbour's by inverse iteration on the quadratic problem
+   (:func:`track_eigen`) instead of its dense eigensolve, where that is shown to give the
+   same set: every family represented at the neighbour and here (they number ``2 nd / H``),
+   each member converged with ``|kappa| <= 1/2``, and its neighbouring copy on the side of the
+   tie outside ``|kappa| <= 1/2``; otherwise (a jump between branches, two members meeting,
+   the period-doubling line) the dense eigensolve.
 
 Exponents not reported: a node that sticks all period (or a contact point behind a spring that
 sticks all period) holds its contact DOFs, so the modes of the structure with that part of the
@@ -69,11 +76,11 @@ mass, ``q`` other coordinates; at most :data:`PENCIL_MAX` before the companion f
 where coordinates whose law does not vary over the period split off, harmonic by harmonic,
 :func:`_components`) and,
 with a memory, a few evaluations of ``T(s)`` and ``m H`` LU factorisations per refined
-exponent. Measured at 10-30 ms of CPU a point on the benchmark's small models, tens of times
-a warm-started sweep point's solve (docs/theory.md, section 9): the whole spectrum at every
-point and the evaluations of ``T(s)`` are what cost (tracking the candidates from the
-previous point by Rayleigh-quotient iteration was measured slower on the two-DOF sweep and
-not kept: docs/theory.md, section 9). Dense up to :data:`DENSE_MAX` unknowns of the
+exponent; along a sweep, where the candidates are tracked, a few LU factorisations of the
+blocks of the quadratic problem per candidate instead of its dense eigensolve. Measured on
+the benchmark's small models (docs/theory.md, section 9): about 1-3 times a warm-started
+point's solve; the evaluations of ``T(s)`` (a law with a memory) and the dense eigensolve at
+the points that cannot be tracked are what cost. Dense up to :data:`DENSE_MAX` unknowns of the
 balance. The sign of ``det J`` (``J = T(0)``) is reported with the exponents
 (:attr:`FloquetResult.det_sign`).
 """
