@@ -20,6 +20,7 @@ from helpers.models import two_dof
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.options import SweepOptions
 from fretwear.hb.reduce import exact_condenser
+from fretwear.hb.stability import HillOptions
 from fretwear.hb.sweep import sweep
 from fretwear.hb.sweep_stability import branch_events, sweep_stability
 
@@ -70,3 +71,26 @@ def test_events_are_where_neighbours_differ(folded):
         if e.kind == "period-doubling":
             assert e.multiplier.real < -1
         assert f"{e.f_lo:.6g}" in e.line()
+
+
+def test_tracked_candidates_give_the_dense_multipliers(folded):
+    """Hill's method along the sweep continues each point's candidates from the previous
+    point's (inverse iteration, :func:`fretwear.hb.stability.track_eigen`) instead of the dense
+    eigensolve of the quadratic problem; the reference is the dense eigensolve at every point
+    (``HillOptions(track=False)``): the same multipliers, one for one, to 1e-10 (both are
+    the same simple eigenvalues of the same matrices, each computed to about 1e-14; the
+    tolerance leaves room for their condition). Some points must be tracked and some not
+    (the arclength's jumps between branches and the period-doubling stretch fall back to the
+    dense eigensolve), so that the comparison covers both."""
+    res, st = folded
+    model = two_dof()
+    dense = sweep_stability(model, res, condenser=exact_condenser(model),
+                            options=HillOptions(track=False))
+    tracked = [fl.tracked for fl in st.floquet if fl is not None]
+    assert any(tracked) and not all(tracked)
+    assert not any(fl.tracked for fl in dense.floquet if fl is not None)
+    for a, b in zip(st.floquet, dense.floquet, strict=True):
+        assert (a is None) == (b is None)
+        if a is not None:
+            assert a.multipliers.shape == b.multipliers.shape
+            np.testing.assert_allclose(a.multipliers, b.multipliers, rtol=0, atol=1e-10)

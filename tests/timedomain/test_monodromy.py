@@ -178,3 +178,39 @@ def test_fold_and_period_doubling_of_the_unilateral_sweep_agree_with_the_time_in
             doubled += 1
     assert middle >= 10 and compared >= 40  # both branches are compared
     assert doubled >= 5
+
+
+def test_neimark_sacker_point_of_the_unilateral_sweep_agrees_with_the_time_integration():
+    """The unilateral oscillator forced harder (0.3 N) loses stability between 0.80 and 0.81
+    rad/s by a complex pair of multipliers leaving the unit circle: a Neimark-Sacker point,
+    which the sweep's stability reports (15 harmonics, 256 samples). The monodromy of the exact
+    integration (512 steps a period) at the two ends of the stretch has its dominant pair
+    complex too, inside the unit circle at 0.80 rad/s and outside at 0.83 rad/s, within 0.03 of
+    Hill's pair (measured 0.008 and 0.02: the balance's truncation of the contact's kink and the
+    integration's step)."""
+    from fretwear.hb.options import SweepOptions
+    from fretwear.hb.reduce import exact_condenser
+    from fretwear.hb.sweep import sweep
+    from fretwear.hb.sweep_stability import sweep_stability
+
+    model = unilateral(force=0.3)
+    cond = exact_condenser(model)
+    res = sweep(model, FourierBasis.up_to(15, 256), 0.80 / (2 * np.pi), 0.83 / (2 * np.pi), 4,
+                options=SweepOptions(spacing="linear"), condenser=cond)
+    st = sweep_stability(model, res, condenser=cond)
+    assert list(st.stable) == [1, 0, 0, 0]
+    (event,) = st.events
+    assert event.kind == "Neimark-Sacker" and event.change == "stable -> unstable"
+    assert abs(event.multiplier.imag) > 0.1 and abs(event.multiplier) > 1
+    for i, outside in ((0, False), (3, True)):
+        p, fl = res.points[i], st.floquet[i]
+        hill = fl.critical(1)[0]
+        U0, V0 = initial_state(model, p.solution, cond)
+        mono = monodromy(model, p.frequency_hz, start=InitialState(U0=U0, V0=V0),
+                         integration=SHOOTING.replace(steps_per_period=512))
+        assert mono.success
+        r = mono.multipliers[np.argsort(-np.abs(mono.multipliers))]
+        assert abs(r[0].imag) > 0.1 and abs(r[0] - np.conj(r[1])) < 1e-8  # a complex pair
+        td = r[0] if r[0].imag * hill.imag > 0 else r[1]
+        assert abs(td - hill) < 0.03, (p.frequency_hz, td, hill)
+        assert (abs(td) > 1) == (abs(hill) > 1) == outside

@@ -56,6 +56,13 @@ How they are computed
    followed by inverse iteration on one LU per evaluation, :func:`_pair`). A
    candidate near which the exact problem has no exponent is an artefact of the frozen memory
    (:attr:`FloquetResult.spurious`).
+4. **Along a sweep** (``previous``: the neighbouring point's result), the candidates of step 1
+   are continued from the neighbour's by inverse iteration on the quadratic problem
+   (:func:`track_eigen`) instead of its dense eigensolve, where that is shown to give the
+   same set: every family represented at the neighbour and here (they number ``2 nd / H``),
+   each member converged with ``|kappa| <= 1/2``, and its neighbouring copy on the side of the
+   tie outside ``|kappa| <= 1/2``; otherwise (a jump between branches, two members meeting,
+   the period-doubling line) the dense eigensolve.
 
 Exponents not reported: a node that sticks all period (or a contact point behind a spring that
 sticks all period) holds its contact DOFs, so the modes of the structure with that part of the
@@ -69,11 +76,11 @@ mass, ``q`` other coordinates; at most :data:`PENCIL_MAX` before the companion f
 where coordinates whose law does not vary over the period split off, harmonic by harmonic,
 :func:`_components`) and,
 with a memory, a few evaluations of ``T(s)`` and ``m H`` LU factorisations per refined
-exponent. Measured at 10-30 ms of CPU a point on the benchmark's small models, tens of times
-a warm-started sweep point's solve (docs/theory.md, section 9): the whole spectrum at every
-point and the evaluations of ``T(s)`` are what cost (tracking the candidates from the
-previous point by Rayleigh-quotient iteration was measured slower on the two-DOF sweep and
-not kept: docs/theory.md, section 9). Dense up to :data:`DENSE_MAX` unknowns of the
+exponent; along a sweep, where the candidates are tracked, a few LU factorisations of the
+blocks of the quadratic problem per candidate instead of its dense eigensolve. Measured on
+the benchmark's small models (docs/theory.md, section 9): about 1-3 times a warm-started
+point's solve; the evaluations of ``T(s)`` (a law with a memory) and the dense eigensolve at
+the points that cannot be tracked are what cost. Dense up to :data:`DENSE_MAX` unknowns of the
 balance. The sign of ``det J`` (``J = T(0)``) is reported with the exponents
 (:attr:`FloquetResult.det_sign`).
 """
@@ -87,6 +94,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 from numba import njit
+from scipy.linalg.lapack import zgetrf, zgetrs
 from scipy.sparse.csgraph import connected_components
 
 from fretwear.errors import InputError
@@ -137,6 +145,10 @@ class HillOptions:
     newton_tol : relative residual ``|T v| / (|T| |v|)`` at which a refinement stops.
     newton_max_iter : iterations of one refinement.
     stable_tol : ``|rho| <= 1 + stable_tol`` counts as stable (rounding of a neutral exponent).
+    track : given the result at a neighbouring solution (``previous`` of
+        :func:`hill_stability`), continue its candidates by inverse iteration instead of the
+        dense eigensolve, where that is shown to give the same ones (:func:`track_eigen`);
+        False: the dense eigensolve at every point.
     """
 
     refine: int = 2
@@ -144,8 +156,11 @@ class HillOptions:
     newton_tol: float = 1e-10
     newton_max_iter: int = 20
     stable_tol: float = 1e-6
+    track: bool = True
 
     def __post_init__(self):
+        if not isinstance(self.track, bool):
+            raise InputError(f"track = {self.track!r}: expected true or false")
         n = self.refine
         if isinstance(n, bool) or not isinstance(n, int) or n < 0:
             raise InputError(f"refine = {n!r}: expected a whole number >= 0")
@@ -156,6 +171,25 @@ class HillOptions:
         n = self.newton_max_iter
         if isinstance(n, bool) or not isinstance(n, int) or n < 1:
             raise InputError(f"newton_max_iter = {n!r}: expected a whole number >= 1")
+
+
+@dataclass
+class HillTrack:
+    """The centred candidates of one solution, for its neighbour (:func:`track_eigen`).
+
+    sigma : (k,) the members ``s / w`` with ``Im s >= 0``; Y : (nd, k) their eigenvectors on
+    the dynamic coordinates ``dyn``; block : (k,) the block of :class:`QuadraticReduction`
+    each lies in; nd, dyn, blocks : that reduction's coordinates and blocks; complete : every
+    family of the truncated problem is represented.
+    """
+
+    sigma: np.ndarray
+    Y: np.ndarray
+    block: np.ndarray
+    nd: int
+    dyn: np.ndarray
+    blocks: list
+    complete: bool
 
 
 @dataclass
@@ -185,6 +219,9 @@ class FloquetResult:
     evaluations : evaluations of ``T(s)``; wall_time : seconds.
     det_sign : sign of ``det J``, ``J = T(0)`` the balance's Jacobian (a change between
         neighbours of a branch: a fold or a branch point, :mod:`fretwear.hb.sweep_stability`).
+    tracked : the candidates were continued from a neighbouring solution's
+        (:func:`track_eigen`), not from a dense eigensolve.
+    track : what a neighbouring solution continues from (None: it cannot).
     """
 
     exponents: np.ndarray
@@ -199,6 +236,8 @@ class FloquetResult:
     wall_time: float
     stable_tol: float = 1e-6
     det_sign: int = 0
+    tracked: bool = False
+    track: HillTrack | None = None
 
     @property
     def period(self) -> float:
@@ -417,11 +456,6 @@ class HillProblem:
                              f"{DENSE_MAX} unknowns (m H)")
         if dyn.m != prob.m:
             raise InputError(f"the structure has {dyn.m} contact DOFs, the problem {prob.m}")
-        if (dyn.m + dyn.q) * prob.H > PENCIL_MAX:
-            raise InputError(f"Hill's method solves its quadratic eigenvalue problem densely "
-                             f"up to {PENCIL_MAX} unknowns (structure coordinates x kept "
-                             f"harmonics); this one has {(dyn.m + dyn.q) * prob.H}: use fewer "
-                             "harmonics or a modal condenser with fewer modes")
         self.prob = prob
         self.U = np.asarray(U, dtype=float).reshape(prob.m, prob.H)
         self.dyn = dyn
@@ -481,6 +515,11 @@ class HillProblem:
         Exact for a law without memory (:meth:`memoryless`); the hysteretic damping keeps
         the sign of ``n`` (none on the static coefficient)."""
         dyn, prob, w = self.dyn, self.prob, self.omega
+        if (dyn.m + dyn.q) * prob.H > PENCIL_MAX:
+            raise InputError(f"Hill's method solves its quadratic eigenvalue problem densely "
+                             f"up to {PENCIL_MAX} unknowns (structure coordinates x kept "
+                             f"harmonics); this one has {(dyn.m + dyn.q) * prob.H}: use fewer "
+                             "harmonics or a modal condenser with fewer modes")
         orders = prob.basis.orders
         nw = orders * w
         q = dyn.q
@@ -539,15 +578,38 @@ def centroid(p: np.ndarray, k: int) -> np.ndarray:
     return float(out) if np.ndim(out) == 0 else out
 
 
-def quadratic_eigen(A0: np.ndarray, A1: np.ndarray, A2: np.ndarray):
-    """Eigenvalues (k,) and eigenvectors (n, k) of ``(A0 + s A1 + s^2 A2) y = 0``.
+@dataclass
+class QuadraticReduction:
+    """``A0 + s A1 + s^2 A2`` with its algebraic coordinates eliminated
+    (:func:`reduce_quadratic`): ``B0 + s B1 + s^2 B2`` on the coordinates ``dyn`` with a mass
+    or a damping, the algebraic ones ``alg = back @ y[dyn]``; ``blocks`` the index sets (into
+    ``dyn``) of the blocks the problem decouples into (:func:`_components`)."""
 
-    Coordinates whose rows and columns of ``A1`` and ``A2`` vanish (massless contact points
-    behind springs, rows the law holds) are algebraic: they are eliminated exactly by the
-    Schur complement of ``A0`` (their blocks do not depend on ``s``). The rest is linearised
-    as ``[[0, I], [-A2^-1 A0, -A2^-1 A1]]`` (a standard real eigenvalue problem) when ``A2``
-    is well conditioned there, else as the generalised problem of the companion pencil
-    (infinite eigenvalues are dropped)."""
+    n: int
+    dyn: np.ndarray
+    alg: np.ndarray
+    back: np.ndarray | None
+    B0: np.ndarray
+    B1: np.ndarray
+    B2: np.ndarray
+    blocks: list
+
+    def full(self, Y: np.ndarray) -> np.ndarray:
+        """Eigenvectors (n, k) on every coordinate from those (nd, k) on ``dyn``."""
+        vecs = np.zeros((self.n, Y.shape[1]), dtype=complex)
+        vecs[self.dyn] = Y
+        if self.alg.size:
+            vecs[self.alg] = self.back @ Y
+        return vecs
+
+
+def reduce_quadratic(A0: np.ndarray, A1: np.ndarray, A2: np.ndarray,
+                     hint: HillTrack | None = None) -> QuadraticReduction:
+    """Coordinates whose rows and columns of ``A1`` and ``A2`` vanish (massless contact points
+    behind springs, rows the law holds) are algebraic: eliminated exactly by the Schur
+    complement of ``A0`` (their blocks do not depend on ``s``); the rest split into the blocks
+    it decouples into (:func:`_components`; ``hint``: a neighbour's, kept when the problem
+    decouples into them by the same test, which costs less than finding them)."""
     n = A0.shape[0]
     dyn_ = np.flatnonzero(np.any(A1 != 0, axis=1) | np.any(A2 != 0, axis=1)
                           | np.any(A1 != 0, axis=0) | np.any(A2 != 0, axis=0))
@@ -561,23 +623,193 @@ def quadratic_eigen(A0: np.ndarray, A1: np.ndarray, A2: np.ndarray):
             back = -np.linalg.lstsq(A0[np.ix_(alg, alg)], A0[np.ix_(alg, dyn_)],
                                     rcond=None)[0]
         B0 = B0 + A0[np.ix_(dyn_, alg)] @ back
-    nd = dyn_.size
+    blocks = None
+    if hint is not None and np.array_equal(hint.dyn, dyn_):
+        blocks = hint.blocks if _decouples(B0, B1, B2, hint.blocks) else None
+    if blocks is None:
+        blocks = _components(B0, B1, B2) if dyn_.size else []
+    return QuadraticReduction(n, dyn_, alg, back, B0, B1, B2, blocks)
+
+
+def _decouples(B0: np.ndarray, B1: np.ndarray, B2: np.ndarray, blocks: list) -> bool:
+    """Whether ``B0 + s B1 + s^2 B2`` has no entry coupling two of ``blocks`` (the test of
+    :func:`_components`: none above :data:`DECOUPLED_TOL` times the largest of its matrix)."""
+    label = np.empty(B0.shape[0], dtype=int)
+    for i, b in enumerate(blocks):
+        label[b] = i
+    off = label[:, None] != label[None, :]
+    for X in (B0, B1, B2):
+        big = np.abs(X).max(initial=0.0)
+        if big > 0 and np.any(np.abs(X[off]) > DECOUPLED_TOL * big):
+            return False
+    return True
+
+
+def quadratic_eigen(A0: np.ndarray, A1: np.ndarray, A2: np.ndarray):
+    """Eigenvalues (k,) and eigenvectors (n, k) of ``(A0 + s A1 + s^2 A2) y = 0``.
+
+    Algebraic coordinates are eliminated (:func:`reduce_quadratic`). The rest is linearised
+    as ``[[0, I], [-A2^-1 A0, -A2^-1 A1]]`` (a standard real eigenvalue problem) when ``A2``
+    is well conditioned there, else as the generalised problem of the companion pencil
+    (infinite eigenvalues are dropped)."""
+    return dense_eigen(reduce_quadratic(A0, A1, A2))
+
+
+def dense_eigen(red: QuadraticReduction):
+    """Every eigenpair of a :class:`QuadraticReduction` (:func:`quadratic_eigen`), block by
+    block."""
+    nd = red.dyn.size
     if nd == 0:
-        return np.zeros(0, dtype=complex), np.zeros((n, 0), dtype=complex)
+        return np.zeros(0, dtype=complex), np.zeros((red.n, 0), dtype=complex)
     parts = []
-    for comp in _components(B0, B1, B2):
+    for comp in red.blocks:
         ix = np.ix_(comp, comp)
-        v, Yc = _companion_eigen(B0[ix], B1[ix], B2[ix])
+        v, Yc = _companion_eigen(red.B0[ix], red.B1[ix], red.B2[ix])
         Y = np.zeros((nd, v.size), dtype=complex)
         Y[comp] = Yc
         parts.append((v, Y))
     vals = np.concatenate([v for v, _ in parts])
     Y = np.hstack([y for _, y in parts])
-    vecs = np.zeros((n, vals.size), dtype=complex)
-    vecs[dyn_] = Y
-    if alg.size:
-        vecs[alg] = back @ Y
-    return vals, vecs
+    return vals, red.full(Y)
+
+
+def _inverse_iteration(B0, B1, B2, sigma: complex, y: np.ndarray, max_iter: int = 10):
+    """The eigenpair of ``(B0 + s B1 + s^2 B2) y = 0`` nearest ``(sigma, y)``: one step of
+    inverse iteration with ``P(sigma)`` (the start vector turned towards the eigenvector of
+    the eigenvalue nearest ``sigma``), then the nonlinear inverse iteration (Ruhe, SIAM J.
+    Numer. Anal. 10, 1973, section 3: ``u = P(s)^-1 P'(s) x``, ``s <- s - (v^H x) / (v^H u)``,
+    quadratically convergent to a simple eigenvalue), one LU of ``P(s)`` a step. Returns
+    ``(sigma, y, converged)``; converged when the step is below 1e-14 of ``max(1, |sigma|)``
+    (the rounding of the dense eigensolver's eigenvalue, whose backward error is of the same
+    order)."""
+    x = y / np.linalg.norm(y)
+    first = True
+    B0, B1, B2 = (np.asarray(b, dtype=complex) for b in (B0, B1, B2))
+    for _ in range(max_iter):
+        lu, piv, info = zgetrf(B0 + sigma * B1 + (sigma * sigma) * B2)
+        if info != 0:
+            return sigma, x, False
+        if first:  # towards the eigenvector of the eigenvalue nearest sigma
+            x = zgetrs(lu, piv, x)[0]
+            x = x / np.linalg.norm(x)
+            first = False
+        u = zgetrs(lu, piv, (B1 + (2.0 * sigma) * B2) @ x)[0]
+        den = np.vdot(x, u)
+        if not np.isfinite(den) or den == 0:
+            return sigma, x, False
+        step = 1.0 / den
+        sigma = complex(sigma - step)
+        x = u / np.linalg.norm(u)
+        if abs(step) <= 1e-14 * max(1.0, abs(sigma)):
+            return sigma, x, True
+    return sigma, x, False
+
+
+def track_eigen(red: QuadraticReduction, track: HillTrack | None, shape: tuple):
+    """The centred members (``|kappa| <= 1/2``, ``Im s >= 0``) of every family of
+    ``(A0 + s A1 + s^2 A2) y = 0`` continued from those of a neighbouring solution
+    (:class:`HillTrack`) by inverse iteration (:func:`_inverse_iteration`), or None where that
+    is not shown to give the set that :func:`dense_eigen` and the centroid rule keep
+    (``shape``: ``(m + q, H, k)`` of :func:`centroid`):
+
+    * the problem has the same coordinates and blocks as at the neighbour, and every family
+      was represented there (``track.complete``);
+    * every member converges (to the dense eigensolver's eigenvalue, to its rounding), to a
+      different eigenvalue, with ``|kappa| <= 1/2``, ``Im s >= 0``, off the period-doubling
+      line ``Im s = w/2`` by :data:`EDGE_KAPPA` (where :func:`_edge_members` acts) and below
+      the magnitude cut;
+    * they number the families of the truncated problem, ``2 nd / H`` (``nd`` coordinates with
+      a mass; a complex member stands for two, its conjugate being another family's): every
+      family is represented;
+    * the copy ``s + i sign(kappa)`` of each (the neighbour in its family on the side of the
+      tie at ``|kappa| = 1/2``; a copy ``s + i j`` has the centroid ``kappa - j``) has
+      ``|kappa| > 1/2``: no family has a second member that the rule keeps (copies further
+      off have ``|kappa| >= 3/2`` less their truncation).
+
+    Returns ``(vals, vecs, kap)`` as :func:`dense_eigen`, the members only."""
+    if track is None or not track.complete or red.dyn.size != track.nd:
+        return None
+    if not np.array_equal(red.dyn, track.dyn) or len(red.blocks) != len(track.blocks) or any(
+            not np.array_equal(a, b) for a, b in zip(red.blocks, track.blocks, strict=True)):
+        return None
+    r, H, k = shape
+    cut = 2.0 * (k + 1) + 10.0
+    nd = red.dyn.size
+    vals = np.empty(track.sigma.size, dtype=complex)
+    Y = np.zeros((nd, track.sigma.size), dtype=complex)
+    kap = np.empty(track.sigma.size)
+    near = []
+    for j, (s0, b) in enumerate(zip(track.sigma, track.block, strict=True)):
+        comp = red.blocks[b]
+        ix = np.ix_(comp, comp)
+        B = (red.B0[ix], red.B1[ix], red.B2[ix])
+        s1, y, ok = _inverse_iteration(*B, complex(s0), track.Y[comp, j])
+        if not ok:
+            return None
+        if abs(s1.imag) <= 1e-12 * max(abs(s1), 1.0):
+            s1 = complex(s1.real, 0.0)
+        if s1.imag < 0:  # the conjugate pair's other member
+            s1, y = s1.conjugate(), y.conj()
+        Y[comp, j] = y
+        kap[j] = centroid(red.full(Y[:, j:j + 1]).T.reshape(r, H), k)
+        if abs(kap[j]) > 0.5:  # the centre moved to the next copy, s + i round(kappa)
+            s1, y, ok = _inverse_iteration(*B, s1 + 1j * round(kap[j]), y)
+            if not ok:
+                return None
+            if abs(s1.imag) <= 1e-12 * max(abs(s1), 1.0):
+                s1 = complex(s1.real, 0.0)
+            if s1.imag < 0:
+                s1, y = s1.conjugate(), y.conj()
+            Y[comp, j] = y
+            kap[j] = centroid(red.full(Y[:, j:j + 1]).T.reshape(r, H), k)
+        if (abs(kap[j]) > 0.5 or abs(s1) > 0.9 * cut
+                or abs(abs(s1.imag) - 0.5) <= EDGE_KAPPA):
+            return None
+        vals[j] = s1
+        near.append((B, comp, s1 + (1j if kap[j] >= 0 else -1j), y))
+    if vals.size > 1:
+        gap = np.abs(vals[:, None] - vals[None, :]) + np.eye(vals.size)
+        if gap.min() <= 1e-8 * max(1.0, np.abs(vals).max()):
+            return None
+    real = vals.imag == 0.0
+    if int(np.sum(np.where(real, 1, 2))) * H != 2 * nd:
+        return None
+    for B, comp, sn, y in near:  # the neighbouring copy of each member
+        s2, y2, ok = _inverse_iteration(*B, sn, y)
+        if not ok:
+            return None
+        Yn = np.zeros((nd, 1), dtype=complex)
+        Yn[comp, 0] = y2
+        kn = centroid(red.full(Yn).T.reshape(r, H), k)
+        if abs(kn) <= 0.5 + EDGE_KAPPA and s2.imag >= -1e-12 * max(abs(s2), 1.0):
+            if np.min(np.abs(vals - s2)) > 1e-8 * max(1.0, abs(s2)):
+                return None  # another member the rule may keep (or nearly)
+    return vals, red.full(Y), kap
+
+
+def _track_record(red: QuadraticReduction, vals: np.ndarray, vecs: np.ndarray,
+                  kap: np.ndarray, edge: np.ndarray, H: int, cut: float):
+    """The :class:`HillTrack` of the kept members ``vals`` (``Im s >= 0``) with their
+    eigenvectors ``vecs`` (n, k), centroids ``kap`` and edge flags, None where it cannot be
+    continued (an edge member or one near the period-doubling line, a member near the
+    magnitude cut ``cut``, or one spread over two blocks)."""
+    if red.dyn.size == 0 or np.any(edge) or np.any(np.abs(kap) > 0.5):
+        return None
+    if np.any(np.abs(vals) > 0.9 * cut) or np.any(
+            np.abs(np.abs(vals.imag) - 0.5) <= EDGE_KAPPA):
+        return None
+    real = np.abs(vals.imag) <= 1e-12 * np.maximum(np.abs(vals), 1.0)
+    families = int(np.sum(np.where(real, 1, 2)))
+    Y = vecs[red.dyn]
+    block = np.empty(vals.size, dtype=int)
+    for j in range(vals.size):
+        share = [np.linalg.norm(Y[c, j]) for c in red.blocks]
+        block[j] = int(np.argmax(share))
+        if share[block[j]] < (1.0 - 1e-12) * np.linalg.norm(Y[:, j]):
+            return None
+    complete = 2 * red.dyn.size == families * H
+    return HillTrack(vals.copy(), Y.copy(), block, red.dyn.size, red.dyn.copy(),
+                     [b.copy() for b in red.blocks], complete)
 
 
 def _components(B0: np.ndarray, B1: np.ndarray, B2: np.ndarray) -> list:
@@ -726,26 +958,41 @@ def _mu_derivative(hp: HillProblem, sigma: complex, v: np.ndarray, T: np.ndarray
 
 
 def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
-                   options: HillOptions | None = None) -> FloquetResult:
+                   options: HillOptions | None = None,
+                   previous: FloquetResult | None = None) -> FloquetResult:
     """Floquet exponents and multipliers of the converged solution ``U`` (m, H) of ``prob``
     by Hill's method (module docstring); ``dyn`` the structure
-    (:func:`fretwear.hb.dynamics.structure_dynamics` of the model)."""
+    (:func:`fretwear.hb.dynamics.structure_dynamics` of the model); ``previous``: the result
+    at a neighbouring solution of the same model and basis (the previous point of a sweep),
+    whose candidates are continued where that gives the dense eigensolve's
+    (:func:`track_eigen`, ``options.track``)."""
     opt = HillOptions() if options is None else options
     t0 = time.perf_counter()
     hp = HillProblem(prob, U, dyn)
     det_sign = int(np.sign(np.linalg.slogdet(np.real(hp.matrix(0.0)))[0]))
     m, H, k = prob.m, prob.H, len(prob.basis.harmonics)
     q = dyn.q
-    vals, vecs = quadratic_eigen(*hp.pencil())
-    finite = np.flatnonzero(np.isfinite(vals) & (np.abs(vals) < 2.0 * (k + 1) + 10.0))
-    kap = np.atleast_1d(centroid(vecs[:, finite].T.reshape(-1, m + q, H), k))
-    keep = np.abs(kap) <= 0.5 + 1e-9
-    keep |= _edge_members(vals[finite], kap, keep)
-    idx, kap = finite[keep], kap[keep]
-    half = vals[idx].imag >= -1e-12 * np.maximum(np.abs(vals[idx]), 1.0)
-    idx, kap = idx[half], kap[half]
+    prev = previous.track if (previous is not None and opt.track) else None
+    red = reduce_quadratic(*hp.pencil(), hint=prev)
+    cut = 2.0 * (k + 1) + 10.0
+    got = track_eigen(red, prev, (m + q, H, k))
+    if got is not None:
+        vals, vecs, kap = got
+        idx = np.arange(vals.size)
+        edge = np.zeros(vals.size, dtype=bool)
+    else:
+        vals, vecs = dense_eigen(red)
+        finite = np.flatnonzero(np.isfinite(vals) & (np.abs(vals) < cut))
+        kap = np.atleast_1d(centroid(vecs[:, finite].T.reshape(-1, m + q, H), k))
+        keep = np.abs(kap) <= 0.5 + 1e-9
+        edge = _edge_members(vals[finite], kap, keep)
+        keep |= edge
+        idx, kap, edge = finite[keep], kap[keep], edge[keep]
+        half = vals[idx].imag >= -1e-12 * np.maximum(np.abs(vals[idx]), 1.0)
+        idx, kap, edge = idx[half], kap[half], edge[half]
     order = np.argsort(-vals[idx].real, kind="stable")
-    idx, kap = idx[order], kap[order]
+    idx, kap, edge = idx[order], kap[order], edge[order]
+    track = _track_record(red, vals[idx], vecs[:, idx], kap, edge, H, cut)
     exact = hp.memoryless() and dyn.exact
     sig, kaps, res, kind, spurious = [], [], [], [], []
     refined = 0
@@ -793,20 +1040,24 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
                          kind=allkind[chosen], neutral=hp.neutral(), omega=w,
                          spurious=np.array(spurious, dtype=complex) * w,
                          evaluations=hp.evaluations, wall_time=time.perf_counter() - t0,
-                         stable_tol=opt.stable_tol, det_sign=det_sign)
+                         stable_tol=opt.stable_tol, det_sign=det_sign,
+                         tracked=got is not None, track=track)
 
 
 def stability(model: Model, sol: PeriodicSolution, *, options: HillOptions | None = None,
-              dyn: StructureDynamics | None = None, condenser=None) -> FloquetResult:
+              dyn: StructureDynamics | None = None, condenser=None,
+              previous: FloquetResult | None = None) -> FloquetResult:
     """:func:`hill_stability` of a converged :class:`~fretwear.hb.solution.PeriodicSolution`
     of ``model`` (its problem rebuilt from the solution: frequency, basis, gap, eps,
     anchors); ``dyn``: the model's :func:`fretwear.hb.dynamics.structure_dynamics` if already
-    made (a sweep makes it once); ``condenser``: the model's condenser, as the solve had it."""
+    made (a sweep makes it once); ``condenser``: the model's condenser, as the solve had it;
+    ``previous``: the result at a neighbouring solution (:func:`hill_stability`)."""
     if not sol.success:
         raise InputError(f"stability of a solution that did not converge ({sol.message})")
     prob = problem_of(model, sol, condenser=condenser)
     dyn = structure_dynamics(model, condenser) if dyn is None else dyn
-    return hill_stability(prob, sol.U.reshape(prob.m, prob.H), dyn, options=options)
+    return hill_stability(prob, sol.U.reshape(prob.m, prob.H), dyn, options=options,
+                          previous=previous)
 
 
 def problem_of(model: Model, sol: PeriodicSolution, *, condenser=None) -> DLFTProblem:

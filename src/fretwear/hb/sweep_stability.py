@@ -127,7 +127,7 @@ def sweep_stability(model: Model, result: SweepResult, *, options: HillOptions |
         try:
             prob = problem_of(model, p.solution, condenser=condenser)
             fl = hill_stability(prob, p.solution.U.reshape(prob.m, prob.H), dyn,
-                                options=options)
+                                options=options, previous=floquet[i - 1] if i else None)
             det[i] = fl.det_sign
         except InputError as exc:
             notes.append(f"{p.frequency_hz:.6g} Hz: stability not computed: {exc}")
