@@ -140,7 +140,15 @@ def _normal(normal, lam_u):
     nc, _, N = lam_u.shape
     if normal is None:
         return np.full((nc, N), np.nan)
-    return np.ascontiguousarray(np.broadcast_to(np.asarray(normal, float), (nc, N)))
+    return np.array(np.broadcast_to(np.asarray(normal, float), (nc, N)), order="C")
+
+
+def kernel_array(a) -> np.ndarray:
+    """``a`` as the compiled kernels take every array: float64, C-ordered and writable (a
+    copy only where it is not). Numba compiles a kernel once per layout and writability of
+    its arguments: read-only, Fortran-ordered or broadcast views would each cost another
+    compilation (seconds) of the same kernel."""
+    return np.require(a, np.float64, ["C", "W"])
 
 
 @njit(cache=True)
@@ -342,8 +350,9 @@ def dlft_jacobian(lam_u, lam_x, state, mu, P, Q, x_start=None, tol=1e-12, max_sw
     nc, d, _ = lam_u.shape
     if x_start is None:
         x_start = np.zeros((nc, d - 1))
-    return _dlft_jacobian(lam_u, lam_x, state, mu, P, Q, np.ascontiguousarray(x_start, float),
-                          float(tol), int(max_sweeps), _normal(normal, lam_u))
+    return _dlft_jacobian(lam_u, lam_x, state, mu, kernel_array(P), kernel_array(Q),
+                          kernel_array(x_start), float(tol), int(max_sweeps),
+                          _normal(normal, lam_u))
 
 
 @njit(cache=True)

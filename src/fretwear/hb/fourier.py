@@ -155,7 +155,7 @@ class FourierBasis:
     def forward_matrix(self) -> np.ndarray:
         """``P`` (1+2k, N) with ``coeffs = P @ samples`` (so that ``P @ Q = I``)."""
         q = self.inverse_matrix()
-        p = q.T * (2.0 / self.n_samples)
+        p = np.ascontiguousarray(q.T) * (2.0 / self.n_samples)  # C-ordered, as kernels take it
         p[0] *= 0.5
         return p
 

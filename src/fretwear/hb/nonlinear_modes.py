@@ -272,7 +272,7 @@ class ModeProblem:
         self.anchor = np.asarray(anchor, dtype=float).reshape(nc, d - 1)
         self.W = np.zeros((self.m, self.H))
         self.W[0::d, 0] = gap
-        self.P, self.Q = basis.matrices()
+        self.P, self.Q = (law.kernel_array(a) for a in basis.matrices())
         F = np.zeros((self.n, self.H))
         F[:, 0] = system.loads()
         self.F = F

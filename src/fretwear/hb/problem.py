@@ -90,7 +90,9 @@ class DLFTProblem:
         self.normal = contact.normal_force_samples(basis.tau)  # None: all unilateral
         self.set_gap(contact.gap if gap is None else gap)
         self.anchor = np.zeros((nc, d - 1)) if anchor is None else np.array(anchor, float)
-        self.P, self.Q = basis.matrices()
+        # the basis's shared read-only matrices, copied as the kernels take them
+        # (law.kernel_array: one compilation of each kernel)
+        self.P, self.Q = (law.kernel_array(a) for a in basis.matrices())
         # small problems: residual and Jacobian in one compiled call (hb/small.py)
         self.small = self.jacobian == "dense" and self.m * self.H <= small.SMALL_MAX
         self._normal = law._normal(self.normal, np.empty((nc, d, basis.n_samples)))
