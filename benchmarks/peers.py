@@ -10,7 +10,7 @@ then, from the repository root (with fretwear importable, e.g. ``PYTHONPATH=src`
         [--problems a b] [--default-only] [--recorded-references]
 
 (``--problems``: which problems; ``--default-only``: on (b) only fretwear's default rule and
-pyHarm, without the rows of "stiff" and eps = 1000 N/m; ``--recorded-references``: the
+pyHarm, without the rows of "top" and eps = 1000 N/m; ``--recorded-references``: the
 references of :data:`RECORDED`, as this script computes them, instead of computing them
 again: for a loaded machine.)
 
@@ -30,13 +30,13 @@ References: event-driven integration with exact stick/slip switching plus Newton
 Each code runs in a fresh process of its own interpreter (``cold``: first run in that process,
 imports and just-in-time compilation included) and runs the same analysis again in that
 process (``warm``). fretwear: 121 (a) / 137 (b) linearly spaced frequencies (``fretwear.sweep``,
-default eps rule, "top"; on (b) also with the rule "stiff", ten times "top", row
-``fretwear^``, and with pyHarm's eps = 1000, row ``fretwear*``); pyHarm: its
-arclength continuation over the same band (step ``ds = 0.05``:
-its default continuation did not end on (b)), stopped after ``PYHARM_MAX_SOLUTIONS`` solutions
-if it has not left the band by then. The peak of each curve is the largest A1 of its
-points refined by a parabola through the three points around it, then refined by the same
-code on grids 10, 100, 1000 and 10000 times finer around it
+default eps rule, "contact": the spring on (a), "stiff" (ten times "top") on (b); on (b)
+also with the rule "top", the default before "contact", row ``fretwear^``, and with
+pyHarm's eps = 1000, row ``fretwear*``); pyHarm: its arclength continuation over the same
+band (step ``ds = 0.05``: its default continuation did not end on (b)), stopped after
+``PYHARM_MAX_SOLUTIONS`` solutions if it has not left the band by then. The peak of each
+curve is the largest A1 of its points refined by a parabola through the three points around
+it, then refined by the same code on grids 10, 100, 1000 and 10000 times finer around it
 (:func:`refined_peak`, untimed; the same estimator for both codes).
 
 Prints per code, problem and H: points, converged, warm and cold wall time [s], CPU time of the
@@ -308,7 +308,7 @@ def main(argv=None):
     ap.add_argument("--problems", nargs="+", choices=sorted(BAND), default=sorted(BAND),
                     help="problems to run (default: both)")
     ap.add_argument("--default-only", action="store_true",
-                    help='on (b), leave out the rows of "stiff" and of eps = 1000 N/m')
+                    help='on (b), leave out the rows of "top" and of eps = 1000 N/m')
     ap.add_argument("--recorded-references", action="store_true",
                     help="take the references from RECORDED instead of computing them")
     args = ap.parse_args(argv)
@@ -339,10 +339,10 @@ def main(argv=None):
         for H in args.harmonics:
             rows = {"fretwear": child(sys.executable, FRETWEAR_CHILD,
                                       [prob, H, N_POINTS[prob], *BAND[prob], "default"], env)}
-            if prob == "b" and not args.default_only:  # the rule "stiff" (ten times the
-                # default "top"), and the penalty that pyHarm is given, for a like-for-like
-                # accuracy
-                for code, eps in (("fretwear^", "stiff"), ("fretwear*", 1000.0)):
+            if prob == "b" and not args.default_only:  # the rule "top" (the default before
+                # "contact", which takes ten times it on (b)), and the penalty that pyHarm is
+                # given, for a like-for-like accuracy
+                for code, eps in (("fretwear^", "top"), ("fretwear*", 1000.0)):
                     rows[code] = child(sys.executable, FRETWEAR_CHILD,
                                        [prob, H, N_POINTS[prob], *BAND[prob], eps], env)
             errors = {}

@@ -123,7 +123,8 @@ def solve_periodic(model, basis, frequency: float | None = None, *, quasi_static
     **kwargs : the other keywords of :func:`fretwear.hb.periodic.solve_periodic`, with its
         defaults: ``reduced`` (a :class:`~fretwear.hb.reduce.Reduced` to reuse), ``gap``
         (nc,) [m], ``eps`` (DLFT penalty [N/m] or ``"auto"``/``"top"``/``"stiff"``/
-        ``"static"``), ``anchor`` (nc, d-1) stick anchors [m], ``U0`` (start), ``options``
+        ``"contact"``/``"static"``), ``anchor`` (nc, d-1) stick anchors [m], ``U0`` (start),
+        ``options``
         (:class:`~fretwear.hb.options.SolveOptions`: ``solver``, ``tol``, ``max_iter``,
         ``strategy``, ``jacobian``, ``time_domain_periods``), ``raise_on_failure``,
         ``condenser``.
@@ -156,7 +157,8 @@ def sweep(model, basis, f_min: float, f_max: float, n_points: int, *, time_domai
     **kwargs : the other keywords of :func:`fretwear.hb.sweep.sweep`, with its defaults:
         ``options`` (:class:`~fretwear.hb.options.SweepOptions`: ``solve`` (a
         :class:`~fretwear.hb.options.SolveOptions`), ``spacing`` (``"log"``/``"linear"``),
-        ``eps`` [N/m or ``"stiff"``/``"top"``/``"static"``/``"auto"``], ``eps_band`` [Hz],
+        ``eps`` [N/m or ``"contact"``/``"stiff"``/``"top"``/``"static"``/``"auto"``],
+        ``eps_band`` [Hz],
         ``continuation``, ``max_bisections``, ``flag``, ``progress``, ``checkpoint``,
         ``resume``; or a SolveOptions alone), ``gap`` (nc,) [m], ``anchor`` (nc, d-1) [m],
         ``condenser``. ``time_domain`` here replaces ``options.time_domain``.

@@ -9,13 +9,15 @@ matrix of the basis ``[cos, sin]`` per kept harmonic (``[[Re Z, Im Z], [-Im Z, R
 static term ``Re Z_0``), whose eigenvalues are those of ``Z_r`` and their conjugates.
 """
 
+import dataclasses
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
 
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.options import SolveOptions, SweepOptions
-from fretwear.hb.penalty import STIFF_FACTOR, penalty
+from fretwear.hb.penalty import STIFF_FACTOR, penalty, rigid_slider, sweep_penalty
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.reduce import condense
@@ -142,10 +144,11 @@ def test_the_solvers_take_the_same_words():
 
 
 def test_sweep_static_and_top_are_one_penalty_and_auto_one_per_frequency():
-    """``"top"`` (the default) in a sweep is one eps for every point: the median over 5
+    """``"top"`` in a sweep is one eps for every point: the median over 5
     frequencies of the band of the spectral radius of Z_r at the highest kept harmonic,
     compared with ``reference_radius`` (dense matrices, module docstring) to rounding;
-    ``"stiff"`` is ten times that (``STIFF_FACTOR``)."""
+    ``"stiff"`` is ten times that (``STIFF_FACTOR``); the default ``"contact"`` is ``"top"``
+    on this unilateral interface."""
     model = tiny_model()
     basis = FourierBasis((1,), 16)
     # between the resonances of the interior node with the contact held (675 and 1031 Hz),
@@ -189,6 +192,43 @@ def test_top_is_the_spectral_radius_at_the_highest_kept_harmonic():
             ref, rel=1e-12)
         assert penalty("stiff", model=model, frequency=f, orders=ORDERS) == pytest.approx(
             10.0 * ref, rel=1e-12)
+
+
+def _with_contact(model: Model, **changes) -> Model:
+    """``model`` with its contact interface changed (``normal_load``, ``kt``)."""
+    return dataclasses.replace(model, contact=dataclasses.replace(model.contact, **changes))
+
+
+def test_contact_is_stiff_on_rigid_sliders_under_a_prescribed_load_and_top_elsewhere():
+    """The default rule ``"contact"``: ten times ``"top"`` (checked against the dense
+    reference above) when every node rubs rigidly under a prescribed normal load, ``"top"``
+    when a node is unilateral, the contact spring where every law row has the same one
+    (exact, :func:`fretwear.hb.penalty.spring_penalty`). Exact equalities: the rule picks one
+    of the other rules, so the values are the same floating-point numbers."""
+    model, orders = tiny_model(), [0, 1]
+    both = _with_contact(model, normal_load=Load(np.array([20.0, 30.0]), "constant"))
+    one = _with_contact(model, normal_load=Load(np.array([20.0, np.nan]), "constant"))
+    spring = _with_contact(both, kt=np.full(2, 4e6))
+    assert rigid_slider(both.contact)
+    assert not rigid_slider(model.contact) and not rigid_slider(one.contact)
+    assert not rigid_slider(spring.contact) and not rigid_slider(None)
+    f = 800.0
+    # with both normal loads prescribed the law rows are the two tangential ones (DOFs 0 and
+    # 2 of the structure: Z_r's rows 1 and 3 in the contact frames): their reference radius
+    K, M = both.K.toarray(), both.M.toarray()
+    w, c, i = 2 * np.pi * f, np.array([0, 2]), np.array([1, 3, 4, 5])
+    Z = K * (1 + 1j * ETA) - w**2 * M
+    Zr = Z[np.ix_(c, c)] - Z[np.ix_(c, i)] @ np.linalg.solve(Z[np.ix_(i, i)], Z[np.ix_(i, c)])
+    ref_top = float(np.max(np.abs(np.linalg.eigvals(Zr))))
+    for m, factor in ((both, STIFF_FACTOR), (one, 1.0), (model, 1.0)):
+        top = penalty("top", model=m, frequency=f, orders=orders)
+        assert penalty("contact", model=m, frequency=f, orders=orders) == factor * top
+        assert sweep_penalty("contact", m, orders, 700.0, 900.0) == factor * sweep_penalty(
+            "top", m, orders, 700.0, 900.0)
+    assert penalty("top", model=both, frequency=f, orders=orders) == pytest.approx(
+        ref_top, rel=1e-12)
+    assert penalty("contact", model=spring, frequency=f, orders=orders) == 4e6
+    assert SweepOptions().eps == "contact"
 
 
 def test_radius_estimate_of_large_blocks():

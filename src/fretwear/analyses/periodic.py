@@ -546,6 +546,8 @@ def _frequency_needed(out: dict, path: str) -> None:
 
 _EPS_RULES = ('"auto": the spectral radius of Z_r over the kept harmonics (the paper); '
               '"top": that of Z_r at the highest kept harmonic; "stiff": ten times "top"; '
+              '"contact": "stiff" on rigid sliders under a prescribed normal load, "top" '
+              'elsewhere; '
               '"static": that of the static '
               "reduced stiffness K_r; or a value")
 

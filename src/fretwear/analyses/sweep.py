@@ -473,8 +473,9 @@ SWEEP = Analysis.define(
                                   "excitation level; a study varying it gives the family of "
                                   "FRFs over the level (docs/study.md)", default=1.0),
         "eps_band": Field(ListOf(Number(lo=0, lo_open=True), sizes=(2,)),
-                          'the band [f_min, f_max] over which eps = "stiff" or "top" takes its '
-                          "median (default: the sweep's band; the chunks of a split sweep give "
+                          'the band [f_min, f_max] over which eps = "contact", "stiff" or '
+                          '"top" takes its median '
+                          "(default: the sweep's band; the chunks of a split sweep give "
                           "the whole band, so that they share the whole sweep's eps)", unit="Hz"),
         "linear_references": Field(
             ListOf(Text(linear.INTERFACES), unique=True),
@@ -487,9 +488,11 @@ SWEEP = Analysis.define(
                                default=default_of(linear_reference_grid, "linear_points")),
         **harmonic_balance_fields(
             SWEEP_OPTIONS.solve, SWEEP_OPTIONS.eps,
-            'DLFT penalty, one value for the whole sweep (a smooth FRF): "top": the spectral '
-            "radius of Z_r at the highest kept harmonic, its median over the band (chosen from "
-            'measurements, docs/studies/eps-rule.md); "stiff": ten times "top"; '
+            'DLFT penalty, one value for the whole sweep (a smooth FRF): "contact": "stiff" '
+            'where every contact node is a rigid slider under a prescribed normal load, "top" '
+            'elsewhere (chosen from measurements, docs/studies/eps-rule.md); "top": the '
+            "spectral radius of Z_r at the highest kept harmonic, its median over the band; "
+            '"stiff": ten times "top"; '
             '"static": that of the static reduced stiffness K_r; or a value. "auto": the '
             "paper's rule (spectral radius of Z_r over the kept harmonics) at each frequency"),
     },

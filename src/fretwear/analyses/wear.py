@@ -113,7 +113,7 @@ def options_from_table(a: dict) -> WearOptions:
 def penalty_of(a: dict) -> dict:
     """The keyword ``eps`` of the wear run and of its FRFs when the table gives it, else none:
     each function then takes its own default (:func:`~fretwear.wear.simulate.simulate_wear`:
-    ``"auto"``, the paper's rule; :func:`~fretwear.hb.sweep.sweep`: ``"top"``)."""
+    ``"auto"``, the paper's rule; :func:`~fretwear.hb.sweep.sweep`: ``"contact"``)."""
     return {"eps": a["eps"]} if "eps" in a else {}
 
 
@@ -646,9 +646,11 @@ SCHEMA = {
                        default=default_of(FourierBasis.up_to, "n_samples")),
     **condensation_fields(),
     "eps": Field(AnyOf((Text(RULES), _POS)), 'DLFT penalty: "auto" (the spectral radius of '
-                 'Z_r over the kept harmonics, the paper), "top" (that of Z_r at the highest kept '
-                 'harmonic), "stiff" (ten times "top"), "static" (that of the static K_r) or a '
-                 'value; default: "auto" for the wear run (simulate_wear), "top" for the FRFs '
+                 'Z_r over the kept harmonics, the paper), "top" (that of Z_r at the highest '
+                 'kept harmonic), "stiff" (ten times "top"), "contact" ("stiff" on rigid sliders '
+                 'under a prescribed normal load, "top" elsewhere), "static" (that of the static '
+                 'K_r) or a value; default: "auto" for the wear run (simulate_wear), "contact" '
+                 'for the FRFs '
                  'of frf_before_after (as sweeps)', unit="N/m"),
     # wear options: option() takes the default of WearOptions
     "solver": option("solver", Text(SOLVERS), "nonlinear solver of the first periodic solve "

@@ -150,10 +150,12 @@ class SweepOptions:
         the neighbours, 40 iterations before the sweep's own ladder takes over).
     spacing : ``"log"`` or ``"linear"`` grid.
     eps : DLFT penalty, one value for every point (:func:`fretwear.hb.penalty.sweep_penalty`):
-        ``"top"`` (default: the spectral radius of ``Z_r`` at the highest kept harmonic, its
-        median over the band), ``"stiff"`` (ten times ``"top"``), ``"static"``, ``"auto"`` (the
-        paper's rule at each frequency) or a positive number [N/m].
-    eps_band : ``(f_min, f_max)`` [Hz] over which ``"stiff"`` and ``"top"`` take their median
+        ``"contact"`` (default: ``"stiff"`` on rigid sliders under a prescribed normal load,
+        ``"top"`` elsewhere), ``"top"`` (the spectral radius of ``Z_r`` at the highest kept
+        harmonic, its median over the band), ``"stiff"`` (ten times ``"top"``), ``"static"``,
+        ``"auto"`` (the paper's rule at each frequency) or a positive number [N/m].
+    eps_band : ``(f_min, f_max)`` [Hz] over which ``"contact"``, ``"stiff"`` and ``"top"``
+        take their median
         (default: the
         sweep's band; the chunks of a split sweep give the whole band).
     continuation : pseudo-arclength continuation when a grid step fails.
@@ -171,7 +173,7 @@ class SweepOptions:
 
     solve: SolveOptions = SWEEP_POINT
     spacing: str = "log"
-    eps: str | float = "top"
+    eps: str | float = "contact"
     eps_band: tuple | None = None
     continuation: bool = True
     max_bisections: int = 4

@@ -86,7 +86,9 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
         :class:`~fretwear.hb.options.SolveOptions` stands for ``SweepOptions(solve=...)``.
 
         The penalty is one value for every point (:func:`fretwear.hb.penalty.sweep_penalty`).
-        ``"top"`` (default) and ``"stiff"`` (ten times ``"top"``): the spectral radius of
+        ``"contact"`` (default): ``"stiff"`` where every contact node is a rigid slider under
+        a prescribed normal load (:func:`fretwear.hb.penalty.rigid_slider`), ``"top"``
+        elsewhere. ``"top"`` and ``"stiff"`` (ten times ``"top"``): the spectral radius of
         ``Z_r`` at the
         highest kept harmonic, its median over the band (``eps_band``, default the sweep's
         own: the chunks of a sweep split across workers, :mod:`fretwear.study`, give the whole

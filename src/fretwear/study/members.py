@@ -184,8 +184,8 @@ def _ensemble(study: Study, base: dict) -> list[dict]:
 def _chunks(study: Study, base: dict) -> list[dict]:
     """The sweep band cut into chunks of the base's frequency grid; neighbours share their
     end frequency (the join, checked after the run). Every chunk takes its eps from the whole
-    band (``eps_band``): the "top" rule's median over a chunk's own band would differ from
-    chunk to chunk, and the joins with it."""
+    band (``eps_band``): the "contact" or "top" rule's median over a chunk's own band would
+    differ from chunk to chunk, and the joins with it."""
     a = validate(base, analysis_tables(), study.base.parent)["analysis"]
     if a["type"] != "sweep":
         raise InputError(f"[split] needs a sweep as base case; {study.base.name} has "
