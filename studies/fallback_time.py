@@ -94,7 +94,7 @@ def install() -> None:
     import pkgutil
 
     for m in pkgutil.walk_packages(fretwear.__path__, "fretwear."):
-        if any(s in m.name for s in (".paper", ".study", "examples")):
+        if any(s in m.name for s in (".paper", ".study", "examples", "__main__")):
             continue
         with contextlib.suppress(Exception):
             importlib.import_module(m.name)
@@ -151,7 +151,7 @@ def measure(label: str, run, clock: Clock, out: Path) -> dict:
             status = "ok"
         except SystemExit as e:
             results, status = None, f"exit {e.code}"
-        except Exception as e:  # noqa: BLE001: a failed run is a row of the table too
+        except Exception as e:  # noqa: BLE001 (a failed run is a row of the table too)
             results, status = None, f"{type(e).__name__}: {e}"
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     text = buf.getvalue()
