@@ -421,8 +421,8 @@ def plot_sweep(ds: xr.Dataset, path: Path, point: str, *, title: str | None = No
                      ds["stable"].values if "stable" in ds else None,
                      label=f"friction, harmonic {h}")
         half = 0.5 * ds["response_peak_to_peak"].sel(point=point, axis=axis).values
-        ax.plot(f, np.where(half > 0, half, np.nan), color="0.5", lw=0.8, linestyle=":",
-                label="friction, half peak-to-peak")
+        ax.plot(f, np.where(half > 0, half, np.nan), color="0.5", lw=2.4, linestyle="-",
+                alpha=0.5, zorder=1.5, label="friction, half peak-to-peak")  # a band below
         _mark_failures(ax, f, conv, flagged, y)
         ax.set_xscale("log")
         ax.set_yscale("log")
