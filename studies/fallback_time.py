@@ -4,6 +4,7 @@
     PYTHONPATH=<tree>/src python studies/fallback_time.py examples OUT [--only a,b]
     PYTHONPATH=<tree>/src python studies/fallback_time.py tutorial OUT
     PYTHONPATH=<tree>/src python studies/fallback_time.py lapjoint OUT [--frequency F]
+    python studies/fallback_time.py table BEFORE_OUT AFTER_OUT   (the markdown table)
 
 Versions before the fallbacks were summarised print nothing about them, so this script
 measures from the outside, with hooks that exist in every version:
@@ -366,13 +367,57 @@ def lapjoint(out: Path, frequency: float | None) -> None:
     measure("lapjoint3d-wear", wear, clock, out)
 
 
+def fallback_seconds(rec: dict) -> float:
+    """The seconds in fallbacks of a record, counted alike for every version: the attempts
+    after the first (``ladder``) plus the time in time integrations, the larger of ``td``
+    and ``wear_td_steps`` (the second holds the first for a wear run: not counted twice)."""
+    return rec["ladder"] + max(rec["td"], rec["wear_td_steps"] or 0.0)
+
+
+def table(before: Path, after: Path) -> str:
+    """The markdown table of two measurement folders (every ``fallbacks.jsonl`` below each):
+    one row per case, before and after."""
+    def read(root):
+        rows = {}
+        for f in sorted(root.rglob("fallbacks.jsonl")):
+            for line in f.read_text().splitlines():
+                r = json.loads(line)
+                rows[r["case"]] = r
+        return rows
+
+    b, a = read(before), read(after)
+    out = ["| case | before: fallback s / wall s (share) | CPU s | after: fallback s / wall s "
+           "(share) | CPU s | after: the run's own summary |",
+           "|---|---|---|---|---|---|"]
+
+    def cell(r):
+        if r is None:
+            return "not run", ""
+        if r["status"] != "ok":
+            return f"{r['status'][:40]}", f"{r['cpu']:.1f}"
+        fb = fallback_seconds(r)
+        return (f"{fb:.1f} / {r['wall']:.1f} ({100 * fb / max(r['wall'], 1e-9):.0f} %)",
+                f"{r['cpu']:.1f}")
+
+    for case in sorted(set(b) | set(a)):
+        rb, ra = b.get(case), a.get(case)
+        own = "; ".join(ra["summary"]) if ra and ra["summary"] else ""
+        own = own.replace("|", "/")[:160] or ("none printed" if ra else "")
+        out.append(f"| {case} | {' | '.join(cell(rb))} | {' | '.join(cell(ra))} | {own} |")
+    return "\n".join(out)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("what", choices=("examples", "tutorial", "lapjoint"))
+    ap.add_argument("what", choices=("examples", "tutorial", "lapjoint", "table"))
     ap.add_argument("out", type=Path)
+    ap.add_argument("after", type=Path, nargs="?")
     ap.add_argument("--only", default="")
     ap.add_argument("--frequency", type=float, default=None)
     a = ap.parse_args(argv)
+    if a.what == "table":
+        print(table(a.out, a.after))
+        return 0
     a.out.mkdir(parents=True, exist_ok=True)
     print("fretwear from", fretwear.__file__, flush=True)
     if a.what == "examples":
