@@ -27,6 +27,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import dataclasses
+import functools
 import io
 import json
 import os
@@ -84,6 +85,7 @@ class Clock:
 
 
 def _timed(fn):
+    @functools.wraps(fn)
     def wrapper(*args, **kwargs):
         t0 = time.perf_counter()
         try:
@@ -124,11 +126,13 @@ def install() -> None:
                                  averaged_rate=_timed(fb.averaged_rate))
     sp, sw = periodic.solve_periodic, sweep.sweep
 
+    @functools.wraps(sp)
     def solve_periodic(*args, **kwargs):
         sol = sp(*args, **kwargs)
         CLOCK[0].points([sol])
         return sol
 
+    @functools.wraps(sw)
     def sweep_(*args, **kwargs):
         res = sw(*args, **kwargs)
         CLOCK[0].points(res.points)
