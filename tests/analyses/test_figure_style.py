@@ -122,7 +122,7 @@ def test_series_styles_tell_every_curve_apart():
     for n in (1, 2, 5, 10):
         styles = [series_style(i, n) for i in range(n)]
         assert len({(s["linestyle"], s["marker"]) for s in styles}) == n
-        for a, b in zip(styles, styles[1:]):
+        for a, b in zip(styles[:-1], styles[1:], strict=True):
             assert a["linewidth"] > b["linewidth"] and a["markersize"] > b["markersize"]
             assert a["zorder"] < b["zorder"]
     assert "marker" not in series_style(0, 3, markers=False)
