@@ -231,6 +231,45 @@ def test_sweep_progress_bar_and_callable(block, capsys):
                  options=SweepOptions(progress=lambda *a: None))
 
 
+@pytest.mark.parametrize("facade,core,own", [
+    ("sweep", "fretwear.hb.sweep.sweep", {"time_domain", "progress"}),
+    ("simulate_wear", "fretwear.wear.simulate.simulate_wear", {"progress", "condenser"}),
+])
+def test_first_drivers_have_real_signatures(facade, core, own):
+    """fw.sweep and fw.simulate_wear show every option (they took **kwargs, so help() and an
+    IDE showed nothing): no catch-all, the same keywords as the core function they call (the
+    independent reference: its own signature) plus the facade's own, each named in the
+    docstring."""
+    import importlib
+    import inspect
+
+    func = getattr(fw, facade)
+    params = inspect.signature(func).parameters
+    assert not any(p.kind in (p.VAR_KEYWORD, p.VAR_POSITIONAL) for p in params.values())
+    mod, name = core.rsplit(".", 1)
+    core_params = set(inspect.signature(getattr(importlib.import_module(mod), name)).parameters)
+    assert set(params) == core_params | own
+    doc = inspect.getdoc(func)
+    for p in set(params) - {"model", "basis"}:
+        assert f"{p} :" in doc or f"{p}," in doc, f"fw.{facade}: {p} not documented"
+
+
+def test_wear_progress_bar(block, capsys):
+    """fw.simulate_wear(..., progress=True) draws the run's bar as fw.sweep does (it was a
+    TypeError from the core function); the bar only reports, so the history is the same bit
+    for bit; progress given twice, or not a bool, is one InputError."""
+    opts = fw.WearOptions(max_steps=2)
+    a = fw.simulate_wear(block, BASIS, quasi_static=True, options=opts, progress=True)
+    b = fw.simulate_wear(block, BASIS, quasi_static=True, options=opts)
+    assert capsys.readouterr().err
+    np.testing.assert_array_equal(a.history.wear_depth, b.history.wear_depth)
+    with pytest.raises(InputError, match="progress given twice"):
+        fw.simulate_wear(block, BASIS, quasi_static=True, options=opts, progress=True,
+                         run=fw.RunControl(progress=True))
+    with pytest.raises(InputError, match="progress = 'yes': expected True or False"):
+        fw.simulate_wear(block, BASIS, quasi_static=True, options=opts, progress="yes")
+
+
 def test_sweep_amplitude_names_its_axes_and_points(block):
     """res.amplitude takes "x"/"y" as count_resonances does (it raised a raw IndexError):
     the named axis is the same component as its index, bit for bit; an unknown axis, point or

@@ -16,7 +16,10 @@ do without: it then only scales time). The older spellings (``stick_anchor``, ``
 in case files, whose key ``time_domain`` is this argument (the analyses of
 :mod:`fretwear.analyses` call these drivers). Every other keyword is passed to the function
 named in the docstring unchanged, with its default: each option has one default, that of the
-function that uses it. ``condenser=`` is among them: the condenser of the model
+function that uses it. :func:`sweep` and :func:`simulate_wear`, the drivers a user calls
+first, have real signatures instead (every keyword of the core function, each documented, so
+that ``help()`` and an IDE show them; docs/architecture.md records why they take more than
+nine parameters). ``condenser=`` is among the keywords: the condenser of the model
 (:func:`fretwear.hb.reduce.exact_condenser` or :func:`fretwear.hb.modal.modal_condenser`),
 built once by the caller and passed to every driver that condenses the same model.
 """
@@ -25,6 +28,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import functools
 import math
 
 from fretwear import linear as _linear
@@ -35,7 +39,7 @@ from fretwear.hb import nonlinear_modes as _modes
 from fretwear.hb import periodic as _periodic
 from fretwear.hb import sweep as _sweep
 from fretwear.hb.dynamics import structure_dynamics
-from fretwear.hb.options import sweep_options
+from fretwear.hb.options import SolveOptions, SweepOptions, sweep_options
 from fretwear.threads import limited
 from fretwear.timedomain import integrate as _integrate
 from fretwear.timedomain import quasistatic as _quasistatic
@@ -140,9 +144,27 @@ def solve_periodic(model, basis, frequency: float | None = None, *, quasi_static
                                     time_domain=_fallback(time_domain), **kwargs)
 
 
+def _other_spellings(name: str):
+    """Decorator of a driver with a real signature: a keyword spelt as another entry point
+    spells it is a TypeError that names the public one (before Python's own "unexpected
+    keyword"); the signature shown by ``help()`` and IDEs is the driver's own."""
+
+    def decorate(func):
+        @functools.wraps(func)
+        def wrapper(*args, **kwargs):
+            _public_names(name, kwargs)
+            return func(*args, **kwargs)
+
+        return wrapper
+
+    return decorate
+
+
 @limited
-def sweep(model, basis, f_min: float, f_max: float, n_points: int, *, time_domain: bool = True,
-          progress=False, **kwargs) -> _sweep.SweepResult:
+@_other_spellings("sweep")
+def sweep(model, basis, f_min: float, f_max: float, n_points: int, *,
+          options: SweepOptions | SolveOptions | None = None, gap=None, anchor=None,
+          condenser=None, time_domain: bool = True, progress=False) -> _sweep.SweepResult:
     """Nonlinear FRF: periodic solutions of the DLFT from ``f_min`` to ``f_max`` [Hz] on
     ``n_points`` grid frequencies, each starting from its neighbours (continuation).
 
@@ -150,18 +172,32 @@ def sweep(model, basis, f_min: float, f_max: float, n_points: int, *, time_domai
     ----------
     model, basis : the structure and the Fourier basis.
     f_min, f_max, n_points : the frequency band [Hz] and its number of grid frequencies.
+    options : :class:`~fretwear.hb.options.SweepOptions` (default
+        :data:`~fretwear.hb.options.SWEEP`; a :class:`~fretwear.hb.options.SolveOptions`
+        alone stands for ``SweepOptions(solve=...)``), the case-file keys of a sweep:
+
+        - ``solve``: the solve of one point (:class:`~fretwear.hb.options.SolveOptions`:
+          ``solver``, ``tol``, ``max_iter`` (40 by default), ``strategy``, ``jacobian``,
+          ``time_domain_periods``);
+        - ``spacing``: ``"log"`` (default) or ``"linear"`` grid;
+        - ``eps``: the DLFT penalty [N/m], or ``"contact"`` (default), ``"top"``,
+          ``"stiff"``, ``"static"``, ``"auto"`` (:func:`fretwear.hb.sweep.sweep` explains
+          each);
+          ``eps_band``: the band [Hz] over which ``"top"``/``"stiff"`` are taken;
+        - ``continuation`` (True): continue along the branch where it turns;
+          ``max_bisections`` (4): halvings of a step before the next rung;
+        - ``flag``: a check of each converged point (e.g. a stability check);
+        - ``checkpoint`` (a ``.npz`` path) and ``resume``: save after every grid frequency
+          and continue a stopped sweep to the same points, bit for bit;
+        - ``progress``: a callable ``(i, n, point)`` (or give ``progress=`` here).
+    gap : (nc,) initial normal gaps [m] (default the model's).
+    anchor : (nc, d-1) stick anchors [m] (default: the static preload state).
+    condenser : the condenser of the model (:func:`fretwear.condenser`), built once by the
+        caller and shared by the drivers that condense the same model (default: a new one).
     time_domain : at points whose balance still fails, integrate in time from the neighbour
-        (the case-file key ``time_domain`` of a sweep).
+        (the case-file key ``time_domain`` of a sweep; replaces ``options.time_domain``).
     progress : True draws a progress bar over the grid frequencies (stderr); a callable
         ``(i, n, point)`` is called after each grid frequency instead; False: nothing.
-    **kwargs : the other keywords of :func:`fretwear.hb.sweep.sweep`, with its defaults:
-        ``options`` (:class:`~fretwear.hb.options.SweepOptions`: ``solve`` (a
-        :class:`~fretwear.hb.options.SolveOptions`), ``spacing`` (``"log"``/``"linear"``),
-        ``eps`` [N/m or ``"contact"``/``"stiff"``/``"top"``/``"static"``/``"auto"``],
-        ``eps_band`` [Hz],
-        ``continuation``, ``max_bisections``, ``flag``, ``progress``, ``checkpoint``,
-        ``resume``; or a SolveOptions alone), ``gap`` (nc,) [m], ``anchor`` (nc, d-1) [m],
-        ``condenser``. ``time_domain`` here replaces ``options.time_domain``.
 
     Returns
     -------
@@ -170,18 +206,33 @@ def sweep(model, basis, f_min: float, f_max: float, n_points: int, *, time_domai
     with ``frequency_hz`` [Hz], ``solution`` or None, ``success``, ``message``, ``flags``),
     ``frequency_hz`` [Hz], ``point_success``, ``amplitude(point, axis)`` [m].
     """
-    _public_names("sweep", kwargs)
-    options = sweep_options(kwargs.pop("options", None))
+    options = sweep_options(options)
     with _sweep_progress(progress, options, n_points) as options:
         return _sweep.sweep(model, basis, f_min, f_max, n_points,
                             options=options.replace(time_domain=_fallback(time_domain)),
-                            **kwargs)
+                            gap=gap, anchor=anchor, condenser=condenser)
+
+
+def _wear_run(run, progress):
+    """The :class:`~fretwear.wear.simulate.RunControl` of ``run=`` and ``progress=``."""
+    if progress is None or progress is False:
+        return run
+    if progress is not True:
+        raise InputError(f"progress = {progress!r}: expected True or False (a bar of the "
+                         "run's steps; a callable goes to run=RunControl(callback=...))")
+    run = _wear.RunControl() if run is None else run
+    if run.progress:
+        raise InputError("progress given twice (progress= and run.progress); give one")
+    return dataclasses.replace(run, progress=True)
 
 
 @limited
+@_other_spellings("simulate_wear")
 def simulate_wear(model, basis, frequency: float | None = None, *, quasi_static: bool = False,
-                  wear0=None, time_domain: bool = True, condenser=None,
-                  **kwargs) -> _wear.WearResult:
+                  options: _wear.WearOptions | None = None, wear0=None,
+                  balance: _wear.BalanceSetup | None = None, run: _wear.RunControl | None = None,
+                  time_domain: bool = True, condenser=None,
+                  progress: bool = False) -> _wear.WearResult:
     """Fretting wear on the slow time scale (paper section 3.3, eq. 29-30) at the excitation
     ``frequency`` [Hz] or under quasi-static loading.
 
@@ -191,16 +242,26 @@ def simulate_wear(model, basis, frequency: float | None = None, *, quasi_static:
     frequency : excitation frequency [Hz]; required unless ``quasi_static`` (then it only
         scales time; default 1 Hz).
     quasi_static : drop inertia and damping.
+    options : :class:`~fretwear.wear.options.WearOptions` (the case-file keys of a wear
+        analysis; defaults: adaptive linearly implicit steps, tolerance 1e-2): ``law``
+        (``"archard"`` or ``"energy"``) and ``energy_coefficient``; ``scheme``,
+        ``adaptive``, ``tolerance``, ``initial_jump``, ``max_jump``, ``min_jump`` [cycles];
+        the stops ``max_cycles``, ``max_depth`` [m], ``plateau_rate``, ``max_steps``; the
+        balance of a step ``solve`` (:class:`~fretwear.hb.options.SolveOptions`),
+        ``max_iter_coupled``, ``max_iter_implicit``, ``implicit_newton``, ``max_retries``;
+        the time-domain fallback ``time_domain_rescue`` (True), ``time_domain_settle``,
+        ``time_domain_average`` [periods], ``time_domain_steps``; ``checkpoint_every_s``.
     wear0 : (nc,) initial wear [m] (default 0).
+    balance : :class:`~fretwear.wear.simulate.BalanceSetup`: ``reduced`` (a condensation to
+        reuse), ``eps`` (the DLFT penalty: ``"auto"`` default, ``"static"`` or [N/m]),
+        ``anchor`` (nc, d-1) stick anchors [m], ``U0`` the start of the first solve.
+    run : :class:`~fretwear.wear.simulate.RunControl`: ``checkpoint`` (``.npz``),
+        ``resume``, ``progress``, ``callback(step, record)``.
     time_domain : the time-domain fallback of the steps whose balance fails (whether it is
         used is ``options.time_domain_rescue``, default true, as in case files).
     condenser : the condenser of the model, as every driver takes it (it becomes the
         ``condenser`` of ``balance``; giving both is an error).
-    **kwargs : the other keywords of :func:`fretwear.wear.simulate.simulate_wear`, with its
-        defaults: ``options`` (:class:`~fretwear.wear.options.WearOptions`), ``balance``
-        (:class:`~fretwear.wear.simulate.BalanceSetup`: ``reduced``, ``eps``, ``anchor``
-        (nc, d-1) [m], ``U0``), ``run`` (:class:`~fretwear.wear.simulate.RunControl`:
-        ``checkpoint``, ``resume``, ``progress``, ``callback``).
+    progress : True draws a progress bar of the run's steps (``run.progress``).
 
     Returns
     -------
@@ -210,16 +271,16 @@ def simulate_wear(model, basis, frequency: float | None = None, *, quasi_static:
     ``final_wear`` [m], ``initial`` and ``final`` periodic solutions (None where the rate came
     from a time integration).
     """
-    _public_names("simulate_wear", kwargs)
     if condenser is not None:
-        balance = kwargs.pop("balance", None) or _wear.BalanceSetup()
+        balance = balance or _wear.BalanceSetup()
         if balance.condenser is not None:
             raise InputError("simulate_wear: condenser given twice (condenser= and "
                              "balance.condenser); give one")
-        kwargs["balance"] = dataclasses.replace(balance, condenser=condenser)
+        balance = dataclasses.replace(balance, condenser=condenser)
     return _wear.simulate_wear(model, basis, **_frequency(frequency, quasi_static),
-                               quasi_static=quasi_static, wear0=wear0,
-                               time_domain=_fallback(time_domain), **kwargs)
+                               quasi_static=quasi_static, options=options, wear0=wear0,
+                               balance=balance, run=_wear_run(run, progress),
+                               time_domain=_fallback(time_domain))
 
 
 @limited

@@ -111,3 +111,47 @@ def test_shared_axes_name_the_unit_their_ticks_are_in():
     assert right.get_ylabel() == "|u| [pm]"
     assert right.yaxis.get_minor_formatter()(7.85e-10, 0) == "785"
     assert right.get_xlabel() == "t [s]" and right.xaxis.get_major_formatter()(2.0, 0) == "2.0"
+
+
+def test_series_styles_tell_every_curve_apart():
+    """The curves of a family get distinct (dash, marker) pairs, widths and marker sizes
+    that fall from the first to the last and rising z-order (the earlier curve drawn wider,
+    below): the rule that keeps a curve visible under a later one that coincides with it."""
+    from fretwear.analyses.figure_style import series_style
+
+    for n in (1, 2, 5, 10):
+        styles = [series_style(i, n) for i in range(n)]
+        assert len({(s["linestyle"], s["marker"]) for s in styles}) == n
+        for a, b in zip(styles[:-1], styles[1:], strict=True):
+            assert a["linewidth"] > b["linewidth"] and a["markersize"] > b["markersize"]
+            assert a["zorder"] < b["zorder"]
+    assert "marker" not in series_style(0, 3, markers=False)
+    with pytest.raises(ValueError):
+        series_style(3, 3)
+
+
+def test_coinciding_frfs_before_and_after_wear_both_show(tmp_path):
+    """The FRFs before and after wear drawn by the wear analysis, equal to the last bit (a
+    wear too small to move them): the first one ("unworn") still shows around the second in
+    the written image (its colour covers at least a third as many pixels as the second's).
+    Drawn alike, the second hid the first entirely but for its legend line."""
+    import matplotlib.image as mpimg
+    import numpy as np
+    import xarray as xr
+
+    from fretwear.analyses.wear import plot_frf_before_after
+
+    f = np.linspace(900.0, 1100.0, 41)
+    y = 1e-6 / np.sqrt((1 - (f / 1e3) ** 2) ** 2 + 0.05**2)
+    amp = np.broadcast_to(y[None, :, None, None], (2, f.size, 1, 1))
+    ds = xr.Dataset({"frf_amplitude": (("wear_state", "frequency", "point", "axis"), amp)},
+                    coords={"wear_state": ["unworn", "worn"], "frequency": f,
+                            "point": ["tip"], "axis": ["y"]})
+    img = mpimg.imread(plot_frf_before_after(ds, tmp_path / "frf.png", "tip"))[..., :3]
+
+    def pixels(colour):
+        rgb = np.array([int(colour[i:i + 2], 16) / 255 for i in (1, 3, 5)])
+        return int((np.abs(img - rgb).max(axis=-1) < 0.08).sum())
+
+    first, second = pixels("#1f77b4"), pixels("#ff7f0e")  # C0, C1
+    assert second > 0 and first >= second / 3, (first, second)

@@ -205,3 +205,64 @@ def test_killed_sweep_run_resumes_to_the_same_results_file(tmp_path):
     # equals itself)
     np.testing.assert_equal({k: v for k, v in x.attrs.items() if k not in skip},
                             {k: v for k, v in y.attrs.items() if k not in skip})
+
+
+def _interrupt_after(monkeypatch, n):
+    """Ctrl-C right after the ``n``-th checkpoint of a sweep is written (a deterministic
+    stand-in for the user's key press)."""
+    import fretwear.hb.sweep as hb_sweep
+
+    save, calls = hb_sweep.save_sweep_checkpoint, []
+
+    def save_then_stop(*args, **kwargs):
+        save(*args, **kwargs)
+        calls.append(1)
+        if len(calls) == n:
+            raise KeyboardInterrupt
+    monkeypatch.setattr(hb_sweep, "save_sweep_checkpoint", save_then_stop)
+
+
+def test_interrupted_sweep_writes_partial_results(model, tmp_path, monkeypatch):
+    """A sweep run through fw.run stopped by Ctrl-C after 3 of 8 grid frequencies writes
+    sweep-partial.nc beside its checkpoint, marked complete = 0 and converged = 0: the points
+    computed so far, whose responses are the uninterrupted run's at the same frequencies bit
+    for bit (the independent reference: the same run not interrupted); --resume then writes
+    results.nc and the partial file stays as it was."""
+    import fretwear as fw
+
+    keys = dict(f_min=GRID[0], f_max=GRID[1], n_points=GRID[2], harmonics=3, n_samples=32,
+                figures=False, vtu=False)
+    ref = fw.run(model, "sweep", tmp_path / "ref", **keys).dataset
+    _interrupt_after(monkeypatch, 3)
+    with pytest.raises(KeyboardInterrupt):
+        fw.run(model, "sweep", tmp_path / "out", **keys)
+    assert not (tmp_path / "out" / "results.nc").exists()
+    part = read_results(tmp_path / "out" / "sweep-partial.nc")
+    assert part.attrs["complete"] == 0 and part.attrs["converged"] == 0
+    assert part.attrs["message"].startswith("interrupted after 3 of 8 grid frequencies")
+    f = part["frequency"].values
+    grid = ref["frequency"].values
+    assert f.size >= 3  # 3 grid frequencies and any continuation points between them
+    at = np.isin(grid, f)
+    assert at.sum() == f.size and grid[at].max() < grid.max()
+    np.testing.assert_array_equal(part["response_amplitude"].values,
+                                  ref["response_amplitude"].values[at])
+    np.testing.assert_array_equal(part["converged"].values, ref["converged"].values[at])
+    monkeypatch.undo()
+    again = fw.run(model, "sweep", tmp_path / "out", resume=True, **keys).dataset
+    np.testing.assert_array_equal(again["response_amplitude"].values,
+                                  ref["response_amplitude"].values)
+    assert (tmp_path / "out" / "sweep-partial.nc").exists()
+
+
+def test_cli_names_the_partial_results_of_a_sweep(tmp_path, monkeypatch, capsys):
+    """``fretwear run`` of a sweep stopped by Ctrl-C says it saved sweep-partial.nc beside the
+    checkpoint (exit 130), as a wear run says wear-partial.nc."""
+    from fretwear import cli
+
+    case = small_case(tmp_path, SWEEP)
+    _interrupt_after(monkeypatch, 1)
+    assert cli.main(["run", str(case), "-o", str(tmp_path / "out"), "--no-progress"]) == 130
+    err = capsys.readouterr().err
+    assert "sweep-checkpoint.npz" in err and "sweep-partial.nc" in err, err
+    assert read_results(tmp_path / "out" / "sweep-partial.nc").sizes["frequency"] >= 1

@@ -11,6 +11,7 @@ import xarray as xr
 
 from fretwear.analyses.base import Analysis, RunContext, RunOutput
 from fretwear.analyses.common import figure_path
+from fretwear.analyses.figure_style import series_style
 from fretwear.analyses.figures import new_figure, save
 from fretwear.errors import InputError
 from fretwear.hb.cyclic import cyclic_modes
@@ -55,9 +56,10 @@ def plot_nodal_diameters(ds: xr.Dataset, path: Path | str, *, title: str | None 
     fig, axes = new_figure(title=title, panel_size=(6.0, 4.0))
     ax = axes[0, 0]
     nd = ds["nodal_diameter"].values
-    for m in ds["mode"].values:
+    modes = ds["mode"].values
+    for j, m in enumerate(modes):
         f = ds["cyclic_frequency"].sel(mode=m).values
-        ax.plot(nd, f, marker="o", label=f"family {m}")
+        ax.plot(nd, f, label=f"family {m}", **series_style(j, len(modes)))
     ax.set_xlabel("nodal diameter")
     ax.set_ylabel("natural frequency [Hz]")
     ax.set_xticks(nd)

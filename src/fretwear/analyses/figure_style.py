@@ -7,6 +7,12 @@
 * a frequency axis on a log scale only when its band spans more than one decade
   (:func:`frequency_scale`): a 900-1100 Hz sweep is drawn on a linear axis.
 
+* the curves of one family on the same axes (profiles at several cycle counts, the FRFs
+  before and after wear, linear references, modes) never hide one another
+  (:func:`series_style`): each has its own marker and dash pattern, and the earlier ones are
+  drawn wider, with larger open markers, below the later ones, so that where two curves
+  coincide the earlier shows as a band and rings around the later.
+
 The rules are pure functions of numbers and strings, so they are tested without drawing.
 """
 
@@ -49,6 +55,31 @@ def si_prefix(largest: float, unit: str) -> tuple[float, str]:
     if base == "Hz" and k < 0:  # mHz: keep hertz
         k = 0
     return 10.0 ** (-k * p), PREFIXES[k] + shown
+
+
+#: markers and dash patterns of the curves of a family, in order (:func:`series_style`)
+SERIES_MARKERS = ("o", "s", "^", "v", "D", "P", "X", "<", ">", "*")
+SERIES_DASHES = ("-", "--", "-.", ":")
+#: the most points a curve of a family carries markers on (denser curves: dashes and widths)
+MARKED_POINTS = 80
+
+
+def series_style(i: int, n: int, *, markers: bool = True) -> dict:
+    """Matplotlib keywords of the ``i``-th of ``n`` curves of one family drawn on the same
+    axes, so that none hides another where they coincide: its own dash pattern and open
+    marker, the line width from 2.6 (first) down to 1.0 (last) and the marker size from 8
+    down to 3, drawn in order (``zorder`` rising), so that an earlier curve under a later one
+    shows as a wider band with rings around the later one's markers. ``markers=False`` for
+    dense curves (hundreds of points): dashes and widths only."""
+    if n < 1 or not 0 <= i < n:
+        raise ValueError(f"series_style: curve {i} of {n}")
+    t = i / (n - 1) if n > 1 else 1.0
+    style = {"linestyle": SERIES_DASHES[i % len(SERIES_DASHES)],
+             "linewidth": round(2.6 - 1.6 * t, 2), "zorder": 2.0 + 0.01 * i}
+    if markers:
+        style.update(marker=SERIES_MARKERS[i % len(SERIES_MARKERS)],
+                     markersize=round(8.0 - 5.0 * t, 2), markerfacecolor="none")
+    return style
 
 
 def frequency_scale(f_min: float, f_max: float) -> str:

@@ -21,14 +21,14 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 
 from fretwear.analyses.common import cell_edges, interface_abscissa
-from fretwear.analyses.figure_style import apply_style
+from fretwear.analyses.figure_style import apply_style, series_style
 from fretwear.hb.contact import STATE_NAMES
 
 #: line style of each linear interface, shared by all figures
-INTERFACE_STYLE = {
-    "free": {"color": "tab:green", "linestyle": ":"},
-    "sliding": {"color": "tab:blue", "linestyle": "-"},
-    "stuck": {"color": "tab:red", "linestyle": "--"},
+INTERFACE_STYLE = {  # widest below, so that coinciding references all show
+    "free": {"color": "tab:green", "linestyle": ":", "linewidth": 1.2, "zorder": 2.2},
+    "sliding": {"color": "tab:blue", "linestyle": "-", "linewidth": 2.6, "zorder": 2.0},
+    "stuck": {"color": "tab:red", "linestyle": "--", "linewidth": 1.8, "zorder": 2.1},
 }
 #: colours of the contact states (separation, stick, slip) in every figure
 STATE_COLOURS = ("0.85", "tab:blue", "tab:orange")
@@ -208,15 +208,17 @@ def plot_natural_frequencies(ds, path: Path | str, *, title: str | None = None) 
     fig, axes = new_figure(title=title, panel_size=(8.0, 3.6))
     ax = axes[0, 0]
     rigid_below = 1e-6 * float(np.nanmax(ds["natural_frequency"].values, initial=0.0))
-    for interface in ds["interface"].values:
+    interfaces = ds["interface"].values
+    for j, interface in enumerate(interfaces):
         f = ds["natural_frequency"].sel(interface=interface).values
         ok = np.isfinite(f) & (f > rigid_below)
         n_rigid = int(np.sum(np.isfinite(f) & ~ok))
         label = str(interface) + (f"\n({n_rigid} rigid-body modes\nat ~0 Hz not shown)"
                                   if n_rigid else "")
         style = INTERFACE_STYLE.get(str(interface), {})
-        ax.semilogy(ds["mode"].values[ok], f[ok], marker="o", color=style.get("color"),
-                    linestyle=style.get("linestyle", "-"), label=label)
+        ax.semilogy(ds["mode"].values[ok], f[ok], label=label,
+                    **{**series_style(j, len(interfaces)), "color": style.get("color"),
+                       "linestyle": style.get("linestyle", "-")})
     ax.set_xlabel("mode number")
     ax.set_ylabel("natural frequency [Hz]")
     ax.grid(True, which="both", alpha=0.3)

@@ -34,6 +34,7 @@ from fretwear.analyses.common import (
     solve_options_of,
     titled,
 )
+from fretwear.analyses.figure_style import MARKED_POINTS, series_style
 from fretwear.errors import InputError
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.dynamics import structure_dynamics
@@ -263,12 +264,13 @@ def plot_backbone(ds: xr.Dataset, path: Path, *, title: str | None = None) -> Pa
     if rows == 3:
         ax = axes[2, 0]
         h = int(ds["harmonic"].values[0])
-        for point in ds["point"].values:
-            for axis in live_axes(ds, str(point)) or [str(ds["axis"].values[0])]:
-                y = ds["response_amplitude"].sel(point=point, axis=axis, harmonic=h).values
-                if np.any(y > 0):
-                    ax.plot(a, np.where(y > 0, y, np.nan), marker=".", ms=3,
-                            label=f"{point} {axis}")
+        curves = [(point, axis) for point in ds["point"].values
+                  for axis in live_axes(ds, str(point)) or [str(ds["axis"].values[0])]]
+        for j, (point, axis) in enumerate(curves):
+            y = ds["response_amplitude"].sel(point=point, axis=axis, harmonic=h).values
+            if np.any(y > 0):
+                ax.plot(a, np.where(y > 0, y, np.nan), label=f"{point} {axis}",
+                        **series_style(j, len(curves), markers=a.size <= MARKED_POINTS))
         ax.set_yscale("log")
         ax.set_ylabel(f"|u_{h}| [m]")
         if ax.get_legend_handles_labels()[0]:

@@ -38,6 +38,7 @@ from fretwear.analyses.common import (
     solver_attributes,
     titled,
 )
+from fretwear.analyses.figure_style import MARKED_POINTS, series_style
 from fretwear.errors import InputError
 from fretwear.hb import fallbacks
 from fretwear.hb.contact import STATE_NAMES
@@ -468,17 +469,18 @@ def plot_profiles(ds: xr.Dataset, path: Path, *, title: str | None = None) -> Pa
     fig, axes = plots.new_figure(3, 1, title=title, panel_size=(7.0, 2.6), sharex=True)
     ax = axes[0, 0]
     k, unit = si_scale(ds["pressure_max"].values, "Pa")
-    ax.plot(x[o], k * ds["pressure_mean"].values[o], marker=".", label="mean")
-    ax.plot(x[o], k * ds["pressure_max"].values[o], marker=".", linestyle="--",
-            label="maximum")
+    marked = x.size <= MARKED_POINTS
+    first, second = series_style(0, 2, markers=marked), series_style(1, 2, markers=marked)
+    ax.plot(x[o], k * ds["pressure_mean"].values[o], label="mean", **first)
+    ax.plot(x[o], k * ds["pressure_max"].values[o], label="maximum", **second)
     ax.set_ylabel(f"normal pressure [{unit}]")
     ax.legend(fontsize="small")
     ax = axes[1, 0]
     k, unit = si_scale(ds["slip_path"].values, "m")
-    ax.plot(x[o], k * ds["slip_amplitude"].values[o], marker=".", color="tab:orange",
-            label="slip amplitude (half range, T1)")
-    ax.plot(x[o], k * ds["slip_path"].values[o], marker=".", linestyle="--", color="tab:red",
-            label="slip path per period")
+    ax.plot(x[o], k * ds["slip_amplitude"].values[o], color="tab:orange",
+            label="slip amplitude (half range, T1)", **first)
+    ax.plot(x[o], k * ds["slip_path"].values[o], color="tab:red",
+            label="slip path per period", **second)
     ax.set_ylabel(f"slip [{unit}]")
     ax.legend(fontsize="small")
     ax = axes[2, 0]

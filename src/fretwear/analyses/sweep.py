@@ -33,6 +33,7 @@ from fretwear.analyses.common import (
     solve_options_of,
     titled,
 )
+from fretwear.errors import interrupted
 from fretwear.hb import fallbacks
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.fourier import FourierBasis
@@ -40,7 +41,7 @@ from fretwear.hb.options import SWEEP as SWEEP_OPTIONS
 from fretwear.hb.solution import PeriodicSolution
 from fretwear.hb.sweep import SweepResult
 from fretwear.hb.sweep_stability import SweepStability, sweep_stability
-from fretwear.io.results import label_coordinate, variable
+from fretwear.io.results import label_coordinate, variable, write_results
 from fretwear.io.schema import Field, Flag, Integer, ListOf, Number, Text, increasing
 from fretwear.levels import excitation_scaled
 from fretwear.timedomain.stability import sweep_check
@@ -301,9 +302,15 @@ def run_sweep(model, analysis: dict, case, context: RunContext) -> RunOutput:
                               condenser=cond)
                   if analysis["check_stability"] else None),
             progress=tick, checkpoint=context.out_dir / CHECKPOINT_FILE, resume=context.resume)
-        result = api.sweep(model, basis, analysis["f_min"], analysis["f_max"], n,
-                           options=options, time_domain=analysis["time_domain"],
-                           condenser=cond)
+        try:
+            result = api.sweep(model, basis, analysis["f_min"], analysis["f_max"], n,
+                               options=options, time_domain=analysis["time_domain"],
+                               condenser=cond)
+        except (KeyboardInterrupt, SystemError) as exc:
+            if not interrupted(exc) or getattr(exc, "partial", None) is None:
+                raise
+            write_partial(model, exc.partial, basis, analysis, case, context.out_dir)
+            raise KeyboardInterrupt from None
     linear_hz = linear_reference_grid(analysis["f_min"], analysis["f_max"],
                                       analysis["spacing"], result.frequency_hz,
                                       analysis["linear_points"])
@@ -333,6 +340,32 @@ def run_sweep(model, analysis: dict, case, context: RunContext) -> RunOutput:
     summary = "\n".join([_sweep_summary(result, ds), *events, *([fallback] if fallback else []),
                          cond.choice.summary()])
     return RunOutput(ds, figures, summary, grid_ok, warnings=list(result.warnings))
+
+
+#: the results of an interrupted sweep, beside its checkpoint (attribute ``complete = 0``)
+PARTIAL_FILE = "sweep-partial.nc"
+
+
+def write_partial(model, partial: SweepResult, basis: FourierBasis, analysis: dict, case,
+                  out_dir: Path):
+    """The points an interrupted sweep computed (``partial``, those of its checkpoint) as a
+    results file (:data:`PARTIAL_FILE`: the variables of ``results.nc`` on the frequencies
+    reached, without the linear references; ``complete = 0``, ``converged = 0``) to look at
+    while the sweep is not finished; None when no point was computed. ``--resume``
+    continues from the checkpoint and writes ``results.nc``."""
+    if not partial.points:
+        return None
+    f = partial.frequency_hz
+    message = (f"interrupted after {len(f)} of {analysis['n_points']} grid frequencies "
+               f"({plots.format_frequency(f.min())} to {plots.format_frequency(f.max())}): "
+               "partial results (run again with --resume to continue)")
+    ds = sweep_dataset(excitation_scaled(model, analysis["excitation_scale"]), partial, basis,
+                       check_points(model, analysis.get("points")), [])
+    ds.attrs.update({"complete": 0, "message": message,
+                     "sweep_converged": partial.summary().splitlines()[0].split("=", 1)[1]})
+    return write_results(out_dir / PARTIAL_FILE, ds, title=case.title, analysis_type="sweep",
+                         converged=False, case_text=case.text, case_path=str(case.path),
+                         analysis=analysis)
 
 
 # --- figures -------------------------------------------------------------------------------
@@ -388,8 +421,8 @@ def plot_sweep(ds: xr.Dataset, path: Path, point: str, *, title: str | None = No
                      ds["stable"].values if "stable" in ds else None,
                      label=f"friction, harmonic {h}")
         half = 0.5 * ds["response_peak_to_peak"].sel(point=point, axis=axis).values
-        ax.plot(f, np.where(half > 0, half, np.nan), color="0.5", lw=0.8, linestyle=":",
-                label="friction, half peak-to-peak")
+        ax.plot(f, np.where(half > 0, half, np.nan), color="0.5", lw=2.4, linestyle="-",
+                alpha=0.5, zorder=1.5, label="friction, half peak-to-peak")  # a band below
         _mark_failures(ax, f, conv, flagged, y)
         ax.set_xscale("log")
         ax.set_yscale("log")
@@ -504,7 +537,9 @@ SWEEP = Analysis.define(
     "converge are kept as NaN with `converged = 0` and the reason in `flags`; the run then "
     "exits with status 1. The points computed so far are saved in `sweep-checkpoint.npz` after "
     "every grid frequency: `fretwear run CASE.toml --resume` continues a killed sweep to the "
-    "same result. Writes `sweep-<point>.png` (amplitude against frequency, with the "
-    "linear references) and `sweep-interface.png` (friction energy and contact states).",
+    "same result; an interrupted one (Ctrl-C, SIGTERM) also writes them as `sweep-partial.nc` "
+    "(attribute `complete = 0`) to look at. Writes `sweep-<point>.png` (amplitude against "
+    "frequency, with the linear references) and `sweep-interface.png` (friction energy and "
+    "contact states).",
     preload_check=True,
 )

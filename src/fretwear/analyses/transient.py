@@ -31,6 +31,7 @@ from fretwear.analyses.common import (
     si_scale,
     titled,
 )
+from fretwear.analyses.figure_style import MARKED_POINTS, series_style
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.fourier import FourierBasis, amplitude
 from fretwear.io.results import label_coordinate, variable
@@ -431,9 +432,10 @@ def plot_incremental_profiles(ds: xr.Dataset, path: Path, *, title: str | None =
     fig, axes = plots.new_figure(title=title, panel_size=(7.0, 3.6))
     ax = axes[0, 0]
     k, unit = si_scale(ds["wear_depth"].values, "m")
-    for i in rows:
-        ax.plot(x[o], k * ds["wear_depth"].values[i][o], marker=".",
-                label=f"{int(ds['cycles'][i]):.3g} cycles")
+    for j, i in enumerate(rows):
+        ax.plot(x[o], k * ds["wear_depth"].values[i][o],
+                label=f"{int(ds['cycles'][i]):.3g} cycles",
+                **series_style(j, len(rows), markers=x.size <= MARKED_POINTS))
     ax.set_xlabel(xlabel)
     ax.set_ylabel(f"wear depth [{unit}]")
     ax.grid(True, alpha=0.3)

@@ -27,6 +27,7 @@ from fretwear.analyses.common import (
     default_of,
     interface_labels,
 )
+from fretwear.analyses.figure_style import MARKED_POINTS, series_style
 from fretwear.errors import InputError, interrupted
 from fretwear.files import safe_name
 from fretwear.hb import fallbacks
@@ -321,8 +322,10 @@ def _profile(ax, x, y, **kw) -> None:
     share an ``x`` (a surface in 3D, several interfaces side by side: a line would zig-zag
     between them; the maps of ``wear-maps.png`` show those)."""
     o = np.argsort(x, kind="stable")
-    style = {} if np.unique(x).size == x.size else {"linestyle": "none"}
-    ax.plot(x[o], y[o], marker=".", **style, **kw)
+    style = {"marker": ".", **kw}
+    if np.unique(x).size != x.size:
+        style["linestyle"] = "none"
+    ax.plot(x[o], y[o], **style)
 
 
 def plot_wear_profiles(ds, path: Path, *, title=None) -> Path:
@@ -331,8 +334,10 @@ def plot_wear_profiles(ds, path: Path, *, title=None) -> Path:
     fig, axes = plots.new_figure(title=title)
     ax = axes[0, 0]
     cyc = ds["cycles"].values
-    for i in selected_steps(cyc):
-        _profile(ax, x, ds["wear_depth"].values[i], label=f"N = {cyc[i]:.3g}")
+    steps = selected_steps(cyc)
+    for k, i in enumerate(steps):
+        _profile(ax, x, ds["wear_depth"].values[i], label=f"N = {cyc[i]:.3g}",
+                 **series_style(k, len(steps), markers=x.size <= MARKED_POINTS))
     ax.set_xlabel(xl)
     ax.set_ylabel("wear depth [m]")  # in SI: the figure style writes it in µm or nm
     ax.grid(True, alpha=0.3)
@@ -361,9 +366,10 @@ def plot_wear_kinetics(ds, path: Path, nodes, *, title=None) -> Path:
     fig, axes = plots.new_figure(title=title)
     ax = axes[0, 0]
     cyc = ds["cycles"].values
-    for p in nodes:
-        ax.semilogx(cyc[1:], ds["wear_depth"].values[1:, p], marker=".",
-                    label=f"node {p} ({xl[0]} = {x[p]:.4g} m)")
+    for k, p in enumerate(nodes):
+        ax.semilogx(cyc[1:], ds["wear_depth"].values[1:, p],
+                    label=f"node {p} ({xl[0]} = {x[p]:.4g} m)",
+                    **series_style(k, len(nodes), markers=cyc.size <= MARKED_POINTS))
     ax.set_xlabel("cycles N")
     ax.set_ylabel("wear depth [m]")  # in SI: the figure style writes it in µm or nm
     ax.grid(True, which="both", alpha=0.3)
@@ -377,10 +383,12 @@ def plot_pressure_slip(ds, path: Path, *, title=None) -> Path:
     x, xl = _x_along(ds)
     fig, axes = plots.new_figure(2, 1, title=title, sharex=True)
     cyc = ds["cycles"].values
-    for i in selected_steps(cyc):
-        lab = f"N = {cyc[i]:.3g}"
-        _profile(axes[0, 0], x, ds["pressure_max"].values[i], label=lab)
-        _profile(axes[1, 0], x, ds["slip_amplitude"].values[i], label=lab)
+    steps = selected_steps(cyc)
+    for k, i in enumerate(steps):
+        kw = {"label": f"N = {cyc[i]:.3g}",
+              **series_style(k, len(steps), markers=x.size <= MARKED_POINTS)}
+        _profile(axes[0, 0], x, ds["pressure_max"].values[i], **kw)
+        _profile(axes[1, 0], x, ds["slip_amplitude"].values[i], **kw)
     axes[0, 0].set_ylabel("max normal pressure [Pa]")
     axes[1, 0].set_ylabel("tangential amplitude [m]")
     axes[1, 0].set_xlabel(xl)
@@ -409,9 +417,11 @@ def plot_frf_before_after(ds, path: Path, point: str, *, title=None) -> Path:
     fig, axes = plots.new_figure(len(axes_labels), 1, title=title, sharex=True)
     f = ds["frequency"].values
     for ax, axis in zip(axes[:, 0], axes_labels, strict=True):
-        for state in ds["wear_state"].values:
+        states = ds["wear_state"].values
+        for k, state in enumerate(states):
             y = amp.sel(wear_state=state, axis=axis).values
-            ax.semilogy(f, np.where(y > 0, y, np.nan), label=str(state))
+            ax.semilogy(f, np.where(y > 0, y, np.nan), label=str(state),
+                        **series_style(k, len(states), markers=f.size <= MARKED_POINTS))
         ax.set_ylabel(f"|u_{axis}| at {point} [m]")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend()

@@ -22,6 +22,7 @@ import numpy as np
 from fretwear import api
 from fretwear.analyses import figures as plots
 from fretwear.analyses.base import Analysis, RunContext, RunOutput
+from fretwear.analyses.figure_style import MARKED_POINTS, series_style
 from fretwear.analyses.wear import (
     SCHEMA as WEAR_SCHEMA,
 )
@@ -88,13 +89,18 @@ def plot_worn_state(ds, path: Path, *, title=None) -> Path:
     x, xlabel = _x_along(ds)
     fig, axes = plots.new_figure(3, 1, title=title, sharex=True)
     surf = ds["worn_depth_surface"].values[-1]
-    _profile(axes[0, 0], x, surf[:, 0] * 1e6, label="contact surface")
-    if np.any(surf[:, 1] > 0):
-        _profile(axes[0, 0], x, surf[:, 1] * 1e6, label="partner surface")
+    marked = x.size <= MARKED_POINTS
+    both = bool(np.any(surf[:, 1] > 0))
+    _profile(axes[0, 0], x, surf[:, 0] * 1e6, label="contact surface",
+             **series_style(0, 1 + both, markers=marked))
+    if both:
+        _profile(axes[0, 0], x, surf[:, 1] * 1e6, label="partner surface",
+                 **series_style(1, 2, markers=marked))
     axes[0, 0].set_ylabel("worn depth [um]")
-    for k, lab in ((0, "unworn"), (-1, "worn state")):
-        _profile(axes[1, 0], x, ds["pressure_mean"].values[k] / 1e6, label=lab)
-        _profile(axes[2, 0], x, ds["slip_path"].values[k] * 1e6, label=lab)
+    for j, (k, lab) in enumerate(((0, "unworn"), (-1, "worn state"))):
+        style = series_style(j, 2, markers=marked)
+        _profile(axes[1, 0], x, ds["pressure_mean"].values[k] / 1e6, label=lab, **style)
+        _profile(axes[2, 0], x, ds["slip_path"].values[k] * 1e6, label=lab, **style)
     axes[1, 0].set_ylabel("mean pressure [MPa]")
     axes[2, 0].set_ylabel("slip path / cycle [um]")
     axes[2, 0].set_xlabel(xlabel)

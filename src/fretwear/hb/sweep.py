@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fretwear.errors import InputError
+from fretwear.errors import InputError, interrupted
 from fretwear.files import check_state_file
 from fretwear.hb.attempts import Point, point_ladder
 from fretwear.hb.branch import Branch, Problems
@@ -127,6 +127,13 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
     :class:`SweepResult`: ``success`` (every point converged), ``message`` (how many did),
     the points in increasing frequency (a point that did not converge has no solution and
     says why in ``flags``).
+
+    Raises
+    ------
+    KeyboardInterrupt
+        On Ctrl-C (or the SystemError of a compiled function interrupted), the same
+        exception with ``partial``: a :class:`SweepResult` of the points computed so far
+        (``sweep-partial.nc`` of the sweep analysis).
     """
     t_start = time.perf_counter()
     opts = sweep_options(options)
@@ -154,16 +161,24 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
     if key is not None and opts.resume and Path(opts.checkpoint).exists():
         first, entries = load_sweep_checkpoint(opts.checkpoint, key, shape)
         branch.resume(probs, entries)
-    for i in range(first, len(grid)):
-        pt = _grid_point(point_ladder(Point(grid[i], probs, branch, opts)))
-        branch.points.append(pt)
-        if key is not None:
-            save_sweep_checkpoint(opts.checkpoint, key, i + 1, branch.points, shape)
-        if opts.progress is not None:
-            opts.progress(i, len(grid), pt)
+    resumed = first if key is not None and opts.resume and first else -1
+    try:
+        for i in range(first, len(grid)):
+            pt = _grid_point(point_ladder(Point(grid[i], probs, branch, opts)))
+            branch.points.append(pt)
+            if key is not None:
+                save_sweep_checkpoint(opts.checkpoint, key, i + 1, branch.points, shape)
+            if opts.progress is not None:
+                opts.progress(i, len(grid), pt)
+    except (KeyboardInterrupt, SystemError) as exc:
+        # Ctrl-C: the same exception goes on, carrying the points computed so far
+        # (``exc.partial``, a SweepResult) for the caller to write as partial results
+        if interrupted(exc) and not hasattr(exc, "partial"):
+            done = sorted(branch.points, key=lambda p: p.frequency_hz)
+            exc.partial = SweepResult(done, time.perf_counter() - t_start, resumed, warnings)
+        raise
     branch.points.sort(key=lambda p: p.frequency_hz)
-    return SweepResult(branch.points, time.perf_counter() - t_start,
-                       first if key is not None and opts.resume and first else -1, warnings)
+    return SweepResult(branch.points, time.perf_counter() - t_start, resumed, warnings)
 
 
 def _checkpoint_key(probs: Problems, grid, opts: SweepOptions, anchor) -> str | None:

@@ -154,3 +154,4 @@ class SweepResult:
             if p.flags:
                 lines.append(f"  {p.frequency_hz:12.6g} Hz: " + "; ".join(p.flags))
         return "\n".join(lines)
+
