@@ -30,7 +30,7 @@ import numpy as np
 import xarray as xr
 
 from fretwear import __version__
-from fretwear.errors import InputError
+from fretwear.errors import ConvergenceError, InputError
 from fretwear.files import atomic_write
 
 ENGINE = "h5netcdf"
@@ -118,6 +118,38 @@ def check_schema(ds: xr.Dataset) -> None:
             )
 
 
+#: variables that hold a solution (displacements, velocities, contact forces, wear depths):
+#: NaN or inf in one of them means the computation failed, so the writer refuses it
+#: (:func:`check_finite`); along a dimension that a ``converged`` flag shares (a sweep's
+#: ``frequency``), only the converged entries are checked
+SOLUTION_VARIABLES = ("displacement", "velocity", "displacement_coefficients",
+                      "displacement_harmonic_amplitude", "contact_displacement_coefficients",
+                      "contact_force_coefficients", "corrected_displacement_coefficients",
+                      "contact_force", "corrected_displacement", "contact_displacement",
+                      "wear_depth", "worn_depth_surface", "worn_volume")
+
+
+def check_finite(ds: xr.Dataset) -> None:
+    """Refuse a dataset whose solution variables (:data:`SOLUTION_VARIABLES`) hold NaN or
+    inf: a :class:`~fretwear.errors.ConvergenceError` naming the variable, so that a failed
+    computation is never written as a result."""
+    for name in SOLUTION_VARIABLES:
+        if name not in ds.data_vars:
+            continue
+        values = np.asarray(ds[name].values)
+        if values.dtype.kind not in "fc":
+            continue
+        flag = ds.data_vars.get("converged")
+        if flag is not None and flag.ndim == 1 and flag.dims[0] in ds[name].dims:
+            axis = ds[name].dims.index(flag.dims[0])
+            values = np.compress(np.asarray(flag.values).astype(bool), values, axis=axis)
+        if not np.all(np.isfinite(values)):
+            what = ds[name].attrs.get("long_name", "")
+            raise ConvergenceError(f"results variable {name!r} ({what}) holds non-finite "
+                                   "values (NaN or inf): the computation failed; no results "
+                                   "file was written")
+
+
 # --- writing ----------------------------------------------------------------------------
 def run_attributes(*, title: str, analysis_type: str, converged: bool, case_text: str = "",
                    case_path: str = "", analysis: Mapping | None = None) -> dict:
@@ -149,6 +181,7 @@ def write_results(path: Path | str, ds: xr.Dataset, **attrs) -> Path:
     The absolute path written.
     """
     check_schema(ds)
+    check_finite(ds)
     ds = ds.copy()
     ds.attrs = {**ds.attrs, **run_attributes(**attrs)}
     return atomic_write(path, lambda tmp: ds.to_netcdf(tmp, engine=ENGINE))
