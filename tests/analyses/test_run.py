@@ -104,8 +104,8 @@ def test_keys_the_analysis_does_not_read_are_named(tmp_path, capsys):
 
     from helpers.cases import small_case
 
-    from fretwear.analyses.run import load_case
     from fretwear.analyses.registry import analysis_tables
+    from fretwear.analyses.run import load_case
     from fretwear.io.case import ignored_notes
 
     modes = '[analysis]\ntype = "modes"\nn_modes = 2\n[output]\nwhole_disk = true\n'

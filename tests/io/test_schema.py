@@ -165,8 +165,7 @@ def test_unused_keys_walks_every_kind_of_table():
     its path and value; its default and a switch turned off are not named (they change
     nothing); under an analysis that reads it nothing is named. Reference: the hand-written
     case below."""
-    from fretwear.io.schema import Dict, Field, Flag, Number, Table, TableList, Variant, \
-        unused_keys
+    from fretwear.io.schema import Dict, Field, Flag, Number, Table, TableList, Variant, unused_keys
 
     k = Field(Number(), "a coefficient", default=0.0, used_by=("wear",))
     s = Field(Flag(), "a switch", default=False, used_by=("wear",))
