@@ -41,6 +41,7 @@ from fretwear.errors import InputError
 from fretwear.hb import sparse_lu
 from fretwear.model.core import Model
 from fretwear.model.interfaces import observed_map, relative_model
+from fretwear.resources import require_memory
 
 
 @dataclass
@@ -486,6 +487,7 @@ class Condenser:
         """The :class:`Reduced` model on harmonic ``orders`` at ``omega`` [rad/s]."""
         orders = np.asarray(orders, dtype=np.int64)
         m, no, nb = self.m, self.structure.obs.size, orders.size
+        self.check_size(orders)
         F_all = self.load_harmonics(int(orders.max()) if orders.size else 0)
         if (self.dense and self.ni <= BATCH_MAX and isinstance(self.R, np.ndarray)
                 and not quasi_static and omega > 0):
@@ -512,6 +514,26 @@ class Condenser:
             for j, i in self.obs_i:
                 ob[b, j] = xf[i]
         return self._result(omega, orders, Zr, Fr, oA, ob, quasi_static, frequency)
+
+    def check_size(self, orders) -> None:
+        """Refuse (one InputError with the estimate and the machine's memory) a condensation
+        on ``orders`` that cannot fit, before it allocates: per harmonic the condensed
+        blocks, the observation rows and the factorisation of ``Z_ii`` kept until all are
+        done (dense: ``16 n_i^2`` bytes; sparse: ten times the nonzeros of ``K``, a rough
+        fill), the load amplitudes of every order up to the highest, and the Fourier basis
+        that the balance needs with it (at least ``2 k + 2`` samples of ``2 k + 1``
+        coefficients, four arrays)."""
+        orders = np.asarray(orders, dtype=np.int64)
+        if not orders.size:
+            return
+        nb, k = orders.size, int(orders.max())
+        m, no, ni = self.m, self.structure.obs.size, self.ni
+        lu = 16.0 * ni * ni if self.dense else 160.0 * self.structure.K.nnz
+        per_order = 16.0 * (2 * m * m + no * m + no + m) + lu
+        basis = 8.0 * (2 * k + 2) * (2 * k + 1) * 4
+        require_memory(nb * per_order + 16.0 * (k + 1) * self.structure.ndof + basis,
+                       f"a balance of {nb} harmonic orders (up to {k}) on {self.structure.ndof:,}"
+                       f" DOFs ({m} at the contact)")
 
     def load_harmonics(self, nmax: int) -> np.ndarray:
         """The structure's load amplitudes (nmax+1, ndof) complex [N], kept until
