@@ -36,6 +36,7 @@ from fretwear.hb import periodic as _periodic
 from fretwear.hb import sweep as _sweep
 from fretwear.hb.dynamics import structure_dynamics
 from fretwear.hb.options import sweep_options
+from fretwear.model.checks import model_argument
 from fretwear.threads import limited
 from fretwear.timedomain import integrate as _integrate
 from fretwear.timedomain import quasistatic as _quasistatic
@@ -105,6 +106,7 @@ def _sweep_progress(progress, options, n_points):
         yield options.replace(progress=tick)
 
 
+@model_argument
 @limited
 def solve_periodic(model, basis, frequency: float | None = None, *, quasi_static: bool = False,
                    time_domain: bool = True, **kwargs) -> _periodic.PeriodicSolution:
@@ -139,6 +141,7 @@ def solve_periodic(model, basis, frequency: float | None = None, *, quasi_static
                                     time_domain=_fallback(time_domain), **kwargs)
 
 
+@model_argument
 @limited
 def sweep(model, basis, f_min: float, f_max: float, n_points: int, *, time_domain: bool = True,
           progress=False, **kwargs) -> _sweep.SweepResult:
@@ -176,6 +179,7 @@ def sweep(model, basis, f_min: float, f_max: float, n_points: int, *, time_domai
                             **kwargs)
 
 
+@model_argument
 @limited
 def simulate_wear(model, basis, frequency: float | None = None, *, quasi_static: bool = False,
                   wear0=None, time_domain: bool = True, condenser=None,
@@ -220,6 +224,7 @@ def simulate_wear(model, basis, frequency: float | None = None, *, quasi_static:
                                time_domain=_fallback(time_domain), **kwargs)
 
 
+@model_argument
 @limited
 def worn_state(model, basis, frequency: float | None = None, *, quasi_static: bool = False,
                wear0=None, time_domain: bool = True, condenser=None, **kwargs):
@@ -257,6 +262,7 @@ def worn_state(model, basis, frequency: float | None = None, *, quasi_static: bo
                        time_domain=_fallback(time_domain), **kwargs)
 
 
+@model_argument
 @limited
 def frf_worn(model, basis, wear, f_min: float, f_max: float, n_points: int, *,
              time_domain: bool = True, progress=False, **kwargs) -> _sweep.SweepResult:
@@ -316,6 +322,7 @@ def mode_target(model, mode: int = 1, interface: str = "stuck", dyn=None) -> flo
     return float(2.0 * math.pi * r.frequency_hz[mode - 1])
 
 
+@model_argument
 @limited
 def nonlinear_mode(model, basis, amplitudes, *, mode: int = 1, interface: str = "stuck",
                    **kwargs) -> _modes.Backbone:
@@ -354,6 +361,7 @@ def nonlinear_mode(model, basis, amplitudes, *, mode: int = 1, interface: str = 
                                  **kwargs)
 
 
+@model_argument
 @limited
 def mode_frf(model, backbone: _modes.Backbone, *, damping: str = "viscous", condenser=None,
              dyn=None):
@@ -379,6 +387,7 @@ def mode_frf(model, backbone: _modes.Backbone, *, damping: str = "viscous", cond
                              damping=damping)
 
 
+@model_argument
 @limited
 def integrate(model, frequency: float, **kwargs):
     """Integrate the forced response at ``frequency`` [Hz] in time with exact contact and
@@ -406,6 +415,7 @@ def integrate(model, frequency: float, **kwargs):
     return _integrate.integrate(model, frequency, **kwargs)
 
 
+@model_argument
 @limited
 def steady_state(model, frequency: float, **kwargs):
     """Integrate at ``frequency`` [Hz] until the response is periodic (or classified
@@ -432,6 +442,7 @@ def steady_state(model, frequency: float, **kwargs):
     return _steady.steady_state(model, frequency, **kwargs)
 
 
+@model_argument
 @limited
 def incremental_wear(model, *, wear_coefficient: float | None = None, wear0=None, **kwargs):
     """Quasi-static fretting wear by load steps (in the spirit of Stromberg 1997).

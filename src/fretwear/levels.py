@@ -21,6 +21,7 @@ import numpy as np
 
 from fretwear import api
 from fretwear.errors import InputError
+from fretwear.model.checks import model_argument
 
 
 def excitation_scaled(model, level: float):
@@ -70,6 +71,7 @@ class LoadLevels:
         return amp, freq
 
 
+@model_argument
 def load_levels(model, basis, f_min: float, f_max: float, n_points: int, levels, *,
                 options=None, condenser=None) -> LoadLevels:
     """The nonlinear FRF at each excitation level: :func:`fretwear.sweep` of the model with

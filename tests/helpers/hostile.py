@@ -90,7 +90,15 @@ ANALYSES = {
     "wear": ('type = "wear"\nquasi_static = true\nharmonics = 1\nn_samples = 16\n'
              'max_steps = 3\n'),
     "incremental-wear": 'type = "incremental-wear"\nn_cycles = 3\nsteps_per_cycle = 16\n',
+    "worn-state": ('type = "worn-state"\nquasi_static = true\nharmonics = 1\nn_samples = 16\n'
+                   'max_steps = 3\n'),
+    "cyclic-modes": 'type = "cyclic-modes"\nn_modes = 2\n',
 }
+
+#: the analyses run on a bladed-disk sector (:data:`SECTOR_FILES`, tests/helpers/cyclic.py)
+SECTOR_ANALYSES = ("cyclic-modes",)
+#: the files a sector case needs beside it (written by :func:`run_generated`)
+SECTOR_FILES = ("sector.msh", "sector.toml")
 
 #: time limit of one generated run [s]; a run that takes longer counts as a hang
 TIME_LIMIT = 60
@@ -104,7 +112,17 @@ INVALID_OTHER = ("", "x", "../../../escape", "a/b", "y" * 400, True, False, [], 
 
 
 def base_case(analysis: str) -> dict:
-    """A small valid case (parsed TOML) with the given analysis type."""
+    """A small valid case (parsed TOML) with the given analysis type (on the annulus sector
+    of tests/helpers/cyclic.py for :data:`SECTOR_ANALYSES`)."""
+    if analysis in SECTOR_ANALYSES:
+        import tempfile
+
+        from helpers.cyclic import write_sector_case
+
+        with tempfile.TemporaryDirectory() as tmp:
+            path, _ = write_sector_case(Path(tmp), n_sectors=8, engine_order=1)
+            text = path.read_text()
+        return tomllib.loads(text + "[analysis]\n" + ANALYSES[analysis])
     return tomllib.loads(MODEL + "[analysis]\n" + ANALYSES[analysis])
 
 
@@ -147,6 +165,13 @@ def _tables(case: dict) -> list[tuple[tuple, Table]]:
     """(key path of a table in ``case``, its schema) for every table the case has."""
     from fretwear.analyses.registry import analysis_tables
 
+    if "cyclic" in case:
+        out = [(("model",), case_schema.MODEL_TYPES[case["model"]["type"]]),
+               (("material",), case_schema.MATERIAL), (("cyclic",), case_schema.CYCLIC),
+               (("analysis",), analysis_tables()[case["analysis"]["type"]])]
+        for i in range(len(case.get("loads", []))):
+            out.append((("loads", i), case_schema.LOAD_MESH))
+        return out
     out = [(("model",), case_schema.MODEL_TYPES[case["model"]["type"]]),
            (("material",), case_schema.MATERIAL), (("damping",), case_schema.DAMPING),
            (("contact",), case_schema.CONTACT_MESH), (("output",), case_schema.OUTPUT),
@@ -204,7 +229,8 @@ def hostile_cases(draw, analyses=tuple(ANALYSES)) -> tuple[dict, list[str]]:
         value = _spec_values(table.fields[key].spec, data)
         _get(case, path)[key] = value
         changes.append(f"{'.'.join(map(str, path))}.{key} = {value!r}"[:120])
-    if draw(st.integers(0, 3)) == 0:  # one in four: a key whose meaning depends on others
+    if "cyclic" not in case and draw(st.integers(0, 3)) == 0:  # one in four: a key whose
+        # meaning depends on others (of the rectangle's tables)
         path, value = draw(st.sampled_from(MEANINGS))
         _get(case, path[:-1])[path[-1]] = value
         changes.append(f"{'.'.join(path)} = {value!r}")
@@ -261,6 +287,10 @@ def run_generated(case: dict, folder: Path) -> tuple[int | None, str, str]:
 
     path = folder / "case.toml"
     path.write_text(toml_text(case))
+    if case.get("model", {}).get("file") == SECTOR_FILES[0]:
+        from helpers.cyclic import write_sector_case
+
+        write_sector_case(folder, n_sectors=8, engine_order=1)  # the mesh file it reads
     err = io.StringIO()
     old = signal.signal(signal.SIGALRM, _alarm)
     signal.alarm(TIME_LIMIT)

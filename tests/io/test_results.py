@@ -146,3 +146,18 @@ def test_writer_refuses_non_finite_solution_values(tmp_path):
         "residual": variable(("frequency",), [1e-9, np.nan], "1", "residual")})
     write_results(tmp_path / "s.nc", ds, title="t", analysis_type="sweep", converged=False)
     assert (tmp_path / "s.nc").is_file()
+
+
+def test_writer_accepts_the_padded_axes_of_points():
+    """A point of one DOF in a model of two axes has its second axis NaN over the whole
+    period (pad_axes): padding, written; a NaN inside the period of a real axis is refused."""
+    from fretwear.errors import ConvergenceError
+    from fretwear.io.results import check_finite
+
+    disp = np.array([[[1.0, 2.0, 3.0], [np.nan] * 3]])  # (point, axis, tau)
+    check_finite(xr.Dataset({"displacement": variable(("point", "axis", "tau"), disp, "m",
+                                                      "d")}))
+    disp[0, 0, 1] = np.nan
+    with pytest.raises(ConvergenceError, match="'displacement'"):
+        check_finite(xr.Dataset({"displacement": variable(("point", "axis", "tau"), disp,
+                                                          "m", "d")}))

@@ -31,6 +31,7 @@ from fretwear.analyses.run import RESULTS_FILE, check_output, run_built
 from fretwear.errors import InputError
 from fretwear.io.case import OUTPUT, Case
 from fretwear.io.schema import Context, Variant, show
+from fretwear.model.checks import model_argument
 
 #: the file name a Python run stands for in messages and in ``case_path``
 PYTHON_CASE = "python-model.toml"
@@ -81,6 +82,7 @@ def python_case(analysis, keys: dict, output: Path, title: str = "") -> Case:
                 text=text, raw=raw, model={}, analysis=checked, output=out)
 
 
+@model_argument
 def run(model, analysis, output, *, title: str = "", progress: bool = False,
         resume: bool = False, echo: bool = False, **keys) -> RunOutput:
     """Run ``model`` (built in Python) as a case file with this analysis would run: the same
@@ -161,6 +163,7 @@ def results_dataset(result, model, basis, points=None, frequency=None):
     return kind, wear_dataset(model, result, basis, frequency_hz=float(frequency))
 
 
+@model_argument
 def write_results(result, output, model, basis=None, *, title: str = "", points=None,
                   frequency=None) -> Path:
     """Write ``output/results.nc`` for a result obtained in Python, in the format of the
@@ -193,6 +196,7 @@ def write_results(result, output, model, basis=None, *, title: str = "", points=
                  case_path="", analysis={"type": kind})
 
 
+@model_argument
 def plot(result, output, model, basis=None, *, title: str = "", fmt: str = "png",
          vtu: bool = True) -> list[Path]:
     """The figures (and, for a model with a mesh and ``vtu``, the ParaView files) the analysis

@@ -28,6 +28,7 @@ import scipy.sparse.linalg as spla
 
 from fretwear.errors import InputError
 from fretwear.hb.reduce import Condenser, Reduced, Structure, _fingerprint
+from fretwear.model.checks import model_argument
 from fretwear.model.core import Model
 from fretwear.model.cyclic import (
     CyclicSector,
@@ -180,12 +181,14 @@ class CyclicCondenser(Condenser):
         return out
 
 
+@model_argument
 def cyclic_condenser(sector: CyclicSector, engine_order: int) -> CyclicCondenser:
     """A :class:`CyclicCondenser` of ``sector`` under the engine order ``engine_order``: pass
     it as ``condenser=`` with ``sector.model`` to any periodic solve, sweep or wear run."""
     return CyclicCondenser(sector, engine_order)
 
 
+@model_argument
 def cyclic_modes(sector: CyclicSector, k: int, n_modes: int = 6) -> tuple[np.ndarray,
                                                                           np.ndarray]:
     """The ``n_modes`` lowest modes of harmonic index (nodal diameter) ``k`` of the disk,
@@ -213,6 +216,7 @@ def cyclic_modes(sector: CyclicSector, k: int, n_modes: int = 6) -> tuple[np.nda
     return np.sqrt(np.maximum(w2, 0.0)) / (2 * np.pi), (T @ q).T
 
 
+@model_argument
 def cyclic_frf(sector: CyclicSector, engine_order: int, frequencies) -> np.ndarray:
     """Linear response of the sector to the engine-order excitation, contact free:
     ``U_1`` (nf, ndof) complex [m] on the sector's DOFs at each excitation frequency [Hz]

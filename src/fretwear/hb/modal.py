@@ -52,6 +52,7 @@ from fretwear.hb.reduce import (
     _solve,
     _structure,
 )
+from fretwear.model.checks import model_argument
 from fretwear.model.core import Model
 
 #: keep the fixed-interface modes up to this multiple of the highest harmonic frequency
@@ -398,6 +399,7 @@ def _real_times(A: np.ndarray, x: np.ndarray) -> np.ndarray:
     return A @ x
 
 
+@model_argument
 def modal_condenser(model: Model, f_max: float, max_order: int, *, modes: int | None = None,
                     cutoff: float = CUTOFF, tol: float = TOL, raise_modes: bool = False,
                     residual: bool = False) -> ModalCondenser:

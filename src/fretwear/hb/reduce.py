@@ -39,6 +39,7 @@ import scipy.sparse as sp
 
 from fretwear.errors import InputError
 from fretwear.hb import sparse_lu
+from fretwear.model.checks import model_argument
 from fretwear.model.core import Model
 from fretwear.model.interfaces import observed_map, relative_model
 from fretwear.resources import require_memory
@@ -667,6 +668,7 @@ def _solve(lu, B):
     return lu.solve(np.ascontiguousarray(B.real)) + 1j * lu.solve(np.ascontiguousarray(B.imag))
 
 
+@model_argument
 def exact_condenser(model: Model) -> Condenser:
     """A new exact :class:`Condenser` of ``model`` (eq. 19): build it once and pass it
     (``condenser=``) to every condensation, solve, sweep or wear run of this model, which then
@@ -750,6 +752,7 @@ def condense_static(model: Model, *, condenser=None) -> StaticCondensation:
     return StaticCondensation(np.ascontiguousarray(0.5 * (Kr + Kr.T)), cond, lu, Kci)
 
 
+@model_argument
 def condense(model: Model, frequency: float, orders, *, quasi_static: bool = False,
              condenser=None) -> Reduced:
     """Condense ``model`` onto its contact DOFs for harmonic ``orders`` (``[0, h1, .., hk]``)

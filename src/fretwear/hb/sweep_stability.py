@@ -37,6 +37,7 @@ from fretwear.hb.stability import (
     problem_of,
 )
 from fretwear.hb.sweep_result import SweepResult
+from fretwear.model.checks import model_argument
 from fretwear.model.core import Model
 
 #: |Im rho| / |rho| below this: the multiplier is real (period doubling / fold, not
@@ -101,6 +102,7 @@ def jacobian_sign(hp: HillProblem) -> int:
     return int(np.sign(sign))
 
 
+@model_argument
 def sweep_stability(model: Model, result: SweepResult, *, options: HillOptions | None = None,
                     dyn: StructureDynamics | None = None, condenser=None) -> SweepStability:
     """Hill's method at every converged point of ``result`` (a sweep of ``model``) and the

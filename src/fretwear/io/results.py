@@ -121,12 +121,33 @@ def check_schema(ds: xr.Dataset) -> None:
 #: variables that hold a solution (displacements, velocities, contact forces, wear depths):
 #: NaN or inf in one of them means the computation failed, so the writer refuses it
 #: (:func:`check_finite`); along a dimension that a ``converged`` flag shares (a sweep's
-#: ``frequency``), only the converged entries are checked
+#: ``frequency``), only the converged entries are checked, and the axes a point does not have
+#: (NaN over all of them: a point of fewer DOFs than the model's axes) are padding
 SOLUTION_VARIABLES = ("displacement", "velocity", "displacement_coefficients",
                       "displacement_harmonic_amplitude", "contact_displacement_coefficients",
                       "contact_force_coefficients", "corrected_displacement_coefficients",
                       "contact_force", "corrected_displacement", "contact_displacement",
-                      "wear_depth", "worn_depth_surface", "worn_volume")
+                      "wear_depth", "worn_volume")
+
+
+def _checked_values(ds: xr.Dataset, name: str) -> np.ndarray:
+    """The values of ``ds[name]`` that must be finite: the converged entries, without the
+    padded axes of points."""
+    var = ds[name]
+    values = np.asarray(var.values, dtype=float)
+    dims = list(var.dims)
+    flag = ds.data_vars.get("converged")
+    if flag is not None and flag.ndim == 1 and flag.dims[0] in dims:
+        values = np.compress(np.asarray(flag.values).astype(bool), values,
+                             axis=dims.index(flag.dims[0]))
+    if "axis" in dims and values.size:
+        keep = [dims.index(d) for d in ("point", "axis") if d in dims]
+        other = tuple(i for i in range(values.ndim) if i not in keep)
+        padded = np.all(np.isnan(values), axis=other, keepdims=True) if other else \
+            np.isnan(values)
+        if not np.all(padded):  # a point with no finite axis at all is not padding
+            values = values[~np.broadcast_to(padded, values.shape)]
+    return values
 
 
 def check_finite(ds: xr.Dataset) -> None:
@@ -134,16 +155,9 @@ def check_finite(ds: xr.Dataset) -> None:
     inf: a :class:`~fretwear.errors.ConvergenceError` naming the variable, so that a failed
     computation is never written as a result."""
     for name in SOLUTION_VARIABLES:
-        if name not in ds.data_vars:
+        if name not in ds.data_vars or np.asarray(ds[name].values).dtype.kind not in "fc":
             continue
-        values = np.asarray(ds[name].values)
-        if values.dtype.kind not in "fc":
-            continue
-        flag = ds.data_vars.get("converged")
-        if flag is not None and flag.ndim == 1 and flag.dims[0] in ds[name].dims:
-            axis = ds[name].dims.index(flag.dims[0])
-            values = np.compress(np.asarray(flag.values).astype(bool), values, axis=axis)
-        if not np.all(np.isfinite(values)):
+        if not np.all(np.isfinite(_checked_values(ds, name))):
             what = ds[name].attrs.get("long_name", "")
             raise ConvergenceError(f"results variable {name!r} ({what}) holds non-finite "
                                    "values (NaN or inf): the computation failed; no results "

@@ -25,6 +25,7 @@ import scipy.sparse as sp
 
 from fretwear.errors import InputError
 from fretwear.limits import RANGES, UnusualValueWarning, check_loss_factor, unusual
+from fretwear.model.checks import check_mesh
 from fretwear.model.core import WAVEFORMS, ContactInterface, Load, Mesh, Model, ObservedPoint
 from fretwear.model.fem import assemble, check_material, check_thickness
 from fretwear.model.interfaces import combine
@@ -684,6 +685,7 @@ def from_mesh(mesh: Mesh, material: Material, *, thickness=1.0, damping: Damping
     """
     if not isinstance(mesh, Mesh):
         raise InputError(f"mesh = {mesh!r} is not a fretwear Mesh")
+    check_mesh(mesh)
     check_cells(mesh)
     if damping is not None and not isinstance(damping, Damping):
         raise InputError(f"damping = {damping!r} is not a Damping(...)")

@@ -32,6 +32,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from fretwear.errors import InputError
+from fretwear.model.checks import model_argument
 from fretwear.model.core import Model, ObservedPoint
 from fretwear.model.cyclic import (
     CyclicSector,
@@ -121,6 +122,7 @@ def sector_point_name(name: str, j: int) -> str:
     return f"{name}@{j}"
 
 
+@model_argument
 def mistuned_disk(sector: CyclicSector, engine_order: int, mistuned: Mistuning) -> Model:
     """The disk of ``N`` sectors, sector ``j`` mistuned by the ``j``-th factors of
     ``mistuned`` (module docstring), under the travelling wave of ``engine_order`` (the
@@ -175,6 +177,7 @@ def mistuned_disk(sector: CyclicSector, engine_order: int, mistuned: Mistuning) 
         name=f"{m.name} (mistuned disk of {n})")
 
 
+@model_argument
 def sector_responses(sector: CyclicSector, U) -> np.ndarray:
     """``U`` (..., ndof_disk) of the whole disk as each sector's DOFs in its own axes:
     (..., N, ndof) (sector ``j``'s are ``A_j^T U``, :func:`~fretwear.model.cyclic.sector_maps`)."""

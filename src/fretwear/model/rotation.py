@@ -26,6 +26,7 @@ import math
 import numpy as np
 
 from fretwear.errors import InputError
+from fretwear.model.checks import model_argument
 from fretwear.model.core import Load, Model
 
 
@@ -57,6 +58,7 @@ def radial_positions(model: Model, axis=(0.0, 0.0, 1.0), point=(0.0, 0.0, 0.0)) 
     return out
 
 
+@model_argument
 def centrifugal_load(model: Model, speed: float, *, axis=(0.0, 0.0, 1.0),
                      point=(0.0, 0.0, 0.0), name: str = "centrifugal") -> Load:
     """The static :class:`~fretwear.model.core.Load` of the body force ``rho Omega^2 r`` at

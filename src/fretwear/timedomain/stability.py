@@ -24,6 +24,7 @@ import numpy as np
 
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.solution import PeriodicSolution, initial_state
+from fretwear.model.checks import model_argument
 from fretwear.model.core import Model
 from fretwear.timedomain.options import InitialState, IntegrationOptions, SteadyStateOptions
 from fretwear.timedomain.steady import steady_state, steady_state_at_omega
@@ -62,6 +63,7 @@ class StabilityCheck:
         return [] if self.verdict == "stable" else [f"{self.verdict}: {self.message}"]
 
 
+@model_argument
 def check_periodic(model: Model, sol: PeriodicSolution, *, max_periods: int = 3000,
                    steps_per_period: int | None = None, perturbation: float = 1e-3,
                    tolerance: float = 0.2, periodicity_tol: float = 1e-4,
