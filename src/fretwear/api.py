@@ -35,6 +35,7 @@ from fretwear.hb import nonlinear_modes as _modes
 from fretwear.hb import periodic as _periodic
 from fretwear.hb import sweep as _sweep
 from fretwear.hb.dynamics import structure_dynamics
+from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.options import sweep_options
 from fretwear.model.checks import model_argument
 from fretwear.threads import limited
@@ -42,6 +43,7 @@ from fretwear.timedomain import integrate as _integrate
 from fretwear.timedomain import quasistatic as _quasistatic
 from fretwear.timedomain import steady as _steady
 from fretwear.timedomain.fallback import FALLBACK
+from fretwear.validate import flag, instance, number, reals
 from fretwear.wear.worn_frf import WORN_FRF
 from fretwear.wear.worn_state import worn_state as _worn_state
 
@@ -51,9 +53,12 @@ _RENAMED = {"stick_anchor": "anchor", "W0": "wear0", "k_w": "wear_coefficient",
 
 
 def _fallback(time_domain: bool):
-    if not isinstance(time_domain, bool):
-        raise TypeError(f"time_domain = {time_domain!r}: expected True or False")
-    return FALLBACK if time_domain else None
+    return FALLBACK if flag(time_domain, "time_domain") else None
+
+
+def _basis(basis) -> None:
+    """Refuse a ``basis`` that is not a :class:`~fretwear.hb.fourier.FourierBasis`."""
+    instance(basis, FourierBasis, "basis", "a FourierBasis (e.g. FourierBasis.up_to(7, 128))")
 
 
 #: where the time-domain drivers take the stick anchors
@@ -72,11 +77,13 @@ def _frequency(frequency, quasi_static: bool) -> dict:
     """The ``frequency`` keyword of the core function: required unless ``quasi_static``
     (where it only scales time, and the core's default applies)."""
     if frequency is None:
-        if quasi_static:
+        if flag(quasi_static, "quasi_static"):
             return {}
         raise InputError("frequency = None: expected the excitation frequency [Hz], a number "
                          "> 0 (only a quasi_static solve can do without)")
-    return {"frequency": frequency}
+    flag(quasi_static, "quasi_static")
+    return {"frequency": number(frequency, "frequency", low=0.0, open_low=not quasi_static,
+                                unit="Hz")}
 
 
 @contextlib.contextmanager
@@ -136,6 +143,7 @@ def solve_periodic(model, basis, frequency: float | None = None, *, quasi_static
     the harmonics and time histories of the contact (see its docstring).
     """
     _public_names("solve_periodic", kwargs)
+    _basis(basis)
     return _periodic.solve_periodic(model, basis, **_frequency(frequency, quasi_static),
                                     quasi_static=quasi_static,
                                     time_domain=_fallback(time_domain), **kwargs)
@@ -172,6 +180,7 @@ def sweep(model, basis, f_min: float, f_max: float, n_points: int, *, time_domai
     ``frequency_hz`` [Hz], ``point_success``, ``amplitude(point, axis)`` [m].
     """
     _public_names("sweep", kwargs)
+    _basis(basis)
     options = sweep_options(kwargs.pop("options", None))
     with _sweep_progress(progress, options, n_points) as options:
         return _sweep.sweep(model, basis, f_min, f_max, n_points,
@@ -213,6 +222,7 @@ def simulate_wear(model, basis, frequency: float | None = None, *, quasi_static:
     from a time integration).
     """
     _public_names("simulate_wear", kwargs)
+    _basis(basis)
     if condenser is not None:
         balance = kwargs.pop("balance", None) or _wear.BalanceSetup()
         if balance.condenser is not None:
@@ -251,6 +261,7 @@ def worn_state(model, basis, frequency: float | None = None, *, quasi_static: bo
     periodic solutions.
     """
     _public_names("worn_state", kwargs)
+    _basis(basis)
     if condenser is not None:
         balance = kwargs.pop("balance", None) or _wear.BalanceSetup()
         if balance.condenser is not None:
@@ -286,6 +297,10 @@ def frf_worn(model, basis, wear, f_min: float, f_max: float, n_points: int, *,
     :class:`~fretwear.hb.sweep.SweepResult` (``success``, ``message``, as :func:`sweep`).
     """
     _public_names("frf_worn", kwargs)
+    _basis(basis)
+    reals(wear, "wear", low=0.0)
+    for name, value in (("f_min", f_min), ("f_max", f_max)):
+        number(value, name, low=0.0, open_low=True, unit="Hz")
     options = sweep_options(kwargs.pop("options", None), WORN_FRF)
     with _sweep_progress(progress, options, n_points) as options:
         return _wear.frf_worn(model, basis, wear, f_min, f_max, n_points,
@@ -351,6 +366,8 @@ def nonlinear_mode(model, basis, amplitudes, *, mode: int = 1, interface: str = 
     ``state``, ``observed``), ``array(name)``.
     """
     _public_names("nonlinear_mode", kwargs)
+    _basis(basis)
+    reals(amplitudes, "amplitudes", low=0.0, open_low=True)
     if "omega_target" in kwargs:
         raise TypeError("nonlinear_mode() takes mode and interface, not omega_target")
     dyn = kwargs.pop("dyn", None)
@@ -412,6 +429,7 @@ def integrate(model, frequency: float, **kwargs):
     recorded samples and the final state ``U, V`` to continue the run.
     """
     _public_names("integrate", kwargs, _IN_START)
+    number(frequency, "frequency", low=0.0, open_low=True, unit="Hz")
     return _integrate.integrate(model, frequency, **kwargs)
 
 
@@ -439,6 +457,7 @@ def steady_state(model, frequency: float, **kwargs):
     ``classification``, the harmonics of the last period.
     """
     _public_names("steady_state", kwargs, _IN_START)
+    number(frequency, "frequency", low=0.0, open_low=True, unit="Hz")
     return _steady.steady_state(model, frequency, **kwargs)
 
 
@@ -466,5 +485,7 @@ def incremental_wear(model, *, wear_coefficient: float | None = None, wear0=None
     wear [m] per recorded cycle.
     """
     _public_names("incremental_wear", kwargs)
+    if wear_coefficient is not None:
+        number(wear_coefficient, "wear_coefficient", low=0.0, unit="1/Pa")
     return _quasistatic.incremental_wear(model, wear_coefficient=wear_coefficient, wear0=wear0,
                                          **kwargs)

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import contextlib
 import io
-import signal
 import tomllib
 from pathlib import Path
 
@@ -120,17 +119,13 @@ def run_study_file(kind: str, study: dict, folder: Path) -> tuple[int | None, st
     path = folder / "study.toml"
     path.write_text(_toml(study))
     err = io.StringIO()
-    old = signal.signal(signal.SIGALRM, hostile._alarm)
-    signal.alarm(hostile.TIME_LIMIT)
     try:
-        with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+        with hostile.cpu_time_limit(hostile.TIME_LIMIT), contextlib.redirect_stderr(err), \
+                contextlib.redirect_stdout(io.StringIO()):
             rc = cli.main(["study", str(path), "-o", str(folder / "out"), "--collect",
                            "--no-progress"])
     except hostile.Hang:
         return None, err.getvalue(), "hang"
     except BaseException as exc:  # what would be a traceback on the command line
         return None, err.getvalue(), f"traceback: {type(exc).__name__}: {exc}"[:300]
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, old)
     return rc, err.getvalue(), "message" if rc == 2 else "ran"

@@ -39,10 +39,12 @@ import scipy.sparse as sp
 
 from fretwear.errors import InputError
 from fretwear.hb import sparse_lu
+from fretwear.limits import RANGES
 from fretwear.model.checks import model_argument
 from fretwear.model.core import Model
 from fretwear.model.interfaces import observed_map, relative_model
 from fretwear.resources import require_memory
+from fretwear.validate import number
 
 
 @dataclass
@@ -753,6 +755,22 @@ def condense_static(model: Model, *, condenser=None) -> StaticCondensation:
 
 
 @model_argument
+def whole_orders(orders) -> np.ndarray:
+    """``orders`` as an int64 array after checking it holds distinct whole numbers in
+    ``[0, 2^62]``, at least one (an InputError naming ``orders`` otherwise)."""
+    if isinstance(orders, str | bytes):
+        raise InputError(f"orders = {orders!r}; expected harmonic orders (whole numbers >= 0)")
+    try:
+        a = np.asarray(orders)
+    except (TypeError, ValueError):
+        raise InputError("orders: expected a list of harmonic orders") from None
+    if a.ndim != 1 or not a.size or a.dtype.kind not in "iu" or np.any(a < 0) or np.any(
+            a > 2**62) or np.unique(a).size != a.size:
+        raise InputError(f"orders = {orders!r}; expected distinct harmonic orders, whole "
+                         "numbers >= 0, at least one (e.g. [0, 1, 2, 3])")
+    return a.astype(np.int64)
+
+
 def condense(model: Model, frequency: float, orders, *, quasi_static: bool = False,
              condenser=None) -> Reduced:
     """Condense ``model`` onto its contact DOFs for harmonic ``orders`` (``[0, h1, .., hk]``)
@@ -766,6 +784,10 @@ def condense(model: Model, frequency: float, orders, *, quasi_static: bool = Fal
     contact-local coordinates with the observed-DOF recovery rows
     (``Reduced.omega = 2 pi frequency`` [rad/s], ``Reduced.frequency`` as given).
     """
+    frequency = number(frequency, "frequency", low=0.0, high=RANGES["frequency"][1], unit="Hz")
+    if not (quasi_static or frequency > 0):
+        raise InputError("frequency = 0 Hz: expected a frequency > 0 [Hz] (or quasi_static)")
+    orders = whole_orders(orders)
     return _condense(model, 2 * np.pi * frequency, orders, quasi_static=quasi_static,
                      frequency=frequency, condenser=condenser)
 

@@ -19,10 +19,31 @@ import scipy.sparse as sp
 
 from fretwear.errors import InputError
 from fretwear.model.core import WAVEFORMS, ContactInterface, Load, Mesh, Model, ObservedPoint
-from fretwear.validate import ArgumentTypeError
+from fretwear.validate import ArgumentTypeError, whole
+
+#: the largest magnitude of a whole-number argument (as the case files' integer keys)
+INTEGER_MAX = 2**62
 
 
-def _array(value, what: str, *, kind: str = "f", shape=None, low=None, positive=False):
+def whole_number(value, what: str, low: int | None = None) -> int:
+    """``value`` as an int after checking it is an integer (not a bool, float or string) of
+    magnitude at most :data:`INTEGER_MAX` and ``>= low``."""
+    return whole(value, what, low=-INTEGER_MAX if low is None else low, high=INTEGER_MAX)
+
+
+def amplitudes(value, what: str, *, nan: bool = False) -> np.ndarray:
+    """A non-empty array of real or complex amplitudes, finite (NaN allowed with ``nan``:
+    an entry not computed), of moduli as given."""
+    a = _array(value, what, kind="c", allow_nan=nan)
+    if not a.size:
+        raise InputError(f"{what} is empty; expected at least one amplitude")
+    if nan and not np.any(np.isfinite(a)):
+        raise InputError(f"{what} holds no finite value")
+    return a
+
+
+def _array(value, what: str, *, kind: str = "f", shape=None, low=None, positive=False,
+           allow_nan=False):
     """``value`` as an array after checking its kind (``"f"`` real, ``"c"`` real or complex,
     ``"i"`` integer), ``shape`` (None entries free), finiteness and bounds."""
     if isinstance(value, str | bytes) or value is None:
@@ -39,7 +60,7 @@ def _array(value, what: str, *, kind: str = "f", shape=None, low=None, positive=
             s is not None and n != s for n, s in zip(a.shape, shape, strict=True))):
         want = "(" + ", ".join("n" if s is None else str(s) for s in shape) + ")"
         raise InputError(f"{what} has shape {a.shape}; expected {want}")
-    if a.dtype.kind in "fc" and not np.all(np.isfinite(a)):
+    if a.dtype.kind in "fc" and not np.all(np.isfinite(a) | (allow_nan & np.isnan(a))):
         raise InputError(f"{what} holds non-finite values (nan or inf); expected finite ones")
     if low is not None and a.size and np.any(a.real < low):
         raise InputError(f"{what} holds {a.real.min():g}; expected values >= {low:g}")

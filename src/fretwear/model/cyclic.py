@@ -30,7 +30,7 @@ import scipy.sparse as sp
 
 from fretwear.errors import InputError
 from fretwear.model.build import _contact
-from fretwear.model.checks import model_argument
+from fretwear.model.checks import model_argument, whole_number
 from fretwear.model.core import ContactInterface, Load, Model, ObservedPoint
 from fretwear.model.interfaces import check_distinct, combine
 
@@ -475,6 +475,7 @@ def whole_disk(sector: CyclicSector, engine_order: int = 0) -> Model:
     cyclic boundaries, every sector with the sector's contact (frames turned) and loads
     (phased by the travelling wave of ``engine_order``); observed points of sector 0. The
     reference of the cyclic reduction (no mesh kept)."""
+    engine_order = whole_number(engine_order, "engine_order")
     m = sector.model
     A, nd = sector_maps(sector)
 

@@ -9,7 +9,6 @@ on ``[normal, tangential(s)]``, with the sign of the normal DOF flipped when
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 import scipy.io
@@ -23,6 +22,7 @@ from fretwear.model.interfaces import relative_model
 from fretwear.model.supports import rigid_motion_check
 from fretwear.resources import require_memory
 from fretwear.validate import is_real
+from fretwear.validate import path as file_path
 
 SYMMETRY_TOL = 1e-9  # max |A - A^T| relative to max |A|
 
@@ -592,7 +592,7 @@ def read_matrix_market(path, *, shape: tuple | None = None):
         shape other than ``shape``, or a size that cannot fit in memory (checked from the
         header before reading).
     """
-    path = Path(path)
+    path = file_path(path, "path")
     if not path.is_file():
         raise InputError(f"Matrix Market file {str(path)!r} does not exist")
     try:
