@@ -104,6 +104,8 @@ def _toml(d: dict, prefix: str = "") -> str:
 
 
 def _value(v) -> str:
+    if isinstance(v, list) and not v:
+        return "[]"
     text = hostile.toml_text({"k": v})  # '"k" = ...' or a table
     return text.split("=", 1)[1].strip()
 
