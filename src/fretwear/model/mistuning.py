@@ -101,7 +101,8 @@ def random_mistuning(n_sectors: int, std: float, seed: int, kinds=("young",)) ->
     every factor positive (a few per cent, as measured on real disks)."""
     if isinstance(std, bool) or not isinstance(std, int | float) or not 0 <= std < 0.5:
         raise InputError(f"mistuning std = {std!r}: expected a standard deviation in [0, 0.5)")
-    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or not \
+            0 <= seed <= 2**62:
         raise InputError(f"mistuning seed = {seed!r}: expected an integer >= 0")
     unknown = [k for k in kinds if k not in KINDS]
     if unknown or not kinds:

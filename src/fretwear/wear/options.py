@@ -189,5 +189,6 @@ def _is_number(v) -> bool:
 
 
 def _is_integer(v) -> bool:
-    """A whole number of an integer type (numpy's included), not a boolean (2.0 is refused)."""
-    return isinstance(v, numbers.Integral) and not isinstance(v, bool)
+    """A whole number of an integer type (numpy's included), not a boolean (2.0 is refused),
+    of magnitude at most 2^62 (as the case files' integer keys)."""
+    return isinstance(v, numbers.Integral) and not isinstance(v, bool) and abs(v) <= 2**62
