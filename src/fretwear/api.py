@@ -398,6 +398,7 @@ def mode_frf(model, backbone: _modes.Backbone, *, damping: str = "viscous", cond
     :class:`~fretwear.hb.mode_synthesis.ModalFRF`: ``amplitude``, ``modal_force``,
     ``omega_lo``, ``omega_hi`` [rad/s], ``observed``, ``peak``, ``curve()``.
     """
+    instance(backbone, _modes.Backbone, "backbone", "the Backbone of fretwear.nonlinear_mode")
     if dyn is None:
         dyn = structure_dynamics(model, condenser)
     return _synth.synthesize(backbone, _synth.modal_forces(model, backbone, dyn=dyn),

@@ -23,6 +23,7 @@ import math
 from pathlib import Path
 from types import SimpleNamespace
 
+import numpy as np
 import tomli_w
 
 from fretwear.analyses.base import RunContext, RunOutput
@@ -32,6 +33,7 @@ from fretwear.errors import InputError
 from fretwear.io.case import OUTPUT, Case
 from fretwear.io.schema import Context, Variant, show
 from fretwear.model.checks import model_argument
+from fretwear.validate import is_real
 
 #: the file name a Python run stands for in messages and in ``case_path``
 PYTHON_CASE = "python-model.toml"
@@ -125,9 +127,48 @@ def _kind(result) -> str:
     for kind, cls in (("sweep", SweepResult), ("periodic", PeriodicSolution),
                       ("wear", WearResult), ("transient", TransientResult)):
         if isinstance(result, cls):
+            check_record(kind, result)
             return kind
     raise InputError(f"result = {type(result).__name__}: expected the result of fw.sweep, "
                      "fw.frf_worn, fw.solve_periodic, fw.simulate_wear or fw.integrate")
+
+
+def check_record(kind: str, result) -> None:
+    """Refuse a result record whose fields are not what fretwear writes in it (a record
+    built or edited by hand): one InputError naming the field."""
+    from fretwear.hb.solution import PeriodicSolution, non_finite
+    from fretwear.hb.sweep_result import SweepPoint
+    from fretwear.wear.history import WearHistory
+    from fretwear.wear.options import STOP_REASONS
+
+    def bad(field, expected):
+        value = getattr(result, field)
+        raise InputError(f"result.{field} = {repr(value)[:60]}; expected {expected}")
+
+    if kind == "sweep":
+        pts = result.points
+        if not isinstance(pts, list) or not pts or not all(isinstance(p, SweepPoint)
+                                                            for p in pts):
+            bad("points", "a non-empty list of the sweep's points (SweepPoint)")
+    elif kind == "periodic":
+        why = non_finite(result)
+        if why:
+            raise InputError(f"result holds non-finite values in {why}: not a solution")
+    elif kind == "wear":
+        if not isinstance(result.history, WearHistory):
+            bad("history", "the run's WearHistory")
+        for field in ("initial", "final"):
+            if getattr(result, field) is not None and not isinstance(getattr(result, field),
+                                                                     PeriodicSolution):
+                bad(field, "a PeriodicSolution or None")
+        if not isinstance(result.success, bool | np.bool_):
+            bad("success", "True or False")
+        if not isinstance(result.message, str):
+            bad("message", "a string")
+        if result.stop_reason not in (*STOP_REASONS, ""):
+            bad("stop_reason", f"one of {list(STOP_REASONS)}")
+        if not (is_real(result.wall_time) and 0 <= result.wall_time < math.inf):
+            bad("wall_time", "a number of seconds >= 0")
 
 
 def results_dataset(result, model, basis, points=None, frequency=None):

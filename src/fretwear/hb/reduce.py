@@ -78,6 +78,19 @@ class Reduced:
     frequency: float = math.nan
 
     def __post_init__(self):
+        self.omega = number(self.omega, "Reduced omega", low=0.0, unit="rad/s")
+        self.orders = whole_orders(self.orders)
+        nb = self.orders.size
+        for name, ndim in (("Z", 3), ("F", 2), ("obs_A", 3), ("obs_b", 2)):
+            a = getattr(self, name)
+            if not isinstance(a, np.ndarray) or a.ndim != ndim or a.shape[0] != nb or \
+                    a.dtype.kind not in "fc" or not np.all(np.isfinite(a)):
+                raise InputError(f"Reduced {name} = {repr(a)[:50]}; expected a finite "
+                                 f"{ndim}-dimensional array, one block per order ({nb})")
+        m = self.Z.shape[1]
+        if self.Z.shape[2] != m or self.F.shape[1] != m or self.obs_A.shape[2] != m:
+            raise InputError(f"Reduced arrays of inconsistent sizes: Z {self.Z.shape}, F "
+                             f"{self.F.shape}, obs_A {self.obs_A.shape}")
         if math.isnan(self.frequency):
             self.frequency = self.omega / (2 * np.pi)
 
