@@ -88,6 +88,10 @@ def survey_files(what: str, n: int, strategy, run, kind_of, changes_of, result: 
         if kind not in ("ran", "message"):
             examples.setdefault(kind, []).append(
                 f"{kind_of(generated)}: {'; '.join(changes_of(generated))} -> {outcome}")
+            print(f"  [{what}] {examples[kind][-1]}"[:400], flush=True)
+        if sum(counts.values()) % 10 == 0:  # a running tally (a long survey on a busy machine)
+            print(f"  [{what}] so far {sum(counts.values())}: " + ", ".join(
+                f"{k} {v}" for k, v in counts.most_common()), flush=True)
 
     survey()
     total = sum(counts.values())
