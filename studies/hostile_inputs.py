@@ -123,20 +123,46 @@ def checkpoint_survey() -> None:
 
 
 def api_survey() -> None:
-    """Each hostile call of tests/helpers/hostile_api.py: counts of each outcome and every call
-    that did not end in a message."""
-    from helpers import hostile_api
+    """Each hostile call of tests/helpers/hostile_api.py over every public name: counts of
+    each outcome, the accepted calls classified (legal, with why, or a silent accept of a
+    wrong input), every deep error, and the public names not covered."""
+    from helpers import hostile_api, hostile_api_more
+
+    import fretwear as fw
 
     counts: Counter = Counter()
+    reasons: Counter = Counter()
     others = []
-    for label, thunk in hostile_api.calls():
-        out = hostile_api.outcome(thunk)
-        counts[out.split(":")[0]] += 1
-        if out != "message":
-            others.append(f"{label} -> {out}")
-    print(f"API calls: {sum(counts.values())}")
+    with tempfile.TemporaryDirectory() as tmp:
+        calls = hostile_api.all_calls(Path(tmp))
+        for label, name, key, value, thunk in calls:
+            out = hostile_api.outcome(thunk)
+            kind = out.split(":")[0]
+            if kind == "accepted":
+                why = hostile_api.legal(name, key, value)
+                kind = "accepted (legal)" if why else "silent accept"
+                if why:
+                    reasons[why] += 1
+                else:
+                    others.append(f"{label} -> silent accept")
+            elif kind != "message":
+                others.append(f"{label} -> {out}")
+            counts[kind] += 1
+    names = {name for _, name, _, _, _ in calls} | set(hostile_api_more.NOT_CALLED)
+    names |= {n for v in hostile_api.COVERS.values() for n in v}
+    missing = sorted(set(fw.__all__) - names)
+    bad = hostile_api_more.check_not_called()
+    failed = "; FAILED: " + ", ".join(bad) if bad else ""
+    print(f"API calls: {sum(counts.values())} over {len(set(fw.__all__) - set(missing))} of "
+          f"the {len(fw.__all__)} public names (fretwear.__all__; "
+          f"{len(hostile_api_more.NOT_CALLED)} checked without calls: "
+          f"{', '.join(hostile_api_more.NOT_CALLED)}{failed})")
+    print(f"  names not covered: {', '.join(missing) if missing else 'none'}")
     for kind, n in counts.most_common():
         print(f"  {kind}: {n}")
+    print("  why the accepted calls are legal:")
+    for why, n in reasons.most_common():
+        print(f"    {n} x {why}")
     for line in others:
         print("  " + line)
 
