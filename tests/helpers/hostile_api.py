@@ -88,11 +88,16 @@ def calls():
 
 def outcome(thunk) -> str:
     """``"message"`` (an InputError or a ConvergenceError, or Python's TypeError for a wrong
-    call), ``"accepted"`` (the call returned) or ``"deep error: <type>"``."""
+    call), ``"accepted"`` (the call returned), ``"hang"`` (beyond the CPU time limit of the
+    case-file survey) or ``"deep error: <type>"``."""
+    from helpers.hostile import TIME_LIMIT, Hang, cpu_time_limit
+
     try:
-        with warnings.catch_warnings():
+        with warnings.catch_warnings(), cpu_time_limit(TIME_LIMIT):
             warnings.simplefilter("ignore")
             thunk()
+    except Hang:
+        return "hang"
     except (fw.InputError, fw.ConvergenceError):  # a one-line message of fretwear
         return "message"
     except TypeError as exc:  # Python's own: a missing or unexpected argument

@@ -23,8 +23,9 @@ def positive(value, what: str) -> float:
 def count(value, what: str, minimum: int = 1) -> int:
     if isinstance(value, bool) or not isinstance(value, int | np.integer):
         raise InputError(f"{what} = {value!r}; expected an integer >= {minimum}")
-    if value < minimum:
-        raise InputError(f"{what} = {value}; expected an integer >= {minimum}")
+    if value < minimum or value > 2**62:
+        raise InputError(f"{what} = {value}; expected an integer >= {minimum} (and at most "
+                         "2^62)")
     return int(value)
 
 
