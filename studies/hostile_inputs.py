@@ -145,7 +145,7 @@ def api_survey() -> None:
                     reasons[why] += 1
                 else:
                     others.append(f"{label} -> silent accept")
-            elif kind != "message":
+            elif kind not in ("message", "accepted with a warning"):
                 others.append(f"{label} -> {out}")
             counts[kind] += 1
     names = {name for _, name, _, _, _ in calls} | set(hostile_api_more.NOT_CALLED)

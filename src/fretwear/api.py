@@ -43,7 +43,7 @@ from fretwear.timedomain import integrate as _integrate
 from fretwear.timedomain import quasistatic as _quasistatic
 from fretwear.timedomain import steady as _steady
 from fretwear.timedomain.fallback import FALLBACK
-from fretwear.validate import flag, instance, number, reals
+from fretwear.validate import flag, instance, number, reals, whole
 from fretwear.wear.worn_frf import WORN_FRF
 from fretwear.wear.worn_state import worn_state as _worn_state
 
@@ -54,6 +54,14 @@ _RENAMED = {"stick_anchor": "anchor", "W0": "wear0", "k_w": "wear_coefficient",
 
 def _fallback(time_domain: bool):
     return FALLBACK if flag(time_domain, "time_domain") else None
+
+
+def _band(f_min, f_max, n_points) -> None:
+    """Refuse a frequency band that is not two frequencies > 0 [Hz] and a whole number of
+    points >= 1."""
+    for name, value in (("f_min", f_min), ("f_max", f_max)):
+        number(value, name, low=0.0, open_low=True, unit="Hz")
+    whole(n_points, "n_points", low=1)
 
 
 def _basis(basis) -> None:
@@ -181,6 +189,7 @@ def sweep(model, basis, f_min: float, f_max: float, n_points: int, *, time_domai
     """
     _public_names("sweep", kwargs)
     _basis(basis)
+    _band(f_min, f_max, n_points)
     options = sweep_options(kwargs.pop("options", None))
     with _sweep_progress(progress, options, n_points) as options:
         return _sweep.sweep(model, basis, f_min, f_max, n_points,
@@ -299,8 +308,7 @@ def frf_worn(model, basis, wear, f_min: float, f_max: float, n_points: int, *,
     _public_names("frf_worn", kwargs)
     _basis(basis)
     reals(wear, "wear", low=0.0)
-    for name, value in (("f_min", f_min), ("f_max", f_max)):
-        number(value, name, low=0.0, open_low=True, unit="Hz")
+    _band(f_min, f_max, n_points)
     options = sweep_options(kwargs.pop("options", None), WORN_FRF)
     with _sweep_progress(progress, options, n_points) as options:
         return _wear.frf_worn(model, basis, wear, f_min, f_max, n_points,

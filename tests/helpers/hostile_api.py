@@ -88,13 +88,15 @@ def calls():
 
 def outcome(thunk) -> str:
     """``"message"`` (an InputError or a ConvergenceError, or Python's TypeError for a wrong
-    call), ``"accepted"`` (the call returned), ``"hang"`` (beyond the CPU time limit of the
-    case-file survey) or ``"deep error: <type>"``."""
+    call), ``"accepted"`` (the call returned), ``"accepted with a warning"`` (it returned
+    with a warning of fretwear, e.g. an UnusualValueWarning naming the value: not silent),
+    ``"hang"`` (beyond the CPU time limit of the case-file survey) or
+    ``"deep error: <type>"``."""
     from helpers.hostile import TIME_LIMIT, Hang, cpu_time_limit
 
     try:
-        with warnings.catch_warnings(), cpu_time_limit(TIME_LIMIT):
-            warnings.simplefilter("ignore")
+        with warnings.catch_warnings(record=True) as caught, cpu_time_limit(TIME_LIMIT):
+            warnings.simplefilter("always")
             thunk()
     except Hang:
         return "hang"
@@ -104,7 +106,8 @@ def outcome(thunk) -> str:
         return "message" if "argument" in str(exc) else f"deep error: TypeError: {exc}"
     except Exception as exc:  # noqa: BLE001 (the survey classifies every escape)
         return f"deep error: {type(exc).__name__}: {exc}"[:160]
-    return "accepted"
+    named = [w for w in caught if issubclass(w.category, UserWarning)]
+    return "accepted with a warning" if named else "accepted"
 
 
 #: the public name each target of :func:`targets` calls (and the others it takes part in)
@@ -183,6 +186,11 @@ _NONE_MEANS = {
     ("RunControl", "checkpoint"): "no checkpoint file",
     ("incremental_wear", "wear_coefficient"): "the model's contact wear coefficient",
     ("mistuning", "young"): "no mistuning of Young's modulus (all factors 1)",
+    ("WearResult", "initial"): "no initial solution (a run resumed from its last state)",
+    ("WearResult", "final"): "no final solution (a run that stopped before a balance)",
+    ("InitialState", "U0"): "start from rest",
+    ("InitialState", "V0"): "start from rest",
+    ("set_blas_threads", "n"): "the BLAS library's own setting",
 }
 
 #: ((names or "*", arguments or "*", values), why the values are legal there)
@@ -225,4 +233,9 @@ _LEGAL = (
     ((("Traction",), ("pressure",), (-1,)), "a negative pressure pulls (a traction load)"),
     ((("ObservedPoint",), ("coords",), ([],)), "the coordinates of a point of user matrices "
      "(none: the point is DOFs only)"),
+    ((("Load", "ObservedPoint"), ("name",), ("1",)), "'1' is a valid name (any string)"),
+    ((("WearResult",), ("message",), ("1",)), "a message is any string"),
+    ((("RunControl",), ("checkpoint",), ("1",)), "'1' is a relative file path (a file named 1)"),
+    ((("blade_amplitudes",), ("amplitude",), (-1,)), "a (complex) amplitude of -1 m: its modulus "
+     "1 m is taken"),
 )

@@ -34,6 +34,7 @@ from fretwear.io.case import OUTPUT, Case
 from fretwear.io.schema import Context, Variant, show
 from fretwear.model.checks import model_argument
 from fretwear.validate import is_real
+from fretwear.validate import path as file_path
 
 #: the file name a Python run stands for in messages and in ``case_path``
 PYTHON_CASE = "python-model.toml"
@@ -111,7 +112,7 @@ def run(model, analysis, output, *, title: str = "", progress: bool = False,
     :class:`~fretwear.analyses.base.RunOutput`: ``success``, ``message``, ``dataset``,
     ``results`` (the ``results.nc`` written), ``figures``, ``files``.
     """
-    out_dir = Path(output).expanduser().resolve()
+    out_dir = file_path(output, "output").expanduser().resolve()
     case = python_case(analysis, dict(keys), out_dir, title)
     return run_built(model, case, out_dir, RunContext(out_dir, resume=resume,
                                                       progress=progress), echo=echo)
@@ -228,7 +229,7 @@ def write_results(result, output, model, basis=None, *, title: str = "", points=
     """
     from fretwear.io.results import write_results as write
 
-    out_dir = Path(output).expanduser().resolve()
+    out_dir = file_path(output, "output").expanduser().resolve()
     check_output(out_dir, [RESULTS_FILE])
     kind, ds = results_dataset(result, model, basis, points, frequency)
     return write(out_dir / RESULTS_FILE, ds, title=title or "results obtained in Python",
@@ -253,7 +254,7 @@ def plot(result, output, model, basis=None, *, title: str = "", fmt: str = "png"
     -------
     The files written.
     """
-    out_dir = Path(output).expanduser().resolve()
+    out_dir = file_path(output, "output").expanduser().resolve()
     check_output(out_dir)
     kind, ds = results_dataset(result, model, basis)
     name = title or "results obtained in Python"

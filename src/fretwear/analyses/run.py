@@ -34,6 +34,7 @@ from fretwear.io import case as case_files
 from fretwear.io.case import Case, build_model, ignored_notes, observed_notes, unusual_notes
 from fretwear.io.results import read_results, write_results
 from fretwear.threads import limited
+from fretwear.validate import path as file_path
 
 RESULTS_FILE = "results.nc"
 
@@ -48,7 +49,7 @@ def load_case(path: Path | str) -> Case:
     (``case.analysis``, ``case.output``, ...), the case text and its path; SI units
     (frequencies in Hz) as in ``docs/case-files.md``.
     """
-    return case_files.load_case(path, analysis_tables())
+    return case_files.load_case(file_path(path, "path"), analysis_tables())
 
 
 def case_docs() -> str:

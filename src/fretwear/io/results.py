@@ -32,6 +32,7 @@ import xarray as xr
 from fretwear import __version__
 from fretwear.errors import ConvergenceError, InputError
 from fretwear.files import atomic_write
+from fretwear.validate import path as file_path
 
 ENGINE = "h5netcdf"
 
@@ -215,6 +216,7 @@ def read_results(path: Path | str) -> xr.Dataset:
     InputError
         The file does not exist or is not a NetCDF file.
     """
+    path = file_path(path, "path")
     path = Path(path)
     if not path.is_file():
         raise InputError(f"results file {str(path)!r} does not exist")

@@ -99,6 +99,7 @@ def random_mistuning(n_sectors: int, std: float, seed: int, kinds=("young",)) ->
     (``numpy.random.default_rng(seed)``, drawn sector by sector, kind after kind in the
     order of :data:`KINDS`) for each kind in ``kinds``; the others 1. ``std`` must keep
     every factor positive (a few per cent, as measured on real disks)."""
+    n_sectors = whole_number(n_sectors, "n_sectors", low=1)
     if isinstance(std, bool) or not isinstance(std, int | float) or not 0 <= std < 0.5:
         raise InputError(f"mistuning std = {std!r}: expected a standard deviation in [0, 0.5)")
     if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or not \
