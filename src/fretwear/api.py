@@ -495,6 +495,6 @@ def incremental_wear(model, *, wear_coefficient: float | None = None, wear0=None
     """
     _public_names("incremental_wear", kwargs)
     if wear_coefficient is not None:
-        number(wear_coefficient, "wear_coefficient", low=0.0, unit="1/Pa")
+        number(wear_coefficient, "wear_coefficient", low=0.0, high=1.0, unit="1/Pa")
     return _quasistatic.incremental_wear(model, wear_coefficient=wear_coefficient, wear0=wear0,
                                          **kwargs)

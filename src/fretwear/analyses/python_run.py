@@ -33,7 +33,7 @@ from fretwear.errors import InputError
 from fretwear.io.case import OUTPUT, Case
 from fretwear.io.schema import Context, Variant, show
 from fretwear.model.checks import model_argument
-from fretwear.validate import is_real
+from fretwear.validate import flag, is_real
 from fretwear.validate import path as file_path
 
 #: the file name a Python run stands for in messages and in ``case_path``
@@ -134,6 +134,19 @@ def _kind(result) -> str:
                      "fw.frf_worn, fw.solve_periodic, fw.simulate_wear or fw.integrate")
 
 
+def _check_basis(basis) -> None:
+    """``basis`` is None, a FourierBasis, or (for a time integration) a whole number of
+    harmonics >= 1."""
+    from fretwear.hb.fourier import FourierBasis
+
+    if basis is None or isinstance(basis, FourierBasis):
+        return
+    if isinstance(basis, bool) or not isinstance(basis, int | np.integer) or not \
+            1 <= basis <= 2**62:
+        raise InputError(f"basis = {repr(basis)[:60]}; expected the FourierBasis of the "
+                         "result (or, for a time integration, a number of harmonics >= 1)")
+
+
 def check_record(kind: str, result) -> None:
     """Refuse a result record whose fields are not what fretwear writes in it (a record
     built or edited by hand): one InputError naming the field."""
@@ -227,6 +240,7 @@ def write_results(result, output, model, basis=None, *, title: str = "", points=
     -------
     The path of the file written.
     """
+    _check_basis(basis)
     from fretwear.io.results import write_results as write
 
     out_dir = file_path(output, "output").expanduser().resolve()
@@ -254,6 +268,8 @@ def plot(result, output, model, basis=None, *, title: str = "", fmt: str = "png"
     -------
     The files written.
     """
+    _check_basis(basis)
+    flag(vtu, "vtu")
     out_dir = file_path(output, "output").expanduser().resolve()
     check_output(out_dir)
     kind, ds = results_dataset(result, model, basis)

@@ -38,12 +38,20 @@ from fretwear.model.regions import region_nodes, restricted
 from fretwear.model.supports import check_supported
 from fretwear.validate import is_real, number
 
-
 # --------------------------------------------------------------------------------------------
 # input dataclasses
 # --------------------------------------------------------------------------------------------
+#: the largest magnitude of a stiffness, pressure, force or damping coefficient of a model (far
+#: beyond any structure; a larger one is a typo, and would make the matrices overflow)
+MAGNITUDE_MAX = 1e20
+
+
 def _finite(value, what: str, *, minimum=None, allow_inf=False) -> float:
-    return number(value, what, low=minimum, allow_inf=allow_inf)
+    v = number(value, what, low=minimum, allow_inf=allow_inf)
+    if math.isfinite(v) and abs(v) > MAGNITUDE_MAX:
+        raise InputError(f"{what} = {value!r}; expected a magnitude at most {MAGNITUDE_MAX:g}"
+                         + (" (inf for rigid)" if allow_inf else ""))
+    return v
 
 
 def _warn_unusual(*checks) -> None:
