@@ -43,7 +43,7 @@ from fretwear.timedomain import integrate as _integrate
 from fretwear.timedomain import quasistatic as _quasistatic
 from fretwear.timedomain import steady as _steady
 from fretwear.timedomain.fallback import FALLBACK
-from fretwear.validate import flag, instance, number, reals, whole
+from fretwear.validate import ArgumentTypeError, flag, instance, is_real, number, reals, whole
 from fretwear.wear.worn_frf import WORN_FRF
 from fretwear.wear.worn_state import worn_state as _worn_state
 
@@ -66,7 +66,9 @@ def _band(f_min, f_max, n_points) -> None:
 
 def _basis(basis) -> None:
     """Refuse a ``basis`` that is not a :class:`~fretwear.hb.fourier.FourierBasis`."""
-    instance(basis, FourierBasis, "basis", "a FourierBasis (e.g. FourierBasis.up_to(7, 128))")
+    if not isinstance(basis, FourierBasis):
+        raise ArgumentTypeError(f"basis = {basis!r}: expected a fretwear FourierBasis (e.g. "
+                                "FourierBasis.up_to(7, 128))")
 
 
 #: where the time-domain drivers take the stick anchors
@@ -90,8 +92,9 @@ def _frequency(frequency, quasi_static: bool) -> dict:
         raise InputError("frequency = None: expected the excitation frequency [Hz], a number "
                          "> 0 (only a quasi_static solve can do without)")
     flag(quasi_static, "quasi_static")
-    return {"frequency": number(frequency, "frequency", low=0.0, open_low=not quasi_static,
-                                unit="Hz")}
+    if not is_real(frequency):  # its value is checked by the solver's own message
+        raise InputError(f"frequency = {frequency!r}: expected a number > 0 [Hz]")
+    return {"frequency": frequency}
 
 
 @contextlib.contextmanager

@@ -144,7 +144,7 @@ def check_observed(p, ndof: int, what: str) -> None:
 def check_model(model, what: str = "model") -> Model:
     """``model`` after checking it is a :class:`Model` whose every field is sound."""
     if not isinstance(model, Model):
-        raise ArgumentTypeError(f"{what} = {_short(model)}; expected a fretwear Model "
+        raise ArgumentTypeError(f"{what} = {_short(model)}: expected a fretwear Model "
                                 "(fretwear.from_mesh, fretwear.from_matrices)")
     n = _matrix(model.K, f"{what}.K", None)
     if n < 1:
