@@ -191,6 +191,8 @@ _NONE_MEANS = {
     ("InitialState", "U0"): "start from rest",
     ("InitialState", "V0"): "start from rest",
     ("set_blas_threads", "n"): "the BLAS library's own setting",
+    ("write_results", "basis"): "the result's own basis (5 harmonics for a time integration)",
+    ("plot", "basis"): "the result's own basis (5 harmonics for a time integration)",
 }
 
 #: ((names or "*", arguments or "*", values), why the values are legal there)

@@ -189,6 +189,8 @@ class Traction:
                 f"traction (vector in Pa); got pressure={self.pressure!r}, "
                 f"traction={self.traction!r}"
             )
+        if self.pressure is not None and not callable(self.pressure):
+            self.pressure = _finite(self.pressure, f"{what}: pressure")
         _check_waveform(self.waveform, self.coefficients, what)
 
 
@@ -309,10 +311,11 @@ class ContactSpec:
         for key in ("normal_stiffness", "tangential_stiffness"):
             v = number(getattr(self, key), f"{what}: {key}", low=0.0, open_low=True,
                        allow_inf=True, unit="Pa/m")
-            setattr(self, key, v)
+            setattr(self, key, _finite(v, f"{what}: {key}", allow_inf=True))
         if self.normal_pressure is not None:
-            self.normal_pressure = number(self.normal_pressure, f"{what}: normal_pressure",
-                                          low=0.0, unit="Pa")
+            self.normal_pressure = _finite(number(self.normal_pressure,
+                                                  f"{what}: normal_pressure", low=0.0,
+                                                  unit="Pa"), f"{what}: normal_pressure")
         waveforms = [w for w in WAVEFORMS if w != "fourier"]
         if self.normal_waveform not in waveforms:
             raise InputError(f"{what}: normal_waveform = {self.normal_waveform!r}; expected one "

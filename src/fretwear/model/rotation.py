@@ -32,7 +32,7 @@ from fretwear.model.core import Load, Model
 
 def _speed(speed) -> float:
     if isinstance(speed, bool) or not isinstance(speed, int | float | np.floating) \
-            or not math.isfinite(speed) or speed < 0:
+            or not math.isfinite(speed) or not 0 <= speed <= 1e10:
         raise InputError(f"speed = {speed!r}: expected a rotation speed >= 0 [rad/s]")
     return float(speed)
 
