@@ -57,11 +57,12 @@ def _fallback(time_domain: bool):
 
 
 def _band(f_min, f_max, n_points) -> None:
-    """Refuse a frequency band that is not two frequencies > 0 [Hz] and a whole number of
-    points >= 1."""
+    """Refuse a frequency band that is not two numbers [Hz] and a whole number of points
+    (their values are checked by the sweep's own messages)."""
     for name, value in (("f_min", f_min), ("f_max", f_max)):
-        number(value, name, low=0.0, open_low=True, unit="Hz")
-    whole(n_points, "n_points", low=1)
+        if not is_real(value):
+            raise InputError(f"{name} = {value!r}: expected a frequency > 0 [Hz]")
+    whole(n_points, "n_points")
 
 
 def _basis(basis) -> None:

@@ -22,7 +22,7 @@ import numpy as np
 from fretwear import api
 from fretwear.errors import InputError
 from fretwear.model.checks import model_argument
-from fretwear.validate import number, reals, whole
+from fretwear.validate import is_real, whole
 
 
 def excitation_scaled(model, level: float):
@@ -93,9 +93,12 @@ def load_levels(model, basis, f_min: float, f_max: float, n_points: int, levels,
     :class:`LoadLevels`.
     """
     for name, value in (("f_min", f_min), ("f_max", f_max)):
-        number(value, name, low=0.0, open_low=True, unit="Hz")
-    whole(n_points, "n_points", low=1)
-    reals(levels, "levels", low=0.0, open_low=True, ndim=1)
+        if not is_real(value):
+            raise InputError(f"{name} = {value!r}: expected a frequency > 0 [Hz]")
+    whole(n_points, "n_points")
+    if isinstance(levels, str | bytes) or any(not is_real(v) for v in np.ravel(
+            np.asarray(levels, dtype=object))):
+        raise InputError(f"levels = {levels!r}: expected factors > 0 (numbers)")
     try:
         values = sorted(float(v) for v in levels)
     except (TypeError, ValueError):
