@@ -239,3 +239,16 @@ def test_gap_larger_than_any_structure_is_refused():
     with pytest.raises(InputError, match="gap .m.: 1e.300; expected magnitudes <= 100000"):
         _contact_dofs(gap=1e300)
     assert fw.ContactSpec("bottom", mu=0.3, gap=1e-3).gap == 1e-3
+
+
+def test_the_hostile_api_survey_covers_every_public_name():
+    """Every name of fretwear.__all__ is called by the API survey (tests/helpers/
+    hostile_api.py and hostile_api_more.py) or checked without calls (the version string and
+    the exceptions), so a name added to the API without its hostile calls fails here. The
+    reference is fretwear.__all__ itself."""
+    from helpers import hostile_api, hostile_api_more
+
+    names = {n for v in hostile_api.COVERS.values() for n in v}
+    names |= set(hostile_api_more.TARGET_NAMES) | set(hostile_api_more.NOT_CALLED)
+    assert set(fw.__all__) <= names, sorted(set(fw.__all__) - names)
+    assert hostile_api_more.check_not_called() == []

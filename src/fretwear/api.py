@@ -39,12 +39,15 @@ from fretwear.hb import nonlinear_modes as _modes
 from fretwear.hb import periodic as _periodic
 from fretwear.hb import sweep as _sweep
 from fretwear.hb.dynamics import structure_dynamics
+from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.options import SolveOptions, SweepOptions, sweep_options
+from fretwear.model.checks import model_argument
 from fretwear.threads import limited
 from fretwear.timedomain import integrate as _integrate
 from fretwear.timedomain import quasistatic as _quasistatic
 from fretwear.timedomain import steady as _steady
 from fretwear.timedomain.fallback import FALLBACK
+from fretwear.validate import ArgumentTypeError, flag, instance, is_real, number, reals, whole
 from fretwear.wear.worn_frf import WORN_FRF
 from fretwear.wear.worn_state import worn_state as _worn_state
 
@@ -54,9 +57,23 @@ _RENAMED = {"stick_anchor": "anchor", "W0": "wear0", "k_w": "wear_coefficient",
 
 
 def _fallback(time_domain: bool):
-    if not isinstance(time_domain, bool):
-        raise TypeError(f"time_domain = {time_domain!r}: expected True or False")
-    return FALLBACK if time_domain else None
+    return FALLBACK if flag(time_domain, "time_domain") else None
+
+
+def _band(f_min, f_max, n_points) -> None:
+    """Refuse a frequency band that is not two numbers [Hz] and a whole number of points
+    (their values are checked by the sweep's own messages)."""
+    for name, value in (("f_min", f_min), ("f_max", f_max)):
+        if not is_real(value):
+            raise InputError(f"{name} = {value!r}: expected a frequency > 0 [Hz]")
+    whole(n_points, "n_points")
+
+
+def _basis(basis) -> None:
+    """Refuse a ``basis`` that is not a :class:`~fretwear.hb.fourier.FourierBasis`."""
+    if not isinstance(basis, FourierBasis):
+        raise ArgumentTypeError(f"basis = {basis!r}: expected a fretwear FourierBasis (e.g. "
+                                "FourierBasis.up_to(7, 128))")
 
 
 #: where the time-domain drivers take the stick anchors
@@ -75,10 +92,13 @@ def _frequency(frequency, quasi_static: bool) -> dict:
     """The ``frequency`` keyword of the core function: required unless ``quasi_static``
     (where it only scales time, and the core's default applies)."""
     if frequency is None:
-        if quasi_static:
+        if flag(quasi_static, "quasi_static"):
             return {}
         raise InputError("frequency = None: expected the excitation frequency [Hz], a number "
                          "> 0 (only a quasi_static solve can do without)")
+    flag(quasi_static, "quasi_static")
+    if not is_real(frequency):  # its value is checked by the solver's own message
+        raise InputError(f"frequency = {frequency!r}: expected a number > 0 [Hz]")
     return {"frequency": frequency}
 
 
@@ -109,6 +129,7 @@ def _sweep_progress(progress, options, n_points):
         yield options.replace(progress=tick)
 
 
+@model_argument
 @limited
 def solve_periodic(model, basis, frequency: float | None = None, *, quasi_static: bool = False,
                    time_domain: bool = True, **kwargs) -> _periodic.PeriodicSolution:
@@ -139,6 +160,7 @@ def solve_periodic(model, basis, frequency: float | None = None, *, quasi_static
     the harmonics and time histories of the contact (see its docstring).
     """
     _public_names("solve_periodic", kwargs)
+    _basis(basis)
     return _periodic.solve_periodic(model, basis, **_frequency(frequency, quasi_static),
                                     quasi_static=quasi_static,
                                     time_domain=_fallback(time_domain), **kwargs)
@@ -160,6 +182,7 @@ def _other_spellings(name: str):
     return decorate
 
 
+@model_argument
 @limited
 @_other_spellings("sweep")
 def sweep(model, basis, f_min: float, f_max: float, n_points: int, *,
@@ -206,6 +229,8 @@ def sweep(model, basis, f_min: float, f_max: float, n_points: int, *,
     with ``frequency_hz`` [Hz], ``solution`` or None, ``success``, ``message``, ``flags``),
     ``frequency_hz`` [Hz], ``point_success``, ``amplitude(point, axis)`` [m].
     """
+    _basis(basis)
+    _band(f_min, f_max, n_points)
     options = sweep_options(options)
     with _sweep_progress(progress, options, n_points) as options:
         return _sweep.sweep(model, basis, f_min, f_max, n_points,
@@ -226,6 +251,7 @@ def _wear_run(run, progress):
     return dataclasses.replace(run, progress=True)
 
 
+@model_argument
 @limited
 @_other_spellings("simulate_wear")
 def simulate_wear(model, basis, frequency: float | None = None, *, quasi_static: bool = False,
@@ -271,6 +297,7 @@ def simulate_wear(model, basis, frequency: float | None = None, *, quasi_static:
     ``final_wear`` [m], ``initial`` and ``final`` periodic solutions (None where the rate came
     from a time integration).
     """
+    _basis(basis)
     if condenser is not None:
         balance = balance or _wear.BalanceSetup()
         if balance.condenser is not None:
@@ -283,6 +310,7 @@ def simulate_wear(model, basis, frequency: float | None = None, *, quasi_static:
                                time_domain=_fallback(time_domain))
 
 
+@model_argument
 @limited
 def worn_state(model, basis, frequency: float | None = None, *, quasi_static: bool = False,
                wear0=None, time_domain: bool = True, condenser=None, **kwargs):
@@ -309,6 +337,7 @@ def worn_state(model, basis, frequency: float | None = None, *, quasi_static: bo
     periodic solutions.
     """
     _public_names("worn_state", kwargs)
+    _basis(basis)
     if condenser is not None:
         balance = kwargs.pop("balance", None) or _wear.BalanceSetup()
         if balance.condenser is not None:
@@ -320,6 +349,7 @@ def worn_state(model, basis, frequency: float | None = None, *, quasi_static: bo
                        time_domain=_fallback(time_domain), **kwargs)
 
 
+@model_argument
 @limited
 def frf_worn(model, basis, wear, f_min: float, f_max: float, n_points: int, *,
              time_domain: bool = True, progress=False, **kwargs) -> _sweep.SweepResult:
@@ -343,6 +373,9 @@ def frf_worn(model, basis, wear, f_min: float, f_max: float, n_points: int, *,
     :class:`~fretwear.hb.sweep.SweepResult` (``success``, ``message``, as :func:`sweep`).
     """
     _public_names("frf_worn", kwargs)
+    _basis(basis)
+    reals(wear, "wear", low=0.0)
+    _band(f_min, f_max, n_points)
     options = sweep_options(kwargs.pop("options", None), WORN_FRF)
     with _sweep_progress(progress, options, n_points) as options:
         return _wear.frf_worn(model, basis, wear, f_min, f_max, n_points,
@@ -379,6 +412,7 @@ def mode_target(model, mode: int = 1, interface: str = "stuck", dyn=None) -> flo
     return float(2.0 * math.pi * r.frequency_hz[mode - 1])
 
 
+@model_argument
 @limited
 def nonlinear_mode(model, basis, amplitudes, *, mode: int = 1, interface: str = "stuck",
                    **kwargs) -> _modes.Backbone:
@@ -407,6 +441,8 @@ def nonlinear_mode(model, basis, amplitudes, *, mode: int = 1, interface: str = 
     ``state``, ``observed``), ``array(name)``.
     """
     _public_names("nonlinear_mode", kwargs)
+    _basis(basis)
+    reals(amplitudes, "amplitudes", low=0.0, open_low=True)
     if "omega_target" in kwargs:
         raise TypeError("nonlinear_mode() takes mode and interface, not omega_target")
     dyn = kwargs.pop("dyn", None)
@@ -417,6 +453,7 @@ def nonlinear_mode(model, basis, amplitudes, *, mode: int = 1, interface: str = 
                                  **kwargs)
 
 
+@model_argument
 @limited
 def mode_frf(model, backbone: _modes.Backbone, *, damping: str = "viscous", condenser=None,
              dyn=None):
@@ -436,12 +473,14 @@ def mode_frf(model, backbone: _modes.Backbone, *, damping: str = "viscous", cond
     :class:`~fretwear.hb.mode_synthesis.ModalFRF`: ``amplitude``, ``modal_force``,
     ``omega_lo``, ``omega_hi`` [rad/s], ``observed``, ``peak``, ``curve()``.
     """
+    instance(backbone, _modes.Backbone, "backbone", "the Backbone of fretwear.nonlinear_mode")
     if dyn is None:
         dyn = structure_dynamics(model, condenser)
     return _synth.synthesize(backbone, _synth.modal_forces(model, backbone, dyn=dyn),
                              damping=damping)
 
 
+@model_argument
 @limited
 def integrate(model, frequency: float, **kwargs):
     """Integrate the forced response at ``frequency`` [Hz] in time with exact contact and
@@ -466,9 +505,11 @@ def integrate(model, frequency: float, **kwargs):
     recorded samples and the final state ``U, V`` to continue the run.
     """
     _public_names("integrate", kwargs, _IN_START)
+    number(frequency, "frequency", low=0.0, open_low=True, unit="Hz")
     return _integrate.integrate(model, frequency, **kwargs)
 
 
+@model_argument
 @limited
 def steady_state(model, frequency: float, **kwargs):
     """Integrate at ``frequency`` [Hz] until the response is periodic (or classified
@@ -492,9 +533,11 @@ def steady_state(model, frequency: float, **kwargs):
     ``classification``, the harmonics of the last period.
     """
     _public_names("steady_state", kwargs, _IN_START)
+    number(frequency, "frequency", low=0.0, open_low=True, unit="Hz")
     return _steady.steady_state(model, frequency, **kwargs)
 
 
+@model_argument
 @limited
 def incremental_wear(model, *, wear_coefficient: float | None = None, wear0=None, **kwargs):
     """Quasi-static fretting wear by load steps (in the spirit of Stromberg 1997).
@@ -518,5 +561,7 @@ def incremental_wear(model, *, wear_coefficient: float | None = None, wear0=None
     wear [m] per recorded cycle.
     """
     _public_names("incremental_wear", kwargs)
+    if wear_coefficient is not None:
+        number(wear_coefficient, "wear_coefficient", low=0.0, high=1.0, unit="1/Pa")
     return _quasistatic.incremental_wear(model, wear_coefficient=wear_coefficient, wear0=wear0,
                                          **kwargs)

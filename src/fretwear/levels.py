@@ -21,6 +21,8 @@ import numpy as np
 
 from fretwear import api
 from fretwear.errors import InputError
+from fretwear.model.checks import model_argument
+from fretwear.validate import is_real, whole
 
 
 def excitation_scaled(model, level: float):
@@ -70,6 +72,7 @@ class LoadLevels:
         return amp, freq
 
 
+@model_argument
 def load_levels(model, basis, f_min: float, f_max: float, n_points: int, levels, *,
                 options=None, condenser=None) -> LoadLevels:
     """The nonlinear FRF at each excitation level: :func:`fretwear.sweep` of the model with
@@ -89,6 +92,13 @@ def load_levels(model, basis, f_min: float, f_max: float, n_points: int, levels,
     -------
     :class:`LoadLevels`.
     """
+    for name, value in (("f_min", f_min), ("f_max", f_max)):
+        if not is_real(value):
+            raise InputError(f"{name} = {value!r}: expected a frequency > 0 [Hz]")
+    whole(n_points, "n_points")
+    if isinstance(levels, str | bytes) or any(not is_real(v) for v in np.ravel(
+            np.asarray(levels, dtype=object))):
+        raise InputError(f"levels = {levels!r}: expected factors > 0 (numbers)")
     try:
         values = sorted(float(v) for v in levels)
     except (TypeError, ValueError):

@@ -34,6 +34,7 @@ import scipy.sparse.linalg as spla
 from fretwear.errors import InputError
 from fretwear.hb.reduce import condenser_for
 from fretwear.limits import RANGES
+from fretwear.model.checks import model_argument
 from fretwear.model.core import Model
 from fretwear.model.interfaces import pair_transform
 from fretwear.resources import require_memory
@@ -251,6 +252,7 @@ def _normalise(X: np.ndarray, M) -> np.ndarray:
     return X * np.where(big < 0, -1.0, 1.0)
 
 
+@model_argument
 def modes(model: Model, n_modes: int = 10, *, interface: str = "sliding",
           f_max: float | None = None) -> ModesResult:
     """Normal modes of the undamped structure with the given linear interface.
@@ -570,6 +572,7 @@ def _frf_condensed(model: Model, freqs: np.ndarray, interface: str, condenser=No
     return _split_observed(model, Uo), np.array(con), np.array(rea)
 
 
+@model_argument
 def frf(model: Model, frequencies_hz, *, interface: str = "sliding",
         method: str = "direct", condenser=None) -> FRFResult:
     """Frequency response to the harmonic (n = 1) part of the model loads.

@@ -50,7 +50,7 @@ def set_blas_threads(n: int | None) -> None:
     """Run fretwear's drivers with ``n`` BLAS threads from now on (``None``: as the BLAS
     library is set, e.g. by ``OPENBLAS_NUM_THREADS``). Large models whose dense blocks have
     several thousand rows may gain from more than one thread on a quiet machine."""
-    if n is not None and (isinstance(n, bool) or not isinstance(n, int) or n < 1):
+    if n is not None and (isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= 4096):
         raise InputError(f"set_blas_threads({n!r}): expected a whole number >= 1 or None")
     _state["n"] = n
 

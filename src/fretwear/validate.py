@@ -50,12 +50,19 @@ def number(value, what: str, *, low: float | None = None, high: float | None = N
     return v
 
 
+#: the largest magnitude of a whole-number argument, as of the case files' integer keys (below
+#: numpy's int64 limit; no count or index of a model comes near it)
+WHOLE_MAX = 2**62
+
+
 def whole(value, what: str, *, low: int | None = None, high: int | None = None) -> int:
     """``value`` as an int, after checking it is an integer (not a float, string or bool) in
     ``[low, high]``."""
     if not isinstance(value, numbers.Integral) or isinstance(value, bool | np.bool_):
         raise InputError(f"{what} = {value!r}; expected a whole number")
     v = int(value)
+    low = -WHOLE_MAX if low is None else max(low, -WHOLE_MAX)
+    high = WHOLE_MAX if high is None else min(high, WHOLE_MAX)
     if (low is not None and v < low) or (high is not None and v > high):
         rng = " and ".join(s for s in ("" if low is None else f">= {low}",
                                        "" if high is None else f"<= {high}") if s)

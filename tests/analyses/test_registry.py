@@ -95,3 +95,39 @@ def test_type_is_not_a_schema_key():
         Analysis.define("scratch", {"type": Field(Integer(), "no")}, run_a)
     with pytest.raises(ValueError, match="'type' is added by the registry"):
         Analysis("scratch", Table({"type": Field(Integer(), "no")}), run_a)
+
+
+def test_keys_read_by_some_analyses_name_registered_ones():
+    """Every key of the case-file schema declared for some analyses (``Field.used_by``, what
+    the pass naming ignored keys reads) names registered analyses only: a misspelt type
+    would make the key look ignored everywhere. Walks every table of every model kind."""
+    from fretwear.analyses.registry import analysis_tables, available
+    from fretwear.io import case as case_files
+    from fretwear.io.schema import AnyOf, Dict, ListOf, Table, TableList, Variant
+
+    seen, declared = set(), []
+
+    def walk(spec):
+        if id(spec) in seen:
+            return
+        seen.add(id(spec))
+        if isinstance(spec, Variant):
+            for t in spec.tables().values():
+                walk(t)
+        elif isinstance(spec, Table):
+            for f in spec.fields.values():
+                if f.used_by is not None:
+                    declared.append(f.used_by)
+                walk(f.spec)
+        elif isinstance(spec, TableList):
+            walk(spec.table)
+        elif isinstance(spec, Dict | ListOf):
+            walk(spec.value if isinstance(spec, Dict) else spec.item)
+        elif isinstance(spec, AnyOf):
+            for o in spec.options:
+                walk(o)
+
+    for kind in ("mesh", "matrices", "fe"):
+        walk(case_files._case_table(kind, analysis_tables()))
+    assert declared  # the wear coefficients and output switches at least
+    assert {a for used in declared for a in used} <= set(available())

@@ -91,3 +91,32 @@ def test_point_names_never_write_outside_the_output_folder(tmp_path, point):
     assert new and all(work / "out" in p.parents or p == work / "out" for p in new), new
     figures = [p for p in (work / "out").iterdir() if p.suffix == ".png"]
     assert figures and all(len(p.name) <= 120 for p in figures)
+
+
+def test_keys_the_analysis_does_not_read_are_named(tmp_path, capsys):
+    """The shipped beam keeps its wear coefficient, unused, outside wear (as the shipped
+    examples do), and is given `[output] whole_disk = true`, which only a periodic analysis
+    reads. For a modes analysis both are named, each in one line with the analyses that read
+    it: the wear coefficient as a note (a property of the interface), whole_disk as a warning
+    (an option of the run); for a periodic analysis only the wear coefficient is, and
+    `vtu = false` (a switch turned off) is not. Reference: the schema's declarations, by
+    hand."""
+
+    from helpers.cases import small_case
+
+    from fretwear.analyses.registry import analysis_tables
+    from fretwear.analyses.run import load_case
+    from fretwear.io.case import ignored_notes
+
+    modes = '[analysis]\ntype = "modes"\nn_modes = 2\n[output]\nwhole_disk = true\n'
+    lines = ignored_notes(load_case(small_case(tmp_path, modes)), analysis_tables())
+    assert lines == [
+        "note: contact.wear_coefficient = 1e-11 is not used by a modes analysis (only by "
+        "wear, incremental-wear, worn-state): it is ignored",
+        "warning: output.whole_disk = true is not used by a modes analysis (only by "
+        "periodic): it is ignored"]
+    periodic = ('[analysis]\ntype = "periodic"\nfrequency = 1e4\n[output]\nwhole_disk = true\n'
+                'vtu = false\n')
+    lines = ignored_notes(load_case(small_case(tmp_path, periodic)), analysis_tables())
+    assert lines == ["note: contact.wear_coefficient = 1e-11 is not used by a periodic "
+                     "analysis (only by wear, incremental-wear, worn-state): it is ignored"]

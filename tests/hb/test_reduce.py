@@ -337,3 +337,25 @@ def test_one_driver_call_builds_one_condenser(constructions):
         constructions[0] = 0
         runs[name](cond)
         assert constructions[0] == 0, name
+
+
+def test_a_condensation_that_cannot_fit_is_refused_before_it_allocates(monkeypatch):
+    """Harmonics 10000 (the issue's case, with 20001 samples): the condensation of the truss
+    is refused in one line with its estimate and the machine's memory before any block is
+    formed, here on a machine said to hold 4 GiB: the Fourier basis it needs alone is
+    8 x 20002 x 20001 x 4 bytes = 12.8 GB, written out by hand. The paper's 7 harmonics on
+    the same machine condense as before (the check does not refuse what fits)."""
+    from fretwear import resources
+
+    monkeypatch.setattr(resources, "machine_memory", lambda: 4 * 2**30)
+    model = truss()
+    cond = reduce.exact_condenser(model)
+    with pytest.raises(InputError) as err:
+        cond.reduced(2 * np.pi * 100.0, np.arange(10001))
+    msg = str(err.value)
+    assert "10001 harmonic orders (up to 10000)" in msg and "this machine has 4 GiB" in msg
+    assert "\n" not in msg
+    est = float(msg.split("needs about ")[1].split(" GiB")[0]) * 2**30
+    assert est >= 8.0 * 20002 * 20001 * 4
+    red = cond.reduced(2 * np.pi * 100.0, np.arange(8))
+    assert red.Z.shape[0] == 8

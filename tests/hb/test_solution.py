@@ -66,3 +66,53 @@ def test_stops_per_period_counts_the_zeros_of_the_velocity(solved, a3, stops):
     c[0, 3] = a3  # cos 3 tau
     probe = dataclasses.replace(sol, observed={"p": c})
     assert probe.stops_per_period("p", rel_tol=1e-3) == stops
+
+
+def _nan_ladder(real):
+    """A ladder that answers a converged statistics with one NaN harmonic (what a
+    diverging linear solve could give), to check that it is never taken as a solution."""
+    def ladder(*args, **kwargs):
+        best = real(*args, **kwargs)
+        x = np.array(best.x, dtype=float)
+        x.flat[0] = np.nan
+        return dataclasses.replace(best, x=x, stats=dataclasses.replace(best.stats,
+                                                                        success=True))
+    return ladder
+
+
+def test_a_solution_holding_nan_is_a_failure_naming_the_variable(monkeypatch):
+    """A ladder that claims convergence with a NaN harmonic: solve_periodic reports a failure
+    whose message names U (the harmonic given NaN here, by construction), never a success;
+    with raise_on_failure it raises. The reference is the construction itself."""
+    from fretwear.errors import ConvergenceError
+    from fretwear.hb import attempts, periodic
+
+    monkeypatch.setattr(periodic, "solve_ladder", _nan_ladder(attempts.solve_ladder))
+    model = oscillator()
+    sol = solve_periodic(model, FourierBasis.up_to(1, 16), frequency=15.0)
+    assert not sol.success
+    assert "non-finite" in sol.message and "U (the contact displacement harmonics)" in sol.message
+    with pytest.raises(ConvergenceError, match="non-finite"):
+        solve_periodic(model, FourierBasis.up_to(1, 16), frequency=15.0, raise_on_failure=True)
+
+
+def test_a_sweep_point_holding_nan_is_not_converged(monkeypatch):
+    """A converged answer given one NaN harmonic as a grid point adopts it (every rung of a
+    point's ladder ends in ``Point.adopt``): each point is recorded as not converged with the
+    message naming U, and no solution is kept."""
+    from fretwear.hb import attempts
+    from fretwear.hb.sweep import sweep
+
+    real = attempts.Point.adopt
+
+    def adopt(self, prob, U, stats, how):
+        U = np.array(U, dtype=float)
+        U.flat[0] = np.nan
+        return real(self, prob, U, stats, how)
+
+    monkeypatch.setattr(attempts.Point, "adopt", adopt)
+    res = sweep(oscillator(), FourierBasis.up_to(1, 16), 14.0, 16.0, 2)
+    assert not any(res.point_success)
+    for p in res.points:
+        assert p.solution is None or not p.solution.success
+        assert any("non-finite" in f and "U (" in f for f in p.flags), p.flags

@@ -90,9 +90,19 @@ ANALYSES = {
     "wear": ('type = "wear"\nquasi_static = true\nharmonics = 1\nn_samples = 16\n'
              'max_steps = 3\n'),
     "incremental-wear": 'type = "incremental-wear"\nn_cycles = 3\nsteps_per_cycle = 16\n',
+    "worn-state": ('type = "worn-state"\nquasi_static = true\nharmonics = 1\nn_samples = 16\n'
+                   'max_steps = 3\n'),
+    "cyclic-modes": 'type = "cyclic-modes"\nn_modes = 2\n',
 }
 
-#: time limit of one generated run [s]; a run that takes longer counts as a hang
+#: the analyses run on a bladed-disk sector (:data:`SECTOR_FILES`, tests/helpers/cyclic.py)
+SECTOR_ANALYSES = ("cyclic-modes",)
+#: the files a sector case needs beside it (written by :func:`run_generated`)
+SECTOR_FILES = ("sector.msh", "sector.toml")
+
+#: time limit of one generated run [s of CPU time of this process]; a run that takes longer
+#: counts as a hang (CPU, not wall time: on a machine loaded by other work a run can wait
+#: minutes for a core without computing more)
 TIME_LIMIT = 60
 
 HUGE_INT = 10**400
@@ -104,7 +114,17 @@ INVALID_OTHER = ("", "x", "../../../escape", "a/b", "y" * 400, True, False, [], 
 
 
 def base_case(analysis: str) -> dict:
-    """A small valid case (parsed TOML) with the given analysis type."""
+    """A small valid case (parsed TOML) with the given analysis type (on the annulus sector
+    of tests/helpers/cyclic.py for :data:`SECTOR_ANALYSES`)."""
+    if analysis in SECTOR_ANALYSES:
+        import tempfile
+
+        from helpers.cyclic import write_sector_case
+
+        with tempfile.TemporaryDirectory() as tmp:
+            path, _ = write_sector_case(Path(tmp), n_sectors=8, engine_order=1)
+            text = path.read_text()
+        return tomllib.loads(text + "[analysis]\n" + ANALYSES[analysis])
     return tomllib.loads(MODEL + "[analysis]\n" + ANALYSES[analysis])
 
 
@@ -147,6 +167,13 @@ def _tables(case: dict) -> list[tuple[tuple, Table]]:
     """(key path of a table in ``case``, its schema) for every table the case has."""
     from fretwear.analyses.registry import analysis_tables
 
+    if "cyclic" in case:
+        out = [(("model",), case_schema.MODEL_TYPES[case["model"]["type"]]),
+               (("material",), case_schema.MATERIAL), (("cyclic",), case_schema.CYCLIC),
+               (("analysis",), analysis_tables()[case["analysis"]["type"]])]
+        for i in range(len(case.get("loads", []))):
+            out.append((("loads", i), case_schema.LOAD_MESH))
+        return out
     out = [(("model",), case_schema.MODEL_TYPES[case["model"]["type"]]),
            (("material",), case_schema.MATERIAL), (("damping",), case_schema.DAMPING),
            (("contact",), case_schema.CONTACT_MESH), (("output",), case_schema.OUTPUT),
@@ -204,7 +231,8 @@ def hostile_cases(draw, analyses=tuple(ANALYSES)) -> tuple[dict, list[str]]:
         value = _spec_values(table.fields[key].spec, data)
         _get(case, path)[key] = value
         changes.append(f"{'.'.join(map(str, path))}.{key} = {value!r}"[:120])
-    if draw(st.integers(0, 3)) == 0:  # one in four: a key whose meaning depends on others
+    if "cyclic" not in case and draw(st.integers(0, 3)) == 0:  # one in four: a key whose
+        # meaning depends on others (of the rectangle's tables)
         path, value = draw(st.sampled_from(MEANINGS))
         _get(case, path[:-1])[path[-1]] = value
         changes.append(f"{'.'.join(path)} = {value!r}")
@@ -249,6 +277,18 @@ class Hang(Exception):
     """A generated run took longer than :data:`TIME_LIMIT`."""
 
 
+@contextlib.contextmanager
+def cpu_time_limit(seconds: float):
+    """Raise :class:`Hang` in the body once it has used ``seconds`` of CPU time (SIGPROF)."""
+    old = signal.signal(signal.SIGPROF, _alarm)
+    signal.setitimer(signal.ITIMER_PROF, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_PROF, 0)
+        signal.signal(signal.SIGPROF, old)
+
+
 def _alarm(signum, frame):
     raise Hang
 
@@ -261,17 +301,17 @@ def run_generated(case: dict, folder: Path) -> tuple[int | None, str, str]:
 
     path = folder / "case.toml"
     path.write_text(toml_text(case))
+    if case.get("model", {}).get("file") == SECTOR_FILES[0]:
+        from helpers.cyclic import write_sector_case
+
+        write_sector_case(folder, n_sectors=8, engine_order=1)  # the mesh file it reads
     err = io.StringIO()
-    old = signal.signal(signal.SIGALRM, _alarm)
-    signal.alarm(TIME_LIMIT)
     try:
-        with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+        with cpu_time_limit(TIME_LIMIT), contextlib.redirect_stderr(err), \
+                contextlib.redirect_stdout(io.StringIO()):
             rc = cli.main(["run", str(path), "-o", str(folder / "out"), "--no-progress"])
     except Hang:
         return None, err.getvalue(), "hang"
     except BaseException as exc:  # what would be a traceback on the command line
         return None, err.getvalue(), f"traceback: {type(exc).__name__}: {exc}"[:300]
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, old)
     return rc, err.getvalue(), "message" if rc == 2 else "ran"

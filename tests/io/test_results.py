@@ -123,3 +123,41 @@ def test_vtu_and_pvd_for_paraview(tmp_path):
     assert back.cells[0].type == "quad"
     pvd = write_pvd(tmp_path / "modes.pvd", [(1, path)])
     assert 'timestep="1" part="0" file="modes/mode-001.vtu"' in pvd.read_text()
+
+
+def test_writer_refuses_non_finite_solution_values(tmp_path):
+    """A displacement holding NaN or inf (a diverged computation) is refused by the writer
+    with one line naming the variable, and no file is written; NaN at a sweep frequency
+    whose ``converged`` flag is 0 (a failed point, said as such) is written, and NaN in a
+    variable that is not a solution (a residual) is left alone."""
+    from fretwear.errors import ConvergenceError
+
+    for bad in (np.nan, np.inf):
+        ds = xr.Dataset({"displacement": variable(("tau",), [0.0, bad], "m", "displacement")})
+        with pytest.raises(ConvergenceError) as err:
+            write_results(tmp_path / "r.nc", ds, title="t", analysis_type="periodic",
+                          converged=True)
+        assert "'displacement'" in str(err.value) and "\n" not in str(err.value)
+        assert not (tmp_path / "r.nc").exists() and not leftovers(tmp_path)
+    ds = xr.Dataset({
+        "displacement_harmonic_amplitude": variable(("frequency",), [1e-6, np.nan], "m",
+                                                    "amplitude"),
+        "converged": variable(("frequency",), np.array([1, 0], np.int8), "1", "converged"),
+        "residual": variable(("frequency",), [1e-9, np.nan], "1", "residual")})
+    write_results(tmp_path / "s.nc", ds, title="t", analysis_type="sweep", converged=False)
+    assert (tmp_path / "s.nc").is_file()
+
+
+def test_writer_accepts_the_padded_axes_of_points():
+    """A point of one DOF in a model of two axes has its second axis NaN over the whole
+    period (pad_axes): padding, written; a NaN inside the period of a real axis is refused."""
+    from fretwear.errors import ConvergenceError
+    from fretwear.io.results import check_finite
+
+    disp = np.array([[[1.0, 2.0, 3.0], [np.nan] * 3]])  # (point, axis, tau)
+    check_finite(xr.Dataset({"displacement": variable(("point", "axis", "tau"), disp, "m",
+                                                      "d")}))
+    disp[0, 0, 1] = np.nan
+    with pytest.raises(ConvergenceError, match="'displacement'"):
+        check_finite(xr.Dataset({"displacement": variable(("point", "axis", "tau"), disp,
+                                                          "m", "d")}))

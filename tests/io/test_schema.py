@@ -157,3 +157,25 @@ def test_render_table_documents_every_key():
     assert md.startswith("## [material]\n\nA table.\n")
     assert "| `E` | a number > 0 | Pa | **required** | Young's modulus |" in md
     assert "| `n` | an integer |  | `3` | count \\| pipes escaped |" in md
+
+
+def test_unused_keys_walks_every_kind_of_table():
+    """A key declared for some analyses (``used_by``) is named wherever it sits (a table, an
+    array of tables numbered as the messages number them, a free-key table, a variant), with
+    its path and value; its default and a switch turned off are not named (they change
+    nothing); under an analysis that reads it nothing is named. Reference: the hand-written
+    case below."""
+    from fretwear.io.schema import Dict, Field, Flag, Number, Table, TableList, Variant, unused_keys
+
+    k = Field(Number(), "a coefficient", default=0.0, used_by=("wear",))
+    s = Field(Flag(), "a switch", default=False, used_by=("wear",))
+    inner = Table({"k": k, "s": s, "x": Field(Number(), "x")})
+    top = Table({"one": Field(inner, "one"), "many": Field(TableList(inner), "many"),
+                 "free": Field(Dict(inner), "free"),
+                 "v": Field(Variant({"a": inner}), "variant")})
+    case = {"one": {"k": 1.0, "x": 2.0}, "many": [{"k": 0.0}, {"k": 3.0, "s": True}],
+            "free": {"body": {"s": False, "k": 4.0}}, "v": {"type": "a", "k": 5.0}}
+    found = [(p, v) for p, v, _ in unused_keys(top, case, "periodic")]
+    assert found == [("one.k", 1.0), ("many[2].k", 3.0), ("many[2].s", True),
+                     ("free.body.k", 4.0), ("v.k", 5.0)]
+    assert unused_keys(top, case, "wear") == []

@@ -94,3 +94,42 @@ def test_study_on_a_real_scheduler_survives_a_killed_client(tmp_path):
             assert np.array_equal(ds["slip_amplitude"].values[i], one["slip_amplitude"].values)
     finally:
         _stop(procs[::-1])
+
+
+_CLIENT_DIES = """
+import os, sys
+
+def main():
+    import psutil
+    from fretwear.study.runner import dask_client
+    with dask_client(None, 1) as client:
+        client.run(os.getpid)
+        print(*[p.pid for p in psutil.Process().children(recursive=True)], flush=True)
+        raise MemoryError("the client ran out of memory")
+
+if __name__ == "__main__":
+    main()
+"""
+
+
+def test_a_client_dying_of_memory_error_leaves_no_process(tmp_path):
+    """The client of a LocalCluster (the default of `fretwear study`) dies of a MemoryError
+    while its worker runs: every process it started (worker, nanny, resource tracker), listed
+    by the operating system while the cluster ran, is gone once the client has exited, which
+    is what the issue found left running."""
+    import psutil
+
+    script = tmp_path / "client.py"
+    script.write_text(_CLIENT_DIES)
+    out = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                         env=worker_env(), timeout=RUN_S, cwd=tmp_path)
+    assert out.returncode == 1 and "MemoryError" in out.stderr
+    children = [int(p) for p in out.stdout.split()]
+    assert children  # the worker was listed
+    deadline = time.monotonic() + 30
+    alive = children
+    while alive and time.monotonic() < deadline:
+        alive = [p for p in alive if psutil.pid_exists(p)
+                 and psutil.Process(p).status() != psutil.STATUS_ZOMBIE]
+        time.sleep(0.5)
+    assert not alive, f"processes left running: {alive}"

@@ -23,6 +23,7 @@ import math
 from pathlib import Path
 from types import SimpleNamespace
 
+import numpy as np
 import tomli_w
 
 from fretwear.analyses.base import RunContext, RunOutput
@@ -31,6 +32,9 @@ from fretwear.analyses.run import RESULTS_FILE, check_output, run_built
 from fretwear.errors import InputError
 from fretwear.io.case import OUTPUT, Case
 from fretwear.io.schema import Context, Variant, show
+from fretwear.model.checks import model_argument
+from fretwear.validate import flag, is_real
+from fretwear.validate import path as file_path
 
 #: the file name a Python run stands for in messages and in ``case_path``
 PYTHON_CASE = "python-model.toml"
@@ -81,6 +85,7 @@ def python_case(analysis, keys: dict, output: Path, title: str = "") -> Case:
                 text=text, raw=raw, model={}, analysis=checked, output=out)
 
 
+@model_argument
 def run(model, analysis, output, *, title: str = "", progress: bool = False,
         resume: bool = False, echo: bool = False, **keys) -> RunOutput:
     """Run ``model`` (built in Python) as a case file with this analysis would run: the same
@@ -107,7 +112,7 @@ def run(model, analysis, output, *, title: str = "", progress: bool = False,
     :class:`~fretwear.analyses.base.RunOutput`: ``success``, ``message``, ``dataset``,
     ``results`` (the ``results.nc`` written), ``figures``, ``files``.
     """
-    out_dir = Path(output).expanduser().resolve()
+    out_dir = file_path(output, "output").expanduser().resolve()
     case = python_case(analysis, dict(keys), out_dir, title)
     return run_built(model, case, out_dir, RunContext(out_dir, resume=resume,
                                                       progress=progress), echo=echo)
@@ -123,9 +128,61 @@ def _kind(result) -> str:
     for kind, cls in (("sweep", SweepResult), ("periodic", PeriodicSolution),
                       ("wear", WearResult), ("transient", TransientResult)):
         if isinstance(result, cls):
+            check_record(kind, result)
             return kind
     raise InputError(f"result = {type(result).__name__}: expected the result of fw.sweep, "
                      "fw.frf_worn, fw.solve_periodic, fw.simulate_wear or fw.integrate")
+
+
+def _check_basis(basis) -> None:
+    """``basis`` is None, a FourierBasis, or (for a time integration) a whole number of
+    harmonics >= 1."""
+    from fretwear.hb.fourier import FourierBasis
+
+    if basis is None or isinstance(basis, FourierBasis):
+        return
+    if isinstance(basis, bool) or not isinstance(basis, int | np.integer) or not \
+            1 <= basis <= 2**62:
+        raise InputError(f"basis = {repr(basis)[:60]}; expected the FourierBasis of the "
+                         "result (or, for a time integration, a number of harmonics >= 1)")
+
+
+def check_record(kind: str, result) -> None:
+    """Refuse a result record whose fields are not what fretwear writes in it (a record
+    built or edited by hand): one InputError naming the field."""
+    from fretwear.hb.solution import PeriodicSolution, non_finite
+    from fretwear.hb.sweep_result import SweepPoint
+    from fretwear.wear.history import WearHistory
+    from fretwear.wear.options import STOP_REASONS
+
+    def bad(field, expected):
+        value = getattr(result, field)
+        raise InputError(f"result.{field} = {repr(value)[:60]}; expected {expected}")
+
+    if kind == "sweep":
+        pts = result.points
+        if not isinstance(pts, list) or not pts or not all(isinstance(p, SweepPoint)
+                                                            for p in pts):
+            bad("points", "a non-empty list of the sweep's points (SweepPoint)")
+    elif kind == "periodic":
+        why = non_finite(result)
+        if why:
+            raise InputError(f"result holds non-finite values in {why}: not a solution")
+    elif kind == "wear":
+        if not isinstance(result.history, WearHistory):
+            bad("history", "the run's WearHistory")
+        for field in ("initial", "final"):
+            if getattr(result, field) is not None and not isinstance(getattr(result, field),
+                                                                     PeriodicSolution):
+                bad(field, "a PeriodicSolution or None")
+        if not isinstance(result.success, bool | np.bool_):
+            bad("success", "True or False")
+        if not isinstance(result.message, str):
+            bad("message", "a string")
+        if result.stop_reason not in (*STOP_REASONS, ""):
+            bad("stop_reason", f"one of {list(STOP_REASONS)}")
+        if not (is_real(result.wall_time) and 0 <= result.wall_time <= 1e12):
+            bad("wall_time", "a number of seconds >= 0")
 
 
 def results_dataset(result, model, basis, points=None, frequency=None):
@@ -161,6 +218,7 @@ def results_dataset(result, model, basis, points=None, frequency=None):
     return kind, wear_dataset(model, result, basis, frequency_hz=float(frequency))
 
 
+@model_argument
 def write_results(result, output, model, basis=None, *, title: str = "", points=None,
                   frequency=None) -> Path:
     """Write ``output/results.nc`` for a result obtained in Python, in the format of the
@@ -182,9 +240,10 @@ def write_results(result, output, model, basis=None, *, title: str = "", points=
     -------
     The path of the file written.
     """
+    _check_basis(basis)
     from fretwear.io.results import write_results as write
 
-    out_dir = Path(output).expanduser().resolve()
+    out_dir = file_path(output, "output").expanduser().resolve()
     check_output(out_dir, [RESULTS_FILE])
     kind, ds = results_dataset(result, model, basis, points, frequency)
     return write(out_dir / RESULTS_FILE, ds, title=title or "results obtained in Python",
@@ -193,6 +252,7 @@ def write_results(result, output, model, basis=None, *, title: str = "", points=
                  case_path="", analysis={"type": kind})
 
 
+@model_argument
 def plot(result, output, model, basis=None, *, title: str = "", fmt: str = "png",
          vtu: bool = True) -> list[Path]:
     """The figures (and, for a model with a mesh and ``vtu``, the ParaView files) the analysis
@@ -208,7 +268,9 @@ def plot(result, output, model, basis=None, *, title: str = "", fmt: str = "png"
     -------
     The files written.
     """
-    out_dir = Path(output).expanduser().resolve()
+    _check_basis(basis)
+    flag(vtu, "vtu")
+    out_dir = file_path(output, "output").expanduser().resolve()
     check_output(out_dir)
     kind, ds = results_dataset(result, model, basis)
     name = title or "results obtained in Python"

@@ -31,9 +31,10 @@ from fretwear.analyses.registry import analysis_tables, get
 from fretwear.errors import InputError, interrupted
 from fretwear.files import remove_stale_temporaries
 from fretwear.io import case as case_files
-from fretwear.io.case import Case, build_model, observed_notes, unusual_notes
+from fretwear.io.case import Case, build_model, ignored_notes, observed_notes, unusual_notes
 from fretwear.io.results import read_results, write_results
 from fretwear.threads import limited
+from fretwear.validate import path as file_path
 
 RESULTS_FILE = "results.nc"
 
@@ -48,7 +49,7 @@ def load_case(path: Path | str) -> Case:
     (``case.analysis``, ``case.output``, ...), the case text and its path; SI units
     (frequencies in Hz) as in ``docs/case-files.md``.
     """
-    return case_files.load_case(path, analysis_tables())
+    return case_files.load_case(file_path(path, "path"), analysis_tables())
 
 
 def case_docs() -> str:
@@ -216,6 +217,9 @@ def run_built(model, case, out_dir: Path, how: RunContext, echo: bool = True) ->
         say(out.summary)
     for w in out.warnings:
         say(f"warning: {w}")
+    if isinstance(getattr(case, "raw", None), dict) and case.raw.get("analysis"):
+        for note in ignored_notes(case, analysis_tables()):  # keys the analysis never read
+            say(note)
     if not out.success:
         say("warning: some solves did not converge (results.nc has converged = 0)")
     say(f"results: {out.results}  ({time.time() - start:.1f} s)")

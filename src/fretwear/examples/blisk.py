@@ -18,8 +18,11 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from fretwear.errors import InputError
+from fretwear.limits import check_loss_factor
 from fretwear.model.core import ContactInterface, Load, Model, ObservedPoint
 from fretwear.model.cyclic import CyclicSector, cyclic_sector_from_dofs
+from fretwear.validate import number, reals, whole
 
 
 def lumped_blisk(n_sectors: int = 12, *, coupling: float = 5e4, blade_stiffness: float = 1e6,
@@ -31,7 +34,15 @@ def lumped_blisk(n_sectors: int = 12, *, coupling: float = 5e4, blade_stiffness:
     its radial ``preload`` ``N0`` [N] and the tangential excitation amplitude ``force`` [N].
     DOFs: ``(Dx, Dy, D'x, D'y, Bx, By)``; observed point ``"blade"`` (B); radii 0.2 m and
     0.3 m. With the defaults the blades vibrate near 503 Hz (``sqrt(k_b / m_b) / 2 pi``)."""
-    n = int(n_sectors)
+    n = whole(n_sectors, "n_sectors", low=2, high=10**6)
+    for name, value in (("coupling", coupling), ("blade_stiffness", blade_stiffness),
+                        ("ground_stiffness", ground_stiffness), ("force", force)):
+        number(value, name, low=0.0, open_low=name.endswith("_stiffness"), high=1e20)
+    number(preload, "preload", low=0.0, high=1e20)
+    number(mu, "mu", low=0.0, high=10.0)
+    check_loss_factor(loss_factor)
+    if len(reals(masses, "masses", low=0.0, open_low=True, ndim=1)) != 2:
+        raise InputError(f"masses = {masses!r}; expected two masses (m_d, m_b) > 0 [kg]")
     a = 2 * np.pi / n
     r_d, r_b = 0.2, 0.3
     pts = np.array([[r_d, 0.0], [r_d * np.cos(a), r_d * np.sin(a)],

@@ -144,6 +144,9 @@ class Branch:
         history (not to :attr:`points`)."""
         sol = assemble_solution(prob, U, self.model, stats)
         pt = SweepPoint(omega / (2 * np.pi), sol, stats, how, [])
+        if not sol.success:  # non-finite values (assemble_solution): a failure, no predictor
+            pt.flags.append(f"not converged: {stats.message}")
+            return pt
         if self.flag is not None:
             pt.flags.extend(self.flag(sol))
         self.history.append((omega, U))

@@ -31,6 +31,7 @@ import numpy as np
 from fretwear.errors import InputError
 from fretwear.hb.modal import CUTOFF, TOL, CheckFailed, modal_condenser
 from fretwear.hb.reduce import exact_condenser
+from fretwear.model.checks import model_argument
 from fretwear.model.core import Model
 
 #: the methods of :func:`condenser`
@@ -141,6 +142,7 @@ def _check(method, f_max, max_order, modes, cutoff, tol) -> None:
                          "required")
 
 
+@model_argument
 def condenser(model: Model, method: str = "auto", *, f_max: float | None = None,
               max_order: int = 1, modes: int | None = None, cutoff: float = CUTOFF,
               tol: float = TOL, residual: bool | None = None):

@@ -28,6 +28,7 @@ import scipy.sparse.linalg as spla
 
 from fretwear.errors import InputError
 from fretwear.hb.reduce import Condenser, Reduced, Structure, _fingerprint
+from fretwear.model.checks import model_argument, whole_number
 from fretwear.model.core import Model
 from fretwear.model.cyclic import (
     CyclicSector,
@@ -36,16 +37,15 @@ from fretwear.model.cyclic import (
     relative_harmonic_model,
 )
 from fretwear.model.interfaces import observed_map
+from fretwear.validate import reals
 
 #: at most this many kept DOFs: cyclic modes by a dense Hermitian eigensolver
 DENSE_MODES = 600
 
 
 def _engine_order(engine_order) -> int:
-    if isinstance(engine_order, bool) or not isinstance(engine_order, int | np.integer):
-        raise InputError(f"engine_order = {engine_order!r}: expected an integer (negative: "
-                         "the wave travelling the other way)")
-    return int(engine_order)
+    """An integer (negative: the wave travelling the other way)."""
+    return whole_number(engine_order, "engine_order")
 
 
 def _structure_k(sector: CyclicSector, k: int) -> tuple[Structure, sp.csr_matrix]:
@@ -180,12 +180,14 @@ class CyclicCondenser(Condenser):
         return out
 
 
+@model_argument
 def cyclic_condenser(sector: CyclicSector, engine_order: int) -> CyclicCondenser:
     """A :class:`CyclicCondenser` of ``sector`` under the engine order ``engine_order``: pass
     it as ``condenser=`` with ``sector.model`` to any periodic solve, sweep or wear run."""
     return CyclicCondenser(sector, engine_order)
 
 
+@model_argument
 def cyclic_modes(sector: CyclicSector, k: int, n_modes: int = 6) -> tuple[np.ndarray,
                                                                           np.ndarray]:
     """The ``n_modes`` lowest modes of harmonic index (nodal diameter) ``k`` of the disk,
@@ -196,6 +198,7 @@ def cyclic_modes(sector: CyclicSector, k: int, n_modes: int = 6) -> tuple[np.nda
     if isinstance(k, bool) or not isinstance(k, int | np.integer) or not \
             0 <= k < sector.n_sectors:
         raise InputError(f"k = {k!r}: expected a harmonic index 0..{sector.n_sectors - 1}")
+    n_modes = whole_number(n_modes, "n_modes", low=1)
     red, T = harmonic_model(sector, int(k))
     free = red.free_dofs()
     K = red.K.tocsr()[free][:, free]
@@ -213,11 +216,13 @@ def cyclic_modes(sector: CyclicSector, k: int, n_modes: int = 6) -> tuple[np.nda
     return np.sqrt(np.maximum(w2, 0.0)) / (2 * np.pi), (T @ q).T
 
 
+@model_argument
 def cyclic_frf(sector: CyclicSector, engine_order: int, frequencies) -> np.ndarray:
     """Linear response of the sector to the engine-order excitation, contact free:
     ``U_1`` (nf, ndof) complex [m] on the sector's DOFs at each excitation frequency [Hz]
     (the first harmonic of the loads; index ``k = EO mod N``): ``T_k (Z_k)^-1 T_k^H F_1``."""
     eo = _engine_order(engine_order)
+    frequencies = np.atleast_1d(reals(frequencies, "frequencies", low=0.0))
     k = int(harmonic_index(1, eo, sector.n_sectors))
     red, T = harmonic_model(sector, k)
     free = red.free_dofs()

@@ -53,7 +53,9 @@ from fretwear.hb.reduce import (
     _solve,
     _structure,
 )
+from fretwear.model.checks import model_argument
 from fretwear.model.core import Model
+from fretwear.validate import number, whole
 
 #: keep the fixed-interface modes up to this multiple of the highest harmonic frequency
 CUTOFF = 3.0
@@ -531,6 +533,7 @@ def _real_times(A: np.ndarray, x: np.ndarray) -> np.ndarray:
     return A @ x
 
 
+@model_argument
 def modal_condenser(model: Model, f_max: float, max_order: int, *, modes: int | None = None,
                     cutoff: float = CUTOFF, tol: float = TOL, raise_modes: bool = False,
                     residual: bool = False) -> ModalCondenser:
@@ -549,6 +552,10 @@ def modal_condenser(model: Model, f_max: float, max_order: int, *, modes: int | 
     it is a :class:`BlockedModalCondenser` (the same condensation
     without ``Psi`` or dense blocks per harmonic).
     """
+    max_order = whole(max_order, "max_order", low=0)
+    if modes is not None:
+        modes = whole(modes, "modes", low=1)
+    f_max = number(f_max, "f_max", low=0.0, open_low=True, unit="Hz")
     if dense_storage_gib(model, max_order) > DENSE_STORAGE_GIB:
         # the blocked condenser keeps every mode below the cutoff (or ``modes``) and adds no
         # residual vectors: their m extra solves are what it cannot afford at this size

@@ -30,8 +30,9 @@ JACOBIANS = ("auto", "dense", "krylov")
 #: (:mod:`fretwear.hb.attempts`)
 STRATEGY = ("start", "best-point", "eps-continuation", "harmonic-continuation", "time-start")
 def _is_integer(v) -> bool:
-    """A whole number of an integer type (numpy's included), not a boolean."""
-    return isinstance(v, numbers.Integral) and not isinstance(v, bool)
+    """A whole number of an integer type (numpy's included), not a boolean, of magnitude at
+    most 2^62 (as the case files' integer keys: no count comes near it)."""
+    return isinstance(v, numbers.Integral) and not isinstance(v, bool) and abs(v) <= 2**62
 
 
 #: the solver a rung "other solver" switches to

@@ -102,12 +102,12 @@ def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float | None
     best = solve_ladder(trial)
     st = best.stats
     st.wall_time = time.perf_counter() - t0
-    if not st.success and raise_on_failure:
+    sol = assemble_solution(best.prob, best.x.reshape(best.prob.m, best.prob.H), model, st)
+    if not st.success and raise_on_failure:  # (after assembly: a NaN solution is a failure)
         raise ConvergenceError(
             f"periodic solve at f = {reduced.frequency:.6g} Hz did not converge: "
             f"{st.message} (relative residual {st.residual:.3g} > {options.tol:g}; "
             f"{len(trial.attempts)} attempts: {', '.join(a.method for a in trial.attempts)})")
-    sol = assemble_solution(best.prob, best.x.reshape(best.prob.m, best.prob.H), model, st)
     sol.attempts = trial.attempts
     sol.fallback_seconds = trial.fallback_seconds
     if trial.found:

@@ -39,8 +39,12 @@ import scipy.sparse as sp
 
 from fretwear.errors import InputError
 from fretwear.hb import sparse_lu
+from fretwear.limits import RANGES
+from fretwear.model.checks import model_argument
 from fretwear.model.core import Model
 from fretwear.model.interfaces import observed_map, relative_model
+from fretwear.resources import require_memory
+from fretwear.validate import number
 
 
 @dataclass
@@ -74,6 +78,19 @@ class Reduced:
     frequency: float = math.nan
 
     def __post_init__(self):
+        self.omega = number(self.omega, "Reduced omega", low=0.0, unit="rad/s")
+        self.orders = whole_orders(self.orders)
+        nb = self.orders.size
+        for name, ndim in (("Z", 3), ("F", 2), ("obs_A", 3), ("obs_b", 2)):
+            a = getattr(self, name)
+            if not isinstance(a, np.ndarray) or a.ndim != ndim or a.shape[0] != nb or \
+                    a.dtype.kind not in "fc" or not np.all(np.isfinite(a)):
+                raise InputError(f"Reduced {name} = {repr(a)[:50]}; expected a finite "
+                                 f"{ndim}-dimensional array, one block per order ({nb})")
+        m = self.Z.shape[1]
+        if self.Z.shape[2] != m or self.F.shape[1] != m or self.obs_A.shape[2] != m:
+            raise InputError(f"Reduced arrays of inconsistent sizes: Z {self.Z.shape}, F "
+                             f"{self.F.shape}, obs_A {self.obs_A.shape}")
         if math.isnan(self.frequency):
             self.frequency = self.omega / (2 * np.pi)
 
@@ -486,6 +503,7 @@ class Condenser:
         """The :class:`Reduced` model on harmonic ``orders`` at ``omega`` [rad/s]."""
         orders = np.asarray(orders, dtype=np.int64)
         m, no, nb = self.m, self.structure.obs.size, orders.size
+        self.check_size(orders)
         F_all = self.load_harmonics(int(orders.max()) if orders.size else 0)
         if (self.dense and self.ni <= BATCH_MAX and isinstance(self.R, np.ndarray)
                 and not quasi_static and omega > 0):
@@ -512,6 +530,26 @@ class Condenser:
             for j, i in self.obs_i:
                 ob[b, j] = xf[i]
         return self._result(omega, orders, Zr, Fr, oA, ob, quasi_static, frequency)
+
+    def check_size(self, orders) -> None:
+        """Refuse (one InputError with the estimate and the machine's memory) a condensation
+        on ``orders`` that cannot fit, before it allocates: per harmonic the condensed
+        blocks, the observation rows and the factorisation of ``Z_ii`` kept until all are
+        done (dense: ``16 n_i^2`` bytes; sparse: ten times the nonzeros of ``K``, a rough
+        fill), the load amplitudes of every order up to the highest, and the Fourier basis
+        that the balance needs with it (at least ``2 k + 2`` samples of ``2 k + 1``
+        coefficients, four arrays)."""
+        orders = np.asarray(orders, dtype=np.int64)
+        if not orders.size:
+            return
+        nb, k = orders.size, int(orders.max())
+        m, no, ni = self.m, self.structure.obs.size, self.ni
+        lu = 16.0 * ni * ni if self.dense else 160.0 * self.structure.K.nnz
+        per_order = 16.0 * (2 * m * m + no * m + no + m) + lu
+        basis = 8.0 * (2 * k + 2) * (2 * k + 1) * 4
+        require_memory(nb * per_order + 16.0 * (k + 1) * self.structure.ndof + basis,
+                       f"a balance of {nb} harmonic orders (up to {k}) on {self.structure.ndof:,}"
+                       f" DOFs ({m} at the contact)")
 
     def load_harmonics(self, nmax: int) -> np.ndarray:
         """The structure's load amplitudes (nmax+1, ndof) complex [N], kept until
@@ -645,6 +683,7 @@ def _solve(lu, B):
     return lu.solve(np.ascontiguousarray(B.real)) + 1j * lu.solve(np.ascontiguousarray(B.imag))
 
 
+@model_argument
 def exact_condenser(model: Model) -> Condenser:
     """A new exact :class:`Condenser` of ``model`` (eq. 19): build it once and pass it
     (``condenser=``) to every condensation, solve, sweep or wear run of this model, which then
@@ -728,6 +767,23 @@ def condense_static(model: Model, *, condenser=None) -> StaticCondensation:
     return StaticCondensation(np.ascontiguousarray(0.5 * (Kr + Kr.T)), cond, lu, Kci)
 
 
+@model_argument
+def whole_orders(orders) -> np.ndarray:
+    """``orders`` as an int64 array after checking it holds distinct whole numbers in
+    ``[0, 2^62]``, at least one (an InputError naming ``orders`` otherwise)."""
+    if isinstance(orders, str | bytes):
+        raise InputError(f"orders = {orders!r}; expected harmonic orders (whole numbers >= 0)")
+    try:
+        a = np.asarray(orders)
+    except (TypeError, ValueError):
+        raise InputError("orders: expected a list of harmonic orders") from None
+    if a.ndim != 1 or not a.size or a.dtype.kind not in "iu" or np.any(a < 0) or np.any(
+            a > 2**62) or np.unique(a).size != a.size:
+        raise InputError(f"orders = {orders!r}; expected distinct harmonic orders, whole "
+                         "numbers >= 0, at least one (e.g. [0, 1, 2, 3])")
+    return a.astype(np.int64)
+
+
 def condense(model: Model, frequency: float, orders, *, quasi_static: bool = False,
              condenser=None) -> Reduced:
     """Condense ``model`` onto its contact DOFs for harmonic ``orders`` (``[0, h1, .., hk]``)
@@ -741,6 +797,10 @@ def condense(model: Model, frequency: float, orders, *, quasi_static: bool = Fal
     contact-local coordinates with the observed-DOF recovery rows
     (``Reduced.omega = 2 pi frequency`` [rad/s], ``Reduced.frequency`` as given).
     """
+    frequency = number(frequency, "frequency", low=0.0, high=RANGES["frequency"][1], unit="Hz")
+    if not (quasi_static or frequency > 0):
+        raise InputError("frequency = 0 Hz: expected a frequency > 0 [Hz] (or quasi_static)")
+    orders = whole_orders(orders)
     return _condense(model, 2 * np.pi * frequency, orders, quasi_static=quasi_static,
                      frequency=frequency, condenser=condenser)
 

@@ -243,7 +243,7 @@ def assemble_solution(prob: DLFTProblem, U, model: Model, stats: SolveStats) -> 
             nd = len(p.dofs)
             observed[p.name] = real[i : i + nd]
             i += nd
-    return PeriodicSolution(
+    sol = PeriodicSolution(
         frequency=red.frequency, omega=red.omega, quasi_static=red.quasi_static, basis=b,
         U=U.reshape(nc, d, H).copy(),
         lam=lam, X=X, lam_t=lam_t, x_t=x_t, state=state, gap=prob.gap.copy(),
@@ -251,6 +251,31 @@ def assemble_solution(prob: DLFTProblem, U, model: Model, stats: SolveStats) -> 
         area=np.asarray(model.contact.area, float), coords=np.asarray(model.contact.coords),
         stats=stats, U_node=U_node,
     )
+    bad = non_finite(sol)
+    if bad and stats.success:  # never a converged solution that holds NaN or inf
+        stats.success = False
+        stats.message = f"the solution holds non-finite values (NaN or inf) in {bad}"
+    return sol
+
+
+#: the arrays of a :class:`PeriodicSolution` that must be finite, with what they hold
+FINITE_ARRAYS = {"U": "U (the contact displacement harmonics)",
+                 "lam": "lam (the contact force harmonics)",
+                 "X": "X (the corrected displacement harmonics)",
+                 "lam_t": "lam_t (the contact forces in time)",
+                 "x_t": "x_t (the corrected displacements in time)"}
+
+
+def non_finite(sol: PeriodicSolution) -> str:
+    """What of ``sol`` holds NaN or inf (the arrays of :data:`FINITE_ARRAYS`, then the
+    observed points), ``""`` when all is finite."""
+    for name, what in FINITE_ARRAYS.items():
+        if not np.all(np.isfinite(getattr(sol, name))):
+            return what
+    for name, values in sol.observed.items():
+        if not np.all(np.isfinite(values)):
+            return f"the displacement of the observed point {name!r}"
+    return ""
 
 
 def initial_state(model: Model, sol: PeriodicSolution, condenser=None):

@@ -29,6 +29,7 @@ from fretwear.hb.options import SWEEP, SWEEP_POINT, SolveOptions, SweepOptions, 
 from fretwear.hb.penalty import sweep_penalty
 from fretwear.hb.preload import preload_anchor
 from fretwear.hb.reduce import condenser_for
+from fretwear.hb.solution import FINITE_ARRAYS
 from fretwear.hb.sweep_checkpoint import (
     WHAT,
     fingerprint,
@@ -203,6 +204,9 @@ def _grid_point(p: Point) -> SweepPoint:
     """The grid point of a ladder's outcome: converged (recorded on the branch, with its
     attempts) or not (no solution; why, and what a time integration found, in its flags)."""
     st = p.stats
+    if st.success and not np.all(np.isfinite(p.U)):  # never a converged point of NaN or inf
+        st.success = False
+        st.message = f"the solution holds non-finite values (NaN or inf) in {FINITE_ARRAYS['U']}"
     if st.success:
         pt = p.branch.record(p.omega, p.prob, p.U, st, p.how)
         pt.solution.attempts = p.tried

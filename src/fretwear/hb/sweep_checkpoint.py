@@ -141,6 +141,9 @@ def _check(data: dict) -> str:
     for k in ("U", "anchor", "omega", "eps"):
         if not np.isfinite(data[k][conv]).all():
             return f"non-finite {k} at a converged point"
+    for k in ("omega", "eps"):
+        if np.any(data[k][conv] <= 0):
+            return f"{k} <= 0 at a converged point"
     return ""
 
 

@@ -37,7 +37,9 @@ from fretwear.hb.stability import (
     problem_of,
 )
 from fretwear.hb.sweep_result import SweepResult
+from fretwear.model.checks import model_argument
 from fretwear.model.core import Model
+from fretwear.validate import instance
 
 #: |Im rho| / |rho| below this: the multiplier is real (period doubling / fold, not
 #: Neimark-Sacker)
@@ -101,12 +103,14 @@ def jacobian_sign(hp: HillProblem) -> int:
     return int(np.sign(sign))
 
 
+@model_argument
 def sweep_stability(model: Model, result: SweepResult, *, options: HillOptions | None = None,
                     dyn: StructureDynamics | None = None, condenser=None) -> SweepStability:
     """Hill's method at every converged point of ``result`` (a sweep of ``model``) and the
     branch events between them (module docstring). ``dyn``: the model's
     :func:`~fretwear.hb.dynamics.structure_dynamics` if already made; ``condenser``: the
     model's condenser as the sweep had it (for the problems rebuilt from the solutions)."""
+    instance(result, SweepResult, "result", "the SweepResult of fretwear.sweep (or frf_worn)")
     n = len(result.points)
     stable = np.full(n, -1, dtype=np.int8)
     rho = np.full(n, np.nan)

@@ -52,6 +52,7 @@ from fretwear.io.schema import (
     show,
     suggest,
     table_label,
+    unused_keys,
 )
 from fretwear.limits import LOSS_FACTOR_MAX, UnusualValueWarning, unusual
 from fretwear.model.core import WAVEFORMS
@@ -93,7 +94,10 @@ _COEFFICIENTS = Field(
 )
 _LOAD_NAME = Field(Text(), "label used in output")
 _MU = Field(_NON_NEG, "Coulomb friction coefficient", required=True, unit="-")
-_WEAR = Field(_NON_NEG, "Archard wear coefficient k_w (paper eq. 29)", default=0.0, unit="1/Pa")
+#: the analyses that wear the interface (read its wear coefficients)
+WEAR_ANALYSES = ("wear", "incremental-wear", "worn-state")
+_WEAR = Field(_NON_NEG, "Archard wear coefficient k_w (paper eq. 29)", default=0.0, unit="1/Pa",
+              used_by=WEAR_ANALYSES)
 _CONTACT_NAME = Field(Text(), "label of the interface in output", default="contact")
 _CONTACT_K = Number(lo=0, lo_open=True, hi=1e20, allow_inf=True)
 
@@ -379,7 +383,8 @@ CONTACT_MESH = Table(
                            "mortar and node-to-segment pairs)", unit="m"),
         "partner_wear_coefficient": Field(_NON_NEG, "Archard wear coefficient of the "
                                           "partner's surface (the gap opens by the sum of both "
-                                          "worn depths; default 0)", unit="1/Pa"),
+                                          "worn depths; default 0)", unit="1/Pa",
+                                          used_by=WEAR_ANALYSES),
         "normal_stiffness": Field(_CONTACT_K, "normal contact stiffness per unit area, in "
                                   "series with the contact law (a property of the interface, "
                                   "not a regularisation; inf: rigid)", default=math.inf,
@@ -603,7 +608,8 @@ CONTACT_FE = Table(
                       "tributary area, one value or one per node", default=1.0, unit="m^2"),
         "wear_coefficient": _WEAR,
         "partner_wear_coefficient": Field(_NON_NEG, "Archard coefficient of the partners' "
-                                          "surface", default=0.0, unit="1/Pa"),
+                                          "surface", default=0.0, unit="1/Pa",
+                                          used_by=WEAR_ANALYSES),
         "name": _CONTACT_NAME,
     },
     doc="A frictional interface on nodes of the exported matrices, one `[[contact]]` block "
@@ -639,13 +645,14 @@ OUTPUT = Table(
         "figures": Field(Flag(), "write figures", default=True),
         "figure_format": Field(Text(FIGURE_FORMATS), "figure file format", default="png"),
         "vtu": Field(Flag(), "write ParaView files (.vtu/.pvd) of fields when the model has a "
-                     "mesh", default=True),
+                     "mesh", default=True, used_by=("modes", "periodic", "wear")),
         "whole_disk": Field(Flag(), "a sector ([cyclic]): also the whole disk rebuilt from "
                             "the sector in ParaView, every sector turned: `periodic-disk.pvd` "
                             "of a periodic analysis (each harmonic n phased by "
                             "e^{i n EO j 2 pi / N}), `wear-disk.pvd` of a wear run (every "
                             "sector with the sector's wear: the tuned assumption); a sweep "
-                            "writes no ParaView fields; default false"),
+                            "writes no ParaView fields; default false",
+                            used_by=("periodic", "wear")),
     },
     doc="Where and what to write. `fretwear run -o DIR` overrides `directory`.",
 )
@@ -713,14 +720,36 @@ def validate(raw: Mapping, analyses: Mapping[str, Table], base_dir: Path | str =
     InputError
         At the first mistake, naming its key path.
     """
+    raw = {"damping": {}, "output": {}, **raw}  # absent tables get their defaults
+    return _case_table(_model_kind(raw), analyses).check(raw, "", Context(Path(base_dir)))
+
+
+def _model_kind(raw: Mapping) -> str:
+    """``"fe"``, ``"matrices"`` or ``"mesh"``: which tables the case file has."""
     model = raw.get("model")
     kind = model.get("type") if isinstance(model, Mapping) else None
     if kind == "matrices" and fe_mode(model):
         kind = "fe"
-    raw = {"damping": {}, "output": {}, **raw}  # absent tables get their defaults
-    return _case_table(kind if kind in ("matrices", "fe") else "mesh", analyses).check(
-        raw, "", Context(Path(base_dir))
-    )
+    return kind if kind in ("matrices", "fe") else "mesh"
+
+
+#: the tables whose keys say how to run (an ignored one is a warning); the others describe the
+#: model (an ignored one, such as a wear coefficient kept in a file run for its FRF, is a note)
+_RUN_TABLES = ("analysis", "output")
+
+
+def ignored_notes(case: Case, analyses: Mapping[str, Table]) -> list[str]:
+    """One line for every key of the case file that its analysis does not read (declared by
+    the schema: :attr:`fretwear.io.schema.Field.used_by`, found by
+    :func:`fretwear.io.schema.unused_keys`), naming the key and the analyses that read it."""
+    kind = case.analysis["type"]
+    lines = []
+    for path, value, used_by in unused_keys(_case_table(_model_kind(case.raw), analyses),
+                                            case.raw, kind):
+        level = "warning" if path.split(".")[0].split("[")[0] in _RUN_TABLES else "note"
+        lines.append(f"{level}: {path} = {show(value)} is not used by a {kind} analysis (only "
+                     f"by {', '.join(used_by)}): it is ignored")
+    return lines
 
 
 # --- loading ----------------------------------------------------------------------------

@@ -30,8 +30,9 @@ import numpy as np
 import xarray as xr
 
 from fretwear import __version__
-from fretwear.errors import InputError
+from fretwear.errors import ConvergenceError, InputError
 from fretwear.files import atomic_write
+from fretwear.validate import path as file_path
 
 ENGINE = "h5netcdf"
 
@@ -118,6 +119,52 @@ def check_schema(ds: xr.Dataset) -> None:
             )
 
 
+#: variables that hold a solution (displacements, velocities, contact forces, wear depths):
+#: NaN or inf in one of them means the computation failed, so the writer refuses it
+#: (:func:`check_finite`); along a dimension that a ``converged`` flag shares (a sweep's
+#: ``frequency``), only the converged entries are checked, and the axes a point does not have
+#: (NaN over all of them: a point of fewer DOFs than the model's axes) are padding
+SOLUTION_VARIABLES = ("displacement", "velocity", "displacement_coefficients",
+                      "displacement_harmonic_amplitude", "contact_displacement_coefficients",
+                      "contact_force_coefficients", "corrected_displacement_coefficients",
+                      "contact_force", "corrected_displacement", "contact_displacement",
+                      "wear_depth", "worn_volume")
+
+
+def _checked_values(ds: xr.Dataset, name: str) -> np.ndarray:
+    """The values of ``ds[name]`` that must be finite: the converged entries, without the
+    padded axes of points."""
+    var = ds[name]
+    values = np.asarray(var.values, dtype=float)
+    dims = list(var.dims)
+    flag = ds.data_vars.get("converged")
+    if flag is not None and flag.ndim == 1 and flag.dims[0] in dims:
+        values = np.compress(np.asarray(flag.values).astype(bool), values,
+                             axis=dims.index(flag.dims[0]))
+    if "axis" in dims and values.size:
+        keep = [dims.index(d) for d in ("point", "axis") if d in dims]
+        other = tuple(i for i in range(values.ndim) if i not in keep)
+        padded = np.all(np.isnan(values), axis=other, keepdims=True) if other else \
+            np.isnan(values)
+        if not np.all(padded):  # a point with no finite axis at all is not padding
+            values = values[~np.broadcast_to(padded, values.shape)]
+    return values
+
+
+def check_finite(ds: xr.Dataset) -> None:
+    """Refuse a dataset whose solution variables (:data:`SOLUTION_VARIABLES`) hold NaN or
+    inf: a :class:`~fretwear.errors.ConvergenceError` naming the variable, so that a failed
+    computation is never written as a result."""
+    for name in SOLUTION_VARIABLES:
+        if name not in ds.data_vars or np.asarray(ds[name].values).dtype.kind not in "fc":
+            continue
+        if not np.all(np.isfinite(_checked_values(ds, name))):
+            what = ds[name].attrs.get("long_name", "")
+            raise ConvergenceError(f"results variable {name!r} ({what}) holds non-finite "
+                                   "values (NaN or inf): the computation failed; no results "
+                                   "file was written")
+
+
 # --- writing ----------------------------------------------------------------------------
 def run_attributes(*, title: str, analysis_type: str, converged: bool, case_text: str = "",
                    case_path: str = "", analysis: Mapping | None = None) -> dict:
@@ -149,6 +196,7 @@ def write_results(path: Path | str, ds: xr.Dataset, **attrs) -> Path:
     The absolute path written.
     """
     check_schema(ds)
+    check_finite(ds)
     ds = ds.copy()
     ds.attrs = {**ds.attrs, **run_attributes(**attrs)}
     return atomic_write(path, lambda tmp: ds.to_netcdf(tmp, engine=ENGINE))
@@ -168,6 +216,7 @@ def read_results(path: Path | str) -> xr.Dataset:
     InputError
         The file does not exist or is not a NetCDF file.
     """
+    path = file_path(path, "path")
     path = Path(path)
     if not path.is_file():
         raise InputError(f"results file {str(path)!r} does not exist")

@@ -350,6 +350,7 @@ class Field:
     required : the key must be given.
     default : value used when the key is absent (``MISSING``: left out of the output).
     unit : SI unit written in the docs (``""`` for none, ``"-"`` for dimensionless).
+    used_by : the analysis types that read the key (None: every one).
     """
 
     spec: Spec
@@ -357,6 +358,9 @@ class Field:
     required: bool = False
     default: Any = MISSING
     unit: str = ""
+    used_by: tuple | None = None
+    """The analysis types that read the key (None: every one); given to another, the key is
+    named as ignored (:func:`unused_keys`)."""
 
 
 @dataclass
@@ -489,6 +493,45 @@ class Variant(Spec):
         table = self.tables()[kind]
         full = Table({self.key: sel, **table.fields}, table.checks, table.doc)
         return full.check(value, path, ctx)
+
+
+# --- keys an analysis does not read -----------------------------------------------------
+def unused_keys(spec: Spec, value: Any, analysis: str, path: str = "") -> list[tuple]:
+    """``(key path, value, used_by)`` of every key given in the validated ``value`` of
+    ``spec`` that the analysis type ``analysis`` does not read (its :attr:`Field.used_by`
+    leaves it out), walking the schema: so a key declared with ``used_by`` is covered
+    wherever it sits. A key given its default, or a switch turned off (``false``), changes
+    nothing and is not listed."""
+    out: list[tuple] = []
+    if isinstance(spec, Variant) and isinstance(value, Mapping):
+        table = spec.tables().get(value.get(spec.key))
+        if table is not None:
+            out += unused_keys(table, value, analysis, path)
+    elif isinstance(spec, Table) and isinstance(value, Mapping):
+        for key, f in spec.fields.items():
+            if key not in value:
+                continue
+            v, sub = value[key], join(path, key)
+            if f.used_by is not None and analysis not in f.used_by:
+                if not (v is False or (f.default is not MISSING and v == f.default)):
+                    out.append((sub, v, f.used_by))
+            else:
+                out += unused_keys(f.spec, v, analysis, sub)
+    elif isinstance(spec, TableList) and isinstance(value, list | tuple):
+        for i, item in enumerate(value):
+            out += unused_keys(spec.table, item, analysis,
+                               f"{path}[{i + 1}]" if len(value) > 1 else path)
+    elif isinstance(spec, TableList) and isinstance(value, Mapping):
+        out += unused_keys(spec.table, value, analysis, path)
+    elif isinstance(spec, Dict) and isinstance(value, Mapping):
+        for key, v in value.items():
+            out += unused_keys(spec.value, v, analysis, join(path, str(key)))
+    elif isinstance(spec, AnyOf):
+        for option in spec.options:
+            if option.matches(value):
+                out += unused_keys(option, value, analysis, path)
+                break
+    return out
 
 
 # --- rules across keys of a table (for Table.checks) ---------------------------------

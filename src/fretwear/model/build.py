@@ -25,6 +25,7 @@ import scipy.sparse as sp
 
 from fretwear.errors import InputError
 from fretwear.limits import RANGES, UnusualValueWarning, check_loss_factor, unusual
+from fretwear.model.checks import check_mesh
 from fretwear.model.core import WAVEFORMS, ContactInterface, Load, Mesh, Model, ObservedPoint
 from fretwear.model.fem import assemble, check_material, check_thickness
 from fretwear.model.interfaces import combine
@@ -37,12 +38,20 @@ from fretwear.model.regions import region_nodes, restricted
 from fretwear.model.supports import check_supported
 from fretwear.validate import is_real, number
 
-
 # --------------------------------------------------------------------------------------------
 # input dataclasses
 # --------------------------------------------------------------------------------------------
+#: the largest magnitude of a stiffness, pressure, force or damping coefficient of a model (far
+#: beyond any structure; a larger one is a typo, and would make the matrices overflow)
+MAGNITUDE_MAX = 1e20
+
+
 def _finite(value, what: str, *, minimum=None, allow_inf=False) -> float:
-    return number(value, what, low=minimum, allow_inf=allow_inf)
+    v = number(value, what, low=minimum, allow_inf=allow_inf)
+    if math.isfinite(v) and abs(v) > MAGNITUDE_MAX:
+        raise InputError(f"{what} = {value!r}; expected a magnitude at most {MAGNITUDE_MAX:g}"
+                         + (" (inf for rigid)" if allow_inf else ""))
+    return v
 
 
 def _warn_unusual(*checks) -> None:
@@ -180,6 +189,8 @@ class Traction:
                 f"traction (vector in Pa); got pressure={self.pressure!r}, "
                 f"traction={self.traction!r}"
             )
+        if self.pressure is not None and not callable(self.pressure):
+            self.pressure = _finite(self.pressure, f"{what}: pressure")
         _check_waveform(self.waveform, self.coefficients, what)
 
 
@@ -300,10 +311,11 @@ class ContactSpec:
         for key in ("normal_stiffness", "tangential_stiffness"):
             v = number(getattr(self, key), f"{what}: {key}", low=0.0, open_low=True,
                        allow_inf=True, unit="Pa/m")
-            setattr(self, key, v)
+            setattr(self, key, _finite(v, f"{what}: {key}", allow_inf=True))
         if self.normal_pressure is not None:
-            self.normal_pressure = number(self.normal_pressure, f"{what}: normal_pressure",
-                                          low=0.0, unit="Pa")
+            self.normal_pressure = _finite(number(self.normal_pressure,
+                                                  f"{what}: normal_pressure", low=0.0,
+                                                  unit="Pa"), f"{what}: normal_pressure")
         waveforms = [w for w in WAVEFORMS if w != "fourier"]
         if self.normal_waveform not in waveforms:
             raise InputError(f"{what}: normal_waveform = {self.normal_waveform!r}; expected one "
@@ -699,6 +711,7 @@ def unchecked_from_mesh(mesh: Mesh, material: Material, *, thickness=1.0,
     it. Any other use should call :func:`from_mesh`."""
     if not isinstance(mesh, Mesh):
         raise InputError(f"mesh = {mesh!r} is not a fretwear Mesh")
+    check_mesh(mesh)
     check_cells(mesh)
     if damping is not None and not isinstance(damping, Damping):
         raise InputError(f"damping = {damping!r} is not a Damping(...)")

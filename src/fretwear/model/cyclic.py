@@ -30,6 +30,7 @@ import scipy.sparse as sp
 
 from fretwear.errors import InputError
 from fretwear.model.build import _contact
+from fretwear.model.checks import model_argument, whole_number
 from fretwear.model.core import ContactInterface, Load, Model, ObservedPoint
 from fretwear.model.interfaces import check_distinct, combine
 from fretwear.model.supports import Neighbours, check_supported
@@ -168,6 +169,7 @@ def match_boundaries(left_coords, right_coords, axis, point, n_sectors: int,
     return order
 
 
+@model_argument
 def cyclic_sector(model: Model, n_sectors: int, left, right, *, axis=(0.0, 0.0, 1.0),
                   point=(0.0, 0.0, 0.0), tolerance: float | None = None) -> CyclicSector:
     """The sector ``model`` (built from a mesh) of a disk of ``n_sectors`` sectors.
@@ -282,6 +284,7 @@ def _positions(sector: CyclicSector, dofs, what: str) -> np.ndarray:
     return out
 
 
+@model_argument
 def neighbour_contact(sector: CyclicSector, spec) -> CyclicSector:
     """The sector with an inter-blade contact added (a damper, a shroud): ``spec`` a
     :class:`~fretwear.model.build.ContactSpec` whose ``boundary`` A touches the *next*
@@ -476,11 +479,13 @@ def _wave_loads(loads: list[Load], A: list[sp.csr_matrix], engine_order: int,
     return out
 
 
+@model_argument
 def whole_disk(sector: CyclicSector, engine_order: int = 0) -> Model:
     """The disk of ``N`` copies of the sector, turned into the disk's axes, merged at the
     cyclic boundaries, every sector with the sector's contact (frames turned) and loads
     (phased by the travelling wave of ``engine_order``); observed points of sector 0. The
     reference of the cyclic reduction (no mesh kept)."""
+    engine_order = whole_number(engine_order, "engine_order")
     m = sector.model
     A, nd = sector_maps(sector)
 

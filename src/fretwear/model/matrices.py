@@ -9,7 +9,6 @@ on ``[normal, tangential(s)]``, with the sign of the normal DOF flipped when
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 import scipy.io
@@ -23,6 +22,7 @@ from fretwear.model.interfaces import relative_model
 from fretwear.model.supports import rigid_motion_check
 from fretwear.resources import require_memory
 from fretwear.validate import is_real
+from fretwear.validate import path as file_path
 
 SYMMETRY_TOL = 1e-9  # max |A - A^T| relative to max |A|
 
@@ -399,8 +399,9 @@ def _interface(contact: ContactDofs, dofs: np.ndarray, n: int) -> ContactInterfa
         dofs=dofs,
         frame=frame,
         gap=_bounded(_per_node(contact.gap, nc, "gap"), RANGES["length"][1], "gap [m]"),
-        area=_per_node(contact.area, nc, "area", positive=True),
-        mu=_nonnegative(contact.mu, "friction coefficient mu"),
+        area=_bounded(_per_node(contact.area, nc, "area", positive=True), 1e10, "area"),
+        mu=float(_bounded(np.asarray(_nonnegative(contact.mu, "friction coefficient mu")),
+                          1e3, "friction coefficient mu")),
         coords=xyz,
         node_ids=np.full(nc, -1, dtype=np.int64),
         wear_coefficient=_nonnegative(contact.wear_coefficient, "wear_coefficient"),
@@ -592,7 +593,7 @@ def read_matrix_market(path, *, shape: tuple | None = None):
         shape other than ``shape``, or a size that cannot fit in memory (checked from the
         header before reading).
     """
-    path = Path(path)
+    path = file_path(path, "path")
     if not path.is_file():
         raise InputError(f"Matrix Market file {str(path)!r} does not exist")
     try:

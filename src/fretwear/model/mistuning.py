@@ -32,6 +32,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from fretwear.errors import InputError
+from fretwear.model.checks import amplitudes, model_argument, whole_number
 from fretwear.model.core import Model, ObservedPoint
 from fretwear.model.cyclic import (
     CyclicSector,
@@ -98,9 +99,11 @@ def random_mistuning(n_sectors: int, std: float, seed: int, kinds=("young",)) ->
     (``numpy.random.default_rng(seed)``, drawn sector by sector, kind after kind in the
     order of :data:`KINDS`) for each kind in ``kinds``; the others 1. ``std`` must keep
     every factor positive (a few per cent, as measured on real disks)."""
+    n_sectors = whole_number(n_sectors, "n_sectors", low=1)
     if isinstance(std, bool) or not isinstance(std, int | float) or not 0 <= std < 0.5:
         raise InputError(f"mistuning std = {std!r}: expected a standard deviation in [0, 0.5)")
-    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or not \
+            0 <= seed <= 2**62:
         raise InputError(f"mistuning seed = {seed!r}: expected an integer >= 0")
     unknown = [k for k in kinds if k not in KINDS]
     if unknown or not kinds:
@@ -113,6 +116,7 @@ def random_mistuning(n_sectors: int, std: float, seed: int, kinds=("young",)) ->
 def whitehead_bound(n_sectors: int) -> float:
     """Whitehead's largest amplification of a mistuned disk's forced response,
     ``(1 + sqrt(N)) / 2`` (one mode family; module docstring)."""
+    n_sectors = whole_number(n_sectors, "n_sectors", low=1)
     return 0.5 * (1.0 + np.sqrt(float(n_sectors)))
 
 
@@ -121,11 +125,13 @@ def sector_point_name(name: str, j: int) -> str:
     return f"{name}@{j}"
 
 
+@model_argument
 def mistuned_disk(sector: CyclicSector, engine_order: int, mistuned: Mistuning) -> Model:
     """The disk of ``N`` sectors, sector ``j`` mistuned by the ``j``-th factors of
     ``mistuned`` (module docstring), under the travelling wave of ``engine_order`` (the
     loads of :func:`~fretwear.model.cyclic.whole_disk`); every observed point of the sector
     on every sector, named ``"<name>@<j>"`` (positions turned into the disk's axes)."""
+    engine_order = whole_number(engine_order, "engine_order")
     n = sector.n_sectors
     if not isinstance(mistuned, Mistuning) or mistuned.n_sectors != n:
         got = mistuned.n_sectors if isinstance(mistuned, Mistuning) else mistuned
@@ -175,13 +181,14 @@ def mistuned_disk(sector: CyclicSector, engine_order: int, mistuned: Mistuning) 
         name=f"{m.name} (mistuned disk of {n})")
 
 
+@model_argument
 def sector_responses(sector: CyclicSector, U) -> np.ndarray:
     """``U`` (..., ndof_disk) of the whole disk as each sector's DOFs in its own axes:
     (..., N, ndof) (sector ``j``'s are ``A_j^T U``, :func:`~fretwear.model.cyclic.sector_maps`)."""
     A, nd = sector_maps(sector)
-    U = np.asarray(U)
-    if U.shape[-1] != nd:
-        raise InputError(f"U: {U.shape[-1]} DOFs; expected the disk's {nd}")
+    U = amplitudes(U, "U")
+    if U.shape[-1:] != (nd,):
+        raise InputError(f"U has shape {U.shape}; expected (..., {nd}): the disk's DOFs last")
     flat = U.reshape(-1, nd)
     out = np.stack([(Aj.T @ flat.T).T for Aj in A], axis=1)
     return out.reshape((*U.shape[:-1], sector.n_sectors, sector.model.ndof))
@@ -192,13 +199,18 @@ def blade_amplitudes(amplitude) -> np.ndarray:
     (..., N, d) [m] (the moduli of the point's components in any axes: sector ``j``'s or
     the disk's): ``(..., N)`` the length ``sqrt(sum_c |U_c|^2)`` of the complex amplitude
     vector, which no rotation changes."""
-    a = np.asarray(amplitude)
+    a = amplitudes(amplitude, "amplitude", nan=True)
     return np.sqrt(np.sum(np.abs(a) ** 2, axis=-1))
 
 
 def amplification_factor(mistuned, tuned) -> float:
     """The largest blade response of the mistuned disk over the tuned disk's largest:
     ``max(mistuned) / max(tuned)`` over every blade (and frequency) given [-]."""
+    for name, value in (("mistuned", mistuned), ("tuned", tuned)):
+        a = amplitudes(value, name, nan=True)
+        if a.dtype.kind == "c" or np.nanmin(a) < 0:
+            raise InputError(f"{name} holds {np.nanmin(a.real):g}; expected blade responses "
+                             ">= 0 (moduli, e.g. blade_amplitudes)")
     top = float(np.nanmax(np.asarray(tuned, float)))
     if not np.isfinite(top) or top <= 0:
         raise InputError(f"tuned response max {top!r}: expected a positive amplitude")

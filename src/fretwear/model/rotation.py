@@ -26,12 +26,13 @@ import math
 import numpy as np
 
 from fretwear.errors import InputError
+from fretwear.model.checks import model_argument
 from fretwear.model.core import Load, Model
 
 
 def _speed(speed) -> float:
     if isinstance(speed, bool) or not isinstance(speed, int | float | np.floating) \
-            or not math.isfinite(speed) or speed < 0:
+            or not math.isfinite(speed) or not 0 <= speed <= 1e10:
         raise InputError(f"speed = {speed!r}: expected a rotation speed >= 0 [rad/s]")
     return float(speed)
 
@@ -57,6 +58,7 @@ def radial_positions(model: Model, axis=(0.0, 0.0, 1.0), point=(0.0, 0.0, 0.0)) 
     return out
 
 
+@model_argument
 def centrifugal_load(model: Model, speed: float, *, axis=(0.0, 0.0, 1.0),
                      point=(0.0, 0.0, 0.0), name: str = "centrifugal") -> Load:
     """The static :class:`~fretwear.model.core.Load` of the body force ``rho Omega^2 r`` at

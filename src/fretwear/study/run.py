@@ -27,6 +27,7 @@ from fretwear.study.runner import (
 )
 from fretwear.study.spec import Study, read_study
 from fretwear.study.sweep_split import join_chunks
+from fretwear.validate import path as file_path
 
 STUDY_RESULTS = "study.nc"
 
@@ -210,6 +211,7 @@ def shipped_studies() -> dict[str, Path]:
 
 def resolve_study(path) -> Path:
     """``path`` itself when it is a file, else the shipped study of that name."""
+    file_path(path, "path")
     p = Path(path).expanduser()
     if p.is_file() or p.suffix == ".toml" or "/" in str(path):
         if not p.is_file():

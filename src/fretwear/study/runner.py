@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from fretwear.errors import FretwearError, InputError
-from fretwear.files import atomic_write
+from fretwear.files import atomic_write, damaged
 from fretwear.resources import require_memory
 from fretwear.study.members import CASE_FILE, Member
 from fretwear.validate import ArgumentTypeError, whole
@@ -53,11 +53,34 @@ class MemberRecord:
     skipped: bool = False
     case_sha256: str = ""
     warnings: str = ""
+    results_sha256: str = ""
 
     def to_json(self) -> str:
-        d = {k: getattr(self, k) for k in ("index", "status", "message", "seconds", "worker",
-                                           "case_sha256", "warnings")}
+        """The record as JSON, sealed: ``content_sha256`` is the SHA-256 of the other fields
+        (:func:`record_digest`), checked on reading (:func:`read_status`)."""
+        d = {k: getattr(self, k) for k in RECORD_FIELDS}
+        d[SEAL_KEY] = record_digest(d)
         return json.dumps(d, indent=1) + "\n"
+
+
+#: the fields of a status file (besides its seal, :data:`SEAL_KEY`)
+RECORD_FIELDS = ("index", "status", "message", "seconds", "worker", "case_sha256", "warnings",
+                 "results_sha256")
+#: the key of a status file that holds the SHA-256 of its other fields
+SEAL_KEY = "content_sha256"
+
+
+def record_digest(d: dict) -> str:
+    """SHA-256 of the fields of a status file (every key but :data:`SEAL_KEY`, sorted, as
+    compact JSON)."""
+    body = {k: v for k, v in d.items() if k != SEAL_KEY}
+    return hashlib.sha256(json.dumps(body, sort_keys=True, separators=(",", ":"))
+                          .encode("utf-8")).hexdigest()
+
+
+def file_hash(path: Path) -> str:
+    """The SHA-256 of a file's bytes."""
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
 
 
 def case_hash(text: str) -> str:
@@ -98,15 +121,38 @@ def write_case(folder: Path, text: str) -> Path:
 
 
 def read_status(folder: Path) -> MemberRecord | None:
-    """The recorded status of the member in ``folder`` (None: none, or unreadable)."""
+    """The recorded status of the member in ``folder`` (None: none, or not JSON: the member
+    runs again and its status is written anew).
+
+    Raises
+    ------
+    InputError
+        A status whose content checksum (:data:`SEAL_KEY`) is missing while it records the
+        case's hash (written by this fretwear), or does not match its fields: edited or
+        corrupted after it was written; one line naming the file. A status of an earlier
+        fretwear (no case hash, no checksum) is read as before (its case file is checked).
+    """
+    path = folder / STATUS_FILE
     try:
-        d = json.loads((folder / STATUS_FILE).read_text(encoding="utf-8"))
+        d = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    if not isinstance(d, dict):
+        raise damaged(path, "study member status", "not a JSON object")
+    if SEAL_KEY in d or "case_sha256" in d:
+        if d.get(SEAL_KEY) != record_digest(d):
+            why = ("no content checksum" if SEAL_KEY not in d else "its content does not match "
+                   "its checksum: it was edited or corrupted after it was written")
+            raise damaged(path, "study member status", why)
+    try:
         return MemberRecord(int(d["index"]), str(d["status"]), str(d.get("message", "")),
                             float(d.get("seconds", 0.0)), str(d.get("worker", "")),
                             case_sha256=str(d.get("case_sha256", "")),
-                            warnings=str(d.get("warnings", "")))
-    except (OSError, ValueError, KeyError, TypeError):
-        return None
+                            warnings=str(d.get("warnings", "")),
+                            results_sha256=str(d.get("results_sha256", "")))
+    except (ValueError, KeyError, TypeError):
+        raise damaged(path, "study member status", "a field is missing or of the wrong "
+                      "kind") from None
 
 
 def finished(folder: Path, text: str) -> MemberRecord | None:
@@ -115,6 +161,9 @@ def finished(folder: Path, text: str) -> MemberRecord | None:
     rec = read_status(folder)
     if rec is None or rec.status not in FINISHED or not (folder / RESULTS_FILE).is_file():
         return None
+    if rec.results_sha256 and file_hash(folder / RESULTS_FILE) != rec.results_sha256:
+        raise damaged(folder / RESULTS_FILE, "study member results file", "its content is not "
+                      f"the one its status {STATUS_FILE} records: it was edited or replaced")
     if rec.case_sha256:
         if rec.case_sha256 != case_hash(text):  # the study changed this member since
             return None
@@ -156,7 +205,9 @@ def run_member(index: int, text: str, folder: str) -> MemberPayload:
         except Exception as exc:  # recorded with its message, never dropped
             status, message = "failed", f"{type(exc).__name__}: {' '.join(str(exc).split())}"
     rec = MemberRecord(index, status, message, time.perf_counter() - start, worker,
-                       case_sha256=case_hash(text), warnings=warning_lines(caught))
+                       case_sha256=case_hash(text), warnings=warning_lines(caught),
+                       results_sha256="" if results is None else hashlib.sha256(
+                           results).hexdigest())
     with contextlib.suppress(OSError):
         _write_text(folder_path / STATUS_FILE, rec.to_json())
     return MemberPayload(rec, results)

@@ -43,6 +43,7 @@ from fretwear.io.schema import (
     exactly_one,
     show,
 )
+from fretwear.validate import path as file_path
 
 KINDS = ("grid", "samples", "ensemble", "split")
 DISTRIBUTIONS = ("uniform", "loguniform", "normal")
@@ -291,6 +292,7 @@ def read_study(path: Path | str) -> Study:
     InputError
         One line naming the study file and the key.
     """
+    path = file_path(path, "path")
     path = Path(path).expanduser().resolve()
     try:
         text, raw = read_toml(path)

@@ -10,21 +10,27 @@ from fretwear.errors import InputError
 from fretwear.model.core import Model
 
 
-def positive(value, what: str) -> float:
+def positive(value, what: str, high: float = 1e20) -> float:
+    """``value`` as a float after checking it is a real number (not a string or a bool) in
+    ``(0, high]``."""
+    if isinstance(value, str | bytes | bool | np.bool_):
+        raise InputError(f"{what} = {value!r}; expected a positive number")
     try:
         v = float(value)
     except (TypeError, ValueError):
         raise InputError(f"{what} = {value!r}; expected a positive number") from None
-    if not (math.isfinite(v) and v > 0.0):
-        raise InputError(f"{what} = {value!r}; expected a positive finite number")
+    if not (math.isfinite(v) and 0.0 < v <= high):
+        raise InputError(f"{what} = {value!r}; expected a positive finite number (at most "
+                         f"{high:g})")
     return v
 
 
 def count(value, what: str, minimum: int = 1) -> int:
     if isinstance(value, bool) or not isinstance(value, int | np.integer):
         raise InputError(f"{what} = {value!r}; expected an integer >= {minimum}")
-    if value < minimum:
-        raise InputError(f"{what} = {value}; expected an integer >= {minimum}")
+    if value < minimum or value > 2**62:
+        raise InputError(f"{what} = {value}; expected an integer >= {minimum} (and at most "
+                         "2^62)")
     return int(value)
 
 

@@ -69,7 +69,7 @@ class IntegrationOptions:
     def __post_init__(self):
         _set(self, "steps_per_period", count(self.steps_per_period, "steps_per_period", 4))
         try:
-            gamma = float(self.gamma)
+            gamma = float(self.gamma) if not isinstance(self.gamma, str | bool) else np.nan
         except (TypeError, ValueError):
             gamma = np.nan
         if not (0.5 <= gamma <= 1.0):
@@ -128,7 +128,8 @@ class SteadyStateOptions:
         _set(self, "max_periods", count(self.max_periods, "max_periods", 1))
         _set(self, "check_every", count(self.check_every, "check_every", 1))
         _set(self, "window", count(self.window, "window", 8))
-        _set(self, "tol", positive(self.tol, "tol"))
+        _set(self, "tol", positive(self.tol, "tol", high=1.0))
+        _set(self, "harmonics", count(self.harmonics, "harmonics", 1))
 
     def replace(self, **changes) -> SteadyStateOptions:
         """A copy with ``changes`` (checked)."""

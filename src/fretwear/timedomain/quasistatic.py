@@ -12,6 +12,7 @@ import numpy as np
 from fretwear.errors import ConvergenceError, InputError
 from fretwear.hb.reduce import condense_static
 from fretwear.model.core import Model
+from fretwear.resources import require_memory
 from fretwear.timedomain.checks import c_float, check_contact, count, node_wear
 from fretwear.timedomain.contact_solve import OPEN, STICK, Contact, ContactState, Settings
 from fretwear.timedomain.kernels import LoadCycle, WearRecords, WearState, run_quasistatic
@@ -86,6 +87,10 @@ def incremental_wear(model: Model, *, n_cycles: int = 100,
     Ft = model.load_time(tau) if model.loads else np.zeros((N, model.ndof))
     btab = np.ascontiguousarray(cond.loads(Ft))
     fscale = float(np.abs(btab).max(initial=0.0))
+    computed = 1 + -(-(n_cycles - 1) // J)  # cycles computed (each stands for up to J)
+    require_memory(8.0 * computed * (2 + 3 * nc / rec_every),
+                   f"an incremental wear run of {computed:,} computed cycles (n_cycles = "
+                   f"{n_cycles:,}, cycle_jump = {J:,})")
     jumps = _cycle_jumps(n_cycles, J)
     ncomp = jumps.size
     nrec = sum(1 for i in range(ncomp) if (i + 1) % rec_every == 0 or i == ncomp - 1)

@@ -24,9 +24,11 @@ import numpy as np
 
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.solution import PeriodicSolution, initial_state
+from fretwear.model.checks import model_argument
 from fretwear.model.core import Model
 from fretwear.timedomain.options import InitialState, IntegrationOptions, SteadyStateOptions
 from fretwear.timedomain.steady import steady_state, steady_state_at_omega
+from fretwear.validate import instance
 
 VERDICTS = ("stable", "settles elsewhere", "drifting", "quasi-periodic", "irregular",
             "undecided")
@@ -62,6 +64,7 @@ class StabilityCheck:
         return [] if self.verdict == "stable" else [f"{self.verdict}: {self.message}"]
 
 
+@model_argument
 def check_periodic(model: Model, sol: PeriodicSolution, *, max_periods: int = 3000,
                    steps_per_period: int | None = None, perturbation: float = 1e-3,
                    tolerance: float = 0.2, periodicity_tol: float = 1e-4,
@@ -97,6 +100,7 @@ def check_periodic(model: Model, sol: PeriodicSolution, *, max_periods: int = 30
     :data:`RESOLVED_STEPS` steps, the message says so and gives the ``steps_per_period`` that
     would: stick-slip there depends on the step, and so may the verdict.
     """
+    instance(sol, PeriodicSolution, "sol", "the PeriodicSolution of fretwear.solve_periodic")
 
     t0 = time.perf_counter()
     if sol.quasi_static or sol.omega <= 0:

@@ -179,6 +179,9 @@ def _check_arrays(data: dict) -> str:
 #: worn depth, a cycle count, a jump)
 _FINITE = ("state_U", "state_anchor", "state_g", "hist_U")
 _NON_NEGATIVE = ("state_W", "state_cycles", "state_jump", "hist_wear_depth", "hist_cycles")
+#: counts of a checkpoint (>= 0), and its index arrays (>= -1: -1 for none)
+_COUNTS = ("state_step", "hist_newton_iterations", "hist_rejected", "hist_rescued")
+_INDICES = ("hist_response",)
 
 
 def _check_values(data: dict) -> str:
@@ -191,6 +194,9 @@ def _check_values(data: dict) -> str:
             return f"{k} holds non-finite values"
         if k in _NON_NEGATIVE and np.any(a < 0):
             return f"{k} holds a negative value ({float(a.min()):g})"
+    for k in (*_COUNTS, *_INDICES):
+        if k in data and np.any(np.asarray(data[k]) < (0 if k in _COUNTS else -1)):
+            return f"{k} holds {int(np.min(data[k]))}, out of range"
     if np.any(np.diff(data["hist_cycles"]) < 0) \
             or float(data["state_cycles"]) != float(data["hist_cycles"][-1]):
         return "its cycle counts are not those of one run (they decrease or disagree)"

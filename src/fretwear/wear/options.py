@@ -132,6 +132,12 @@ class WearOptions:
             v = getattr(self, name)
             if not (_is_number(v) and v > 0):
                 raise InputError(f"{name} = {v!r}: expected a positive number")
+            if name == "tolerance" and not v <= 1.0:
+                raise InputError(f"tolerance = {v!r}: expected a relative error in (0, 1]")
+            if math.isfinite(v) and v > 1e20 or (math.isinf(v) and name in ("tolerance",
+                                                                             "min_jump")):
+                raise InputError(f"{name} = {v!r}: expected a positive number up to 1e20 "
+                                 "(inf: no limit)")
         if self.initial_jump is not None and not (_is_number(self.initial_jump)
                                                   and self.initial_jump > 0):
             raise InputError(f"initial_jump = {self.initial_jump!r}: expected > 0 cycles")
@@ -151,6 +157,9 @@ class WearOptions:
             v = getattr(self, name)
             if not (_is_number(v) and v >= 0):
                 raise InputError(f"{name} = {v!r}: expected a number >= 0")
+        if not self.plateau_rate <= 1.0:
+            raise InputError(f"plateau_rate = {self.plateau_rate!r}: expected a fraction of the "
+                             "initial rate in [0, 1]")
         for name, lo in (("max_steps", 1), ("max_iter_coupled", 1),
                          ("max_iter_implicit", 0), ("max_retries", 0)):
             v = getattr(self, name)
@@ -189,5 +198,6 @@ def _is_number(v) -> bool:
 
 
 def _is_integer(v) -> bool:
-    """A whole number of an integer type (numpy's included), not a boolean (2.0 is refused)."""
-    return isinstance(v, numbers.Integral) and not isinstance(v, bool)
+    """A whole number of an integer type (numpy's included), not a boolean (2.0 is refused),
+    of magnitude at most 2^62 (as the case files' integer keys)."""
+    return isinstance(v, numbers.Integral) and not isinstance(v, bool) and abs(v) <= 2**62

@@ -36,7 +36,8 @@ from fretwear.hb.reduce import Reduced, condense, condenser_for
 from fretwear.hb.solution import PeriodicSolution
 from fretwear.hb.solvers import SolveStats
 from fretwear.model.core import Model
-from fretwear.validate import reals
+from fretwear.validate import ArgumentTypeError, flag, reals
+from fretwear.validate import path as file_path
 from fretwear.wear.checkpoint import (
     check_checkpoint_path,
     fingerprint,
@@ -98,6 +99,14 @@ class RunControl:
     resume: bool = False
     progress: bool = False
     callback: Callable | None = None
+
+    def __post_init__(self):
+        if self.checkpoint is not None:
+            file_path(self.checkpoint, "checkpoint")
+        flag(self.resume, "resume")
+        flag(self.progress, "progress")
+        if self.callback is not None and not callable(self.callback):
+            raise InputError(f"callback = {self.callback!r}; expected a function or None")
 
 
 
@@ -230,7 +239,7 @@ def _settings(balance, run, options) -> tuple[BalanceSetup, RunControl, WearOpti
     for name, value, kind in (("balance", balance, BalanceSetup), ("run", run, RunControl),
                               ("options", options, WearOptions)):
         if value is not None and not isinstance(value, kind):
-            raise TypeError(f"{name} = {value!r}: expected a {kind.__name__}")
+            raise ArgumentTypeError(f"{name} = {value!r}: expected a {kind.__name__}")
     return balance or BalanceSetup(), run or RunControl(), (options or WearOptions()).check()
 
 

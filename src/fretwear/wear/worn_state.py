@@ -60,6 +60,7 @@ from fretwear.hb.inputs import check_inputs
 from fretwear.hb.solution import PeriodicSolution
 from fretwear.hb.solvers import SolveStats
 from fretwear.model.core import Model
+from fretwear.validate import number, whole
 from fretwear.wear.checkpoint import check_checkpoint_path, fingerprint
 from fretwear.wear.history import WearHistory
 from fretwear.wear.laws import worn_volume
@@ -129,16 +130,13 @@ class WornStateOptions:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and not isinstance(v, bool) and 0 < v < 1):
                 raise InputError(f"{name} = {v!r}: expected a number in (0, 1)")
-        if not (isinstance(self.max_steps, int) and not isinstance(self.max_steps, bool)
-                and self.max_steps >= 1):
-            raise InputError(f"max_steps = {self.max_steps!r}: expected a whole number >= 1")
+        whole(self.max_steps, "max_steps", low=1, high=2**62)
         j = self.initial_jump
         if j is not None and not (isinstance(j, (int, float)) and j > 0):
             raise InputError(f"initial_jump = {j!r}: expected > 0 cycles or None")
         if not isinstance(self.stick_set, bool):
             raise InputError(f"stick_set = {self.stick_set!r}: expected true or false")
-        if not (isinstance(self.max_growth, (int, float)) and self.max_growth > 1):
-            raise InputError(f"max_growth = {self.max_growth!r}: expected a number > 1")
+        number(self.max_growth, "max_growth", low=1.0, open_low=True, high=1e6)
 
     def march_options(self, path: bool = False) -> WearOptions:
         """The wear options of the steps: linearly implicit, no stop criterion of the march;
