@@ -554,7 +554,7 @@ def modal_condenser(model: Model, f_max: float, max_order: int, *, modes: int | 
     """
     max_order = whole(max_order, "max_order", low=0)
     if modes is not None:
-        modes = whole(modes, "modes", low=1)
+        modes = whole(modes, "modes", low=0)  # 0: the static modes and load responses alone
     f_max = number(f_max, "f_max", low=0.0, open_low=True, unit="Hz")
     if dense_storage_gib(model, max_order) > DENSE_STORAGE_GIB:
         # the blocked condenser keeps every mode below the cutoff (or ``modes``) and adds no

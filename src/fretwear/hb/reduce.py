@@ -83,8 +83,12 @@ class Reduced:
         nb = self.orders.size
         for name, ndim in (("Z", 3), ("F", 2), ("obs_A", 3), ("obs_b", 2)):
             a = getattr(self, name)
-            if not isinstance(a, np.ndarray) or a.ndim != ndim or a.shape[0] != nb or \
-                    a.dtype.kind not in "fc" or not np.all(np.isfinite(a)):
+            if name == "Z" and hasattr(a, "arrays"):  # the modal ReducedOperator: its arrays
+                ok = a.shape[0] == nb and all(np.all(np.isfinite(x)) for x in a.arrays())
+            else:
+                ok = (isinstance(a, np.ndarray) and a.ndim == ndim and a.shape[0] == nb
+                      and a.dtype.kind in "fc" and bool(np.all(np.isfinite(a))))
+            if not ok:
                 raise InputError(f"Reduced {name} = {repr(a)[:50]}; expected a finite "
                                  f"{ndim}-dimensional array, one block per order ({nb})")
         m = self.Z.shape[1]
