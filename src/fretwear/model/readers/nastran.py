@@ -1,5 +1,6 @@
 """Nastran matrices: DMIG cards (punch files of ``DMIGPCH`` / ``EXTSEOUT`` and bulk data)
-and OP4 files (ASCII), read from the documented formats with NumPy alone.
+and OP4 files (ASCII or binary: :mod:`~.op4`), read from the documented formats with NumPy
+alone.
 
 A DMIG card set carries its DOF map: every term is named by grid (or scalar point) id and
 component. A superelement exported by ``EXTSEOUT(ASMBULK, EXTBULK, DMIGPCH)`` writes its
@@ -19,6 +20,7 @@ import scipy.sparse as sp
 from fretwear.errors import InputError
 from fretwear.model.readers.dofmap import DofMap, FEMatrices
 from fretwear.model.readers.fields import byte_lines, fixed_fields, integers, reals
+from fretwear.model.readers.op4 import read_op4
 
 #: default DMIG names of K, M, C (viscous) and D (structural) of an EXTSEOUT superelement
 DMIG_NAMES = {"K": "KAAX", "M": "MAAX", "C": "BAAX", "D": "K4AX"}
@@ -256,109 +258,9 @@ def read_nastran_dmig(path, names: dict | None = None) -> FEMatrices:
     return FEMatrices(out["K"], out["M"], dofs, C=out.get("C"), D=out.get("D"), source=src)
 
 
-# --- OP4 (ASCII) ----------------------------------------------------------------------------
-_OP4_FMT = re.compile(r"(\d+)P?,?(\d+)[EDed](\d+)\.(\d+)")
-
-
-def read_op4(path) -> dict[str, sp.csr_matrix]:
-    """Every real matrix of an ASCII OP4 file: name -> sparse matrix.
-
-    Dense columns (``ICOL IROW NW`` then ``NW`` values) and the sparse forms (``IROW = 0``,
-    strings of ``L IROW`` or packed ``IS``) of Nastran's OUTPUT4 are read; binary OP4 files are
-    refused with a message (write them with ``FORMATTED``).
-    """
-    path = Path(path)
-    if not path.is_file():
-        raise InputError(f"OP4 file {str(path)!r} does not exist")
-    src = str(path)
-    data = path.read_bytes()
-    if b"\x00" in data[:64]:
-        raise InputError(f"OP4 file {src!r} is binary; expected an ASCII OP4 (Nastran "
-                         "OUTPUT4 with FORMATTED, or pyNastran's write_op4(is_binary=False))")
-    lines = data.decode(errors="replace").splitlines()
-    out = {}
-    k = 0
-    try:
-        while k < len(lines):
-            if not lines[k].strip():
-                k += 1
-                continue
-            name, A, k = _op4_matrix(lines, k, src)
-            out[name] = A
-    except (IndexError, ValueError):
-        raise InputError(f"OP4 file {src!r}: cannot read the record at line {k + 1} (a "
-                         "truncated or malformed file)") from None
-    if not out:
-        raise InputError(f"OP4 file {src!r} holds no matrix")
-    return out
-
-
-_INTS = re.compile(r"^\s*-?\d+(\s+-?\d+){0,2}\s*$")
-
-
-def _op4_matrix(lines, k, src):
-    """One matrix from line ``k`` (its header): name, matrix, the line after it.
-
-    Records are told apart by their look: a column header has three integers, a string header
-    of a sparse column one (packed ``IS``) or two (``L IROW``), and value lines hold reals; the
-    values of a string are those up to the next integer line, whatever the word count says
-    (writers count double-precision words differently).
-    """
-    head = lines[k]
-    ncol, nrow, _form, typ = (int(head[i:i + 8]) for i in range(0, 32, 8))
-    name = head[32:40].strip().upper()
-    m = _OP4_FMT.search(head[40:])
-    if not m:
-        raise InputError(f"OP4 file {src!r}, line {k + 1}: no number format after the name "
-                         f"{name!r} (e.g. 1P,3E23.16)")
-    per_line, width = int(m.group(2)), int(m.group(3))
-    if typ not in (1, 2):
-        raise InputError(f"OP4 file {src!r}: matrix {name} has type {typ} (complex); expected "
-                         "a real matrix (type 1 or 2)")
-    nrow = abs(nrow)
-    k += 1
-    rows, cols, vals = [], [], []
-    while True:
-        tok = lines[k].split()
-        if len(tok) != 3 or not _INTS.match(lines[k]):
-            raise ValueError(lines[k])
-        icol, irow = int(tok[0]), int(tok[1])
-        k += 1
-        if icol > ncol:  # the closing record: its NW words on whole lines
-            k += -(-int(tok[2]) // per_line)
-            break
-        v, k = _op4_values(lines, k, width)
-        if irow != 0:  # dense column from row irow
-            rows.extend(range(irow - 1, irow - 1 + len(v)))
-            cols.extend([icol - 1] * len(v))
-            vals.extend(v)
-            continue
-        while k < len(lines) and _INTS.match(lines[k]) and len(lines[k].split()) < 3:
-            tok = lines[k].split()  # a string header: L IROW, or IS = (L + 1) 65536 + IROW
-            row = int(tok[1]) if len(tok) == 2 else int(tok[0]) % 65536
-            v, k = _op4_values(lines, k + 1, width)
-            rows.extend(range(row - 1, row - 1 + len(v)))
-            cols.extend([icol - 1] * len(v))
-            vals.extend(v)
-    if rows and (max(rows) >= nrow or min(rows) < 0):
-        raise ValueError("row out of range")
-    A = sp.csr_matrix((np.array(vals, dtype=float), (rows, cols)), shape=(nrow, ncol))
-    return name, A, k
-
-
-def _op4_values(lines, k, width):
-    """The reals on the lines from ``k`` up to the next line of integers (or the end)."""
-    out = []
-    while k < len(lines) and lines[k].strip() and not _INTS.match(lines[k]):
-        line = lines[k].rstrip()
-        k += 1
-        out.extend(nastran_real(line[i:i + width], "OP4 value")
-                   for i in range(0, len(line), width) if line[i:i + width].strip())
-    return out, k
-
-
 def read_nastran_op4(path, dofs: DofMap, names: dict | None = None) -> FEMatrices:
-    """K, M (and C, D where present) from an ASCII OP4 file, on the rows of ``dofs``.
+    """K, M (and C, D where present) from an OP4 file (ASCII or binary, :mod:`~.op4`), on
+    the rows of ``dofs``.
 
     ``names`` as for :func:`read_nastran_dmig` (default ``KAAX``, ``MAAX``, ``BAAX``,
     ``K4AX``; any other names when the file holds exactly K and M: give them).
