@@ -1,0 +1,215 @@
+"""The shipped dovetail (6618 DOFs, 86 pairs on two flanks) exported as an FE code would, read
+back with fretwear.model.readers, against the model built from the mesh: the same modes,
+periodic solve and wear step to 1e-10?
+
+Formats: Nastran DMIG (large field, 10 significant digits) and OP4 (ASCII and binary, sparse
+strings, 17 digits or the doubles themselves) and Abaqus ``*MATRIX OUTPUT, FORMAT=MATRIX
+INPUT`` (17 digits), written from the documented formats (tests/helpers/fe_files.py); with
+``--pynastran PYTHON`` (a Python whose environment has pyNastran and NumPy < 2, never a
+fretwear dependency) also pyNastran's own DMIG and ASCII OP4 writers. A format that keeps 10
+digits is compared with the mesh model whose K, M, D are rounded to 10 digits, as the files
+hold them. ``--superelement`` adds the dovetail as a Craig-Bampton superelement with every
+fixed-interface mode kept (exact; a dense eigenproblem of the 5.9e3 interior DOFs).
+
+    python3 -m venv /tmp/pynastran-venv && /tmp/pynastran-venv/bin/pip install "numpy<2" \\
+        pyNastran
+    PYTHONPATH=src OPENBLAS_NUM_THREADS=1 python studies/dovetail_exports.py \\
+        --pynastran /tmp/pynastran-venv/bin/python --superelement
+
+Prints one line a model and writes docs/studies/figures/dovetail-exports.json; the write-up
+is docs/studies/dovetail-exports.md.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import resource
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import scipy.sparse as sp
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests"))  # the writers of the documented formats
+
+from helpers import fe_files as ff  # noqa: E402
+
+from fretwear import simulate_wear, solve_periodic  # noqa: E402
+from fretwear.analyses.run import load_case  # noqa: E402
+from fretwear.examples import example_path  # noqa: E402
+from fretwear.hb.fourier import FourierBasis  # noqa: E402
+from fretwear.io.case import build_model  # noqa: E402
+from fretwear.linear import modes  # noqa: E402
+from fretwear.model.readers import from_fe, read_fe, write_dofmap  # noqa: E402
+from fretwear.wear import WearOptions  # noqa: E402
+
+BASIS = FourierBasis.up_to(3, 32)
+F_HZ = 1800.0
+NAMES = {"K": "KAAX", "M": "MAAX", "D": "K4AX"}
+
+PYNASTRAN = '''
+import sys
+import numpy as np
+np.in1d = getattr(np, "in1d", np.isin)
+import scipy.sparse as sp
+from pyNastran.bdf.bdf import BDF
+from pyNastran.op4.op4 import OP4
+d = sys.argv[1]
+z = np.load(d + "/mats.npz")
+node, comp = z["node"], z["comp"]
+model, op4 = BDF(debug=None), {}
+for name in ("KAAX", "MAAX", "K4AX"):
+    A = sp.csc_matrix((z[name + "_data"], z[name + "_indices"], z[name + "_indptr"]),
+                      shape=(node.size, node.size))
+    L = sp.tril(A).tocoo()
+    order = np.lexsort((L.row, L.col))
+    r, c, v = L.row[order], L.col[order], L.data[order]
+    model.add_dmig(name, ifo=6, tin=2, tout=2, polar=0, ncols=node.size,
+                   GCj=[(int(node[j]), int(comp[j])) for j in c],
+                   GCi=[(int(node[i]), int(comp[i])) for i in r], Real=list(v))
+    op4[name] = (6, A.tocoo())
+model.write_bdf(d + "/pynastran.bdf", size=16, is_double=True)
+OP4().write_op4(d + "/pynastran.op4", op4, precision="double", is_binary=False)
+print("RESULT ok")
+'''
+
+
+def ten_digits(A):
+    """``A`` with every entry rounded to 10 significant digits, as DMIG's fields hold them."""
+    A = sp.csr_matrix(A, copy=True)
+    A.data = np.char.mod("%.9e", A.data).astype(float)
+    return A
+
+
+def rebuilt(model, fe):
+    return from_fe(fe, contact=ff.contacts_of(model), nodes=ff.node_table(model),
+                   loads=ff.forces_of(model), fixed=ff.fixed_of(model),
+                   observed=ff.observed_of(model), name=model.name)
+
+
+def cpu() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_utime
+
+
+def exports(m0, d: Path, pynastran: str | None) -> dict:
+    """Every format's files of the dovetail's K, M, D: name -> (read_fe args, kwargs)."""
+    dofs = ff.dofmap_of(m0)
+    mats = {NAMES[k]: getattr(m0, k) for k in NAMES}
+    write_dofmap(d / "dofs.txt", dofs)
+    ff.write_dmig(d / "m.pch", mats, dofs)
+    ff.write_op4(d / "ascii.op4", mats, sparse=True)
+    ff.write_op4(d / "binary.op4", mats, sparse=True, binary=True)
+    for k in NAMES:
+        ff.write_abaqus_matrix_input(d / f"{k}.mtx", getattr(m0, k), dofs)
+    out = {"dmig": ((d / "m.pch",), {}),
+           "op4 ascii": ((d / "ascii.op4",), {"dofmap": d / "dofs.txt"}),
+           "op4 binary": ((d / "binary.op4",), {"dofmap": d / "dofs.txt"}),
+           "abaqus matrix input": ((d / "K.mtx", d / "M.mtx"),
+                                   {"D": d / "D.mtx", "format": "abaqus-matrix-input"})}
+    if pynastran:
+        arrays = {"node": dofs.node, "comp": dofs.component}
+        for name, A in mats.items():
+            A = sp.csc_matrix(A)
+            arrays.update({f"{name}_data": A.data, f"{name}_indices": A.indices,
+                           f"{name}_indptr": A.indptr})
+        np.savez(d / "mats.npz", **arrays)
+        (d / "child.py").write_text(PYNASTRAN)
+        proc = subprocess.run([pynastran, str(d / "child.py"), str(d)], capture_output=True,
+                              text=True, timeout=3600)
+        if "RESULT ok" not in proc.stdout:
+            print("pyNastran writers failed:", proc.stderr.strip().splitlines()[-1:])
+        else:
+            out["dmig (pyNastran)"] = ((d / "pynastran.bdf",), {})
+            out["op4 ascii (pyNastran)"] = ((d / "pynastran.op4",), {"dofmap": d / "dofs.txt"})
+    return out
+
+
+def answers(model) -> dict:
+    """Three modes with sliding flanks, one periodic solve, one wear step."""
+    f = modes(model, 3, interface="sliding").frequency_hz
+    s = solve_periodic(model, BASIS, F_HZ, eps=1e12)
+    w = simulate_wear(model, BASIS, F_HZ, options=WearOptions(max_steps=1)).final_wear
+    return {"f": f, "U": s.U, "lam": s.lam, "wear": w, "success": bool(s.success)}
+
+
+def rel(a, b) -> float:
+    return float(np.abs(np.asarray(a) - np.asarray(b)).max() / np.abs(b).max())
+
+
+def compare(name, m1, ref, answers_ref, t_read) -> dict:
+    """K, M, D and the answers of ``m1`` against ``ref`` (the mesh model, rounded as the
+    format holds its digits)."""
+    a1 = answers(m1)
+    row = {"format": name, "read_cpu_s": round(t_read, 2),
+           **{f"{k}_rel": rel((getattr(m1, k) - getattr(ref, k)).data
+                              if (getattr(m1, k) - getattr(ref, k)).nnz else [0.0],
+                              getattr(ref, k).data) for k in NAMES},
+           "modes_rel": rel(a1["f"], answers_ref["f"]),
+           "U_rel": rel(a1["U"], answers_ref["U"]), "lam_rel": rel(a1["lam"], answers_ref["lam"]),
+           "wear_rel": rel(a1["wear"], answers_ref["wear"]), "converged": a1["success"]}
+    print(json.dumps(row))
+    return row
+
+
+def superelement(m0, answers_ref) -> dict:
+    """The dovetail as a Craig-Bampton superelement with every fixed-interface mode."""
+    from fretwear.model.core import Load
+    from fretwear.model.readers import FEMatrices, craig_bampton
+
+    fe = FEMatrices(m0.K, m0.M, ff.dofmap_of(m0), D=m0.D)
+    contact = ff.contacts_of(m0)
+    boundary = np.concatenate([np.concatenate([c.nodes, c.partners]) for c in contact]
+                              + [[m0.observed[0].dofs[0] // 3 + 1]])
+    t = cpu()
+    se = craig_bampton(fe, boundary, n_modes=None, fixed=m0.fixed_dofs)
+    n_interior = int(se.fe.dofs.size - 3 * boundary.size)
+    t_cb = cpu() - t
+    loads = [Load(se.reduce(ld.vector), ld.waveform, ld.coefficients, ld.name)
+             for ld in m0.loads]
+    m1 = from_fe(se.fe, contact=contact, loads=loads, observed=ff.observed_of(m0))
+    a1 = answers(m1)
+    row = {"format": f"Craig-Bampton, all {n_interior} interior modes",
+           "reduce_cpu_s": round(t_cb, 1), "dofs": int(se.fe.dofs.size),
+           "modes_rel": rel(a1["f"], answers_ref["f"]),
+           "U_rel": rel(a1["U"], answers_ref["U"]), "lam_rel": rel(a1["lam"], answers_ref["lam"]),
+           "wear_rel": rel(a1["wear"], answers_ref["wear"]), "converged": a1["success"]}
+    print(json.dumps(row))
+    return row
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--pynastran", help="Python with pyNastran and NumPy < 2 (optional)")
+    p.add_argument("--superelement", action="store_true",
+                   help="also the Craig-Bampton superelement with every interior mode")
+    p.add_argument("--out", default=str(ROOT / "docs" / "studies" / "figures"
+                                        / "dovetail-exports.json"))
+    args = p.parse_args(argv)
+    m0 = build_model(load_case(example_path("dovetail-frf")))
+    m10 = dataclasses.replace(m0, K=ten_digits(m0.K), M=ten_digits(m0.M), D=ten_digits(m0.D))
+    t = cpu()
+    ref, ref10 = answers(m0), answers(m10)
+    print(f"mesh model: modes {np.round(ref['f'], 1)} Hz, max wear {ref['wear'].max():.3e} m, "
+          f"{cpu() - t:.1f} s CPU for both references")
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, (a, kw) in exports(m0, Path(tmp), args.pynastran).items():
+            t = cpu()
+            fe = read_fe(*a, **kw)
+            t_read = cpu() - t
+            ten = name.startswith("dmig")
+            rows.append(compare(name, rebuilt(m0, fe), m10 if ten else m0,
+                                ref10 if ten else ref, t_read))
+    if args.superelement:
+        rows.append(superelement(m0, ref))
+    Path(args.out).write_text(json.dumps({"f_hz": F_HZ, "harmonics": 3, "rows": rows},
+                                         indent=1) + "\n")
+
+
+if __name__ == "__main__":
+    main()
