@@ -245,3 +245,36 @@ def test_patch_test_3d_tetrahedra():
                       contact=ContactSpec("upper.zmin", mu=0.0, partner="base.zmax"))
     assert model.contact.segments is not None
     assert pressure_error(model) < 1e-10
+
+
+def test_mortar_pairs_in_a_cyclic_sector_are_refused():
+    """Refused, in one line naming the pairing: the harmonic-index model of a sector
+    (model.cyclic.relative_harmonic_model) changes to relative coordinates ``q_a = q'_a + c
+    R^s q'_b``, one partner node for each contact node, which a mortar or node-to-segment
+    pair (several weighted master nodes for each contact node) is not. Both ways in: a
+    sector model whose own contact has segment pairs, and a neighbour contact asking for
+    ``pairing = "mortar"``."""
+    import dataclasses
+
+    from helpers.cyclic import sector_model
+
+    from fretwear.errors import InputError
+    from fretwear.model.core import Segments
+    from fretwear.model.cyclic import harmonic_model, neighbour_contact
+
+    sector, model = sector_model(8)
+    c = model.contact
+    segs = Segments(np.full((c.n_nodes, 2, 2), -1), np.zeros((c.n_nodes, 2)),
+                    np.full((c.n_nodes, 2), -1))
+    bad = dataclasses.replace(sector, model=dataclasses.replace(
+        model, contact=dataclasses.replace(c, segments=segs)))
+    with pytest.raises(InputError, match="mortar pairs .* in a cyclic sector") as exc:
+        harmonic_model(bad, 3)
+    assert "\n" not in str(exc.value)
+    harmonic_model(sector, 3)  # the same sector with node-to-node pairs is accepted
+    slit, _ = sector_model(8, slit=True)
+    for pairing in ("mortar", "node-to-segment"):
+        spec = ContactSpec("slit_a", mu=0.3, partner="slit_b", name="n2", pairing=pairing)
+        with pytest.raises(InputError, match=f"pairing = '{pairing}' between neighbour") as exc:
+            neighbour_contact(slit, spec)
+        assert "\n" not in str(exc.value)
