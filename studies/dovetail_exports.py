@@ -48,7 +48,7 @@ from fretwear.linear import modes  # noqa: E402
 from fretwear.model.readers import from_fe, read_fe, write_dofmap  # noqa: E402
 from fretwear.wear import WearOptions  # noqa: E402
 
-BASIS = FourierBasis.up_to(3, 32)
+BASIS = FourierBasis.up_to(1, 16)
 F_HZ = 1800.0
 NAMES = {"K": "KAAX", "M": "MAAX", "D": "K4AX"}
 
@@ -129,8 +129,36 @@ def exports(m0, d: Path, pynastran: str | None) -> dict:
     return out
 
 
+def fingerprint(model) -> str:
+    """A hash of every array the answers depend on (K, M, D, contact, loads, supports)."""
+    import hashlib
+
+    h = hashlib.sha256()
+    for A in (model.K, model.M, model.D):
+        A = sp.csr_matrix(A)
+        A.sort_indices()
+        for a in (A.data, A.indices, A.indptr):
+            h.update(np.ascontiguousarray(a).tobytes())
+    c = model.contact
+    for a in (c.dofs, c.partner_dofs, c.frame, c.area, c.gap, model.fixed_dofs,
+              *[ld.vector for ld in model.loads]):
+        h.update(np.ascontiguousarray(a).tobytes())
+    return h.hexdigest()
+
+
+_SOLVED: dict[str, dict] = {}
+
+
 def answers(model) -> dict:
-    """Three modes with sliding flanks, one periodic solve, one wear step."""
+    """Three modes with sliding flanks, one periodic solve, one wear step (solved once for
+    models whose arrays are the same bit for bit: their answers are the same)."""
+    key = fingerprint(model)
+    if key not in _SOLVED:
+        _SOLVED[key] = _answers(model)
+    return {**_SOLVED[key], "same_bits_as": key[:12]}
+
+
+def _answers(model) -> dict:
     f = modes(model, 3, interface="sliding").frequency_hz
     s = solve_periodic(model, BASIS, F_HZ, eps=1e12)
     w = simulate_wear(model, BASIS, F_HZ, options=WearOptions(max_steps=1)).final_wear
@@ -146,12 +174,12 @@ def compare(name, m1, ref, answers_ref, t_read) -> dict:
     format holds its digits)."""
     a1 = answers(m1)
     row = {"format": name, "read_cpu_s": round(t_read, 2),
-           **{f"{k}_rel": rel((getattr(m1, k) - getattr(ref, k)).data
-                              if (getattr(m1, k) - getattr(ref, k)).nnz else [0.0],
-                              getattr(ref, k).data) for k in NAMES},
+           **{f"{k}_rel": float(abs(getattr(m1, k) - getattr(ref, k)).max()
+                                / abs(getattr(ref, k)).max()) for k in NAMES},
            "modes_rel": rel(a1["f"], answers_ref["f"]),
            "U_rel": rel(a1["U"], answers_ref["U"]), "lam_rel": rel(a1["lam"], answers_ref["lam"]),
-           "wear_rel": rel(a1["wear"], answers_ref["wear"]), "converged": a1["success"]}
+           "wear_rel": rel(a1["wear"], answers_ref["wear"]), "converged": a1["success"],
+           "same_bits_as_reference": a1["same_bits_as"] == answers_ref["same_bits_as"]}
     print(json.dumps(row))
     return row
 
@@ -207,7 +235,7 @@ def main(argv=None):
                                 ref10 if ten else ref, t_read))
     if args.superelement:
         rows.append(superelement(m0, ref))
-    Path(args.out).write_text(json.dumps({"f_hz": F_HZ, "harmonics": 3, "rows": rows},
+    Path(args.out).write_text(json.dumps({"f_hz": F_HZ, "harmonics": 1, "rows": rows},
                                          indent=1) + "\n")
 
 
