@@ -70,7 +70,7 @@ def _bytes(text) -> np.ndarray:
 def byte_lines(lines: list[str], width: int) -> np.ndarray:
     """Lines as an (n, width) array of bytes (ASCII; blanks past the end of a line)."""
     arr = np.array([x.encode("ascii", "replace") for x in lines], dtype=f"S{width}")
-    u8 = arr.view(np.uint8).reshape(len(lines), width).copy()
+    u8 = arr.view(np.uint8).reshape(len(lines), width).copy()  # (0, width) for no line
     u8[u8 == 0] = ord(" ")
     return u8
 

@@ -23,7 +23,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from fretwear.errors import InputError
-from fretwear.model.readers.fields import reals
+from fretwear.model.readers.fields import byte_lines, reals
 
 _FMT = re.compile(r"(\d+)P?,?(\d+)[EDed](\d+)\.(\d+)")
 _INTS = re.compile(r"^\s*-?\d+(\s+-?\d+){0,2}\s*$")
@@ -124,12 +124,10 @@ def _ascii_matrix(lines, records, layout, size, where):
     body = lines[first:last]
     is_val = np.ones(len(body), dtype=bool)
     is_val[at[:-1] - first] = False
-    vlines = [body[i].rstrip() for i in np.flatnonzero(is_val)]
-    cut = np.array(vlines or [""], dtype=f"U{per_line * width}")[:len(vlines)]
-    fields = np.strings.strip(np.stack([np.strings.slice(cut, i * width, (i + 1) * width)
-                                        for i in range(per_line)], axis=1)
-                              if cut.size else np.zeros((0, per_line), dtype="U1"))
-    filled = fields != ""
+    vlines = [body[i] for i in np.flatnonzero(is_val)]
+    u8 = byte_lines(vlines, per_line * width)  # (n, per_line * width) bytes
+    fields = np.strings.strip(u8.view(f"S{width}").reshape(len(vlines), per_line))
+    filled = fields != b""
     vals = reals(fields[filled], where)
     # values per line of the matrix body, then per integer record (up to the next one)
     per_body_line = np.zeros(len(body) + 1, dtype=np.int64)
