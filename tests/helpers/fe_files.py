@@ -87,24 +87,62 @@ def write_dmig(path, matrices: dict, dofs: DofMap) -> None:
     path.write_text("\n".join(lines) + "\n")
 
 
-def write_op4(path, matrices: dict) -> None:
-    """ASCII OP4, dense columns, 3 values of 23 characters a line (1P,3E23.16)."""
-    lines = []
+def write_op4(path, matrices: dict, sparse: bool = False, binary: bool = False) -> None:
+    """OP4 of real double-precision matrices (OUTPUT4's documented format): ASCII with 3
+    values of 23 characters a line (1P,3E23.16) or binary (Fortran records, little-endian
+    4-byte integers); columns dense from their first to their last nonzero row, or
+    ``sparse``: strings of consecutive nonzero rows, each headed by ``IS = IROW + 65536 (L +
+    1)`` (``L`` words of values: 2 a double)."""
+    out = bytearray() if binary else []
+
+    def record(ints, vals=()):
+        if binary:
+            body = np.asarray(ints, "<i4").tobytes() + np.asarray(vals, "<f8").tobytes()
+            out.extend(np.int32(len(body)).tobytes() + body + np.int32(len(body)).tobytes())
+            return
+        out.append("".join(f"{i:8d}" for i in ints[:3]))
+        for k in range(0, len(vals), 3):
+            out.append("".join(f"{x:23.16E}" for x in vals[k:k + 3]))
+
     for name, A in matrices.items():
         A = sp.csc_matrix(A)
+        A.sort_indices()
         n = A.shape[0]
-        lines.append(f"{n:8d}{n:8d}{6:8d}{2:8d}{name:<8s}1P,3E23.16")
+        if binary:
+            body = np.array([n, n, 6, 2], "<i4").tobytes() + f"{name:<8s}".encode()
+            out.extend(np.int32(24).tobytes() + body + np.int32(24).tobytes())
+        else:
+            out.append(f"{n:8d}{n:8d}{6:8d}{2:8d}{name:<8s}1P,3E23.16")
         for j in range(n):
-            col = A[:, j].toarray().ravel()
-            nz = np.flatnonzero(col)
-            if nz.size == 0:
+            rows = A.indices[A.indptr[j]:A.indptr[j + 1]]
+            vals = A.data[A.indptr[j]:A.indptr[j + 1]]
+            if rows.size == 0:
                 continue
-            v = col[nz[0]:nz[-1] + 1]
-            lines.append(f"{j + 1:8d}{nz[0] + 1:8d}{v.size:8d}")
-            for k in range(0, v.size, 3):
-                lines.append("".join(f"{x:23.16E}" for x in v[k:k + 3]))
-        lines += [f"{n + 1:8d}{1:8d}{1:8d}", f"{1.0:23.16E}"]
-    path.write_text("\n".join(lines) + "\n")
+            if not sparse:
+                col = np.zeros(rows[-1] - rows[0] + 1)
+                col[rows - rows[0]] = vals
+                record([j + 1, rows[0] + 1, 2 * col.size], col)
+                continue
+            brk = np.flatnonzero(np.diff(rows) != 1) + 1
+            runs = list(zip(np.split(rows, brk), np.split(vals, brk), strict=True))
+            nw = sum(1 + 2 * r.size for r, _ in runs)
+            if binary:
+                words = b"".join(np.int32(r[0] + 1 + 65536 * (2 * r.size + 1)).tobytes()
+                                 + np.asarray(v, "<f8").tobytes() for r, v in runs)
+                body = np.array([j + 1, 0, nw], "<i4").tobytes() + words
+                out.extend(np.int32(len(body)).tobytes() + body
+                           + np.int32(len(body)).tobytes())
+                continue
+            out.append(f"{j + 1:8d}{0:8d}{nw:8d}")
+            for r, v in runs:
+                out.append(f"{r[0] + 1 + 65536 * (2 * r.size + 1):8d}")
+                for k in range(0, v.size, 3):
+                    out.append("".join(f"{x:23.16E}" for x in v[k:k + 3]))
+        record([n + 1, 1, 2], [1.0])
+    if binary:
+        path.write_bytes(bytes(out))
+    else:
+        path.write_text("\n".join(out) + "\n")
 
 
 def write_abaqus_substructure(path, matrices: dict, dofs: DofMap) -> None:

@@ -245,3 +245,54 @@ def test_patch_test_3d_tetrahedra():
                       contact=ContactSpec("upper.zmin", mu=0.0, partner="base.zmax"))
     assert model.contact.segments is not None
     assert pressure_error(model) < 1e-10
+
+
+def test_mortar_pairs_in_a_cyclic_sector_are_refused():
+    """Refused, in one line naming the pairing: the harmonic-index model of a sector
+    (model.cyclic.relative_harmonic_model) changes to relative coordinates ``q_a = q'_a + c
+    R^s q'_b``, one partner node for each contact node, which a mortar or node-to-segment
+    pair (several weighted master nodes for each contact node) is not. Both ways in: a
+    sector model whose own contact has segment pairs, and a neighbour contact asking for
+    ``pairing = "mortar"``."""
+    import dataclasses
+
+    from helpers.cyclic import sector_model
+
+    from fretwear.errors import InputError
+    from fretwear.model.core import Segments
+    from fretwear.model.cyclic import harmonic_model, neighbour_contact
+
+    sector, model = sector_model(8)
+    c = model.contact
+    segs = Segments(np.full((c.n_nodes, 2, 2), -1), np.zeros((c.n_nodes, 2)),
+                    np.full((c.n_nodes, 2), -1))
+    bad = dataclasses.replace(sector, model=dataclasses.replace(
+        model, contact=dataclasses.replace(c, segments=segs)))
+    with pytest.raises(InputError, match="mortar pairs .* in a cyclic sector") as exc:
+        harmonic_model(bad, 3)
+    assert "\n" not in str(exc.value)
+    harmonic_model(sector, 3)  # the same sector with node-to-node pairs is accepted
+    slit, _ = sector_model(8, slit=True)
+    for pairing in ("mortar", "node-to-segment"):
+        spec = ContactSpec("slit_a", mu=0.3, partner="slit_b", name="n2", pairing=pairing)
+        with pytest.raises(InputError, match=f"pairing = '{pairing}' between neighbour") as exc:
+            neighbour_contact(slit, spec)
+        assert "\n" not in str(exc.value)
+
+
+@pytest.mark.parametrize("case", ["q4", "seg"])
+def test_weights_of_the_facet_by_facet_implementation(case):
+    """The whole-array build gives the weights and coverages that the former facet-by-facet
+    loop gave (recorded in tests/data/mortar-reference.npz): a 4 x 3 quadrilateral face on
+    a 3 x 4 one, both with their in-plane node positions jittered by up to 0.2 mm (general
+    overlaps: 3- to 8-sided clipped polygons), and 7 segments on 5 in 2D. The same master
+    nodes; weights and coverages to 1e-14 (sums of the same products in another order)."""
+    from pathlib import Path
+
+    ref = np.load(Path(__file__).resolve().parents[1] / "data" / "mortar-reference.npz")
+    sf = ref[f"{case}_sf"]
+    got = mortar(ref[f"{case}_points"], np.unique(sf), sf, ref[f"{case}_mf"])
+    np.testing.assert_array_equal(got.nodes, ref[f"{case}_nodes"])
+    np.testing.assert_allclose(got.weights, ref[f"{case}_weights"], rtol=0, atol=1e-14)
+    np.testing.assert_allclose(got.coverage, ref[f"{case}_coverage"], rtol=0, atol=1e-14)
+    assert np.any((ref[f"{case}_weights"] != 0).sum(axis=1) > 2)  # nodes with several masters

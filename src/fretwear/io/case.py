@@ -1365,7 +1365,7 @@ names. Give the code's input file as `nodes` for coordinates and node sets.
   `ASET`/`BSET`, modes on `QSET` scalar points, `SPOINT`s) punches `KAAX`, `MAAX` (`BAAX`,
   `K4AX` with damping) as DMIG cards (so does the older `PARAM,EXTOUT,DMIGPCH`):
   `format = "dmig"`, `K = "model.pch"`. Full matrices: a DMAP `OUTPUT4` of `KGG`/`MGG`
-  (`format = "op4"`, ASCII `FORMATTED`, with a `dofmap` file; `names = {K = "KGG", M =
+  (`format = "op4"`, ASCII `FORMATTED` or binary, with a `dofmap` file; `names = {K = "KGG", M =
   "MGG"}`).
 - **Abaqus**: `*SUBSTRUCTURE GENERATE` with `*RETAINED NODAL DOFS` (contact and observed
   nodes) and `*SUBSTRUCTURE MATRIX OUTPUT, STIFFNESS=YES, MASS=YES` writes one `.mtx` file:

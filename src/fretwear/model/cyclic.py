@@ -312,6 +312,11 @@ def neighbour_contact(sector: CyclicSector, spec) -> CyclicSector:
                          "next sector's copy of it)")
     if spec.partner not in mesh.boundaries:
         raise InputError(f"contact {spec.name!r}: unknown partner boundary {spec.partner!r}")
+    if spec.pairing in ("node-to-segment", "mortar"):
+        raise InputError(f"contact {spec.name!r}: pairing = {spec.pairing!r} between "
+                         "neighbour sectors is not supported (the harmonic-index model takes "
+                         "one partner node a contact node); expected matching nodes (pairing "
+                         '= "auto" or "node-to-node")')
     c = _contact(mesh, dataclasses.replace(spec, partner=None, partner_wear_coefficient=0.0,
                                            pairing="auto"),
                  model.thickness)
@@ -357,9 +362,10 @@ def harmonic_model(sector: CyclicSector, k: int) -> tuple[Model, sp.csr_matrix]:
 
     c = model.contact
     if c.segments is not None:
-        raise InputError("contact: node-to-segment pairs (non-matching interface meshes) in a "
-                         "cyclic sector are not supported; expected node-to-node pairs "
-                         '(pairing = "node-to-node", matching nodes)')
+        raise InputError("contact: node-to-segment or mortar pairs (non-matching interface "
+                         "meshes) in a cyclic sector are not supported (the harmonic-index "
+                         "model takes one partner node a contact node); expected node-to-node "
+                         'pairs (pairing = "node-to-node", matching nodes)')
     contact = dataclasses.replace(
         c, dofs=_positions(sector, c.dofs, "contact"),
         partner_dofs=None if c.partner_dofs is None

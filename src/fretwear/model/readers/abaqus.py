@@ -49,7 +49,7 @@ def read_abaqus_substructure(path) -> FEMatrices:
         raise InputError(f"Abaqus matrix file {src!r} does not exist")
     nodes: list[int] = []
     dof_lines: list[list[int]] = []
-    blocks: dict[str, list[float]] = {}
+    blocks: dict[str, list[str]] = {}
     unsym = in_nodes = False
     state = None
     for k, raw in enumerate(path.read_text(errors="replace").splitlines(), start=1):
@@ -84,21 +84,39 @@ def read_abaqus_substructure(path) -> FEMatrices:
             if state == "dofs":
                 dof_lines.append([int(t) for t in line.rstrip(",").split(",")])
             elif state in blocks:
-                blocks[state].extend(float(t.replace("D", "E")) for t in
-                                     line.rstrip(",").split(",") if t.strip())
+                blocks[state].append(line.rstrip(","))
         except ValueError:
             raise InputError(f"{where}: {line[:60]!r} is not a list of numbers") from None
     if not dof_lines or not nodes:
         raise InputError(f"{src}: no *USER ELEMENT card with its '** ELEMENT NODES' list; "
                          "expected a file of *SUBSTRUCTURE MATRIX OUTPUT")
     dofs = _substructure_dofs(nodes, dof_lines, src)
-    mats = {what: _triangle(vals, dofs.size, unsym, f"{src}: *MATRIX {what}")
-            for what, vals in blocks.items()}
+    mats = {what: _triangle(_values(lines, f"{src}: *MATRIX {what}"), dofs.size, unsym,
+                            f"{src}: *MATRIX {what}") for what, lines in blocks.items()}
     for what in ("K", "M"):
         if what not in mats:
             raise InputError(f"{src}: no *MATRIX, TYPE={'STIFFNESS' if what == 'K' else 'MASS'}"
                              f"; expected K and M (STIFFNESS=YES, MASS=YES)")
     return FEMatrices(mats["K"], mats["M"], dofs, C=mats.get("C"), D=mats.get("D"), source=src)
+
+
+def _values(lines: list[str], where: str) -> np.ndarray:
+    """The numbers of a matrix block's lines (comma separated), converted as one array."""
+    tokens = np.array(",".join(lines).replace("D", "E").replace("d", "e").split(","))
+    tokens = tokens[np.strings.strip(tokens) != ""]
+    try:
+        return tokens.astype(float)
+    except ValueError:
+        bad = next(t for t in tokens.tolist() if not _is_float(t))
+        raise InputError(f"{where}: {bad.strip()[:30]!r} is not a number") from None
+
+
+def _is_float(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 def _substructure_dofs(nodes, dof_lines, src) -> DofMap:
@@ -154,24 +172,33 @@ def read_abaqus_matrix_input(K, M, C=None, D=None) -> FEMatrices:
 
 
 def _read_terms(path):
+    """The terms of one ``FORMAT=MATRIX INPUT`` file, converted as whole arrays."""
     path = Path(path)
     if not path.is_file():
         raise InputError(f"Abaqus matrix file {str(path)!r} does not exist")
-    rows, vals = [], []
-    for k, raw in enumerate(path.read_text(errors="replace").splitlines(), start=1):
-        line = raw.strip()
-        if not line or line.startswith("*"):
-            continue
-        tok = [t for t in line.replace(",", " ").split()]
-        try:
-            if len(tok) != 5:
-                raise ValueError
-            rows.append([int(t) for t in tok[:4]])
-            vals.append(float(tok[4].replace("D", "E")))
-        except ValueError:
-            raise InputError(f"{path}, line {k}: {line[:60]!r}; expected 'row node, row DOF, "
-                             "column node, column DOF, value' (*MATRIX OUTPUT, FORMAT=MATRIX "
-                             "INPUT)") from None
-    if not rows:
+    raw = path.read_text(errors="replace").splitlines()
+    number = [k for k, x in enumerate(raw, start=1) if x.strip() and not x.lstrip()
+              .startswith("*")]
+    if not number:
         raise InputError(f"{path}: no matrix terms (an empty or truncated file)")
-    return np.array(rows, dtype=np.int64), np.array(vals)
+    tokens = np.array(" ".join(raw[k - 1] for k in number).replace(",", " ").split())
+    if tokens.size != 5 * len(number):  # a line without its five fields: find it
+        k = next(k for k in number if len(raw[k - 1].replace(",", " ").split()) != 5)
+        _bad_term(path, k, raw[k - 1])
+    t = tokens.reshape(-1, 5)
+    try:
+        return t[:, :4].astype(np.int64), np.strings.replace(
+            np.strings.upper(t[:, 4]), "D", "E").astype(float)
+    except ValueError:
+        for k in number:
+            tok = raw[k - 1].replace(",", " ").split()
+            try:
+                [int(x) for x in tok[:4]] + [float(tok[4].replace("D", "E"))]
+            except ValueError:
+                _bad_term(path, k, raw[k - 1])
+        raise
+
+
+def _bad_term(path, k, line):
+    raise InputError(f"{path}, line {k}: {line.strip()[:60]!r}; expected 'row node, row DOF, "
+                     "column node, column DOF, value' (*MATRIX OUTPUT, FORMAT=MATRIX INPUT)")

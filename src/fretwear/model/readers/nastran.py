@@ -1,5 +1,6 @@
 """Nastran matrices: DMIG cards (punch files of ``DMIGPCH`` / ``EXTSEOUT`` and bulk data)
-and OP4 files (ASCII), read from the documented formats with NumPy alone.
+and OP4 files (ASCII or binary: :mod:`~.op4`), read from the documented formats with NumPy
+alone.
 
 A DMIG card set carries its DOF map: every term is named by grid (or scalar point) id and
 component. A superelement exported by ``EXTSEOUT(ASMBULK, EXTBULK, DMIGPCH)`` writes its
@@ -18,6 +19,8 @@ import scipy.sparse as sp
 
 from fretwear.errors import InputError
 from fretwear.model.readers.dofmap import DofMap, FEMatrices
+from fretwear.model.readers.fields import byte_lines, fixed_fields, integers, reals
+from fretwear.model.readers.op4 import read_op4
 
 #: default DMIG names of K, M, C (viscous) and D (structural) of an EXTSEOUT superelement
 DMIG_NAMES = {"K": "KAAX", "M": "MAAX", "C": "BAAX", "D": "K4AX"}
@@ -37,18 +40,16 @@ def nastran_real(text: str, where: str) -> float:
         raise InputError(f"{where}: {text.strip()!r} is not a number") from None
 
 
-def _int(text: str, where: str) -> int:
-    try:
-        return int(text.strip() or "0")
-    except ValueError:
-        raise InputError(f"{where}: {text.strip()!r}; expected an integer") from None
+def _free_fields(line: str) -> tuple[str, list[str]]:
+    """The first field and the eight data fields of a free-field (comma) line."""
+    tok = [t.strip() for t in line.split(",")]
+    return tok[0], (tok[1:] + [""] * 8)[:8]
 
 
 def _fields(line: str) -> tuple[str, list[str]]:
     """The first field and the data fields of one line (small, large or free field)."""
     if "," in line:
-        tok = [t.strip() for t in line.split(",")]
-        return tok[0], (tok[1:] + [""] * 8)[:8]
+        return _free_fields(line)
     first = line[:8].strip()
     if first.endswith("*") or first.startswith("*"):
         body = line[8:72].ljust(64)
@@ -57,31 +58,37 @@ def _fields(line: str) -> tuple[str, list[str]]:
     return first, [body[i:i + 8].strip() for i in range(0, 64, 8)]
 
 
-def _dmig_cards(text: str, where: str) -> list[tuple[int, list[str]]]:
-    """The DMIG cards of a bulk-data or punch text: (line number, data fields) each."""
-    cards: list[tuple[int, list[str]]] = []
-    current = None
-    for k, raw in enumerate(text.splitlines(), start=1):
-        line = raw.split("$")[0].rstrip("\n")
-        if not line.strip():
-            continue
-        first, data = _fields(line.expandtabs(8))
-        head = first.upper()
-        if head.rstrip("*") == "DMIG":
-            current = [k, list(data)]
-            cards.append(current)
-        elif current is not None and (not head or head[0] in "+*"):
-            current[1].extend(data)
-        else:
-            current = None  # another card: its continuations are not ours
-    return cards
+def _dmig_lines(text: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The lines of the DMIG cards of a bulk-data or punch text: line numbers (n,), whether
+    each starts a card (n,), and the eight data fields of each (n, 8, bytes). A continuation
+    (first field blank or starting with ``+`` or ``*``) belongs to the card before it; the
+    lines of other cards are left out. Fixed fields are cut as whole arrays."""
+    lines = [r.split("$")[0] if "$" in r else r for r in text.splitlines()]
+    lines = [x.expandtabs(8) if "\t" in x else x for x in lines]
+    number = np.array([k for k, x in enumerate(lines, start=1) if x.strip()], dtype=np.int64)
+    lines = [x for x in lines if x.strip()]
+    first, fields = fixed_fields(byte_lines(lines, 72))
+    for i in (k for k, x in enumerate(lines) if "," in x):  # free field, line by line
+        head, data = _free_fields(lines[i])
+        first[i] = head.upper().encode("ascii", "replace")[:8]
+        fields[i] = [d.encode("ascii", "replace") for d in data]
+    start = np.strings.strip(first, b"*") == b"DMIG"
+    cont = (first == b"") | np.strings.startswith(first, b"+") | np.strings.startswith(
+        first, b"*")
+    cont &= ~start
+    # a continuation is ours if the last card start or other card before it is a DMIG start
+    event = np.where(start | ~cont, np.arange(start.size), -1)
+    last = np.maximum.accumulate(event) if event.size else event
+    ours = start | (cont & (last >= 0) & start[np.maximum(last, 0)])
+    return number[ours], start[ours], fields[ours]
 
 
 def read_dmig(path) -> dict[str, tuple[DofMap, DofMap, sp.coo_matrix, int]]:
     """Every DMIG matrix of a file: name -> (row map, column map, matrix, IFO).
 
     Rows and columns are numbered in sorted (grid, component) order. A symmetric matrix
-    (IFO 6) given by one triangle is filled in.
+    (IFO 6) given by one triangle is filled in. The fields are converted as whole arrays
+    (:mod:`~.fields`): a file of 10^5 terms reads in a fraction of a second.
 
     Raises
     ------
@@ -93,56 +100,80 @@ def read_dmig(path) -> dict[str, tuple[DofMap, DofMap, sp.coo_matrix, int]]:
     if not path.is_file():
         raise InputError(f"Nastran file {str(path)!r} does not exist")
     src = str(path)
-    cards = _dmig_cards(path.read_text(errors="replace"), src)
-    if not cards:
+    number, start, fields = _dmig_lines(path.read_text(errors="replace"))
+    if not start.any():
         raise InputError(f"Nastran file {src!r} has no DMIG card; expected DMIG matrices "
                          "(DMIGPCH punch file or bulk data)")
+    card = np.cumsum(start) - 1  # the card of each line
+    heads = np.flatnonzero(start)
+    name = np.strings.upper(fields[heads, 0]).astype(str)
+    header = (fields[heads, 1] == b"0") | (fields[heads, 1] == b"")
     headers: dict[str, int] = {}
-    terms: dict[str, list] = {}
-    for line, f in cards:
-        name = f[0].upper()
-        where = f"{src}, line {line} (DMIG {name})"
-        if f[1] in ("0", ""):  # header: NAME 0 IFO TIN TOUT POLAR _ NCOL
-            if f[1] == "" and len(f) < 4:
-                raise InputError(f"{where}: truncated card")
-            ifo, tin = _int(f[2], where), _int(f[3], where)
-            if tin not in (1, 2):
-                raise InputError(f"{where}: TIN = {tin} (complex terms); expected a real matrix "
-                                 "(TIN 1 or 2)")
-            headers[name] = ifo
-            terms.setdefault(name, [])
-            continue
-        if name not in headers:
-            raise InputError(f"{where}: column card before the DMIG {name} header (field 2 = "
-                             "0); expected the header card first")
-        gj, cj = _int(f[1], where), _int(f[2], where)
-        entries = f[4:]
-        n_groups = len(entries) // 4
-        if not any(e.strip() for e in entries):
-            raise InputError(f"{where}: column ({gj}, {cj}) has no terms (a truncated card?)")
-        for g in range(n_groups):
-            gi, ci, a = entries[4 * g:4 * g + 3]
-            if not gi and not ci and not a:
-                continue
-            if not gi or not a:
-                raise InputError(f"{where}: term {g + 1} of column ({gj}, {cj}) lacks its grid "
-                                 "or value (a truncated card?)")
-            terms[name].append((_int(gi, where), _int(ci, where), gj, cj,
-                                nastran_real(a, where)))
-    return {name: _assemble(name, headers[name], terms[name], src) for name in headers}
+    for h in np.flatnonzero(header):  # one header card a matrix
+        i = heads[h]
+        where = f"{src}, line {number[i]} (DMIG {name[h]})"
+        ifo, tin = integers(fields[i, 2:4], where)
+        if tin not in (1, 2):
+            raise InputError(f"{where}: TIN = {tin} (complex terms); expected a real matrix "
+                             "(TIN 1 or 2)")
+        headers[str(name[h])] = int(ifo)
+    columns = np.flatnonzero(~header)
+    unknown = [k for k in columns if str(name[k]) not in headers]
+    if unknown:
+        k = unknown[0]
+        raise InputError(f"{src}, line {number[heads[k]]} (DMIG {name[k]}): column card before "
+                         f"the DMIG {name[k]} header (field 2 = 0); expected the header card "
+                         "first")
+    # the groups of four fields: (name, GJ, CJ, -) opens a card, then (GI, CI, A, -) terms
+    groups = fields.reshape(-1, 4)
+    g_line = np.repeat(np.arange(number.size), 2)
+    g_card = card[g_line]
+    opening = np.zeros(groups.shape[0], dtype=bool)
+    opening[2 * heads] = True
+    is_term = ~opening & ~header[g_card] & np.any(groups[:, :3] != b"", axis=1)
+    where = f"{src} (DMIG)"
+    gj = integers(fields[heads, 1], where)
+    cj = integers(fields[heads, 2], where)
+    has_terms = np.zeros(heads.size, dtype=bool)
+    has_terms[g_card[is_term]] = True
+    empty = np.flatnonzero(~header & ~has_terms)
+    if empty.size:
+        k = empty[0]
+        raise InputError(f"{src}, line {number[heads[k]]} (DMIG {name[k]}): column ({gj[k]}, "
+                         f"{cj[k]}) has no terms (a truncated card?)")
+    t = groups[is_term]
+    lacking = np.flatnonzero((t[:, 0] == b"") | (t[:, 2] == b""))
+    if lacking.size:
+        k = g_card[is_term][lacking[0]]
+        raise InputError(f"{src}, line {number[g_line[is_term][lacking[0]]]} (DMIG {name[k]}): "
+                         f"a term of column ({gj[k]}, {cj[k]}) lacks its grid or value (a "
+                         "truncated card?)")
+    tc = g_card[is_term]
+    term_name = name[tc]
+    gi, ci = integers(t[:, 0], where), integers(t[:, 1], where)
+    vals = reals(t[:, 2], where)
+    out = {}
+    for nm, ifo in headers.items():
+        sel = term_name == nm
+        terms = np.column_stack([gi[sel], ci[sel], gj[tc[sel]], cj[tc[sel]]])
+        out[nm] = _assemble(nm, ifo, terms, vals[sel], src)
+    return out
 
 
-def _assemble(name, ifo, terms, src):
-    if not terms:
+def _keys(node, comp) -> DofMap:
+    """The sorted distinct (node, component) pairs (components 0-6)."""
+    code = np.unique(np.asarray(node, np.int64) * 8 + np.asarray(comp, np.int64))
+    return DofMap(code // 8, code % 8)
+
+
+def _assemble(name, ifo, t, vals, src):
+    if t.shape[0] == 0:
         raise InputError(f"{src}: DMIG {name} has a header but no terms (a truncated file?)")
-    t = np.array([x[:4] for x in terms], dtype=np.int64)
-    vals = np.array([x[4] for x in terms], dtype=float)
     if ifo == 6:  # one map for rows and columns
-        keys = np.unique(np.concatenate([t[:, 0:2], t[:, 2:4]]), axis=0)
-        rmap = cmap = DofMap(keys[:, 0], keys[:, 1])
+        rmap = cmap = _keys(np.concatenate([t[:, 0], t[:, 2]]),
+                            np.concatenate([t[:, 1], t[:, 3]]))
     else:
-        rk, ck = np.unique(t[:, 0:2], axis=0), np.unique(t[:, 2:4], axis=0)
-        rmap, cmap = DofMap(rk[:, 0], rk[:, 1]), DofMap(ck[:, 0], ck[:, 1])
+        rmap, cmap = _keys(t[:, 0], t[:, 1]), _keys(t[:, 2], t[:, 3])
     ri = _index(rmap, t[:, 0], t[:, 1])
     ci = _index(cmap, t[:, 2], t[:, 3])
     pos = ri * cmap.size + ci
@@ -227,109 +258,9 @@ def read_nastran_dmig(path, names: dict | None = None) -> FEMatrices:
     return FEMatrices(out["K"], out["M"], dofs, C=out.get("C"), D=out.get("D"), source=src)
 
 
-# --- OP4 (ASCII) ----------------------------------------------------------------------------
-_OP4_FMT = re.compile(r"(\d+)P?,?(\d+)[EDed](\d+)\.(\d+)")
-
-
-def read_op4(path) -> dict[str, sp.csr_matrix]:
-    """Every real matrix of an ASCII OP4 file: name -> sparse matrix.
-
-    Dense columns (``ICOL IROW NW`` then ``NW`` values) and the sparse forms (``IROW = 0``,
-    strings of ``L IROW`` or packed ``IS``) of Nastran's OUTPUT4 are read; binary OP4 files are
-    refused with a message (write them with ``FORMATTED``).
-    """
-    path = Path(path)
-    if not path.is_file():
-        raise InputError(f"OP4 file {str(path)!r} does not exist")
-    src = str(path)
-    data = path.read_bytes()
-    if b"\x00" in data[:64]:
-        raise InputError(f"OP4 file {src!r} is binary; expected an ASCII OP4 (Nastran "
-                         "OUTPUT4 with FORMATTED, or pyNastran's write_op4(is_binary=False))")
-    lines = data.decode(errors="replace").splitlines()
-    out = {}
-    k = 0
-    try:
-        while k < len(lines):
-            if not lines[k].strip():
-                k += 1
-                continue
-            name, A, k = _op4_matrix(lines, k, src)
-            out[name] = A
-    except (IndexError, ValueError):
-        raise InputError(f"OP4 file {src!r}: cannot read the record at line {k + 1} (a "
-                         "truncated or malformed file)") from None
-    if not out:
-        raise InputError(f"OP4 file {src!r} holds no matrix")
-    return out
-
-
-_INTS = re.compile(r"^\s*-?\d+(\s+-?\d+){0,2}\s*$")
-
-
-def _op4_matrix(lines, k, src):
-    """One matrix from line ``k`` (its header): name, matrix, the line after it.
-
-    Records are told apart by their look: a column header has three integers, a string header
-    of a sparse column one (packed ``IS``) or two (``L IROW``), and value lines hold reals; the
-    values of a string are those up to the next integer line, whatever the word count says
-    (writers count double-precision words differently).
-    """
-    head = lines[k]
-    ncol, nrow, _form, typ = (int(head[i:i + 8]) for i in range(0, 32, 8))
-    name = head[32:40].strip().upper()
-    m = _OP4_FMT.search(head[40:])
-    if not m:
-        raise InputError(f"OP4 file {src!r}, line {k + 1}: no number format after the name "
-                         f"{name!r} (e.g. 1P,3E23.16)")
-    per_line, width = int(m.group(2)), int(m.group(3))
-    if typ not in (1, 2):
-        raise InputError(f"OP4 file {src!r}: matrix {name} has type {typ} (complex); expected "
-                         "a real matrix (type 1 or 2)")
-    nrow = abs(nrow)
-    k += 1
-    rows, cols, vals = [], [], []
-    while True:
-        tok = lines[k].split()
-        if len(tok) != 3 or not _INTS.match(lines[k]):
-            raise ValueError(lines[k])
-        icol, irow = int(tok[0]), int(tok[1])
-        k += 1
-        if icol > ncol:  # the closing record: its NW words on whole lines
-            k += -(-int(tok[2]) // per_line)
-            break
-        v, k = _op4_values(lines, k, width)
-        if irow != 0:  # dense column from row irow
-            rows.extend(range(irow - 1, irow - 1 + len(v)))
-            cols.extend([icol - 1] * len(v))
-            vals.extend(v)
-            continue
-        while k < len(lines) and _INTS.match(lines[k]) and len(lines[k].split()) < 3:
-            tok = lines[k].split()  # a string header: L IROW, or IS = (L + 1) 65536 + IROW
-            row = int(tok[1]) if len(tok) == 2 else int(tok[0]) % 65536
-            v, k = _op4_values(lines, k + 1, width)
-            rows.extend(range(row - 1, row - 1 + len(v)))
-            cols.extend([icol - 1] * len(v))
-            vals.extend(v)
-    if rows and (max(rows) >= nrow or min(rows) < 0):
-        raise ValueError("row out of range")
-    A = sp.csr_matrix((np.array(vals, dtype=float), (rows, cols)), shape=(nrow, ncol))
-    return name, A, k
-
-
-def _op4_values(lines, k, width):
-    """The reals on the lines from ``k`` up to the next line of integers (or the end)."""
-    out = []
-    while k < len(lines) and lines[k].strip() and not _INTS.match(lines[k]):
-        line = lines[k].rstrip()
-        k += 1
-        out.extend(nastran_real(line[i:i + width], "OP4 value")
-                   for i in range(0, len(line), width) if line[i:i + width].strip())
-    return out, k
-
-
 def read_nastran_op4(path, dofs: DofMap, names: dict | None = None) -> FEMatrices:
-    """K, M (and C, D where present) from an ASCII OP4 file, on the rows of ``dofs``.
+    """K, M (and C, D where present) from an OP4 file (ASCII or binary, :mod:`~.op4`), on
+    the rows of ``dofs``.
 
     ``names`` as for :func:`read_nastran_dmig` (default ``KAAX``, ``MAAX``, ``BAAX``,
     ``K4AX``; any other names when the file holds exactly K and M: give them).
