@@ -130,4 +130,4 @@ def test_integrate_and_steady_state_share_their_step_and_frequency_defaults():
 def test_eps_words_not_none():
     """The penalty is spelt with the same words in Python and case files: no None default."""
     for source in (solve_periodic, SWEEP, WORN_FRF, BalanceSetup):
-        assert python_default(source, "eps") in ("auto", "static", "top"), source
+        assert python_default(source, "eps") in ("auto", "static", "top", "contact"), source

@@ -160,8 +160,8 @@ def test_a_failed_solve_reports_its_attempts_and_the_time_integration(tmp_path, 
     ("frequency = -50.0", "analysis.frequency = -50.0: expected a number > 0"),
     ('solver = "powel"', 'analysis.solver = "powel": expected one of "powell", "newton", '
                          '"hybr" (did you mean "powell"?)'),
-    ('eps = "paper"', 'analysis.eps = "paper": expected one of "auto", "static", "top", "stiff" '
-                      "or a number > 0"),
+    ('eps = "paper"', 'analysis.eps = "paper": expected one of "auto", "static", "top", "stiff", '
+                      '"contact" or a number > 0'),
     ("harmonics = 0", "analysis.harmonics = 0: expected an integer >= 1 or a non-empty list "
                       "of integers >= 1 (no repeats)"),
     ('condensation = "craig"', 'analysis.condensation = "craig": expected one of "auto", '

@@ -95,7 +95,7 @@ def test_point_names_never_write_outside_the_output_folder(tmp_path, point):
 
 def test_keys_the_analysis_does_not_read_are_named(tmp_path, capsys):
     """The shipped beam keeps its wear coefficient, unused, outside wear (as the shipped
-    examples do), and is given `[output] whole_disk = true`, which only a periodic analysis
+    examples do), and is given `[output] whole_disk = true`, which only a periodic or wear analysis
     reads. For a modes analysis both are named, each in one line with the analyses that read
     it: the wear coefficient as a note (a property of the interface), whole_disk as a warning
     (an option of the run); for a periodic analysis only the wear coefficient is, and
@@ -114,7 +114,7 @@ def test_keys_the_analysis_does_not_read_are_named(tmp_path, capsys):
         "note: contact.wear_coefficient = 1e-11 is not used by a modes analysis (only by "
         "wear, incremental-wear, worn-state): it is ignored",
         "warning: output.whole_disk = true is not used by a modes analysis (only by "
-        "periodic): it is ignored"]
+        "periodic, wear): it is ignored"]
     periodic = ('[analysis]\ntype = "periodic"\nfrequency = 1e4\n[output]\nwhole_disk = true\n'
                 'vtu = false\n')
     lines = ignored_notes(load_case(small_case(tmp_path, periodic)), analysis_tables())

@@ -19,12 +19,16 @@ from fretwear.timedomain.checks import c_float, check_contact, count, node_wear,
 
 
 def test_positive_numbers():
-    assert positive(5e-324, "h") == 5e-324 and positive("2.5", "h") == 2.5
-    for bad in (0.0, -1.0, math.nan, math.inf):
-        with pytest.raises(InputError, match=r"^h = .*; expected a positive finite number$"):
+    """Real numbers in (0, 1e20]; strings are refused as the API refuses them (no silent
+    conversion of "2.5"), as are bools."""
+    assert positive(5e-324, "h") == 5e-324 and positive(np.float32(2.5), "h") == 2.5
+    for bad in (0.0, -1.0, math.nan, math.inf, 1e21):
+        with pytest.raises(InputError, match=r"^h = .*; expected a positive finite number "
+                                             r"\(at most 1e\+20\)$"):
             positive(bad, "h")
-    with pytest.raises(InputError, match=r"^h = 'x'; expected a positive number$"):
-        positive("x", "h")
+    for bad in ("x", "2.5", True):
+        with pytest.raises(InputError, match=r"^h = .*; expected a positive number$"):
+            positive(bad, "h")
 
 
 def test_counts_are_integers_from_their_minimum():
@@ -35,8 +39,10 @@ def test_counts_are_integers_from_their_minimum():
     for bad in (True, 3.0, "3", None):
         with pytest.raises(InputError, match=r"^n = .*; expected an integer >= 1$"):
             count(bad, "n")
-    with pytest.raises(InputError, match=r"^n = 0; expected an integer >= 1$"):
-        count(0, "n")
+    for bad in (0, 2**62 + 1):
+        with pytest.raises(InputError, match=r"^n = \d+; expected an integer >= 1 \(and at "
+                                             r"most 2\^62\)$"):
+            count(bad, "n")
 
 
 def test_c_float_is_a_contiguous_float_copy_of_any_layout():
