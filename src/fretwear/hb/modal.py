@@ -68,19 +68,12 @@ MIN_RAISE = 8
 #: ... and at most this many (beyond, the interior is not well represented by modes: the
 #: exact condensation is the better choice)
 MAX_MODES = 512
-#: how :meth:`ModalCondenser.reduced` returns ``Z_r`` (the class's ``representation``)
+#: how :meth:`ModalCondenser.reduced` returns ``Z_r`` (the class's ``representation``).
+#: ``"auto"`` keeps the dense blocks for now: on the partial-slip pad of
+#: benchmarks/scale_3d.py at 1024 contact nodes the operator's solve left its first attempt
+#: for the ladder's later rungs where the dense blocks converge at once, not understood yet
+#: (docs/theory.md, "Large interfaces")
 REPRESENTATIONS = ("auto", "dense", "operator")
-
-
-def uses_operator(representation: str, m: int, nb: int) -> bool:
-    """Whether ``representation`` gives ``Z_r`` on ``nb`` harmonic orders of ``m`` contact
-    DOFs as a :class:`~fretwear.hb.modal_operator.ReducedOperator`: only when asked
-    (``"operator"``). ``"auto"`` keeps the dense blocks: on the partial-slip pad of
-    benchmarks/scale_3d.py at 1024 contact nodes the operator's solve left its first attempt
-    for the ladder's later rungs where the dense blocks converge at once, not understood yet
-    (docs/theory.md, "Large interfaces")."""
-    del m, nb  # the sizes the choice will depend on once the case above is understood
-    return representation == "operator"
 
 
 def next_mode_count(n_modes: int, n_interior: int) -> int | None:
@@ -122,7 +115,7 @@ class ModalCondenser(Condenser):
     representation : how :meth:`reduced` returns ``Z_r``: ``"dense"`` (an (nb, m, m) array),
         ``"operator"`` (a :class:`~fretwear.hb.modal_operator.ReducedOperator`: the
         frequency-independent ``X^cc`` shared by every harmonic plus a rank-``q`` term per
-        harmonic) or ``"auto"`` (the dense blocks for now: :func:`uses_operator`). The same
+        harmonic) or ``"auto"`` (the dense blocks for now: :data:`REPRESENTATIONS`). The same
         condensation either way (to rounding).
 
     Attributes
@@ -340,7 +333,7 @@ class ModalCondenser(Condenser):
         """The :class:`~fretwear.hb.reduce.Reduced` model on ``orders`` at ``omega`` [rad/s]
         from the modal representation (``Z`` an array or an operator: ``representation``)."""
         orders = np.asarray(orders, dtype=np.int64)
-        if uses_operator(self.representation, self.m, orders.size):
+        if self.representation == "operator":
             return self._reduced_operator(omega, orders, quasi_static, frequency)
         m, no, nb, R = self.m, self.structure.obs.size, orders.size, self.R
         F_all = self.structure.load_harmonics(int(orders.max()) if orders.size else 0)
