@@ -353,39 +353,9 @@ def _rule(region: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def shape_functions(x: np.ndarray, p: np.ndarray) -> np.ndarray:
     """Shape functions (n, k) of facet ``x`` (k, d) at the feet of the normals from the
     points ``p`` (n, d), their facet coordinates clamped to the facet (exact for points on a
-    flat facet; the closest point's for points off a gently curved one)."""
-    k = x.shape[0]
-    if k == 2:
-        ab = x[1] - x[0]
-        t = np.clip((p - x[0]) @ ab / (ab @ ab), 0.0, 1.0)
-        return np.column_stack([1.0 - t, t])
-    if k == 3:
-        e1, e2 = x[1] - x[0], x[2] - x[0]
-        G = np.array([[e1 @ e1, e1 @ e2], [e1 @ e2, e2 @ e2]])
-        st = np.linalg.solve(G, np.column_stack([(p - x[0]) @ e1, (p - x[0]) @ e2]).T).T
-        N = np.clip(np.column_stack([1.0 - st.sum(axis=1), st]), 0.0, None)
-        return N / N.sum(axis=1, keepdims=True)
-    xi = np.zeros(p.shape[0])
-    eta = np.zeros(p.shape[0])
-    for _ in range(20):
-        N = 0.25 * np.column_stack([(1 - xi) * (1 - eta), (1 + xi) * (1 - eta),
-                                    (1 + xi) * (1 + eta), (1 - xi) * (1 + eta)])
-        dxi = 0.25 * np.column_stack([-(1 - eta), 1 - eta, 1 + eta, -(1 + eta)]) @ x
-        deta = 0.25 * np.column_stack([-(1 - xi), -(1 + xi), 1 + xi, 1 - xi]) @ x
-        r = p - N @ x
-        a11 = np.einsum("nd,nd->n", dxi, dxi)
-        a12 = np.einsum("nd,nd->n", dxi, deta)
-        a22 = np.einsum("nd,nd->n", deta, deta)
-        b1 = np.einsum("nd,nd->n", dxi, r)
-        b2 = np.einsum("nd,nd->n", deta, r)
-        det = a11 * a22 - a12 * a12
-        s1, s2 = (a22 * b1 - a12 * b2) / det, (a11 * b2 - a12 * b1) / det
-        xi, eta = xi + s1, eta + s2
-        if max(np.abs(s1).max(), np.abs(s2).max()) < 1e-14:
-            break
-    xi, eta = np.clip(xi, -1.0, 1.0), np.clip(eta, -1.0, 1.0)
-    return 0.25 * np.column_stack([(1 - xi) * (1 - eta), (1 + xi) * (1 - eta),
-                                   (1 + xi) * (1 + eta), (1 - xi) * (1 + eta)])
+    flat facet; the closest point's for points off a gently curved one): the one-facet case
+    of :func:`_shape_functions`."""
+    return _shape_functions(np.asarray(x)[None], np.asarray(p)[None])[0]
 
 
 def _dual(N: np.ndarray, k: int) -> np.ndarray:
