@@ -180,3 +180,20 @@ def write_matrix_market(path, A) -> None:
 
 def write_harwell_boeing(path, A) -> None:
     scipy.io.hb_write(str(path), sp.csc_matrix(A))
+
+
+def write_bdf_mesh(path, model) -> None:
+    """The mesh as Nastran bulk data (free field, every digit): ``GRID`` cards (node id =
+    number + 1) and ``CQUAD4``/``CTRIA3``/``CTETRA``/``CHEXA`` cards of its cells."""
+    pts = model.mesh.points
+    xyz = np.zeros((len(pts), 3))
+    xyz[:, :model.dim] = pts
+    lines = [f"GRID,{i + 1},,{x!r},{y!r},{z!r}" for i, (x, y, z) in enumerate(xyz.tolist())]
+    card = {3: "CTRIA3", 4: "CTETRA" if model.mesh.cell_type == "tetra" else "CQUAD4",
+            8: "CHEXA"}[model.mesh.cells.shape[1]]
+    for e, cell in enumerate(np.asarray(model.mesh.cells) + 1):
+        ids = [str(int(n)) for n in cell]
+        lines.append(",".join([card, str(e + 1), "1", *ids[:6]]))
+        if len(ids) > 6:
+            lines.append(",".join(["", *ids[6:]]))
+    path.write_text("\n".join(lines) + "\n")
