@@ -58,8 +58,9 @@ def _same_files(a, b):
 
 
 def test_periodic_and_wear_fields_equal_the_mesh_models(models, tmp_path):
-    """periodic.pvd (displacement, contact state and pressure) and wear.pvd (worn depth) of
-    the model from matrices + .bdf equal the meshed model's. Both solve the same 10-digit
+    """periodic.pvd (displacement, contact state and pressure), wear.pvd (worn depth) and
+    modes-stuck.pvd (mode shapes) of the model from matrices + .bdf equal the meshed
+    model's. Both solve the same 10-digit
     matrices with the same contact DOFs in the same order, so the fields agree to rounding
     (1e-12 relative: the sparse factorisations see the DOFs in the same order)."""
     m0, m1 = models
@@ -68,7 +69,9 @@ def test_periodic_and_wear_fields_equal_the_mesh_models(models, tmp_path):
                eps=1e12, figures=False)
         fw.run(m, "wear", tmp_path / f"w{k}", frequency=2000.0, harmonics=3, n_samples=32,
                eps=1e12, max_steps=1, figures=False)
+        fw.run(m, "modes", tmp_path / f"m{k}", n_modes=3, interfaces=["stuck"], figures=False)
     _same_files(tmp_path / "p0" / "periodic", tmp_path / "p1" / "periodic")
+    _same_files(tmp_path / "m0" / "modes-stuck", tmp_path / "m1" / "modes-stuck")
     _same_files(tmp_path / "w0" / "wear", tmp_path / "w1" / "wear")
     assert np.isfinite(_vtus(tmp_path / "w1" / "wear")[-1].point_data["worn_depth"]).sum() \
         == m1.contact.n_nodes
