@@ -67,13 +67,16 @@ NASTRAN_ELEMENTS = {"CTRIA3": 3, "CQUAD4": 4, "CTETRA": 4, "CHEXA": 8}
 
 
 def _nastran_nodes(text: str, src: str) -> NodeTable:
-    ids, xyz, elements = [], [], {}
+    ids, xyz, elements, bad = [], [], {}, []
     lines = text.splitlines()
     for k, raw in enumerate(lines):
         line = raw.split("$")[0].expandtabs(8)
         first, data = _fields(line)
         if first.upper() in NASTRAN_ELEMENTS:
-            _nastran_element(first.upper(), data, lines, k, src, elements)
+            try:
+                _nastran_element(first.upper(), data, lines, k, src, elements)
+            except InputError as exc:  # told once the nodes are known to be there
+                bad.append(exc)
             continue
         if first.upper().rstrip("*") != "GRID":
             continue
@@ -88,6 +91,8 @@ def _nastran_nodes(text: str, src: str) -> NodeTable:
         except ValueError:
             raise InputError(f"{where}: node id {data[0]!r}; expected an integer") from None
         xyz.append([nastran_real(v or "0", where) for v in data[2:5]])
+    if bad and ids:
+        raise bad[0]
     return NodeTable(np.array(ids, dtype=np.int64), np.array(xyz, dtype=float).reshape(-1, 3),
                      elements=_arrays(elements))
 
