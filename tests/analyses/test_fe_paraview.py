@@ -15,15 +15,22 @@ from helpers.blocks import block
 
 import fretwear as fw
 from fretwear.io.results import no_fields_line, nodal_vectors
+from fretwear.model import (
+    ContactSpec,
+    Damping,
+    Material,
+    Spring,
+    Traction,
+    from_mesh,
+    join,
+    rectangle,
+)
 from fretwear.model.readers import DofMap, FEMatrices, from_fe, read_fe, read_nodes
 
 
-@pytest.fixture(scope="module")
-def models(tmp_path_factory):
-    """The meshed block and the same block from DMIG matrices and a .bdf node file."""
-    d = tmp_path_factory.mktemp("fe-paraview")
-    m0 = block(2, 0.01)
-    m0.contact.wear_coefficient = 1e-12
+def _from_files(m0, d):
+    """``m0`` exported to DMIG (K, M, D) and a .bdf, read back; and ``m0`` with the matrices
+    as the 10-digit DMIG file holds them."""
     dofs = ff.dofmap_of(m0)
     ff.write_dmig(d / "m.pch", {"KAAX": m0.K, "MAAX": m0.M, "K4AX": m0.D}, dofs)
     ff.write_bdf_mesh(d / "mesh.bdf", m0)
@@ -31,9 +38,15 @@ def models(tmp_path_factory):
     m1 = from_fe(fe, contact=ff.contacts_of(m0), nodes=read_nodes(d / "mesh.bdf"),
                  loads=ff.forces_of(m0), fixed=ff.fixed_of(m0),
                  observed=ff.observed_of(m0), name=m0.name)
-    # the mesh model with the matrices as the 10-digit DMIG file holds them
-    m0 = dataclasses.replace(m0, K=fe.K, M=fe.M, D=fe.D)
-    return m0, m1
+    return dataclasses.replace(m0, K=fe.K, M=fe.M, D=fe.D), m1
+
+
+@pytest.fixture(scope="module")
+def models(tmp_path_factory):
+    """The meshed block and the same block from DMIG matrices and a .bdf node file."""
+    m0 = block(2, 0.01)
+    m0.contact.wear_coefficient = 1e-12
+    return _from_files(m0, tmp_path_factory.mktemp("fe-paraview"))
 
 
 def _vtus(folder):
@@ -75,6 +88,29 @@ def test_periodic_and_wear_fields_equal_the_mesh_models(models, tmp_path):
     _same_files(tmp_path / "w0" / "wear", tmp_path / "w1" / "wear")
     assert np.isfinite(_vtus(tmp_path / "w1" / "wear")[-1].point_data["worn_depth"]).sum() \
         == m1.contact.n_nodes
+
+
+def test_pairs_show_on_both_surfaces(tmp_path):
+    """Two blocks (4 x 1 elements each, matching nodes on the interface, node-to-node pairs):
+    the contact state and pressure of a pair show on its node and on its partner, as for the
+    meshed model (the partners named by node id, mapped to points)."""
+    mesh = join(("lower", rectangle(0.02, 0.005, 4, 1)),
+                ("upper", rectangle(0.02, 0.005, 4, 1, origin=(0.0, 0.005))))
+    steel = Material(210e9, 0.3, 7800.0)
+    m = from_mesh(mesh, steel, supports=[("lower.bottom", "all"),
+                                         Spring("upper.top", "x", 1e7)],
+                  loads=[Traction("upper.top", pressure=1e6),
+                         Traction("upper.top", traction=(2e5, 0.0), waveform="cos")],
+                  contact=ContactSpec("upper.bottom", mu=0.3, partner="lower.top"),
+                  damping=Damping(loss_factor=0.01))
+    assert m.contact.has_pairs
+    m0, m1 = _from_files(m, tmp_path)
+    for k, model in enumerate((m0, m1)):
+        fw.run(model, "periodic", tmp_path / f"p{k}", frequency=2000.0, harmonics=1,
+               n_samples=16, eps=1e12, figures=False)
+    _same_files(tmp_path / "p0" / "periodic", tmp_path / "p1" / "periodic")
+    data = _vtus(tmp_path / "p1" / "periodic")[0].point_data["contact_state"]
+    assert np.isfinite(data).sum() == 2 * m.contact.n_nodes
 
 
 def test_without_node_file_one_line_says_so(models, tmp_path):
