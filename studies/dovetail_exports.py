@@ -4,8 +4,9 @@ periodic solve and wear step to 1e-10?
 
 Formats: Nastran DMIG (large field, 10 significant digits) and OP4 (ASCII and binary, sparse
 strings, 17 digits or the doubles themselves), Abaqus ``*MATRIX OUTPUT, FORMAT=MATRIX
-INPUT`` (17 digits) and ANSYS ``.full`` (the doubles; K and M only, D from the case's loss
-factor), written from the documented formats (tests/helpers/fe_files.py); with
+INPUT`` (17 digits) and ANSYS ``.full`` (the doubles; K and M only: D given as a matrix,
+or from the case's loss factor), written from the documented formats
+(tests/helpers/fe_files.py); with
 ``--pynastran PYTHON`` (a Python whose environment has pyNastran and NumPy < 2, never a
 fretwear dependency) also pyNastran's own DMIG and ASCII OP4 writers. A format that keeps 10
 digits is compared with the mesh model whose K, M, D are rounded to 10 digits, as the files
@@ -114,7 +115,8 @@ def exports(m0, d: Path, pynastran: str | None) -> dict:
         ff.write_abaqus_matrix_input(d / f"{k}.mtx", getattr(m0, k), dofs)
     ff.write_ansys_full(d / "dovetail.full", m0.K, m0.M, dofs)
     out = {"dmig": ((d / "m.pch",), {}),
-           "ansys full": ((d / "dovetail.full",), {}),
+           "ansys full, D given": ((d / "dovetail.full",), {}),
+           "ansys full, loss factor": ((d / "dovetail.full",), {}),
            "op4 ascii": ((d / "ascii.op4",), {"dofmap": d / "dofs.txt"}),
            "op4 binary": ((d / "binary.op4",), {"dofmap": d / "dofs.txt"}),
            "abaqus matrix input": ((d / "K.mtx", d / "M.mtx"),
@@ -271,21 +273,23 @@ def main(argv=None):
             t = cpu()
             fe = read_fe(*a, **kw)
             t_read = cpu() - t
-            # a .full holds K and M only: the loss factor of the case gives D = eta K
-            damping = (Damping(loss_factor=LOSS_FACTOR) if name.startswith("ansys")
-                       else None)
+            # a .full holds K and M only: the hysteretic D given as a matrix (as exported
+            # apart, e.g. Matrix Market), or the case's loss factor (D = eta K)
+            damping = {"ansys full, D given": Damping(D=m0.D),
+                       "ansys full, loss factor": Damping(loss_factor=LOSS_FACTOR)}.get(name)
             ten = name.startswith("dmig")
             r0, a0 = (m10, ref10) if ten else (m0, ref)
             if name == "dmig (pyNastran)":
                 r0 = dataclasses.replace(m0, **{k: ROUNDED_BY_PYNASTRAN[NAMES[k]].tocsr()
                                                 for k in NAMES})
                 a0 = answers(r0)
-            if damping is not None:  # the mesh model's D damps its springs not: D = eta K
+            loss = name == "ansys full, loss factor"
+            if loss:  # the mesh model's D leaves its springs undamped: D = eta K here
                 r0 = dataclasses.replace(m0, D=sp.csr_matrix(LOSS_FACTOR * m0.K))
                 a0 = answers(r0)
             m1 = rebuilt(m0, fe, damping)
             rows.append(compare(name, m1, r0, a0, t_read))
-            if damping is not None:  # and against the mesh model itself
+            if loss:  # and against the mesh model itself
                 a1 = answers(m1)
                 rows[-1].update({f"{k}_rel_to_mesh_model": rel(a1[k], ref[k])
                                  for k in ("f", "U", "lam", "wear")})
