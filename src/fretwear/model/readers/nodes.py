@@ -1,8 +1,8 @@
 """Node coordinates and node sets of the mesh that exported matrices came from, read from the
 FE code's input file: Nastran bulk data (``GRID`` cards, basic coordinates; the ``CQUAD4``,
 ``CTRIA3``, ``CTETRA``, ``CHEXA`` connectivity for ParaView), Abaqus ``.inp`` (``*NODE``,
-``*NSET``, ``*ELEMENT``) and ANSYS ``.cdb`` (``NBLOCK``, node components ``CMBLOCK``; its
-elements are not read: ParaView shows the nodes as points).
+``*NSET``, ``*ELEMENT``) and ANSYS ``.cdb`` (``NBLOCK``, node components ``CMBLOCK``, the
+solid-format ``EBLOCK``).
 
 Only the positions are read (frames, pairing, output); the matrices carry the mechanics.
 """
@@ -161,21 +161,42 @@ def _abaqus_nodes(text: str, src: str) -> NodeTable:
 
 
 def _ansys_nodes(text: str, src: str) -> NodeTable:
-    ids, xyz, sets = [], [], {}
+    ids, xyz, sets, elements = [], [], {}, {}
     lines = text.splitlines()
     try:
-        _ansys_blocks(lines, ids, xyz, sets, src)
+        _ansys_blocks(lines, ids, xyz, sets, src, elements)
     except (ValueError, IndexError):
-        raise InputError(f"{src}: cannot read its NBLOCK or CMBLOCK (a truncated or malformed "
-                         "file?)") from None
+        raise InputError(f"{src}: cannot read its NBLOCK, EBLOCK or CMBLOCK (a truncated or "
+                         "malformed file?)") from None
     return NodeTable(np.array(ids, dtype=np.int64), np.array(xyz, dtype=float).reshape(-1, 3),
-                     sets)
+                     sets, _arrays(elements))
 
 
-def _ansys_blocks(lines, ids, xyz, sets, src: str) -> None:
+def _ansys_elements(lines, k: int, src: str, elements: dict) -> int:
+    """The elements of the ``EBLOCK`` (solid format) whose format line is line ``k``: on each
+    element's line field 9 the number of nodes, 12-19 the first eight nodes, the others on
+    the next line; up to the ``-1`` line. Returns the line after the block."""
+    widths = _fortran_widths(lines[k], src, k + 1)
+    k += 1
+    while k < len(lines) and not lines[k].strip().startswith("-1"):
+        vals = [int(v) for v in _fixed_columns(lines[k], widths) if v.strip()]
+        n = vals[8]
+        nodes = vals[11:11 + min(n, 8)]
+        if n > 8:
+            k += 1
+            nodes += [int(v) for v in _fixed_columns(lines[k], widths) if v.strip()][:n - 8]
+        elements.setdefault(n, []).append(nodes)
+        k += 1
+    return k
+
+
+def _ansys_blocks(lines, ids, xyz, sets, src: str, elements: dict) -> None:
     k = 0
     while k < len(lines):
         head = lines[k].strip().upper()
+        if head.startswith("EBLOCK") and "SOLID" in head:
+            k = _ansys_elements(lines, k + 1, src, elements)
+            continue
         if head.startswith("NBLOCK"):
             fmt = lines[k + 1]
             widths = _fortran_widths(fmt, src, k + 2)
