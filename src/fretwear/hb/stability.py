@@ -489,15 +489,18 @@ class HillProblem:
         self.G0 = law.dlft_jacobian(self.lu, self.lx, self.state, prob.mu, prob.P, prob.Q,
                                     prob.eps * prob.anchor, prob.tol, prob.max_sweeps,
                                     prob.normal)
+        # the law's arrays as the kernel of :func:`shifted_gain` takes them, made once
+        self._law = (np.ascontiguousarray(prob.mu, dtype=float), np.ascontiguousarray(prob.P),
+                     np.ascontiguousarray(prob.Q), law._normal(prob.normal, self.lu))
         self.evaluations = 0
 
     def gain(self, sigma: complex) -> np.ndarray:
         """``G(s)`` at ``s = sigma w`` (the solve's own ``G`` at 0)."""
-        p = self.prob
         if sigma == 0:
             return self.G0.astype(complex)
         z = np.exp(-2.0 * np.pi * complex(sigma) / self.N)  # e^{-s h}: h = T / N
-        return shifted_gain(self.lu, self.lx, self.state, p.mu, p.P, p.Q, z, p.normal)
+        mu, P, Q, normal = self._law
+        return _shifted_gain(self.lu, self.lx, self.state, mu, P, Q, z, normal)
 
     def stiffness(self, sigma: complex) -> np.ndarray:
         """``Z(s)`` (m H, m H) at ``s = sigma w``: ``Z_r(s + i n w)`` with the hysteretic
@@ -514,6 +517,12 @@ class HillProblem:
         """``T(s)`` (m H, m H) complex at ``s = sigma w``."""
         self.evaluations += 1
         return jacobian_form(self.gain(sigma), self.stiffness(sigma), self.prob.eps)
+
+    def jacobian(self) -> np.ndarray:
+        """``J = T(0)`` (m H, m H) real: the balance's Jacobian from the solve's own ``G``
+        and its problem's ``Z~`` (eq. 22-28), not re-assembled from the structure (the same
+        matrix to rounding, tests/hb/test_stability.py)."""
+        return jacobian_form(self.G0, self.prob.Z, self.prob.eps)
 
     def neutral(self) -> int:
         """Tangential directions of the nodes that stick all period (multiplier 1)."""
@@ -923,12 +932,13 @@ def _pair(T: np.ndarray, v: np.ndarray, mu0: complex, steps: int = 2):
     error by ``|mu - mu0| / |mu' - mu0|`` over the next eigenvalue ``mu'``: the pair tracked
     stays the one started, as a full eigendecomposition with the largest overlap picks it,
     at the cost of one LU instead of a dense nonsymmetric eigensolve."""
-    n = T.shape[0]
-    A = T - mu0 * np.eye(n)
-    lu = sla.lu_factor(A, check_finite=False)
+    A = np.array(T, dtype=complex)
+    if mu0 != 0:
+        A[np.diag_indices(A.shape[0])] -= mu0
+    lu = zgetrf(A, overwrite_a=True)[:2]
     y = v / np.linalg.norm(v)
     for _ in range(steps):
-        y = sla.lu_solve(lu, y, check_finite=False)
+        y = zgetrs(*lu, y)[0]
         y = y / np.linalg.norm(y)
     mu = complex(np.vdot(y, T @ y))
     return mu, y, lu
@@ -1011,8 +1021,8 @@ def _mu_derivative(hp: HillProblem, sigma: complex, v: np.ndarray, T: np.ndarray
     """``d mu / d sigma = w^H T' v / w^H v`` of a simple eigenvalue with right eigenvector
     ``v`` (left eigenvector ``w`` of ``T`` by inverse iteration on ``T^H`` with the LU of
     :func:`_pair`), ``T'`` by a forward difference."""
-    w = sla.lu_solve(lu, v, trans=2, check_finite=False)
-    w = sla.lu_solve(lu, w / np.linalg.norm(w), trans=2, check_finite=False)
+    w = zgetrs(*lu, v, trans=2)[0]
+    w = zgetrs(*lu, w / np.linalg.norm(w), trans=2)[0]
     dT = (hp.matrix(sigma + step) - T) / step
     den = np.vdot(w, v)
     return complex(np.vdot(w, dT @ v) / den) if den != 0 else 0.0
@@ -1030,7 +1040,7 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
     opt = HillOptions() if options is None else options
     t0 = time.perf_counter()
     hp = HillProblem(prob, U, dyn)
-    det_sign = int(np.sign(np.linalg.slogdet(np.real(hp.matrix(0.0)))[0]))
+    det_sign = int(np.sign(np.linalg.slogdet(hp.jacobian())[0]))
     m, H, k = prob.m, prob.H, len(prob.basis.harmonics)
     q = dyn.q
     prev = previous.track if (previous is not None and opt.track) else None

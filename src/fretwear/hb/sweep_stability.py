@@ -99,7 +99,7 @@ class SweepStability:
 
 def jacobian_sign(hp: HillProblem) -> int:
     """Sign of ``det J``, ``J = T(0)`` the balance's Jacobian (real at ``s = 0``)."""
-    sign, _ = np.linalg.slogdet(np.real(hp.matrix(0.0)))
+    sign, _ = np.linalg.slogdet(hp.jacobian())
     return int(np.sign(sign))
 
 
