@@ -23,7 +23,7 @@ from fretwear.hb.options import SweepOptions
 from fretwear.hb.reduce import exact_condenser
 from fretwear.hb.stability import HillOptions, stability
 from fretwear.hb.sweep import sweep
-from fretwear.hb.sweep_stability import branch_events, sweep_stability
+from fretwear.hb.sweep_stability import branch_events, nearest, sweep_stability
 from fretwear.model.build import Damping
 from fretwear.model.core import Load
 from fretwear.model.matrices import ContactDofs, from_matrices
@@ -167,3 +167,18 @@ def test_candidates_are_not_continued_out_of_full_stick():
         np.testing.assert_allclose(a.multipliers, b.multipliers, rtol=0, atol=1e-12)
     last = pairs[held.index(False)][0]
     assert not last.tracked and np.all(last.multipliers.imag == 0) and last.multipliers.size == 2
+
+
+def test_nearest_is_the_closest_solution_that_can_be_continued(folded):
+    """:func:`nearest` returns the result of the solution closest to ``U`` (Euclidean norm of
+    the harmonics, computed here directly) among those with a track, skipping a closer one
+    without (its candidates cannot be continued), and None when none has one."""
+    _, st = folded
+    with_track = [fl for fl in st.floquet if fl is not None and fl.track is not None]
+    without = [fl for fl in st.floquet if fl is not None and fl.track is None]
+    assert len(with_track) >= 2 and without
+    U = np.zeros((2, 3))
+    seen = [(U + 3.0, with_track[0]), (U - 1.0, with_track[1]), (U + 0.5, without[0])]
+    assert nearest(U, seen) is with_track[1]
+    assert nearest(U + 2.0, seen) is with_track[0]
+    assert nearest(U, seen[2:]) is None and nearest(U, []) is None
