@@ -53,16 +53,20 @@ How they are computed
    parts, candidates are refined on the exact ``T(s)`` (condensed on the contact points,
    ``m H`` unknowns) until ``options.refine`` have converged (:func:`_track`: the secant
    method on the eigenvalue of ``T(s)`` whose eigenvector continues the candidate's,
-   followed by inverse iteration on one LU per evaluation, :func:`_pair`). A
+   followed by inverse iteration on one LU per evaluation, :func:`_pair`; it stops when
+   ``|mu| / |T|`` and ``|T v - mu v| / |T|`` are both below ``options.newton_tol``). A
    candidate near which the exact problem has no exponent is an artefact of the frozen memory
    (:attr:`FloquetResult.spurious`).
 4. **Along a sweep** (``previous``: the neighbouring point's result), the candidates of step 1
    are continued from the neighbour's by inverse iteration on the quadratic problem
    (:func:`track_eigen`) instead of its dense eigensolve, where that is shown to give the
-   same set: every family represented at the neighbour and here (they number ``2 nd / H``),
-   each member converged with ``|kappa| <= 1/2``, and its neighbouring copy on the side of the
-   tie outside ``|kappa| <= 1/2``; otherwise (a jump between branches, two members meeting,
-   the period-doubling line) the dense eigensolve.
+   same set: the same contact regime (:meth:`HillProblem.regime`), every family represented
+   at the neighbour and here (they number ``2 nd / H``), each member converged with
+   ``|kappa| <= 1/2``, and its neighbouring copy on the side of the tie outside
+   ``|kappa| <= 1/2``; otherwise (a jump between branches, two members meeting, the
+   period-doubling line, a node leaving full stick) the dense eigensolve. A continued
+   candidate's refinement starts from the neighbour's refined exponent with its last secant
+   slope (:func:`_warm_start`; same stopping rule, from the candidate if it fails).
 
 Exponents not reported: a node that sticks all period (or a contact point behind a spring that
 sticks all period) holds its contact DOFs, so the modes of the structure with that part of the
@@ -76,13 +80,15 @@ mass, ``q`` other coordinates; at most :data:`PENCIL_MAX` before the companion f
 where coordinates whose law does not vary over the period split off, harmonic by harmonic,
 :func:`_components`) and,
 with a memory, a few evaluations of ``T(s)`` and ``m H`` LU factorisations per refined
-exponent; along a sweep, where the candidates are tracked, a few LU factorisations of the
-blocks of the quadratic problem per candidate instead of its dense eigensolve. Measured on
-the benchmark's small models (docs/theory.md, section 9): about 1-3 times a warm-started
-point's solve; the evaluations of ``T(s)`` (a law with a memory) and the dense eigensolve at
-the points that cannot be tracked are what cost. Dense up to :data:`DENSE_MAX` unknowns of the
-balance. The sign of ``det J`` (``J = T(0)``) is reported with the exponents
-(:attr:`FloquetResult.det_sign`).
+exponent (3-5 from a neighbour's exponent, 4-9 from a candidate); along a sweep, where the
+candidates are tracked, a few LU factorisations of the blocks of the quadratic problem per
+candidate instead of its dense eigensolve. ``det J`` is read from the solve's own ``G`` and
+``Z~`` (:meth:`HillProblem.jacobian`). Measured on the benchmark's small models
+(docs/studies/method-costs.md, "Hill's method"): about 1.5-2.5 times a warm-started point's
+solve; the evaluations of ``T(s)`` (a law with a memory), the dense eigensolve at the points
+that cannot be tracked and the problem rebuilt from the solution are what cost. Dense up to
+:data:`DENSE_MAX` unknowns of the balance. The sign of ``det J`` (``J = T(0)``) is reported
+with the exponents (:attr:`FloquetResult.det_sign`).
 """
 
 from __future__ import annotations
