@@ -101,6 +101,7 @@ import numpy as np
 import scipy.linalg as sla
 from numba import njit
 from scipy.linalg.lapack import zgetrf, zgetrs
+from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
 
 from fretwear.errors import InputError
@@ -658,8 +659,8 @@ def reduce_quadratic(A0: np.ndarray, A1: np.ndarray, A2: np.ndarray,
     it decouples into (:func:`_components`; ``hint``: a neighbour's, kept when the problem
     decouples into them by the same test, which costs less than finding them)."""
     n = A0.shape[0]
-    dyn_ = np.flatnonzero(np.any(A1 != 0, axis=1) | np.any(A2 != 0, axis=1)
-                          | np.any(A1 != 0, axis=0) | np.any(A2 != 0, axis=0))
+    moving = (A1 != 0) | (A2 != 0)
+    dyn_ = np.flatnonzero(np.any(moving, axis=1) | np.any(moving, axis=0))
     alg = np.setdiff1d(np.arange(n), dyn_)
     B0, B1, B2 = (X[np.ix_(dyn_, dyn_)] for X in (A0, A1, A2))
     back = None
@@ -873,7 +874,8 @@ def _components(B0: np.ndarray, B1: np.ndarray, B2: np.ndarray) -> list:
         big = np.abs(X).max(initial=0.0)
         if big > 0:
             pattern |= np.abs(X) > DECOUPLED_TOL * big
-    count, label = connected_components(pattern, directed=False)
+    # a sparse pattern: the dense one goes through csgraph's masked-array validation
+    count, label = connected_components(csr_matrix(pattern), directed=False)
     blocks, group, size = [], [], 0
     for c in range(count):  # small blocks are solved together, up to MIN_BLOCK unknowns (a
         idx = np.flatnonzero(label == c)  # call costs more than the flops saved)
