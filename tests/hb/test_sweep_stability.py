@@ -78,8 +78,9 @@ def test_events_are_where_neighbours_differ(folded):
 
 
 def test_tracked_candidates_give_the_dense_multipliers(folded):
-    """Hill's method along the sweep continues each point's candidates from the previous
-    point's (inverse iteration, :func:`fretwear.hb.stability.track_eigen`) instead of the dense
+    """Hill's method along the sweep continues each point's candidates from those of the
+    nearest point already computed (:func:`nearest`; inverse iteration,
+    :func:`fretwear.hb.stability.track_eigen`) instead of the dense
     eigensolve of the quadratic problem; the reference is the dense eigensolve at every point
     (``HillOptions(track=False)``): the same multipliers, one for one, to 1e-10 (both are
     the same simple eigenvalues of the same matrices, each computed to about 1e-14; the
