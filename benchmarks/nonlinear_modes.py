@@ -10,7 +10,7 @@
   tests/hb/test_nonlinear_modes.py) and the linear stuck and sliding modes; its cost.
 * Hill's method at every point of two frequency sweeps (a forced Jenkins oscillator, 7
   harmonics; the two-DOF oscillator with a unilateral spring, 15 harmonics), each point given
-  the previous point's result to track its candidates from (as
+  the result of the nearest point already computed to track its candidates from (as
   :func:`fretwear.hb.sweep_stability.sweep_stability` does): its time against the point's
   solve (the sum of the attempts' times the sweep records), median and range.
 
@@ -38,6 +38,7 @@ from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.reduce import exact_condenser
 from fretwear.hb.stability import stability
 from fretwear.hb.sweep import sweep
+from fretwear.hb.sweep_stability import nearest
 from fretwear.model.beam import cantilever_matrices, modal_damping
 from fretwear.model.build import Damping
 from fretwear.model.core import Load
@@ -143,22 +144,23 @@ def hill_ratios(model, basis, f_min, f_max, n_points, label):
                 condenser=cond)
     dyn = structure_dynamics(model, cond)
     ratios, cpu_ratios, unstable, cpu, evals, unrecorded = [], [], 0, 0.0, 0, 0
-    prev, prev_fl, tracked = None, None, 0
+    prev, seen, tracked = None, [], 0
     for p in res.points:
         if p.solution is None:
             continue
         if not p.attempts:  # an intermediate point (a substep, the arclength branch): its
             unrecorded += 1  # solve is not recorded per point (the ratio divided by ~0)
             prev = p.solution
-            prev_fl = stability(model, p.solution, dyn=dyn, condenser=cond,
-                                previous=prev_fl)  # as sweep_stability does, every point
-            continue
+            seen.append((p.solution.U, stability(model, p.solution, dyn=dyn, condenser=cond,
+                                                 previous=nearest(p.solution.U, seen))))
+            continue  # (as sweep_stability does, every point)
         solve_t = sum(a.wall_time for a in p.attempts)
         t0, c0 = time.perf_counter(), time.process_time()
-        fl = stability(model, p.solution, dyn=dyn, condenser=cond, previous=prev_fl)
+        fl = stability(model, p.solution, dyn=dyn, condenser=cond,
+                       previous=nearest(p.solution.U, seen))
         ratios.append((time.perf_counter() - t0) / max(solve_t, 1e-9))
         hill_cpu = time.process_time() - c0
-        prev_fl = fl
+        seen.append((p.solution.U, fl))
         tracked += fl.tracked
         cpu += hill_cpu
         evals += fl.evaluations
@@ -175,8 +177,8 @@ def hill_ratios(model, basis, f_min, f_max, n_points, label):
           f"{np.median(r):.2f}, range {r.min():.2f}-{r.max():.2f} (wall); CPU, the solve "
           f"repeated warm-started: median {np.median(rc):.2f}; Hill CPU "
           f"{1e3 * cpu / max(r.size, 1):.1f} ms and {evals / max(r.size, 1):.1f} evaluations "
-          f"of T(s) per point; {tracked} points' candidates tracked from the previous "
-          f"point; {unrecorded} points without a recorded solve time left out")
+          f"of T(s) per point; {tracked} points' candidates tracked from the nearest "
+          f"computed point; {unrecorded} points without a recorded solve time left out")
     return r, rc
 
 

@@ -197,7 +197,8 @@ def test_shifted_gain_at_zero_is_the_solve_s_gain():
 # --- Hill's matrix and the exponents --------------------------------------------------------
 def test_hill_matrix_at_zero_is_the_solve_jacobian():
     """``T(0)`` is the Jacobian the solve used (``J = eps I - G (eps I - Z)``), to rounding,
-    on a Jenkins solution that sticks and slips."""
+    on a Jenkins solution that sticks and slips; so is :meth:`HillProblem.jacobian` (from the
+    solve's ``G`` and the problem's ``Z~``: what ``det J`` is read from), which must be real."""
     model = jenkins(0.2)
     basis = FourierBasis.up_to(5, 64)
     sol = solve_periodic(model, basis, frequency=1.18 / (2 * np.pi), time_domain=None)
@@ -207,6 +208,8 @@ def test_hill_matrix_at_zero_is_the_solve_jacobian():
     _, J = prob.residual(U, True)
     T = hp.matrix(0.0)
     assert np.abs(T - J).max() <= 1e-10 * np.abs(J).max()
+    J0 = hp.jacobian()
+    assert J0.dtype == float and np.abs(J0 - J).max() <= 1e-10 * np.abs(J).max()
 
 
 def test_exponents_of_a_linear_response_are_the_structure_s_eigenvalues():

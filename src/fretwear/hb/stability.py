@@ -53,16 +53,20 @@ How they are computed
    parts, candidates are refined on the exact ``T(s)`` (condensed on the contact points,
    ``m H`` unknowns) until ``options.refine`` have converged (:func:`_track`: the secant
    method on the eigenvalue of ``T(s)`` whose eigenvector continues the candidate's,
-   followed by inverse iteration on one LU per evaluation, :func:`_pair`). A
+   followed by inverse iteration on one LU per evaluation, :func:`_pair`; it stops when
+   ``|mu| / |T|`` and ``|T v - mu v| / |T|`` are both below ``options.newton_tol``). A
    candidate near which the exact problem has no exponent is an artefact of the frozen memory
    (:attr:`FloquetResult.spurious`).
 4. **Along a sweep** (``previous``: the neighbouring point's result), the candidates of step 1
    are continued from the neighbour's by inverse iteration on the quadratic problem
    (:func:`track_eigen`) instead of its dense eigensolve, where that is shown to give the
-   same set: every family represented at the neighbour and here (they number ``2 nd / H``),
-   each member converged with ``|kappa| <= 1/2``, and its neighbouring copy on the side of the
-   tie outside ``|kappa| <= 1/2``; otherwise (a jump between branches, two members meeting,
-   the period-doubling line) the dense eigensolve.
+   same set: the same contact regime (:meth:`HillProblem.regime`), every family represented
+   at the neighbour and here (they number ``2 nd / H``), each member converged with
+   ``|kappa| <= 1/2``, and its neighbouring copy on the side of the tie outside
+   ``|kappa| <= 1/2``; otherwise (a jump between branches, two members meeting, the
+   period-doubling line, a node leaving full stick) the dense eigensolve. A continued
+   candidate's refinement starts from the neighbour's refined exponent with its last secant
+   slope (:func:`_warm_start`; same stopping rule, from the candidate if it fails).
 
 Exponents not reported: a node that sticks all period (or a contact point behind a spring that
 sticks all period) holds its contact DOFs, so the modes of the structure with that part of the
@@ -76,13 +80,15 @@ mass, ``q`` other coordinates; at most :data:`PENCIL_MAX` before the companion f
 where coordinates whose law does not vary over the period split off, harmonic by harmonic,
 :func:`_components`) and,
 with a memory, a few evaluations of ``T(s)`` and ``m H`` LU factorisations per refined
-exponent; along a sweep, where the candidates are tracked, a few LU factorisations of the
-blocks of the quadratic problem per candidate instead of its dense eigensolve. Measured on
-the benchmark's small models (docs/theory.md, section 9): about 1-3 times a warm-started
-point's solve; the evaluations of ``T(s)`` (a law with a memory) and the dense eigensolve at
-the points that cannot be tracked are what cost. Dense up to :data:`DENSE_MAX` unknowns of the
-balance. The sign of ``det J`` (``J = T(0)``) is reported with the exponents
-(:attr:`FloquetResult.det_sign`).
+exponent (3-5 from a neighbour's exponent, 4-9 from a candidate); along a sweep, where the
+candidates are tracked, a few LU factorisations of the blocks of the quadratic problem per
+candidate instead of its dense eigensolve. ``det J`` is read from the solve's own ``G`` and
+``Z~`` (:meth:`HillProblem.jacobian`). Measured on the benchmark's small models
+(docs/studies/method-costs.md, "Hill's method"): about 1.5-2.5 times a warm-started point's
+solve; the evaluations of ``T(s)`` (a law with a memory), the dense eigensolve at the points
+that cannot be tracked and the problem rebuilt from the solution are what cost. Dense up to
+:data:`DENSE_MAX` unknowns of the balance. The sign of ``det J`` (``J = T(0)``) is reported
+with the exponents (:attr:`FloquetResult.det_sign`).
 """
 
 from __future__ import annotations
@@ -95,6 +101,7 @@ import numpy as np
 import scipy.linalg as sla
 from numba import njit
 from scipy.linalg.lapack import zgetrf, zgetrs
+from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
 
 from fretwear.errors import InputError
@@ -147,8 +154,10 @@ class HillOptions:
     stable_tol : ``|rho| <= 1 + stable_tol`` counts as stable (rounding of a neutral exponent).
     track : given the result at a neighbouring solution (``previous`` of
         :func:`hill_stability`), continue its candidates by inverse iteration instead of the
-        dense eigensolve, where that is shown to give the same ones (:func:`track_eigen`);
-        False: the dense eigensolve at every point.
+        dense eigensolve, where that is shown to give the same ones (:func:`track_eigen`),
+        and start each refinement from the neighbour's refined exponent of the same
+        candidate (:func:`_warm_start`); False: the dense eigensolve and the refinements
+        from the candidates at every point.
     """
 
     refine: int = 2
@@ -180,7 +189,9 @@ class HillTrack:
     sigma : (k,) the members ``s / w`` with ``Im s >= 0``; Y : (nd, k) their eigenvectors on
     the dynamic coordinates ``dyn``; block : (k,) the block of :class:`QuadraticReduction`
     each lies in; nd, dyn, blocks : that reduction's coordinates and blocks; complete : every
-    family of the truncated problem is represented.
+    family of the truncated problem is represented; refined : (k,) per member, its
+    refinement on the exact ``T(s)`` as :class:`Refined` (None: not refined, or it did not
+    converge); regime : the contact regime it was found in (:meth:`HillProblem.regime`).
     """
 
     sigma: np.ndarray
@@ -190,6 +201,22 @@ class HillTrack:
     dyn: np.ndarray
     blocks: list
     complete: bool
+    refined: list | None = None
+    regime: tuple | None = None
+
+
+@dataclass
+class Refined:
+    """The refinement of one candidate (:func:`_track`), for the neighbouring solution's
+    (:func:`_warm_start`): ``sigma`` the exponent ``s / w`` of the exact ``T(s)`` continued
+    from the candidate ``candidate`` (both in units of ``w``), ``v`` (m H,) its eigenvector,
+    ``slope`` the last secant slope ``d mu / d sigma`` of the eigenvalue of ``T`` that vanishes
+    there."""
+
+    candidate: complex
+    sigma: complex
+    v: np.ndarray
+    slope: complex
 
 
 @dataclass
@@ -469,15 +496,18 @@ class HillProblem:
         self.G0 = law.dlft_jacobian(self.lu, self.lx, self.state, prob.mu, prob.P, prob.Q,
                                     prob.eps * prob.anchor, prob.tol, prob.max_sweeps,
                                     prob.normal)
+        # the law's arrays as the kernel of :func:`shifted_gain` takes them, made once
+        self._law = (np.ascontiguousarray(prob.mu, dtype=float), np.ascontiguousarray(prob.P),
+                     np.ascontiguousarray(prob.Q), law._normal(prob.normal, self.lu))
         self.evaluations = 0
 
     def gain(self, sigma: complex) -> np.ndarray:
         """``G(s)`` at ``s = sigma w`` (the solve's own ``G`` at 0)."""
-        p = self.prob
         if sigma == 0:
             return self.G0.astype(complex)
         z = np.exp(-2.0 * np.pi * complex(sigma) / self.N)  # e^{-s h}: h = T / N
-        return shifted_gain(self.lu, self.lx, self.state, p.mu, p.P, p.Q, z, p.normal)
+        mu, P, Q, normal = self._law
+        return _shifted_gain(self.lu, self.lx, self.state, mu, P, Q, z, normal)
 
     def stiffness(self, sigma: complex) -> np.ndarray:
         """``Z(s)`` (m H, m H) at ``s = sigma w``: ``Z_r(s + i n w)`` with the hysteretic
@@ -495,10 +525,28 @@ class HillProblem:
         self.evaluations += 1
         return jacobian_form(self.gain(sigma), self.stiffness(sigma), self.prob.eps)
 
+    def jacobian(self) -> np.ndarray:
+        """``J = T(0)`` (m H, m H) real: the balance's Jacobian from the solve's own ``G``
+        and its problem's ``Z~`` (eq. 22-28), not re-assembled from the structure (the same
+        matrix to rounding, tests/hb/test_stability.py)."""
+        return jacobian_form(self.G0, self.prob.Z, self.prob.eps)
+
     def neutral(self) -> int:
         """Tangential directions of the nodes that stick all period (multiplier 1)."""
         stuck = np.all(self.state == STICK, axis=1)
         return int(stuck.sum()) * (self.prob.d - 1)
+
+    def regime(self) -> tuple:
+        """Per node, the contact states it takes over the period and how many times it
+        changes state: where a neighbouring solution's differ (a node that begins to slip or
+        to separate, a stick interval born or closed), the law's derivative ``G`` changes its
+        structure and the frozen-memory problem's families with it (a held pair goes, real
+        exponents come: measured on a Jenkins oscillator leaving full stick), so the
+        candidates are not continued from the neighbour's (:func:`hill_stability`)."""
+        st = self.state
+        changes = np.count_nonzero(st != np.roll(st, 1, axis=-1), axis=-1)
+        return tuple((tuple(np.unique(st[p]).tolist()), int(changes[p]))
+                     for p in range(st.shape[0]))
 
     def memoryless(self) -> bool:
         """No node sticks at any instant nor slips in 3D: ``G(s) = G(0)`` for every ``s``
@@ -611,8 +659,8 @@ def reduce_quadratic(A0: np.ndarray, A1: np.ndarray, A2: np.ndarray,
     it decouples into (:func:`_components`; ``hint``: a neighbour's, kept when the problem
     decouples into them by the same test, which costs less than finding them)."""
     n = A0.shape[0]
-    dyn_ = np.flatnonzero(np.any(A1 != 0, axis=1) | np.any(A2 != 0, axis=1)
-                          | np.any(A1 != 0, axis=0) | np.any(A2 != 0, axis=0))
+    moving = (A1 != 0) | (A2 != 0)
+    dyn_ = np.flatnonzero(np.any(moving, axis=1) | np.any(moving, axis=0))
     alg = np.setdiff1d(np.arange(n), dyn_)
     B0, B1, B2 = (X[np.ix_(dyn_, dyn_)] for X in (A0, A1, A2))
     back = None
@@ -826,7 +874,8 @@ def _components(B0: np.ndarray, B1: np.ndarray, B2: np.ndarray) -> list:
         big = np.abs(X).max(initial=0.0)
         if big > 0:
             pattern |= np.abs(X) > DECOUPLED_TOL * big
-    count, label = connected_components(pattern, directed=False)
+    # a sparse pattern: the dense one goes through csgraph's masked-array validation
+    count, label = connected_components(csr_matrix(pattern), directed=False)
     blocks, group, size = [], [], 0
     for c in range(count):  # small blocks are solved together, up to MIN_BLOCK unknowns (a
         idx = np.flatnonzero(label == c)  # call costs more than the flops saved)
@@ -891,18 +940,20 @@ def _pair(T: np.ndarray, v: np.ndarray, mu0: complex, steps: int = 2):
     error by ``|mu - mu0| / |mu' - mu0|`` over the next eigenvalue ``mu'``: the pair tracked
     stays the one started, as a full eigendecomposition with the largest overlap picks it,
     at the cost of one LU instead of a dense nonsymmetric eigensolve."""
-    n = T.shape[0]
-    A = T - mu0 * np.eye(n)
-    lu = sla.lu_factor(A, check_finite=False)
+    A = np.array(T, dtype=complex)
+    if mu0 != 0:
+        A[np.diag_indices(A.shape[0])] -= mu0
+    lu = zgetrf(A, overwrite_a=True)[:2]
     y = v / np.linalg.norm(v)
     for _ in range(steps):
-        y = sla.lu_solve(lu, y, check_finite=False)
+        y = zgetrs(*lu, y)[0]
         y = y / np.linalg.norm(y)
     mu = complex(np.vdot(y, T @ y))
     return mu, y, lu
 
 
-def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions):
+def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions,
+           warm: Refined | None = None):
     """The exponent of the exact ``T`` continued from ``sigma`` with eigenvector ``v``: the
     scalar equation ``mu(sigma) = 0`` for the eigenvalue ``mu`` of the linear problem
     ``T(sigma) y = mu y`` whose eigenvector continues ``v`` (:func:`_pair`: inverse iteration
@@ -910,13 +961,19 @@ def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions):
     method. Following an eigenvector of ``T(sigma)`` rather than Newton's method on
     ``T(sigma) v = 0`` keeps to the member of the family that was started (centred): the
     truncated problem has copies of every exponent one harmonic apart, and Newton's iterate
-    drifts to a near copy whose eigenvector its normalisation does not see. Returns
-    ``(sigma, v, residual, converged)``; the residual is ``|mu| / |T|`` (with ``|T v - mu v|
-    / |T|`` below the same tolerance: an eigenpair)."""
+    drifts to a near copy whose eigenvector its normalisation does not see. ``warm``: the
+    start ``(sigma, v)`` and the first step's slope instead of the candidate's and a forward
+    difference (:func:`_warm_start`); the neighbourhood of the candidate ``sigma`` that the
+    iterates must not leave, and the stopping rule, are the same. Returns ``(sigma, v,
+    residual, converged, slope)``; the residual is ``|mu| / |T|`` (with ``|T v - mu v| / |T|``
+    below the same tolerance: an eigenpair), ``slope`` the last ``d mu / d sigma`` used."""
     prev = None
     res = np.inf
     start = sigma
-    real = sigma.imag == 0.0  # a real exponent of the real problem stays real (until it
+    slope = 0.0
+    if warm is not None:
+        sigma, v, slope = warm.sigma, warm.v, warm.slope
+    real = start.imag == 0.0  # a real exponent of the real problem stays real (until it
     # meets another one, which the frozen-memory candidates would show as a pair)
     mu0 = 0.0
     for _ in range(opt.newton_max_iter):
@@ -928,13 +985,14 @@ def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions):
         pair = float(np.linalg.norm(T @ v - mu * v) / scale)
         res = max(float(abs(mu) / scale), pair)
         if res <= opt.newton_tol:
-            return sigma, v, res, True
-        if prev is None:  # first step: the derivative by a forward difference
-            dmu = _mu_derivative(hp, sigma, v, T, lu, opt.step)
-            new = sigma - mu / dmu if dmu != 0 else sigma
+            return sigma, v, res, True, slope
+        if prev is None:  # first step: the neighbour's slope, or a forward difference
+            if slope == 0:
+                slope = _mu_derivative(hp, sigma, v, T, lu, opt.step)
         else:
             s0, m0 = prev
-            new = sigma - mu * (sigma - s0) / (mu - m0) if mu != m0 else sigma
+            slope = (mu - m0) / (sigma - s0) if mu != m0 else 0.0
+        new = sigma - mu / slope if slope != 0 else sigma
         prev = (sigma, mu)
         mu0 = 0.0 if pair < 1e-3 else mu  # near the root, the eigenvalue nearest 0
         if real:
@@ -942,7 +1000,28 @@ def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions):
         if not np.isfinite(new) or new == sigma:
             break
         sigma = complex(new)
-    return sigma, v, res, res <= opt.newton_tol
+    return sigma, v, res, res <= opt.newton_tol, slope
+
+
+def _warm_start(track: HillTrack | None, j: int | None, s0: complex) -> Refined | None:
+    """Where the refinement of candidate ``s0`` starts along a sweep: the neighbour's
+    refinement of the same candidate (member ``j`` of its :class:`HillTrack`, which
+    :func:`track_eigen` continued to ``s0``) moved by as much as the candidate moved, with its
+    eigenvector and its last secant slope; None (start from the candidate, the slope by a
+    forward difference) where the neighbour did not refine it or the candidates were not
+    tracked. The refinement stops by the same rule from either start and keeps to the
+    candidate's neighbourhood, so it converges to the same exponent (to ``newton_tol``), in
+    fewer evaluations of ``T(s)``: the start is a neighbour's root, and no forward
+    difference is taken."""
+    if track is None or j is None or track.refined is None:
+        return None
+    r = track.refined[j]
+    if r is None or abs(s0 - r.candidate) > 0.25:  # (a candidate whose centre moved to the
+        return None  # next copy: the neighbour's eigenvector is another copy's)
+    moved = r.sigma + (s0 - r.candidate)
+    if s0.imag == 0.0:  # a real exponent stays on the real axis (:func:`_track`)
+        moved = complex(moved.real, 0.0)
+    return Refined(r.candidate, moved, r.v, r.slope)
 
 
 def _mu_derivative(hp: HillProblem, sigma: complex, v: np.ndarray, T: np.ndarray, lu,
@@ -950,8 +1029,8 @@ def _mu_derivative(hp: HillProblem, sigma: complex, v: np.ndarray, T: np.ndarray
     """``d mu / d sigma = w^H T' v / w^H v`` of a simple eigenvalue with right eigenvector
     ``v`` (left eigenvector ``w`` of ``T`` by inverse iteration on ``T^H`` with the LU of
     :func:`_pair`), ``T'`` by a forward difference."""
-    w = sla.lu_solve(lu, v, trans=2, check_finite=False)
-    w = sla.lu_solve(lu, w / np.linalg.norm(w), trans=2, check_finite=False)
+    w = zgetrs(*lu, v, trans=2)[0]
+    w = zgetrs(*lu, w / np.linalg.norm(w), trans=2)[0]
     dT = (hp.matrix(sigma + step) - T) / step
     den = np.vdot(w, v)
     return complex(np.vdot(w, dT @ v) / den) if den != 0 else 0.0
@@ -969,14 +1048,17 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
     opt = HillOptions() if options is None else options
     t0 = time.perf_counter()
     hp = HillProblem(prob, U, dyn)
-    det_sign = int(np.sign(np.linalg.slogdet(np.real(hp.matrix(0.0)))[0]))
+    det_sign = int(np.sign(np.linalg.slogdet(hp.jacobian())[0]))
     m, H, k = prob.m, prob.H, len(prob.basis.harmonics)
     q = dyn.q
     prev = previous.track if (previous is not None and opt.track) else None
+    regime = hp.regime()
+    if prev is not None and prev.regime != regime:
+        prev = None
     red = reduce_quadratic(*hp.pencil(), hint=prev)
     cut = 2.0 * (k + 1) + 10.0
     got = track_eigen(red, prev, (m + q, H, k))
-    if got is not None:
+    if got is not None:  # member j continues member j of the neighbour's track
         vals, vecs, kap = got
         idx = np.arange(vals.size)
         edge = np.zeros(vals.size, dtype=bool)
@@ -993,10 +1075,13 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
     order = np.argsort(-vals[idx].real, kind="stable")
     idx, kap, edge = idx[order], kap[order], edge[order]
     track = _track_record(red, vals[idx], vecs[:, idx], kap, edge, H, cut)
+    if track is not None:
+        track.regime = regime
     exact = hp.memoryless() and dyn.exact
     sig, kaps, res, kind, spurious = [], [], [], [], []
     refined = 0
-    for i, kp in zip(idx, kap, strict=True):
+    done: list = [None] * idx.size  # the refinements, for the neighbour's warm starts
+    for pos, (i, kp) in enumerate(zip(idx, kap, strict=True)):
         s0 = complex(vals[i])
         y = vecs[:, i]
         vx = y[:m * H]
@@ -1008,15 +1093,21 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
             res.append(np.nan)
             kind.append("held" if held else "exact" if exact else "candidate")
             continue
-        s1, v1, r1, conv = _track(hp, s0, vx, opt)
+        warm = _warm_start(prev, int(i) if got is not None else None, s0)
+        s1, v1, r1, conv, slope = _track(hp, s0, vx, opt, warm)
+        if not conv and warm is not None:  # from the candidate, as without a neighbour
+            s1, v1, r1, conv, slope = _track(hp, s0, vx, opt)
         refined += conv
         if not conv:  # no exponent of the exact problem near it: an artefact of the frozen
             spurious.append(s0)  # memory (a node that sticks part of the period)
             continue
+        done[pos] = Refined(s0, s1, v1, slope)
         sig.append(s1)
         kaps.append(centroid(v1.reshape(m, H), k))
         res.append(r1)
         kind.append("refined")
+    if track is not None:
+        track.refined = done
     sig = np.array(sig, dtype=complex)
     kaps = np.array(kaps)
     res = np.array(res)

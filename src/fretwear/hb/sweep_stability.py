@@ -15,9 +15,10 @@ solution changes stability where one leaves the unit circle:
   response is born).
 
 :func:`sweep_stability` computes the multipliers and ``sign det J`` of every converged point
-and :func:`branch_events` lists these changes between neighbouring converged points (the
-event lies between the two frequencies; its kind is read from the multipliers of the
-unstable neighbour, nearest the unit circle's crossing).
+(each point's candidates continued from those of the nearest point already computed,
+:func:`nearest`) and :func:`branch_events` lists these changes between neighbouring
+converged points (the event lies between the two frequencies; its kind is read from the
+multipliers of the unstable neighbour, nearest the unit circle's crossing).
 """
 
 from __future__ import annotations
@@ -99,7 +100,7 @@ class SweepStability:
 
 def jacobian_sign(hp: HillProblem) -> int:
     """Sign of ``det J``, ``J = T(0)`` the balance's Jacobian (real at ``s = 0``)."""
-    sign, _ = np.linalg.slogdet(np.real(hp.matrix(0.0)))
+    sign, _ = np.linalg.slogdet(hp.jacobian())
     return int(np.sign(sign))
 
 
@@ -124,6 +125,7 @@ def sweep_stability(model: Model, result: SweepResult, *, options: HillOptions |
         except InputError as exc:
             notes.append(f"stability not computed: {exc}")
             return SweepStability(stable, rho, det, floquet, [], wall, notes)
+    seen: list = []  # (U, result) of the points computed, for the nearest one's candidates
     for i, p in enumerate(result.points):
         if not p.success:
             continue
@@ -131,7 +133,8 @@ def sweep_stability(model: Model, result: SweepResult, *, options: HillOptions |
         try:
             prob = problem_of(model, p.solution, condenser=condenser)
             fl = hill_stability(prob, p.solution.U.reshape(prob.m, prob.H), dyn,
-                                options=options, previous=floquet[i - 1] if i else None)
+                                options=options, previous=nearest(p.solution.U, seen))
+            seen.append((np.ravel(p.solution.U), fl))
             det[i] = fl.det_sign
         except InputError as exc:
             notes.append(f"{p.frequency_hz:.6g} Hz: stability not computed: {exc}")
@@ -144,6 +147,25 @@ def sweep_stability(model: Model, result: SweepResult, *, options: HillOptions |
     out = SweepStability(stable, rho, det, floquet, [], wall, notes)
     out.events = branch_events(result.frequency_hz, out)
     return out
+
+
+def nearest(U, seen: list) -> FloquetResult | None:
+    """The result, among ``seen`` (``(U, FloquetResult)`` of the points already computed),
+    at the solution nearest ``U`` (Euclidean norm of the harmonics) of those whose candidates
+    can be continued (:attr:`FloquetResult.track`): the previous point of the sweep's list
+    is not always the neighbour on the branch (the arclength through a fold records points
+    of two branches in turn; on the benchmark's unilateral two-DOF sweep, 25 of 46 points
+    tracked from the nearest against 15 from the previous, the same multipliers)."""
+    U = np.ravel(U)
+    best, far = None, np.inf
+    for V, fl in seen:
+        V = np.ravel(V)
+        if fl.track is None or V.shape != U.shape:
+            continue
+        d = float(np.linalg.norm(U - V))
+        if d < far:
+            best, far = fl, d
+    return best
 
 
 def _critical(fl: FloquetResult | None) -> complex:
