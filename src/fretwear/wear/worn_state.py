@@ -18,7 +18,10 @@ and the rate decays, the step is set by switched evolution relaxation (SER),
 ``max_growth``): it grows without bound as the rate falls, and the iteration turns into
 Newton's method on ``g(W) = 0`` (``dW -> -Js^-1 g``), the direct solve of the null-wear-rate
 condition. A step that wears a node into separation for the whole period (past its lift-off,
-where the rate is 0 too) is pulled back to the lift-off (:func:`_pull_back`).
+where the rate is 0 too) is pulled back to the lift-off (:func:`_pull_back`). Where a
+growing mode of ``Js`` (a stuck neighbour loaded until it slips) would cut the march's step,
+the step is the exponential Euler one, which follows the growth exactly in fewer steps
+(``exponential``, :mod:`fretwear.wear.exponential_step`).
 
 Honesty (issue 29): the state is reported reached only when the null-wear-rate residual
 
