@@ -92,12 +92,24 @@ def test_case_file_gives_the_python_model(tmp_path):
     np.testing.assert_array_equal(got.fe_mesh.cells, mesh_model.mesh.cells)
 
 
+def test_frames_from_the_node_file_without_a_normal(tmp_path):
+    """No `normal`: the frames come from the .inp's CPE4 faces on the bottom nodes, those of
+    the block meshed (its bottom face's outward normal and tangent), node for node."""
+    mesh_model, bottom, _ = _files(tmp_path, CASE.replace("normal = [0.0, -1.0]\n", ""))
+    got = build_model(load_case(tmp_path / "case.toml"))
+    np.testing.assert_array_equal(got.contact.node_ids, bottom)
+    np.testing.assert_array_equal(mesh_model.contact.node_ids + 1, bottom)
+    np.testing.assert_array_equal(got.contact.frame, mesh_model.contact.frame)
+
+
 @pytest.mark.parametrize("edit, msg", [
     (("{fixed}", "999"), "node 999 is not in the matrices' DOF map"),
     (('nodes = "bottom"', 'nodes = "floor"'), "no node set of that name"),
     (('K = "block.pch"', 'K = "block.pch"\nM = "block.pch"'), "model.M: format 'dmig' holds"),
     (('format = "dmig"', 'format = "op4"'), "carries no DOF map"),
     (("normal = [0.0, -1.0]", "normal = [0.0, -1.0, 0.0]"), "expected 2 components"),
+    (("mu = 0.5", "mu = 0.5\ntolerance = 1e-6"), "'tolerance' needs 'partners'"),
+    (("mu = 0.5", 'mu = 0.5\npairing = "mortar"'), "pairing or tolerance without partners"),
 ])
 def test_mistakes_are_one_line(tmp_path, edit, msg):
     _files(tmp_path, CASE.replace(*edit) if edit[0] != "{fixed}" else CASE, fixed=(
