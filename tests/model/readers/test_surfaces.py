@@ -26,6 +26,7 @@ from fretwear.model import (
     Material,
     Spring,
     Traction,
+    box,
     from_mesh,
     join,
     rectangle,
@@ -106,6 +107,22 @@ def test_frames_of_a_curved_face_from_the_node_file(tmp_path):
     flat = rebuilt(m0, fe, table, NodeContact(nodes=c0.node_ids + 1, mu=0.5, area=c0.area,
                                               normal=[0.0, -1.0]))
     assert np.abs(flat.contact.frame[:, 0] - c0.frame[:, 0]).max() > 0.2
+
+
+def test_frames_of_an_inclined_hexahedral_face(tmp_path):
+    """3D: a 2 x 2 x 1 hexahedral box turned about an oblique axis, on its zmin face (CHEXA
+    cards): the frames [n, t1, t2] from the node file equal the meshed model's."""
+    from scipy.spatial.transform import Rotation
+
+    mesh = transformed(box(0.01, 0.01, 0.005, 2, 2, 1),
+                       Rotation.from_rotvec([0.3, -0.2, 0.1]).as_matrix())
+    m0 = from_mesh(mesh, STEEL, supports=[Spring("zmax", "x", 1e7), Spring("zmax", "y", 1e7)],
+                   contact=ContactSpec("zmin", mu=0.5))
+    fe, table = exported(m0, tmp_path)
+    c0 = m0.contact
+    m1 = from_fe(fe, contact=NodeContact(nodes=c0.node_ids + 1, mu=0.5), nodes=table)
+    assert np.abs(c0.frame[:, 0, 2]).min() < 0.99  # not an axis
+    np.testing.assert_allclose(m1.contact.frame, c0.frame, rtol=0, atol=1e-15)
 
 
 def test_mortar_pairing_of_a_non_matching_joint_from_the_node_file(tmp_path):
