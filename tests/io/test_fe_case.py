@@ -94,9 +94,12 @@ def test_case_file_gives_the_python_model(tmp_path):
 
 def test_frames_from_the_node_file_without_a_normal(tmp_path):
     """No `normal`: the frames come from the .inp's CPE4 faces on the bottom nodes, those of
-    the block meshed (its bottom face's outward normal and tangent), node for node."""
-    mesh_model, bottom, _ = _files(tmp_path, CASE.replace("normal = [0.0, -1.0]\n", ""))
+    the block meshed (its bottom face's outward normal and tangent), node for node; area =
+    "mesh" gives its nodal areas (to rounding: 1e-15 relative)."""
+    mesh_model, bottom, _ = _files(tmp_path, CASE.replace("normal = [0.0, -1.0]\n", "")
+                                   .replace("area = 1e-3", 'area = "mesh"'))
     got = build_model(load_case(tmp_path / "case.toml"))
+    np.testing.assert_allclose(got.contact.area, mesh_model.contact.area, rtol=1e-15, atol=0)
     np.testing.assert_array_equal(got.contact.node_ids, bottom)
     np.testing.assert_array_equal(mesh_model.contact.node_ids + 1, bottom)
     np.testing.assert_array_equal(got.contact.frame, mesh_model.contact.frame)

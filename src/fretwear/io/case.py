@@ -616,8 +616,14 @@ CONTACT_FE = Table(
         "mu": _MU,
         "gap": Field(Number(), "initial normal gap (>= 0 open, < 0 interference)", default=0.0,
                      unit="m"),
-        "area": Field(AnyOf((_POSITIVE, ListOf(_POSITIVE, non_empty=True))),
-                      "tributary area, one value or one per node", default=1.0, unit="m^2"),
+        "area": Field(AnyOf((_POSITIVE, ListOf(_POSITIVE, non_empty=True),
+                             Text(("mesh",)))),
+                      "tributary area, one value or one per node; \"mesh\": the consistent "
+                      "nodal areas of the `nodes` file's element faces on the contact nodes, "
+                      "as for a meshed model (2D: times `thickness`)", default=1.0,
+                      unit="m^2"),
+        "thickness": Field(_POSITIVE, "out-of-plane thickness of a 2D model, for area = "
+                           "\"mesh\"", default=1.0, unit="m"),
         "wear_coefficient": _WEAR,
         "partner_wear_coefficient": Field(_NON_NEG, "Archard coefficient of the partners' "
                                           "surface", default=0.0, unit="1/Pa",

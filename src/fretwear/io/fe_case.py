@@ -48,7 +48,7 @@ def build_from_fe(m: dict, title: str):
             area=np.asarray(area, dtype=float) if isinstance(area, list) else area,
             wear_coefficient=c["wear_coefficient"],
             partner_wear_coefficient=c["partner_wear_coefficient"], name=c["name"],
-            pairing=c["pairing"], tolerance=c.get("tolerance")))
+            pairing=c["pairing"], tolerance=c.get("tolerance"), thickness=c["thickness"]))
     loads = []
     for i, ld in enumerate(m.get("loads", [])):
         force = np.asarray(ld["force"], dtype=float)

@@ -95,14 +95,16 @@ def assert_same_solution(m0, m1):
 
 def test_frames_of_a_curved_face_from_the_node_file(tmp_path):
     """No normal given: each node's frame from the element faces on the contact nodes equals
-    the meshed model's (per-node normals of the arc), and so does the periodic solution; a
-    constant normal (the override) would be off by the arc's half angle."""
+    the meshed model's (per-node normals of the arc), so do the nodal areas (area = "mesh")
+    and the periodic solution; a constant normal (the override) would be off by the arc's
+    half angle."""
     m0 = arc_block()
     c0 = m0.contact
     assert np.ptp(c0.frame[:, 0, 0]) > 0.4  # normals spread over the arc
     fe, table = exported(m0, tmp_path)
-    m1 = rebuilt(m0, fe, table, NodeContact(nodes=c0.node_ids + 1, mu=0.5, area=c0.area))
+    m1 = rebuilt(m0, fe, table, NodeContact(nodes=c0.node_ids + 1, mu=0.5, area="mesh"))
     np.testing.assert_allclose(m1.contact.frame, c0.frame, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(m1.contact.area, c0.area, rtol=1e-14, atol=0)
     assert_same_solution(m0, m1)
     flat = rebuilt(m0, fe, table, NodeContact(nodes=c0.node_ids + 1, mu=0.5, area=c0.area,
                                               normal=[0.0, -1.0]))
@@ -134,7 +136,7 @@ def test_mortar_pairing_of_a_non_matching_joint_from_the_node_file(tmp_path):
     assert c0.segments is not None
     fe, table = exported(m0, tmp_path)
     base_top = np.unique(m0.mesh.boundaries["base.top"]) + 1
-    contact = NodeContact(nodes=c0.node_ids + 1, mu=0.3, area=c0.area, partners=base_top,
+    contact = NodeContact(nodes=c0.node_ids + 1, mu=0.3, area="mesh", partners=base_top,
                           pairing="mortar")
     m1 = rebuilt(m0, fe, table, contact)
     c1 = m1.contact
@@ -146,6 +148,7 @@ def test_mortar_pairing_of_a_non_matching_joint_from_the_node_file(tmp_path):
     np.testing.assert_array_equal(c1.partner_dofs, c0.partner_dofs)
     np.testing.assert_allclose(c1.gap, c0.gap, rtol=0, atol=1e-15)
     np.testing.assert_allclose(c1.frame, c0.frame, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(c1.area, c0.area, rtol=1e-14, atol=0)
     assert_same_solution(m0, m1)
     table.node_sets["base_top"] = base_top
     m2 = rebuilt(m0, fe, table, dataclasses.replace(contact, partners="base_top",

@@ -17,6 +17,7 @@ import numpy as np
 from fretwear.errors import InputError
 from fretwear.model.build import Damping, surface_frames
 from fretwear.model.core import Load, Mesh, Model, Segments
+from fretwear.model.loads import nodal_areas
 from fretwear.model.matrices import ContactDofs, from_matrices
 from fretwear.model.pairing import check_pairing, pair
 from fretwear.model.readers.dofmap import FEMatrices
@@ -55,7 +56,12 @@ class NodeContact:
         (:mod:`fretwear.model.pairing`, on the element faces of the node file).
     tolerance : largest distance [m] between a node and its partner point (as
         :class:`~fretwear.model.build.ContactSpec`'s; default there).
-    gap, area, wear_coefficient, partner_wear_coefficient, name, kn, kt : as in
+    area : the tributary area of each node [m^2], one value or one per node; or ``"mesh"``:
+        the consistent nodal areas of the node file's element faces on the contact nodes, as
+        a meshed model's (:func:`fretwear.model.loads.nodal_areas`; in 2D the faces' lengths
+        times ``thickness``).
+    thickness : the out-of-plane thickness [m] of a 2D model, for ``area = "mesh"``.
+    gap, wear_coefficient, partner_wear_coefficient, name, kn, kt : as in
         :class:`~fretwear.model.matrices.ContactDofs` (gap [m], area [m^2], k_w [1/Pa],
         stiffness [N/m]); a non-matching pairing adds each node's distance to its partner
         point along the normal to ``gap`` (0 on flat faces).
@@ -75,6 +81,7 @@ class NodeContact:
     kt: object = None
     pairing: str = "auto"
     tolerance: float | None = None
+    thickness: float = 1.0
 
 
 @dataclass
@@ -157,6 +164,17 @@ def _node_frames(c: NodeContact, ids, geo: _Geometry, dim: int, label: str):
     return surface_frames(mesh, facets, pts, None, None, label, "contact nodes")[1], facets
 
 
+def _mesh_areas(c: NodeContact, ids, facets, geo: _Geometry, label: str) -> np.ndarray:
+    """The consistent nodal areas (nc,) of the element faces on the contact nodes."""
+    mesh = geo.mesh(f"{label}: area = 'mesh'")
+    pts = mesh.point_index(ids)
+    if facets is None:
+        facets = surface(mesh, pts, f"{label} nodes")
+    nodes, area = nodal_areas(dataclasses.replace(mesh, boundaries={"contact": facets}),
+                              "contact", c.thickness)
+    return area[np.searchsorted(nodes, pts)]
+
+
 def _partners(c: NodeContact, ids, frames, facets, geo: _Geometry, label: str):
     """``(pids, gap, seg)``: the partner node ids (of largest weight), the gap to add and
     the non-matching pairs ``(ids (nc, k), weights (nc, k))`` or None."""
@@ -219,6 +237,11 @@ def _contact_dofs(contacts, fe: FEMatrices, table, dim: int) -> tuple[ContactDof
         except (TypeError, ValueError):
             raise InputError(f"{label}: gap = {c.gap!r}; expected a number [m] or one per "
                              f"node ({ids.size})") from None
+        if isinstance(c.area, str):
+            if c.area != "mesh":
+                raise InputError(f"{label}: area = {c.area!r}; expected a number [m^2], one "
+                                 "per node, or 'mesh'")
+            c = dataclasses.replace(c, area=_mesh_areas(c, ids, facets, geo, label))
         part = dict(c=c, ids=ids, rows=rows, prow=None, frames=frames, pids=None, seg=None,
                     gap=gap)
         if c.partners is not None:
