@@ -136,10 +136,13 @@ class _Geometry:
     def __init__(self, table: NodeTable | None, dim: int):
         self.table, self.dim, self._mesh = table, dim, False
 
-    def mesh(self, what: str) -> Mesh:
+    def has_elements(self) -> bool:
         if self._mesh is False:
             self._mesh = None if self.table is None else geometry(self.table, self.dim)
-        if self._mesh is None:
+        return self._mesh is not None
+
+    def mesh(self, what: str) -> Mesh:
+        if not self.has_elements():
             kinds = ", ".join(sorted(CELL_TYPES.values()))
             raise InputError(f"{what}: no node file with elements ({kinds}); give either "
                              "normal or frames (the contact "
@@ -188,8 +191,7 @@ def _partners(c: NodeContact, ids, frames, facets, geo: _Geometry, label: str):
         try:
             return _coincident(ids, pids, geo.table, geo.dim, f"{label} partners"), zero, None
         except InputError:
-            if c.pairing == "node-to-node" or geo.table is None or \
-                    geometry(geo.table, geo.dim) is None:
+            if c.pairing == "node-to-node" or not geo.has_elements():
                 raise
     mesh = geo.mesh(f"{label}: pairing = {c.pairing!r}")
     pts = mesh.point_index(ids)
