@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 from helpers import fe_files as ff
 
-from fretwear import solve_periodic
+from fretwear import simulate_wear, solve_periodic
 from fretwear.errors import InputError
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.options import SolveOptions
@@ -34,11 +34,13 @@ from fretwear.model import (
 )
 from fretwear.model.readers import FEMatrices, NodeContact, NodeTable, from_fe, read_nodes
 from fretwear.model.readers.surfaces import geometry, surface
+from fretwear.wear import WearOptions
 
 BASIS = FourierBasis.up_to(3, 32)
 F_HZ = 2000.0
 STEEL = Material(210e9, 0.3, 7800.0)
 R = 0.02  # radius of the curved contact face [m]
+KW = (1e-13, 3e-13)  # Archard coefficients of the joint's two surfaces [1/Pa]
 
 
 def arc_block():
@@ -59,7 +61,7 @@ def arc_block():
 
 def inclined_joint():
     """A 20 x 10 mm block (4 x 2 Q4) on a 20 x 5 mm base of 5 x 1 Q4 held at its bottom
-    (non-matching: mortar pairs), the whole joint turned by 0.3 rad."""
+    (non-matching: mortar pairs), the whole joint turned by 0.3 rad; both surfaces wear."""
     mesh = join(("block", rectangle(0.02, 0.01, 4, 2, origin=(0.0, 0.005))),
                 ("base", rectangle(0.02, 0.005, 5, 1)))
     c, s = np.cos(0.3), np.sin(0.3)
@@ -69,7 +71,8 @@ def inclined_joint():
         supports=[Spring("block.top_left", "x", 1e7), ("base.bottom", "all")],
         loads=[Traction("block.top", pressure=20e6),
                Traction("block.right", traction=(-1e7 * c, -1e7 * s), waveform="cos")],
-        contact=ContactSpec("block.bottom", mu=0.3, partner="base.top"))
+        contact=ContactSpec("block.bottom", mu=0.3, partner="base.top", wear_coefficient=KW[0],
+                            partner_wear_coefficient=KW[1]))
 
 
 def exported(model, tmp_path):
@@ -128,16 +131,18 @@ def test_frames_of_an_inclined_hexahedral_face(tmp_path):
 
 
 def test_mortar_pairing_of_a_non_matching_joint_from_the_node_file(tmp_path):
-    """An inclined 4 | 5 element joint: the mortar weights, partner nodes, gaps and frames
-    from the node file's elements equal the meshed model's, and so does the periodic
-    solution. The partner surface named by a node set gives the same."""
+    """An inclined 4 | 5 element joint: the mortar weights, partner nodes, gaps, frames and
+    areas from the node file's elements equal the meshed model's, and so do the periodic
+    solution and one wear step (both surfaces worn). The partner surface named by a node set
+    gives the same."""
     m0 = inclined_joint()
     c0 = m0.contact
     assert c0.segments is not None
     fe, table = exported(m0, tmp_path)
     base_top = np.unique(m0.mesh.boundaries["base.top"]) + 1
     contact = NodeContact(nodes=c0.node_ids + 1, mu=0.3, area="mesh", partners=base_top,
-                          pairing="mortar")
+                          pairing="mortar", wear_coefficient=KW[0],
+                          partner_wear_coefficient=KW[1])
     m1 = rebuilt(m0, fe, table, contact)
     c1 = m1.contact
     seg0, seg1 = c0.segments, c1.segments
@@ -150,6 +155,10 @@ def test_mortar_pairing_of_a_non_matching_joint_from_the_node_file(tmp_path):
     np.testing.assert_allclose(c1.frame, c0.frame, rtol=0, atol=1e-15)
     np.testing.assert_allclose(c1.area, c0.area, rtol=1e-14, atol=0)
     assert_same_solution(m0, m1)
+    w0, w1 = (simulate_wear(m, BASIS, F_HZ, options=WearOptions(max_steps=1)).final_wear
+              for m in (m0, m1))
+    assert w0.max() > 0
+    assert abs(w1 - w0).max() <= 1e-10 * w0.max()  # measured 3e-14
     table.node_sets["base_top"] = base_top
     m2 = rebuilt(m0, fe, table, dataclasses.replace(contact, partners="base_top",
                                                     pairing="auto"))
