@@ -92,12 +92,27 @@ def test_case_file_gives_the_python_model(tmp_path):
     np.testing.assert_array_equal(got.fe_mesh.cells, mesh_model.mesh.cells)
 
 
+def test_frames_from_the_node_file_without_a_normal(tmp_path):
+    """No `normal`: the frames come from the .inp's CPE4 faces on the bottom nodes, those of
+    the block meshed (its bottom face's outward normal and tangent), node for node; area =
+    "mesh" gives its nodal areas (to rounding: 1e-15 relative)."""
+    mesh_model, bottom, _ = _files(tmp_path, CASE.replace("normal = [0.0, -1.0]\n", "")
+                                   .replace("area = 1e-3", 'area = "mesh"'))
+    got = build_model(load_case(tmp_path / "case.toml"))
+    np.testing.assert_allclose(got.contact.area, mesh_model.contact.area, rtol=1e-15, atol=0)
+    np.testing.assert_array_equal(got.contact.node_ids, bottom)
+    np.testing.assert_array_equal(mesh_model.contact.node_ids + 1, bottom)
+    np.testing.assert_array_equal(got.contact.frame, mesh_model.contact.frame)
+
+
 @pytest.mark.parametrize("edit, msg", [
     (("{fixed}", "999"), "node 999 is not in the matrices' DOF map"),
     (('nodes = "bottom"', 'nodes = "floor"'), "no node set of that name"),
     (('K = "block.pch"', 'K = "block.pch"\nM = "block.pch"'), "model.M: format 'dmig' holds"),
     (('format = "dmig"', 'format = "op4"'), "carries no DOF map"),
     (("normal = [0.0, -1.0]", "normal = [0.0, -1.0, 0.0]"), "expected 2 components"),
+    (("mu = 0.5", "mu = 0.5\ntolerance = 1e-6"), "'tolerance' needs 'partners'"),
+    (("mu = 0.5", 'mu = 0.5\npairing = "mortar"'), "pairing or tolerance without partners"),
 ])
 def test_mistakes_are_one_line(tmp_path, edit, msg):
     _files(tmp_path, CASE.replace(*edit) if edit[0] != "{fixed}" else CASE, fixed=(
@@ -105,3 +120,56 @@ def test_mistakes_are_one_line(tmp_path, edit, msg):
     with pytest.raises(InputError, match=msg) as exc:
         build_model(load_case(tmp_path / "case.toml"))
     assert "\n" not in str(exc.value)
+
+
+JOINT = """
+title = "non-matching joint"
+[model]
+type = "matrices"
+format = "dmig"
+K = "joint.pch"
+nodes = "joint.inp"
+[[contact]]
+nodes = "bottom"
+partners = "top"
+pairing = "mortar"
+mu = 0.3
+area = "mesh"
+[[fixed]]
+nodes = "held"
+[analysis]
+type = "modes"
+"""
+
+
+def test_non_matching_joint_from_a_case_file(tmp_path):
+    """A 4 | 5 element joint (block on a held base, mortar pairs) as DMIG + .inp with node
+    sets: the pairs' weights, partner nodes, frames and areas are the meshed model's (the
+    geometry comes from the .inp's 17-digit coordinates, so to rounding: 1e-15)."""
+    from fretwear.model import ContactSpec, Material, Spring, from_mesh, join, rectangle
+
+    mesh = join(("block", rectangle(0.02, 0.01, 4, 2, origin=(0.0, 0.005))),
+                ("base", rectangle(0.02, 0.005, 5, 1)))
+    m0 = from_mesh(mesh, Material(210e9, 0.3, 7800.0),
+                   supports=[Spring("block.top_left", "x", 1e7), ("base.bottom", "all")],
+                   contact=ContactSpec("block.bottom", mu=0.3, partner="base.top"))
+    ff.write_dmig(tmp_path / "joint.pch", {"KAAX": m0.K, "MAAX": m0.M}, ff.dofmap_of(m0))
+    sets = {name: np.unique(mesh.boundaries[key]) + 1 for name, key in
+            (("bottom", "block.bottom"), ("top", "base.top"), ("held", "base.bottom"))}
+    lines = ["*NODE"] + [f"{i + 1}, {float(x)!r}, {float(y)!r}"
+                         for i, (x, y) in enumerate(mesh.points)]
+    for name, ids in sets.items():
+        lines += [f"*NSET, NSET={name}", ", ".join(map(str, ids))]
+    lines += ["*ELEMENT, TYPE=CPE4"] + [", ".join(map(str, [e + 1, *(cell + 1)]))
+                                        for e, cell in enumerate(mesh.cells)]
+    (tmp_path / "joint.inp").write_text("\n".join(lines) + "\n")
+    (tmp_path / "case.toml").write_text(JOINT)
+    got = build_model(load_case(tmp_path / "case.toml")).contact
+    c0 = m0.contact
+    order = np.argsort(c0.node_ids)  # the node set lists the nodes by increasing id
+    np.testing.assert_array_equal(got.node_ids, c0.node_ids[order] + 1)
+    np.testing.assert_array_equal(got.segments.ids, np.where(c0.segments.ids >= 0,
+                                                             c0.segments.ids + 1, -1)[order])
+    np.testing.assert_allclose(got.segments.weights, c0.segments.weights[order], atol=1e-15)
+    np.testing.assert_allclose(got.frame, c0.frame[order], atol=1e-15)
+    np.testing.assert_allclose(got.area, c0.area[order], rtol=1e-15)

@@ -595,23 +595,42 @@ CONTACT_FE = Table(
     {
         "nodes": Field(_NODES, "contact node ids, or the name of a node set of the `nodes` "
                        "file", required=True),
-        "partners": Field(_NODES, "node-to-node pairs: each node's partner on the other body, "
-                          "ids in the order of `nodes`, or a node set (each node paired with "
-                          "the set's node at its position)"),
+        "partners": Field(_NODES, "two-body contact: each node's partner on the other body, "
+                          "ids in the order of `nodes`; or the partner surface, a node set (or "
+                          "its ids with `pairing` mortar or node-to-segment): each node paired "
+                          "with the set's node at its position, or with the faces of the "
+                          "`nodes` file's elements on the set when the meshes do not match"),
+        "pairing": Field(Text(("auto", "node-to-node", "mortar", "node-to-segment")),
+                         "how `nodes` meet the partner surface: \"node-to-node\", \"mortar\", "
+                         "\"node-to-segment\" (on the faces of the `nodes` file's elements) "
+                         "or \"auto\": node-to-node when every node has a partner at its "
+                         "position, else mortar", default="auto"),
+        "tolerance": Field(_NON_NEG, "largest distance between a node and its partner point "
+                           "(mortar and node-to-segment; default a tenth of the partner's "
+                           "longest facet edge)", unit="m"),
         "normal": Field(Vector(), "the normal of every node, pointing from its body into the "
-                        "obstacle (or the partner's body); the tangents are chosen from it",
-                        required=True),
+                        "obstacle (or the partner's body); the tangents are chosen from it. "
+                        "Default: from the `nodes` file's elements, the outward normal of "
+                        "their faces on the contact nodes (each node's own on a curved "
+                        "face), as for a meshed model"),
         "mu": _MU,
         "gap": Field(Number(), "initial normal gap (>= 0 open, < 0 interference)", default=0.0,
                      unit="m"),
-        "area": Field(AnyOf((_POSITIVE, ListOf(_POSITIVE, non_empty=True))),
-                      "tributary area, one value or one per node", default=1.0, unit="m^2"),
+        "area": Field(AnyOf((_POSITIVE, ListOf(_POSITIVE, non_empty=True),
+                             Text(("mesh",)))),
+                      "tributary area, one value or one per node; \"mesh\": the consistent "
+                      "nodal areas of the `nodes` file's element faces on the contact nodes, "
+                      "as for a meshed model (2D: times `thickness`)", default=1.0,
+                      unit="m^2"),
+        "thickness": Field(_POSITIVE, "out-of-plane thickness of a 2D model, for area = "
+                           "\"mesh\"", default=1.0, unit="m"),
         "wear_coefficient": _WEAR,
         "partner_wear_coefficient": Field(_NON_NEG, "Archard coefficient of the partners' "
                                           "surface", default=0.0, unit="1/Pa",
                                           used_by=WEAR_ANALYSES),
         "name": _CONTACT_NAME,
     },
+    checks=(requires("tolerance", "partners"),),
     doc="A frictional interface on nodes of the exported matrices, one `[[contact]]` block "
     "each (all node-to-rigid, or all with `partners`).",
 )

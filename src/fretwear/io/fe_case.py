@@ -37,8 +37,8 @@ def build_from_fe(m: dict, title: str):
     dim = 3 if np.any(fe.dofs.component == 3) else 2
     contacts = []
     for i, c in enumerate(m["contact"]):
-        normal = np.asarray(c["normal"], dtype=float)
-        if normal.size != dim:
+        normal = None if "normal" not in c else np.asarray(c["normal"], dtype=float)
+        if normal is not None and normal.size != dim:
             raise InputError(f"contact[{i + 1}].normal = {c['normal']}: expected {dim} "
                              f"components (the matrices are {dim}D)")
         area = c["area"]
@@ -47,7 +47,8 @@ def build_from_fe(m: dict, title: str):
             partners=None if "partners" not in c else _nodes(c["partners"]), gap=c["gap"],
             area=np.asarray(area, dtype=float) if isinstance(area, list) else area,
             wear_coefficient=c["wear_coefficient"],
-            partner_wear_coefficient=c["partner_wear_coefficient"], name=c["name"]))
+            partner_wear_coefficient=c["partner_wear_coefficient"], name=c["name"],
+            pairing=c["pairing"], tolerance=c.get("tolerance"), thickness=c["thickness"]))
     loads = []
     for i, ld in enumerate(m.get("loads", [])):
         force = np.asarray(ld["force"], dtype=float)

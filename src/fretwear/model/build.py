@@ -530,9 +530,6 @@ def _contact(mesh: Mesh, spec: ContactSpec, thickness: float) -> ContactInterfac
         mesh, face = restricted(mesh, spec.boundary, spec.region, what)
         facets = _boundary(mesh, face)
     facets = orient_facets(mesh, facets, f"boundary {spec.boundary!r}")
-    outward = facet_normals(mesh, facets)
-    mean = outward.mean(axis=0)
-    mean /= np.linalg.norm(mean)
     nodes, area = nodal_areas(mesh, face, thickness)
     if np.any(~(area > 0.0)):
         i = int(np.flatnonzero(~(area > 0.0))[0])
@@ -540,34 +537,16 @@ def _contact(mesh: Mesh, spec: ContactSpec, thickness: float) -> ContactInterfac
                          f"{tuple(np.round(mesh.points[nodes[i]], 12).tolist())} has a zero "
                          f"contact area ({area[i]:.3g} m^2): degenerate facets on boundary "
                          f"{spec.boundary!r}")
-    per_node = None
-    if spec.normal is None:
-        dev = np.linalg.norm(outward - mean, axis=1).max()
-        n = mean
-        if dev > 1e-6:  # curved or multi-flank: one normal per node
-            per_node = nodal_normals(mesh, facets, nodes, f"{what}: boundary {spec.boundary!r}")
-    else:
-        n = unit_direction(spec.normal, mesh.dim, f"{what}: normal")
-        if n @ mean <= 0.0:
-            raise InputError(
-                f"{what}: normal {spec.normal!r} points into the structure; it must point from "
-                f"the structure into the obstacle (the boundary's outward normal is "
-                f"{tuple(np.round(mean, 6).tolist())})"
-            )
-    frame = _tangents(n, spec.tangent, what)
+    frame, frames = surface_frames(mesh, facets, nodes, spec.normal, spec.tangent, what,
+                                   f"boundary {spec.boundary!r}")
 
     coords = mesh.points[nodes]
     if mesh.dim == 2:
         order = np.argsort(coords @ frame[1], kind="stable")
     else:
         order = np.lexsort((coords @ frame[1], coords @ frame[2]))
-    nodes, area, coords = nodes[order], area[order], coords[order]
+    nodes, area, coords, frames = nodes[order], area[order], coords[order], frames[order]
     nc, d = nodes.size, mesh.dim
-    if per_node is None:
-        frames = np.broadcast_to(frame, (nc, d, d)).copy()
-    else:
-        frames = np.array([_node_frame(v, frame, spec.tangent, what)
-                           for v in per_node[order]])
 
     if callable(spec.gap):
         gap = np.asarray(spec.gap(coords.copy()), dtype=float)
@@ -603,6 +582,43 @@ def _contact(mesh: Mesh, spec: ContactSpec, thickness: float) -> ContactInterfac
                               f"{what}: tangential_stiffness"),
         **partner,
     )
+
+
+def surface_frames(mesh: Mesh, facets: np.ndarray, nodes: np.ndarray, normal=None,
+                   tangent=None, what: str = "contact",
+                   label: str = "boundary") -> tuple[np.ndarray, np.ndarray]:
+    """``(frame, frames)``: the mean contact frame (d, d) of the outward-oriented ``facets``
+    and the frame (nc, d, d) of each of ``nodes`` (rows ``[n, t1(, t2)]``).
+
+    Without ``normal`` the normal is the facets' outward normal: the same for every node on
+    a flat surface; on a curved or multi-flank one each node's own (:func:`nodal_normals`),
+    its tangents turned from the mean frame's (:func:`_node_frame`). A given ``normal`` (one
+    for every node) must point out of the structure. ``tangent`` as in :class:`ContactSpec`.
+    Meshed models (:func:`from_mesh`) and FE-matrix models with a node file's elements
+    (:func:`fretwear.model.readers.from_fe`) take their frames from here.
+    """
+    outward = facet_normals(mesh, facets)
+    mean = outward.mean(axis=0)
+    mean /= np.linalg.norm(mean)
+    per_node = None
+    if normal is None:
+        dev = np.linalg.norm(outward - mean, axis=1).max()
+        n = mean
+        if dev > 1e-6:  # curved or multi-flank: one normal per node
+            per_node = nodal_normals(mesh, facets, nodes, f"{what}: {label}")
+    else:
+        n = unit_direction(normal, mesh.dim, f"{what}: normal")
+        if n @ mean <= 0.0:
+            raise InputError(
+                f"{what}: normal {normal!r} points into the structure; it must point from "
+                f"the structure into the obstacle (the boundary's outward normal is "
+                f"{tuple(np.round(mean, 6).tolist())})"
+            )
+    frame = _tangents(n, tangent, what)
+    nc, d = nodes.size, mesh.dim
+    if per_node is None:
+        return frame, np.broadcast_to(frame, (nc, d, d)).copy()
+    return frame, np.array([_node_frame(v, frame, tangent, what) for v in per_node])
 
 
 def _node_frame(n: np.ndarray, mean_frame: np.ndarray, tangent, what: str) -> np.ndarray:

@@ -17,7 +17,7 @@ import scipy.sparse as sp
 from fretwear.errors import InputError
 from fretwear.limits import RANGES
 from fretwear.model.build import Damping
-from fretwear.model.core import WAVEFORMS, ContactInterface, Load, Model, ObservedPoint
+from fretwear.model.core import WAVEFORMS, ContactInterface, Load, Model, ObservedPoint, Segments
 from fretwear.model.interfaces import relative_model
 from fretwear.model.supports import rigid_motion_check
 from fretwear.resources import require_memory
@@ -229,6 +229,10 @@ class ContactDofs:
         Normal and tangential contact stiffness [N/m] (> 0, ``inf`` rigid; default rigid), in
         series with the contact law (:mod:`fretwear.hb.connectors`): a finite ``kt`` is a
         Jenkins element.
+    segments : Segments, optional
+        Node-to-segment or mortar pairs (non-matching meshes): each node's partner facet
+        nodes' DOFs (nc, k, d) and weights (:class:`~fretwear.model.core.Segments`);
+        ``partner_dofs`` then holds the DOFs of each node's partner of largest weight.
     """
 
     normal_dofs: object
@@ -246,6 +250,7 @@ class ContactDofs:
     normal_load: object = None
     kn: object = None
     kt: object = None
+    segments: object = None
 
 
 def from_matrices(K, M, *, contact: ContactDofs, damping: Damping | None = None, loads=(),
@@ -387,7 +392,7 @@ def _interface(contact: ContactDofs, dofs: np.ndarray, n: int) -> ContactInterfa
     """The model's :class:`ContactInterface` from the record (every field checked)."""
     nc, dim = dofs.shape
     frame = _frames(contact, nc, dim)
-    partner = _partner(contact.partner_dofs, dofs, n)
+    partner = _partner(contact.partner_dofs, dofs, n, contact.segments)
     if contact.coords is None:
         xyz = np.zeros((nc, dim))
     else:
@@ -413,6 +418,7 @@ def _interface(contact: ContactDofs, dofs: np.ndarray, n: int) -> ContactInterfa
         normal_load=_normal_load(contact.normal_load, nc),
         kn=_stiffness(contact.kn, nc, "kn"),
         kt=_stiffness(contact.kt, nc, "kt"),
+        segments=None if partner is None else contact.segments,
     )
     if contact.normal_dofs is None and np.isnan(interface.normal_load.vector).any():
         raise InputError("normal_load has NaN entries (unilateral nodes) but the nodes have no "
@@ -440,8 +446,10 @@ def _frames(contact: ContactDofs, nc: int, dim: int) -> np.ndarray:
     return frame
 
 
-def _partner(partner_dofs, dofs: np.ndarray, n: int) -> np.ndarray | None:
-    """The partners' DOFs (nc, d) of node-to-node pairs, checked; None without pairs."""
+def _partner(partner_dofs, dofs: np.ndarray, n: int, segments=None) -> np.ndarray | None:
+    """The partners' DOFs (nc, d) of node-to-node pairs, checked; None without pairs. With
+    ``segments`` (non-matching pairs) the partners (of largest weight) may repeat, and the
+    segments' DOFs are checked."""
     if partner_dofs is None:
         return None
     nc, dim = dofs.shape
@@ -450,11 +458,34 @@ def _partner(partner_dofs, dofs: np.ndarray, n: int) -> np.ndarray | None:
         raise InputError(f"contact_partner_dofs has shape {partner.shape}; expected "
                          f"({nc}, {dim}): the DOFs of each node's partner, ordered like "
                          "its own [normal, tangential..]")
+    if segments is not None:
+        _segments(segments, nc, dim, n, dofs)
+        if np.intersect1d(partner, dofs).size:
+            raise InputError("contact_partner_dofs: a partner DOF is also a contact DOF; each "
+                             "pair has its own two nodes")
+        return partner
     clash = np.intersect1d(partner, dofs)
     if clash.size or np.unique(partner).size != partner.size:
         raise InputError("contact_partner_dofs: a partner DOF is also a contact DOF or "
                          "is listed twice; each pair has its own two nodes")
     return partner
+
+
+def _segments(segments, nc: int, dim: int, n: int, dofs: np.ndarray) -> None:
+    """Check the DOFs (nc, k, d) and weights (nc, k) of node-to-segment pairs."""
+    if not isinstance(segments, Segments):
+        raise InputError(f"contact segments = {segments!r}; expected a Segments(dofs, weights, "
+                         "ids)")
+    sd = np.asarray(segments.dofs)
+    w = np.asarray(segments.weights, dtype=float)
+    if sd.ndim != 3 or sd.shape[0] != nc or sd.shape[2] != dim or w.shape != sd.shape[:2]:
+        raise InputError(f"contact segments: dofs {sd.shape} and weights {w.shape}; expected "
+                         f"({nc}, k, {dim}) and ({nc}, k)")
+    used = sd[sd >= 0]
+    if np.any(used >= n) or np.intersect1d(used, dofs).size:
+        raise InputError("contact segments: a partner DOF out of range or also a contact DOF")
+    if not np.allclose(w.sum(axis=1), 1.0, atol=1e-12, rtol=0.0):
+        raise InputError("contact segments: the weights of a node do not add up to 1")
 
 
 def _damping(damping: Damping | None, K: sp.csr_matrix, M: sp.csr_matrix, n_user: int):

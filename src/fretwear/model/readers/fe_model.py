@@ -15,11 +15,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from fretwear.errors import InputError
-from fretwear.model.build import Damping
-from fretwear.model.core import Load, Mesh, Model
+from fretwear.model.build import Damping, surface_frames
+from fretwear.model.core import Load, Mesh, Model, Segments
+from fretwear.model.loads import nodal_areas
 from fretwear.model.matrices import ContactDofs, from_matrices
+from fretwear.model.pairing import check_pairing, pair
 from fretwear.model.readers.dofmap import FEMatrices
 from fretwear.model.readers.nodes import NodeTable
+from fretwear.model.readers.surfaces import CELL_TYPES, geometry, surface
 
 AXES = {"x": 1, "y": 2, "z": 3}
 
@@ -34,15 +37,34 @@ class NodeContact:
     mu : Coulomb friction coefficient [-].
     normal : (d,) or (nc, d), optional
         The normal of each node in the global axes, pointing from the node's body into the
-        obstacle (or into the partner's body); the tangents are chosen from it. Give
-        ``normal`` or ``frames``.
+        obstacle (or into the partner's body); the tangents are chosen from it
+        (:func:`frames_from_normals`). An explicit override of the frames from the mesh.
     frames : (nc, d, d), optional
-        Orthonormal rows ``[n, t1(, t2)]`` of each node in the global axes.
+        Orthonormal rows ``[n, t1(, t2)]`` of each node's frame in the global axes.
+        Without ``normal`` and ``frames`` the frames come from the node file's elements as
+        for a meshed model (:func:`fretwear.model.build.surface_frames`): the outward
+        normal of the element faces whose nodes are all contact nodes (each node's own on a
+        curved or multi-flank surface), the tangents as :class:`~fretwear.model.build.
+        ContactSpec` chooses them.
     partners : (nc,) node ids or a node-set name, optional
-        Node-to-node pairs: each node's partner on the other body (same order).
-    gap, area, wear_coefficient, partner_wear_coefficient, name, kn, kt : as in
+        Node ids: each node's partner on the other body (same order). A node set, or the
+        node ids of the partner surface with ``pairing = "mortar"`` or
+        ``"node-to-segment"``: each node is paired with the set's node at its position, or,
+        when the meshes do not match, with the set's element faces (``pairing``).
+    pairing : ``"auto"`` (default: node-to-node when every node has a partner at its
+        position, else mortar), ``"node-to-node"``, ``"mortar"`` or ``"node-to-segment"``
+        (:mod:`fretwear.model.pairing`, on the element faces of the node file).
+    tolerance : largest distance [m] between a node and its partner point (as
+        :class:`~fretwear.model.build.ContactSpec`'s; default there).
+    area : the tributary area of each node [m^2], one value or one per node; or ``"mesh"``:
+        the consistent nodal areas of the node file's element faces on the contact nodes, as
+        a meshed model's (:func:`fretwear.model.loads.nodal_areas`; in 2D the faces' lengths
+        times ``thickness``).
+    thickness : the out-of-plane thickness [m] of a 2D model, for ``area = "mesh"``.
+    gap, wear_coefficient, partner_wear_coefficient, name, kn, kt : as in
         :class:`~fretwear.model.matrices.ContactDofs` (gap [m], area [m^2], k_w [1/Pa],
-        stiffness [N/m]).
+        stiffness [N/m]); a non-matching pairing adds each node's distance to its partner
+        point along the normal to ``gap`` (0 on flat faces).
     """
 
     nodes: object
@@ -57,6 +79,9 @@ class NodeContact:
     name: str = "contact"
     kn: object = None
     kt: object = None
+    pairing: str = "auto"
+    tolerance: float | None = None
+    thickness: float = 1.0
 
 
 @dataclass
@@ -105,8 +130,102 @@ def frames_from_normals(normal, nc: int, dim: int, what: str = "normal") -> np.n
     return np.stack([n, t1, np.cross(n, t1)], axis=1)
 
 
+class _Geometry:
+    """The node file's elements as a mesh (:func:`~.surfaces.geometry`), built once."""
+
+    def __init__(self, table: NodeTable | None, dim: int):
+        self.table, self.dim, self._mesh = table, dim, False
+
+    def has_elements(self) -> bool:
+        if self._mesh is False:
+            self._mesh = None if self.table is None else geometry(self.table, self.dim)
+        return self._mesh is not None
+
+    def mesh(self, what: str) -> Mesh:
+        if not self.has_elements():
+            kinds = ", ".join(sorted(CELL_TYPES.values()))
+            raise InputError(f"{what}: no node file with elements ({kinds}); give either "
+                             "normal or frames (the contact "
+                "directions) and partners at the nodes' positions, or a node file (nodes=) "
+                "that lists the elements")
+        return self._mesh
+
+
+def _node_frames(c: NodeContact, ids, geo: _Geometry, dim: int, label: str):
+    """``(frames, facets)``: the frames of the contact nodes (given, from the normal, or
+    from the element faces on them: ``facets``, else None)."""
+    if c.normal is not None and c.frames is not None:
+        raise InputError(f"{label}: give either normal or frames (the contact directions), "
+                         "not both")
+    if c.frames is not None:
+        return np.asarray(c.frames, dtype=float), None
+    if c.normal is not None:
+        return frames_from_normals(c.normal, ids.size, dim, f"{label} normal"), None
+    mesh = geo.mesh(f"{label}: frames from the mesh")
+    pts = mesh.point_index(ids)
+    facets = surface(mesh, pts, f"{label} nodes")
+    return surface_frames(mesh, facets, pts, None, None, label, "contact nodes")[1], facets
+
+
+def _mesh_areas(c: NodeContact, ids, facets, geo: _Geometry, label: str) -> np.ndarray:
+    """The consistent nodal areas (nc,) of the element faces on the contact nodes."""
+    mesh = geo.mesh(f"{label}: area = 'mesh'")
+    pts = mesh.point_index(ids)
+    if facets is None:
+        facets = surface(mesh, pts, f"{label} nodes")
+    nodes, area = nodal_areas(dataclasses.replace(mesh, boundaries={"contact": facets}),
+                              "contact", c.thickness)
+    return area[np.searchsorted(nodes, pts)]
+
+
+def _partners(c: NodeContact, ids, frames, facets, geo: _Geometry, label: str):
+    """``(pids, gap, seg)``: the partner node ids (of largest weight), the gap to add and
+    the non-matching pairs ``(ids (nc, k), weights (nc, k))`` or None."""
+    check_pairing(c.pairing, label)
+    zero = np.zeros(ids.size)
+    pids = _ids(c.partners, geo.table, f"{label} partners")
+    surface_given = isinstance(c.partners, str) or c.pairing in ("mortar", "node-to-segment")
+    if not surface_given:  # node by node
+        return pids, zero, None
+    if c.pairing in ("auto", "node-to-node"):  # the partners is a node set
+        try:
+            return _coincident(ids, pids, geo.table, geo.dim, f"{label} partners"), zero, None
+        except InputError:
+            if c.pairing == "node-to-node" or not geo.has_elements():
+                raise
+    mesh = geo.mesh(f"{label}: pairing = {c.pairing!r}")
+    pts = mesh.point_index(ids)
+    if facets is None:
+        facets = surface(mesh, pts, f"{label} nodes")
+    other = surface(mesh, mesh.point_index(pids), f"{label} partners")
+    name = c.partners if isinstance(c.partners, str) else "partners"
+    found = pair(dataclasses.replace(mesh, boundaries={name: other}), pts,
+                 np.asarray(frames)[:, 0], name, face=facets, tolerance=c.tolerance,
+                 pairing=c.pairing, what=label)
+    if found.segments is None:
+        return mesh.ids[found.partner_ids], zero, None
+    sid = np.asarray(found.segments.ids)
+    return (mesh.ids[found.partner_ids], found.gap,
+            (np.where(sid >= 0, mesh.ids[sid], -1), np.asarray(found.segments.weights)))
+
+
+def _segments(parts, fe: FEMatrices, comps) -> Segments | None:
+    """The non-matching pairs of every node (node-to-node pairs with weight 1), on rows."""
+    if all(p["seg"] is None for p in parts):
+        return None
+    items = [p["seg"] or (p["pids"][:, None], np.ones((p["pids"].size, 1))) for p in parts]
+    k = max(i[0].shape[1] for i in items)
+    ids = np.concatenate([np.pad(i[0], ((0, 0), (0, k - i[0].shape[1])), constant_values=-1)
+                          for i in items])
+    weights = np.concatenate([np.pad(i[1], ((0, 0), (0, k - i[1].shape[1]))) for i in items])
+    dofs = np.full(ids.shape + (len(comps),), -1, dtype=np.int64)
+    dofs[ids >= 0] = fe.dofs.rows(ids[ids >= 0], comps, "contact partners")
+    return Segments(dofs=dofs, weights=weights, ids=ids)
+
+
 def _contact_dofs(contacts, fe: FEMatrices, table, dim: int) -> tuple[ContactDofs, dict]:
     comps = list(range(1, dim + 1))
+    geo = _Geometry(table, dim)
     parts = []
     for k, c in enumerate(contacts):
         if not isinstance(c, NodeContact):
@@ -114,45 +233,56 @@ def _contact_dofs(contacts, fe: FEMatrices, table, dim: int) -> tuple[ContactDof
         label = f"contact {c.name!r}"
         ids = _ids(c.nodes, table, f"{label} nodes")
         rows = fe.dofs.rows(ids, comps, f"{label} nodes")
-        prow = None
+        frames, facets = _node_frames(c, ids, geo, dim, label)
+        try:
+            gap = np.broadcast_to(np.asarray(c.gap, dtype=float), (ids.size,)).copy()
+        except (TypeError, ValueError):
+            raise InputError(f"{label}: gap = {c.gap!r}; expected a number [m] or one per "
+                             f"node ({ids.size})") from None
+        if isinstance(c.area, str):
+            if c.area != "mesh":
+                raise InputError(f"{label}: area = {c.area!r}; expected a number [m^2], one "
+                                 "per node, or 'mesh'")
+            c = dataclasses.replace(c, area=_mesh_areas(c, ids, facets, geo, label))
+        part = dict(c=c, ids=ids, rows=rows, prow=None, frames=frames, pids=None, seg=None,
+                    gap=gap)
         if c.partners is not None:
-            pids = _ids(c.partners, table, f"{label} partners")
-            if isinstance(c.partners, str):  # a node set: each node's coincident partner
-                pids = _coincident(ids, pids, table, dim, f"{label} partners")
+            pids, extra_gap, part["seg"] = _partners(c, ids, frames, facets, geo, label)
             if pids.size != ids.size:
                 raise InputError(f"{label}: {pids.size} partners for {ids.size} nodes; expected "
                                  "one partner per node")
-            prow = fe.dofs.rows(pids, comps, f"{label} partners")
-        if (c.normal is None) == (c.frames is None):
-            raise InputError(f"{label}: give either normal or frames (the contact directions)")
-        frames = (frames_from_normals(c.normal, ids.size, dim, f"{label} normal")
-                  if c.frames is None else np.asarray(c.frames, dtype=float))
-        parts.append((c, ids, rows, prow, frames, None if c.partners is None else pids))
-    nc = [p[1].size for p in parts]
-    per = lambda f: np.concatenate([np.broadcast_to(np.asarray(f(p[0]), dtype=float),  # noqa: E731
+            part.update(pids=pids, gap=gap + extra_gap,
+                        prow=fe.dofs.rows(pids, comps, f"{label} partners"))
+        elif c.pairing != "auto" or c.tolerance is not None:
+            raise InputError(f"{label}: pairing or tolerance without partners (they are for "
+                             "two-body contact)")
+        parts.append(part)
+    nc = [p["ids"].size for p in parts]
+    per = lambda f: np.concatenate([np.broadcast_to(np.asarray(f(p["c"]), dtype=float),  # noqa: E731
                                                     (n,)) for p, n in zip(parts, nc, strict=True)])
-    rows = np.concatenate([p[2] for p in parts])
-    paired = [p[3] is not None for p in parts]
+    rows = np.concatenate([p["rows"] for p in parts])
+    paired = [p["prow"] is not None for p in parts]
     if any(paired) and not all(paired):
         raise InputError("contact: node-to-node interfaces (with partners) and node-to-rigid "
                          "ones cannot be mixed in one model built from FE matrices")
-    ids = np.concatenate([p[1] for p in parts])
+    ids = np.concatenate([p["ids"] for p in parts])
     coords = None if table is None else table.coordinates(ids, dim, "contact nodes")
-    stiff = {k: (None if all(getattr(p[0], k) is None for p in parts)
+    stiff = {k: (None if all(getattr(p["c"], k) is None for p in parts)
                  else per(lambda c, k=k: np.inf if getattr(c, k) is None else getattr(c, k)))
              for k in ("kn", "kt")}
     contact = ContactDofs(
         normal_dofs=rows[:, 0], tangential_dofs=rows[:, 1:] if dim == 3 else rows[:, 1],
-        mu=float(parts[0][0].mu), gap=per(lambda c: c.gap), area=per(lambda c: c.area),
-        frames=np.concatenate([p[4] for p in parts]), coords=coords,
-        name=str(parts[0][0].name),
-        partner_dofs=np.concatenate([p[3] for p in parts]) if all(paired) else None,
-        kn=stiff["kn"], kt=stiff["kt"])
+        mu=float(parts[0]["c"].mu), gap=np.concatenate([p["gap"] for p in parts]),
+        area=per(lambda c: c.area), frames=np.concatenate([p["frames"] for p in parts]),
+        coords=coords, name=str(parts[0]["c"].name),
+        partner_dofs=np.concatenate([p["prow"] for p in parts]) if all(paired) else None,
+        kn=stiff["kn"], kt=stiff["kt"],
+        segments=_segments(parts, fe, comps) if all(paired) else None)
     extra = {"mu": per(lambda c: c.mu), "wear": per(lambda c: c.wear_coefficient),
              "pwear": per(lambda c: c.partner_wear_coefficient), "ids": ids,
-             "pids": np.concatenate([p[5] for p in parts]) if all(paired) else None,
+             "pids": np.concatenate([p["pids"] for p in parts]) if all(paired) else None,
              "interface": np.repeat(np.arange(len(parts)), nc),
-             "names": tuple(str(p[0].name) for p in parts)}
+             "names": tuple(str(p["c"].name) for p in parts)}
     return contact, extra
 
 
@@ -286,10 +416,6 @@ def from_fe(fe: FEMatrices, *, contact, nodes: NodeTable | None = None, damping=
         ci.interface = extra["interface"]
         ci.interface_names = extra["names"]
     return model
-
-
-#: meshio cell types of elements by (dimension, number of nodes)
-CELL_TYPES = {(2, 3): "triangle", (2, 4): "quad", (3, 4): "tetra", (3, 8): "hexahedron"}
 
 
 def fe_mesh(fe: FEMatrices, table: NodeTable, dim: int) -> Mesh:
