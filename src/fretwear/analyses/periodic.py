@@ -42,14 +42,16 @@ from fretwear.analyses.figure_style import MARKED_POINTS, series_style
 from fretwear.errors import InputError
 from fretwear.hb import fallbacks
 from fretwear.hb.contact import STATE_NAMES
+from fretwear.hb.dynamics import structure_dynamics
 from fretwear.hb.inputs import QUASI_STATIC_FREQUENCY
 from fretwear.hb.options import PERIODIC as PERIODIC_SOLVE
 from fretwear.hb.penalty import penalty
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.reduce import condense, recover
+from fretwear.hb.slow_mode import slow_mode
 from fretwear.hb.solution import PeriodicSolution
 from fretwear.hb.solvers import SolveStats
-from fretwear.hb.stability import stability
+from fretwear.hb.stability import problem_of, stability
 from fretwear.io.results import nodal_vectors, variable, write_pvd, write_vtu
 from fretwear.io.schema import Field, Flag, Integer, Number, join
 
@@ -229,6 +231,10 @@ def run_periodic(model, analysis: dict, case, context: RunContext) -> RunOutput:
     if sol.success and analysis["hill_stability"] and not qs:
         verdict, hill_attrs = hill_verdict(model, sol, cond)
         attrs.update(hill_attrs)
+    slow_line = ""
+    if sol.success and not qs:
+        slow_line, slow_attrs = slow_verdict(model, sol, cond)
+        attrs.update(slow_attrs)
     if not sol.success:  # never saved as a result: the diagnostics only
         return RunOutput(xr.Dataset(attrs=attrs), [],
                          _failure_summary(stats, analysis, where, sol), False,
@@ -247,12 +253,34 @@ def run_periodic(model, analysis: dict, case, context: RunContext) -> RunOutput:
     summary = _periodic_summary(sol, ds, analysis, where)
     if verdict:
         summary += "\n" + verdict
+    if slow_line:
+        summary += "\n" + slow_line
     fallback = fallbacks.of_solutions([sol], sol.stats.wall_time).line(
         "solves", fallbacks.eps_hint("eps" in analysis))
     if fallback:
         summary += "\n" + fallback
     return RunOutput(ds, figures, summary + "\n" + cond.choice.summary(), True, files,
                      warnings=list(sol.warnings))
+
+
+def slow_verdict(model, sol: PeriodicSolution, cond) -> tuple[str, dict]:
+    """Is the state held only weakly along some direction (:func:`fretwear.hb.slow_mode.
+    slow_mode`: the balance's near-null direction, e.g. the interface's mean tangential
+    position where every node slips at some instant)? The attribute ``slow_multiplier`` (its
+    real Floquet multiplier nearest 1; NaN: no such direction, or not computed) and a summary
+    line where a start elsewhere relaxes to the state over more than
+    :data:`fretwear.hb.slow_mode.SLOW_PERIODS` periods or moves away from it (empty
+    otherwise)."""
+    attrs = {"slow_multiplier": float("nan")}
+    try:
+        prob = problem_of(model, sol, condenser=cond)
+        sm = slow_mode(prob, sol.U.reshape(prob.m, prob.H), structure_dynamics(model, cond))
+    except InputError:  # beyond the dense Hill matrix, a sector, ...: not computed
+        return "", attrs
+    attrs["slow_multiplier"] = sm.multiplier
+    if sm.multiplier > 1 or sm.slow():
+        return sm.line(), attrs
+    return "", attrs
 
 
 def hill_verdict(model, sol: PeriodicSolution, cond) -> tuple[str, dict]:
