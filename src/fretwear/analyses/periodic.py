@@ -51,7 +51,7 @@ from fretwear.hb.reduce import condense, recover
 from fretwear.hb.slow_mode import slow_mode
 from fretwear.hb.solution import PeriodicSolution
 from fretwear.hb.solvers import SolveStats
-from fretwear.hb.stability import problem_of, stability
+from fretwear.hb.stability import DENSE_MAX, problem_of, stability
 from fretwear.io.results import nodal_vectors, variable, write_pvd, write_vtu
 from fretwear.io.schema import Field, Flag, Integer, Number, join
 
@@ -272,6 +272,8 @@ def slow_verdict(model, sol: PeriodicSolution, cond) -> tuple[str, dict]:
     :data:`fretwear.hb.slow_mode.SLOW_PERIODS` periods or moves away from it (empty
     otherwise)."""
     attrs = {"slow_multiplier": float("nan")}
+    if sol.U.size > DENSE_MAX:  # Hill's matrix is formed densely: not computed (before the
+        return "", attrs  # condensation and the structure's matrices are built for it)
     try:
         prob = problem_of(model, sol, condenser=cond)
         sm = slow_mode(prob, sol.U.reshape(prob.m, prob.H), structure_dynamics(model, cond))
