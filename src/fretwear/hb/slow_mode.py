@@ -94,12 +94,14 @@ class SlowMode:
         what = ("the interface's mean tangential position" if self.rigid >= 0.9 else
                 "the balance's slowest direction")
         rho = self.multiplier
-        head = f"{what} is held only weakly: Floquet multiplier 1 {rho - 1:+.2g} along it"
+        near = f"1 {'-' if rho < 1 else '+'} {abs(1 - rho):.2g}"
+        head = f"{what} is held only weakly: Floquet multiplier {near} along it"
         if rho > 1:
-            return (f"{head}: a start next to this state moves away from it (UNSTABLE), an "
-                    f"offset growing e-fold over {self.periods:.2g} periods")
+            return (f"{what} is not held: Floquet multiplier {near} along it: a start next "
+                    f"to this state moves away from it (UNSTABLE), an offset growing e-fold "
+                    f"over about {self.periods:.2g} periods")
         if not self.slow():
-            return (f"{what}: Floquet multiplier 1 {rho - 1:+.2g} along it (relaxes over "
+            return (f"{what}: Floquet multiplier {near} along it (relaxes over "
                     f"{self.periods:.2g} periods)")
         return (f"{head} (Jacobian nearly singular there: eigenvalue {self.eigenvalue:.2g} "
                 f"of eps): a start at another position relaxes to this state over about "
