@@ -145,6 +145,8 @@ def slow_mode(prob: DLFTProblem, U, dyn: StructureDynamics, *,
     v = _near_null(lu, start, 0)
     u = _near_null(lu, start, 1)
     uv = float(u @ v)
+    if not abs(uv) > 1e-12:  # left and right vectors orthogonal (a Jordan block): no estimate
+        return SlowMode(math.nan, math.nan, math.nan, float(np.max(np.abs(E.T @ v))), 0)
 
     def mu(sigma: float) -> float:
         return float(np.real(u @ (hp.matrix(sigma) @ v))) / uv
