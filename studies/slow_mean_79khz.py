@@ -14,7 +14,7 @@ The example ``salles2011-79khz-periodic`` (exact condensation, 7 harmonics, 128 
    vibration from the balance's.
 
 Run: ``python studies/slow_mean_79khz.py [periods_128] [periods_1024]`` (default 3000 and
-1500; about 5 minutes of CPU). Results: docs/studies/79khz-slow-mean.md.
+1500; about 2 minutes of CPU). Results: docs/studies/79khz-slow-mean.md.
 """
 
 from __future__ import annotations
