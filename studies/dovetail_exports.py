@@ -3,8 +3,10 @@ back with fretwear.model.readers, against the model built from the mesh: the sam
 periodic solve and wear step to 1e-10?
 
 Formats: Nastran DMIG (large field, 10 significant digits) and OP4 (ASCII and binary, sparse
-strings, 17 digits or the doubles themselves) and Abaqus ``*MATRIX OUTPUT, FORMAT=MATRIX
-INPUT`` (17 digits), written from the documented formats (tests/helpers/fe_files.py); with
+strings, 17 digits or the doubles themselves), Abaqus ``*MATRIX OUTPUT, FORMAT=MATRIX
+INPUT`` (17 digits) and ANSYS ``.full`` (the doubles; K and M only: D given as a matrix,
+or from the case's loss factor), written from the documented formats
+(tests/helpers/fe_files.py); with
 ``--pynastran PYTHON`` (a Python whose environment has pyNastran and NumPy < 2, never a
 fretwear dependency) also pyNastran's own DMIG and ASCII OP4 writers. A format that keeps 10
 digits is compared with the mesh model whose K, M, D are rounded to 10 digits, as the files
@@ -45,12 +47,14 @@ from fretwear.examples import example_path  # noqa: E402
 from fretwear.hb.fourier import FourierBasis  # noqa: E402
 from fretwear.io.case import build_model  # noqa: E402
 from fretwear.linear import modes  # noqa: E402
+from fretwear.model.build import Damping  # noqa: E402
 from fretwear.model.readers import from_fe, read_fe, write_dofmap  # noqa: E402
 from fretwear.wear import WearOptions  # noqa: E402
 
 BASIS = FourierBasis.up_to(1, 16)
 F_HZ = 1800.0
 NAMES = {"K": "KAAX", "M": "MAAX", "D": "K4AX"}
+LOSS_FACTOR = 0.002  # [damping] of the dovetail's case file
 
 PYNASTRAN = '''
 import sys
@@ -89,10 +93,10 @@ def ten_digits(A):
     return A
 
 
-def rebuilt(model, fe):
+def rebuilt(model, fe, damping=None):
     return from_fe(fe, contact=ff.contacts_of(model), nodes=ff.node_table(model),
                    loads=ff.forces_of(model), fixed=ff.fixed_of(model),
-                   observed=ff.observed_of(model), name=model.name)
+                   observed=ff.observed_of(model), name=model.name, damping=damping)
 
 
 def cpu() -> float:
@@ -109,7 +113,10 @@ def exports(m0, d: Path, pynastran: str | None) -> dict:
     ff.write_op4(d / "binary.op4", mats, sparse=True, binary=True)
     for k in NAMES:
         ff.write_abaqus_matrix_input(d / f"{k}.mtx", getattr(m0, k), dofs)
+    ff.write_ansys_full(d / "dovetail.full", m0.K, m0.M, dofs)
     out = {"dmig": ((d / "m.pch",), {}),
+           "ansys full, D given": ((d / "dovetail.full",), {}),
+           "ansys full, loss factor": ((d / "dovetail.full",), {}),
            "op4 ascii": ((d / "ascii.op4",), {"dofmap": d / "dofs.txt"}),
            "op4 binary": ((d / "binary.op4",), {"dofmap": d / "dofs.txt"}),
            "abaqus matrix input": ((d / "K.mtx", d / "M.mtx"),
@@ -242,6 +249,8 @@ def main(argv=None):
     p.add_argument("--pynastran", help="Python with pyNastran and NumPy < 2 (optional)")
     p.add_argument("--superelement", action="store_true",
                    help="also the Craig-Bampton superelement with every interior mode")
+    p.add_argument("--formats", nargs="+", help="only these formats (e.g. 'ansys full'): "
+                   "their rows replace those of the same name in the --out file")
     p.add_argument("--out", default=str(ROOT / "docs" / "studies" / "figures"
                                         / "dovetail-exports.json"))
     args = p.parse_args(argv)
@@ -259,18 +268,38 @@ def main(argv=None):
     print(json.dumps(rows[0]))
     with tempfile.TemporaryDirectory() as tmp:
         for name, (a, kw) in exports(m0, Path(tmp), args.pynastran).items():
+            if args.formats and name not in args.formats:
+                continue
             t = cpu()
             fe = read_fe(*a, **kw)
             t_read = cpu() - t
+            # a .full holds K and M only: the hysteretic D given as a matrix (as exported
+            # apart, e.g. Matrix Market), or the case's loss factor (D = eta K)
+            damping = {"ansys full, D given": Damping(D=m0.D),
+                       "ansys full, loss factor": Damping(loss_factor=LOSS_FACTOR)}.get(name)
             ten = name.startswith("dmig")
             r0, a0 = (m10, ref10) if ten else (m0, ref)
             if name == "dmig (pyNastran)":
                 r0 = dataclasses.replace(m0, **{k: ROUNDED_BY_PYNASTRAN[NAMES[k]].tocsr()
                                                 for k in NAMES})
                 a0 = answers(r0)
-            rows.append(compare(name, rebuilt(m0, fe), r0, a0, t_read))
+            loss = name == "ansys full, loss factor"
+            if loss:  # the mesh model's D leaves its springs undamped: D = eta K here
+                r0 = dataclasses.replace(m0, D=sp.csr_matrix(LOSS_FACTOR * m0.K))
+                a0 = answers(r0)
+            m1 = rebuilt(m0, fe, damping)
+            rows.append(compare(name, m1, r0, a0, t_read))
+            if loss:  # and against the mesh model itself
+                a1 = answers(m1)
+                rows[-1].update({f"{k}_rel_to_mesh_model": rel(a1[k], ref[k])
+                                 for k in ("f", "U", "lam", "wear")})
+                print(json.dumps(rows[-1]))
     if args.superelement:
         rows.append(superelement(m0, ref))
+    if args.formats:  # the other rows as the last full run left them
+        old = json.loads(Path(args.out).read_text())["rows"]
+        names = [r["format"] for r in rows[1:]]
+        rows = [r for r in old if r["format"] not in names] + rows[1:]
     Path(args.out).write_text(json.dumps({"f_hz": F_HZ, "harmonics": 1, "rows": rows},
                                          indent=1) + "\n")
 

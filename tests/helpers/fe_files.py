@@ -5,6 +5,8 @@ ids. Node id = mesh node number + 1 (FE codes count from 1)."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import scipy.io
 import scipy.sparse as sp
@@ -180,3 +182,83 @@ def write_matrix_market(path, A) -> None:
 
 def write_harwell_boeing(path, A) -> None:
     scipy.io.hb_write(str(path), sp.csc_matrix(A))
+
+
+def write_bdf_mesh(path, model) -> None:
+    """The mesh as Nastran bulk data (free field, every digit): ``GRID`` cards (node id =
+    number + 1) and ``CQUAD4``/``CTRIA3``/``CTETRA``/``CHEXA`` cards of its cells."""
+    pts = model.mesh.points
+    xyz = np.zeros((len(pts), 3))
+    xyz[:, :model.dim] = pts
+    lines = [f"GRID,{i + 1},,{x!r},{y!r},{z!r}" for i, (x, y, z) in enumerate(xyz.tolist())]
+    card = {3: "CTRIA3", 4: "CTETRA" if model.mesh.cell_type == "tetra" else "CQUAD4",
+            8: "CHEXA"}[model.mesh.cells.shape[1]]
+    for e, cell in enumerate(np.asarray(model.mesh.cells) + 1):
+        ids = [str(int(n)) for n in cell]
+        lines.append(",".join([card, str(e + 1), "1", *ids[:6]]))
+        if len(ids) > 6:
+            lines.append(",".join(["", *ids[6:]]))
+    path.write_text("\n".join(lines) + "\n")
+
+
+def write_ansys_full(path, K, M, dofs: DofMap, held=()) -> None:
+    """An uncompressed ANSYS ``.full`` file from its documented layout (``fdfull.inc``):
+    records ``[n, flags, data, n]`` (flags bit 31: integers); the standard header (file
+    number 4, version 18.0), the full header, the DOF labels, node ids, DOFs per node, the
+    constraint table (``held`` rows negative, their diagonal 1 as MAPDL writes it) and one
+    pair of records a column (rows from 1 of the lower triangle, values) for K and for M.
+    Every node has the same components, its rows consecutive (a node-major DOF map)."""
+    out: list[np.ndarray] = []
+    pos = [0]
+
+    def record(data, integer=True):
+        data = np.asarray(data, "<i4" if integer else "<f8")
+        words = data.view("<i4") if not integer else data
+        flag = np.int32(-2**31) if integer else np.int32(0)
+        out.append(np.concatenate([[words.size, flag], words, [words.size]]).astype("<i4"))
+        start = pos[0]
+        pos[0] += words.size + 3
+        return start
+
+    nodes, first = np.unique(dofs.node, return_index=True)
+    nodes = dofs.node[np.sort(first)]
+    labels = dofs.component[dofs.node == nodes[0]]
+    n = dofs.size
+    held = np.asarray(held, dtype=np.int64)
+    K, M = (sp.lil_matrix(A) for A in (K, M))
+    for A in (K, M):
+        for r in held:
+            A[r, :] = 0.0
+            A[:, r] = 0.0
+        for r in held:
+            A[r, r] = 1.0 if A is K else 0.0
+    K, M = (sp.tril(sp.csc_matrix(A)).tocsc() for A in (K, M))
+    std = np.zeros(100, dtype=np.int64)
+    std[0] = 4  # file number: a .full file
+    std[9] = int.from_bytes(b"0.81", "little")  # version "18.0", stored reversed
+    record(std)
+    header = np.zeros(100, dtype=np.int64)
+    header_at = record(header)  # filled in below
+    record(labels)
+    record(nodes)
+
+    def matrix(A):
+        A.sort_indices()
+        at = pos[0]
+        for j in range(n):
+            rows = A.indices[A.indptr[j]:A.indptr[j + 1]]
+            record(rows + 1)
+            record(A.data[A.indptr[j]:A.indptr[j + 1]], integer=False)
+        return at, A.nnz
+
+    ptr_k, nterm_k = matrix(K)
+    ptr_m, nterm_m = matrix(M)
+    const = np.arange(1, n + 1)
+    const[held] = -const[held]
+    ptr_dof = record(np.full(nodes.size, labels.size))
+    record(const)
+    header[[0, 1, 2, 7, 8, 18, 26, 32, 33, 35]] = [-4, n, n - held.size, labels.size, nterm_k,
+                                                   ptr_k, ptr_m, nodes.size, nterm_m, ptr_dof]
+    out[1] = np.concatenate([[100, -2**31], header, [100]]).astype("<i4")
+    assert header_at == 103
+    Path(path).write_bytes(np.concatenate(out).tobytes())

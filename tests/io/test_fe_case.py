@@ -55,7 +55,9 @@ def _files(tmp_path, text=CASE, fixed="19"):
     top = np.flatnonzero(np.isclose(pts[:, 1], pts[:, 1].max())) + 1
     lines = ["*NODE"] + [f"{i + 1}, {float(x)!r}, {float(y)!r}" for i, (x, y) in enumerate(pts)]
     lines += ["*NSET, NSET=bottom", ", ".join(map(str, bottom)),
-              "*NSET, NSET=top", ", ".join(map(str, top))]
+              "*NSET, NSET=top", ", ".join(map(str, top)), "*ELEMENT, TYPE=CPE4"]
+    lines += [", ".join(map(str, [e + 1, *(cell + 1)])) for e, cell in
+              enumerate(model.mesh.cells)]
     (tmp_path / "block.inp").write_text("\n".join(lines) + "\n")
     (tmp_path / "case.toml").write_text(text.replace("{fixed}", fixed))
     return model, bottom, top
@@ -83,6 +85,11 @@ def test_case_file_gives_the_python_model(tmp_path):
     assert got.loads[0].vector.sum() == pytest.approx(-500.0 * top.size)
     np.testing.assert_array_equal(got.observed[0].coords, mesh_model.mesh.points[20])
     assert got.contact.wear_coefficient == 1e-12
+    # the ParaView points: the .inp's nodes with their rows (node-major here) and elements
+    np.testing.assert_array_equal(got.fe_mesh.points, mesh_model.mesh.points)
+    np.testing.assert_array_equal(got.fe_mesh.rows.ravel(), np.arange(got.ndof))
+    assert got.fe_mesh.cell_type == mesh_model.mesh.cell_type
+    np.testing.assert_array_equal(got.fe_mesh.cells, mesh_model.mesh.cells)
 
 
 @pytest.mark.parametrize("edit, msg", [

@@ -96,6 +96,26 @@ def test_stiff_non_matching_base_is_a_rigid_flat(pairing):
                                atol=2 * RATIO * np.abs(b.observed["tip"]).max())
 
 
+def test_sweep_on_a_stiff_non_matching_base():
+    """A sweep (3 points about 2 kHz) of the soft block on the stiff mortar-paired base gives
+    the contact forces and tip motion of the sweep on a rigid flat at every point, to 2 x the
+    stiffness ratio as the periodic solve above (the sweep goes through the same contact
+    transform)."""
+    from fretwear.api import sweep
+
+    stiff = block_on_base(E_base=1e7 / RATIO, block=SOFT, scale=SCALE)
+    assert stiff.contact.segments is not None
+    opts = SolveOptions(tol=1e-12)
+    a, b = (sweep(m, BASIS, 1900.0, 2100.0, 3, options=opts)
+            for m in (stiff, block_on_rigid(block=SOFT, scale=SCALE)))
+    assert a.success and b.success
+    np.testing.assert_array_equal(a.frequency_hz, b.frequency_hz)
+    for pa, pb in ((p.solution, q.solution) for p, q in zip(a.points, b.points, strict=True)):
+        np.testing.assert_allclose(pa.lam, pb.lam, rtol=0, atol=2 * RATIO * np.abs(pb.lam).max())
+        np.testing.assert_allclose(pa.observed["tip"], pb.observed["tip"], rtol=0,
+                                   atol=2 * RATIO * np.abs(pb.observed["tip"]).max())
+
+
 def test_wear_and_time_integration_on_a_stiff_non_matching_base():
     """A wear run (3 steps) and 6 periods of time integration of the soft block on the stiff
     mortar-paired base = the same on a rigid flat (the wear coefficients of both surfaces

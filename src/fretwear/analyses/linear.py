@@ -22,7 +22,9 @@ from fretwear.hb.reduce import exact_condenser
 from fretwear.io.results import (
     complex_variables,
     label_coordinate,
+    no_fields_line,
     nodal_vectors,
+    output_mesh,
     variable,
     write_pvd,
     write_vtu,
@@ -106,8 +108,8 @@ def run_modes(model, analysis: dict, case, context: RunContext) -> RunOutput:
                 figures.append(plots.plot_mode_shapes(
                     model.mesh, r.frequency_hz, r.shapes, p,
                     title=f"{case.title}: modes, {interface} interface"))
-            if case.output["vtu"]:
-                files.append(_write_mode_files(model.mesh, r, context.out_dir, interface))
+        if output_mesh(model) is not None and len(r.frequency_hz) and case.output["vtu"]:
+            files.append(_write_mode_files(output_mesh(model), r, context.out_dir, interface))
     p = figure_path(case, context.out_dir, "natural-frequencies")
     if p is not None:
         figures.append(plots.plot_natural_frequencies(ds, p, title=case.title))
@@ -116,6 +118,8 @@ def run_modes(model, analysis: dict, case, context: RunContext) -> RunOutput:
         fs = ", ".join(f"{f:.5g}" for f in r.frequency_hz[:12]) or "none"
         more = " ..." if len(r.frequency_hz) > 12 else ""
         lines.append(f"{interface:>8}: {len(r.frequency_hz)} modes [Hz]: {fs}{more}")
+    if case.output["vtu"] and no_fields_line(model):
+        lines.append(no_fields_line(model))
     return RunOutput(ds, figures, "\n".join(lines), True, files)
 
 

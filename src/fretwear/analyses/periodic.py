@@ -52,7 +52,14 @@ from fretwear.hb.slow_mode import slow_mode
 from fretwear.hb.solution import PeriodicSolution
 from fretwear.hb.solvers import SolveStats
 from fretwear.hb.stability import DENSE_MAX, problem_of, stability
-from fretwear.io.results import nodal_vectors, variable, write_pvd, write_vtu
+from fretwear.io.results import (
+    no_fields_line,
+    nodal_vectors,
+    output_mesh,
+    variable,
+    write_pvd,
+    write_vtu,
+)
 from fretwear.io.schema import Field, Flag, Integer, Number, join
 
 
@@ -244,7 +251,7 @@ def run_periodic(model, analysis: dict, case, context: RunContext) -> RunOutput:
     ds.attrs.update(attrs)
     figures = periodic_figures(ds, case, context.out_dir, titled(case.title, where))
     files = []
-    if model.mesh is not None and case.output["vtu"]:
+    if output_mesh(model) is not None and case.output["vtu"]:
         files.append(write_period_fields(model, sol, context.out_dir / "periodic.pvd",
                                          condenser=cond))
     if model.meta.get("cyclic") is not None and case.output.get("whole_disk"):
@@ -255,6 +262,8 @@ def run_periodic(model, analysis: dict, case, context: RunContext) -> RunOutput:
         summary += "\n" + verdict
     if slow_line:
         summary += "\n" + slow_line
+    if case.output["vtu"] and no_fields_line(model):
+        summary += "\n" + no_fields_line(model)
     fallback = fallbacks.of_solutions([sol], sol.stats.wall_time).line(
         "solves", fallbacks.eps_hint("eps" in analysis))
     if fallback:
@@ -369,8 +378,9 @@ def write_period_fields(model, sol: PeriodicSolution, pvd: Path, *, condenser=No
     ``pvd.stem`` (point arrays ``displacement`` [m], ``contact_state`` and
     ``contact_pressure`` [Pa] on both surfaces of node-to-node pairs, NaN off the
     interfaces), stepped through by the ``.pvd`` with
-    the time [s] as time step. ``condenser``: the condenser that condensed ``sol``
-    (:func:`fretwear.hb.reduce.exact_condenser`; None: a new exact one).
+    the time [s] as time step; on the mesh, or on the node file's points of a model from FE
+    matrices (:func:`fretwear.io.results.output_mesh`). ``condenser``: the condenser that
+    condensed ``sol`` (:func:`fretwear.hb.reduce.exact_condenser`; None: a new exact one).
 
     Returns
     -------
@@ -382,9 +392,9 @@ def write_period_fields(model, sol: PeriodicSolution, pvd: Path, *, condenser=No
     full = recover(model, sol.frequency, b.orders, u_loc, quasi_static=sol.quasi_static,
                    condenser=condenser)
     samples = b.to_time(b.from_complex(full))  # (ndof, N)
-    mesh = model.mesh
+    mesh = output_mesh(model)
     nn = mesh.points.shape[0]
-    nodes = np.asarray(model.contact.node_ids)
+    nodes = mesh.point_index(model.contact.node_ids)
     state = np.full((nn, b.n_samples), np.nan)
     pressure = np.full((nn, b.n_samples), np.nan)
     state[nodes] = sol.state
@@ -392,8 +402,9 @@ def write_period_fields(model, sol: PeriodicSolution, pvd: Path, *, condenser=No
     c = model.contact
     if c.has_pairs:  # both surfaces of a pair: its partner node shows the same contact
         pair = c.paired()
-        state[np.asarray(c.partner_ids)[pair]] = sol.state[pair]
-        pressure[np.asarray(c.partner_ids)[pair]] = sol.pressure_t()[pair]
+        partners = mesh.point_index(np.asarray(c.partner_ids)[pair])
+        state[partners] = sol.state[pair]
+        pressure[partners] = sol.pressure_t()[pair]
     folder = pvd.parent / pvd.stem
     entries = []
     for j, t in enumerate(sol.time):

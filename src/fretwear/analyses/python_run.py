@@ -31,6 +31,7 @@ from fretwear.analyses.registry import analysis_tables
 from fretwear.analyses.run import RESULTS_FILE, check_output, run_built
 from fretwear.errors import InputError
 from fretwear.io.case import OUTPUT, Case
+from fretwear.io.results import output_mesh
 from fretwear.io.schema import Context, Variant, show
 from fretwear.model.checks import model_argument
 from fretwear.validate import flag, is_real
@@ -262,7 +263,8 @@ def plot(result, output, model, basis=None, *, title: str = "", fmt: str = "png"
     ----------
     result, output, model, basis, title : as :func:`write_results`.
     fmt : figure file format (``"png"``, ``"pdf"``, ``"svg"``).
-    vtu : write ParaView ``.vtu``/``.pvd`` files where the model has a mesh.
+    vtu : write ParaView ``.vtu``/``.pvd`` files where the model has a mesh (or, built from
+        FE matrices, a node file).
 
     Returns
     -------
@@ -285,7 +287,7 @@ def plot(result, output, model, basis=None, *, title: str = "", fmt: str = "png"
         from fretwear.analyses.periodic import periodic_figures, write_period_fields
 
         files += periodic_figures(ds, case, out_dir, name)
-        if vtu and model.mesh is not None:
+        if vtu and output_mesh(model) is not None:
             files.append(write_period_fields(model, result, out_dir / "periodic.pvd"))
     elif kind == "transient":
         from fretwear.analyses.transient import transient_figures
@@ -295,6 +297,6 @@ def plot(result, output, model, basis=None, *, title: str = "", fmt: str = "png"
         from fretwear.analyses.wear import wear_figures, write_wear_fields
 
         files += wear_figures(ds, case, out_dir, [])
-        if vtu and model.mesh is not None:
+        if vtu and output_mesh(model) is not None:
             files.append(write_wear_fields(model, ds, out_dir / "wear.pvd"))
     return files

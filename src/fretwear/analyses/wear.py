@@ -39,6 +39,8 @@ from fretwear.hb.solvers import SOLVERS
 from fretwear.hb.sweep import frequency_grid
 from fretwear.io.results import (
     label_coordinate,
+    no_fields_line,
+    output_mesh,
     variable,
     write_pvd,
     write_results,
@@ -472,7 +474,7 @@ def run_wear(model, analysis: dict, case, context: RunContext) -> RunOutput:
     ds.attrs.update(cond.choice.attributes())
     figures = wear_figures(ds, case, context.out_dir, nodes)
     files = [context.out_dir / CHECKPOINT_FILE]
-    if model.mesh is not None and case.output["vtu"]:
+    if output_mesh(model) is not None and case.output["vtu"]:
         files.append(write_wear_fields(model, ds, context.out_dir / "wear.pvd"))
     if model.meta.get("cyclic") is not None and case.output.get("whole_disk"):
         files.append(write_wear_disk_fields(model, ds, context.out_dir / "wear-disk.pvd"))
@@ -490,6 +492,8 @@ def run_wear(model, analysis: dict, case, context: RunContext) -> RunOutput:
     ]
     if frf_note:
         lines.append(frf_note)
+    if case.output["vtu"] and no_fields_line(model):
+        lines.append(no_fields_line(model))
     fallback = fallbacks.of_wear(h.rescued[1:], h.wall_time[1:], result.wall_time).line(
         "slow steps", fallbacks.eps_hint("eps" in a))
     if fallback:
@@ -541,7 +545,7 @@ def write_wear_fields(model, ds, pvd: Path) -> Path:
     folder = pvd.parent / pvd.stem
     entries = []
     for k, cycles in enumerate(ds["cycles"].values):
-        path = write_vtu(folder / f"step-{k:04d}.vtu", model.mesh,
+        path = write_vtu(folder / f"step-{k:04d}.vtu", output_mesh(model),
                          {"worn_depth": _node_depths(model, ds, k)}, {"cycles": float(cycles)})
         entries.append((float(cycles), path))
     return write_pvd(pvd, entries)
@@ -552,11 +556,12 @@ def _node_depths(model, ds, k: int) -> np.ndarray:
     interfaces; :func:`write_wear_fields`)."""
     c = model.contact
     worn = ds["worn_depth_surface"].values
-    w = np.full(model.mesh.points.shape[0], np.nan)
-    w[np.asarray(c.node_ids)] = worn[k, :, 0]
+    mesh = output_mesh(model)
+    w = np.full(mesh.points.shape[0], np.nan)
+    w[mesh.point_index(c.node_ids)] = worn[k, :, 0]
     if c.has_pairs:  # node-to-segment: shape-function average on the facet nodes
         partner, depth = partner_node_values(c, worn[k, :, 1])
-        w[partner] = depth
+        w[mesh.point_index(partner)] = depth
     return w
 
 

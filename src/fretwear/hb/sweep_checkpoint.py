@@ -53,7 +53,7 @@ def _digest(h, obj) -> None:
         h.update(np.ascontiguousarray(obj).tobytes())
     elif dataclasses.is_dataclass(obj):
         for f in dataclasses.fields(obj):
-            if f.name not in ("mesh", "meta", "name"):  # descriptions, not data
+            if f.name not in ("mesh", "fe_mesh", "meta", "name"):  # descriptions, not data
                 h.update(f.name.encode())
                 _digest(h, getattr(obj, f.name))
     elif isinstance(obj, dict):

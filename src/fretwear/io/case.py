@@ -645,7 +645,8 @@ OUTPUT = Table(
         "figures": Field(Flag(), "write figures", default=True),
         "figure_format": Field(Text(FIGURE_FORMATS), "figure file format", default="png"),
         "vtu": Field(Flag(), "write ParaView files (.vtu/.pvd) of fields when the model has a "
-                     "mesh", default=True, used_by=("modes", "periodic", "wear")),
+                     "mesh (or is FE matrices with their node file, model.nodes)",
+                     default=True, used_by=("modes", "periodic", "wear")),
         "whole_disk": Field(Flag(), "a sector ([cyclic]): also the whole disk rebuilt from "
                             "the sector in ParaView, every sector turned: `periodic-disk.pvd` "
                             "of a periodic analysis (each harmonic n phased by "

@@ -231,9 +231,37 @@ def read_results(path: Path | str) -> xr.Dataset:
 def nodal_vectors(mesh, vector: np.ndarray) -> np.ndarray:
     """A DOF vector ``(ndof,)`` of a mesh model as nodal vectors ``(nn, dim)``.
 
-    Mesh models number DOFs node-major (``dim*i + c``, :mod:`fretwear.model.core`).
+    Mesh models number DOFs node-major (``dim*i + c``, :mod:`fretwear.model.core`); the
+    points of a model from FE matrices (``model.fe_mesh``) name each translation's DOF in
+    ``mesh.rows`` (NaN where the matrices have none).
     """
-    return np.asarray(vector).reshape(mesh.points.shape[0], mesh.dim)
+    vector = np.asarray(vector)
+    if getattr(mesh, "rows", None) is None:
+        return vector.reshape(mesh.points.shape[0], mesh.dim)
+    out = np.full(mesh.rows.shape, np.nan, dtype=vector.dtype if vector.dtype.kind == "c"
+                  else float)
+    have = mesh.rows >= 0
+    out[have] = vector[mesh.rows[have]]
+    return out
+
+
+def output_mesh(model):
+    """The mesh of a model's ParaView files: its mesh, or the node file's points of a model
+    from FE matrices (``model.fe_mesh``); None when there is neither (:func:`no_fields_line`
+    says why)."""
+    return model.mesh if model.mesh is not None else getattr(model, "fe_mesh", None)
+
+
+def no_fields_line(model) -> str:
+    """The one line saying that no ParaView file is written for a model without a mesh and
+    why ('' when it has one)."""
+    if output_mesh(model) is not None:
+        return ""
+    if model.meta.get("source") == "fe":
+        why = "its matrices came without a node file (give the mesh file: model.nodes)"
+    else:
+        why = "the model is matrices without node coordinates"
+    return f"no ParaView (.vtu) files: {why}"
 
 
 def write_vtu(path: Path | str, mesh, point_data: Mapping, field_data: Mapping | None = None

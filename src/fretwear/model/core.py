@@ -313,6 +313,10 @@ class Mesh:
     points : (nn, d) node coordinates [m]; cells : (ne, k) connectivity; cell_type : meshio
     name (``"quad"``, ``"triangle"``, ``"hexahedron"``, ``"tetra"``); boundaries : name ->
     (nf, kf) facet connectivity; node_sets : name -> node numbers.
+    rows : (nn, d) the DOF of each point's translations (-1: none), or None when the DOFs are
+    node-major (``d * i + c``, meshed models); set on the points of a model built from an FE
+    code's matrices (:attr:`Model.fe_mesh`). ids : (nn,) the FE code's node id of each point,
+    or None (the contact's ``node_ids`` are then point numbers).
     """
 
     points: np.ndarray
@@ -320,6 +324,16 @@ class Mesh:
     cell_type: str
     boundaries: dict[str, np.ndarray] = field(default_factory=dict)
     node_sets: dict[str, np.ndarray] = field(default_factory=dict)
+    rows: np.ndarray | None = None
+    ids: np.ndarray | None = None
+
+    def point_index(self, ids) -> np.ndarray:
+        """The point numbers of node ids (of ``ids`` when set; else the ids are numbers)."""
+        ids = np.asarray(ids, dtype=np.int64)
+        if self.ids is None:
+            return ids
+        order = np.argsort(self.ids)
+        return order[np.searchsorted(self.ids[order], ids)]
 
     @property
     def dim(self) -> int:
@@ -341,6 +355,9 @@ class Model:
     fixed_dofs : DOFs held at zero (Dirichlet), removed before any solve.
     dim : 2 (plane strain) or 3.
     mesh : the mesh, when built from one.
+    fe_mesh : for a model built from an FE code's matrices with its node file, the nodes (and
+        elements) of that file as a :class:`Mesh` with ``rows`` and ``ids``, for ParaView
+        output only (``mesh`` stays None: nothing else reads it); None otherwise.
     thickness : out-of-plane width [m] (2D only; 1 for matrices).
     """
 
@@ -354,6 +371,7 @@ class Model:
     fixed_dofs: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     dim: int = 2
     mesh: Mesh | None = None
+    fe_mesh: Mesh | None = None
     thickness: float = 1.0
     name: str = "model"
     meta: dict = field(default_factory=dict)

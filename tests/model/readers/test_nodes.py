@@ -75,3 +75,38 @@ def test_bad_node_files(tmp_path):
     (tmp_path / "cp.bdf").write_text("GRID    1       2       0.0     1.0     2.0\n")
     with pytest.raises(InputError, match="coordinate system CP = 2"):
         read_nodes(tmp_path / "cp.bdf")
+
+
+def _i9(*values):
+    return "".join(f"{v:9d}" for v in values)
+
+
+EBLOCK = "\n".join(["EBLOCK,19,SOLID,         2,         2", "(19i9)",
+                    _i9(1, 1, 1, 1, 0, 0, 0, 0, 8, 0, 1, 1, 2, 3, 4, 5, 6, 7, 8),
+                    _i9(1, 1, 1, 1, 0, 0, 0, 0, 10, 0, 2, 1, 2, 3, 4, 5, 6, 7, 8),
+                    _i9(9, 10), _i9(-1)]) + "\n"
+
+
+def test_elements_for_paraview(tmp_path):
+    """Element connectivity by node ids as written here from each code's documented card
+    layout: Nastran CQUAD4 (small field) and CHEXA (free field with its continuation line),
+    Abaqus *ELEMENT (one line, and one going on after a trailing comma), ANSYS solid EBLOCK
+    (8 nodes on the element's line, the 9th and 10th on the next)."""
+    (tmp_path / "m.bdf").write_text(BDF.format(3, 0, "4.0", "5.0", "6.0")
+                                    + "CHEXA,2,1,1,2,3,4,5,6\n,7,8\n")
+    t = read_nodes(tmp_path / "m.bdf")
+    np.testing.assert_array_equal(t.elements[4], [[1, 2, 3, 3]])
+    np.testing.assert_array_equal(t.elements[8], [[1, 2, 3, 4, 5, 6, 7, 8]])
+    (tmp_path / "m.inp").write_text(INP + "1, 10, 11, 12, 10,\n 11, 12, 10, 11\n"
+                                    "*ELEMENT, TYPE=CPE4\n2, 10, 11, 12, 12\n")
+    t = read_nodes(tmp_path / "m.inp")
+    np.testing.assert_array_equal(t.elements[8], [[10, 11, 12, 10, 11, 12, 10, 11]])
+    np.testing.assert_array_equal(t.elements[4], [[10, 11, 12, 12]])
+    (tmp_path / "m.cdb").write_text(CDB + EBLOCK)
+    t = read_nodes(tmp_path / "m.cdb")
+    np.testing.assert_array_equal(t.elements[8], [[1, 2, 3, 4, 5, 6, 7, 8]])
+    np.testing.assert_array_equal(t.elements[10], [[1, 2, 3, 4, 5, 6, 7, 8, 9, 10]])
+    (tmp_path / "bad.bdf").write_text(BDF.format(3, 0, "4.0", "5.0", "6.0")
+                                      + "CTRIA3  1       1       1       x       3\n")
+    with pytest.raises(InputError, match=r"line 7 \(CTRIA3\)"):
+        read_nodes(tmp_path / "bad.bdf")

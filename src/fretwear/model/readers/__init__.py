@@ -2,7 +2,8 @@
 
 :func:`read_fe` reads K, M (and exported damping) from Nastran DMIG (punch or bulk data) and
 OP4, Abaqus ``.mtx`` (``*SUBSTRUCTURE MATRIX OUTPUT``, ``*MATRIX GENERATE``), ANSYS ``.full``
-(optional package ``ansys-mapdl-reader``) and Harwell-Boeing (``HBMAT``), and Matrix Market;
+(compressed ones through the optional ``ansys-mapdl-reader``) and Harwell-Boeing (``HBMAT``),
+and Matrix Market;
 :func:`~.nodes.read_nodes` the node coordinates and node sets of the mesh (``.bdf``, ``.inp``,
 ``.cdb``); :func:`~.fe_model.from_fe` builds the model with everything named by node ids;
 :func:`~.superelement.craig_bampton` reduces full matrices to a superelement.

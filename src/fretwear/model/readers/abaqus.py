@@ -176,11 +176,16 @@ def _read_terms(path):
     path = Path(path)
     if not path.is_file():
         raise InputError(f"Abaqus matrix file {str(path)!r} does not exist")
-    raw = path.read_text(errors="replace").splitlines()
+    text = path.read_text(errors="replace")
+    raw = text.splitlines()
     number = [k for k, x in enumerate(raw, start=1) if x.strip() and not x.lstrip()
               .startswith("*")]
     if not number:
         raise InputError(f"{path}: no matrix terms (an empty or truncated file)")
+    if not text.endswith("\n") and number[-1] == len(raw):
+        raise InputError(f"{path}, line {len(raw)}: the file ends inside a term, without its "
+                         "line end (a truncated file?); expected the whole file (add the final "
+                         "newline if it is whole)")
     tokens = np.array(" ".join(raw[k - 1] for k in number).replace(",", " ").split())
     if tokens.size != 5 * len(number):  # a line without its five fields: find it
         k = next(k for k in number if len(raw[k - 1].replace(",", " ").split()) != 5)

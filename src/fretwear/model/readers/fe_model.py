@@ -16,7 +16,7 @@ import numpy as np
 
 from fretwear.errors import InputError
 from fretwear.model.build import Damping
-from fretwear.model.core import Load, Model
+from fretwear.model.core import Load, Mesh, Model
 from fretwear.model.matrices import ContactDofs, from_matrices
 from fretwear.model.readers.dofmap import FEMatrices
 from fretwear.model.readers.nodes import NodeTable
@@ -226,7 +226,9 @@ def from_fe(fe: FEMatrices, *, contact, nodes: NodeTable | None = None, damping=
     nodes : NodeTable, optional
         Node coordinates and node sets of the mesh the matrices came from
         (:func:`~fretwear.model.readers.nodes.read_nodes`): coordinates of the contact nodes
-        and observed points for output, node sets to name nodes.
+        and observed points for output, node sets to name nodes, and the points of the
+        ParaView output (``model.fe_mesh``, :func:`fe_mesh`); without it no ParaView file is
+        written.
     damping : Damping, optional (loss factor, Rayleigh factors); the matrices' own C and D
         (exported damping) are used when present and ``damping`` does not give them.
     loads : NodeForce or Load (on the rows of the matrices) items.
@@ -264,6 +266,8 @@ def from_fe(fe: FEMatrices, *, contact, nodes: NodeTable | None = None, damping=
         for p in model.observed:
             p.coords = nodes.coordinates(_ids(observed[p.name], nodes, p.name)[:1], dim,
                                          f"observed {p.name!r}")[0]
+    if nodes is not None:
+        model.fe_mesh = fe_mesh(fe, nodes, dim)
     ci = model.contact
     ci.node_ids = extra["ids"]
     ci.partner_ids = extra["pids"]
@@ -282,3 +286,35 @@ def from_fe(fe: FEMatrices, *, contact, nodes: NodeTable | None = None, damping=
         ci.interface = extra["interface"]
         ci.interface_names = extra["names"]
     return model
+
+
+#: meshio cell types of elements by (dimension, number of nodes)
+CELL_TYPES = {(2, 3): "triangle", (2, 4): "quad", (3, 4): "tetra", (3, 8): "hexahedron"}
+
+
+def fe_mesh(fe: FEMatrices, table: NodeTable, dim: int) -> Mesh:
+    """The points of the ParaView output of a model from FE matrices: every node of ``table``
+    with a translation in the matrices' DOF map, in the node file's order, with ``rows`` the
+    DOF of each translation (-1 where the matrices have none) and ``ids`` the node ids; the
+    cells are the node file's elements of the commonest kind whose nodes are all points (the
+    nodes as ``vertex`` cells when there is none, e.g. a superelement's boundary nodes)."""
+    key = fe.dofs.node * 8 + fe.dofs.component
+    order = np.argsort(key)
+    comps = np.arange(1, dim + 1)
+    want = table.ids[:, None] * 8 + comps[None, :]
+    pos = np.searchsorted(key[order], want).clip(0, max(key.size - 1, 0))
+    found = key[order][pos] == want
+    rows = np.where(found, order[pos], -1)
+    keep = np.any(found, axis=1)
+    ids, rows = table.ids[keep], rows[keep]
+    index = {int(n): i for i, n in enumerate(ids.tolist())}
+    cells, cell_type = np.arange(ids.size, dtype=np.int64)[:, None], "vertex"
+    best = 0
+    for n, conn in sorted(table.elements.items()):
+        kind = CELL_TYPES.get((dim, n))
+        inside = np.all(np.isin(conn, ids), axis=1)
+        if kind is not None and np.count_nonzero(inside) > best:
+            best = int(np.count_nonzero(inside))
+            cells = np.vectorize(index.__getitem__, otypes=[np.int64])(conn[inside])
+            cell_type = kind
+    return Mesh(table.xyz[keep, :dim].copy(), cells, cell_type, rows=rows, ids=ids)

@@ -100,10 +100,16 @@ def read_dmig(path) -> dict[str, tuple[DofMap, DofMap, sp.coo_matrix, int]]:
     if not path.is_file():
         raise InputError(f"Nastran file {str(path)!r} does not exist")
     src = str(path)
-    number, start, fields = _dmig_lines(path.read_text(errors="replace"))
+    text = path.read_text(errors="replace")
+    number, start, fields = _dmig_lines(text)
     if not start.any():
         raise InputError(f"Nastran file {src!r} has no DMIG card; expected DMIG matrices "
                          "(DMIGPCH punch file or bulk data)")
+    last = text.rstrip("\r\n ").count("\n") + 1
+    if not text.endswith("\n") and number[-1] == last:
+        raise InputError(f"Nastran file {src!r} ends inside a DMIG card, line {last}, "
+                         "without its line end (a truncated file?); expected the whole file "
+                         "(add the final newline if it is whole)")
     card = np.cumsum(start) - 1  # the card of each line
     heads = np.flatnonzero(start)
     name = np.strings.upper(fields[heads, 0]).astype(str)

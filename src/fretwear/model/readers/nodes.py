@@ -1,6 +1,8 @@
 """Node coordinates and node sets of the mesh that exported matrices came from, read from the
-FE code's input file: Nastran bulk data (``GRID`` cards, basic coordinates), Abaqus ``.inp``
-(``*NODE``, ``*NSET``) and ANSYS ``.cdb`` (``NBLOCK``, node components ``CMBLOCK``).
+FE code's input file: Nastran bulk data (``GRID`` cards, basic coordinates; the ``CQUAD4``,
+``CTRIA3``, ``CTETRA``, ``CHEXA`` connectivity for ParaView), Abaqus ``.inp`` (``*NODE``,
+``*NSET``, ``*ELEMENT``) and ANSYS ``.cdb`` (``NBLOCK``, node components ``CMBLOCK``, the
+solid-format ``EBLOCK``).
 
 Only the positions are read (frames, pairing, output); the matrices carry the mechanics.
 """
@@ -18,11 +20,13 @@ from fretwear.model.readers.nastran import _fields, nastran_real
 
 @dataclass
 class NodeTable:
-    """Node ids, their coordinates [m] (n, 3) and named node sets (name -> ids)."""
+    """Node ids, their coordinates [m] (n, 3), named node sets (name -> ids) and the
+    elements' connectivity by node ids (number of nodes -> (ne, k) ids), for output only."""
 
     ids: np.ndarray
     xyz: np.ndarray
     node_sets: dict[str, np.ndarray] = field(default_factory=dict)
+    elements: dict[int, np.ndarray] = field(default_factory=dict)
 
     def coordinates(self, ids, dim: int, what: str) -> np.ndarray:
         """Coordinates (len(ids), dim) of the given node ids."""
@@ -58,12 +62,22 @@ def read_nodes(path) -> NodeTable:
     return table
 
 
+#: Nastran element cards read for output: name -> number of nodes (after EID and PID)
+NASTRAN_ELEMENTS = {"CTRIA3": 3, "CQUAD4": 4, "CTETRA": 4, "CHEXA": 8}
+
+
 def _nastran_nodes(text: str, src: str) -> NodeTable:
-    ids, xyz = [], []
+    ids, xyz, elements, bad = [], [], {}, []
     lines = text.splitlines()
     for k, raw in enumerate(lines):
         line = raw.split("$")[0].expandtabs(8)
         first, data = _fields(line)
+        if first.upper() in NASTRAN_ELEMENTS:
+            try:
+                _nastran_element(first.upper(), data, lines, k, src, elements)
+            except InputError as exc:  # told once the nodes are known to be there
+                bad.append(exc)
+            continue
         if first.upper().rstrip("*") != "GRID":
             continue
         if first.endswith("*"):  # large field: x, y on this line, z on the continuation
@@ -77,12 +91,35 @@ def _nastran_nodes(text: str, src: str) -> NodeTable:
         except ValueError:
             raise InputError(f"{where}: node id {data[0]!r}; expected an integer") from None
         xyz.append([nastran_real(v or "0", where) for v in data[2:5]])
-    return NodeTable(np.array(ids, dtype=np.int64), np.array(xyz, dtype=float).reshape(-1, 3))
+    if bad and ids:
+        raise bad[0]
+    return NodeTable(np.array(ids, dtype=np.int64), np.array(xyz, dtype=float).reshape(-1, 3),
+                     elements=_arrays(elements))
+
+
+def _nastran_element(card: str, data: list, lines: list, k: int, src: str,
+                     elements: dict) -> None:
+    """The node ids of one small- or free-field element card (its continuation line read for
+    ``CHEXA``) added to ``elements``."""
+    n = NASTRAN_ELEMENTS[card]
+    fields = list(data[2:])
+    if len(fields) < n and k + 1 < len(lines):
+        fields += _fields(lines[k + 1].split("$")[0].expandtabs(8))[1]
+    try:
+        nodes = [int(v) for v in fields[:n]]
+    except ValueError:
+        raise InputError(f"{src}, line {k + 1} ({card}): node ids {fields[:n]!r}; expected "
+                         f"{n} integers") from None
+    elements.setdefault(n, []).append(nodes)
+
+
+def _arrays(elements: dict) -> dict[int, np.ndarray]:
+    return {n: np.array(v, dtype=np.int64).reshape(-1, n) for n, v in elements.items() if v}
 
 
 def _abaqus_nodes(text: str, src: str) -> NodeTable:
-    ids, xyz, sets = [], [], {}
-    state, current, generate = None, None, False
+    ids, xyz, sets, elements = [], [], {}, {}
+    state, current, generate, pending = None, None, False, []
     for k, raw in enumerate(text.splitlines(), start=1):
         line = raw.strip()
         if not line or line.startswith("**"):
@@ -92,7 +129,8 @@ def _abaqus_nodes(text: str, src: str) -> NodeTable:
             key = parts[0].upper()
             params = {p.partition("=")[0].strip().upper(): p.partition("=")[2].strip()
                       for p in parts[1:]}
-            state = key if key in ("NODE", "NSET") else None
+            state = key if key in ("NODE", "NSET", "ELEMENT") else None
+            pending = []
             if key == "NSET":
                 current = params.get("NSET", "")
                 generate = "GENERATE" in params
@@ -103,6 +141,11 @@ def _abaqus_nodes(text: str, src: str) -> NodeTable:
             if state == "NODE":
                 ids.append(int(tok[0]))
                 xyz.append(([float(t) for t in tok[1:4]] + [0.0, 0.0])[:3])
+            elif state == "ELEMENT":  # id, nodes; a line ending with "," goes on
+                pending.extend(int(t) for t in tok)
+                if not line.endswith(","):
+                    elements.setdefault(len(pending) - 1, []).append(pending[1:])
+                    pending = []
             elif state == "NSET":
                 if generate:
                     a, b, step = (int(t) for t in (tok + ["1"])[:3])
@@ -113,25 +156,47 @@ def _abaqus_nodes(text: str, src: str) -> NodeTable:
             raise InputError(f"{src}, line {k}: {line[:60]!r}; expected numbers (a node set "
                              "given by name inside *NSET is not read)") from None
     return NodeTable(np.array(ids, dtype=np.int64), np.array(xyz, dtype=float).reshape(-1, 3),
-                     {name: np.array(v, dtype=np.int64) for name, v in sets.items()})
+                     {name: np.array(v, dtype=np.int64) for name, v in sets.items()},
+                     _arrays(elements))
 
 
 def _ansys_nodes(text: str, src: str) -> NodeTable:
-    ids, xyz, sets = [], [], {}
+    ids, xyz, sets, elements = [], [], {}, {}
     lines = text.splitlines()
     try:
-        _ansys_blocks(lines, ids, xyz, sets, src)
+        _ansys_blocks(lines, ids, xyz, sets, src, elements)
     except (ValueError, IndexError):
-        raise InputError(f"{src}: cannot read its NBLOCK or CMBLOCK (a truncated or malformed "
-                         "file?)") from None
+        raise InputError(f"{src}: cannot read its NBLOCK, EBLOCK or CMBLOCK (a truncated or "
+                         "malformed file?)") from None
     return NodeTable(np.array(ids, dtype=np.int64), np.array(xyz, dtype=float).reshape(-1, 3),
-                     sets)
+                     sets, _arrays(elements))
 
 
-def _ansys_blocks(lines, ids, xyz, sets, src: str) -> None:
+def _ansys_elements(lines, k: int, src: str, elements: dict) -> int:
+    """The elements of the ``EBLOCK`` (solid format) whose format line is line ``k``: on each
+    element's line field 9 the number of nodes, 12-19 the first eight nodes, the others on
+    the next line; up to the ``-1`` line. Returns the line after the block."""
+    widths = _fortran_widths(lines[k], src, k + 1)
+    k += 1
+    while k < len(lines) and not lines[k].strip().startswith("-1"):
+        vals = [int(v) for v in _fixed_columns(lines[k], widths) if v.strip()]
+        n = vals[8]
+        nodes = vals[11:11 + min(n, 8)]
+        if n > 8:
+            k += 1
+            nodes += [int(v) for v in _fixed_columns(lines[k], widths) if v.strip()][:n - 8]
+        elements.setdefault(n, []).append(nodes)
+        k += 1
+    return k
+
+
+def _ansys_blocks(lines, ids, xyz, sets, src: str, elements: dict) -> None:
     k = 0
     while k < len(lines):
         head = lines[k].strip().upper()
+        if head.startswith("EBLOCK") and "SOLID" in head:
+            k = _ansys_elements(lines, k + 1, src, elements)
+            continue
         if head.startswith("NBLOCK"):
             fmt = lines[k + 1]
             widths = _fortran_widths(fmt, src, k + 2)
