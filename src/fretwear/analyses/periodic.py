@@ -286,8 +286,8 @@ def slow_verdict(model, sol: PeriodicSolution, cond) -> tuple[str, dict]:
     try:
         prob = problem_of(model, sol, condenser=cond)
         sm = slow_mode(prob, sol.U.reshape(prob.m, prob.H), structure_dynamics(model, cond))
-    except InputError:  # beyond the dense Hill matrix, a sector, ...: not computed
-        return "", attrs
+    except (InputError, np.linalg.LinAlgError):  # beyond the dense Hill matrix, a sector, a
+        return "", attrs  # singular structure with its contact held, ...: not computed
     attrs["slow_multiplier"] = sm.multiplier
     if sm.multiplier > 1 or sm.slow():
         return sm.line(), attrs
