@@ -76,7 +76,7 @@ def main():
     red = condense(model, f, basis.orders, condenser=cond)
     eps = penalty(an["eps"], model=model, reduced=red, condenser=cond)
     sol = solve_periodic(model, basis, frequency=f, options=solve_options_of(an, PERIODIC),
-                         reduced=red, eps=eps, time_domain=False, condenser=cond)
+                         reduced=red, eps=eps, time_domain=None, condenser=cond)
     c = sol.observed["Pe"]
     stuck = int(np.all(sol.state == 1, axis=1).sum())
     stamp(f"solve: {sol.message}; mean x(Pe) {c[0, 0] * 1e6:.4f} um; interface mean "
