@@ -10,9 +10,10 @@ middle branch get Hill's multipliers (dense) and a time integration from the sta
 velocity perturbed by 1e-3 of its largest value. About 5 s of CPU per period of the time
 integration (128 steps): a study, run once (results in docs/studies/dovetail-fold-stability.md).
 
-Run: ``python studies/dovetail_fold_stability.py [max_periods] [--no-residual]`` (0 periods:
-no time integration; ``--no-residual``: the modal condensation without its residual vectors,
-checked as the default one is, so that Hill's quadratic problem is small enough to be dense).
+Run: ``python studies/dovetail_fold_stability.py [max_periods] [--no-residual] [--refine=N]``
+(0 periods: no time integration; ``--no-residual``: the modal condensation without its
+residual vectors, checked as the default one is, so that Hill's quadratic problem is small
+enough to be dense; ``--refine=N``: Hill's exponents refined on the exact ``T(s)``, default 2).
 """
 
 from __future__ import annotations
@@ -30,7 +31,7 @@ from fretwear.hb.condensers import condenser
 from fretwear.hb.dynamics import structure_dynamics
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.options import SweepOptions
-from fretwear.hb.stability import HillProblem, hill_stability, problem_of
+from fretwear.hb.stability import HillOptions, HillProblem, hill_stability, problem_of
 from fretwear.hb.sweep import sweep
 from fretwear.io.case import build_model
 from fretwear.timedomain.stability import check_periodic
@@ -42,8 +43,9 @@ def stamp(text):
 
 
 def main():
-    max_periods = int(sys.argv[1]) if len(sys.argv) > 1 else 150
+    max_periods = int(sys.argv[1]) if len(sys.argv) > 1 and sys.argv[1].isdigit() else 150
     residual = "--no-residual" not in sys.argv  # fewer coordinates for Hill's dense problem
+    refine = next((int(a.split("=")[1]) for a in sys.argv if a.startswith("--refine=")), 2)
     model = build_model(load_case(example_path("dovetail-frf")))
     if residual:
         cond = condenser(model, "auto", f_max=2800.0, max_order=1)
@@ -76,7 +78,7 @@ def main():
     for label, (p, prob, U, sign, _amp) in picks:
         c0 = time.process_time()
         try:
-            fl = hill_stability(prob, U, dyn)
+            fl = hill_stability(prob, U, dyn, options=HillOptions(refine=refine))
             crit = fl.critical(2)
             stamp(f"{label}: {p.frequency_hz:.3f} Hz, Hill: "
                   f"{'stable' if fl.stable else 'unstable'}, largest |rho| "

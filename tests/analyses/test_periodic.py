@@ -57,6 +57,7 @@ def test_periodic_writes_documented_results_figures_and_paraview(tmp_path, capsy
     assert ds.attrs["converged"] == 1
     assert ds.attrs["open_under_preload"] == "" and "warning" not in out
     assert ds.attrs["warnings"] == ""  # the static preload solve converged
+    assert "slow_multiplier" in ds.attrs
     assert ds.sizes == {"point": 1, "axis": 2, "contact_node": 11, "component": 2,
                         "harmonic_coefficient": 7, "tau": 32, "harmonic": 3}
     check_documented(ds, "periodic")
@@ -295,3 +296,33 @@ def test_hill_stability_says_what_the_state_is(tmp_path, capsys):
     word = ("stable by Hill's method" if top <= 1 else "UNSTABLE by Hill's method"
             if ds.attrs["hill_stable"] == 0 else "stability UNDECIDED by Hill's method")
     assert word in out and f"{stuck} tangential direction(s)" in out
+
+
+def test_a_state_held_only_weakly_is_said_so():
+    """The summary line and the attribute ``slow_multiplier`` of :func:`slow_verdict` on a
+    slider held by a weak spring (tests/helpers/slow.py; the multiplier itself is checked
+    against the time integration in tests/hb/test_slow_mode.py): with ``kw`` 1e-4 a start
+    elsewhere relaxes over 346 periods, below the 1000 of a slow state: no line; with ``kw``
+    1e-5 over about 3500: the line says the state is where a drift ends. With ``kw`` 0.1 the
+    balance is not nearly singular: NaN, no line. The small beam of the other tests records
+    the attribute (test_periodic_writes_documented_results_figures_and_paraview)."""
+    from helpers.slow import weakly_held
+
+    from fretwear.analyses.periodic import slow_verdict
+    from fretwear.hb.fourier import FourierBasis
+    from fretwear.hb.periodic import solve_periodic
+
+    found = {}
+    for kw in (1e-5, 1e-4, 0.1):
+        model = weakly_held(kw)
+        sol = solve_periodic(model, FourierBasis.up_to(15, 256), frequency=1.1 / (2 * np.pi),
+                             time_domain=None, eps=10.0)
+        found[kw] = slow_verdict(model, sol, None)
+    line, attrs = found[1e-5]
+    rho = attrs["slow_multiplier"]
+    assert 1 - 1e-3 < rho < 1 and "mean tangential position is held only weakly" in line
+    assert f"{1 / (1 - rho):.2g} periods" in line and "drifting" in line
+    line, attrs = found[1e-4]
+    assert line == "" and 1 - 1e-2 < attrs["slow_multiplier"] < 1 - 1e-3
+    line, attrs = found[0.1]
+    assert line == "" and np.isnan(attrs["slow_multiplier"])

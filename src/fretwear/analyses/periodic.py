@@ -42,14 +42,16 @@ from fretwear.analyses.figure_style import MARKED_POINTS, series_style
 from fretwear.errors import InputError
 from fretwear.hb import fallbacks
 from fretwear.hb.contact import STATE_NAMES
+from fretwear.hb.dynamics import structure_dynamics
 from fretwear.hb.inputs import QUASI_STATIC_FREQUENCY
 from fretwear.hb.options import PERIODIC as PERIODIC_SOLVE
 from fretwear.hb.penalty import penalty
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.reduce import condense, recover
+from fretwear.hb.slow_mode import slow_mode
 from fretwear.hb.solution import PeriodicSolution
 from fretwear.hb.solvers import SolveStats
-from fretwear.hb.stability import stability
+from fretwear.hb.stability import DENSE_MAX, problem_of, stability
 from fretwear.io.results import (
     no_fields_line,
     nodal_vectors,
@@ -236,6 +238,10 @@ def run_periodic(model, analysis: dict, case, context: RunContext) -> RunOutput:
     if sol.success and analysis["hill_stability"] and not qs:
         verdict, hill_attrs = hill_verdict(model, sol, cond)
         attrs.update(hill_attrs)
+    slow_line = ""
+    if sol.success and not qs:
+        slow_line, slow_attrs = slow_verdict(model, sol, cond)
+        attrs.update(slow_attrs)
     if not sol.success:  # never saved as a result: the diagnostics only
         return RunOutput(xr.Dataset(attrs=attrs), [],
                          _failure_summary(stats, analysis, where, sol), False,
@@ -254,6 +260,8 @@ def run_periodic(model, analysis: dict, case, context: RunContext) -> RunOutput:
     summary = _periodic_summary(sol, ds, analysis, where)
     if verdict:
         summary += "\n" + verdict
+    if slow_line:
+        summary += "\n" + slow_line
     if case.output["vtu"] and no_fields_line(model):
         summary += "\n" + no_fields_line(model)
     fallback = fallbacks.of_solutions([sol], sol.stats.wall_time).line(
@@ -262,6 +270,28 @@ def run_periodic(model, analysis: dict, case, context: RunContext) -> RunOutput:
         summary += "\n" + fallback
     return RunOutput(ds, figures, summary + "\n" + cond.choice.summary(), True, files,
                      warnings=list(sol.warnings))
+
+
+def slow_verdict(model, sol: PeriodicSolution, cond) -> tuple[str, dict]:
+    """Is the state held only weakly along some direction (:func:`fretwear.hb.slow_mode.
+    slow_mode`: the balance's near-null direction, e.g. the interface's mean tangential
+    position where every node slips at some instant)? The attribute ``slow_multiplier`` (its
+    real Floquet multiplier nearest 1; NaN: no such direction, or not computed) and a summary
+    line where a start elsewhere relaxes to the state over more than
+    :data:`fretwear.hb.slow_mode.SLOW_PERIODS` periods or moves away from it (empty
+    otherwise)."""
+    attrs = {"slow_multiplier": float("nan")}
+    if sol.U.size > DENSE_MAX:  # Hill's matrix is formed densely: not computed (before the
+        return "", attrs  # condensation and the structure's matrices are built for it)
+    try:
+        prob = problem_of(model, sol, condenser=cond)
+        sm = slow_mode(prob, sol.U.reshape(prob.m, prob.H), structure_dynamics(model, cond))
+    except (InputError, np.linalg.LinAlgError):  # beyond the dense Hill matrix, a sector, a
+        return "", attrs  # singular structure with its contact held, ...: not computed
+    attrs["slow_multiplier"] = sm.multiplier
+    if sm.multiplier > 1 or sm.slow():
+        return sm.line(), attrs
+    return "", attrs
 
 
 def hill_verdict(model, sol: PeriodicSolution, cond) -> tuple[str, dict]:
