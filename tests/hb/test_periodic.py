@@ -23,7 +23,7 @@ import pytest
 import scipy.sparse as sp
 from scipy import integrate, optimize
 
-from fretwear.errors import ConvergenceError
+from fretwear.errors import ConvergenceError, InputError
 from fretwear.hb import contact as law
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.options import SolveOptions
@@ -202,6 +202,16 @@ def test_den_hartog_from_default_initial_guess():
                          options=SolveOptions(tol=1e-10))
     st = sol.stats
     assert st.success, st.message
+
+
+@pytest.mark.parametrize("bad", [False, "yes", 1])
+def test_time_domain_that_is_not_a_fallback_is_refused(bad):
+    """``time_domain`` takes None or a TimeDomainFallback: anything else (``False`` was
+    accepted and crashed with an AttributeError once the first attempt failed) is refused in
+    one InputError naming the argument, before any solve (the check cannot pass a bool)."""
+    model, w, _ = den_hartog_case(0.02)
+    with pytest.raises(InputError, match="time_domain"):
+        solve_periodic(model, basis_for(1), frequency=w / (2 * np.pi), time_domain=bad)
 
 
 # --------------------------------------------------------------------------------------------

@@ -133,6 +133,10 @@ def _time_start(model: Model, frequency: float, reduced: Reduced, time_domain, q
     """The time-domain start of the ladder, where it answers the same problem: not with
     ``quasi_static``, a ``gap`` other than the model's, or contact springs (the time-domain
     solver models none of these)."""
+    if time_domain is not None and not isinstance(time_domain, TimeDomainFallback):
+        raise InputError(f"time_domain = {time_domain!r}: expected None (no time-domain start) "
+                         "or a fretwear.hb.fallback.TimeDomainFallback "
+                         "(fretwear.timedomain.FALLBACK)")
     if time_domain is None or quasi_static or model.contact.has_connectors:
         return None
     if gap is not None and not np.array_equal(
