@@ -48,6 +48,7 @@ from fretwear.hb.penalty import penalty
 from fretwear.hb.reduce import to_real_blocks
 from fretwear.hb.solvers import solve
 from fretwear.model.core import Model
+from fretwear.resources import require_memory
 
 #: relative step of the finite differences in ``w`` and ``xi`` (the Jacobian's last columns)
 FD_STEP = 1e-7
@@ -445,6 +446,15 @@ def nonlinear_mode(model: Model, basis: FourierBasis, amplitudes, *, omega_targe
         raise InputError(f"basis keeps harmonics {list(basis.harmonics)}: nonlinear modes "
                          "need the fundamental (1)")
     system = mode_system(model, omega_target, masters=masters, dyn=dyn)
+    # the dense Jacobian of the corrector and the real operator Z~ (n H each side, with
+    # their factorisation and products), the complex blocks on every structure coordinate
+    # per harmonic order with their condensation, and the points of the backbone
+    unknowns = system.size * basis.size + 2
+    full = system.m + system.phi.shape[1]
+    require_memory(8.0 * 6 * unknowns**2 + 48.0 * basis.orders.size * full**2
+                   + 32.0 * amps.size * unknowns,
+                   f"a nonlinear mode of {unknowns:,} unknowns ({system.size:,} coordinates x "
+                   f"{basis.size} Fourier coefficients) at {amps.size:,} amplitudes")
     c = model.contact
     w0 = (float(system.omega_held[system.masters[0]]) if system.masters.size
           else float(omega_target or 1.0))
