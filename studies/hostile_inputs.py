@@ -26,7 +26,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-from helpers import hostile, hostile_checkpoints, hostile_studies  # noqa: E402
+from helpers import hostile, hostile_checkpoints, hostile_sizes, hostile_studies  # noqa: E402
 from hypothesis import HealthCheck, given, settings  # noqa: E402
 
 #: files a generated run writes beside its case file (inputs, not outputs)
@@ -38,6 +38,7 @@ def main() -> None:
     ap.add_argument("--n", type=int, default=500, help="generated case files")
     ap.add_argument("--studies", type=int, default=100, help="generated study files")
     ap.add_argument("--no-checkpoints", action="store_true", help="skip the checkpoint edits")
+    ap.add_argument("--no-sizes", action="store_true", help="skip the sizes that cannot fit")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--api", action="store_true", help="survey the Python API calls instead")
     a = ap.parse_args()
@@ -55,6 +56,8 @@ def main() -> None:
                      lambda g: g[0], lambda g: g[2], "study.nc")
     if not a.no_checkpoints:
         checkpoint_survey()
+    if not a.no_sizes:
+        size_survey()
 
 
 def survey_files(what: str, n: int, strategy, run, kind_of, changes_of, result: str) -> None:
@@ -119,6 +122,23 @@ def checkpoint_survey() -> None:
     for kind, label, verdict in rows:
         if verdict != "refused":
             print(f"  {kind}: {label} -> {verdict}")
+    sys.stdout.flush()
+
+
+def size_survey() -> None:
+    """One call per family of arrays that grow with an input, sized not to fit: refused by
+    its own check (one line, estimate and machine's memory) or not."""
+    calls = hostile_sizes.size_calls()
+    verdicts = Counter()
+    for c in calls:
+        v = hostile_sizes.verdict(c)
+        verdicts[v.split(":")[0]] += 1
+        if v != "refused":
+            print(f"  size: {c.family} -> {v}"[:400])
+    print(f"sizes that cannot fit: {len(calls)} calls over "
+          f"{len({c.family for c in calls})} families")
+    for v, k in verdicts.most_common():
+        print(f"  {v}: {k}")
     sys.stdout.flush()
 
 
