@@ -18,6 +18,7 @@ edit and whether it was refused.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import random
 import sys
 import tempfile
@@ -153,8 +154,8 @@ def api_survey() -> None:
     counts: Counter = Counter()
     reasons: Counter = Counter()
     others = []
-    with tempfile.TemporaryDirectory() as tmp:
-        calls = hostile_api.all_calls(Path(tmp))
+    with tempfile.TemporaryDirectory() as tmp, contextlib.chdir(tmp):  # a relative path given
+        calls = hostile_api.all_calls(Path(tmp))  # to a call (a checkpoint '1') lands there
         for label, name, key, value, thunk in calls:
             out = hostile_api.outcome(thunk)
             kind = out.split(":")[0]
