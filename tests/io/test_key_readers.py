@@ -118,7 +118,8 @@ def test_analysis_keys_are_read_by_their_own_type():
 def test_an_ignored_key_is_a_note_in_the_model_a_warning_in_the_run(tmp_path):
     """Each ignored key is one line naming it, its value and who reads it: a note for the
     model's tables (a property of the structure, kept in a file run for other analyses), a
-    warning for the run's ([output], [analysis])."""
+    warning for the run's ([output], [analysis]); and the static load P, which an FRF (the
+    response to the harmonic 1 of the loads) does not read."""
     text = ('[analysis]\ntype = "frf"\nf_min = 100.0\nf_max = 200.0\nn_points = 2\n'
             "[output]\nwhole_disk = true\n")
     lines = ignored_notes(load_case(small_case(tmp_path, text)), analysis_tables())
@@ -128,7 +129,9 @@ def test_an_ignored_key_is_a_note_in_the_model_a_warning_in_the_run(tmp_path):
         "note: contact.wear_coefficient = 1e-11 is not used by a frf analysis (only by wear, "
         "incremental-wear, worn-state): it is ignored",
         "warning: output.whole_disk = true is not used by a frf analysis (only by periodic, "
-        "wear): it is ignored"]
+        "wear): it is ignored",
+        'note: load "P" (waveform "constant") is not used by a frf analysis (the response to '
+        "the harmonic 1 of the loads): it is ignored"]
 
 
 #: keys the linear analyses are declared not to read, and a second value for each
@@ -228,3 +231,16 @@ def test_keys_another_key_makes_unread_are_named(tmp_path):
     assert notes(None, path) == [
         'warning: analysis.condensation = "modal" is not used: a sector ([cyclic]) is '
         "condensed exactly, one condensation per harmonic index: it is ignored"]
+
+
+def test_the_periodic_part_of_a_load_is_named_in_a_nonlinear_mode(tmp_path):
+    """A nonlinear mode is a free vibration preloaded by the static loads
+    (fretwear.hb.nonlinear_modes.ModeSystem.loads: harmonic 0): the beam's load Q
+    (waveform "sin") is named, its static load P is not."""
+    text = ('[analysis]\ntype = "nonlinear-modes"\namplitude_min = 1e-9\n'
+            "amplitude_max = 1e-8\nn_amplitudes = 2\n")
+    lines = ignored_notes(load_case(small_case(tmp_path, text)), analysis_tables())
+    assert [n for n in lines if "load " in n] == [
+        'note: load "Q" (waveform "sin") is not used by a nonlinear-modes analysis beyond its '
+        "static part (a free vibration, preloaded by the static loads): its periodic part is "
+        "ignored"]

@@ -803,7 +803,29 @@ def ignored_notes(case: Case, analyses: Mapping[str, Table]) -> list[str]:
                                                         and given[key] == f.default):
                 lines.append(f"warning: analysis.{key} = {show(given[key])} is not used: "
                              f"{why}: it is ignored")
-    return lines
+    return lines + _load_notes(case.raw.get("loads"), kind)
+
+
+def _load_notes(loads, kind: str) -> list[str]:
+    """The loads an FRF or a nonlinear mode leaves unread, one note each: the FRF takes the
+    harmonic 1 of the loads (a constant load is ignored), the nonlinear mode, a free
+    vibration, only their static part (the periodic part of a waveform is ignored)."""
+    if kind not in ("frf", "nonlinear-modes") or not isinstance(loads, list):
+        return []
+    out = []
+    for i, ld in enumerate(loads):
+        if not isinstance(ld, Mapping):
+            continue
+        wf = ld.get("waveform", "constant")
+        name = show(ld.get("name", f"{i + 1}"))
+        if kind == "frf" and wf == "constant":
+            out.append(f"note: load {name} (waveform \"constant\") is not used by a frf "
+                       "analysis (the response to the harmonic 1 of the loads): it is ignored")
+        elif kind == "nonlinear-modes" and wf != "constant":
+            out.append(f"note: load {name} (waveform {show(wf)}) is not used by a "
+                       "nonlinear-modes analysis beyond its static part (a free vibration, "
+                       "preloaded by the static loads): its periodic part is ignored")
+    return out
 
 
 _MODAL_KEYS = ("condensation_modes", "condensation_cutoff", "condensation_tol")
