@@ -77,7 +77,7 @@ def incremental_wear(model: Model, *, n_cycles: int = 100,
     if computed * N > MAX_LOAD_STEPS:
         raise InputError(f"an incremental wear run of {computed:,} computed cycles of {N} load "
                          f"steps (n_cycles = {n_cycles:,}, cycle_jump = {J:,}): expected at "
-                         f"most {MAX_LOAD_STEPS:.0e} load steps (days of computing); raise "
+                         f"most {MAX_LOAD_STEPS:,} load steps (days of computing); raise "
                          "cycle_jump or lower n_cycles")
     kw = _archard_coefficient(model, wear_coefficient)
     t0 = time.perf_counter()
