@@ -211,13 +211,21 @@ def cyclic_modes(sector: CyclicSector, k: int, n_modes: int = 6) -> tuple[np.nda
     require_memory(16.0 * (free.size * (2 * n_modes + 1) + 3 * red.ndof * n_modes)
                    + 48.0 * (2 * n_modes + 1) ** 2,
                    f"{n_modes:,} modes of harmonic index {k} of a sector of {red.ndof:,} DOFs")
-    if free.size <= DENSE_MODES:
-        w2, X = sla.eigh(K.toarray(), M.toarray(), subset_by_index=[0, n_modes - 1])
-    else:
-        w2, X = spla.eigsh(K.tocsc(), n_modes, M.tocsc(), sigma=0.0, which="LM",
-                           v0=np.random.default_rng(0).standard_normal(K.shape[0]))
-        order = np.argsort(w2)
-        w2, X = w2[order], X[:, order]
+    if M.nnz == 0 or not np.any(M.diagonal()):
+        raise InputError("cyclic modes: the sector has no mass (material.rho = 0 or a zero mass "
+                         "matrix); modes need a mass")
+    try:
+        if free.size <= DENSE_MODES:
+            w2, X = sla.eigh(K.toarray(), M.toarray(), subset_by_index=[0, n_modes - 1])
+        else:
+            w2, X = spla.eigsh(K.tocsc(), n_modes, M.tocsc(), sigma=0.0, which="LM",
+                               v0=np.random.default_rng(0).standard_normal(K.shape[0]))
+            order = np.argsort(w2)
+            w2, X = w2[order], X[:, order]
+    except (np.linalg.LinAlgError, RuntimeError) as exc:  # (ARPACK's errors are RuntimeErrors)
+        raise InputError(f"cyclic modes of harmonic index {k}: the eigenproblem is singular "
+                         "(a DOF without mass, or a motion with neither stiffness nor mass): "
+                         "give every DOF a mass (material.rho > 0) and hold the sector") from exc
     q = np.zeros((red.ndof, n_modes), dtype=complex)
     q[free] = X
     return np.sqrt(np.maximum(w2, 0.0)) / (2 * np.pi), (T @ q).T
