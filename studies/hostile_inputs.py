@@ -18,6 +18,7 @@ edit and whether it was refused.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import random
 import sys
 import tempfile
@@ -26,7 +27,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-from helpers import hostile, hostile_checkpoints, hostile_studies  # noqa: E402
+from helpers import hostile, hostile_checkpoints, hostile_sizes, hostile_studies  # noqa: E402
 from hypothesis import HealthCheck, given, settings  # noqa: E402
 
 #: files a generated run writes beside its case file (inputs, not outputs)
@@ -38,6 +39,7 @@ def main() -> None:
     ap.add_argument("--n", type=int, default=500, help="generated case files")
     ap.add_argument("--studies", type=int, default=100, help="generated study files")
     ap.add_argument("--no-checkpoints", action="store_true", help="skip the checkpoint edits")
+    ap.add_argument("--no-sizes", action="store_true", help="skip the sizes that cannot fit")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--api", action="store_true", help="survey the Python API calls instead")
     a = ap.parse_args()
@@ -55,6 +57,8 @@ def main() -> None:
                      lambda g: g[0], lambda g: g[2], "study.nc")
     if not a.no_checkpoints:
         checkpoint_survey()
+    if not a.no_sizes:
+        size_survey()
 
 
 def survey_files(what: str, n: int, strategy, run, kind_of, changes_of, result: str) -> None:
@@ -122,6 +126,23 @@ def checkpoint_survey() -> None:
     sys.stdout.flush()
 
 
+def size_survey() -> None:
+    """One call per family of arrays that grow with an input, sized not to fit: refused by
+    its own check (one line, estimate and machine's memory) or not."""
+    calls = hostile_sizes.size_calls()
+    verdicts = Counter()
+    for c in calls:
+        v = hostile_sizes.verdict(c)
+        verdicts[v.split(":")[0]] += 1
+        if v != "refused":
+            print(f"  size: {c.family} -> {v}"[:400])
+    print(f"sizes that cannot fit: {len(calls)} calls over "
+          f"{len({c.family for c in calls})} families")
+    for v, k in verdicts.most_common():
+        print(f"  {v}: {k}")
+    sys.stdout.flush()
+
+
 def api_survey() -> None:
     """Each hostile call of tests/helpers/hostile_api.py over every public name: counts of
     each outcome, the accepted calls classified (legal, with why, or a silent accept of a
@@ -133,8 +154,8 @@ def api_survey() -> None:
     counts: Counter = Counter()
     reasons: Counter = Counter()
     others = []
-    with tempfile.TemporaryDirectory() as tmp:
-        calls = hostile_api.all_calls(Path(tmp))
+    with tempfile.TemporaryDirectory() as tmp, contextlib.chdir(tmp):  # a relative path given
+        calls = hostile_api.all_calls(Path(tmp))  # to a call (a checkpoint '1') lands there
         for label, name, key, value, thunk in calls:
             out = hostile_api.outcome(thunk)
             kind = out.split(":")[0]

@@ -217,6 +217,19 @@ def _eig_sparse(K, M, k: int, sigma: float):
     return lam, X
 
 
+def _check_eig(n: int, k: int, dense: bool) -> None:
+    """Refuse (one InputError with the estimate and the machine's memory) ``k`` modes of
+    ``n`` DOFs that cannot fit: densely, the two matrices, the eigenvectors and LAPACK's
+    work arrays (``n x n`` each); by Lanczos, its basis (``2 k + 1`` vectors of ``n``), the
+    ``k`` modes and its dense ``(2 k + 1)^2`` work arrays."""
+    if dense:
+        require_memory(8.0 * 5 * n * n, f"the dense eigenproblem of {n:,} DOFs (every mode: "
+                       "n_modes or f_max reach the model's size)")
+    else:
+        require_memory(8.0 * n * (3 * k + 2) + 24.0 * (2 * k + 1) ** 2,
+                       f"{k:,} modes of {n:,} DOFs")
+
+
 def _lowest_modes(K, M, n_modes: int, lam_max: float | None):
     """Lowest eigenpairs ``(lam, X)`` of the pencil; all below ``lam_max`` when given."""
     n = K.shape[0]
@@ -227,8 +240,10 @@ def _lowest_modes(K, M, n_modes: int, lam_max: float | None):
         k = max(1, n_modes)
         while True:
             if k >= n - 1:
+                _check_eig(n, n, True)
                 lam, X = _eig_dense(K, M, sigma)
                 break
+            _check_eig(n, k, False)
             lam, X = _eig_sparse(K, M, k, sigma)
             if lam_max is None or lam.max() > lam_max:
                 break

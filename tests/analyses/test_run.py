@@ -98,9 +98,10 @@ def test_keys_the_analysis_does_not_read_are_named(tmp_path, capsys):
     examples do), and is given `[output] whole_disk = true`, which only a periodic or wear analysis
     reads. For a modes analysis both are named, each in one line with the analyses that read
     it: the wear coefficient as a note (a property of the interface), whole_disk as a warning
-    (an option of the run); for a periodic analysis only the wear coefficient is, and
-    `vtu = false` (a switch turned off) is not. Reference: the schema's declarations, by
-    hand."""
+    (an option of the run); so are, for the modes (free vibration of the undamped structure
+    with the interface held or free), its damping, its loads and its friction coefficient;
+    for a periodic analysis only the wear coefficient is, and `vtu = false` (a switch turned
+    off) is not. Reference: the schema's declarations, by hand."""
 
     from helpers.cases import small_case
 
@@ -111,6 +112,13 @@ def test_keys_the_analysis_does_not_read_are_named(tmp_path, capsys):
     modes = '[analysis]\ntype = "modes"\nn_modes = 2\n[output]\nwhole_disk = true\n'
     lines = ignored_notes(load_case(small_case(tmp_path, modes)), analysis_tables())
     assert lines == [
+        "note: damping = {loss_factor = 0.001} is not used by a modes analysis (read by every "
+        "analysis but modes, cyclic-modes, incremental-wear): it is ignored",
+        'note: loads = [{name = "P", boundary = "top", pressure = 10000.0, wavef... is not '
+        "used by a modes analysis (read by every analysis but modes, cyclic-modes): it is "
+        "ignored",
+        "note: contact.mu = 0.3 is not used by a modes analysis (read by every analysis but "
+        "modes, frf, cyclic-modes): it is ignored",
         "note: contact.wear_coefficient = 1e-11 is not used by a modes analysis (only by "
         "wear, incremental-wear, worn-state): it is ignored",
         "warning: output.whole_disk = true is not used by a modes analysis (only by "

@@ -372,3 +372,15 @@ def test_3d_short_sweep_and_wear_steps_equal_the_disk():
     W, W_d = r.history.wear_depth, r_d.history.wear_depth.reshape(-1, 6, nc)
     assert W[-1].max() > 1e-9  # it wears
     assert np.max(np.abs(W[:, None, :] - W_d)) < 1e-8 * W.max()
+
+
+def test_cyclic_modes_of_a_massless_sector_are_refused(sector):
+    """material.rho = 0 (the survey's case file: a LinAlgError from the generalized
+    eigensolver): one InputError saying modes need a mass, for every harmonic index."""
+    import dataclasses
+
+    massless = dataclasses.replace(sector, model=dataclasses.replace(
+        sector.model, M=0.0 * sector.model.M))
+    for k in (0, 1):
+        with pytest.raises(InputError, match="the sector has no mass"):
+            cyclic_modes(massless, k, 2)

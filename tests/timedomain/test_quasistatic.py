@@ -120,3 +120,20 @@ def test_3d_pad_sliding_bodily_wears_every_node():
     F = MU_PAD * 10e6 * 1e-4
     Q0 = 1.5 * F
     assert res.dissipation[-1] == pytest.approx(4 * F * (Q0 - F) / 1e7, rel=0.03)
+
+
+def test_a_run_of_more_load_steps_than_a_day_is_refused_at_once():
+    """n_cycles = 10^9 without a cycle jump: 10^9 computed cycles of 16 load steps, refused in
+    one line before the condensation (the survey found it building its list of jumps for
+    minutes, then running for days). The jumps of a run that fits are those of the loop
+    they replace (1, then J, the last shortened), written out here for 7 and 23 cycles."""
+    from fretwear.errors import InputError
+    from fretwear.timedomain.quasistatic import _cycle_jumps
+
+    opts = IncrementalWearOptions(steps_per_cycle=16)
+    with pytest.raises(InputError, match=r"1,000,000,000 computed cycles of 16 load steps "
+                                         r"\(n_cycles = 1,000,000,000, cycle_jump = 1\)"):
+        incremental_wear(None, n_cycles=10**9, options=opts)
+    assert _cycle_jumps(7, 3).tolist() == [1, 3, 3]
+    assert _cycle_jumps(23, 5).tolist() == [1, 5, 5, 5, 5, 2]
+    assert _cycle_jumps(1, 4).tolist() == [1]

@@ -23,6 +23,10 @@ def run_cyclic_modes(model, analysis: dict, case, context: RunContext) -> RunOut
     """The ``n_modes`` lowest modes of every nodal diameter ``k = 0 .. N // 2`` (index ``k``
     and ``N - k`` share their frequencies)."""
     sector = model.meta.get("cyclic")
+    if model.meta.get("mistuning") is not None:
+        raise InputError('analysis.type = "cyclic-modes": the modes of the tuned sector, every '
+                         "nodal diameter; [cyclic.mistuning] makes the whole mistuned disk, "
+                         "which has none: remove [cyclic.mistuning]")
     if sector is None:
         raise InputError('analysis.type = "cyclic-modes": the case has no [cyclic] table; '
                          'expected a sector (or use type = "modes")')

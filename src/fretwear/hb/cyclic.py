@@ -37,6 +37,7 @@ from fretwear.model.cyclic import (
     relative_harmonic_model,
 )
 from fretwear.model.interfaces import observed_map
+from fretwear.resources import require_memory
 from fretwear.validate import reals
 
 #: at most this many kept DOFs: cyclic modes by a dense Hermitian eigensolver
@@ -149,6 +150,7 @@ class CyclicCondenser(Condenser):
         """The sector's :class:`~fretwear.hb.reduce.Reduced` model on ``orders`` at ``omega``
         [rad/s]: harmonic ``n``'s blocks from harmonic index ``n EO mod N``."""
         orders = np.asarray(orders, dtype=np.int64)
+        self.check_size(orders)  # every index's blocks as harmonic index 0's (same sizes)
         ks = self.index(orders)
         m, no, nb = self.m, self.structure.obs.size, orders.size
         Zr = np.zeros((nb, m, m), dtype=complex)
@@ -204,13 +206,26 @@ def cyclic_modes(sector: CyclicSector, k: int, n_modes: int = 6) -> tuple[np.nda
     K = red.K.tocsr()[free][:, free]
     M = red.M.tocsr()[free][:, free]
     n_modes = min(int(n_modes), free.size)
-    if free.size <= DENSE_MODES:
-        w2, X = sla.eigh(K.toarray(), M.toarray(), subset_by_index=[0, n_modes - 1])
-    else:
-        w2, X = spla.eigsh(K.tocsc(), n_modes, M.tocsc(), sigma=0.0, which="LM",
-                           v0=np.random.default_rng(0).standard_normal(K.shape[0]))
-        order = np.argsort(w2)
-        w2, X = w2[order], X[:, order]
+    # the complex Lanczos basis (2 k + 1 vectors), the modes and their expansion to the
+    # sector's DOFs, and the dense work arrays
+    require_memory(16.0 * (free.size * (2 * n_modes + 1) + 3 * red.ndof * n_modes)
+                   + 48.0 * (2 * n_modes + 1) ** 2,
+                   f"{n_modes:,} modes of harmonic index {k} of a sector of {red.ndof:,} DOFs")
+    if M.nnz == 0 or not np.any(M.diagonal()):
+        raise InputError("cyclic modes: the sector has no mass (material.rho = 0 or a zero mass "
+                         "matrix); modes need a mass")
+    try:
+        if free.size <= DENSE_MODES:
+            w2, X = sla.eigh(K.toarray(), M.toarray(), subset_by_index=[0, n_modes - 1])
+        else:
+            w2, X = spla.eigsh(K.tocsc(), n_modes, M.tocsc(), sigma=0.0, which="LM",
+                               v0=np.random.default_rng(0).standard_normal(K.shape[0]))
+            order = np.argsort(w2)
+            w2, X = w2[order], X[:, order]
+    except (np.linalg.LinAlgError, RuntimeError) as exc:  # (ARPACK's errors are RuntimeErrors)
+        raise InputError(f"cyclic modes of harmonic index {k}: the eigenproblem is singular "
+                         "(a DOF without mass, or a motion with neither stiffness nor mass): "
+                         "give every DOF a mass (material.rho > 0) and hold the sector") from exc
     q = np.zeros((red.ndof, n_modes), dtype=complex)
     q[free] = X
     return np.sqrt(np.maximum(w2, 0.0)) / (2 * np.pi), (T @ q).T
@@ -223,6 +238,9 @@ def cyclic_frf(sector: CyclicSector, engine_order: int, frequencies) -> np.ndarr
     (the first harmonic of the loads; index ``k = EO mod N``): ``T_k (Z_k)^-1 T_k^H F_1``."""
     eo = _engine_order(engine_order)
     frequencies = np.atleast_1d(reals(frequencies, "frequencies", low=0.0))
+    require_memory(16.0 * frequencies.size * sector.model.ndof,
+                   f"a sector FRF of {frequencies.size:,} frequencies on "
+                   f"{sector.model.ndof:,} DOFs")
     k = int(harmonic_index(1, eo, sector.n_sectors))
     red, T = harmonic_model(sector, k)
     free = red.free_dofs()

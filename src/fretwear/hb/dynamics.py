@@ -44,6 +44,7 @@ from fretwear.hb.connectors import springs
 from fretwear.hb.modal import ModalCondenser
 from fretwear.hb.reduce import condenser_for
 from fretwear.model.core import Model
+from fretwear.resources import require_memory
 
 #: at most this many interior DOFs: the exact transformation is formed densely; above, the
 #: model needs a modal condenser (:func:`fretwear.hb.modal.modal_condenser`)
@@ -195,6 +196,23 @@ def _loads_with_springs(load_c, load_q, contact):
     return lx, np.concatenate([load_c[sp.f], load_q])
 
 
+def check_dense(cond) -> None:
+    """Refuse (one InputError with the estimate and the machine's memory) the dense
+    matrices of :func:`structure_dynamics` that cannot fit, before they are formed: with a
+    modal condenser the blocks on ``m + q`` coordinates and ``Psi R^T`` (``n_i x m``); else
+    the blocks of ``K, M, C, D`` on every DOF (``(m + n_i)^2`` each, the partitions, the
+    transformed blocks and their products); with the frame matrix ``R`` (``m x m``)."""
+    m, ni = cond.m, cond.ni
+    if isinstance(cond, ModalCondenser):
+        nbytes = 8.0 * (2 * ni * m + 6 * (m + cond.q) ** 2 + m * m)
+    elif ni > DENSE_INTERIOR_MAX:
+        return  # refused below, with what to do instead
+    else:
+        nbytes = 8.0 * (12 * (m + ni) ** 2 + m * m)
+    require_memory(nbytes, f"the dense structure matrices of Hill's method and nonlinear modes "
+                   f"({m:,} contact and {ni:,} interior DOFs)")
+
+
 def structure_dynamics(model: Model, condenser=None) -> StructureDynamics:
     """The :class:`StructureDynamics` of ``model``: that of its modal condenser when
     ``condenser`` is one (:func:`fretwear.hb.modal.modal_condenser`), else the exact
@@ -206,6 +224,7 @@ def structure_dynamics(model: Model, condenser=None) -> StructureDynamics:
             "condenser: Hill's method and nonlinear modes are not available on one sector "
             "with cyclic symmetry (fretwear.hb.cyclic) yet; use the whole disk "
             "(fretwear.model.cyclic.whole_disk)")
+    check_dense(cond)
     if isinstance(cond, ModalCondenser):
         blocks = {name: tuple(np.asarray(b) for b in cond.proj_local[name])
                   for name in MATRICES if name in cond.proj_local}

@@ -55,6 +55,7 @@ from fretwear.hb.reduce import (
 )
 from fretwear.model.checks import model_argument
 from fretwear.model.core import Model
+from fretwear.resources import require_memory
 from fretwear.validate import number, whole
 
 #: keep the fixed-interface modes up to this multiple of the highest harmonic frequency
@@ -144,6 +145,11 @@ class ModalCondenser(Condenser):
         super().__init__(_structure(model), dense=False)
         if not self.ni:
             raise InputError("the model has no interior DOFs: nothing to represent by modes")
+        # Psi (n_i x m), with the residual vectors a second n_i x m, K_ii Psi of the
+        # projections a third, and the projected blocks of K, M, C, D (m x m each)
+        require_memory(8.0 * (self.ni * self.m * (3 if residual else 2) + 5 * self.m**2),
+                       f"a modal condensation of {self.ni:,} interior and {self.m:,} contact "
+                       "DOFs (its static modes, n_i x m, and projected blocks, m x m)")
         self.f_max, self.max_order, self.tol = float(f_max), int(max_order), float(tol)
         lu = self.factor(0.0, 0, True)  # real LU of K_ii, kept
         # static constraint modes Psi = -K_ii^-1 K_ic (blocked multi-RHS solves)
@@ -222,6 +228,9 @@ class ModalCondenser(Condenser):
             return np.zeros(0), np.zeros((n, 0))
         k = min(modes if modes is not None else 20, n - 2)
         while True:
+            # the Lanczos basis (2 k + 1 vectors of n), the k modes and its dense work arrays
+            require_memory(8.0 * n * (3 * k + 2) + 24.0 * (2 * k + 1) ** 2,
+                           f"{k:,} fixed-interface modes of {n:,} interior DOFs")
             # a fixed start vector: SciPy's default is drawn from fresh entropy, and the modes
             # of a degenerate eigenspace (a square pad) then differ by rounding from run to
             # run, and with them every result computed from the condensation
@@ -328,11 +337,31 @@ class ModalCondenser(Condenser):
         return e
 
     # -- the Condenser interface --------------------------------------------------------------
+    def check_size(self, orders) -> None:
+        """Refuse (one InputError with the estimate and the machine's memory) a reduced
+        model on ``orders`` that cannot fit, before it allocates: per harmonic the dense
+        ``Z_r`` block (``m x m``, none for the operator), the rank-``q`` term of the operator
+        or ``Z^qq^-1 Z^qc`` (``q x m``), the observation rows and loads; the load amplitudes
+        of every order up to the highest and the Fourier basis of the balance (as
+        :meth:`fretwear.hb.reduce.Condenser.check_size`)."""
+        orders = np.asarray(orders, dtype=np.int64)
+        if not orders.size:
+            return
+        nb, k = orders.size, int(orders.max())
+        m, no, q = self.m, self.structure.obs.size, self.q
+        zr = 0.0 if self.representation == "operator" else 16.0 * m * m
+        per_order = zr + 16.0 * (q * m + no * m + no + m)
+        basis = 8.0 * (2 * k + 2) * (2 * k + 1) * 4
+        require_memory(nb * per_order + 16.0 * (k + 1) * self.structure.ndof + basis,
+                       f"a modal condensation on {nb} harmonic orders (up to {k}) with "
+                       f"{m:,} contact DOFs and {q:,} interior coordinates")
+
     def reduced(self, omega: float, orders, quasi_static: bool = False,
                 frequency: float | None = None) -> Reduced:
         """The :class:`~fretwear.hb.reduce.Reduced` model on ``orders`` at ``omega`` [rad/s]
         from the modal representation (``Z`` an array or an operator: ``representation``)."""
         orders = np.asarray(orders, dtype=np.int64)
+        self.check_size(orders)
         if self.representation == "operator":
             return self._reduced_operator(omega, orders, quasi_static, frequency)
         m, no, nb, R = self.m, self.structure.obs.size, orders.size, self.R
@@ -628,6 +657,11 @@ class BlockedModalCondenser(ModalCondenser):
         Condenser.__init__(self, _structure(model), dense=False)
         if not self.ni:
             raise InputError("the model has no interior DOFs: nothing to represent by modes")
+        # the projected X^cc of K, M, C, D (m x m each) and a block of BLOCK columns of
+        # Psi and of the projections at a time (n_i x BLOCK, a few)
+        require_memory(8.0 * (4 * self.m**2 + 6 * self.ni * min(BLOCK, self.m)),
+                       f"a blocked modal condensation of {self.ni:,} interior and "
+                       f"{self.m:,} contact DOFs (its projected blocks, m x m)")
         self.f_max, self.max_order, self.tol = float(f_max), int(max_order), float(tol)
         lu = self.factor(0.0, 0, True)  # real LU of K_ii, kept
         self._lu0 = lu

@@ -48,6 +48,7 @@ from fretwear.hb.penalty import penalty
 from fretwear.hb.reduce import to_real_blocks
 from fretwear.hb.solvers import solve
 from fretwear.model.core import Model
+from fretwear.resources import require_memory
 
 #: relative step of the finite differences in ``w`` and ``xi`` (the Jacobian's last columns)
 FD_STEP = 1e-7
@@ -78,10 +79,21 @@ class ModeSystem:
     def size(self) -> int:
         return self.dyn.m + self.masters.size
 
+    #: the matrices on ``(x, eta)`` by name (:meth:`full`), projected once per system
+    _full: dict = field(default_factory=dict, init=False, repr=False, compare=False)
+
     def _blocks(self, name):
         xx, xq, qx, qq = (np.asarray(b) for b in self.dyn.blocks[name])
         P = self.phi
         return xx, xq @ P, P.T @ qx, P.T @ qq @ P
+
+    def full(self, name) -> np.ndarray:
+        """The structure's matrix ``name`` (K, M, C, D) on ``(x, eta)``, (m + q, m + q):
+        projected on the held modes once (every corrector iteration uses it)."""
+        if name not in self._full:
+            xx, xe, ex, ee = self._blocks(name)
+            self._full[name] = np.block([[xx, xe], [ex, ee]]) if self.phi.shape[1] else xx
+        return self._full[name]
 
     def stiffness(self, omega: float, xi: float, orders) -> tuple[np.ndarray, np.ndarray]:
         """``(Z, S)``: ``Z`` (nb, n, n) complex on ``(x, eta_masters)`` per harmonic order at
@@ -98,9 +110,7 @@ class ModeSystem:
         nfull = m + q
         Zf = np.zeros((orders.size, nfull, nfull), dtype=complex)
         for nm in names:
-            xx, xe, ex, ee = self._blocks(nm)
-            B = np.block([[xx, xe], [ex, ee]]) if q else xx
-            Zf += coef[nm][:, None, None] * B
+            Zf += coef[nm][:, None, None] * self.full(nm)
         keep = np.concatenate([np.arange(m), m + self.masters])
         rest = np.setdiff1d(np.arange(nfull), keep)
         Zkk = Zf[:, keep[:, None], keep]
@@ -122,8 +132,7 @@ class ModeSystem:
         return F[keep] - K[np.ix_(keep, rest)] @ np.linalg.solve(K[np.ix_(rest, rest)], F[rest])
 
     def _full_static(self) -> np.ndarray:
-        xx, xe, ex, ee = self._blocks("K")
-        return np.block([[xx, xe], [ex, ee]]) if self.phi.shape[1] else xx
+        return self.full("K")
 
     def coordinates(self, Y: np.ndarray, omega: float, xi: float,
                     basis: FourierBasis) -> np.ndarray:
@@ -159,8 +168,7 @@ class ModeSystem:
         """``T^H M T`` (n, n) at harmonic 1 for the recovery ``eta_rest = S1 y``: the
         structure's mass seen by the kept coordinates (the modal amplitude's norm)."""
         m, q = self.m, self.phi.shape[1]
-        xx, xe, ex, ee = self._blocks("M")
-        Mf = np.block([[xx, xe], [ex, ee]]) if q else xx
+        Mf = self.full("M")
         keep = np.concatenate([np.arange(m), m + self.masters])
         rest = np.setdiff1d(np.arange(m + q), keep)
         T = np.zeros((m + q, keep.size), dtype=complex)
@@ -263,6 +271,7 @@ class ModeProblem:
     def __init__(self, system: ModeSystem, contact, basis: FourierBasis, eps: float,
                  anchor: np.ndarray, gap: np.ndarray):
         self.sys, self.contact, self.basis = system, contact, basis
+        self._operators: dict = {}  # (w, xi) -> operator(w, xi), the last three
         nc, d = contact.dofs.shape
         self.nc, self.d = nc, d
         self.m, self.n, self.H = system.m, system.size, basis.size
@@ -289,8 +298,13 @@ class ModeProblem:
     def operator(self, omega, xi):
         """``(Z~ (n H, n H) real, S1)``: the real block operator at ``(w, xi)`` and the
         recovery of the condensed coordinates at harmonic 1."""
-        Zc, S = self.sys.stiffness(omega, xi, self.orders)
-        return to_real_blocks(Zc, self.orders), S[self.h1]
+        key = (float(omega), float(xi))
+        if key not in self._operators:  # the corrector asks again at the same (w, xi)
+            Zc, S = self.sys.stiffness(omega, xi, self.orders)
+            if len(self._operators) >= 3:  # the point and its two difference steps
+                self._operators.pop(next(iter(self._operators)))
+            self._operators[key] = (to_real_blocks(Zc, self.orders), S[self.h1])
+        return self._operators[key]
 
     def amplitude_of(self, Y, S1):
         """Modal amplitude of ``Y`` (n, H) and its gradient (n, H)."""
@@ -445,6 +459,15 @@ def nonlinear_mode(model: Model, basis: FourierBasis, amplitudes, *, omega_targe
         raise InputError(f"basis keeps harmonics {list(basis.harmonics)}: nonlinear modes "
                          "need the fundamental (1)")
     system = mode_system(model, omega_target, masters=masters, dyn=dyn)
+    # the dense Jacobian of the corrector and the real operator Z~ (n H each side, with
+    # their factorisation and products), the complex blocks on every structure coordinate
+    # per harmonic order with their condensation, and the points of the backbone
+    unknowns = system.size * basis.size + 2
+    full = system.m + system.phi.shape[1]
+    require_memory(8.0 * 6 * unknowns**2 + 48.0 * basis.orders.size * full**2
+                   + 32.0 * amps.size * unknowns,
+                   f"a nonlinear mode of {unknowns:,} unknowns ({system.size:,} coordinates x "
+                   f"{basis.size} Fourier coefficients) at {amps.size:,} amplitudes")
     c = model.contact
     w0 = (float(system.omega_held[system.masters[0]]) if system.masters.size
           else float(omega_target or 1.0))

@@ -113,6 +113,7 @@ from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.reduce import condense, to_real_blocks
 from fretwear.hb.solution import PeriodicSolution
 from fretwear.model.core import Model
+from fretwear.resources import require_memory
 
 #: Hill's matrix is formed and its quadratic eigenvalue problem solved densely up to this
 #: many unknowns ``m H`` (the companion pencil has twice as many)
@@ -483,6 +484,14 @@ class HillProblem:
                              f"{DENSE_MAX} unknowns (m H)")
         if dyn.m != prob.m:
             raise InputError(f"the structure has {dyn.m} contact DOFs, the problem {prob.m}")
+        # T(s) and its factorisation and derivative (n x n complex, a few), the gains G
+        # (nc blocks of d H), and the pencil's three real matrices on (m + q) H unknowns with
+        # the companion eigenproblem (twice as many, complex, with its eigenvectors)
+        npen = min((dyn.m + dyn.q) * prob.H, PENCIL_MAX)  # pencil() refuses beyond
+        require_memory(16.0 * 6 * n * n + 16.0 * prob.nc * (prob.d * prob.H) ** 2
+                       + 8.0 * 4 * npen**2 + 16.0 * 3 * (2 * npen) ** 2,
+                       f"Hill's method on {n:,} unknowns ({prob.m:,} contact DOFs x {prob.H} "
+                       f"Fourier coefficients, {dyn.q:,} interior coordinates)")
         self.prob = prob
         self.U = np.asarray(U, dtype=float).reshape(prob.m, prob.H)
         self.dyn = dyn

@@ -28,6 +28,7 @@ import numpy as np
 
 from fretwear.errors import InputError
 from fretwear.io.schema import (
+    MISSING,
     AnyOf,
     Choice,
     Context,
@@ -678,6 +679,43 @@ OUTPUT = Table(
 )
 
 
+# --- which analyses read which keys ----------------------------------------------------
+#: every analysis type (the registry's, fretwear.analyses.registry; a test checks both agree)
+ANALYSES = ("modes", "frf", "cyclic-modes", "periodic", "sweep", "nonlinear-modes",
+            "transient", "incremental-wear", "wear", "worn-state")
+#: the analyses that solve the contact law (friction, gaps, contact stiffness, prescribed
+#: normal loads); the linear ones (modes, frf, cyclic-modes) hold the interface or leave it
+#: free (fretwear.linear: "free", "sliding", "stuck"), whatever those keys say
+CONTACT_LAW_ANALYSES = tuple(a for a in ANALYSES if a not in ("modes", "frf", "cyclic-modes"))
+#: the analyses that read the loads: not the modes (free vibration)
+LOADED_ANALYSES = tuple(a for a in ANALYSES if a not in ("modes", "cyclic-modes"))
+#: the analyses that read the damping: not the modes (undamped) nor the incremental wear
+#: (quasi-static load steps: no inertia, no damping)
+DAMPED_ANALYSES = tuple(a for a in LOADED_ANALYSES if a != "incremental-wear")
+#: the analyses of a sector's own model (cyclic-modes: the disk's modes from the sector's
+#: matrices alone, every nodal diameter, contact free, no observed point)
+NOT_CYCLIC_MODES = tuple(a for a in ANALYSES if a != "cyclic-modes")
+
+#: (table, key, the analyses that read it): the keys that some analyses do not read; given to
+#: another (and not left at its default), the key is named (:func:`ignored_notes`). Every
+#: other key is read by every analysis. Top-level tables: :data:`_TOP_READERS`.
+_READERS = (
+    *((t, k, CONTACT_LAW_ANALYSES) for t in (CONTACT_MESH, CONTACT_MATRICES, CONTACT_FE)
+      for k in ("mu", "gap", "area", "normal_stiffness", "tangential_stiffness",
+                "normal_pressure", "normal_waveform", "kn", "kt", "normal_load")
+      if k in t.fields),
+    (MODEL.tables()["matrices"], "C", DAMPED_ANALYSES),
+    (MODEL.tables()["matrices"], "D", DAMPED_ANALYSES),
+    (CYCLIC, "engine_order", NOT_CYCLIC_MODES),
+    (CYCLIC, "mistuning", NOT_CYCLIC_MODES),
+    (CYCLIC, "neighbour", NOT_CYCLIC_MODES),
+)
+for _table, _key, _readers in _READERS:
+    _table.fields[_key] = dataclasses.replace(_table.fields[_key], used_by=_readers)
+#: top-level key of the case file -> the analyses that read it (the others: every one)
+_TOP_READERS = {"damping": DAMPED_ANALYSES, "loads": LOADED_ANALYSES,
+                "observed": NOT_CYCLIC_MODES}
+
 _TITLE = Field(Text(), "one line describing the case (used in figures and results)")
 
 
@@ -722,6 +760,8 @@ def _case_table(model_kind: str, analyses: Mapping[str, Table]) -> Table:
             "cyclic": Field(CYCLIC, "cyclic symmetry: the model is one sector of a disk"),
             "centrifugal": Field(CENTRIFUGAL, "centrifugal loading at a rotation speed"),
         }
+    for key, readers in _TOP_READERS.items():
+        fields[key] = dataclasses.replace(fields[key], used_by=readers)
     fields["analysis"] = Field(Variant(dict(analyses), key_doc="analysis type"),
                                "what to compute", required=True)
     fields["output"] = Field(OUTPUT, "what to write")
@@ -767,9 +807,57 @@ def ignored_notes(case: Case, analyses: Mapping[str, Table]) -> list[str]:
     for path, value, used_by in unused_keys(_case_table(_model_kind(case.raw), analyses),
                                             case.raw, kind):
         level = "warning" if path.split(".")[0].split("[")[0] in _RUN_TABLES else "note"
-        lines.append(f"{level}: {path} = {show(value)} is not used by a {kind} analysis (only "
-                     f"by {', '.join(used_by)}): it is ignored")
-    return lines
+        others = [a for a in analyses if a not in used_by]
+        readers = (f"only by {', '.join(used_by)}" if len(used_by) <= len(others)
+                   else f"read by every analysis but {', '.join(others)}")
+        lines.append(f"{level}: {path} = {show(value)} is not used by a {kind} analysis "
+                     f"({readers}): it is ignored")
+    given = case.raw["analysis"]
+    table = analyses[kind].fields if kind in analyses else {}
+    for keys, applies, why in _OVERRIDDEN:
+        if not applies(case.raw, given):
+            continue
+        for key in keys:
+            f = table.get(key)
+            if f is not None and key in given and not (f.default is not MISSING
+                                                        and given[key] == f.default):
+                lines.append(f"warning: analysis.{key} = {show(given[key])} is not used: "
+                             f"{why}: it is ignored")
+    return lines + _load_notes(case.raw.get("loads"), kind)
+
+
+def _load_notes(loads, kind: str) -> list[str]:
+    """The loads an FRF or a nonlinear mode leaves unread, one note each: the FRF takes the
+    harmonic 1 of the loads (a constant load is ignored), the nonlinear mode, a free
+    vibration, only their static part (the periodic part of a waveform is ignored)."""
+    if kind not in ("frf", "nonlinear-modes") or not isinstance(loads, list):
+        return []
+    out = []
+    for i, ld in enumerate(loads):
+        if not isinstance(ld, Mapping):
+            continue
+        wf = ld.get("waveform", "constant")
+        name = show(ld.get("name", f"{i + 1}"))
+        if kind == "frf" and wf == "constant":
+            out.append(f"note: load {name} (waveform \"constant\") is not used by a frf "
+                       "analysis (the response to the harmonic 1 of the loads): it is ignored")
+        elif kind == "nonlinear-modes" and wf != "constant":
+            out.append(f"note: load {name} (waveform {show(wf)}) is not used by a "
+                       "nonlinear-modes analysis beyond its static part (a free vibration, "
+                       "preloaded by the static loads): its periodic part is ignored")
+    return out
+
+
+_MODAL_KEYS = ("condensation_modes", "condensation_cutoff", "condensation_tol")
+#: (keys of [analysis], when they go unread (case as written, its [analysis]), why): keys that
+#: another key makes unread
+_OVERRIDDEN = (
+    (("n_modes",), lambda raw, a: "f_max" in a, "f_max is given (every mode up to it)"),
+    (("condensation", *_MODAL_KEYS), lambda raw, a: "cyclic" in raw,
+     "a sector ([cyclic]) is condensed exactly, one condensation per harmonic index"),
+    (_MODAL_KEYS, lambda raw, a: "cyclic" not in raw and a.get("condensation") == "exact",
+     'condensation = "exact" (the keys of the modal condensation)'),
+)
 
 
 # --- loading ----------------------------------------------------------------------------

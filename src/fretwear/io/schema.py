@@ -603,7 +603,8 @@ def render_table(table: Table, heading: str) -> str:
         else:
             default = f"`{show(f.default)}`"
         unit = f.unit or ""
+        doc = f.doc + (f" (read by {', '.join(f.used_by)} only)" if f.used_by else "")
         lines.append(
-            f"| `{key}` | {_md(f.spec.expected())} | {_md(unit)} | {default} | {_md(f.doc)} |"
+            f"| `{key}` | {_md(f.spec.expected())} | {_md(unit)} | {default} | {_md(doc)} |"
         )
     return "\n".join(lines) + "\n"

@@ -34,6 +34,7 @@ from fretwear.model.checks import model_argument, whole_number
 from fretwear.model.core import ContactInterface, Load, Model, ObservedPoint
 from fretwear.model.interfaces import check_distinct, combine
 from fretwear.model.supports import Neighbours, check_supported
+from fretwear.resources import require_memory
 
 
 @dataclass
@@ -423,9 +424,23 @@ def relative_harmonic_model(sector: CyclicSector, k: int):
 # --------------------------------------------------------------------------------------------
 # the whole disk: the independent reference
 # --------------------------------------------------------------------------------------------
+def check_disk(sector: CyclicSector) -> None:
+    """Refuse (one InputError with the estimate and the machine's memory) a whole disk of
+    ``sector`` that cannot fit, before it is built: per sector the stored entries of its
+    matrices (the disk's, and the temporaries of their assembly), its DOF maps and block
+    rotations."""
+    m = sector.model
+    stored = sum(X.nnz if sp.issparse(X) else np.size(X)
+                 for X in (m.K, m.M, m.C, m.D) if X is not None)
+    n = sector.n_sectors
+    require_memory(n * (36.0 * stored + 8.0 * m.ndof * (3 + 3 * sector.dim)),
+                   f"the whole disk of {n:,} sectors of {m.ndof:,} DOFs")
+
+
 def _disk_numbering(sector: CyclicSector) -> tuple[np.ndarray, int]:
     """``maps`` (N, ndof): disk DOF of every DOF of sector ``j`` (its right boundary is the
     next sector's left one), and the disk's number of DOFs."""
+    check_disk(sector)
     keep = sector.kept_dofs()
     n, nq = sector.n_sectors, keep.size
     pos = np.full(sector.model.ndof, -1, dtype=np.int64)
@@ -560,6 +575,8 @@ def disk_harmonics(sector: CyclicSector, engine_order: int, orders, U) -> np.nda
     components), the travelling wave of the module docstring."""
     U = np.asarray(U, dtype=complex)
     orders = np.asarray(orders, dtype=np.int64)
+    require_memory(16.0 * (sector.n_sectors + 2) * U.size,
+                   f"the harmonics of {sector.n_sectors:,} sectors ({U.size:,} values each)")
     out = np.empty((sector.n_sectors, *U.shape), dtype=complex)
     for j in range(sector.n_sectors):
         phase = np.exp(1j * orders * int(engine_order) * j * sector.angle)
@@ -577,6 +594,8 @@ def disk_mesh(sector: CyclicSector):
     if mesh is None:
         raise InputError("disk_mesh: the sector model has no mesh")
     nn, d = mesh.points.shape
+    require_memory(2.0 * sector.n_sectors * (mesh.points.nbytes + np.asarray(mesh.cells).nbytes),
+                   f"the mesh of {sector.n_sectors:,} sectors")
     pt = sector.point[:d]
     points = np.concatenate([pt + (mesh.points - pt) @ sector.turn(j).T
                              for j in range(sector.n_sectors)])

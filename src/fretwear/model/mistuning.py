@@ -41,6 +41,7 @@ from fretwear.model.cyclic import (
     _wave_loads,
     sector_maps,
 )
+from fretwear.resources import require_memory
 
 #: the kinds of mistuning factors, one per sector each
 KINDS = ("young", "mu", "wear")
@@ -90,6 +91,7 @@ def mistuning(n_sectors: int, *, young=None, mu=None, wear=None) -> Mistuning:
             or n_sectors < 2:
         raise InputError(f"n_sectors = {n_sectors!r}: expected an integer >= 2")
     n = int(n_sectors)
+    require_memory(8.0 * 2 * len(KINDS) * n, f"the mistuning factors of {n:,} sectors")
     return Mistuning(_factors(young, "young", n), _factors(mu, "mu", n),
                      _factors(wear, "wear", n))
 
@@ -108,6 +110,8 @@ def random_mistuning(n_sectors: int, std: float, seed: int, kinds=("young",)) ->
     unknown = [k for k in kinds if k not in KINDS]
     if unknown or not kinds:
         raise InputError(f"mistuning kinds = {list(kinds)!r}: expected some of {list(KINDS)}")
+    require_memory(8.0 * 3 * len(KINDS) * int(n_sectors),
+                   f"the mistuning factors of {int(n_sectors):,} sectors")
     rng = np.random.default_rng(int(seed))
     draws = {k: 1.0 + float(std) * rng.standard_normal(int(n_sectors)) for k in KINDS}
     return mistuning(n_sectors, **{k: draws[k] for k in kinds})

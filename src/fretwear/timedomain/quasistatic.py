@@ -73,6 +73,12 @@ def incremental_wear(model: Model, *, n_cycles: int = 100,
     n_cycles = count(n_cycles, "n_cycles", 1)
     J = options.cycle_jump
     rec_every = options.record_every
+    computed = 1 + -(-(n_cycles - 1) // J)  # cycles computed (each stands for up to J)
+    if computed * N > MAX_LOAD_STEPS:
+        raise InputError(f"an incremental wear run of {computed:,} computed cycles of {N} load "
+                         f"steps (n_cycles = {n_cycles:,}, cycle_jump = {J:,}): expected at "
+                         f"most {MAX_LOAD_STEPS:,} load steps (days of computing); raise "
+                         "cycle_jump or lower n_cycles")
     kw = _archard_coefficient(model, wear_coefficient)
     t0 = time.perf_counter()
     c = model.contact
@@ -87,7 +93,6 @@ def incremental_wear(model: Model, *, n_cycles: int = 100,
     Ft = model.load_time(tau) if model.loads else np.zeros((N, model.ndof))
     btab = np.ascontiguousarray(cond.loads(Ft))
     fscale = float(np.abs(btab).max(initial=0.0))
-    computed = 1 + -(-(n_cycles - 1) // J)  # cycles computed (each stands for up to J)
     require_memory(8.0 * computed * (2 + 3 * nc / rec_every),
                    f"an incremental wear run of {computed:,} computed cycles (n_cycles = "
                    f"{n_cycles:,}, cycle_jump = {J:,})")
@@ -123,6 +128,11 @@ def incremental_wear(model: Model, *, n_cycles: int = 100,
         info={"max_active_set_iterations": int(maxit), "records": int(nr)})
 
 
+#: the most load steps (computed cycles x steps per cycle) of one run: at the ~0.1 ms of a
+#: load step of a small model, a day of computing
+MAX_LOAD_STEPS = 10**9
+
+
 def _archard_coefficient(model: Model, wear_coefficient) -> float:
     """``wear_coefficient`` k_w [1/Pa] checked, or by default the model's (both surfaces of a
     pair summed: the gap opens by both worn depths), which must be the same at every node."""
@@ -145,9 +155,9 @@ def _archard_coefficient(model: Model, wear_coefficient) -> float:
 def _cycle_jumps(n_cycles: int, J: int) -> np.ndarray:
     """The cycles each computed cycle stands for: 1 (the first, with the initial loading),
     then ``J``, the last shortened so that they add up to ``n_cycles``."""
-    jumps = [1]
-    left = n_cycles - 1
-    while left > 0:
-        jumps.append(min(J, left))
-        left -= jumps[-1]
-    return np.asarray(jumps, dtype=np.int64)
+    rest = n_cycles - 1
+    jumps = np.full(1 + -(-rest // J), J, dtype=np.int64)
+    jumps[0] = 1
+    if rest:
+        jumps[-1] = rest - J * (jumps.size - 2)
+    return jumps

@@ -63,6 +63,7 @@ from fretwear.hb.inputs import check_inputs
 from fretwear.hb.solution import PeriodicSolution
 from fretwear.hb.solvers import SolveStats
 from fretwear.model.core import Model
+from fretwear.resources import require_memory
 from fretwear.validate import number, whole
 from fretwear.wear.checkpoint import check_checkpoint_path, fingerprint
 from fretwear.wear.exponential_step import exponential_step
@@ -245,6 +246,7 @@ def worn_state(model: Model, basis: FourierBasis, *, frequency: float | None = N
         check_checkpoint_path(run.checkpoint)
     t_start = time.perf_counter()
     nc, d = model.contact.dofs.shape
+    check_history(options.max_steps, nc, d, basis.size)
     condenser, reduced, coef, wear0, anchor, warnings, sp = slow_setup(
         model, basis, frequency, quasi_static, balance, opts, wear0, time_domain)
     key = fingerprint(model, reduced, basis, sp.eps, coef,
@@ -277,6 +279,17 @@ def worn_state(model: Model, basis: FourierBasis, *, frequency: float | None = N
         _assemble(sp, balanced[-1]) if balanced else None, sp.eps,
         int(hist.newton_iterations.sum()) + found.jump_iterations,
         time.perf_counter() - t_start, resumed_from, warnings)
+
+
+def check_history(max_steps: int, nc: int, d: int, H: int) -> None:
+    """Refuse (one InputError with the estimate and the machine's memory) a march of
+    ``max_steps`` steps whose history cannot fit, before it starts: every step's record is
+    kept (the Fourier coefficients of the contact displacements and forces, ``nc d H`` each,
+    and about ten per-node quantities)."""
+    record = 8.0 * (2 * nc * d * H + (10 + d) * nc) + 600.0
+    require_memory(max_steps * record, f"max_steps = {max_steps:,}: the history of a march "
+                   f"of up to {max_steps:,} steps ({nc:,} contact nodes, {H} Fourier "
+                   "coefficients)")
 
 
 @dataclass(frozen=True)
