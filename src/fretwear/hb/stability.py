@@ -84,9 +84,12 @@ exponent (3-5 from a neighbour's exponent, 4-9 from a candidate); along a sweep,
 candidates are tracked, a few LU factorisations of the blocks of the quadratic problem per
 candidate instead of its dense eigensolve. ``det J`` is read from the solve's own ``G`` and
 ``Z~`` (:meth:`HillProblem.jacobian`). Measured on the benchmark's small models
-(docs/studies/method-costs.md, "Hill's method"): about 1.5-2.5 times a warm-started point's
-solve; the evaluations of ``T(s)`` (a law with a memory), the dense eigensolve at the points
-that cannot be tracked and the problem rebuilt from the solution are what cost. Dense up to
+(docs/studies/method-costs.md, "Hill's method"): about 1.2-2.2 times a warm-started point's
+solve along a sweep, which hands each point's own problem
+(:func:`fretwear.hb.sweep_stability.point_problem`; :func:`stability` rebuilds it from the
+solution, about 1.1-1.5 ms more there); the evaluations of ``T(s)`` (a law with a memory) and
+the dense eigensolve at the points that cannot be tracked (the period-doubling line) are what
+cost. Dense up to
 :data:`DENSE_MAX` unknowns of the balance. The sign of ``det J`` (``J = T(0)``) is reported
 with the exponents (:attr:`FloquetResult.det_sign`).
 """
