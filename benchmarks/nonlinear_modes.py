@@ -11,7 +11,8 @@
 * Hill's method at every point of two frequency sweeps (a forced Jenkins oscillator, 7
   harmonics; the two-DOF oscillator with a unilateral spring, 15 harmonics), each point given
   the result of the nearest point already computed to track its candidates from (as
-  :func:`fretwear.hb.sweep_stability.sweep_stability` does): its time against the point's
+  :func:`fretwear.hb.sweep_stability.sweep_stability` does, on the problem the sweep solved
+  the point on): its time against the point's
   solve (the sum of the attempts' times the sweep records), median and range.
 
 Ends with ``epmc_jenkins_err=<max relative error, one harmonic, 1024 samples>`` and
@@ -36,9 +37,9 @@ from fretwear.hb.nonlinear_modes import nonlinear_mode
 from fretwear.hb.options import SweepOptions
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.reduce import exact_condenser
-from fretwear.hb.stability import stability
+from fretwear.hb.stability import hill_stability, stability
 from fretwear.hb.sweep import sweep
-from fretwear.hb.sweep_stability import nearest
+from fretwear.hb.sweep_stability import nearest, point_problem
 from fretwear.model.beam import cantilever_matrices, modal_damping
 from fretwear.model.build import Damping
 from fretwear.model.core import Load
@@ -135,6 +136,14 @@ def beam_backbone():
           f"{100 * z7.max():.2f} % at log10 a = {np.log10(amps[np.argmax(z7)]):.2f}")
 
 
+def _hill(model, p, dyn, cond, seen):
+    """Hill's method at the sweep point ``p`` as :func:`sweep_stability` does it: on the
+    problem the sweep solved it on, candidates from the nearest point already computed."""
+    prob = point_problem(model, p, cond)
+    return hill_stability(prob, p.solution.U.reshape(prob.m, prob.H), dyn,
+                          previous=nearest(p.solution.U, seen))
+
+
 def hill_ratios(model, basis, f_min, f_max, n_points, label):
     """Hill's time at every converged point over the point's solve time (wall seconds, as the
     sweep records its attempts; the machine may be loaded, so the CPU seconds of Hill's
@@ -151,13 +160,11 @@ def hill_ratios(model, basis, f_min, f_max, n_points, label):
         if not p.attempts:  # an intermediate point (a substep, the arclength branch): its
             unrecorded += 1  # solve is not recorded per point (the ratio divided by ~0)
             prev = p.solution
-            seen.append((p.solution.U, stability(model, p.solution, dyn=dyn, condenser=cond,
-                                                 previous=nearest(p.solution.U, seen))))
+            seen.append((p.solution.U, _hill(model, p, dyn, cond, seen)))
             continue  # (as sweep_stability does, every point)
         solve_t = sum(a.wall_time for a in p.attempts)
         t0, c0 = time.perf_counter(), time.process_time()
-        fl = stability(model, p.solution, dyn=dyn, condenser=cond,
-                       previous=nearest(p.solution.U, seen))
+        fl = _hill(model, p, dyn, cond, seen)
         ratios.append((time.perf_counter() - t0) / max(solve_t, 1e-9))
         hill_cpu = time.process_time() - c0
         seen.append((p.solution.U, fl))

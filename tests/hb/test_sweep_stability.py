@@ -13,6 +13,8 @@ References (none is the code under test's own bookkeeping):
   definition, counted here independently).
 """
 
+import dataclasses
+
 import numpy as np
 import pytest
 from helpers.models import two_dof
@@ -21,9 +23,9 @@ from fretwear.hb.dynamics import structure_dynamics
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.options import SweepOptions
 from fretwear.hb.reduce import exact_condenser
-from fretwear.hb.stability import HillOptions, stability
+from fretwear.hb.stability import HillOptions, HillProblem, problem_of, stability
 from fretwear.hb.sweep import sweep
-from fretwear.hb.sweep_stability import branch_events, nearest, sweep_stability
+from fretwear.hb.sweep_stability import branch_events, nearest, point_problem, sweep_stability
 from fretwear.model.build import Damping
 from fretwear.model.core import Load
 from fretwear.model.matrices import ContactDofs, from_matrices
@@ -95,6 +97,38 @@ def test_tracked_candidates_give_the_dense_multipliers(folded):
     assert any(tracked) and not all(tracked)
     assert not any(fl.tracked for fl in dense.floquet if fl is not None)
     for a, b in zip(st.floquet, dense.floquet, strict=True):
+        assert (a is None) == (b is None)
+        if a is not None:
+            assert a.multipliers.shape == b.multipliers.shape
+            np.testing.assert_allclose(a.multipliers, b.multipliers, rtol=0, atol=1e-10)
+
+
+def test_the_sweeps_own_problems_give_the_rebuilt_problems_multipliers(folded):
+    """Every converged point of the sweep keeps the problem it was solved on, and Hill's
+    method runs on it (:func:`point_problem`) instead of condensing the model again; the
+    reference is the problem rebuilt from the solution (:func:`problem_of`, the only path
+    before; the points copied without their problem, as a checkpoint's are): the balance's
+    Jacobian equal to 1e-12 relative and the multipliers, one for one, to 1e-10 (the same
+    condensation at the frequency recorded in hertz rather than in rad/s, a rounding of
+    1e-16 relative; the multipliers' tolerance as in the test above)."""
+    res, st = folded
+    model = two_dof()
+    cond = exact_condenser(model)
+    dyn = structure_dynamics(model, cond)
+    bare = [dataclasses.replace(p, problem=None) for p in res.points]
+    assert all(p.problem is not None for p in res.points if p.success)
+    for p, q in zip(res.points, bare, strict=True):
+        if not p.success:
+            continue
+        assert point_problem(model, p, cond) is p.problem
+        a = HillProblem(p.problem, p.solution.U, dyn).jacobian()
+        b = HillProblem(problem_of(model, q.solution, condenser=cond), q.solution.U,
+                        dyn).jacobian()
+        np.testing.assert_allclose(a, b, rtol=0, atol=1e-12 * np.abs(b).max())
+    rebuilt = sweep_stability(model, dataclasses.replace(res, points=bare), condenser=cond)
+    np.testing.assert_array_equal(rebuilt.stable, st.stable)
+    np.testing.assert_array_equal(rebuilt.det_sign, st.det_sign)
+    for a, b in zip(st.floquet, rebuilt.floquet, strict=True):
         assert (a is None) == (b is None)
         if a is not None:
             assert a.multipliers.shape == b.multipliers.shape

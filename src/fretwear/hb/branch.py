@@ -25,6 +25,13 @@ from fretwear.hb.sweep_result import SweepPoint
 #: "Large interfaces")
 CACHE_SIZE = 8
 CACHE_BYTES = 3 * 2**30
+#: a converged point keeps the problem it was solved on (:attr:`SweepPoint.problem`, for
+#: Hill's method) when its reduced model (``Z`` and the observed DOFs' recovery) takes at most
+#: this many bytes: Hill's method then does not condense the model again (0.6-0.9 ms a point
+#: on small models). The problem's own arrays (its harmonic blocks, its Jacobian once formed)
+#: take a few times that, so 100 points pin some tens of MiB at most; larger models would
+#: pin one reduced model per point for the whole sweep
+KEEP_PROBLEM_BYTES = 2**16
 
 
 class Problems:
@@ -144,6 +151,9 @@ class Branch:
         history (not to :attr:`points`)."""
         sol = assemble_solution(prob, U, self.model, stats)
         pt = SweepPoint(omega / (2 * np.pi), sol, stats, how, [])
+        red = prob.reduced
+        if sol.success and red.Z.nbytes + red.obs_A.nbytes <= KEEP_PROBLEM_BYTES:
+            pt.problem = prob
         if not sol.success:  # non-finite values (assemble_solution): a failure, no predictor
             pt.flags.append(f"not converged: {stats.message}")
             return pt

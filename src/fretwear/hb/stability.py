@@ -84,9 +84,12 @@ exponent (3-5 from a neighbour's exponent, 4-9 from a candidate); along a sweep,
 candidates are tracked, a few LU factorisations of the blocks of the quadratic problem per
 candidate instead of its dense eigensolve. ``det J`` is read from the solve's own ``G`` and
 ``Z~`` (:meth:`HillProblem.jacobian`). Measured on the benchmark's small models
-(docs/studies/method-costs.md, "Hill's method"): about 1.5-2.5 times a warm-started point's
-solve; the evaluations of ``T(s)`` (a law with a memory), the dense eigensolve at the points
-that cannot be tracked and the problem rebuilt from the solution are what cost. Dense up to
+(docs/studies/method-costs.md, "Hill's method"): about 1.2-2.2 times a warm-started point's
+solve along a sweep, which hands each point's own problem
+(:func:`fretwear.hb.sweep_stability.point_problem`; :func:`stability` rebuilds it from the
+solution, about 1.1-1.5 ms more there); the evaluations of ``T(s)`` (a law with a memory) and
+the dense eigensolve at the points that cannot be tracked (the period-doubling line) are what
+cost. Dense up to
 :data:`DENSE_MAX` unknowns of the balance. The sign of ``det J`` (``J = T(0)``) is reported
 with the exponents (:attr:`FloquetResult.det_sign`).
 """
@@ -129,6 +132,10 @@ EDGE_TOL = 1e-2
 #: a member of a period-doubling family whose centroid the truncation puts up to this above
 #: 1/2, within this of Im s = w/2, is kept when no other member is (:func:`_edge_members`)
 EDGE_KAPPA = 0.05
+#: margin on the thresholds of the centroid rule when a tracked member's neighbouring copy is
+#: checked (:func:`_may_keep`): the centroids of one eigenvector found by inverse iteration
+#: and by the dense eigensolver differ by rounding (about 1e-12 on the benchmark's models)
+KAPPA_MARGIN = 1e-6
 #: entries of the quadratic problem below this times the largest of their matrix are taken as
 #: zeros when it is split into the blocks it decouples into (:func:`_components`): rounding of
 #: the law's time-invariant parts (``P Q = I`` to 1e-16), whose dropping moves the exponents
@@ -779,9 +786,11 @@ def track_eigen(red: QuadraticReduction, track: HillTrack | None, shape: tuple):
       a mass; a complex member stands for two, its conjugate being another family's): every
       family is represented;
     * the copy ``s + i sign(kappa)`` of each (the neighbour in its family on the side of the
-      tie at ``|kappa| = 1/2``; a copy ``s + i j`` has the centroid ``kappa - j``) has
-      ``|kappa| > 1/2``: no family has a second member that the rule keeps (copies further
-      off have ``|kappa| >= 3/2`` less their truncation).
+      tie at ``|kappa| = 1/2``; a copy ``s + i j`` has the centroid ``kappa - j``) is one
+      that the dense path would not keep (:func:`_may_keep`: ``|kappa| > 1/2`` and not a
+      period-doubling member that :func:`_edge_members` may add, with a margin for
+      rounding): no family has a second member that the rule keeps (copies further off
+      have ``|kappa| >= 3/2`` less their truncation).
 
     Returns ``(vals, vecs, kap)`` as :func:`dense_eigen`, the members only."""
     if track is None or not track.complete or red.dyn.size != track.nd:
@@ -838,10 +847,22 @@ def track_eigen(red: QuadraticReduction, track: HillTrack | None, shape: tuple):
         Yn = np.zeros((nd, 1), dtype=complex)
         Yn[comp, 0] = y2
         kn = centroid(red.full(Yn).T.reshape(r, H), k)
-        if abs(kn) <= 0.5 + EDGE_KAPPA and s2.imag >= -1e-12 * max(abs(s2), 1.0):
-            if np.min(np.abs(vals - s2)) > 1e-8 * max(1.0, abs(s2)):
-                return None  # another member the rule may keep (or nearly)
+        if _may_keep(s2, kn) and np.min(np.abs(vals - s2)) > 1e-8 * max(1.0, abs(s2)):
+            return None  # another member the rule may keep (or nearly)
     return vals, red.full(Y), kap
+
+
+def _may_keep(s: complex, kap: float) -> bool:
+    """Whether the dense path's selection (:func:`hill_stability`: ``|kappa| <= 1/2`` and
+    ``Im s >= 0``, or a member :func:`_edge_members` may add) could keep the eigenvalue ``s``
+    (in ``s / w``) of centroid ``kap``, with :data:`KAPPA_MARGIN` on every threshold (``s``
+    and ``kap`` found by inverse iteration differ from the dense eigensolver's by rounding)."""
+    if s.imag < -KAPPA_MARGIN * max(abs(s), 1.0):
+        return False
+    if abs(kap) <= 0.5 + KAPPA_MARGIN:
+        return True
+    return (abs(abs(s.imag) - 0.5) <= EDGE_KAPPA + KAPPA_MARGIN
+            and abs(kap) <= 0.5 + EDGE_KAPPA + KAPPA_MARGIN)
 
 
 def _track_record(red: QuadraticReduction, vals: np.ndarray, vecs: np.ndarray,

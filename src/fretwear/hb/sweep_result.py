@@ -43,7 +43,10 @@ class SweepPoint:
     (False for the intermediate points the sweep added); time_domain : what the time
     integration found at a point whose balance failed (``""`` when none ran);
     fallback_seconds : wall time [s] spent after the first attempt
-    (:mod:`fretwear.hb.fallbacks`).
+    (:mod:`fretwear.hb.fallbacks`); problem : the
+    :class:`~fretwear.hb.problem.DLFTProblem` the solution was solved on, kept for Hill's
+    method (:func:`fretwear.hb.sweep_stability.sweep_stability`) when its reduced model is
+    small (None otherwise, and for a point read from a checkpoint: rebuilt from the solution).
     """
 
     frequency_hz: float
@@ -55,6 +58,7 @@ class SweepPoint:
     time_domain: str = ""
     attempts: list = field(default_factory=list)
     fallback_seconds: float = 0.0
+    problem: object = field(default=None, repr=False, compare=False)
 
     @property
     def success(self) -> bool:

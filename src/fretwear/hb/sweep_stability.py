@@ -30,6 +30,7 @@ import numpy as np
 
 from fretwear.errors import InputError
 from fretwear.hb.dynamics import StructureDynamics, structure_dynamics
+from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.stability import (
     FloquetResult,
     HillOptions,
@@ -108,7 +109,8 @@ def jacobian_sign(hp: HillProblem) -> int:
 def sweep_stability(model: Model, result: SweepResult, *, options: HillOptions | None = None,
                     dyn: StructureDynamics | None = None, condenser=None) -> SweepStability:
     """Hill's method at every converged point of ``result`` (a sweep of ``model``) and the
-    branch events between them (module docstring). ``dyn``: the model's
+    branch events between them (module docstring), each on the problem its point was solved
+    on (:func:`point_problem`). ``dyn``: the model's
     :func:`~fretwear.hb.dynamics.structure_dynamics` if already made; ``condenser``: the
     model's condenser as the sweep had it (for the problems rebuilt from the solutions)."""
     instance(result, SweepResult, "result", "the SweepResult of fretwear.sweep (or frf_worn)")
@@ -131,7 +133,7 @@ def sweep_stability(model: Model, result: SweepResult, *, options: HillOptions |
             continue
         t0 = time.perf_counter()
         try:
-            prob = problem_of(model, p.solution, condenser=condenser)
+            prob = point_problem(model, p, condenser)
             fl = hill_stability(prob, p.solution.U.reshape(prob.m, prob.H), dyn,
                                 options=options, previous=nearest(p.solution.U, seen))
             seen.append((np.ravel(p.solution.U), fl))
@@ -147,6 +149,18 @@ def sweep_stability(model: Model, result: SweepResult, *, options: HillOptions |
     out = SweepStability(stable, rho, det, floquet, [], wall, notes)
     out.events = branch_events(result.frequency_hz, out)
     return out
+
+
+def point_problem(model: Model, point, condenser=None) -> DLFTProblem:
+    """The :class:`~fretwear.hb.problem.DLFTProblem` a converged sweep point was solved on:
+    the one the sweep kept (:attr:`~fretwear.hb.sweep_result.SweepPoint.problem`, small
+    models), otherwise rebuilt from its solution (:func:`~fretwear.hb.stability.problem_of`,
+    ``condenser`` the model's). The sweep's own saves the condensation and the problem's
+    set-up, 1.1-1.5 ms a point on the benchmark's models (docs/studies/method-costs.md)."""
+    prob = getattr(point, "problem", None)
+    if isinstance(prob, DLFTProblem) and prob.m * prob.H == np.size(point.solution.U):
+        return prob
+    return problem_of(model, point.solution, condenser=condenser)
 
 
 def nearest(U, seen: list) -> FloquetResult | None:
