@@ -1033,6 +1033,60 @@ def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions,
     return sigma, v, res, res <= opt.newton_tol, slope
 
 
+#: a refined exponent from a complex candidate whose imaginary part is below this [w] and
+#: a thousandth of the candidate's landed on the real axis: a real exponent (a multiplier's
+#: phase of 2 pi 1e-6 per period is no oscillation)
+ON_REAL = 1e-6
+
+
+def _landed_real(s0: complex, s1: complex) -> bool:
+    """The refinement of the complex candidate ``s0`` converged to the real ``s1``: the
+    frozen-memory pair split on the real axis in the exact problem (a pair of real
+    multipliers, one of which is the other member of the pair)."""
+    return s0.imag != 0.0 and abs(s1.imag) <= min(ON_REAL, 1e-3 * abs(s0.imag))
+
+
+def _second_real(hp: HillProblem, s0: complex, s1: float, v: np.ndarray, opt: HillOptions):
+    """The other real exponent of a candidate pair ``s0`` (and its conjugate) whose
+    refinement landed on the real root ``s1`` (:func:`_landed_real`): the same scalar
+    equation as :func:`_track` on the real axis, ``mu(sigma) = 0`` for the eigenvalue that
+    continues ``v``, deflated by the root found, ``mu(sigma) / (sigma - s1)`` (a pair of
+    complex roots of the frozen problem becomes two real crossings of one eigenvalue branch),
+    by the secant method from the candidate's real part. Returns ``(sigma, v, residual,
+    converged)``; ``converged`` only at a root apart from ``s1`` by more than
+    :data:`ON_REAL`."""
+    sigma = complex(s0.real if abs(s0.real - s1) > 10 * ON_REAL else s1 - 0.01, 0.0)
+    prev = None
+    res = np.inf
+    mu0 = 0.0
+    for _ in range(opt.newton_max_iter):
+        if abs(sigma - s0.real) > 0.5 or 2.0 * np.pi * sigma.real < np.log(NEGLIGIBLE) \
+                or abs(sigma.real - s1) <= ON_REAL:
+            break  # left the candidate's neighbourhood, or back on the root found
+        T = hp.matrix(sigma)
+        scale = np.linalg.norm(T, 1)
+        mu, v, lu = _pair(T, v, mu0)
+        pair = float(np.linalg.norm(T @ v - mu * v) / scale)
+        res = max(float(abs(mu) / scale), pair)
+        if res <= opt.newton_tol:
+            return sigma.real, v, res, True
+        f = mu / (sigma - s1)
+        if prev is None:
+            d = _mu_derivative(hp, sigma, v, T, lu, opt.step)
+            slope = (d * (sigma - s1) - mu) / (sigma - s1) ** 2
+        else:
+            slope = (f - prev[1]) / (sigma - prev[0]) if f != prev[1] else 0.0
+        if slope == 0:
+            break
+        prev = (sigma, f)
+        new = complex((sigma - f / slope).real, 0.0)
+        mu0 = 0.0 if pair < 1e-3 else mu
+        if not np.isfinite(new) or new == sigma:
+            break
+        sigma = new
+    return sigma.real, v, res, False
+
+
 def _warm_start(track: HillTrack | None, j: int | None, s0: complex) -> Refined | None:
     """Where the refinement of candidate ``s0`` starts along a sweep: the neighbour's
     refinement of the same candidate (member ``j`` of its :class:`HillTrack`, which
@@ -1131,6 +1185,13 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
         if not conv:  # no exponent of the exact problem near it: an artefact of the frozen
             spurious.append(s0)  # memory (a node that sticks part of the period)
             continue
+        if _landed_real(s0, s1):  # a pair of real exponents: find the other one, or say
+            s1 = complex(s1.real, 0.0)  # that it is missing (the conjugate candidate)
+            s2, v2, r2, conv2 = _second_real(hp, s0, s1.real, vx, opt)
+            sig.append(complex(s2, 0.0) if conv2 else np.conj(s0))
+            kaps.append(centroid(v2.reshape(m, H), k) if conv2 else -kp)
+            res.append(r2 if conv2 else np.nan)
+            kind.append("refined" if conv2 else "candidate")
         done[pos] = Refined(s0, s1, v1, slope)
         sig.append(s1)
         kaps.append(centroid(v1.reshape(m, H), k))
