@@ -218,7 +218,15 @@ def test_first_sweep_point_is_as_robust_as_a_single_solve():
     assert abs(a_sweep - a_single) <= 1e-6 * a_single
 
 
-def test_tutorial_joint_at_its_resonance_converges_at_the_first_attempt():
+@pytest.fixture(scope="module")
+def tutorial():
+    """The tutorial's lap joint and its basis (harmonics 0-3, 64 samples)."""
+    from helpers.lap_joint import tutorial_joint
+
+    return tutorial_joint(), FourierBasis.up_to(3, 64)
+
+
+def test_tutorial_joint_at_its_resonance_converges_at_the_first_attempt(tutorial):
     """The tutorial's lap joint at its resonance (interface open 94 % of the period): from the
     contact-closed guess Powell stalled at a relative residual of 2e-2 in 200 iterations and
     the ladder went on to the harmonic continuation; the start from the first harmonic alone
@@ -227,11 +235,11 @@ def test_tutorial_joint_at_its_resonance_converges_at_the_first_attempt():
     start existed): a converged balance at one eps and one set of anchors is one point of the
     response, so the amplitudes agree to the solvers' tolerance (1e-6 relative; measured
     1e-10); and a fresh problem evaluates the residual of the answer below 1e-8."""
-    from helpers.lap_joint import AMPLITUDE_AT_PEAK, F_PEAK, tutorial_joint
+    from helpers.lap_joint import AMPLITUDE_AT_PEAK, F_PEAK
 
     import fretwear as fw
 
-    model, basis = tutorial_joint(), FourierBasis.up_to(3, 64)
+    model, basis = tutorial
     sol = fw.solve_periodic(model, basis, F_PEAK)
     assert sol.success and [a.method for a in sol.attempts] == ["start"], sol.attempts
     amp = sol.observed_amplitude("joint")[1, list(basis.harmonics).index(1)]
@@ -241,3 +249,22 @@ def test_tutorial_joint_at_its_resonance_converges_at_the_first_attempt():
     U = sol.U.reshape(prob.m, prob.H)
     f, _ = prob.residual(U, jacobian=False)
     assert np.linalg.norm(f) <= 1e-8 * prob.scale(U)
+
+
+def test_first_sweep_point_of_the_tutorial_converges_at_its_grid_attempt(tutorial):
+    """The first point of the tutorial's sweep (400 Hz) has no neighbour: from the
+    contact-closed guess in a warm-started point's 40 iterations it stalled at a relative
+    residual of 6e-2 and the point needed the eps continuation; started as a single solve
+    (the first harmonic alone, 200 iterations) its grid attempt converges. Compared with
+    fw.solve_periodic at the sweep's own eps (its own ladder and start): one converged
+    balance, so the amplitudes agree to the solvers' tolerance (1e-6 relative)."""
+    import fretwear as fw
+
+    model, basis = tutorial
+    res = fw.sweep(model, basis, 400.0, 410.0, 2, time_domain=False)
+    pt = res.points[0]
+    assert pt.success and [a.method for a in pt.attempts] == ["grid"], pt.attempts
+    single = fw.solve_periodic(model, basis, 400.0, eps=pt.solution.eps)
+    assert single.success
+    a_single = single.observed_amplitude("joint")[1, list(basis.harmonics).index(1)]
+    assert abs(res.amplitude("joint", "y")[0] - a_single) <= 1e-6 * a_single
