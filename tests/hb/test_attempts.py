@@ -140,7 +140,7 @@ def test_strategy_without_an_attempt_at_the_target_reports_the_start_residual():
 
 # --- the cold start of a single solve -------------------------------------------------------
 def test_cold_start_on_the_operator_path_is_the_contact_closed_guess(monkeypatch):
-    """Above 3 harmonics a single solve on the dense path starts from the first harmonic
+    """With more than one harmonic a single solve on the dense path starts from the first harmonic
     alone; on the operator path (large interfaces, in partial slip where fretting happens) it
     starts from the contact-closed guess, and converges from there to the dense path's answer.
     The reference is independent of the start: the dense path's converged harmonics (formed
