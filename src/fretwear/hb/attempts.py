@@ -70,7 +70,13 @@ EPS_STEP_MAX_ITER = 20
 #: of the sweep's ``max_iter``: 5 x 40 is the single solve's default of 200
 FRESH_ITER_FACTOR = 5
 #: harmonics above which a single solve without a start begins from the first harmonic alone
-COLD_START_HARMONICS = 3
+#: (the first point of a sweep too): with more than one. From the contact-closed guess the
+#: solvers stalled with 15+ harmonics (docs/verification.md), and with 3 wherever the
+#: interface opens for most of the period: the tutorial's lap joint at its resonance (open 94 %
+#: of the time) stalled at a relative residual of 2e-2 in 200 Powell iterations, where the
+#: first harmonic alone started a 6-iteration solve to the same answer, and the wear run then
+#: took its first state from a time integration (docs/studies/fallbacks.md)
+COLD_START_HARMONICS = 1
 #: on the operator path (large interfaces) the first-harmonic start gives up after this many
 #: Jacobians in a row without an iteration that decreased ``|f|^2`` by 10 % (MINPACK's
 #: progress test, fretwear.hb.solvers.powell): it is a start, and a stalled one is not used
@@ -409,9 +415,18 @@ def _solve(prob: DLFTProblem, x0, options: SolveOptions):
 
 
 def grid(p: Point) -> bool:
-    """``"grid"``: the solver from the secant predictor, with the anchors of the history."""
-    b = p.branch
-    prob, U, st = solve_at(p.probs, p.omega, b.anchor(), b.predict(p.omega), p.options.solve)
+    """``"grid"``: the solver from the secant predictor, with the anchors of the history; at
+    the first point of a branch (no predictor) from the start of a single solve
+    (:func:`cold_start`: the first harmonic alone with more than one) with a single solve's
+    iterations (:data:`~fretwear.hb.options.PERIODIC`): the 40 of a warm-started point left
+    the tutorial's lap joint at 400 Hz at a relative residual of 6e-2 from the contact-closed
+    guess (then the eps continuation, 4 s: docs/studies/fallbacks.md)."""
+    b, so = p.branch, p.options.solve
+    U0 = b.predict(p.omega)
+    if U0 is None:
+        so = so.replace(max_iter=max(so.max_iter, PERIODIC.max_iter))
+        U0 = cold_start(p.probs.get(p.omega, b.anchor()), None, so)
+    prob, U, st = solve_at(p.probs, p.omega, b.anchor(), U0, so)
     p.tried.append(Attempt.of("grid", prob.eps, st))
     return p.adopt(prob, U, st, "grid")
 

@@ -63,9 +63,10 @@ def first_state(sp: SlowProblem, wear0, anchor, U0, opts: WearOptions
     sp.set_state(wear0, anchor)
     # the first balance goes through solve_periodic (its start strategies for a cold start);
     # its attempts are opts.solve.strategy, by default the solver alone (WEAR_STEP): a wear
-    # run has its own fallback (a start from a time integration), and its examples are
-    # validated with it (the further attempts of solve_periodic find a balance of the 79 kHz
-    # reduced example that the time-domain start replaces today)
+    # run has its own fallback (a start from a time integration). Its start is a single
+    # solve's (from the first harmonic alone with more than one harmonic): on the 79 kHz
+    # reduced example (3 harmonics) it finds the balance that the time integration from rest
+    # led to at the next step, where the contact-closed guess failed (tests/test_examples.py)
     first = opts.solve.replace(max_iter=max(opts.solve.max_iter, 200))
     sol0 = solve_periodic(sp.model, sp.prob.basis, frequency=sp.prob.reduced.frequency,
                           quasi_static=sp.prob.reduced.quasi_static, options=first,
