@@ -72,3 +72,24 @@ def test_cost_of_points_and_of_a_wear_history():
     small = fallbacks.of_wear([0, 1], [9.0, 1.0], total=100.0)
     assert small.line("slow steps", hint).endswith("1.0 s (1 % of 100.0 s)")  # no hint < 20 %
     assert fallbacks.FallbackCost().line() == ""
+
+
+def test_halved_steps_and_arclength_are_the_sweeps_path_not_fallbacks():
+    """A sweep point that needed only a halved step or the arclength past a fold (the rungs
+    of fallbacks.CONTINUATION) is counted apart from the fallbacks and said on its own line;
+    one that needed another solver (retry) or a time integration stays a fallback. Counted by
+    hand on made-up points."""
+    points = [SimpleNamespace(attempts=_attempts("grid", "substep"), fallback_seconds=1.0),
+              SimpleNamespace(attempts=_attempts("grid", "arclength"), fallback_seconds=3.0),
+              SimpleNamespace(attempts=_attempts("grid", "arclength", "time-start"),
+                              fallback_seconds=4.0),
+              SimpleNamespace(attempts=_attempts("grid", "retry"), fallback_seconds=2.0)]
+    cost = fallbacks.of_solutions(points, total=20.0)
+    assert (cost.count, cost.time_domain, cost.seconds) == (2, 1, 6.0)
+    assert (cost.continued, cost.continued_seconds) == (2, 4.0)
+    assert cost.continuation_line() == (
+        "continuation: 2 frequencies needed halved steps or arclength past a fold (the "
+        "sweep's own path, not fallbacks): 4.0 s (20 % of 20.0 s)")
+    only = fallbacks.of_solutions(points[:2], total=20.0)
+    assert only.line("frequencies") == "" and only.continued == 2
+    assert fallbacks.FallbackCost().continuation_line() == ""

@@ -335,10 +335,11 @@ def run_sweep(model, analysis: dict, case, context: RunContext) -> RunOutput:
     })
     figures = sweep_figures(ds, case, context.out_dir)
     grid_ok = all(p.success for p in result.points if p.on_grid)
-    fallback = fallbacks.of_solutions(result.points, result.wall_time).line(
-        "frequencies", fallbacks.eps_hint("eps" in analysis))
-    summary = "\n".join([_sweep_summary(result, ds), *events, *([fallback] if fallback else []),
-                         cond.choice.summary()])
+    cost = fallbacks.of_solutions(result.points, result.wall_time)
+    said = [line for line in (cost.continuation_line("frequencies"),
+                              cost.line("frequencies", fallbacks.eps_hint("eps" in analysis)))
+            if line]
+    summary = "\n".join([_sweep_summary(result, ds), *events, *said, cond.choice.summary()])
     return RunOutput(ds, figures, summary, grid_ok, warnings=list(result.warnings))
 
 

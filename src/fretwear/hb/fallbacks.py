@@ -19,6 +19,10 @@ from dataclasses import dataclass
 log = logging.getLogger("fretwear")
 #: the share of the run's time in fallbacks above which the summary names a setting to try
 HINT_SHARE = 0.2
+#: the rungs of a sweep point that are the sweep's own path along its branch, not fallbacks:
+#: the grid step, its halving and the pseudo-arclength continuation past a fold (a point
+#: that needed only these is counted apart, :attr:`FallbackCost.continued`)
+CONTINUATION = ("grid", "substep", "arclength")
 
 
 def said(message: str) -> None:
@@ -36,6 +40,8 @@ class FallbackCost:
     time_domain: int = 0
     seconds: float = 0.0
     total: float = 0.0
+    continued: int = 0
+    continued_seconds: float = 0.0
 
     @property
     def share(self) -> float:
@@ -59,15 +65,34 @@ class FallbackCost:
                 f"{self.seconds:.1f} s{share}{tail}")
 
 
+    def continuation_line(self, what: str = "frequencies") -> str:
+        """One summary line of the points that needed only the sweep's own continuation
+        (:data:`CONTINUATION`; "" without them): said apart from the fallbacks, since
+        halving a step or following the branch past a fold is the sweep's path, which a
+        different default would not avoid."""
+        if not self.continued:
+            return ""
+        share = (f" ({100 * self.continued_seconds / self.total:.0f} % of {self.total:.1f} s)"
+                 if self.total > 0 else "")
+        return (f"continuation: {self.continued} {what} needed halved steps or arclength past "
+                f"a fold (the sweep's own path, not fallbacks): "
+                f"{self.continued_seconds:.1f} s{share}")
+
+
 def of_solutions(points, total: float) -> FallbackCost:
     """The cost of the fallbacks of periodic solutions or sweep points (anything with
-    ``fallback_seconds`` and ``attempts``), out of ``total`` seconds."""
+    ``fallback_seconds`` and ``attempts``), out of ``total`` seconds; a sweep point that
+    needed only the rungs of :data:`CONTINUATION` is counted apart (``continued``)."""
     cost = FallbackCost(total=float(total))
     for p in points:
         attempts = getattr(p, "attempts", [])
         if len(attempts) > 1 or (attempts and not attempts[0].success):
-            cost.add(getattr(p, "fallback_seconds", 0.0),
-                     any(a.method == "time-start" for a in attempts))
+            seconds = float(getattr(p, "fallback_seconds", 0.0))
+            if all(a.method in CONTINUATION for a in attempts):
+                cost.continued += 1
+                cost.continued_seconds += seconds
+                continue
+            cost.add(seconds, any(a.method == "time-start" for a in attempts))
     return cost
 
 
