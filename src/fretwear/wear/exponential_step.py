@@ -38,16 +38,15 @@ balance, the rejection of a step whose error estimate exceeds the tolerance.
 
 from __future__ import annotations
 
-import math
 import time
 
 import numpy as np
 import scipy.linalg as sla
 
 from fretwear.wear.options import GROWTH_LIMIT, MIN_JUMP_FRACTION, WearOptions
+from fretwear.wear.schemes import accept
 from fretwear.wear.slow_problem import SlowProblem
-from fretwear.wear.state import SlowStep, StepRecord, StepStats
-from fretwear.wear.step_control import local_error, next_jump
+from fretwear.wear.state import SlowStep
 
 #: the largest ``dN lam`` of a growing mode ``lam`` of ``Js`` in one step (a growth of the
 #: mode by ``e^2`` at most; the error control judges the step)
@@ -78,12 +77,12 @@ def exponential_step(sp: SlowProblem, st: SlowStep, opts: WearOptions):
     Js, dUdW = sp.slow_jacobian(st.U, with_dUdW=True)
     dN = min(st.jump, opts.max_jump, opts.max_cycles - st.cycles)
     floor = max(opts.min_jump, MIN_JUMP_FRACTION * st.cycles)
-    iters, rejected, failures = 1, 0, 0
     lam_plus = float(np.max(np.linalg.eigvals(Js).real))
     exponential = lam_plus > 0 and dN * lam_plus > GROWTH_LIMIT  # the march would cut it
     if exponential:
         dN = min(dN, EXP_GROWTH_LIMIT / lam_plus)
-    while True:
+
+    def attempt(dN):  # the balance at the end of a jump of dN (as advance's _attempt)
         if exponential:
             dW = increment(Js, st.g, dN)
         else:  # the march's step, to the bit
@@ -92,29 +91,11 @@ def exponential_step(sp: SlowProblem, st: SlowStep, opts: WearOptions):
         W1 = st.W + dW
         U1, stats = sp.solve_balance(W1, anchor, st.U + (dUdW @ dW).reshape(sp.m, sp.H),
                                      options=opts.solve)
-        iters += stats.iterations
         if not stats.success:  # as advance(): from the previous balance, shifted
+            its = stats.iterations
             U1, stats = sp.solve_balance(W1, anchor, sp.shift_guess(st.U, dW),
                                          options=opts.solve)
-            iters += stats.iterations
-        if not stats.success:
-            failures += 1
-            rejected += 1
-            if failures > opts.max_retries or dN <= floor:
-                return None, None, (f"{stats.message} at N = {st.cycles:.4g} with a jump of "
-                                    f"{dN:.3g} cycles after {failures} attempts")
-            dN = max(dN / 4.0, floor)
-            continue
-        sp.set_state(W1, anchor)
-        g1 = sp.rate(U1)
-        err = local_error(dN, W1, st.W, g1, st.g)
-        if opts.adaptive and err > opts.tolerance and dN > floor:
-            rejected += 1
-            dN = max(dN * max(0.1, 0.9 * math.sqrt(opts.tolerance / err)), floor)
-            continue
-        break
-    jump = next_jump(dN, err, opts, st.jump, 1.0 if failures else 5.0)
-    sol = sp.solution(U1, W1, anchor, stats)
-    record = StepRecord.balanced(sol, W1, g1, StepStats(st.cycles + dN, dN, iters, rejected,
-                                                        err, time.perf_counter() - t0))
-    return SlowStep.balanced(record, jump, st), record, ""
+            stats.iterations += its
+        return W1, U1, stats
+
+    return accept(sp, opts, st, anchor, attempt, (dN, floor, floor), (t0, 1, 0))

@@ -121,7 +121,7 @@ def advance(sp: SlowProblem, st: SlowStep, opts: WearOptions):
     rescue = sp.time_domain is not None
     # failed solves: with a time-domain rescue behind, stop cutting where the rescue starts
     fail_floor = max(floor, RESCUE_START_FRACTION * st.cycles) if rescue else floor
-    iters = rejected = failures = 0
+    iters = rejected = 0
     lin = None
     if opts.scheme != "explicit":
         sp.set_state(st.W, anchor)
@@ -132,8 +132,25 @@ def advance(sp: SlowProblem, st: SlowStep, opts: WearOptions):
         lam_plus = float(np.max(np.linalg.eigvals(lin[0]).real))
         if lam_plus > 0:
             dN = min(dN, GROWTH_LIMIT / lam_plus)
+    return accept(sp, opts, st, anchor, lambda dn: _attempt(sp, opts, start, dn, lin),
+                  (dN, floor, fail_floor), (t0, iters, rejected))
+
+
+def accept(sp: SlowProblem, opts: WearOptions, st: SlowStep, anchor, attempt, jumps,
+           counts):
+    """The acceptance loop of a slow step from ``st`` (:func:`advance` and
+    :func:`fretwear.wear.exponential_step.exponential_step`): ``attempt(dN) -> (W1, U1,
+    stats)`` tries a jump of ``dN`` cycles; a failed balance is retried with the jump divided
+    by 4 (up to ``max_retries`` times, not below ``fail_floor``); with ``adaptive``, a step
+    whose error estimate exceeds the tolerance is retried with the jump the controller
+    proposes (not below ``floor``). ``jumps`` = ``(dN, floor, fail_floor)``, ``counts`` =
+    ``(t0, iterations, rejected)`` so far. Returns ``(new_state, record, "")`` or ``(None,
+    None, message)``."""
+    dN, floor, fail_floor = jumps
+    t0, iters, rejected = counts
+    failures = 0
     while True:
-        W1, U1, stats = _attempt(sp, opts, start, dN, lin)
+        W1, U1, stats = attempt(dN)
         iters += stats.iterations
         if not stats.success:
             failures += 1
