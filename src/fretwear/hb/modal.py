@@ -44,6 +44,7 @@ from numba import njit
 
 from fretwear.errors import InputError
 from fretwear.hb.modal_operator import ReducedOperator
+from fretwear.hb.problem import DENSE_JACOBIAN_MAX
 from fretwear.hb.reduce import (
     BLOCK,
     Condenser,
@@ -79,9 +80,8 @@ MAX_MODES = 512
 #: representation shows (docs/studies/large-interface-solve.md)
 REPRESENTATIONS = ("auto", "dense", "operator")
 #: real unknowns ``m H`` above which ``"auto"`` takes the operator: where the periodic solve
-#: takes the operator Jacobian (fretwear.hb.problem.DENSE_JACOBIAN_MAX, which this module,
-#: a layer below, does not import; tests/hb/test_modal_blocked.py checks that they agree)
-OPERATOR_MIN_UNKNOWNS = 3000
+#: takes the operator Jacobian
+OPERATOR_MIN_UNKNOWNS = DENSE_JACOBIAN_MAX
 
 
 def next_mode_count(n_modes: int, n_interior: int) -> int | None:
