@@ -72,7 +72,7 @@ def test_periodic_solve_in_partial_slip_equals_dense_modal_path():
 @pytest.mark.parametrize("damping", [None, Damping(loss_factor=0.02, rayleigh_mass=100.0,
                                                    rayleigh_stiffness=1e-7)])
 def test_dense_condenser_as_operator_equals_its_blocks(damping):
-    """ModalCondenser with ``representation="operator"`` (what "auto" takes above
+    """ModalCondenser with ``representation="operator"`` (what "auto" takes on large
     interfaces) against the same condenser's dense blocks: the same projections summed in
     another order, so equal to rounding (1e-12, as above); "auto" keeps the blocks on this
     small model; a periodic solve in partial slip through the operator reaches the dense
@@ -109,32 +109,3 @@ def test_representation_is_checked():
 
     with pytest.raises(InputError, match="representation = 'sparse'"):
         ModalCondenser(block(None), F_MAX, 3, tol=1e-2, representation="sparse")
-
-
-def test_auto_takes_the_operator_where_the_solve_takes_the_operator_jacobian(monkeypatch):
-    """``representation="auto"`` returns the operator above ``OPERATOR_MIN_UNKNOWNS`` real
-    unknowns ``m H`` (order 0 one coefficient, every other order two: the count of
-    fretwear.hb.problem, whose DENSE_JACOBIAN_MAX it is) and the dense blocks at and below
-    it, as the periodic solve switches from the formed Jacobian to the operator one; the
-    operator's blocks equal the dense representation's to rounding (1e-12, as above). The
-    bound is moved around this small model's ``m H`` (monkeypatch) rather than building a
-    model of 3000 unknowns."""
-    from fretwear.hb import modal
-    from fretwear.hb.problem import DENSE_JACOBIAN_MAX
-
-    assert modal.OPERATOR_MIN_UNKNOWNS == DENSE_JACOBIAN_MAX
-    model = block(None)
-    w = 2 * np.pi * 15e3
-    dense = ModalCondenser(model, F_MAX, 7, tol=1e-2, representation="dense")
-    auto = ModalCondenser(model, F_MAX, 7, tol=1e-2)
-    unknowns = dense.m * (2 * ORDERS.size - 1)  # ORDERS = 0..7
-    a = dense.reduced(w, ORDERS)
-    monkeypatch.setattr(modal, "OPERATOR_MIN_UNKNOWNS", unknowns)
-    assert isinstance(auto.reduced(w, ORDERS).Z, np.ndarray)
-    monkeypatch.setattr(modal, "OPERATOR_MIN_UNKNOWNS", unknowns - 1)
-    b = auto.reduced(w, ORDERS)
-    assert isinstance(b.Z, ReducedOperator)
-    for n in range(ORDERS.size):
-        assert rel(b.Z[n], a.Z[n]) < 1e-12, n
-    # the static preload (order 0 alone: m unknowns) stays dense
-    assert isinstance(auto.reduced(w, ORDERS[:1]).Z, np.ndarray)
