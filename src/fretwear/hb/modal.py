@@ -44,7 +44,6 @@ from numba import njit
 
 from fretwear.errors import InputError
 from fretwear.hb.modal_operator import ReducedOperator
-from fretwear.hb.problem import DENSE_JACOBIAN_MAX
 from fretwear.hb.reduce import (
     BLOCK,
     Condenser,
@@ -70,18 +69,11 @@ MIN_RAISE = 8
 #: exact condensation is the better choice)
 MAX_MODES = 512
 #: how :meth:`ModalCondenser.reduced` returns ``Z_r`` (the class's ``representation``).
-#: ``"auto"`` takes the operator where the periodic solve takes the operator Jacobian (more
-#: than :data:`OPERATOR_MIN_UNKNOWNS` real unknowns ``m H``: the dense Jacobian forms every
-#: block anyway below), the dense blocks otherwise. The operator's solve once left its first
-#: attempt on the partial-slip pad of benchmarks/scale_3d.py at 1024 contact nodes where the
-#: dense blocks' converged: not a defect of the operator (at the same iterate the two agree
-#: as closely as the dense path agrees with itself after a 1e-15 perturbation of the
-#: iterate), but the sensitivity of that solve's path to rounding, which either
-#: representation shows (docs/studies/large-interface-solve.md)
+#: ``"auto"`` keeps the dense blocks for now: on the partial-slip pad of
+#: benchmarks/scale_3d.py at 1024 contact nodes the operator's solve left its first attempt
+#: for the ladder's later rungs where the dense blocks converge at once, not understood yet
+#: (docs/theory.md, "Large interfaces")
 REPRESENTATIONS = ("auto", "dense", "operator")
-#: real unknowns ``m H`` above which ``"auto"`` takes the operator: where the periodic solve
-#: takes the operator Jacobian
-OPERATOR_MIN_UNKNOWNS = DENSE_JACOBIAN_MAX
 
 
 def next_mode_count(n_modes: int, n_interior: int) -> int | None:
@@ -123,8 +115,7 @@ class ModalCondenser(Condenser):
     representation : how :meth:`reduced` returns ``Z_r``: ``"dense"`` (an (nb, m, m) array),
         ``"operator"`` (a :class:`~fretwear.hb.modal_operator.ReducedOperator`: the
         frequency-independent ``X^cc`` shared by every harmonic plus a rank-``q`` term per
-        harmonic) or ``"auto"`` (the operator above :data:`OPERATOR_MIN_UNKNOWNS` real
-        unknowns ``m H``, the dense blocks below: :data:`REPRESENTATIONS`). The same
+        harmonic) or ``"auto"`` (the dense blocks for now: :data:`REPRESENTATIONS`). The same
         condensation either way (to rounding).
 
     Attributes
@@ -342,7 +333,7 @@ class ModalCondenser(Condenser):
         """The :class:`~fretwear.hb.reduce.Reduced` model on ``orders`` at ``omega`` [rad/s]
         from the modal representation (``Z`` an array or an operator: ``representation``)."""
         orders = np.asarray(orders, dtype=np.int64)
-        if self._as_operator(orders):
+        if self.representation == "operator":
             return self._reduced_operator(omega, orders, quasi_static, frequency)
         m, no, nb, R = self.m, self.structure.obs.size, orders.size, self.R
         F_all = self.structure.load_harmonics(int(orders.max()) if orders.size else 0)
@@ -376,14 +367,6 @@ class ModalCondenser(Condenser):
         return self._result(omega, orders, Zr, Fr, oA, ob, quasi_static, frequency)
 
     # -- Z_r as an operator (representation "operator"; the blocked condenser's only one) ----
-    def _as_operator(self, orders: np.ndarray) -> bool:
-        """Whether :meth:`reduced` on ``orders`` returns the operator: ``representation``
-        ``"operator"``, or ``"auto"`` above :data:`OPERATOR_MIN_UNKNOWNS` real unknowns
-        (``m`` times one coefficient for order 0, two for every other order)."""
-        if self.representation != "auto":
-            return self.representation == "operator"
-        return self.m * int(np.sum(np.where(orders == 0, 1, 2))) > OPERATOR_MIN_UNKNOWNS
-
     def _op_terms(self, omega, n, quasi_static):
         """``(coef, Z^cq, Z^qc, Z^qq)`` of harmonic ``n``: the coefficients of the stored
         ``X^cc`` (:data:`NAMES` order) and the modal blocks (contact-local frames)."""
