@@ -71,9 +71,12 @@ MIN_RAISE = 8
 MAX_MODES = 512
 #: how :meth:`ModalCondenser.reduced` returns ``Z_r`` (the class's ``representation``).
 #: ``"auto"`` keeps the dense blocks for now: on the partial-slip pad of
-#: benchmarks/scale_3d.py at 1024 contact nodes the operator's solve left its first attempt
-#: for the ladder's later rungs where the dense blocks converge at once, not understood yet
-#: (docs/theory.md, "Large interfaces")
+#: benchmarks/scale_3d.py at 1024 contact nodes the operator's solve leaves its first attempt
+#: where the dense blocks' converges. Not a defect of the operator (at one iterate the two
+#: agree as closely as the dense path with itself after a 1e-15 change of the iterate, and
+#: from a start changed by 1e-15 the roles swap): the path of that solve depends on rounding
+#: (docs/studies/large-interface-solve.md); the default waits for a solve whose convergence
+#: does not depend on that path
 REPRESENTATIONS = ("auto", "dense", "operator")
 
 
