@@ -75,21 +75,31 @@ def test_cost_of_points_and_of_a_wear_history():
 
 
 def test_halved_steps_and_arclength_are_the_sweeps_path_not_fallbacks():
-    """A sweep point that needed only a halved step or the arclength past a fold (the rungs
-    of fallbacks.CONTINUATION) is counted apart from the fallbacks and said on its own line;
-    one that needed another solver (retry) or a time integration stays a fallback. Counted by
-    hand on made-up points."""
+    """The time of the rungs of fallbacks.CONTINUATION after the first attempt (halved steps,
+    the arclength past a fold: the sweep's own path) is counted apart from the fallbacks and
+    said on its own line; a point that needed only these is not a fallback; one that also
+    tried another solver (retry) or a time integration is, with the rest of its time. Counted
+    by hand on made-up points (attempts of 0.1 s, the arclength's 9 s: a fold crossed after a
+    failed retry, as the shipped dovetail's)."""
+    def tried(*rungs):
+        return [Attempt(m, "powell", 1.0, i == len(rungs) - 1, 0.0, 1, t, "")
+                for i, (m, t) in enumerate(rungs)]
+
     points = [SimpleNamespace(attempts=_attempts("grid", "substep"), fallback_seconds=1.0),
               SimpleNamespace(attempts=_attempts("grid", "arclength"), fallback_seconds=3.0),
               SimpleNamespace(attempts=_attempts("grid", "arclength", "time-start"),
                               fallback_seconds=4.0),
-              SimpleNamespace(attempts=_attempts("grid", "retry"), fallback_seconds=2.0)]
-    cost = fallbacks.of_solutions(points, total=20.0)
-    assert (cost.count, cost.time_domain, cost.seconds) == (2, 1, 6.0)
-    assert (cost.continued, cost.continued_seconds) == (2, 4.0)
+              SimpleNamespace(attempts=_attempts("grid", "retry"), fallback_seconds=2.0),
+              SimpleNamespace(attempts=tried(("grid", 0.1), ("retry", 0.5), ("arclength", 9.0)),
+                              fallback_seconds=10.0)]
+    cost = fallbacks.of_solutions(points, total=40.0)
+    assert (cost.count, cost.time_domain) == (3, 1)
+    assert cost.seconds == pytest.approx(3.9 + 2.0 + 1.0)
+    assert cost.continued == 2
+    assert cost.continued_seconds == pytest.approx(1.0 + 3.0 + 0.1 + 9.0)
     assert cost.continuation_line() == (
-        "continuation: 2 frequencies needed halved steps or arclength past a fold (the "
-        "sweep's own path, not fallbacks): 4.0 s (20 % of 20.0 s)")
+        "continuation (halved steps, arclength past a fold: the sweep's own path, not "
+        "fallbacks): 13.1 s (33 % of 40.0 s); 2 frequencies needed nothing else")
     only = fallbacks.of_solutions(points[:2], total=20.0)
     assert only.line("frequencies") == "" and only.continued == 2
     assert fallbacks.FallbackCost().continuation_line() == ""

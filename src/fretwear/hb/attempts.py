@@ -493,7 +493,10 @@ def arclength_branch(p: Point) -> bool:
                                "the continuation did not reach this frequency"))
         return False
     prob, U, st = solve_at(p.probs, p.omega, b.anchor(), b.history[-1][1], opts.solve)
-    p.tried.append(Attempt.of("arclength", prob.eps, st))
+    # the attempt's time is the whole continuation (its points and this solve), the point's
+    # solve statistics this solve's alone
+    p.tried.append(dataclasses.replace(Attempt.of("arclength", prob.eps, st),
+                                       wall_time=time.perf_counter() - t_arc))
     return p.adopt(prob, U, st, "arclength")
 
 

@@ -64,35 +64,43 @@ class FallbackCost:
         return (f"fallbacks: {self.count} {what} needed more than their first attempt{td}: "
                 f"{self.seconds:.1f} s{share}{tail}")
 
-
     def continuation_line(self, what: str = "frequencies") -> str:
-        """One summary line of the points that needed only the sweep's own continuation
-        (:data:`CONTINUATION`; "" without them): said apart from the fallbacks, since
-        halving a step or following the branch past a fold is the sweep's path, which a
-        different default would not avoid."""
-        if not self.continued:
+        """One summary line of the time in the sweep's own continuation (:data:`CONTINUATION`:
+        halved steps and the arclength past a fold; "" without it), said apart from the
+        fallbacks, since following the branch is the sweep's path, which a different default
+        would not avoid: the points that needed nothing else (``continued``) and the
+        continuation's time at every point (``continued_seconds``)."""
+        if not (self.continued or self.continued_seconds > 0):
             return ""
         share = (f" ({100 * self.continued_seconds / self.total:.0f} % of {self.total:.1f} s)"
                  if self.total > 0 else "")
-        return (f"continuation: {self.continued} {what} needed halved steps or arclength past "
-                f"a fold (the sweep's own path, not fallbacks): "
-                f"{self.continued_seconds:.1f} s{share}")
+        return (f"continuation (halved steps, arclength past a fold: the sweep's own path, not "
+                f"fallbacks): {self.continued_seconds:.1f} s{share}; {self.continued} {what} "
+                f"needed nothing else")
 
 
 def of_solutions(points, total: float) -> FallbackCost:
     """The cost of the fallbacks of periodic solutions or sweep points (anything with
-    ``fallback_seconds`` and ``attempts``), out of ``total`` seconds; a sweep point that
-    needed only the rungs of :data:`CONTINUATION` is counted apart (``continued``)."""
+    ``fallback_seconds`` and ``attempts``), out of ``total`` seconds. The time of the rungs
+    of :data:`CONTINUATION` after the first attempt (each attempt's ``wall_time``; the
+    arclength's is its whole continuation) is the sweep's path, counted apart
+    (``continued_seconds``); a point that needed only these is counted apart
+    (``continued``), any other is a fallback with the rest of its time after the first
+    attempt."""
     cost = FallbackCost(total=float(total))
     for p in points:
         attempts = getattr(p, "attempts", [])
         if len(attempts) > 1 or (attempts and not attempts[0].success):
             seconds = float(getattr(p, "fallback_seconds", 0.0))
-            if all(a.method in CONTINUATION for a in attempts):
+            later = attempts[1:]
+            path = min(sum(float(a.wall_time) for a in later if a.method in CONTINUATION),
+                       seconds)
+            cost.continued_seconds += path
+            if all(a.method in CONTINUATION for a in later):
                 cost.continued += 1
-                cost.continued_seconds += seconds
+                cost.continued_seconds += seconds - path  # the rungs' overheads
                 continue
-            cost.add(seconds, any(a.method == "time-start" for a in attempts))
+            cost.add(seconds - path, any(a.method == "time-start" for a in attempts))
     return cost
 
 
