@@ -44,7 +44,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from fretwear.wear.options import GROWTH_LIMIT, MIN_JUMP_FRACTION, WearOptions
-from fretwear.wear.schemes import accept
+from fretwear.wear.schemes import StepStart, accept, balance_after
 from fretwear.wear.slow_problem import SlowProblem
 from fretwear.wear.state import SlowStep
 
@@ -82,20 +82,13 @@ def exponential_step(sp: SlowProblem, st: SlowStep, opts: WearOptions):
     if exponential:
         dN = min(dN, EXP_GROWTH_LIMIT / lam_plus)
 
+    start = StepStart(st.W, st.U, st.g, anchor)
+
     def attempt(dN):  # the balance at the end of a jump of dN (as advance's _attempt)
         if exponential:
             dW = increment(Js, st.g, dN)
         else:  # the march's step, to the bit
             dW = dN * np.linalg.solve(np.eye(sp.nc) - dN * Js, st.g)
-        dW = np.maximum(dW, 0.0)  # a node's wear never decreases
-        W1 = st.W + dW
-        U1, stats = sp.solve_balance(W1, anchor, st.U + (dUdW @ dW).reshape(sp.m, sp.H),
-                                     options=opts.solve)
-        if not stats.success:  # as advance(): from the previous balance, shifted
-            its = stats.iterations
-            U1, stats = sp.solve_balance(W1, anchor, sp.shift_guess(st.U, dW),
-                                         options=opts.solve)
-            stats.iterations += its
-        return W1, U1, stats
+        return balance_after(sp, opts, start, np.maximum(dW, 0.0), dUdW)  # wear never decreases
 
     return accept(sp, opts, st, anchor, attempt, (dN, floor, floor), (t0, 1, 0))

@@ -195,20 +195,32 @@ def _attempt(sp: SlowProblem, opts: WearOptions, start: StepStart, dN: float, li
     Js, dUdW = lin
     dW = dN * np.linalg.solve(np.eye(sp.nc) - dN * Js, start.g)
     dW = np.maximum(dW, 0.0)  # a node's wear never decreases (g >= 0)
-    Wp = W_k + dW
-    Up = U_k + (dUdW @ dW).reshape(sp.m, sp.H)
     if opts.scheme == "rosenbrock":
-        U1, stats = sp.solve_balance(Wp, anchor, Up, **kw)
-        if not stats.success:
-            its = stats.iterations
-            U1, stats = sp.solve_balance(Wp, anchor, sp.shift_guess(U_k, dW), **kw)
-            stats.iterations += its
-        return Wp, U1, stats
+        return balance_after(sp, opts, start, dW, dUdW)
+    Wp = W_k + dW  # the predictor of the implicit step
+    Up = U_k + (dUdW @ dW).reshape(sp.m, sp.H)
     if opts.implicit_newton == "coupled":
         kw["options"] = opts.solve.replace(max_iter=opts.max_iter_coupled)
         U1, W1, stats = sp.solve_implicit(W_k, dN, anchor, Up, Wp, **kw)
         return W1, U1, stats
     return _BackwardEuler(sp, opts, start, dN).solve(Wp, Up, lin)
+
+
+def balance_after(sp: SlowProblem, opts: WearOptions, start: StepStart, dW: np.ndarray,
+                  dUdW: np.ndarray):
+    """``(W1, U1, stats)``: the balance at ``W1 = W_k + dW`` from the predictor
+    ``U_k + dU~/dW dW``, else from the previous balance shifted by the wear
+    (:meth:`SlowProblem.shift_guess`); ``stats.iterations`` counts both solves. The end of a
+    linearly implicit (rosenbrock) or exponential step."""
+    W1 = start.W + dW
+    U1, stats = sp.solve_balance(W1, start.anchor,
+                                 start.U + (dUdW @ dW).reshape(sp.m, sp.H), options=opts.solve)
+    if not stats.success:
+        its = stats.iterations
+        U1, stats = sp.solve_balance(W1, start.anchor, sp.shift_guess(start.U, dW),
+                                     options=opts.solve)
+        stats.iterations += its
+    return W1, U1, stats
 
 
 class _BackwardEuler:
