@@ -983,7 +983,7 @@ def _pair(T: np.ndarray, v: np.ndarray, mu0: complex, steps: int = 2):
 
 
 def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions,
-           warm: Refined | None = None):
+           warm: Refined | None = None, deflate: float | None = None):
     """The exponent of the exact ``T`` continued from ``sigma`` with eigenvector ``v``: the
     scalar equation ``mu(sigma) = 0`` for the eigenvalue ``mu`` of the linear problem
     ``T(sigma) y = mu y`` whose eigenvector continues ``v`` (:func:`_pair`: inverse iteration
@@ -996,7 +996,10 @@ def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions,
     difference (:func:`_warm_start`); the neighbourhood of the candidate ``sigma`` that the
     iterates must not leave, and the stopping rule, are the same. Returns ``(sigma, v,
     residual, converged, slope)``; the residual is ``|mu| / |T|`` (with ``|T v - mu v| / |T|``
-    below the same tolerance: an eigenpair), ``slope`` the last ``d mu / d sigma`` used."""
+    below the same tolerance: an eigenpair), ``slope`` the last ``d mu / d sigma`` used.
+    ``deflate``: a real root already found, the equation ``mu(sigma) / (sigma - deflate) = 0``
+    instead (another crossing of the same eigenvalue branch, :func:`_landed_real`; not
+    converged back on ``deflate``, within :data:`ON_REAL`)."""
     prev = None
     res = np.inf
     start = sigma
@@ -1007,8 +1010,9 @@ def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions,
     # meets another one, which the frozen-memory candidates would show as a pair)
     mu0 = 0.0
     for _ in range(opt.newton_max_iter):
-        if abs(sigma - start) > 0.5 or 2.0 * np.pi * sigma.real < np.log(NEGLIGIBLE):
-            break  # left the neighbourhood of the candidate: not its exponent
+        if abs(sigma - start) > 0.5 or 2.0 * np.pi * sigma.real < np.log(NEGLIGIBLE) or (
+                deflate is not None and abs(sigma - deflate) <= ON_REAL):
+            break  # left the neighbourhood of the candidate (or back on the root deflated)
         T = hp.matrix(sigma)
         scale = np.linalg.norm(T, 1)
         mu, v, lu = _pair(T, v, mu0)
@@ -1016,14 +1020,17 @@ def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions,
         res = max(float(abs(mu) / scale), pair)
         if res <= opt.newton_tol:
             return sigma, v, res, True, slope
+        f = mu if deflate is None else mu / (sigma - deflate)
         if prev is None:  # first step: the neighbour's slope, or a forward difference
             if slope == 0:
                 slope = _mu_derivative(hp, sigma, v, T, lu, opt.step)
+                if deflate is not None:  # d/ds of mu / (s - s1)
+                    slope = (slope * (sigma - deflate) - mu) / (sigma - deflate) ** 2
         else:
-            s0, m0 = prev
-            slope = (mu - m0) / (sigma - s0) if mu != m0 else 0.0
-        new = sigma - mu / slope if slope != 0 else sigma
-        prev = (sigma, mu)
+            s0, f0 = prev
+            slope = (f - f0) / (sigma - s0) if f != f0 else 0.0
+        new = sigma - f / slope if slope != 0 else sigma
+        prev = (sigma, f)
         mu0 = 0.0 if pair < 1e-3 else mu  # near the root, the eigenvalue nearest 0
         if real:
             new = complex(new.real, 0.0)
@@ -1044,47 +1051,6 @@ def _landed_real(s0: complex, s1: complex) -> bool:
     frozen-memory pair split on the real axis in the exact problem (a pair of real
     multipliers, one of which is the other member of the pair)."""
     return s0.imag != 0.0 and abs(s1.imag) <= min(ON_REAL, 1e-3 * abs(s0.imag))
-
-
-def _second_real(hp: HillProblem, s0: complex, s1: float, v: np.ndarray, opt: HillOptions):
-    """The other real exponent of a candidate pair ``s0`` (and its conjugate) whose
-    refinement landed on the real root ``s1`` (:func:`_landed_real`): the same scalar
-    equation as :func:`_track` on the real axis, ``mu(sigma) = 0`` for the eigenvalue that
-    continues ``v``, deflated by the root found, ``mu(sigma) / (sigma - s1)`` (a pair of
-    complex roots of the frozen problem becomes two real crossings of one eigenvalue branch),
-    by the secant method from the candidate's real part. Returns ``(sigma, v, residual,
-    converged)``; ``converged`` only at a root apart from ``s1`` by more than
-    :data:`ON_REAL`."""
-    sigma = complex(s0.real if abs(s0.real - s1) > 10 * ON_REAL else s1 - 0.01, 0.0)
-    prev = None
-    res = np.inf
-    mu0 = 0.0
-    for _ in range(opt.newton_max_iter):
-        if abs(sigma - s0.real) > 0.5 or 2.0 * np.pi * sigma.real < np.log(NEGLIGIBLE) \
-                or abs(sigma.real - s1) <= ON_REAL:
-            break  # left the candidate's neighbourhood, or back on the root found
-        T = hp.matrix(sigma)
-        scale = np.linalg.norm(T, 1)
-        mu, v, lu = _pair(T, v, mu0)
-        pair = float(np.linalg.norm(T @ v - mu * v) / scale)
-        res = max(float(abs(mu) / scale), pair)
-        if res <= opt.newton_tol:
-            return sigma.real, v, res, True
-        f = mu / (sigma - s1)
-        if prev is None:
-            d = _mu_derivative(hp, sigma, v, T, lu, opt.step)
-            slope = (d * (sigma - s1) - mu) / (sigma - s1) ** 2
-        else:
-            slope = (f - prev[1]) / (sigma - prev[0]) if f != prev[1] else 0.0
-        if slope == 0:
-            break
-        prev = (sigma, f)
-        new = complex((sigma - f / slope).real, 0.0)
-        mu0 = 0.0 if pair < 1e-3 else mu
-        if not np.isfinite(new) or new == sigma:
-            break
-        sigma = new
-    return sigma.real, v, res, False
 
 
 def _warm_start(track: HillTrack | None, j: int | None, s0: complex) -> Refined | None:
@@ -1187,8 +1153,9 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
             continue
         if _landed_real(s0, s1):  # a pair of real exponents: find the other one, or say
             s1 = complex(s1.real, 0.0)  # that it is missing (the conjugate candidate)
-            s2, v2, r2, conv2 = _second_real(hp, s0, s1.real, vx, opt)
-            sig.append(complex(s2, 0.0) if conv2 else np.conj(s0))
+            a = s0.real if abs(s0.real - s1.real) > 10 * ON_REAL else s1.real - 0.01
+            s2, v2, r2, conv2, _ = _track(hp, complex(a, 0.0), vx, opt, deflate=s1.real)
+            sig.append(complex(s2.real, 0.0) if conv2 else np.conj(s0))
             kaps.append(centroid(v2.reshape(m, H), k) if conv2 else -kp)
             res.append(r2 if conv2 else np.nan)
             kind.append("refined" if conv2 else "candidate")
