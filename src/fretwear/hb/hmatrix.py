@@ -47,7 +47,7 @@ from fretwear.errors import InputError
 #: nodes in a leaf cluster
 LEAF = 32
 #: admissibility ``max(diam s, diam t) <= ETA dist(s, t)``
-ETA = 1.0
+ETA = 2.0
 #: columns of the random sample per step of the range finder
 SAMPLES = 16
 
@@ -289,8 +289,8 @@ class _Plan:
     range the ``V`` stack gives ``C[idx] = V_s^T x_s``, per row range the ``U`` stack adds
     ``U_s C[idx]`` (the transpose swaps the two). Near field: per row range the dense blocks
     side by side times the gathered ``x``, those whose mirror is a block below the diagonal
-    last, applied transposed too (a symmetric near field is stored once). The blocks' arrays are replaced by views into
-    the stacks (nothing is held twice, except where a stack is shared)."""
+    last, applied transposed too (a symmetric near field is stored once). The blocks' arrays
+    are replaced by views into the stacks (nothing is held twice)."""
 
     def __init__(self, blocks: list[Block]):
         views = {}  # id of a block's array -> its view in a stack

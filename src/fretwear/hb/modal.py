@@ -43,6 +43,7 @@ import scipy.sparse.linalg as spla
 from numba import njit
 
 from fretwear.errors import InputError
+from fretwear.hb import hmatrix
 from fretwear.hb.modal_operator import ReducedOperator
 from fretwear.hb.reduce import (
     BLOCK,
@@ -121,6 +122,12 @@ class ModalCondenser(Condenser):
         frequency-independent ``X^cc`` shared by every harmonic plus a rank-``q`` term per
         harmonic) or ``"auto"`` (the dense blocks for now: :data:`REPRESENTATIONS`). The same
         condensation either way (to rounding).
+    compress : None, or a relative error ``tol`` (0 < tol < 1): the operator's shared
+        ``X^cc`` are also held compressed (:func:`fretwear.hb.hmatrix.compress`, a
+        hierarchical low-rank form of the contact nodes' positions with
+        ``||X - X_H||_F <= tol ||X||_F``), once for every frequency, and the solver's products
+        take those (below ``m^2`` per column); the blocks it forms (the preconditioner's)
+        stay exact. Implies ``representation="operator"`` (refused with ``"dense"``).
 
     Attributes
     ----------
@@ -131,13 +138,15 @@ class ModalCondenser(Condenser):
 
     def __init__(self, model: Model, f_max: float, max_order: int, *, modes: int | None = None,
                  cutoff: float = CUTOFF, tol: float = TOL, raise_modes: bool = False,
-                 residual: bool = False, representation: str = "auto"):
+                 residual: bool = False, representation: str = "auto",
+                 compress: float | None = None):
         if not (isinstance(f_max, int | float) and math.isfinite(f_max) and f_max > 0):
             raise InputError(f"f_max = {f_max!r}: expected a positive frequency [Hz]")
         if representation not in REPRESENTATIONS:
             raise InputError(f"representation = {representation!r}: expected one of "
                              + ", ".join(f'"{r}"' for r in REPRESENTATIONS))
-        self.representation = representation
+        self._set_compress(model, compress, representation)
+        self.representation = "operator" if compress is not None else representation
         if modes is not None and (isinstance(modes, bool) or not isinstance(modes, int)
                                   or modes < 0):
             raise InputError(f"modes = {modes!r}: expected a number of modes >= 0")
@@ -471,7 +480,33 @@ class ModalCondenser(Condenser):
                 for (j, _), a, v in zip(self.obs_i, np.atleast_2d(A), bo, strict=True):
                     oA[b, j], ob[b, j] = a, v
         Z = self._operator(parts)
+        Z.products = self._compressed()
         return self._result(omega, orders, Z, Fr, oA, ob, quasi_static, frequency)
+
+    def _set_compress(self, model: Model, compress, representation: str) -> None:
+        """Check and keep ``compress`` (the class's parameter) and the contact nodes'
+        positions it needs."""
+        if compress is not None:
+            if (isinstance(compress, bool) or not isinstance(compress, int | float)
+                    or not 0 < compress < 1):
+                raise InputError(f"compress = {compress!r}: expected None or a relative "
+                                 "error in (0, 1)")
+            if representation == "dense":
+                raise InputError('compress with representation = "dense": the compressed '
+                                 'products are those of the operator ("operator" or "auto")')
+        self.compress = None if compress is None else float(compress)
+        self._coords = np.asarray(model.contact.coords, dtype=float)
+        self._products = None
+
+    def _compressed(self) -> list | None:
+        """The compressed ``X^cc`` (``compress``), made on first use and kept: they do not
+        depend on the frequency."""
+        if getattr(self, "compress", None) is None:
+            return None
+        if self._products is None:
+            self._products = [hmatrix.compress(self.proj_local[nm][0], self._coords,
+                                               self.compress) for nm in self.proj_local]
+        return self._products
 
     def _psi_at(self, rows: np.ndarray) -> np.ndarray:
         """The rows ``rows`` of ``Psi`` (len(rows), m)."""
@@ -558,12 +593,13 @@ def _real_times(A: np.ndarray, x: np.ndarray) -> np.ndarray:
 @model_argument
 def modal_condenser(model: Model, f_max: float, max_order: int, *, modes: int | None = None,
                     cutoff: float = CUTOFF, tol: float = TOL, raise_modes: bool = False,
-                    residual: bool = False) -> ModalCondenser:
+                    residual: bool = False, compress: float | None = None) -> ModalCondenser:
     """A :class:`ModalCondenser` of ``model`` for excitation frequencies up to ``f_max`` [Hz]
     and harmonic orders up to ``max_order``, checked against the exact condensation (an
     :class:`~fretwear.errors.InputError` when its error exceeds ``tol``; ``modes``, ``cutoff``,
-    ``raise_modes``, ``residual``: see the class; :func:`fretwear.hb.condensers.condenser`
-    chooses them, and between this and the exact condensation).
+    ``raise_modes``, ``residual``, ``compress``: see the class;
+    :func:`fretwear.hb.condensers.condenser` chooses them, and between this and the exact
+    condensation).
 
     Pass it as ``condenser=`` to every condensation of ``model`` that should use it
     (:func:`~fretwear.hb.reduce.condense`, periodic solves, sweeps, wear runs, recovery), as
@@ -582,9 +618,9 @@ def modal_condenser(model: Model, f_max: float, max_order: int, *, modes: int | 
         # the blocked condenser keeps every mode below the cutoff (or ``modes``) and adds no
         # residual vectors: their m extra solves are what it cannot afford at this size
         return BlockedModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff,
-                                     tol=tol)
+                                     tol=tol, compress=compress)
     return ModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff, tol=tol,
-                          raise_modes=raise_modes, residual=residual)
+                          raise_modes=raise_modes, residual=residual, compress=compress)
 
 
 #: above this estimated storage [GiB] :func:`modal_condenser` builds the blocked condenser
@@ -655,8 +691,9 @@ class BlockedModalCondenser(ModalCondenser):
     representation = "operator"  # it holds no Psi to form dense blocks from
 
     def __init__(self, model: Model, f_max: float, max_order: int, *, modes: int | None = None,
-                 cutoff: float = CUTOFF, tol: float = TOL):
+                 cutoff: float = CUTOFF, tol: float = TOL, compress: float | None = None):
         self._check_args(f_max, modes)
+        self._set_compress(model, compress, "operator")
         Condenser.__init__(self, _structure(model), dense=False)
         if not self.ni:
             raise InputError("the model has no interior DOFs: nothing to represent by modes")

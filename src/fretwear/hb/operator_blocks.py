@@ -130,7 +130,7 @@ class OperatorBlocks(HarmonicBlocks):
                                for A in self.op.mats], self.op.coef,
                               [None if u is None else u[rows] for u in self.op.U],
                               [None if y is None else y[:, cols] for y in self.op.Y],
-                              False)
+                              False, self.op.cut(rows, cols))
         if self.real:
             X = U.transpose(0, 2, 1).reshape(cols.size, r * self.H)  # columns (r, H)
             blocks = np.tile(self._layout(), r)
