@@ -29,7 +29,8 @@ textbook one (Hackbusch, *Hierarchical Matrices*, 2015, ch. 5-6; Bebendorf 2008)
 Frobenius error of the whole matrix is at most ``tol``. The achieved error is kept
 (:attr:`HMatrix.error`, relative, exact up to rounding) and is what callers quote. For a
 symmetric ``A`` only the blocks on and above the diagonal are compressed; the mirrored
-block is the transpose, sharing the arrays.
+block is the transpose, sharing the arrays (an asymmetry of rounding's size is added to the
+stated error: then a bound, by the triangle inequality).
 
 A product ``A X`` (``X`` of ``r`` columns) costs ``sum_b k_b (b_r + b_c) r`` for the
 low-rank blocks plus the dense leaves: ``O(m log m)`` per column for a fixed rank, against
@@ -385,9 +386,10 @@ def compress(A: np.ndarray, coords: np.ndarray, tol: float, *, symmetric: bool |
              leaf: int = LEAF, eta: float = ETA, seed: int = 0) -> HMatrix:
     """The :class:`HMatrix` of ``A`` (m, m), real, with ``||A - A_H||_F <= tol ||A||_F``
     (module docstring). ``coords`` (n, dim): the position of each node, whose ``d = m / n``
-    DOFs are rows ``d p .. d p + d - 1``; ``symmetric``: compress the upper blocks only
-    (None: when ``A`` is symmetric to rounding); ``seed``: the range finder's random
-    samples (the result is reproducible)."""
+    DOFs are rows ``d p .. d p + d - 1``; ``symmetric``: compress the upper blocks only, the
+    lower ones their transposes (None: when ``||A - A^T||_F / sqrt 2 <= tol ||A||_F / 100``;
+    that asymmetry is then taken from the budget and counted in the stated error);
+    ``seed``: the range finder's random samples (the result is reproducible)."""
     A = np.asarray(A)
     coords = np.asarray(coords, dtype=float)
     if A.ndim != 2 or A.shape[0] != A.shape[1] or np.iscomplexobj(A):
@@ -402,11 +404,16 @@ def compress(A: np.ndarray, coords: np.ndarray, tol: float, *, symmetric: bool |
         raise InputError(f"tol = {tol!r}: expected a relative error in (0, 1)")
     m, n = A.shape[0], coords.shape[0]
     d = m // n
+    norm = float(np.linalg.norm(A))
+    # stored symmetric, the blocks below the diagonal are the upper ones transposed: their
+    # asymmetry (the lower triangle of A - A^T) adds to the error
+    asym = float(np.linalg.norm(A - A.T)) / np.sqrt(2.0)
     if symmetric is None:
-        symmetric = bool(np.allclose(A, A.T, rtol=0.0, atol=1e-13 * np.abs(A).max()))
+        symmetric = asym <= 0.01 * tol * norm
+    asym = asym if symmetric else 0.0
     order, root = cluster_tree(coords, leaf)
     perm = (order[:, None] * d + np.arange(d)).reshape(-1)
-    scale2 = (tol * float(np.linalg.norm(A))) ** 2 / (m * m)
+    scale2 = (max(tol * norm - asym, 0.0)) ** 2 / (m * m)
     rng = np.random.default_rng(seed)
     blocks, err2 = [], 0.0
     for s, t, adm in block_tree(root, eta):
@@ -423,5 +430,4 @@ def compress(A: np.ndarray, coords: np.ndarray, tol: float, *, symmetric: bool |
         blocks.append(blk)
         if symmetric and s.start != t.start:
             blocks.append(blk.mirror())
-    norm = float(np.linalg.norm(A))
-    return HMatrix(perm, perm, blocks, np.sqrt(err2) / norm if norm else 0.0, tol)
+    return HMatrix(perm, perm, blocks, (np.sqrt(err2) + asym) / norm if norm else 0.0, tol)
