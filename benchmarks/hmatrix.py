@@ -15,8 +15,8 @@ the table.
 
 ``--solve N`` instead runs the periodic solve at N x N contact nodes (scale_3d's
 ``solve_periodic`` call, the static preload first) with the operator representation, dense
-products, then compressed at each tolerance of ``--tols``, then dense again (the first
-after the compiled kernels' warm-up), in one process, and prints
+products (``--reference``: the operator's or the dense blocks'), then compressed at each
+tolerance of ``--tols``, then (up to 256 nodes) dense again, in one process, and prints
 CPU and wall seconds, iteration counts and the relative difference of each converged
 solution ``U~`` from the dense one.
 
@@ -38,11 +38,12 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from scale_3d import LOADS, Clock, Counts, H, options, pad, peak_gib, warm_up  # noqa: E402
 
 
-def _condenser(model, load, compress=None):
+def _condenser(model, load, compress=None, representation="operator"):
     from fretwear.hb.modal import ModalCondenser
 
     return ModalCondenser(model, load.freq * 1.2, H, modes=load.modes,
-                          representation="operator", compress=compress)
+                          representation=representation if compress is None else "operator",
+                          compress=compress)
 
 
 def _median_time(f, reps: int) -> float:
@@ -128,7 +129,7 @@ def growth(rows: list[dict]) -> None:
                  if "bytes_ratio" in ra else ""))
 
 
-def solves(n: int, tols, dense: bool = True) -> None:
+def solves(n: int, tols, dense: bool = True, reference: str = "operator") -> None:
     """The periodic solve with dense and compressed products (module docstring)."""
     from fretwear.hb.fourier import FourierBasis
     from fretwear.hb.periodic import solve_periodic
@@ -139,10 +140,11 @@ def solves(n: int, tols, dense: bool = True) -> None:
     basis = FourierBasis.up_to(H, 128)
     warm_up(load)  # the compiled kernels loaded, untimed
     ref = None
-    for tol in ([None, *tols, None] if dense else tols):
+    for tol in ([None, *tols, None] if dense and n * n <= 256 else
+                [None, *tols] if dense else tols):
         before = os.getloadavg()[0]
         with Clock() as cc:
-            mc = _condenser(model, load, tol)
+            mc = _condenser(model, load, tol, reference)
             red = mc.reduced(2 * np.pi * load.freq, basis.orders, frequency=load.freq)
         with Counts() as counts, Clock() as c:
             anchor = static_anchor(model, condenser=mc)
@@ -155,7 +157,9 @@ def solves(n: int, tols, dense: bool = True) -> None:
                 else float(np.linalg.norm(U - ref) / np.linalg.norm(ref)))
         err = ("" if tol is None else
                "compression errors " + ", ".join(f"{p.error:.1e}" for p in red.Z.products))
-        print(f"{n * n} nodes, {'dense' if tol is None else f'compress={tol:g}'}: "
+        name = f"dense ({reference})" if tol is None else f"compress={tol:g}"
+        print(f"{n * n} nodes, {name}: attempts "
+              + "; ".join(f"{a.method} ({a.iterations})" for a in sol.attempts) + ": "
               f"condensation{'+compression' if tol else ''} {cc}, solve {c}, success "
               f"{sol.success}, Powell {sol.stats.iterations}, Newton {counts.steps}, GMRES "
               f"{sum(counts.gmres)}, eps {sol.eps:.4g}, |U - U_dense| / |U_dense| = "
@@ -169,13 +173,15 @@ def main():
     ap.add_argument("--tols", default="1e-4,1e-6,1e-8")
     ap.add_argument("--reps", type=int, default=5)
     ap.add_argument("--solve", type=int, default=0)
+    ap.add_argument("--reference", choices=("operator", "dense"), default="operator",
+                    help="--solve: the uncompressed run's representation")
     ap.add_argument("--no-dense", action="store_true",
                     help="--solve: the compressed solves only (no difference printed)")
     args = ap.parse_args()
     tols = [float(t) for t in args.tols.split(",")]
     print(f"load {os.getloadavg()[0]:.1f}", flush=True)
     if args.solve:
-        solves(args.solve, tols, not args.no_dense)
+        solves(args.solve, tols, not args.no_dense, args.reference)
         return
     rows = []
     for n in (int(s) for s in args.sizes.split(",")):
