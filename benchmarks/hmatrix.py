@@ -41,9 +41,10 @@ from scale_3d import LOADS, Clock, Counts, H, options, pad, peak_gib, warm_up  #
 def _condenser(model, load, compress=None, representation="operator"):
     from fretwear.hb.modal import ModalCondenser
 
-    return ModalCondenser(model, load.freq * 1.2, H, modes=load.modes,
-                          representation=representation if compress is None else "operator",
-                          compress=compress)
+    out = ModalCondenser(model, load.freq * 1.2, H, modes=load.modes,
+                         representation=representation if compress is None else "compressed")
+    out.compress = compress  # the bound of "compressed" (before the first reduced model)
+    return out
 
 
 def _median_time(f, reps: int) -> float:

@@ -125,11 +125,16 @@ def test_condenser_compress_option():
     """``compress=`` of the modal condensers: the operator of every frequency carries the
     compressed ``X^cc`` (made once: the same objects at two frequencies), each within its
     bound, and its products are the dense operator's within that bound (column ``j`` on
-    harmonic ``b``: ``sum_t |c_t(b)| e_t ||X_t||_F |x_j|``, plus rounding); refused with the
-    dense representation and for a bad value."""
+    harmonic ``b``: ``sum_t |c_t(b)| e_t ||X_t||_F |x_j|``, plus rounding); a bad value is
+    refused."""
     from helpers.operator_models import F_MAX, ORDERS, block
 
-    from fretwear.hb.modal import BlockedModalCondenser, ModalCondenser
+    from fretwear.hb.modal import (
+        COMPRESS_TOL,
+        BlockedModalCondenser,
+        ModalCondenser,
+        modal_condenser,
+    )
 
     model = block()
     bc = BlockedModalCondenser(model, F_MAX, 7, tol=1e-2, compress=1e-6)
@@ -145,7 +150,11 @@ def test_condenser_compress_option():
     Z1.products = None
     diff = np.linalg.norm(got - Z1.matmat(blocks, X), axis=0)
     assert np.all(diff <= bound * np.linalg.norm(X, axis=0) + 1e-13 * np.abs(got).max())
+    mc = ModalCondenser(model, F_MAX, 7, tol=1e-2, representation="compressed")
+    assert mc.compress == COMPRESS_TOL and mc.reduced(2 * np.pi * 12e3, ORDERS).Z.products
     with pytest.raises(InputError, match="compress"):
-        ModalCondenser(model, F_MAX, 7, representation="dense", compress=1e-6)
+        modal_condenser(model, F_MAX, 7, compress=2.0)
     with pytest.raises(InputError, match="compress"):
-        ModalCondenser(model, F_MAX, 7, compress=2.0)
+        BlockedModalCondenser(model, F_MAX, 7, compress="1e-6")
+    with pytest.raises(InputError, match="representation"):
+        ModalCondenser(model, F_MAX, 7, representation="hmatrix")
