@@ -577,9 +577,9 @@ class Condenser:
         square of the interior response's change away from it), or None where those two
         error estimate of the local basis nearer ``omega`` exceeds ``tol`` (relative, in
         ``Z_r`` or ``F_r``, of any harmonic), or a harmonic has fewer than two. The estimate
-        (the result's attribute ``estimate``) is the error's leading term ``c d^2`` at the
-        distance ``d`` [rad/s] from the basis's frequency, ``c`` measured by the two bases'
-        disagreement one spacing beyond the later one (:meth:`_curvature`). Harmonic 0 is the
+        (the result's attribute ``estimate``) is the error's leading term at the distance
+        from the basis's frequency, scaled by the two latest bases' disagreement one spacing
+        beyond the later one (:meth:`_disagreement`). Harmonic 0 is the
         exact static condensation. No factorisation and no interior solve
         (:meth:`keep_interior`)."""
         orders = np.asarray(orders, dtype=np.int64)
@@ -603,9 +603,10 @@ class Condenser:
                 continue
             Fn = F_all[n]
             refs = self._interior[int(n)]
-            c = self._curvature(int(n), Fn)
+            dis, h = self._disagreement(int(n), Fn)
             ref = min(refs, key=lambda r: abs(r[0] - omega))
-            estimate = max(estimate, c * (omega - ref[0]) ** 2)
+            d = abs(omega - ref[0])
+            estimate = max(estimate, dis * max(d / h, d * d / (3 * h * h)))
             near = None if not estimate <= tol else self._near(omega, int(n), ref, Fn)
             if near is None:
                 return None
@@ -617,24 +618,27 @@ class Condenser:
         out.estimate = estimate
         return out
 
-    def _curvature(self, n: int, Fn) -> float:
-        """``c`` [1/(rad/s)^2] of the error ``c d^2`` of harmonic ``n``'s local bases: the
-        two latest bases (at ``a``, ``b``; errors ``E (w - a)^2`` and ``E (w - b)^2``) differ by
-        ``E (b - a) (2 w - a - b)``, measured at ``w = 2 b - a``: ``c = |E| = disagreement /
-        (3 (b - a)^2)`` (relative, the larger of ``Z_r``'s and ``F_r``'s); infinite when a
-        basis is unusable."""
+    def _disagreement(self, n: int, Fn) -> tuple[float, float]:
+        """``(D, h)``: the relative disagreement ``D`` (the larger of ``Z_r``'s and ``F_r``'s)
+        of harmonic ``n``'s two latest local bases (at ``a``, ``b``; ``h = |b - a|`` [rad/s])
+        one spacing beyond the later one, at ``2 b - a`` (D infinite when a basis is unusable
+        there). An error ``E (w - a)^2`` of each basis (the stationary Galerkin projection)
+        makes ``D = 3 |E| h^2``; one linear in the distance, ``E |w - a|`` (the load of a
+        damped sector's complex Hermitian blocks, whose adjoint differs from ``X`` by the loss
+        factor), ``D = |E| h``: the estimate at a distance ``d`` from the nearer basis is the
+        larger, ``D max(d / h, d^2 / (3 h^2))`` (:meth:`nearby`)."""
         (a, *_), (b, *_) = refs = self._interior[n]
-        key = ("curvature", n, a, b)
-        c = self._bases.get(key)
-        if c is None:
+        key = ("disagreement", n, a, b)
+        out = self._bases.get(key)
+        if out is None:
             both = [self._near(2 * b - a, n, r, Fn) for r in refs]
             if any(x is None for x in both):
-                c = math.inf
+                out = (math.inf, abs(b - a))
             else:
                 (Z1, F1, _), (Z2, F2, _) = both
-                c = max(_rel(Z1, Z2), _rel(F1, F2)) / (3 * (b - a) ** 2)
-            self._bases[key] = c
-        return c
+                out = (max(_rel(Z1, Z2), _rel(F1, F2)), abs(b - a))
+            self._bases[key] = out
+        return out
 
     def _near(self, omega: float, n: int, ref, Fn):
         """``(Z_r, F_r, (Xo, xo))`` of harmonic ``n`` at ``omega`` from the local basis of the
@@ -649,7 +653,7 @@ class Condenser:
         if basis is None:
             kept = {(n2, r[0]) for n2, rs in self._interior.items() for r in rs}
             self._bases = {k: v for k, v in self._bases.items()  # those of kept references
-                           if k in kept or (k[0] == "curvature" and k[1:3] in kept)}
+                           if k in kept or (k[0] == "disagreement" and k[1:3] in kept)}
             basis = self._bases[(n, w_a)] = local_basis(self, w_a, n, X, xf, Fi)
         try:
             Zcq, Y, yF = basis.blocks(omega)
