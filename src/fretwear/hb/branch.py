@@ -142,16 +142,18 @@ class Problems:
         """The problem at ``omega`` [rad/s] on the exact condensation (replacing in the cache
         the local basis's model there, whose error it measures)."""
         key = float(omega)
-        if key in self.nearby_keys:
-            near = self.cache.pop(key)
+        if key in self.nearby_keys or key not in self.cache:
+            near = self.cache.pop(key, None)
             self.nearby_keys.discard(key)
+            self._room()
             red, _ = self._condense(omega, True)
-            self.nearby_errors.append(max(
-                max(np.linalg.norm(a - b) / max(np.linalg.norm(b), 1e-300)
-                    for a, b in zip(x, y, strict=True))
-                for x, y in ((near.Z, red.Z), (near.F, red.F))))
-            if self.nearby_errors[-1] > NEARBY_STOP:
-                self.use_nearby = False
+            if near is not None:  # (not when it has left the cache since)
+                self.nearby_errors.append(max(
+                    max(np.linalg.norm(a - b) / max(np.linalg.norm(b), 1e-300)
+                        for a, b in zip(x, y, strict=True))
+                    for x, y in ((near.Z, red.Z), (near.F, red.F))))
+                if self.nearby_errors[-1] > NEARBY_STOP:
+                    self.use_nearby = False
             self.cache[key] = red
         return self.get(omega, anchor)
 
