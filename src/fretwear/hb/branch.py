@@ -57,8 +57,8 @@ class Problems:
     at its frequency (:meth:`polish`: the solver from that point to the sweep's tolerance),
     so that every recorded point is a converged point of the exact condensation. The
     frequencies of ``exact_at`` (the grid's, [rad/s]) are always condensed exactly. Every
-    exact condensation at a frequency the local basis served measures its error there
-    (:attr:`nearby_errors`); above :data:`NEARBY_STOP` the sweep condenses exactly from then
+    polish measures the error of the local basis's model it starts from against the exact
+    one (:attr:`nearby_errors`); above :data:`NEARBY_STOP` the sweep condenses exactly from then
     on (docs/theory.md, "Cost of the condensation")."""
 
     def __init__(self, model, basis, gap, eps, condenser, jacobian="auto", cache_size=CACHE_SIZE,
@@ -83,7 +83,7 @@ class Problems:
         #: ``polish_failed``
         self.counts = {"exact": 0, "nearby": 0, "polished": 0, "polish_failed": 0}
         #: relative error of the local basis's Z_r and F_r (worst harmonic) at each
-        #: frequency it served and that was condensed exactly afterwards
+        #: polished point
         self.nearby_errors: list = []
 
     def _room(self) -> None:
@@ -140,21 +140,13 @@ class Problems:
 
     def exact(self, omega: float, anchor) -> DLFTProblem:
         """The problem at ``omega`` [rad/s] on the exact condensation (replacing in the cache
-        the local basis's model there, whose error it measures)."""
+        the local basis's model there)."""
         key = float(omega)
         if key in self.nearby_keys or key not in self.cache:
-            near = self.cache.pop(key, None)
+            self.cache.pop(key, None)
             self.nearby_keys.discard(key)
             self._room()
-            red, _ = self._condense(omega, True)
-            if near is not None:  # (not when it has left the cache since)
-                self.nearby_errors.append(max(
-                    max(np.linalg.norm(a - b) / max(np.linalg.norm(b), 1e-300)
-                        for a, b in zip(x, y, strict=True))
-                    for x, y in ((near.Z, red.Z), (near.F, red.F))))
-                if self.nearby_errors[-1] > NEARBY_STOP:
-                    self.use_nearby = False
-            self.cache[key] = red
+            self.cache[key], _ = self._condense(omega, True)
         return self.get(omega, anchor)
 
     def polish(self, omega: float, prob: DLFTProblem, U, stats):
@@ -165,6 +157,13 @@ class Problems:
         if not getattr(prob.reduced, "nearby", False):
             return prob, U, stats
         pe = self.exact(omega, prob.anchor)
+        near, red = prob.reduced, pe.reduced
+        self.nearby_errors.append(max(
+            max(np.linalg.norm(a - b) / max(np.linalg.norm(b), 1e-300)
+                for a, b in zip(x, y, strict=True))
+            for x, y in ((near.Z, red.Z), (near.F, red.F))))
+        if self.nearby_errors[-1] > NEARBY_STOP:
+            self.use_nearby = False
         so = self.solve
         for method in (so.solver, so.other_solver):
             x, _, st = solve(lambda x, jac=True: pe.residual(x.reshape(pe.m, pe.H), jac),
