@@ -151,9 +151,10 @@ class Problems:
 
     def polish(self, omega: float, prob: DLFTProblem, U, stats):
         """``(problem, U, stats)`` of a point converged at ``omega`` [rad/s] on the local
-        basis's model (its reduced model's ``nearby``): the solver from ``U`` on the exact condensation there
-        (the sweep's solver, then the other one), its statistics added to ``stats``'s. A
-        point converged on an exact model is returned as it is."""
+        basis's model (its reduced model's ``nearby``): the solver from ``U`` on the exact
+        condensation there (the sweep's solver, then the other one), its statistics added to
+        ``stats``'s, the local basis's error there measured (:attr:`nearby_errors`). A point
+        converged on an exact model is returned as it is."""
         if not getattr(prob.reduced, "nearby", False):
             return prob, U, stats
         pe = self.exact(omega, prob.anchor)

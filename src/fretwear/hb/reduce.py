@@ -572,21 +572,22 @@ class Condenser:
     def nearby(self, omega: float, orders, tol: float, frequency: float | None = None
                ) -> Reduced | None:
         """The :class:`Reduced` model on ``orders`` at ``omega`` [rad/s] from the interior
-        solutions of the two latest exact condensations of each harmonic
+        solutions of the latest exact condensation of each harmonic
         (:func:`fretwear.hb.local_basis.local_basis`: exact at its frequency, off by the
-        square of the interior response's change away from it), or None where those two
-        error estimate of the local basis nearer ``omega`` exceeds ``tol`` (relative, in
-        ``Z_r`` or ``F_r``, of any harmonic), or a harmonic has fewer than two. The estimate
+        square of the interior response's change away from it; always the latest, so that a
+        difference quotient in frequency never spans two bases), or None where its error
+        estimate at ``omega`` exceeds ``tol`` (relative, in ``Z_r`` or ``F_r``, of any
+        harmonic), or a harmonic has fewer than two exact condensations kept. The estimate
         (the result's attribute ``estimate``) is the error's leading term at the distance
         from the basis's frequency, scaled by the two latest bases' disagreement one spacing
-        beyond the later one (:meth:`_disagreement`). Harmonic 0 is the
-        exact static condensation. No factorisation and no interior solve
+        beyond the later one (:meth:`_disagreement`). Harmonic 0 is the exact static
+        condensation. No factorisation and no interior solve
         (:meth:`keep_interior`)."""
         orders = np.asarray(orders, dtype=np.int64)
         dyn = [int(n) for n in orders if n > 0]
         if self._interior is None or any(len(self._interior.get(n, ())) < 2 for n in dyn):
             return None
-        m, no, nb, R = self.m, self.structure.obs.size, orders.size, self.R
+        m, no, nb = self.m, self.structure.obs.size, orders.size
         F_all = self.load_harmonics(int(orders.max()))
         Zr = np.zeros((nb, m, m), dtype=complex)
         Fr = np.zeros((nb, m), dtype=complex)
@@ -604,8 +605,8 @@ class Condenser:
             Fn = F_all[n]
             refs = self._interior[int(n)]
             dis, h = self._disagreement(int(n), Fn)
-            ref = min(refs, key=lambda r: abs(r[0] - omega))
-            d = abs(omega - ref[0])
+            ref = refs[-1]  # the latest: one basis until the next exact condensation (a
+            d = abs(omega - ref[0])  # difference quotient in frequency never spans two)
             estimate = max(estimate, dis * max(d / h, d * d / (3 * h * h)))
             near = None if not estimate <= tol else self._near(omega, int(n), ref, Fn)
             if near is None:
