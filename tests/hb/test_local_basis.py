@@ -58,15 +58,17 @@ def test_exact_at_its_frequency_and_its_estimate_bounds_the_error(joint):
     assert cond.nearby(w[1] + 2 * np.pi * 300.0, ORDERS, 1e-12) is None  # beyond tol
 
 
-def test_sweep_condenses_exactly_only_its_recorded_points(joint, monkeypatch):
+def test_sweep_condenses_exactly_a_fraction_of_its_frequencies(joint, monkeypatch):
     """A sweep of the lap joint through its resonance (4 grid points, 900-1300 Hz, one
-    harmonic) adds frequencies by halved steps (and, with the exact condensation at every
-    frequency, by the arclength: 169 condensations for 28 points, measured). With the local
-    bases every exact condensation of the balance's orders is at the frequency of a recorded
-    point, at most once each (the continuation's other frequencies by the local bases), and
-    the amplitudes at the frequencies both sweeps recorded equal those of the sweep with the
-    local bases off to 1e-6 (the issue's bar for the same converged points; measured 2e-10:
-    both are converged points of the exact condensation, the solver's tolerance 1e-8)."""
+    harmonic) crosses a fold: halved steps and 21 arclength points. With the exact
+    condensation at every frequency it adds (the local bases off, as before they existed) it
+    condenses 163 times for its 28 points (measured); with the local bases at most twice per
+    recorded point (measured 42: each recorded point polished on its exact condensation, the
+    frequencies where the estimate exceeds ``NEARBY_TOL`` condensed exactly), the rest (at
+    least 5) by the local bases. The two sweeps take the same path (the same rungs), and the
+    amplitudes at the grid frequencies are equal to 1e-6 of the peak (the issue's bar for the
+    same converged points; measured 3.5e-10: both are converged points of the exact
+    condensation, the solver's tolerance 1e-8)."""
     basis = fw.FourierBasis.up_to(1, 32)
     calls, nearby = [], []
     reduced, near = reduce.Condenser.reduced, reduce.Condenser.nearby
@@ -85,19 +87,17 @@ def test_sweep_condenses_exactly_only_its_recorded_points(joint, monkeypatch):
     monkeypatch.setattr(reduce.Condenser, "nearby", counted_near)
     res = fw.sweep(joint, basis, 900.0, 1300.0, 4)
     assert all(p.success for p in res.points)
-    recorded = 2 * np.pi * res.frequency_hz  # (Hz -> rad/s: a rounding of 1e-16)
     assert sum(nearby) >= 5  # the local bases served the continuation
-    at = [np.flatnonzero(np.isclose(recorded, w, rtol=1e-13, atol=0)) for w in calls]
-    assert all(i.size == 1 for i in at)  # each at a recorded point
-    assert len({int(i[0]) for i in at}) == len(calls)  # at most once each
+    assert len(calls) <= 2 * len(res.points)
 
     monkeypatch.setattr(reduce.Condenser, "keep_interior", lambda self: False)
     calls.clear()
     ref = fw.sweep(joint, basis, 900.0, 1300.0, 4)
-    assert len(calls) > 2 * len(res.points)  # the exact condensation at every frequency
-    fa, fb = res.frequency_hz, ref.frequency_hz
-    both = np.intersect1d(fa, fb)
-    assert both.size >= 4
-    a = res.amplitude("joint", "y")[np.isin(fa, both)]
-    b = ref.amplitude("joint", "y")[np.isin(fb, both)]
+    assert len(calls) > 4 * len(ref.points)  # the exact condensation at every frequency
+    assert [p.how for p in res.points] == [p.how for p in ref.points]
+    on_a = np.array([p.on_grid for p in res.points])
+    on_b = np.array([p.on_grid for p in ref.points])
+    a = res.amplitude("joint", "y")[on_a]
+    b = ref.amplitude("joint", "y")[on_b]
+    assert a.size == b.size == 4
     assert np.max(np.abs(a - b)) <= 1e-6 * np.max(np.abs(b))
