@@ -85,6 +85,7 @@ class CyclicCondenser(Condenser):
     def __init__(self, sector: CyclicSector, engine_order: int, dense: bool | None = None):
         self.sector = sector
         self.engine_order = _engine_order(engine_order)
+        self._keep_all = False  # keep_interior: every index's, new ones too
         self._dense = dense
         self._fp = _fingerprint(sector.model)
         self._subs: dict[int, tuple[Condenser, sp.csr_matrix]] = {}
@@ -103,6 +104,8 @@ class CyclicCondenser(Condenser):
             cond = Condenser(structure, self._dense)
             self._subs[k] = (cond, T)
             self._set_loads(cond, T)
+            if self._keep_all:
+                cond.keep_interior()
         return self._subs[k]
 
     def _set_loads(self, cond: Condenser, T: sp.csr_matrix) -> None:
@@ -168,6 +171,43 @@ class CyclicCondenser(Condenser):
                     if self.sector.model.observed else np.zeros(0, np.int64))
         return Reduced(float(omega), orders, Zr, Fr, oA, ob, obs_dofs, bool(quasi_static),
                        math.nan if frequency is None else float(frequency))
+
+    def keep_interior(self) -> bool:
+        """Keep the interior solutions of every harmonic index's latest exact condensation
+        (:meth:`~fretwear.hb.reduce.Condenser.keep_interior`), for :meth:`nearby`."""
+        self._keep_all = True
+        return all([self._keep() if cond is self else cond.keep_interior()
+                    for cond, _ in self._subs.values()])
+
+    def nearby(self, omega: float, orders, tol: float, frequency: float | None = None
+               ) -> Reduced | None:
+        """As :meth:`reduced` from each harmonic index's local bases
+        (:meth:`~fretwear.hb.reduce.Condenser.nearby`, with its ``tol`` and ``estimate``);
+        None when one gives none."""
+        orders = np.asarray(orders, dtype=np.int64)
+        ks = self.index(orders)
+        m, no, nb = self.m, self.structure.obs.size, orders.size
+        Zr = np.zeros((nb, m, m), dtype=complex)
+        Fr = np.zeros((nb, m), dtype=complex)
+        oA = np.zeros((nb, no, m), dtype=complex)
+        ob = np.zeros((nb, no), dtype=complex)
+        estimate = 0.0
+        for k in np.unique(ks):
+            sel = np.flatnonzero(ks == k)
+            cond, _ = self._sub(int(k))
+            get = super().nearby if cond is self else cond.nearby
+            r = get(omega, orders[sel], tol, frequency)
+            if r is None:
+                return None
+            Zr[sel], Fr[sel], oA[sel], ob[sel] = r.Z, r.F, r.obs_A, r.obs_b
+            estimate = max(estimate, getattr(r, "estimate", 0.0))
+        obs_dofs = (np.concatenate([np.asarray(p.dofs, np.int64)
+                                    for p in self.sector.model.observed])
+                    if self.sector.model.observed else np.zeros(0, np.int64))
+        out = Reduced(float(omega), orders, Zr, Fr, oA, ob, obs_dofs, False,
+                      math.nan if frequency is None else float(frequency))
+        out.estimate = estimate
+        return out
 
     def recover(self, omega: float, orders, u_loc, quasi_static: bool = False) -> np.ndarray:
         """The sector's DOFs ``U_n`` (nb, ndof) complex [m] from ``u_loc`` (nb, m): each
