@@ -32,7 +32,8 @@ def test_exact_at_its_frequency_and_its_estimate_bounds_the_error(joint):
     """The tutorial's lap joint (328 interior DOFs, 32 at the contact), references at 1100 and
     1105 Hz: at 1105 Hz ``Z_r``, ``F_r`` and the observed rows equal the exact condensation's
     to 1e-11 (the projection is exact there; rounding of the solves and of the ``q x q``
-    solve); at 1 to 100 Hz away (estimates up to 8e-4, the sweeps use them up to 1e-4) the
+    solve); at 1 to 100 Hz away (estimates up to 8e-4; a sweep uses them up to
+    ``NEARBY_TOL`` = 1e-6) the
     estimate (``estimate``) bounds the error of ``Z_r`` and ``F_r`` against a fresh exact
     condenser within a factor 1.5 (measured: 0.01 to 0.7 times the estimate up to 10 Hz, 1.13
     at 30 Hz, 1.49 at 100 Hz, where higher terms start: harmonic 2 nears a fixed-interface
