@@ -154,23 +154,40 @@ class CyclicCondenser(Condenser):
         [rad/s]: harmonic ``n``'s blocks from harmonic index ``n EO mod N``."""
         orders = np.asarray(orders, dtype=np.int64)
         self.check_size(orders)  # every index's blocks as harmonic index 0's (same sizes)
+        return self._by_index("reduced", omega, orders, quasi_static, frequency)
+
+    def _by_index(self, name: str, omega: float, orders: np.ndarray, arg,
+                  frequency: float | None) -> Reduced | None:
+        """The :class:`~fretwear.hb.reduce.Reduced` model on ``orders`` at ``omega`` [rad/s]
+        gathered from each harmonic index's condenser's method ``name`` (``"reduced"``: ``arg``
+        is ``quasi_static``; ``"nearby"``: ``tol``) on that index's harmonics; None when one
+        gives None. Its ``estimate`` (``"nearby"``): the largest of the indices'."""
         ks = self.index(orders)
         m, no, nb = self.m, self.structure.obs.size, orders.size
         Zr = np.zeros((nb, m, m), dtype=complex)
         Fr = np.zeros((nb, m), dtype=complex)
         oA = np.zeros((nb, no, m), dtype=complex)
         ob = np.zeros((nb, no), dtype=complex)
+        estimates = []
         for k in np.unique(ks):
             sel = np.flatnonzero(ks == k)
             cond, _ = self._sub(int(k))
-            get = super().reduced if cond is self else cond.reduced
-            r = get(omega, orders[sel], quasi_static, frequency)
+            get = getattr(super(), name) if cond is self else getattr(cond, name)
+            r = get(omega, orders[sel], arg, frequency)
+            if r is None:
+                return None
             Zr[sel], Fr[sel], oA[sel], ob[sel] = r.Z, r.F, r.obs_A, r.obs_b
+            if hasattr(r, "estimate"):
+                estimates.append(r.estimate)
         obs_dofs = (np.concatenate([np.asarray(p.dofs, np.int64)
                                     for p in self.sector.model.observed])
                     if self.sector.model.observed else np.zeros(0, np.int64))
-        return Reduced(float(omega), orders, Zr, Fr, oA, ob, obs_dofs, bool(quasi_static),
-                       math.nan if frequency is None else float(frequency))
+        quasi_static = name == "reduced" and bool(arg)
+        out = Reduced(float(omega), orders, Zr, Fr, oA, ob, obs_dofs, quasi_static,
+                      math.nan if frequency is None else float(frequency))
+        if estimates:
+            out.estimate = max(estimates)
+        return out
 
     def keep_interior(self) -> bool:
         """Keep the interior solutions of every harmonic index's latest exact condensation
@@ -185,29 +202,7 @@ class CyclicCondenser(Condenser):
         (:meth:`~fretwear.hb.reduce.Condenser.nearby`, with its ``tol`` and ``estimate``);
         None when one gives none."""
         orders = np.asarray(orders, dtype=np.int64)
-        ks = self.index(orders)
-        m, no, nb = self.m, self.structure.obs.size, orders.size
-        Zr = np.zeros((nb, m, m), dtype=complex)
-        Fr = np.zeros((nb, m), dtype=complex)
-        oA = np.zeros((nb, no, m), dtype=complex)
-        ob = np.zeros((nb, no), dtype=complex)
-        estimate = 0.0
-        for k in np.unique(ks):
-            sel = np.flatnonzero(ks == k)
-            cond, _ = self._sub(int(k))
-            get = super().nearby if cond is self else cond.nearby
-            r = get(omega, orders[sel], tol, frequency)
-            if r is None:
-                return None
-            Zr[sel], Fr[sel], oA[sel], ob[sel] = r.Z, r.F, r.obs_A, r.obs_b
-            estimate = max(estimate, getattr(r, "estimate", 0.0))
-        obs_dofs = (np.concatenate([np.asarray(p.dofs, np.int64)
-                                    for p in self.sector.model.observed])
-                    if self.sector.model.observed else np.zeros(0, np.int64))
-        out = Reduced(float(omega), orders, Zr, Fr, oA, ob, obs_dofs, False,
-                      math.nan if frequency is None else float(frequency))
-        out.estimate = estimate
-        return out
+        return self._by_index("nearby", omega, orders, tol, frequency)
 
     def recover(self, omega: float, orders, u_loc, quasi_static: bool = False) -> np.ndarray:
         """The sector's DOFs ``U_n`` (nb, ndof) complex [m] from ``u_loc`` (nb, m): each
