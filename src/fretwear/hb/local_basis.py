@@ -75,12 +75,12 @@ def local_basis(cond, omega: float, n: int, X: np.ndarray, xf: np.ndarray,
     real = all(np.asarray(getattr(B.ii, "data", B.ii)).dtype.kind != "c"
                for B in (cond.K, cond.M, cond.C, cond.D) if B is not None)
     left = W.T if real else W.conj().T  # complex symmetric: W^T; Hermitian blocks: W^H
-    Zic = cond._z("ic", omega, n, False)
+    Zic = _dense(cond._z("ic", omega, n, False))  # formed once: G's and qc's
     Zci = cond._z("ci", omega, n, False)
-    rhs = (np.column_stack([_dense(Zic), Fi]) if load else _dense(Zic)) / scale
+    rhs = (np.column_stack([Zic, Fi]) if load else Zic) / scale
     # (Z_ii(w_a) W, by the solves' own identity: no product with Z_ii)
     G = {"0": left @ rhs}
-    qc = {"0": left @ _dense(Zic)}
+    qc = {"0": left @ Zic}
     cq = {"0": _times(Zci, W)}
     for key, B in (("M", cond.M), ("C", cond.C)):
         if B is None:
