@@ -587,13 +587,21 @@ class Condenser:
         dyn = [int(n) for n in orders if n > 0]
         if self._interior is None or any(len(self._interior.get(n, ())) < 2 for n in dyn):
             return None
-        m, no, nb = self.m, self.structure.obs.size, orders.size
         F_all = self.load_harmonics(int(orders.max()))
+        estimate = 0.0
+        for n in dyn:  # the estimate first: no block formed for a model it refuses
+            dis, h = self._disagreement(n, F_all[n])
+            # from the latest basis: one until the next exact condensation (a difference
+            # quotient in frequency never spans two)
+            d = abs(omega - self._interior[n][-1][0])
+            estimate = max(estimate, dis * max(d / h, d * d / (3 * h * h)))
+            if not estimate <= tol:
+                return None
+        m, no, nb = self.m, self.structure.obs.size, orders.size
         Zr = np.zeros((nb, m, m), dtype=complex)
         Fr = np.zeros((nb, m), dtype=complex)
         oA = np.zeros((nb, no, m), dtype=complex)
         ob = np.zeros((nb, no), dtype=complex)
-        estimate = 0.0
         for b, n in enumerate(orders):
             if n == 0:
                 Zr_0, lu, Zci, Xo = self.schur(0.0, 0)
@@ -602,13 +610,7 @@ class Condenser:
                 for j, i in self.obs_i:
                     ob[b, j] = xf[i]
                 continue
-            Fn = F_all[n]
-            refs = self._interior[int(n)]
-            dis, h = self._disagreement(int(n), Fn)
-            ref = refs[-1]  # the latest: one basis until the next exact condensation (a
-            d = abs(omega - ref[0])  # difference quotient in frequency never spans two)
-            estimate = max(estimate, dis * max(d / h, d * d / (3 * h * h)))
-            near = None if not estimate <= tol else self._near(omega, int(n), ref, Fn)
+            near = self._near(omega, int(n), self._interior[int(n)][-1], F_all[n])
             if near is None:
                 return None
             Zr[b], Fr[b], (A, x) = near
