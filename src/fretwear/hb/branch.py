@@ -97,8 +97,9 @@ class Problems:
         size = next(iter(self.cache.values())).Z.nbytes if self.cache else 0
         while self.cache and (len(self.cache) >= self.size or size + sum(
                 r.Z.nbytes for r in self.cache.values()) > CACHE_BYTES):
-            self.nearby_keys.discard(next(iter(self.cache)))
-            self.cache.pop(next(iter(self.cache)))
+            oldest = next(iter(self.cache))
+            self.nearby_keys.discard(oldest)
+            self.cache.pop(oldest)
 
     def _condense(self, omega: float, exact: bool):
         """The reduced model at ``omega`` (springs connected) and whether it is exact."""
