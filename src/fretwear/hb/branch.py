@@ -270,7 +270,8 @@ class Branch:
 
     def add(self, omega, prob, U, stats, how) -> None:
         """An intermediate converged point (a substep, a point of the arclength branch);
-        left out when its polish on the exact condensation fails (:meth:`record`)."""
+        left out when :meth:`record` makes it a failure (its polish on the exact condensation
+        failed, or it holds non-finite values)."""
         pt = self.record(omega, prob, U, stats, how)
         if pt.solution is not None and pt.solution.success:
             self.points.append(pt)
