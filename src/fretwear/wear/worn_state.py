@@ -121,6 +121,11 @@ class WornStateOptions:
         follows it exactly (:mod:`fretwear.wear.exponential_step`; on Stromberg's beam 51
         steps instead of 63 to the same state); elsewhere the step is the march's. False:
         the march's step throughout.
+    order : 1: the path steps as above (first order, the march's error control); 2: the
+        exponential Rosenbrock-Euler step on every path step, second order with the exact
+        slow Jacobian, its error estimated by the embedded third-order correction and the
+        jump controlled with the cube root (:mod:`fretwear.wear.exponential_step`; measured
+        in docs/studies/method-costs.md).
     """
 
     wear: WearOptions = field(default_factory=WearOptions)
@@ -133,6 +138,7 @@ class WornStateOptions:
     path_tolerance: float = 1e-2
     stick_set: bool = False
     exponential: bool = True
+    order: int = 1
 
     def __post_init__(self):
         if not isinstance(self.wear, WearOptions):
@@ -145,6 +151,8 @@ class WornStateOptions:
         j = self.initial_jump
         if j is not None and not (isinstance(j, (int, float)) and j > 0):
             raise InputError(f"initial_jump = {j!r}: expected > 0 cycles or None")
+        if self.order not in (1, 2) or isinstance(self.order, bool):
+            raise InputError(f"order = {self.order!r}: expected 1 or 2")
         for name in ("stick_set", "exponential"):
             if not isinstance(getattr(self, name), bool):
                 raise InputError(f"{name} = {getattr(self, name)!r}: expected true or false")
@@ -161,9 +169,12 @@ class WornStateOptions:
 
     def key(self) -> dict:
         """What changes the path (the checkpoint's fingerprint)."""
-        return {"initial_jump": self.initial_jump, "max_growth": self.max_growth,
-                "min_growth": self.min_growth, "path_tolerance": self.path_tolerance,
-                "stick_set": self.stick_set, "exponential": self.exponential}
+        key = {"initial_jump": self.initial_jump, "max_growth": self.max_growth,
+               "min_growth": self.min_growth, "path_tolerance": self.path_tolerance,
+               "stick_set": self.stick_set, "exponential": self.exponential}
+        if self.order != 1:  # (the checkpoints of first-order runs keep their key)
+            key["order"] = self.order
+        return key
 
 
 @dataclass
@@ -381,7 +392,8 @@ def _continue(sp: SlowProblem, state: SlowStep, records: list[StepRecord],
         try:
             settled = _settled(records)
             new, record, msg = _path_step(sp, state, opts if settled else path,
-                                          options.exponential)
+                                          options.exponential, 1 if settled else options.order,
+                                          path_cycles(records) if options.order == 2 else None)
             if new is not None and not new.in_time_integration:
                 new, record = _pull_back(sp, state, new, record, opts)
                 msg = msg or "the balance after pulling back over-worn nodes failed"
@@ -405,13 +417,22 @@ def _continue(sp: SlowProblem, state: SlowStep, records: list[StepRecord],
             raise KeyboardInterrupt from None
 
 
-def _path_step(sp: SlowProblem, state: SlowStep, opts: WearOptions, exponential: bool):
+def path_cycles(records: list[StepRecord]) -> float:
+    """The cycles of the steps that followed the path (taken before the path had settled,
+    :func:`_settled`), without the pseudo-time of the relaxation (SER) steps; from the
+    records alone, so a resumed run counts the same."""
+    return sum(records[k].jump for k in range(1, len(records))
+               if not _settled(records[:k]))
+
+
+def _path_step(sp: SlowProblem, state: SlowStep, opts: WearOptions, exponential: bool,
+               order: int = 1, cycles: float | None = None):
     """The next pseudo-time step: the exponential Euler step
     (:func:`~fretwear.wear.exponential_step.exponential_step`) with ``exponential``, else
     or where it failed or from a time integration the march's step
     (:func:`fretwear.wear.simulate._step`, with its time-domain rescue)."""
     if exponential and not state.in_time_integration:
-        new, record, msg = exponential_step(sp, state, opts)
+        new, record, msg = exponential_step(sp, state, opts, order, cycles)
         if new is not None:
             return new, record, msg
     return _step(sp, state, opts)
