@@ -147,12 +147,14 @@ def test_direct_state_is_the_march_plateau(name, nx, orders, tmp_path):
     full ones run in benchmarks/worn_state.py): the direct state equals the state the march
     reaches at its plateau: the worn profile within 1 % of the deepest wear, the same stuck
     nodes (carrying load and not wearing) and the mean pressure within 1 % of the
-    largest (issue 29's tolerances; measured 0.43 %, 0.016 % and 0.22 %). The march runs to a
+    largest (issue 29's tolerances; measured 0.01 %, 0.00 % and 0.00 % with the path's first-order
+    steps, 0.63 % and 0.01 % with the second-order ones). The march runs to a
     worn-volume rate of 1e-8 of the initial one: at its default plateau (1e-3) it has not
     reached the state yet on Stromberg's full beam (a loaded node next to the pillar wears
     later, by 8.8 % of the deepest wear; docs/theory.md). The second-order path steps
     (``order = 2``) against the same march, where they are claimed to hold (the reduced
-    triangle beam's state moves by 3.7 % with them: docs/studies/method-costs.md)."""
+    triangle beam's state moves by 1.5 % with them, closer to the march's at tolerance 1e-4
+    than the march's at 1e-2 is: docs/studies/method-costs.md)."""
     from fretwear.analyses.run import load_case
     from fretwear.examples import example_path
     from fretwear.io.case import build_model

@@ -126,6 +126,12 @@ class WornStateOptions:
         slow Jacobian, its error estimated by the embedded third-order correction and the
         jump controlled with the cube root (:mod:`fretwear.wear.exponential_step`; measured
         in docs/studies/method-costs.md).
+    settle_rate : the path counts as settled (the relaxation steps may start) only once the
+        worn-volume rate has fallen to this fraction of the initial one, besides the same
+        slipping nodes over three records and a falling rate (without it the relaxation
+        started at the third step of a reduced triangle beam, whose rate had fallen by
+        0.1 %, and jumped over the slip events to come: 0.73 % of the deepest wear from the
+        march's state instead of 1e-5).
     """
 
     wear: WearOptions = field(default_factory=WearOptions)
@@ -139,6 +145,7 @@ class WornStateOptions:
     stick_set: bool = False
     exponential: bool = True
     order: int = 1
+    settle_rate: float = 0.01
 
     def __post_init__(self):
         if not isinstance(self.wear, WearOptions):
@@ -157,6 +164,7 @@ class WornStateOptions:
             if not isinstance(getattr(self, name), bool):
                 raise InputError(f"{name} = {getattr(self, name)!r}: expected true or false")
         number(self.max_growth, "max_growth", low=1.0, open_low=True, high=1e6)
+        number(self.settle_rate, "settle_rate", low=0.0, open_low=True, high=1.0)
 
     def march_options(self, path: bool = False) -> WearOptions:
         """The wear options of the steps: linearly implicit, no stop criterion of the march;
@@ -171,7 +179,8 @@ class WornStateOptions:
         """What changes the path (the checkpoint's fingerprint)."""
         key = {"initial_jump": self.initial_jump, "max_growth": self.max_growth,
                "min_growth": self.min_growth, "path_tolerance": self.path_tolerance,
-               "stick_set": self.stick_set, "exponential": self.exponential}
+               "stick_set": self.stick_set, "exponential": self.exponential,
+               "settle_rate": self.settle_rate}
         if self.order != 1:  # (the checkpoints of first-order runs keep their key)
             key["order"] = self.order
         return key
@@ -381,7 +390,7 @@ def _continue(sp: SlowProblem, state: SlowStep, records: list[StepRecord],
                                  f"/ max g0 = {r:.3g} (tolerance {options.tolerance:g}), last "
                                  f"correction {c:.3g} of the deepest wear", r, c,
                                  jumps.iterations)
-        if options.stick_set and _settled(records):
+        if options.stick_set and _settled(records, options.settle_rate):
             hit = jumps.accept(state, records)
             if hit is not None:
                 state = hit[0]
@@ -390,10 +399,11 @@ def _continue(sp: SlowProblem, state: SlowStep, records: list[StepRecord],
                     run.callback(state.step, records[-1])
                 return hit
         try:
-            settled = _settled(records)
+            settled = _settled(records, options.settle_rate)
             new, record, msg = _path_step(sp, state, opts if settled else path,
                                           options.exponential, 1 if settled else options.order,
-                                          path_cycles(records) if options.order == 2 else None)
+                                          path_cycles(records, options.settle_rate)
+                                          if options.order == 2 else None)
             if new is not None and not new.in_time_integration:
                 new, record = _pull_back(sp, state, new, record, opts)
                 msg = msg or "the balance after pulling back over-worn nodes failed"
@@ -417,12 +427,12 @@ def _continue(sp: SlowProblem, state: SlowStep, records: list[StepRecord],
             raise KeyboardInterrupt from None
 
 
-def path_cycles(records: list[StepRecord]) -> float:
+def path_cycles(records: list[StepRecord], settle_rate: float) -> float:
     """The cycles of the steps that followed the path (taken before the path had settled,
     :func:`_settled`), without the pseudo-time of the relaxation (SER) steps; from the
     records alone, so a resumed run counts the same."""
     return sum(records[k].jump for k in range(1, len(records))
-               if not _settled(records[:k]))
+               if not _settled(records[:k], settle_rate))
 
 
 def _path_step(sp: SlowProblem, state: SlowStep, opts: WearOptions, exponential: bool,
@@ -501,11 +511,12 @@ class _Jumps:
             res, c, self.iterations, True)
 
 
-def _settled(records: list[StepRecord]) -> bool:
-    """Whether the path has settled: the same slipping nodes over the last three records and
-    a worn-volume rate that fell over both steps. Then only the decay to the state is left,
-    and the steps may grow as fast as SER lets them."""
-    if len(records) < 3:
+def _settled(records: list[StepRecord], settle_rate: float = 1.0) -> bool:
+    """Whether the path has settled: the same slipping nodes over the last three records, a
+    worn-volume rate that fell over both steps and is at most ``settle_rate`` of the initial
+    one. Then only the decay to the state is left, and the steps may grow as fast as SER lets
+    them."""
+    if len(records) < 3 or records[-1].volume_rate > settle_rate * records[0].volume_rate:
         return False
     last = records[-3:]
     same = all(np.array_equal(state_slip(last[0]), state_slip(r)) for r in last[1:])
