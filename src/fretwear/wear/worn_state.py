@@ -13,7 +13,8 @@ the linearly implicit Euler step of the march (:mod:`fretwear.wear.schemes`, ``J
 along balanced solutions). While the set of slipping nodes changes, ``dN_k`` comes from the
 march's error control (``path_tolerance``): the state is not unique, it depends on the path
 (which nodes stick, and when), so that part is followed. Once the slipping set has settled
-and the rate decays, the step is set by switched evolution relaxation (SER),
+and the rate decays (below ``settle_rate`` of the initial one), the step is set by switched
+evolution relaxation (SER),
 ``dN_{k+1} = dN_k min_growth V'_k / V'_{k+1}`` (``V'`` the worn-volume rate, growth capped at
 ``max_growth``): it grows without bound as the rate falls, and the iteration turns into
 Newton's method on ``g(W) = 0`` (``dW -> -Js^-1 g``), the direct solve of the null-wear-rate
@@ -360,11 +361,15 @@ def _judge(records: list[StepRecord], options: WornStateOptions) -> _Found | Non
                       f"residual max g / max g0 = {r:.3g} <= {options.tolerance:g}, last "
                       f"correction {c:.3g} of the deepest wear <= {options.depth_tolerance:g}",
                       r, c)
-    if n >= 3 and _rate_change(records) <= options.tolerance and r > 0.1:
+    # steady: the rate profile did not change over a step that moved the profile (a tiny
+    # step, e.g. after failed balances, leaves any rate unchanged)
+    if (n >= 3 and _rate_change(records) <= options.tolerance and r > 0.1
+            and c >= options.depth_tolerance):
         return _Found(True, "steady_wear",
                       f"no null-wear-rate state: the wear goes on at a steady rate (residual "
                       f"{r:.3g}, the rate profile changed by {_rate_change(records):.3g} over "
-                      "the last step); the rate profile is the steady one", r, c)
+                      f"the last step, which moved the profile by {c:.3g} of the deepest "
+                      "wear); the rate profile is the steady one", r, c)
     return None
 
 
