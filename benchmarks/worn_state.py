@@ -33,8 +33,8 @@ The last lines are ``worn_state_speedup=<geometric mean of march / direct proces
 and ``worn_state_diff=<largest profile difference / largest depth>``.
 
 Run: ``python benchmarks/worn_state.py [--cases salles2011-quasistatic,stromberg1997]
-[--steps 200] [--dovetail-steps 60]``. Quote the figures with the machine load (``uptime``:
-printed before and after).
+[--steps 200] [--dovetail-steps 60] [--order 2]``. Quote the figures with the machine load
+(``uptime``: printed before and after).
 """
 
 from __future__ import annotations
@@ -117,14 +117,15 @@ def jumps(model, basis, f_hz, quasi, opts, balance, h, k: int) -> None:
               "march's final state")
 
 
-def run_case(name: str, steps: int) -> tuple[float, float] | None:
-    """March and direct solve of one example: ``(speedup, profile difference)``, None when
-    either reached no state within ``steps``."""
+def run_case(name: str, steps: int, order: int = 1) -> tuple[float, float] | None:
+    """March and direct solve (its path steps of ``order``, :class:`WornStateOptions`) of
+    one example: ``(speedup, profile difference)``, None when either reached no state
+    within ``steps``."""
     model, basis, f_hz, quasi, opts, balance = _setup(name, steps)
     kw = {"frequency": f_hz, "quasi_static": quasi, "balance": balance}
     march, c_m, w_m = _timed(lambda: simulate_wear(model, basis, options=opts, **kw))
     direct, c_d, w_d = _timed(lambda: worn_state(
-        model, basis, options=WornStateOptions(wear=opts, max_steps=steps), **kw))
+        model, basis, options=WornStateOptions(wear=opts, max_steps=steps, order=order), **kw))
     h = march.history
     Wm, Wd = h.wear_depth[-1], direct.wear
     top = float(np.max(Wm))
@@ -172,13 +173,13 @@ def run_case(name: str, steps: int) -> tuple[float, float] | None:
     return c_m / c_d, diff
 
 
-def not_reached(steps: int) -> None:
+def not_reached(steps: int, order: int = 1) -> None:
     """The 79 kHz beam (salles2011-79khz), whose wear path is chaotic: the direct solve
     must say that it did not reach a state, with the residual."""
     model, basis, f_hz, quasi, opts, balance = _setup("salles2011-79khz", steps)
     res, c, w = _timed(lambda: api.worn_state(
-        model, basis, frequency=f_hz, options=WornStateOptions(wear=opts, max_steps=steps),
-        balance=balance))
+        model, basis, frequency=f_hz,
+        options=WornStateOptions(wear=opts, max_steps=steps, order=order), balance=balance))
     print(f"salles2011-79khz: {res.message}")
     print(f"  kind {res.kind}, success {res.success}, residual {res.residual:.3g}; processor "
           f"{c:.1f} s, wall {w:.1f} s")
@@ -192,6 +193,8 @@ def main():
                     help="slow steps of the dovetail's march and direct solve at most")
     ap.add_argument("--steps-79khz", type=int, default=20,
                     help="steps of the direct solve on the 79 kHz beam (0: skip it)")
+    ap.add_argument("--order", type=int, default=1, choices=(1, 2),
+                    help="the direct solve's path steps: 1 (default) or 2 (second order)")
     args = ap.parse_args()
     print("load before:", os.getloadavg())
     # warm-up: compiles the numba kernels (not timed)
@@ -201,12 +204,13 @@ def main():
     speed, diffs = [], []
     for name in args.cases.split(","):
         name = name.strip()
-        out = run_case(name, args.dovetail_steps if name == "dovetail-wear" else args.steps)
+        out = run_case(name, args.dovetail_steps if name == "dovetail-wear" else args.steps,
+                       args.order)
         if out is not None:
             speed.append(out[0])
             diffs.append(out[1])
     if args.steps_79khz > 0:
-        not_reached(args.steps_79khz)
+        not_reached(args.steps_79khz, args.order)
     print("load after:", os.getloadavg())
     if not speed:
         print("no case reached a state: no summary")

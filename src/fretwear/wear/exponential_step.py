@@ -38,6 +38,7 @@ balance, the rejection of a step whose error estimate exceeds the tolerance.
 
 from __future__ import annotations
 
+import math
 import time
 
 import numpy as np
@@ -64,22 +65,61 @@ def increment(Js, g, dN: float) -> np.ndarray:
     return dN * sla.expm(B)[:nc, nc]
 
 
-def exponential_step(sp: SlowProblem, st: SlowStep, opts: WearOptions):
+def phi(Js, v, dN: float, k: int) -> np.ndarray:
+    """``phi_k(dN Js) v`` (nc,), ``phi_k(z) = sum_j z^j / (j + k)!``, from the exponential of
+    the bordered matrix ``[[dN Js, v e_1^T], [0, S]]``, ``S`` the ``k x k`` shift (Higham,
+    Functions of Matrices, section 10.7.4; Hochbruck and Ostermann 2010, eq. 2.10):
+    its last column holds ``phi_k(dN Js) v``."""
+    v = np.asarray(v, float)
+    nc = v.size
+    B = np.zeros((nc + k, nc + k))
+    B[:nc, :nc] = dN * np.asarray(Js, float)
+    B[:nc, nc] = v
+    B[nc + np.arange(k - 1), nc + 1 + np.arange(k - 1)] = 1.0
+    return sla.expm(B)[:nc, -1]
+
+
+def rosenbrock_error(Js, dN: float, dW, g0, g1) -> np.ndarray:
+    """The local error estimate (nc,) [m] of the exponential Rosenbrock-Euler step
+    ``dW = dN phi1(dN Js) g0``: ``2 dN phi3(dN Js) D`` with the nonlinear remainder
+    ``D = g1 - g0 - Js dW`` (``g1`` the rate at ``W_k + dW``). It is the correction of the
+    embedded third-order method exprb32 (Hochbruck, Ostermann and Schweitzer, SIAM J. Numer.
+    Anal. 47, 2009, section 5.1), so the error of the second-order step is ``O(dN^3)``; it
+    costs no balance (``g1`` is the step's own)."""
+    D = np.asarray(g1, float) - np.asarray(g0, float) - np.asarray(Js, float) @ dW
+    return 2.0 * dN * phi(Js, D, dN, 3)
+
+
+def exponential_step(sp: SlowProblem, st: SlowStep, opts: WearOptions, order: int = 1,
+                     cycles: float | None = None):
     """One accepted slow step from ``st``: ``(new_state, record, failure)``,
     ``(None, None, message)`` when its balance failed after ``opts.max_retries`` smaller
-    jumps. The exponential Euler step where ``Js`` has a growing mode ``lam`` that would cut
-    the march's jump (``dN lam > GROWTH_LIMIT``), up to ``dN lam = EXP_GROWTH_LIMIT``; the
-    march's step otherwise (:func:`fretwear.wear.schemes.advance`, the same numbers: the
-    path of a march where nothing grows)."""
+    jumps.
+
+    ``order = 1``: the exponential Euler step where ``Js`` has a growing mode ``lam`` that
+    would cut the march's jump (``dN lam > GROWTH_LIMIT``), up to ``dN lam =
+    EXP_GROWTH_LIMIT``; the march's step otherwise (:func:`fretwear.wear.schemes.advance`,
+    the same numbers: the path of a march where nothing grows), with the march's error
+    control.
+
+    ``order = 2``: the exponential step everywhere (with the exact slow Jacobian it is the
+    exponential Rosenbrock-Euler method, of second order: Hochbruck, Ostermann and
+    Schweitzer 2009), its error estimated by :func:`rosenbrock_error` and the jump
+    controlled with the cube root of ``tolerance / error``.
+
+    ``cycles``: the cycle count the error control's floor is a fraction of
+    (``MIN_JUMP_FRACTION``; None: ``st.cycles``). The pseudo-time of the worn state's
+    continuation passes the cycles of its path steps alone: after a relaxation step of
+    ``1e9`` pseudo-cycles the floor would otherwise accept any jump below ``1e4``."""
     t0 = time.perf_counter()
     anchor = st.U.reshape(sp.nc, sp.d, sp.H)[:, 1:, 0].copy()  # the history rule
     sp.set_state(st.W, anchor)
     Js, dUdW = sp.slow_jacobian(st.U, with_dUdW=True)
     dN = min(st.jump, opts.max_jump, opts.max_cycles - st.cycles)
-    floor = max(opts.min_jump, MIN_JUMP_FRACTION * st.cycles)
+    floor = max(opts.min_jump, MIN_JUMP_FRACTION * (st.cycles if cycles is None else cycles))
     lam_plus = float(np.max(np.linalg.eigvals(Js).real))
-    exponential = lam_plus > 0 and dN * lam_plus > GROWTH_LIMIT  # the march would cut it
-    if exponential:
+    exponential = order == 2 or (lam_plus > 0 and dN * lam_plus > GROWTH_LIMIT)
+    if lam_plus > 0 and dN * lam_plus > GROWTH_LIMIT:  # the march would cut it
         dN = min(dN, EXP_GROWTH_LIMIT / lam_plus)
 
     start = StepStart(st.W, st.U, st.g, anchor)
@@ -91,4 +131,11 @@ def exponential_step(sp: SlowProblem, st: SlowStep, opts: WearOptions):
             dW = dN * np.linalg.solve(np.eye(sp.nc) - dN * Js, st.g)
         return balance_after(sp, opts, start, np.maximum(dW, 0.0), dUdW)  # wear never decreases
 
-    return accept(sp, opts, st, anchor, attempt, (dN, floor, floor), (t0, 1, 0))
+    error = None
+    if order == 2:
+        def estimate(dN, W1, g1):  # relative to the deepest wear, as local_error
+            scale = float(np.max(np.abs(W1)))
+            e = float(np.max(np.abs(rosenbrock_error(Js, dN, W1 - st.W, st.g, g1))))
+            return 0.0 if e == 0.0 else (e / scale if scale > 0 else math.inf)
+        error = (estimate, 2)
+    return accept(sp, opts, st, anchor, attempt, (dN, floor, floor), (t0, 1, 0), error)

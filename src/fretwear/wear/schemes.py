@@ -37,7 +37,7 @@ from fretwear.wear.options import (
 )
 from fretwear.wear.slow_problem import SlowProblem
 from fretwear.wear.state import SlowStep, StepRecord, StepStats
-from fretwear.wear.step_control import local_error, next_jump
+from fretwear.wear.step_control import local_error, next_jump, root
 from fretwear.wear.time_steps import time_domain_start
 
 
@@ -137,17 +137,22 @@ def advance(sp: SlowProblem, st: SlowStep, opts: WearOptions):
 
 
 def accept(sp: SlowProblem, opts: WearOptions, st: SlowStep, anchor, attempt, jumps,
-           counts):
+           counts, error=None):
     """The acceptance loop of a slow step from ``st`` (:func:`advance` and
     :func:`fretwear.wear.exponential_step.exponential_step`): ``attempt(dN) -> (W1, U1,
     stats)`` tries a jump of ``dN`` cycles; a failed balance is retried with the jump divided
     by 4 (up to ``max_retries`` times, not below ``fail_floor``); with ``adaptive``, a step
     whose error estimate exceeds the tolerance is retried with the jump the controller
     proposes (not below ``floor``). ``jumps`` = ``(dN, floor, fail_floor)``, ``counts`` =
-    ``(t0, iterations, rejected)`` so far. Returns ``(new_state, record, "")`` or ``(None,
-    None, message)``."""
+    ``(t0, iterations, rejected)`` so far. ``error`` = ``(estimate, order)``: the local error
+    estimate ``estimate(dN, W1, g1)`` of a scheme of that order (the jump scales with its
+    ``order + 1``-th root); None: the first-order defect of :func:`local_error`. Returns
+    ``(new_state, record, "")`` or ``(None, None, message)``."""
     dN, floor, fail_floor = jumps
     t0, iters, rejected = counts
+    if error is None:
+        error = (lambda dn, W1, g1: local_error(dn, W1, st.W, g1, st.g), 1)
+    estimate, order = error
     failures = 0
     while True:
         W1, U1, stats = attempt(dN)
@@ -162,14 +167,14 @@ def accept(sp: SlowProblem, opts: WearOptions, st: SlowStep, anchor, attempt, ju
             continue
         sp.set_state(W1, anchor)
         g1 = sp.rate(U1)
-        err = local_error(dN, W1, st.W, g1, st.g)
+        err = estimate(dN, W1, g1)
         if opts.adaptive and err > opts.tolerance and dN > floor:
             rejected += 1
-            dN = max(dN * max(0.1, 0.9 * math.sqrt(opts.tolerance / err)), floor)
+            dN = max(dN * max(0.1, 0.9 * root(opts.tolerance / err, order)), floor)
             continue
         break
     # no growth right after a failed solve (stiff ODE practice)
-    jump = next_jump(dN, err, opts, st.jump, 1.0 if failures else 5.0)
+    jump = next_jump(dN, err, opts, st.jump, 1.0 if failures else 5.0, order)
     sol = sp.solution(U1, W1, anchor, stats)
     record = StepRecord.balanced(sol, W1, g1, StepStats(st.cycles + dN, dN, iters, rejected,
                                                         err, time.perf_counter() - t0))

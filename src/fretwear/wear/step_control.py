@@ -31,11 +31,19 @@ def local_error(dN, W1, W_k, g1, g0) -> float:
     return num / scale if scale > 0 else math.inf
 
 
+def root(x: float, order: int) -> float:
+    """``x^(1 / (order + 1))``: the factor on a jump that brings a local error growing as
+    ``dN^(order + 1)`` from ``tolerance / x`` to the tolerance (``math.sqrt`` for the
+    first-order schemes, to the bit)."""
+    return math.sqrt(x) if order == 1 else x ** (1.0 / (order + 1))
+
+
 def next_jump(dN: float, err: float, opts: WearOptions, fixed: float,
-              grow_limit: float = 5.0) -> float:
+              grow_limit: float = 5.0, order: int = 1) -> float:
     """The jump proposed after an accepted step of ``dN`` cycles with error estimate ``err``
-    (``fixed``, the jump in force, without ``adaptive``)."""
+    (``fixed``, the jump in force, without ``adaptive``) of a scheme of ``order`` (its local
+    error grows as ``dN^(order + 1)``)."""
     if not opts.adaptive:
         return fixed
-    grow = 5.0 if err == 0.0 else min(5.0, max(0.2, 0.9 * math.sqrt(opts.tolerance / err)))
+    grow = 5.0 if err == 0.0 else min(5.0, max(0.2, 0.9 * root(opts.tolerance / err, order)))
     return dN * min(grow, grow_limit)

@@ -13,7 +13,8 @@ the linearly implicit Euler step of the march (:mod:`fretwear.wear.schemes`, ``J
 along balanced solutions). While the set of slipping nodes changes, ``dN_k`` comes from the
 march's error control (``path_tolerance``): the state is not unique, it depends on the path
 (which nodes stick, and when), so that part is followed. Once the slipping set has settled
-and the rate decays, the step is set by switched evolution relaxation (SER),
+and the rate decays (below ``settle_rate`` of the initial one), the step is set by switched
+evolution relaxation (SER),
 ``dN_{k+1} = dN_k min_growth V'_k / V'_{k+1}`` (``V'`` the worn-volume rate, growth capped at
 ``max_growth``): it grows without bound as the rate falls, and the iteration turns into
 Newton's method on ``g(W) = 0`` (``dW -> -Js^-1 g``), the direct solve of the null-wear-rate
@@ -121,6 +122,17 @@ class WornStateOptions:
         follows it exactly (:mod:`fretwear.wear.exponential_step`; on Stromberg's beam 51
         steps instead of 63 to the same state); elsewhere the step is the march's. False:
         the march's step throughout.
+    order : 1: the path steps as above (first order, the march's error control); 2: the
+        exponential Rosenbrock-Euler step on every path step, second order with the exact
+        slow Jacobian, its error estimated by the embedded third-order correction and the
+        jump controlled with the cube root (:mod:`fretwear.wear.exponential_step`; measured
+        in docs/studies/method-costs.md).
+    settle_rate : the path counts as settled (the relaxation steps may start) only once the
+        worn-volume rate has fallen to this fraction of the initial one, besides the same
+        slipping nodes over three records and a falling rate (without it the relaxation
+        started at the third step of a reduced triangle beam, whose rate had fallen by
+        0.1 %, and jumped over the slip events to come: 0.73 % of the deepest wear from the
+        march's state instead of 1e-5).
     """
 
     wear: WearOptions = field(default_factory=WearOptions)
@@ -133,6 +145,8 @@ class WornStateOptions:
     path_tolerance: float = 1e-2
     stick_set: bool = False
     exponential: bool = True
+    order: int = 1
+    settle_rate: float = 0.01
 
     def __post_init__(self):
         if not isinstance(self.wear, WearOptions):
@@ -145,10 +159,13 @@ class WornStateOptions:
         j = self.initial_jump
         if j is not None and not (isinstance(j, (int, float)) and j > 0):
             raise InputError(f"initial_jump = {j!r}: expected > 0 cycles or None")
+        if self.order not in (1, 2) or isinstance(self.order, bool):
+            raise InputError(f"order = {self.order!r}: expected 1 or 2")
         for name in ("stick_set", "exponential"):
             if not isinstance(getattr(self, name), bool):
                 raise InputError(f"{name} = {getattr(self, name)!r}: expected true or false")
         number(self.max_growth, "max_growth", low=1.0, open_low=True, high=1e6)
+        number(self.settle_rate, "settle_rate", low=0.0, open_low=True, high=1.0)
 
     def march_options(self, path: bool = False) -> WearOptions:
         """The wear options of the steps: linearly implicit, no stop criterion of the march;
@@ -161,9 +178,13 @@ class WornStateOptions:
 
     def key(self) -> dict:
         """What changes the path (the checkpoint's fingerprint)."""
-        return {"initial_jump": self.initial_jump, "max_growth": self.max_growth,
-                "min_growth": self.min_growth, "path_tolerance": self.path_tolerance,
-                "stick_set": self.stick_set, "exponential": self.exponential}
+        key = {"initial_jump": self.initial_jump, "max_growth": self.max_growth,
+               "min_growth": self.min_growth, "path_tolerance": self.path_tolerance,
+               "stick_set": self.stick_set, "exponential": self.exponential,
+               "settle_rate": self.settle_rate}
+        if self.order != 1:  # (the checkpoints of first-order runs keep their key)
+            key["order"] = self.order
+        return key
 
 
 @dataclass
@@ -340,11 +361,15 @@ def _judge(records: list[StepRecord], options: WornStateOptions) -> _Found | Non
                       f"residual max g / max g0 = {r:.3g} <= {options.tolerance:g}, last "
                       f"correction {c:.3g} of the deepest wear <= {options.depth_tolerance:g}",
                       r, c)
-    if n >= 3 and _rate_change(records) <= options.tolerance and r > 0.1:
+    # steady: the rate profile did not change over a step that moved the profile (a tiny
+    # step, e.g. after failed balances, leaves any rate unchanged)
+    if (n >= 3 and _rate_change(records) <= options.tolerance and r > 0.1
+            and c >= options.depth_tolerance):
         return _Found(True, "steady_wear",
                       f"no null-wear-rate state: the wear goes on at a steady rate (residual "
                       f"{r:.3g}, the rate profile changed by {_rate_change(records):.3g} over "
-                      "the last step); the rate profile is the steady one", r, c)
+                      f"the last step, which moved the profile by {c:.3g} of the deepest "
+                      "wear); the rate profile is the steady one", r, c)
     return None
 
 
@@ -370,7 +395,7 @@ def _continue(sp: SlowProblem, state: SlowStep, records: list[StepRecord],
                                  f"/ max g0 = {r:.3g} (tolerance {options.tolerance:g}), last "
                                  f"correction {c:.3g} of the deepest wear", r, c,
                                  jumps.iterations)
-        if options.stick_set and _settled(records):
+        if options.stick_set and _settled(records, options.settle_rate):
             hit = jumps.accept(state, records)
             if hit is not None:
                 state = hit[0]
@@ -379,9 +404,11 @@ def _continue(sp: SlowProblem, state: SlowStep, records: list[StepRecord],
                     run.callback(state.step, records[-1])
                 return hit
         try:
-            settled = _settled(records)
+            settled = _settled(records, options.settle_rate)
             new, record, msg = _path_step(sp, state, opts if settled else path,
-                                          options.exponential)
+                                          options.exponential, 1 if settled else options.order,
+                                          path_cycles(records, options.settle_rate)
+                                          if options.order == 2 else None)
             if new is not None and not new.in_time_integration:
                 new, record = _pull_back(sp, state, new, record, opts)
                 msg = msg or "the balance after pulling back over-worn nodes failed"
@@ -405,13 +432,22 @@ def _continue(sp: SlowProblem, state: SlowStep, records: list[StepRecord],
             raise KeyboardInterrupt from None
 
 
-def _path_step(sp: SlowProblem, state: SlowStep, opts: WearOptions, exponential: bool):
+def path_cycles(records: list[StepRecord], settle_rate: float) -> float:
+    """The cycles of the steps that followed the path (taken before the path had settled,
+    :func:`_settled`), without the pseudo-time of the relaxation (SER) steps; from the
+    records alone, so a resumed run counts the same."""
+    return sum(records[k].jump for k in range(1, len(records))
+               if not _settled(records[:k], settle_rate))
+
+
+def _path_step(sp: SlowProblem, state: SlowStep, opts: WearOptions, exponential: bool,
+               order: int = 1, cycles: float | None = None):
     """The next pseudo-time step: the exponential Euler step
     (:func:`~fretwear.wear.exponential_step.exponential_step`) with ``exponential``, else
     or where it failed or from a time integration the march's step
     (:func:`fretwear.wear.simulate._step`, with its time-domain rescue)."""
     if exponential and not state.in_time_integration:
-        new, record, msg = exponential_step(sp, state, opts)
+        new, record, msg = exponential_step(sp, state, opts, order, cycles)
         if new is not None:
             return new, record, msg
     return _step(sp, state, opts)
@@ -480,11 +516,12 @@ class _Jumps:
             res, c, self.iterations, True)
 
 
-def _settled(records: list[StepRecord]) -> bool:
-    """Whether the path has settled: the same slipping nodes over the last three records and
-    a worn-volume rate that fell over both steps. Then only the decay to the state is left,
-    and the steps may grow as fast as SER lets them."""
-    if len(records) < 3:
+def _settled(records: list[StepRecord], settle_rate: float = 1.0) -> bool:
+    """Whether the path has settled: the same slipping nodes over the last three records, a
+    worn-volume rate that fell over both steps and is at most ``settle_rate`` of the initial
+    one. Then only the decay to the state is left, and the steps may grow as fast as SER lets
+    them."""
+    if len(records) < 3 or records[-1].volume_rate > settle_rate * records[0].volume_rate:
         return False
     last = records[-3:]
     same = all(np.array_equal(state_slip(last[0]), state_slip(r)) for r in last[1:])
