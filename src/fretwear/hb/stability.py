@@ -521,7 +521,6 @@ class HillProblem:
         # the law's arrays as the kernel of :func:`shifted_gain` takes them, made once
         self._law = (np.ascontiguousarray(prob.mu, dtype=float), np.ascontiguousarray(prob.P),
                      np.ascontiguousarray(prob.Q), law._normal(prob.normal, self.lu))
-        self._structure = _stacked(dyn)
         self.evaluations = 0
 
     def gain(self, sigma: complex) -> np.ndarray:
@@ -540,18 +539,8 @@ class HillProblem:
         nw = 1j * self.harmonics * w
         lam = np.concatenate([[s], s + nw, s - nw])
         k = self.harmonics.size
-        mats, m, names = self._structure
-        coef = {"K": np.ones_like(lam), "M": lam * lam, "C": lam, "D": 1j * np.sign(lam.imag)}
-        n = m + self.dyn.q
-        Z = (np.stack([coef[nm] for nm in names], axis=1) @ mats).reshape(lam.size, n, n)
-        if n > m:  # the Schur complement on the contact points (StructureDynamics.condensed)
-            try:
-                Z = Z[:, :m, :m] - Z[:, :m, m:] @ np.linalg.solve(Z[:, m:, m:], Z[:, m:, :m])
-            except np.linalg.LinAlgError:
-                raise InputError("the structure with its contact points held is singular at "
-                                 "a value of the Laplace variable (an eigenvalue of the held "
-                                 "interface)") from None
-        return hill_blocks(Z[0], Z[1:k + 1], Z[k + 1:])
+        Zr = self.dyn.condensed(lam * lam, lam, 1j * np.sign(lam.imag))
+        return hill_blocks(Zr[0], Zr[1:k + 1], Zr[k + 1:])
 
     def matrix(self, sigma: complex) -> np.ndarray:
         """``T(s)`` (m H, m H) complex at ``s = sigma w``."""
@@ -642,19 +631,6 @@ class HillProblem:
             A[nx:] = Z[nx:]
             mats.append(A)
         return tuple(mats)
-
-
-def _stacked(dyn: StructureDynamics):
-    """The structure's matrices on ``(x, q)`` stacked, ``(nmat, (m + q)^2)`` complex, with
-    ``m`` and their names (``K``, ``M``, then ``C``, ``D`` where the model has them): ``Z``
-    at many values of ``lambda`` is one product of their coefficients with this array (the
-    sum of :meth:`StructureDynamics.assemble`, in one call instead of one per block)."""
-    names = [nm for nm in ("K", "M", "C", "D") if nm in dyn.blocks]
-    mats = []
-    for nm in names:
-        xx, xq, qx, qq = (np.asarray(b, dtype=float) for b in dyn.blocks[nm])
-        mats.append(np.block([[xx, xq], [qx, qq]]).ravel() if dyn.q else xx.ravel())
-    return np.array(mats, dtype=complex), dyn.m, names
 
 
 def centroid(p: np.ndarray, k: int) -> np.ndarray:
@@ -841,8 +817,9 @@ def track_eigen(red: QuadraticReduction, track: HillTrack | None, shape: tuple):
     cut = 2.0 * (k + 1) + 10.0
     nd = red.dyn.size
     members = []  # (s, y on the block, kappa, block, neighbour's index)
+    mats: dict = {}  # per block, its complex matrices (made once)
     for j, (s0, b) in enumerate(zip(track.sigma, track.block, strict=True)):
-        got = _member(red, b, complex(s0), track.Y[red.blocks[b], j], shape)
+        got = _member(red, b, complex(s0), track.Y[red.blocks[b], j], shape, mats)
         if got is None:
             return None
         s1, y, kp = got
@@ -863,7 +840,7 @@ def track_eigen(red: QuadraticReduction, track: HillTrack | None, shape: tuple):
             y0 = track.Y[red.blocks[b], j]
             starts.append((complex(track.sigma[j]).conjugate() + 1j, y0.conj(), True))
         for sn, y0, mirror in starts:
-            got = _member(red, b, sn, y0, shape, fold=False)
+            got = _member(red, b, sn, y0, shape, mats, fold=False)
             if got is None:
                 return None
             s2, y2, kn = got
@@ -888,17 +865,20 @@ def track_eigen(red: QuadraticReduction, track: HillTrack | None, shape: tuple):
 
 
 def _member(red: QuadraticReduction, b: int, s0: complex, y0: np.ndarray, shape: tuple,
-            fold: bool = True):
+            mats: dict, fold: bool = True):
     """The eigenpair of block ``b`` of ``red`` nearest ``(s0, y0)`` by inverse iteration
     (:func:`_inverse_iteration`), and its centroid. ``fold`` (a member): a real one made
     exactly real, one below the real axis replaced by its conjugate, and where the centre
     moved to the next copy (``|kappa| > 1/2``), that copy ``s + i round(kappa)`` instead;
     otherwise (a neighbouring copy or a mirror) the eigenpair as found. None where an
-    iteration does not converge."""
+    iteration does not converge. ``mats``: the blocks' complex matrices made so far (one
+    block's are made on its first use)."""
     r, H, k = shape
     comp = red.blocks[b]
-    ix = np.ix_(comp, comp)
-    B = (red.B0[ix], red.B1[ix], red.B2[ix])
+    if b not in mats:
+        ix = np.ix_(comp, comp)
+        mats[b] = tuple(np.asarray(X[ix], dtype=complex) for X in (red.B0, red.B1, red.B2))
+    B = mats[b]
     nd = red.dyn.size
     for again in (False, True):
         s1, y, ok = _inverse_iteration(*B, s0, y0)
