@@ -831,7 +831,8 @@ def track_eigen(red: QuadraticReduction, track: HillTrack | None, shape: tuple):
     todo = list(range(len(members)))
     while todo:  # each member's neighbouring copy, and the mirror of those near the line
         s1, y, kp, b, j = members[todo.pop(0)]
-        starts = [(s1 + (1j if kp >= 0 else -1j), y, False)]
+        side = 1 if kp >= 0 else -1
+        starts = [(s1 + 1j * side, _shifted_copy(red, b, y, shape, side), False)]
         if _on_line(s1) != "off":
             starts.append((s1.conjugate() + 1j, y.conj(), True))
         if _on_line(s1) == "on" and j >= 0 and _on_line(complex(track.sigma[j])) != "on":
@@ -862,6 +863,37 @@ def track_eigen(red: QuadraticReduction, track: HillTrack | None, shape: tuple):
         Y[red.blocks[m[3]], j] = m[1]
     return (vals, red.full(Y), np.array([m[2] for m in members]),
             np.array([m[4] for m in members], dtype=int))
+
+
+def _shifted_copy(red: QuadraticReduction, b: int, y: np.ndarray, shape: tuple,
+                  side: int) -> np.ndarray:
+    """The eigenvector ``y`` (on block ``b`` of ``red``) of a member ``s`` moved to its copy
+    ``s + i side`` (``p e^{-i side w t}``: complex-exponential coefficient ``n`` from
+    ``n + side``, harmonic orders as their index among the kept harmonics, as
+    :func:`centroid` takes them): the copy's eigenvector up to the truncation, the start of
+    the inverse iteration that finds the copy (:func:`track_eigen`)."""
+    r, H, k = shape
+    comp = red.blocks[b]
+    Yj = np.zeros((red.dyn.size, 1), dtype=complex)
+    Yj[comp, 0] = y
+    p = red.full(Yj)[:, 0].reshape(r, H)
+    a, bb = p[:, 1:1 + k], p[:, 1 + k:]
+    c = np.zeros((r, 2 * k + 1), dtype=complex)  # orders -k..k
+    c[:, k] = p[:, 0]
+    c[:, k + 1:] = (a - 1j * bb) / 2.0
+    c[:, :k] = ((a + 1j * bb) / 2.0)[:, ::-1]
+    out = np.zeros_like(c)
+    if side > 0:
+        out[:, :-1] = c[:, 1:]
+    else:
+        out[:, 1:] = c[:, :-1]
+    q = np.empty_like(p)
+    q[:, 0] = out[:, k]
+    q[:, 1:1 + k] = out[:, k + 1:] + out[:, :k][:, ::-1]
+    q[:, 1 + k:] = 1j * (out[:, k + 1:] - out[:, :k][:, ::-1])
+    v = q.reshape(-1)[red.dyn][comp]
+    nrm = np.linalg.norm(v)
+    return v / nrm if nrm > 0 else y
 
 
 def _member(red: QuadraticReduction, b: int, s0: complex, y0: np.ndarray, shape: tuple,
