@@ -26,8 +26,10 @@ from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.stability import (
     HillProblem,
+    QuadraticReduction,
     _companion_eigen,
     _components,
+    _shifted_copy,
     centroid,
     problem_of,
     quadratic_eigen,
@@ -296,6 +298,34 @@ def test_centroid_of_shifted_eigenvectors():
     base = centroid(real_layout(c), k)
     assert centroid(real_layout(np.roll(c, 2, axis=1)), k) == pytest.approx(base + 2, abs=1e-12)
     assert centroid(real_layout(np.roll(c, -3, axis=1)), k) == pytest.approx(base - 3, abs=1e-12)
+
+
+def test_shifted_copy_moves_the_coefficients_by_one_harmonic():
+    """The start of the neighbouring copy's inverse iteration (:func:`_shifted_copy`): the
+    eigenvector of ``s + i side`` is ``p e^{-i side w t}``, whose complex-exponential
+    coefficient ``n`` is ``p``'s ``n + side``; the reference is that shift done on the
+    hand-made coefficients (``np.roll``) and written in the real layout as in the test
+    above, both normalised: equal to rounding (1e-14), and the centroid moved by ``-side``."""
+    k = 6
+    H = 2 * k + 1
+    rng = np.random.default_rng(2)
+    c = np.zeros((2, H), dtype=complex)
+    c[:, k - 2:k + 3] = rng.standard_normal((2, 5)) + 1j * rng.standard_normal((2, 5))
+
+    def real_layout(c):
+        cp, cm = c[:, k + 1:], c[:, :k][:, ::-1]
+        return np.concatenate([c[:, k:k + 1], cp + cm, 1j * (cp - cm)], axis=1)
+
+    n = 2 * H
+    red = QuadraticReduction(n, np.arange(n), np.zeros(0, dtype=int), None, *(
+        np.zeros((n, n)) for _ in range(3)), [np.arange(n)])
+    y = real_layout(c).reshape(-1)
+    for side in (1, -1):
+        got = _shifted_copy(red, 0, y, (2, H, k), side)
+        ref = real_layout(np.roll(c, -side, axis=1)).reshape(-1)
+        np.testing.assert_allclose(got, ref / np.linalg.norm(ref), rtol=0, atol=1e-14)
+        assert centroid(got.reshape(2, H), k) == pytest.approx(
+            centroid(y.reshape(2, H), k) - side, abs=1e-12)
 
 
 def test_quadratic_problem_split_into_its_blocks_keeps_every_eigenpair():

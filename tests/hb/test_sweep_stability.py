@@ -23,7 +23,13 @@ from fretwear.hb.dynamics import structure_dynamics
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.options import SweepOptions
 from fretwear.hb.reduce import exact_condenser
-from fretwear.hb.stability import HillOptions, HillProblem, problem_of, stability
+from fretwear.hb.stability import (
+    EDGE_TOL,
+    HillOptions,
+    HillProblem,
+    problem_of,
+    stability,
+)
 from fretwear.hb.sweep import sweep
 from fretwear.hb.sweep_stability import branch_events, nearest, point_problem, sweep_stability
 from fretwear.model.build import Damping
@@ -79,7 +85,16 @@ def test_events_are_where_neighbours_differ(folded):
         assert f"{e.f_lo:.6g}" in e.line()
 
 
-def test_tracked_candidates_give_the_dense_multipliers(folded):
+@pytest.fixture(scope="module")
+def dense(folded):
+    """The dense eigensolve at every point of the folded sweep (``HillOptions(track=False)``)."""
+    res, _ = folded
+    model = two_dof()
+    return sweep_stability(model, res, condenser=exact_condenser(model),
+                           options=HillOptions(track=False))
+
+
+def test_tracked_candidates_give_the_dense_multipliers(folded, dense):
     """Hill's method along the sweep continues each point's candidates from those of the
     nearest point already computed (:func:`nearest`; inverse iteration,
     :func:`fretwear.hb.stability.track_eigen`) instead of the dense
@@ -90,9 +105,6 @@ def test_tracked_candidates_give_the_dense_multipliers(folded):
     (the arclength's jumps between branches and the period-doubling stretch fall back to the
     dense eigensolve), so that the comparison covers both."""
     res, st = folded
-    model = two_dof()
-    dense = sweep_stability(model, res, condenser=exact_condenser(model),
-                            options=HillOptions(track=False))
     tracked = [fl.tracked for fl in st.floquet if fl is not None]
     assert any(tracked) and not all(tracked)
     assert not any(fl.tracked for fl in dense.floquet if fl is not None)
@@ -101,6 +113,34 @@ def test_tracked_candidates_give_the_dense_multipliers(folded):
         if a is not None:
             assert a.multipliers.shape == b.multipliers.shape
             np.testing.assert_allclose(a.multipliers, b.multipliers, rtol=0, atol=1e-10)
+
+
+def test_period_doubling_members_are_tracked_as_the_dense_eigensolve(folded, dense):
+    """Points whose dense eigensolve has real negative multipliers (exponents on the
+    period-doubling line ``Im s = w/2``, within ``EDGE_TOL``: two per period doubling, born
+    where a complex pair met on the line) are continued from the nearest point by inverse
+    iteration, each member on the line followed alone (its mirror ``conj(s) + i`` checked):
+    some of them are tracked (none was before: the tracker refused the line), and at each
+    the multipliers and exponents are the dense eigensolve's, one for one, to 1e-10 (the
+    same simple eigenvalues of the same matrices, each to about 1e-14, as in the test
+    above), with the real negative multipliers among them."""
+    _, st = folded
+    on_line = []
+    for a, b in zip(st.floquet, dense.floquet, strict=True):
+        if b is None:
+            continue
+        line = np.abs(np.abs(b.exponents.imag / b.omega) - 0.5) <= EDGE_TOL
+        if line.any():
+            on_line.append((a, b, line))
+    assert len(on_line) >= 3
+    tracked = [(a, b, line) for a, b, line in on_line if a.tracked]
+    assert len(tracked) >= 2
+    for a, b, line in tracked:
+        np.testing.assert_allclose(a.multipliers, b.multipliers, rtol=0, atol=1e-10)
+        np.testing.assert_allclose(a.exponents / a.omega, b.exponents / b.omega, rtol=0,
+                                   atol=1e-10)
+        neg = b.multipliers[line]
+        assert np.all(neg.imag == 0) and np.all(neg.real < 0)
 
 
 def test_the_sweeps_own_problems_give_the_rebuilt_problems_multipliers(folded):

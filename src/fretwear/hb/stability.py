@@ -63,8 +63,13 @@ How they are computed
    same set: the same contact regime (:meth:`HillProblem.regime`), every family represented
    at the neighbour and here (they number ``2 nd / H``), each member converged with
    ``|kappa| <= 1/2``, and its neighbouring copy on the side of the tie outside
-   ``|kappa| <= 1/2``; otherwise (a jump between branches, two members meeting, the
-   period-doubling line, a node leaving full stick) the dense eigensolve. A continued
+   ``|kappa| <= 1/2``. On and near the period-doubling line (:func:`_on_line`) the mirror
+   ``conj(s) + i`` of a member is checked too: there the two real negative multipliers of a
+   period doubling are two simple eigenvalues ``a + i/2``, ``b + i/2``, each continued
+   alone; where a complex pair lands on the line the mirror search may find the second one,
+   and where the two meet into a complex pair they converge to one member. Otherwise (a
+   jump between branches, a pair landing on the line whose second member is not found, a
+   node leaving full stick) the dense eigensolve. A continued
    candidate's refinement starts from the neighbour's refined exponent with its last secant
    slope (:func:`_warm_start`; same stopping rule, from the candidate if it fails).
 
@@ -87,9 +92,10 @@ candidate instead of its dense eigensolve. ``det J`` is read from the solve's ow
 (docs/studies/method-costs.md, "Hill's method"): about 1.2-2.2 times a warm-started point's
 solve along a sweep, which hands each point's own problem
 (:func:`fretwear.hb.sweep_stability.point_problem`; :func:`stability` rebuilds it from the
-solution, about 1.1-1.5 ms more there); the evaluations of ``T(s)`` (a law with a memory) and
-the dense eigensolve at the points that cannot be tracked (the period-doubling line) are what
-cost. Dense up to
+solution, about 1.1-1.5 ms more there); the evaluations of ``T(s)`` (a law with a memory),
+the inverse iterations of the tracked candidates and the dense eigensolve at the points that
+cannot be tracked (a jump, a pair landing on the period-doubling line) are what cost. Dense
+up to
 :data:`DENSE_MAX` unknowns of the balance. The sign of ``det J`` (``J = T(0)``) is reported
 with the exponents (:attr:`FloquetResult.det_sign`).
 """
@@ -199,7 +205,11 @@ class HillTrack:
     each lies in; nd, dyn, blocks : that reduction's coordinates and blocks; complete : every
     family of the truncated problem is represented; refined : (k,) per member, its
     refinement on the exact ``T(s)`` as :class:`Refined` (None: not refined, or it did not
-    converge); regime : the contact regime it was found in (:meth:`HillProblem.regime`).
+    converge); regime : the contact regime it was found in (:meth:`HillProblem.regime`);
+    omega : the solution's circular frequency [rad/s]; velocity : (k,) per member, its motion
+    ``d sigma / d omega`` [s/rad] from the neighbour it was continued from (0 where it was
+    not, None for a dense eigensolve's): the next point's start moves it by as much
+    (:func:`track_eigen`; the start only, the checks are the same).
     """
 
     sigma: np.ndarray
@@ -211,6 +221,8 @@ class HillTrack:
     complete: bool
     refined: list | None = None
     regime: tuple | None = None
+    omega: float | None = None
+    velocity: np.ndarray | None = None
 
 
 @dataclass
@@ -769,7 +781,8 @@ def _inverse_iteration(B0, B1, B2, sigma: complex, y: np.ndarray, max_iter: int 
     return sigma, x, False
 
 
-def track_eigen(red: QuadraticReduction, track: HillTrack | None, shape: tuple):
+def track_eigen(red: QuadraticReduction, track: HillTrack | None, shape: tuple,
+                omega: float | None = None):
     """The centred members (``|kappa| <= 1/2``, ``Im s >= 0``) of every family of
     ``(A0 + s A1 + s^2 A2) y = 0`` continued from those of a neighbouring solution
     (:class:`HillTrack`) by inverse iteration (:func:`_inverse_iteration`), or None where that
@@ -778,13 +791,20 @@ def track_eigen(red: QuadraticReduction, track: HillTrack | None, shape: tuple):
 
     * the problem has the same coordinates and blocks as at the neighbour, and every family
       was represented there (``track.complete``);
-    * every member converges (to the dense eigensolver's eigenvalue, to its rounding), to a
-      different eigenvalue, with ``|kappa| <= 1/2``, ``Im s >= 0``, off the period-doubling
-      line ``Im s = w/2`` by :data:`EDGE_KAPPA` (where :func:`_edge_members` acts) and below
-      the magnitude cut;
+    * every member converges (to the dense eigensolver's eigenvalue, to its rounding) with
+      ``|kappa| <= 1/2``, ``Im s >= 0``, below the magnitude cut, on the period-doubling line
+      ``Im s = w/2`` (within :data:`EDGE_TOL`), near it or off it (:func:`_on_line`), not at
+      the threshold between the two;
+    * two members that converge to one eigenvalue count once (the two real negative
+      multipliers of a period doubling meeting into a complex pair near the line);
+    * the mirror ``conj(s) + i`` of a member on or near the line (the member of the
+      conjugate family across the line) is the member itself, or another eigenvalue: one on
+      the line with ``|kappa| <= 1/2`` is a member (the second real negative multiplier born
+      where a complex pair met on the line), any other one the dense path would not keep
+      (:func:`_may_keep`);
     * they number the families of the truncated problem, ``2 nd / H`` (``nd`` coordinates with
-      a mass; a complex member stands for two, its conjugate being another family's): every
-      family is represented;
+      a mass; a complex member off the line stands for two, its conjugate being another
+      family's; a real one or one on the line for one): every family is represented;
     * the copy ``s + i sign(kappa)`` of each (the neighbour in its family on the side of the
       tie at ``|kappa| = 1/2``; a copy ``s + i j`` has the centroid ``kappa - j``) is one
       that the dense path would not keep (:func:`_may_keep`: ``|kappa| > 1/2`` and not a
@@ -792,7 +812,14 @@ def track_eigen(red: QuadraticReduction, track: HillTrack | None, shape: tuple):
       rounding): no family has a second member that the rule keeps (copies further off
       have ``|kappa| >= 3/2`` less their truncation).
 
-    Returns ``(vals, vecs, kap)`` as :func:`dense_eigen`, the members only."""
+    ``omega``: the solution's circular frequency, with the track's velocities the start of
+    each member's iteration (a member moved 2-3e-2 a step on the benchmark's two-DOF sweep:
+    4-6 LU steps from the neighbour's eigenvalue, fewer from the extrapolated one; the
+    sweep's LU factorisations 1081 -> 935).
+
+    Returns ``(vals, vecs, kap, origin)``: ``vals``, ``vecs`` as :func:`dense_eigen`, the
+    members only, with their centroids, and per member the index of the neighbour's member it
+    continues (-1: a mirror found here)."""
     if track is None or not track.complete or red.dyn.size != track.nd:
         return None
     if not np.array_equal(red.dyn, track.dyn) or len(red.blocks) != len(track.blocks) or any(
@@ -801,68 +828,161 @@ def track_eigen(red: QuadraticReduction, track: HillTrack | None, shape: tuple):
     r, H, k = shape
     cut = 2.0 * (k + 1) + 10.0
     nd = red.dyn.size
-    vals = np.empty(track.sigma.size, dtype=complex)
-    Y = np.zeros((nd, track.sigma.size), dtype=complex)
-    kap = np.empty(track.sigma.size)
-    near = []
+    members = []  # (s, y on the block, kappa, block, neighbour's index)
+    mats: dict = {}  # per block, its complex matrices (made once)
+    step = 0.0 if omega is None or track.omega is None else omega - track.omega
     for j, (s0, b) in enumerate(zip(track.sigma, track.block, strict=True)):
-        comp = red.blocks[b]
-        ix = np.ix_(comp, comp)
-        B = (red.B0[ix], red.B1[ix], red.B2[ix])
-        s1, y, ok = _inverse_iteration(*B, complex(s0), track.Y[comp, j])
-        if not ok:
+        if track.velocity is not None and abs(track.velocity[j] * step) < 0.1:
+            s0 = s0 + track.velocity[j] * step  # the member's own motion, extrapolated
+        got = _member(red, b, complex(s0), track.Y[red.blocks[b], j], shape, mats)
+        if got is None:
             return None
-        if abs(s1.imag) <= 1e-12 * max(abs(s1), 1.0):
-            s1 = complex(s1.real, 0.0)
-        if s1.imag < 0:  # the conjugate pair's other member
-            s1, y = s1.conjugate(), y.conj()
-        Y[comp, j] = y
-        kap[j] = centroid(red.full(Y[:, j:j + 1]).T.reshape(r, H), k)
-        if abs(kap[j]) > 0.5:  # the centre moved to the next copy, s + i round(kappa)
-            s1, y, ok = _inverse_iteration(*B, s1 + 1j * round(kap[j]), y)
-            if not ok:
+        s1, y, kp = got
+        if abs(kp) > 0.5 or abs(s1) > 0.9 * cut or _on_line(s1) is None:
+            return None
+        if any(abs(s1 - m[0]) <= 1e-8 * max(1.0, abs(s1)) for m in members):
+            continue  # a second start converged to the same member (a pair met)
+        members.append((s1, y, kp, b, j))
+    todo = list(range(len(members)))
+    while todo:  # each member's neighbouring copy, and the mirror of those near the line
+        s1, y, kp, b, j = members[todo.pop(0)]
+        side = 1 if kp >= 0 else -1
+        starts = [(s1 + 1j * side, _shifted_copy(red, b, y, shape, side), False)]
+        if _on_line(s1) != "off":
+            starts.append((s1.conjugate() + 1j, y.conj(), True))
+        if _on_line(s1) == "on" and j >= 0 and _on_line(complex(track.sigma[j])) != "on":
+            # landed on the line from a complex pair: the pair's other member, from the
+            # mirror of the neighbour's
+            y0 = track.Y[red.blocks[b], j]
+            starts.append((complex(track.sigma[j]).conjugate() + 1j, y0.conj(), True))
+        for sn, y0, mirror in starts:
+            got = _member(red, b, sn, y0, shape, mats, fold=False)
+            if got is None:
                 return None
-            if abs(s1.imag) <= 1e-12 * max(abs(s1), 1.0):
-                s1 = complex(s1.real, 0.0)
-            if s1.imag < 0:
-                s1, y = s1.conjugate(), y.conj()
-            Y[comp, j] = y
-            kap[j] = centroid(red.full(Y[:, j:j + 1]).T.reshape(r, H), k)
-        if (abs(kap[j]) > 0.5 or abs(s1) > 0.9 * cut
-                or abs(abs(s1.imag) - 0.5) <= EDGE_KAPPA):
-            return None
-        vals[j] = s1
-        near.append((B, comp, s1 + (1j if kap[j] >= 0 else -1j), y))
-    if vals.size > 1:
-        gap = np.abs(vals[:, None] - vals[None, :]) + np.eye(vals.size)
-        if gap.min() <= 1e-8 * max(1.0, np.abs(vals).max()):
-            return None
-    real = vals.imag == 0.0
-    if int(np.sum(np.where(real, 1, 2))) * H != 2 * nd:
+            s2, y2, kn = got
+            vals = np.array([m[0] for m in members])
+            if np.min(np.abs(vals - s2)) <= 1e-8 * max(1.0, abs(s2)):
+                continue  # a member (the mirror of one on the line is itself)
+            if (mirror and _on_line(s2) == "on" and abs(kn) <= 0.5 and s2.imag > 0
+                    and abs(s2) <= 0.9 * cut):
+                members.append((s2, y2, kn, b, -1))  # the other real negative multiplier
+                todo.append(len(members) - 1)
+            elif _may_keep(s2, kn, vals):
+                return None  # another member the rule may keep (or nearly)
+    vals = np.array([m[0] for m in members], dtype=complex)
+    single = (vals.imag == 0.0) | np.array([_on_line(v) == "on" for v in vals], dtype=bool)
+    if int(np.sum(np.where(single, 1, 2))) * H != 2 * nd:
         return None
-    for B, comp, sn, y in near:  # the neighbouring copy of each member
-        s2, y2, ok = _inverse_iteration(*B, sn, y)
+    Y = np.zeros((nd, vals.size), dtype=complex)
+    for j, m in enumerate(members):
+        Y[red.blocks[m[3]], j] = m[1]
+    return (vals, red.full(Y), np.array([m[2] for m in members]),
+            np.array([m[4] for m in members], dtype=int))
+
+
+def _shifted_copy(red: QuadraticReduction, b: int, y: np.ndarray, shape: tuple,
+                  side: int) -> np.ndarray:
+    """The eigenvector ``y`` (on block ``b`` of ``red``) of a member ``s`` moved to its copy
+    ``s + i side`` (``p e^{-i side w t}``: complex-exponential coefficient ``n`` from
+    ``n + side``, harmonic orders as their index among the kept harmonics, as
+    :func:`centroid` takes them): the copy's eigenvector up to the truncation, the start of
+    the inverse iteration that finds the copy (:func:`track_eigen`)."""
+    r, H, k = shape
+    comp = red.blocks[b]
+    Yj = np.zeros((red.dyn.size, 1), dtype=complex)
+    Yj[comp, 0] = y
+    p = red.full(Yj)[:, 0].reshape(r, H)
+    a, bb = p[:, 1:1 + k], p[:, 1 + k:]
+    c = np.zeros((r, 2 * k + 1), dtype=complex)  # orders -k..k
+    c[:, k] = p[:, 0]
+    c[:, k + 1:] = (a - 1j * bb) / 2.0
+    c[:, :k] = ((a + 1j * bb) / 2.0)[:, ::-1]
+    out = np.zeros_like(c)
+    if side > 0:
+        out[:, :-1] = c[:, 1:]
+    else:
+        out[:, 1:] = c[:, :-1]
+    q = np.empty_like(p)
+    q[:, 0] = out[:, k]
+    q[:, 1:1 + k] = out[:, k + 1:] + out[:, :k][:, ::-1]
+    q[:, 1 + k:] = 1j * (out[:, k + 1:] - out[:, :k][:, ::-1])
+    v = q.reshape(-1)[red.dyn][comp]
+    nrm = np.linalg.norm(v)
+    return v / nrm if nrm > 0 else y
+
+
+def _member(red: QuadraticReduction, b: int, s0: complex, y0: np.ndarray, shape: tuple,
+            mats: dict, fold: bool = True):
+    """The eigenpair of block ``b`` of ``red`` nearest ``(s0, y0)`` by inverse iteration
+    (:func:`_inverse_iteration`), and its centroid. ``fold`` (a member): a real one made
+    exactly real, one below the real axis replaced by its conjugate, and where the centre
+    moved to the next copy (``|kappa| > 1/2``), that copy ``s + i round(kappa)`` instead;
+    otherwise (a neighbouring copy or a mirror) the eigenpair as found. None where an
+    iteration does not converge. ``mats``: the blocks' complex matrices made so far (one
+    block's are made on its first use)."""
+    r, H, k = shape
+    comp = red.blocks[b]
+    if b not in mats:
+        ix = np.ix_(comp, comp)
+        mats[b] = tuple(np.asarray(X[ix], dtype=complex) for X in (red.B0, red.B1, red.B2))
+    B = mats[b]
+    nd = red.dyn.size
+    for again in (False, True):
+        s1, y, ok = _inverse_iteration(*B, s0, y0)
         if not ok:
             return None
-        Yn = np.zeros((nd, 1), dtype=complex)
-        Yn[comp, 0] = y2
-        kn = centroid(red.full(Yn).T.reshape(r, H), k)
-        if _may_keep(s2, kn) and np.min(np.abs(vals - s2)) > 1e-8 * max(1.0, abs(s2)):
-            return None  # another member the rule may keep (or nearly)
-    return vals, red.full(Y), kap
+        if fold and abs(s1.imag) <= 1e-12 * max(abs(s1), 1.0):
+            s1 = complex(s1.real, 0.0)
+        if fold and s1.imag < 0:  # the conjugate pair's other member
+            s1, y = s1.conjugate(), y.conj()
+        Yj = np.zeros((nd, 1), dtype=complex)
+        Yj[comp, 0] = y
+        kp = centroid(red.full(Yj).T.reshape(r, H), k)
+        if again or not fold or abs(kp) <= 0.5:
+            return s1, y, kp
+        s0, y0 = s1 + 1j * round(kp), y  # the centre moved to the next copy
 
 
-def _may_keep(s: complex, kap: float) -> bool:
+def _on_line(s: complex) -> str | None:
+    """Where the member ``s`` (``s / w``, ``Im s >= 0``) lies from the period-doubling line
+    ``Im s = 1/2``: ``"on"`` within :data:`EDGE_TOL` (a real negative multiplier, one family:
+    :func:`hill_stability` counts it once), ``"near"`` up to :data:`EDGE_KAPPA` (a complex
+    pair close to meeting on the line, where :func:`_edge_members` may act), ``"off"``
+    beyond; None within :data:`KAPPA_MARGIN` of :data:`EDGE_TOL` (a member whose count the
+    rounding could change: not continued).
+
+    On the line the truncated problem has one eigenvalue per real negative multiplier (the
+    members ``a + i/2`` of the two families born where a complex pair met; measured on the
+    two-DOF unilateral oscillator's sweep): simple and apart from each other, so inverse
+    iteration continues each as it continues any member. On and near the line, the mirror
+    ``conj(s) + i`` (the member of the conjugate family across the line: the same
+    eigenvalue on it) is the neighbour the dense path's selection could also keep, so
+    :func:`track_eigen` checks it as it checks the neighbouring copies."""
+    dist = abs(abs(s.imag) - 0.5)
+    if abs(dist - EDGE_TOL) <= KAPPA_MARGIN:
+        return None
+    if dist <= EDGE_TOL:
+        return "on"
+    return "near" if dist <= EDGE_KAPPA else "off"
+
+
+def _may_keep(s: complex, kap: float, kept: np.ndarray) -> bool:
     """Whether the dense path's selection (:func:`hill_stability`: ``|kappa| <= 1/2`` and
     ``Im s >= 0``, or a member :func:`_edge_members` may add) could keep the eigenvalue ``s``
     (in ``s / w``) of centroid ``kap``, with :data:`KAPPA_MARGIN` on every threshold (``s``
-    and ``kap`` found by inverse iteration differ from the dense eigensolver's by rounding)."""
+    and ``kap`` found by inverse iteration differ from the dense eigensolver's by rounding).
+    ``kept``: members the centroid rule keeps (``Im s >= 0``; their conjugates are kept too):
+    :func:`_edge_members` adds no member within :data:`EDGE_KAPPA` of one of them or of its
+    conjugate (the mirror of a member near the period-doubling line, :func:`_on_line`)."""
     if s.imag < -KAPPA_MARGIN * max(abs(s), 1.0):
         return False
     if abs(kap) <= 0.5 + KAPPA_MARGIN:
         return True
-    return (abs(abs(s.imag) - 0.5) <= EDGE_KAPPA + KAPPA_MARGIN
-            and abs(kap) <= 0.5 + EDGE_KAPPA + KAPPA_MARGIN)
+    if not (abs(abs(s.imag) - 0.5) <= EDGE_KAPPA + KAPPA_MARGIN
+            and abs(kap) <= 0.5 + EDGE_KAPPA + KAPPA_MARGIN):
+        return False
+    d = np.minimum(np.abs(kept - s), np.abs(kept - np.conj(s)))
+    return not bool(np.any(d <= EDGE_KAPPA - KAPPA_MARGIN))
 
 
 def _track_record(red: QuadraticReduction, vals: np.ndarray, vecs: np.ndarray,
@@ -873,11 +993,11 @@ def _track_record(red: QuadraticReduction, vals: np.ndarray, vecs: np.ndarray,
     magnitude cut ``cut``, or one spread over two blocks)."""
     if red.dyn.size == 0 or np.any(edge) or np.any(np.abs(kap) > 0.5):
         return None
-    if np.any(np.abs(vals) > 0.9 * cut) or np.any(
-            np.abs(np.abs(vals.imag) - 0.5) <= EDGE_KAPPA):
+    line = np.array([_on_line(v) for v in vals], dtype=object)
+    if np.any(np.abs(vals) > 0.9 * cut) or np.any(line == None):  # noqa: E711
         return None
     real = np.abs(vals.imag) <= 1e-12 * np.maximum(np.abs(vals), 1.0)
-    families = int(np.sum(np.where(real, 1, 2)))
+    families = int(np.sum(np.where(real | (line == "on"), 1, 2)))
     Y = vecs[red.dyn]
     block = np.empty(vals.size, dtype=int)
     for j in range(vals.size):
@@ -1107,9 +1227,10 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
         prev = None
     red = reduce_quadratic(*hp.pencil(), hint=prev)
     cut = 2.0 * (k + 1) + 10.0
-    got = track_eigen(red, prev, (m + q, H, k))
-    if got is not None:  # member j continues member j of the neighbour's track
-        vals, vecs, kap = got
+    got = track_eigen(red, prev, (m + q, H, k), hp.omega)
+    origin = None
+    if got is not None:  # member j continues member origin[j] of the neighbour's track
+        vals, vecs, kap, origin = got
         idx = np.arange(vals.size)
         edge = np.zeros(vals.size, dtype=bool)
     else:
@@ -1127,6 +1248,14 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
     track = _track_record(red, vals[idx], vecs[:, idx], kap, edge, H, cut)
     if track is not None:
         track.regime = regime
+        track.omega = hp.omega
+        if got is not None and prev.omega is not None and hp.omega != prev.omega:
+            src = origin[idx]
+            vel = np.zeros(idx.size, dtype=complex)
+            ok = src >= 0
+            moved = vals[idx][ok] - prev.sigma[src[ok]]
+            vel[ok] = np.where(np.abs(moved) < 0.1, moved, 0.0) / (hp.omega - prev.omega)
+            track.velocity = vel
     exact = hp.memoryless() and dyn.exact
     sig, kaps, res, kind, spurious = [], [], [], [], []
     refined = 0
@@ -1143,7 +1272,8 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
             res.append(np.nan)
             kind.append("held" if held else "exact" if exact else "candidate")
             continue
-        warm = _warm_start(prev, int(i) if got is not None else None, s0)
+        j = None if origin is None or origin[i] < 0 else int(origin[i])
+        warm = _warm_start(prev, j, s0)
         s1, v1, r1, conv, slope = _track(hp, s0, vx, opt, warm)
         if not conv and warm is not None:  # from the candidate, as without a neighbour
             s1, v1, r1, conv, slope = _track(hp, s0, vx, opt)
