@@ -1,7 +1,8 @@
 """Pseudo-arclength continuation of the DLFT balance in frequency (the rung ``"arclength"`` of a
 sweep point, :mod:`fretwear.hb.attempts`): from the last two converged points of a sweep along
 the response curve until the frequency passes the target, through folds where frequency is not
-a good parameter."""
+a good parameter; and the test that a fold lies ahead of the last converged points
+(:func:`fold_ahead`), which puts that rung before the other solver's."""
 
 from __future__ import annotations
 
@@ -14,6 +15,49 @@ from fretwear.hb.solvers import SolveStats
 #: Newton iterations of an arclength corrector without halving its best residual after which
 #: the step is shortened (rather than spending the rest of ``max_iter`` on a diverging step)
 STALL_ITERATIONS = 5
+
+
+def scaled_points(history):
+    """The converged points ``(omega, U)`` of ``history`` as the arclength scales them:
+    ``y = (U / sx, omega / sw)`` with ``sx = |U|`` and ``sw = |omega|`` of the last one."""
+    w_last, U_last = history[-1]
+    sx = max(float(np.linalg.norm(U_last)), 1e-30)
+    sw = max(abs(float(w_last)), 1e-30)
+    return [np.concatenate([np.ravel(U) / sx, [w / sw]]) for w, U in history]
+
+
+def fold_ahead(history, omega_target: float) -> bool:
+    """Whether the branch through the last three converged points ``(omega, U)`` of
+    ``history`` turns back in frequency before ``omega_target`` [rad/s] (a fold between the
+    last point and the target).
+
+    The frequency along the branch as a function of its arclength ``s`` (the scaled
+    variables of :func:`arclength`; ``s`` the chords between the points), ``omega(s)``, is
+    the parabola through the three points. Marching towards the target, a fold is where
+    ``d omega / ds`` vanishes: the parabola decelerates (``omega''`` against the march) and
+    its extremum lies short of the target. A straight or accelerating branch (``omega(s)``
+    with ``omega''`` along the march: the tangent turning back towards the frequency axis, as
+    past a peak) has none. The extremum of three points is an estimate: on the dovetail's FRF
+    (tests in docs/studies/fallbacks.md) the points at 2260, 2350 and 2395 Hz put it at 2404
+    Hz, where the arclength found the fold (2404.6 Hz). Fewer than three points, or two at one
+    place: False."""
+    if len(history) < 3:
+        return False
+    w = np.array([float(h[0]) for h in history[-3:]])
+    y = scaled_points(history[-3:])
+    d1, d2 = np.linalg.norm(y[1] - y[0]), np.linalg.norm(y[2] - y[1])
+    if d1 == 0.0 or d2 == 0.0:
+        return False
+    # omega(s) = w2 + b (s - s2) + a (s - s2)^2 through s = -d1 - d2, -d2, 0 (divided
+    # differences)
+    g1, g2 = (w[1] - w[0]) / d1, (w[2] - w[1]) / d2
+    a = (g2 - g1) / (d1 + d2)
+    b = g2 + a * d2
+    march = np.sign(omega_target - w[2])
+    if march == 0.0 or march * a >= 0.0:
+        return False
+    w_turn = w[2] - b * b / (4.0 * a)  # the extremum of the parabola
+    return bool(march * (omega_target - w_turn) > 0.0)
 
 
 def arclength(probs, anchor, y_prev, y_last, omega_target, solver_tol, max_steps=20,

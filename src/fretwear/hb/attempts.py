@@ -25,15 +25,16 @@ Single solve (:class:`Trial`; :data:`~fretwear.hb.options.STRATEGY`, the rungs t
    steady state starts one more solve with its mean tangential positions as anchors.
 
 Sweep point (:class:`Point`; :data:`POINT_RUNGS`): ``"grid"`` (the solver from the secant
-predictor), ``"substep"`` (bisection of the step from the last converged point),
-``"retry"`` (the other solver from the neighbour), ``"arclength"`` (pseudo-arclength
-continuation past a fold, :mod:`fretwear.hb.arclength`), the rungs 3-4 of a single solve
-from the neighbour (at the first point of a branch, which has none, from the contact-closed
-guess with a single solve's iterations), ``"fresh-start"`` (as a single solve from the first
-harmonic alone with the static anchors and five times the iterations: the neighbour's state
-can lie on the wrong side of a jump of the mean position) and ``"time-start"`` (a time
-integration from the neighbour). Single-solve rungs that ``SolveOptions.strategy`` leaves
-out are left out of a sweep point too.
+predictor), ``"substep"`` (bisection of the step from the last converged point), ``"retry"``
+(the other solver from the neighbour), ``"arclength"`` (pseudo-arclength continuation past a
+fold, :mod:`fretwear.hb.arclength`; before ``"retry"`` when the branch turns back short of the
+grid frequency, :data:`FOLD_RUNGS`, :func:`point_ladder`), the rungs 3-4 of a single solve from
+the neighbour (at the first point of a branch, which has none, from the contact-closed guess
+with a single solve's iterations), ``"fresh-start"`` (as a single solve from the first harmonic
+alone with the static anchors and five times the iterations: the neighbour's state can lie on
+the wrong side of a jump of the mean position) and ``"time-start"`` (a time integration from
+the neighbour). Single-solve rungs that ``SolveOptions.strategy`` leaves out are left out of a
+sweep point too.
 """
 
 from __future__ import annotations
@@ -44,7 +45,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fretwear.hb.arclength import arclength
+from fretwear.hb.arclength import arclength, fold_ahead
 from fretwear.hb.branch import Branch, Problems
 from fretwear.hb.connectors import Connected
 from fretwear.hb.fallback import TimeDomainFallback
@@ -569,6 +570,9 @@ def point_time_start(p: Point) -> bool:
 POINT_RUNGS = (("grid", grid), ("substep", substep), ("retry", retry),
                ("arclength", arclength_branch), ("continuation", continuation),
                ("fresh-start", fresh_start), ("time-start", point_time_start))
+#: the rungs of a sweep point with a fold ahead (:func:`point_ladder`): the arclength before
+#: the other solver, the rest in order
+FOLD_RUNGS = (POINT_RUNGS[0], POINT_RUNGS[1], POINT_RUNGS[3], POINT_RUNGS[2], *POINT_RUNGS[4:])
 
 
 #: the rungs of a sweep point said as they start (the costly ones; the first four are the
@@ -577,13 +581,34 @@ SAID_RUNGS = ("continuation", "fresh-start", "time-start")
 
 
 def point_ladder(p: Point) -> Point:
-    """Run the rungs of a sweep point (:data:`POINT_RUNGS`) until one converges; the wall time
+    """Run the rungs of a sweep point until one converges: :data:`POINT_RUNGS`, or
+    :data:`FOLD_RUNGS` when the grid step and its halvings failed before a fold; the wall time
     after the first rung is ``p.fallback_seconds``, the costly rungs are said as they start
-    (:func:`~fretwear.hb.fallbacks.said`)."""
+    (:func:`~fretwear.hb.fallbacks.said`).
+
+    Why the arclength goes first at a fold: past a fold of the response curve (a turning point
+    in frequency) the branch the sweep follows has no point at the grid frequency, so no
+    solver started from the neighbour can land on it. The other solver (``"retry"``) then
+    either fails, after a full solve (the dovetail's FRF at 2440 Hz: Newton stopped at a
+    relative residual of 0.13), or converges on another branch after a jump that the sweep
+    does not see (the bladed disk's at 3100 Hz), and the point counts as a fallback; the
+    pseudo-arclength continuation follows the branch round the fold, which is the sweep's own
+    path. Whether a fold lies ahead is read from the branch itself, free (no solve, no
+    condensation): :func:`~fretwear.hb.arclength.fold_ahead`, the frequency along the
+    arclength through the last three converged points (the halved steps' among them, which
+    crowd at the fold) turning back short of the grid frequency. Where it does not (a solver
+    that stalls on a smooth stretch, where Newton converges after Powell's trust region
+    stalled and the reverse), the other solver keeps its place before the arclength: one
+    solve at the grid frequency, where the arclength would pay a condensation per corrector
+    iterate at every new frequency."""
     t_first = None
-    for i, (name, rung) in enumerate(POINT_RUNGS):
+    rungs = POINT_RUNGS
+    for i in range(len(rungs)):
         if i == 1:
             t_first = time.perf_counter()
+        elif i == 2 and p.options.continuation and fold_ahead(p.branch.history, p.omega):
+            rungs = FOLD_RUNGS
+        name, rung = rungs[i]
         if name in SAID_RUNGS:
             said(f"sweep at {p.frequency:.6g} Hz: the continuation failed; trying "
                  f"{name}" + (" (a time integration can take minutes)"
