@@ -38,7 +38,7 @@ def fold_ahead(history, omega_target: float) -> bool:
     its extremum lies short of the target. A straight or accelerating branch (``omega(s)``
     with ``omega''`` along the march: the tangent turning back towards the frequency axis, as
     past a peak) has none. The extremum of three points is an estimate: on the dovetail's FRF
-    (tests in docs/studies/fallbacks.md) the points at 2260, 2350 and 2395 Hz put it at 2404
+    (docs/studies/fallbacks.md) the points at 2260, 2350 and 2395 Hz put it at 2404
     Hz, where the arclength found the fold (2404.6 Hz). Fewer than three points, or two at one
     place: False."""
     if len(history) < 3:

@@ -589,18 +589,20 @@ def point_ladder(p: Point) -> Point:
     Why the arclength goes first at a fold: past a fold of the response curve (a turning point
     in frequency) the branch the sweep follows has no point at the grid frequency, so no
     solver started from the neighbour can land on it. The other solver (``"retry"``) then
-    either fails, after a full solve (the dovetail's FRF at 2440 Hz: Newton stopped at a
-    relative residual of 0.13), or converges on another branch after a jump that the sweep
-    does not see (the bladed disk's at 3100 Hz), and the point counts as a fallback; the
-    pseudo-arclength continuation follows the branch round the fold, which is the sweep's own
-    path. Whether a fold lies ahead is read from the branch itself, free (no solve, no
-    condensation): :func:`~fretwear.hb.arclength.fold_ahead`, the frequency along the
-    arclength through the last three converged points (the halved steps' among them, which
-    crowd at the fold) turning back short of the grid frequency. Where it does not (a solver
-    that stalls on a smooth stretch, where Newton converges after Powell's trust region
-    stalled and the reverse), the other solver keeps its place before the arclength: one
-    solve at the grid frequency, where the arclength would pay a condensation per corrector
-    iterate at every new frequency."""
+    either fails after a full solve (the dovetail's FRF at 2440 Hz: Newton stopped at a
+    relative residual of 0.13; the folded friction model of the tests at 0.77 rad/s: 0.11) or
+    converges on another branch after a jump the sweep does not see, and the point counts as
+    a fallback, while the pseudo-arclength continuation follows the branch round the fold,
+    which is the sweep's own path. Whether a fold lies ahead is read from the branch itself,
+    free (no solve, no condensation): :func:`~fretwear.hb.arclength.fold_ahead`, the frequency
+    along the arclength through the last three converged points (the halved steps' among
+    them, which crowd at the fold) turning back short of the grid frequency. Where it does
+    not (a solver that stalls on a smooth stretch or at a corner of the branch, where Newton
+    converges after Powell's trust region stalled, and the reverse: the dovetail's FRF at
+    2800 Hz, where the arclength's corrector diverged and Newton from the neighbour
+    converged), the other solver keeps its place before the arclength: one solve at the grid
+    frequency, where the arclength pays a condensation per corrector iterate at every new
+    frequency."""
     t_first = None
     rungs = POINT_RUNGS
     for i in range(len(rungs)):
