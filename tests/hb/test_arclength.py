@@ -88,3 +88,8 @@ def test_fold_ahead_finds_the_turning_point_of_a_circle():
     assert away[2][0] < away[1][0] < away[0][0]
     assert not fold_ahead(away, 0.5)
     assert not fold_ahead(up[1:], 2.0)
+    # a step halved to its smallest without converging: a fold wherever the branch
+    # decelerates, never where it does not
+    assert fold_ahead(up, 1.0 + 0.95 * R, halved_out=True)
+    assert not fold_ahead(line, 2.0, halved_out=True)
+    assert not fold_ahead(away, 0.5, halved_out=True)

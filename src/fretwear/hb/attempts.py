@@ -386,6 +386,7 @@ class Point:
     tried: list = field(default_factory=list)
     time_domain: str | None = None
     fallback_seconds: float = 0.0
+    halved_out: bool = False
 
     @property
     def omega(self) -> float:
@@ -435,7 +436,8 @@ def grid(p: Point) -> bool:
 def substep(p: Point) -> bool:
     """``"substep"``: from the last converged point, steps halved on failure (at most
     ``max_bisections`` times) and grown by 1.5 on success, each converged intermediate point
-    kept in the sweep."""
+    kept in the sweep. A failure that halved the step below its smallest sets
+    ``p.halved_out`` (a fold's sign, :func:`~fretwear.hb.arclength.fold_ahead`)."""
     b, omega, opts = p.branch, p.omega, p.options
     if not b.history:
         return False
@@ -461,6 +463,7 @@ def substep(p: Point) -> bool:
         step = step * 1.5
         if abs(step) > abs(omega - w_cur):
             step = omega - w_cur
+    p.halved_out = abs(step) < abs(min_step) * (1 - 1e-12)
     return False
 
 
@@ -596,7 +599,8 @@ def point_ladder(p: Point) -> Point:
     which is the sweep's own path. Whether a fold lies ahead is read from the branch itself,
     free (no solve, no condensation): :func:`~fretwear.hb.arclength.fold_ahead`, the frequency
     along the arclength through the last three converged points (the halved steps' among
-    them, which crowd at the fold) turning back short of the grid frequency. Where it does
+    them, which crowd at the fold) decelerating and turning back short of the grid frequency,
+    or decelerating where the halved steps failed down to the smallest. Where it does
     not (a solver that stalls on a smooth stretch or at a corner of the branch, where Newton
     converges after Powell's trust region stalled, and the reverse: the dovetail's FRF at
     2800 Hz, where the arclength's corrector diverged and Newton from the neighbour
@@ -608,7 +612,8 @@ def point_ladder(p: Point) -> Point:
     for i in range(len(rungs)):
         if i == 1:
             t_first = time.perf_counter()
-        elif i == 2 and p.options.continuation and fold_ahead(p.branch.history, p.omega):
+        elif i == 2 and p.options.continuation and fold_ahead(p.branch.history, p.omega,
+                                                               p.halved_out):
             rungs = FOLD_RUNGS
         name, rung = rungs[i]
         if name in SAID_RUNGS:
