@@ -373,7 +373,9 @@ class Point:
     ``omega`` [rad/s], the sweep's problems per frequency, its branch of converged points and
     its options; then what the rungs found: the problem, harmonics and statistics of the last
     solve, how it was made, every attempt, and what a time integration found (None: none
-    ran)."""
+    ran); whether the halved steps failed down to the smallest (``halved_out``) and the index
+    in the branch's history of the last converged point before the arclength ran
+    (``neighbour``: None before it ran)."""
 
     frequency: float
     probs: Problems
@@ -387,6 +389,7 @@ class Point:
     time_domain: str | None = None
     fallback_seconds: float = 0.0
     halved_out: bool = False
+    neighbour: int | None = None
 
     @property
     def omega(self) -> float:
@@ -468,12 +471,19 @@ def substep(p: Point) -> bool:
 
 
 def retry(p: Point) -> bool:
-    """``"retry"``: the other solver from the last converged point."""
+    """``"retry"``: the other solver from the last converged point before the arclength ran
+    (``p.neighbour``; the last converged point when it did not), with its anchors: after an
+    arclength that did not reach the frequency (a fold ahead, :data:`FOLD_RUNGS`) this is the
+    start the retry had before the arclength went first, so the ladder from there on is the
+    same and so are its answers."""
     b, so = p.branch, p.options.solve
     if not b.history:
         return False
-    prob, U, st = solve_at(p.probs, p.omega, b.anchor(), b.history[-1][1],
-                           so.replace(solver=so.other_solver))
+    U0 = b.history[-1 if p.neighbour is None else p.neighbour][1]
+    c = b.model.contact  # the anchors of that point, as Branch.anchor takes the last one's
+    anchor = (b.anchor() if p.neighbour is None
+              else U0.reshape(c.n_nodes, c.dim, -1)[:, 1:, 0].copy())
+    prob, U, st = solve_at(p.probs, p.omega, anchor, U0, so.replace(solver=so.other_solver))
     p.tried.append(Attempt.of("retry", prob.eps, st))
     return p.adopt(prob, U, st, "retry")
 
@@ -485,6 +495,7 @@ def arclength_branch(p: Point) -> bool:
     if not (opts.continuation and len(b.history) >= 2):
         return False
     anc = b.anchor()
+    p.neighbour = len(b.history) - 1
     t_arc = time.perf_counter()
     found = arclength(p.probs, anc, (b.history[-2][1].reshape(-1), b.history[-2][0]),
                       (b.history[-1][1].reshape(-1), b.history[-1][0]), p.omega,
