@@ -65,7 +65,7 @@ def fold_ahead(history, omega_target: float, halved_out: bool = False) -> bool:
     fallbacks.md) the points at 2260, 2350 and 2395 Hz put it at 2404.5 Hz, where the
     arclength found the fold (2404.6 Hz); where the fold is a local feature of a slowly
     bending branch the parabola puts it too far (the bladed disk's at 2800 Hz: 2700, 2750 and
-    2756.25 Hz put it at 2800.6 Hz, the arclength found it at 2760.7 Hz, where the halved
+    2756.25 Hz put it at about 2800 Hz, the arclength found it at 2760.7 Hz, where the halved
     step had failed), which the halving's failure tells."""
     w_turn = frequency_turn(history, omega_target)
     if w_turn is None:
