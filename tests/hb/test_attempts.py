@@ -268,3 +268,42 @@ def test_first_sweep_point_of_the_tutorial_converges_at_its_grid_attempt(tutoria
     assert single.success
     a_single = single.observed_amplitude("joint")[1, list(basis.harmonics).index(1)]
     assert abs(res.amplitude("joint", "y")[0] - a_single) <= 1e-6 * a_single
+
+
+def test_sweep_passes_a_fold_by_its_continuation_alone():
+    """The folded frictional FRF of :func:`helpers.folded.inclined` (3 harmonics, 64
+    samples, 0.60 to 0.78 rad/s on 19 points): the grid step from 0.76 to 0.77 rad/s crosses
+    the fold where the upper branch (the node touching the wall) ends. The branch turns back
+    short of 0.77 rad/s (:func:`fretwear.hb.arclength.fold_ahead`), so the arclength goes
+    first and follows the middle branch back below 0.70 rad/s, round the lower fold and up the
+    lower branch past 0.77 rad/s: the point needs no fallback (attempts ``grid``,
+    ``arclength``; before, the other solver was tried first, failed at a relative residual of
+    0.11 and made the point a fallback). Independent check of the point reached: on the lower
+    branch the node never touches the wall (separation all period), so the balance is the
+    linear response of the model with the contact open, ``(K - w^2 M + i w C) X = F``
+    (1e-8 relative: the solve's tolerance; measured 1e-11)."""
+    from helpers.folded import inclined
+
+    from fretwear.hb import fallbacks
+    from fretwear.hb.options import SweepOptions
+    from fretwear.hb.reduce import exact_condenser
+    from fretwear.hb.sweep import sweep
+
+    model = inclined()
+    res = sweep(model, FourierBasis.up_to(3, 64), 0.60 / (2 * np.pi), 0.78 / (2 * np.pi), 19,
+                options=SweepOptions(spacing="linear"), condenser=exact_condenser(model))
+    grid = [p for p in res.points if p.on_grid]
+    assert all(p.success for p in grid)
+    assert fallbacks.of_solutions(grid, res.wall_time).count == 0
+    w = np.array([2 * np.pi * p.frequency_hz for p in grid])
+    at = grid[int(np.argmin(np.abs(w - 0.77)))]
+    assert [a.method for a in at.attempts] == ["grid", "arclength"], at.attempts
+    traced = [2 * np.pi * p.frequency_hz for p in res.points if p.how == "arclength"]
+    assert min(traced) < 0.70 < 0.77 < max(traced)
+    assert at.solution.state_fractions()[0, 0] == 1.0  # separated all period
+    K, M, C = (np.asarray(a.todense()) if hasattr(a, "todense") else np.asarray(a)
+               for a in (model.K, model.M, model.C))
+    wa = 2 * np.pi * at.frequency_hz
+    open_x1 = abs(np.linalg.solve(K - wa**2 * M + 1j * wa * C, model.loads[0].vector)[0])
+    amp = res.amplitude("x1", 0)[res.points.index(at)]
+    assert abs(amp - open_x1) <= 1e-8 * open_x1

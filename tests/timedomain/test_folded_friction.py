@@ -2,21 +2,22 @@
 the same way by Hill's method (:mod:`fretwear.hb.stability`) and by the exact time integration
 (:mod:`fretwear.timedomain.monodromy`, :func:`fretwear.timedomain.stability.check_periodic`).
 
-The model (:func:`inclined`): two masses (springs 1, 1 N/m from the wall to the second mass,
-0.1 N forcing on it) and the first mass striking a rigid wall inclined at 30 degrees, with
-friction ``mu = 0.3``, through a light contact node (1 g) held by a normal spring ``kn`` and a
-tangential spring ``kt`` (10 N/m each) along the wall. When the first mass moves more than
-``gap / cos 30`` towards the wall the node touches it: its normal load grows with the motion
-(``kn (x1 cos 30 - gap)``) and, since ``mu < tan 30``, the node slides along the wall for as
-long as it touches it, dissipating ``mu N`` times the slip. Why the FRF folds: touching the wall
-adds the normal spring (and the tangential one, up to the slip limit) over part of the period,
-a piecewise-linear hardening spring whose resonance rises with the amplitude, and the
+The model (:func:`helpers.folded.inclined`): two masses (springs 1, 1 N/m from the wall to the
+second mass, 0.1 N forcing on it) and the first mass striking a rigid wall inclined at 30
+degrees, with friction ``mu = 0.3``, through a light contact node (1 g) held by a normal spring
+``kn`` and a tangential spring ``kt`` (10 N/m each) along the wall. When the first mass moves
+more than ``gap / cos 30`` towards the wall the node touches it: its normal load grows with the
+motion (``kn (x1 cos 30 - gap)``) and, since ``mu < tan 30``, the node slides along the wall
+for as long as it touches it, dissipating ``mu N`` times the slip. Why the FRF folds: touching
+the wall adds the normal spring (and the tangential one, up to the slip limit) over part of the
+period, a piecewise-linear hardening spring whose resonance rises with the amplitude, and the
 friction's dissipation is too small to keep the bent resonance single-valued: between 0.68 and
 0.76 rad/s there are three periodic states (an upper branch in contact, a middle one in
 contact, a lower one that does not touch the wall).
 """
 
 import numpy as np
+from helpers.folded import inclined
 
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.options import SweepOptions
@@ -25,30 +26,9 @@ from fretwear.hb.solution import initial_state
 from fretwear.hb.stability import HillOptions
 from fretwear.hb.sweep import sweep
 from fretwear.hb.sweep_stability import sweep_stability
-from fretwear.model.build import Damping
-from fretwear.model.core import Load
-from fretwear.model.matrices import ContactDofs, from_matrices
 from fretwear.timedomain.monodromy import SHOOTING, monodromy
 from fretwear.timedomain.options import InitialState
 from fretwear.timedomain.stability import check_periodic
-
-MS = 1e-3  # mass of the contact node [kg]
-
-
-def inclined(kn=10.0, kt=10.0, angle=30.0, mu=0.3, gap=0.5, force=0.1):
-    """DOFs: the two masses (1 kg), the node's normal and tangential displacements; the node's
-    springs ``kn (n - x1 cos a)`` and ``kt (t - x1 sin a)`` (20 % of critical damping on its
-    own modes), the masses' springs with 0.03 K damping."""
-    c, s = np.cos(np.radians(angle)), np.sin(np.radians(angle))
-    Ks = np.array([[1, -1, 0, 0], [-1, 2, 0, 0], [0, 0, 0, 0], [0, 0, 0, 0.0]])
-    bn, bt = np.array([-c, 0, 1, 0]), np.array([-s, 0, 0, 1])
-    K = Ks + kn * np.outer(bn, bn) + kt * np.outer(bt, bt)
-    cn, ct = 2 * 0.2 * np.sqrt(kn * MS), 2 * 0.2 * np.sqrt(kt * MS)
-    C = 0.03 * Ks + cn * np.outer(bn, bn) + ct * np.outer(bt, bt)
-    return from_matrices(K, np.diag([1.0, 1.0, MS, MS]),
-                         contact=ContactDofs(normal_dofs=[2], tangential_dofs=[3], gap=gap, mu=mu),
-                         damping=Damping(C=C), loads=[Load(np.array([0, force, 0, 0]), "cos")],
-                         observed={"x1": 0, "x2": 1})
 
 
 def _near(candidates, target):

@@ -25,15 +25,16 @@ Single solve (:class:`Trial`; :data:`~fretwear.hb.options.STRATEGY`, the rungs t
    steady state starts one more solve with its mean tangential positions as anchors.
 
 Sweep point (:class:`Point`; :data:`POINT_RUNGS`): ``"grid"`` (the solver from the secant
-predictor), ``"substep"`` (bisection of the step from the last converged point),
-``"retry"`` (the other solver from the neighbour), ``"arclength"`` (pseudo-arclength
-continuation past a fold, :mod:`fretwear.hb.arclength`), the rungs 3-4 of a single solve
-from the neighbour (at the first point of a branch, which has none, from the contact-closed
-guess with a single solve's iterations), ``"fresh-start"`` (as a single solve from the first
-harmonic alone with the static anchors and five times the iterations: the neighbour's state
-can lie on the wrong side of a jump of the mean position) and ``"time-start"`` (a time
-integration from the neighbour). Single-solve rungs that ``SolveOptions.strategy`` leaves
-out are left out of a sweep point too.
+predictor), ``"substep"`` (bisection of the step from the last converged point), ``"retry"``
+(the other solver from the neighbour), ``"arclength"`` (pseudo-arclength continuation past a
+fold, :mod:`fretwear.hb.arclength`; before ``"retry"`` when the branch turns back short of the
+grid frequency, :data:`FOLD_RUNGS`, :func:`point_ladder`), the rungs 3-4 of a single solve from
+the neighbour (at the first point of a branch, which has none, from the contact-closed guess
+with a single solve's iterations), ``"fresh-start"`` (as a single solve from the first harmonic
+alone with the static anchors and five times the iterations: the neighbour's state can lie on
+the wrong side of a jump of the mean position) and ``"time-start"`` (a time integration from
+the neighbour). Single-solve rungs that ``SolveOptions.strategy`` leaves out are left out of a
+sweep point too.
 """
 
 from __future__ import annotations
@@ -44,7 +45,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fretwear.hb.arclength import arclength
+from fretwear.hb.arclength import arclength, fold_ahead
 from fretwear.hb.branch import Branch, Problems
 from fretwear.hb.connectors import Connected
 from fretwear.hb.fallback import TimeDomainFallback
@@ -372,7 +373,9 @@ class Point:
     ``omega`` [rad/s], the sweep's problems per frequency, its branch of converged points and
     its options; then what the rungs found: the problem, harmonics and statistics of the last
     solve, how it was made, every attempt, and what a time integration found (None: none
-    ran)."""
+    ran); whether the halved steps failed down to the smallest (``halved_out``) and the index
+    in the branch's history of the last converged point before the arclength ran
+    (``neighbour``: None before it ran)."""
 
     frequency: float
     probs: Problems
@@ -385,6 +388,8 @@ class Point:
     tried: list = field(default_factory=list)
     time_domain: str | None = None
     fallback_seconds: float = 0.0
+    halved_out: bool = False
+    neighbour: int | None = None
 
     @property
     def omega(self) -> float:
@@ -434,7 +439,8 @@ def grid(p: Point) -> bool:
 def substep(p: Point) -> bool:
     """``"substep"``: from the last converged point, steps halved on failure (at most
     ``max_bisections`` times) and grown by 1.5 on success, each converged intermediate point
-    kept in the sweep."""
+    kept in the sweep. A failure that halved the step below its smallest sets
+    ``p.halved_out`` (a fold's sign, :func:`~fretwear.hb.arclength.fold_ahead`)."""
     b, omega, opts = p.branch, p.omega, p.options
     if not b.history:
         return False
@@ -460,16 +466,24 @@ def substep(p: Point) -> bool:
         step = step * 1.5
         if abs(step) > abs(omega - w_cur):
             step = omega - w_cur
+    p.halved_out = abs(step) < abs(min_step) * (1 - 1e-12)
     return False
 
 
 def retry(p: Point) -> bool:
-    """``"retry"``: the other solver from the last converged point."""
+    """``"retry"``: the other solver from the last converged point before the arclength ran
+    (``p.neighbour``; the last converged point when it did not), with its anchors: after an
+    arclength that did not reach the frequency (a fold ahead, :data:`FOLD_RUNGS`) this is the
+    start the retry had before the arclength went first, so the ladder from there on is the
+    same and so are its answers."""
     b, so = p.branch, p.options.solve
     if not b.history:
         return False
-    prob, U, st = solve_at(p.probs, p.omega, b.anchor(), b.history[-1][1],
-                           so.replace(solver=so.other_solver))
+    U0 = b.history[-1 if p.neighbour is None else p.neighbour][1]
+    c = b.model.contact  # the anchors of that point, as Branch.anchor takes the last one's
+    anchor = (b.anchor() if p.neighbour is None
+              else U0.reshape(c.n_nodes, c.dim, -1)[:, 1:, 0].copy())
+    prob, U, st = solve_at(p.probs, p.omega, anchor, U0, so.replace(solver=so.other_solver))
     p.tried.append(Attempt.of("retry", prob.eps, st))
     return p.adopt(prob, U, st, "retry")
 
@@ -481,6 +495,7 @@ def arclength_branch(p: Point) -> bool:
     if not (opts.continuation and len(b.history) >= 2):
         return False
     anc = b.anchor()
+    p.neighbour = len(b.history) - 1
     t_arc = time.perf_counter()
     found = arclength(p.probs, anc, (b.history[-2][1].reshape(-1), b.history[-2][0]),
                       (b.history[-1][1].reshape(-1), b.history[-1][0]), p.omega,
@@ -569,6 +584,9 @@ def point_time_start(p: Point) -> bool:
 POINT_RUNGS = (("grid", grid), ("substep", substep), ("retry", retry),
                ("arclength", arclength_branch), ("continuation", continuation),
                ("fresh-start", fresh_start), ("time-start", point_time_start))
+#: the rungs of a sweep point with a fold ahead (:func:`point_ladder`): the arclength before
+#: the other solver, the rest in order
+FOLD_RUNGS = (POINT_RUNGS[0], POINT_RUNGS[1], POINT_RUNGS[3], POINT_RUNGS[2], *POINT_RUNGS[4:])
 
 
 #: the rungs of a sweep point said as they start (the costly ones; the first four are the
@@ -577,13 +595,38 @@ SAID_RUNGS = ("continuation", "fresh-start", "time-start")
 
 
 def point_ladder(p: Point) -> Point:
-    """Run the rungs of a sweep point (:data:`POINT_RUNGS`) until one converges; the wall time
+    """Run the rungs of a sweep point until one converges: :data:`POINT_RUNGS`, or
+    :data:`FOLD_RUNGS` when the grid step and its halvings failed before a fold; the wall time
     after the first rung is ``p.fallback_seconds``, the costly rungs are said as they start
-    (:func:`~fretwear.hb.fallbacks.said`)."""
+    (:func:`~fretwear.hb.fallbacks.said`).
+
+    Why the arclength goes first at a fold: past a fold of the response curve (a turning point
+    in frequency) the branch the sweep follows has no point at the grid frequency, so no
+    solver started from the neighbour can land on it. The other solver (``"retry"``) then
+    either fails after a full solve (the dovetail's FRF at 2440 Hz: Newton stopped at a
+    relative residual of 0.13; the folded friction model of the tests at 0.77 rad/s: 0.11) or
+    converges on another branch after a jump the sweep does not see, and the point counts as
+    a fallback, while the pseudo-arclength continuation follows the branch round the fold,
+    which is the sweep's own path. Whether a fold lies ahead is read from the branch itself,
+    free (no solve, no condensation): :func:`~fretwear.hb.arclength.fold_ahead`, the frequency
+    along the arclength through the last three converged points (the halved steps' among
+    them, which crowd at the fold) decelerating and turning back short of the grid frequency,
+    or decelerating where the halved steps failed down to the smallest. Where it does
+    not (a solver that stalls on a smooth stretch or at a corner of the branch, where Newton
+    converges after Powell's trust region stalled, and the reverse: the dovetail's FRF at
+    2800 Hz, where the arclength's corrector diverged and Newton from the neighbour
+    converged), the other solver keeps its place before the arclength: one solve at the grid
+    frequency, where the arclength pays a condensation per corrector iterate at every new
+    frequency."""
     t_first = None
-    for i, (name, rung) in enumerate(POINT_RUNGS):
+    rungs = POINT_RUNGS
+    for i in range(len(rungs)):
         if i == 1:
             t_first = time.perf_counter()
+        elif i == 2 and p.options.continuation and fold_ahead(p.branch.history, p.omega,
+                                                               p.halved_out):
+            rungs = FOLD_RUNGS
+        name, rung = rungs[i]
         if name in SAID_RUNGS:
             said(f"sweep at {p.frequency:.6g} Hz: the continuation failed; trying "
                  f"{name}" + (" (a time integration can take minutes)"

@@ -5,11 +5,11 @@ runs the ladder of a sweep point (:func:`fretwear.hb.attempts.point_ladder`): th
 its converged neighbours (secant predictor in frequency); when that fails, in order: bisection
 of the step, the other solver from the neighbour, pseudo-arclength continuation from the last
 converged points (which passes folds of the response curve, where frequency is not a good
-parameter), continuation in eps and in harmonics, a fresh start as a single solve, and a time
-integration. A point that still does not converge is kept in the result as *not converged*,
-with the reason, and never used as a solution. The continuation state (the problems per
-frequency, the converged points, the stick anchors of the loading history) is
-:mod:`fretwear.hb.branch`.
+parameter; before the other solver where a fold lies ahead), continuation in eps and in
+harmonics, a fresh start as a single solve, and a time integration. A point that still does not
+converge is kept in the result as *not converged*, with the reason, and never used as a
+solution. The continuation state (the problems per frequency, the converged points, the stick
+anchors of the loading history) is :mod:`fretwear.hb.branch`.
 """
 
 from __future__ import annotations
