@@ -132,7 +132,8 @@ FORCING_GAMMA = 0.9
 POOR_STEP_FULL_ACCURACY = False
 
 
-def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=None):
+def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=None,
+           trace=None):
     """Powell's hybrid dog-leg trust region on ``f(x) = 0`` with analytic Jacobian.
 
     As MINPACK ``hybrj``: the variables are scaled by the running maximum of the Jacobian's
@@ -149,6 +150,10 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
     ``max_slow``: stop (unconverged) after that many iterations on a new Jacobian
     in a row without one that decreased ``|f|^2`` by :data:`SLOW_DECREASE` (MINPACK's "not
     making good progress" test, ``info = 4`` of ``hybrj`` with 5); None: no such test.
+    ``trace``: a list to which every iteration appends a dict (``|f|``, trust radius,
+    predicted and actual decrease of ``|f|^2``, whether the step was the Newton step, its
+    linear relative residual ``|f + J s| / |f|``, the GMRES iterations of a new Newton step,
+    whether it was accepted), for studies of the convergence.
     Returns ``(x, f, stats)``.
     """
     t0 = time.perf_counter()
@@ -186,7 +191,9 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
         if dscale is None:
             dscale = _column_norms(J)
             dscale[dscale == 0] = 1.0
-        if sn is None:  # an iteration on a new Jacobian (or an inexact step redone)
+        new_step = sn is None
+        gm0 = getattr(J, "gmres_iterations", 0)
+        if new_step:  # an iteration on a new Jacobian (or an inexact step redone)
             loose = not (exact or (tight and POOR_STEP_FULL_ACCURACY))
             sn = _lu_step(J, f, max(eta, 0.1 * target / fn) if loose else None)
             slow += 1
@@ -212,8 +219,10 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
                 s_s = sc_s + t * dd
             s = s_s / dscale
         pnorm = vector_norm(dscale * s)
-        pred = fn * fn - vector_norm(f + J @ s) ** 2
+        lin = vector_norm(f + J @ s)
+        pred = fn * fn - lin * lin
         xn = x + s
+        fn_old, J_old, delta_old, newton_step = fn, J, delta, s is sn
         fnew, _ = fun(xn, False)
         nfev += 1
         fnn = vector_norm(fnew)
@@ -246,6 +255,12 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
             stall = 0
         else:
             stall += 1
+        if trace is not None:
+            trace.append({"it": it, "f": fn_old, "f_trial": fnn, "delta": delta_old,
+                          "pred": pred, "actual": actual, "ratio": ratio,
+                          "newton": newton_step, "lin": lin / fn_old, "new_step": new_step,
+                          "gmres": getattr(J_old, "gmres_iterations", 0) - gm0,
+                          "accepted": fnn < fn_old})
         if callback is not None:
             callback(it, x, fn)
         if delta <= 1e-14 * max(vector_norm(dscale * x), 1e-300) or stall > 40:
