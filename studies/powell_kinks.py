@@ -8,7 +8,10 @@ and actual decrease of ``|f|^2`` and their ratio, Newton step or dog-leg, GMRES 
 the step's linear relative residual, accepted or not, and how many contact nodes change their
 regime (stick / slip / separation at some sample) between the iterate and the trial point.
 
-    PYTHONPATH=$PWD/src OPENBLAS_NUM_THREADS=1 python studies/powell_kinks.py 24 dense 1e-15
+    PYTHONPATH=$PWD/src OPENBLAS_NUM_THREADS=1 python studies/powell_kinks.py 24 dense 1e-15 \
+        [max_iter] [monotone]
+
+(``monotone``: without the watchdog stretches of fretwear.hb.solvers.powell, as before them.)
 """
 
 from __future__ import annotations
@@ -28,6 +31,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 def main():
     from scale_3d import LOADS, H, condenser, pad, warm_up
 
+    from fretwear.hb import solvers
     from fretwear.hb.fourier import FourierBasis
     from fretwear.hb.options import PERIODIC
     from fretwear.hb.preload import static_anchor
@@ -38,6 +42,8 @@ def main():
     rep = sys.argv[2] if len(sys.argv) > 2 else "dense"
     pert = float(sys.argv[3]) if len(sys.argv) > 3 else 0.0
     max_iter = int(sys.argv[4]) if len(sys.argv) > 4 else PERIODIC.max_iter
+    if len(sys.argv) > 5 and sys.argv[5] == "monotone":  # without the watchdog stretches
+        solvers.WATCHDOG_AFTER = 10**9
     load = LOADS["slip"]
     warm_up(load)
     model = pad(n, load)
@@ -76,18 +82,24 @@ def main():
 
     x0 = prob.initial_guess().reshape(-1) * (1.0 + pert)
     trace = []
+    print(" it        |f|     delta   pred/|f|^2 act/|f|^2   ratio  N  gm    lin   acc chg")
+
+    def line(it, x, fn):
+        t, ch = trace[-1], changed[-1]
+        print(f"{t['it']:3d} {t['f']:10.4e} {t['delta']:9.3e} {t['pred'] / t['f'] ** 2:10.3e} "
+              f"{t['actual'] / t['f'] ** 2:10.3e} {t['ratio']:7.3f} "
+              f"{'N' if t['newton'] else 'd'} {t['gmres']:3d} {t['lin']:8.2e} "
+              f"{'+' if t['accepted'] else '-'}{'w' if t['watchdog'] else ' '} {ch:4d}",
+              flush=True)
+
     c0, w0 = time.process_time(), time.perf_counter()
     x, f, st = powell(fun, x0, lambda x: prob.scale(x.reshape(prob.m, prob.H)),
-                      tol=PERIODIC.tol, max_iter=max_iter, trace=trace)
+                      tol=PERIODIC.tol, max_iter=max_iter, trace=trace, callback=line)
     cpu, wall = time.process_time() - c0, time.perf_counter() - w0
-    print(" it        |f|     delta   pred/|f|^2 act/|f|^2   ratio  N  gm    lin   acc chg")
-    for t, ch in zip(trace, changed, strict=False):
-        print(f"{t['it']:3d} {t['f']:10.4e} {t['delta']:9.3e} {t['pred'] / t['f'] ** 2:10.3e} "
-              f"{t['actual'] / t['f'] ** 2:10.3e} {t['ratio']:7.3f} {'N' if t['newton'] else 'd'}"
-              f" {t['gmres']:3d} {t['lin']:8.2e} {'+' if t['accepted'] else '-'} {ch:4d}")
     newton = sum(t["new_step"] for t in trace)
     gm = sum(t["gmres"] for t in trace)
-    out = {"n": n, "rep": rep, "pert": pert, "success": st.success, "residual": st.residual,
+    out = {"n": n, "rep": rep, "pert": pert, "watchdog_after": solvers.WATCHDOG_AFTER,
+           "success": st.success, "residual": st.residual,
            "powell": st.iterations, "newton": newton, "gmres": gm, "cpu": cpu, "wall": wall,
            "message": st.message, "load": os.getloadavg()[0],
            "peak_gib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20}
