@@ -289,9 +289,10 @@ def test_powell_watchdog_crosses_kinks_where_the_monotone_test_crawls(monkeypatc
     such a step and Newton steps from it, and returns if they do not get below the start.
     On the kinked problem of seed 7 (drawn once; the counts are recorded, not tuned) the
     monotone Powell takes 48 iterations and the watchdog 15; over 40 seeds the watchdog
-    never takes more (1690 iterations in all against 1893) and every solve reaches the root ``x*`` the problem was built from
-    (independent of the solver: its only root) to 1e-12, the residual test being 1e-12 of
-    ``|rhs|`` on a problem whose smallest slope is 0.1 (error below 1e-11 relative)."""
+    never takes more (1690 iterations in all against 1893) and every solve reaches the root
+    ``x*`` the problem was built from (independent of the solver: its only root) to 1e-11 of
+    its largest entry (the last Newton step, on the root's linear piece, is exact: the
+    solves end at ``x*`` to rounding, 1e-15)."""
     from fretwear.hb import solvers
 
     counts = {}
