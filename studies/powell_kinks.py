@@ -9,9 +9,10 @@ the step's linear relative residual, accepted or not, and how many contact nodes
 regime (stick / slip / separation at some sample) between the iterate and the trial point.
 
     PYTHONPATH=$PWD/src OPENBLAS_NUM_THREADS=1 python studies/powell_kinks.py 24 dense 1e-15 \
-        [max_iter] [monotone]
+        [max_iter] [monotone | memory=M]
 
-(``monotone``: without the watchdog stretches of fretwear.hb.solvers.powell, as before them.)
+(``monotone``: without the watchdog stretches of fretwear.hb.solvers.powell, as before them;
+``memory=M``: their reference the largest ``|f|`` of the last M iterates.)
 """
 
 from __future__ import annotations
@@ -42,8 +43,11 @@ def main():
     rep = sys.argv[2] if len(sys.argv) > 2 else "dense"
     pert = float(sys.argv[3]) if len(sys.argv) > 3 else 0.0
     max_iter = int(sys.argv[4]) if len(sys.argv) > 4 else PERIODIC.max_iter
-    if len(sys.argv) > 5 and sys.argv[5] == "monotone":  # without the watchdog stretches
+    variant = sys.argv[5] if len(sys.argv) > 5 else ""
+    if variant == "monotone":  # without the watchdog stretches
         solvers.WATCHDOG_AFTER = 10**9
+    elif variant.startswith("memory="):  # the stretches' reference over more iterates
+        solvers.WATCHDOG_MEMORY = int(variant.split("=")[1])
     load = LOADS["slip"]
     warm_up(load)
     model = pad(n, load)
@@ -99,6 +103,7 @@ def main():
     newton = sum(t["new_step"] for t in trace)
     gm = sum(t["gmres"] for t in trace)
     out = {"n": n, "rep": rep, "pert": pert, "watchdog_after": solvers.WATCHDOG_AFTER,
+           "memory": solvers.WATCHDOG_MEMORY,
            "success": st.success, "residual": st.residual,
            "powell": st.iterations, "newton": newton, "gmres": gm, "cpu": cpu, "wall": wall,
            "message": st.message, "load": os.getloadavg()[0],

@@ -143,13 +143,16 @@ POOR_STEP_FULL_ACCURACY = False
 WATCHDOG_AFTER = 2
 WATCHDOG_STEPS = 2
 WATCHDOG_DECREASE = 1e-4
+#: the value a stretch must get below: the largest ``|f|`` of this many iterates before it
+#: (1: the iterate where it began; more: nonmonotone, as Grippo, Lampariello and Lucidi 1986)
+WATCHDOG_MEMORY = 1
 
 
 @dataclass
 class _Checkpoint:
     """Where a watchdog stretch of :func:`powell` began: the iterate, its residual and norm,
     Jacobian, Newton step, variable scales and the trust radius after the rejection; ``left``
-    the Newton steps the stretch may still take."""
+    the Newton steps the stretch may still take; ``ref`` the ``|f|`` it must get below."""
 
     x: np.ndarray
     f: np.ndarray
@@ -159,6 +162,7 @@ class _Checkpoint:
     dscale: np.ndarray
     delta: float
     left: int
+    ref: float
 
 
 def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=None,
@@ -207,6 +211,7 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
     tight = False  # after a poor step: Newton steps to the full accuracy
     watch = None  # the checkpoint of a watchdog stretch (nonmonotone Newton steps)
     rejected, ref = 0, fn  # rejected Newton steps since |f| fell below ref / 10
+    kept = [fn]  # |f| of the iterates (a stretch's only once it is kept)
     while True:
         target = tol * scale(x)
         if fn <= target:
@@ -261,7 +266,7 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
         actual = fn * fn - fnn * fnn
         ratio = actual / pred if pred > 0 else -1.0
         if watch is not None:  # a watchdog stretch: measured against its start
-            done = fnn <= (1.0 - WATCHDOG_DECREASE) * watch.fn
+            done = fnn <= (1.0 - WATCHDOG_DECREASE) * watch.ref
             if done or (fnn < fn and watch.left > 1):
                 watch.left -= 1
                 eta = FORCING_MAX
@@ -272,6 +277,7 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
                 dscale = np.maximum(dscale, _column_norms(J))
                 if done:  # the stretch succeeded: the trust region admits its last step
                     delta, watch, stall, nsuc = max(watch.delta, 2.0 * pnorm), None, 0, 0
+                    kept.append(fn)
             else:  # back to its start, as after the rejection that began it
                 x, f, fn, J, sn = watch.x, watch.f, watch.fn, watch.J, watch.sn
                 dscale, delta, watch = watch.dscale, watch.delta, None
@@ -302,10 +308,12 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
                 sn = None
                 dscale = np.maximum(dscale, _column_norms(J))
                 stall = 0
+                kept.append(fn)
             else:
                 stall += 1
                 if newton_step and rejected + 1 >= WATCHDOG_AFTER:  # a watchdog stretch
-                    watch = _Checkpoint(x, f, fn, J, sn, dscale.copy(), delta, WATCHDOG_STEPS)
+                    watch = _Checkpoint(x, f, fn, J, sn, dscale.copy(), delta, WATCHDOG_STEPS,
+                                        max(kept[-WATCHDOG_MEMORY:]))
                     x, f, fn = xn, fnew, fnn
                     _, J = fun(x, True)
                     njev += 1
