@@ -8,7 +8,9 @@ callers never turn it into a result.
 * ``"powell"``: Powell's hybrid dog-leg trust-region method (Powell 1970; the algorithm of
   MINPACK ``hybrj``) with the Newton step from a LAPACK LU of the analytic Jacobian, recomputed
   at every accepted step. MINPACK factorises with its own unblocked QR, which dominates the cost
-  at ~1000 unknowns; this keeps the algorithm at LAPACK speed.
+  at ~1000 unknowns; this keeps the algorithm at LAPACK speed. Where the Newton step keeps
+  crossing the contact law's kinks, watchdog stretches of nonmonotone Newton steps
+  (:data:`WATCHDOG_AFTER`).
 * ``"hybr"``: MINPACK ``hybrj`` itself through :func:`scipy.optimize.root` (what the paper used).
 * ``"newton"``: Newton with a backtracking line search on ``|f|^2``.
 """
@@ -180,6 +182,9 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
     itself, and the converged answer is that of the residual test; after a step that the
     model served poorly, steps to the full accuracy until it serves well again if
     :data:`POOR_STEP_FULL_ACCURACY`).
+    After :data:`WATCHDOG_AFTER` rejected Newton steps without ``|f|`` falling a decade, a
+    rejected Newton step starts a watchdog stretch (:data:`WATCHDOG_STEPS` Newton steps
+    from its point, kept if ``|f|`` ends below its start, else undone).
     ``max_slow``: stop (unconverged) after that many iterations on a new Jacobian
     in a row without one that decreased ``|f|^2`` by :data:`SLOW_DECREASE` (MINPACK's "not
     making good progress" test, ``info = 4`` of ``hybrj`` with 5); None: no such test.
