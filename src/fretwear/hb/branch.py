@@ -16,7 +16,7 @@ import numpy as np
 from fretwear.hb.connectors import connect, springs
 from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.solution import Attempt, assemble_solution
-from fretwear.hb.solvers import SolveStats
+from fretwear.hb.solvers import SolveStats, solve
 from fretwear.hb.sweep_result import SweepPoint
 
 #: reduced models a sweep keeps (it revisits the last few frequencies: sub-steps, retries,
@@ -32,14 +32,41 @@ CACHE_BYTES = 3 * 2**30
 #: take a few times that, so 100 points pin some tens of MiB at most; larger models would
 #: pin one reduced model per point for the whole sweep
 KEEP_PROBLEM_BYTES = 2**16
+#: the local basis (:meth:`fretwear.hb.reduce.Condenser.nearby`) serves a frequency where its
+#: estimated relative error (``Z_r``, ``F_r``) is at most this: the continuation then takes
+#: the exact condensation's steps. At 1e-4 its step lengths differed enough past the bladed
+#: disk's fold for the next grid point to land on another of the coexisting friction states
+#: (1.4 % at 2800 Hz, a point of the exact condensation all the same); at 1e-6 the shortened
+#: FE FRFs take the exact condensation's path, their grid points within 4.4e-9 (bladed disk)
+#: and 2.3e-7 (platform damper, after its fold) of the peak amplitude
+#: (docs/studies/fallbacks.md, "The condensation along the continuation")
+NEARBY_TOL = 1e-6
+#: ... and stop serving the sweep once an error measured afterwards by the exact condensation
+#: at a frequency they served exceeds this (the estimate was wrong there)
+NEARBY_STOP = 1e-2
 
 
 class Problems:
     """DLFT problems per frequency, condensed once and cached (the sweep revisits them): at
     most ``cache_size`` reduced models and :data:`CACHE_BYTES` of them (the newest always).
-    ``eps``: a number [N/m], or ``"auto"`` (the spectral radius of each frequency's ``Z_r``)."""
+    ``eps``: a number [N/m], or ``"auto"`` (the spectral radius of each frequency's ``Z_r``).
 
-    def __init__(self, model, basis, gap, eps, condenser, jacobian="auto", cache_size=CACHE_SIZE):
+    With ``solve`` (the sweep's :class:`~fretwear.hb.options.SolveOptions`) and an exact
+    condenser that keeps its interior solutions (``keep_interior``), the frequencies the
+    continuation adds (its halved steps, the arclength's correctors and their differences in
+    frequency) are condensed by the local basis of the latest exact condensation
+    (:meth:`~fretwear.hb.reduce.Condenser.nearby`: no factorisation, no interior solve), and
+    where the local bases of the two latest exact condensations agree to :data:`NEARBY_TOL`,
+    and every point the sweep records from one of them is polished on the exact condensation
+    at its frequency (:meth:`polish`: the solver from that point to the sweep's tolerance),
+    so that every recorded point is a converged point of the exact condensation. The
+    frequencies of ``exact_at`` (the grid's, [rad/s]) are always condensed exactly. Every
+    polish measures the error of the local basis's model it starts from against the exact
+    one (:attr:`nearby_errors`); above :data:`NEARBY_STOP` the sweep condenses exactly from then
+    on (docs/theory.md, "Cost of the condensation")."""
+
+    def __init__(self, model, basis, gap, eps, condenser, jacobian="auto", cache_size=CACHE_SIZE,
+                 exact_at=(), solve=None):
         self.model, self.basis, self.gap, self.eps = model, basis, gap, eps
         self.jacobian = jacobian
         self.orders = np.array([0, *basis.harmonics])
@@ -51,6 +78,42 @@ class Problems:
         self.condenser = condenser
         self.springs = springs(model.contact)
         self.template = None
+        self.exact_at = {float(w) for w in exact_at}
+        self.solve = solve
+        keep = getattr(condenser, "keep_interior", None)
+        self.use_nearby = solve is not None and keep is not None and bool(keep())
+        self.nearby_keys: set = set()  # cached frequencies served by the local basis
+        #: condensations made: ``exact``, ``nearby`` (local basis), ``polished`` points,
+        #: ``polish_failed``
+        self.counts = {"exact": 0, "nearby": 0, "polished": 0, "polish_failed": 0}
+        #: relative error of the local basis's Z_r and F_r (worst harmonic) at each
+        #: polished point
+        self.nearby_errors: list = []
+
+    def _room(self) -> None:
+        """Room for one more reduced model (every frequency's has the size of the cached
+        ones): made before the new model is condensed, at 1024 nodes one model less held at
+        the peak."""
+        size = next(iter(self.cache.values())).Z.nbytes if self.cache else 0
+        while self.cache and (len(self.cache) >= self.size or size + sum(
+                r.Z.nbytes for r in self.cache.values()) > CACHE_BYTES):
+            oldest = next(iter(self.cache))
+            self.nearby_keys.discard(oldest)
+            self.cache.pop(oldest)
+
+    def _condense(self, omega: float, exact: bool):
+        """The reduced model at ``omega`` (springs connected) and whether it is exact."""
+        red = None
+        if not exact and self.use_nearby:
+            red = self.condenser.nearby(omega, self.orders, NEARBY_TOL)
+        near = red is not None
+        if red is None:
+            red = self.condenser.reduced(omega, self.orders)
+        self.counts["nearby" if near else "exact"] += 1
+        if self.springs is not None:
+            red = connect(red, self.model.contact, self.springs)
+        red.nearby = near  # a problem on it is polished before it is recorded (polish)
+        return red, not near
 
     def get(self, omega: float, anchor) -> DLFTProblem:
         """The problem at the circular frequency ``omega`` [rad/s] (the continuation
@@ -58,16 +121,11 @@ class Problems:
         key = float(omega)
         red = self.cache.get(key)
         if red is None:
-            # room is made before the new model is condensed (every frequency's has the
-            # size of the cached ones): at 1024 nodes one model less held at the peak
-            size = next(iter(self.cache.values())).Z.nbytes if self.cache else 0
-            while self.cache and (len(self.cache) >= self.size or size + sum(
-                    r.Z.nbytes for r in self.cache.values()) > CACHE_BYTES):
-                self.cache.pop(next(iter(self.cache)))
-            red = self.condenser.reduced(omega, self.orders)
-            if self.springs is not None:
-                red = connect(red, self.model.contact, self.springs)
+            self._room()
+            red, exact = self._condense(omega, key in self.exact_at)
             self.cache[key] = red
+            if not exact:
+                self.nearby_keys.add(key)
         if self.template is None:
             prob = DLFTProblem(red, self.model.contact, self.basis, gap=self.gap,
                                eps=self.eps, anchor=anchor, jacobian=self.jacobian)
@@ -84,6 +142,47 @@ class Problems:
         prob._precond = getattr(self.last, "_precond", None)
         self.last = prob
         return prob
+
+    def exact(self, omega: float, anchor) -> DLFTProblem:
+        """The problem at ``omega`` [rad/s] on the exact condensation (replacing in the cache
+        the local basis's model there)."""
+        key = float(omega)
+        if key in self.nearby_keys or key not in self.cache:
+            self.cache.pop(key, None)
+            self.nearby_keys.discard(key)
+            self._room()
+            self.cache[key], _ = self._condense(omega, True)
+        return self.get(omega, anchor)
+
+    def polish(self, omega: float, prob: DLFTProblem, U, stats):
+        """``(problem, U, stats)`` of a point converged at ``omega`` [rad/s] on the local
+        basis's model (its reduced model's ``nearby``): the solver from ``U`` on the exact
+        condensation there (the sweep's solver, then the other one), its statistics added to
+        ``stats``'s, the local basis's error there measured (:attr:`nearby_errors`). A point
+        converged on an exact model is returned as it is."""
+        if not getattr(prob.reduced, "nearby", False):
+            return prob, U, stats
+        pe = self.exact(omega, prob.anchor)
+        near, red = prob.reduced, pe.reduced
+        self.nearby_errors.append(max(
+            max(np.linalg.norm(a - b) / max(np.linalg.norm(b), 1e-300)
+                for a, b in zip(x, y, strict=True))
+            for x, y in ((near.Z, red.Z), (near.F, red.F))))
+        if self.nearby_errors[-1] > NEARBY_STOP:
+            self.use_nearby = False
+        so = self.solve
+        for method in (so.solver, so.other_solver):
+            x, _, st = solve(lambda x, jac=True: pe.residual(x.reshape(pe.m, pe.H), jac),
+                             np.asarray(U, float).reshape(-1),
+                             lambda x: pe.scale(x.reshape(pe.m, pe.H)),
+                             method=method, tol=so.tol, max_iter=so.max_iter)
+            if st.success:
+                break
+        self.counts["polished" if st.success else "polish_failed"] += 1
+        merged = SolveStats(st.success, st.residual, stats.iterations + st.iterations,
+                            stats.nfev + st.nfev, stats.njev + st.njev,
+                            stats.wall_time + st.wall_time, st.message, st.solver)
+        return pe, x.reshape(pe.m, pe.H), merged
 
 
 def rebuild_point(probs: Problems, entry: dict) -> SweepPoint:
@@ -116,11 +215,14 @@ class Branch:
     ----------
     model : the structure; anchor : (nc, d-1) stick anchors of the first point [m] (the
     static preload state unless given); flag : ``(PeriodicSolution) -> list[str]``, reasons
-    for caution about each converged point (None: none).
+    for caution about each converged point (None: none); probs : the sweep's
+    :class:`Problems`, whose :meth:`Problems.polish` every recorded point goes through (None:
+    points are recorded as given).
     """
 
-    def __init__(self, model, anchor, flag=None):
+    def __init__(self, model, anchor, flag=None, probs=None):
         self.model, self.first_anchor, self.flag = model, anchor, flag
+        self.probs = probs
         self.history: list = []  # converged (omega, U (m, H)) in order
         self.last_solution = None  # the last converged solution (a time start's neighbour)
         self.points: list = []  # every point computed, intermediate ones included
@@ -148,7 +250,10 @@ class Branch:
 
     def record(self, omega, prob, U, stats, how) -> SweepPoint:
         """The converged point ``U`` (m, H) at ``omega`` [rad/s] of ``prob``, added to the
-        history (not to :attr:`points`)."""
+        history (not to :attr:`points`); converged on the local basis's model, polished on
+        the exact condensation first (:meth:`Problems.polish`)."""
+        if self.probs is not None:
+            prob, U, stats = self.probs.polish(omega, prob, U, stats)
         sol = assemble_solution(prob, U, self.model, stats)
         pt = SweepPoint(omega / (2 * np.pi), sol, stats, how, [])
         red = prob.reduced
@@ -164,8 +269,12 @@ class Branch:
         return pt
 
     def add(self, omega, prob, U, stats, how) -> None:
-        """An intermediate converged point (a substep, a point of the arclength branch)."""
-        self.points.append(self.record(omega, prob, U, stats, how))
+        """An intermediate converged point (a substep, a point of the arclength branch);
+        left out when :meth:`record` makes it a failure (its polish on the exact condensation
+        failed, or it holds non-finite values)."""
+        pt = self.record(omega, prob, U, stats, how)
+        if pt.solution is not None and pt.solution.success:
+            self.points.append(pt)
 
     def resume(self, probs: Problems, entries) -> None:
         """The points of a checkpoint (:func:`rebuild_point`), as if computed here."""

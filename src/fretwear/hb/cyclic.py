@@ -85,6 +85,7 @@ class CyclicCondenser(Condenser):
     def __init__(self, sector: CyclicSector, engine_order: int, dense: bool | None = None):
         self.sector = sector
         self.engine_order = _engine_order(engine_order)
+        self._keep_all = False  # keep_interior: every index's, new ones too
         self._dense = dense
         self._fp = _fingerprint(sector.model)
         self._subs: dict[int, tuple[Condenser, sp.csr_matrix]] = {}
@@ -103,6 +104,8 @@ class CyclicCondenser(Condenser):
             cond = Condenser(structure, self._dense)
             self._subs[k] = (cond, T)
             self._set_loads(cond, T)
+            if self._keep_all:
+                cond.keep_interior()
         return self._subs[k]
 
     def _set_loads(self, cond: Condenser, T: sp.csr_matrix) -> None:
@@ -151,23 +154,55 @@ class CyclicCondenser(Condenser):
         [rad/s]: harmonic ``n``'s blocks from harmonic index ``n EO mod N``."""
         orders = np.asarray(orders, dtype=np.int64)
         self.check_size(orders)  # every index's blocks as harmonic index 0's (same sizes)
+        return self._by_index("reduced", omega, orders, quasi_static, frequency)
+
+    def _by_index(self, name: str, omega: float, orders: np.ndarray, arg,
+                  frequency: float | None) -> Reduced | None:
+        """The :class:`~fretwear.hb.reduce.Reduced` model on ``orders`` at ``omega`` [rad/s]
+        gathered from each harmonic index's condenser's method ``name`` (``"reduced"``: ``arg``
+        is ``quasi_static``; ``"nearby"``: ``tol``) on that index's harmonics; None when one
+        gives None. Its ``estimate`` (``"nearby"``): the largest of the indices'."""
         ks = self.index(orders)
         m, no, nb = self.m, self.structure.obs.size, orders.size
         Zr = np.zeros((nb, m, m), dtype=complex)
         Fr = np.zeros((nb, m), dtype=complex)
         oA = np.zeros((nb, no, m), dtype=complex)
         ob = np.zeros((nb, no), dtype=complex)
+        estimates = []
         for k in np.unique(ks):
             sel = np.flatnonzero(ks == k)
             cond, _ = self._sub(int(k))
-            get = super().reduced if cond is self else cond.reduced
-            r = get(omega, orders[sel], quasi_static, frequency)
+            get = getattr(super(), name) if cond is self else getattr(cond, name)
+            r = get(omega, orders[sel], arg, frequency)
+            if r is None:
+                return None
             Zr[sel], Fr[sel], oA[sel], ob[sel] = r.Z, r.F, r.obs_A, r.obs_b
+            if hasattr(r, "estimate"):
+                estimates.append(r.estimate)
         obs_dofs = (np.concatenate([np.asarray(p.dofs, np.int64)
                                     for p in self.sector.model.observed])
                     if self.sector.model.observed else np.zeros(0, np.int64))
-        return Reduced(float(omega), orders, Zr, Fr, oA, ob, obs_dofs, bool(quasi_static),
-                       math.nan if frequency is None else float(frequency))
+        quasi_static = name == "reduced" and bool(arg)
+        out = Reduced(float(omega), orders, Zr, Fr, oA, ob, obs_dofs, quasi_static,
+                      math.nan if frequency is None else float(frequency))
+        if estimates:
+            out.estimate = max(estimates)
+        return out
+
+    def keep_interior(self) -> bool:
+        """Keep the interior solutions of every harmonic index's latest exact condensation
+        (:meth:`~fretwear.hb.reduce.Condenser.keep_interior`), for :meth:`nearby`."""
+        self._keep_all = True
+        return all([self._keep() if cond is self else cond.keep_interior()
+                    for cond, _ in self._subs.values()])
+
+    def nearby(self, omega: float, orders, tol: float, frequency: float | None = None
+               ) -> Reduced | None:
+        """As :meth:`reduced` from each harmonic index's local bases
+        (:meth:`~fretwear.hb.reduce.Condenser.nearby`, with its ``tol`` and ``estimate``);
+        None when one gives none."""
+        orders = np.asarray(orders, dtype=np.int64)
+        return self._by_index("nearby", omega, orders, tol, frequency)
 
     def recover(self, omega: float, orders, u_loc, quasi_static: bool = False) -> np.ndarray:
         """The sector's DOFs ``U_n`` (nb, ndof) complex [m] from ``u_loc`` (nb, m): each

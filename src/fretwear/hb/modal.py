@@ -43,6 +43,7 @@ import scipy.sparse.linalg as spla
 from numba import njit
 
 from fretwear.errors import InputError
+from fretwear.hb import hmatrix
 from fretwear.hb.modal_operator import ReducedOperator
 from fretwear.hb.reduce import (
     BLOCK,
@@ -78,11 +79,15 @@ MAX_MODES = 512
 #: Powell's watchdog stretches (fretwear.hb.solvers.WATCHDOG_AFTER) both representations
 #: and both starts converge (docs/studies/large-interface-solve.md, "Powell near the law's
 #: kinks")
-REPRESENTATIONS = ("auto", "dense", "operator")
+REPRESENTATIONS = ("auto", "dense", "operator", "compressed")
 #: real unknowns ``m H`` above which ``"auto"`` takes the operator: where the periodic solve
 #: takes the operator Jacobian (fretwear.hb.problem.DENSE_JACOBIAN_MAX, which this module,
 #: a layer below, does not import; tests/hb/test_modal_operator.py checks that they agree)
 OPERATOR_MIN_UNKNOWNS = 3000
+#: relative error of the compressed ``X^cc`` (``representation="compressed"``): the
+#: partial-slip pad's solution moved by 6e-6 at 256 and 3.6e-5 at 1024 contact nodes with it
+#: (docs/studies/large-interface-solve.md), below the modal check's default TOL
+COMPRESS_TOL = 1e-6
 
 
 def next_mode_count(n_modes: int, n_interior: int) -> int | None:
@@ -126,13 +131,20 @@ class ModalCondenser(Condenser):
         frequency-independent ``X^cc`` shared by every harmonic plus a rank-``q`` term per
         harmonic) or ``"auto"`` (the operator above :data:`OPERATOR_MIN_UNKNOWNS` real
         unknowns ``m H``, the dense blocks below: :data:`REPRESENTATIONS`). The same
-        condensation either way (to rounding).
+        condensation either way (to rounding). ``"compressed"``: the operator, whose shared
+        ``X^cc`` are also held compressed (:func:`fretwear.hb.hmatrix.compress`, a
+        hierarchical low-rank form of the contact nodes' positions with
+        ``||X - X_H||_F <= compress ||X||_F``), once for every frequency; the solver's
+        products take those (below ``m^2`` per column), the blocks it forms (the
+        preconditioner's) stay exact.
 
     Attributes
     ----------
     n_modes : fixed-interface modes kept; q : reduced interior coordinates (modes + load
     responses (+ residual vectors)); mode_frequencies : (n_modes,) [Hz]; error : relative error
-    of the check; residual : whether the residual vectors are in the basis.
+    of the check; residual : whether the residual vectors are in the basis; compress : the
+    compression's bound (``"compressed"``: :data:`COMPRESS_TOL` unless set before the first
+    :meth:`reduced`; None otherwise).
     """
 
     def __init__(self, model: Model, f_max: float, max_order: int, *, modes: int | None = None,
@@ -143,7 +155,9 @@ class ModalCondenser(Condenser):
         if representation not in REPRESENTATIONS:
             raise InputError(f"representation = {representation!r}: expected one of "
                              + ", ".join(f'"{r}"' for r in REPRESENTATIONS))
-        self.representation = representation
+        compressed = representation == "compressed"
+        self._set_compress(model, COMPRESS_TOL if compressed else None)
+        self.representation = "operator" if compressed else representation
         if modes is not None and (isinstance(modes, bool) or not isinstance(modes, int)
                                   or modes < 0):
             raise InputError(f"modes = {modes!r}: expected a number of modes >= 0")
@@ -485,7 +499,25 @@ class ModalCondenser(Condenser):
                 for (j, _), a, v in zip(self.obs_i, np.atleast_2d(A), bo, strict=True):
                     oA[b, j], ob[b, j] = a, v
         Z = self._operator(parts)
+        Z.products = self._compressed()
         return self._result(omega, orders, Z, Fr, oA, ob, quasi_static, frequency)
+
+    def _set_compress(self, model: Model, compress) -> None:
+        """Keep ``compress`` (checked: :func:`_compress_bound`) and the contact nodes'
+        positions it needs."""
+        self.compress = _compress_bound(compress)
+        self._coords = np.asarray(model.contact.coords, dtype=float)
+        self._products = None
+
+    def _compressed(self) -> list | None:
+        """The compressed ``X^cc`` (``compress``), made on first use and kept: they do not
+        depend on the frequency."""
+        if getattr(self, "compress", None) is None:
+            return None
+        if self._products is None:
+            self._products = [hmatrix.compress(self.proj_local[nm][0], self._coords,
+                                               self.compress) for nm in self.proj_local]
+        return self._products
 
     def _psi_at(self, rows: np.ndarray) -> np.ndarray:
         """The rows ``rows`` of ``Psi`` (len(rows), m)."""
@@ -572,12 +604,14 @@ def _real_times(A: np.ndarray, x: np.ndarray) -> np.ndarray:
 @model_argument
 def modal_condenser(model: Model, f_max: float, max_order: int, *, modes: int | None = None,
                     cutoff: float = CUTOFF, tol: float = TOL, raise_modes: bool = False,
-                    residual: bool = False) -> ModalCondenser:
+                    residual: bool = False, compress: float | None = None) -> ModalCondenser:
     """A :class:`ModalCondenser` of ``model`` for excitation frequencies up to ``f_max`` [Hz]
     and harmonic orders up to ``max_order``, checked against the exact condensation (an
     :class:`~fretwear.errors.InputError` when its error exceeds ``tol``; ``modes``, ``cutoff``,
-    ``raise_modes``, ``residual``: see the class; :func:`fretwear.hb.condensers.condenser`
-    chooses them, and between this and the exact condensation).
+    ``raise_modes``, ``residual``: see the class; ``compress``: None, or the relative error
+    ``tol`` of the compressed operator (``representation="compressed"`` with that bound);
+    :func:`fretwear.hb.condensers.condenser` chooses them, and between this and the exact
+    condensation).
 
     Pass it as ``condenser=`` to every condensation of ``model`` that should use it
     (:func:`~fretwear.hb.reduce.condense`, periodic solves, sweeps, wear runs, recovery), as
@@ -592,13 +626,28 @@ def modal_condenser(model: Model, f_max: float, max_order: int, *, modes: int | 
     if modes is not None:
         modes = whole(modes, "modes", low=0)  # 0: the static modes and load responses alone
     f_max = number(f_max, "f_max", low=0.0, open_low=True, unit="Hz")
+    compress = _compress_bound(compress)
     if dense_storage_gib(model, max_order) > DENSE_STORAGE_GIB:
         # the blocked condenser keeps every mode below the cutoff (or ``modes``) and adds no
         # residual vectors: their m extra solves are what it cannot afford at this size
         return BlockedModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff,
-                                     tol=tol)
-    return ModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff, tol=tol,
-                          raise_modes=raise_modes, residual=residual)
+                                     tol=tol, compress=compress)
+    out = ModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff, tol=tol,
+                         raise_modes=raise_modes, residual=residual,
+                         representation="auto" if compress is None else "compressed")
+    out.compress = compress
+    return out
+
+
+def _compress_bound(compress) -> float | None:
+    """``compress`` checked: None or a relative error in (0, 1)."""
+    if compress is None:
+        return None
+    if (isinstance(compress, bool) or not isinstance(compress, int | float)
+            or not 0 < compress < 1):
+        raise InputError(f"compress = {compress!r}: expected None or a relative error in "
+                         "(0, 1)")
+    return float(compress)
 
 
 #: above this estimated storage [GiB] :func:`modal_condenser` builds the blocked condenser
@@ -669,8 +718,9 @@ class BlockedModalCondenser(ModalCondenser):
     representation = "operator"  # it holds no Psi to form dense blocks from
 
     def __init__(self, model: Model, f_max: float, max_order: int, *, modes: int | None = None,
-                 cutoff: float = CUTOFF, tol: float = TOL):
+                 cutoff: float = CUTOFF, tol: float = TOL, compress: float | None = None):
         self._check_args(f_max, modes)
+        self._set_compress(model, compress)
         Condenser.__init__(self, _structure(model), dense=False)
         if not self.ni:
             raise InputError("the model has no interior DOFs: nothing to represent by modes")

@@ -17,6 +17,9 @@ frequency, sweep point and the active sub-blocks; each harmonic adds ``U_n = Z^c
 per stored matrix (all harmonics' columns at once) and ``U_n (Y_n x)``: the same
 ``O(m^2)`` per column as a dense block, with ``2 m^2`` numbers stored instead of
 ``(H + 1) m^2``. A dense block is formed only where a caller asks for one (:meth:`block`).
+With ``products`` (a compressed form of each ``X^cc``, e.g. the hierarchical low-rank
+:class:`~fretwear.hb.hmatrix.HMatrix`) the products take those instead of the stored
+matrices: below ``O(m^2)`` per column, within the compression's error bound.
 The solver's products on the real Fourier basis are in :mod:`fretwear.hb.operator_blocks`.
 """
 
@@ -83,6 +86,9 @@ class ReducedOperator:
         (q, m), or None for a block without a modal term (harmonic 0).
     symmetric : whether every ``X^cc`` is symmetric and ``U_n Y_n`` is (symmetric ``K, M, C,
         D``): then ``Z_r(n)^T = Z_r(n)``.
+    products : None, or per stored matrix a compressed form taken by :meth:`matmat` (``@``,
+        ``.T``, ``sub(rows, cols)``, ``tol``: :class:`~fretwear.hb.hmatrix.HMatrix`); the
+        blocks formed (:meth:`block`, :meth:`node_diagonal`) stay those of ``mats``.
 
     It has the array interface the solvers use: ``shape``, ``dtype``, ``ndim``, ``nbytes``,
     ``len``; an integer index forms that block (dense, (m, m)), a slice gives the operator of
@@ -91,8 +97,9 @@ class ReducedOperator:
 
     ndim = 3
 
-    def __init__(self, mats, coef, U, Y, symmetric: bool = True):
+    def __init__(self, mats, coef, U, Y, symmetric: bool = True, products=None):
         self.mats = list(mats)
+        self.products = None if products is None else list(products)
         self.coef = np.asarray(coef)
         self.U, self.Y = list(U), list(Y)
         self.nb = self.coef.shape[0]
@@ -116,8 +123,9 @@ class ReducedOperator:
 
     @property
     def nbytes(self) -> int:
-        """Bytes held: the shared matrices and the low-rank factors."""
-        return int(sum(a.nbytes for a in self.mats)
+        """Bytes held: the shared matrices, their compressed forms and the low-rank
+        factors."""
+        return int(sum(a.nbytes for a in self.mats + (self.products or []))
                    + sum(u.nbytes + y.nbytes for u, y in zip(self.U, self.Y, strict=True)
                          if u is not None))
 
@@ -125,6 +133,8 @@ class ReducedOperator:
         """Every array that determines the operator (for a fingerprint: hashing the formed
         blocks would form them all)."""
         out = [*self.mats, np.ascontiguousarray(self.coef)]
+        if self.products is not None:  # the compression's bounds (it is reproducible)
+            out.append(np.array([p.tol for p in self.products]))
         for u, y in zip(self.U, self.Y, strict=True):
             out += [] if u is None else [u, y]
         return out
@@ -137,7 +147,7 @@ class ReducedOperator:
             idx = range(self.nb)[key]
             return ReducedOperator(self.mats, self.coef[list(idx)].reshape(len(idx), -1),
                                    [self.U[b] for b in idx], [self.Y[b] for b in idx],
-                                   self.symmetric)
+                                   self.symmetric, self.products)
         return self.block(int(key))
 
     def __iter__(self):
@@ -188,18 +198,25 @@ class ReducedOperator:
             [np.ascontiguousarray(A[ix]) for A in self.mats], self.coef,
             [None if u is None else np.ascontiguousarray(u[dofs]) for u in self.U],
             [None if y is None else np.ascontiguousarray(y[:, dofs]) for y in self.Y],
-            self.symmetric)
+            self.symmetric, self.cut(dofs, dofs))
+
+    def cut(self, rows: np.ndarray, cols: np.ndarray):
+        """The compressed forms (``products``) restricted to ``rows`` and ``cols``, or
+        None."""
+        if self.products is None:
+            return None
+        return [p.sub(rows, cols) for p in self.products]
 
     def matmat(self, blocks, X: np.ndarray, transpose: bool = False) -> np.ndarray:
         """``Z_r(n_b) X[:, j]`` for the column ``j`` of ``X`` (m, r) on block ``blocks[j]``
         (r,): each stored matrix is read once for all columns. ``transpose``: with
         ``Z_r(n_b)^T`` (``Z_r(n_b)^H`` of a conjugated ``X`` for a damped structure is the
-        caller's)."""
+        caller's). With ``products``, those are multiplied instead of ``mats``."""
         blocks = np.asarray(blocks, dtype=np.int64)
         cplx = np.iscomplexobj(X) or not self.real
         rows = self.mats[0].shape[1 if transpose else 0]  # a sub-block may be rectangular
         out = np.zeros((rows, X.shape[1]), dtype=complex if cplx else float)
-        for t, A in enumerate(self.mats):
+        for t, A in enumerate(self.mats if self.products is None else self.products):
             c = self.coef[blocks, t]
             if not np.any(c):
                 continue

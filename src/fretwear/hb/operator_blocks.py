@@ -126,11 +126,14 @@ class OperatorBlocks(HarmonicBlocks):
         out = np.zeros((rows.size, self.H, r))
         if not (rows.size and cols.size):
             return out
-        sub = ReducedOperator([np.ascontiguousarray(A[np.ix_(rows, cols)])
-                               for A in self.op.mats], self.op.coef,
+        # only its products are taken: with compressed forms, no dense cut of the matrices
+        cut = self.op.cut(rows, cols)
+        mats = cut if cut is not None else [np.ascontiguousarray(A[np.ix_(rows, cols)])
+                                            for A in self.op.mats]
+        sub = ReducedOperator(mats, self.op.coef,
                               [None if u is None else u[rows] for u in self.op.U],
                               [None if y is None else y[:, cols] for y in self.op.Y],
-                              False)
+                              False, cut)
         if self.real:
             X = U.transpose(0, 2, 1).reshape(cols.size, r * self.H)  # columns (r, H)
             blocks = np.tile(self._layout(), r)

@@ -334,6 +334,9 @@ BATCH_MAX = 32
 BLOCK = 256
 #: bytes of factorisations a :class:`Condenser` keeps for reuse (static LU first).
 LU_BUDGET = 2**29
+#: bytes of interior solutions ``Z_ii^-1 [Z_ic, F_i]`` a :class:`Condenser` may keep (one
+#: frequency, every harmonic) for :meth:`Condenser.nearby`; above, it keeps none
+INTERIOR_BUDGET = 2**28
 
 
 @dataclass
@@ -392,6 +395,11 @@ class Condenser:
         self._lus: dict = {}
         self._static = None
         self._load_cache: dict = {}
+        # interior solutions of the latest exact condensation per harmonic, and their local
+        # bases (keep_interior, nearby): None when not kept
+        self._interior: dict | None = None
+        self._bases: dict = {}
+        self._last_X = None
         #: the sparse (or dense) solvers that factorised ``Z_ii`` so far (``"cholmod"``,
         #: ``"superlu"``, ``"lapack"``: :mod:`fretwear.hb.sparse_lu`)
         self.lu_backends: set[str] = set()
@@ -485,12 +493,16 @@ class Condenser:
         rows = np.array([i for _, i in self.obs_i], dtype=np.int64)
         Xo = np.zeros((rows.size, self.m), dtype=S.dtype)
         S = S.copy()
+        keep = self._interior is not None and not (n == 0 or quasi_static)
+        self._last_X = np.empty((self.ni, self.m), dtype=complex) if keep else None
         for j0 in range(0, self.m, BLOCK):  # blocked multi-RHS solves
             cols = slice(j0, min(j0 + BLOCK, self.m))
             B = Zic[:, cols]
             X = lu.solve(B if isinstance(B, np.ndarray) else B.toarray())  # Z_ii^-1 Z_ic
             S[:, cols] -= Zci @ X
             Xo[:, cols] = X[rows]
+            if keep:
+                self._last_X[:, cols] = X
         return self.R @ S @ self.R.T, lu, Zci, Xo
 
     def loads(self, F, lu, Zci):
@@ -533,7 +545,127 @@ class Condenser:
             Fr[b], xf = self.loads(F_all[n], lu, Zci)
             for j, i in self.obs_i:
                 ob[b, j] = xf[i]
+            if self._last_X is not None and key[0] != "static":
+                refs = self._interior.setdefault(int(n), [])
+                refs[:] = [r for r in refs if r[0] != float(omega)][-1:]  # the two latest
+                refs.append((float(omega), self._last_X, xf, F_all[n][self.idofs]))
+                self._last_X = None
         return self._result(omega, orders, Zr, Fr, oA, ob, quasi_static, frequency)
+
+    # -- nearby frequencies from the interior solutions (fretwear.hb.local_basis) -----------
+    def keep_interior(self) -> bool:
+        """Keep, from now on, the interior solutions of the latest exact condensation of
+        each harmonic for :meth:`nearby`; False (and nothing kept) where that is not
+        available: the batched path of tiny models, subclasses with their own reduction (the
+        modal condenser), or more than :data:`INTERIOR_BUDGET` bytes."""
+        return type(self).reduced is Condenser.reduced and self._keep()
+
+    def _keep(self) -> bool:
+        """:meth:`keep_interior` without asking whether ``reduced`` is this class's."""
+        batched = self.dense and self.ni <= BATCH_MAX
+        if batched or not self.ni or 16.0 * self.ni * (self.m + 1) * 8 > INTERIOR_BUDGET:
+            return False  # (at most 8 harmonics within the budget)
+        if self._interior is None:
+            self._interior = {}
+        return True
+
+    def nearby(self, omega: float, orders, tol: float, frequency: float | None = None
+               ) -> Reduced | None:
+        """The :class:`Reduced` model on ``orders`` at ``omega`` [rad/s] from the interior
+        solutions of the latest exact condensation of each harmonic
+        (:func:`fretwear.hb.local_basis.local_basis`: exact at its frequency, off by the
+        square of the interior response's change away from it; always the latest, so that a
+        difference quotient in frequency never spans two bases), or None where its error
+        estimate at ``omega`` exceeds ``tol`` (relative, in ``Z_r`` or ``F_r``, of any
+        harmonic), or a harmonic has fewer than two exact condensations kept. The estimate
+        (the result's attribute ``estimate``) is the error's leading term at the distance
+        from the basis's frequency, scaled by the two latest bases' disagreement one spacing
+        beyond the later one (:meth:`_disagreement`). Harmonic 0 is the exact static
+        condensation. No factorisation and no interior solve
+        (:meth:`keep_interior`)."""
+        orders = np.asarray(orders, dtype=np.int64)
+        dyn = [int(n) for n in orders if n > 0]
+        if self._interior is None or any(len(self._interior.get(n, ())) < 2 for n in dyn):
+            return None
+        F_all = self.load_harmonics(int(orders.max()))
+        estimate = 0.0
+        for n in dyn:  # the estimate first: no block formed for a model it refuses
+            dis, h = self._disagreement(n, F_all[n])
+            # from the latest basis: one until the next exact condensation (a difference
+            # quotient in frequency never spans two)
+            d = abs(omega - self._interior[n][-1][0])
+            estimate = max(estimate, dis * max(d / h, d * d / (3 * h * h)))
+            if not estimate <= tol:
+                return None
+        m, no, nb = self.m, self.structure.obs.size, orders.size
+        Zr = np.zeros((nb, m, m), dtype=complex)
+        Fr = np.zeros((nb, m), dtype=complex)
+        oA = np.zeros((nb, no, m), dtype=complex)
+        ob = np.zeros((nb, no), dtype=complex)
+        for b, n in enumerate(orders):
+            if n == 0:
+                Zr_0, lu, Zci, Xo = self.schur(0.0, 0)
+                Zr[b], oA[b] = Zr_0, self._obs_rows(Xo)
+                Fr[b], xf = self.loads(F_all[0], lu, Zci)
+                for j, i in self.obs_i:
+                    ob[b, j] = xf[i]
+                continue
+            near = self._near(omega, int(n), self._interior[int(n)][-1], F_all[n])
+            if near is None:
+                return None
+            Zr[b], Fr[b], (A, x) = near
+            oA[b] = self._obs_rows(A)
+            for (j, _), v in zip(self.obs_i, x, strict=True):
+                ob[b, j] = v
+        out = self._result(omega, orders, Zr, Fr, oA, ob, False, frequency)
+        out.estimate = estimate
+        return out
+
+    def _disagreement(self, n: int, Fn) -> tuple[float, float]:
+        """``(D, h)``: the relative disagreement ``D`` (the larger of ``Z_r``'s and ``F_r``'s)
+        of harmonic ``n``'s two latest local bases (at ``a``, ``b``; ``h = |b - a|`` [rad/s])
+        one spacing beyond the later one, at ``2 b - a`` (D infinite when a basis is unusable
+        there). An error ``E (w - a)^2`` of each basis (the stationary Galerkin projection)
+        makes ``D = 3 |E| h^2``; one linear in the distance, ``E |w - a|`` (the load of a
+        damped sector's complex Hermitian blocks, whose adjoint differs from ``X`` by the loss
+        factor), ``D = |E| h``: the estimate at a distance ``d`` from the nearer basis is the
+        larger, ``D max(d / h, d^2 / (3 h^2))`` (:meth:`nearby`)."""
+        (a, *_), (b, *_) = refs = self._interior[n]
+        key = ("disagreement", n, a, b)
+        out = self._bases.get(key)
+        if out is None:
+            both = [self._near(2 * b - a, n, r, Fn) for r in refs]
+            if any(x is None for x in both):
+                out = (math.inf, abs(b - a))
+            else:
+                (Z1, F1, _), (Z2, F2, _) = both
+                out = (max(_rel(Z1, Z2), _rel(F1, F2)), abs(b - a))
+            self._bases[key] = out
+        return out
+
+    def _near(self, omega: float, n: int, ref, Fn):
+        """``(Z_r, F_r, (Xo, xo))`` of harmonic ``n`` at ``omega`` from the local basis of the
+        reference ``ref`` (its frequency, interior solutions and load); None when the loads
+        changed since or its projected interior matrix is singular there."""
+        from fretwear.hb.local_basis import local_basis
+
+        w_a, X, xf, Fi = ref
+        if not np.array_equal(Fi, Fn[self.idofs]):
+            return None
+        basis = self._bases.get((n, w_a))
+        if basis is None:
+            kept = {(n2, r[0]) for n2, rs in self._interior.items() for r in rs}
+            self._bases = {k: v for k, v in self._bases.items()  # those of kept references
+                           if k in kept or (k[0] == "disagreement" and k[1:3] in kept)}
+            basis = self._bases[(n, w_a)] = local_basis(self, w_a, n, X, xf, Fi)
+        try:
+            Zcq, Y, yF = basis.blocks(omega)
+        except np.linalg.LinAlgError:
+            return None
+        S = self._z("cc", omega, n, False) - Zcq @ Y
+        R = self.R
+        return (R @ S @ R.T, R @ (Fn[self.cdofs] - Zcq @ yF),
+                (basis.Wo @ Y, basis.Wo @ yF))
 
     def check_size(self, orders) -> None:
         """Refuse (one InputError with the estimate and the machine's memory) a condensation
@@ -672,6 +804,13 @@ class Condenser:
                 out[b, self.idofs] = _solve(lu, rhs)
         P = self.structure.P
         return out if P is None else (P @ out.T).T
+
+
+def _rel(a, b) -> float:
+    """``|a - b| / |b|`` (Frobenius; 0 for two zero arrays)."""
+    nb = np.linalg.norm(b)
+    d = np.linalg.norm(a - b)
+    return float(d / nb) if nb > 0 else (0.0 if d == 0 else math.inf)
 
 
 def _solve(lu, B):

@@ -148,14 +148,15 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
     band = (f_min, f_max) if opts.eps_band is None else opts.eps_band
     eps = sweep_penalty(opts.eps, model, [0, *basis.harmonics], *band, spacing=opts.spacing,
                         condenser=condenser)
-    probs = Problems(model, basis, gap, eps, condenser, opts.solve.jacobian)
+    probs = Problems(model, basis, gap, eps, condenser, opts.solve.jacobian,
+                     exact_at=2 * np.pi * grid, solve=opts.solve)
     warnings = []
     if anchor is None:
         preload = preload_anchor(model, condenser=condenser)
         anchor = preload.values
         if not preload.success:
             warnings.append(preload.warning)
-    branch = Branch(model, anchor, opts.flag)
+    branch = Branch(model, anchor, opts.flag, probs)
     shape = (model.contact.n_nodes, model.contact.dim, basis.size)
     key = _checkpoint_key(probs, grid, opts, anchor)
     first = 0

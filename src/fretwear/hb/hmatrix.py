@@ -1,0 +1,433 @@
+"""A hierarchical low-rank (H-matrix) compression of a real ``m x m`` matrix given with the
+positions of the contact nodes its rows and columns belong to: products ``A X`` and
+``A^T X`` below ``m^2`` operations (docs/theory.md, "Compressed interface operator").
+
+The condensed contact stiffness ``K^cc`` and mass ``M^cc`` of an elastic body couple every
+pair of contact nodes, but smoothly away from the diagonal: the block of two groups of nodes
+that are far apart against their size has a low numerical rank. The compression is the
+textbook one (Hackbusch, *Hierarchical Matrices*, 2015, ch. 5-6; Bebendorf 2008):
+
+1. A cluster tree of the nodes by geometric bisection: a cluster of more than ``leaf``
+   nodes is split at the median of its bounding box's longest side; a node's ``d`` DOFs
+   stay together (rows ``d p .. d p + d - 1`` of node ``p``).
+2. A block tree of pairs of clusters ``(s, t)`` from ``(root, root)``: a pair is
+   *admissible* when ``max(diam s, diam t) <= eta dist(s, t)`` (bounding boxes), and its
+   block is stored as ``U V^T`` of the lowest rank within the block's share of the error
+   budget; a pair that is not admissible is split into its children's pairs until one of
+   them is a leaf, where the block is stored dense.
+3. The rank of an admissible block ``B`` (``b_r x b_c``): a randomised range finder
+   (Halko, Martinsson and Tropp 2011, alg. 4.2, blocks of :data:`SAMPLES` columns) gives
+   an orthonormal ``Q`` with ``||B - Q Q^T B||_F`` computed exactly (not estimated) below
+   the block's budget, then the SVD of ``Q^T B`` truncates to the fewest singular values
+   that keep ``||B - U V^T||_F^2 = ||B - Q Q^T B||_F^2 + sum_{i > k} s_i^2`` within it (the
+   two parts are orthogonal). A block whose factors would not be smaller than the block is
+   stored dense.
+
+**Error bound.** Block ``b`` of ``|b|`` entries gets the budget
+``e_b = tol ||A||_F sqrt(|b| / m^2)``; the blocks partition ``A``, so
+``||A - A_H||_F^2 = sum_b ||B_b - U_b V_b^T||_F^2 <= tol^2 ||A||_F^2``: the relative
+Frobenius error of the whole matrix is at most ``tol``. The achieved error is kept
+(:attr:`HMatrix.error`, relative, exact up to rounding) and is what callers quote. For a
+symmetric ``A`` only the blocks on and above the diagonal are compressed; the mirrored
+block is the transpose, sharing the arrays (an asymmetry of rounding's size is added to the
+stated error: then a bound, by the triangle inequality).
+
+A product ``A X`` (``X`` of ``r`` columns) costs ``sum_b k_b (b_r + b_c) r`` for the
+low-rank blocks plus the dense leaves: ``O(m log m)`` per column for a fixed rank, against
+``m^2`` dense.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from fretwear.errors import InputError
+
+#: nodes in a leaf cluster
+LEAF = 32
+#: admissibility ``max(diam s, diam t) <= ETA dist(s, t)``
+ETA = 2.0
+#: columns of the random sample per step of the range finder
+SAMPLES = 16
+
+
+@dataclass
+class Cluster:
+    """Nodes ``order[start:stop]`` of the cluster tree, with their bounding box and
+    children (none for a leaf)."""
+
+    start: int
+    stop: int
+    lo: np.ndarray
+    hi: np.ndarray
+    children: tuple = ()
+
+    @property
+    def diam(self) -> float:
+        return float(np.linalg.norm(self.hi - self.lo))
+
+
+def cluster_tree(coords: np.ndarray, leaf: int = LEAF) -> tuple[np.ndarray, Cluster]:
+    """``(order, root)``: the nodes (rows of ``coords``, (n, dim)) reordered so that every
+    cluster is a contiguous range, and the tree (module docstring, step 1)."""
+    coords = np.asarray(coords, dtype=float)
+    order = np.arange(coords.shape[0])
+
+    def build(start, stop):
+        pts = coords[order[start:stop]]
+        lo, hi = pts.min(axis=0), pts.max(axis=0)
+        c = Cluster(start, stop, lo, hi)
+        if stop - start <= leaf or not np.any(hi > lo):
+            return c
+        axis = int(np.argmax(hi - lo))
+        idx = np.argsort(pts[:, axis], kind="stable")
+        order[start:stop] = order[start:stop][idx]
+        mid = start + (stop - start) // 2
+        c.children = (build(start, mid), build(mid, stop))
+        return c
+
+    return order, build(0, coords.shape[0])
+
+
+def _distance(s: Cluster, t: Cluster) -> float:
+    gap = np.maximum(0.0, np.maximum(s.lo - t.hi, t.lo - s.hi))
+    return float(np.linalg.norm(gap))
+
+
+def block_tree(root: Cluster, eta: float = ETA) -> list[tuple[Cluster, Cluster, bool]]:
+    """The leaves ``(s, t, admissible)`` of the block tree of ``(root, root)`` (module
+    docstring, step 2): a partition of the matrix."""
+    out = []
+
+    def visit(s, t):
+        if max(s.diam, t.diam) <= eta * _distance(s, t):
+            out.append((s, t, True))
+        elif not s.children or not t.children:
+            out.append((s, t, False))
+        else:
+            for a in s.children:
+                for b in t.children:
+                    visit(a, b)
+
+    visit(root, root)
+    return out
+
+
+def low_rank(B: np.ndarray, budget: float, rng: np.random.Generator):
+    """``(U, V, err)`` with ``||B - U V^T||_F = err <= budget`` of the lowest rank the
+    range finder's basis allows (module docstring, step 3), or None when the factors would
+    hold as many numbers as ``B``."""
+    br, bc = B.shape
+    top = br * bc // (br + bc)  # the rank at which the factors are as large as B
+    Q = np.zeros((br, 0))
+    R = B
+    while True:
+        if Q.shape[1] >= top:
+            return None
+        G = rng.standard_normal((bc, min(SAMPLES, top - Q.shape[1])))
+        Y = R @ G  # the part of B's range not yet in Q
+        Y -= Q @ (Q.T @ Y)
+        Qn, _ = np.linalg.qr(Y)
+        Qn -= Q @ (Q.T @ Qn)  # re-orthogonalise (one more pass)
+        Qn, _ = np.linalg.qr(Qn)
+        Q = np.hstack([Q, Qn])
+        C = Q.T @ B
+        R = B - Q @ C
+        rest = float(np.linalg.norm(R))
+        if rest <= budget:
+            break
+    W, s, Vt = np.linalg.svd(C, full_matrices=False)
+    tail = np.sqrt(np.cumsum((s**2)[::-1])[::-1])  # tail[k] = ||s[k:]||
+    tail = np.append(tail, 0.0)
+    err = np.sqrt(rest**2 + tail**2)
+    k = int(np.argmax(err <= budget))
+    if k >= top:
+        return None
+    return (np.ascontiguousarray((Q @ W[:, :k]) * s[:k]), np.ascontiguousarray(Vt[:k].T),
+            float(err[k]))
+
+
+@dataclass
+class Block:
+    """Rows ``r0:r1`` and columns ``c0:c1`` of the reordered matrix: ``D`` dense, or
+    ``U V^T`` (``D`` None). ``of``: for the mirror of a block of a symmetric matrix, that
+    block (the arrays are shared: the mirror is its transpose)."""
+
+    r0: int
+    r1: int
+    c0: int
+    c1: int
+    D: np.ndarray | None = None
+    U: np.ndarray | None = None
+    V: np.ndarray | None = None
+    of: Block | None = None
+
+    def mirror(self) -> Block:
+        """The transpose of this block, sharing its arrays."""
+        if self.D is not None:
+            return Block(self.c0, self.c1, self.r0, self.r1, D=self.D.T, of=self)
+        return Block(self.c0, self.c1, self.r0, self.r1, U=self.V, V=self.U, of=self)
+
+    @property
+    def rank(self) -> int:
+        return -1 if self.D is not None else self.U.shape[1]
+
+
+class HMatrix:
+    """A compressed real matrix (module docstring): ``A @ X``, ``A.T @ X`` for ``X`` (n,)
+    or (n, r), real or complex; :meth:`sub` restricts it to rows and columns.
+
+    The blocks are stored in stacks that make a product a few BLAS calls per cluster, not
+    one per block (:class:`_Plan`): the dense blocks of a block row side by side, the low-rank
+    factors of every block on a cluster side by side (one stack per cluster when the matrix
+    is symmetric: the ``U`` of block ``(s, t)`` is the ``V`` of its mirror ``(t, s)``).
+
+    Attributes
+    ----------
+    rows, cols : the original row (column) of each row (column) of the reordered matrix.
+    blocks : the :class:`Block` partition of the reordered matrix (views into the stacks).
+    error : achieved ``||A - A_H||_F / ||A||_F`` (exact up to rounding).
+    tol : the bound it was compressed to.
+    """
+
+    ndim = 2
+    dtype = np.dtype(float)
+
+    def __init__(self, rows, cols, blocks, error: float = 0.0, tol: float = 0.0):
+        self.rows, self.cols = np.asarray(rows), np.asarray(cols)
+        self.blocks = list(blocks)
+        self.error, self.tol = float(error), float(tol)
+        self._plan = _Plan(self.blocks)
+        self._transposed = False
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return (self.cols.size, self.rows.size) if self._transposed else (self.rows.size,
+                                                                           self.cols.size)
+
+    @property
+    def nbytes(self) -> int:
+        """Bytes held (the stacks and the orderings)."""
+        return self._plan.nbytes + self.rows.nbytes + self.cols.nbytes
+
+    @property
+    def T(self) -> HMatrix:
+        out = object.__new__(HMatrix)
+        out.__dict__.update(self.__dict__)
+        out._transposed = not self._transposed
+        return out
+
+    def ranks(self) -> np.ndarray:
+        """Rank of every low-rank block."""
+        return np.array([b.rank for b in self.blocks if b.D is None], dtype=np.int64)
+
+    def __matmul__(self, X):
+        X = np.asarray(X)
+        if np.iscomplexobj(X):
+            return self @ X.real + 1j * (self @ X.imag)
+        one = X.ndim == 1
+        rows, cols = (self.cols, self.rows) if self._transposed else (self.rows, self.cols)
+        Xp = np.ascontiguousarray(X[cols].reshape(cols.size, -1), dtype=float)
+        Yp = self._plan.apply(Xp, rows.size, self._transposed)
+        Y = np.empty_like(Yp)
+        Y[rows] = Yp
+        return Y[:, 0] if one else Y
+
+    def toarray(self) -> np.ndarray:
+        """The matrix ``A_H`` formed (for checks)."""
+        Ap = np.zeros((self.rows.size, self.cols.size))
+        for b in self.blocks:
+            Ap[b.r0 : b.r1, b.c0 : b.c1] = b.D if b.D is not None else b.U @ b.V.T
+        out = np.empty_like(Ap)
+        out[np.ix_(self.rows, self.cols)] = Ap
+        return out.T if self._transposed else out
+
+    def sub(self, rows: np.ndarray, cols: np.ndarray | None = None) -> HMatrix:
+        """The matrix restricted to the rows ``rows`` and columns ``cols`` (None: ``rows``),
+        in that order; the same blocks, cut (its error is at most this one's in absolute
+        terms)."""
+        if self._transposed:
+            return self.T.sub(rows if cols is None else cols, rows).T
+        rows = np.asarray(rows, dtype=np.int64)
+        cols = rows if cols is None else np.asarray(cols, dtype=np.int64)
+        same = np.array_equal(rows, cols)  # then a block and its mirror stay so
+        rp, rsel = _restrict(self.rows, rows)
+        cp, csel = _restrict(self.cols, cols)
+        cut = {}  # a factor shared by a block and its mirror is cut once
+
+        def take(a, idx, key):
+            k = (id(a), *key)
+            if k not in cut:
+                cut[k] = np.ascontiguousarray(a[idx])
+            return cut[k]
+
+        out, new = [], {}
+        order = sorted(self.blocks, key=lambda b: b.of is not None)  # originals first
+        for b in order:
+            i0, i1 = np.searchsorted(rp, [b.r0, b.r1])
+            j0, j1 = np.searchsorted(cp, [b.c0, b.c1])
+            if i0 == i1 or j0 == j1:
+                continue
+            ri, ci = rp[i0:i1] - b.r0, cp[j0:j1] - b.c0
+            if same and b.of is not None and id(b.of) in new:
+                nb = new[id(b.of)].mirror()
+            elif b.D is not None:
+                nb = Block(i0, i1, j0, j1, D=np.ascontiguousarray(b.D[np.ix_(ri, ci)]))
+            else:
+                tr, tc = ("", "") if same else ("r", "c")
+                nb = Block(i0, i1, j0, j1, U=take(b.U, ri, (tr, b.r0, i0, i1)),
+                           V=take(b.V, ci, (tc, b.c0, j0, j1)))
+            new[id(b)] = nb
+            out.append(nb)
+        return HMatrix(rsel, csel, out, self.error, self.tol)
+
+
+class _Plan:
+    """The stacks of an :class:`HMatrix`'s blocks and their products. Far field: each
+    low-rank block ``b`` owns coefficient rows ``o_b .. o_b + k_b`` of ``C``; per column
+    range the ``V`` stack gives ``C[idx] = V_s^T x_s``, per row range the ``U`` stack adds
+    ``U_s C[idx]`` (the transpose swaps the two). Near field: per row range the dense blocks
+    side by side times the gathered ``x``, those whose mirror is a block below the diagonal
+    last, applied transposed too (a symmetric near field is stored once). The blocks' arrays
+    are replaced by views into the stacks (nothing is held twice)."""
+
+    def __init__(self, blocks: list[Block]):
+        views = {}  # id of a block's array -> its view in a stack
+
+        near = {}  # row range -> its dense blocks, the mirrors' originals last
+        for b in blocks:
+            if b.D is not None and b.of is None:
+                near.setdefault((b.r0, b.r1), []).append(b)
+        mirrored = {id(b.of) for b in blocks if b.D is not None and b.of is not None}
+        self.near = []
+        for (r0, r1), group in near.items():
+            group.sort(key=lambda b: id(b) in mirrored)
+            D = np.hstack([b.D for b in group])
+            gidx = np.concatenate([np.arange(b.c0, b.c1) for b in group])
+            o, j0 = 0, D.shape[1]
+            for b in group:
+                w = b.c1 - b.c0
+                if id(b) in mirrored:
+                    j0 = min(j0, o)
+                b.D = D[:, o : o + w]
+                o += w
+            # columns j0: of D also act transposed (the mirrors below the diagonal)
+            self.near.append((r0, r1, D, gidx, j0))
+        for b in blocks:
+            if b.D is not None and b.of is not None:
+                b.D = b.of.D.T
+
+        far = [b for b in blocks if b.D is None and b.U.shape[1]]
+        off = np.cumsum([0] + [b.U.shape[1] for b in far])
+        self.k = int(off[-1])
+        rowg, colg = {}, {}
+        for b, o in zip(far, off[:-1], strict=True):
+            idx = np.arange(o, o + b.U.shape[1])
+            rowg.setdefault((b.r0, b.r1), []).append((b.U, idx))
+            colg.setdefault((b.c0, b.c1), []).append((b.V, idx))
+        stacks = {}
+
+        def stack(entries):
+            entries = sorted(entries, key=lambda e: id(e[0]))
+            key = tuple(id(a) for a, _ in entries)
+            if key not in stacks:  # the same factors in the same order: one stack
+                W = np.hstack([a for a, _ in entries])
+                o = 0
+                for a, _ in entries:
+                    views[id(a)] = W[:, o : o + a.shape[1]]
+                    o += a.shape[1]
+                stacks[key] = W
+            return stacks[key], np.concatenate([i for _, i in entries])
+
+        self.rows = [(r0, r1, *stack(e)) for (r0, r1), e in rowg.items()]
+        self.cols = [(c0, c1, *stack(e)) for (c0, c1), e in colg.items()]
+        self.nbytes = int(sum(W.nbytes for W in stacks.values())
+                          + sum(D.nbytes + g.nbytes for _, _, D, g, _ in self.near)
+                          + sum(i.nbytes for *_, i in self.rows + self.cols))
+        for b in far:
+            b.U, b.V = views[id(b.U)], views[id(b.V)]
+
+    def apply(self, Xp: np.ndarray, nout: int, transposed: bool) -> np.ndarray:
+        """``A_p Xp`` (or ``A_p^T Xp``) on the reordered rows and columns."""
+        r = Xp.shape[1]
+        Y = np.zeros((nout, r))
+        if self.k:
+            src, dst = (self.rows, self.cols) if transposed else (self.cols, self.rows)
+            C = np.empty((self.k, r))
+            for a0, a1, W, idx in src:
+                C[idx] = W.T @ Xp[a0:a1]
+            for a0, a1, W, idx in dst:
+                Y[a0:a1] += W @ C[idx]
+        for r0, r1, D, gidx, j0 in self.near:
+            if transposed:
+                Y[gidx] += D.T @ Xp[r0:r1]
+                if j0 < D.shape[1]:
+                    Y[r0:r1] += D[:, j0:] @ Xp[gidx[j0:]]
+            else:
+                Y[r0:r1] += D @ Xp[gidx]
+                if j0 < D.shape[1]:
+                    Y[gidx[j0:]] += D[:, j0:].T @ Xp[r0:r1]
+        return Y
+
+
+def _restrict(perm: np.ndarray, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For the original indices ``idx``: their positions in the reordering ``perm``,
+    sorted, and the position in ``idx`` of each of them (the sub-matrix's reordering)."""
+    inv = np.empty_like(perm)
+    inv[perm] = np.arange(perm.size)
+    pos = inv[idx]
+    o = np.argsort(pos, kind="stable")
+    return pos[o], o
+
+
+def compress(A: np.ndarray, coords: np.ndarray, tol: float, *, symmetric: bool | None = None,
+             leaf: int = LEAF, eta: float = ETA, seed: int = 0) -> HMatrix:
+    """The :class:`HMatrix` of ``A`` (m, m), real, with ``||A - A_H||_F <= tol ||A||_F``
+    (module docstring). ``coords`` (n, dim): the position of each node, whose ``d = m / n``
+    DOFs are rows ``d p .. d p + d - 1``; ``symmetric``: compress the upper blocks only, the
+    lower ones their transposes (None: when ``||A - A^T||_F / sqrt 2 <= tol ||A||_F / 100``;
+    that asymmetry is then taken from the budget and counted in the stated error);
+    ``seed``: the range finder's random samples (the result is reproducible)."""
+    A = np.asarray(A)
+    coords = np.asarray(coords, dtype=float)
+    if A.ndim != 2 or A.shape[0] != A.shape[1] or np.iscomplexobj(A):
+        raise InputError(f"A of shape {A.shape}: expected a real square matrix")
+    if coords.ndim != 2 or coords.shape[0] == 0 or A.shape[0] % coords.shape[0]:
+        raise InputError(f"coords of shape {coords.shape}: expected (n, dim) node positions, "
+                         f"n dividing the {A.shape[0]} rows of A")
+    if not np.all(np.isfinite(coords)) or not np.any(np.ptp(coords, axis=0) > 0):
+        raise InputError("coords: expected finite, distinct node positions (the compression "
+                         "groups nodes by position)")
+    if not (isinstance(tol, int | float) and 0 < tol < 1):
+        raise InputError(f"tol = {tol!r}: expected a relative error in (0, 1)")
+    m, n = A.shape[0], coords.shape[0]
+    d = m // n
+    norm = float(np.linalg.norm(A))
+    # stored symmetric, the blocks below the diagonal are the upper ones transposed: their
+    # asymmetry (the lower triangle of A - A^T) adds to the error
+    asym = float(np.linalg.norm(A - A.T)) / np.sqrt(2.0)
+    if symmetric is None:
+        symmetric = asym <= 0.01 * tol * norm
+    asym = asym if symmetric else 0.0
+    order, root = cluster_tree(coords, leaf)
+    perm = (order[:, None] * d + np.arange(d)).reshape(-1)
+    scale2 = (max(tol * norm - asym, 0.0)) ** 2 / (m * m)
+    rng = np.random.default_rng(seed)
+    blocks, err2 = [], 0.0
+    for s, t, adm in block_tree(root, eta):
+        if symmetric and s.start > t.start:
+            continue  # the mirror of a block above the diagonal
+        r0, r1, c0, c1 = d * s.start, d * s.stop, d * t.start, d * t.stop
+        B = A[np.ix_(perm[r0:r1], perm[c0:c1])]
+        lr = low_rank(B, np.sqrt(scale2 * B.size), rng) if adm else None
+        if lr is None:
+            blk = Block(r0, r1, c0, c1, D=np.ascontiguousarray(B))
+        else:
+            blk = Block(r0, r1, c0, c1, U=lr[0], V=lr[1])
+            err2 += lr[2] ** 2 * (2 if symmetric and s.start != t.start else 1)
+        blocks.append(blk)
+        if symmetric and s.start != t.start:
+            blocks.append(blk.mirror())
+    return HMatrix(perm, perm, blocks, (np.sqrt(err2) + asym) / norm if norm else 0.0, tol)

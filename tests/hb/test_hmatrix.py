@@ -1,0 +1,160 @@
+"""fretwear.hb.hmatrix: the hierarchical low-rank compression against the dense matrix it
+compresses (its error bound ``||A - A_H||_F <= tol ||A||_F``), and the compressed products of
+the modal operator (hb/modal_operator.py, hb/operator_blocks.py) against its dense
+products."""
+
+import numpy as np
+import pytest
+from helpers.operator_models import rel
+
+from fretwear.errors import InputError
+from fretwear.hb.hmatrix import compress
+
+
+def _kernel(n, d, seed=0, a=0.05):
+    """``1 / (r + a)`` between ``n`` random points of a flat box (a contact face), each
+    point's ``d`` DOFs coupled by a fixed symmetric positive definite ``d x d`` matrix:
+    smooth away from the diagonal, symmetric."""
+    rng = np.random.default_rng(seed)
+    P = rng.random((n, 3)) * [1.0, 1.0, 0.05]
+    K = 1.0 / (np.linalg.norm(P[:, None] - P[None], axis=2) + a)
+    S = np.eye(d) + 0.3 * np.ones((d, d))
+    return np.kron(K, S), P
+
+
+@pytest.mark.parametrize("tol", [1e-3, 1e-7])
+def test_kernel_compression_within_its_bound(tol):
+    """A smooth kernel on 400 random points (one DOF each) against its compressed form:
+    the formed ``A_H`` is within ``tol ||A||_F`` (the bound, independent of how it is met)
+    and its error is the one the compression states (exactly computed per block, so to a
+    relative 1e-6: rounding of the sums); the products ``A_H X`` and ``A_H^T X`` differ
+    from ``A X`` by at most ``||A - A_H||_2 ||X||_F <= tol ||A||_F ||X||_F``. The form must
+    be smaller than ``A`` and hold low-rank blocks (else the test would check a dense
+    copy)."""
+    A, P = _kernel(400, 1)
+    H = compress(A, P, tol, leaf=16)
+    err = np.linalg.norm(A - H.toarray()) / np.linalg.norm(A)
+    assert err <= tol
+    assert abs(err - H.error) <= 1e-6 * tol
+    assert H.nbytes < 0.7 * A.nbytes and H.ranks().size and H.ranks().max() > 0
+    X = np.random.default_rng(1).standard_normal((400, 5))
+    bound = tol * np.linalg.norm(A) * np.linalg.norm(X)
+    assert np.linalg.norm(H @ X - A @ X) <= bound
+    assert np.linalg.norm(H.T @ X - A.T @ X) <= bound
+    x = X[:, 0] + 1j * X[:, 1]  # a complex vector: real and imaginary parts apart
+    assert np.linalg.norm(H @ x - A @ x) <= tol * np.linalg.norm(A) * np.linalg.norm(x)
+
+
+def test_restriction_to_rows_and_columns():
+    """``sub(rows)`` and ``sub(rows, cols)`` of a compressed 3-DOF kernel against the same
+    rows and columns of ``A``: within the whole matrix's absolute bound ``tol ||A||_F``
+    (a restriction of the error is no larger), in the order asked (unsorted indices); a
+    non-symmetric matrix (its transpose's products) as well."""
+    A, P = _kernel(150, 3, seed=2)
+    tol = 1e-5
+    H = compress(A, P, tol, leaf=8)
+    assert H.ranks().size and H.error > 0  # low-rank blocks to cut
+    rng = np.random.default_rng(3)
+    rows = rng.permutation(A.shape[0])[:200]
+    cols = rng.permutation(A.shape[0])[:120]
+    for S, want in ((H.sub(rows), A[np.ix_(rows, rows)]),
+                    (H.sub(rows, cols), A[np.ix_(rows, cols)])):
+        assert np.linalg.norm(S.toarray() - want) <= tol * np.linalg.norm(A)
+        x = rng.standard_normal(S.shape[1])
+        assert np.linalg.norm(S @ x - want @ x) <= tol * np.linalg.norm(A) * np.linalg.norm(x)
+    B = A + 0.1 * np.triu(A, 3)  # not symmetric: every block compressed on its own
+    HB = compress(B, P, tol, leaf=8)
+    x = rng.standard_normal(B.shape[0])
+    assert np.linalg.norm(HB.T @ x - B.T @ x) <= tol * np.linalg.norm(B) * np.linalg.norm(x)
+
+
+def test_operator_products_compressed_equal_dense_within_bound():
+    """The solver's products on the real Fourier basis (``OperatorBlocks.apply``,
+    ``apply_T``, the active sub-operator's ``apply`` and ``apply_sub``) of a
+    ``ReducedOperator`` whose two shared matrices are compressed, against the same
+    operator without: per harmonic ``Z_n = c_K K + c_M M - U_n Y_n`` differs by
+    ``c_K dK + c_M dM``, so each column of the result by at most
+    ``(|c_K| e_K ||K||_F + |c_M| e_M ||M||_F) |x|`` (``e`` the compressions' stated errors,
+    checked above)."""
+    from fretwear.hb.modal_operator import ReducedOperator
+    from fretwear.hb.operator_blocks import OperatorBlocks
+
+    K, P = _kernel(200, 3, seed=4)
+    M, _ = _kernel(200, 3, seed=4, a=0.2)
+    m, q, k = K.shape[0], 4, 3
+    rng = np.random.default_rng(5)
+    w2 = np.arange(k + 1) ** 2 * 0.5
+    coef = np.column_stack([np.ones(k + 1), -w2])
+    U = [None] + [rng.standard_normal((m, q)) for _ in range(k)]
+    Y = [None] + [u.T.copy() for u in U[1:]]  # U_n Y_n symmetric
+    prods = [compress(A, P, 1e-5, leaf=8) for A in (K, M)]
+    assert all(p.ranks().size and p.error > 0 for p in prods)  # low-rank blocks in both
+    dense = OperatorBlocks(ReducedOperator([K, M], coef, U, Y))
+    comp = OperatorBlocks(ReducedOperator([K, M], coef, U, Y, products=prods))
+    scale = max(abs(c[0]) * prods[0].error * np.linalg.norm(K)
+                + abs(c[1]) * prods[1].error * np.linalg.norm(M) for c in coef)
+    X = rng.standard_normal((m, 2 * k + 1))
+    bound = scale * np.linalg.norm(X)
+    assert np.linalg.norm(comp.apply(X) - dense.apply(X)) <= bound
+    assert np.linalg.norm(comp.apply_T(X) - dense.apply_T(X)) <= bound
+    dofs = np.sort(rng.permutation(m)[:400])
+    Xs = X[dofs]
+    assert (np.linalg.norm(comp.sub(dofs).apply(Xs) - dense.sub(dofs).apply(Xs))
+            <= scale * np.linalg.norm(Xs))
+    cols = np.setdiff1d(np.arange(m), dofs)
+    Xc = rng.standard_normal((cols.size, 2 * k + 1, 2))
+    assert (np.linalg.norm(comp.apply_sub(dofs, cols, Xc) - dense.apply_sub(dofs, cols, Xc))
+            <= scale * np.linalg.norm(Xc))
+    assert rel(comp.apply(X), dense.apply(X)) > 0  # the compressed products were taken
+
+
+def test_bad_input_is_refused():
+    """One InputError naming the argument for each bad input."""
+    A, P = _kernel(20, 1)
+    with pytest.raises(InputError, match="tol"):
+        compress(A, P, 0.0)
+    with pytest.raises(InputError, match="coords"):
+        compress(A, np.zeros((20, 3)), 1e-3)
+    with pytest.raises(InputError, match="coords"):
+        compress(A, P[:7], 1e-3)
+    with pytest.raises(InputError, match="A of shape"):
+        compress(A[:, :5], P, 1e-3)
+
+
+def test_condenser_compress_option():
+    """``compress=`` of the modal condensers: the operator of every frequency carries the
+    compressed ``X^cc`` (made once: the same objects at two frequencies), each within its
+    bound, and its products are the dense operator's within that bound (column ``j`` on
+    harmonic ``b``: ``sum_t |c_t(b)| e_t ||X_t||_F |x_j|``, plus rounding); a bad value is
+    refused."""
+    from helpers.operator_models import F_MAX, ORDERS, block
+
+    from fretwear.hb.modal import (
+        COMPRESS_TOL,
+        BlockedModalCondenser,
+        ModalCondenser,
+        modal_condenser,
+    )
+
+    model = block()
+    bc = BlockedModalCondenser(model, F_MAX, 7, tol=1e-2, compress=1e-6)
+    Z1, Z2 = (bc.reduced(2 * np.pi * f, ORDERS).Z for f in (12e3, 13e3))
+    assert Z1.products is not None and all(a is b for a, b in zip(Z1.products, Z2.products,
+                                                                  strict=True))
+    assert all(p.error <= 1e-6 for p in Z1.products)
+    X = np.random.default_rng(0).standard_normal((Z1.m, ORDERS.size))
+    blocks = np.arange(ORDERS.size)
+    got = Z1.matmat(blocks, X)
+    bound = sum(np.abs(Z1.coef[:, t]) * p.error * np.linalg.norm(A)
+                for t, (p, A) in enumerate(zip(Z1.products, Z1.mats, strict=True)))
+    Z1.products = None
+    diff = np.linalg.norm(got - Z1.matmat(blocks, X), axis=0)
+    assert np.all(diff <= bound * np.linalg.norm(X, axis=0) + 1e-13 * np.abs(got).max())
+    mc = ModalCondenser(model, F_MAX, 7, tol=1e-2, representation="compressed")
+    assert mc.compress == COMPRESS_TOL and mc.reduced(2 * np.pi * 12e3, ORDERS).Z.products
+    with pytest.raises(InputError, match="compress"):
+        modal_condenser(model, F_MAX, 7, compress=2.0)
+    with pytest.raises(InputError, match="compress"):
+        BlockedModalCondenser(model, F_MAX, 7, compress="1e-6")
+    with pytest.raises(InputError, match="representation"):
+        ModalCondenser(model, F_MAX, 7, representation="hmatrix")
