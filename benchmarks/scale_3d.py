@@ -117,7 +117,9 @@ def estimate_gib(n: int, damped: bool = False) -> dict:
     arrays: ten real m x m (the projected stiffness and mass in both frames, a harmonic's
     condensation, the kept harmonic 0, the active sub-blocks and the preconditioner's
     factors; calibrated on the 2.2 GiB measured at 1024 nodes) and 0.4 GiB of Python, NumPy,
-    SciPy and numba.
+    SciPy and numba. An upper bound since that condenser returns ``Z_r`` as an operator above
+    3000 real unknowns (fretwear.hb.modal.OPERATOR_MIN_UNKNOWNS: 2 m x m instead of H + 1;
+    1024 nodes, partial slip: 1.90 GiB peak against 2.37 GiB with the dense blocks).
 
     Where it builds the blocked one (fretwear.hb.modal, 4096 nodes; not yet
     measured at that size): the shared ``K^cc, M^cc`` (two real m x m; four complex-sized

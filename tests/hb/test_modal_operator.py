@@ -49,3 +49,31 @@ def test_formed_rows_columns_and_node_diagonal_equal_the_sum_written_out():
             diag = np.stack([full[p * d:(p + 1) * d, p * d:(p + 1) * d]
                              for p in range(m // d)])
             assert np.abs(op.node_diagonal(b, d) - diag).max() < 1e-13 * 10
+
+
+def test_auto_representation_takes_the_operator_above_the_operator_jacobians_size(
+        monkeypatch):
+    """``representation="auto"`` returns the dense blocks up to OPERATOR_MIN_UNKNOWNS real
+    unknowns ``m H`` and the operator above, the bound being the periodic solve's
+    DENSE_JACOBIAN_MAX (the size above which it takes the operator Jacobian). On the small
+    block (m = 75, H = 15: 1125 unknowns) with the bound moved just below and just at
+    1125; the operator's blocks equal the dense ones to rounding (1e-12 relative: the same
+    condensation, summed in another order)."""
+    from helpers.operator_models import rel
+
+    from fretwear.hb import modal
+    from fretwear.hb.modal import ModalCondenser
+    from fretwear.hb.modal_operator import ReducedOperator
+    from fretwear.hb.problem import DENSE_JACOBIAN_MAX
+
+    assert modal.OPERATOR_MIN_UNKNOWNS == DENSE_JACOBIAN_MAX
+    mc = ModalCondenser(block(), F_MAX, 7, tol=1e-2)
+    w = 2 * np.pi * 12e3
+    assert mc.m * 15 == 1125
+    monkeypatch.setattr(modal, "OPERATOR_MIN_UNKNOWNS", 1125)
+    dense = mc.reduced(w, ORDERS).Z
+    assert isinstance(dense, np.ndarray)
+    monkeypatch.setattr(modal, "OPERATOR_MIN_UNKNOWNS", 1124)
+    op = mc.reduced(w, ORDERS).Z
+    assert isinstance(op, ReducedOperator)
+    assert max(rel(op[b], dense[b]) for b in range(ORDERS.size)) < 1e-12

@@ -71,14 +71,19 @@ MIN_RAISE = 8
 #: exact condensation is the better choice)
 MAX_MODES = 512
 #: how :meth:`ModalCondenser.reduced` returns ``Z_r`` (the class's ``representation``).
-#: ``"auto"`` keeps the dense blocks for now: on the partial-slip pad of
-#: benchmarks/scale_3d.py at 1024 contact nodes the operator's solve leaves its first attempt
-#: where the dense blocks' converges. Not a defect of the operator (at one iterate the two
-#: agree as closely as the dense path with itself after a 1e-15 change of the iterate, and
-#: from a start changed by 1e-15 the roles swap): the path of that solve depends on rounding
-#: (docs/studies/large-interface-solve.md); the default waits for a solve whose convergence
-#: does not depend on that path
+#: ``"auto"`` takes the operator where the periodic solve takes the operator Jacobian (more
+#: than :data:`OPERATOR_MIN_UNKNOWNS` real unknowns ``m H``: the dense Jacobian forms every
+#: block anyway below), the dense blocks otherwise. On the partial-slip pad of
+#: benchmarks/scale_3d.py at 1024 contact nodes the path of Powell's solve once depended on
+#: rounding (a 1e-15 change of the start sent either representation into a crawl); with
+#: Powell's watchdog stretches (fretwear.hb.solvers.WATCHDOG_AFTER) both representations
+#: and both starts converge (docs/studies/large-interface-solve.md, "Powell near the law's
+#: kinks")
 REPRESENTATIONS = ("auto", "dense", "operator", "compressed")
+#: real unknowns ``m H`` above which ``"auto"`` takes the operator: where the periodic solve
+#: takes the operator Jacobian (fretwear.hb.problem.DENSE_JACOBIAN_MAX, which this module,
+#: a layer below, does not import; tests/hb/test_modal_operator.py checks that they agree)
+OPERATOR_MIN_UNKNOWNS = 3000
 #: relative error of the compressed ``X^cc`` (``representation="compressed"``): the
 #: partial-slip pad's solution moved by 6e-6 at 256 and 3.6e-5 at 1024 contact nodes with it
 #: (docs/studies/large-interface-solve.md), below the modal check's default TOL
@@ -124,7 +129,8 @@ class ModalCondenser(Condenser):
     representation : how :meth:`reduced` returns ``Z_r``: ``"dense"`` (an (nb, m, m) array),
         ``"operator"`` (a :class:`~fretwear.hb.modal_operator.ReducedOperator`: the
         frequency-independent ``X^cc`` shared by every harmonic plus a rank-``q`` term per
-        harmonic) or ``"auto"`` (the dense blocks for now: :data:`REPRESENTATIONS`). The same
+        harmonic) or ``"auto"`` (the operator above :data:`OPERATOR_MIN_UNKNOWNS` real
+        unknowns ``m H``, the dense blocks below: :data:`REPRESENTATIONS`). The same
         condensation either way (to rounding). ``"compressed"``: the operator, whose shared
         ``X^cc`` are also held compressed (:func:`fretwear.hb.hmatrix.compress`, a
         hierarchical low-rank form of the contact nodes' positions with
@@ -366,7 +372,7 @@ class ModalCondenser(Condenser):
             return
         nb, k = orders.size, int(orders.max())
         m, no, q = self.m, self.structure.obs.size, self.q
-        zr = 0.0 if self.representation == "operator" else 16.0 * m * m
+        zr = 0.0 if self._as_operator(orders) else 16.0 * m * m
         per_order = zr + 16.0 * (q * m + no * m + no + m)
         basis = 8.0 * (2 * k + 2) * (2 * k + 1) * 4
         require_memory(nb * per_order + 16.0 * (k + 1) * self.structure.ndof + basis,
@@ -379,7 +385,7 @@ class ModalCondenser(Condenser):
         from the modal representation (``Z`` an array or an operator: ``representation``)."""
         orders = np.asarray(orders, dtype=np.int64)
         self.check_size(orders)
-        if self.representation == "operator":
+        if self._as_operator(orders):
             return self._reduced_operator(omega, orders, quasi_static, frequency)
         m, no, nb, R = self.m, self.structure.obs.size, orders.size, self.R
         F_all = self.structure.load_harmonics(int(orders.max()) if orders.size else 0)
@@ -413,6 +419,14 @@ class ModalCondenser(Condenser):
         return self._result(omega, orders, Zr, Fr, oA, ob, quasi_static, frequency)
 
     # -- Z_r as an operator (representation "operator"; the blocked condenser's only one) ----
+    def _as_operator(self, orders: np.ndarray) -> bool:
+        """Whether :meth:`reduced` on ``orders`` returns the operator: ``representation``
+        ``"operator"``, or ``"auto"`` above :data:`OPERATOR_MIN_UNKNOWNS` real unknowns
+        (``m`` times one coefficient for order 0, two for every other order)."""
+        if self.representation != "auto":
+            return self.representation == "operator"
+        return self.m * int(np.sum(np.where(orders == 0, 1, 2))) > OPERATOR_MIN_UNKNOWNS
+
     def _op_terms(self, omega, n, quasi_static):
         """``(coef, Z^cq, Z^qc, Z^qq)`` of harmonic ``n``: the coefficients of the stored
         ``X^cc`` (:data:`NAMES` order) and the modal blocks (contact-local frames)."""

@@ -8,7 +8,9 @@ callers never turn it into a result.
 * ``"powell"``: Powell's hybrid dog-leg trust-region method (Powell 1970; the algorithm of
   MINPACK ``hybrj``) with the Newton step from a LAPACK LU of the analytic Jacobian, recomputed
   at every accepted step. MINPACK factorises with its own unblocked QR, which dominates the cost
-  at ~1000 unknowns; this keeps the algorithm at LAPACK speed.
+  at ~1000 unknowns; this keeps the algorithm at LAPACK speed. Where the Newton step keeps
+  crossing the contact law's kinks, watchdog stretches of nonmonotone Newton steps
+  (:data:`WATCHDOG_AFTER`).
 * ``"hybr"``: MINPACK ``hybrj`` itself through :func:`scipy.optimize.root` (what the paper used).
 * ``"newton"``: Newton with a backtracking line search on ``|f|^2``.
 """
@@ -130,9 +132,43 @@ FORCING_GAMMA = 0.9
 #: many Powell iterations), and the full-accuracy re-solves cost ten decades of GMRES
 #: (docs/studies/large-interface-solve.md)
 POOR_STEP_FULL_ACCURACY = False
+#: a nonmonotone stretch (the watchdog of Chamberlain, Powell, Lemarechal and Pedersen 1982)
+#: once Powell has had this many full Newton steps rejected since ``|f|`` last fell by a
+#: decade: a rejected Newton step is then taken anyway and Newton steps follow from it, each
+#: from the Jacobian at its start, for at most :data:`WATCHDOG_STEPS` steps; the stretch ends
+#: when ``|f|`` falls below ``(1 - WATCHDOG_DECREASE)`` times its value before it (the
+#: iterate kept) or, failing that, returns to where it began and continues as if the step
+#: had been rejected. On the DLFT residual of a large interface in partial slip the Newton
+#: step crosses the law's kinks (stick, slip, separation at some sample) near the solution,
+#: ``|f|`` rises at the trial point and the ratio test rejects it; the trust region then
+#: crawls (docs/studies/large-interface-solve.md, "Powell near the law's kinks")
+WATCHDOG_AFTER = 2
+WATCHDOG_STEPS = 2
+WATCHDOG_DECREASE = 1e-4
+#: the value a stretch must get below: the largest ``|f|`` of this many iterates before it
+#: (1: the iterate where it began; more: nonmonotone, as Grippo, Lampariello and Lucidi 1986)
+WATCHDOG_MEMORY = 1
 
 
-def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=None):
+@dataclass
+class _Checkpoint:
+    """Where a watchdog stretch of :func:`powell` began: the iterate, its residual and norm,
+    Jacobian, Newton step, variable scales and the trust radius after the rejection; ``left``
+    the Newton steps the stretch may still take; ``ref`` the ``|f|`` it must get below."""
+
+    x: np.ndarray
+    f: np.ndarray
+    fn: float
+    J: object
+    sn: np.ndarray
+    dscale: np.ndarray
+    delta: float
+    left: int
+    ref: float
+
+
+def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=None,
+           trace=None):
     """Powell's hybrid dog-leg trust region on ``f(x) = 0`` with analytic Jacobian.
 
     As MINPACK ``hybrj``: the variables are scaled by the running maximum of the Jacobian's
@@ -146,9 +182,16 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
     itself, and the converged answer is that of the residual test; after a step that the
     model served poorly, steps to the full accuracy until it serves well again if
     :data:`POOR_STEP_FULL_ACCURACY`).
+    After :data:`WATCHDOG_AFTER` rejected Newton steps without ``|f|`` falling a decade, a
+    rejected Newton step starts a watchdog stretch (:data:`WATCHDOG_STEPS` Newton steps
+    from its point, kept if ``|f|`` ends below its start, else undone).
     ``max_slow``: stop (unconverged) after that many iterations on a new Jacobian
     in a row without one that decreased ``|f|^2`` by :data:`SLOW_DECREASE` (MINPACK's "not
     making good progress" test, ``info = 4`` of ``hybrj`` with 5); None: no such test.
+    ``trace``: a list to which every iteration appends a dict (``|f|``, trust radius,
+    predicted and actual decrease of ``|f|^2``, whether the step was the Newton step, its
+    linear relative residual ``|f + J s| / |f|``, the GMRES iterations of a new Newton step,
+    whether it was accepted), for studies of the convergence.
     Returns ``(x, f, stats)``.
     """
     t0 = time.perf_counter()
@@ -171,6 +214,9 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
     exact = isinstance(J, np.ndarray)  # a formed Jacobian: exact LU steps
     eta = FORCING_MAX  # the forcing term of an inexact step (operator Jacobians)
     tight = False  # after a poor step: Newton steps to the full accuracy
+    watch = None  # the checkpoint of a watchdog stretch (nonmonotone Newton steps)
+    rejected, ref = 0, fn  # rejected Newton steps since |f| fell below ref / 10
+    kept = [fn]  # |f| of the iterates (a stretch's only once it is kept)
     while True:
         target = tol * scale(x)
         if fn <= target:
@@ -186,14 +232,16 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
         if dscale is None:
             dscale = _column_norms(J)
             dscale[dscale == 0] = 1.0
-        if sn is None:  # an iteration on a new Jacobian (or an inexact step redone)
+        new_step = sn is None
+        gm0 = getattr(J, "gmres_iterations", 0)
+        if new_step:  # an iteration on a new Jacobian (or an inexact step redone)
             loose = not (exact or (tight and POOR_STEP_FULL_ACCURACY))
             sn = _lu_step(J, f, max(eta, 0.1 * target / fn) if loose else None)
             slow += 1
         snd = vector_norm(dscale * sn)
         if delta is None:
             delta = snd
-        if snd <= delta:
+        if snd <= delta or watch is not None:  # (a watchdog stretch: Newton steps)
             s = sn
         else:
             g = (J.T @ f) / dscale  # gradient in scaled variables
@@ -212,45 +260,88 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
                 s_s = sc_s + t * dd
             s = s_s / dscale
         pnorm = vector_norm(dscale * s)
-        pred = fn * fn - vector_norm(f + J @ s) ** 2
+        lin = vector_norm(f + J @ s)
+        pred = fn * fn - lin * lin
         xn = x + s
+        fn_old, J_old, delta_old, newton_step = fn, J, delta, s is sn
+        watching = watch is not None
         fnew, _ = fun(xn, False)
         nfev += 1
         fnn = vector_norm(fnew)
         actual = fn * fn - fnn * fnn
         ratio = actual / pred if pred > 0 else -1.0
-        if ratio < 0.1:
-            nsuc = 0
-            delta = 0.5 * min(delta, pnorm)
-            if loose and fnn >= fn and POOR_STEP_FULL_ACCURACY:  # redo it to full accuracy
-                sn, slow = None, slow - 1
-            tight = True  # the model served poorly: full accuracy until it serves well
+        if watch is not None:  # a watchdog stretch: measured against its start
+            done = fnn <= (1.0 - WATCHDOG_DECREASE) * watch.ref
+            if done or (fnn < fn and watch.left > 1):
+                watch.left -= 1
+                eta = FORCING_MAX
+                x, f, fn = xn, fnew, fnn
+                _, J = fun(x, True)
+                njev += 1
+                sn = None
+                dscale = np.maximum(dscale, _column_norms(J))
+                if done:  # the stretch succeeded: the trust region admits its last step
+                    delta, watch, stall, nsuc = max(watch.delta, 2.0 * pnorm), None, 0, 0
+                    kept.append(fn)
+            else:  # back to its start, as after the rejection that began it
+                x, f, fn, J, sn = watch.x, watch.f, watch.fn, watch.J, watch.sn
+                dscale, delta, watch = watch.dscale, watch.delta, None
+                stall += 1
         else:
-            tight = False
-            nsuc += 1
-            if ratio >= 0.5 or nsuc > 1:
-                delta = max(delta, 2.0 * pnorm)
-            if abs(ratio - 1.0) <= 0.1:
-                delta = 2.0 * pnorm
-        if actual >= SLOW_DECREASE * fn * fn:
-            slow = 0
-        if fnn < fn:  # accept any decrease (non-smooth residual: ratios are noisy)
-            floor = FORCING_GAMMA * eta * eta
-            eta = FORCING_GAMMA * (fnn / fn) ** 2
-            eta = min(FORCING_MAX, max(eta, floor) if floor > 0.1 else eta)
-            x, f, fn = xn, fnew, fnn
-            _, J = fun(x, True)
-            njev += 1
-            sn = None
-            dscale = np.maximum(dscale, _column_norms(J))
-            stall = 0
-        else:
-            stall += 1
+            if ratio < 0.1:
+                nsuc = 0
+                delta = 0.5 * min(delta, pnorm)
+                if loose and fnn >= fn and POOR_STEP_FULL_ACCURACY:  # redo it to full accuracy
+                    sn, slow = None, slow - 1
+                tight = True  # the model served poorly: full accuracy until it serves well
+            else:
+                tight = False
+                nsuc += 1
+                if ratio >= 0.5 or nsuc > 1:
+                    delta = max(delta, 2.0 * pnorm)
+                if abs(ratio - 1.0) <= 0.1:
+                    delta = 2.0 * pnorm
+            if actual >= SLOW_DECREASE * fn * fn:
+                slow = 0
+            if fnn < fn:  # accept any decrease (non-smooth residual: ratios are noisy)
+                floor = FORCING_GAMMA * eta * eta
+                eta = FORCING_GAMMA * (fnn / fn) ** 2
+                eta = min(FORCING_MAX, max(eta, floor) if floor > 0.1 else eta)
+                x, f, fn = xn, fnew, fnn
+                _, J = fun(x, True)
+                njev += 1
+                sn = None
+                dscale = np.maximum(dscale, _column_norms(J))
+                stall = 0
+                kept.append(fn)
+            else:
+                stall += 1
+                if newton_step and rejected + 1 >= WATCHDOG_AFTER:  # a watchdog stretch
+                    watch = _Checkpoint(x, f, fn, J, sn, dscale.copy(), delta, WATCHDOG_STEPS,
+                                        max(kept[-WATCHDOG_MEMORY:]))
+                    x, f, fn = xn, fnew, fnn
+                    _, J = fun(x, True)
+                    njev += 1
+                    sn = None
+                    dscale = np.maximum(dscale, _column_norms(J))
+                    eta = FORCING_MAX
+                if newton_step:
+                    rejected += 1
+        if fn <= 0.1 * ref:
+            rejected, ref = 0, fn
+        if trace is not None:
+            trace.append({"it": it, "f": fn_old, "f_trial": fnn, "delta": delta_old,
+                          "pred": pred, "actual": actual, "ratio": ratio,
+                          "newton": newton_step, "lin": lin / fn_old, "new_step": new_step,
+                          "gmres": getattr(J_old, "gmres_iterations", 0) - gm0,
+                          "accepted": fnn < fn_old, "watchdog": watching})
         if callback is not None:
             callback(it, x, fn)
         if delta <= 1e-14 * max(vector_norm(dscale * x), 1e-300) or stall > 40:
             msg = "trust region collapsed: no further decrease of |f| (non-smooth stall)"
             break
+    if not ok and watch is not None and watch.fn < fn:  # stopped within a stretch
+        x, f, fn = watch.x, watch.f, watch.fn
     wall = time.perf_counter() - t0
     st = SolveStats(ok, float(fn / max(scale(x), 1e-300)), it, nfev, njev, wall, msg, "powell")
     return x, f, st

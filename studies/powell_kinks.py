@@ -1,0 +1,115 @@
+"""Powell on the partial-slip pad of benchmarks/scale_3d.py, iteration by iteration (issue 27,
+item 4; docs/studies/large-interface-solve.md, "Powell near the law's kinks").
+
+One periodic solve of ``pad(n, LOADS["slip"])`` (10 modes, H 7, 128 samples) on the operator
+(Krylov) Jacobian, from the contact-closed guess times ``1 + pert``, with the condensed blocks
+dense or as an operator; prints a line per Powell iteration: ``|f|``, trust radius, predicted
+and actual decrease of ``|f|^2`` and their ratio, Newton step or dog-leg, GMRES iterations and
+the step's linear relative residual, accepted or not, and how many contact nodes change their
+regime (stick / slip / separation at some sample) between the iterate and the trial point.
+
+    PYTHONPATH=$PWD/src OPENBLAS_NUM_THREADS=1 python studies/powell_kinks.py 24 dense 1e-15 \
+        [max_iter] [monotone | memory=M]
+
+(``monotone``: without the watchdog stretches of fretwear.hb.solvers.powell, as before them;
+``memory=M``: their reference the largest ``|f|`` of the last M iterates.)
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import resource
+import sys
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..",
+                                "benchmarks"))
+
+
+def main():
+    from scale_3d import LOADS, H, condenser, pad, warm_up
+
+    from fretwear.hb import solvers
+    from fretwear.hb.fourier import FourierBasis
+    from fretwear.hb.options import PERIODIC
+    from fretwear.hb.preload import static_anchor
+    from fretwear.hb.problem import DLFTProblem
+    from fretwear.hb.solvers import powell
+
+    n = int(sys.argv[1])
+    rep = sys.argv[2] if len(sys.argv) > 2 else "dense"
+    pert = float(sys.argv[3]) if len(sys.argv) > 3 else 0.0
+    max_iter = int(sys.argv[4]) if len(sys.argv) > 4 else PERIODIC.max_iter
+    variant = sys.argv[5] if len(sys.argv) > 5 else ""
+    if variant == "monotone":  # without the watchdog stretches
+        solvers.WATCHDOG_AFTER = 10**9
+    elif variant.startswith("memory="):  # the stretches' reference over more iterates
+        solvers.WATCHDOG_MEMORY = int(variant.split("=")[1])
+    load = LOADS["slip"]
+    warm_up(load)
+    model = pad(n, load)
+    basis = FourierBasis.up_to(H, 128)
+    c0 = time.process_time()
+    mc = condenser(model, load)
+    mc.representation = rep
+    red = mc.reduced(2 * np.pi * load.freq, basis.orders, frequency=load.freq)
+    anchor = static_anchor(model, condenser=mc)
+    print(f"n {n} x {n}, {rep}, pert {pert:g}: condensation + preload "
+          f"{time.process_time() - c0:.1f} s CPU, load {os.getloadavg()[0]:.1f}", flush=True)
+    from fretwear.hb.connectors import connect
+    from fretwear.hb.penalty import penalty
+
+    red = connect(red, model.contact)
+    eps = penalty("auto", model=model, reduced=red, condenser=mc)
+    prob = DLFTProblem(red, model.contact, basis, eps=eps, anchor=anchor, jacobian="krylov")
+    law = prob.time_law
+    seen = {}
+
+    def time_law(U):
+        out = law(U)
+        seen["state"] = out[2].copy()
+        return out
+
+    prob.time_law = time_law
+    changed = []
+
+    def fun(x, jac=True):
+        out = prob.residual(x.reshape(prob.m, prob.H), jac)
+        if jac:
+            seen["at_x"] = seen["state"]
+        else:
+            changed.append(int(np.sum(np.any(seen["state"] != seen["at_x"], axis=1))))
+        return out
+
+    x0 = prob.initial_guess().reshape(-1) * (1.0 + pert)
+    trace = []
+    print(" it        |f|     delta   pred/|f|^2 act/|f|^2   ratio  N  gm    lin   acc chg")
+
+    def line(it, x, fn):
+        t, ch = trace[-1], changed[-1]
+        print(f"{t['it']:3d} {t['f']:10.4e} {t['delta']:9.3e} {t['pred'] / t['f'] ** 2:10.3e} "
+              f"{t['actual'] / t['f'] ** 2:10.3e} {t['ratio']:7.3f} "
+              f"{'N' if t['newton'] else 'd'} {t['gmres']:3d} {t['lin']:8.2e} "
+              f"{'+' if t['accepted'] else '-'}{'w' if t['watchdog'] else ' '} {ch:4d}",
+              flush=True)
+
+    c0, w0 = time.process_time(), time.perf_counter()
+    x, f, st = powell(fun, x0, lambda x: prob.scale(x.reshape(prob.m, prob.H)),
+                      tol=PERIODIC.tol, max_iter=max_iter, trace=trace, callback=line)
+    cpu, wall = time.process_time() - c0, time.perf_counter() - w0
+    newton = sum(t["new_step"] for t in trace)
+    gm = sum(t["gmres"] for t in trace)
+    out = {"n": n, "rep": rep, "pert": pert, "watchdog_after": solvers.WATCHDOG_AFTER,
+           "memory": solvers.WATCHDOG_MEMORY,
+           "success": st.success, "residual": st.residual,
+           "powell": st.iterations, "newton": newton, "gmres": gm, "cpu": cpu, "wall": wall,
+           "message": st.message, "load": os.getloadavg()[0],
+           "peak_gib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20}
+    print("RESULT " + json.dumps(out), flush=True)
+
+
+if __name__ == "__main__":
+    main()
