@@ -349,10 +349,14 @@ class MeanGainPreconditioner:
         budget = getattr(Z, "factor_budget", None)
         most = Z.nb if budget is None else max(1, int(budget // (8 * Z.m * Z.m)))
         for b in range(Z.nb):
+            full = last is not None and len({id(f) for f in self.factors}) >= most
+            if full:  # (the block is not formed: m^2 memory and time for nothing)
+                self.factors.append(last[2])
+                self.shared += 1
+                continue
             Zb = Z.Z0 if b == 0 else Z.block(b)
             g = gbar if b == 0 else gosc
-            full = last is not None and len({id(f) for f in self.factors}) >= most
-            if full or (share and last is not None and self._close(g, Zb, last, eps)):
+            if share and last is not None and self._close(g, Zb, last, eps):
                 self.factors.append(last[2])
                 self.shared += 1
                 continue
