@@ -738,11 +738,11 @@ class _ActiveView:
         return self.block(0)
 
     def block(self, b: int) -> np.ndarray:
-        """Block ``b`` on ``dofs`` (formed, (m_a, m_a))."""
-        if b == 0:
-            return self.Z.Z0[np.ix_(self.dofs, self.dofs)]
-        out = self.Z.op.block(b, self.dofs, self.dofs)
-        return out.real if self.real else out
+        """Block ``b`` on ``dofs`` (formed, (m_a, m_a)): the whole block formed (no
+        temporaries), then one gather (the row-then-column selection of
+        ``ReducedOperator.block(b, rows, cols)`` would hold two more m_a x m arrays)."""
+        Zb = self.Z.Z0 if b == 0 else self.Z.block(b)
+        return Zb[np.ix_(self.dofs, self.dofs)]
 
     def apply(self, U) -> np.ndarray:
         """``Z_aa U`` for ``U`` (m_a H,) or (m_a, H) on the real Fourier basis."""
