@@ -109,3 +109,25 @@ def test_representation_is_checked():
 
     with pytest.raises(InputError, match="representation = 'sparse'"):
         ModalCondenser(block(None), F_MAX, 3, tol=1e-2, representation="sparse")
+
+
+def test_projections_taken_while_psi_is_in_hand():
+    """The blocked condenser takes the rows of ``X^cq = X_ci V + Psi^T X_ii V`` from each
+    block of ``Psi`` while it is in hand: against the same products formed independently
+    with SciPy's sparse LU (``Psi`` whole, from ``-K_ii^-1 K_ic``) to 1e-12 (rounding of a
+    projection conditioned ~1e3, as above); ``K^qc`` is zero (``K_ii Psi = -K_ic``) and
+    ``K^cq`` vanishes to rounding of the static condensation's size; its many-column solves'
+    panels are dropped once the projections are made."""
+    import scipy.sparse.linalg as spla
+
+    model = block(Damping(loss_factor=0.02, rayleigh_mass=100.0, rayleigh_stiffness=1e-7))
+    bc = BlockedModalCondenser(model, F_MAX, 7, tol=1e-2)
+    Psi = -spla.splu(bc.K.ii.tocsc()).solve(bc.K.ic.toarray())
+    for nm in ("M", "C", "D"):
+        X = getattr(bc, nm)
+        cq = bc.R @ (X.ci @ bc.V + Psi.T @ (X.ii @ bc.V))
+        assert rel(bc.proj_local[nm][1], cq) < 1e-12, nm
+    cc, cq, qc, _ = bc.proj_local["K"]
+    assert not np.any(qc)
+    assert np.abs(cq).max() < 1e-12 * np.abs(cc).max() * np.sqrt(bc.m)
+    assert getattr(bc._lu0, "_sn", None) is None

@@ -49,6 +49,11 @@ REBUILD_GROWTH = 2.0
 #: the step is solved by a LAPACK LU of the active block up to this many unknowns (slipping
 #: or separating nodes x d x H), by GMRES above (docs/theory.md, "Large interfaces")
 ACTIVE_DENSE_MAX = 3000
+#: from this fraction of the DOFs active (but not all), the active blocks of an operator
+#: (hb/operator_blocks.py) are a view (:class:`_ActiveView`: products through the whole
+#: operator) instead of copies of its m x m matrices (2 x 1.125 GiB at 4096 contact nodes);
+#: a product costs at most (1 / 0.75)^2 = 1.8 times the copy's
+VIEW_FRACTION = 0.75
 
 
 @njit(cache=True)
@@ -349,10 +354,14 @@ class MeanGainPreconditioner:
         budget = getattr(Z, "factor_budget", None)
         most = Z.nb if budget is None else max(1, int(budget // (8 * Z.m * Z.m)))
         for b in range(Z.nb):
+            full = last is not None and len({id(f) for f in self.factors}) >= most
+            if full:  # (the block is not formed: m^2 memory and time for nothing)
+                self.factors.append(last[2])
+                self.shared += 1
+                continue
             Zb = Z.Z0 if b == 0 else Z.block(b)
             g = gbar if b == 0 else gosc
-            full = last is not None and len({id(f) for f in self.factors}) >= most
-            if full or (share and last is not None and self._close(g, Zb, last, eps)):
+            if share and last is not None and self._close(g, Zb, last, eps):
                 self.factors.append(last[2])
                 self.shared += 1
                 continue
@@ -613,8 +622,11 @@ class KrylovJacobian:
         kept = getattr(self.owner, "_active_Z", None)
         if kept is not None and kept[0] is self.Z and np.array_equal(kept[1], dofs):
             return kept[2]
-        Za = self.Z.sub(dofs)
-        self.owner._active_Z = (self.Z, dofs, Za)
+        Z = self.Z
+        view = (getattr(Z, "op", None) is not None
+                and VIEW_FRACTION * Z.m <= dofs.size < Z.m)
+        Za = _ActiveView(Z, dofs) if view else Z.sub(dofs)
+        self.owner._active_Z = (Z, dofs, Za)
         return Za
 
     def _lu_active(self, rhs, act, dofs) -> np.ndarray:
@@ -705,6 +717,38 @@ class KrylovJacobian:
                     break  # the best preconditioner at hand: GMRES's last iterate
                 self.owner._mean_gain = True  # the oscillating gains failed here
         return x
+
+
+class _ActiveView:
+    """The harmonic blocks of an operator ``Z`` (hb/operator_blocks.py) on the DOFs ``dofs``
+    as the GMRES path and :class:`MeanGainPreconditioner` use them (``apply``, ``block``,
+    ``Z0``, the sizes and ``factor_budget``), without copies of ``Z``'s stored matrices: a
+    product scatters into the whole operator's unknowns and gathers the rows ``dofs``; a
+    block is formed on ``dofs`` only when asked for. The same products as ``Z.sub(dofs)``
+    to rounding (a sum over zeros more)."""
+
+    def __init__(self, Z, dofs: np.ndarray):
+        self.Z, self.dofs = Z, np.asarray(dofs)
+        self.m, self.H, self.k, self.nb = self.dofs.size, Z.H, Z.k, Z.nb
+        self.real = Z.real
+        self.factor_budget = getattr(Z, "factor_budget", None)
+
+    @property
+    def Z0(self) -> np.ndarray:
+        return self.block(0)
+
+    def block(self, b: int) -> np.ndarray:
+        """Block ``b`` on ``dofs`` (formed, (m_a, m_a)): the whole block formed (no
+        temporaries), then one gather (the row-then-column selection of
+        ``ReducedOperator.block(b, rows, cols)`` would hold two more m_a x m arrays)."""
+        Zb = self.Z.Z0 if b == 0 else self.Z.block(b)
+        return Zb[np.ix_(self.dofs, self.dofs)]
+
+    def apply(self, U) -> np.ndarray:
+        """``Z_aa U`` for ``U`` (m_a H,) or (m_a, H) on the real Fourier basis."""
+        full = np.zeros((self.Z.m, self.H))
+        full[self.dofs] = np.asarray(U, dtype=float).reshape(self.m, self.H)
+        return self.Z.apply(full).reshape(self.Z.m, self.H)[self.dofs]
 
 
 class _Transposed:

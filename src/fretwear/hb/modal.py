@@ -674,7 +674,15 @@ def dense_storage_gib(model: Model, max_order: int) -> float:
 # only, shared by every harmonic of a ReducedOperator (fretwear.hb.modal_operator), whose
 # products the solver's operator path takes (fretwear.hb.operator_blocks). Memory: len(X^cc)
 # m^2 reals (two undamped) instead of (H + 3) m^2 + 2 n_i m; time: twice the solves of Psi.
-# docs/theory.md, "Large interfaces".
+# The second solve (Psi^T W for X^cc of M, C, D) is kept on purpose: with Psi stored instead,
+# Psi^T W is a dense product of n_i m^2 flops (symmetric half) against 4 nnz(L) m for the
+# solves through the Cholesky factor L of K_ii: 1.2e11 against 4.7e10 at 1024 contact nodes
+# of benchmarks/scale_3d.py's pad (n_i = 12,288, nnz(L) = 3.8e6), 1.5e13 against about 5e12
+# at 4096 (n_i = 98,304, nnz(L) about 1e8), and Psi holds 9 GiB there. The forward half of
+# the solve does not help either (Psi^T W = -Y^T L^-1 P W with Y = L^-1 P K_ic, but Y keeps
+# 15 % of its n_i m entries, more than L's: measured at 1024), nor does a backward solve on
+# the rows K_ci needs only (their ancestors in the elimination tree hold 96 % of L).
+# docs/theory.md, "Large interfaces"; docs/studies/large-interface-solve.md.
 
 #: the matrices of the structure, in the order of the operator's stored ``X^cc``
 NAMES = ("K", "M", "C", "D")
@@ -744,6 +752,9 @@ class BlockedModalCondenser(ModalCondenser):
         rows = np.array([i for _, i in self.obs_i], dtype=np.int64)
         self._psi_rows = self.Psi.rows(rows) if rows.size else np.zeros((0, self.m))
         self._project()
+        # the many-column solves are done: the dense panels they were made on (3.3 GiB at
+        # 4096 contact nodes) are not held through the solves that follow (few columns)
+        getattr(lu, "release", lambda: None)()
         self.error = self._check()
         self._raise_if_inaccurate(f_max, tol)
 
@@ -776,23 +787,34 @@ class BlockedModalCondenser(ModalCondenser):
     # -- construction -------------------------------------------------------------------------
     def _project(self):
         """``proj_local``: the blocks ``(R X^cc R^T, R X^cq, X^qc R^T, X^qq)`` of every matrix
-        of ``K, M, C, D`` present, built ``BLOCK`` columns (whole nodes) at a time."""
+        of ``K, M, C, D`` present, built ``BLOCK`` columns (whole nodes) at a time.
+
+        While a block ``Psi_js`` is in hand its rows of ``X^cq = X_ci V + Psi^T X_ii V`` are
+        taken from it (``Psi_js^T (X_ii V)``, no solve), and ``K^qc = V^T (K_ic + K_ii Psi)
+        = 0`` is not formed (as :class:`ModalCondenser`). The one product that needs the
+        whole ``Psi``, ``Psi^T W`` for ``X^cc`` of ``M, C, D``, is ``-K_ci K_ii^-1 W``: a
+        second solve of the block (the comment above :data:`NAMES` says why it is not a
+        product with a stored ``Psi``)."""
         lu, V, K, R = self._lu0, self.V, self.K, self.R
         names = [nm for nm in NAMES if getattr(self, nm) is not None]
+        others = [nm for nm in names if nm != "K"]
         m, q, d = self.m, self.q, self.structure.frame.shape[1]
         cc = {nm: np.empty((m, m)) for nm in names}
-        qc = {nm: np.empty((q, m)) for nm in names}
+        qc = {nm: np.zeros((q, m)) for nm in names}
+        XiiV = {nm: np.asarray(getattr(self, nm).ii @ V) for nm in names}
+        cq = {nm: np.asarray(getattr(self, nm).ci @ V) for nm in names}
         step = max(d, BLOCK // d * d)
         for j0 in range(0, m, step):
             js = slice(j0, min(j0 + step, m))
             Psi = -lu.solve(K.ic[:, js].toarray())  # (ni, B)
-            W = {}
             for nm in names:
+                cq[nm][js] += Psi.T @ XiiV[nm]
+            W = {}
+            for nm in others:
                 B = getattr(self, nm)
                 W[nm] = np.asarray(B.ic[:, js].toarray() + B.ii @ Psi)  # X_ic + X_ii Psi
                 qc[nm][:, js] = V.T @ W[nm]
             # Psi^T W = -K_ci K_ii^-1 W for every matrix but K (K_ii Psi = -K_ic: W_K = 0)
-            others = [nm for nm in names if nm != "K"]
             PtW = (-(K.ci @ lu.solve(np.column_stack([W[nm] for nm in others])))
                    if others else np.zeros((m, 0)))
             for i, nm in enumerate(others):
@@ -804,11 +826,8 @@ class BlockedModalCondenser(ModalCondenser):
                 cc[nm][:, js] = self._rotate_columns(R @ cc[nm][:, js], js)
         self.proj_local = {}
         for nm in names:
-            B = getattr(self, nm)
-            BiiV = B.ii @ V
-            cq = B.ci @ V + self.Psi.T @ BiiV
-            self.proj_local[nm] = (cc[nm], R @ cq, self._rotate_columns(qc[nm], slice(0, m)),
-                                   V.T @ BiiV)
+            self.proj_local[nm] = (cc[nm], R @ cq[nm],
+                                   self._rotate_columns(qc[nm], slice(0, m)), V.T @ XiiV[nm])
 
     def _psi_at(self, rows: np.ndarray) -> np.ndarray:
         return self._psi_rows  # the observed rows, found once (Psi is never formed)

@@ -192,7 +192,11 @@ class ReducedOperator:
         return out
 
     def sub(self, dofs: np.ndarray) -> ReducedOperator:
-        """The operator restricted to the rows and columns ``dofs``."""
+        """The operator restricted to the rows and columns ``dofs`` (itself, sharing its
+        matrices, when ``dofs`` are all of them in order: every contact node active)."""
+        dofs = np.asarray(dofs)
+        if dofs.size == self.m and np.array_equal(dofs, np.arange(self.m)):
+            return self
         ix = np.ix_(dofs, dofs)
         return ReducedOperator(
             [np.ascontiguousarray(A[ix]) for A in self.mats], self.coef,

@@ -66,6 +66,8 @@ class OperatorBlocks(HarmonicBlocks):
         dofs = np.asarray(dofs)
         if b == 0:  # held formed
             return self.Z0, dofs
+        if dofs.size == self.m and np.array_equal(dofs, np.arange(self.m)):
+            return self.op.block(b), dofs  # every row: no copy of the stored matrices' rows
         key = dofs.tobytes()
         if self._rows is None or self._rows[0] != key:
             op = self.op
