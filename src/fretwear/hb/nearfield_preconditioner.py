@@ -1,0 +1,168 @@
+"""A preconditioner of the active Newton system built from the compressed interface operator
+only: the near field of the hierarchical compression (:mod:`fretwear.hb.hmatrix`) as a
+sparse matrix per harmonic, factorised by a sparse LU, and the modal condensation's rank-``q``
+term added exactly by the Sherman-Morrison-Woodbury identity (docs/theory.md, "Compressed
+interface operator").
+
+The mean-gain preconditioner (:class:`fretwear.hb.krylov.MeanGainPreconditioner`) factors
+``P_n = eps I + g_n (Z_aa(n w) - eps I)`` (``g_n`` block-diagonal per node) by a dense LU:
+``m_a^3 / 3`` operations and ``m_a^2`` numbers per harmonic, which needs the dense ``X^cc``.
+With the compressed forms ``X^cc_H`` of :class:`~fretwear.hb.modal_operator.ReducedOperator`
+(``products``) the block of harmonic ``n`` is
+
+    Z_aa(n) = sum_X c_X(n) (N_X + F_X) - U_n Y_n,
+
+``N_X`` the dense leaf blocks of ``X^cc_H`` (each leaf cluster with its neighbours: every
+node's own ``d x d`` block among them), ``F_X`` its low-rank far field, ``U_n Y_n`` the
+modal term (rank ``q``). Dropping the far field,
+
+    P_n = A_n - W_n Y_n,  A_n = eps I + g_n (sum_X c_X(n) N_X - eps I),  W_n = g_n U_n,
+
+``A_n`` sparse (the near field's pattern), factorised by SuperLU
+(:func:`scipy.sparse.linalg.splu`, COLAMD ordering), and
+
+    P_n^-1 = A_n^-1 + A_n^-1 W_n (I_q - Y_n A_n^-1 W_n)^-1 Y_n A_n^-1
+
+(``q`` solves with ``A_n`` at the build, a ``q x q`` LU). The far field (smooth, long-range
+coupling) is what the preconditioner leaves to GMRES: it is exact where the far field
+vanishes and otherwise moves the iteration count, never the answer (GMRES's residual is that
+of the compressed operator).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+#: which preconditioner the operator path takes when its operator carries compressed forms
+#: (:func:`preconditioner_for`): "nearfield" (this module) or "mean-gain" (the dense LU of
+#: hb/krylov.py)
+COMPRESSED = "nearfield"
+
+
+def near_field(hm) -> sp.csr_matrix:
+    """The dense leaf blocks of an :class:`~fretwear.hb.hmatrix.HMatrix` (its near field)
+    as a sparse matrix in the original row and column order (the low-rank blocks left
+    out)."""
+    rows, cols, vals = [], [], []
+    for b in hm.blocks:
+        if b.D is None:
+            continue
+        r = hm.rows[b.r0 : b.r1]
+        c = hm.cols[b.c0 : b.c1]
+        rows.append(np.repeat(r, c.size))
+        cols.append(np.tile(c, r.size))
+        vals.append(np.asarray(b.D).reshape(-1))
+    n_r, n_c = hm.rows.size, hm.cols.size
+    if not rows:
+        out = sp.csr_matrix((n_r, n_c))
+    else:
+        out = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows),
+                                                    np.concatenate(cols))), shape=(n_r, n_c))
+    return out.T.tocsr() if hm._transposed else out
+
+
+def _node_diag(g: np.ndarray) -> sp.bsr_matrix:
+    """The block-diagonal sparse matrix of the node blocks ``g`` (nc, d, d)."""
+    nc, d, _ = g.shape
+    return sp.bsr_matrix((g, np.arange(nc), np.arange(nc + 1)), shape=(nc * d, nc * d))
+
+
+class _Factors:
+    """``P^-1`` of one harmonic: the sparse LU of ``A`` and the Woodbury correction."""
+
+    def __init__(self, A: sp.spmatrix, W: np.ndarray | None, Y: np.ndarray | None):
+        self.lu = spla.splu(A.tocsc())
+        self.real = not np.iscomplexobj(A)
+        self.X = self.C = self.Y = None
+        if W is not None:
+            self.X = self._solve_A(W)  # A^-1 W (m, q)
+            self.Y = Y
+            self.C = sla.lu_factor(np.eye(Y.shape[0]) - Y @ self.X, check_finite=False)
+
+    def _solve_A(self, b: np.ndarray) -> np.ndarray:
+        if self.real and np.iscomplexobj(b):  # real factors, complex right-hand side
+            return self.lu.solve(np.ascontiguousarray(b.real)) + 1j * self.lu.solve(
+                np.ascontiguousarray(b.imag))
+        return self.lu.solve(np.ascontiguousarray(b, dtype=complex if not self.real
+                                                  else float))
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        y = self._solve_A(b)
+        if self.X is not None:
+            y = y + self.X @ sla.lu_solve(self.C, self.Y @ y, check_finite=False)
+        return y
+
+
+class NearFieldPreconditioner:
+    """``P^-1`` with ``P_n = A_n - W_n Y_n`` per harmonic (module docstring), for an
+    :class:`~fretwear.hb.operator_blocks.OperatorBlocks` whose operator carries compressed
+    forms (``Z.op.products``). The interface of
+    :class:`~fretwear.hb.krylov.MeanGainPreconditioner`: gbar, gosc the gains of harmonic 0
+    and of the harmonics ``n >= 1`` (:func:`fretwear.hb.krylov.harmonic_gains`); ``share``
+    is accepted and ignored (every harmonic has its own factors: a sparse LU costs little
+    against the dense one it replaces).
+
+    Attributes: ``nnz`` the stored entries of the sparse blocks ``A_n`` (all harmonics),
+    ``factor_nnz`` those of their LU factors.
+    """
+
+    def __init__(self, gbar: np.ndarray, Z, eps: float, share: bool = True,
+                 gosc: np.ndarray | None = None):
+        op = Z.op
+        self.k, self.m, self.H = Z.k, Z.m, Z.H
+        self.shared = 0
+        gosc = gbar if gosc is None else gosc
+        near = [near_field(p) for p in op.products]
+        eye = sp.identity(self.m, format="csr")
+        self.factors = []
+        self.nnz = self.factor_nnz = 0
+        for b in range(Z.nb):
+            g = gbar if b == 0 else gosc
+            c = op.coef[b]
+            N = sum((c[t] * near[t] for t in range(len(near)) if c[t] != 0),
+                    sp.csr_matrix((self.m, self.m)))
+            Gs = _node_diag(g)
+            A = (Gs @ (N - eps * eye) + eps * eye).tocsr()
+            if not Z.real and not np.iscomplexobj(A):
+                A = A.astype(complex)
+            W = Y = None
+            if op.U[b] is not None:
+                q = op.U[b].shape[1]
+                nc, d = g.shape[0], g.shape[1]
+                W = np.matmul(g, op.U[b].reshape(nc, d, q)).reshape(self.m, q)
+                Y = op.Y[b]
+                if Z.real:
+                    W, Y = W.real, Y.real
+            f = _Factors(A, W, Y)
+            self.nnz += A.nnz
+            self.factor_nnz += f.lu.L.nnz + f.lu.U.nnz
+            self.factors.append(f)
+
+    def apply(self, r) -> np.ndarray:
+        """``P^-1 r`` on the real Fourier basis (DOF-major ``(m, H)``, as
+        :meth:`fretwear.hb.krylov.MeanGainPreconditioner.apply`)."""
+        r = np.asarray(r).reshape(self.m, self.H)
+        k = self.k
+        out = np.empty_like(r)
+        out[:, 0] = self.factors[0].solve(r[:, 0]).real
+        for b in range(1, k + 1):
+            f = self.factors[b]
+            if f.real:  # real P_n: P_n (a - i b) = P_n a - i P_n b
+                out[:, [b, k + b]] = f.solve(r[:, [b, k + b]])
+                continue
+            y = f.solve(r[:, b] - 1j * r[:, k + b])
+            out[:, b], out[:, k + b] = y.real, -y.imag
+        return out.reshape(-1)
+
+
+def preconditioner_for(Z):
+    """The preconditioner class for the active blocks ``Z``: :class:`NearFieldPreconditioner`
+    when they are an operator with compressed forms and :data:`COMPRESSED` asks for it,
+    else None (the caller's default)."""
+    op = getattr(Z, "op", None)
+    if COMPRESSED == "nearfield" and getattr(op, "products", None) is not None:
+        return NearFieldPreconditioner
+    return None
