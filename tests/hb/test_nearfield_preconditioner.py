@@ -92,12 +92,12 @@ def test_apply_is_the_inverse_of_near_field_plus_modal_term(real):
 def test_newton_step_equals_the_mean_gain_one(monkeypatch):
     """One Newton step of a compressed operator's partial-slip solve (a pad of 8 x 8 contact
     nodes, 3 harmonics, the modal condensation's ``X^cc`` compressed at 1e-4 with leaves of
-    at most 8 nodes, so that a far field exists) solved by GMRES with the near-field preconditioner and with the
-    mean-gain one. Both solve the same system (the compressed operator's) to GMRES's relative
-    residual 1e-10, so ``|s - s_ref| <= kappa 2e-10 |s|`` with ``kappa`` the active system's
-    condition: 1e-7 relative allows ``kappa`` up to 5e2 (measured difference 1e-10 to 1e-9);
-    a wrong preconditioner would not converge to that residual within GMRES's restarts
-    (asserted through the residual itself)."""
+    at most 8 nodes, so that a far field exists) solved by GMRES with the near-field
+    preconditioner and with the mean-gain one. Both solve the same system (the compressed
+    operator's) to GMRES's relative residual 1e-10, so ``|s - s_ref| <= kappa 2e-10 |s|``
+    with ``kappa`` the active system's condition: 1e-7 relative allows ``kappa`` up to 5e2
+    (measured 4e-11); a wrong preconditioner would not bring GMRES to that residual within
+    its restarts (asserted through the residual itself)."""
     from fretwear.hb.fourier import FourierBasis
     from fretwear.hb.modal import ModalCondenser
     from fretwear.hb.preload import static_anchor
