@@ -71,10 +71,12 @@ def _node_diag(g: np.ndarray) -> sp.bsr_matrix:
 
 
 class _Factors:
-    """``P^-1`` of one harmonic: the sparse LU of ``A`` and the Woodbury correction."""
+    """``P^-1`` of one harmonic: the sparse LU of ``A`` and the Woodbury correction; ``A``,
+    ``W``, ``Y`` kept for :meth:`product` (the sharing test)."""
 
     def __init__(self, A: sp.spmatrix, W: np.ndarray | None, Y: np.ndarray | None):
         self.lu = spla.splu(A.tocsc())
+        self.A, self.W = A, W
         self.real = not np.iscomplexobj(A)
         self.X = self.C = self.Y = None
         if W is not None:
@@ -95,15 +97,45 @@ class _Factors:
             y = y + self.X @ sla.lu_solve(self.C, self.Y @ y, check_finite=False)
         return y
 
+    def product(self, v: np.ndarray) -> np.ndarray:
+        """``P v = A v - W (Y v)``."""
+        out = self.A @ v
+        return out if self.W is None else out - self.W @ (self.Y @ v)
+
+    def close(self, other: _Factors) -> bool:
+        """Whether these factors precondition ``other``'s ``P`` well: the size of
+        ``E = P^-1 (P_other - P)`` by the power iteration of
+        :meth:`fretwear.hb.krylov.MeanGainPreconditioner._close` (the same probes and
+        bound)."""
+        from fretwear.hb.krylov import SHARE_BELOW, SHARE_PROBES
+
+        v = np.random.default_rng(0).standard_normal(self.A.shape[0])
+        size = 0.0
+        for _ in range(SHARE_PROBES):
+            w = self.solve(other.product(v) - self.product(v))
+            size = float(np.linalg.norm(w) / np.linalg.norm(v))
+            v = w.real if self.real else w
+            if not np.isfinite(size) or size == 0.0:
+                break
+        return bool(np.isfinite(size) and size <= SHARE_BELOW)
+
+
+class _Probe(_Factors):
+    """``P = A - W Y`` unfactorised, for :meth:`_Factors.close`."""
+
+    def __init__(self, A, W, Y):  # no super().__init__: no factorisation
+        self.A, self.W, self.Y = A, W, Y
+
 
 class NearFieldPreconditioner:
     """``P^-1`` with ``P_n = A_n - W_n Y_n`` per harmonic (module docstring), for an
     :class:`~fretwear.hb.operator_blocks.OperatorBlocks` whose operator carries compressed
     forms (``Z.op.products``). The interface of
     :class:`~fretwear.hb.krylov.MeanGainPreconditioner`: gbar, gosc the gains of harmonic 0
-    and of the harmonics ``n >= 1`` (:func:`fretwear.hb.krylov.harmonic_gains`); ``share``
-    is accepted and ignored (every harmonic has its own factors: a sparse LU costs little
-    against the dense one it replaces).
+    and of the harmonics ``n >= 1`` (:func:`fretwear.hb.krylov.harmonic_gains`); ``share``:
+    a harmonic ``n >= 2`` takes the factors of the harmonic before it when they precondition
+    its ``P_n`` well (the test of the mean-gain preconditioner: below the first resonances
+    the ``Z_n`` hardly differ).
 
     Attributes: ``nnz`` the stored entries of the sparse blocks ``A_n`` (all harmonics),
     ``factor_nnz`` those of their LU factors.
@@ -136,6 +168,12 @@ class NearFieldPreconditioner:
                 Y = op.Y[b]
                 if Z.real:
                     W, Y = W.real, Y.real
+            last = self.factors[-1] if self.factors else None
+            if share and b > 1 and last.real == (not np.iscomplexobj(A)) and last.close(
+                    _Probe(A, W, Y)):
+                self.factors.append(last)  # harmonic b preconditioned by the last factors
+                self.shared += 1
+                continue
             f = _Factors(A, W, Y)
             self.nnz += A.nnz
             self.factor_nnz += f.lu.L.nnz + f.lu.U.nnz
