@@ -69,10 +69,36 @@ def near_field(hm) -> sp.csr_matrix:
     return out.T.tocsr() if hm._transposed else out
 
 
-def _node_diag(g: np.ndarray) -> sp.bsr_matrix:
-    """The block-diagonal sparse matrix of the node blocks ``g`` (nc, d, d)."""
-    nc, d, _ = g.shape
-    return sp.bsr_matrix((g, np.arange(nc), np.arange(nc + 1)), shape=(nc * d, nc * d))
+class _NodeBlocks:
+    """The near fields of several compressed matrices on one pattern of ``d x d`` node
+    blocks (the union of theirs): ``data`` (len(mats), nblocks, d, d), the block row of each
+    block and the position of each node's diagonal block, so that a combination
+    ``sum_t c_t N_t`` and the products with the node gains are array operations on
+    ``data``."""
+
+    def __init__(self, products, d: int):
+        bsr = [near_field(p).tobsr(blocksize=(d, d)) for p in products]
+        nr = bsr[0].shape[0] // d
+        keys = []
+        for a in bsr:
+            a.sort_indices()
+            rows = np.repeat(np.arange(nr), np.diff(a.indptr))
+            keys.append(rows * nr + a.indices)
+        union = np.unique(np.concatenate(keys))
+        self.data = np.zeros((len(bsr), union.size, d, d))
+        for t, (a, key) in enumerate(zip(bsr, keys, strict=True)):
+            self.data[t, np.searchsorted(union, key)] = a.data
+        self.brow, self.indices = union // nr, union % nr
+        self.indptr = np.searchsorted(self.brow, np.arange(nr + 1))
+        self.diag = np.searchsorted(union, np.arange(nr) * nr + np.arange(nr))
+        self.shape = (nr * d, nr * d)
+
+    def block(self, c: np.ndarray, g: np.ndarray, eps: float) -> sp.csc_matrix:
+        """``eps I + g (sum_t c_t N_t - eps I)`` (``g`` (nr, d, d) the node gains)."""
+        N = np.tensordot(np.asarray(c), self.data, axes=(0, 0))
+        A = np.matmul(g[self.brow], N)
+        A[self.diag] += eps * (np.eye(g.shape[1]) - g)
+        return sp.bsr_matrix((A, self.indices, self.indptr), shape=self.shape).tocsc()
 
 
 class _Factors:
@@ -152,17 +178,12 @@ class NearFieldPreconditioner:
         self.k, self.m, self.H = Z.k, Z.m, Z.H
         self.shared = 0
         gosc = gbar if gosc is None else gosc
-        near = [near_field(p) for p in op.products]
-        eye = sp.identity(self.m, format="csr")
+        near = _NodeBlocks(op.products, gbar.shape[1])
         self.factors = []
         self.nnz = self.factor_nnz = 0
         for b in range(Z.nb):
             g = gbar if b == 0 else gosc
-            c = op.coef[b]
-            N = sum((c[t] * near[t] for t in range(len(near)) if c[t] != 0),
-                    sp.csr_matrix((self.m, self.m)))
-            Gs = _node_diag(g)
-            A = (Gs @ (N - eps * eye) + eps * eye).tocsr()
+            A = near.block(op.coef[b], g, eps)
             if not Z.real and not np.iscomplexobj(A):
                 A = A.astype(complex)
             W = Y = None
