@@ -45,7 +45,7 @@ def test_near_field_is_the_dense_leaf_blocks():
 
 
 @pytest.mark.parametrize("real", [True, False], ids=["real", "damped"])
-def test_apply_is_the_inverse_of_near_field_plus_modal_term(real):
+def test_apply_is_the_inverse_of_near_field_plus_modal_term(real, monkeypatch):
     """``apply`` against the LAPACK solve with the formed ``P_n = eps I + g_n (sum_X c_X N_X
     - U_n Y_n - eps I)`` per harmonic on the real Fourier basis (harmonic ``n``: ``P_n (a - i
     b)``), on the active rows of a compressed two-matrix operator with a rank-4 modal term:
@@ -65,6 +65,8 @@ def test_apply_is_the_inverse_of_near_field_plus_modal_term(real):
     act = np.sort(rng.permutation(200)[:150])
     dofs = (act[:, None] * 3 + np.arange(3)).reshape(-1)
     Za = Z.sub(dofs)
+    assert preconditioner_for(Za) is None  # the default: the mean gain
+    monkeypatch.setattr("fretwear.hb.nearfield_preconditioner.COMPRESSED", "nearfield")
     assert preconditioner_for(Za) is NearFieldPreconditioner
     assert preconditioner_for(OperatorBlocks(ReducedOperator([K, M], coef, U, Y))) is None
     na, ma, eps = act.size, dofs.size, 2.0

@@ -37,9 +37,11 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 #: which preconditioner the operator path takes when its operator carries compressed forms
-#: (:func:`preconditioner_for`): "nearfield" (this module) or "mean-gain" (the dense LU of
-#: hb/krylov.py)
-COMPRESSED = "nearfield"
+#: (:func:`preconditioner_for`): "mean-gain" (the dense LU of hb/krylov.py, the default:
+#: faster up to 1024 contact nodes, docs/studies/large-interface-solve.md) or "nearfield"
+#: (this module: no dense ``m_a x m_a`` factors, for the interfaces whose dense factors do
+#: not fit)
+COMPRESSED = "mean-gain"
 #: SuperLU's column ordering: the near field's pattern is symmetric (a leaf with its
 #: neighbours both ways), for which the minimum degree on ``A^T + A`` left 15 % less fill
 #: than COLAMD and factored 20 % faster at 576 contact nodes
