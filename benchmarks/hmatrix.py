@@ -130,8 +130,61 @@ def growth(rows: list[dict]) -> None:
                  if "bytes_ratio" in ra else ""))
 
 
-def solves(n: int, tols, dense: bool = True, reference: str = "operator") -> None:
-    """The periodic solve with dense and compressed products (module docstring)."""
+class PrecondClock:
+    """CPU seconds and counts of the preconditioners' builds and applies inside a ``with``
+    block (benchmark only: wraps both classes' ``__init__`` and ``apply``)."""
+
+    def __enter__(self):
+        from fretwear.hb import krylov, nearfield_preconditioner
+
+        self.classes = (krylov.MeanGainPreconditioner,
+                        nearfield_preconditioner.NearFieldPreconditioner)
+        self.saved = [(c, c.__init__, c.apply) for c in self.classes]
+        self.build = self.apply = 0.0
+        self.builds = self.applies = 0
+        self.nnz = []
+        clock = self
+
+        for cls, init, apply in self.saved:
+            def new_init(pc, *a, _init=init, **k):
+                t = time.process_time()
+                _init(pc, *a, **k)
+                clock.build += time.process_time() - t
+                clock.builds += 1
+                if hasattr(pc, "factor_nnz"):
+                    clock.nnz.append((pc.m, pc.nnz, pc.factor_nnz))
+
+            def new_apply(pc, r, _apply=apply):
+                t = time.process_time()
+                out = _apply(pc, r)
+                clock.apply += time.process_time() - t
+                clock.applies += 1
+                return out
+
+            cls.__init__, cls.apply = new_init, new_apply
+        return self
+
+    def __exit__(self, *exc):
+        for cls, init, apply in self.saved:
+            cls.__init__, cls.apply = init, apply
+
+    def __str__(self):
+        out = (f"preconditioner: {self.builds} builds {self.build:.2f} s CPU, "
+               f"{self.applies} applies {self.apply:.2f} s CPU"
+               f" ({1e3 * self.apply / max(self.applies, 1):.1f} ms each)")
+        if self.nnz:
+            m, nnz, fnnz = max(self.nnz)
+            out += (f"; largest near field m_a={m}: {nnz} entries ({nnz / m**2 / 8:.3f} of "
+                    f"8 dense blocks), LU factors {fnnz}")
+        return out
+
+
+def solves(n: int, tols, dense: bool = True, reference: str = "operator",
+           preconds=("nearfield",)) -> None:
+    """The periodic solve with dense and compressed products (module docstring); the
+    compressed ones with each preconditioner of ``preconds`` ("nearfield": from the
+    compressed forms, hb/nearfield_preconditioner.py; "mean-gain": the dense LU)."""
+    from fretwear.hb import nearfield_preconditioner
     from fretwear.hb.fourier import FourierBasis
     from fretwear.hb.periodic import solve_periodic
     from fretwear.hb.preload import static_anchor
@@ -141,13 +194,16 @@ def solves(n: int, tols, dense: bool = True, reference: str = "operator") -> Non
     basis = FourierBasis.up_to(H, 128)
     warm_up(load)  # the compiled kernels loaded, untimed
     ref = None
-    for tol in ([None, *tols, None] if dense and n * n <= 256 else
-                [None, *tols] if dense else tols):
+    runs = ([None, *tols, None] if dense and n * n <= 256 else
+            [None, *tols] if dense else list(tols))
+    runs = [(t, p) for t in runs for p in ((None,) if t is None else preconds)]
+    for tol, pname in runs:
+        nearfield_preconditioner.COMPRESSED = pname or "nearfield"
         before = os.getloadavg()[0]
         with Clock() as cc:
             mc = _condenser(model, load, tol, reference)
             red = mc.reduced(2 * np.pi * load.freq, basis.orders, frequency=load.freq)
-        with Counts() as counts, Clock() as c:
+        with Counts() as counts, Clock() as c, PrecondClock() as pcc:
             anchor = static_anchor(model, condenser=mc)
             sol = solve_periodic(model, basis, frequency=load.freq, options=options(load),
                                  reduced=red, anchor=anchor, condenser=mc)
@@ -158,14 +214,14 @@ def solves(n: int, tols, dense: bool = True, reference: str = "operator") -> Non
                 else float(np.linalg.norm(U - ref) / np.linalg.norm(ref)))
         err = ("" if tol is None else
                "compression errors " + ", ".join(f"{p.error:.1e}" for p in red.Z.products))
-        name = f"dense ({reference})" if tol is None else f"compress={tol:g}"
+        name = f"dense ({reference})" if tol is None else f"compress={tol:g} {pname}"
         print(f"{n * n} nodes, {name}: attempts "
               + "; ".join(f"{a.method} ({a.iterations})" for a in sol.attempts) + ": "
               f"condensation{'+compression' if tol else ''} {cc}, solve {c}, success "
               f"{sol.success}, Powell {sol.stats.iterations}, Newton {counts.steps}, GMRES "
               f"{sum(counts.gmres)}, eps {sol.eps:.4g}, |U - U_dense| / |U_dense| = "
               f"{diff:.2e}; {err}; load {before:.1f}-{os.getloadavg()[0]:.1f}, peak "
-              f"{peak_gib():.2f} GiB", flush=True)
+              f"{peak_gib():.2f} GiB; {pcc}", flush=True)
 
 
 def main():
@@ -178,11 +234,14 @@ def main():
                     help="--solve: the uncompressed run's representation")
     ap.add_argument("--no-dense", action="store_true",
                     help="--solve: the compressed solves only (no difference printed)")
+    ap.add_argument("--precond", default="nearfield,mean-gain",
+                    help="--solve: the compressed solves' preconditioners, in turn")
     args = ap.parse_args()
     tols = [float(t) for t in args.tols.split(",")]
     print(f"load {os.getloadavg()[0]:.1f}", flush=True)
     if args.solve:
-        solves(args.solve, tols, not args.no_dense, args.reference)
+        solves(args.solve, tols, not args.no_dense, args.reference,
+               args.precond.split(","))
         return
     rows = []
     for n in (int(s) for s in args.sizes.split(",")):

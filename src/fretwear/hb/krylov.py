@@ -651,7 +651,10 @@ class KrylovJacobian:
                 or not np.array_equal(getattr(pc, "nodes", None), act)):
             gbar, gosc = harmonic_gains(self.G[act], self.d,
                                         not getattr(owner, "_mean_gain", False))
-            pc = MeanGainPreconditioner(gbar, Za, self.eps, share=not rebuild, gosc=gosc)
+            from fretwear.hb.nearfield_preconditioner import preconditioner_for
+
+            cls = preconditioner_for(Za) or MeanGainPreconditioner  # compressed: near field
+            pc = cls(gbar, Za, self.eps, share=not rebuild, gosc=gosc)
             pc.oscillating = gosc is not gbar
             pc.nodes = act
             pc.first_iterations = None  # GMRES iterations per decade, first run
