@@ -292,9 +292,12 @@ def test_powell_watchdog_crosses_kinks_where_the_monotone_test_crawls(monkeypatc
     never takes more (1690 iterations in all against 1893) and every solve reaches the root
     ``x*`` the problem was built from (independent of the solver: its only root) to 1e-11 of
     its largest entry (the last Newton step, on the root's linear piece, is exact: the
-    solves end at ``x*`` to rounding, 1e-15)."""
+    solves end at ``x*`` to rounding, 1e-15). The problems' Jacobians are formed, so the
+    stretches are switched on for them (``WATCHDOG_FORMED``; by default they serve only
+    operator Jacobians)."""
     from fretwear.hb import solvers
 
+    monkeypatch.setattr(solvers, "WATCHDOG_FORMED", True)
     counts = {}
     for after in (10**9, solvers.WATCHDOG_AFTER):
         monkeypatch.setattr(solvers, "WATCHDOG_AFTER", after)
