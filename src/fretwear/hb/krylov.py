@@ -623,7 +623,10 @@ class KrylovJacobian:
         if kept is not None and kept[0] is self.Z and np.array_equal(kept[1], dofs):
             return kept[2]
         Z = self.Z
-        view = (getattr(Z, "op", None) is not None
+        op = getattr(Z, "op", None)
+        # (an operator with compressed forms is cut: its sub-operator carries the cut forms,
+        # which the near-field preconditioner reads; the view serves the stored matrices)
+        view = (op is not None and getattr(op, "products", None) is None
                 and VIEW_FRACTION * Z.m <= dofs.size < Z.m)
         Za = _ActiveView(Z, dofs) if view else Z.sub(dofs)
         self.owner._active_Z = (Z, dofs, Za)
