@@ -103,3 +103,19 @@ def test_sweep_with_hill_stability(tmp_path, capsys):
     assert np.all(np.abs(ds["jacobian_sign"].values[conv]) == 1)
     assert "branch_events" in ds.attrs and ds.attrs["stability_notes"] == ""
     assert (res / "sweep-Pe.png").stat().st_size > 10_000
+
+
+def test_condensation_line_says_the_local_bases_and_their_polishes():
+    """The summary line of how a sweep's frequencies were condensed, from the counts the sweep
+    records (their equality with the condenser's own calls is tested in
+    tests/hb/test_local_basis.py): said with every count when the continuation used local
+    bases, nothing when every frequency was condensed exactly."""
+    from fretwear.analyses.sweep import condensation_line
+    from fretwear.hb.sweep_result import SweepResult
+
+    line = condensation_line(SweepResult([], condensations={
+        "exact": 210, "nearby": 153, "polished": 22, "polish_failed": 1}))
+    assert line.startswith("condensation: 210 exact condensations, 153 frequencies")
+    assert "22 recorded points" in line and "1 failed" in line and "1e-06" in line
+    assert condensation_line(SweepResult([], condensations={"exact": 40, "nearby": 0})) == ""
+    assert condensation_line(SweepResult([])) == ""

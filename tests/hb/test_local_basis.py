@@ -113,6 +113,13 @@ def test_sweep_condenses_exactly_a_fraction_of_its_frequencies(joint, monkeypatc
     assert all(p.success for p in res.points)
     assert sum(nearby) >= 5  # the local bases served the continuation
     assert len(calls) <= 2 * len(res.points)
+    # what the result says of its condensations, against the calls counted here (the
+    # condenser's own methods, patched): every local basis served, every exact condensation
+    # of the sweep's harmonics made by the sweep's problems
+    said = res.condensations
+    assert said["nearby"] == sum(nearby)
+    assert said["exact"] == len(calls)
+    assert 0 < said["polished"] + said["polish_failed"] <= said["exact"]
 
     monkeypatch.setattr(reduce.Condenser, "keep_interior", lambda self: False)
     calls.clear()

@@ -35,6 +35,7 @@ from fretwear.analyses.common import (
 )
 from fretwear.errors import interrupted
 from fretwear.hb import fallbacks
+from fretwear.hb.branch import NEARBY_TOL
 from fretwear.hb.contact import STATE_NAMES
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.options import SWEEP as SWEEP_OPTIONS
@@ -234,6 +235,22 @@ def stability_attributes(st: SweepStability) -> dict:
 
 
 # --- run -----------------------------------------------------------------------------------
+def condensation_line(result: SweepResult) -> str:
+    """One summary line of how the sweep's frequencies were condensed ("" when every one
+    was condensed exactly): the frequencies the continuation added on a local basis of the
+    latest exact condensations (hb/local_basis.py, within ``NEARBY_TOL`` by its estimate),
+    and the recorded points from them re-solved on the exact condensation."""
+    c = result.condensations
+    if not c.get("nearby"):
+        return ""
+    failed = c.get("polish_failed", 0)
+    return (f"condensation: {c.get('exact', 0)} exact condensations, {c['nearby']} frequencies "
+            f"added by the continuation on a local basis of the exact ones (estimated error "
+            f"<= {NEARBY_TOL:g}); {c.get('polished', 0)} recorded points from those re-solved "
+            f"on their exact condensation (counted among the exact ones)"
+            + (f", {failed} failed there and left out" if failed else ""))
+
+
 def _sweep_summary(result: SweepResult, ds: xr.Dataset) -> str:
     lines = [result.summary()]
     if result.resumed_from > 0:
@@ -336,7 +353,7 @@ def run_sweep(model, analysis: dict, case, context: RunContext) -> RunOutput:
     figures = sweep_figures(ds, case, context.out_dir)
     grid_ok = all(p.success for p in result.points if p.on_grid)
     cost = fallbacks.of_solutions(result.points, result.wall_time)
-    said = [line for line in (cost.continuation_line("frequencies"),
+    said = [line for line in (condensation_line(result), cost.continuation_line("frequencies"),
                               cost.line("frequencies", fallbacks.eps_hint("eps" in analysis)))
             if line]
     summary = "\n".join([_sweep_summary(result, ds), *events, *said, cond.choice.summary()])

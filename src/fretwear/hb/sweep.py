@@ -177,10 +177,12 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
         # (``exc.partial``, a SweepResult) for the caller to write as partial results
         if interrupted(exc) and not hasattr(exc, "partial"):
             done = sorted(branch.points, key=lambda p: p.frequency_hz)
-            exc.partial = SweepResult(done, time.perf_counter() - t_start, resumed, warnings)
+            exc.partial = SweepResult(done, time.perf_counter() - t_start, resumed, warnings,
+                                      dict(probs.counts))
         raise
     branch.points.sort(key=lambda p: p.frequency_hz)
-    return SweepResult(branch.points, time.perf_counter() - t_start, resumed, warnings)
+    return SweepResult(branch.points, time.perf_counter() - t_start, resumed, warnings,
+                       dict(probs.counts))
 
 
 def _checkpoint_key(probs: Problems, grid, opts: SweepOptions, anchor) -> str | None:

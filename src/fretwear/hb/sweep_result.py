@@ -79,13 +79,19 @@ class SweepResult:
     failed grid frequencies; ``point_success`` is the per-point array; ``resumed_from`` is the
     number of grid frequencies read from a checkpoint (-1: none was read); ``warnings`` are
     reasons for caution that concern the whole sweep (e.g. the static preload solve that gives
-    the stick anchors did not converge), one line each.
+    the stick anchors did not converge), one line each. ``condensations`` counts how the
+    frequencies of the sweep were condensed (:class:`fretwear.hb.branch.Problems`):
+    ``"exact"`` (exact condensations, the polishes' among them), ``"nearby"`` (frequencies
+    the continuation added, condensed on a local basis of the latest exact condensations),
+    ``"polished"`` and ``"polish_failed"`` (points from a local basis re-solved on their exact
+    condensation before they were recorded).
     """
 
     points: list
     wall_time: float = 0.0
     resumed_from: int = -1
     warnings: list = field(default_factory=list)
+    condensations: dict = field(default_factory=dict)
 
     @property
     def frequency_hz(self) -> np.ndarray:
