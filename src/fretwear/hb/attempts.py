@@ -479,11 +479,9 @@ def retry(p: Point) -> bool:
     b, so = p.branch, p.options.solve
     if not b.history:
         return False
-    U0 = b.history[-1 if p.neighbour is None else p.neighbour][1]
-    c = b.model.contact  # the anchors of that point, as Branch.anchor takes the last one's
-    anchor = (b.anchor() if p.neighbour is None
-              else U0.reshape(c.n_nodes, c.dim, -1)[:, 1:, 0].copy())
-    prob, U, st = solve_at(p.probs, p.omega, anchor, U0, so.replace(solver=so.other_solver))
+    at = -1 if p.neighbour is None else p.neighbour
+    prob, U, st = solve_at(p.probs, p.omega, b.anchor(at), b.history[at][1],
+                           so.replace(solver=so.other_solver))
     p.tried.append(Attempt.of("retry", prob.eps, st))
     return p.adopt(prob, U, st, "retry")
 

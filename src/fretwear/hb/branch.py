@@ -239,13 +239,14 @@ class Branch:
             return U1
         return U1 + (U1 - U0) * (omega - w1) / (w1 - w0)
 
-    def anchor(self):
-        """Stick anchors of the next point: the mean tangential positions of the last
-        converged point (the first point's before any)."""
+    def anchor(self, index: int = -1):
+        """Stick anchors of the next point: the mean tangential positions of the converged
+        point ``index`` of the history (the last by default; the first point's before
+        any)."""
         if not self.history:
             return self.first_anchor
         c = self.model.contact
-        U = self.history[-1][1].reshape(c.n_nodes, c.dim, -1)
+        U = self.history[index][1].reshape(c.n_nodes, c.dim, -1)
         return U[:, 1:, 0].copy()
 
     def record(self, omega, prob, U, stats, how) -> SweepPoint:
