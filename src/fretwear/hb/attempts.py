@@ -54,6 +54,7 @@ from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.options import PERIODIC, STRATEGY, SolveOptions, SweepOptions
 from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.reduce import Reduced
+from fretwear.hb.runs import run
 from fretwear.hb.solution import Attempt
 from fretwear.hb.solvers import SolveStats, solve, vector_norm
 from fretwear.model.core import Model
@@ -89,20 +90,6 @@ START_MAX_SLOW = 5
 
 
 # --- solver runs and starts -----------------------------------------------------------------
-def run(prob: DLFTProblem, x0, options: SolveOptions):
-    """One run of ``options.solver`` on ``prob`` from ``x0`` (m, H): ``(x (m, H), stats)``."""
-
-    def fun(x, jac=True):
-        return prob.residual(x.reshape(prob.m, prob.H), jac)
-
-    t0 = time.perf_counter()
-    x, _, st = solve(fun, np.asarray(x0, float).reshape(-1),
-                     lambda x: prob.scale(x.reshape(prob.m, prob.H)), method=options.solver,
-                     tol=options.tol, max_iter=options.max_iter)
-    st.wall_time = time.perf_counter() - t0
-    return x.reshape(prob.m, prob.H), st
-
-
 def first_harmonic_start(prob: DLFTProblem, options: SolveOptions):
     """A starting point for a many-harmonic solve: the solution on the first kept harmonic
     from the contact-closed guess, embedded in the full basis (None if that fails). From the
@@ -405,18 +392,8 @@ def solve_at(probs: Problems, omega: float, anchor, U0, options: SolveOptions):
     """One solver run at ``omega`` [rad/s] with the stick anchors ``anchor`` from ``U0``
     (None: the contact-closed guess): ``(problem, U (m, H), stats)``."""
     prob = probs.get(omega, anchor)
-    x0 = prob.initial_guess() if U0 is None else np.asarray(U0, float).reshape(prob.m, prob.H)
-    x, st = _solve(prob, x0, options)
+    x, st = run(prob, prob.initial_guess() if U0 is None else U0, options)
     return prob, x, st
-
-
-def _solve(prob: DLFTProblem, x0, options: SolveOptions):
-    def fun(x, jac=True):
-        return prob.residual(x.reshape(prob.m, prob.H), jac)
-
-    x, _, st = solve(fun, x0.reshape(-1), lambda x: prob.scale(x.reshape(prob.m, prob.H)),
-                     method=options.solver, tol=options.tol, max_iter=options.max_iter)
-    return x.reshape(prob.m, prob.H), st
 
 
 def grid(p: Point) -> bool:

@@ -177,17 +177,15 @@ class CyclicCondenser(Condenser):
             if r is None:
                 return None
             Zr[sel], Fr[sel], oA[sel], ob[sel] = r.Z, r.F, r.obs_A, r.obs_b
-            if hasattr(r, "estimate"):
+            if r.estimate is not None:
                 estimates.append(r.estimate)
         obs_dofs = (np.concatenate([np.asarray(p.dofs, np.int64)
                                     for p in self.sector.model.observed])
                     if self.sector.model.observed else np.zeros(0, np.int64))
         quasi_static = name == "reduced" and bool(arg)
-        out = Reduced(float(omega), orders, Zr, Fr, oA, ob, obs_dofs, quasi_static,
-                      math.nan if frequency is None else float(frequency))
-        if estimates:
-            out.estimate = max(estimates)
-        return out
+        return Reduced(float(omega), orders, Zr, Fr, oA, ob, obs_dofs, quasi_static,
+                       math.nan if frequency is None else float(frequency),
+                       max(estimates) if estimates else None)
 
     def keep_interior(self) -> bool:
         """Keep the interior solutions of every harmonic index's latest exact condensation
