@@ -182,14 +182,10 @@ class ModalCondenser(Condenser):
     def __init__(self, model: Model, f_max: float, max_order: int, *, modes: int | None = None,
                  cutoff: float = CUTOFF, tol: float = TOL, raise_modes: bool = False,
                  residual: bool = False, representation: str | Representation = "auto"):
-        if not (isinstance(f_max, int | float) and math.isfinite(f_max) and f_max > 0):
-            raise InputError(f"f_max = {f_max!r}: expected a positive frequency [Hz]")
+        self._check_args(f_max, modes)
         rep = Representation.of(representation)
         self._set_compress(model, rep.compress)
         self.representation = "operator" if rep.kind == "compressed" else rep.kind
-        if modes is not None and (isinstance(modes, bool) or not isinstance(modes, int)
-                                  or modes < 0):
-            raise InputError(f"modes = {modes!r}: expected a number of modes >= 0")
         for name, value in (("cutoff", cutoff), ("tol", tol)):
             if (isinstance(value, bool) or not isinstance(value, int | float)
                     or not math.isfinite(value) or value <= 0):
@@ -238,6 +234,16 @@ class ModalCondenser(Condenser):
                 "vectors (residual=True) or condense exactly")
 
     # -- construction -------------------------------------------------------------------------
+    @staticmethod
+    def _check_args(f_max, modes):
+        """One InputError for an ``f_max`` that is not a positive frequency or ``modes`` that
+        is not None or a number of modes."""
+        if not (isinstance(f_max, int | float) and math.isfinite(f_max) and f_max > 0):
+            raise InputError(f"f_max = {f_max!r}: expected a positive frequency [Hz]")
+        if modes is not None and (isinstance(modes, bool) or not isinstance(modes, int)
+                                  or modes < 0):
+            raise InputError(f"modes = {modes!r}: expected a number of modes >= 0")
+
     def _basis(self, mode_frequencies, Phi, extra):
         """Interior basis ``V``: the modes ``Phi`` and the static vectors ``extra``, scaled and
         orthonormalised (pivoted QR, dependent columns dropped); then the projections and the
@@ -785,14 +791,6 @@ class BlockedModalCondenser(ModalCondenser):
         lu.release()  # (a sparse factorisation: the interior is never dense here)
         self.error = self._check()
         self._raise_if_inaccurate(f_max, tol)
-
-    @staticmethod
-    def _check_args(f_max, modes):
-        if not (isinstance(f_max, int | float) and math.isfinite(f_max) and f_max > 0):
-            raise InputError(f"f_max = {f_max!r}: expected a positive frequency [Hz]")
-        if modes is not None and (isinstance(modes, bool) or not isinstance(modes, int)
-                                  or modes < 0):
-            raise InputError(f"modes = {modes!r}: expected a number of modes >= 0")
 
     @staticmethod
     def _basis(Phi, Xl):
