@@ -147,6 +147,7 @@ class WornStateOptions:
     exponential: bool = True
     order: int = 1
     settle_rate: float = 0.01
+    events: bool = False
 
     def __post_init__(self):
         if not isinstance(self.wear, WearOptions):
@@ -161,7 +162,7 @@ class WornStateOptions:
             raise InputError(f"initial_jump = {j!r}: expected > 0 cycles or None")
         if self.order not in (1, 2) or isinstance(self.order, bool):
             raise InputError(f"order = {self.order!r}: expected 1 or 2")
-        for name in ("stick_set", "exponential"):
+        for name in ("stick_set", "exponential", "events"):
             if not isinstance(getattr(self, name), bool):
                 raise InputError(f"{name} = {getattr(self, name)!r}: expected true or false")
         number(self.max_growth, "max_growth", low=1.0, open_low=True, high=1e6)
@@ -184,6 +185,8 @@ class WornStateOptions:
                "settle_rate": self.settle_rate}
         if self.order != 1:  # (the checkpoints of first-order runs keep their key)
             key["order"] = self.order
+        if self.events:
+            key["events"] = True
         return key
 
 
@@ -408,7 +411,7 @@ def _continue(sp: SlowProblem, state: SlowStep, records: list[StepRecord],
             new, record, msg = _path_step(sp, state, opts if settled else path,
                                           options.exponential, 1 if settled else options.order,
                                           path_cycles(records, options.settle_rate)
-                                          if options.order == 2 else None)
+                                          if options.order == 2 else None, options.events)
             if new is not None and not new.in_time_integration:
                 new, record = _pull_back(sp, state, new, record, opts)
                 msg = msg or "the balance after pulling back over-worn nodes failed"
@@ -441,13 +444,13 @@ def path_cycles(records: list[StepRecord], settle_rate: float) -> float:
 
 
 def _path_step(sp: SlowProblem, state: SlowStep, opts: WearOptions, exponential: bool,
-               order: int = 1, cycles: float | None = None):
+               order: int = 1, cycles: float | None = None, events: bool = False):
     """The next pseudo-time step: the exponential Euler step
     (:func:`~fretwear.wear.exponential_step.exponential_step`) with ``exponential``, else
     or where it failed or from a time integration the march's step
     (:func:`fretwear.wear.simulate._step`, with its time-domain rescue)."""
     if exponential and not state.in_time_integration:
-        new, record, msg = exponential_step(sp, state, opts, order, cycles)
+        new, record, msg = exponential_step(sp, state, opts, order, cycles, events)
         if new is not None:
             return new, record, msg
     return _step(sp, state, opts)
