@@ -53,9 +53,9 @@ from fretwear.wear.state import SlowStep
 #: the largest ``dN lam`` of a growing mode ``lam`` of ``Js`` in one step (a growth of the
 #: mode by ``e^2`` at most; the error control judges the step)
 EXP_GROWTH_LIMIT = 2.0
+#: with ``events``, the largest ``dN lam`` of a growing mode over which the first
+#: contact-state event is looked for (a growth of ``e^8``: the stuck neighbour slips before)
 EVENT_GROWTH_LIMIT = 8.0
-EVENTS_EVERYWHERE = False
-EVENT_KEEPS_PROPOSAL = True
 
 
 def increment(Js, g, dN: float) -> np.ndarray:
@@ -111,6 +111,13 @@ def exponential_step(sp: SlowProblem, st: SlowStep, opts: WearOptions, order: in
     Schweitzer 2009), its error estimated by :func:`rosenbrock_error` and the jump
     controlled with the cube root of ``tolerance / error``.
 
+    ``events``: where a growing mode binds, the step ends just past the first change of the
+    contact-state pattern predicted along the linearised path within ``dN lam <=
+    EVENT_GROWTH_LIMIT`` (:mod:`fretwear.wear.events`; the growth ends when the loaded
+    neighbour slips), else at ``EXP_GROWTH_LIMIT``; the next step starts from the jump the
+    controller had proposed. Measured in docs/studies/method-costs.md ("Events along the
+    path"): it does not pay, hence off by default.
+
     ``cycles``: the cycle count the error control's floor is a fraction of
     (``MIN_JUMP_FRACTION``; None: ``st.cycles``). The pseudo-time of the worn state's
     continuation passes the cycles of its path steps alone: after a relaxation step of
@@ -128,9 +135,9 @@ def exponential_step(sp: SlowProblem, st: SlowStep, opts: WearOptions, order: in
     proposal, cut = dN, False
     if growing:
         dN = min(dN, EXP_GROWTH_LIMIT / lam_plus)
-    if events and (growing or EVENTS_EVERYWHERE):
+    if events and growing:  # the step ends just past the first event, if it comes first
         event = first_event(pattern_along(sp, st.W, st.U, anchor, st.g, Js, dUdW), look)
-        if event is not None and (growing or event[1] < dN):
+        if event is not None:
             dN, exponential, cut = event[1], True, True
 
     start = StepStart(st.W, st.U, st.g, anchor)
@@ -151,7 +158,7 @@ def exponential_step(sp: SlowProblem, st: SlowStep, opts: WearOptions, order: in
         error = (estimate, 2)
     new, record, msg = accept(sp, opts, st, anchor, attempt, (dN, floor, floor), (t0, 1, 0),
                               error)
-    if cut and new is not None and EVENT_KEEPS_PROPOSAL:
+    if cut and new is not None:
         # an event, not the error, ended the step: the next one starts from the jump the
         # controller had proposed (the next slow Jacobian caps it again where it must)
         new.jump = max(new.jump, proposal)

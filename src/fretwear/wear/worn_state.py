@@ -133,6 +133,12 @@ class WornStateOptions:
         started at the third step of a reduced triangle beam, whose rate had fallen by
         0.1 %, and jumped over the slip events to come: 0.73 % of the deepest wear from the
         march's state instead of 1e-5).
+    events : end a path step whose slow Jacobian has a growing mode at the first change of
+        the contact-state pattern (a node starting or ending to slip or to open) predicted
+        along the linearised path (:mod:`fretwear.wear.events`), instead of at the growth
+        limit. Off by default: measured on the three quasi-static examples it does not pay
+        (the steps that land past an event need more Newton iterations than those it saves;
+        docs/studies/method-costs.md, "Events along the path").
     """
 
     wear: WearOptions = field(default_factory=WearOptions)
