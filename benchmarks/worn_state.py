@@ -33,7 +33,9 @@ The last lines are ``worn_state_speedup=<geometric mean of march / direct proces
 and ``worn_state_diff=<largest profile difference / largest depth>``.
 
 Run: ``python benchmarks/worn_state.py [--cases salles2011-quasistatic,stromberg1997]
-[--steps 200] [--dovetail-steps 60] [--order 2]``. Quote the figures with the machine load
+[--steps 200] [--dovetail-steps 60] [--order 2] [--events] [--no-jumps]``
+(``--events``: the direct solve with ``events = True``; ``--no-jumps``: without the
+stick-set jumps). Quote the figures with the machine load
 (``uptime``: printed before and after).
 """
 
@@ -176,13 +178,14 @@ def run_case(name: str, steps: int, order: int = 1, events: bool = False,
     return c_m / c_d, diff
 
 
-def not_reached(steps: int, order: int = 1) -> None:
+def not_reached(steps: int, order: int = 1, events: bool = False) -> None:
     """The 79 kHz beam (salles2011-79khz), whose wear path is chaotic: the direct solve
     must say that it did not reach a state, with the residual."""
     model, basis, f_hz, quasi, opts, balance = _setup("salles2011-79khz", steps)
     res, c, w = _timed(lambda: api.worn_state(
         model, basis, frequency=f_hz,
-        options=WornStateOptions(wear=opts, max_steps=steps, order=order), balance=balance))
+        options=WornStateOptions(wear=opts, max_steps=steps, order=order, events=events),
+        balance=balance))
     print(f"salles2011-79khz: {res.message}")
     print(f"  kind {res.kind}, success {res.success}, residual {res.residual:.3g}; processor "
           f"{c:.1f} s, wall {w:.1f} s")
@@ -217,7 +220,7 @@ def main():
             speed.append(out[0])
             diffs.append(out[1])
     if args.steps_79khz > 0:
-        not_reached(args.steps_79khz, args.order)
+        not_reached(args.steps_79khz, args.order, args.events)
     print("load after:", os.getloadavg())
     if not speed:
         print("no case reached a state: no summary")
