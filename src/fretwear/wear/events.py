@@ -8,11 +8,14 @@ linearised path ``W(N) = W_k + N phi1(N Js) g(W_k)`` (the exponential Euler path
 implicit-function derivative ``dU~/dW`` that the slow Jacobian is made of,
 ``U~(N) = U~_k + dU~/dW (W(N) - W_k)``, and the contact law (eq. 23) at that prediction says
 which state each node is in at each time sample: the pattern the balance would have there.
-:func:`first_event` finds the first ``N`` at which a predicate on the path (a changed
-pattern) turns true, by sampling the step and bisecting, and :func:`pattern_change` builds
-that predicate for a slow problem. A step that ends just past the event lands on the new
-pattern, where the next slow Jacobian is right; events closer together than ``group`` (a
-relative distance in ``N``) are taken by one step.
+:func:`first_event` finds the first ``N`` at which the pattern differs from the step's, by
+sampling the step and bisecting, and :func:`pattern_along` gives that pattern as a function
+of ``N`` for a slow problem. A step that ends just past the event lands on the new pattern,
+where the next slow Jacobian is right (used by
+:func:`fretwear.wear.exponential_step.exponential_step` with ``events``, where a growing
+mode binds). Events passed inside one step are grouped by the step's error control, as in
+the march. Measured in docs/studies/method-costs.md, "Events along the path": the pattern
+that matters for the cost is that of every time sample, which changes on nearly every step.
 """
 
 from __future__ import annotations
