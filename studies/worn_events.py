@@ -6,8 +6,8 @@ of 1e-8 of the initial one and the direct solve (``fretwear.worn_state``, defaul
 then for every accepted step of each:
 
 * whether the step changed the slipping set (nodes that slip during the period), the open
-  set (nodes separated during part of the period) or only the finer pattern (the contact
-  state of some node at some time sample);
+  set (nodes separated during part of the period), and how many (node, time sample) pairs
+  changed contact state (the finer pattern);
 * the DLFT solves (Newton iterations and slow Jacobians, as counted by the march) and the
   rejected attempts;
 * what limited its jump: ``rejected`` (the error test or a failed balance cut it), ``growth``
@@ -62,7 +62,8 @@ def table(sp, h, tol: float, relaxed: set, verbose: bool, label: str):
         cur = patterns(sp, h, k)
         slip = not np.array_equal(prev[0], cur[0])
         opened = not np.array_equal(prev[1], cur[1])
-        fine = not np.array_equal(prev[2], cur[2])
+        switches = int(np.count_nonzero(prev[2] != cur[2]))
+        fine = switches > 0
         sp.set_state(h.wear_depth[k - 1], h.anchor[k])
         U0 = np.asarray(h.U[k - 1], float).reshape(sp.m, sp.H)
         Js = sp.slow_jacobian(U0)
@@ -83,11 +84,11 @@ def table(sp, h, tol: float, relaxed: set, verbose: bool, label: str):
         else:
             limit = "growth-cap"
         rows.append((k, slip, opened, fine, int(h.newton_iterations[k]), int(h.rejected[k]),
-                     limit, nonlin, jump, lam * jump))
+                     limit, nonlin, jump, lam * jump, switches))
         if verbose:
             print(f"  {label} {k:3d} N={h.cycles[k]:.3e} dN={jump:.3e} lam dN={lam * jump:7.3f} "
                   f"slip {'X' if slip else '.'} open {'X' if opened else '.'} "
-                  f"pattern {'X' if fine else '.'} solves {h.newton_iterations[k]:2d} "
+                  f"pattern {switches:4d} solves {h.newton_iterations[k]:2d} "
                   f"rej {h.rejected[k]} {limit:10s} nonlin {nonlin:.3g} "
                   f"nslip {int(cur[0].sum())}")
         prev = cur
@@ -101,7 +102,8 @@ def table(sp, h, tol: float, relaxed: set, verbose: bool, label: str):
     total = int(h.newton_iterations.sum())
     print(f"  {label}: {len(rows)} steps, {total} solves; at events {len(ev)} steps, "
           f"{sum(r[4] for r in ev)} solves in {groups} groups; fine pattern changed on "
-          f"{sum(1 for r in rows if r[3])} steps; nonlinearity median smooth "
+          f"{sum(1 for r in rows if r[3])} steps (median {np.median([r[10] for r in rows]):.0f} "
+          f"sample switches a step); nonlinearity median smooth "
           f"{np.median(smooth) if smooth else 0:.3g}, events {np.median(evn) if evn else 0:.3g}"
           f"; limits {limits}")
 

@@ -99,6 +99,23 @@ def test_gross_slip_is_steady_wear_at_the_analytic_rate():
     assert res.residual > 0.5
 
 
+def test_a_small_first_jump_claims_no_steady_wear():
+    """From a first jump of 1e-3 cycles the first steps wear almost nothing, and the rate
+    profile does not change over them although each moves the profile by much of its own
+    (tiny) deepest wear: that is no steady wear (it was claimed after 3 steps, residual 1).
+    The Winkler punch then reaches its analytic state as from the default first jump, to the
+    same tolerance as :func:`test_winkler_punch_reaches_the_analytic_state`; the punch in
+    gross slip is still steady wear from the same small first jump."""
+    res = worn_state(winkler(), BASIS, quasi_static=True,
+                     options=WornStateOptions(initial_jump=1e-3))
+    assert res.success and res.kind == "null_wear_rate", res.message
+    exact = np.where(MU * F < T, F / KN, 0.0)
+    assert np.max(np.abs(res.wear - exact)) <= 1e-3 * exact.max()
+    gross = worn_state(winkler(punch_load=12.0), BASIS, quasi_static=True,
+                       options=WornStateOptions(initial_jump=1e-3, max_steps=30))
+    assert gross.kind == "steady_wear", gross.message
+
+
 def test_not_reached_is_said_with_its_residual():
     """Two pseudo-time steps cannot reach the Winkler state: success False, the residual
     (the wear rate left, well above the tolerance) in the result and its message."""

@@ -41,7 +41,9 @@ the state depends on the path, and the jump, which does not follow it, can land 
 null-wear-rate state than the march (measured in docs/theory.md).
 
 Wear that goes on (gross slip) has no null-rate state; when the rate stops changing (``max
-|g_{k+1} - g_k| <= tolerance max g``) while the residual stays large, the result says so
+|g_{k+1} - g_k| <= tolerance max g``) over a step that moved the profile by
+``depth_tolerance`` of the larger of the deepest wear and the contact's displacement
+(:func:`_moved`) while the residual stays large, the result says so
 (``kind = "steady_wear"``) with the steady rate profile.
 
 The number of cycles a march needs to get within 1 % of the state is estimated (it is an
@@ -348,6 +350,16 @@ def _correction(records: list[StepRecord]) -> float:
     return float(np.max(np.abs(W1 - W0))) / top if top > 0 else 0.0
 
 
+def _moved(records: list[StepRecord]) -> float:
+    """The last step's ``max |W_{k+1} - W_k|`` over the larger of the deepest wear and the
+    largest contact displacement coefficient ``max |U~|`` (0 before any step)."""
+    if len(records) < 2:
+        return 0.0
+    W1, W0 = records[-1].wear_depth, records[-2].wear_depth
+    scale = max(float(np.max(W1)), float(np.max(np.abs(records[-1].U))))
+    return float(np.max(np.abs(W1 - W0))) / scale if scale > 0 else 0.0
+
+
 def _rate_change(records: list[StepRecord]) -> float:
     """``max |g_{k+1} - g_k| / max g_{k+1}`` over the last step (inf before any step)."""
     if len(records) < 2:
@@ -371,9 +383,11 @@ def _judge(records: list[StepRecord], options: WornStateOptions) -> _Found | Non
                       f"correction {c:.3g} of the deepest wear <= {options.depth_tolerance:g}",
                       r, c)
     # steady: the rate profile did not change over a step that moved the profile (a tiny
-    # step, e.g. after failed balances, leaves any rate unchanged)
+    # step, e.g. after failed balances or from a small initial_jump, leaves any rate
+    # unchanged), measured against the interface's motion as well as the wear (from the
+    # unworn state every step moves the profile by much of its own deepest wear)
     if (n >= 3 and _rate_change(records) <= options.tolerance and r > 0.1
-            and c >= options.depth_tolerance):
+            and _moved(records) >= options.depth_tolerance):
         return _Found(True, "steady_wear",
                       f"no null-wear-rate state: the wear goes on at a steady rate (residual "
                       f"{r:.3g}, the rate profile changed by {_rate_change(records):.3g} over "
