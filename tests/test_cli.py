@@ -209,6 +209,6 @@ def test_a_wear_run_that_cannot_wear_says_so_in_one_line(tmp_path, monkeypatch, 
     said = [line for line in err if "wear_coefficient" in line]
     assert said == ["warning: UnusualValueWarning: contact.wear_coefficient = 0 on every "
                     "contact node (and on their partners): nothing wears under the Archard "
-                    "law, and the run will report no wear; give Archard's k_w [1/Pa] (steel "
-                    "on steel: about 1e-15 to 1e-13)"]
+                    "law, and the run will report no wear; give Archard's k_w [1/Pa] "
+                    "(metals: 1e-17 to 1e-12)"]
     assert not any(line.startswith(" ") or ".py:" in line for line in err)

@@ -125,8 +125,11 @@ def test_every_public_driver_runs_with_the_drivers_blas_threads(name, monkeypatc
     monkeypatch.setattr(threads, "_state", {"n": 1})
     monkeypatch.setattr(importlib.import_module(module_name), inner, recorder)
     with threadpoolctl.threadpool_limits(limits=2, user_api="blas"):
+        outside = blas()  # {2}, or {1, 2} with a single-threaded BLAS loaded beside
+        if 2 not in outside:
+            pytest.skip("no BLAS library here takes 2 threads")
         with pytest.raises(_Stop):
             getattr(fw, name)(*args)
         after = blas()
     assert seen == [{1}]
-    assert after == {2}
+    assert after == outside

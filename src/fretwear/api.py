@@ -108,12 +108,13 @@ def _frequency(frequency, quasi_static: bool) -> dict:
 #: what a wear run whose Archard coefficients are all zero says (a case run says it as a note)
 NOTHING_WEARS = ("contact.wear_coefficient = 0 on every contact node (and on their partners): "
                  "nothing wears under the Archard law, and the run will report no wear; give "
-                 "Archard's k_w [1/Pa] (steel on steel: about 1e-15 to 1e-13)")
+                 "Archard's k_w [1/Pa] (metals: 1e-17 to 1e-12)")
 
 
-def _nothing_wears(model, law: str) -> None:
+def _nothing_wears(model, law: str | None) -> None:
     """Warn when an Archard wear run cannot wear (every coefficient 0, the default of a
-    contact): it would stop at once with "no wear" and ``success=True``."""
+    contact): it would stop at once with "no wear" and ``success=True``. ``law`` None: options
+    of the wrong type, refused by the run's own check."""
     c = model.contact
     if law == "archard" and c is not None and c.n_nodes and not (
             c.wear_nodes().any() or c.partner_wear_nodes().any()):
@@ -316,7 +317,8 @@ def simulate_wear(model, basis, frequency: float | None = None, *, quasi_static:
     from a time integration).
     """
     _basis(basis)
-    _nothing_wears(model, (options or _wear.WearOptions()).law)
+    _nothing_wears(model, options.law if isinstance(options, _wear.WearOptions)
+                   else None if options is not None else "archard")
     if condenser is not None:
         balance = balance or _wear.BalanceSetup()
         if balance.condenser is not None:
@@ -357,8 +359,9 @@ def worn_state(model, basis, frequency: float | None = None, *, quasi_static: bo
     """
     _public_names("worn_state", kwargs)
     _basis(basis)
-    opts = kwargs.get("options") or _WornStateOptions()
-    _nothing_wears(model, opts.wear.law)
+    opts = kwargs.get("options")
+    _nothing_wears(model, opts.wear.law if isinstance(opts, _WornStateOptions)
+                   else None if opts is not None else "archard")
     if condenser is not None:
         balance = kwargs.pop("balance", None) or _wear.BalanceSetup()
         if balance.condenser is not None:
