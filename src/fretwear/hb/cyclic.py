@@ -38,6 +38,7 @@ from fretwear.model.cyclic import (
 )
 from fretwear.model.interfaces import observed_map
 from fretwear.resources import require_memory
+from fretwear.threads import limited
 from fretwear.validate import reals
 
 #: at most this many kept DOFs: cyclic modes by a dense Hermitian eigensolver
@@ -223,6 +224,7 @@ def cyclic_condenser(sector: CyclicSector, engine_order: int) -> CyclicCondenser
 
 
 @model_argument
+@limited
 def cyclic_modes(sector: CyclicSector, k: int, n_modes: int = 6) -> tuple[np.ndarray,
                                                                           np.ndarray]:
     """The ``n_modes`` lowest modes of harmonic index (nodal diameter) ``k`` of the disk,
@@ -265,6 +267,7 @@ def cyclic_modes(sector: CyclicSector, k: int, n_modes: int = 6) -> tuple[np.nda
 
 
 @model_argument
+@limited
 def cyclic_frf(sector: CyclicSector, engine_order: int, frequencies) -> np.ndarray:
     """Linear response of the sector to the engine-order excitation, contact free:
     ``U_1`` (nf, ndof) complex [m] on the sector's DOFs at each excitation frequency [Hz]
