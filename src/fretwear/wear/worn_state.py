@@ -369,13 +369,17 @@ def _rate_change(records: list[StepRecord]) -> float:
     return float(np.max(np.abs(g1 - g0))) / top if top > 0 else math.inf
 
 
-def _judge(records: list[StepRecord], options: WornStateOptions) -> _Found | None:
-    """The verdict on the last iterate, or None to go on."""
+def _judge(records: list[StepRecord], options: WornStateOptions, can_wear: bool = True
+           ) -> _Found | None:
+    """The verdict on the last iterate, or None to go on (``can_wear`` False: every wear
+    coefficient is 0, the reason a zero rate is then given)."""
     r, c = rate_residual(records), _correction(records)
     n = len(records) - 1
     if float(np.max(records[0].wear_rate)) <= 0:
-        return _Found(True, "no_wear", "no wear: no contact node slips at the start (wear rate "
-                      "0); the worn state is the initial one", 0.0, 0.0)
+        why = ("no contact node slips at the start" if can_wear else
+               "every wear coefficient is 0 (set the contact's wear_coefficient)")
+        return _Found(True, "no_wear", f"no wear: {why} (wear rate 0); the worn state is the "
+                      "initial one", 0.0, 0.0)
     if r <= options.tolerance and c <= options.depth_tolerance:
         return _Found(True, "null_wear_rate",
                       f"worn state reached after {n} pseudo-time steps: null-wear-rate "
@@ -406,7 +410,7 @@ def _continue(sp: SlowProblem, state: SlowStep, records: list[StepRecord],
     path = options.march_options(path=True)
     jumps = _Jumps(sp, options, opts)
     while True:
-        found = _judge(records, options)
+        found = _judge(records, options, bool(np.any(sp.coef)))
         if found is not None:
             return state, replace(found, jump_iterations=jumps.iterations)
         if state.step >= options.max_steps:
