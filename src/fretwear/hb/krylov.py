@@ -49,6 +49,10 @@ REBUILD_GROWTH = 2.0
 #: the step is solved by a LAPACK LU of the active block up to this many unknowns (slipping
 #: or separating nodes x d x H), by GMRES above (docs/theory.md, "Large interfaces")
 ACTIVE_DENSE_MAX = 3000
+#: rows of a block formed at a time by :meth:`KrylovJacobian.column_norms` (an operator's
+#: blocks, hb/operator_blocks.py: a panel of 2.4 MB at 1024 contact nodes, reused, in place of
+#: a fresh m x m block per harmonic)
+COLUMN_NORM_PANEL = 96
 #: from this fraction of the DOFs active (but not all), the active blocks of an operator
 #: (hb/operator_blocks.py) are a view (:class:`_ActiveView`: products through the whole
 #: operator) instead of copies of its m x m matrices (2 x 1.125 GiB at 4096 contact nodes);
@@ -57,15 +61,16 @@ VIEW_FRACTION = 0.75
 
 
 @njit(cache=True)
-def _gram_quad(Are, Aim, rows, M, c0, c1):
-    """``out[t, c] = sum_p x_pc^T M[t, p] x_pc`` for the columns ``c0 <= c < c1`` of a block,
-    where ``x_pc`` (r,) holds the block's entries in the rows ``rows[p]`` (d,) of node ``p``:
-    ``Are[rows[p], c]`` if ``r = d``, followed by ``Aim[rows[p], c]`` if ``r = 2 d`` (the
-    real and imaginary parts of a complex block). One pass over the active rows, without
-    the copies and the ``(na, r, ncol)`` product of the batched NumPy form."""
+def _gram_quad(Are, Aim, rows, M, c0, c1, out):
+    """``out[t, c - c0] += sum_p x_pc^T M[t, p] x_pc`` for the columns ``c0 <= c < c1`` of a
+    block, where ``x_pc`` (r,) holds the block's entries in the rows ``rows[p]`` (d,) of
+    node ``p``: ``Are[rows[p], c]`` if ``r = d``, followed by ``Aim[rows[p], c]`` if
+    ``r = 2 d`` (the real and imaginary parts of a complex block). One pass over the rows,
+    without the copies and the ``(na, r, ncol)`` product of the batched NumPy form; the
+    nodes in order, so that a block's rows taken panel by panel (:meth:`KrylovJacobian.
+    column_norms`) sum as in one call."""
     nt, na, r, _ = M.shape
     d = rows.shape[1]
-    out = np.zeros((nt, c1 - c0))
     x = np.empty(r)
     for p in range(na):
         for c in range(c0, c1):
@@ -85,12 +90,11 @@ def _gram_quad(Are, Aim, rows, M, c0, c1):
 
 
 @njit(cache=True)
-def _gram_quad_real3(A, rows, M, c0, c1):
+def _gram_quad_real3(A, rows, M, c0, c1, out):
     """:func:`_gram_quad` for a real block and 3 DOFs per node (3D), the common case of
     large interfaces: the symmetric form ``sum_ij M_ij x_i x_j`` with its six coefficients
     taken out of the loop over the columns (five times faster)."""
     nt, na = M.shape[0], M.shape[1]
-    out = np.zeros((nt, c1 - c0))
     for p in range(na):
         r0, r1, r2 = A[rows[p, 0]], A[rows[p, 1]], A[rows[p, 2]]
         for t in range(nt):
@@ -152,6 +156,11 @@ class HarmonicBlocks:
         :meth:`block`): the stored block and ``dofs`` themselves here; an operator forms
         only those rows."""
         return (self.Z0 if b == 0 else self.block(b)), np.asarray(dofs)
+
+    def row_panel(self, b: int, dofs: np.ndarray, buf: np.ndarray):
+        """As :meth:`row_block`, for a panel of rows taken in turn (the column norms): the
+        stored block here (``buf`` unused); an operator forms the panel into ``buf``."""
+        return self.row_block(b, dofs)
 
     def node_diagonal(self, b: int, d: int) -> np.ndarray:
         """The (m / d, d, d) diagonal node blocks of block ``b`` (as :meth:`block`)."""
@@ -498,17 +507,16 @@ class KrylovJacobian:
         na = act.size
         rows = np.ascontiguousarray(act[:, None] * d + np.arange(d))  # (na, d)
 
+        # the active rows formed panel by panel into one buffer (an operator's blocks)
+        panel = max(1, min(na, COLUMN_NORM_PANEL // d))
+        buf = np.empty((panel * d, m), dtype=complex if not Z.real else float)
         for b in range(Z.nb):
             cs = [0] if b == 0 else [b, Z.k + b]
             nl = len(cs)
             Gs = np.ascontiguousarray(Gr[:, :, :, cs].reshape(nc, dH, d * nl))
             Ga = Gs[act]
             gram = np.matmul(np.transpose(Ga, (0, 2, 1)), Ga)  # (na, d nl, d nl)
-            # the block's rows of the active nodes (an operator forms only these) and every
-            # node's own d x d block
-            Zb, lrows = Z.row_block(b, rows.reshape(-1))
-            lrows = np.ascontiguousarray(lrows.reshape(na, d))
-            diag = Z.node_diagonal(b, d)  # (nc, d, d)
+            diag = Z.node_diagonal(b, d)  # every node's own d x d block (nc, d, d)
             if b == 0:
                 M = gram[None]
             elif Z.real:
@@ -524,15 +532,22 @@ class KrylovJacobian:
                 A, B, D = g5[:, :, 0, :, 0], g5[:, :, 0, :, 1], g5[:, :, 1, :, 1]
                 M = np.stack([np.block([[A, -B], [-np.transpose(B, (0, 2, 1)), D]]),
                               np.block([[D, np.transpose(B, (0, 2, 1))], [B, A]])])
-            M = np.ascontiguousarray(M)
-            Are, Aim = (Zb.real, Zb.imag) if np.iscomplexobj(Zb) else (Zb, Zb)
+            S = np.zeros((M.shape[0], m))  # sum over the active nodes, in their order
+            for p0 in range(0, na, panel):
+                ps = slice(p0, min(p0 + panel, na))
+                # the block's rows of these active nodes (an operator forms only these)
+                Zb, lrows = Z.row_panel(b, rows[ps].reshape(-1), buf)
+                lrows = np.ascontiguousarray(np.reshape(lrows, (-1, d)))
+                Mp = np.ascontiguousarray(M[:, ps])
+                if d == 3 and not np.iscomplexobj(Zb):
+                    _gram_quad_real3(Zb, lrows, Mp, 0, m, S)
+                else:
+                    Are, Aim = (Zb.real, Zb.imag) if np.iscomplexobj(Zb) else (Zb, Zb)
+                    _gram_quad(Are, Aim, lrows, Mp, 0, m, S)
             for j0 in range(0, m, chunk):
                 sl = slice(j0, min(j0 + chunk, m))
                 js = np.arange(sl.start, sl.stop)
-                if d == 3 and not np.iscomplexobj(Zb):
-                    sq = _gram_quad_real3(Zb, lrows, M, sl.start, sl.stop).T  # (ncol, nl)
-                else:
-                    sq = _gram_quad(Are, Aim, lrows, M, sl.start, sl.stop).T
+                sq = S[:, sl].T.copy()  # (ncol, nl)
                 # + eps (I - G) on the owner's block: column (j, c) -> node j // d, row j%d, c
                 q = js // d
                 ci = np.arange(js.size)
