@@ -509,7 +509,8 @@ class KrylovJacobian:
 
         # the active rows formed panel by panel into one buffer (an operator's blocks)
         panel = max(1, min(na, COLUMN_NORM_PANEL // d))
-        buf = np.empty((panel * d, m), dtype=complex if not Z.real else float)
+        # (twice a panel's rows: a panel of active nodes with stuck ones between them)
+        buf = np.empty((2 * panel * d, m), dtype=complex if not Z.real else float)
         for b in range(Z.nb):
             cs = [0] if b == 0 else [b, Z.k + b]
             nl = len(cs)
