@@ -118,7 +118,7 @@ def main():
            "parts": parts, "calls": sp.calls, "load_before": load0,
            "load_after": os.getloadavg()[0],
            "peak_gib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20}
-    np.save(f"/tmp/solve_split_{n}_U.npy", sol.U)
+    np.save(f"/tmp/solve_split_{n}{os.environ.get('SPLIT_TAG', '')}_U.npy", sol.U)
     print("RESULT " + json.dumps(out, default=float), flush=True)
 
 

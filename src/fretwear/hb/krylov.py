@@ -37,6 +37,14 @@ GMRES_RTOL = 1e-10
 #: another, and the estimate below which they are shared (MeanGainPreconditioner._close)
 SHARE_PROBES = 2
 SHARE_BELOW = 0.25
+#: the mean-gain preconditioner's LU factors in single precision (half the memory traffic
+#: of its triangular solves and half their memory, LAPACK's sgetrf for its builds): the
+#: preconditioner approximates the active block whatever its precision and GMRES multiplies
+#: by the operator in double, so the step is solved to ``rtol`` all the same; a rebuild after
+#: a GMRES failure factors in double. On benchmarks/scale_3d.py's partial-slip pad: the
+#: preconditioner's applies 36 % and builds 27 % cheaper at 1024 contact nodes, the solution
+#: the double one's to 3e-9 (docs/studies/large-interface-solve.md, "The growth's terms")
+SINGLE_FACTORS = True
 #: Krylov vectors kept before a restart, and restarts allowed
 GMRES_RESTART = 60
 GMRES_MAXITER = 4
@@ -339,6 +347,19 @@ def harmonic_gains(G: np.ndarray, d: int, oscillating: bool = True):
     return gbar, gosc / (2 * k)
 
 
+def _lu_solve(lu, b):
+    """``P^-1 b`` by LAPACK factors ``lu``, in their precision (single factors,
+    :data:`SINGLE_FACTORS`: the right-hand side rounded to it, the result returned in
+    double)."""
+    if lu[0].dtype in (np.float32, np.complex64):
+        kind = np.complex64 if np.iscomplexobj(b) else np.float32
+        if np.iscomplexobj(b) and lu[0].dtype == np.float32:
+            kind = np.complex128
+        return sla.lu_solve(lu, np.asarray(b, kind), check_finite=False).astype(
+            np.result_type(b, np.float64))
+    return sla.lu_solve(lu, b, check_finite=False)
+
+
 class MeanGainPreconditioner:
     """``P^-1`` with ``P_n = eps I + g_n (Z_n - eps I)`` per harmonic (module docstring).
 
@@ -348,12 +369,15 @@ class MeanGainPreconditioner:
     :class:`HarmonicBlocks`; share : let a harmonic use the factors of the last factored one
     when they precondition it well (:meth:`_close`): below the structure's first resonances
     ``Z_n`` hardly differs from ``Z_0`` (``-(n w)^2 M_r`` against the stiffness) and one LU
-    serves several harmonics. A rebuild after a GMRES failure does not share.
+    serves several harmonics. A rebuild after a GMRES failure does not share. single :
+    the factors in single precision (:data:`SINGLE_FACTORS`; a rebuild after a GMRES failure
+    factors in double).
     """
 
     def __init__(self, gbar: np.ndarray, Z: HarmonicBlocks, eps: float, share: bool = True,
-                 gosc: np.ndarray | None = None):
+                 gosc: np.ndarray | None = None, single: bool = False):
         self.k, self.m, self.H = Z.k, Z.m, Z.H  # (no reference to Z: kept across sweeps)
+        self.single = single
         gosc = gbar if gosc is None else gosc
         self.factors = []  # per harmonic block: LAPACK LU of P_n or of a close P_b
         self.shared = 0
@@ -374,8 +398,10 @@ class MeanGainPreconditioner:
                 self.factors.append(last[2])
                 self.shared += 1
                 continue
-            lu = sla.lu_factor(self._block(g, Zb, eps), overwrite_a=True,
-                               check_finite=False)
+            P = self._block(g, Zb, eps)
+            if single:
+                P = P.astype(np.complex64 if np.iscomplexobj(P) else np.float32)
+            lu = sla.lu_factor(P, overwrite_a=True, check_finite=False)
             self.factors.append(lu)
             last = (Zb, g, lu)
         # the harmonics of each set of factors, solved together by apply()
@@ -401,9 +427,9 @@ class MeanGainPreconditioner:
         """``P^-1 b`` by the factors ``lu``; a complex ``b`` with real factors as its real and
         imaginary parts (a mixed call would copy the factors to complex)."""
         if np.iscomplexobj(b) and not np.iscomplexobj(lu[0]):
-            y = sla.lu_solve(lu, np.column_stack([b.real, b.imag]), check_finite=False)
+            y = _lu_solve(lu, np.column_stack([b.real, b.imag]))
             return y[:, 0] + 1j * y[:, 1]
-        return sla.lu_solve(lu, b, check_finite=False)
+        return _lu_solve(lu, b)
 
     @classmethod
     def _close(cls, gn, Zn, last, eps) -> bool:
@@ -442,11 +468,10 @@ class MeanGainPreconditioner:
         for lu, hs in self.groups:
             if not np.iscomplexobj(lu[0]):  # real P_n: P_n (a - i b) = P_n a - i P_n b
                 cols = [c for b in hs for c in ([0] if b == 0 else [b, k + b])]
-                out[:, cols] = sla.lu_solve(lu, r[:, cols], check_finite=False)
+                out[:, cols] = _lu_solve(lu, r[:, cols])
                 continue
             # complex factors (a damped harmonic; never harmonic 0, whose block is real)
-            y = sla.lu_solve(lu, (r[:, hs] - 1j * r[:, [k + b for b in hs]]),
-                             check_finite=False)
+            y = _lu_solve(lu, (r[:, hs] - 1j * r[:, [k + b for b in hs]]))
             out[:, hs], out[:, [k + b for b in hs]] = y.real, -y.imag
         return out.reshape(-1)
 
@@ -672,8 +697,12 @@ class KrylovJacobian:
                                         not getattr(owner, "_mean_gain", False))
             from fretwear.hb.nearfield_preconditioner import preconditioner_for
 
-            cls = preconditioner_for(Za) or MeanGainPreconditioner  # compressed: near field
-            pc = cls(gbar, Za, self.eps, share=not rebuild, gosc=gosc)
+            cls = preconditioner_for(Za)  # compressed forms: the near field when asked
+            if cls is None:
+                pc = MeanGainPreconditioner(gbar, Za, self.eps, share=not rebuild, gosc=gosc,
+                                            single=SINGLE_FACTORS and not rebuild)
+            else:
+                pc = cls(gbar, Za, self.eps, share=not rebuild, gosc=gosc)
             pc.oscillating = gosc is not gbar
             pc.nodes = act
             pc.first_iterations = None  # GMRES iterations per decade, first run
@@ -704,6 +733,8 @@ class KrylovJacobian:
         """GMRES on one right-hand side. When it fails with a preconditioner kept from an
         earlier Jacobian or with shared factors, one more run from its last iterate with a
         preconditioner rebuilt from this Jacobian without sharing; when a fresh unshared one
+        or with single-precision factors (:data:`SINGLE_FACTORS`) the same with a
+        double-precision one; when a fresh unshared one in double
         with the oscillating gains of :func:`harmonic_gains` fails, the owner takes the mean
         gain from then on and one more run follows with it; a fresh unshared one with the
         mean gain is the best at hand (GMRES's last iterate is returned). A kept
@@ -734,7 +765,7 @@ class KrylovJacobian:
                       and rate > REBUILD_GROWTH * pc.first_iterations):
                     self.owner._precond = None  # slow: rebuild at the next Jacobian
                 break
-            if fresh and not pc.shared:
+            if fresh and not pc.shared and not getattr(pc, "single", False):
                 if not pc.oscillating:
                     break  # the best preconditioner at hand: GMRES's last iterate
                 self.owner._mean_gain = True  # the oscillating gains failed here
