@@ -41,9 +41,10 @@ SHARE_BELOW = 0.25
 #: of its triangular solves and half their memory, LAPACK's sgetrf for its builds): the
 #: preconditioner approximates the active block whatever its precision and GMRES multiplies
 #: by the operator in double, so the step is solved to ``rtol`` all the same; a rebuild after
-#: a GMRES failure factors in double. On benchmarks/scale_3d.py's partial-slip pad: the
-#: preconditioner's applies 36 % and builds 27 % cheaper at 1024 contact nodes, the solution
-#: the double one's to 3e-9 (docs/studies/large-interface-solve.md, "The growth's terms")
+#: a GMRES failure factors in double. On benchmarks/scale_3d.py's partial-slip pad at 1024
+#: contact nodes: the preconditioner's applies 9.6 to 5.9-6.1 s CPU, its builds 6.1-6.4 to
+#: 4.6-5.7 s, the solution the double one's to 3e-9 (docs/studies/large-interface-solve.md,
+#: "The growth's terms, measured")
 SINGLE_FACTORS = True
 #: Krylov vectors kept before a restart, and restarts allowed
 GMRES_RESTART = 60
