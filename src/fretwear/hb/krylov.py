@@ -15,11 +15,11 @@ with per-harmonic factorisations of the active block: replacing each node's time
 by its mean over the period (``gbar_p``, the (0, 0) coefficient block of ``G_p``) makes it
 block-diagonal per harmonic, ``P_n = eps I + gbar (Z_aa(n w) - eps I)`` (``gbar``
 block-diagonal per node), so the preconditioner is ``k + 1`` dense LUs of ``m_a x m_a``
-(``m_a`` = active DOFs). It is exact for nodes whose gain does not vary over the period and
-for a linear interface; it is kept while the active set does not change and rebuilt when
-GMRES slows down. The contact law and the residual are those of the dense path: only the
-linear algebra of the step differs, so the converged answer is the same
-(tests/hb/test_krylov.py).
+(``m_a`` = active DOFs; in single precision, :data:`SINGLE_FACTORS`). It is exact for
+nodes whose gain does not vary over the period and for a linear interface; it is kept
+while the active set does not change and rebuilt when GMRES slows down. The contact law and
+the residual are those of the dense path: only the linear algebra of the step differs, so
+the converged answer is the same (tests/hb/test_krylov.py).
 """
 
 from __future__ import annotations
