@@ -66,20 +66,32 @@ def test_the_api_reference_lists_every_public_name():
 
 #: what a lab notebook leaves in a page: the machine's load, sessions and issue numbers of
 #: the development, "before this version", commit hashes (a word of 7-40 hex digits with a
-#: letter and a digit)
+#: letter and a digit), the rounds of a development ("the fourth round")
 NOTEBOOK = [r"load\s+average", r"\bat\s+a\s+load\b", r"\bload\s+\d+(\.\d+)?\s*-\s*\d",
             r"\bloaded\s+machine", r"\bsession\b", r"\bissue\s+\d+", r"\bthe\s+issue'?s?\b",
-            r"\bbefore\s+this\s+version", r"\b(?=[0-9a-f]*[a-f])(?=[0-9a-f]*\d)[0-9a-f]{7,40}\b"]
+            r"\bbefore\s+this\s+version", r"\b(?=[0-9a-f]*[a-f])(?=[0-9a-f]*\d)[0-9a-f]{7,40}\b",
+            r"\b(first|second|third|fourth|fifth|sixth)\s+round\b"]
+
+
+def _nav_pages(section: str) -> list[Path]:
+    """The pages under `section` ("User guide", "Reference", ...) in mkdocs.yml's nav."""
+    import re
+
+    nav = (ROOT / "mkdocs.yml").read_text().split("\nnav:\n", 1)[1]
+    part = nav.split(f"  - {section}:\n", 1)[1].split("\n  - ", 1)[0]
+    return [ROOT / "docs" / p for p in re.findall(r":\s*(\S+\.md)\s*$", part, re.M)]
 
 
 def _user_guide_pages() -> list[Path]:
     """The pages under "User guide" in mkdocs.yml's nav (and the home page)."""
+    return [ROOT / "docs" / "index.md"] + _nav_pages("User guide")
+
+
+def _notebook_phrases(pages: list[Path]) -> list[str]:
     import re
 
-    nav = (ROOT / "mkdocs.yml").read_text().split("\nnav:\n", 1)[1]
-    guide = nav.split("  - User guide:\n", 1)[1].split("\n  - ", 1)[0]
-    return [ROOT / "docs" / "index.md"] + [ROOT / "docs" / p for p in
-                                           re.findall(r":\s*(\S+\.md)\s*$", guide, re.M)]
+    return [f"docs/{page.relative_to(ROOT / 'docs').as_posix()}: {m.group(0)!r}"
+            for page in pages for p in NOTEBOOK for m in re.finditer(p, page.read_text(), re.I)]
 
 
 def test_user_guide_pages_read_as_a_guide_not_a_lab_notebook():
@@ -92,13 +104,34 @@ def test_user_guide_pages_read_as_a_guide_not_a_lab_notebook():
 
     samples = ["(load\naverage 4-5)", "at a load of 12", "load 18-29", "on the loaded machine",
                "issue 29's second session", "The issue's oscillator", "before this version",
-               "commit f956b9d"]
+               "commit f956b9d", "At the fifth\nround"]
     for text in samples:
         assert any(re.search(p, text, re.I) for p in NOTEBOOK), text
     assert not any(re.search(p, "static load 20 MPa; 1e-6 m; 2e+11; 0.0001", re.I)
                    for p in NOTEBOOK)
     pages = _user_guide_pages()
     assert {"tutorial.md", "api.md", "wear.md", "study.md"} <= {p.name for p in pages}
-    found = [f"docs/{page.name}: {m.group(0)!r}" for page in pages
-             for p in NOTEBOOK for m in re.finditer(p, page.read_text(), re.I)]
-    assert found == []
+    assert _notebook_phrases(pages) == []
+
+
+def test_reference_and_validation_pages_state_results_not_their_history():
+    """The Reference pages (theory, architecture) and the Validation pages (verification,
+    reproduction, the paper's examples, peer codes) state what a method is and what it
+    guarantees, with the figures a user needs; the machine's loads, sessions, rounds, issue
+    numbers and commit hashes of the measurements are in docs/studies/ (the Investigations),
+    linked from them. The same phrases as the user guide's test, whose samples check the
+    patterns."""
+    pages = _nav_pages("Reference") + _nav_pages("Validation")
+    assert {"theory.md", "architecture.md", "verification.md", "reproduction.md",
+            "examples.md", "peers.md"} <= {p.name for p in pages}
+    assert _notebook_phrases(pages) == []
+
+
+def test_the_investigations_hold_the_history():
+    """The studies are where the history goes: the scan above leaves them out, and the nav
+    lists them under "Investigations" (a study page put under Reference would fail the scan
+    by design, one put nowhere fails the nav test)."""
+    studies = {p.relative_to(ROOT / "docs").as_posix() for p in _nav_pages("Investigations")}
+    on_disk = {p.relative_to(ROOT / "docs").as_posix()
+               for p in (ROOT / "docs" / "studies").glob("*.md")}
+    assert on_disk and on_disk <= studies
