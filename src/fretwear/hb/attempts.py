@@ -25,10 +25,13 @@ Single solve (:class:`Trial`; :data:`~fretwear.hb.options.STRATEGY`, the rungs t
    steady state starts one more solve with its mean tangential positions as anchors.
 
 Sweep point (:class:`Point`; :data:`POINT_RUNGS`): ``"grid"`` (the solver from the secant
-predictor), ``"substep"`` (bisection of the step from the last converged point), ``"retry"``
-(the other solver from the neighbour), ``"arclength"`` (pseudo-arclength continuation past a
-fold, :mod:`fretwear.hb.arclength`; before ``"retry"`` when the branch turns back short of the
-grid frequency, :data:`FOLD_RUNGS`, :func:`point_ladder`), the rungs 3-4 of a single solve from
+predictor, on past its ``max_iter`` while it makes progress, :func:`go_on`), ``"substep"``
+(bisection of the step from the last converged point), ``"retry"`` (the other solver from the
+neighbour), ``"arclength"`` (pseudo-arclength continuation past a fold,
+:mod:`fretwear.hb.arclength`; before ``"retry"`` when the branch turns back short of the grid
+frequency, :data:`FOLD_RUNGS`, :func:`point_ladder`), ``"jump"`` (where the arclength turned
+back at a fold short of the frequency: the grid attempt from the fold's point, :func:`jump`),
+the rungs 3-4 of a single solve from
 the neighbour (at the first point of a branch, which has none, from the contact-closed guess
 with a single solve's iterations), ``"fresh-start"`` (as a single solve from the first harmonic
 alone with the static anchors and five times the iterations: the neighbour's state can lie on
@@ -70,6 +73,14 @@ EPS_STEP_MAX_ITER = 20
 #: iterations of the fresh start of a sweep point (as a single solve makes it), as a multiple
 #: of the sweep's ``max_iter``: 5 x 40 is the single solve's default of 200
 FRESH_ITER_FACTOR = 5
+#: a grid attempt that used its ``max_iter`` iterations without converging goes on from its
+#: last iterate for at most this many times ``max_iter`` more, while the solver makes
+#: progress (MINPACK's test with :data:`GRID_MAX_SLOW` Jacobians, :func:`go_on`): Powell
+#: from the secant predictor converged in 68 iterations on the dovetail's FRF at 2800 Hz and
+#: in 88 on the bladed disk's at 3100 Hz, where 40 sent the point down the ladder to the
+#: other solver (docs/studies/fallbacks.md, "The four crossings")
+GRID_MORE_ITER = 4
+GRID_MAX_SLOW = 5
 #: harmonics above which a single solve without a start begins from the first harmonic alone
 #: (the first point of a sweep too): with more than one. From the contact-closed guess the
 #: solvers stalled with 15+ harmonics (docs/verification.md), and with 3 wherever the
@@ -375,7 +386,8 @@ class Point:
     solve, how it was made, every attempt, and what a time integration found (None: none
     ran); whether the halved steps failed down to the smallest (``halved_out``) and the index
     in the branch's history of the last converged point before the arclength ran
-    (``neighbour``: None before it ran)."""
+    (``neighbour``: None before it ran) and of its point at a fold it turned back from short
+    of the frequency (``fold``: None if it did not, :func:`jump`)."""
 
     frequency: float
     probs: Problems
@@ -390,6 +402,7 @@ class Point:
     fallback_seconds: float = 0.0
     halved_out: bool = False
     neighbour: int | None = None
+    fold: int | None = None
 
     @property
     def omega(self) -> float:
@@ -410,13 +423,31 @@ def solve_at(probs: Problems, omega: float, anchor, U0, options: SolveOptions):
     return prob, x, st
 
 
-def _solve(prob: DLFTProblem, x0, options: SolveOptions):
+def _solve(prob: DLFTProblem, x0, options: SolveOptions, max_slow=None):
     def fun(x, jac=True):
         return prob.residual(x.reshape(prob.m, prob.H), jac)
 
     x, _, st = solve(fun, x0.reshape(-1), lambda x: prob.scale(x.reshape(prob.m, prob.H)),
-                     method=options.solver, tol=options.tol, max_iter=options.max_iter)
+                     method=options.solver, tol=options.tol, max_iter=options.max_iter,
+                     max_slow=max_slow)
     return x.reshape(prob.m, prob.H), st
+
+
+def go_on(prob: DLFTProblem, U, st: SolveStats, options: SolveOptions):
+    """``(U, stats)`` of a solve that used its ``options.max_iter`` iterations without
+    converging, continued from its last iterate ``U`` for at most :data:`GRID_MORE_ITER` times
+    as many while it makes progress (MINPACK's test, ``max_slow`` =
+    :data:`GRID_MAX_SLOW` Jacobians in a row without decreasing ``|f|^2`` by 10 %; a
+    non-smooth stall or a failed line search ends it too); a solve that converged, or
+    stopped for another reason, is returned as it is. The statistics add up both runs."""
+    if st.success or st.iterations < options.max_iter:
+        return U, st
+    x, st2 = _solve(prob, U, options.replace(max_iter=GRID_MORE_ITER * options.max_iter),
+                    max_slow=GRID_MAX_SLOW)
+    merged = SolveStats(st2.success, st2.residual, st.iterations + st2.iterations,
+                        st.nfev + st2.nfev, st.njev + st2.njev, st.wall_time + st2.wall_time,
+                        st2.message, st2.solver)
+    return x, merged
 
 
 def grid(p: Point) -> bool:
@@ -432,6 +463,8 @@ def grid(p: Point) -> bool:
         so = so.replace(max_iter=max(so.max_iter, PERIODIC.max_iter))
         U0 = cold_start(p.probs.get(p.omega, b.anchor()), None, so)
     prob, U, st = solve_at(p.probs, p.omega, b.anchor(), U0, so)
+    if len(b.history) >= 2:  # a warm-started point: on while the solver makes progress
+        U, st = go_on(prob, U, st, so)
     p.tried.append(Attempt.of("grid", prob.eps, st))
     return p.adopt(prob, U, st, "grid")
 
@@ -500,6 +533,7 @@ def arclength_branch(p: Point) -> bool:
                       opts.solve.tol)
     for Ub, wb, stb, pb in found:
         b.add(wb, pb, Ub.reshape(pb.m, pb.H), stb, "arclength")
+    p.fold = turned_back(b.history, p.neighbour, p.omega)
     if not found:
         p.tried.append(Attempt("arclength", "arclength", p.probs.get(p.omega, anc).eps, False,
                                float("nan"), 0, time.perf_counter() - t_arc,
@@ -511,6 +545,41 @@ def arclength_branch(p: Point) -> bool:
     p.tried.append(dataclasses.replace(Attempt.of("arclength", prob.eps, st),
                                        wall_time=time.perf_counter() - t_arc))
     return p.adopt(prob, U, st, "arclength")
+
+
+def turned_back(history, start: int, omega: float) -> int | None:
+    """The index in ``history`` of the point where the branch after ``history[start]`` turned
+    back short of ``omega`` [rad/s] (the farthest towards ``omega``, with a later point back
+    from it: a fold the arclength went round), None if it did not (it went on towards
+    ``omega``, or reached it)."""
+    march = np.sign(omega - history[start][0])
+    ws = [march * float(w) for w, _ in history[start:]]
+    tip = int(np.argmax(ws))
+    if tip == 0 or tip == len(ws) - 1 or ws[tip] >= march * omega:
+        return None
+    return start + tip
+
+
+def jump(p: Point) -> bool:
+    """``"jump"``: after an arclength that turned back at a fold short of this frequency and
+    did not come back to it (``p.fold``, :func:`turned_back`), the sweep's first attempt (its
+    solver, :func:`go_on`) from the branch's point at the fold, with its anchors: the jump a
+    stepped-sine test makes there (the response leaves the branch at its fold for the branch
+    that exists at the next frequency). Said as a line, and in the run's summary
+    (:func:`fretwear.hb.fallbacks.of_solutions`). Not tried where no fold was passed."""
+    if p.fold is None:
+        return False
+    b, so = p.branch, p.options.solve
+    w_fold = float(b.history[p.fold][0])
+    prob, U, st = solve_at(p.probs, p.omega, b.anchor(p.fold), b.history[p.fold][1], so)
+    U, st = go_on(prob, U, st, so)
+    f_fold = w_fold / (2 * np.pi)
+    p.tried.append(Attempt.of("jump", prob.eps, st,
+                              f"{st.message} (from the fold at {f_fold:.6g} Hz)"))
+    said(f"sweep at {p.frequency:.6g} Hz: the branch turns back at a fold at {f_fold:.6g} Hz; "
+         f"jump from there to {p.frequency:.6g} Hz: "
+         + ("converged" if st.success else f"not converged ({st.residual:.2e})"))
+    return p.adopt(prob, U, st, "jump")
 
 
 def _single(p: Point, prob: DLFTProblem, x0, options: SolveOptions, rungs, how) -> bool:
@@ -580,11 +649,13 @@ def point_time_start(p: Point) -> bool:
 
 #: the rungs of a sweep point, in order
 POINT_RUNGS = (("grid", grid), ("substep", substep), ("retry", retry),
-               ("arclength", arclength_branch), ("continuation", continuation),
-               ("fresh-start", fresh_start), ("time-start", point_time_start))
-#: the rungs of a sweep point with a fold ahead (:func:`point_ladder`): the arclength before
-#: the other solver, the rest in order
-FOLD_RUNGS = (POINT_RUNGS[0], POINT_RUNGS[1], POINT_RUNGS[3], POINT_RUNGS[2], *POINT_RUNGS[4:])
+               ("arclength", arclength_branch), ("jump", jump),
+               ("continuation", continuation), ("fresh-start", fresh_start),
+               ("time-start", point_time_start))
+#: the rungs of a sweep point with a fold ahead (:func:`point_ladder`): the arclength (and the
+#: jump from a fold it turned back at) before the other solver, the rest in order
+FOLD_RUNGS = (POINT_RUNGS[0], POINT_RUNGS[1], POINT_RUNGS[3], POINT_RUNGS[4], POINT_RUNGS[2],
+              *POINT_RUNGS[5:])
 
 
 #: the rungs of a sweep point said as they start (the costly ones; the first four are the
@@ -615,7 +686,28 @@ def point_ladder(p: Point) -> Point:
     2800 Hz, where the arclength's corrector diverged and Newton from the neighbour
     converged), the other solver keeps its place before the arclength: one solve at the grid
     frequency, where the arclength pays a condensation per corrector iterate at every new
-    frequency."""
+    frequency.
+
+    Why the grid attempt goes on past ``max_iter`` while it makes progress (:func:`go_on`):
+    on the FE FRFs the grid attempts that fell back away from a fold were Powell solves
+    still converging at their 40th iteration (docs/studies/fallbacks.md, "The four
+    crossings"): the dovetail at 2800 Hz (1.9 -> 7.6e-2 in 40, converged in 68) and the
+    bladed disk at 3100 Hz (0.82 -> 6.2e-3, converged in 88); cut at 40, the point went down
+    the halved steps (each a failed 40-iteration solve near the target), the arclength and
+    the other solver. Where the solver stalls (a fold with no point ahead, a non-smooth
+    stall) MINPACK's progress test ends the extension within a few Jacobians (the bladed
+    disk's fold at 2800 Hz: 15 more iterations). A grid attempt that converged within
+    ``max_iter`` is unchanged.
+
+    Why a jump (:func:`jump`): where the arclength went round a fold and turned back short of
+    the grid frequency without coming back to it (the platform damper's FRF: the branch
+    turns at 38476.5 Hz and leads back down, 41016.8 Hz lies beyond the fold), the response
+    of a stepped-sine test leaves the branch at the fold for the branch that exists at the
+    next frequency. The sweep computes that jump with its own first attempt (its solver, its
+    iterations) from the branch's point at the fold and its stick anchors, says it, and
+    lists it in the run's summary; the other solver and the eps continuation from the last
+    point of the arclength (on the branch leading away, which the test never visits) came
+    after it and remain for a jump that does not converge."""
     t_first = None
     rungs = POINT_RUNGS
     for i in range(len(rungs)):
