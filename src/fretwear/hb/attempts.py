@@ -25,9 +25,9 @@ Single solve (:class:`Trial`; :data:`~fretwear.hb.options.STRATEGY`, the rungs t
    steady state starts one more solve with its mean tangential positions as anchors.
 
 Sweep point (:class:`Point`; :data:`POINT_RUNGS`): ``"grid"`` (the solver from the secant
-predictor, on past its ``max_iter`` while it makes progress, :func:`go_on`), ``"substep"``
-(bisection of the step from the last converged point), ``"retry"`` (the other solver from the
-neighbour), ``"arclength"`` (pseudo-arclength continuation past a fold,
+predictor), ``"substep"`` (bisection of the step from the last converged point, each step on
+past its ``max_iter`` while the solver makes progress, :func:`go_on`), ``"retry"`` (the
+other solver from the neighbour), ``"arclength"`` (pseudo-arclength continuation past a fold,
 :mod:`fretwear.hb.arclength`; before ``"retry"`` when the branch turns back short of the grid
 frequency, :data:`FOLD_RUNGS`, :func:`point_ladder`), ``"jump"`` (where the arclength turned
 back at a fold short of the frequency: the grid attempt from the fold's point, :func:`jump`),
@@ -73,14 +73,14 @@ EPS_STEP_MAX_ITER = 20
 #: iterations of the fresh start of a sweep point (as a single solve makes it), as a multiple
 #: of the sweep's ``max_iter``: 5 x 40 is the single solve's default of 200
 FRESH_ITER_FACTOR = 5
-#: a grid attempt that used its ``max_iter`` iterations without converging goes on from its
-#: last iterate for at most this many times ``max_iter`` more, while the solver makes
-#: progress (MINPACK's test with :data:`GRID_MAX_SLOW` Jacobians, :func:`go_on`): Powell
-#: from the secant predictor converged in 68 iterations on the dovetail's FRF at 2800 Hz and
-#: in 88 on the bladed disk's at 3100 Hz, where 40 sent the point down the ladder to the
-#: other solver (docs/studies/fallbacks.md, "The four crossings")
-GRID_MORE_ITER = 4
-GRID_MAX_SLOW = 5
+#: a halved step of a sweep point that used its ``max_iter`` iterations without converging
+#: goes on from its last iterate for at most this many times ``max_iter`` more, while the
+#: solver makes progress (MINPACK's test with :data:`STEP_MAX_SLOW` Jacobians,
+#: :func:`go_on`): on the FE FRFs Powell was still converging at its 40th iteration where the
+#: ladder then went on to the other solver (the dovetail at 2800 Hz: 1.9 -> 7.6e-2 in 40,
+#: converged in 68; docs/studies/fallbacks.md, "The four crossings")
+STEP_MORE_ITER = 4
+STEP_MAX_SLOW = 5
 #: harmonics above which a single solve without a start begins from the first harmonic alone
 #: (the first point of a sweep too): with more than one. From the contact-closed guess the
 #: solvers stalled with 15+ harmonics (docs/verification.md), and with 3 wherever the
@@ -435,15 +435,15 @@ def _solve(prob: DLFTProblem, x0, options: SolveOptions, max_slow=None):
 
 def go_on(prob: DLFTProblem, U, st: SolveStats, options: SolveOptions):
     """``(U, stats)`` of a solve that used its ``options.max_iter`` iterations without
-    converging, continued from its last iterate ``U`` for at most :data:`GRID_MORE_ITER` times
+    converging, continued from its last iterate ``U`` for at most :data:`STEP_MORE_ITER` times
     as many while it makes progress (MINPACK's test, ``max_slow`` =
-    :data:`GRID_MAX_SLOW` Jacobians in a row without decreasing ``|f|^2`` by 10 %; a
+    :data:`STEP_MAX_SLOW` Jacobians in a row without decreasing ``|f|^2`` by 10 %; a
     non-smooth stall or a failed line search ends it too); a solve that converged, or
     stopped for another reason, is returned as it is. The statistics add up both runs."""
     if st.success or st.iterations < options.max_iter:
         return U, st
-    x, st2 = _solve(prob, U, options.replace(max_iter=GRID_MORE_ITER * options.max_iter),
-                    max_slow=GRID_MAX_SLOW)
+    x, st2 = _solve(prob, U, options.replace(max_iter=STEP_MORE_ITER * options.max_iter),
+                    max_slow=STEP_MAX_SLOW)
     merged = SolveStats(st2.success, st2.residual, st.iterations + st2.iterations,
                         st.nfev + st2.nfev, st.njev + st2.njev, st.wall_time + st2.wall_time,
                         st2.message, st2.solver)
@@ -463,8 +463,6 @@ def grid(p: Point) -> bool:
         so = so.replace(max_iter=max(so.max_iter, PERIODIC.max_iter))
         U0 = cold_start(p.probs.get(p.omega, b.anchor()), None, so)
     prob, U, st = solve_at(p.probs, p.omega, b.anchor(), U0, so)
-    if len(b.history) >= 2:  # a warm-started point: on while the solver makes progress
-        U, st = go_on(prob, U, st, so)
     p.tried.append(Attempt.of("grid", prob.eps, st))
     return p.adopt(prob, U, st, "grid")
 
@@ -472,7 +470,8 @@ def grid(p: Point) -> bool:
 def substep(p: Point) -> bool:
     """``"substep"``: from the last converged point, steps halved on failure (at most
     ``max_bisections`` times) and grown by 1.5 on success, each converged intermediate point
-    kept in the sweep. A failure that halved the step below its smallest sets
+    kept in the sweep; a step's solve goes on while it makes progress (:func:`go_on`). A
+    failure that halved the step below its smallest sets
     ``p.halved_out`` (a fold's sign, :func:`~fretwear.hb.arclength.fold_ahead`)."""
     b, omega, opts = p.branch, p.omega, p.options
     if not b.history:
@@ -488,6 +487,7 @@ def substep(p: Point) -> bool:
         if last:
             w_try = omega
         pb, Ub, stb = solve_at(p.probs, w_try, b.anchor(), b.predict(w_try), opts.solve)
+        Ub, stb = go_on(pb, Ub, stb, opts.solve)
         if not stb.success:
             step *= 0.5
             continue
@@ -688,16 +688,20 @@ def point_ladder(p: Point) -> Point:
     frequency, where the arclength pays a condensation per corrector iterate at every new
     frequency.
 
-    Why the grid attempt goes on past ``max_iter`` while it makes progress (:func:`go_on`):
-    on the FE FRFs the grid attempts that fell back away from a fold were Powell solves
+    Why the halved steps go on past ``max_iter`` while the solver makes progress
+    (:func:`go_on`): on the FE FRFs the points that fell back away from a fold (the other
+    solver from the neighbour converging after the halved steps failed) were Powell solves
     still converging at their 40th iteration (docs/studies/fallbacks.md, "The four
-    crossings"): the dovetail at 2800 Hz (1.9 -> 7.6e-2 in 40, converged in 68) and the
-    bladed disk at 3100 Hz (0.82 -> 6.2e-3, converged in 88); cut at 40, the point went down
-    the halved steps (each a failed 40-iteration solve near the target), the arclength and
-    the other solver. Where the solver stalls (a fold with no point ahead, a non-smooth
-    stall) MINPACK's progress test ends the extension within a few Jacobians (the bladed
-    disk's fold at 2800 Hz: 15 more iterations). A grid attempt that converged within
-    ``max_iter`` is unchanged.
+    crossings"): the dovetail at 2800 Hz (from the predictor 1.9 -> 7.6e-2 in 40, converged
+    in 68), the bladed disk at 3100 Hz (converged in 88) and at 2900 Hz (where Powell
+    stalls over the whole 100 Hz step, but converges over its half). Cut at 40, every halved
+    step failed down to the smallest and the point went to the other solver; going on, a
+    halved step converges and the point is reached along the branch. The grid attempt keeps
+    its ``max_iter``: a longer solve over the whole grid step lands, where the friction
+    state depends on the loading path, on the state of the coarser path (the bladed disk at
+    3100 Hz: 5 % from a sweep of 10 Hz steps), and past a fold it only costs more. Where the
+    solver stalls (a fold with no point ahead, a non-smooth stall) MINPACK's progress test
+    ends the extension within a few Jacobians.
 
     Why a jump (:func:`jump`): where the arclength went round a fold and turned back short of
     the grid frequency without coming back to it (the platform damper's FRF: the branch
