@@ -352,7 +352,8 @@ def test_turned_back_finds_the_fold_the_branch_went_round():
     turn (the fold is the point at 0 degrees, the one farthest towards the target); up to
     0 degrees it has not turned back yet, and one that comes back past the target (an
     S-shaped branch, as the folded friction model's) or never reaches the turn has no fold
-    to jump from. The same marching down (target 0.8, the circle mirrored)."""
+    to jump from, nor one whose last point lies back from the turn by less than 1 % of the
+    way (a corrector's jitter). The same marching down (target 0.8, the circle mirrored)."""
     from fretwear.hb.attempts import turned_back
 
     def arc(degrees, sign=1.0):
@@ -366,3 +367,5 @@ def test_turned_back_finds_the_fold_the_branch_went_round():
     back_past = [*went_round, (1.25, np.zeros(1))]
     assert turned_back(back_past, 0, 1.2) is None  # reached the target after all
     assert turned_back(arc([-40, -20, 0, 15, 30], -1.0), 0, 0.8) == 2
+    jitter = [*arc([-40, -20, 0]), (1.1 - 1e-6, np.zeros(1))]  # back by 4e-5 of the way
+    assert turned_back(jitter, 0, 1.2) is None

@@ -81,6 +81,11 @@ FRESH_ITER_FACTOR = 5
 #: converged in 68; docs/studies/fallbacks.md, "The four crossings")
 STEP_MORE_ITER = 4
 STEP_MAX_SLOW = 5
+#: a branch turned back at a fold (:func:`turned_back`, the rung ``"jump"``) when its last
+#: point lies back from its farthest one by more than this fraction of the way it went: on
+#: the platform damper's FRF the arclength went 360 Hz up to its fold at 38476.5 Hz and 63 Hz
+#: back (0.17); its correctors' jitter at a fold's tip moves a few 1e-4 of that
+TURN_BACK = 0.01
 #: harmonics above which a single solve without a start begins from the first harmonic alone
 #: (the first point of a sweep too): with more than one. From the contact-closed guess the
 #: solvers stalled with 15+ harmonics (docs/verification.md), and with 3 wherever the
@@ -549,13 +554,15 @@ def arclength_branch(p: Point) -> bool:
 
 def turned_back(history, start: int, omega: float) -> int | None:
     """The index in ``history`` of the point where the branch after ``history[start]`` turned
-    back short of ``omega`` [rad/s] (the farthest towards ``omega``, with a later point back
-    from it: a fold the arclength went round), None if it did not (it went on towards
-    ``omega``, or reached it)."""
+    back short of ``omega`` [rad/s] (the farthest towards ``omega``, with the last point back
+    from it by at least :data:`TURN_BACK` of the way from ``history[start]`` to it: a fold the
+    arclength went round, not the jitter of its correctors), None if it did not (it went on
+    towards ``omega``, or reached it)."""
     march = np.sign(omega - history[start][0])
     ws = [march * float(w) for w, _ in history[start:]]
     tip = int(np.argmax(ws))
-    if tip == 0 or tip == len(ws) - 1 or ws[tip] >= march * omega:
+    if tip == 0 or ws[tip] >= march * omega or ws[tip] - ws[-1] <= TURN_BACK * (ws[tip]
+                                                                                - ws[0]):
         return None
     return start + tip
 
