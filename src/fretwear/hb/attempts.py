@@ -472,11 +472,12 @@ def grid(p: Point) -> bool:
     return p.adopt(prob, U, st, "grid")
 
 
-def substep(p: Point) -> bool:
+def substep(p: Point, patient: bool = False) -> bool:
     """``"substep"``: from the last converged point, steps halved on failure (at most
     ``max_bisections`` times) and grown by 1.5 on success, each converged intermediate point
-    kept in the sweep; a step's solve goes on while it makes progress (:func:`go_on`). A
-    failure that halved the step below its smallest sets
+    kept in the sweep; with ``patient`` (:func:`patient_substep`) each step's solve goes on
+    while it makes progress (:func:`go_on`). A failure that halved the step below its
+    smallest sets
     ``p.halved_out`` (a fold's sign, :func:`~fretwear.hb.arclength.fold_ahead`)."""
     b, omega, opts = p.branch, p.omega, p.options
     if not b.history:
@@ -492,7 +493,8 @@ def substep(p: Point) -> bool:
         if last:
             w_try = omega
         pb, Ub, stb = solve_at(p.probs, w_try, b.anchor(), b.predict(w_try), opts.solve)
-        Ub, stb = go_on(pb, Ub, stb, opts.solve)
+        if patient:
+            Ub, stb = go_on(pb, Ub, stb, opts.solve)
         if not stb.success:
             step *= 0.5
             continue
@@ -506,6 +508,14 @@ def substep(p: Point) -> bool:
             step = omega - w_cur
     p.halved_out = abs(step) < abs(min_step) * (1 - 1e-12)
     return False
+
+
+def patient_substep(p: Point) -> bool:
+    """``"substep"`` again after the halved steps failed (and, with a fold ahead, after the
+    arclength did not reach the frequency), each step's solve going on past ``max_iter``
+    while the solver makes progress (:func:`go_on`): the sweep's own path along the branch
+    where the solver converges slowly (:func:`point_ladder`). Recorded as ``"substep"``."""
+    return substep(p, patient=True)
 
 
 def retry(p: Point) -> bool:
@@ -655,14 +665,15 @@ def point_time_start(p: Point) -> bool:
 
 
 #: the rungs of a sweep point, in order
-POINT_RUNGS = (("grid", grid), ("substep", substep), ("retry", retry),
-               ("arclength", arclength_branch), ("jump", jump),
+POINT_RUNGS = (("grid", grid), ("substep", substep), ("patient-substep", patient_substep),
+               ("retry", retry), ("arclength", arclength_branch), ("jump", jump),
                ("continuation", continuation), ("fresh-start", fresh_start),
                ("time-start", point_time_start))
 #: the rungs of a sweep point with a fold ahead (:func:`point_ladder`): the arclength (and the
-#: jump from a fold it turned back at) before the other solver, the rest in order
-FOLD_RUNGS = (POINT_RUNGS[0], POINT_RUNGS[1], POINT_RUNGS[3], POINT_RUNGS[4], POINT_RUNGS[2],
-              *POINT_RUNGS[5:])
+#: jump from a fold it turned back at) before the patient halved steps and the other solver,
+#: the rest in order
+FOLD_RUNGS = (POINT_RUNGS[0], POINT_RUNGS[1], POINT_RUNGS[4], POINT_RUNGS[5], POINT_RUNGS[2],
+              POINT_RUNGS[3], *POINT_RUNGS[6:])
 
 
 #: the rungs of a sweep point said as they start (the costly ones; the first four are the
