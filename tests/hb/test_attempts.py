@@ -315,8 +315,9 @@ def test_halved_steps_go_on_while_the_solver_makes_progress():
     their first iteration. The old ladder's halved steps stopped there too, and at 0.74 rad/s
     every one failed: the arclength, the other solver (a fallback), then the eps continuation
     from the last point, which landed on the lower branch (0.29 against 1.05, a jump the
-    sweep did not see). The halved steps now go on from their last iterate while the solver
-    makes progress (:func:`fretwear.hb.attempts.go_on`), so every point is reached by the
+    sweep did not see). The halved steps are now tried again with each step going on from its
+    last iterate while the solver makes progress (:func:`fretwear.hb.attempts.
+    patient_substep`, :func:`~fretwear.hb.attempts.go_on`), so every point is reached by the
     sweep's own path (no fallback). Independent check: the same grid points as the sweep
     with the default 40 iterations a point (which converges at every grid attempt), to 1e-8
     of the amplitude (the solve's relative tolerance; measured 1e-15)."""

@@ -25,11 +25,13 @@ Single solve (:class:`Trial`; :data:`~fretwear.hb.options.STRATEGY`, the rungs t
    steady state starts one more solve with its mean tangential positions as anchors.
 
 Sweep point (:class:`Point`; :data:`POINT_RUNGS`): ``"grid"`` (the solver from the secant
-predictor), ``"substep"`` (bisection of the step from the last converged point, each step on
-past its ``max_iter`` while the solver makes progress, :func:`go_on`), ``"retry"`` (the
+predictor), ``"substep"`` (bisection of the step from the last converged point), the same
+again with each step going on past its ``max_iter`` while the solver makes progress
+(:func:`patient_substep`, :func:`go_on`; recorded as ``"substep"``), ``"retry"`` (the
 other solver from the neighbour), ``"arclength"`` (pseudo-arclength continuation past a fold,
 :mod:`fretwear.hb.arclength`; before ``"retry"`` when the branch turns back short of the grid
-frequency, :data:`FOLD_RUNGS`, :func:`point_ladder`), ``"jump"`` (where the arclength turned
+frequency, :data:`FOLD_RUNGS`, :func:`point_ladder`; before the patient halved steps too),
+``"jump"`` (where the arclength turned
 back at a fold short of the frequency: the grid attempt from the fold's point, :func:`jump`),
 the rungs 3-4 of a single solve from
 the neighbour (at the first point of a branch, which has none, from the contact-closed guess
@@ -706,18 +708,22 @@ def point_ladder(p: Point) -> Point:
     frequency, where the arclength pays a condensation per corrector iterate at every new
     frequency.
 
-    Why the halved steps go on past ``max_iter`` while the solver makes progress
-    (:func:`go_on`): on the FE FRFs the points that fell back away from a fold (the other
-    solver from the neighbour converging after the halved steps failed) were Powell solves
-    still converging at their 40th iteration (docs/studies/fallbacks.md, "The four
-    crossings"): the dovetail at 2800 Hz (from the predictor 1.9 -> 7.6e-2 in 40, converged
-    in 68), the bladed disk at 3100 Hz (converged in 88) and at 2900 Hz (where Powell
-    stalls over the whole 100 Hz step, but converges over its half). Cut at 40, every halved
-    step failed down to the smallest and the point went to the other solver; going on, a
-    halved step converges and the point is reached along the branch. The grid attempt keeps
-    its ``max_iter``: a longer solve over the whole grid step lands, where the friction
-    state depends on the loading path, on the state of the coarser path (the bladed disk at
-    3100 Hz: 5 % from a sweep of 10 Hz steps), and past a fold it only costs more. Where the
+    Why the patient halved steps (:func:`patient_substep`: each step going on past
+    ``max_iter`` while the solver makes progress, :func:`go_on`) come before the other
+    solver: on the FE FRFs the points that fell back away from a fold (the other solver from
+    the neighbour converging after the halved steps failed) were Powell solves still
+    converging at their 40th iteration (docs/studies/fallbacks.md, "The four crossings"):
+    the dovetail at 2800 Hz (from the predictor 1.9 -> 7.6e-2 in 40, converged in 68), the
+    bladed disk at 3100 Hz (converged in 88) and at 2900 Hz (where Powell stalls over the
+    whole 100 Hz step, but converges over its half). Cut at 40, every halved step failed
+    down to the smallest and the point went to the other solver; going on, a halved step
+    converges and the point is reached along the branch. They come after the plain halved
+    steps (and after the arclength where a fold lies ahead) so that wherever those pass, the
+    path is the same as before: going on at once, the halved steps stepped over the lap
+    joint's resonance peak (recorded up to 5.04e-5 m where the arclength's points resolve
+    6.15e-5 m). The grid attempt keeps its ``max_iter``: a longer solve over the whole grid
+    step landed, where the friction state depends on the loading path, on the state of the
+    coarser path (the bladed disk at 3100 Hz: 5 % from a sweep of 10 Hz steps). Where the
     solver stalls (a fold with no point ahead, a non-smooth stall) MINPACK's progress test
     ends the extension within a few Jacobians.
 
