@@ -39,12 +39,11 @@ from scale_3d import LOADS, Clock, Counts, H, options, pad, peak_gib, warm_up  #
 
 
 def _condenser(model, load, compress=None, representation="operator"):
-    from fretwear.hb.modal import ModalCondenser
+    from fretwear.hb.modal import ModalCondenser, Representation
 
-    out = ModalCondenser(model, load.freq * 1.2, H, modes=load.modes,
-                         representation=representation if compress is None else "compressed")
-    out.compress = compress  # the bound of "compressed" (before the first reduced model)
-    return out
+    return ModalCondenser(model, load.freq * 1.2, H, modes=load.modes,
+                          representation=(representation if compress is None
+                                          else Representation("compressed", compress)))
 
 
 def _median_time(f, reps: int) -> float:

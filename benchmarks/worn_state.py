@@ -33,7 +33,9 @@ The last lines are ``worn_state_speedup=<geometric mean of march / direct proces
 and ``worn_state_diff=<largest profile difference / largest depth>``.
 
 Run: ``python benchmarks/worn_state.py [--cases salles2011-quasistatic,stromberg1997]
-[--steps 200] [--dovetail-steps 60] [--order 2]``. Quote the figures with the machine load
+[--steps 200] [--dovetail-steps 60] [--order 2] [--events] [--no-jumps]``
+(``--events``: the direct solve with ``events = True``; ``--no-jumps``: without the
+stick-set jumps). Quote the figures with the machine load
 (``uptime``: printed before and after).
 """
 
@@ -117,7 +119,8 @@ def jumps(model, basis, f_hz, quasi, opts, balance, h, k: int) -> None:
               "march's final state")
 
 
-def run_case(name: str, steps: int, order: int = 1) -> tuple[float, float] | None:
+def run_case(name: str, steps: int, order: int = 1, events: bool = False,
+             with_jumps: bool = True) -> tuple[float, float] | None:
     """March and direct solve (its path steps of ``order``, :class:`WornStateOptions`) of
     one example: ``(speedup, profile difference)``, None when either reached no state
     within ``steps``."""
@@ -125,7 +128,8 @@ def run_case(name: str, steps: int, order: int = 1) -> tuple[float, float] | Non
     kw = {"frequency": f_hz, "quasi_static": quasi, "balance": balance}
     march, c_m, w_m = _timed(lambda: simulate_wear(model, basis, options=opts, **kw))
     direct, c_d, w_d = _timed(lambda: worn_state(
-        model, basis, options=WornStateOptions(wear=opts, max_steps=steps, order=order), **kw))
+        model, basis, options=WornStateOptions(wear=opts, max_steps=steps, order=order,
+                                               events=events), **kw))
     h = march.history
     Wm, Wd = h.wear_depth[-1], direct.wear
     top = float(np.max(Wm))
@@ -158,14 +162,15 @@ def run_case(name: str, steps: int, order: int = 1) -> tuple[float, float] | Non
     print(f"  profile difference {diff:.3g} of the largest depth, same stuck nodes "
           f"{same_stuck}, mean pressure difference {pdiff:.3g} of the largest; "
           f"speedup (processor) {c_m / c_d:.3g}, (wall) {w_m / w_d:.3g}")
-    jumps(model, basis, f_hz, quasi, opts, balance, h, k)
-    fast, c_j, w_j = _timed(lambda: worn_state(
-        model, basis, options=WornStateOptions(wear=opts, max_steps=steps, stick_set=True),
-        **kw))
-    print(f"  direct, stick_set = True: {fast.message}")
-    print(f"          processor {c_j:.2f} s, wall {w_j:.2f} s, {fast.dlft_solves} DLFT solves; "
-          f"{float(np.max(np.abs(fast.wear - Wm))) / top:.3g} of the largest depth from the "
-          f"march's final state; speedup (processor) {c_m / c_j:.3g}")
+    if with_jumps:
+        jumps(model, basis, f_hz, quasi, opts, balance, h, k)
+        fast, c_j, w_j = _timed(lambda: worn_state(
+            model, basis, options=WornStateOptions(wear=opts, max_steps=steps, stick_set=True),
+            **kw))
+        print(f"  direct, stick_set = True: {fast.message}")
+        print(f"          processor {c_j:.2f} s, wall {w_j:.2f} s, {fast.dlft_solves} DLFT "
+              f"solves; {float(np.max(np.abs(fast.wear - Wm))) / top:.3g} of the largest depth "
+              f"from the march's final state; speedup (processor) {c_m / c_j:.3g}")
     if march.stop_reason != "plateau" or not direct.success:
         print(f"  {name}: no state reached within {steps} steps (march: {march.stop_reason}, "
               f"direct: {direct.kind}); left out of the summary")
@@ -173,13 +178,14 @@ def run_case(name: str, steps: int, order: int = 1) -> tuple[float, float] | Non
     return c_m / c_d, diff
 
 
-def not_reached(steps: int, order: int = 1) -> None:
+def not_reached(steps: int, order: int = 1, events: bool = False) -> None:
     """The 79 kHz beam (salles2011-79khz), whose wear path is chaotic: the direct solve
     must say that it did not reach a state, with the residual."""
     model, basis, f_hz, quasi, opts, balance = _setup("salles2011-79khz", steps)
     res, c, w = _timed(lambda: api.worn_state(
         model, basis, frequency=f_hz,
-        options=WornStateOptions(wear=opts, max_steps=steps, order=order), balance=balance))
+        options=WornStateOptions(wear=opts, max_steps=steps, order=order, events=events),
+        balance=balance))
     print(f"salles2011-79khz: {res.message}")
     print(f"  kind {res.kind}, success {res.success}, residual {res.residual:.3g}; processor "
           f"{c:.1f} s, wall {w:.1f} s")
@@ -195,6 +201,10 @@ def main():
                     help="steps of the direct solve on the 79 kHz beam (0: skip it)")
     ap.add_argument("--order", type=int, default=1, choices=(1, 2),
                     help="the direct solve's path steps: 1 (default) or 2 (second order)")
+    ap.add_argument("--events", action="store_true",
+                    help="the direct solve locates the contact-state events along its path")
+    ap.add_argument("--no-jumps", action="store_true",
+                    help="skip the stick-set jumps and the stick_set = True solve")
     args = ap.parse_args()
     print("load before:", os.getloadavg())
     # warm-up: compiles the numba kernels (not timed)
@@ -205,12 +215,12 @@ def main():
     for name in args.cases.split(","):
         name = name.strip()
         out = run_case(name, args.dovetail_steps if name == "dovetail-wear" else args.steps,
-                       args.order)
+                       args.order, args.events, not args.no_jumps)
         if out is not None:
             speed.append(out[0])
             diffs.append(out[1])
     if args.steps_79khz > 0:
-        not_reached(args.steps_79khz, args.order)
+        not_reached(args.steps_79khz, args.order, args.events)
     print("load after:", os.getloadavg())
     if not speed:
         print("no case reached a state: no summary")

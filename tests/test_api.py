@@ -328,3 +328,32 @@ def test_subpackages_are_attributes_in_a_fresh_interpreter():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          timeout=120)
     assert out.returncode == 0 and out.stdout.strip() == "ok", out.stderr
+
+
+@pytest.mark.parametrize("driver", ["simulate_wear", "worn_state"])
+def test_a_wear_run_that_cannot_wear_is_warned(block, driver, monkeypatch):
+    """Archard coefficients all 0 (the contact's default, as in ``block``): the run stopped at
+    once with "no wear ... success=True" and said nothing else; now an UnusualValueWarning
+    names the key before the run. With k_w > 0, or under the energy law (its own
+    coefficient), no such warning. The core is replaced by a stub: only the check runs."""
+    import warnings
+
+    import fretwear.api
+    from fretwear.limits import UnusualValueWarning
+
+    core = {"simulate_wear": (fretwear.api._wear, "simulate_wear"),
+            "worn_state": (fretwear.api, "_worn_state")}[driver]
+    monkeypatch.setattr(*core, lambda *a, **k: "ran")
+    call = getattr(fw, driver)
+    with pytest.warns(UnusualValueWarning, match=r"contact.wear_coefficient = 0 on every"):
+        assert call(block, BASIS, quasi_static=True) == "ran"
+    worn = from_mesh(rectangle(0.02, 0.01, 4, 2), Material(210e9, 0.3, 7800.0),
+                     thickness=0.01, supports=[Spring(at=(0.0, 0.005), direction="x",
+                                                      stiffness=1e7)],
+                     contact=ContactSpec("bottom", mu=0.3, wear_coefficient=1e-14))
+    energy = fw.WearOptions(law="energy", energy_coefficient=1e-14)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", UnusualValueWarning)
+        assert call(worn, BASIS, quasi_static=True) == "ran"
+        opts = energy if driver == "simulate_wear" else fw.WornStateOptions(wear=energy)
+        assert call(block, BASIS, quasi_static=True, options=opts) == "ran"

@@ -186,3 +186,29 @@ def test_example_run_writes_beside_the_working_directory(tmp_path, monkeypatch, 
     assert cli.main(["example", "run", "beam-linear-frf", "--no-progress"]) == 0
     assert (work / "beam-linear-frf-results" / "results.nc").is_file()
     assert not (tmp_path / "src" / "beam-results").exists()  # nothing beside the example
+
+
+def test_a_wear_run_that_cannot_wear_says_so_in_one_line(tmp_path, monkeypatch, capsys):
+    """A wear case whose Archard coefficient is 0 (the default of a contact) stopped at once
+    with "no wear" and exit 0, saying nothing else; now a warning says why before the run,
+    printed as one line (Python's default format adds the file, the line number and the
+    source line). The run itself is replaced by a Ctrl-C here: only what is said before it
+    is checked."""
+    import fretwear.analyses.wear  # noqa: F401 (reads the defaults of the real driver)
+    import fretwear.wear
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(fretwear.wear, "simulate_wear", interrupted)
+    analysis = ('[analysis]\ntype = "wear"\nquasi_static = true\nharmonics = 1\n'
+                'n_samples = 16\n')
+    path = reduced_example(tmp_path, analysis, **{"wear_coefficient = 1e-11": ""})
+    assert cli.main(["run", str(path), "--no-progress"]) == 130
+    err = capsys.readouterr().err.splitlines()
+    said = [line for line in err if "wear_coefficient" in line]
+    assert said == ["warning: UnusualValueWarning: contact.wear_coefficient = 0 on every "
+                    "contact node (and on their partners): nothing wears under the Archard "
+                    "law, and the run will report no wear; give Archard's k_w [1/Pa] "
+                    "(metals: 1e-17 to 1e-12)"]
+    assert not any(line.startswith(" ") or ".py:" in line for line in err)

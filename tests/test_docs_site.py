@@ -62,3 +62,43 @@ def test_the_api_reference_lists_every_public_name():
     page = (ROOT / "docs" / "reference" / "python.md").read_text()
     missing = [n for n, m in fretwear._API.items() if f"::: {m}.{n}\n" not in page]
     assert not missing, f"run scripts/write_api_reference.py; missing: {missing}"
+
+
+#: what a lab notebook leaves in a page: the machine's load, sessions and issue numbers of
+#: the development, "before this version", commit hashes (a word of 7-40 hex digits with a
+#: letter and a digit)
+NOTEBOOK = [r"load\s+average", r"\bat\s+a\s+load\b", r"\bload\s+\d+(\.\d+)?\s*-\s*\d",
+            r"\bloaded\s+machine", r"\bsession\b", r"\bissue\s+\d+", r"\bthe\s+issue'?s?\b",
+            r"\bbefore\s+this\s+version", r"\b(?=[0-9a-f]*[a-f])(?=[0-9a-f]*\d)[0-9a-f]{7,40}\b"]
+
+
+def _user_guide_pages() -> list[Path]:
+    """The pages under "User guide" in mkdocs.yml's nav (and the home page)."""
+    import re
+
+    nav = (ROOT / "mkdocs.yml").read_text().split("\nnav:\n", 1)[1]
+    guide = nav.split("  - User guide:\n", 1)[1].split("\n  - ", 1)[0]
+    return [ROOT / "docs" / "index.md"] + [ROOT / "docs" / p for p in
+                                           re.findall(r":\s*(\S+\.md)\s*$", guide, re.M)]
+
+
+def test_user_guide_pages_read_as_a_guide_not_a_lab_notebook():
+    """The user guide (tutorial, case files, Python API, results, studies, wear, time domain,
+    gallery) says how to use fretwear, not how it was developed: no machine load, session,
+    issue number, "before this version" or commit hash (those belong to docs/studies/). The
+    pattern list is checked on phrases written here first, so that it cannot pass by
+    matching nothing."""
+    import re
+
+    samples = ["(load\naverage 4-5)", "at a load of 12", "load 18-29", "on the loaded machine",
+               "issue 29's second session", "The issue's oscillator", "before this version",
+               "commit f956b9d"]
+    for text in samples:
+        assert any(re.search(p, text, re.I) for p in NOTEBOOK), text
+    assert not any(re.search(p, "static load 20 MPa; 1e-6 m; 2e+11; 0.0001", re.I)
+                   for p in NOTEBOOK)
+    pages = _user_guide_pages()
+    assert {"tutorial.md", "api.md", "wear.md", "study.md"} <= {p.name for p in pages}
+    found = [f"docs/{page.name}: {m.group(0)!r}" for page in pages
+             for p in NOTEBOOK for m in re.finditer(p, page.read_text(), re.I)]
+    assert found == []

@@ -60,3 +60,76 @@ def test_bad_environment_variable_is_one_line(fresh, raw):
 def test_bad_count_is_refused(fresh, n):
     with pytest.raises(InputError, match=r"set_blas_threads\("):
         threads.set_blas_threads(n)
+
+
+class _Stop(Exception):
+    """Raised by the recorder once it has seen the thread count inside a driver."""
+
+
+def _block():
+    from fretwear.model import ContactSpec, Material, Spring, Traction, from_mesh, rectangle
+
+    return from_mesh(rectangle(0.02, 0.01, 4, 2), Material(210e9, 0.3, 7800.0), thickness=0.01,
+                     supports=[Spring(at=(0.0, 0.005), direction="x", stiffness=1e7)],
+                     loads=[Traction("top", pressure=1e6),
+                            Traction("right", pressure=1e5, waveform="cos")],
+                     contact=ContactSpec("bottom", mu=0.3))
+
+
+def _sector():
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from helpers.cyclic import sector_model
+
+    return sector_model(4)[0]
+
+
+#: public driver -> (module of the function it calls inside, that function, its arguments)
+DRIVERS = {
+    "run": ("fretwear.analyses.python_run", "run_built",
+            lambda fw, tmp: (_block(), "modes", tmp)),
+    "load_levels": ("fretwear.levels", "excitation_scaled",
+                    lambda fw, tmp: (_block(), fw.FourierBasis.up_to(1, 8), 1e3, 2e3, 2, [1.0])),
+    "modes": ("fretwear.linear", "_lowest_modes", lambda fw, tmp: (_block(),)),
+    "frf": ("fretwear.linear", "_check_contact", lambda fw, tmp: (_block(), [1e3])),
+    "cyclic_modes": ("fretwear.hb.cyclic", "harmonic_model", lambda fw, tmp: (_sector(), 1)),
+    "cyclic_frf": ("fretwear.hb.cyclic", "harmonic_model",
+                   lambda fw, tmp: (_sector(), 1, [1e3])),
+}
+
+
+@pytest.mark.parametrize("name", sorted(DRIVERS))
+def test_every_public_driver_runs_with_the_drivers_blas_threads(name, monkeypatch, tmp_path):
+    """Each public driver that computes (not only fw.sweep and the wear drivers: fw.run, the
+    load levels, the linear modes and FRFs, the cyclic ones) runs its body with
+    :func:`blas_threads` BLAS threads: the count read by threadpoolctl (independent of
+    fretwear) inside the driver's first computation is 1 while the caller has set 2. The
+    recorder stops the driver there (no solve is run). fw.run, fw.load_levels, fw.modes,
+    fw.frf and the cyclic drivers saw the caller's 2 threads before they were limited."""
+    import importlib
+
+    import fretwear as fw
+
+    if not blas():
+        pytest.skip("no BLAS library reported by threadpoolctl")
+    module_name, inner, arguments = DRIVERS[name]
+    seen = []
+
+    def recorder(*args, **kwargs):
+        seen.append(blas())
+        raise _Stop
+
+    args = arguments(fw, tmp_path)
+    monkeypatch.setattr(threads, "_state", {"n": 1})
+    monkeypatch.setattr(importlib.import_module(module_name), inner, recorder)
+    with threadpoolctl.threadpool_limits(limits=2, user_api="blas"):
+        outside = blas()  # {2}, or {1, 2} with a single-threaded BLAS loaded beside
+        if 2 not in outside:
+            pytest.skip("no BLAS library here takes 2 threads")
+        with pytest.raises(_Stop):
+            getattr(fw, name)(*args)
+        after = blas()
+    assert seen == [{1}]
+    assert after == outside

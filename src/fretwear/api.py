@@ -30,6 +30,7 @@ import contextlib
 import dataclasses
 import functools
 import math
+import warnings
 
 from fretwear import linear as _linear
 from fretwear import wear as _wear
@@ -41,6 +42,7 @@ from fretwear.hb import sweep as _sweep
 from fretwear.hb.dynamics import structure_dynamics
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.options import SolveOptions, SweepOptions, sweep_options
+from fretwear.limits import UnusualValueWarning
 from fretwear.model.checks import model_argument
 from fretwear.threads import limited
 from fretwear.timedomain import integrate as _integrate
@@ -49,6 +51,7 @@ from fretwear.timedomain import steady as _steady
 from fretwear.timedomain.fallback import FALLBACK
 from fretwear.validate import ArgumentTypeError, flag, instance, is_real, number, reals, whole
 from fretwear.wear.worn_frf import WORN_FRF
+from fretwear.wear.worn_state import WornStateOptions as _WornStateOptions
 from fretwear.wear.worn_state import worn_state as _worn_state
 
 #: spellings of other entry points -> the public one
@@ -100,6 +103,22 @@ def _frequency(frequency, quasi_static: bool) -> dict:
     if not is_real(frequency):  # its value is checked by the solver's own message
         raise InputError(f"frequency = {frequency!r}: expected a number > 0 [Hz]")
     return {"frequency": frequency}
+
+
+#: what a wear run whose Archard coefficients are all zero says (a case run says it as a note)
+NOTHING_WEARS = ("contact.wear_coefficient = 0 on every contact node (and on their partners): "
+                 "nothing wears under the Archard law, and the run will report no wear; give "
+                 "Archard's k_w [1/Pa] (metals: 1e-17 to 1e-12)")
+
+
+def _nothing_wears(model, law: str | None) -> None:
+    """Warn when an Archard wear run cannot wear (every coefficient 0, the default of a
+    contact): it would stop at once with "no wear" and ``success=True``. ``law`` None: options
+    of the wrong type, refused by the run's own check."""
+    c = model.contact
+    if law == "archard" and c is not None and c.n_nodes and not (
+            c.wear_nodes().any() or c.partner_wear_nodes().any()):
+        warnings.warn(NOTHING_WEARS, UnusualValueWarning, stacklevel=5)
 
 
 @contextlib.contextmanager
@@ -298,6 +317,8 @@ def simulate_wear(model, basis, frequency: float | None = None, *, quasi_static:
     from a time integration).
     """
     _basis(basis)
+    _nothing_wears(model, options.law if isinstance(options, _wear.WearOptions)
+                   else None if options is not None else "archard")
     if condenser is not None:
         balance = balance or _wear.BalanceSetup()
         if balance.condenser is not None:
@@ -338,6 +359,9 @@ def worn_state(model, basis, frequency: float | None = None, *, quasi_static: bo
     """
     _public_names("worn_state", kwargs)
     _basis(basis)
+    opts = kwargs.get("options")
+    _nothing_wears(model, opts.wear.law if isinstance(opts, _WornStateOptions)
+                   else None if opts is not None else "archard")
     if condenser is not None:
         balance = kwargs.pop("balance", None) or _wear.BalanceSetup()
         if balance.condenser is not None:

@@ -17,6 +17,7 @@ import os
 import signal
 import sys
 import threading
+import warnings
 from importlib import resources
 from pathlib import Path
 
@@ -285,12 +286,27 @@ def _said_lines():
         logger.setLevel(level)
 
 
+@contextlib.contextmanager
+def _one_line_warnings():
+    """Python warnings printed as one line each, ``warning: Category: message`` on stderr (not
+    the file, line number and source line of Python's default format) while the command
+    runs."""
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        text = " ".join(str(message).split())
+        print(f"warning: {category.__name__}: {text}", file=file or sys.stderr)
+
+    with warnings.catch_warnings():
+        warnings.showwarning = show
+        yield
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``fretwear`` command; returns the exit status."""
     args = _parser().parse_args(argv)
     term = TerminateAsInterrupt()
     try:
-        with term, _said_lines():
+        with term, _said_lines(), _one_line_warnings():
             return args.func(args)
     except FretwearError as exc:
         print(f"error: {' '.join(str(exc).split())}", file=sys.stderr)

@@ -22,6 +22,7 @@ import numpy as np
 from fretwear import api
 from fretwear.errors import InputError
 from fretwear.model.checks import model_argument
+from fretwear.threads import limited
 from fretwear.validate import is_real, whole
 
 
@@ -73,6 +74,7 @@ class LoadLevels:
 
 
 @model_argument
+@limited
 def load_levels(model, basis, f_min: float, f_max: float, n_points: int, levels, *,
                 options=None, condenser=None) -> LoadLevels:
     """The nonlinear FRF at each excitation level: :func:`fretwear.sweep` of the model with

@@ -38,6 +38,7 @@ from fretwear.model.checks import model_argument
 from fretwear.model.core import Model
 from fretwear.model.interfaces import pair_transform
 from fretwear.resources import require_memory
+from fretwear.threads import limited
 from fretwear.validate import instance, number, reals, whole
 
 INTERFACES = ("free", "sliding", "stuck")
@@ -268,6 +269,7 @@ def _normalise(X: np.ndarray, M) -> np.ndarray:
 
 
 @model_argument
+@limited
 def modes(model: Model, n_modes: int = 10, *, interface: str = "sliding",
           f_max: float | None = None) -> ModesResult:
     """Normal modes of the undamped structure with the given linear interface.
@@ -588,6 +590,7 @@ def _frf_condensed(model: Model, freqs: np.ndarray, interface: str, condenser=No
 
 
 @model_argument
+@limited
 def frf(model: Model, frequencies_hz, *, interface: str = "sliding",
         method: str = "direct", condenser=None) -> FRFResult:
     """Frequency response to the harmonic (n = 1) part of the model loads.

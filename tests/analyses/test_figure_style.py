@@ -155,3 +155,29 @@ def test_coinciding_frfs_before_and_after_wear_both_show(tmp_path):
 
     first, second = pixels("#1f77b4"), pixels("#ff7f0e")  # C0, C1
     assert second > 0 and first >= second / 3, (first, second)
+
+
+def test_an_axis_without_unit_has_no_multiplier_in_its_corner():
+    """Axes with no unit to prefix and values from 1e6 up (cycles to 1e7, a varied Young's
+    modulus 2.0e11-2.1e11 as a study's x axis): matplotlib would print "1e7" or "1e11" in the
+    axis corner; each tick says its own value instead (read back from the drawn figure), with
+    digits enough to tell 2.025e11 from 2.05e11. Small plain values keep matplotlib's ticks."""
+    fig = Figure()
+    ax, bx, cx = fig.subplots(1, 3)
+    ax.plot([0.0, 1e7], [0.0, 1.0])
+    ax.set_xlabel("cycles N")
+    bx.plot([2.0e11, 2.1e11], [1.0, 2.0])
+    bx.set_xlabel("material.E")
+    cx.plot([0.0, 3.0], [0.0, 1.0])
+    cx.set_xlabel("member")
+    apply_style(fig)
+    fig.canvas.draw()
+    for axes in (ax, bx):
+        assert axes.xaxis.get_offset_text().get_text() == ""
+        labels = [t.get_text() for t in axes.get_xticklabels() if t.get_text()]
+        assert len(set(labels)) == len(labels) >= 2
+        assert all("e+" in t or t == "0" for t in labels)
+    assert bx.xaxis.get_major_formatter()(2.025e11, 0) == "2.025e+11"
+    from matplotlib import ticker
+
+    assert isinstance(cx.xaxis.get_major_formatter(), ticker.ScalarFormatter)

@@ -125,14 +125,17 @@ def test_condenser_compress_option():
     """``compress=`` of the modal condensers: the operator of every frequency carries the
     compressed ``X^cc`` (made once: the same objects at two frequencies), each within its
     bound, and its products are the dense operator's within that bound (column ``j`` on
-    harmonic ``b``: ``sum_t |c_t(b)| e_t ||X_t||_F |x_j|``, plus rounding); a bad value is
-    refused."""
+    harmonic ``b``: ``sum_t |c_t(b)| e_t ||X_t||_F |x_j|``, plus rounding); the bound is part
+    of the construction (``representation=Representation("compressed", tol)``, what
+    ``modal_condenser(compress=tol)`` passes; none for the other representations); a bad
+    value is refused."""
     from helpers.operator_models import F_MAX, ORDERS, block
 
     from fretwear.hb.modal import (
         COMPRESS_TOL,
         BlockedModalCondenser,
         ModalCondenser,
+        Representation,
         modal_condenser,
     )
 
@@ -152,6 +155,13 @@ def test_condenser_compress_option():
     assert np.all(diff <= bound * np.linalg.norm(X, axis=0) + 1e-13 * np.abs(got).max())
     mc = ModalCondenser(model, F_MAX, 7, tol=1e-2, representation="compressed")
     assert mc.compress == COMPRESS_TOL and mc.reduced(2 * np.pi * 12e3, ORDERS).Z.products
+    assert mc.representation == "operator"
+    assert modal_condenser(model, F_MAX, 7, tol=1e-2, compress=1e-4).compress == 1e-4
+    assert ModalCondenser(model, F_MAX, 7, tol=1e-2).compress is None
+    with pytest.raises(InputError, match="only \"compressed\" has a bound"):
+        Representation("operator", 1e-6)
+    with pytest.raises(InputError, match="compress"):
+        Representation("compressed", 0.0)
     with pytest.raises(InputError, match="compress"):
         modal_condenser(model, F_MAX, 7, compress=2.0)
     with pytest.raises(InputError, match="compress"):

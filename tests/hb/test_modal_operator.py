@@ -46,6 +46,14 @@ def test_formed_rows_columns_and_node_diagonal_equal_the_sum_written_out():
                 want = full[(slice(None) if r is None else r)][:, (slice(None) if c is None
                                                                     else c)]
                 assert np.abs(op.block(b, r, c) - want).max() < 1e-13 * 10, (b, r, c)
+            # rows r0:r1 formed into a kept buffer: the sum written out to rounding, and
+            # block()'s own rows bit for bit (the same operations entry by entry)
+            buf = np.full((m, m), np.nan, dtype=op.dtype)
+            for r0, r1 in ((0, m), (3, 9), (11, 12)):
+                got = op.block_rows(b, r0, r1, buf[: r1 - r0])
+                assert np.shares_memory(got, buf)
+                assert np.abs(got - full[r0:r1]).max() < 1e-13 * 10, (b, r0, r1)
+                assert np.array_equal(got, op.block(b, np.arange(r0, r1))), (b, r0, r1)
             diag = np.stack([full[p * d:(p + 1) * d, p * d:(p + 1) * d]
                              for p in range(m // d)])
             assert np.abs(op.node_diagonal(b, d) - diag).max() < 1e-13 * 10

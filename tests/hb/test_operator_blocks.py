@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from helpers.operator_models import F_MAX, ORDERS, block, rel
 
+from fretwear.hb import krylov
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.krylov import HarmonicBlocks, KrylovJacobian
 from fretwear.hb.modal import BlockedModalCondenser
@@ -45,6 +46,20 @@ def test_operator_blocks_products_equal_stored_blocks(damping):
             B, rb = hb.row_block(b, r)
             assert rel(A[ra], B[rb]) < 1e-13, b
             assert rel(ob.node_diagonal(b, 3), hb.node_diagonal(b, 3)) < 1e-13, b
+    # the panels the column norms form into one buffer: consecutive rows (views of the
+    # stored matrices' rows), rows with gaps (formed from the first to the last) and rows too
+    # far apart (taken): the same entries as row_block's to rounding (the gemm of the modal
+    # term on another number of rows may round differently: measured <= 5e-18 of the
+    # largest entry)
+    buf = np.empty((12, ob.m), dtype=ob.op.dtype)
+    for r in (np.arange(6, 18), np.array([0, 1, 2, 9, 10, 11]), np.array([0, 1, 2, 30, 31, 32]),
+              np.arange(ob.m - 3, ob.m)):
+        for b in range(ob.nb):
+            A, ra = ob.row_panel(b, r, buf)
+            B, rb = ob.row_block(b, r)
+            assert np.abs(A[ra] - B[rb]).max() <= 1e-15 * np.abs(B[rb]).max(), b
+            if b and r[-1] - r[0] < buf.shape[0]:
+                assert np.shares_memory(A, buf)  # formed into the buffer, no new array
 
 
 def test_operator_jacobian_against_dense_and_finite_differences():
@@ -66,6 +81,7 @@ def test_operator_jacobian_against_dense_and_finite_differences():
     U = U * (1.0 + 1e-3 * np.random.default_rng(4).standard_normal(U.shape))
     fk, J = pk.residual(U)
     fd, Jd = pd.residual(U)
+    norms = J.column_norms()
     assert isinstance(J, KrylovJacobian) and isinstance(J.Z, OperatorBlocks)
     assert J.active_nodes().size > 0  # partial slip: the step is not trivial
     assert rel(fk, fd) < 1e-10
@@ -73,6 +89,13 @@ def test_operator_jacobian_against_dense_and_finite_differences():
     assert rel(J @ v, Jd @ v) < 1e-12
     assert rel(J.T @ v, Jd.T @ v) < 1e-12
     assert rel(J.column_norms(), np.linalg.norm(Jd, axis=0)) < 1e-12
+    # the active rows in panels of one and of two nodes (several panels per block, the
+    # sums in the same node order): the same norms (bit for bit with this BLAS; the modal
+    # term's gemm on fewer rows may round otherwise, 1e-14 bounds that)
+    for panel in (3, 6):
+        with pytest.MonkeyPatch.context() as mp:
+            mp.setattr(krylov, "COLUMN_NORM_PANEL", panel)
+            assert rel(J.column_norms(), norms) < 1e-14
     assert rel(J.solve(v), np.linalg.solve(Jd, v)) < 1e-8
     h = 1e-7 * np.linalg.norm(U) / np.linalg.norm(v)
     fp, _ = pk.residual(U + h * v.reshape(U.shape), False)

@@ -135,3 +135,51 @@ def test_periodic_members_draw_their_response_against_the_varied_key(tmp_path, d
     np.testing.assert_array_equal(line.get_ydata(), amp[[1, 2, 0], 0, 1, 0])
     assert ax.get_xlabel() == "contact.mu" and ax.get_ylabel() == \
         "amplitude Pe y (harmonic 1) [µm]"
+
+
+def test_linear_frf_members_draw_one_frf_per_member_and_interface(tmp_path, drawn):
+    """Linear FRF members (``frf``: ``displacement_amplitude`` over member, interface,
+    frequency, point, axis) wrote no study figure; now one curve per member and interface,
+    of the first point on its axis of largest response (x here, 10 x y), in the member's
+    colour and the interface's dash, with the values of the dataset."""
+    f = np.array([100.0, 200.0, 300.0])
+    amp = np.arange(1.0, 13.0).reshape(2, 2, 3, 1, 1) * np.array([10.0, 1.0]) * 1e-7
+    ds = xr.Dataset({"displacement_amplitude": (("member", "interface", "frequency",
+                                                 "point", "axis"), amp)},
+                    coords={"frequency": f, "interface": ["sliding", "stuck"], "point": ["tip"],
+                            "axis": ["x", "y"], "material.E": ("member", [2.0e11, 2.2e11])},
+                    attrs={"title": "t"})
+    paths = figures.study_figures(ds, tmp_path, ["material.E"])
+    assert [p.name for p in paths] == ["study-frf-family.png"]
+    assert paths[0].read_bytes()[:8] == PNG
+    lines = drawn["study-frf-family.png"].axes[0].get_lines()
+    assert [ln.get_label() for ln in lines] == [
+        "material.E = 2e+11, sliding", "material.E = 2e+11, stuck",
+        "material.E = 2.2e+11, sliding", "material.E = 2.2e+11, stuck"]
+    for k, ln in enumerate(lines):
+        np.testing.assert_array_equal(ln.get_ydata(), amp[k // 2, k % 2, :, 0, 0])
+    assert lines[0].get_color() == lines[1].get_color() != lines[2].get_color()
+    assert lines[0].get_linestyle() != lines[1].get_linestyle()
+
+
+def test_modes_members_draw_their_natural_frequencies_against_the_varied_key(tmp_path, drawn):
+    """Modes members (``natural_frequency`` over member, interface, mode) wrote no study
+    figure; now each mode's frequency against the varied key, sorted by it, in Hz (the
+    figure's kHz after the style), and no multiplier in the x axis corner."""
+    fn = np.array([[[1e3, 3e3]], [[2e3, 5e3]], [[1.5e3, 4e3]]])  # (member, interface, mode)
+    ds = xr.Dataset({"natural_frequency": (("member", "interface", "mode"), fn)},
+                    coords={"interface": ["stuck"], "mode": [1, 2],
+                            "material.E": ("member", [2.0e11, 2.2e11, 2.1e11])},
+                    attrs={"title": "t"})
+    paths = figures.study_figures(ds, tmp_path, ["material.E"])
+    assert [p.name for p in paths] == ["study-natural-frequencies.png"]
+    fig = drawn["study-natural-frequencies.png"]
+    ax = fig.axes[0]
+    lines = ax.get_lines()
+    assert len(lines) == 2
+    np.testing.assert_array_equal(lines[0].get_xdata(), [2.0e11, 2.1e11, 2.2e11])
+    np.testing.assert_array_equal(lines[1].get_ydata(), [3e3, 4e3, 5e3])
+    assert ax.get_ylabel() == "natural frequency [kHz]" and ax.get_xlabel() == "material.E"
+    fig.canvas.draw()
+    assert ax.xaxis.get_offset_text().get_text() == ""
+

@@ -252,3 +252,23 @@ def test_a_study_of_the_excitation_level_gives_the_family_of_frfs_and_its_peaks(
     levels = [x.strip() for x in res.message.splitlines() if x.strip().startswith("level ")]
     assert [x.split(":")[0] for x in levels] == ["level 0.5", "level 1", "level 10"]
     assert levels[1].startswith(f"level 1: peak {stuck:.4g} m at 90 Hz")
+
+
+def test_a_study_whose_members_have_no_study_figure_says_so(tmp_path):
+    """Figures asked (output.figures = true) but the members' results have none that a study
+    draws (here only slip_amplitude): the summary says that no study figure was written and
+    where each member's figures are, instead of printing nothing about figures."""
+    base_case(tmp_path)
+    path = study_file(tmp_path, "[set]\noutput.figures = true\n[grid]\ncontact.mu = [0.1]\n")
+    members = expand(read_study(path))
+    out = tmp_path / "out"
+    done = out / members[0].folder_name
+    done.mkdir(parents=True)
+    xr.Dataset({"slip_amplitude": (("contact_node", "harmonic"), np.ones((2, 2)))}).to_netcdf(
+        done / RESULTS_FILE, engine="h5netcdf")
+    (done / STATUS_FILE).write_text(MemberRecord(0, "ok", "periodic solution",
+                                                 case_sha256=case_hash(members[0].text)
+                                                 ).to_json())
+    res = run_study(path, out, collect=True, progress=False, echo=False)
+    assert res.success and res.figures == []
+    assert res.message.splitlines()[-1].startswith("figures: none for the study")

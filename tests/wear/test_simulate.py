@@ -343,6 +343,23 @@ def test_no_wear_without_slip(tmp_path):
     assert np.all(r.final_wear == 0.0) and math.isfinite(r.wall_time)
 
 
+def test_no_wear_names_the_zero_coefficient_not_the_slip():
+    """The same block in partial slip (q_ratio 0.5, where the other tests see nodes slip) with
+    every Archard coefficient 0: the rate is 0 because nothing CAN wear, so the stop message
+    (of the march and of the direct worn state) names the coefficient, not the slip; with a
+    fully stuck block and k_w > 0 it still names the slip."""
+    from fretwear.wear.worn_state import worn_state
+
+    m = block(q_ratio=0.5, wear_coefficient=0.0)
+    r = simulate_wear(m, BASIS, quasi_static=True)
+    assert r.stop_reason == "no_wear" and "every wear coefficient is 0" in r.message
+    assert "slips" not in r.message
+    ws = worn_state(m, BASIS, quasi_static=True)
+    assert ws.kind == "no_wear" and "every wear coefficient is 0" in ws.message
+    stuck = simulate_wear(block(q_ratio=0.01), BASIS, quasi_static=True)
+    assert "no contact node slips" in stuck.message
+
+
 def test_dynamic_run_needs_a_frequency(monkeypatch):
     """A dynamic wear run without ``frequency`` (which used to default to 1 Hz) is refused in
     one line naming it, before anything is computed, at both entry points; settings records of

@@ -98,7 +98,7 @@ def tick_text(value: float) -> str:
     a = abs(value)
     if 1e-4 <= a < 1e6:
         return f"{value:.6g}" if a >= 1e-3 else f"{value:.6f}".rstrip("0").rstrip(".")
-    return f"{value:.3g}"
+    return f"{value:.6g}"  # enough digits to tell neighbouring ticks apart
 
 
 def relabel(label: str, largest: float) -> tuple[float, str]:
@@ -136,6 +136,10 @@ def _style_axis(ax, which: str) -> None:
     if not _UNIT.search(new) or not (theirs or ours is not None):
         if isinstance(fmt, ticker.ScalarFormatter):
             fmt.set_useOffset(False)
+            if not log and not 1e-4 <= max(abs(lo), abs(hi)) < 1e6:
+                # no unit to prefix (cycles, a varied case-file key): each tick says its
+                # exponent, not a multiplier (1e7) in the axis corner
+                axis.set_major_formatter(ticker.FuncFormatter(lambda v, _pos: tick_text(v)))
         axis.set_label_text(relabel(label, 0.0)[1])  # "um" -> "µm", powers, no prefix
         return
     if ours is not None and ours != factor:  # a shared axis styled with another label

@@ -34,6 +34,7 @@ from fretwear.io.case import OUTPUT, Case
 from fretwear.io.results import output_mesh
 from fretwear.io.schema import Context, Variant, show
 from fretwear.model.checks import model_argument
+from fretwear.threads import limited
 from fretwear.validate import flag, is_real
 from fretwear.validate import path as file_path
 
@@ -87,6 +88,7 @@ def python_case(analysis, keys: dict, output: Path, title: str = "") -> Case:
 
 
 @model_argument
+@limited
 def run(model, analysis, output, *, title: str = "", progress: bool = False,
         resume: bool = False, echo: bool = False, **keys) -> RunOutput:
     """Run ``model`` (built in Python) as a case file with this analysis would run: the same
@@ -96,7 +98,7 @@ def run(model, analysis, output, *, title: str = "", progress: bool = False,
     ----------
     model : a :class:`~fretwear.model.core.Model` (``fw.from_mesh``, ``fw.from_matrices``...).
     analysis : the analysis type (``"sweep"``, ``"periodic"``, ``"wear"``, ``"transient"``,
-        ``"linear"``, ...), its keys given as ``keys``; or a dict holding the whole
+        ``"modes"``, ``"frf"``, ...), its keys given as ``keys``; or a dict holding the whole
         ``[analysis]`` table with its ``type``.
     output : the results folder (made if needed).
     title : the title of figures and of the results file.

@@ -59,6 +59,7 @@ from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.options import PERIODIC, STRATEGY, SolveOptions, SweepOptions
 from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.reduce import Reduced
+from fretwear.hb.runs import run
 from fretwear.hb.solution import Attempt
 from fretwear.hb.solvers import SolveStats, solve, vector_norm
 from fretwear.model.core import Model
@@ -107,20 +108,6 @@ START_MAX_SLOW = 5
 
 
 # --- solver runs and starts -----------------------------------------------------------------
-def run(prob: DLFTProblem, x0, options: SolveOptions):
-    """One run of ``options.solver`` on ``prob`` from ``x0`` (m, H): ``(x (m, H), stats)``."""
-
-    def fun(x, jac=True):
-        return prob.residual(x.reshape(prob.m, prob.H), jac)
-
-    t0 = time.perf_counter()
-    x, _, st = solve(fun, np.asarray(x0, float).reshape(-1),
-                     lambda x: prob.scale(x.reshape(prob.m, prob.H)), method=options.solver,
-                     tol=options.tol, max_iter=options.max_iter)
-    st.wall_time = time.perf_counter() - t0
-    return x.reshape(prob.m, prob.H), st
-
-
 def first_harmonic_start(prob: DLFTProblem, options: SolveOptions):
     """A starting point for a many-harmonic solve: the solution on the first kept harmonic
     from the contact-closed guess, embedded in the full basis (None if that fails). From the
@@ -425,19 +412,8 @@ def solve_at(probs: Problems, omega: float, anchor, U0, options: SolveOptions):
     """One solver run at ``omega`` [rad/s] with the stick anchors ``anchor`` from ``U0``
     (None: the contact-closed guess): ``(problem, U (m, H), stats)``."""
     prob = probs.get(omega, anchor)
-    x0 = prob.initial_guess() if U0 is None else np.asarray(U0, float).reshape(prob.m, prob.H)
-    x, st = _solve(prob, x0, options)
+    x, st = run(prob, prob.initial_guess() if U0 is None else U0, options)
     return prob, x, st
-
-
-def _solve(prob: DLFTProblem, x0, options: SolveOptions, max_slow=None):
-    def fun(x, jac=True):
-        return prob.residual(x.reshape(prob.m, prob.H), jac)
-
-    x, _, st = solve(fun, x0.reshape(-1), lambda x: prob.scale(x.reshape(prob.m, prob.H)),
-                     method=options.solver, tol=options.tol, max_iter=options.max_iter,
-                     max_slow=max_slow)
-    return x.reshape(prob.m, prob.H), st
 
 
 def go_on(prob: DLFTProblem, U, st: SolveStats, options: SolveOptions):
@@ -449,12 +425,19 @@ def go_on(prob: DLFTProblem, U, st: SolveStats, options: SolveOptions):
     stopped for another reason, is returned as it is. The statistics add up both runs."""
     if st.success or st.iterations < options.max_iter:
         return U, st
-    x, st2 = _solve(prob, U, options.replace(max_iter=STEP_MORE_ITER * options.max_iter),
-                    max_slow=STEP_MAX_SLOW)
+
+    def fun(x, jac=True):
+        return prob.residual(x.reshape(prob.m, prob.H), jac)
+
+    t0 = time.perf_counter()
+    x, _, st2 = solve(fun, np.asarray(U, float).reshape(-1),
+                      lambda x: prob.scale(x.reshape(prob.m, prob.H)), method=options.solver,
+                      tol=options.tol, max_iter=STEP_MORE_ITER * options.max_iter,
+                      max_slow=STEP_MAX_SLOW)
     merged = SolveStats(st2.success, st2.residual, st.iterations + st2.iterations,
-                        st.nfev + st2.nfev, st.njev + st2.njev, st.wall_time + st2.wall_time,
-                        st2.message, st2.solver)
-    return x, merged
+                        st.nfev + st2.nfev, st.njev + st2.njev,
+                        st.wall_time + time.perf_counter() - t0, st2.message, st2.solver)
+    return x.reshape(prob.m, prob.H), merged
 
 
 def grid(p: Point) -> bool:

@@ -15,8 +15,9 @@ import numpy as np
 
 from fretwear.hb.connectors import connect, springs
 from fretwear.hb.problem import DLFTProblem
+from fretwear.hb.runs import run
 from fretwear.hb.solution import Attempt, assemble_solution
-from fretwear.hb.solvers import SolveStats, solve
+from fretwear.hb.solvers import SolveStats
 from fretwear.hb.sweep_result import SweepPoint
 
 #: reduced models a sweep keeps (it revisits the last few frequencies: sub-steps, retries,
@@ -62,8 +63,10 @@ class Problems:
     so that every recorded point is a converged point of the exact condensation. The
     frequencies of ``exact_at`` (the grid's, [rad/s]) are always condensed exactly. Every
     polish measures the error of the local basis's model it starts from against the exact
-    one (:attr:`nearby_errors`); above :data:`NEARBY_STOP` the sweep condenses exactly from then
-    on (docs/theory.md, "Cost of the condensation")."""
+    one; above :data:`NEARBY_STOP` the sweep condenses exactly from then on (docs/theory.md,
+    "Cost of the condensation"). :attr:`counts`: the condensations made, ``exact`` and
+    ``nearby`` (local basis), and the points ``polished`` and ``polish_failed`` (the sweep's
+    summary, :attr:`~fretwear.hb.sweep_result.SweepResult.condensations`)."""
 
     def __init__(self, model, basis, gap, eps, condenser, jacobian="auto", cache_size=CACHE_SIZE,
                  exact_at=(), solve=None):
@@ -83,12 +86,7 @@ class Problems:
         keep = getattr(condenser, "keep_interior", None)
         self.use_nearby = solve is not None and keep is not None and bool(keep())
         self.nearby_keys: set = set()  # cached frequencies served by the local basis
-        #: condensations made: ``exact``, ``nearby`` (local basis), ``polished`` points,
-        #: ``polish_failed``
         self.counts = {"exact": 0, "nearby": 0, "polished": 0, "polish_failed": 0}
-        #: relative error of the local basis's Z_r and F_r (worst harmonic) at each
-        #: polished point
-        self.nearby_errors: list = []
 
     def _room(self) -> None:
         """Room for one more reduced model (every frequency's has the size of the cached
@@ -102,7 +100,9 @@ class Problems:
             self.cache.pop(oldest)
 
     def _condense(self, omega: float, exact: bool):
-        """The reduced model at ``omega`` (springs connected) and whether it is exact."""
+        """The reduced model at ``omega`` (springs connected) and whether it is exact (a
+        model of the local basis carries its ``estimate``: a point converged on it is
+        polished before it is recorded, :meth:`polish`)."""
         red = None
         if not exact and self.use_nearby:
             red = self.condenser.nearby(omega, self.orders, NEARBY_TOL)
@@ -112,7 +112,6 @@ class Problems:
         self.counts["nearby" if near else "exact"] += 1
         if self.springs is not None:
             red = connect(red, self.model.contact, self.springs)
-        red.nearby = near  # a problem on it is polished before it is recorded (polish)
         return red, not near
 
     def get(self, omega: float, anchor) -> DLFTProblem:
@@ -156,33 +155,31 @@ class Problems:
 
     def polish(self, omega: float, prob: DLFTProblem, U, stats):
         """``(problem, U, stats)`` of a point converged at ``omega`` [rad/s] on the local
-        basis's model (its reduced model's ``nearby``): the solver from ``U`` on the exact
-        condensation there (the sweep's solver, then the other one), its statistics added to
-        ``stats``'s, the local basis's error there measured (:attr:`nearby_errors`). A point
+        basis's model (its reduced model's ``estimate`` is not None): the solver from ``U`` on
+        the exact condensation there (the sweep's solver, then the other one:
+        :func:`~fretwear.hb.runs.run`), its statistics added to ``stats``'s; the local basis's
+        error there measured (the worst harmonic's relative error of ``Z_r`` and ``F_r``):
+        above :data:`NEARBY_STOP`, the sweep condenses exactly from then on. A point
         converged on an exact model is returned as it is."""
-        if not getattr(prob.reduced, "nearby", False):
+        if prob.reduced.estimate is None:
             return prob, U, stats
         pe = self.exact(omega, prob.anchor)
         near, red = prob.reduced, pe.reduced
-        self.nearby_errors.append(max(
-            max(np.linalg.norm(a - b) / max(np.linalg.norm(b), 1e-300)
-                for a, b in zip(x, y, strict=True))
-            for x, y in ((near.Z, red.Z), (near.F, red.F))))
-        if self.nearby_errors[-1] > NEARBY_STOP:
+        error = max(max(np.linalg.norm(a - b) / max(np.linalg.norm(b), 1e-300)
+                        for a, b in zip(x, y, strict=True))
+                    for x, y in ((near.Z, red.Z), (near.F, red.F)))
+        if error > NEARBY_STOP:
             self.use_nearby = False
         so = self.solve
         for method in (so.solver, so.other_solver):
-            x, _, st = solve(lambda x, jac=True: pe.residual(x.reshape(pe.m, pe.H), jac),
-                             np.asarray(U, float).reshape(-1),
-                             lambda x: pe.scale(x.reshape(pe.m, pe.H)),
-                             method=method, tol=so.tol, max_iter=so.max_iter)
+            x, st = run(pe, U, so.replace(solver=method))
             if st.success:
                 break
         self.counts["polished" if st.success else "polish_failed"] += 1
         merged = SolveStats(st.success, st.residual, stats.iterations + st.iterations,
                             stats.nfev + st.nfev, stats.njev + st.njev,
                             stats.wall_time + st.wall_time, st.message, st.solver)
-        return pe, x.reshape(pe.m, pe.H), merged
+        return pe, x, merged
 
 
 def rebuild_point(probs: Problems, entry: dict) -> SweepPoint:

@@ -36,7 +36,8 @@ class Connected(Reduced):
 
     ``Z``, ``F``, ``obs_A``, ``obs_b`` are those of the contact points ``x``; the structure's
     contact nodes are ``u = node_A @ x + node_b`` harmonic by harmonic: ``node_A`` (nb, m, m),
-    ``node_b`` (nb, m) complex. ``structure`` is the reduced model of the structure alone.
+    ``node_b`` (nb, m) complex. ``structure`` is the reduced model of the structure alone;
+    ``estimate`` is its (a model of the local bases is one through the springs too).
     """
 
     node_A: np.ndarray = None
@@ -162,8 +163,8 @@ def connect(reduced: Reduced, contact: ContactInterface,
     obs_A = reduced.obs_A @ nA
     obs_b = reduced.obs_b + (reduced.obs_A @ nbv[:, :, None])[:, :, 0]
     return Connected(reduced.omega, reduced.orders, Zx, Fx, obs_A, obs_b, reduced.obs_dofs,
-                     reduced.quasi_static, reduced.frequency, node_A=nA, node_b=nbv,
-                     structure=reduced)
+                     reduced.quasi_static, reduced.frequency, reduced.estimate, node_A=nA,
+                     node_b=nbv, structure=reduced)
 
 
 def node_displacements(reduced: Reduced, X: np.ndarray) -> np.ndarray:

@@ -248,6 +248,63 @@ def _newton_start(start, end, S):
 
 
 @njit(cache=True)
+def _slip_gain(lu, lx, n, prev, mu, pn, that, B):
+    """The slip instant ``n``'s direction and gain (:func:`slip_derivative_step`): on the
+    cone ``lambda_T(n) = lambda_u,T(n) - lambda_x,T(n) = mu pn t``, so ``that`` (d-1,) gets
+    ``t``, and ``B`` (d-1, d-1) gets ``mu pn (I - t t^T) / |lambda_u,T(n) - prev|``, ``prev``
+    (d-1,) the tangential ``lambda_x`` of the instant before; ``lu``, ``lx`` the node's (d, N)
+    samples."""
+    dt = that.shape[0]
+    nrm2 = 0.0
+    for c in range(dt):
+        that[c] = lu[1 + c, n] - lx[1 + c, n]
+        nrm2 += that[c] * that[c]
+    lam_t = np.sqrt(nrm2)
+    for c in range(dt):
+        that[c] = that[c] / lam_t if lam_t > 0.0 else 0.0
+    nrm2 = 0.0
+    for c in range(dt):
+        v = lu[1 + c, n] - prev[c]
+        nrm2 += v * v
+    rho = np.sqrt(nrm2)
+    g = mu * pn / rho if rho > 0.0 else 0.0
+    for a in range(dt):
+        for b in range(dt):
+            B[a, b] = g * ((1.0 if a == b else 0.0) - that[a] * that[b])
+
+
+@njit(cache=True)
+def _times_gain(B, D, tmp):
+    """``D <- B D`` in place (``D`` (d-1, k): derivatives of the tangential ``lambda_x``,
+    carried through a slip instant), ``tmp`` (d-1, k) a work array."""
+    dt, k = D.shape
+    for a in range(dt):
+        for j in range(k):
+            acc = 0.0
+            for b in range(dt):
+                acc += B[a, b] * D[b, j]
+            tmp[a, j] = acc
+    for a in range(dt):
+        for j in range(k):
+            D[a, j] = tmp[a, j]
+
+
+@njit(cache=True)
+def _slip_phi(D, n, Q, that, B, dcap):
+    """``D <- D + (I - B) e_T phi(n) - dcap t e_N phi(n)`` (``D`` (d-1, dH), rows the
+    tangential components): the slip instant ``n``'s own dependence on ``lambda_u~``
+    (``dcap = mu``, or 0 under a prescribed normal force)."""
+    dt = D.shape[0]
+    H = Q.shape[1]
+    for a in range(dt):
+        for h in range(H):
+            qh = Q[n, h]
+            for b in range(dt):
+                D[a, (1 + b) * H + h] += ((1.0 if a == b else 0.0) - B[a, b]) * qh
+            D[a, h] += -dcap * that[a] * qh
+
+
+@njit(cache=True)
 def _propagate(lu, lx, state, mu, Q, xprev0, D, nfix):
     """Derivative of one pass of :func:`_sweep`: on entry ``D`` (d-1, dH) is
     ``d lambda_x,T(-1) / d lambda_u~`` (the derivative of the pass's start state); on exit it is
@@ -269,38 +326,10 @@ def _propagate(lu, lx, state, mu, Q, xprev0, D, nfix):
                 for h in range(H):
                     D[c, (1 + c) * H + h] = Q[n, h]
         elif st == SLIP:
-            pn = nfix[n] if fixed else lu[0, n]
-            nrm2 = 0.0
-            for c in range(dt):
-                that[c] = lu[1 + c, n] - lx[1 + c, n]
-                nrm2 += that[c] * that[c]
-            lam_t = np.sqrt(nrm2)
-            for c in range(dt):
-                that[c] = that[c] / lam_t if lam_t > 0.0 else 0.0
-            nrm2 = 0.0
-            for c in range(dt):
-                prev = lx[1 + c, n - 1] if n > 0 else xprev0[c]
-                v = lu[1 + c, n] - prev
-                nrm2 += v * v
-            rho = np.sqrt(nrm2)
-            g = mu * pn / rho if rho > 0.0 else 0.0
-            for a in range(dt):
-                for b in range(dt):
-                    B[a, b] = g * ((1.0 if a == b else 0.0) - that[a] * that[b])
-            for a in range(dt):
-                for j in range(dH):
-                    acc = 0.0
-                    for b in range(dt):
-                        acc += B[a, b] * D[b, j]
-                    tmp[a, j] = acc
-            for a in range(dt):
-                for j in range(dH):
-                    D[a, j] = tmp[a, j]
-                for h in range(H):
-                    qh = Q[n, h]
-                    for b in range(dt):
-                        D[a, (1 + b) * H + h] += ((1.0 if a == b else 0.0) - B[a, b]) * qh
-                    D[a, h] += -dcap * that[a] * qh
+            _slip_gain(lu, lx, n, lx[1:, n - 1] if n > 0 else xprev0,
+                       mu, nfix[n] if fixed else lu[0, n], that, B)
+            _times_gain(B, D, tmp)
+            _slip_phi(D, n, Q, that, B, dcap)
         # STICK: D carried unchanged
 
 
@@ -370,51 +399,14 @@ def slip_derivative_step(lu, lx, n, m, mu, Q, A0, S, that, B, tmpA, tmpS, pfix):
     ``lambda_u`` (no ``- mu t e_N`` term) and ``lambda_x,N = lambda_u,N - pfix`` gives
     ``A0_N = e_N phi(n)``.
     """
-    d = lu.shape[0]
-    dt = d - 1
     H = Q.shape[1]
-    dH = d * H
     fixed = not np.isnan(pfix)
     pn = pfix if fixed else lu[0, n]
     dcap = 0.0 if fixed else mu
-    # on the cone lam_T(n) = lam_u,T(n) - lam_x,T(n) = mu pn t^: gives the direction t^
-    nrm2 = 0.0
-    for c in range(dt):
-        that[c] = lu[1 + c, n] - lx[1 + c, n]
-        nrm2 += that[c] * that[c]
-    lam_t = np.sqrt(nrm2)
-    for c in range(dt):
-        that[c] = that[c] / lam_t if lam_t > 0.0 else 0.0
-    nrm2 = 0.0
-    for c in range(dt):
-        v = lu[1 + c, n] - lx[1 + c, m]
-        nrm2 += v * v
-    rho = np.sqrt(nrm2)
-    g = mu * pn / rho if rho > 0.0 else 0.0
-    for a in range(dt):
-        for b in range(dt):
-            B[a, b] = g * ((1.0 if a == b else 0.0) - that[a] * that[b])
-    for a in range(dt):
-        for j in range(dH):
-            acc = 0.0
-            for b in range(dt):
-                acc += B[a, b] * A0[1 + b, j]
-            tmpA[a, j] = acc
-        for j in range(dt):
-            acc = 0.0
-            for b in range(dt):
-                acc += B[a, b] * S[1 + b, j]
-            tmpS[a, j] = acc
-    for a in range(dt):
-        for j in range(dH):
-            A0[1 + a, j] = tmpA[a, j]
-        for h in range(H):
-            qh = Q[n, h]
-            for b in range(dt):
-                A0[1 + a, (1 + b) * H + h] += ((1.0 if a == b else 0.0) - B[a, b]) * qh
-            A0[1 + a, h] += -dcap * that[a] * qh
-        for j in range(dt):
-            S[1 + a, j] = tmpS[a, j]
+    _slip_gain(lu, lx, n, lx[1:, m], mu, pn, that, B)
+    _times_gain(B, A0[1:], tmpA)
+    _slip_phi(A0[1:], n, Q, that, B, dcap)
+    _times_gain(B, S[1:], tmpS)
     A0[0, :] = 0.0
     S[0, :] = 0.0
     if fixed:

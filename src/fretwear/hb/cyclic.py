@@ -38,6 +38,7 @@ from fretwear.model.cyclic import (
 )
 from fretwear.model.interfaces import observed_map
 from fretwear.resources import require_memory
+from fretwear.threads import limited
 from fretwear.validate import reals
 
 #: at most this many kept DOFs: cyclic modes by a dense Hermitian eigensolver
@@ -177,17 +178,15 @@ class CyclicCondenser(Condenser):
             if r is None:
                 return None
             Zr[sel], Fr[sel], oA[sel], ob[sel] = r.Z, r.F, r.obs_A, r.obs_b
-            if hasattr(r, "estimate"):
+            if r.estimate is not None:
                 estimates.append(r.estimate)
         obs_dofs = (np.concatenate([np.asarray(p.dofs, np.int64)
                                     for p in self.sector.model.observed])
                     if self.sector.model.observed else np.zeros(0, np.int64))
         quasi_static = name == "reduced" and bool(arg)
-        out = Reduced(float(omega), orders, Zr, Fr, oA, ob, obs_dofs, quasi_static,
-                      math.nan if frequency is None else float(frequency))
-        if estimates:
-            out.estimate = max(estimates)
-        return out
+        return Reduced(float(omega), orders, Zr, Fr, oA, ob, obs_dofs, quasi_static,
+                       math.nan if frequency is None else float(frequency),
+                       max(estimates) if estimates else None)
 
     def keep_interior(self) -> bool:
         """Keep the interior solutions of every harmonic index's latest exact condensation
@@ -225,6 +224,7 @@ def cyclic_condenser(sector: CyclicSector, engine_order: int) -> CyclicCondenser
 
 
 @model_argument
+@limited
 def cyclic_modes(sector: CyclicSector, k: int, n_modes: int = 6) -> tuple[np.ndarray,
                                                                           np.ndarray]:
     """The ``n_modes`` lowest modes of harmonic index (nodal diameter) ``k`` of the disk,
@@ -267,6 +267,7 @@ def cyclic_modes(sector: CyclicSector, k: int, n_modes: int = 6) -> tuple[np.nda
 
 
 @model_argument
+@limited
 def cyclic_frf(sector: CyclicSector, engine_order: int, frequencies) -> np.ndarray:
     """Linear response of the sector to the engine-order excitation, contact free:
     ``U_1`` (nf, ndof) complex [m] on the sector's DOFs at each excitation frequency [Hz]

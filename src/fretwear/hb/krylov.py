@@ -15,11 +15,11 @@ with per-harmonic factorisations of the active block: replacing each node's time
 by its mean over the period (``gbar_p``, the (0, 0) coefficient block of ``G_p``) makes it
 block-diagonal per harmonic, ``P_n = eps I + gbar (Z_aa(n w) - eps I)`` (``gbar``
 block-diagonal per node), so the preconditioner is ``k + 1`` dense LUs of ``m_a x m_a``
-(``m_a`` = active DOFs). It is exact for nodes whose gain does not vary over the period and
-for a linear interface; it is kept while the active set does not change and rebuilt when
-GMRES slows down. The contact law and the residual are those of the dense path: only the
-linear algebra of the step differs, so the converged answer is the same
-(tests/hb/test_krylov.py).
+(``m_a`` = active DOFs; in single precision, :data:`SINGLE_FACTORS`). It is exact for
+nodes whose gain does not vary over the period and for a linear interface; it is kept
+while the active set does not change and rebuilt when GMRES slows down. The contact law and
+the residual are those of the dense path: only the linear algebra of the step differs, so
+the converged answer is the same (tests/hb/test_krylov.py).
 """
 
 from __future__ import annotations
@@ -37,6 +37,15 @@ GMRES_RTOL = 1e-10
 #: another, and the estimate below which they are shared (MeanGainPreconditioner._close)
 SHARE_PROBES = 2
 SHARE_BELOW = 0.25
+#: the mean-gain preconditioner's LU factors in single precision (half the memory traffic
+#: of its triangular solves and half their memory, LAPACK's sgetrf for its builds): the
+#: preconditioner approximates the active block whatever its precision and GMRES multiplies
+#: by the operator in double, so the step is solved to ``rtol`` all the same; a rebuild after
+#: a GMRES failure factors in double. On benchmarks/scale_3d.py's partial-slip pad at 1024
+#: contact nodes: the preconditioner's applies 9.6 to 5.9-6.1 s CPU, its builds 6.1-6.4 to
+#: 4.6-5.7 s, the solution the double one's to 3e-9 (docs/studies/large-interface-solve.md,
+#: "The growth's terms, measured")
+SINGLE_FACTORS = True
 #: Krylov vectors kept before a restart, and restarts allowed
 GMRES_RESTART = 60
 GMRES_MAXITER = 4
@@ -49,6 +58,10 @@ REBUILD_GROWTH = 2.0
 #: the step is solved by a LAPACK LU of the active block up to this many unknowns (slipping
 #: or separating nodes x d x H), by GMRES above (docs/theory.md, "Large interfaces")
 ACTIVE_DENSE_MAX = 3000
+#: rows of a block formed at a time by :meth:`KrylovJacobian.column_norms` (an operator's
+#: blocks, hb/operator_blocks.py: a panel of 2.4 MB at 1024 contact nodes, reused, in place of
+#: a fresh m x m block per harmonic)
+COLUMN_NORM_PANEL = 96
 #: from this fraction of the DOFs active (but not all), the active blocks of an operator
 #: (hb/operator_blocks.py) are a view (:class:`_ActiveView`: products through the whole
 #: operator) instead of copies of its m x m matrices (2 x 1.125 GiB at 4096 contact nodes);
@@ -57,15 +70,16 @@ VIEW_FRACTION = 0.75
 
 
 @njit(cache=True)
-def _gram_quad(Are, Aim, rows, M, c0, c1):
-    """``out[t, c] = sum_p x_pc^T M[t, p] x_pc`` for the columns ``c0 <= c < c1`` of a block,
-    where ``x_pc`` (r,) holds the block's entries in the rows ``rows[p]`` (d,) of node ``p``:
-    ``Are[rows[p], c]`` if ``r = d``, followed by ``Aim[rows[p], c]`` if ``r = 2 d`` (the
-    real and imaginary parts of a complex block). One pass over the active rows, without
-    the copies and the ``(na, r, ncol)`` product of the batched NumPy form."""
+def _gram_quad(Are, Aim, rows, M, c0, c1, out):
+    """``out[t, c - c0] += sum_p x_pc^T M[t, p] x_pc`` for the columns ``c0 <= c < c1`` of a
+    block, where ``x_pc`` (r,) holds the block's entries in the rows ``rows[p]`` (d,) of
+    node ``p``: ``Are[rows[p], c]`` if ``r = d``, followed by ``Aim[rows[p], c]`` if
+    ``r = 2 d`` (the real and imaginary parts of a complex block). One pass over the rows,
+    without the copies and the ``(na, r, ncol)`` product of the batched NumPy form; the
+    nodes in order, so that a block's rows taken panel by panel (:meth:`KrylovJacobian.
+    column_norms`) sum as in one call."""
     nt, na, r, _ = M.shape
     d = rows.shape[1]
-    out = np.zeros((nt, c1 - c0))
     x = np.empty(r)
     for p in range(na):
         for c in range(c0, c1):
@@ -85,12 +99,11 @@ def _gram_quad(Are, Aim, rows, M, c0, c1):
 
 
 @njit(cache=True)
-def _gram_quad_real3(A, rows, M, c0, c1):
+def _gram_quad_real3(A, rows, M, c0, c1, out):
     """:func:`_gram_quad` for a real block and 3 DOFs per node (3D), the common case of
     large interfaces: the symmetric form ``sum_ij M_ij x_i x_j`` with its six coefficients
     taken out of the loop over the columns (five times faster)."""
     nt, na = M.shape[0], M.shape[1]
-    out = np.zeros((nt, c1 - c0))
     for p in range(na):
         r0, r1, r2 = A[rows[p, 0]], A[rows[p, 1]], A[rows[p, 2]]
         for t in range(nt):
@@ -152,6 +165,11 @@ class HarmonicBlocks:
         :meth:`block`): the stored block and ``dofs`` themselves here; an operator forms
         only those rows."""
         return (self.Z0 if b == 0 else self.block(b)), np.asarray(dofs)
+
+    def row_panel(self, b: int, dofs: np.ndarray, buf: np.ndarray):
+        """As :meth:`row_block`, for a panel of rows taken in turn (the column norms): the
+        stored block here (``buf`` unused); an operator forms the panel into ``buf``."""
+        return self.row_block(b, dofs)
 
     def node_diagonal(self, b: int, d: int) -> np.ndarray:
         """The (m / d, d, d) diagonal node blocks of block ``b`` (as :meth:`block`)."""
@@ -330,6 +348,19 @@ def harmonic_gains(G: np.ndarray, d: int, oscillating: bool = True):
     return gbar, gosc / (2 * k)
 
 
+def _lu_solve(lu, b):
+    """``P^-1 b`` by LAPACK factors ``lu``, in their precision (single factors,
+    :data:`SINGLE_FACTORS`: the right-hand side rounded to it, the result returned in
+    double)."""
+    if lu[0].dtype in (np.float32, np.complex64):
+        kind = np.complex64 if np.iscomplexobj(b) else np.float32
+        if np.iscomplexobj(b) and lu[0].dtype == np.float32:
+            kind = np.complex128
+        return sla.lu_solve(lu, np.asarray(b, kind), check_finite=False).astype(
+            np.result_type(b, np.float64))
+    return sla.lu_solve(lu, b, check_finite=False)
+
+
 class MeanGainPreconditioner:
     """``P^-1`` with ``P_n = eps I + g_n (Z_n - eps I)`` per harmonic (module docstring).
 
@@ -339,12 +370,15 @@ class MeanGainPreconditioner:
     :class:`HarmonicBlocks`; share : let a harmonic use the factors of the last factored one
     when they precondition it well (:meth:`_close`): below the structure's first resonances
     ``Z_n`` hardly differs from ``Z_0`` (``-(n w)^2 M_r`` against the stiffness) and one LU
-    serves several harmonics. A rebuild after a GMRES failure does not share.
+    serves several harmonics. A rebuild after a GMRES failure does not share. single :
+    the factors in single precision (:data:`SINGLE_FACTORS`; a rebuild after a GMRES failure
+    factors in double).
     """
 
     def __init__(self, gbar: np.ndarray, Z: HarmonicBlocks, eps: float, share: bool = True,
-                 gosc: np.ndarray | None = None):
+                 gosc: np.ndarray | None = None, single: bool = False):
         self.k, self.m, self.H = Z.k, Z.m, Z.H  # (no reference to Z: kept across sweeps)
+        self.single = single
         gosc = gbar if gosc is None else gosc
         self.factors = []  # per harmonic block: LAPACK LU of P_n or of a close P_b
         self.shared = 0
@@ -365,8 +399,10 @@ class MeanGainPreconditioner:
                 self.factors.append(last[2])
                 self.shared += 1
                 continue
-            lu = sla.lu_factor(self._block(g, Zb, eps), overwrite_a=True,
-                               check_finite=False)
+            P = self._block(g, Zb, eps)
+            if single:
+                P = P.astype(np.complex64 if np.iscomplexobj(P) else np.float32)
+            lu = sla.lu_factor(P, overwrite_a=True, check_finite=False)
             self.factors.append(lu)
             last = (Zb, g, lu)
         # the harmonics of each set of factors, solved together by apply()
@@ -392,9 +428,9 @@ class MeanGainPreconditioner:
         """``P^-1 b`` by the factors ``lu``; a complex ``b`` with real factors as its real and
         imaginary parts (a mixed call would copy the factors to complex)."""
         if np.iscomplexobj(b) and not np.iscomplexobj(lu[0]):
-            y = sla.lu_solve(lu, np.column_stack([b.real, b.imag]), check_finite=False)
+            y = _lu_solve(lu, np.column_stack([b.real, b.imag]))
             return y[:, 0] + 1j * y[:, 1]
-        return sla.lu_solve(lu, b, check_finite=False)
+        return _lu_solve(lu, b)
 
     @classmethod
     def _close(cls, gn, Zn, last, eps) -> bool:
@@ -433,11 +469,10 @@ class MeanGainPreconditioner:
         for lu, hs in self.groups:
             if not np.iscomplexobj(lu[0]):  # real P_n: P_n (a - i b) = P_n a - i P_n b
                 cols = [c for b in hs for c in ([0] if b == 0 else [b, k + b])]
-                out[:, cols] = sla.lu_solve(lu, r[:, cols], check_finite=False)
+                out[:, cols] = _lu_solve(lu, r[:, cols])
                 continue
             # complex factors (a damped harmonic; never harmonic 0, whose block is real)
-            y = sla.lu_solve(lu, (r[:, hs] - 1j * r[:, [k + b for b in hs]]),
-                             check_finite=False)
+            y = _lu_solve(lu, (r[:, hs] - 1j * r[:, [k + b for b in hs]]))
             out[:, hs], out[:, [k + b for b in hs]] = y.real, -y.imag
         return out.reshape(-1)
 
@@ -498,17 +533,17 @@ class KrylovJacobian:
         na = act.size
         rows = np.ascontiguousarray(act[:, None] * d + np.arange(d))  # (na, d)
 
+        # the active rows formed panel by panel into one buffer (an operator's blocks)
+        panel = max(1, min(na, COLUMN_NORM_PANEL // d))
+        # (twice a panel's rows: a panel of active nodes with stuck ones between them)
+        buf = np.empty((2 * panel * d, m), dtype=complex if not Z.real else float)
         for b in range(Z.nb):
             cs = [0] if b == 0 else [b, Z.k + b]
             nl = len(cs)
             Gs = np.ascontiguousarray(Gr[:, :, :, cs].reshape(nc, dH, d * nl))
             Ga = Gs[act]
             gram = np.matmul(np.transpose(Ga, (0, 2, 1)), Ga)  # (na, d nl, d nl)
-            # the block's rows of the active nodes (an operator forms only these) and every
-            # node's own d x d block
-            Zb, lrows = Z.row_block(b, rows.reshape(-1))
-            lrows = np.ascontiguousarray(lrows.reshape(na, d))
-            diag = Z.node_diagonal(b, d)  # (nc, d, d)
+            diag = Z.node_diagonal(b, d)  # every node's own d x d block (nc, d, d)
             if b == 0:
                 M = gram[None]
             elif Z.real:
@@ -524,15 +559,22 @@ class KrylovJacobian:
                 A, B, D = g5[:, :, 0, :, 0], g5[:, :, 0, :, 1], g5[:, :, 1, :, 1]
                 M = np.stack([np.block([[A, -B], [-np.transpose(B, (0, 2, 1)), D]]),
                               np.block([[D, np.transpose(B, (0, 2, 1))], [B, A]])])
-            M = np.ascontiguousarray(M)
-            Are, Aim = (Zb.real, Zb.imag) if np.iscomplexobj(Zb) else (Zb, Zb)
+            S = np.zeros((M.shape[0], m))  # sum over the active nodes, in their order
+            for p0 in range(0, na, panel):
+                ps = slice(p0, min(p0 + panel, na))
+                # the block's rows of these active nodes (an operator forms only these)
+                Zb, lrows = Z.row_panel(b, rows[ps].reshape(-1), buf)
+                lrows = np.ascontiguousarray(np.reshape(lrows, (-1, d)))
+                Mp = np.ascontiguousarray(M[:, ps])
+                if d == 3 and not np.iscomplexobj(Zb):
+                    _gram_quad_real3(Zb, lrows, Mp, 0, m, S)
+                else:
+                    Are, Aim = (Zb.real, Zb.imag) if np.iscomplexobj(Zb) else (Zb, Zb)
+                    _gram_quad(Are, Aim, lrows, Mp, 0, m, S)
             for j0 in range(0, m, chunk):
                 sl = slice(j0, min(j0 + chunk, m))
                 js = np.arange(sl.start, sl.stop)
-                if d == 3 and not np.iscomplexobj(Zb):
-                    sq = _gram_quad_real3(Zb, lrows, M, sl.start, sl.stop).T  # (ncol, nl)
-                else:
-                    sq = _gram_quad(Are, Aim, lrows, M, sl.start, sl.stop).T
+                sq = S[:, sl].T.copy()  # (ncol, nl)
                 # + eps (I - G) on the owner's block: column (j, c) -> node j // d, row j%d, c
                 q = js // d
                 ci = np.arange(js.size)
@@ -656,8 +698,12 @@ class KrylovJacobian:
                                         not getattr(owner, "_mean_gain", False))
             from fretwear.hb.nearfield_preconditioner import preconditioner_for
 
-            cls = preconditioner_for(Za) or MeanGainPreconditioner  # compressed: near field
-            pc = cls(gbar, Za, self.eps, share=not rebuild, gosc=gosc)
+            cls = preconditioner_for(Za)  # compressed forms: the near field when asked
+            if cls is None:
+                pc = MeanGainPreconditioner(gbar, Za, self.eps, share=not rebuild, gosc=gosc,
+                                            single=SINGLE_FACTORS and not rebuild)
+            else:
+                pc = cls(gbar, Za, self.eps, share=not rebuild, gosc=gosc)
             pc.oscillating = gosc is not gbar
             pc.nodes = act
             pc.first_iterations = None  # GMRES iterations per decade, first run
@@ -688,6 +734,8 @@ class KrylovJacobian:
         """GMRES on one right-hand side. When it fails with a preconditioner kept from an
         earlier Jacobian or with shared factors, one more run from its last iterate with a
         preconditioner rebuilt from this Jacobian without sharing; when a fresh unshared one
+        or with single-precision factors (:data:`SINGLE_FACTORS`) the same with a
+        double-precision one; when a fresh unshared one in double
         with the oscillating gains of :func:`harmonic_gains` fails, the owner takes the mean
         gain from then on and one more run follows with it; a fresh unshared one with the
         mean gain is the best at hand (GMRES's last iterate is returned). A kept
@@ -718,7 +766,7 @@ class KrylovJacobian:
                       and rate > REBUILD_GROWTH * pc.first_iterations):
                     self.owner._precond = None  # slow: rebuild at the next Jacobian
                 break
-            if fresh and not pc.shared:
+            if fresh and not pc.shared and not getattr(pc, "single", False):
                 if not pc.oscillating:
                     break  # the best preconditioner at hand: GMRES's last iterate
                 self.owner._mean_gain = True  # the oscillating gains failed here

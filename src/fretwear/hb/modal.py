@@ -35,6 +35,7 @@ LU and ``m`` complex solves per harmonic and frequency for the exact condensatio
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sla
@@ -90,6 +91,35 @@ OPERATOR_MIN_UNKNOWNS = 3000
 COMPRESS_TOL = 1e-6
 
 
+@dataclass(frozen=True)
+class Representation:
+    """How :meth:`ModalCondenser.reduced` returns ``Z_r`` (the condenser's ``representation``:
+    a string is this record's ``kind``). ``kind``: one of :data:`REPRESENTATIONS`
+    (:class:`ModalCondenser` says what each is); ``compress``: the bound of ``"compressed"``,
+    ``||X - X_H||_F <= compress ||X||_F`` for each shared ``X^cc``, a relative error in
+    (0, 1) (:data:`COMPRESS_TOL` when None; the other kinds take none)."""
+
+    kind: str = "auto"
+    compress: float | None = None
+
+    def __post_init__(self):
+        if self.kind not in REPRESENTATIONS:
+            raise InputError(f"representation = {self.kind!r}: expected one of "
+                             + ", ".join(f'"{r}"' for r in REPRESENTATIONS))
+        compress = _compress_bound(self.compress)
+        if compress is not None and self.kind != "compressed":
+            raise InputError(f"compress = {compress!r} with representation {self.kind!r}: "
+                             'expected None (only "compressed" has a bound)')
+        if self.kind == "compressed" and compress is None:
+            compress = COMPRESS_TOL
+        object.__setattr__(self, "compress", compress)
+
+    @classmethod
+    def of(cls, value) -> Representation:
+        """``value`` itself, or the record of the kind ``value`` names."""
+        return value if isinstance(value, Representation) else cls(value)
+
+
 def next_mode_count(n_modes: int, n_interior: int) -> int | None:
     """The number of modes to try after ``n_modes`` failed the error check: twice as many, at
     least :data:`MIN_RAISE`, at most :data:`MAX_MODES` and ``n_interior - 2`` (the
@@ -126,7 +156,8 @@ class ModalCondenser(Condenser):
     residual : add the static responses of the interior to the constraint modes' inertia
         loads (``m`` vectors, :meth:`_residual_vectors`): the omitted modes' error falls from
         ``(w / w_k)^2`` to ``(w / w_k)^4``; ``q`` grows by ``m``.
-    representation : how :meth:`reduced` returns ``Z_r``: ``"dense"`` (an (nb, m, m) array),
+    representation : how :meth:`reduced` returns ``Z_r`` (a :class:`Representation`, or its
+        ``kind`` alone): ``"dense"`` (an (nb, m, m) array),
         ``"operator"`` (a :class:`~fretwear.hb.modal_operator.ReducedOperator`: the
         frequency-independent ``X^cc`` shared by every harmonic plus a rank-``q`` term per
         harmonic) or ``"auto"`` (the operator above :data:`OPERATOR_MIN_UNKNOWNS` real
@@ -134,7 +165,8 @@ class ModalCondenser(Condenser):
         condensation either way (to rounding). ``"compressed"``: the operator, whose shared
         ``X^cc`` are also held compressed (:func:`fretwear.hb.hmatrix.compress`, a
         hierarchical low-rank form of the contact nodes' positions with
-        ``||X - X_H||_F <= compress ||X||_F``), once for every frequency; the solver's
+        ``||X - X_H||_F <= compress ||X||_F``, ``compress`` the record's bound), once for
+        every frequency; the solver's
         products take those (below ``m^2`` per column), the blocks it forms (the
         preconditioner's) stay exact.
 
@@ -142,25 +174,18 @@ class ModalCondenser(Condenser):
     ----------
     n_modes : fixed-interface modes kept; q : reduced interior coordinates (modes + load
     responses (+ residual vectors)); mode_frequencies : (n_modes,) [Hz]; error : relative error
-    of the check; residual : whether the residual vectors are in the basis; compress : the
-    compression's bound (``"compressed"``: :data:`COMPRESS_TOL` unless set before the first
-    :meth:`reduced`; None otherwise).
+    of the check; residual : whether the residual vectors are in the basis; representation :
+    ``"dense"``, ``"operator"`` (``"compressed"`` among them) or ``"auto"``; compress : the
+    compression's bound (``"compressed"``; None otherwise).
     """
 
     def __init__(self, model: Model, f_max: float, max_order: int, *, modes: int | None = None,
                  cutoff: float = CUTOFF, tol: float = TOL, raise_modes: bool = False,
-                 residual: bool = False, representation: str = "auto"):
-        if not (isinstance(f_max, int | float) and math.isfinite(f_max) and f_max > 0):
-            raise InputError(f"f_max = {f_max!r}: expected a positive frequency [Hz]")
-        if representation not in REPRESENTATIONS:
-            raise InputError(f"representation = {representation!r}: expected one of "
-                             + ", ".join(f'"{r}"' for r in REPRESENTATIONS))
-        compressed = representation == "compressed"
-        self._set_compress(model, COMPRESS_TOL if compressed else None)
-        self.representation = "operator" if compressed else representation
-        if modes is not None and (isinstance(modes, bool) or not isinstance(modes, int)
-                                  or modes < 0):
-            raise InputError(f"modes = {modes!r}: expected a number of modes >= 0")
+                 residual: bool = False, representation: str | Representation = "auto"):
+        self._check_args(f_max, modes)
+        rep = Representation.of(representation)
+        self._set_compress(model, rep.compress)
+        self.representation = "operator" if rep.kind == "compressed" else rep.kind
         for name, value in (("cutoff", cutoff), ("tol", tol)):
             if (isinstance(value, bool) or not isinstance(value, int | float)
                     or not math.isfinite(value) or value <= 0):
@@ -209,6 +234,16 @@ class ModalCondenser(Condenser):
                 "vectors (residual=True) or condense exactly")
 
     # -- construction -------------------------------------------------------------------------
+    @staticmethod
+    def _check_args(f_max, modes):
+        """One InputError for an ``f_max`` that is not a positive frequency or ``modes`` that
+        is not None or a number of modes."""
+        if not (isinstance(f_max, int | float) and math.isfinite(f_max) and f_max > 0):
+            raise InputError(f"f_max = {f_max!r}: expected a positive frequency [Hz]")
+        if modes is not None and (isinstance(modes, bool) or not isinstance(modes, int)
+                                  or modes < 0):
+            raise InputError(f"modes = {modes!r}: expected a number of modes >= 0")
+
     def _basis(self, mode_frequencies, Phi, extra):
         """Interior basis ``V``: the modes ``Phi`` and the static vectors ``extra``, scaled and
         orthonormalised (pivoted QR, dependent columns dropped); then the projections and the
@@ -512,7 +547,7 @@ class ModalCondenser(Condenser):
     def _compressed(self) -> list | None:
         """The compressed ``X^cc`` (``compress``), made on first use and kept: they do not
         depend on the frequency."""
-        if getattr(self, "compress", None) is None:
+        if self.compress is None:
             return None
         if self._products is None:
             self._products = [hmatrix.compress(self.proj_local[nm][0], self._coords,
@@ -632,11 +667,10 @@ def modal_condenser(model: Model, f_max: float, max_order: int, *, modes: int | 
         # residual vectors: their m extra solves are what it cannot afford at this size
         return BlockedModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff,
                                      tol=tol, compress=compress)
-    out = ModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff, tol=tol,
-                         raise_modes=raise_modes, residual=residual,
-                         representation="auto" if compress is None else "compressed")
-    out.compress = compress
-    return out
+    return ModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff, tol=tol,
+                          raise_modes=raise_modes, residual=residual,
+                          representation=("auto" if compress is None
+                                          else Representation("compressed", compress)))
 
 
 def _compress_bound(compress) -> float | None:
@@ -754,17 +788,9 @@ class BlockedModalCondenser(ModalCondenser):
         self._project()
         # the many-column solves are done: the dense panels they were made on (3.3 GiB at
         # 4096 contact nodes) are not held through the solves that follow (few columns)
-        getattr(lu, "release", lambda: None)()
+        lu.release()  # (a sparse factorisation: the interior is never dense here)
         self.error = self._check()
         self._raise_if_inaccurate(f_max, tol)
-
-    @staticmethod
-    def _check_args(f_max, modes):
-        if not (isinstance(f_max, int | float) and math.isfinite(f_max) and f_max > 0):
-            raise InputError(f"f_max = {f_max!r}: expected a positive frequency [Hz]")
-        if modes is not None and (isinstance(modes, bool) or not isinstance(modes, int)
-                                  or modes < 0):
-            raise InputError(f"modes = {modes!r}: expected a number of modes >= 0")
 
     @staticmethod
     def _basis(Phi, Xl):

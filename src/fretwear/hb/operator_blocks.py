@@ -77,6 +77,21 @@ class OperatorBlocks(HarmonicBlocks):
                 [None if u is None else u[dofs] for u in op.U], op.Y, False))
         return self._rows[1].block(b), np.arange(dofs.size)
 
+    def row_panel(self, b: int, dofs: np.ndarray, buf: np.ndarray):
+        """As :meth:`HarmonicBlocks.row_panel`: the rows from the first to the last of the
+        increasing ``dofs`` of block ``b`` formed into ``buf`` when they fit (every node
+        active, or active nodes with a few stuck ones between them, whose rows are formed
+        and not read), else formed from the stored matrices' rows ``dofs`` taken; with the
+        rows of ``dofs`` in the result. The same entries as :meth:`row_block`."""
+        dofs = np.asarray(dofs)
+        if b == 0:  # held formed
+            return self.Z0, dofs
+        if dofs.size and dofs[-1] - dofs[0] < buf.shape[0] and np.all(np.diff(dofs) > 0):
+            r0 = int(dofs[0])
+            r1 = int(dofs[-1]) + 1
+            return self.op.block_rows(b, r0, r1, buf[: r1 - r0]), dofs - r0
+        return self.op.block(b, rows=dofs), np.arange(dofs.size)
+
     def node_diagonal(self, b: int, d: int) -> np.ndarray:
         if b == 0:
             return super().node_diagonal(0, d)

@@ -65,6 +65,10 @@ class Reduced:
     obs_dofs : (no,) global DOFs of the observed points, in the order of ``model.observed``.
     quasi_static : True when inertia and damping were dropped.
     frequency : excitation frequency [Hz], as given to :func:`condense`.
+    estimate : None for an exact condensation; for a model from the local bases
+        (:meth:`Condenser.nearby`) the estimate of its relative error in ``Z`` and ``F``
+        (the worst harmonic): a point converged on it is polished on the exact condensation
+        before a sweep records it (:meth:`fretwear.hb.branch.Problems.polish`).
     """
 
     omega: float
@@ -76,6 +80,7 @@ class Reduced:
     obs_dofs: np.ndarray
     quasi_static: bool = False
     frequency: float = math.nan
+    estimate: float | None = None
 
     def __post_init__(self):
         self.omega = number(self.omega, "Reduced omega", low=0.0, unit="rad/s")
@@ -578,7 +583,7 @@ class Condenser:
         difference quotient in frequency never spans two bases), or None where its error
         estimate at ``omega`` exceeds ``tol`` (relative, in ``Z_r`` or ``F_r``, of any
         harmonic), or a harmonic has fewer than two exact condensations kept. The estimate
-        (the result's attribute ``estimate``) is the error's leading term at the distance
+        (the result's field ``estimate``) is the error's leading term at the distance
         from the basis's frequency, scaled by the two latest bases' disagreement one spacing
         beyond the later one (:meth:`_disagreement`). Harmonic 0 is the exact static
         condensation. No factorisation and no interior solve
@@ -618,7 +623,7 @@ class Condenser:
             for (j, _), v in zip(self.obs_i, x, strict=True):
                 ob[b, j] = v
         out = self._result(omega, orders, Zr, Fr, oA, ob, False, frequency)
-        out.estimate = estimate
+        out.estimate = estimate  # the declared field (no second validation of the arrays)
         return out
 
     def _disagreement(self, n: int, Fn) -> tuple[float, float]:

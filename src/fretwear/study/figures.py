@@ -8,7 +8,13 @@
   excitation level alone (``analysis.excitation_scale``): the FRFs divided by the level on
   one axis and the peak amplitude and frequency against the level;
 * periodic studies: the response amplitude of each member against the first varied numeric
-  key.
+  key;
+* linear FRF studies (``frf``): one FRF per member and interface (first observed point, on
+  its axis of largest response);
+* modes studies (``modes``): the natural frequencies against the first varied numeric key.
+
+Members of the other analysis types have no study figure (the summary says so; each member's
+own figures are in its folder).
 """
 
 from __future__ import annotations
@@ -114,11 +120,8 @@ def frf_family(ds, path: Path, varied: list[str]) -> Path:
     f = ds["frequency"].values
     fig, ax = _figure(figsize=(7, 4.5))
     for i in range(ds.sizes["member"]):
-        text = ", ".join(f"{k} = {ds[k].values[i]:.3g}" if ds[k].dtype.kind == "f"
-                         else f"{k} = {ds[k].values[i]}" for k in varied if k in ds.coords
-                         and ds[k].dims == ("member",))
         ax.plot(f, amp.values[i], lw=1, marker="." if f.size <= 80 else None, ms=3,
-                alpha=0.85, label=text or f"member {i}")
+                alpha=0.85, label=_member_label(ds, i, varied))
     ax.set_yscale("log")
     ax.set_xscale(frequency_scale(f.min(), f.max()))
     ax.set_xlabel("frequency [Hz]")
@@ -237,6 +240,66 @@ def response_per_member(ds, path: Path, varied: list[str]) -> Path:
     return _save(fig, path)
 
 
+def _member_label(ds, i: int, varied: list[str]) -> str:
+    """``key = value, ...`` of member ``i``'s varied keys (``member i`` when none)."""
+    text = ", ".join(f"{k} = {ds[k].values[i]:.3g}" if ds[k].dtype.kind == "f"
+                     else f"{k} = {ds[k].values[i]}" for k in varied if k in ds.coords
+                     and ds[k].dims == ("member",))
+    return text or f"member {i}"
+
+
+def linear_frf_family(ds, path: Path, varied: list[str]) -> Path:
+    """Linear FRFs (``frf`` members): the amplitude of the first observed point on its axis
+    of largest response, one colour per member, one line style per interface."""
+    amp = ds["displacement_amplitude"].isel(point=0)
+    label = str(ds["point"].values[0]) if "point" in ds else ""
+    with warnings.catch_warnings():  # an axis the point does not have is all NaN
+        warnings.simplefilter("ignore", RuntimeWarning)
+        largest = np.nanmax(amp.values.reshape(-1, amp.sizes["axis"]), axis=0)
+    axis = int(np.nanargmax(np.where(np.isnan(largest), -np.inf, largest)))
+    amp = amp.isel(axis=axis)
+    f = ds["frequency"].values
+    interfaces = [str(v) for v in ds["interface"].values]
+    fig, ax = _figure(figsize=(7, 4.5))
+    for i in range(ds.sizes["member"]):
+        for j, name in enumerate(interfaces):
+            ax.plot(f, amp.isel(member=i, interface=j).values, lw=1, color=f"C{i % 10}",
+                    ls=("-", "--", ":", "-.")[j % 4],
+                    label=f"{_member_label(ds, i, varied)}, {name}")
+    ax.set_yscale("log")
+    ax.set_xscale(frequency_scale(f.min(), f.max()))
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel(f"amplitude {label} {str(ds['axis'].values[axis])} [m]")
+    ax.set_title(ds.attrs.get("title", ""), fontsize=9)
+    if ds.sizes["member"] * len(interfaces) <= 12:
+        ax.legend(fontsize=7)
+    ax.grid(alpha=0.3, which="both")
+    return _save(fig, path)
+
+
+def natural_frequencies(ds, path: Path, varied: list[str]) -> Path:
+    """Modes members: each natural frequency against the first varied numeric key (the member
+    number when none), one colour per mode, one line style per interface."""
+    key = _numeric_key(ds, varied)
+    x = ds[key].values if key else ds["member"].values
+    order = np.argsort(x, kind="stable")
+    fn = ds["natural_frequency"]
+    fig, ax = _figure(figsize=(7, 4.5))
+    for j, name in enumerate(str(v) for v in ds["interface"].values):
+        for m in range(fn.sizes["mode"]):
+            y = fn.isel(interface=j, mode=m).values
+            ax.plot(x[order], y[order], marker="o", lw=0.8, color=f"C{m % 10}",
+                    ls=("-", "--", ":", "-.")[j % 4],
+                    label=f"{name}, mode {m + 1}" if fn.sizes["mode"] <= 6 else None)
+    ax.set_xlabel(key or "member")
+    ax.set_ylabel("natural frequency [Hz]")
+    ax.set_title(ds.attrs.get("title", ""), fontsize=9)
+    if fn.sizes["mode"] <= 6:
+        ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    return _save(fig, path)
+
+
 def study_figures(ds, outdir: Path, varied: list[str], fmt: str = "png") -> list[Path]:
     """Every figure that applies to the dataset; returns the files written."""
     out = []
@@ -251,4 +314,9 @@ def study_figures(ds, outdir: Path, varied: list[str], fmt: str = "png") -> list
         out.append(frf_family(ds, outdir / f"study-frf-family.{fmt}", varied))
         if varied == [LEVEL_KEY] and "peak_frequency" in ds:
             out.append(load_levels(ds, outdir / f"study-load-levels.{fmt}"))
+    elif "displacement_amplitude" in ds and "member" in ds["displacement_amplitude"].dims \
+            and "frequency" in ds["displacement_amplitude"].dims:
+        out.append(linear_frf_family(ds, outdir / f"study-frf-family.{fmt}", varied))
+    elif "natural_frequency" in ds and "member" in ds["natural_frequency"].dims:
+        out.append(natural_frequencies(ds, outdir / f"study-natural-frequencies.{fmt}", varied))
     return out

@@ -44,6 +44,7 @@ import time
 import numpy as np
 import scipy.linalg as sla
 
+from fretwear.wear.events import first_event, pattern_along
 from fretwear.wear.options import GROWTH_LIMIT, MIN_JUMP_FRACTION, WearOptions
 from fretwear.wear.schemes import StepStart, accept, balance_after
 from fretwear.wear.slow_problem import SlowProblem
@@ -52,6 +53,9 @@ from fretwear.wear.state import SlowStep
 #: the largest ``dN lam`` of a growing mode ``lam`` of ``Js`` in one step (a growth of the
 #: mode by ``e^2`` at most; the error control judges the step)
 EXP_GROWTH_LIMIT = 2.0
+#: with ``events``, the largest ``dN lam`` of a growing mode over which the first
+#: contact-state event is looked for (a growth of ``e^8``: the stuck neighbour slips before)
+EVENT_GROWTH_LIMIT = 8.0
 
 
 def increment(Js, g, dN: float) -> np.ndarray:
@@ -91,7 +95,7 @@ def rosenbrock_error(Js, dN: float, dW, g0, g1) -> np.ndarray:
 
 
 def exponential_step(sp: SlowProblem, st: SlowStep, opts: WearOptions, order: int = 1,
-                     cycles: float | None = None):
+                     cycles: float | None = None, events: bool = False):
     """One accepted slow step from ``st``: ``(new_state, record, failure)``,
     ``(None, None, message)`` when its balance failed after ``opts.max_retries`` smaller
     jumps.
@@ -107,6 +111,13 @@ def exponential_step(sp: SlowProblem, st: SlowStep, opts: WearOptions, order: in
     Schweitzer 2009), its error estimated by :func:`rosenbrock_error` and the jump
     controlled with the cube root of ``tolerance / error``.
 
+    ``events``: where a growing mode binds, the step ends just past the first change of the
+    contact-state pattern predicted along the linearised path within ``dN lam <=
+    EVENT_GROWTH_LIMIT`` (:mod:`fretwear.wear.events`; the growth ends when the loaded
+    neighbour slips), else at ``EXP_GROWTH_LIMIT``; the next step starts from the jump the
+    controller had proposed. Measured in docs/studies/method-costs.md ("Events along the
+    path"): it does not pay, hence off by default.
+
     ``cycles``: the cycle count the error control's floor is a fraction of
     (``MIN_JUMP_FRACTION``; None: ``st.cycles``). The pseudo-time of the worn state's
     continuation passes the cycles of its path steps alone: after a relaxation step of
@@ -118,9 +129,16 @@ def exponential_step(sp: SlowProblem, st: SlowStep, opts: WearOptions, order: in
     dN = min(st.jump, opts.max_jump, opts.max_cycles - st.cycles)
     floor = max(opts.min_jump, MIN_JUMP_FRACTION * (st.cycles if cycles is None else cycles))
     lam_plus = float(np.max(np.linalg.eigvals(Js).real))
-    exponential = order == 2 or (lam_plus > 0 and dN * lam_plus > GROWTH_LIMIT)
-    if lam_plus > 0 and dN * lam_plus > GROWTH_LIMIT:  # the march would cut it
+    growing = lam_plus > 0 and dN * lam_plus > GROWTH_LIMIT  # the march would cut it
+    exponential = order == 2 or growing
+    look = min(dN, EVENT_GROWTH_LIMIT / lam_plus) if growing else dN
+    proposal, cut = dN, False
+    if growing:
         dN = min(dN, EXP_GROWTH_LIMIT / lam_plus)
+    if events and growing:  # the step ends just past the first event, if it comes first
+        event = first_event(pattern_along(sp, st.W, st.U, anchor, st.g, Js, dUdW), look)
+        if event is not None:
+            dN, exponential, cut = event[1], True, True
 
     start = StepStart(st.W, st.U, st.g, anchor)
 
@@ -138,4 +156,10 @@ def exponential_step(sp: SlowProblem, st: SlowStep, opts: WearOptions, order: in
             e = float(np.max(np.abs(rosenbrock_error(Js, dN, W1 - st.W, st.g, g1))))
             return 0.0 if e == 0.0 else (e / scale if scale > 0 else math.inf)
         error = (estimate, 2)
-    return accept(sp, opts, st, anchor, attempt, (dN, floor, floor), (t0, 1, 0), error)
+    new, record, msg = accept(sp, opts, st, anchor, attempt, (dN, floor, floor), (t0, 1, 0),
+                              error)
+    if cut and new is not None:
+        # an event, not the error, ended the step: the next one starts from the jump the
+        # controller had proposed (the next slow Jacobian caps it again where it must)
+        new.jump = max(new.jump, proposal)
+    return new, record, msg

@@ -229,7 +229,8 @@ def simulate_wear(model: Model, basis: FourierBasis, *, frequency: float | None 
     balanced = [r for r in records if r.has_balance]
     final = _assemble(sp, balanced[-1]) if balanced else None
     return WearResult(WearHistory.from_records(records, reason), initial, final, reason,
-                      _message(reason, state, opts, extra), reason != "solver_failed",
+                      _message(reason, state, opts, extra, can_wear=bool(np.any(coef))),
+                      reason != "solver_failed",
                       time.perf_counter() - t_start, state.stability_jump, resumed_from,
                       penalty=sp.eps, warnings=warnings)
 
@@ -363,13 +364,18 @@ def _stop_reason(st: SlowStep, opts: WearOptions) -> str:
     return ""
 
 
-def _message(reason: str, st: SlowStep, opts: WearOptions, extra: str = "") -> str:
+def _message(reason: str, st: SlowStep, opts: WearOptions, extra: str = "",
+             can_wear: bool = True) -> str:
+    """The run's stop message; ``can_wear`` False: every wear coefficient is 0, which is then
+    the reason given for "no_wear" (not the slip)."""
     txt = {
         "max_cycles": f"reached max_cycles = {opts.max_cycles:.4g}",
         "max_depth": f"a wear depth reached max_depth = {opts.max_depth:.4g} m",
         "plateau": (f"plateau: worn-volume rate {st.volume_rate:.3g} m^3/cycle <= "
                     f"{opts.plateau_rate:g} x initial {st.volume_rate0:.3g}"),
-        "no_wear": "no wear: no contact node slips (worn-volume rate 0)",
+        "no_wear": ("no wear: no contact node slips (worn-volume rate 0)" if can_wear else
+                    "no wear: every wear coefficient is 0 (worn-volume rate 0; set the contact's "
+                    "wear_coefficient)"),
         "max_steps": f"reached max_steps = {opts.max_steps}",
         "solver_failed": "stopped: a periodic solve failed even with smaller jumps",
     }[reason]

@@ -41,7 +41,9 @@ the state depends on the path, and the jump, which does not follow it, can land 
 null-wear-rate state than the march (measured in docs/theory.md).
 
 Wear that goes on (gross slip) has no null-rate state; when the rate stops changing (``max
-|g_{k+1} - g_k| <= tolerance max g``) while the residual stays large, the result says so
+|g_{k+1} - g_k| <= tolerance max g``) over a step that moved the profile by
+``depth_tolerance`` of the larger of the deepest wear and the contact's displacement
+(:func:`_moved`) while the residual stays large, the result says so
 (``kind = "steady_wear"``) with the steady rate profile.
 
 The number of cycles a march needs to get within 1 % of the state is estimated (it is an
@@ -133,6 +135,12 @@ class WornStateOptions:
         started at the third step of a reduced triangle beam, whose rate had fallen by
         0.1 %, and jumped over the slip events to come: 0.73 % of the deepest wear from the
         march's state instead of 1e-5).
+    events : end a path step whose slow Jacobian has a growing mode at the first change of
+        the contact-state pattern (a node starting or ending to slip or to open) predicted
+        along the linearised path (:mod:`fretwear.wear.events`), instead of at the growth
+        limit. Off by default: measured on the three quasi-static examples it does not pay
+        (the steps that land past an event need more Newton iterations than those it saves;
+        docs/studies/method-costs.md, "Events along the path").
     """
 
     wear: WearOptions = field(default_factory=WearOptions)
@@ -147,6 +155,7 @@ class WornStateOptions:
     exponential: bool = True
     order: int = 1
     settle_rate: float = 0.01
+    events: bool = False
 
     def __post_init__(self):
         if not isinstance(self.wear, WearOptions):
@@ -161,7 +170,7 @@ class WornStateOptions:
             raise InputError(f"initial_jump = {j!r}: expected > 0 cycles or None")
         if self.order not in (1, 2) or isinstance(self.order, bool):
             raise InputError(f"order = {self.order!r}: expected 1 or 2")
-        for name in ("stick_set", "exponential"):
+        for name in ("stick_set", "exponential", "events"):
             if not isinstance(getattr(self, name), bool):
                 raise InputError(f"{name} = {getattr(self, name)!r}: expected true or false")
         number(self.max_growth, "max_growth", low=1.0, open_low=True, high=1e6)
@@ -184,6 +193,8 @@ class WornStateOptions:
                "settle_rate": self.settle_rate}
         if self.order != 1:  # (the checkpoints of first-order runs keep their key)
             key["order"] = self.order
+        if self.events:
+            key["events"] = True
         return key
 
 
@@ -339,6 +350,16 @@ def _correction(records: list[StepRecord]) -> float:
     return float(np.max(np.abs(W1 - W0))) / top if top > 0 else 0.0
 
 
+def _moved(records: list[StepRecord]) -> float:
+    """The last step's ``max |W_{k+1} - W_k|`` over the larger of the deepest wear and the
+    largest contact displacement coefficient ``max |U~|`` (0 before any step)."""
+    if len(records) < 2:
+        return 0.0
+    W1, W0 = records[-1].wear_depth, records[-2].wear_depth
+    scale = max(float(np.max(W1)), float(np.max(np.abs(records[-1].U))))
+    return float(np.max(np.abs(W1 - W0))) / scale if scale > 0 else 0.0
+
+
 def _rate_change(records: list[StepRecord]) -> float:
     """``max |g_{k+1} - g_k| / max g_{k+1}`` over the last step (inf before any step)."""
     if len(records) < 2:
@@ -348,13 +369,17 @@ def _rate_change(records: list[StepRecord]) -> float:
     return float(np.max(np.abs(g1 - g0))) / top if top > 0 else math.inf
 
 
-def _judge(records: list[StepRecord], options: WornStateOptions) -> _Found | None:
-    """The verdict on the last iterate, or None to go on."""
+def _judge(records: list[StepRecord], options: WornStateOptions, can_wear: bool = True
+           ) -> _Found | None:
+    """The verdict on the last iterate, or None to go on (``can_wear`` False: every wear
+    coefficient is 0, the reason a zero rate is then given)."""
     r, c = rate_residual(records), _correction(records)
     n = len(records) - 1
     if float(np.max(records[0].wear_rate)) <= 0:
-        return _Found(True, "no_wear", "no wear: no contact node slips at the start (wear rate "
-                      "0); the worn state is the initial one", 0.0, 0.0)
+        why = ("no contact node slips at the start" if can_wear else
+               "every wear coefficient is 0 (set the contact's wear_coefficient)")
+        return _Found(True, "no_wear", f"no wear: {why} (wear rate 0); the worn state is the "
+                      "initial one", 0.0, 0.0)
     if r <= options.tolerance and c <= options.depth_tolerance:
         return _Found(True, "null_wear_rate",
                       f"worn state reached after {n} pseudo-time steps: null-wear-rate "
@@ -362,9 +387,11 @@ def _judge(records: list[StepRecord], options: WornStateOptions) -> _Found | Non
                       f"correction {c:.3g} of the deepest wear <= {options.depth_tolerance:g}",
                       r, c)
     # steady: the rate profile did not change over a step that moved the profile (a tiny
-    # step, e.g. after failed balances, leaves any rate unchanged)
+    # step, e.g. after failed balances or from a small initial_jump, leaves any rate
+    # unchanged), measured against the interface's motion as well as the wear (from the
+    # unworn state every step moves the profile by much of its own deepest wear)
     if (n >= 3 and _rate_change(records) <= options.tolerance and r > 0.1
-            and c >= options.depth_tolerance):
+            and _moved(records) >= options.depth_tolerance):
         return _Found(True, "steady_wear",
                       f"no null-wear-rate state: the wear goes on at a steady rate (residual "
                       f"{r:.3g}, the rate profile changed by {_rate_change(records):.3g} over "
@@ -383,7 +410,7 @@ def _continue(sp: SlowProblem, state: SlowStep, records: list[StepRecord],
     path = options.march_options(path=True)
     jumps = _Jumps(sp, options, opts)
     while True:
-        found = _judge(records, options)
+        found = _judge(records, options, bool(np.any(sp.coef)))
         if found is not None:
             return state, replace(found, jump_iterations=jumps.iterations)
         if state.step >= options.max_steps:
@@ -408,7 +435,7 @@ def _continue(sp: SlowProblem, state: SlowStep, records: list[StepRecord],
             new, record, msg = _path_step(sp, state, opts if settled else path,
                                           options.exponential, 1 if settled else options.order,
                                           path_cycles(records, options.settle_rate)
-                                          if options.order == 2 else None)
+                                          if options.order == 2 else None, options.events)
             if new is not None and not new.in_time_integration:
                 new, record = _pull_back(sp, state, new, record, opts)
                 msg = msg or "the balance after pulling back over-worn nodes failed"
@@ -441,13 +468,13 @@ def path_cycles(records: list[StepRecord], settle_rate: float) -> float:
 
 
 def _path_step(sp: SlowProblem, state: SlowStep, opts: WearOptions, exponential: bool,
-               order: int = 1, cycles: float | None = None):
+               order: int = 1, cycles: float | None = None, events: bool = False):
     """The next pseudo-time step: the exponential Euler step
     (:func:`~fretwear.wear.exponential_step.exponential_step`) with ``exponential``, else
     or where it failed or from a time integration the march's step
     (:func:`fretwear.wear.simulate._step`, with its time-domain rescue)."""
     if exponential and not state.in_time_integration:
-        new, record, msg = exponential_step(sp, state, opts, order, cycles)
+        new, record, msg = exponential_step(sp, state, opts, order, cycles, events)
         if new is not None:
             return new, record, msg
     return _step(sp, state, opts)
