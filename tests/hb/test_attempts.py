@@ -307,3 +307,66 @@ def test_sweep_passes_a_fold_by_its_continuation_alone():
     open_x1 = abs(np.linalg.solve(K - wa**2 * M + 1j * wa * C, model.loads[0].vector)[0])
     amp = res.amplitude("x1", 0)[res.points.index(at)]
     assert abs(amp - open_x1) <= 1e-8 * open_x1
+
+
+def test_halved_steps_go_on_while_the_solver_makes_progress():
+    """The folded frictional model of :func:`helpers.folded.inclined` below its fold (0.60 to
+    0.74 rad/s, 8 points, 3 harmonics) with one iteration a point: the grid attempts stop at
+    their first iteration. The old ladder's halved steps stopped there too, and at 0.74 rad/s
+    every one failed: the arclength, the other solver (a fallback), then the eps continuation
+    from the last point, which landed on the lower branch (0.29 against 1.05, a jump the
+    sweep did not see). The halved steps are now tried again with each step going on from its
+    last iterate while the solver makes progress (:func:`fretwear.hb.attempts.
+    patient_substep`, :func:`~fretwear.hb.attempts.go_on`), so every point is reached by the
+    sweep's own path (no fallback). Independent check: the same grid points as the sweep
+    with the default 40 iterations a point (which converges at every grid attempt), to 1e-8
+    of the amplitude (the solve's relative tolerance; measured 1e-15)."""
+    from helpers.folded import inclined
+
+    from fretwear.hb import fallbacks
+    from fretwear.hb.options import SWEEP_POINT, SweepOptions
+    from fretwear.hb.reduce import exact_condenser
+    from fretwear.hb.sweep import sweep
+
+    model = inclined()
+    basis = FourierBasis.up_to(3, 64)
+
+    def run(max_iter):
+        return sweep(model, basis, 0.60 / (2 * np.pi), 0.74 / (2 * np.pi), 8,
+                     options=SweepOptions(spacing="linear",
+                                          solve=SWEEP_POINT.replace(max_iter=max_iter)),
+                     condenser=exact_condenser(model))
+
+    short, ref = run(1), run(40)
+    assert all([a.method for a in p.attempts] == ["grid"] for p in ref.points)
+    grid = [p for p in short.points if p.on_grid]
+    assert fallbacks.of_solutions(grid, short.wall_time).count == 0, [
+        [a.method for a in p.attempts] for p in grid]
+    assert any("substep" in [a.method for a in p.attempts] for p in grid)
+    a = np.array([short.amplitude("x1", 0)[short.points.index(p)] for p in grid])
+    np.testing.assert_allclose(a, ref.amplitude("x1", 0), rtol=1e-8, atol=0)
+
+
+def test_turned_back_finds_the_fold_the_branch_went_round():
+    """Points on a circle ``omega = 1 + 0.1 cos a`` (its frequency turns back at ``a = 0``,
+    omega = 1.1) marching towards 1.2: from -40 to +30 degrees the branch went round the
+    turn (the fold is the point at 0 degrees, the one farthest towards the target); up to
+    0 degrees it has not turned back yet, and one that comes back past the target (an
+    S-shaped branch, as the folded friction model's) or never reaches the turn has no fold
+    to jump from, nor one whose last point lies back from the turn by less than 1 % of the
+    way (a corrector's jitter). The same marching down (target 0.8, the circle mirrored)."""
+    from fretwear.hb.attempts import turned_back
+
+    def arc(degrees, sign=1.0):
+        return [(1.0 + sign * 0.1 * np.cos(np.radians(d)), np.zeros(1)) for d in degrees]
+
+    went_round = arc([-40, -20, 0, 15, 30])
+    assert turned_back(went_round, 0, 1.2) == 2
+    assert turned_back(went_round, 1, 1.2) == 2
+    assert turned_back(went_round[:3], 0, 1.2) is None  # the turn is its last point
+    assert turned_back(arc([-60, -40, -20]), 0, 1.2) is None  # still marching
+    back_past = [*went_round, (1.25, np.zeros(1))]
+    assert turned_back(back_past, 0, 1.2) is None  # reached the target after all
+    assert turned_back(arc([-40, -20, 0, 15, 30], -1.0), 0, 0.8) == 2
+    jitter = [*arc([-40, -20, 0]), (1.1 - 1e-6, np.zeros(1))]  # back by 4e-5 of the way
+    assert turned_back(jitter, 0, 1.2) is None

@@ -98,7 +98,7 @@ def _sweep_point_variables(result: SweepResult) -> dict:
                               "the periodic solve converged", flag_values=np.array(
                                   [0, 1], dtype=np.int8), flag_meanings="no yes"),
         "how": variable(f, np.array([p.how for p in result.points], dtype=str), "1",
-                        "how the point was reached: grid, substep, retry, arclength, "
+                        "how the point was reached: grid, substep, retry, arclength, jump, "
                         "eps-continuation, harmonic-continuation, time-start"),
         "flags": variable(f, np.array(["; ".join(p.flags) for p in result.points], dtype=str),
                           "1", "reasons for caution (empty: none)"),

@@ -25,10 +25,15 @@ Single solve (:class:`Trial`; :data:`~fretwear.hb.options.STRATEGY`, the rungs t
    steady state starts one more solve with its mean tangential positions as anchors.
 
 Sweep point (:class:`Point`; :data:`POINT_RUNGS`): ``"grid"`` (the solver from the secant
-predictor), ``"substep"`` (bisection of the step from the last converged point), ``"retry"``
-(the other solver from the neighbour), ``"arclength"`` (pseudo-arclength continuation past a
-fold, :mod:`fretwear.hb.arclength`; before ``"retry"`` when the branch turns back short of the
-grid frequency, :data:`FOLD_RUNGS`, :func:`point_ladder`), the rungs 3-4 of a single solve from
+predictor), ``"substep"`` (bisection of the step from the last converged point), the same
+again with each step going on past its ``max_iter`` while the solver makes progress
+(:func:`patient_substep`, :func:`go_on`; recorded as ``"substep"``), ``"retry"`` (the
+other solver from the neighbour), ``"arclength"`` (pseudo-arclength continuation past a fold,
+:mod:`fretwear.hb.arclength`; before ``"retry"`` when the branch turns back short of the grid
+frequency, :data:`FOLD_RUNGS`, :func:`point_ladder`; before the patient halved steps too),
+``"jump"`` (where the arclength turned
+back at a fold short of the frequency: the grid attempt from the fold's point, :func:`jump`),
+the rungs 3-4 of a single solve from
 the neighbour (at the first point of a branch, which has none, from the contact-closed guess
 with a single solve's iterations), ``"fresh-start"`` (as a single solve from the first harmonic
 alone with the static anchors and five times the iterations: the neighbour's state can lie on
@@ -71,6 +76,19 @@ EPS_STEP_MAX_ITER = 20
 #: iterations of the fresh start of a sweep point (as a single solve makes it), as a multiple
 #: of the sweep's ``max_iter``: 5 x 40 is the single solve's default of 200
 FRESH_ITER_FACTOR = 5
+#: a halved step of a sweep point that used its ``max_iter`` iterations without converging
+#: goes on from its last iterate for at most this many times ``max_iter`` more, while the
+#: solver makes progress (MINPACK's test with :data:`STEP_MAX_SLOW` Jacobians,
+#: :func:`go_on`): on the FE FRFs Powell was still converging at its 40th iteration where the
+#: ladder then went on to the other solver (the dovetail at 2800 Hz: 1.9 -> 7.6e-2 in 40,
+#: converged in 68; docs/studies/fallbacks.md, "The four crossings")
+STEP_MORE_ITER = 4
+STEP_MAX_SLOW = 5
+#: a branch turned back at a fold (:func:`turned_back`, the rung ``"jump"``) when its last
+#: point lies back from its farthest one by more than this fraction of the way it went: on
+#: the platform damper's FRF the arclength went 360 Hz up to its fold at 38476.5 Hz and 63 Hz
+#: back (0.17); its correctors' jitter at a fold's tip moves a few 1e-4 of that
+TURN_BACK = 0.01
 #: harmonics above which a single solve without a start begins from the first harmonic alone
 #: (the first point of a sweep too): with more than one. From the contact-closed guess the
 #: solvers stalled with 15+ harmonics (docs/verification.md), and with 3 wherever the
@@ -362,7 +380,8 @@ class Point:
     solve, how it was made, every attempt, and what a time integration found (None: none
     ran); whether the halved steps failed down to the smallest (``halved_out``) and the index
     in the branch's history of the last converged point before the arclength ran
-    (``neighbour``: None before it ran)."""
+    (``neighbour``: None before it ran) and of its point at a fold it turned back from short
+    of the frequency (``fold``: None if it did not, :func:`jump`)."""
 
     frequency: float
     probs: Problems
@@ -377,6 +396,7 @@ class Point:
     fallback_seconds: float = 0.0
     halved_out: bool = False
     neighbour: int | None = None
+    fold: int | None = None
 
     @property
     def omega(self) -> float:
@@ -396,6 +416,30 @@ def solve_at(probs: Problems, omega: float, anchor, U0, options: SolveOptions):
     return prob, x, st
 
 
+def go_on(prob: DLFTProblem, U, st: SolveStats, options: SolveOptions):
+    """``(U, stats)`` of a solve that used its ``options.max_iter`` iterations without
+    converging, continued from its last iterate ``U`` for at most :data:`STEP_MORE_ITER` times
+    as many while it makes progress (MINPACK's test, ``max_slow`` =
+    :data:`STEP_MAX_SLOW` Jacobians in a row without decreasing ``|f|^2`` by 10 %; a
+    non-smooth stall or a failed line search ends it too); a solve that converged, or
+    stopped for another reason, is returned as it is. The statistics add up both runs."""
+    if st.success or st.iterations < options.max_iter:
+        return U, st
+
+    def fun(x, jac=True):
+        return prob.residual(x.reshape(prob.m, prob.H), jac)
+
+    t0 = time.perf_counter()
+    x, _, st2 = solve(fun, np.asarray(U, float).reshape(-1),
+                      lambda x: prob.scale(x.reshape(prob.m, prob.H)), method=options.solver,
+                      tol=options.tol, max_iter=STEP_MORE_ITER * options.max_iter,
+                      max_slow=STEP_MAX_SLOW)
+    merged = SolveStats(st2.success, st2.residual, st.iterations + st2.iterations,
+                        st.nfev + st2.nfev, st.njev + st2.njev,
+                        st.wall_time + time.perf_counter() - t0, st2.message, st2.solver)
+    return x.reshape(prob.m, prob.H), merged
+
+
 def grid(p: Point) -> bool:
     """``"grid"``: the solver from the secant predictor, with the anchors of the history; at
     the first point of a branch (no predictor) from the start of a single solve
@@ -413,10 +457,12 @@ def grid(p: Point) -> bool:
     return p.adopt(prob, U, st, "grid")
 
 
-def substep(p: Point) -> bool:
+def substep(p: Point, patient: bool = False) -> bool:
     """``"substep"``: from the last converged point, steps halved on failure (at most
     ``max_bisections`` times) and grown by 1.5 on success, each converged intermediate point
-    kept in the sweep. A failure that halved the step below its smallest sets
+    kept in the sweep; with ``patient`` (:func:`patient_substep`) each step's solve goes on
+    while it makes progress (:func:`go_on`). A failure that halved the step below its
+    smallest sets
     ``p.halved_out`` (a fold's sign, :func:`~fretwear.hb.arclength.fold_ahead`)."""
     b, omega, opts = p.branch, p.omega, p.options
     if not b.history:
@@ -432,6 +478,8 @@ def substep(p: Point) -> bool:
         if last:
             w_try = omega
         pb, Ub, stb = solve_at(p.probs, w_try, b.anchor(), b.predict(w_try), opts.solve)
+        if patient:
+            Ub, stb = go_on(pb, Ub, stb, opts.solve)
         if not stb.success:
             step *= 0.5
             continue
@@ -445,6 +493,14 @@ def substep(p: Point) -> bool:
             step = omega - w_cur
     p.halved_out = abs(step) < abs(min_step) * (1 - 1e-12)
     return False
+
+
+def patient_substep(p: Point) -> bool:
+    """``"substep"`` again after the halved steps failed (and, with a fold ahead, after the
+    arclength did not reach the frequency), each step's solve going on past ``max_iter``
+    while the solver makes progress (:func:`go_on`): the sweep's own path along the branch
+    where the solver converges slowly (:func:`point_ladder`). Recorded as ``"substep"``."""
+    return substep(p, patient=True)
 
 
 def retry(p: Point) -> bool:
@@ -477,6 +533,7 @@ def arclength_branch(p: Point) -> bool:
                       opts.solve.tol)
     for Ub, wb, stb, pb in found:
         b.add(wb, pb, Ub.reshape(pb.m, pb.H), stb, "arclength")
+    p.fold = turned_back(b.history, p.neighbour, p.omega)
     if not found:
         p.tried.append(Attempt("arclength", "arclength", p.probs.get(p.omega, anc).eps, False,
                                float("nan"), 0, time.perf_counter() - t_arc,
@@ -488,6 +545,43 @@ def arclength_branch(p: Point) -> bool:
     p.tried.append(dataclasses.replace(Attempt.of("arclength", prob.eps, st),
                                        wall_time=time.perf_counter() - t_arc))
     return p.adopt(prob, U, st, "arclength")
+
+
+def turned_back(history, start: int, omega: float) -> int | None:
+    """The index in ``history`` of the point where the branch after ``history[start]`` turned
+    back short of ``omega`` [rad/s] (the farthest towards ``omega``, with the last point back
+    from it by at least :data:`TURN_BACK` of the way from ``history[start]`` to it: a fold the
+    arclength went round, not the jitter of its correctors), None if it did not (it went on
+    towards ``omega``, or reached it)."""
+    march = np.sign(omega - history[start][0])
+    ws = [march * float(w) for w, _ in history[start:]]
+    tip = int(np.argmax(ws))
+    if tip == 0 or ws[tip] >= march * omega or ws[tip] - ws[-1] <= TURN_BACK * (ws[tip]
+                                                                                - ws[0]):
+        return None
+    return start + tip
+
+
+def jump(p: Point) -> bool:
+    """``"jump"``: after an arclength that turned back at a fold short of this frequency and
+    did not come back to it (``p.fold``, :func:`turned_back`), the sweep's first attempt (its
+    solver, :func:`go_on`) from the branch's point at the fold, with its anchors: the jump a
+    stepped-sine test makes there (the response leaves the branch at its fold for the branch
+    that exists at the next frequency). Said as a line, and in the run's summary
+    (:func:`fretwear.hb.fallbacks.of_solutions`). Not tried where no fold was passed."""
+    if p.fold is None:
+        return False
+    b, so = p.branch, p.options.solve
+    w_fold = float(b.history[p.fold][0])
+    prob, U, st = solve_at(p.probs, p.omega, b.anchor(p.fold), b.history[p.fold][1], so)
+    U, st = go_on(prob, U, st, so)
+    f_fold = w_fold / (2 * np.pi)
+    p.tried.append(Attempt.of("jump", prob.eps, st,
+                              f"{st.message} (from the fold at {f_fold:.6g} Hz)"))
+    said(f"sweep at {p.frequency:.6g} Hz: the branch turns back at a fold at {f_fold:.6g} Hz; "
+         f"jump from there to {p.frequency:.6g} Hz: "
+         + ("converged" if st.success else f"not converged ({st.residual:.2e})"))
+    return p.adopt(prob, U, st, "jump")
 
 
 def _single(p: Point, prob: DLFTProblem, x0, options: SolveOptions, rungs, how) -> bool:
@@ -556,12 +650,15 @@ def point_time_start(p: Point) -> bool:
 
 
 #: the rungs of a sweep point, in order
-POINT_RUNGS = (("grid", grid), ("substep", substep), ("retry", retry),
-               ("arclength", arclength_branch), ("continuation", continuation),
-               ("fresh-start", fresh_start), ("time-start", point_time_start))
-#: the rungs of a sweep point with a fold ahead (:func:`point_ladder`): the arclength before
-#: the other solver, the rest in order
-FOLD_RUNGS = (POINT_RUNGS[0], POINT_RUNGS[1], POINT_RUNGS[3], POINT_RUNGS[2], *POINT_RUNGS[4:])
+POINT_RUNGS = (("grid", grid), ("substep", substep), ("patient-substep", patient_substep),
+               ("retry", retry), ("arclength", arclength_branch), ("jump", jump),
+               ("continuation", continuation), ("fresh-start", fresh_start),
+               ("time-start", point_time_start))
+#: the rungs of a sweep point with a fold ahead (:func:`point_ladder`): the arclength (and the
+#: jump from a fold it turned back at) before the patient halved steps and the other solver,
+#: the rest in order
+FOLD_RUNGS = (POINT_RUNGS[0], POINT_RUNGS[1], POINT_RUNGS[4], POINT_RUNGS[5], POINT_RUNGS[2],
+              POINT_RUNGS[3], *POINT_RUNGS[6:])
 
 
 #: the rungs of a sweep point said as they start (the costly ones; the first four are the
@@ -592,7 +689,36 @@ def point_ladder(p: Point) -> Point:
     2800 Hz, where the arclength's corrector diverged and Newton from the neighbour
     converged), the other solver keeps its place before the arclength: one solve at the grid
     frequency, where the arclength pays a condensation per corrector iterate at every new
-    frequency."""
+    frequency.
+
+    Why the patient halved steps (:func:`patient_substep`: each step going on past
+    ``max_iter`` while the solver makes progress, :func:`go_on`) come before the other
+    solver: on the FE FRFs the points that fell back away from a fold (the other solver from
+    the neighbour converging after the halved steps failed) were Powell solves still
+    converging at their 40th iteration (docs/studies/fallbacks.md, "The four crossings"):
+    the dovetail at 2800 Hz (from the predictor 1.9 -> 7.6e-2 in 40, converged in 68), the
+    bladed disk at 3100 Hz (converged in 88) and at 2900 Hz (where Powell stalls over the
+    whole 100 Hz step, but converges over its half). Cut at 40, every halved step failed
+    down to the smallest and the point went to the other solver; going on, a halved step
+    converges and the point is reached along the branch. They come after the plain halved
+    steps (and after the arclength where a fold lies ahead) so that wherever those pass, the
+    path is the same as before: going on at once, the halved steps stepped over the lap
+    joint's resonance peak (recorded up to 5.04e-5 m where the arclength's points resolve
+    6.15e-5 m). The grid attempt keeps its ``max_iter``: a longer solve over the whole grid
+    step landed, where the friction state depends on the loading path, on the state of the
+    coarser path (the bladed disk at 3100 Hz: 5 % from a sweep of 10 Hz steps). Where the
+    solver stalls (a fold with no point ahead, a non-smooth stall) MINPACK's progress test
+    ends the extension within a few Jacobians.
+
+    Why a jump (:func:`jump`): where the arclength went round a fold and turned back short of
+    the grid frequency without coming back to it (the platform damper's FRF: the branch
+    turns at 38476.5 Hz and leads back down, 41016.8 Hz lies beyond the fold), the response
+    of a stepped-sine test leaves the branch at the fold for the branch that exists at the
+    next frequency. The sweep computes that jump with its own first attempt (its solver, its
+    iterations) from the branch's point at the fold and its stick anchors, says it, and
+    lists it in the run's summary; the other solver and the eps continuation from the last
+    point of the arclength (on the branch leading away, which the test never visits) came
+    after it and remain for a jump that does not converge."""
     t_first = None
     rungs = POINT_RUNGS
     for i in range(len(rungs)):

@@ -13,16 +13,18 @@ setting that may avoid them (:func:`eps_hint`).
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 #: the logger of the lines said as fallbacks happen
 log = logging.getLogger("fretwear")
 #: the share of the run's time in fallbacks above which the summary names a setting to try
 HINT_SHARE = 0.2
 #: the rungs of a sweep point that are the sweep's own path along its branch, not fallbacks:
-#: the grid step, its halving and the pseudo-arclength continuation past a fold (a point
-#: that needed only these is counted apart, :attr:`FallbackCost.continued`)
-CONTINUATION = ("grid", "substep", "arclength")
+#: the grid step, its halving, the pseudo-arclength continuation past a fold and the jump
+#: from a fold the continuation turned back at (the sweep's first attempt from the fold's
+#: point, as a stepped-sine test jumps there; said and listed in the summary); a point that
+#: needed only these is counted apart, :attr:`FallbackCost.continued`
+CONTINUATION = ("grid", "substep", "arclength", "jump")
 
 
 def said(message: str) -> None:
@@ -42,6 +44,7 @@ class FallbackCost:
     total: float = 0.0
     continued: int = 0
     continued_seconds: float = 0.0
+    jumps: list = field(default_factory=list)
 
     @property
     def share(self) -> float:
@@ -74,9 +77,10 @@ class FallbackCost:
             return ""
         share = (f" ({100 * self.continued_seconds / self.total:.0f} % of {self.total:.1f} s)"
                  if self.total > 0 else "")
+        jumps = f"; jumps at folds: {', '.join(self.jumps)}" if self.jumps else ""
         return (f"continuation (halved steps, arclength past a fold: the sweep's own path, not "
                 f"fallbacks): {self.continued_seconds:.1f} s{share}; {self.continued} {what} "
-                f"needed nothing else")
+                f"needed nothing else{jumps}")
 
 
 def of_solutions(points, total: float) -> FallbackCost:
@@ -86,10 +90,15 @@ def of_solutions(points, total: float) -> FallbackCost:
     arclength's is its whole continuation) is the sweep's path, counted apart
     (``continued_seconds``); a point that needed only these is counted apart
     (``continued``), any other is a fallback with the rest of its time after the first
-    attempt."""
+    attempt. A point reached by a jump from a fold (``"jump"``) is listed (``jumps``: the
+    fold's frequency and the point's)."""
     cost = FallbackCost(total=float(total))
     for p in points:
         attempts = getattr(p, "attempts", [])
+        for a in attempts:  # a jump at a fold (fretwear.hb.attempts.jump): where from, to
+            if a.method == "jump" and a.success and hasattr(p, "frequency_hz"):
+                fold = a.message.rsplit("(from the fold at ", 1)[-1].rstrip(")")
+                cost.jumps.append(f"{fold} -> {p.frequency_hz:.6g} Hz")
         if len(attempts) > 1 or (attempts and not attempts[0].success):
             seconds = float(getattr(p, "fallback_seconds", 0.0))
             later = attempts[1:]

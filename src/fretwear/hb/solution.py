@@ -193,8 +193,9 @@ class Attempt:
         another penalty, then stepped back to the target one: the answer is at the target
         eps), ``"harmonic-continuation"`` (the first harmonic alone, then all of them),
         ``"time-start"`` (from a time integration), and for sweeps ``"grid"``, ``"substep"``,
-        ``"retry"``, ``"arclength"``, ``"fresh-start"`` (the first harmonic alone with the
-        static anchors, then ``"start"`` and ``"eps-continuation"`` with a single solve's
+        ``"retry"``, ``"arclength"``, ``"jump"`` (from a fold the arclength turned back at),
+        ``"fresh-start"`` (the first harmonic alone with the static anchors, then ``"start"``
+        and ``"eps-continuation"`` with a single solve's
         iterations).
     solver : the nonlinear solver; eps : the penalty of the answer [N/m]; success, residual
     (relative), iterations, wall_time [s], message : as :class:`~fretwear.hb.solvers.SolveStats`.

@@ -36,8 +36,8 @@ class SweepPoint:
     frequency_hz : the frequency [Hz]; solution : the converged periodic solution, or None
     when the solve did not converge (a failed solve is never kept as a solution); stats :
     solver statistics of the last solve; how : ``"grid"``, ``"substep"``, ``"retry"``,
-    ``"arclength"``, ``"eps-continuation"``, ``"harmonic-continuation"``, ``"fresh-start"``
-    or ``"time-start"``; attempts : every attempt made at this frequency, in order
+    ``"arclength"``, ``"jump"``, ``"eps-continuation"``, ``"harmonic-continuation"``,
+    ``"fresh-start"`` or ``"time-start"``; attempts : every attempt made at this frequency, in order
     (:class:`~fretwear.hb.solution.Attempt`); flags : reasons for caution
     (``"not converged: ..."``, time-domain findings); on_grid : a requested grid frequency
     (False for the intermediate points the sweep added); time_domain : what the time
