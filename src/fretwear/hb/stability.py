@@ -600,13 +600,7 @@ class HillProblem:
         nw = orders * w
         q = dyn.q
 
-        def full(name):
-            if name not in dyn.blocks:
-                return None
-            xx, xq, qx, qq = (np.asarray(b, dtype=float) for b in dyn.blocks[name])
-            return np.block([[xx, xq], [qx, qq]]) if q else xx
-
-        K, M, C, D = (full(nm) for nm in ("K", "M", "C", "D"))
+        K, M, C, D = (dyn.full.get(nm) for nm in ("K", "M", "C", "D"))
         nb = orders.size
         # complex blocks per harmonic of the coefficients of sigma^0, sigma^1, sigma^2 of
         # Z(lambda), lambda = w (sigma + i n), in the layout of reduce.to_real_blocks
@@ -762,7 +756,7 @@ def _inverse_iteration(B0, B1, B2, sigma: complex, y: np.ndarray, max_iter: int 
     first = True
     B0, B1, B2 = (np.asarray(b, dtype=complex) for b in (B0, B1, B2))
     for _ in range(max_iter):
-        lu, piv, info = zgetrf(B0 + sigma * B1 + (sigma * sigma) * B2)
+        lu, piv, info = zgetrf(B0 + sigma * B1 + (sigma * sigma) * B2, overwrite_a=True)
         if info != 0:
             return sigma, x, False
         if first:  # towards the eigenvector of the eigenvalue nearest sigma
