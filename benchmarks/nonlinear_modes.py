@@ -17,17 +17,17 @@
 The point's solve is what the sweep spent on it, as the sweep records it
 (``SweepPoint.cpu_seconds`` and ``seconds``, :meth:`fretwear.hb.branch.Branch.lap`): the
 predictor, the condensation at its frequency, every attempt (failed ones included), the
-polish, the solution assembled. The median is over the grid points; the intermediate
-points a ladder adds (substeps, the arclength's branch: each carries its own share of the
-ladder) are in the sweep's totals, also printed. Two other
-denominators were used before and both were wrong: the attempts' own times (the solver's
-iterations alone, without the condensation and the recording: about 60 % of the point's
-CPU on these models, so the ratio was too high, and the intermediate points had none), and a
-warm-started :func:`~fretwear.hb.periodic.solve_periodic` repeated per point (a single
-solve's set-up, the static preload solve, the penalty and the input checks, which the sweep
-pays once: 2.5 times the point's CPU, so the ratio was too low). The ratio is of CPU seconds
-(the machine is shared: a wall time holds 4-8 ms of waiting for a core at random points, as
-large as a point's solve); the wall ratio is printed too.
+polish, the solution assembled. The median is over the grid points; the intermediate points
+a ladder adds (substeps, the arclength's branch, each with its own share of the ladder) are
+in the sweep's totals, printed too. Two other denominators were used before, and both were
+wrong: the attempts' own wall times (the solver's iterations alone, without the
+condensation and the recording: about two thirds of the point's CPU on these models, so the
+ratio was too high; none for the intermediate points), and a warm-started
+:func:`~fretwear.hb.periodic.solve_periodic` repeated per point (with a single solve's
+set-up, the static preload solve, a second condensation and the input checks, which the
+sweep pays once: 2-2.5 times the point's CPU, so the ratio was too low). The ratio is of CPU
+seconds: the machine is shared, and a wall time holds 4-8 ms of waiting for a core at random
+points, more than a point's solve; the wall ratio is printed too.
 
 Ends with ``epmc_jenkins_err=<max relative error, one harmonic, 1024 samples>``,
 ``hill_cost_ratio_wall=`` (wall seconds) and ``hill_cost_ratio=<stability time / solve
