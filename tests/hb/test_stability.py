@@ -31,6 +31,7 @@ from fretwear.hb.stability import (
     _components,
     _shifted_copy,
     centroid,
+    jacobian_form,
     problem_of,
     quadratic_eigen,
     shifted_gain,
@@ -197,6 +198,36 @@ def test_shifted_gain_at_zero_is_the_solve_s_gain():
 
 
 # --- Hill's matrix and the exponents --------------------------------------------------------
+@pytest.mark.parametrize("case", ["jenkins-hysteretic", "unilateral-two-dof"])
+def test_compiled_hill_matrix_is_its_parts(case):
+    """``HillProblem.matrix`` (compiled: ``Z_r`` by elimination on the held structure, then
+    ``G Z`` over the nonzero entries of ``Z``) equals ``jacobian_form(gain, stiffness)``
+    (numpy and LAPACK: tested against the law's recursion, the solve's Jacobian and the dense
+    Schur complement in this module and test_dynamics.py) to 1e-13 of its largest entry:
+    the same terms summed in another order and a ``q x q`` elimination instead of LAPACK's
+    (measured within 1e-15; the margin is for the conditioning of the held structure). At
+    ``s = 0``, on the imaginary axis and in both half-planes, on a Jenkins solution with
+    viscous and hysteretic damping (``Im s`` signs the hysteretic term of every harmonic,
+    the static one included) and on the unilateral two-DOF oscillator (contact springs:
+    three interior coordinates, a Schur complement per argument)."""
+    if case == "jenkins-hysteretic":
+        model = from_matrices([[1.0]], [[1.0]],
+                              contact=ContactDofs(normal_dofs=None, tangential_dofs=[0],
+                                                  mu=0.5, normal_load=1.0, kt=0.5),
+                              damping=Damping(C=[[0.02]], D=[[0.03]]),
+                              loads=[Load(np.array([0.2]), "cos")], observed={"x": 0})
+        basis, w = FourierBasis.up_to(5, 64), 1.18
+    else:
+        model, basis, w = two_dof(), FourierBasis.up_to(5, 64), 0.7
+    sol = solve_periodic(model, basis, frequency=w / (2 * np.pi), time_domain=None)
+    assert sol.success
+    prob = problem_of(model, sol)
+    hp = HillProblem(prob, sol.U.reshape(prob.m, prob.H), structure_dynamics(model))
+    for sigma in (0.0, 0.3j, -0.02 + 0.47j, 0.1 - 0.2j):
+        ref = jacobian_form(hp.gain(sigma), hp.stiffness(sigma), prob.eps)
+        assert np.abs(hp.matrix(sigma) - ref).max() <= 1e-13 * np.abs(ref).max()
+
+
 def test_hill_matrix_at_zero_is_the_solve_jacobian():
     """``T(0)`` is the Jacobian the solve used (``J = eps I - G (eps I - Z)``), to rounding,
     on a Jenkins solution that sticks and slips; so is :meth:`HillProblem.jacobian` (from the

@@ -489,6 +489,122 @@ def jacobian_form(G: np.ndarray, Z: np.ndarray, eps: float) -> np.ndarray:
     return T
 
 
+@njit(cache=True)
+def _hill_matrix(G, Zr, eps):
+    """``T(s) = eps I - G(s) (eps I - Z(s))`` (m H, m H) complex (:func:`jacobian_form` of
+    :func:`hill_blocks`) from ``G(s)`` (nc, dH, dH) and ``Z_r`` (1 + 2k, m, m) at ``s``,
+    ``s + i n w``, ``s - i n w`` (:meth:`HillProblem.stiffness`), in one compiled call: the
+    product ``G Z`` over the nonzero entries of ``Z(s)`` only (per column, the harmonic's
+    own coefficient and its cosine/sine partner of every DOF: ``2 m`` terms, not ``m H``),
+    which at the sizes of a refinement (tens of unknowns) costs less than the calls of the
+    numpy form. The same terms as the dense product, summed in another order: equal to a
+    few units of rounding."""
+    nl, m, _ = Zr.shape
+    k = (nl - 1) // 2
+    H = 1 + 2 * k
+    n = m * H
+    nc, dH, _ = G.shape
+    T = np.zeros((n, n), dtype=np.complex128)
+    for p in range(nc):
+        lo = p * dH
+        for i in range(dH):
+            row = lo + i
+            for c in range(m):
+                acc = 0.0 + 0.0j
+                for r in range(m):
+                    acc += G[p, i, r * H - lo] * Zr[0, r, c] if lo <= r * H < lo + dH else 0.0
+                T[row, c * H] = acc
+                for j in range(k):
+                    ia, ib = 1 + j, 1 + k + j
+                    acc_a = 0.0 + 0.0j
+                    acc_b = 0.0 + 0.0j
+                    for r in range(m):
+                        ca, cb = r * H + ia - lo, r * H + ib - lo
+                        if not (0 <= ca < dH):
+                            continue
+                        zp = Zr[1 + j, r, c]
+                        zm = Zr[1 + k + j, r, c]
+                        half = 0.5 * (zp + zm)
+                        ga, gb = G[p, i, ca], G[p, i, cb]
+                        acc_a += ga * half + gb * (0.5j * (zp - zm))
+                        acc_b += ga * (0.5j * (zm - zp)) + gb * half
+                    T[row, c * H + ia] = acc_a
+                    T[row, c * H + ib] = acc_b
+        for i in range(dH):
+            for j in range(dH):
+                T[lo + i, lo + j] -= eps * G[p, i, j]
+    for i in range(n):
+        T[i, i] += eps
+    return T
+
+
+@njit(cache=True)
+def _condensed_at(Kf, Mf, Cf, Df, m, harmonics, omega, sigma):
+    """``(Z_r, ok)``: ``Z_r`` (1 + 2k, m, m) complex at ``lambda = s``, ``s + i n w``,
+    ``s - i n w`` (``s = sigma w``), the hysteretic term signed by ``Im lambda``, from the
+    structure's whole matrices (m + q, m + q) (``Cf``, ``Df`` zero where the model has none):
+    the Schur complement ``Z^xx - Z^xq (Z^qq)^-1 Z^qx`` (:meth:`StructureDynamics.condensed`)
+    by Gaussian elimination with partial pivoting on the ``q x q`` block, in one compiled call
+    (the same values to rounding); ``ok`` False where that block is singular."""
+    k = harmonics.size
+    ns = Kf.shape[0]
+    q = ns - m
+    s = sigma * omega
+    Zr = np.empty((1 + 2 * k, m, m), dtype=np.complex128)
+    Z = np.empty((ns, ns), dtype=np.complex128)
+    A = np.empty((q, q), dtype=np.complex128)
+    B = np.empty((q, m), dtype=np.complex128)
+    X = np.empty((q, m), dtype=np.complex128)
+    for idx in range(1 + 2 * k):
+        if idx == 0:
+            lam = s
+        elif idx <= k:
+            lam = s + 1j * (harmonics[idx - 1] * omega)
+        else:
+            lam = s - 1j * (harmonics[idx - 1 - k] * omega)
+        a = lam * lam
+        c = 1j * np.sign(lam.imag)
+        for i in range(ns):
+            for j in range(ns):
+                Z[i, j] = ((a * Mf[i, j] + Kf[i, j]) + lam * Cf[i, j]) + c * Df[i, j]
+        for i in range(q):
+            for j in range(q):
+                A[i, j] = Z[m + i, m + j]
+            for j in range(m):
+                B[i, j] = Z[m + i, j]
+        for col in range(q):
+            piv = col
+            for r in range(col + 1, q):
+                if abs(A[r, col]) > abs(A[piv, col]):
+                    piv = r
+            if A[piv, col] == 0:
+                return Zr, False
+            if piv != col:
+                for j in range(q):
+                    A[col, j], A[piv, j] = A[piv, j], A[col, j]
+                for j in range(m):
+                    B[col, j], B[piv, j] = B[piv, j], B[col, j]
+            for r in range(col + 1, q):
+                f = A[r, col] / A[col, col]
+                for j in range(col, q):
+                    A[r, j] -= f * A[col, j]
+                for j in range(m):
+                    B[r, j] -= f * B[col, j]
+        for col in range(q - 1, -1, -1):
+            for j in range(m):
+                x = B[col, j]
+                for t in range(col + 1, q):
+                    x -= A[col, t] * X[t, j]
+                X[col, j] = x / A[col, col]
+        for i in range(m):
+            for j in range(m):
+                acc = Z[i, j]
+                for t in range(q):
+                    acc -= Z[i, m + t] * X[t, j]
+                Zr[idx, i, j] = acc
+    return Zr, True
+
+
 class HillProblem:
     """``T(s)`` of a converged solution ``U`` (m, H) of ``prob`` (module docstring), with the
     structure ``dyn`` for ``Z_r`` at complex arguments. Evaluated in ``sigma = s / w``."""
@@ -527,6 +643,11 @@ class HillProblem:
         # the law's arrays as the kernel of :func:`shifted_gain` takes them, made once
         self._law = (np.ascontiguousarray(prob.mu, dtype=float), np.ascontiguousarray(prob.P),
                      np.ascontiguousarray(prob.Q), law._normal(prob.normal, self.lu))
+        # the structure's whole matrices as :func:`_condensed_at` takes them (zeros for a
+        # damping the model has not)
+        full = dyn.full
+        zero = np.zeros_like(full["K"])
+        self._structure = tuple(full.get(nm, zero) for nm in ("K", "M", "C", "D"))
         self.evaluations = 0
 
     def gain(self, sigma: complex) -> np.ndarray:
@@ -537,21 +658,33 @@ class HillProblem:
         mu, P, Q, normal = self._law
         return _shifted_gain(self.lu, self.lx, self.state, mu, P, Q, z, normal)
 
-    def stiffness(self, sigma: complex) -> np.ndarray:
-        """``Z(s)`` (m H, m H) at ``s = sigma w``: ``Z_r(s + i n w)`` with the hysteretic
-        damping signed by the frequency ``Im(s) + n w`` of each component."""
+    def condensed(self, sigma: complex) -> np.ndarray:
+        """``Z_r`` (1 + 2k, m, m) at ``s``, ``s + i n w``, ``s - i n w`` for ``s = sigma w``,
+        with the hysteretic damping signed by the frequency ``Im(s) + n w`` of each."""
         w = self.omega
         s = complex(sigma) * w
         nw = 1j * self.harmonics * w
         lam = np.concatenate([[s], s + nw, s - nw])
+        return self.dyn.condensed(lam * lam, lam, 1j * np.sign(lam.imag))
+
+    def stiffness(self, sigma: complex) -> np.ndarray:
+        """``Z(s)`` (m H, m H) at ``s = sigma w``: ``Z_r(s + i n w)`` with the hysteretic
+        damping signed by the frequency ``Im(s) + n w`` of each component."""
         k = self.harmonics.size
-        Zr = self.dyn.condensed(lam * lam, lam, 1j * np.sign(lam.imag))
+        Zr = self.condensed(sigma)
         return hill_blocks(Zr[0], Zr[1:k + 1], Zr[k + 1:])
 
     def matrix(self, sigma: complex) -> np.ndarray:
-        """``T(s)`` (m H, m H) complex at ``s = sigma w``."""
+        """``T(s)`` (m H, m H) complex at ``s = sigma w``: ``jacobian_form(gain, stiffness)``
+        with the product and the blocks in one compiled call (:func:`_hill_matrix`)."""
         self.evaluations += 1
-        return jacobian_form(self.gain(sigma), self.stiffness(sigma), self.prob.eps)
+        Zr, ok = _condensed_at(*self._structure, self.prob.m, self.harmonics, self.omega,
+                               complex(sigma))
+        if not ok:
+            raise InputError("the structure with its contact points held is singular at a "
+                             "value of the Laplace variable (an eigenvalue of the held "
+                             "interface)")
+        return _hill_matrix(self.gain(sigma), Zr, float(self.prob.eps))
 
     def jacobian(self) -> np.ndarray:
         """``J = T(0)`` (m H, m H) real: the balance's Jacobian from the solve's own ``G``
