@@ -29,6 +29,7 @@ from fretwear.hb.stability import (
     QuadraticReduction,
     _companion_eigen,
     _components,
+    _inverse_iteration,
     _pair,
     _pair_lapack,
     _shifted_copy,
@@ -253,6 +254,32 @@ def test_compiled_pair_is_lapacks():
     with np.errstate(all="ignore"):
         assert _pair(T, np.ones(6, dtype=complex), 0.0)[2] is None  # no zero pivot at 0
         assert _pair(T, np.ones(6, dtype=complex), 1.0)[2] is not None
+
+
+def test_compiled_inverse_iteration_finds_the_dense_eigenvalue(monkeypatch):
+    """``_inverse_iteration`` on a block of at most ``PAIR_COMPILED_MAX`` unknowns (compiled,
+    its own LU) converges, from 1e-3 off an eigenvalue of a random quadratic problem of 20
+    coordinates with its eigenvector perturbed, to that eigenvalue of the companion
+    eigensolve (``_companion_eigen``, LAPACK) and to LAPACK's path (``PAIR_COMPILED_MAX``
+    set to 0), within 1e-12 of ``max(1, |s|)``: both stop at a Newton step below 1e-14 of
+    it, and the dense eigenvalues are backward stable to rounding (the eigenvalues here are
+    simple and O(1) apart)."""
+    from fretwear.hb import stability as hs
+
+    rng = np.random.default_rng(7)
+    n = 20
+    B0, B1 = rng.standard_normal((2, n, n))
+    B2 = np.eye(n)
+    vals, Y = _companion_eigen(B0, B1, B2)
+    for i in np.argsort(-np.abs(vals.imag))[:6:2]:
+        start = vals[i] + 1e-3 * (1 + 1j)
+        y0 = Y[:, i] + 1e-3 * rng.standard_normal(n)
+        s1, _, ok = _inverse_iteration(B0, B1, B2, start, y0)
+        assert ok and abs(s1 - vals[i]) <= 1e-12 * max(1.0, abs(vals[i]))
+        monkeypatch.setattr(hs, "PAIR_COMPILED_MAX", 0)
+        s2, _, ok2 = _inverse_iteration(B0, B1, B2, start, y0)
+        monkeypatch.undo()
+        assert ok2 and abs(s1 - s2) <= 1e-12 * max(1.0, abs(s2))
 
 
 def test_hill_matrix_at_zero_is_the_solve_jacobian():

@@ -885,9 +885,14 @@ def _inverse_iteration(B0, B1, B2, sigma: complex, y: np.ndarray, max_iter: int 
     ``(sigma, y, converged)``; converged when the step is below 1e-14 of ``max(1, |sigma|)``
     (the rounding of the dense eigensolver's eigenvalue, whose backward error is of the same
     order)."""
+    B0, B1, B2 = (np.asarray(b, dtype=complex) for b in (B0, B1, B2))
+    if B0.shape[0] <= PAIR_COMPILED_MAX:  # compiled, the same steps (:func:`_ruhe_small`)
+        s1, x1, ok = _ruhe_small(*(np.ascontiguousarray(b) for b in (B0, B1, B2)),
+                                 complex(sigma), np.ascontiguousarray(y, dtype=complex),
+                                 max_iter)
+        return complex(s1), x1, bool(ok)
     x = y / np.linalg.norm(y)
     first = True
-    B0, B1, B2 = (np.asarray(b, dtype=complex) for b in (B0, B1, B2))
     for _ in range(max_iter):
         lu, piv, info = zgetrf(B0 + sigma * B1 + (sigma * sigma) * B2, overwrite_a=True)
         if info != 0:
@@ -1217,14 +1222,11 @@ PAIR_COMPILED_MAX = 48
 
 
 @njit(cache=True)
-def _pair_small(T, v, mu0, steps):
-    """:func:`_pair` compiled: the LU of ``T - mu0 I`` with partial pivoting, ``steps``
-    solves from ``v``, the Rayleigh quotient. Returns ``(mu, y, ok)``; ``ok`` False at a zero
-    pivot (LAPACK's path then runs)."""
-    n = T.shape[0]
-    A = T.copy()
-    for i in range(n):
-        A[i, i] -= mu0
+def _lu_small(A):
+    """LU with partial pivoting of ``A`` (n, n) complex in place (``L`` unit lower below the
+    diagonal, ``U`` on and above): ``(piv, ok)``, ``ok`` False at a zero pivot (where
+    LAPACK's ``zgetrf`` reports a singular ``U``)."""
+    n = A.shape[0]
     piv = np.arange(n)
     for col in range(n):
         p = col
@@ -1232,7 +1234,7 @@ def _pair_small(T, v, mu0, steps):
             if abs(A[r, col]) > abs(A[p, col]):
                 p = r
         if A[p, col] == 0:
-            return 0j, v, False
+            return piv, False
         if p != col:
             for j in range(n):
                 A[col, j], A[p, j] = A[p, j], A[col, j]
@@ -1243,30 +1245,53 @@ def _pair_small(T, v, mu0, steps):
             A[r, col] = f
             for j in range(col + 1, n):
                 A[r, j] -= f * A[col, j]
-    y = v.copy()
-    for _ in range(steps + 1):
-        nrm = 0.0
-        for i in range(n):
-            nrm += y[i].real * y[i].real + y[i].imag * y[i].imag
-        nrm = np.sqrt(nrm)
-        for i in range(n):
-            y[i] = y[i] / nrm
-        if _ == steps:
-            break
-        x = np.empty(n, dtype=np.complex128)
-        for i in range(n):  # P y, then L and U
-            x[i] = y[piv[i]]
-        for i in range(n):
-            acc = x[i]
-            for j in range(i):
-                acc -= A[i, j] * x[j]
-            x[i] = acc
-        for i in range(n - 1, -1, -1):
-            acc = x[i]
-            for j in range(i + 1, n):
-                acc -= A[i, j] * x[j]
-            x[i] = acc / A[i, i]
-        y = x
+    return piv, True
+
+
+@njit(cache=True)
+def _lu_solve_small(A, piv, b):
+    """``x`` with ``A0 x = b`` from the LU of ``A0`` by :func:`_lu_small`."""
+    n = A.shape[0]
+    x = np.empty(n, dtype=np.complex128)
+    for i in range(n):
+        x[i] = b[piv[i]]
+    for i in range(n):
+        acc = x[i]
+        for j in range(i):
+            acc -= A[i, j] * x[j]
+        x[i] = acc
+    for i in range(n - 1, -1, -1):
+        acc = x[i]
+        for j in range(i + 1, n):
+            acc -= A[i, j] * x[j]
+        x[i] = acc / A[i, i]
+    return x
+
+
+@njit(cache=True)
+def _unit(y):
+    """``y / |y|`` (2-norm)."""
+    nrm = 0.0
+    for i in range(y.size):
+        nrm += y[i].real * y[i].real + y[i].imag * y[i].imag
+    return y / np.sqrt(nrm)
+
+
+@njit(cache=True)
+def _pair_small(T, v, mu0, steps):
+    """:func:`_pair` compiled: the LU of ``T - mu0 I`` with partial pivoting, ``steps``
+    solves from ``v``, the Rayleigh quotient. Returns ``(mu, y, ok)``; ``ok`` False at a zero
+    pivot (LAPACK's path then runs)."""
+    n = T.shape[0]
+    A = T.copy()
+    for i in range(n):
+        A[i, i] -= mu0
+    piv, ok = _lu_small(A)
+    if not ok:
+        return 0j, v, False
+    y = _unit(v)
+    for _ in range(steps):
+        y = _unit(_lu_solve_small(A, piv, y))
     mu = 0j
     for i in range(n):
         acc = 0j
@@ -1274,6 +1299,47 @@ def _pair_small(T, v, mu0, steps):
             acc += T[i, j] * y[j]
         mu += np.conj(y[i]) * acc
     return mu, y, True
+
+
+@njit(cache=True)
+def _ruhe_small(B0, B1, B2, sigma, y, max_iter):
+    """:func:`_inverse_iteration` compiled (the same steps, the LU by :func:`_lu_small`):
+    ``(sigma, y, converged)``."""
+    n = B0.shape[0]
+    x = _unit(y)
+    first = True
+    A = np.empty((n, n), dtype=np.complex128)
+    r = np.empty(n, dtype=np.complex128)
+    s2 = sigma * sigma
+    for _ in range(max_iter):
+        s2 = sigma * sigma
+        for i in range(n):
+            for j in range(n):
+                A[i, j] = B0[i, j] + sigma * B1[i, j] + s2 * B2[i, j]
+        piv, ok = _lu_small(A)
+        if not ok:
+            return sigma, x, False
+        if first:  # towards the eigenvector of the eigenvalue nearest sigma
+            x = _unit(_lu_solve_small(A, piv, x))
+            first = False
+        two = 2.0 * sigma
+        for i in range(n):
+            acc = 0j
+            for j in range(n):
+                acc += (B1[i, j] + two * B2[i, j]) * x[j]
+            r[i] = acc
+        u = _lu_solve_small(A, piv, r)
+        den = 0j
+        for i in range(n):
+            den += np.conj(x[i]) * u[i]
+        if not np.isfinite(den.real) or not np.isfinite(den.imag) or den == 0:
+            return sigma, x, False
+        step = 1.0 / den
+        sigma = sigma - step
+        x = _unit(u)
+        if abs(step) <= 1e-14 * max(1.0, abs(sigma)):
+            return sigma, x, True
+    return sigma, x, False
 
 
 def _pair(T: np.ndarray, v: np.ndarray, mu0: complex, steps: int = 2):
