@@ -2,6 +2,8 @@
 their memory budget, the secant predictor and the stick anchors of the loading history,
 compared with hand-computed values."""
 
+import time
+
 import numpy as np
 from helpers.blocks import closed_block
 
@@ -46,3 +48,15 @@ def test_predictor_and_anchors_follow_the_history():
     np.testing.assert_allclose(b.predict(35.0), A + 35.0 * B, rtol=0, atol=1e-12)
     U = (A + 20.0 * B).reshape(nc, d, -1)
     np.testing.assert_array_equal(b.anchor(), U[:, 1:, 0])
+
+
+def test_lap_is_wall_and_cpu_since_the_last_lap():
+    """``Branch.lap``: the wall and CPU seconds since the previous lap, the clock restarted.
+    Against ``time.sleep`` (wall time that takes no CPU): the first lap holds at least the
+    sleep's 20 ms of wall time and less than 10 ms of CPU; a lap right after is short."""
+    b = Branch(closed_block(), None)
+    b.lap()
+    time.sleep(0.02)
+    wall, cpu = b.lap()
+    assert wall >= 0.02 and cpu < 0.01
+    assert b.lap()[0] < 0.02

@@ -75,6 +75,25 @@ def test_condensed_stiffness_at_complex_lambda_is_the_dense_schur_complement(dam
     np.testing.assert_array_equal(dyn.load_q, load_q)
 
 
+def test_blocks_of_z_are_those_of_each_matrix_entry_by_entry():
+    """``assemble`` forms ``Z = K + a M + b C + c D`` once on the whole matrices
+    (``StructureDynamics.full``) and cuts it into ``(xx, xq, qx, qq)``: bit for bit the same as
+    forming it block by block from ``blocks`` (the same operations on every entry), checked
+    on the braced truss with both dampings at two complex coefficients, and ``full`` is
+    ``[[xx, xq], [qx, qq]]`` of each matrix."""
+    dyn = structure_dynamics(truss(damping="both"))
+    lam = np.array([150.0 + 2j * np.pi * 900.0, -80.0 + 4000j])
+    a, b, c = lam**2, lam, 1j * np.sign(lam.imag)
+    got = dyn.assemble(a, b, c)
+    for i in range(4):
+        ref = a[:, None, None] * dyn.blocks["M"][i] + dyn.blocks["K"][i]
+        ref = ref + b[:, None, None] * dyn.blocks["C"][i]
+        ref = ref + c[:, None, None] * dyn.blocks["D"][i]
+        np.testing.assert_array_equal(got[i], ref)
+    for name, (xx, xq, qx, qq) in dyn.blocks.items():
+        np.testing.assert_array_equal(dyn.full[name], np.block([[xx, xq], [qx, qq]]))
+
+
 def test_a_large_interior_needs_a_modal_representation(monkeypatch):
     """Above DENSE_INTERIOR_MAX interior DOFs the exact transformation is not formed: one
     InputError saying how many and what to do."""

@@ -29,8 +29,12 @@ from fretwear.hb.stability import (
     QuadraticReduction,
     _companion_eigen,
     _components,
+    _inverse_iteration,
+    _pair,
+    _pair_lapack,
     _shifted_copy,
     centroid,
+    jacobian_form,
     problem_of,
     quadratic_eigen,
     shifted_gain,
@@ -197,6 +201,87 @@ def test_shifted_gain_at_zero_is_the_solve_s_gain():
 
 
 # --- Hill's matrix and the exponents --------------------------------------------------------
+@pytest.mark.parametrize("case", ["jenkins-hysteretic", "unilateral-two-dof"])
+def test_compiled_hill_matrix_is_its_parts(case):
+    """``HillProblem.matrix`` (compiled: ``Z_r`` by elimination on the held structure, then
+    ``G Z`` over the nonzero entries of ``Z``) equals ``jacobian_form(gain, stiffness)``
+    (numpy and LAPACK: tested against the law's recursion, the solve's Jacobian and the dense
+    Schur complement in this module and test_dynamics.py) to 1e-13 of its largest entry:
+    the same terms summed in another order and a ``q x q`` elimination instead of LAPACK's
+    (measured within 1e-15; the margin is for the conditioning of the held structure). At
+    ``s = 0``, on the imaginary axis and in both half-planes, on a Jenkins solution with
+    viscous and hysteretic damping (``Im s`` signs the hysteretic term of every harmonic,
+    the static one included) and on the unilateral two-DOF oscillator (contact springs:
+    three interior coordinates, a Schur complement per argument)."""
+    if case == "jenkins-hysteretic":
+        model = from_matrices([[1.0]], [[1.0]],
+                              contact=ContactDofs(normal_dofs=None, tangential_dofs=[0],
+                                                  mu=0.5, normal_load=1.0, kt=0.5),
+                              damping=Damping(C=[[0.02]], D=[[0.03]]),
+                              loads=[Load(np.array([0.2]), "cos")], observed={"x": 0})
+        basis, w = FourierBasis.up_to(5, 64), 1.18
+    else:
+        model, basis, w = two_dof(), FourierBasis.up_to(5, 64), 0.7
+    sol = solve_periodic(model, basis, frequency=w / (2 * np.pi), time_domain=None)
+    assert sol.success
+    prob = problem_of(model, sol)
+    hp = HillProblem(prob, sol.U.reshape(prob.m, prob.H), structure_dynamics(model))
+    for sigma in (0.0, 0.3j, -0.02 + 0.47j, 0.1 - 0.2j):
+        ref = jacobian_form(hp.gain(sigma), hp.stiffness(sigma), prob.eps)
+        assert np.abs(hp.matrix(sigma) - ref).max() <= 1e-13 * np.abs(ref).max()
+
+
+def test_compiled_pair_is_lapacks():
+    """``_pair`` up to ``PAIR_COMPILED_MAX`` unknowns (compiled LU with partial pivoting) is
+    ``_pair_lapack`` (LAPACK's ``zgetrf``/``zgetrs``) on random complex matrices of 5, 30
+    and 48 unknowns and random shifts: the eigenvalue estimate and the vector to 1e-11
+    (the same elimination in another order, amplified by the conditioning of ``T - mu0 I``
+    through two solves: measured within 3e-14). At a zero pivot (``mu0`` an eigenvalue of a
+    triangular ``T``) it takes LAPACK's path, which returns its LU."""
+    rng = np.random.default_rng(3)
+    for n in (5, 30, 48):
+        for _ in range(5):
+            T = rng.standard_normal((n, n)) + 1j * rng.standard_normal((n, n))
+            v = rng.standard_normal(n) + 1j * rng.standard_normal(n)
+            mu0 = complex(rng.standard_normal(), rng.standard_normal())
+            mu, y, lu = _pair(T, v, mu0)
+            mu_ref, y_ref, _ = _pair_lapack(T, v, mu0)
+            assert lu is None
+            assert abs(mu - mu_ref) <= 1e-11 * abs(mu_ref)
+            np.testing.assert_allclose(y, y_ref, rtol=0, atol=1e-11)
+    T = np.triu(rng.standard_normal((6, 6))) + 0j
+    T[np.diag_indices(6)] = np.arange(1.0, 7.0)
+    with np.errstate(all="ignore"):
+        assert _pair(T, np.ones(6, dtype=complex), 0.0)[2] is None  # no zero pivot at 0
+        assert _pair(T, np.ones(6, dtype=complex), 1.0)[2] is not None
+
+
+def test_compiled_inverse_iteration_finds_the_dense_eigenvalue(monkeypatch):
+    """``_inverse_iteration`` on a block of at most ``PAIR_COMPILED_MAX`` unknowns (compiled,
+    its own LU) converges, from 1e-3 off an eigenvalue of a random quadratic problem of 20
+    coordinates with its eigenvector perturbed, to that eigenvalue of the companion
+    eigensolve (``_companion_eigen``, LAPACK) and to LAPACK's path (``PAIR_COMPILED_MAX``
+    set to 0), within 1e-12 of ``max(1, |s|)``: both stop at a Newton step below 1e-14 of
+    it, and the dense eigenvalues are backward stable to rounding (the eigenvalues here are
+    simple and O(1) apart)."""
+    from fretwear.hb import stability as hs
+
+    rng = np.random.default_rng(7)
+    n = 20
+    B0, B1 = rng.standard_normal((2, n, n))
+    B2 = np.eye(n)
+    vals, Y = _companion_eigen(B0, B1, B2)
+    for i in np.argsort(-np.abs(vals.imag))[:6:2]:
+        start = vals[i] + 1e-3 * (1 + 1j)
+        y0 = Y[:, i] + 1e-3 * rng.standard_normal(n)
+        s1, _, ok = _inverse_iteration(B0, B1, B2, start, y0)
+        assert ok and abs(s1 - vals[i]) <= 1e-12 * max(1.0, abs(vals[i]))
+        monkeypatch.setattr(hs, "PAIR_COMPILED_MAX", 0)
+        s2, _, ok2 = _inverse_iteration(B0, B1, B2, start, y0)
+        monkeypatch.undo()
+        assert ok2 and abs(s1 - s2) <= 1e-12 * max(1.0, abs(s2))
+
+
 def test_hill_matrix_at_zero_is_the_solve_jacobian():
     """``T(0)`` is the Jacobian the solve used (``J = eps I - G (eps I - Z)``), to rounding,
     on a Jenkins solution that sticks and slips; so is :meth:`HillProblem.jacobian` (from the

@@ -88,3 +88,21 @@ def test_point_passed_by_eps_continuation_keeps_the_sweep_eps_and_its_attempts()
     U = p.solution.U.reshape(prob.m, prob.H)
     fres, _ = prob.residual(U, jacobian=False)
     assert np.linalg.norm(fres) <= 1e-8 * prob.scale(U)
+
+
+def test_point_times_hold_every_attempt_and_add_up_within_the_sweep():
+    """``SweepPoint.seconds`` is the lap of the sweep's clock from the start of the point's
+    ladder to its recording (``Branch.lap``): it encloses each of the point's attempts, timed
+    inside it (their sum is a lower bound), and the laps of all the points, which do not
+    overlap, add up to at most the sweep's own wall time (its set-up before the first point is
+    outside them). Converged points and failed ones (recorded in ``_grid_point``) alike."""
+    for model, solve, ok in ((closed_block(), SWEEP_POINT, True),
+                             (closed_block(mu=0.3, q=2e6), SWEEP_POINT.replace(max_iter=1),
+                              False)):
+        res = sweep(model, BASIS, 1e3, 3e3, 3,
+                    options=SweepOptions(solve=solve, continuation=False, max_bisections=0))
+        assert res.point_success.all() == ok
+        for p in res.points:
+            assert p.seconds >= sum(a.wall_time for a in p.attempts) > 0.0
+            assert p.cpu_seconds > 0.0
+        assert sum(p.seconds for p in res.points) <= res.wall_time

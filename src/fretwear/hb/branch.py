@@ -11,6 +11,8 @@ mean position".
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 
 from fretwear.hb.connectors import connect, springs
@@ -220,6 +222,7 @@ class Branch:
     def __init__(self, model, anchor, flag=None, probs=None):
         self.model, self.first_anchor, self.flag = model, anchor, flag
         self.probs = probs
+        self._clock = (time.perf_counter(), time.process_time())
         self.history: list = []  # converged (omega, U (m, H)) in order
         self.last_solution = None  # the last converged solution (a time start's neighbour)
         self.points: list = []  # every point computed, intermediate ones included
@@ -246,6 +249,16 @@ class Branch:
         U = self.history[index][1].reshape(c.n_nodes, c.dim, -1)
         return U[:, 1:, 0].copy()
 
+    def lap(self) -> tuple[float, float]:
+        """Wall and CPU seconds since the last lap (the branch's creation before any); the
+        clock restarts. Every recorded point takes its lap (:attr:`SweepPoint.seconds`), so a
+        grid point's and its intermediate points' laps add up to what the sweep spent on
+        it from the lap that started it."""
+        now = (time.perf_counter(), time.process_time())
+        wall, cpu = now[0] - self._clock[0], now[1] - self._clock[1]
+        self._clock = now
+        return wall, cpu
+
     def record(self, omega, prob, U, stats, how) -> SweepPoint:
         """The converged point ``U`` (m, H) at ``omega`` [rad/s] of ``prob``, added to the
         history (not to :attr:`points`); converged on the local basis's model, polished on
@@ -259,11 +272,13 @@ class Branch:
             pt.problem = prob
         if not sol.success:  # non-finite values (assemble_solution): a failure, no predictor
             pt.flags.append(f"not converged: {stats.message}")
+            pt.seconds, pt.cpu_seconds = self.lap()
             return pt
         if self.flag is not None:
             pt.flags.extend(self.flag(sol))
         self.history.append((omega, U))
         self.last_solution = sol
+        pt.seconds, pt.cpu_seconds = self.lap()
         return pt
 
     def add(self, omega, prob, U, stats, how) -> None:

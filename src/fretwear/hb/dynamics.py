@@ -35,6 +35,7 @@ balance's condensation through the springs (tests/hb/test_stability.py).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import scipy.linalg as sla
@@ -88,28 +89,44 @@ class StructureDynamics:
     def q(self) -> int:
         return int(self.blocks["K"][3].shape[0])
 
+    @cached_property
+    def full(self) -> dict:
+        """name -> the whole matrix ``[[xx, xq], [qx, qq]]`` (m + q, m + q) real, C-ordered
+        (made once: the blocks do not change)."""
+        out = {}
+        for name, (xx, xq, qx, qq) in self.blocks.items():
+            out[name] = (np.ascontiguousarray(np.block([[xx, xq], [qx, qq]]), dtype=float)
+                         if self.q else np.ascontiguousarray(xx, dtype=float))
+        return out
+
     def assemble(self, mass, visc, hyst):
         """The blocks ``(xx, xq, qx, qq)`` of ``Z = K + a M + b C + c D`` for the coefficient
-        arrays ``a``, ``b``, ``c`` (nl,): complex arrays (nl, ...)."""
+        arrays ``a``, ``b``, ``c`` (nl,): complex arrays (nl, ...), each C-ordered."""
+        Z = self._whole(mass, visc, hyst)
+        m = self.m
+        return [np.ascontiguousarray(b) for b in (Z[:, :m, :m], Z[:, :m, m:], Z[:, m:, :m],
+                                                 Z[:, m:, m:])]
+
+    def _whole(self, mass, visc, hyst):
+        """``Z = K + a M + b C + c D`` (nl, m + q, m + q) complex: entry by entry the same
+        operations as on each block."""
         mass, visc, hyst = (np.atleast_1d(np.asarray(x, dtype=complex))
                             for x in (mass, visc, hyst))
-        out = []
-        for i in range(4):
-            Z = mass[:, None, None] * self.blocks["M"][i] + self.blocks["K"][i]
-            if "C" in self.blocks:
-                Z = Z + visc[:, None, None] * self.blocks["C"][i]
-            if "D" in self.blocks:
-                Z = Z + hyst[:, None, None] * self.blocks["D"][i]
-            out.append(Z)
-        return out
+        F = self.full
+        Z = mass[:, None, None] * F["M"] + F["K"]
+        if "C" in F:
+            Z = Z + visc[:, None, None] * F["C"]
+        if "D" in F:
+            Z = Z + hyst[:, None, None] * F["D"]
+        return Z
 
     def condensed(self, mass, visc, hyst) -> np.ndarray:
         """``Z_r`` (nl, m, m) complex seen by the contact law [N/m]: the Schur complement
         ``Z^xx - Z^xq (Z^qq)^-1 Z^qx`` (eq. 19, and :func:`fretwear.hb.connectors.connect`
         when there are contact springs)."""
-        xx, xq, qx, qq = self.assemble(mass, visc, hyst)
         if not self.q:
-            return xx
+            return self._whole(mass, visc, hyst)
+        xx, xq, qx, qq = self.assemble(mass, visc, hyst)
         try:
             return xx - xq @ np.linalg.solve(qq, qx)
         except np.linalg.LinAlgError:

@@ -489,6 +489,122 @@ def jacobian_form(G: np.ndarray, Z: np.ndarray, eps: float) -> np.ndarray:
     return T
 
 
+@njit(cache=True)
+def _hill_matrix(G, Zr, eps):
+    """``T(s) = eps I - G(s) (eps I - Z(s))`` (m H, m H) complex (:func:`jacobian_form` of
+    :func:`hill_blocks`) from ``G(s)`` (nc, dH, dH) and ``Z_r`` (1 + 2k, m, m) at ``s``,
+    ``s + i n w``, ``s - i n w`` (:meth:`HillProblem.stiffness`), in one compiled call: the
+    product ``G Z`` over the nonzero entries of ``Z(s)`` only (per column, the harmonic's
+    own coefficient and its cosine/sine partner of every DOF: ``2 m`` terms, not ``m H``),
+    which at the sizes of a refinement (tens of unknowns) costs less than the calls of the
+    numpy form. The same terms as the dense product, summed in another order: equal to a
+    few units of rounding."""
+    nl, m, _ = Zr.shape
+    k = (nl - 1) // 2
+    H = 1 + 2 * k
+    n = m * H
+    nc, dH, _ = G.shape
+    T = np.zeros((n, n), dtype=np.complex128)
+    for p in range(nc):
+        lo = p * dH
+        for i in range(dH):
+            row = lo + i
+            for c in range(m):
+                acc = 0.0 + 0.0j
+                for r in range(m):
+                    acc += G[p, i, r * H - lo] * Zr[0, r, c] if lo <= r * H < lo + dH else 0.0
+                T[row, c * H] = acc
+                for j in range(k):
+                    ia, ib = 1 + j, 1 + k + j
+                    acc_a = 0.0 + 0.0j
+                    acc_b = 0.0 + 0.0j
+                    for r in range(m):
+                        ca, cb = r * H + ia - lo, r * H + ib - lo
+                        if not (0 <= ca < dH):
+                            continue
+                        zp = Zr[1 + j, r, c]
+                        zm = Zr[1 + k + j, r, c]
+                        half = 0.5 * (zp + zm)
+                        ga, gb = G[p, i, ca], G[p, i, cb]
+                        acc_a += ga * half + gb * (0.5j * (zp - zm))
+                        acc_b += ga * (0.5j * (zm - zp)) + gb * half
+                    T[row, c * H + ia] = acc_a
+                    T[row, c * H + ib] = acc_b
+        for i in range(dH):
+            for j in range(dH):
+                T[lo + i, lo + j] -= eps * G[p, i, j]
+    for i in range(n):
+        T[i, i] += eps
+    return T
+
+
+@njit(cache=True)
+def _condensed_at(Kf, Mf, Cf, Df, m, harmonics, omega, sigma):
+    """``(Z_r, ok)``: ``Z_r`` (1 + 2k, m, m) complex at ``lambda = s``, ``s + i n w``,
+    ``s - i n w`` (``s = sigma w``), the hysteretic term signed by ``Im lambda``, from the
+    structure's whole matrices (m + q, m + q) (``Cf``, ``Df`` zero where the model has none):
+    the Schur complement ``Z^xx - Z^xq (Z^qq)^-1 Z^qx`` (:meth:`StructureDynamics.condensed`)
+    by Gaussian elimination with partial pivoting on the ``q x q`` block, in one compiled call
+    (the same values to rounding); ``ok`` False where that block is singular."""
+    k = harmonics.size
+    ns = Kf.shape[0]
+    q = ns - m
+    s = sigma * omega
+    Zr = np.empty((1 + 2 * k, m, m), dtype=np.complex128)
+    Z = np.empty((ns, ns), dtype=np.complex128)
+    A = np.empty((q, q), dtype=np.complex128)
+    B = np.empty((q, m), dtype=np.complex128)
+    X = np.empty((q, m), dtype=np.complex128)
+    for idx in range(1 + 2 * k):
+        if idx == 0:
+            lam = s
+        elif idx <= k:
+            lam = s + 1j * (harmonics[idx - 1] * omega)
+        else:
+            lam = s - 1j * (harmonics[idx - 1 - k] * omega)
+        a = lam * lam
+        c = 1j * np.sign(lam.imag)
+        for i in range(ns):
+            for j in range(ns):
+                Z[i, j] = ((a * Mf[i, j] + Kf[i, j]) + lam * Cf[i, j]) + c * Df[i, j]
+        for i in range(q):
+            for j in range(q):
+                A[i, j] = Z[m + i, m + j]
+            for j in range(m):
+                B[i, j] = Z[m + i, j]
+        for col in range(q):
+            piv = col
+            for r in range(col + 1, q):
+                if abs(A[r, col]) > abs(A[piv, col]):
+                    piv = r
+            if A[piv, col] == 0:
+                return Zr, False
+            if piv != col:
+                for j in range(q):
+                    A[col, j], A[piv, j] = A[piv, j], A[col, j]
+                for j in range(m):
+                    B[col, j], B[piv, j] = B[piv, j], B[col, j]
+            for r in range(col + 1, q):
+                f = A[r, col] / A[col, col]
+                for j in range(col, q):
+                    A[r, j] -= f * A[col, j]
+                for j in range(m):
+                    B[r, j] -= f * B[col, j]
+        for col in range(q - 1, -1, -1):
+            for j in range(m):
+                x = B[col, j]
+                for t in range(col + 1, q):
+                    x -= A[col, t] * X[t, j]
+                X[col, j] = x / A[col, col]
+        for i in range(m):
+            for j in range(m):
+                acc = Z[i, j]
+                for t in range(q):
+                    acc -= Z[i, m + t] * X[t, j]
+                Zr[idx, i, j] = acc
+    return Zr, True
+
+
 class HillProblem:
     """``T(s)`` of a converged solution ``U`` (m, H) of ``prob`` (module docstring), with the
     structure ``dyn`` for ``Z_r`` at complex arguments. Evaluated in ``sigma = s / w``."""
@@ -527,6 +643,11 @@ class HillProblem:
         # the law's arrays as the kernel of :func:`shifted_gain` takes them, made once
         self._law = (np.ascontiguousarray(prob.mu, dtype=float), np.ascontiguousarray(prob.P),
                      np.ascontiguousarray(prob.Q), law._normal(prob.normal, self.lu))
+        # the structure's whole matrices as :func:`_condensed_at` takes them (zeros for a
+        # damping the model has not)
+        full = dyn.full
+        zero = np.zeros_like(full["K"])
+        self._structure = tuple(full.get(nm, zero) for nm in ("K", "M", "C", "D"))
         self.evaluations = 0
 
     def gain(self, sigma: complex) -> np.ndarray:
@@ -537,21 +658,33 @@ class HillProblem:
         mu, P, Q, normal = self._law
         return _shifted_gain(self.lu, self.lx, self.state, mu, P, Q, z, normal)
 
-    def stiffness(self, sigma: complex) -> np.ndarray:
-        """``Z(s)`` (m H, m H) at ``s = sigma w``: ``Z_r(s + i n w)`` with the hysteretic
-        damping signed by the frequency ``Im(s) + n w`` of each component."""
+    def condensed(self, sigma: complex) -> np.ndarray:
+        """``Z_r`` (1 + 2k, m, m) at ``s``, ``s + i n w``, ``s - i n w`` for ``s = sigma w``,
+        with the hysteretic damping signed by the frequency ``Im(s) + n w`` of each."""
         w = self.omega
         s = complex(sigma) * w
         nw = 1j * self.harmonics * w
         lam = np.concatenate([[s], s + nw, s - nw])
+        return self.dyn.condensed(lam * lam, lam, 1j * np.sign(lam.imag))
+
+    def stiffness(self, sigma: complex) -> np.ndarray:
+        """``Z(s)`` (m H, m H) at ``s = sigma w``: ``Z_r(s + i n w)`` with the hysteretic
+        damping signed by the frequency ``Im(s) + n w`` of each component."""
         k = self.harmonics.size
-        Zr = self.dyn.condensed(lam * lam, lam, 1j * np.sign(lam.imag))
+        Zr = self.condensed(sigma)
         return hill_blocks(Zr[0], Zr[1:k + 1], Zr[k + 1:])
 
     def matrix(self, sigma: complex) -> np.ndarray:
-        """``T(s)`` (m H, m H) complex at ``s = sigma w``."""
+        """``T(s)`` (m H, m H) complex at ``s = sigma w``: ``jacobian_form(gain, stiffness)``
+        with the product and the blocks in one compiled call (:func:`_hill_matrix`)."""
         self.evaluations += 1
-        return jacobian_form(self.gain(sigma), self.stiffness(sigma), self.prob.eps)
+        Zr, ok = _condensed_at(*self._structure, self.prob.m, self.harmonics, self.omega,
+                               complex(sigma))
+        if not ok:
+            raise InputError("the structure with its contact points held is singular at a "
+                             "value of the Laplace variable (an eigenvalue of the held "
+                             "interface)")
+        return _hill_matrix(self.gain(sigma), Zr, float(self.prob.eps))
 
     def jacobian(self) -> np.ndarray:
         """``J = T(0)`` (m H, m H) real: the balance's Jacobian from the solve's own ``G``
@@ -600,13 +733,7 @@ class HillProblem:
         nw = orders * w
         q = dyn.q
 
-        def full(name):
-            if name not in dyn.blocks:
-                return None
-            xx, xq, qx, qq = (np.asarray(b, dtype=float) for b in dyn.blocks[name])
-            return np.block([[xx, xq], [qx, qq]]) if q else xx
-
-        K, M, C, D = (full(nm) for nm in ("K", "M", "C", "D"))
+        K, M, C, D = (dyn.full.get(nm) for nm in ("K", "M", "C", "D"))
         nb = orders.size
         # complex blocks per harmonic of the coefficients of sigma^0, sigma^1, sigma^2 of
         # Z(lambda), lambda = w (sigma + i n), in the layout of reduce.to_real_blocks
@@ -758,11 +885,16 @@ def _inverse_iteration(B0, B1, B2, sigma: complex, y: np.ndarray, max_iter: int 
     ``(sigma, y, converged)``; converged when the step is below 1e-14 of ``max(1, |sigma|)``
     (the rounding of the dense eigensolver's eigenvalue, whose backward error is of the same
     order)."""
+    B0, B1, B2 = (np.asarray(b, dtype=complex) for b in (B0, B1, B2))
+    if B0.shape[0] <= PAIR_COMPILED_MAX:  # compiled, the same steps (:func:`_ruhe_small`)
+        s1, x1, ok = _ruhe_small(*(np.ascontiguousarray(b) for b in (B0, B1, B2)),
+                                 complex(sigma), np.ascontiguousarray(y, dtype=complex),
+                                 max_iter)
+        return complex(s1), x1, bool(ok)
     x = y / np.linalg.norm(y)
     first = True
-    B0, B1, B2 = (np.asarray(b, dtype=complex) for b in (B0, B1, B2))
     for _ in range(max_iter):
-        lu, piv, info = zgetrf(B0 + sigma * B1 + (sigma * sigma) * B2)
+        lu, piv, info = zgetrf(B0 + sigma * B1 + (sigma * sigma) * B2, overwrite_a=True)
         if info != 0:
             return sigma, x, False
         if first:  # towards the eigenvector of the eigenvalue nearest sigma
@@ -1082,14 +1214,154 @@ def _edge_members(vals: np.ndarray, kap: np.ndarray, keep: np.ndarray) -> np.nda
     return out
 
 
+#: :func:`_pair` runs compiled (:func:`_pair_small`) up to this many unknowns (a refinement
+#: on a small model, where the calls of an LU and its solves cost more than their flops:
+#: 2.4 against 30 us at 5 unknowns, 25 against 54 us at 30), LAPACK's LU beyond (as fast
+#: at 64)
+PAIR_COMPILED_MAX = 48
+
+
+@njit(cache=True)
+def _lu_small(A):
+    """LU with partial pivoting of ``A`` (n, n) complex in place (``L`` unit lower below the
+    diagonal, ``U`` on and above): ``(piv, ok)``, ``ok`` False at a zero pivot (where
+    LAPACK's ``zgetrf`` reports a singular ``U``)."""
+    n = A.shape[0]
+    piv = np.arange(n)
+    for col in range(n):
+        p = col
+        for r in range(col + 1, n):
+            if abs(A[r, col]) > abs(A[p, col]):
+                p = r
+        if A[p, col] == 0:
+            return piv, False
+        if p != col:
+            for j in range(n):
+                A[col, j], A[p, j] = A[p, j], A[col, j]
+            piv[col], piv[p] = piv[p], piv[col]
+        d = A[col, col]
+        for r in range(col + 1, n):
+            f = A[r, col] / d
+            A[r, col] = f
+            for j in range(col + 1, n):
+                A[r, j] -= f * A[col, j]
+    return piv, True
+
+
+@njit(cache=True)
+def _lu_solve_small(A, piv, b):
+    """``x`` with ``A0 x = b`` from the LU of ``A0`` by :func:`_lu_small`."""
+    n = A.shape[0]
+    x = np.empty(n, dtype=np.complex128)
+    for i in range(n):
+        x[i] = b[piv[i]]
+    for i in range(n):
+        acc = x[i]
+        for j in range(i):
+            acc -= A[i, j] * x[j]
+        x[i] = acc
+    for i in range(n - 1, -1, -1):
+        acc = x[i]
+        for j in range(i + 1, n):
+            acc -= A[i, j] * x[j]
+        x[i] = acc / A[i, i]
+    return x
+
+
+@njit(cache=True)
+def _unit(y):
+    """``y / |y|`` (2-norm)."""
+    nrm = 0.0
+    for i in range(y.size):
+        nrm += y[i].real * y[i].real + y[i].imag * y[i].imag
+    return y / np.sqrt(nrm)
+
+
+@njit(cache=True)
+def _pair_small(T, v, mu0, steps):
+    """:func:`_pair` compiled: the LU of ``T - mu0 I`` with partial pivoting, ``steps``
+    solves from ``v``, the Rayleigh quotient. Returns ``(mu, y, ok)``; ``ok`` False at a zero
+    pivot (LAPACK's path then runs)."""
+    n = T.shape[0]
+    A = T.copy()
+    for i in range(n):
+        A[i, i] -= mu0
+    piv, ok = _lu_small(A)
+    if not ok:
+        return 0j, v, False
+    y = _unit(v)
+    for _ in range(steps):
+        y = _unit(_lu_solve_small(A, piv, y))
+    mu = 0j
+    for i in range(n):
+        acc = 0j
+        for j in range(n):
+            acc += T[i, j] * y[j]
+        mu += np.conj(y[i]) * acc
+    return mu, y, True
+
+
+@njit(cache=True)
+def _ruhe_small(B0, B1, B2, sigma, y, max_iter):
+    """:func:`_inverse_iteration` compiled (the same steps, the LU by :func:`_lu_small`):
+    ``(sigma, y, converged)``."""
+    n = B0.shape[0]
+    x = _unit(y)
+    first = True
+    A = np.empty((n, n), dtype=np.complex128)
+    r = np.empty(n, dtype=np.complex128)
+    s2 = sigma * sigma
+    for _ in range(max_iter):
+        s2 = sigma * sigma
+        for i in range(n):
+            for j in range(n):
+                A[i, j] = B0[i, j] + sigma * B1[i, j] + s2 * B2[i, j]
+        piv, ok = _lu_small(A)
+        if not ok:
+            return sigma, x, False
+        if first:  # towards the eigenvector of the eigenvalue nearest sigma
+            x = _unit(_lu_solve_small(A, piv, x))
+            first = False
+        two = 2.0 * sigma
+        for i in range(n):
+            acc = 0j
+            for j in range(n):
+                acc += (B1[i, j] + two * B2[i, j]) * x[j]
+            r[i] = acc
+        u = _lu_solve_small(A, piv, r)
+        den = 0j
+        for i in range(n):
+            den += np.conj(x[i]) * u[i]
+        if not np.isfinite(den.real) or not np.isfinite(den.imag) or den == 0:
+            return sigma, x, False
+        step = 1.0 / den
+        sigma = sigma - step
+        x = _unit(u)
+        if abs(step) <= 1e-14 * max(1.0, abs(sigma)):
+            return sigma, x, True
+    return sigma, x, False
+
+
 def _pair(T: np.ndarray, v: np.ndarray, mu0: complex, steps: int = 2):
     """The eigenpair ``(mu, y)`` of ``T`` nearest ``mu0`` that continues ``v``: inverse
     iteration from ``v`` with the shift ``mu0`` (one LU of ``T - mu0 I``, ``steps`` solves),
-    ``mu`` the Rayleigh quotient of ``y``; also the LU (for the left vector). From a start
-    close to the eigenvector (the previous iterate of :func:`_track`) each solve reduces its
-    error by ``|mu - mu0| / |mu' - mu0|`` over the next eigenvalue ``mu'``: the pair tracked
-    stays the one started, as a full eigendecomposition with the largest overlap picks it,
-    at the cost of one LU instead of a dense nonsymmetric eigensolve."""
+    ``mu`` the Rayleigh quotient of ``y``; also the LU (for the left vector; None when it
+    ran compiled, :func:`_pair_small`, up to :data:`PAIR_COMPILED_MAX` unknowns: made again
+    where needed). From a start close to the eigenvector (the previous iterate of
+    :func:`_track`) each solve reduces its error by ``|mu - mu0| / |mu' - mu0|`` over the
+    next eigenvalue ``mu'``: the pair tracked stays the one started, as a full
+    eigendecomposition with the largest overlap picks it, at the cost of one LU instead of a
+    dense nonsymmetric eigensolve."""
+    if T.shape[0] <= PAIR_COMPILED_MAX:
+        mu, y, ok = _pair_small(np.ascontiguousarray(T, dtype=complex),
+                                np.ascontiguousarray(v, dtype=complex), complex(mu0), steps)
+        if ok:
+            return complex(mu), y, None
+    return _pair_lapack(T, v, mu0, steps)
+
+
+def _pair_lapack(T: np.ndarray, v: np.ndarray, mu0: complex, steps: int = 2):
+    """:func:`_pair` by LAPACK's LU (``zgetrf``), which it returns."""
     A = np.array(T, dtype=complex)
     if mu0 != 0:
         A[np.diag_indices(A.shape[0])] -= mu0
@@ -1143,6 +1415,8 @@ def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions,
         f = mu if deflate is None else mu / (sigma - deflate)
         if prev is None:  # first step: the neighbour's slope, or a forward difference
             if slope == 0:
+                if lu is None:  # the compiled pair's: LAPACK's for the left vector
+                    lu = _pair_lapack(T, v, mu0, 0)[2]
                 slope = _mu_derivative(hp, sigma, v, T, lu, opt.step)
                 if deflate is not None:  # d/ds of mu / (s - s1)
                     slope = (slope * (sigma - deflate) - mu) / (sigma - deflate) ** 2

@@ -166,6 +166,7 @@ def sweep(model: Model, basis: FourierBasis, f_min: float, f_max: float, n_point
     resumed = first if key is not None and opts.resume and first else -1
     try:
         for i in range(first, len(grid)):
+            branch.lap()  # the point's time starts here (SweepPoint.seconds)
             pt = _grid_point(point_ladder(Point(grid[i], probs, branch, opts)))
             branch.points.append(pt)
             if key is not None:
@@ -220,6 +221,7 @@ def _grid_point(p: Point) -> SweepPoint:
         if p.time_domain is not None:
             pt.flags.append(p.time_domain)
             pt.time_domain = p.time_domain
+        pt.seconds, pt.cpu_seconds = p.branch.lap()
     pt.on_grid = True
     pt.attempts = p.tried
     pt.fallback_seconds = p.fallback_seconds

@@ -46,7 +46,12 @@ class SweepPoint:
     (:mod:`fretwear.hb.fallbacks`); problem : the
     :class:`~fretwear.hb.problem.DLFTProblem` the solution was solved on, kept for Hill's
     method (:func:`fretwear.hb.sweep_stability.sweep_stability`) when its reduced model is
-    small (None otherwise, and for a point read from a checkpoint: rebuilt from the solution).
+    small (None otherwise, and for a point read from a checkpoint: rebuilt from the solution);
+    seconds, cpu_seconds : wall and CPU time [s] the sweep spent on this point since the
+    previous point was recorded (:meth:`fretwear.hb.branch.Branch.lap`): the predictor, the
+    condensations, every attempt, failed ones included, the polish and the flags; a grid
+    point's and the intermediate points' its ladder added sum to the ladder's cost (0 for a
+    point read from a checkpoint).
     """
 
     frequency_hz: float
@@ -59,6 +64,8 @@ class SweepPoint:
     attempts: list = field(default_factory=list)
     fallback_seconds: float = 0.0
     problem: object = field(default=None, repr=False, compare=False)
+    seconds: float = field(default=0.0, compare=False)
+    cpu_seconds: float = field(default=0.0, compare=False)
 
     @property
     def success(self) -> bool:
