@@ -97,6 +97,8 @@ DRIVERS = {
     "cyclic_modes": ("fretwear.hb.cyclic", "harmonic_model", lambda fw, tmp: (_sector(), 1)),
     "cyclic_frf": ("fretwear.hb.cyclic", "harmonic_model",
                    lambda fw, tmp: (_sector(), 1, [1e3])),
+    "sweep_stability": ("fretwear.hb.sweep_stability", "instance",
+                        lambda fw, tmp: (_block(), None)),
 }
 
 
@@ -107,7 +109,8 @@ def test_every_public_driver_runs_with_the_drivers_blas_threads(name, monkeypatc
     :func:`blas_threads` BLAS threads: the count read by threadpoolctl (independent of
     fretwear) inside the driver's first computation is 1 while the caller has set 2. The
     recorder stops the driver there (no solve is run). fw.run, fw.load_levels, fw.modes,
-    fw.frf and the cyclic drivers saw the caller's 2 threads before they were limited."""
+    fw.frf, the cyclic drivers and fw.sweep_stability saw the caller's 2 threads before they
+    were limited."""
     import importlib
 
     import fretwear as fw

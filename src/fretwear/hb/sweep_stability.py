@@ -41,6 +41,7 @@ from fretwear.hb.stability import (
 from fretwear.hb.sweep_result import SweepResult
 from fretwear.model.checks import model_argument
 from fretwear.model.core import Model
+from fretwear.threads import limited
 from fretwear.validate import instance
 
 #: |Im rho| / |rho| below this: the multiplier is real (period doubling / fold, not
@@ -106,6 +107,7 @@ def jacobian_sign(hp: HillProblem) -> int:
 
 
 @model_argument
+@limited
 def sweep_stability(model: Model, result: SweepResult, *, options: HillOptions | None = None,
                     dyn: StructureDynamics | None = None, condenser=None) -> SweepStability:
     """Hill's method at every converged point of ``result`` (a sweep of ``model``) and the
