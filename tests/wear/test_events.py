@@ -6,7 +6,8 @@ References, each independent of the code under test:
   a decaying mode), whose path is ``W_p(N) = W0_p + g0_p (e^{lam_p N} - 1) / lam_p`` in closed
   form: the first ``N`` at which a depth reaches a threshold is
   ``ln(1 + lam c / g0) / lam``, against which :func:`first_event` on
-  :func:`path_point` is checked;
+  :func:`~fretwear.wear.exponential_step.increment` (the exponential step's path) is
+  checked;
 * the Winkler punch (tests/helpers/winkler.py): decoupled nodes whose contact force is
   ``F_p - k_n W_p``, so the linearised path of each slipping node and the depth at which
   it separates are known in closed form, and with them the first event along the path.
@@ -20,7 +21,8 @@ import numpy as np
 from helpers.winkler import BASIS, KN, MU, F, T, winkler
 
 from fretwear.wear import WearOptions
-from fretwear.wear.events import first_event, path_point, pattern, pattern_along
+from fretwear.wear.events import first_event, pattern, pattern_along
+from fretwear.wear.exponential_step import increment
 from fretwear.wear.schemes import first_state
 from fretwear.wear.simulate import BalanceSetup, slow_setup
 
@@ -46,7 +48,7 @@ def test_first_event_brackets_the_analytic_crossing():
     assert exact[1] < exact[0] < 1e4
 
     def key(N, which=(0, 1)):
-        dW = path_point(Js, G0, N)
+        dW = increment(Js, G0, N)
         return tuple(bool(dW[p] >= c[p]) for p in which)
 
     lo, hi = first_event(key, 1e4)
@@ -80,8 +82,9 @@ def test_winkler_event_is_the_analytic_unloading_on_the_linearised_path():
     ``W_p(N) = g_p (e^{j_p N} - 1) / j_p`` (``j_p = Js_pp``) a slipping node opens when
     ``W_p`` reaches ``F_p / k_n``, at ``N_p = ln(1 + j_p F_p / (k_n g_p)) / j_p``: the first
     event :func:`pattern_along` predicts is the earliest ``N_p``, to the bisection's 1e-3
-    (the nodes' linear paths are written out here, not taken from :func:`path_point`). The
-    analytic march itself never gets there (the rate falls with the load: the unloading is
+    (the nodes' linear paths are written out here, not taken from the exponential step's
+    :func:`~fretwear.wear.exponential_step.increment`, which the key is given). The analytic
+    march itself never gets there (the rate falls with the load: the unloading is
     asymptotic), which is why an event step must be judged by the balance at its end."""
     sp, st = _punch()
     anchor = st.U.reshape(sp.nc, sp.d, sp.H)[:, 1:, 0].copy()
@@ -95,7 +98,8 @@ def test_winkler_event_is_the_analytic_unloading_on_the_linearised_path():
     N_open = np.where(arg > 0, np.log(np.where(arg > 0, arg, 1.0)) / j, np.inf)
     exact = float(N_open.min())
     assert math.isfinite(exact)
-    key = pattern_along(sp, st.W, st.U, anchor, st.g, Js, dUdW)
+    key = pattern_along(sp, st.W, st.U, anchor,
+                        lambda N: np.maximum(increment(Js, st.g, N), 0.0), dUdW)
     lo, hi = first_event(key, 4.0 * exact)
     assert lo < exact * (1 + 1e-9) and exact <= hi * (1 + 1e-9)
     assert hi - lo <= 1e-3 * hi

@@ -23,7 +23,6 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
-import scipy.linalg as sla
 
 from fretwear.wear.slow_problem import SlowProblem
 
@@ -62,17 +61,6 @@ def first_event(key: Callable[[float], object], dN: float, *, samples: int = 8,
     return lo, hi
 
 
-def path_point(Js, g, N: float) -> np.ndarray:
-    """``W(N) - W_k`` (nc,) [m] on the linearised path (module docstring), wear never
-    decreasing."""
-    g = np.asarray(g, float)
-    nc = g.size
-    B = np.zeros((nc + 1, nc + 1))
-    B[:nc, :nc] = N * np.asarray(Js, float)
-    B[:nc, nc] = g
-    return np.maximum(N * sla.expm(B)[:nc, nc], 0.0)
-
-
 def pattern(sp: SlowProblem, W, U, anchor) -> tuple[np.ndarray, np.ndarray]:
     """``(slipping, opening)`` (nc,) booleans: the nodes that slip, and those separated, at
     some time sample of the contact law at ``U`` (m, H) with the wear ``W`` (nc,) [m] and the
@@ -83,16 +71,18 @@ def pattern(sp: SlowProblem, W, U, anchor) -> tuple[np.ndarray, np.ndarray]:
     return np.any(state == 2, axis=1), np.any(state == 0, axis=1)
 
 
-def pattern_along(sp: SlowProblem, W, U, anchor, g, Js, dUdW) -> Callable[[float], tuple]:
+def pattern_along(sp: SlowProblem, W, U, anchor, path: Callable[[float], np.ndarray],
+                  dUdW) -> Callable[[float], tuple]:
     """``key(N)``: the pattern (:func:`pattern`, as bytes, comparable with ``==``)
-    predicted at ``N`` cycles along the linearised path from the balanced state ``(W, U)``
-    with rate ``g``. ``Js`` (nc, nc) and ``dUdW`` (n, nc) are the slow Jacobian and the
-    balance's derivative at ``(W, U)`` (:meth:`SlowProblem.slow_jacobian`)."""
+    predicted at ``N`` cycles along the linearised path from the balanced state ``(W, U)``:
+    ``path(N)`` (nc,) [m] is ``W(N) - W_k`` on it (the exponential step's, module docstring:
+    :func:`fretwear.wear.exponential_step.increment`, wear never decreasing), ``dUdW`` (n, nc)
+    the balance's derivative at ``(W, U)`` (:meth:`SlowProblem.slow_jacobian`)."""
     W = np.asarray(W, float)
     U = np.asarray(U, float).reshape(sp.m, sp.H)
 
     def key(N: float) -> tuple:
-        dW = path_point(Js, g, N)
+        dW = path(N)
         slip, opened = pattern(sp, W + dW, U + (dUdW @ dW).reshape(sp.m, sp.H), anchor)
         return slip.tobytes(), opened.tobytes()
 

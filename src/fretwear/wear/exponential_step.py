@@ -135,8 +135,12 @@ def exponential_step(sp: SlowProblem, st: SlowStep, opts: WearOptions, order: in
     proposal, cut = dN, False
     if growing:
         dN = min(dN, EXP_GROWTH_LIMIT / lam_plus)
+
+    def path(dN):  # W(dN) - W_k on the linearised path, wear never decreasing
+        return np.maximum(increment(Js, st.g, dN), 0.0)
+
     if events and growing:  # the step ends just past the first event, if it comes first
-        event = first_event(pattern_along(sp, st.W, st.U, anchor, st.g, Js, dUdW), look)
+        event = first_event(pattern_along(sp, st.W, st.U, anchor, path, dUdW), look)
         if event is not None:
             dN, exponential, cut = event[1], True, True
 
@@ -144,10 +148,10 @@ def exponential_step(sp: SlowProblem, st: SlowStep, opts: WearOptions, order: in
 
     def attempt(dN):  # the balance at the end of a jump of dN (as advance's _attempt)
         if exponential:
-            dW = increment(Js, st.g, dN)
-        else:  # the march's step, to the bit
-            dW = dN * np.linalg.solve(np.eye(sp.nc) - dN * Js, st.g)
-        return balance_after(sp, opts, start, np.maximum(dW, 0.0), dUdW)  # wear never decreases
+            dW = path(dN)
+        else:  # the march's step, to the bit; wear never decreases
+            dW = np.maximum(dN * np.linalg.solve(np.eye(sp.nc) - dN * Js, st.g), 0.0)
+        return balance_after(sp, opts, start, dW, dUdW)
 
     error = None
     if order == 2:
