@@ -350,15 +350,13 @@ def harmonic_gains(G: np.ndarray, d: int, oscillating: bool = True):
 
 def _lu_solve(lu, b):
     """``P^-1 b`` by LAPACK factors ``lu``, in their precision (single factors,
-    :data:`SINGLE_FACTORS`: the right-hand side rounded to it, the result returned in
-    double)."""
-    if lu[0].dtype in (np.float32, np.complex64):
-        kind = np.complex64 if np.iscomplexobj(b) else np.float32
-        if np.iscomplexobj(b) and lu[0].dtype == np.float32:
-            kind = np.complex128
-        return sla.lu_solve(lu, np.asarray(b, kind), check_finite=False).astype(
-            np.result_type(b, np.float64))
-    return sla.lu_solve(lu, b, check_finite=False)
+    :data:`SINGLE_FACTORS`: the right-hand side rounded to the single type of the factors and
+    of ``b`` together, the result returned in double, complex where either is)."""
+    if lu[0].dtype not in (np.float32, np.complex64):
+        return sla.lu_solve(lu, b, check_finite=False)
+    kind = np.result_type(lu[0].dtype, np.complex64 if np.iscomplexobj(b) else np.float32)
+    return sla.lu_solve(lu, np.asarray(b, kind), check_finite=False).astype(
+        np.result_type(kind, np.float64))
 
 
 class MeanGainPreconditioner:
