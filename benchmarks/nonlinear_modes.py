@@ -18,8 +18,9 @@ The point's solve is what the sweep spent on it, as the sweep records it
 (``SweepPoint.cpu_seconds`` and ``seconds``, :meth:`fretwear.hb.branch.Branch.lap`): the
 predictor, the condensation at its frequency, every attempt (failed ones included), the
 polish, the solution assembled. The median is over the grid points; the intermediate points
-a ladder adds (substeps, the arclength's branch, each with its own share of the ladder) are
-in the sweep's totals, printed too. Two other denominators were used before, and both were
+a ladder adds (substeps, the arclength's branch: the arclength records its points after
+computing them all, so the first holds the others' share) are in the sweep's totals, printed
+too. Two other denominators were used before, and both were
 wrong: the attempts' own wall times (the solver's iterations alone, without the
 condensation and the recording: about two thirds of the point's CPU on these models, so the
 ratio was too high; none for the intermediate points), and a warm-started

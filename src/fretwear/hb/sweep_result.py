@@ -51,7 +51,8 @@ class SweepPoint:
     previous point was recorded (:meth:`fretwear.hb.branch.Branch.lap`): the predictor, the
     condensations, every attempt, failed ones included, the polish and the flags; a grid
     point's and the intermediate points' its ladder added sum to the ladder's cost (0 for a
-    point read from a checkpoint).
+    point read from a checkpoint). The arclength records its points after computing them all:
+    the first of them holds the whole continuation's time, the others only their recording.
     """
 
     frequency_hz: float
