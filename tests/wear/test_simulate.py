@@ -360,6 +360,17 @@ def test_no_wear_names_the_zero_coefficient_not_the_slip():
     assert "no contact node slips" in stuck.message
 
 
+def test_no_wear_under_the_energy_law_names_its_coefficient():
+    """The block of :func:`test_no_wear_names_the_zero_coefficient_not_the_slip` under the
+    energy law with ``k_e = 0`` (and k_w > 0, which that law does not use): the stop message
+    names what sets that law's factors (``energy_coefficient``, ``mu``), not the Archard
+    ``wear_coefficient``."""
+    r = simulate_wear(block(q_ratio=0.5), BASIS, quasi_static=True,
+                      options=WearOptions(law="energy", energy_coefficient=0.0))
+    assert r.stop_reason == "no_wear" and "every wear coefficient is 0" in r.message
+    assert "energy_coefficient" in r.message and "wear_coefficient)" not in r.message
+
+
 def test_dynamic_run_needs_a_frequency(monkeypatch):
     """A dynamic wear run without ``frequency`` (which used to default to 1 Hz) is refused in
     one line naming it, before anything is computed, at both entry points; settings records of

@@ -61,6 +61,14 @@ def wear_coefficients(model: Model, law_name: str = "archard",
     raise InputError(f"law = {law_name!r}: expected one of {LAWS}")
 
 
+def coefficient_keys(law_name: str) -> str:
+    """What sets the wear factors of :func:`wear_coefficients` under ``law_name``, for a run
+    whose factors are all 0 to say (the Archard law: the contact's k_w; the energy law: k_e
+    and the friction coefficient it multiplies)."""
+    return ("the contact's wear_coefficient" if law_name == "archard" else
+            "energy_coefficient and the contact's mu")
+
+
 def energy_sides(model: Model, energy_coefficient, partner_energy_coefficient=None):
     """Energy-law coefficients ``(k_e(a), k_e(b))`` (nc,) [m^3/J] of the two surfaces of every
     contact node: ``k_e(b)`` is 0 at a node-to-rigid node and without a partner coefficient."""

@@ -45,7 +45,7 @@ from fretwear.wear.checkpoint import (
     save_checkpoint,
 )
 from fretwear.wear.history import WearHistory, WearResult
-from fretwear.wear.laws import wear_coefficients, worn_volume
+from fretwear.wear.laws import coefficient_keys, wear_coefficients, worn_volume
 from fretwear.wear.options import WearOptions
 from fretwear.wear.schemes import advance, first_state
 from fretwear.wear.slow_problem import SlowProblem
@@ -374,8 +374,8 @@ def _message(reason: str, st: SlowStep, opts: WearOptions, extra: str = "",
         "plateau": (f"plateau: worn-volume rate {st.volume_rate:.3g} m^3/cycle <= "
                     f"{opts.plateau_rate:g} x initial {st.volume_rate0:.3g}"),
         "no_wear": ("no wear: no contact node slips (worn-volume rate 0)" if can_wear else
-                    "no wear: every wear coefficient is 0 (worn-volume rate 0; set the contact's "
-                    "wear_coefficient)"),
+                    "no wear: every wear coefficient is 0 (worn-volume rate 0; set "
+                    f"{coefficient_keys(opts.law)})"),
         "max_steps": f"reached max_steps = {opts.max_steps}",
         "solver_failed": "stopped: a periodic solve failed even with smaller jumps",
     }[reason]

@@ -71,7 +71,7 @@ from fretwear.validate import number, whole
 from fretwear.wear.checkpoint import check_checkpoint_path, fingerprint
 from fretwear.wear.exponential_step import exponential_step
 from fretwear.wear.history import WearHistory
-from fretwear.wear.laws import worn_volume
+from fretwear.wear.laws import coefficient_keys, worn_volume
 from fretwear.wear.options import WearOptions
 from fretwear.wear.schemes import first_state
 from fretwear.wear.simulate import (
@@ -377,7 +377,7 @@ def _judge(records: list[StepRecord], options: WornStateOptions, can_wear: bool 
     n = len(records) - 1
     if float(np.max(records[0].wear_rate)) <= 0:
         why = ("no contact node slips at the start" if can_wear else
-               "every wear coefficient is 0 (set the contact's wear_coefficient)")
+               f"every wear coefficient is 0 (set {coefficient_keys(options.wear.law)})")
         return _Found(True, "no_wear", f"no wear: {why} (wear rate 0); the worn state is the "
                       "initial one", 0.0, 0.0)
     if r <= options.tolerance and c <= options.depth_tolerance:
