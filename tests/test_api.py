@@ -334,8 +334,9 @@ def test_subpackages_are_attributes_in_a_fresh_interpreter():
 def test_a_wear_run_that_cannot_wear_is_warned(block, driver, monkeypatch):
     """Archard coefficients all 0 (the contact's default, as in ``block``): the run stopped at
     once with "no wear ... success=True" and said nothing else; now an UnusualValueWarning
-    names the key before the run. With k_w > 0, or under the energy law (its own
-    coefficient), no such warning. The core is replaced by a stub: only the check runs."""
+    names the key before the run, at the caller's line (not inside fretwear). With k_w > 0,
+    or under the energy law (its own coefficient), no such warning. The core is replaced by
+    a stub: only the check runs."""
     import warnings
 
     import fretwear.api
@@ -345,8 +346,10 @@ def test_a_wear_run_that_cannot_wear_is_warned(block, driver, monkeypatch):
             "worn_state": (fretwear.api, "_worn_state")}[driver]
     monkeypatch.setattr(*core, lambda *a, **k: "ran")
     call = getattr(fw, driver)
-    with pytest.warns(UnusualValueWarning, match=r"contact.wear_coefficient = 0 on every"):
+    with pytest.warns(UnusualValueWarning,
+                      match=r"contact.wear_coefficient = 0 on every") as caught:
         assert call(block, BASIS, quasi_static=True) == "ran"
+    assert caught[0].filename == __file__  # the user's call, past the driver's decorators
     worn = from_mesh(rectangle(0.02, 0.01, 4, 2), Material(210e9, 0.3, 7800.0),
                      thickness=0.01, supports=[Spring(at=(0.0, 0.005), direction="x",
                                                       stiffness=1e7)],

@@ -111,14 +111,16 @@ NOTHING_WEARS = ("contact.wear_coefficient = 0 on every contact node (and on the
                  "Archard's k_w [1/Pa] (metals: 1e-17 to 1e-12)")
 
 
-def _nothing_wears(model, law: str | None) -> None:
+def _nothing_wears(model, law: str | None, stacklevel: int) -> None:
     """Warn when an Archard wear run cannot wear (every coefficient 0, the default of a
     contact): it would stop at once with "no wear" and ``success=True``. ``law`` None: options
-    of the wrong type, refused by the run's own check."""
+    of the wrong type, refused by the run's own check. ``stacklevel``: the frames from here
+    to the user's call (this function, the driver and its decorators, which differ between
+    the drivers)."""
     c = model.contact
     if law == "archard" and c is not None and c.n_nodes and not (
             c.wear_nodes().any() or c.partner_wear_nodes().any()):
-        warnings.warn(NOTHING_WEARS, UnusualValueWarning, stacklevel=5)
+        warnings.warn(NOTHING_WEARS, UnusualValueWarning, stacklevel=stacklevel)
 
 
 @contextlib.contextmanager
@@ -318,7 +320,7 @@ def simulate_wear(model, basis, frequency: float | None = None, *, quasi_static:
     """
     _basis(basis)
     _nothing_wears(model, options.law if isinstance(options, _wear.WearOptions)
-                   else None if options is not None else "archard")
+                   else None if options is not None else "archard", 6)
     if condenser is not None:
         balance = balance or _wear.BalanceSetup()
         if balance.condenser is not None:
@@ -361,7 +363,7 @@ def worn_state(model, basis, frequency: float | None = None, *, quasi_static: bo
     _basis(basis)
     opts = kwargs.get("options")
     _nothing_wears(model, opts.wear.law if isinstance(opts, _WornStateOptions)
-                   else None if opts is not None else "archard")
+                   else None if opts is not None else "archard", 5)
     if condenser is not None:
         balance = kwargs.pop("balance", None) or _wear.BalanceSetup()
         if balance.condenser is not None:
