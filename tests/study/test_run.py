@@ -25,6 +25,17 @@ from fretwear.study.runner import RESULTS_FILE, STATUS_FILE, MemberRecord, case_
 from fretwear.study.spec import read_study
 
 
+def _finished(out, member, amp):
+    """A member's folder in ``out`` as a finished run leaves it: its results (``amp`` as
+    slip_amplitude) and an "ok" status with the hash of its case text."""
+    done = out / member.folder_name
+    done.mkdir(parents=True)
+    xr.Dataset({"slip_amplitude": (("contact_node", "harmonic"), amp)}).to_netcdf(
+        done / RESULTS_FILE, engine="h5netcdf")
+    (done / STATUS_FILE).write_text(MemberRecord(0, "ok", "periodic solution",
+                                                 case_sha256=case_hash(member.text)).to_json())
+
+
 def test_collect_writes_the_study_of_the_finished_members_only(tmp_path):
     """Member 0 finished (its status and results as a run leaves them), member 1 never ran:
     ``collect`` records them as "ok" (finished before) and "not run", writes study.nc with
@@ -34,14 +45,8 @@ def test_collect_writes_the_study_of_the_finished_members_only(tmp_path):
     path = study_file(tmp_path, "[grid]\ncontact.mu = [0.1, 0.3]\n")
     members = expand(read_study(path))
     out = tmp_path / "out"
-    done = out / members[0].folder_name
-    done.mkdir(parents=True)
     amp = np.array([[1.0, 2.0], [3.0, 4.0]])
-    xr.Dataset({"slip_amplitude": (("contact_node", "harmonic"), amp)}).to_netcdf(
-        done / RESULTS_FILE, engine="h5netcdf")
-    (done / STATUS_FILE).write_text(MemberRecord(0, "ok", "periodic solution",
-                                                 case_sha256=case_hash(members[0].text)
-                                                 ).to_json())
+    _finished(out, members[0], amp)
     res = run_study(path, out, collect=True, progress=False, echo=False)
     assert [r.status for r in res.records] == ["ok", "not run"]
     assert not res.success and res.figures == []  # figures = false in the base case
@@ -262,13 +267,7 @@ def test_a_study_whose_members_have_no_study_figure_says_so(tmp_path):
     path = study_file(tmp_path, "[set]\noutput.figures = true\n[grid]\ncontact.mu = [0.1]\n")
     members = expand(read_study(path))
     out = tmp_path / "out"
-    done = out / members[0].folder_name
-    done.mkdir(parents=True)
-    xr.Dataset({"slip_amplitude": (("contact_node", "harmonic"), np.ones((2, 2)))}).to_netcdf(
-        done / RESULTS_FILE, engine="h5netcdf")
-    (done / STATUS_FILE).write_text(MemberRecord(0, "ok", "periodic solution",
-                                                 case_sha256=case_hash(members[0].text)
-                                                 ).to_json())
+    _finished(out, members[0], np.ones((2, 2)))
     res = run_study(path, out, collect=True, progress=False, echo=False)
     assert res.success and res.figures == []
     assert res.message.splitlines()[-1].startswith("figures: none for the study")
