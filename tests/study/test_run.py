@@ -26,7 +26,7 @@ from fretwear.study.spec import read_study
 
 
 def _finished(out, member, amp):
-    """A member's folder in ``out`` as a finished run leaves it: its results (``amp`` as
+    """Member 0's folder (``member``) in ``out`` as a finished run leaves it: results (``amp`` as
     slip_amplitude) and an "ok" status with the hash of its case text."""
     done = out / member.folder_name
     done.mkdir(parents=True)
