@@ -705,8 +705,9 @@ class HillProblem:
         exponents come: measured on a Jenkins oscillator leaving full stick), so the
         candidates are not continued from the neighbour's (:func:`hill_stability`)."""
         st = self.state
-        changes = np.count_nonzero(st != np.roll(st, 1, axis=-1), axis=-1)
-        return tuple((tuple(np.unique(st[p]).tolist()), int(changes[p]))
+        prev = np.concatenate([st[..., -1:], st[..., :-1]], axis=-1)  # np.roll's, cheaper
+        changes = np.count_nonzero(st != prev, axis=-1)
+        return tuple((tuple(sorted(set(st[p].ravel().tolist()))), int(changes[p]))
                      for p in range(st.shape[0]))
 
     def memoryless(self) -> bool:
@@ -815,8 +816,8 @@ def reduce_quadratic(A0: np.ndarray, A1: np.ndarray, A2: np.ndarray,
     decouples into them by the same test, which costs less than finding them)."""
     n = A0.shape[0]
     moving = (A1 != 0) | (A2 != 0)
-    dyn_ = np.flatnonzero(np.any(moving, axis=1) | np.any(moving, axis=0))
-    alg = np.setdiff1d(np.arange(n), dyn_)
+    has = np.any(moving, axis=1) | np.any(moving, axis=0)
+    dyn_, alg = np.flatnonzero(has), np.flatnonzero(~has)  # both sorted, as setdiff1d's
     B0, B1, B2 = (X[np.ix_(dyn_, dyn_)] for X in (A0, A1, A2))
     back = None
     if alg.size:
@@ -894,7 +895,10 @@ def _inverse_iteration(B0, B1, B2, sigma: complex, y: np.ndarray, max_iter: int 
     x = y / np.linalg.norm(y)
     first = True
     for _ in range(max_iter):
-        lu, piv, info = zgetrf(B0 + sigma * B1 + (sigma * sigma) * B2, overwrite_a=True)
+        P = sigma * B1  # B0 + sigma B1 + sigma^2 B2, the same sums without temporaries
+        P += B0
+        P += (sigma * sigma) * B2
+        lu, piv, info = zgetrf(P, overwrite_a=True)
         if info != 0:
             return sigma, x, False
         if first:  # towards the eigenvector of the eigenvalue nearest sigma
