@@ -385,6 +385,34 @@ def test_centroid_of_shifted_eigenvectors():
     assert centroid(real_layout(np.roll(c, -3, axis=1)), k) == pytest.approx(base - 3, abs=1e-12)
 
 
+def test_compiled_centroid_equals_the_numpy_formula():
+    """:func:`centroid` (compiled) against its formula written with numpy here
+    (``sum_n n (|c_n|^2 - |c_-n|^2) / sum |c|^2`` on the real layout), on random vectors
+    one at a time and in a batch of shape (2, 3, r, H): equal to rounding (1e-14 absolute
+    on centroids of order 1: the two differ only in the order of the sums)."""
+    k, r = 5, 3
+    rng = np.random.default_rng(7)
+    p = rng.standard_normal((2, 3, r, 2 * k + 1)) + 1j * rng.standard_normal((2, 3, r, 2 * k + 1))
+    p[0, 0, :, 1:] *= 0.01  # mostly static content
+    p[1, 2, :, 1 + k:] = 1j * p[1, 2, :, 1:1 + k]  # one-sided content: |kappa| large
+
+    def numpy_centroid(p):
+        a, b = p[..., 1:1 + k], p[..., 1 + k:]
+        wp = np.sum(np.abs(a - 1j * b) ** 2, axis=-2) / 4.0
+        wm = np.sum(np.abs(a + 1j * b) ** 2, axis=-2) / 4.0
+        total = np.sum(np.abs(p[..., 0]) ** 2, axis=-1) + wp.sum(-1) + wm.sum(-1)
+        return np.sum(np.arange(1, k + 1) * (wp - wm), axis=-1) / total
+
+    ref = numpy_centroid(p)
+    got = centroid(p, k)
+    assert got.shape == (2, 3)
+    np.testing.assert_allclose(got, ref, rtol=0, atol=1e-14)
+    assert abs(ref[1, 2]) > 1.0  # the one-sided vector is far off centre
+    one = centroid(p[1, 1], k)
+    assert isinstance(one, float) and abs(one - ref[1, 1]) <= 1e-14
+    assert centroid(np.zeros((r, 2 * k + 1)), k) == 0.0
+
+
 def test_shifted_copy_moves_the_coefficients_by_one_harmonic():
     """The start of the neighbouring copy's inverse iteration (:func:`_shifted_copy`): the
     eigenvector of ``s + i side`` is ``p e^{-i side w t}``, whose complex-exponential
