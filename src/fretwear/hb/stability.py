@@ -119,7 +119,7 @@ from fretwear.hb.contact import SEPARATION, STICK
 from fretwear.hb.dynamics import StructureDynamics, structure_dynamics
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.problem import DLFTProblem
-from fretwear.hb.reduce import condense, to_real_blocks
+from fretwear.hb.reduce import condense
 from fretwear.hb.solution import PeriodicSolution
 from fretwear.model.core import Model
 from fretwear.resources import require_memory
@@ -730,41 +730,79 @@ class HillProblem:
                              f"up to {PENCIL_MAX} unknowns (structure coordinates x kept "
                              f"harmonics); this one has {(dyn.m + dyn.q) * prob.H}: use fewer "
                              "harmonics or a modal condenser with fewer modes")
-        orders = prob.basis.orders
-        nw = orders * w
-        q = dyn.q
+        nw = np.ascontiguousarray(prob.basis.orders * w, dtype=float)
+        K, M, C, D = self._structure
+        A = _pencil(K, M, C, D, np.ascontiguousarray(self.G0, dtype=float),
+                    float(prob.eps), nw, w)
+        return A[0], A[1], A[2]
 
-        K, M, C, D = (dyn.full.get(nm) for nm in ("K", "M", "C", "D"))
-        nb = orders.size
-        # complex blocks per harmonic of the coefficients of sigma^0, sigma^1, sigma^2 of
-        # Z(lambda), lambda = w (sigma + i n), in the layout of reduce.to_real_blocks
-        Z0 = np.repeat(K[None].astype(complex), nb, axis=0)
-        Z0 -= (nw ** 2)[:, None, None] * M
-        Z1 = np.repeat((2j * w * nw)[:, None, None] * M, 1, axis=0)
-        if C is not None:
-            Z0 += (1j * nw)[:, None, None] * C
-            Z1 = Z1 + w * C
-        if D is not None:
-            Z0[1:] += 1j * D
-        Z2 = np.repeat((w * w * M)[None], nb, axis=0).astype(complex)
-        H = prob.H
-        nx = prob.m * H
-        n = (prob.m + q) * H
-        G = self.G0
-        mats = []
-        for power, Zc in enumerate((Z0, Z1, Z2)):
-            Z = to_real_blocks(Zc, orders)
-            A = np.empty((n, n))
-            # rows of x: eps x - G (eps x - Z^xx x - Z^xq q); rows of q: Z^qx x + Z^qq q
-            A[:nx] = np.matmul(G, Z[:nx].reshape(prob.nc, -1, n)).reshape(nx, n)
-            if power == 0:
-                for p in range(prob.nc):
-                    sl = slice(p * G.shape[1], (p + 1) * G.shape[1])
-                    A[sl, sl] -= prob.eps * G[p]
-                A[np.arange(nx), np.arange(nx)] += prob.eps
-            A[nx:] = Z[nx:]
-            mats.append(A)
-        return tuple(mats)
+
+@njit(cache=True)
+def _pencil(K, M, C, D, G, eps, nw, w):
+    """:meth:`HillProblem.pencil` compiled: ``A`` (3, n, n), ``n = r H`` in the DOF-major
+    layout of :func:`fretwear.hb.reduce.to_real_blocks`, from the structure's whole matrices
+    (r, r) and the law's ``G`` (nc, dH, dH) of the first ``nc d`` coordinates. The complex
+    blocks of ``Z`` per harmonic ``h`` (``nw[h]`` its circular frequency, ``nw[0] = 0``) and
+    power of ``sigma``: ``K - nw^2 M + i (nw C + D)`` (no ``D`` on the static coefficient),
+    ``w C + 2 i w nw M``, ``w^2 M``; each couples only the cosine and sine coefficients of
+    its own harmonic, so the rows of ``x`` (``G Z``) sum ``2 d`` terms an entry, not ``dH``.
+    Equal to the numpy form (``np.block``-free products of numpy's) to rounding."""
+    r = K.shape[0]
+    nb = nw.size
+    k = nb - 1
+    H = 1 + 2 * k
+    n = r * H
+    nc, dH = G.shape[0], G.shape[1]
+    d = dH // H
+    nx = nc * dH
+    m = nc * d
+    A = np.zeros((3, n, n))  # rows of q: Z itself
+    Z = np.zeros((3, nx, n))  # rows of x: Z, multiplied by G below
+    for h in range(nb):
+        for j in range(r):
+            X = Z if j < m else A  # the same row index in either
+            for col in range(r):
+                re0 = K[j, col] - nw[h] * nw[h] * M[j, col]
+                im0 = nw[h] * C[j, col] + (D[j, col] if h > 0 else 0.0)
+                re1 = w * C[j, col]
+                im1 = 2.0 * w * nw[h] * M[j, col]
+                re2 = w * w * M[j, col]
+                if h == 0:
+                    X[0, j * H, col * H] = re0
+                    X[1, j * H, col * H] = re1
+                    X[2, j * H, col * H] = re2
+                    continue
+                a, b = j * H + h, j * H + h + k
+                ca, cb = col * H + h, col * H + h + k
+                X[0, a, ca], X[0, a, cb], X[0, b, ca], X[0, b, cb] = re0, im0, -im0, re0
+                X[1, a, ca], X[1, a, cb], X[1, b, ca], X[1, b, cb] = re1, im1, -im1, re1
+                X[2, a, ca], X[2, b, cb] = re2, re2
+    for pw in range(3):
+        for p in range(nc):
+            for i in range(dH):
+                row = p * dH + i
+                for col in range(n):
+                    c = col % H  # the column's coefficient, and its harmonic's pair
+                    if c == 0:
+                        lo, hi = 0, 0
+                    elif c <= k:
+                        lo, hi = c, c + k
+                    else:
+                        lo, hi = c - k, c
+                    acc = 0.0
+                    for jj in range(d):
+                        base = (p * d + jj) * H
+                        acc += G[p, i, jj * H + lo] * Z[pw, base + lo, col]
+                        if hi != lo:
+                            acc += G[p, i, jj * H + hi] * Z[pw, base + hi, col]
+                    A[pw, row, col] = acc
+    for p in range(nc):
+        for i in range(dH):
+            for t in range(dH):
+                A[0, p * dH + i, p * dH + t] -= eps * G[p, i, t]
+    for i in range(nx):
+        A[0, i, i] += eps
+    return A
 
 
 def centroid(p: np.ndarray, k: int) -> np.ndarray:
