@@ -1028,9 +1028,15 @@ def track_eigen(red: QuadraticReduction, track: HillTrack | None, shape: tuple,
     mats: dict = {}  # per block, its complex matrices (made once)
     step = 0.0 if omega is None or track.omega is None else omega - track.omega
     for j, (s0, b) in enumerate(zip(track.sigma, track.block, strict=True)):
+        starts = [complex(s0)]
         if track.velocity is not None and abs(track.velocity[j] * step) < 0.1:
-            s0 = s0 + track.velocity[j] * step  # the member's own motion, extrapolated
-        got = _member(red, b, complex(s0), track.Y[red.blocks[b], j], shape, mats)
+            # the member's own motion, extrapolated; the neighbour's eigenvalue where the
+            # iteration from there does not converge
+            starts.insert(0, complex(s0 + track.velocity[j] * step))
+        for s0 in starts:
+            got = _member(red, b, s0, track.Y[red.blocks[b], j], shape, mats)
+            if got is not None:
+                break
         if got is None:
             return None
         s1, y, kp = got
