@@ -206,8 +206,9 @@ def main():
                 options=SweepOptions(spacing="linear"))
     stability(sol_model, res.points[-1].solution)
     # and Hill's along a sweep: the tracking's and the warm-started refinement's kernels are
-    # loaded from numba's cache at their first call (the Jenkins sweep's Hill took 0.23 s of
-    # CPU on its first pass, 0.08 s on the next ones)
+    # loaded from numba's cache at their first call, which the point above does not make
+    # (with no Hill run before, the Jenkins sweep's Hill took 0.23 s of CPU on its first
+    # pass, 0.08 s on the next ones)
     res = sweep(sol_model, FourierBasis.up_to(3, 32), 0.15, 0.23, 8,
                 options=SweepOptions(spacing="linear"))
     sweep_stability(sol_model, res)
