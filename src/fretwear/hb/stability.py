@@ -723,7 +723,7 @@ class HillProblem:
         (``G(s) = G(0)``): rows of ``x``: ``eps x - G (eps x - Z^xx x - Z^xq q)``, rows of
         ``q``: ``Z^qx x + Z^qq q``, with ``Z^ab(lambda)`` of ``lambda = w (sigma + i n)``.
         Exact for a law without memory (:meth:`memoryless`); the hysteretic damping keeps
-        the sign of ``n`` (none on the static coefficient)."""
+        the sign of ``n`` (none on the static coefficient). Compiled (:func:`_pencil`)."""
         dyn, prob, w = self.dyn, self.prob, self.omega
         if (dyn.m + dyn.q) * prob.H > PENCIL_MAX:
             raise InputError(f"Hill's method solves its quadratic eigenvalue problem densely "
