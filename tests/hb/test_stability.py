@@ -16,7 +16,7 @@ Independent references (none calls the code under test):
 
 import numpy as np
 import pytest
-from helpers.models import C2, K2, two_dof
+from helpers.models import C2, K2, oscillator, two_dof
 from scipy.integrate import solve_ivp
 from scipy.optimize import root
 
@@ -231,6 +231,47 @@ def test_compiled_hill_matrix_is_its_parts(case):
         assert np.abs(hp.matrix(sigma) - ref).max() <= 1e-13 * np.abs(ref).max()
 
 
+@pytest.mark.parametrize("case", ["jenkins-hysteretic", "unilateral-two-dof", "oscillator-2d"])
+def test_pencil_condensed_is_the_frozen_memory_hill_matrix(case):
+    """``HillProblem.pencil`` (compiled) with its interior coordinates ``q`` eliminated (the
+    Schur complement of ``A0 + sigma A1 + sigma^2 A2`` onto the contact coordinates, done
+    here densely) is ``T(s)`` with the law's memory frozen: ``jacobian_form(G(0), Z(s))``,
+    ``Z(s)`` from the structure's condensation at complex arguments
+    (:meth:`HillProblem.stiffness`, tested against the dense Schur complement in
+    test_dynamics.py). Equal to 1e-12 of the largest entry: the same terms eliminated in
+    another order, through ``Z^qq`` (conditioned 1e2-1e3 here). On a Jenkins solution with
+    viscous and hysteretic damping (real ``s`` only: the pencil signs the hysteretic term by
+    the harmonic, as ``Z(s)`` does where ``Im s`` is below ``w``, with none on the static
+    coefficient as at ``Im s = 0``), on the unilateral two-DOF oscillator (three interior
+    coordinates) and on a two-dimensional contact node (``d = 2``: the law's ``G`` couples
+    the normal and tangential coefficients)."""
+    if case == "jenkins-hysteretic":
+        model = from_matrices([[1.0]], [[1.0]],
+                              contact=ContactDofs(normal_dofs=None, tangential_dofs=[0],
+                                                  mu=0.5, normal_load=1.0, kt=0.5),
+                              damping=Damping(C=[[0.02]], D=[[0.03]]),
+                              loads=[Load(np.array([0.2]), "cos")], observed={"x": 0})
+        basis, f, sigmas = FourierBasis.up_to(5, 64), 1.18 / (2 * np.pi), (0.0, -0.05, 0.2)
+    elif case == "unilateral-two-dof":
+        model, basis, f = two_dof(), FourierBasis.up_to(5, 64), 0.7 / (2 * np.pi)
+        sigmas = (0.0, 0.3j, -0.02 + 0.47j, 0.1 - 0.2j)
+    else:
+        model, basis, f = oscillator(), FourierBasis.up_to(3, 32), 15.0
+        sigmas = (0.0, 0.3j, -0.02 + 0.47j, 0.1 - 0.2j)
+    sol = solve_periodic(model, basis, frequency=f, time_domain=None)
+    assert sol.success
+    prob = problem_of(model, sol)
+    hp = HillProblem(prob, sol.U.reshape(prob.m, prob.H), structure_dynamics(model))
+    A = hp.pencil()
+    nx = prob.m * prob.H
+    assert case != "oscillator-2d" or prob.d == 2
+    for sigma in sigmas:
+        P = A[0] + sigma * A[1] + sigma**2 * A[2]
+        S = P[:nx, :nx] - P[:nx, nx:] @ np.linalg.solve(P[nx:, nx:], P[nx:, :nx])
+        ref = jacobian_form(hp.G0, hp.stiffness(sigma), prob.eps)
+        assert np.abs(S - ref).max() <= 1e-12 * np.abs(ref).max()
+
+
 def test_compiled_pair_is_lapacks():
     """``_pair`` up to ``PAIR_COMPILED_MAX`` unknowns (compiled LU with partial pivoting) is
     ``_pair_lapack`` (LAPACK's ``zgetrf``/``zgetrs``) on random complex matrices of 5, 30
@@ -383,6 +424,34 @@ def test_centroid_of_shifted_eigenvectors():
     base = centroid(real_layout(c), k)
     assert centroid(real_layout(np.roll(c, 2, axis=1)), k) == pytest.approx(base + 2, abs=1e-12)
     assert centroid(real_layout(np.roll(c, -3, axis=1)), k) == pytest.approx(base - 3, abs=1e-12)
+
+
+def test_compiled_centroid_equals_the_numpy_formula():
+    """:func:`centroid` (compiled) against its formula written with numpy here
+    (``sum_n n (|c_n|^2 - |c_-n|^2) / sum |c|^2`` on the real layout), on random vectors
+    one at a time and in a batch of shape (2, 3, r, H): equal to rounding (1e-14 absolute
+    on centroids of order 1: the two differ only in the order of the sums)."""
+    k, r = 5, 3
+    rng = np.random.default_rng(7)
+    p = rng.standard_normal((2, 3, r, 2 * k + 1)) + 1j * rng.standard_normal((2, 3, r, 2 * k + 1))
+    p[0, 0, :, 1:] *= 0.01  # mostly static content
+    p[1, 2, :, 1 + k:] = 1j * p[1, 2, :, 1:1 + k]  # one-sided content: |kappa| large
+
+    def numpy_centroid(p):
+        a, b = p[..., 1:1 + k], p[..., 1 + k:]
+        wp = np.sum(np.abs(a - 1j * b) ** 2, axis=-2) / 4.0
+        wm = np.sum(np.abs(a + 1j * b) ** 2, axis=-2) / 4.0
+        total = np.sum(np.abs(p[..., 0]) ** 2, axis=-1) + wp.sum(-1) + wm.sum(-1)
+        return np.sum(np.arange(1, k + 1) * (wp - wm), axis=-1) / total
+
+    ref = numpy_centroid(p)
+    got = centroid(p, k)
+    assert got.shape == (2, 3)
+    np.testing.assert_allclose(got, ref, rtol=0, atol=1e-14)
+    assert abs(ref[1, 2]) > 1.0  # the one-sided vector is far off centre
+    one = centroid(p[1, 1], k)
+    assert isinstance(one, float) and abs(one - ref[1, 1]) <= 1e-14
+    assert centroid(np.zeros((r, 2 * k + 1)), k) == 0.0
 
 
 def test_shifted_copy_moves_the_coefficients_by_one_harmonic():

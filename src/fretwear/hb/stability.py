@@ -119,7 +119,7 @@ from fretwear.hb.contact import SEPARATION, STICK
 from fretwear.hb.dynamics import StructureDynamics, structure_dynamics
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.problem import DLFTProblem
-from fretwear.hb.reduce import condense, to_real_blocks
+from fretwear.hb.reduce import condense
 from fretwear.hb.solution import PeriodicSolution
 from fretwear.model.core import Model
 from fretwear.resources import require_memory
@@ -705,8 +705,9 @@ class HillProblem:
         exponents come: measured on a Jenkins oscillator leaving full stick), so the
         candidates are not continued from the neighbour's (:func:`hill_stability`)."""
         st = self.state
-        changes = np.count_nonzero(st != np.roll(st, 1, axis=-1), axis=-1)
-        return tuple((tuple(np.unique(st[p]).tolist()), int(changes[p]))
+        prev = np.concatenate([st[..., -1:], st[..., :-1]], axis=-1)  # np.roll's, cheaper
+        changes = np.count_nonzero(st != prev, axis=-1)
+        return tuple((tuple(sorted(set(st[p].ravel().tolist()))), int(changes[p]))
                      for p in range(st.shape[0]))
 
     def memoryless(self) -> bool:
@@ -722,48 +723,86 @@ class HillProblem:
         (``G(s) = G(0)``): rows of ``x``: ``eps x - G (eps x - Z^xx x - Z^xq q)``, rows of
         ``q``: ``Z^qx x + Z^qq q``, with ``Z^ab(lambda)`` of ``lambda = w (sigma + i n)``.
         Exact for a law without memory (:meth:`memoryless`); the hysteretic damping keeps
-        the sign of ``n`` (none on the static coefficient)."""
+        the sign of ``n`` (none on the static coefficient). Compiled (:func:`_pencil`)."""
         dyn, prob, w = self.dyn, self.prob, self.omega
         if (dyn.m + dyn.q) * prob.H > PENCIL_MAX:
             raise InputError(f"Hill's method solves its quadratic eigenvalue problem densely "
                              f"up to {PENCIL_MAX} unknowns (structure coordinates x kept "
                              f"harmonics); this one has {(dyn.m + dyn.q) * prob.H}: use fewer "
                              "harmonics or a modal condenser with fewer modes")
-        orders = prob.basis.orders
-        nw = orders * w
-        q = dyn.q
+        nw = np.ascontiguousarray(prob.basis.orders * w, dtype=float)
+        K, M, C, D = self._structure
+        A = _pencil(K, M, C, D, np.ascontiguousarray(self.G0, dtype=float),
+                    float(prob.eps), nw, w)
+        return A[0], A[1], A[2]
 
-        K, M, C, D = (dyn.full.get(nm) for nm in ("K", "M", "C", "D"))
-        nb = orders.size
-        # complex blocks per harmonic of the coefficients of sigma^0, sigma^1, sigma^2 of
-        # Z(lambda), lambda = w (sigma + i n), in the layout of reduce.to_real_blocks
-        Z0 = np.repeat(K[None].astype(complex), nb, axis=0)
-        Z0 -= (nw ** 2)[:, None, None] * M
-        Z1 = np.repeat((2j * w * nw)[:, None, None] * M, 1, axis=0)
-        if C is not None:
-            Z0 += (1j * nw)[:, None, None] * C
-            Z1 = Z1 + w * C
-        if D is not None:
-            Z0[1:] += 1j * D
-        Z2 = np.repeat((w * w * M)[None], nb, axis=0).astype(complex)
-        H = prob.H
-        nx = prob.m * H
-        n = (prob.m + q) * H
-        G = self.G0
-        mats = []
-        for power, Zc in enumerate((Z0, Z1, Z2)):
-            Z = to_real_blocks(Zc, orders)
-            A = np.empty((n, n))
-            # rows of x: eps x - G (eps x - Z^xx x - Z^xq q); rows of q: Z^qx x + Z^qq q
-            A[:nx] = np.matmul(G, Z[:nx].reshape(prob.nc, -1, n)).reshape(nx, n)
-            if power == 0:
-                for p in range(prob.nc):
-                    sl = slice(p * G.shape[1], (p + 1) * G.shape[1])
-                    A[sl, sl] -= prob.eps * G[p]
-                A[np.arange(nx), np.arange(nx)] += prob.eps
-            A[nx:] = Z[nx:]
-            mats.append(A)
-        return tuple(mats)
+
+@njit(cache=True)
+def _pencil(K, M, C, D, G, eps, nw, w):
+    """:meth:`HillProblem.pencil` compiled: ``A`` (3, n, n), ``n = r H`` in the DOF-major
+    layout of :func:`fretwear.hb.reduce.to_real_blocks`, from the structure's whole matrices
+    (r, r) and the law's ``G`` (nc, dH, dH) of the first ``nc d`` coordinates. The complex
+    blocks of ``Z`` per harmonic ``h`` (``nw[h]`` its circular frequency, ``nw[0] = 0``) and
+    power of ``sigma``: ``K - nw^2 M + i (nw C + D)`` (no ``D`` on the static coefficient),
+    ``w C + 2 i w nw M``, ``w^2 M``; each couples only the cosine and sine coefficients of
+    its own harmonic, so the rows of ``x`` (``G Z``) sum ``2 d`` terms an entry, not ``dH``.
+    Equal to the numpy form (``np.block``-free products of numpy's) to rounding."""
+    r = K.shape[0]
+    nb = nw.size
+    k = nb - 1
+    H = 1 + 2 * k
+    n = r * H
+    nc, dH = G.shape[0], G.shape[1]
+    d = dH // H
+    nx = nc * dH
+    m = nc * d
+    A = np.zeros((3, n, n))  # rows of q: Z itself
+    Z = np.zeros((3, nx, n))  # rows of x: Z, multiplied by G below
+    for h in range(nb):
+        for j in range(r):
+            X = Z if j < m else A  # the same row index in either
+            for col in range(r):
+                re0 = K[j, col] - nw[h] * nw[h] * M[j, col]
+                im0 = nw[h] * C[j, col] + (D[j, col] if h > 0 else 0.0)
+                re1 = w * C[j, col]
+                im1 = 2.0 * w * nw[h] * M[j, col]
+                re2 = w * w * M[j, col]
+                if h == 0:
+                    X[0, j * H, col * H] = re0
+                    X[1, j * H, col * H] = re1
+                    X[2, j * H, col * H] = re2
+                    continue
+                a, b = j * H + h, j * H + h + k
+                ca, cb = col * H + h, col * H + h + k
+                X[0, a, ca], X[0, a, cb], X[0, b, ca], X[0, b, cb] = re0, im0, -im0, re0
+                X[1, a, ca], X[1, a, cb], X[1, b, ca], X[1, b, cb] = re1, im1, -im1, re1
+                X[2, a, ca], X[2, b, cb] = re2, re2
+    for pw in range(3):
+        for p in range(nc):
+            for i in range(dH):
+                row = p * dH + i
+                for col in range(n):
+                    c = col % H  # the column's coefficient, and its harmonic's pair
+                    if c == 0:
+                        lo, hi = 0, 0
+                    elif c <= k:
+                        lo, hi = c, c + k
+                    else:
+                        lo, hi = c - k, c
+                    acc = 0.0
+                    for jj in range(d):
+                        base = (p * d + jj) * H
+                        acc += G[p, i, jj * H + lo] * Z[pw, base + lo, col]
+                        if hi != lo:
+                            acc += G[p, i, jj * H + hi] * Z[pw, base + hi, col]
+                    A[pw, row, col] = acc
+    for p in range(nc):
+        for i in range(dH):
+            for t in range(dH):
+                A[0, p * dH + i, p * dH + t] -= eps * G[p, i, t]
+    for i in range(nx):
+        A[0, i, i] += eps
+    return A
 
 
 def centroid(p: np.ndarray, k: int) -> np.ndarray:
@@ -771,14 +810,36 @@ def centroid(p: np.ndarray, k: int) -> np.ndarray:
     real-coefficient layout ``[a0, a.., b..]``: ``sum_n n |c_n|^2 / sum |c_n|^2`` over their
     complex-exponential coefficients ``c_{+n} = (a_n - i b_n)/2``,
     ``c_{-n} = (a_n + i b_n)/2``, ``c_0 = a0``; harmonic orders are taken as their index
-    among the kept harmonics (``1..k``). A float for one vector, an array (...) otherwise."""
-    a, b = p[..., 1:1 + k], p[..., 1 + k:]
-    wp = np.sum(np.abs(a - 1j * b) ** 2, axis=-2) / 4.0
-    wm = np.sum(np.abs(a + 1j * b) ** 2, axis=-2) / 4.0
-    total = np.sum(np.abs(p[..., 0]) ** 2, axis=-1) + wp.sum(-1) + wm.sum(-1)
-    order = np.arange(1, k + 1)
-    out = np.sum(order * (wp - wm), axis=-1) / np.maximum(total, 1e-300)
+    among the kept harmonics (``1..k``). A float for one vector, an array (...) otherwise.
+    Compiled (:func:`_centroids`: a call of numpy's dozen operations cost 15-20 us on a
+    single vector, and a tracked point computes one per inverse iteration)."""
+    p = np.asarray(p)
+    lead = p.shape[:-2]
+    flat = np.ascontiguousarray(p.reshape((-1,) + p.shape[-2:]), dtype=complex)
+    out = _centroids(flat, int(k)).reshape(lead)
     return float(out) if np.ndim(out) == 0 else out
+
+
+@njit(cache=True)
+def _centroids(p, k):
+    """:func:`centroid` of the vectors ``p`` (B, r, 1 + 2k) complex: (B,)."""
+    nv, r = p.shape[0], p.shape[1]
+    out = np.empty(nv)
+    for v in range(nv):
+        total = 0.0
+        moment = 0.0
+        for i in range(r):
+            total += p[v, i, 0].real ** 2 + p[v, i, 0].imag ** 2
+            for n in range(k):
+                a, b = p[v, i, 1 + n], p[v, i, 1 + k + n]
+                cp = a - 1j * b  # 2 c_{+n}, 2 c_{-n}
+                cm = a + 1j * b
+                wp = (cp.real ** 2 + cp.imag ** 2) / 4.0
+                wm = (cm.real ** 2 + cm.imag ** 2) / 4.0
+                total += wp + wm
+                moment += (n + 1) * (wp - wm)
+        out[v] = moment / max(total, 1e-300)
+    return out
 
 
 @dataclass
@@ -815,8 +876,8 @@ def reduce_quadratic(A0: np.ndarray, A1: np.ndarray, A2: np.ndarray,
     decouples into them by the same test, which costs less than finding them)."""
     n = A0.shape[0]
     moving = (A1 != 0) | (A2 != 0)
-    dyn_ = np.flatnonzero(np.any(moving, axis=1) | np.any(moving, axis=0))
-    alg = np.setdiff1d(np.arange(n), dyn_)
+    has = np.any(moving, axis=1) | np.any(moving, axis=0)
+    dyn_, alg = np.flatnonzero(has), np.flatnonzero(~has)  # both sorted, as setdiff1d's
     B0, B1, B2 = (X[np.ix_(dyn_, dyn_)] for X in (A0, A1, A2))
     back = None
     if alg.size:
@@ -894,7 +955,10 @@ def _inverse_iteration(B0, B1, B2, sigma: complex, y: np.ndarray, max_iter: int 
     x = y / np.linalg.norm(y)
     first = True
     for _ in range(max_iter):
-        lu, piv, info = zgetrf(B0 + sigma * B1 + (sigma * sigma) * B2, overwrite_a=True)
+        P = sigma * B1  # B0 + sigma B1 + sigma^2 B2, the same sums without temporaries
+        P += B0
+        P += (sigma * sigma) * B2
+        lu, piv, info = zgetrf(P, overwrite_a=True)
         if info != 0:
             return sigma, x, False
         if first:  # towards the eigenvector of the eigenvalue nearest sigma
@@ -964,9 +1028,15 @@ def track_eigen(red: QuadraticReduction, track: HillTrack | None, shape: tuple,
     mats: dict = {}  # per block, its complex matrices (made once)
     step = 0.0 if omega is None or track.omega is None else omega - track.omega
     for j, (s0, b) in enumerate(zip(track.sigma, track.block, strict=True)):
+        starts = [complex(s0)]
         if track.velocity is not None and abs(track.velocity[j] * step) < 0.1:
-            s0 = s0 + track.velocity[j] * step  # the member's own motion, extrapolated
-        got = _member(red, b, complex(s0), track.Y[red.blocks[b], j], shape, mats)
+            # the member's own motion, extrapolated; the neighbour's eigenvalue where the
+            # iteration from there does not converge
+            starts.insert(0, complex(s0 + track.velocity[j] * step))
+        for s0 in starts:
+            got = _member(red, b, s0, track.Y[red.blocks[b], j], shape, mats)
+            if got is not None:
+                break
         if got is None:
             return None
         s1, y, kp = got
