@@ -21,6 +21,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import root
 
 from fretwear.hb import contact as law
+from fretwear.hb import stability as hill_module
 from fretwear.hb.dynamics import structure_dynamics
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import solve_periodic
@@ -201,8 +202,9 @@ def test_shifted_gain_at_zero_is_the_solve_s_gain():
 
 
 # --- Hill's matrix and the exponents --------------------------------------------------------
+@pytest.mark.parametrize("compiled", [True, False])
 @pytest.mark.parametrize("case", ["jenkins-hysteretic", "unilateral-two-dof"])
-def test_compiled_hill_matrix_is_its_parts(case):
+def test_compiled_hill_matrix_is_its_parts(case, compiled, monkeypatch):
     """``HillProblem.matrix`` (compiled: ``Z_r`` by elimination on the held structure, then
     ``G Z`` over the nonzero entries of ``Z``) equals ``jacobian_form(gain, stiffness)``
     (numpy and LAPACK: tested against the law's recursion, the solve's Jacobian and the dense
@@ -212,7 +214,11 @@ def test_compiled_hill_matrix_is_its_parts(case):
     ``s = 0``, on the imaginary axis and in both half-planes, on a Jenkins solution with
     viscous and hysteretic damping (``Im s`` signs the hysteretic term of every harmonic,
     the static one included) and on the unilateral two-DOF oscillator (contact springs:
-    three interior coordinates, a Schur complement per argument)."""
+    three interior coordinates, a Schur complement per argument). ``compiled`` False: the
+    interior held above ``CONDENSED_COMPILED_MAX`` (set to -1), ``Z_r`` by LAPACK's
+    solve, the same comparison."""
+    if not compiled:
+        monkeypatch.setattr(hill_module, "CONDENSED_COMPILED_MAX", -1)
     if case == "jenkins-hysteretic":
         model = from_matrices([[1.0]], [[1.0]],
                               contact=ContactDofs(normal_dofs=None, tangential_dofs=[0],

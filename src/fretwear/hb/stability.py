@@ -538,6 +538,15 @@ def _hill_matrix(G, Zr, eps):
     return T
 
 
+#: the most interior coordinates ``q`` for which :meth:`HillProblem.matrix` condenses in the
+#: compiled, unblocked elimination of :func:`_condensed_at`; beyond, LAPACK's blocked solve
+#: (:meth:`StructureDynamics.condensed`) is faster (one ``T(s)`` on FE blocks, one BLAS
+#: thread: q = 20 0.4 ms compiled / 0.3 ms LAPACK, q = 88 8.1 / 3.7 ms, q = 336 267 / 58 ms,
+#: the same values to 1e-15), while on the small oscillators (q <= 2) the compiled call is
+#: 2-3 times faster
+CONDENSED_COMPILED_MAX = 16
+
+
 @njit(cache=True)
 def _condensed_at(Kf, Mf, Cf, Df, m, harmonics, omega, sigma):
     """``(Z_r, ok)``: ``Z_r`` (1 + 2k, m, m) complex at ``lambda = s``, ``s + i n w``,
@@ -678,6 +687,8 @@ class HillProblem:
         """``T(s)`` (m H, m H) complex at ``s = sigma w``: ``jacobian_form(gain, stiffness)``
         with the product and the blocks in one compiled call (:func:`_hill_matrix`)."""
         self.evaluations += 1
+        if self._structure[0].shape[0] - self.prob.m > CONDENSED_COMPILED_MAX:
+            return _hill_matrix(self.gain(sigma), self.condensed(sigma), float(self.prob.eps))
         Zr, ok = _condensed_at(*self._structure, self.prob.m, self.harmonics, self.omega,
                                complex(sigma))
         if not ok:
