@@ -382,8 +382,8 @@ def test_grid_point_after_one_that_failed_starts_as_a_branch_first_point(monkeyp
     attempt starts as a branch's first point (the first harmonic alone) and converges
     (:func:`fretwear.hb.attempts.after_failure`). Independent check: the eps continuation
     alone (from 0.1 eps, where it converges there) from the contact-closed guess at the same
-    eps and anchors (the answer the ladder reached before), to 1e-8 of the largest harmonic (the solves' relative tolerance;
-    measured 5e-15)."""
+    eps and anchors (the answer the ladder reached before), to 1e-8 of the largest harmonic
+    (the solves' relative tolerance; measured 5e-15)."""
     from helpers.cases import EXAMPLES
 
     from fretwear.analyses.run import load_case
