@@ -26,8 +26,8 @@ Single solve (:class:`Trial`; :data:`~fretwear.hb.options.STRATEGY`, the rungs t
 
 Sweep point (:class:`Point`; :data:`POINT_RUNGS`): ``"grid"`` (the solver from the secant
 predictor; after a grid point that did not converge, from the first harmonic alone,
-:func:`after_failure`), ``"substep"`` (bisection of the step from the last converged point), the same
-again with each step going on past its ``max_iter`` while the solver makes progress
+:func:`after_failure`), ``"substep"`` (bisection of the step from the last converged
+point), the same again with each step going on past its ``max_iter`` while the solver makes progress
 (:func:`patient_substep`, :func:`go_on`; recorded as ``"substep"``), ``"retry"`` (the
 other solver from the neighbour), ``"arclength"`` (pseudo-arclength continuation past a fold,
 :mod:`fretwear.hb.arclength`; before ``"retry"`` when the branch turns back short of the grid
