@@ -79,13 +79,13 @@ def test_wear_summary_says_where_no_periodic_response_exists():
     """A wear run whose slow steps took their rate from time integrations that found no
     periodic response (the paper's beam at 70 kHz: quasi-periodic, code 3 of
     RESPONSE_KINDS, at every step) is told so, not given a penalty to try that cannot find
-    what the structure does not have; where some steps did find a periodic response (code 0,
-    the balance then failed), the hint stays beside the count of those that did not. The
+    what the structure does not have; where some steps' integrations ran out of periods before
+    they settled (code 5, transient), the hint stays beside the count of those that did not. The
     codes are those of fretwear.timedomain.averaged_rate.RESPONSE_KINDS (checked here)."""
     from fretwear.timedomain.averaged_rate import RESPONSE_KINDS
 
     assert [RESPONSE_KINDS[k] for k in fallbacks.NOT_PERIODIC] == [
-        "subharmonic", "quasi-periodic", "irregular"]
+        "subharmonic", "drifting", "quasi-periodic", "irregular"]
     hint = fallbacks.eps_hint(False)
     none = fallbacks.of_wear([0, 2, 2, 2], [1.0, 30.0, 40.0, 5.0], 80.0, [-1, 3, 3, 3])
     line = none.line("slow steps", hint)
@@ -93,7 +93,7 @@ def test_wear_summary_says_where_no_periodic_response_exists():
     assert "eps =" not in line
     assert line.endswith("the structure has no periodic response at them (a time "
                          "integration found none)")
-    some = fallbacks.of_wear([0, 2, 2], [1.0, 30.0, 40.0], 80.0, [-1, 0, 4])
+    some = fallbacks.of_wear([0, 2, 2], [1.0, 30.0, 40.0], 80.0, [-1, 5, 4])  # 5: transient
     assert some.line("slow steps", hint).endswith(
         f"no periodic response at 1 of them (a time integration found none); {hint}")
 

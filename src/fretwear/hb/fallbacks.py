@@ -122,8 +122,11 @@ def of_solutions(points, total: float) -> FallbackCost:
 
 #: the codes of the history's ``response`` (:data:`fretwear.timedomain.averaged_rate.
 #: RESPONSE_KINDS`) of a time integration that found no periodic response: subharmonic,
-#: quasi-periodic, irregular (drifting and transient may still settle)
-NOT_PERIODIC = (1, 3, 4)
+#: drifting, quasi-periodic, irregular (not "transient": out of periods before it settled).
+#: Drifting included as measured: the paper's beam at 79 kHz drifts at every step, and with
+#: ``eps = "static"`` its steps came from time integrations all the same (the same worn
+#: volume; docs/studies/fallbacks.md)
+NOT_PERIODIC = (1, 2, 3, 4)
 
 
 def of_wear(rescued, wall_time, total: float, response=None) -> FallbackCost:
@@ -133,7 +136,7 @@ def of_wear(rescued, wall_time, total: float, response=None) -> FallbackCost:
     the history's ``response`` (the kind of each step's time integration), the steps whose
     integration found no periodic response (:data:`NOT_PERIODIC`) are counted
     (``no_periodic``), and the summary line says so instead of a setting that could not
-    avoid them (the paper's beam at 30, 70 and 79 kHz: quasi-periodic or chaotic;
+    avoid them (the paper's beam at 30, 70 and 79 kHz: quasi-periodic or drifting;
     docs/studies/fallbacks.md)."""
     cost = FallbackCost(total=float(total))
     response = [-1] * len(rescued) if response is None else response
