@@ -59,6 +59,31 @@ def test_branch_passes_the_target_with_balanced_points():
         assert np.linalg.norm(f) <= 1e-8 * prob.scale(Ux)
 
 
+def test_branch_never_steps_below_zero_frequency():
+    """Marching down from 1100 and 300 Hz towards 100 Hz on the closed block (a linear
+    response), the first predictor lands at -500 Hz: the step is shortened until it is at a
+    positive frequency (before, the condensation at a negative frequency raised an
+    InputError: a sweep point of the paper's beam whose neighbour lay 9 times lower in
+    frequency). Every point returned lies at a positive frequency and is a balance there
+    (relative residual of a freshly condensed problem below 1e-8, as above)."""
+    model = closed_block()
+    probs = Problems(model, BASIS, None, EPS, exact_condenser(model))
+    anchor = np.zeros((model.contact.n_nodes, 1))
+    opts = SolveOptions(tol=1e-10)
+    w0, w1, target = (2 * np.pi * f for f in (1100.0, 300.0, 100.0))
+    _, U0, s0 = solve_at(probs, w0, anchor, None, opts)
+    _, U1, s1 = solve_at(probs, w1, anchor, U0, opts)
+    assert s0.success and s1.success
+    branch = arclength(probs, anchor, (U0.reshape(-1), w0), (U1.reshape(-1), w1), target, 1e-10)
+    assert branch and branch[-1][1] <= target
+    for U, w, _, _ in branch:
+        assert w > 0
+        red = condense(model, w / (2 * np.pi), BASIS.orders)
+        prob = DLFTProblem(red, model.contact, BASIS, eps=EPS, anchor=anchor)
+        Ux = U.reshape(prob.m, prob.H)
+        f, _ = prob.residual(Ux, jacobian=False)
+        assert np.linalg.norm(f) <= 1e-8 * prob.scale(Ux)
+
 def _arc(degrees, R=0.1):
     """Points ``(omega, U)`` on the circle ``omega = 1 + R cos a``, ``U = 1 + R sin a`` at the
     angles ``degrees``: a branch whose frequency turns back at ``a = 0`` (``omega = 1 + R``)."""

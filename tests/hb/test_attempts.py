@@ -370,3 +370,50 @@ def test_turned_back_finds_the_fold_the_branch_went_round():
     assert turned_back(arc([-40, -20, 0, 15, 30], -1.0), 0, 0.8) == 2
     jitter = [*arc([-40, -20, 0]), (1.1 - 1e-6, np.zeros(1))]  # back by 4e-5 of the way
     assert turned_back(jitter, 0, 1.2) is None
+
+
+def test_grid_point_after_one_that_failed_starts_as_a_branch_first_point(monkeypatch):
+    """The paper's beam (salles2011-frf's model, 7 harmonics, 128 samples, the static eps) on
+    16237.8, 29763.5 and 54555.9 Hz: the middle point has no periodic response (a time
+    integration finds a quasi-periodic one there, docs/studies/fallbacks.md); here it is
+    made to fail without a try. Its neighbour at 16237.8 Hz, three times lower, is no start
+    for 54555.9 Hz (before, the grid attempt from it failed and the point needed more rungs),
+    so the grid
+    attempt starts as a branch's first point (the first harmonic alone) and converges
+    (:func:`fretwear.hb.attempts.after_failure`). Independent check: the eps continuation
+    alone (from 0.1 eps, where it converges there) from the contact-closed guess at the same
+    eps and anchors (the answer the ladder reached before), to 1e-8 of the largest harmonic
+    (the solves' relative tolerance; measured 5e-15)."""
+    from helpers.cases import EXAMPLES
+
+    from fretwear.analyses.run import load_case
+    from fretwear.hb import attempts
+    from fretwear.hb import sweep as sweep_module
+    from fretwear.hb.options import SWEEP_POINT, SweepOptions
+    from fretwear.hb.solvers import SolveStats
+    from fretwear.io.case import build_model
+
+    model = build_model(load_case(EXAMPLES / "salles2011-frf.toml"))
+    basis = FourierBasis.up_to(7, 128)
+    f_lo, f_hi = 16237.8, 54555.9
+    real = attempts.point_ladder
+
+    def ladder(p):
+        if f_lo < p.frequency < f_hi:  # no periodic response here
+            p.stats = SolveStats(False, float("nan"), 0, 0, 0, 0.0, "made to fail", "powell")
+            return p
+        return real(p)
+
+    monkeypatch.setattr(sweep_module, "point_ladder", ladder)
+    res = sweep_module.sweep(model, basis, f_lo, f_hi, 3, options=SweepOptions(eps="static"))
+    grid = [p for p in res.points if p.on_grid]
+    last = grid[-1]
+    assert [p.success for p in grid] == [True, False, True]
+    assert [a.method for a in last.attempts] == ["grid"], [a.method for a in last.attempts]
+    assert "did not converge" in last.attempts[0].message
+    sol = last.solution
+    monkeypatch.setattr(attempts, "EPS_FACTORS", (0.1,))  # the one that converges there
+    ref = solve_periodic(model, basis, frequency=f_hi, eps=sol.eps, anchor=sol.anchor,
+                         options=SWEEP_POINT.replace(strategy=("eps-continuation",)))
+    assert ref.success
+    assert np.abs(sol.U - ref.U).max() <= 1e-8 * np.abs(ref.U).max()

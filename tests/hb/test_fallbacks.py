@@ -74,6 +74,29 @@ def test_cost_of_points_and_of_a_wear_history():
     assert fallbacks.FallbackCost().line() == ""
 
 
+
+def test_wear_summary_says_where_no_periodic_response_exists():
+    """A wear run whose slow steps took their rate from time integrations that found no
+    periodic response (the paper's beam at 70 kHz: quasi-periodic, code 3 of
+    RESPONSE_KINDS, at every step) is told so, not given a penalty to try that cannot find
+    what the structure does not have; where some steps' integrations ran out of periods before
+    they settled (code 5, transient), the hint stays beside the count of those that did not. The
+    codes are those of fretwear.timedomain.averaged_rate.RESPONSE_KINDS (checked here)."""
+    from fretwear.timedomain.averaged_rate import RESPONSE_KINDS
+
+    assert [RESPONSE_KINDS[k] for k in fallbacks.NOT_PERIODIC] == [
+        "subharmonic", "drifting", "quasi-periodic", "irregular"]
+    hint = fallbacks.eps_hint(False)
+    none = fallbacks.of_wear([0, 2, 2, 2], [1.0, 30.0, 40.0, 5.0], 80.0, [-1, 3, 3, 3])
+    line = none.line("slow steps", hint)
+    assert (none.count, none.no_periodic) == (3, 3)
+    assert "eps =" not in line
+    assert line.endswith("the structure has no periodic response at them (a time "
+                         "integration found none)")
+    some = fallbacks.of_wear([0, 2, 2], [1.0, 30.0, 40.0], 80.0, [-1, 5, 4])  # 5: transient
+    assert some.line("slow steps", hint).endswith(
+        f"no periodic response at 1 of them (a time integration found none); {hint}")
+
 def test_halved_steps_and_arclength_are_the_sweeps_path_not_fallbacks():
     """The time of the rungs of fallbacks.CONTINUATION after the first attempt (halved steps,
     the arclength past a fold: the sweep's own path) is counted apart from the fallbacks and

@@ -494,7 +494,8 @@ def run_wear(model, analysis: dict, case, context: RunContext) -> RunOutput:
         lines.append(frf_note)
     if case.output["vtu"] and no_fields_line(model):
         lines.append(no_fields_line(model))
-    fallback = fallbacks.of_wear(h.rescued[1:], h.wall_time[1:], result.wall_time).line(
+    fallback = fallbacks.of_wear(h.rescued[1:], h.wall_time[1:], result.wall_time,
+                                 h.response[1:]).line(
         "slow steps", fallbacks.eps_hint("eps" in a))
     if fallback:
         lines.append(fallback)

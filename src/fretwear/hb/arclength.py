@@ -109,6 +109,8 @@ def arclength(probs, anchor, y_prev, y_last, omega_target, solver_tol, max_steps
             best = []
             for _it in range(max_iter):
                 U, w = y[:-1] * sx, y[-1] * sw
+                if not (np.isfinite(w) and w > 0.0):
+                    break  # a step past zero frequency: a shorter one (no balance there)
                 prob = probs.get(w, anchor)
                 f, J = prob.residual(U.reshape(prob.m, prob.H))
                 nf += 1

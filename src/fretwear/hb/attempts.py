@@ -25,8 +25,9 @@ Single solve (:class:`Trial`; :data:`~fretwear.hb.options.STRATEGY`, the rungs t
    steady state starts one more solve with its mean tangential positions as anchors.
 
 Sweep point (:class:`Point`; :data:`POINT_RUNGS`): ``"grid"`` (the solver from the secant
-predictor), ``"substep"`` (bisection of the step from the last converged point), the same
-again with each step going on past its ``max_iter`` while the solver makes progress
+predictor; after a grid point that did not converge, from the first harmonic alone,
+:func:`after_failure`), ``"substep"`` (bisection of the step from the last converged
+point), the same again with each step going on past its ``max_iter`` while the solver makes progress
 (:func:`patient_substep`, :func:`go_on`; recorded as ``"substep"``), ``"retry"`` (the
 other solver from the neighbour), ``"arclength"`` (pseudo-arclength continuation past a fold,
 :mod:`fretwear.hb.arclength`; before ``"retry"`` when the branch turns back short of the grid
@@ -446,15 +447,40 @@ def grid(p: Point) -> bool:
     (:func:`cold_start`: the first harmonic alone with more than one) with a single solve's
     iterations (:data:`~fretwear.hb.options.PERIODIC`): the 40 of a warm-started point left
     the tutorial's lap joint at 400 Hz at a relative residual of 6e-2 from the contact-closed
-    guess (then the eps continuation, 4 s: docs/studies/fallbacks.md)."""
+    guess (then the eps continuation, 4 s: docs/studies/fallbacks.md). The same after a grid
+    point that did not converge (:func:`after_failure`: the last converged point is no
+    neighbour), with the last converged point's anchors: on the paper's beam at 54555.9 Hz,
+    three times the frequency of the last converged point, the predictor and that point
+    start at relative residuals of 0.84 and 0.78 and neither solver converges from them in
+    200 iterations, where the first harmonic alone starts at 8.5e-2 and Powell converges in
+    15 to the answer of the eps continuation (the fallback it took before;
+    docs/studies/fallbacks.md, "The last fallbacks")."""
     b, so = p.branch, p.options.solve
     U0 = b.predict(p.omega)
-    if U0 is None:
+    broken = U0 is not None and after_failure(b)
+    if U0 is None or broken:
         so = so.replace(max_iter=max(so.max_iter, PERIODIC.max_iter))
         U0 = cold_start(p.probs.get(p.omega, b.anchor()), None, so)
     prob, U, st = solve_at(p.probs, p.omega, b.anchor(), U0, so)
-    p.tried.append(Attempt.of("grid", prob.eps, st))
+    how = ""
+    if broken:
+        how = " (the grid point before did not converge: started as a branch's first point)"
+        said(f"sweep at {p.frequency:.6g} Hz: the grid point before did not converge; "
+             "starting as a branch's first point: "
+             + ("converged" if st.success else f"not converged ({st.residual:.2e})"))
+    p.tried.append(Attempt.of("grid", prob.eps, st, st.message + how if how else None))
     return p.adopt(prob, U, st, "grid")
+
+
+def after_failure(b: Branch) -> bool:
+    """Whether the last grid point of the branch ``b`` did not converge: its last converged
+    point then lies a grid step or more back (the paper's beam, 20 points from 1 Hz to
+    100 kHz: 17928.5 Hz, a halved step before 29763.5 Hz, which has no periodic response,
+    for the grid point at 54555.9 Hz) and is no neighbour to start from (:func:`grid`)."""
+    for pt in reversed(b.points):
+        if pt.on_grid:
+            return not pt.success
+    return False
 
 
 def substep(p: Point, patient: bool = False) -> bool:

@@ -45,6 +45,7 @@ class FallbackCost:
     continued: int = 0
     continued_seconds: float = 0.0
     jumps: list = field(default_factory=list)
+    no_periodic: int = 0
 
     @property
     def share(self) -> float:
@@ -64,6 +65,12 @@ class FallbackCost:
         td = f", {self.time_domain} from a time integration" if self.time_domain else ""
         share = f" ({100 * self.share:.0f} % of {self.total:.1f} s)" if self.total > 0 else ""
         tail = f"; {hint}" if hint and self.share >= HINT_SHARE else ""
+        if self.no_periodic:  # no setting of the balance finds what the structure lacks
+            tail = ("; the structure has no periodic response at "
+                    + ("them" if self.no_periodic == self.count
+                       else f"{self.no_periodic} of them")
+                    + " (a time integration found none)"
+                    + (tail if self.no_periodic < self.count else ""))
         return (f"fallbacks: {self.count} {what} needed more than their first attempt{td}: "
                 f"{self.seconds:.1f} s{share}{tail}")
 
@@ -113,14 +120,30 @@ def of_solutions(points, total: float) -> FallbackCost:
     return cost
 
 
-def of_wear(rescued, wall_time, total: float) -> FallbackCost:
+#: the codes of the history's ``response`` (:data:`fretwear.timedomain.averaged_rate.
+#: RESPONSE_KINDS`) of a time integration that found no periodic response: subharmonic,
+#: drifting, quasi-periodic, irregular (not "transient": out of periods before it settled).
+#: Drifting included as measured: the paper's beam at 79 kHz drifts at every step, and with
+#: ``eps = "static"`` its steps came from time integrations all the same (the same worn
+#: volume; docs/studies/fallbacks.md)
+NOT_PERIODIC = (1, 2, 3, 4)
+
+
+def of_wear(rescued, wall_time, total: float, response=None) -> FallbackCost:
     """The cost of the fallbacks of a wear run from its history: the steps whose rate did not
     come from a balance warm-started from the previous step (``rescued`` > 0: started from or
-    averaged over a time integration) and their ``wall_time`` [s], out of ``total``."""
+    averaged over a time integration) and their ``wall_time`` [s], out of ``total``; with
+    the history's ``response`` (the kind of each step's time integration), the steps whose
+    integration found no periodic response (:data:`NOT_PERIODIC`) are counted
+    (``no_periodic``), and the summary line says so instead of a setting that could not
+    avoid them (the paper's beam at 30, 70 and 79 kHz: quasi-periodic or drifting;
+    docs/studies/fallbacks.md)."""
     cost = FallbackCost(total=float(total))
-    for r, w in zip(rescued, wall_time, strict=True):
+    response = [-1] * len(rescued) if response is None else response
+    for r, w, k in zip(rescued, wall_time, response, strict=True):
         if int(r) > 0:
             cost.add(float(w), True)
+            cost.no_periodic += int(k) in NOT_PERIODIC
     return cost
 
 
