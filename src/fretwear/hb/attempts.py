@@ -687,9 +687,11 @@ FOLD_RUNGS = (POINT_RUNGS[0], POINT_RUNGS[1], POINT_RUNGS[4], POINT_RUNGS[5], PO
               POINT_RUNGS[3], *POINT_RUNGS[6:])
 
 
-#: the rungs of a sweep point said as they start (the costly ones; the first four are the
-#: continuation's own steps)
-SAID_RUNGS = ("continuation", "fresh-start", "time-start")
+#: the rungs of a sweep point said as they start (the costly ones, after the sweep's own path:
+#: the grid step, the halved steps, the arclength and the jump), with the words said
+SAID_RUNGS = {"continuation": "the eps and harmonic continuations from the last converged point",
+              "fresh-start": "a fresh start from the first harmonic alone",
+              "time-start": "a time integration (it can take minutes)"}
 
 
 def point_ladder(p: Point) -> Point:
@@ -755,9 +757,8 @@ def point_ladder(p: Point) -> Point:
             rungs = FOLD_RUNGS
         name, rung = rungs[i]
         if name in SAID_RUNGS:
-            said(f"sweep at {p.frequency:.6g} Hz: the continuation failed; trying "
-                 f"{name}" + (" (a time integration can take minutes)"
-                              if name == "time-start" else ""))
+            said(f"sweep at {p.frequency:.6g} Hz: the sweep's own path and the other solver "
+                 f"failed; trying {SAID_RUNGS[name]} ({name})")
         if rung(p):
             break
     if t_first is not None:
