@@ -86,3 +86,18 @@ def test_3d_pad_is_reported_stable_when_the_step_resolves_the_contact():
     assert coarse.verdict != "stable"
     need = int(coarse.message.rsplit(">= ", 1)[1])
     assert 1024 * RESOLVED_STEPS < need < 4096
+
+
+def test_settles_elsewhere_says_why_whatever_the_distance():
+    """A subharmonic response (twice the period) can lie within the distance tolerance of
+    the periodic solution over one period and still be another state: the verdict's message
+    then says the distance is within the tolerance but the period is not the solution's,
+    never "distance 0.18 > 0.2" (which a run on the platform damper printed); beyond the
+    tolerance it says so as before."""
+    from fretwear.timedomain.stability import _verdict
+
+    near = _verdict("subharmonic", 0.18, 12, 1.0, 0.2, None)
+    assert near.verdict == "settles elsewhere"
+    assert "0.18 <= 0.2" in near.message and "> 0.2" not in near.message
+    far = _verdict("periodic", 0.5, 12, 1.0, 0.2, None)
+    assert "distance 0.5 > 0.2" in far.message

@@ -153,9 +153,11 @@ def check_periodic(model: Model, sol: PeriodicSolution, *, max_periods: int = 30
 def _verdict(kind, dist, n, wall, tolerance, res) -> StabilityCheck:
     """The verdict of a response that did not settle back to the periodic solution."""
     if kind in ("periodic", "subharmonic"):
+        why = (f"distance {dist:.2g} > {tolerance:g}" if dist > tolerance else
+               f"distance {dist:.2g} <= {tolerance:g} but not of the solution's period")
         return StabilityCheck("settles elsewhere", dist, n, wall,
                               f"time integration settles to another {kind} state after {n} "
-                              f"periods (distance {dist:.2g} > {tolerance:g})")
+                              f"periods ({why})")
     if kind == "drifting":
         return StabilityCheck("drifting", dist, n, wall,
                               f"time integration ratchets away (period means drift) over {n} "
