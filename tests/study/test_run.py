@@ -271,3 +271,46 @@ def test_a_study_whose_members_have_no_study_figure_says_so(tmp_path):
     res = run_study(path, out, collect=True, progress=False, echo=False)
     assert res.success and res.figures == []
     assert res.message.splitlines()[-1].startswith("figures: none for the study")
+
+
+def test_a_nonlinear_modes_study_draws_the_members_backbones(tmp_path, monkeypatch):
+    """Two nonlinear-modes members of the shipped Jenkins oscillator (mu = 0.2, 0.3; 4
+    amplitudes, 64 samples: a second of CPU): study.nc holds each member's backbone_frequency,
+    damping_ratio and modal amplitudes equal bit for bit to its own results.nc (read back
+    independently), and study-backbones.png draws exactly those curves, one per member
+    labelled with its mu (read back from the figure's lines). Before, such a study stopped
+    with a KeyError (its response_amplitude has no frequency axis)."""
+    import shutil
+
+    from fretwear.study import figures
+
+    drawn = {}
+    save = figures._save
+    monkeypatch.setattr(figures, "_save",
+                        lambda fig, path: drawn.setdefault(path.name, fig) and save(fig, path))
+    for name in ("jenkins-nonlinear-modes.toml", "jenkins-K.mtx", "jenkins-M.mtx"):
+        shutil.copy(EXAMPLES_DIR / name, tmp_path / name)
+    case = tmp_path / "jenkins-nonlinear-modes.toml"
+    case.write_text(case.read_text().replace("n_amplitudes = 30", "n_amplitudes = 4")
+                    .replace("n_samples = 1024", "n_samples = 64")
+                    + "\n[output]\nvtu = false\nfigures = false\n")
+    path = study_file(tmp_path, "[grid]\ncontact.mu = [0.2, 0.3]\n",
+                      base="jenkins-nonlinear-modes.toml")
+    out = tmp_path / "out"
+    members = _run_members_here(path, out)
+    res = run_study(path, out, collect=True, progress=False, echo=False)
+    ds = res.dataset
+    assert [p.name for p in res.figures] == ["study-backbones.png"]
+    assert ds["member_modal_amplitude"].attrs["units"] == "m kg^0.5"
+    fig = drawn["study-backbones.png"]
+    for i, m in enumerate(members):
+        own = xr.open_dataset(out / m.folder_name / RESULTS_FILE, engine="h5netcdf").load()
+        a = own["modal_amplitude"].values
+        np.testing.assert_array_equal(ds["member_modal_amplitude"].values[i], a)
+        for ax, name in zip(fig.axes, ("backbone_frequency", "damping_ratio"), strict=True):
+            np.testing.assert_array_equal(ds[name].values[i], own[name].values)
+            line = ax.get_lines()[i]
+            assert line.get_label() == f"contact.mu = {(0.2, 0.3)[i]:.3g}"
+            np.testing.assert_array_equal(line.get_xdata(), a)
+            np.testing.assert_array_equal(line.get_ydata(), own[name].values)
+    assert fig.axes[1].get_xlabel() == "modal amplitude [m kg^0.5]"

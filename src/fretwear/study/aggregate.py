@@ -14,6 +14,8 @@ solve is never a result). Two kinds get more:
   family of FRFs over the excitation level, ``analysis.excitation_scale``, the curves a
   joint engineer reads first); for a split sweep (:mod:`fretwear.study.sweep_split`) the
   chunks joined into one sweep instead;
+* nonlinear-modes members: each member's own modal amplitudes (``member_modal_amplitude``),
+  the abscissa of its stacked ``backbone_frequency`` and ``damping_ratio``;
 * mistuned disks (``[cyclic.mistuning]``): each member's blade responses and amplification
   factor against Whitehead's bound (:mod:`fretwear.study.mistuning`).
 
@@ -366,6 +368,26 @@ def _own_variables(members: list[Member], own: dict) -> dict:
     }
 
 
+def _backbone_amplitudes(members: list[Member], done: dict, stacked: dict) -> dict:
+    """Nonlinear-modes members: each member's own modal amplitudes
+    (``member_modal_amplitude``), the abscissa of its backbone and damping curve (the
+    stacked ``backbone_frequency`` and ``damping_ratio``), whether or not the members' grids
+    of amplitude agree."""
+    if "backbone_frequency" not in stacked:
+        return {}
+    n = stacked["backbone_frequency"][1].shape[1]
+    amp = np.full((len(members), n), np.nan)
+    attrs = {}
+    for i, m in enumerate(members):
+        if m.index in done and "modal_amplitude" in done[m.index].coords:
+            amp[i] = done[m.index]["modal_amplitude"].values
+            attrs = dict(done[m.index]["modal_amplitude"].attrs)
+    return {"member_modal_amplitude": (("member", "modal_amplitude"), amp, {
+        "units": attrs.get("units", "m kg^0.5"),
+        "long_name": "the member's modal amplitudes (abscissa of its backbone_frequency "
+                     "and damping_ratio)"})}
+
+
 def aggregate(study, members: list[Member], records: list[MemberRecord], outdir) -> xr.Dataset:
     """The study's dataset (see the module docstring)."""
     done = _open(outdir, members, records)
@@ -392,6 +414,7 @@ def aggregate(study, members: list[Member], records: list[MemberRecord], outdir)
         data.update(_frf_band(stacked))
         data.update(_own_variables(members, own))
         data.update(_peaks(stacked, coords))
+        data.update(_backbone_amplitudes(members, done, stacked))
     amp_data, amp_attrs = amplification(members, done)
     data.update(amp_data)
     ds = xr.Dataset(data, coords=coords)

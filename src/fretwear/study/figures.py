@@ -11,7 +11,9 @@
   key;
 * linear FRF studies (``frf``): one FRF per member and interface (first observed point, on
   its axis of largest response);
-* modes studies (``modes``): the natural frequencies against the first varied numeric key.
+* modes studies (``modes``): the natural frequencies against the first varied numeric key;
+* nonlinear-modes studies: the natural frequency and the damping ratio against the modal
+  amplitude, one curve per member (``study-backbones``).
 
 Members of the other analysis types have no study figure (the summary says so; each member's
 own figures are in its folder).
@@ -300,6 +302,29 @@ def natural_frequencies(ds, path: Path, varied: list[str]) -> Path:
     return _save(fig, path)
 
 
+def backbones(ds, path: Path, varied: list[str]) -> Path:
+    """Nonlinear-modes members: the natural frequency and the damping ratio against the
+    modal amplitude (log x), one curve per member labelled with its varied keys."""
+    a = ds["member_modal_amplitude"].values
+    unit = ds["member_modal_amplitude"].attrs.get("units", "m kg^0.5")
+    fig, axes = _figure(2, 1, figsize=(7, 6.5), sharex=True)
+    for i in range(ds.sizes["member"]):
+        style = {"lw": 1, "marker": ".", "ms": 3, "color": f"C{i % 10}",
+                 "label": _member_label(ds, i, varied)}
+        axes[0].plot(a[i], ds["backbone_frequency"].values[i], **style)
+        axes[1].plot(a[i], ds["damping_ratio"].values[i], **style)
+    axes[0].set_ylabel("natural frequency [Hz]")
+    axes[1].set_ylabel("damping ratio [-]")
+    axes[1].set_xlabel(f"modal amplitude [{unit}]")
+    for ax in axes:
+        ax.set_xscale("log")
+        ax.grid(alpha=0.3, which="both")
+    if ds.sizes["member"] <= 12:
+        axes[0].legend(fontsize=7)
+    axes[0].set_title(ds.attrs.get("title", ""), fontsize=9)
+    return _save(fig, path)
+
+
 def study_figures(ds, outdir: Path, varied: list[str], fmt: str = "png") -> list[Path]:
     """Every figure that applies to the dataset; returns the files written."""
     out = []
@@ -308,6 +333,8 @@ def study_figures(ds, outdir: Path, varied: list[str], fmt: str = "png") -> list
     elif "worn_volume_on_cycles" in ds:
         out.append(fan_chart(ds, outdir / f"study-worn-volume.{fmt}"))
         out.append(profile_band(ds, outdir / f"study-wear-profiles.{fmt}"))
+    elif "member_modal_amplitude" in ds and "backbone_frequency" in ds:
+        out.append(backbones(ds, outdir / f"study-backbones.{fmt}", varied))
     elif PERIODIC_RESPONSE in ds and "member" in ds[PERIODIC_RESPONSE].dims:
         out.append(response_per_member(ds, outdir / f"study-response.{fmt}", varied))
     elif "response_amplitude" in ds and "member" in ds["response_amplitude"].dims:
