@@ -314,3 +314,43 @@ def test_a_nonlinear_modes_study_draws_the_members_backbones(tmp_path, monkeypat
             np.testing.assert_array_equal(line.get_xdata(), a)
             np.testing.assert_array_equal(line.get_ydata(), own[name].values)
     assert fig.axes[1].get_xlabel() == "modal amplitude [m kg^0.5]"
+
+
+def test_a_worn_state_study_draws_the_members_worn_profiles(tmp_path, monkeypatch):
+    """Two worn-state members of the wear tests' beam block (mu = 0.3, 0.4; 3 harmonics, 32
+    samples, residual 1e-2): study.nc holds each member's final worn profile, worn volume,
+    maximum depth, stop reason and kind of worn state equal to the last step and attributes
+    of its own results.nc (read back independently), and study-worn-profiles.png draws those
+    profiles against x, one per member labelled with its mu and its kind."""
+    from helpers.cases import WEAR_BLOCK
+
+    from fretwear.study import figures
+
+    drawn = {}
+    save = figures._save
+    monkeypatch.setattr(figures, "_save",
+                        lambda fig, path: drawn.setdefault(path.name, fig) and save(fig, path))
+    (tmp_path / "w.toml").write_text(
+        f'title = "worn state"\n{WEAR_BLOCK}[analysis]\ntype = "worn-state"\n'
+        "quasi_static = true\nharmonics = 3\nn_samples = 32\ncheckpoint_every_s = 0.0\n"
+        "residual_tolerance = 1e-2\n[output]\nvtu = false\nfigures = false\n")
+    path = study_file(tmp_path, "[grid]\ncontact.mu = [0.3, 0.4]\n", base="w.toml")
+    out = tmp_path / "out"
+    members = _run_members_here(path, out)
+    res = run_study(path, out, collect=True, progress=False, echo=False)
+    ds = res.dataset
+    assert [p.name for p in res.figures] == ["study-worn-profiles.png"]
+    lines = drawn["study-worn-profiles.png"].axes[0].get_lines()
+    for i, m in enumerate(members):
+        own = xr.open_dataset(out / m.folder_name / RESULTS_FILE, engine="h5netcdf").load()
+        w = own["wear_depth"].values[-1]
+        np.testing.assert_array_equal(ds["final_wear_depth"].values[i], w)
+        assert ds["final_max_wear_depth"].values[i] == w.max() > 0
+        assert ds["final_worn_volume"].values[i] == own["worn_volume"].values[-1]
+        kind = own.attrs["worn_state_kind"]
+        assert ds["member_worn_state_kind"].values[i] == kind
+        assert ds["member_stop_reason"].values[i] == own.attrs["stop_reason"]
+        assert lines[i].get_label() == f"contact.mu = {(0.3, 0.4)[i]:.3g} ({kind})"
+        np.testing.assert_array_equal(lines[i].get_xdata(), own["contact_position"].values[:, 0])
+        np.testing.assert_array_equal(lines[i].get_ydata(), w)
+    assert ds["final_wear_depth"].attrs["units"] == "m"

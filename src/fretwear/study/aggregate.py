@@ -16,6 +16,9 @@ solve is never a result). Two kinds get more:
   chunks joined into one sweep instead;
 * nonlinear-modes members: each member's own modal amplitudes (``member_modal_amplitude``),
   the abscissa of its stacked ``backbone_frequency`` and ``damping_ratio``;
+* worn-state members: each member's final worn profile, worn volume and maximum depth (the
+  names of the wear members' final state), why it stopped and the kind of worn state it
+  reached (``member_worn_state_kind``);
 * mistuned disks (``[cyclic.mistuning]``): each member's blade responses and amplification
   factor against Whitehead's bound (:mod:`fretwear.study.mistuning`).
 
@@ -388,6 +391,42 @@ def _backbone_amplitudes(members: list[Member], done: dict, stacked: dict) -> di
                      "and damping_ratio)"})}
 
 
+def _worn_states(members: list[Member], done: dict) -> dict:
+    """Worn-state members (their results have ``worn_state_kind``): each member's worn
+    profile, worn volume and maximum depth at its last pseudo-time step (the worn state when
+    it was reached), what kind of state it reached and why it stopped."""
+    have = {k: ds for k, ds in done.items() if "worn_state_kind" in ds.attrs}
+    if not have:
+        return {}
+    nc = max(ds.sizes["contact_node"] for ds in have.values())
+    vol, depth = np.full(len(members), np.nan), np.full(len(members), np.nan)
+    prof = np.full((len(members), nc), np.nan)
+    for i, m in enumerate(members):
+        ds = have.get(m.index)
+        if ds is not None:
+            w = ds["wear_depth"].values[-1]
+            prof[i, : w.size], depth[i] = w, w.max()
+            vol[i] = ds["worn_volume"].values[-1]
+
+    def attr(name):
+        return np.array([str(have[m.index].attrs.get(name, "")) if m.index in have else ""
+                         for m in members])
+
+    return {
+        "final_worn_volume": ("member", vol, {"units": "m^3", "long_name": "final worn volume"}),
+        "final_max_wear_depth": ("member", depth,
+                                 {"units": "m", "long_name": "final maximum wear depth"}),
+        "final_wear_depth": (("member", "contact_node"), prof,
+                             {"units": "m", "long_name": "final worn profile"}),
+        "member_stop_reason": ("member", attr("stop_reason"),
+                               {"long_name": "why the wear run stopped"}),
+        "member_worn_state_kind": ("member", attr("worn_state_kind"),
+                                   {"long_name": "the worn state the member reached "
+                                    "(null_wear_rate, steady_wear, no_wear or "
+                                    "not_reached)"}),
+    }
+
+
 def aggregate(study, members: list[Member], records: list[MemberRecord], outdir) -> xr.Dataset:
     """The study's dataset (see the module docstring)."""
     done = _open(outdir, members, records)
@@ -415,6 +454,7 @@ def aggregate(study, members: list[Member], records: list[MemberRecord], outdir)
         data.update(_own_variables(members, own))
         data.update(_peaks(stacked, coords))
         data.update(_backbone_amplitudes(members, done, stacked))
+        data.update(_worn_states(members, done))
     amp_data, amp_attrs = amplification(members, done)
     data.update(amp_data)
     ds = xr.Dataset(data, coords=coords)

@@ -13,7 +13,9 @@
   its axis of largest response);
 * modes studies (``modes``): the natural frequencies against the first varied numeric key;
 * nonlinear-modes studies: the natural frequency and the damping ratio against the modal
-  amplitude, one curve per member (``study-backbones``).
+  amplitude, one curve per member (``study-backbones``);
+* worn-state studies: each member's final worn profile, labelled with the kind of worn
+  state it reached (``study-worn-profiles``).
 
 Members of the other analysis types have no study figure (the summary says so; each member's
 own figures are in its folder).
@@ -325,6 +327,27 @@ def backbones(ds, path: Path, varied: list[str]) -> Path:
     return _save(fig, path)
 
 
+def worn_profiles(ds, path: Path, varied: list[str]) -> Path:
+    """Worn-state members: each member's final worn profile (its worn state when reached;
+    dashed when not), labelled with its varied keys and the kind of state it reached."""
+    fig, ax = _figure(figsize=(7, 4.5))
+    for i in range(ds.sizes["member"]):
+        x = ds["contact_position"].values[i, :, 0] if "contact_position" in ds else \
+            np.arange(ds.sizes["contact_node"])
+        kind = str(ds["member_worn_state_kind"].values[i])
+        w = ds["final_wear_depth"].values[i]
+        ax.plot(x[: w.size], w, lw=1, marker=".", ms=3, color=f"C{i % 10}",
+                ls="--" if kind == "not_reached" else "-",
+                label=f"{_member_label(ds, i, varied)} ({kind or 'failed'})")
+    ax.set_xlabel("x [m]" if "contact_position" in ds else "contact node")
+    ax.set_ylabel("wear depth [m]")
+    ax.set_title(ds.attrs.get("title", ""), fontsize=9)
+    if ds.sizes["member"] <= 12:
+        ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    return _save(fig, path)
+
+
 def study_figures(ds, outdir: Path, varied: list[str], fmt: str = "png") -> list[Path]:
     """Every figure that applies to the dataset; returns the files written."""
     out = []
@@ -335,6 +358,8 @@ def study_figures(ds, outdir: Path, varied: list[str], fmt: str = "png") -> list
         out.append(profile_band(ds, outdir / f"study-wear-profiles.{fmt}"))
     elif "member_modal_amplitude" in ds and "backbone_frequency" in ds:
         out.append(backbones(ds, outdir / f"study-backbones.{fmt}", varied))
+    elif "member_worn_state_kind" in ds:
+        out.append(worn_profiles(ds, outdir / f"study-worn-profiles.{fmt}", varied))
     elif PERIODIC_RESPONSE in ds and "member" in ds[PERIODIC_RESPONSE].dims:
         out.append(response_per_member(ds, outdir / f"study-response.{fmt}", varied))
     elif "response_amplitude" in ds and "member" in ds["response_amplitude"].dims:
