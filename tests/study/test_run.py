@@ -354,3 +354,41 @@ def test_a_worn_state_study_draws_the_members_worn_profiles(tmp_path, monkeypatc
         np.testing.assert_array_equal(lines[i].get_xdata(), own["contact_position"].values[:, 0])
         np.testing.assert_array_equal(lines[i].get_ydata(), w)
     assert ds["final_wear_depth"].attrs["units"] == "m"
+
+
+def test_a_cyclic_modes_study_draws_the_members_frequencies_per_nodal_diameter(tmp_path,
+                                                                               monkeypatch):
+    """Two cyclic-modes members of the test sector (8 sectors, 2 families; Young's modulus
+    1 and 4 x: every frequency doubles, sqrt(4)): study.nc holds each member's
+    cyclic_frequency equal bit for bit to its own results.nc (read back independently),
+    member 1's twice member 0's (to 1e-9: two eigensolves), and study-cyclic-frequencies.png
+    draws those curves against the nodal diameter, one colour per member."""
+    from helpers.cyclic import write_sector_case
+
+    from fretwear.study import figures
+
+    drawn = {}
+    save = figures._save
+    monkeypatch.setattr(figures, "_save",
+                        lambda fig, path: drawn.setdefault(path.name, fig) and save(fig, path))
+    base, _ = write_sector_case(tmp_path, 8, 3,
+                                analysis='[analysis]\ntype = "cyclic-modes"\nn_modes = 2\n')
+    assert "\nE = 2e11\n" in base.read_text()
+    path = study_file(tmp_path, "[grid]\nmaterial.E = [2e11, 8e11]\n", base=base.name)
+    out = tmp_path / "out"
+    members = _run_members_here(path, out)
+    res = run_study(path, out, collect=True, progress=False, echo=False)
+    ds = res.dataset
+    assert [p.name for p in res.figures] == ["study-cyclic-frequencies.png"]
+    lines = drawn["study-cyclic-frequencies.png"].axes[0].get_lines()
+    for i, m in enumerate(members):
+        own = xr.open_dataset(out / m.folder_name / RESULTS_FILE, engine="h5netcdf").load()
+        f = own["cyclic_frequency"].values
+        np.testing.assert_array_equal(ds["cyclic_frequency"].values[i], f)
+        for j in range(2):
+            np.testing.assert_array_equal(lines[2 * i + j].get_xdata(), [0, 1, 2, 3, 4])
+            np.testing.assert_array_equal(lines[2 * i + j].get_ydata(), f[:, j])
+        assert lines[2 * i].get_color() != lines[2 * (1 - i)].get_color()
+    np.testing.assert_allclose(ds["cyclic_frequency"].values[1],
+                               2 * ds["cyclic_frequency"].values[0], rtol=1e-9)
+    assert ds["cyclic_frequency"].attrs["units"] == "Hz"

@@ -15,7 +15,9 @@
 * nonlinear-modes studies: the natural frequency and the damping ratio against the modal
   amplitude, one curve per member (``study-backbones``);
 * worn-state studies: each member's final worn profile, labelled with the kind of worn
-  state it reached (``study-worn-profiles``).
+  state it reached (``study-worn-profiles``);
+* cyclic-modes studies: the natural frequencies against the nodal diameter, one colour per
+  member and one line style per family (``study-cyclic-frequencies``).
 
 Members of the other analysis types have no study figure (the summary says so; each member's
 own figures are in its folder).
@@ -348,6 +350,28 @@ def worn_profiles(ds, path: Path, varied: list[str]) -> Path:
     return _save(fig, path)
 
 
+def cyclic_frequencies(ds, path: Path, varied: list[str]) -> Path:
+    """Cyclic-modes members: the natural frequency against the nodal diameter, one colour per
+    member (labelled with its varied keys), one line style per family of modes."""
+    fn = ds["cyclic_frequency"]
+    nd = ds["nodal_diameter"].values if "nodal_diameter" in ds.coords else \
+        np.arange(fn.sizes["nodal_diameter"])
+    fig, ax = _figure(figsize=(7, 4.5))
+    for i in range(ds.sizes["member"]):
+        for m in range(fn.sizes["mode"]):
+            ax.plot(nd, fn.isel(member=i, mode=m).values, lw=1, marker="o", ms=3,
+                    color=f"C{i % 10}", ls=("-", "--", ":", "-.")[m % 4],
+                    label=_member_label(ds, i, varied) if m == 0 else None)
+    ax.set_xlabel("nodal diameter (line style: family of modes)")
+    ax.set_ylabel("natural frequency [Hz]")
+    ax.set_xticks(nd)
+    ax.set_title(ds.attrs.get("title", ""), fontsize=9)
+    if ds.sizes["member"] <= 12:
+        ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    return _save(fig, path)
+
+
 def study_figures(ds, outdir: Path, varied: list[str], fmt: str = "png") -> list[Path]:
     """Every figure that applies to the dataset; returns the files written."""
     out = []
@@ -360,6 +384,8 @@ def study_figures(ds, outdir: Path, varied: list[str], fmt: str = "png") -> list
         out.append(backbones(ds, outdir / f"study-backbones.{fmt}", varied))
     elif "member_worn_state_kind" in ds:
         out.append(worn_profiles(ds, outdir / f"study-worn-profiles.{fmt}", varied))
+    elif "cyclic_frequency" in ds and "member" in ds["cyclic_frequency"].dims:
+        out.append(cyclic_frequencies(ds, outdir / f"study-cyclic-frequencies.{fmt}", varied))
     elif PERIODIC_RESPONSE in ds and "member" in ds[PERIODIC_RESPONSE].dims:
         out.append(response_per_member(ds, outdir / f"study-response.{fmt}", varied))
     elif "response_amplitude" in ds and "member" in ds["response_amplitude"].dims:
