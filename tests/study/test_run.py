@@ -392,3 +392,68 @@ def test_a_cyclic_modes_study_draws_the_members_frequencies_per_nodal_diameter(t
     np.testing.assert_allclose(ds["cyclic_frequency"].values[1],
                                2 * ds["cyclic_frequency"].values[0], rtol=1e-9)
     assert ds["cyclic_frequency"].attrs["units"] == "Hz"
+
+
+def test_a_transient_study_gives_each_members_peak_and_rms_and_draws_them(tmp_path,
+                                                                          monkeypatch):
+    """Two transient members of the small beam (mu = 0.2, 0.3; 5 periods of 64 steps at
+    1.5 kHz): study.nc holds each member's displacement_peak and displacement_rms, computed
+    here from its own results.nc's displacement (read back independently: the largest
+    |u - mean| and the RMS of u - mean over the period, by hand), and study-response.png draws
+    harmonic 1, the peak and the RMS of the first point on its axis of largest response
+    against mu."""
+    from fretwear.study import figures
+
+    drawn = {}
+    save = figures._save
+    monkeypatch.setattr(figures, "_save",
+                        lambda fig, path: drawn.setdefault(path.name, fig) and save(fig, path))
+    base_case(tmp_path, '[analysis]\ntype = "transient"\nfrequency = 1500.0\nmode = "fixed"\n'
+              "n_periods = 5\nsteps_per_period = 64\nmax_periods = 20\n")
+    path = study_file(tmp_path, "[grid]\ncontact.mu = [0.2, 0.3]\n")
+    out = tmp_path / "out"
+    members = _run_members_here(path, out)
+    res = run_study(path, out, collect=True, progress=False, echo=False)
+    ds = res.dataset
+    assert [p.name for p in res.figures] == ["study-response.png"]
+    ax = drawn["study-response.png"].axes[0]
+    lines = {ln.get_label(): ln for ln in ax.get_lines()}
+    axis = int(np.argmax(ds["displacement_harmonic_amplitude"].values[0, 0, :, 0]))
+    for i, m in enumerate(members):
+        own = xr.open_dataset(out / m.folder_name / RESULTS_FILE, engine="h5netcdf").load()
+        u = own["displacement"].values  # (point, axis, tau)
+        dyn = u - u.mean(axis=-1, keepdims=True)
+        np.testing.assert_allclose(ds["displacement_peak"].values[i], np.abs(dyn).max(-1),
+                                   rtol=1e-12)
+        np.testing.assert_allclose(ds["displacement_rms"].values[i],
+                                   np.sqrt((dyn**2).mean(-1)), rtol=1e-12)
+        for label, name in (("harmonic 1", "displacement_harmonic_amplitude"),
+                            ("peak over the period (mean apart)", "displacement_peak"),
+                            ("RMS over the period (mean apart)", "displacement_rms")):
+            want = own[name].values[0, axis, 0] if name.endswith("amplitude") else \
+                ds[name].values[i, 0, axis]
+            assert lines[label].get_ydata()[i] == want
+    np.testing.assert_array_equal(lines["harmonic 1"].get_xdata(), [0.2, 0.3])
+    assert ds["displacement_peak"].attrs["units"] == "m"
+
+
+def test_an_incremental_wear_study_gives_the_wear_statistics_and_figures(tmp_path):
+    """Two incremental-wear members of the small beam (mu = 0.2, 0.3; 3 cycles of 16 steps):
+    its history has cycles, so study.nc holds the wear members' variables, each member's
+    final state equal bit for bit to the last step of its own results.nc (read back
+    independently), and the fan chart and the profile band are written."""
+    base_case(tmp_path, '[analysis]\ntype = "incremental-wear"\nn_cycles = 3\n'
+              "steps_per_cycle = 16\n")
+    path = study_file(tmp_path, "[grid]\ncontact.mu = [0.2, 0.3]\n")
+    out = tmp_path / "out"
+    members = _run_members_here(path, out)
+    res = run_study(path, out, collect=True, progress=False, echo=False)
+    ds = res.dataset
+    assert [p.name for p in res.figures] == ["study-worn-volume.png", "study-wear-profiles.png"]
+    for i, m in enumerate(members):
+        own = xr.open_dataset(out / m.folder_name / RESULTS_FILE, engine="h5netcdf").load()
+        np.testing.assert_array_equal(ds["final_wear_depth"].values[i],
+                                      own["wear_depth"].values[-1])
+        assert ds["final_worn_volume"].values[i] == own["worn_volume"].values[-1] > 0
+        assert ds["final_cycles"].values[i] == own["cycles"].values[-1] == 3
+        assert ds["worn_volume_on_cycles"].values[i, -1] == own["worn_volume"].values[-1]

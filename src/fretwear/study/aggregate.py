@@ -19,6 +19,8 @@ solve is never a result). Two kinds get more:
 * worn-state members: each member's final worn profile, worn volume and maximum depth (the
   names of the wear members' final state), why it stopped and the kind of worn state it
   reached (``member_worn_state_kind``);
+* transient (and periodic) members: the peak and RMS of each observed displacement less its
+  mean over the (last) period (``displacement_peak``, ``displacement_rms``);
 * mistuned disks (``[cyclic.mistuning]``): each member's blade responses and amplification
   factor against Whitehead's bound (:mod:`fretwear.study.mistuning`).
 
@@ -427,6 +429,26 @@ def _worn_states(members: list[Member], done: dict) -> dict:
     }
 
 
+def _transient_peaks(stacked: dict) -> dict:
+    """Transient (and periodic) members: the peak and the RMS over the (last) period of each
+    observed displacement less its mean over the period (``displacement_peak``,
+    ``displacement_rms``), which a response that is not periodic (subharmonic,
+    quasi-periodic, irregular) has as well as a harmonic amplitude."""
+    if "displacement" not in stacked or stacked["displacement"][0][-1] != "tau":
+        return {}
+    dims, arr, attrs = stacked["displacement"]
+    with np.errstate(all="ignore"), _quiet():
+        dyn = arr - np.nanmean(arr, axis=-1, keepdims=True)  # the static offset apart
+        peak = np.nanmax(np.abs(dyn), axis=-1)
+        rms = np.sqrt(np.nanmean(dyn**2, axis=-1))
+    unit = attrs.get("units", "m")
+    over = "over the period (transient: the last period), its mean over it subtracted"
+    return {"displacement_peak": (dims[:-1], peak, {"units": unit, "long_name": "largest "
+                                  f"|displacement| of the observed point {over}"}),
+            "displacement_rms": (dims[:-1], rms, {"units": unit, "long_name": "RMS of the "
+                                 f"displacement of the observed point {over}"})}
+
+
 def aggregate(study, members: list[Member], records: list[MemberRecord], outdir) -> xr.Dataset:
     """The study's dataset (see the module docstring)."""
     done = _open(outdir, members, records)
@@ -455,6 +477,7 @@ def aggregate(study, members: list[Member], records: list[MemberRecord], outdir)
         data.update(_peaks(stacked, coords))
         data.update(_backbone_amplitudes(members, done, stacked))
         data.update(_worn_states(members, done))
+        data.update(_transient_peaks(stacked))
     amp_data, amp_attrs = amplification(members, done)
     data.update(amp_data)
     ds = xr.Dataset(data, coords=coords)

@@ -1,14 +1,14 @@
 """The figures of a study, drawn from ``study.nc`` alone (so they can be redrawn):
 
-* wear studies: a fan chart of the worn volume against cycles (the 5-95 % band, the median,
-  the mean and every member thin) and the band of worn profiles at the last cycle every
-  member reached;
+* wear (and incremental-wear) studies: a fan chart of the worn volume against cycles (the
+  5-95 % band, the median, the mean and every member thin) and the band of worn profiles at
+  the last cycle every member reached;
 * sweep studies: the family of FRFs (one curve per member, labelled with its varied keys)
   and their envelope; a split sweep: the joined FRF with the joins marked; a study of the
   excitation level alone (``analysis.excitation_scale``): the FRFs divided by the level on
   one axis and the peak amplitude and frequency against the level;
-* periodic studies: the response amplitude of each member against the first varied numeric
-  key;
+* periodic and transient studies: the response amplitude of each member (harmonic 1, the
+  peak and the RMS over the period) against the first varied numeric key;
 * linear FRF studies (``frf``): one FRF per member and interface (first observed point, on
   its axis of largest response);
 * modes studies (``modes``): the natural frequencies against the first varied numeric key;
@@ -19,8 +19,9 @@
 * cyclic-modes studies: the natural frequencies against the nodal diameter, one colour per
   member and one line style per family (``study-cyclic-frequencies``).
 
-Members of the other analysis types have no study figure (the summary says so; each member's
-own figures are in its folder).
+Incremental-wear members get the wear figures (their history has cycles). Members whose
+results hold none of these variables with the same shape in every member get no study figure
+(the summary says so; each member's own figures are in its folder).
 """
 
 from __future__ import annotations
@@ -217,9 +218,10 @@ def _numeric_key(ds, varied: list[str]):
 
 def response_per_member(ds, path: Path, varied: list[str]) -> Path:
     """Members without a frequency axis (periodic or transient responses): the amplitude of
-    harmonic 1 of
-    the first observed point (on its axis of largest response) against the first varied numeric
-    key (the member number when none), one marker per member."""
+    harmonic 1 of the first observed point (on its axis of largest response) against the first
+    varied numeric key (the member number when none), one marker per member; with
+    ``displacement_peak`` in the dataset, the peak and RMS of that displacement over the
+    period beside it."""
     amp = ds[PERIODIC_RESPONSE]
     sel = {d: 0 for d in ("point", "harmonic") if d in amp.dims}
     amp = amp.isel(sel)
@@ -233,14 +235,24 @@ def response_per_member(ds, path: Path, varied: list[str]) -> Path:
         y = y[:, a]
         label += f" {str(ds['axis'].values[a])}"
     else:
-        y = y[:, 0]
+        a, y = 0, y[:, 0]
     key = _numeric_key(ds, varied)
     x = ds[key].values if key else ds["member"].values
     fig, ax = _figure(figsize=(7, 4.5))
     order = np.argsort(x, kind="stable")
-    ax.plot(x[order], y[order], marker="o", lw=0.8)
+    if "displacement_peak" not in ds:
+        ax.plot(x[order], y[order], marker="o", lw=0.8)
+        ax.set_ylabel(f"amplitude {label.strip()} (harmonic 1) [m]")
+    else:  # the peak and RMS over the period: a response that is not periodic has them too
+        sel = {"point": 0, "axis": a} if "axis" in amp.dims else {"point": 0}
+        ax.plot(x[order], y[order], marker="o", lw=0.8, label="harmonic 1")
+        for name, what in (("displacement_peak", "peak"), ("displacement_rms", "RMS")):
+            v = ds[name].isel({d: i for d, i in sel.items() if d in ds[name].dims}).values
+            ax.plot(x[order], v[order], marker="s" if what == "peak" else "^", lw=0.8,
+                    label=f"{what} over the period (mean apart)")
+        ax.set_ylabel(f"displacement {label.strip()} [m]")
+        ax.legend(fontsize=7)
     ax.set_xlabel(key or "member")
-    ax.set_ylabel(f"amplitude {label.strip()} (harmonic 1) [m]")
     ax.set_title(ds.attrs.get("title", ""), fontsize=9)
     ax.grid(alpha=0.3)
     return _save(fig, path)
