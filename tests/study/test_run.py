@@ -271,3 +271,189 @@ def test_a_study_whose_members_have_no_study_figure_says_so(tmp_path):
     res = run_study(path, out, collect=True, progress=False, echo=False)
     assert res.success and res.figures == []
     assert res.message.splitlines()[-1].startswith("figures: none for the study")
+
+
+def test_a_nonlinear_modes_study_draws_the_members_backbones(tmp_path, monkeypatch):
+    """Two nonlinear-modes members of the shipped Jenkins oscillator (mu = 0.2, 0.3; 4
+    amplitudes, 64 samples: a second of CPU): study.nc holds each member's backbone_frequency,
+    damping_ratio and modal amplitudes equal bit for bit to its own results.nc (read back
+    independently), and study-backbones.png draws exactly those curves, one per member
+    labelled with its mu (read back from the figure's lines). Before, such a study stopped
+    with a KeyError (its response_amplitude has no frequency axis)."""
+    import shutil
+
+    from fretwear.study import figures
+
+    drawn = {}
+    save = figures._save
+    monkeypatch.setattr(figures, "_save",
+                        lambda fig, path: drawn.setdefault(path.name, fig) and save(fig, path))
+    for name in ("jenkins-nonlinear-modes.toml", "jenkins-K.mtx", "jenkins-M.mtx"):
+        shutil.copy(EXAMPLES_DIR / name, tmp_path / name)
+    case = tmp_path / "jenkins-nonlinear-modes.toml"
+    case.write_text(case.read_text().replace("n_amplitudes = 30", "n_amplitudes = 4")
+                    .replace("n_samples = 1024", "n_samples = 64")
+                    + "\n[output]\nvtu = false\nfigures = false\n")
+    path = study_file(tmp_path, "[grid]\ncontact.mu = [0.2, 0.3]\n",
+                      base="jenkins-nonlinear-modes.toml")
+    out = tmp_path / "out"
+    members = _run_members_here(path, out)
+    res = run_study(path, out, collect=True, progress=False, echo=False)
+    ds = res.dataset
+    assert [p.name for p in res.figures] == ["study-backbones.png"]
+    assert ds["member_modal_amplitude"].attrs["units"] == "m kg^0.5"
+    fig = drawn["study-backbones.png"]
+    for i, m in enumerate(members):
+        own = xr.open_dataset(out / m.folder_name / RESULTS_FILE, engine="h5netcdf").load()
+        a = own["modal_amplitude"].values
+        np.testing.assert_array_equal(ds["member_modal_amplitude"].values[i], a)
+        for ax, name in zip(fig.axes, ("backbone_frequency", "damping_ratio"), strict=True):
+            np.testing.assert_array_equal(ds[name].values[i], own[name].values)
+            line = ax.get_lines()[i]
+            assert line.get_label() == f"contact.mu = {(0.2, 0.3)[i]:.3g}"
+            np.testing.assert_array_equal(line.get_xdata(), a)
+            np.testing.assert_array_equal(line.get_ydata(), own[name].values)
+    assert fig.axes[1].get_xlabel() == "modal amplitude [m kg^0.5]"
+
+
+def test_a_worn_state_study_draws_the_members_worn_profiles(tmp_path, monkeypatch):
+    """Two worn-state members of the wear tests' beam block (mu = 0.3, 0.4; 3 harmonics, 32
+    samples, residual 1e-2): study.nc holds each member's final worn profile, worn volume,
+    maximum depth, stop reason and kind of worn state equal to the last step and attributes
+    of its own results.nc (read back independently), and study-worn-profiles.png draws those
+    profiles against x, one per member labelled with its mu and its kind."""
+    from helpers.cases import WEAR_BLOCK
+
+    from fretwear.study import figures
+
+    drawn = {}
+    save = figures._save
+    monkeypatch.setattr(figures, "_save",
+                        lambda fig, path: drawn.setdefault(path.name, fig) and save(fig, path))
+    (tmp_path / "w.toml").write_text(
+        f'title = "worn state"\n{WEAR_BLOCK}[analysis]\ntype = "worn-state"\n'
+        "quasi_static = true\nharmonics = 3\nn_samples = 32\ncheckpoint_every_s = 0.0\n"
+        "residual_tolerance = 1e-2\n[output]\nvtu = false\nfigures = false\n")
+    path = study_file(tmp_path, "[grid]\ncontact.mu = [0.3, 0.4]\n", base="w.toml")
+    out = tmp_path / "out"
+    members = _run_members_here(path, out)
+    res = run_study(path, out, collect=True, progress=False, echo=False)
+    ds = res.dataset
+    assert [p.name for p in res.figures] == ["study-worn-profiles.png"]
+    lines = drawn["study-worn-profiles.png"].axes[0].get_lines()
+    for i, m in enumerate(members):
+        own = xr.open_dataset(out / m.folder_name / RESULTS_FILE, engine="h5netcdf").load()
+        w = own["wear_depth"].values[-1]
+        np.testing.assert_array_equal(ds["final_wear_depth"].values[i], w)
+        assert ds["final_max_wear_depth"].values[i] == w.max() > 0
+        assert ds["final_worn_volume"].values[i] == own["worn_volume"].values[-1]
+        kind = own.attrs["worn_state_kind"]
+        assert ds["member_worn_state_kind"].values[i] == kind
+        assert ds["member_stop_reason"].values[i] == own.attrs["stop_reason"]
+        assert lines[i].get_label() == f"contact.mu = {(0.3, 0.4)[i]:.3g} ({kind})"
+        np.testing.assert_array_equal(lines[i].get_xdata(), own["contact_position"].values[:, 0])
+        np.testing.assert_array_equal(lines[i].get_ydata(), w)
+    assert ds["final_wear_depth"].attrs["units"] == "m"
+
+
+def test_a_cyclic_modes_study_draws_the_members_frequencies_per_nodal_diameter(tmp_path,
+                                                                               monkeypatch):
+    """Two cyclic-modes members of the test sector (8 sectors, 2 families; Young's modulus
+    1 and 4 x: every frequency doubles, sqrt(4)): study.nc holds each member's
+    cyclic_frequency equal bit for bit to its own results.nc (read back independently),
+    member 1's twice member 0's (to 1e-9: two eigensolves), and study-cyclic-frequencies.png
+    draws those curves against the nodal diameter, one colour per member."""
+    from helpers.cyclic import write_sector_case
+
+    from fretwear.study import figures
+
+    drawn = {}
+    save = figures._save
+    monkeypatch.setattr(figures, "_save",
+                        lambda fig, path: drawn.setdefault(path.name, fig) and save(fig, path))
+    base, _ = write_sector_case(tmp_path, 8, 3,
+                                analysis='[analysis]\ntype = "cyclic-modes"\nn_modes = 2\n')
+    assert "\nE = 2e11\n" in base.read_text()
+    path = study_file(tmp_path, "[grid]\nmaterial.E = [2e11, 8e11]\n", base=base.name)
+    out = tmp_path / "out"
+    members = _run_members_here(path, out)
+    res = run_study(path, out, collect=True, progress=False, echo=False)
+    ds = res.dataset
+    assert [p.name for p in res.figures] == ["study-cyclic-frequencies.png"]
+    lines = drawn["study-cyclic-frequencies.png"].axes[0].get_lines()
+    for i, m in enumerate(members):
+        own = xr.open_dataset(out / m.folder_name / RESULTS_FILE, engine="h5netcdf").load()
+        f = own["cyclic_frequency"].values
+        np.testing.assert_array_equal(ds["cyclic_frequency"].values[i], f)
+        for j in range(2):
+            np.testing.assert_array_equal(lines[2 * i + j].get_xdata(), [0, 1, 2, 3, 4])
+            np.testing.assert_array_equal(lines[2 * i + j].get_ydata(), f[:, j])
+        assert lines[2 * i].get_color() != lines[2 * (1 - i)].get_color()
+    np.testing.assert_allclose(ds["cyclic_frequency"].values[1],
+                               2 * ds["cyclic_frequency"].values[0], rtol=1e-9)
+    assert ds["cyclic_frequency"].attrs["units"] == "Hz"
+
+
+def test_a_transient_study_gives_each_members_peak_and_rms_and_draws_them(tmp_path,
+                                                                          monkeypatch):
+    """Two transient members of the small beam (mu = 0.2, 0.3; 5 periods of 64 steps at
+    1.5 kHz): study.nc holds each member's displacement_peak and displacement_rms, computed
+    here from its own results.nc's displacement (read back independently: the largest
+    |u - mean| and the RMS of u - mean over the period, by hand), and study-response.png draws
+    harmonic 1, the peak and the RMS of the first point on its axis of largest response
+    against mu."""
+    from fretwear.study import figures
+
+    drawn = {}
+    save = figures._save
+    monkeypatch.setattr(figures, "_save",
+                        lambda fig, path: drawn.setdefault(path.name, fig) and save(fig, path))
+    base_case(tmp_path, '[analysis]\ntype = "transient"\nfrequency = 1500.0\nmode = "fixed"\n'
+              "n_periods = 5\nsteps_per_period = 64\nmax_periods = 20\n")
+    path = study_file(tmp_path, "[grid]\ncontact.mu = [0.2, 0.3]\n")
+    out = tmp_path / "out"
+    members = _run_members_here(path, out)
+    res = run_study(path, out, collect=True, progress=False, echo=False)
+    ds = res.dataset
+    assert [p.name for p in res.figures] == ["study-response.png"]
+    ax = drawn["study-response.png"].axes[0]
+    lines = {ln.get_label(): ln for ln in ax.get_lines()}
+    axis = int(np.argmax(ds["displacement_harmonic_amplitude"].values[0, 0, :, 0]))
+    for i, m in enumerate(members):
+        own = xr.open_dataset(out / m.folder_name / RESULTS_FILE, engine="h5netcdf").load()
+        u = own["displacement"].values  # (point, axis, tau)
+        dyn = u - u.mean(axis=-1, keepdims=True)
+        np.testing.assert_allclose(ds["displacement_peak"].values[i], np.abs(dyn).max(-1),
+                                   rtol=1e-12)
+        np.testing.assert_allclose(ds["displacement_rms"].values[i],
+                                   np.sqrt((dyn**2).mean(-1)), rtol=1e-12)
+        for label, name in (("harmonic 1", "displacement_harmonic_amplitude"),
+                            ("peak over the period (mean apart)", "displacement_peak"),
+                            ("RMS over the period (mean apart)", "displacement_rms")):
+            want = own[name].values[0, axis, 0] if name.endswith("amplitude") else \
+                ds[name].values[i, 0, axis]
+            assert lines[label].get_ydata()[i] == want
+    np.testing.assert_array_equal(lines["harmonic 1"].get_xdata(), [0.2, 0.3])
+    assert ds["displacement_peak"].attrs["units"] == "m"
+
+
+def test_an_incremental_wear_study_gives_the_wear_statistics_and_figures(tmp_path):
+    """Two incremental-wear members of the small beam (mu = 0.2, 0.3; 3 cycles of 16 steps):
+    its history has cycles, so study.nc holds the wear members' variables, each member's
+    final state equal bit for bit to the last step of its own results.nc (read back
+    independently), and the fan chart and the profile band are written."""
+    base_case(tmp_path, '[analysis]\ntype = "incremental-wear"\nn_cycles = 3\n'
+              "steps_per_cycle = 16\n")
+    path = study_file(tmp_path, "[grid]\ncontact.mu = [0.2, 0.3]\n")
+    out = tmp_path / "out"
+    members = _run_members_here(path, out)
+    res = run_study(path, out, collect=True, progress=False, echo=False)
+    ds = res.dataset
+    assert [p.name for p in res.figures] == ["study-worn-volume.png", "study-wear-profiles.png"]
+    for i, m in enumerate(members):
+        own = xr.open_dataset(out / m.folder_name / RESULTS_FILE, engine="h5netcdf").load()
+        np.testing.assert_array_equal(ds["final_wear_depth"].values[i],
+                                      own["wear_depth"].values[-1])
+        assert ds["final_worn_volume"].values[i] == own["worn_volume"].values[-1] > 0
+        assert ds["final_cycles"].values[i] == own["cycles"].values[-1] == 3
+        assert ds["worn_volume_on_cycles"].values[i, -1] == own["worn_volume"].values[-1]

@@ -14,6 +14,13 @@ solve is never a result). Two kinds get more:
   family of FRFs over the excitation level, ``analysis.excitation_scale``, the curves a
   joint engineer reads first); for a split sweep (:mod:`fretwear.study.sweep_split`) the
   chunks joined into one sweep instead;
+* nonlinear-modes members: each member's own modal amplitudes (``member_modal_amplitude``),
+  the abscissa of its stacked ``backbone_frequency`` and ``damping_ratio``;
+* worn-state members: each member's final worn profile, worn volume and maximum depth (the
+  names of the wear members' final state), why it stopped and the kind of worn state it
+  reached (``member_worn_state_kind``);
+* transient (and periodic) members: the peak and RMS of each observed displacement less its
+  mean over the (last) period (``displacement_peak``, ``displacement_rms``);
 * mistuned disks (``[cyclic.mistuning]``): each member's blade responses and amplification
   factor against Whitehead's bound (:mod:`fretwear.study.mistuning`).
 
@@ -366,6 +373,82 @@ def _own_variables(members: list[Member], own: dict) -> dict:
     }
 
 
+def _backbone_amplitudes(members: list[Member], done: dict, stacked: dict) -> dict:
+    """Nonlinear-modes members: each member's own modal amplitudes
+    (``member_modal_amplitude``), the abscissa of its backbone and damping curve (the
+    stacked ``backbone_frequency`` and ``damping_ratio``), whether or not the members' grids
+    of amplitude agree."""
+    if "backbone_frequency" not in stacked:
+        return {}
+    n = stacked["backbone_frequency"][1].shape[1]
+    amp = np.full((len(members), n), np.nan)
+    attrs = {}
+    for i, m in enumerate(members):
+        if m.index in done and "modal_amplitude" in done[m.index].coords:
+            amp[i] = done[m.index]["modal_amplitude"].values
+            attrs = dict(done[m.index]["modal_amplitude"].attrs)
+    return {"member_modal_amplitude": (("member", "modal_amplitude"), amp, {
+        "units": attrs.get("units", "m kg^0.5"),
+        "long_name": "the member's modal amplitudes (abscissa of its backbone_frequency "
+                     "and damping_ratio)"})}
+
+
+def _worn_states(members: list[Member], done: dict) -> dict:
+    """Worn-state members (their results have ``worn_state_kind``): each member's worn
+    profile, worn volume and maximum depth at its last pseudo-time step (the worn state when
+    it was reached), what kind of state it reached and why it stopped."""
+    have = {k: ds for k, ds in done.items() if "worn_state_kind" in ds.attrs}
+    if not have:
+        return {}
+    nc = max(ds.sizes["contact_node"] for ds in have.values())
+    vol, depth = np.full(len(members), np.nan), np.full(len(members), np.nan)
+    prof = np.full((len(members), nc), np.nan)
+    for i, m in enumerate(members):
+        ds = have.get(m.index)
+        if ds is not None:
+            w = ds["wear_depth"].values[-1]
+            prof[i, : w.size], depth[i] = w, w.max()
+            vol[i] = ds["worn_volume"].values[-1]
+
+    def attr(name):
+        return np.array([str(have[m.index].attrs.get(name, "")) if m.index in have else ""
+                         for m in members])
+
+    return {
+        "final_worn_volume": ("member", vol, {"units": "m^3", "long_name": "final worn volume"}),
+        "final_max_wear_depth": ("member", depth,
+                                 {"units": "m", "long_name": "final maximum wear depth"}),
+        "final_wear_depth": (("member", "contact_node"), prof,
+                             {"units": "m", "long_name": "final worn profile"}),
+        "member_stop_reason": ("member", attr("stop_reason"),
+                               {"long_name": "why the wear run stopped"}),
+        "member_worn_state_kind": ("member", attr("worn_state_kind"),
+                                   {"long_name": "the worn state the member reached "
+                                    "(null_wear_rate, steady_wear, no_wear or "
+                                    "not_reached)"}),
+    }
+
+
+def _transient_peaks(stacked: dict) -> dict:
+    """Transient (and periodic) members: the peak and the RMS over the (last) period of each
+    observed displacement less its mean over the period (``displacement_peak``,
+    ``displacement_rms``), which a response that is not periodic (subharmonic,
+    quasi-periodic, irregular) has as well as a harmonic amplitude."""
+    if "displacement" not in stacked or stacked["displacement"][0][-1] != "tau":
+        return {}
+    dims, arr, attrs = stacked["displacement"]
+    with np.errstate(all="ignore"), _quiet():
+        dyn = arr - np.nanmean(arr, axis=-1, keepdims=True)  # the static offset apart
+        peak = np.nanmax(np.abs(dyn), axis=-1)
+        rms = np.sqrt(np.nanmean(dyn**2, axis=-1))
+    unit = attrs.get("units", "m")
+    over = "over the period (transient: the last period), its mean over it subtracted"
+    return {"displacement_peak": (dims[:-1], peak, {"units": unit, "long_name": "largest "
+                                  f"|displacement| of the observed point {over}"}),
+            "displacement_rms": (dims[:-1], rms, {"units": unit, "long_name": "RMS of the "
+                                 f"displacement of the observed point {over}"})}
+
+
 def aggregate(study, members: list[Member], records: list[MemberRecord], outdir) -> xr.Dataset:
     """The study's dataset (see the module docstring)."""
     done = _open(outdir, members, records)
@@ -392,6 +475,9 @@ def aggregate(study, members: list[Member], records: list[MemberRecord], outdir)
         data.update(_frf_band(stacked))
         data.update(_own_variables(members, own))
         data.update(_peaks(stacked, coords))
+        data.update(_backbone_amplitudes(members, done, stacked))
+        data.update(_worn_states(members, done))
+        data.update(_transient_peaks(stacked))
     amp_data, amp_attrs = amplification(members, done)
     data.update(amp_data)
     ds = xr.Dataset(data, coords=coords)

@@ -1,20 +1,27 @@
 """The figures of a study, drawn from ``study.nc`` alone (so they can be redrawn):
 
-* wear studies: a fan chart of the worn volume against cycles (the 5-95 % band, the median,
-  the mean and every member thin) and the band of worn profiles at the last cycle every
-  member reached;
+* wear (and incremental-wear) studies: a fan chart of the worn volume against cycles (the
+  5-95 % band, the median, the mean and every member thin) and the band of worn profiles at
+  the last cycle every member reached;
 * sweep studies: the family of FRFs (one curve per member, labelled with its varied keys)
   and their envelope; a split sweep: the joined FRF with the joins marked; a study of the
   excitation level alone (``analysis.excitation_scale``): the FRFs divided by the level on
   one axis and the peak amplitude and frequency against the level;
-* periodic studies: the response amplitude of each member against the first varied numeric
-  key;
+* periodic and transient studies: the response amplitude of each member (harmonic 1, the
+  peak and the RMS over the period) against the first varied numeric key;
 * linear FRF studies (``frf``): one FRF per member and interface (first observed point, on
   its axis of largest response);
-* modes studies (``modes``): the natural frequencies against the first varied numeric key.
+* modes studies (``modes``): the natural frequencies against the first varied numeric key;
+* nonlinear-modes studies: the natural frequency and the damping ratio against the modal
+  amplitude, one curve per member (``study-backbones``);
+* worn-state studies: each member's final worn profile, labelled with the kind of worn
+  state it reached (``study-worn-profiles``);
+* cyclic-modes studies: the natural frequencies against the nodal diameter, one colour per
+  member and one line style per family (``study-cyclic-frequencies``).
 
-Members of the other analysis types have no study figure (the summary says so; each member's
-own figures are in its folder).
+Incremental-wear members get the wear figures (their history has cycles). Members whose
+results hold none of these variables with the same shape in every member get no study figure
+(the summary says so; each member's own figures are in its folder).
 """
 
 from __future__ import annotations
@@ -211,9 +218,10 @@ def _numeric_key(ds, varied: list[str]):
 
 def response_per_member(ds, path: Path, varied: list[str]) -> Path:
     """Members without a frequency axis (periodic or transient responses): the amplitude of
-    harmonic 1 of
-    the first observed point (on its axis of largest response) against the first varied numeric
-    key (the member number when none), one marker per member."""
+    harmonic 1 of the first observed point (on its axis of largest response) against the first
+    varied numeric key (the member number when none), one marker per member; with
+    ``displacement_peak`` in the dataset, the peak and RMS of that displacement over the
+    period beside it."""
     amp = ds[PERIODIC_RESPONSE]
     sel = {d: 0 for d in ("point", "harmonic") if d in amp.dims}
     amp = amp.isel(sel)
@@ -227,14 +235,24 @@ def response_per_member(ds, path: Path, varied: list[str]) -> Path:
         y = y[:, a]
         label += f" {str(ds['axis'].values[a])}"
     else:
-        y = y[:, 0]
+        a, y = 0, y[:, 0]
     key = _numeric_key(ds, varied)
     x = ds[key].values if key else ds["member"].values
     fig, ax = _figure(figsize=(7, 4.5))
     order = np.argsort(x, kind="stable")
-    ax.plot(x[order], y[order], marker="o", lw=0.8)
+    if "displacement_peak" not in ds:
+        ax.plot(x[order], y[order], marker="o", lw=0.8)
+        ax.set_ylabel(f"amplitude {label.strip()} (harmonic 1) [m]")
+    else:  # the peak and RMS over the period: a response that is not periodic has them too
+        sel = {"point": 0, "axis": a} if "axis" in amp.dims else {"point": 0}
+        ax.plot(x[order], y[order], marker="o", lw=0.8, label="harmonic 1")
+        for name, what in (("displacement_peak", "peak"), ("displacement_rms", "RMS")):
+            v = ds[name].isel({d: i for d, i in sel.items() if d in ds[name].dims}).values
+            ax.plot(x[order], v[order], marker="s" if what == "peak" else "^", lw=0.8,
+                    label=f"{what} over the period (mean apart)")
+        ax.set_ylabel(f"displacement {label.strip()} [m]")
+        ax.legend(fontsize=7)
     ax.set_xlabel(key or "member")
-    ax.set_ylabel(f"amplitude {label.strip()} (harmonic 1) [m]")
     ax.set_title(ds.attrs.get("title", ""), fontsize=9)
     ax.grid(alpha=0.3)
     return _save(fig, path)
@@ -300,6 +318,72 @@ def natural_frequencies(ds, path: Path, varied: list[str]) -> Path:
     return _save(fig, path)
 
 
+def backbones(ds, path: Path, varied: list[str]) -> Path:
+    """Nonlinear-modes members: the natural frequency and the damping ratio against the
+    modal amplitude (log x), one curve per member labelled with its varied keys."""
+    a = ds["member_modal_amplitude"].values
+    unit = ds["member_modal_amplitude"].attrs.get("units", "m kg^0.5")
+    fig, axes = _figure(2, 1, figsize=(7, 6.5), sharex=True)
+    for i in range(ds.sizes["member"]):
+        style = {"lw": 1, "marker": ".", "ms": 3, "color": f"C{i % 10}",
+                 "label": _member_label(ds, i, varied)}
+        axes[0].plot(a[i], ds["backbone_frequency"].values[i], **style)
+        axes[1].plot(a[i], ds["damping_ratio"].values[i], **style)
+    axes[0].set_ylabel("natural frequency [Hz]")
+    axes[1].set_ylabel("damping ratio [-]")
+    axes[1].set_xlabel(f"modal amplitude [{unit}]")
+    for ax in axes:
+        ax.set_xscale("log")
+        ax.grid(alpha=0.3, which="both")
+    if ds.sizes["member"] <= 12:
+        axes[0].legend(fontsize=7)
+    axes[0].set_title(ds.attrs.get("title", ""), fontsize=9)
+    return _save(fig, path)
+
+
+def worn_profiles(ds, path: Path, varied: list[str]) -> Path:
+    """Worn-state members: each member's final worn profile (its worn state when reached;
+    dashed when not), labelled with its varied keys and the kind of state it reached."""
+    fig, ax = _figure(figsize=(7, 4.5))
+    for i in range(ds.sizes["member"]):
+        x = ds["contact_position"].values[i, :, 0] if "contact_position" in ds else \
+            np.arange(ds.sizes["contact_node"])
+        kind = str(ds["member_worn_state_kind"].values[i])
+        w = ds["final_wear_depth"].values[i]
+        ax.plot(x[: w.size], w, lw=1, marker=".", ms=3, color=f"C{i % 10}",
+                ls="--" if kind == "not_reached" else "-",
+                label=f"{_member_label(ds, i, varied)} ({kind or 'failed'})")
+    ax.set_xlabel("x [m]" if "contact_position" in ds else "contact node")
+    ax.set_ylabel("wear depth [m]")
+    ax.set_title(ds.attrs.get("title", ""), fontsize=9)
+    if ds.sizes["member"] <= 12:
+        ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    return _save(fig, path)
+
+
+def cyclic_frequencies(ds, path: Path, varied: list[str]) -> Path:
+    """Cyclic-modes members: the natural frequency against the nodal diameter, one colour per
+    member (labelled with its varied keys), one line style per family of modes."""
+    fn = ds["cyclic_frequency"]
+    nd = ds["nodal_diameter"].values if "nodal_diameter" in ds.coords else \
+        np.arange(fn.sizes["nodal_diameter"])
+    fig, ax = _figure(figsize=(7, 4.5))
+    for i in range(ds.sizes["member"]):
+        for m in range(fn.sizes["mode"]):
+            ax.plot(nd, fn.isel(member=i, mode=m).values, lw=1, marker="o", ms=3,
+                    color=f"C{i % 10}", ls=("-", "--", ":", "-.")[m % 4],
+                    label=_member_label(ds, i, varied) if m == 0 else None)
+    ax.set_xlabel("nodal diameter (line style: family of modes)")
+    ax.set_ylabel("natural frequency [Hz]")
+    ax.set_xticks(nd)
+    ax.set_title(ds.attrs.get("title", ""), fontsize=9)
+    if ds.sizes["member"] <= 12:
+        ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    return _save(fig, path)
+
+
 def study_figures(ds, outdir: Path, varied: list[str], fmt: str = "png") -> list[Path]:
     """Every figure that applies to the dataset; returns the files written."""
     out = []
@@ -308,6 +392,12 @@ def study_figures(ds, outdir: Path, varied: list[str], fmt: str = "png") -> list
     elif "worn_volume_on_cycles" in ds:
         out.append(fan_chart(ds, outdir / f"study-worn-volume.{fmt}"))
         out.append(profile_band(ds, outdir / f"study-wear-profiles.{fmt}"))
+    elif "member_modal_amplitude" in ds and "backbone_frequency" in ds:
+        out.append(backbones(ds, outdir / f"study-backbones.{fmt}", varied))
+    elif "member_worn_state_kind" in ds:
+        out.append(worn_profiles(ds, outdir / f"study-worn-profiles.{fmt}", varied))
+    elif "cyclic_frequency" in ds and "member" in ds["cyclic_frequency"].dims:
+        out.append(cyclic_frequencies(ds, outdir / f"study-cyclic-frequencies.{fmt}", varied))
     elif PERIODIC_RESPONSE in ds and "member" in ds[PERIODIC_RESPONSE].dims:
         out.append(response_per_member(ds, outdir / f"study-response.{fmt}", varied))
     elif "response_amplitude" in ds and "member" in ds["response_amplitude"].dims:

@@ -194,9 +194,9 @@ def run_study(path, outdir=None, *, scheduler=None, workers: int | None = None,
             k for m in members for k in m.values)))
     ok, message = _summary(study, records, ds)
     if study.output["figures"] and not figures and any(r.status == "ok" for r in records):
-        message += ("\nfigures: none for the study (its members' results have no study "
-                    "figure: sweep, wear, periodic, frf and modes members do); each member's "
-                    "own figures are in its folder")
+        message += ("\nfigures: none for the study (its members' results hold none of the "
+                    "variables a study figure draws, or not with the same shape in every "
+                    "member); each member's own figures are in its folder")
     say(message)
     say(f"results: {results}  ({report.seconds:.1f} s)")
     for p in figures:
