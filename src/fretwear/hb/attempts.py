@@ -426,19 +426,12 @@ def go_on(prob: DLFTProblem, U, st: SolveStats, options: SolveOptions):
     stopped for another reason, is returned as it is. The statistics add up both runs."""
     if st.success or st.iterations < options.max_iter:
         return U, st
-
-    def fun(x, jac=True):
-        return prob.residual(x.reshape(prob.m, prob.H), jac)
-
-    t0 = time.perf_counter()
-    x, _, st2 = solve(fun, np.asarray(U, float).reshape(-1),
-                      lambda x: prob.scale(x.reshape(prob.m, prob.H)), method=options.solver,
-                      tol=options.tol, max_iter=STEP_MORE_ITER * options.max_iter,
-                      max_slow=STEP_MAX_SLOW)
+    x, st2 = run(prob, U, options.replace(max_iter=STEP_MORE_ITER * options.max_iter),
+                 max_slow=STEP_MAX_SLOW)
     merged = SolveStats(st2.success, st2.residual, st.iterations + st2.iterations,
                         st.nfev + st2.nfev, st.njev + st2.njev,
-                        st.wall_time + time.perf_counter() - t0, st2.message, st2.solver)
-    return x.reshape(prob.m, prob.H), merged
+                        st.wall_time + st2.wall_time, st2.message, st2.solver)
+    return x, merged
 
 
 def grid(p: Point) -> bool:

@@ -15,10 +15,11 @@ from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.solvers import solve
 
 
-def run(prob: DLFTProblem, x0, options: SolveOptions):
+def run(prob: DLFTProblem, x0, options: SolveOptions, max_slow: int | None = None):
     """One run of ``options.solver`` on ``prob`` from ``x0`` (m, H) to ``options.tol`` in at
     most ``options.max_iter`` iterations: ``(x (m, H), stats)`` (converged or the last
-    iterate; ``stats.wall_time`` the whole run's)."""
+    iterate; ``stats.wall_time`` the whole run's). ``max_slow``: the solver's progress test
+    (:func:`fretwear.hb.solvers.solve`; None: none)."""
 
     def fun(x, jac=True):
         return prob.residual(x.reshape(prob.m, prob.H), jac)
@@ -26,6 +27,6 @@ def run(prob: DLFTProblem, x0, options: SolveOptions):
     t0 = time.perf_counter()
     x, _, st = solve(fun, np.asarray(x0, float).reshape(-1),
                      lambda x: prob.scale(x.reshape(prob.m, prob.H)), method=options.solver,
-                     tol=options.tol, max_iter=options.max_iter)
+                     tol=options.tol, max_iter=options.max_iter, max_slow=max_slow)
     st.wall_time = time.perf_counter() - t0
     return x.reshape(prob.m, prob.H), st
