@@ -115,7 +115,7 @@ from scipy.sparse.csgraph import connected_components
 
 from fretwear.errors import InputError
 from fretwear.hb import contact as law
-from fretwear.hb.contact import SEPARATION, STICK
+from fretwear.hb.contact import SEPARATION, STICK, _slip_gain
 from fretwear.hb.dynamics import StructureDynamics, structure_dynamics
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.problem import DLFTProblem
@@ -374,22 +374,7 @@ def _shifted_gain(lam_u, lam_x, state, mu, P, Q, z, normal):
             else:  # slip: as contact.slip_derivative_step, the carried part times z
                 m = n - 1 if n > 0 else N - 1
                 pn = normal[p, n] if fixed else lam_u[p, 0, n]
-                nrm2 = 0.0
-                for c in range(dt):
-                    that[c] = lam_u[p, 1 + c, n] - lam_x[p, 1 + c, n]
-                    nrm2 += that[c] * that[c]
-                lt = np.sqrt(nrm2)
-                for c in range(dt):
-                    that[c] = that[c] / lt if lt > 0.0 else 0.0
-                nrm2 = 0.0
-                for c in range(dt):
-                    v = lam_u[p, 1 + c, n] - lam_x[p, 1 + c, m]
-                    nrm2 += v * v
-                rho = np.sqrt(nrm2)
-                g = mu[p] * pn / rho if rho > 0.0 else 0.0
-                for a in range(dt):
-                    for b in range(dt):
-                        B[a, b] = g * ((1.0 if a == b else 0.0) - that[a] * that[b])
+                _slip_gain(lam_u[p], lam_x[p], n, lam_x[p, 1:, m], mu[p], pn, that, B)
                 for a in range(dt):
                     for j in range(dH):
                         acc = 0.0 + 0.0j
