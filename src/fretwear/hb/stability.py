@@ -538,8 +538,8 @@ def _condensed_at(Kf, Mf, Cf, Df, m, harmonics, omega, sigma):
     ``s - i n w`` (``s = sigma w``), the hysteretic term signed by ``Im lambda``, from the
     structure's whole matrices (m + q, m + q) (``Cf``, ``Df`` zero where the model has none):
     the Schur complement ``Z^xx - Z^xq (Z^qq)^-1 Z^qx`` (:meth:`StructureDynamics.condensed`)
-    by Gaussian elimination with partial pivoting on the ``q x q`` block, in one compiled call
-    (the same values to rounding); ``ok`` False where that block is singular."""
+    by the LU of the ``q x q`` block (:func:`_lu_small`, :func:`_lu_solve_small`), in one
+    compiled call (the same values to rounding); ``ok`` False where that block is singular."""
     k = harmonics.size
     ns = Kf.shape[0]
     q = ns - m
@@ -566,30 +566,11 @@ def _condensed_at(Kf, Mf, Cf, Df, m, harmonics, omega, sigma):
                 A[i, j] = Z[m + i, m + j]
             for j in range(m):
                 B[i, j] = Z[m + i, j]
-        for col in range(q):
-            piv = col
-            for r in range(col + 1, q):
-                if abs(A[r, col]) > abs(A[piv, col]):
-                    piv = r
-            if A[piv, col] == 0:
-                return Zr, False
-            if piv != col:
-                for j in range(q):
-                    A[col, j], A[piv, j] = A[piv, j], A[col, j]
-                for j in range(m):
-                    B[col, j], B[piv, j] = B[piv, j], B[col, j]
-            for r in range(col + 1, q):
-                f = A[r, col] / A[col, col]
-                for j in range(col, q):
-                    A[r, j] -= f * A[col, j]
-                for j in range(m):
-                    B[r, j] -= f * B[col, j]
-        for col in range(q - 1, -1, -1):
-            for j in range(m):
-                x = B[col, j]
-                for t in range(col + 1, q):
-                    x -= A[col, t] * X[t, j]
-                X[col, j] = x / A[col, col]
+        piv, ok = _lu_small(A)
+        if not ok:
+            return Zr, False
+        for j in range(m):
+            X[:, j] = _lu_solve_small(A, piv, B[:, j])
         for i in range(m):
             for j in range(m):
                 acc = Z[i, j]
