@@ -202,6 +202,24 @@ def test_shifted_gain_at_zero_is_the_solve_s_gain():
 
 
 # --- Hill's matrix and the exponents --------------------------------------------------------
+def _jenkins_hysteretic():
+    """A Jenkins oscillator (m = k = 1, kt 0.5, mu N 0.5) with viscous and hysteretic
+    damping, forced by 0.2 cos."""
+    return from_matrices([[1.0]], [[1.0]],
+                         contact=ContactDofs(normal_dofs=None, tangential_dofs=[0], mu=0.5,
+                                             normal_load=1.0, kt=0.5),
+                         damping=Damping(C=[[0.02]], D=[[0.03]]),
+                         loads=[Load(np.array([0.2]), "cos")], observed={"x": 0})
+
+
+def _hill_problem(model, basis, f):
+    """``(prob, HillProblem)`` of the periodic solution of ``model`` at ``f`` [Hz]."""
+    sol = solve_periodic(model, basis, frequency=f, time_domain=None)
+    assert sol.success
+    prob = problem_of(model, sol)
+    return prob, HillProblem(prob, sol.U.reshape(prob.m, prob.H), structure_dynamics(model))
+
+
 @pytest.mark.parametrize("compiled", [True, False])
 @pytest.mark.parametrize("case", ["jenkins-hysteretic", "unilateral-two-dof"])
 def test_compiled_hill_matrix_is_its_parts(case, compiled, monkeypatch):
@@ -220,18 +238,11 @@ def test_compiled_hill_matrix_is_its_parts(case, compiled, monkeypatch):
     if not compiled:
         monkeypatch.setattr(hill_module, "CONDENSED_COMPILED_MAX", -1)
     if case == "jenkins-hysteretic":
-        model = from_matrices([[1.0]], [[1.0]],
-                              contact=ContactDofs(normal_dofs=None, tangential_dofs=[0],
-                                                  mu=0.5, normal_load=1.0, kt=0.5),
-                              damping=Damping(C=[[0.02]], D=[[0.03]]),
-                              loads=[Load(np.array([0.2]), "cos")], observed={"x": 0})
+        model = _jenkins_hysteretic()
         basis, w = FourierBasis.up_to(5, 64), 1.18
     else:
         model, basis, w = two_dof(), FourierBasis.up_to(5, 64), 0.7
-    sol = solve_periodic(model, basis, frequency=w / (2 * np.pi), time_domain=None)
-    assert sol.success
-    prob = problem_of(model, sol)
-    hp = HillProblem(prob, sol.U.reshape(prob.m, prob.H), structure_dynamics(model))
+    prob, hp = _hill_problem(model, basis, w / (2 * np.pi))
     for sigma in (0.0, 0.3j, -0.02 + 0.47j, 0.1 - 0.2j):
         ref = jacobian_form(hp.gain(sigma), hp.stiffness(sigma), prob.eps)
         assert np.abs(hp.matrix(sigma) - ref).max() <= 1e-13 * np.abs(ref).max()
@@ -252,11 +263,7 @@ def test_pencil_condensed_is_the_frozen_memory_hill_matrix(case):
     coordinates) and on a two-dimensional contact node (``d = 2``: the law's ``G`` couples
     the normal and tangential coefficients)."""
     if case == "jenkins-hysteretic":
-        model = from_matrices([[1.0]], [[1.0]],
-                              contact=ContactDofs(normal_dofs=None, tangential_dofs=[0],
-                                                  mu=0.5, normal_load=1.0, kt=0.5),
-                              damping=Damping(C=[[0.02]], D=[[0.03]]),
-                              loads=[Load(np.array([0.2]), "cos")], observed={"x": 0})
+        model = _jenkins_hysteretic()
         basis, f, sigmas = FourierBasis.up_to(5, 64), 1.18 / (2 * np.pi), (0.0, -0.05, 0.2)
     elif case == "unilateral-two-dof":
         model, basis, f = two_dof(), FourierBasis.up_to(5, 64), 0.7 / (2 * np.pi)
@@ -264,10 +271,7 @@ def test_pencil_condensed_is_the_frozen_memory_hill_matrix(case):
     else:
         model, basis, f = oscillator(), FourierBasis.up_to(3, 32), 15.0
         sigmas = (0.0, 0.3j, -0.02 + 0.47j, 0.1 - 0.2j)
-    sol = solve_periodic(model, basis, frequency=f, time_domain=None)
-    assert sol.success
-    prob = problem_of(model, sol)
-    hp = HillProblem(prob, sol.U.reshape(prob.m, prob.H), structure_dynamics(model))
+    prob, hp = _hill_problem(model, basis, f)
     A = hp.pencil()
     nx = prob.m * prob.H
     assert case != "oscillator-2d" or prob.d == 2
