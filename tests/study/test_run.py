@@ -125,6 +125,24 @@ def _run_members_here(path, out):
     return members
 
 
+def _drawn_study(monkeypatch, path, out):
+    """Run the members of the study ``path`` here, then collect it into ``out``, keeping every
+    study figure as drawn (``name -> Figure``): ``(result, members, drawn)``."""
+    from fretwear.study import figures
+
+    drawn = {}
+    save = figures._save
+    monkeypatch.setattr(figures, "_save",
+                        lambda fig, path: drawn.setdefault(path.name, fig) and save(fig, path))
+    members = _run_members_here(path, out)
+    return run_study(path, out, collect=True, progress=False, echo=False), members, drawn
+
+
+def _own(out, member):
+    """A member's own results.nc, read back independently of the study's collection."""
+    return xr.open_dataset(out / member.folder_name / RESULTS_FILE, engine="h5netcdf").load()
+
+
 def test_sweep_members_on_different_frequencies_give_a_study_and_its_figure(tmp_path):
     """Two sweep members whose frequencies differ (4 and 6 grid points over the same band: the
     case of a continuation that adds points where each member needs them) and whose kept
@@ -282,12 +300,6 @@ def test_a_nonlinear_modes_study_draws_the_members_backbones(tmp_path, monkeypat
     with a KeyError (its response_amplitude has no frequency axis)."""
     import shutil
 
-    from fretwear.study import figures
-
-    drawn = {}
-    save = figures._save
-    monkeypatch.setattr(figures, "_save",
-                        lambda fig, path: drawn.setdefault(path.name, fig) and save(fig, path))
     for name in ("jenkins-nonlinear-modes.toml", "jenkins-K.mtx", "jenkins-M.mtx"):
         shutil.copy(EXAMPLES_DIR / name, tmp_path / name)
     case = tmp_path / "jenkins-nonlinear-modes.toml"
@@ -297,14 +309,13 @@ def test_a_nonlinear_modes_study_draws_the_members_backbones(tmp_path, monkeypat
     path = study_file(tmp_path, "[grid]\ncontact.mu = [0.2, 0.3]\n",
                       base="jenkins-nonlinear-modes.toml")
     out = tmp_path / "out"
-    members = _run_members_here(path, out)
-    res = run_study(path, out, collect=True, progress=False, echo=False)
+    res, members, drawn = _drawn_study(monkeypatch, path, out)
     ds = res.dataset
     assert [p.name for p in res.figures] == ["study-backbones.png"]
     assert ds["member_modal_amplitude"].attrs["units"] == "m kg^0.5"
     fig = drawn["study-backbones.png"]
     for i, m in enumerate(members):
-        own = xr.open_dataset(out / m.folder_name / RESULTS_FILE, engine="h5netcdf").load()
+        own = _own(out, m)
         a = own["modal_amplitude"].values
         np.testing.assert_array_equal(ds["member_modal_amplitude"].values[i], a)
         for ax, name in zip(fig.axes, ("backbone_frequency", "damping_ratio"), strict=True):
@@ -324,25 +335,18 @@ def test_a_worn_state_study_draws_the_members_worn_profiles(tmp_path, monkeypatc
     profiles against x, one per member labelled with its mu and its kind."""
     from helpers.cases import WEAR_BLOCK
 
-    from fretwear.study import figures
-
-    drawn = {}
-    save = figures._save
-    monkeypatch.setattr(figures, "_save",
-                        lambda fig, path: drawn.setdefault(path.name, fig) and save(fig, path))
     (tmp_path / "w.toml").write_text(
         f'title = "worn state"\n{WEAR_BLOCK}[analysis]\ntype = "worn-state"\n'
         "quasi_static = true\nharmonics = 3\nn_samples = 32\ncheckpoint_every_s = 0.0\n"
         "residual_tolerance = 1e-2\n[output]\nvtu = false\nfigures = false\n")
     path = study_file(tmp_path, "[grid]\ncontact.mu = [0.3, 0.4]\n", base="w.toml")
     out = tmp_path / "out"
-    members = _run_members_here(path, out)
-    res = run_study(path, out, collect=True, progress=False, echo=False)
+    res, members, drawn = _drawn_study(monkeypatch, path, out)
     ds = res.dataset
     assert [p.name for p in res.figures] == ["study-worn-profiles.png"]
     lines = drawn["study-worn-profiles.png"].axes[0].get_lines()
     for i, m in enumerate(members):
-        own = xr.open_dataset(out / m.folder_name / RESULTS_FILE, engine="h5netcdf").load()
+        own = _own(out, m)
         w = own["wear_depth"].values[-1]
         np.testing.assert_array_equal(ds["final_wear_depth"].values[i], w)
         assert ds["final_max_wear_depth"].values[i] == w.max() > 0
@@ -365,24 +369,17 @@ def test_a_cyclic_modes_study_draws_the_members_frequencies_per_nodal_diameter(t
     draws those curves against the nodal diameter, one colour per member."""
     from helpers.cyclic import write_sector_case
 
-    from fretwear.study import figures
-
-    drawn = {}
-    save = figures._save
-    monkeypatch.setattr(figures, "_save",
-                        lambda fig, path: drawn.setdefault(path.name, fig) and save(fig, path))
     base, _ = write_sector_case(tmp_path, 8, 3,
                                 analysis='[analysis]\ntype = "cyclic-modes"\nn_modes = 2\n')
     assert "\nE = 2e11\n" in base.read_text()
     path = study_file(tmp_path, "[grid]\nmaterial.E = [2e11, 8e11]\n", base=base.name)
     out = tmp_path / "out"
-    members = _run_members_here(path, out)
-    res = run_study(path, out, collect=True, progress=False, echo=False)
+    res, members, drawn = _drawn_study(monkeypatch, path, out)
     ds = res.dataset
     assert [p.name for p in res.figures] == ["study-cyclic-frequencies.png"]
     lines = drawn["study-cyclic-frequencies.png"].axes[0].get_lines()
     for i, m in enumerate(members):
-        own = xr.open_dataset(out / m.folder_name / RESULTS_FILE, engine="h5netcdf").load()
+        own = _own(out, m)
         f = own["cyclic_frequency"].values
         np.testing.assert_array_equal(ds["cyclic_frequency"].values[i], f)
         for j in range(2):
@@ -402,25 +399,18 @@ def test_a_transient_study_gives_each_members_peak_and_rms_and_draws_them(tmp_pa
     |u - mean| and the RMS of u - mean over the period, by hand), and study-response.png draws
     harmonic 1, the peak and the RMS of the first point on its axis of largest response
     against mu."""
-    from fretwear.study import figures
-
-    drawn = {}
-    save = figures._save
-    monkeypatch.setattr(figures, "_save",
-                        lambda fig, path: drawn.setdefault(path.name, fig) and save(fig, path))
     base_case(tmp_path, '[analysis]\ntype = "transient"\nfrequency = 1500.0\nmode = "fixed"\n'
               "n_periods = 5\nsteps_per_period = 64\nmax_periods = 20\n")
     path = study_file(tmp_path, "[grid]\ncontact.mu = [0.2, 0.3]\n")
     out = tmp_path / "out"
-    members = _run_members_here(path, out)
-    res = run_study(path, out, collect=True, progress=False, echo=False)
+    res, members, drawn = _drawn_study(monkeypatch, path, out)
     ds = res.dataset
     assert [p.name for p in res.figures] == ["study-response.png"]
     ax = drawn["study-response.png"].axes[0]
     lines = {ln.get_label(): ln for ln in ax.get_lines()}
     axis = int(np.argmax(ds["displacement_harmonic_amplitude"].values[0, 0, :, 0]))
     for i, m in enumerate(members):
-        own = xr.open_dataset(out / m.folder_name / RESULTS_FILE, engine="h5netcdf").load()
+        own = _own(out, m)
         u = own["displacement"].values  # (point, axis, tau)
         dyn = u - u.mean(axis=-1, keepdims=True)
         np.testing.assert_allclose(ds["displacement_peak"].values[i], np.abs(dyn).max(-1),
@@ -451,7 +441,7 @@ def test_an_incremental_wear_study_gives_the_wear_statistics_and_figures(tmp_pat
     ds = res.dataset
     assert [p.name for p in res.figures] == ["study-worn-volume.png", "study-wear-profiles.png"]
     for i, m in enumerate(members):
-        own = xr.open_dataset(out / m.folder_name / RESULTS_FILE, engine="h5netcdf").load()
+        own = _own(out, m)
         np.testing.assert_array_equal(ds["final_wear_depth"].values[i],
                                       own["wear_depth"].values[-1])
         assert ds["final_worn_volume"].values[i] == own["worn_volume"].values[-1] > 0
