@@ -1357,7 +1357,6 @@ def _ruhe_small(B0, B1, B2, sigma, y, max_iter):
     first = True
     A = np.empty((n, n), dtype=np.complex128)
     r = np.empty(n, dtype=np.complex128)
-    s2 = sigma * sigma
     for _ in range(max_iter):
         s2 = sigma * sigma
         for i in range(n):
