@@ -133,13 +133,13 @@ def test_a_jump_at_a_fold_is_the_sweeps_path_and_listed_in_the_summary():
     arclength turned back short of the frequency, as on the platform damper's FRF at
     38476.5 Hz) needed only the sweep's own path: not a fallback, and the continuation line
     lists where the jump left the branch and where it landed. Counted by hand on made-up
-    points; a jump that failed is not listed (its point fell back)."""
+    points; a jump that failed is not listed (its point fell back). The fold's frequency is the
+    attempt's own field (``from_hz``), not read back from its message."""
     ok = [Attempt("grid", "powell", 1.0, False, 0.1, 40, 0.1, ""),
           Attempt("arclength", "powell", 1.0, False, 0.1, 40, 5.0, ""),
-          Attempt("jump", "powell", 1.0, True, 1e-14, 27, 0.2,
-                  "converged (from the fold at 38476.5 Hz)")]
+          Attempt("jump", "powell", 1.0, True, 1e-14, 27, 0.2, "converged", 38476.5)]
     failed = [*ok[:2], Attempt("jump", "powell", 1.0, False, 0.04, 56, 0.2,
-                               "not converged (from the fold at 0.1214 Hz)"),
+                               "not converged", 0.1214),
               Attempt("eps-continuation", "powell", 1.0, True, 1e-13, 3, 1.0, "")]
     points = [SimpleNamespace(frequency_hz=41016.8, attempts=ok, fallback_seconds=5.3),
               SimpleNamespace(frequency_hz=0.1225, attempts=failed, fallback_seconds=6.5)]

@@ -596,7 +596,7 @@ def jump(p: Point) -> bool:
     U, st = go_on(prob, U, st, so)
     f_fold = w_fold / (2 * np.pi)
     p.tried.append(Attempt.of("jump", prob.eps, st,
-                              f"{st.message} (from the fold at {f_fold:.6g} Hz)"))
+                              f"{st.message} (from the fold at {f_fold:.6g} Hz)", f_fold))
     said(f"sweep at {p.frequency:.6g} Hz: the branch turns back at a fold at {f_fold:.6g} Hz; "
          f"jump from there to {p.frequency:.6g} Hz: "
          + ("converged" if st.success else f"not converged ({st.residual:.2e})"))

@@ -209,12 +209,15 @@ class Attempt:
     iterations: int
     wall_time: float
     message: str
+    from_hz: float | None = None
 
     @classmethod
-    def of(cls, method: str, eps: float, st: SolveStats, message: str | None = None):
+    def of(cls, method: str, eps: float, st: SolveStats, message: str | None = None,
+           from_hz: float | None = None):
         return cls(method, st.solver, float(eps), bool(st.success), float(st.residual),
                    int(st.iterations), float(st.wall_time),
-                   st.message if message is None else message)
+                   st.message if message is None else message,
+                   None if from_hz is None else float(from_hz))
 
 
 def assemble_solution(prob: DLFTProblem, U, model: Model, stats: SolveStats) -> PeriodicSolution:
