@@ -39,24 +39,13 @@ def test_branch_passes_the_target_with_balanced_points():
     1000 and 1100 Hz towards 1300 Hz, the branch reaches past the target and every point on
     it is a balance of its own frequency (relative residual of a freshly condensed problem
     below 1e-8, the corrector's 1e-10 plus the rounding of omega -> Hz -> omega)."""
-    model = closed_block()
-    probs = Problems(model, BASIS, None, EPS, exact_condenser(model))
-    anchor = np.zeros((model.contact.n_nodes, 1))
-    opts = SolveOptions(tol=1e-10)
-    w0, w1, target = (2 * np.pi * f for f in (1000.0, 1100.0, 1300.0))
-    _, U0, s0 = solve_at(probs, w0, anchor, None, opts)
-    _, U1, s1 = solve_at(probs, w1, anchor, U0, opts)
-    assert s0.success and s1.success
-    branch = arclength(probs, anchor, (U0.reshape(-1), w0), (U1.reshape(-1), w1), target, 1e-10)
+    model, branch = _closed_block_branch(1000.0, 1100.0, 1300.0)
+    target = 2 * np.pi * 1300.0
     assert branch and branch[-1][1] >= target
-    assert all(b[1] > w1 for b in branch)
-    for U, w, st, _ in branch:
+    assert all(b[1] > 2 * np.pi * 1100.0 for b in branch)
+    for _, _, st, _ in branch:
         assert st.success and st.solver == "arclength"
-        red = condense(model, w / (2 * np.pi), BASIS.orders)
-        prob = DLFTProblem(red, model.contact, BASIS, eps=EPS, anchor=anchor)
-        Ux = U.reshape(prob.m, prob.H)
-        f, _ = prob.residual(Ux, jacobian=False)
-        assert np.linalg.norm(f) <= 1e-8 * prob.scale(Ux)
+    _assert_balances(model, branch)
 
 
 def test_branch_never_steps_below_zero_frequency():
@@ -66,18 +55,32 @@ def test_branch_never_steps_below_zero_frequency():
     InputError: a sweep point of the paper's beam whose neighbour lay 9 times lower in
     frequency). Every point returned lies at a positive frequency and is a balance there
     (relative residual of a freshly condensed problem below 1e-8, as above)."""
+    model, branch = _closed_block_branch(1100.0, 300.0, 100.0)
+    assert branch and branch[-1][1] <= 2 * np.pi * 100.0
+    assert all(w > 0 for _, w, _, _ in branch)
+    _assert_balances(model, branch)
+
+
+def _closed_block_branch(f0, f1, f_target):
+    """The closed block (a linear response) converged at ``f0`` and ``f1`` [Hz], and the
+    arclength branch from those two points towards ``f_target``: ``(model, branch)``."""
     model = closed_block()
     probs = Problems(model, BASIS, None, EPS, exact_condenser(model))
     anchor = np.zeros((model.contact.n_nodes, 1))
     opts = SolveOptions(tol=1e-10)
-    w0, w1, target = (2 * np.pi * f for f in (1100.0, 300.0, 100.0))
+    w0, w1, target = (2 * np.pi * f for f in (f0, f1, f_target))
     _, U0, s0 = solve_at(probs, w0, anchor, None, opts)
     _, U1, s1 = solve_at(probs, w1, anchor, U0, opts)
     assert s0.success and s1.success
-    branch = arclength(probs, anchor, (U0.reshape(-1), w0), (U1.reshape(-1), w1), target, 1e-10)
-    assert branch and branch[-1][1] <= target
+    return model, arclength(probs, anchor, (U0.reshape(-1), w0), (U1.reshape(-1), w1), target,
+                            1e-10)
+
+
+def _assert_balances(model, branch):
+    """Every point of ``branch`` is a balance of its own frequency: the relative residual of a
+    freshly condensed problem (zero anchor) below 1e-8."""
+    anchor = np.zeros((model.contact.n_nodes, 1))
     for U, w, _, _ in branch:
-        assert w > 0
         red = condense(model, w / (2 * np.pi), BASIS.orders)
         prob = DLFTProblem(red, model.contact, BASIS, eps=EPS, anchor=anchor)
         Ux = U.reshape(prob.m, prob.H)
