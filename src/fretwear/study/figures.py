@@ -58,6 +58,16 @@ def _figure(*args, **kwargs):
     return plt.subplots(*args, **kwargs)
 
 
+def _finish(fig, ax, ds, path: Path, legend: bool, which: str = "major") -> Path:
+    """The study's title over ``ax``, its legend where ``legend`` (few enough curves to
+    read), the grid (``which`` lines), and the figure saved at ``path``."""
+    ax.set_title(ds.attrs.get("title", ""), fontsize=9)
+    if legend:
+        ax.legend(fontsize=7)
+    ax.grid(alpha=0.3, which=which)
+    return _save(fig, path)
+
+
 def fan_chart(ds, path: Path) -> Path:
     """Worn volume against cycles: members, 5-95 % band, median and mean."""
     fig, ax = _figure(figsize=(7, 4.5))
@@ -133,11 +143,7 @@ def frf_family(ds, path: Path, varied: list[str]) -> Path:
     ax.set_xscale(frequency_scale(f.min(), f.max()))
     ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel(f"amplitude {label} [m]")
-    ax.set_title(ds.attrs.get("title", ""), fontsize=9)
-    if ds.sizes["member"] <= 12:
-        ax.legend(fontsize=7)
-    ax.grid(alpha=0.3, which="both")
-    return _save(fig, path)
+    return _finish(fig, ax, ds, path, ds.sizes["member"] <= 12, "both")
 
 
 def joined_frf(ds, path: Path) -> Path:
@@ -154,9 +160,7 @@ def joined_frf(ds, path: Path) -> Path:
         ax.set_xscale(frequency_scale(f.min(), f.max()))
     ax.set_xlabel("frequency [Hz] (dotted: joins of chunks; red: join check failed)")
     ax.set_ylabel(f"amplitude {label} [m]")
-    ax.set_title(ds.attrs.get("title", ""), fontsize=9)
-    ax.grid(alpha=0.3, which="both")
-    return _save(fig, path)
+    return _finish(fig, ax, ds, path, False, "both")
 
 
 LEVEL_KEY = "analysis.excitation_scale"
@@ -253,9 +257,7 @@ def response_per_member(ds, path: Path, varied: list[str]) -> Path:
         ax.set_ylabel(f"displacement {label.strip()} [m]")
         ax.legend(fontsize=7)
     ax.set_xlabel(key or "member")
-    ax.set_title(ds.attrs.get("title", ""), fontsize=9)
-    ax.grid(alpha=0.3)
-    return _save(fig, path)
+    return _finish(fig, ax, ds, path, False)
 
 
 def _member_label(ds, i: int, varied: list[str]) -> str:
@@ -288,11 +290,7 @@ def linear_frf_family(ds, path: Path, varied: list[str]) -> Path:
     ax.set_xscale(frequency_scale(f.min(), f.max()))
     ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel(f"amplitude {label} {str(ds['axis'].values[axis])} [m]")
-    ax.set_title(ds.attrs.get("title", ""), fontsize=9)
-    if ds.sizes["member"] * len(interfaces) <= 12:
-        ax.legend(fontsize=7)
-    ax.grid(alpha=0.3, which="both")
-    return _save(fig, path)
+    return _finish(fig, ax, ds, path, ds.sizes["member"] * len(interfaces) <= 12, "both")
 
 
 def natural_frequencies(ds, path: Path, varied: list[str]) -> Path:
@@ -311,11 +309,7 @@ def natural_frequencies(ds, path: Path, varied: list[str]) -> Path:
                     label=f"{name}, mode {m + 1}" if fn.sizes["mode"] <= 6 else None)
     ax.set_xlabel(key or "member")
     ax.set_ylabel("natural frequency [Hz]")
-    ax.set_title(ds.attrs.get("title", ""), fontsize=9)
-    if fn.sizes["mode"] <= 6:
-        ax.legend(fontsize=7)
-    ax.grid(alpha=0.3)
-    return _save(fig, path)
+    return _finish(fig, ax, ds, path, fn.sizes["mode"] <= 6)
 
 
 def backbones(ds, path: Path, varied: list[str]) -> Path:
@@ -355,11 +349,7 @@ def worn_profiles(ds, path: Path, varied: list[str]) -> Path:
                 label=f"{_member_label(ds, i, varied)} ({kind or 'failed'})")
     ax.set_xlabel("x [m]" if "contact_position" in ds else "contact node")
     ax.set_ylabel("wear depth [m]")
-    ax.set_title(ds.attrs.get("title", ""), fontsize=9)
-    if ds.sizes["member"] <= 12:
-        ax.legend(fontsize=7)
-    ax.grid(alpha=0.3)
-    return _save(fig, path)
+    return _finish(fig, ax, ds, path, ds.sizes["member"] <= 12)
 
 
 def cyclic_frequencies(ds, path: Path, varied: list[str]) -> Path:
@@ -377,11 +367,7 @@ def cyclic_frequencies(ds, path: Path, varied: list[str]) -> Path:
     ax.set_xlabel("nodal diameter (line style: family of modes)")
     ax.set_ylabel("natural frequency [Hz]")
     ax.set_xticks(nd)
-    ax.set_title(ds.attrs.get("title", ""), fontsize=9)
-    if ds.sizes["member"] <= 12:
-        ax.legend(fontsize=7)
-    ax.grid(alpha=0.3)
-    return _save(fig, path)
+    return _finish(fig, ax, ds, path, ds.sizes["member"] <= 12)
 
 
 def study_figures(ds, outdir: Path, varied: list[str], fmt: str = "png") -> list[Path]:
