@@ -20,9 +20,11 @@ complement of the stick set ``S``), the state is one balance:
 
 The nodes of ``S`` keep the wear and anchors of the state the jump starts from: the worn
 state depends on the path (a node that slipped for a while before it stuck keeps that partial
-wear), and a jump from a state that has not yet passed those events misses them. The caller
-(:func:`fretwear.wear.worn_state.worn_state`) therefore takes the jump only from states of the
-path and accepts it only when the jumps from two successive states agree.
+wear; a loaded node that sticks now may slip and wear later, once its neighbours have
+unloaded), and a jump from a state that has not yet passed those events misses them. The
+caller (:func:`fretwear.wear.worn_state.worn_state`) therefore takes the jump only from states
+of the path, and accepts it only when the jumps from two states agree and the path is heading
+for them (:class:`fretwear.wear.worn_state._Jumps`).
 """
 
 from __future__ import annotations
@@ -39,9 +41,6 @@ WEARS = 1e-9
 #: the lift-off ``D`` is this many times the largest displacement and wear, then x 100 at
 #: most twice if a lifted node still touches
 LIFT = 100.0
-#: a node carries load at a state when its mean normal force exceeds this fraction of the
-#: largest node's
-LOADED = 1e-3
 #: Newton iterations of each balance of a jump (a jump that needs more is dropped: the
 #: caller goes on along the path)
 MAX_ITER = 12
@@ -126,26 +125,3 @@ def separation(sp: SlowProblem, U) -> np.ndarray:
     sep = np.min(-lu[:, 0, :], axis=1) / sp.eps
     return np.where(np.all(st == 0, axis=1), np.maximum(sep, 0.0), 0.0)
 
-
-def loaded(sp: SlowProblem, W, U, anchor) -> np.ndarray:
-    """(nc,) the nodes that carry load at the balance ``U`` with wear ``W``: their mean
-    normal contact force over the period above :data:`LOADED` of the largest node's."""
-    sp.set_state(W, anchor)
-    _, lx, _, _ = sp.prob.time_law(np.asarray(U, float).reshape(sp.m, sp.H))
-    p = np.mean(lx[:, 0, :], axis=1)
-    top = float(np.max(p))
-    return p > LOADED * top if top > 0 else np.zeros(p.shape, bool)
-
-
-def unsettled(sp: SlowProblem, jump: StickSetState, anchor, slipping, g, g0: float
-              ) -> np.ndarray:
-    """(nc,) the nodes whose fate the jump from a state cannot know: they slip there
-    (``slipping``) without wearing (rate ``g`` at most :data:`WEARS` of ``g0``: no load)
-    and carry load at the jump's state, where they stick at the anchor of the state the jump
-    started from. Along the path their load comes while they slip, and whether they wear
-    first (and by how much) or stick first is decided by the path (Stromberg's beam: the
-    node next to the deepest ones slips unloaded for 1e6 cycles, then wears by 8.1 % of the
-    deepest wear, while its neighbours, in the same condition, come to stick unworn). A jump
-    with such nodes is not taken."""
-    grazing = np.asarray(slipping, bool) & (np.asarray(g, float) <= WEARS * g0)
-    return grazing & ~jump.worn & loaded(sp, jump.W, jump.U, anchor)

@@ -35,10 +35,13 @@ the residual and the steps tried; the state is never claimed from a plateau of t
 
 The stick-set jump (``stick_set``, :mod:`fretwear.wear.stick_set`) characterises the state
 by its stick set instead: the nodes that wear unloaded until they just touch, every other
-node sticking, one balance. From the settled states of the path it is tried, and the run ends
-there when the jumps from two successive states give the same state. It is off by default:
-the state depends on the path, and the jump, which does not follow it, can land on another
-null-wear-rate state than the march (measured in docs/theory.md).
+node sticking, one balance. Once the worn-volume rate has fallen to :data:`TRY_RATE` of the
+initial one it is tried from the path's states, and the run ends on it when the jumps from
+two states agree AND the path step between them covered at least :data:`PROGRESS` of the way
+to the first (:class:`_Jumps`): agreement alone is not enough, the jumps from many successive
+states of Stromberg's beam agree on a state 8.1 % of the deepest wear from the march's (two
+loaded nodes that stick there slip and wear a million cycles later). It is off by default:
+the rule is measured on three cases, not proved, and gains little (docs/theory.md).
 
 Wear that goes on (gross slip) has no null-rate state; when the rate stops changing (``max
 |g_{k+1} - g_k| <= tolerance max g``) over a step that moved the profile by
@@ -114,11 +117,12 @@ class WornStateOptions:
         this: the step grows by it while the rate stays, faster as it falls; a step that
         changed the set of slipping nodes is not followed by a larger one (the stick
         events decide where the state ends).
-    stick_set : try the stick-set jump (:mod:`fretwear.wear.stick_set`) from the states
-        where the path has settled, and end there when the jumps from two successive states
-        are the same state (module docstring). Off by default: the jump lands on a
-        null-wear-rate state, but not always on the one the march reaches (Stromberg's beam:
-        8.8 % of the deepest wear away, docs/theory.md); the result then warns.
+    stick_set : try the stick-set jump (:mod:`fretwear.wear.stick_set`) from the states of
+        the path once the worn-volume rate has fallen to 0.3 of the initial one, and end there
+        when the jumps from two states agree and the path heads for them (module docstring).
+        Off by default: the rule that says when the jump lands on the march's state is
+        measured on three quasi-static examples (safe on each, 0.89-1.9 times the march's
+        speed), not proved; the result then warns.
     exponential : where a growing mode of the slow Jacobian would cut the step (wear moving
         load onto a stuck neighbour until it slips), take the exponential Euler step, which
         follows it exactly (:mod:`fretwear.wear.exponential_step`; on Stromberg's beam 51
@@ -295,9 +299,11 @@ def worn_state(model: Model, basis: FourierBasis, *, frequency: float | None = N
     state, found = _continue(sp, state, records, options, opts, run, saver)
     if found.by_jump:
         warnings.append("the state is a stick-set jump's (stick_set = True): a null-wear-rate "
-                        "state, but the jump does not follow the path, and the march may reach "
-                        "another (Stromberg's beam: 8.8 % of the deepest wear away, "
-                        "docs/theory.md); stick_set = False follows the path")
+                        "state, taken where the jumps agreed and the path headed for them; "
+                        "the jump does not follow the rest of the path, and the march may "
+                        "reach another state (Stromberg's beam: agreeing jumps 8.1 % of the "
+                        "deepest wear away, docs/theory.md); stick_set = False follows the "
+                        "path")
     saver.save(state, records, now=True)
     hist = WearHistory.from_records(records, found.kind)
     balanced = [r for r in records if r.has_balance]
@@ -405,8 +411,7 @@ def _continue(sp: SlowProblem, state: SlowStep, records: list[StepRecord],
               ) -> tuple[SlowStep, _Found]:
     """Steps from ``state`` until :func:`_judge` decides or ``max_steps``: error-controlled
     (the march's steps) while the set of slipping nodes changes, with SER once it has
-    settled (:func:`_settled`); from the settled states, the stick-set jump
-    (:class:`_Jumps`)."""
+    settled (:func:`_settled`); with ``stick_set``, the stick-set jump (:class:`_Jumps`)."""
     path = options.march_options(path=True)
     jumps = _Jumps(sp, options, opts)
     while True:
@@ -494,19 +499,23 @@ PROGRESS = 0.25
 
 class _Jumps:
     """The stick-set jumps (:func:`~fretwear.wear.stick_set.stick_set_state`) from the
-    recorded states, each taken once (by record index: a resumed run takes the same ones).
+    recorded states, each computed once (by record index).
 
-    A jump from record ``k`` is accepted when (1) the worn-volume rate there is at most
-    :data:`TRY_RATE` of the initial one, (2) the jump from record ``k - 1`` gives the same
-    state, to ``depth_tolerance`` of the deepest wear, and (3) the path step from ``k - 1``
-    to ``k`` covered at least :data:`PROGRESS` of the way from ``W_k-1`` to that jump's
-    state. (2) alone is not enough: on Stromberg's beam the jumps from 23 successive records
-    agree on a state 8.1 % of the deepest wear from the march's, where two loaded nodes that
-    stick through them slip and wear 1e6 cycles later, once their neighbours have unloaded;
-    those records' steps covered 11-22 % of the way to the jump (the path was still far from
-    where it ends, by more than the decay in sight says). The jump's state is a balance with a
-    null-wear-rate residual at most ``tolerance`` (:func:`stick_set_state` checks it); a
-    refused jump leaves the path to go on."""
+    Once the worn-volume rate is at most :data:`TRY_RATE` of the initial one, the jump from
+    that record is the target ``J``. At each later record ``k`` the path step from ``k - 1``
+    is measured against it: when it covered at least :data:`PROGRESS` of the way from
+    ``W_k-1`` to ``J``, the jump from ``k`` is computed; it is accepted when it gives the
+    same state as ``J``, to ``depth_tolerance`` of the deepest wear, else it becomes the new
+    target (a step that covered less computes no jump: the jumps cost balances). A resumed
+    run starts with no target. Agreement alone is not enough: on Stromberg's beam the jumps
+    from 23 successive records agree on a state 8.1 % of the deepest wear from the march's,
+    where two loaded nodes that stick through them slip and wear 1e6 cycles later, once their
+    neighbours have unloaded; those records' steps covered 11-22 % of the way to the jump
+    (the path was still far from where it ends, by more than the decay in sight says; on a
+    reduced copy, jumps equal to 1e-12 land 103 % away, with steps covering 0.1 % of the
+    way). The jump's state is a balance with a null-wear-rate residual at most
+    ``tolerance`` (:func:`stick_set_state` checks it); a refused jump leaves the path to go
+    on."""
 
     def __init__(self, sp: SlowProblem, options: WornStateOptions, opts: WearOptions):
         self.sp, self.options, self.opts = sp, options, opts
