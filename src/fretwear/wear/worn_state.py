@@ -121,8 +121,8 @@ class WornStateOptions:
         the path once the worn-volume rate has fallen to 0.3 of the initial one, and end there
         when the jumps from two states agree and the path heads for them (module docstring).
         Off by default: the rule that says when the jump lands on the march's state is
-        measured on three quasi-static examples (safe on each, 0.89-1.9 times the march's
-        speed), not proved; the result then warns.
+        measured on three quasi-static examples (safe on each, 0.94-1.56 times the march's
+        speed in DLFT solves), not proved; the result then warns.
     exponential : where a growing mode of the slow Jacobian would cut the step (wear moving
         load onto a stuck neighbour until it slips), take the exponential Euler step, which
         follows it exactly (:mod:`fretwear.wear.exponential_step`; on Stromberg's beam 51
