@@ -4,22 +4,24 @@ Reference: the analytic worn state of the Winkler punch (tests/helpers/winkler.p
 with ``mu F_p < T`` slip and wear until they carry nothing, ``W_p = F_p / k_n``; the others
 stick and keep ``W_p = 0`` (Ciavarella and Hills: wear stops once the slip zone is unloaded).
 The jump computes it from the unworn balance without any slow step, so it is compared with
-the formula directly.
+the formula directly. Where the jump lands elsewhere than the march (a reduced Stromberg
+beam), the march to its plateau is the reference.
 """
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers.wear_runs import reduced_example
 from helpers.winkler import BASIS, KN, MU, F, T, winkler
 
 from fretwear.errors import InputError
 from fretwear.hb.options import SolveOptions
-from fretwear.wear import WearOptions
+from fretwear.wear import WearOptions, simulate_wear
 from fretwear.wear.schemes import first_state
 from fretwear.wear.simulate import BalanceSetup, slow_setup
 from fretwear.wear.stick_set import separation, stick_set_state
-from fretwear.wear.worn_state import WornStateOptions, worn_state
+from fretwear.wear.worn_state import PROGRESS, WornStateOptions, agreement, worn_state
 
 
 def _unworn():
@@ -72,3 +74,38 @@ def test_stick_set_option_is_checked():
     """A stick_set that is not a boolean: one InputError naming it."""
     with pytest.raises(InputError, match="stick_set = 'yes'"):
         WornStateOptions(stick_set="yes")
+
+
+def test_agreeing_early_jumps_that_land_elsewhere_are_refused(tmp_path):
+    """The reduced Stromberg beam (30 x 2 Q4, 3 harmonics, 32 samples), against the march
+    to its plateau (a separate integration of the same slow equation): the jumps from the
+    first two records of the direct path agree with each other (within ``depth_tolerance``;
+    measured 1e-12) but land on another null-wear-rate state, more than half the deepest
+    wear from the march's (measured 103 %), so agreement alone would end the run there.
+    The path's step between them covers under a tenth of :data:`PROGRESS` of the way to the
+    jump (measured 0.09 %), and the run with ``stick_set = True`` goes on along the path and
+    ends on the march's state, by a jump, within 1 % of the deepest wear (issue 29's
+    tolerance; measured 4e-9)."""
+    model, basis = reduced_example("stromberg1997", 30, tmp_path)
+    march = simulate_wear(model, basis, quasi_static=True,
+                          options=WearOptions(plateau_rate=1e-8, max_steps=300))
+    Wm = march.history.wear_depth[-1]
+    top = float(np.max(Wm))
+    path = worn_state(model, basis, quasi_static=True).history
+    opts = WearOptions()
+    *_, sp = slow_setup(model, basis, 1.0, True, BalanceSetup(), opts, None, None)
+    g0 = float(np.max(path.wear_rate[0]))
+    jumps = []
+    for k in (1, 2):
+        jump, _ = stick_set_state(sp, path.wear_depth[k],
+                                  np.asarray(path.U[k], float).reshape(sp.m, sp.H),
+                                  path.anchor[k], path.wear_rate[k], g0=g0, options=opts.solve)
+        assert jump is not None
+        assert np.max(np.abs(jump.W - Wm)) > 0.5 * top
+        jumps.append(jump.W)
+    c, progress = agreement(path.wear_depth[1], path.wear_depth[2], *jumps)
+    assert c <= WornStateOptions().depth_tolerance
+    assert progress < 0.1 * PROGRESS
+    fast = worn_state(model, basis, quasi_static=True, options=WornStateOptions(stick_set=True))
+    assert fast.success and "stick-set jump" in fast.message, fast.message
+    assert np.max(np.abs(fast.wear - Wm)) <= 0.01 * top

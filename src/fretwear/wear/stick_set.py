@@ -20,9 +20,11 @@ complement of the stick set ``S``), the state is one balance:
 
 The nodes of ``S`` keep the wear and anchors of the state the jump starts from: the worn
 state depends on the path (a node that slipped for a while before it stuck keeps that partial
-wear), and a jump from a state that has not yet passed those events misses them. The caller
-(:func:`fretwear.wear.worn_state.worn_state`) therefore takes the jump only from states of the
-path and accepts it only when the jumps from two successive states agree.
+wear; a loaded node that sticks now may slip and wear later, once its neighbours have
+unloaded), and a jump from a state that has not yet passed those events misses them. The
+caller (:func:`fretwear.wear.worn_state.worn_state`) therefore takes the jump only from states
+of the path, and accepts it only when the jumps from two states agree and the path is heading
+for them (:class:`fretwear.wear.worn_state._Jumps`).
 """
 
 from __future__ import annotations
@@ -122,3 +124,4 @@ def separation(sp: SlowProblem, U) -> np.ndarray:
     lu, _, st, _ = sp.prob.time_law(U)
     sep = np.min(-lu[:, 0, :], axis=1) / sp.eps
     return np.where(np.all(st == 0, axis=1), np.maximum(sep, 0.0), 0.0)
+
