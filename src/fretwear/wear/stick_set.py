@@ -124,4 +124,3 @@ def separation(sp: SlowProblem, U) -> np.ndarray:
     lu, _, st, _ = sp.prob.time_law(U)
     sep = np.min(-lu[:, 0, :], axis=1) / sp.eps
     return np.where(np.all(st == 0, axis=1), np.maximum(sep, 0.0), 0.0)
-
