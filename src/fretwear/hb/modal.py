@@ -44,7 +44,7 @@ import scipy.sparse.linalg as spla
 from numba import njit
 
 from fretwear.errors import InputError
-from fretwear.hb import hmatrix, schur
+from fretwear.hb import hmatrix, schur, sparse_lu
 from fretwear.hb.modal_operator import ReducedOperator
 from fretwear.hb.reduce import (
     BLOCK,
@@ -178,6 +178,9 @@ class ModalCondenser(Condenser):
     ``"dense"``, ``"operator"`` (``"compressed"`` among them) or ``"auto"``; compress : the
     compression's bound (``"compressed"``; None otherwise).
     """
+
+    #: how the projections were made (logged by :func:`modal_condenser`)
+    path = "static modes (m solves with K_ii)"
 
     def __init__(self, model: Model, f_max: float, max_order: int, *, modes: int | None = None,
                  cutoff: float = CUTOFF, tol: float = TOL, raise_modes: bool = False,
@@ -653,24 +656,54 @@ def modal_condenser(model: Model, f_max: float, max_order: int, *, modes: int | 
     :func:`~fretwear.hb.reduce.exact_condenser`'s condenser is passed; it refuses another
     model, or this one after an edit of its matrices.
 
-    Where the dense storage (:func:`dense_storage_gib`) exceeds :data:`DENSE_STORAGE_GIB`
-    it is a :class:`BlockedModalCondenser` (the same condensation
-    without ``Psi`` or dense blocks per harmonic).
+    Which condenser (its ``path``, also logged): with CHOLMOD (``fretwear[fast]``), no
+    ``residual`` and symmetric matrices, from :data:`SCHUR_MIN_CONTACT` contact DOFs on, a
+    :class:`SchurModalCondenser` (the projected contact blocks by partial factorisations,
+    no ``m`` solves); otherwise, where the dense storage (:func:`dense_storage_gib`) exceeds
+    :data:`DENSE_STORAGE_GIB`, a :class:`BlockedModalCondenser` (the same condensation
+    without ``Psi`` or dense blocks per harmonic), else a :class:`ModalCondenser`.
     """
     max_order = whole(max_order, "max_order", low=0)
     if modes is not None:
         modes = whole(modes, "modes", low=0)  # 0: the static modes and load responses alone
     f_max = number(f_max, "f_max", low=0.0, open_low=True, unit="Hz")
     compress = _compress_bound(compress)
-    if dense_storage_gib(model, max_order) > DENSE_STORAGE_GIB:
+    rep = "auto" if compress is None else Representation("compressed", compress)
+    if _partial_factorisations_apply(model, residual):
+        out = SchurModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff,
+                                  tol=tol, raise_modes=raise_modes, representation=rep)
+    elif dense_storage_gib(model, max_order) > DENSE_STORAGE_GIB:
         # the blocked condenser keeps every mode below the cutoff (or ``modes``) and adds no
         # residual vectors: their m extra solves are what it cannot afford at this size
-        return BlockedModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff,
-                                     tol=tol, compress=compress)
-    return ModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff, tol=tol,
-                          raise_modes=raise_modes, residual=residual,
-                          representation=("auto" if compress is None
-                                          else Representation("compressed", compress)))
+        out = BlockedModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff,
+                                    tol=tol, compress=compress)
+    else:
+        out = ModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff, tol=tol,
+                             raise_modes=raise_modes, residual=residual, representation=rep)
+    sparse_lu.log.info("modal condensation by %s", out.path)
+    return out
+
+
+#: contact DOFs from which :func:`modal_condenser` takes the partial factorisations
+#: (:class:`SchurModalCondenser`) where they apply: measured on the pad of
+#: benchmarks/scale_3d.py (docs/studies/large-interface-solve.md, "The contact blocks by
+#: partial factorisations")
+SCHUR_MIN_CONTACT = 2048
+
+
+def _partial_factorisations_apply(model: Model, residual: bool) -> bool:
+    """Whether :func:`modal_condenser` builds a :class:`SchurModalCondenser`: CHOLMOD here,
+    no residual vectors, at least :data:`SCHUR_MIN_CONTACT` contact DOFs and symmetric
+    ``K, M, C, D`` (CHOLMOD factorises symmetric matrices)."""
+    m = int(np.asarray(model.contact.dofs).size)
+    if residual or m < SCHUR_MIN_CONTACT or not schur.available():
+        return False
+    for A in (model.K, model.M, model.C, model.D):
+        if A is not None and A.shape[0]:
+            A = sp.csr_matrix(A)
+            if abs(A - A.T).max() > 1e-12 * abs(A).max():
+                return False
+    return True
 
 
 def _compress_bound(compress) -> float | None:
@@ -758,6 +791,7 @@ class BlockedModalCondenser(ModalCondenser):
     :func:`fretwear.hb.modal.modal_condenser` for large interfaces."""
 
     representation = "operator"  # it holds no Psi to form dense blocks from
+    path = "blocked static modes (2 m solves with K_ii)"
 
     def __init__(self, model: Model, f_max: float, max_order: int, *, modes: int | None = None,
                  cutoff: float = CUTOFF, tol: float = TOL, compress: float | None = None):
@@ -894,6 +928,8 @@ class SchurModalCondenser(BlockedModalCondenser):
     :class:`~fretwear.hb.schur.ContactBlocks` record (its ``differences``: the step and
     estimated error of each ``X^cc`` by difference; ``cc`` emptied once rotated into
     ``proj_local``)."""
+
+    path = "partial factorisations (CHOLMOD)"
 
     def __init__(self, model: Model, f_max: float, max_order: int, *, modes: int | None = None,
                  cutoff: float = CUTOFF, tol: float = TOL, raise_modes: bool = False,
