@@ -688,7 +688,7 @@ def modal_condenser(model: Model, f_max: float, max_order: int, *, modes: int | 
 #: (:class:`SchurModalCondenser`) where they apply: measured on the pad of
 #: benchmarks/scale_3d.py (docs/studies/large-interface-solve.md, "The contact blocks by
 #: partial factorisations")
-SCHUR_MIN_CONTACT = 2048
+SCHUR_MIN_CONTACT = 3072
 
 
 def _partial_factorisations_apply(model: Model, residual: bool) -> bool:
