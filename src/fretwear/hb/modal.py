@@ -698,6 +698,11 @@ def _partial_factorisations_apply(model: Model, residual: bool) -> bool:
     m = int(np.asarray(model.contact.dofs).size)
     if residual or m < SCHUR_MIN_CONTACT or not schur.available():
         return False
+    return _symmetric_matrices(model)
+
+
+def _symmetric_matrices(model: Model) -> bool:
+    """Whether ``K, M, C, D`` of ``model`` are symmetric (to 1e-12 of their largest entry)."""
     for A in (model.K, model.M, model.C, model.D):
         if A is not None and A.shape[0]:
             A = sp.csr_matrix(A)
@@ -945,8 +950,13 @@ class SchurModalCondenser(BlockedModalCondenser):
             raise InputError("a modal condensation by partial factorisations needs CHOLMOD "
                              "(pip install 'fretwear[fast]'); modal_condenser falls back to "
                              "the static modes without it")
+        if not _symmetric_matrices(model):
+            raise InputError("a modal condensation by partial factorisations needs symmetric "
+                             "K, M, C, D (CHOLMOD factorises K -/+ h X); build a "
+                             "ModalCondenser instead")
         names = [nm for nm in NAMES if getattr(self, nm) is not None]
-        # the projected X^cc (m x m each), the contact block of the factor and its product
+        # the projected X^cc (m x m each), the product L_cc L_cc^T and its copy, and the
+        # factor's contact block as kvxopt copies it out (values and int64 rows, m^2 / 2)
         require_memory(8.0 * (len(names) + 3) * self.m**2,
                        f"a modal condensation by partial factorisations of {self.ni:,} "
                        f"interior and {self.m:,} contact DOFs (its projected blocks, m x m)")

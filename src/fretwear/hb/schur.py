@@ -24,14 +24,17 @@ first here) and ``Psi = -K_ii^-1 K_ic``: made from ``Psi``, that is ``m`` solves
   ``~ (h nu)^2`` relative, ``nu`` the largest ``|eig(K_ii^-1 X_ii)|`` (for ``M``: one over
   the lowest fixed-interface eigenvalue), its rounding ``~ eps (|S| + alpha) / (h |X^cc|)``;
   ``h`` balances the two (:func:`step`). Measured against the condensation through ``Psi``
-  on the pad of benchmarks/scale_3d.py: ``K^cc`` to 2e-15 relative, ``M^cc`` to 2e-9
+  on the pad of benchmarks/scale_3d.py: ``K^cc`` to 5e-15 relative, ``M^cc`` to 3e-9
   (docs/studies/large-interface-solve.md, "The contact blocks by partial factorisations").
 
 The rest of the projection needs ``Psi`` only against the ``q`` columns of the interior basis
-(``Psi^T Y = -K_ci K_ii^-1 Y``: a solve of ``q`` columns). Cost at 1024 contact nodes of that
-pad: three factorisations of about 1.2 s against the ``2 m`` solves of the blocked condenser
-(8 s). CHOLMOD is needed (``fretwear[fast]``): SciPy has no partial factorisation, and
-without kvxopt :func:`fretwear.hb.modal.modal_condenser` keeps the path through ``Psi``.
+(``Psi^T Y = -K_ci K_ii^-1 Y``: a solve of ``q`` columns). Cost, measured on that pad
+(CPU, load 6): at 1024 contact nodes a tie with the ``m`` solves of the dense condenser
+(8.8-10.8 s against 9.6-13.2 s), at 2304 95.6 s against 129.7 s for the ``2 m`` solves of
+the blocked one; three factorisations whose contact front (``m^3``: its update, CHOLMOD's
+factorisation of it and the product ``L_cc L_cc^T``) dominates. CHOLMOD is needed
+(``fretwear[fast]``): SciPy has no partial factorisation, and without kvxopt
+:func:`fretwear.hb.modal.modal_condenser` keeps the path through ``Psi``.
 """
 
 from __future__ import annotations
@@ -44,6 +47,7 @@ import scipy.sparse as sp
 from numba import njit
 from scipy.linalg.lapack import dlauum
 
+from fretwear.errors import InputError
 from fretwear.hb import sparse_lu
 
 #: the relative errors of the central difference measured on the pad of
@@ -63,7 +67,7 @@ def available() -> bool:
     ``FRETWEAR_SPARSE_LU``)."""
     try:
         return sparse_lu.default_backend() == "cholmod"
-    except Exception:  # a forced backend not available: the caller says so elsewhere
+    except InputError:  # a forced backend not available: the caller says so elsewhere
         return False
 
 
