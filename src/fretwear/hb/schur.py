@@ -231,11 +231,13 @@ def contact_blocks(K, others: dict, lu) -> ContactBlocks:
     rng = np.random.default_rng(0)
     for name, X in others.items():
         nu = _nu(lu, X.ii, rng)
-        xcc = float(np.max(np.abs(np.diag(np.asarray(X.cc)))))
+        # |X^cc| is not known before: the contact block of X stands for it (its interior
+        # block where the contact block has a zero diagonal)
+        xcc = (float(np.max(np.abs(np.diag(np.asarray(X.cc))), initial=0.0))
+               or float(np.max(np.abs(X.ii.diagonal()), initial=0.0)))
         kx = float(abs(K.ii).max()) / max(float(abs(X.ii).max()), 1e-300)
         if nu <= 0.0:  # no interior part: S(sigma) is quadratic, the difference is exact
             nu = 1.0 / kx if np.isfinite(kx) and kx > 0 else 1.0
-        # |X^cc| is not known before: the contact block of X itself stands for it
         h = step(nu, scale * nu / max(xcc, 1e-300 * scale))
         Sm = pf.schur(K.ii + h * X.ii, K.ic + h * X.ic, K.ci + h * X.ci,
                       np.asarray(K.cc) + h * np.asarray(X.cc))
