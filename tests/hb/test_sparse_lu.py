@@ -83,6 +83,23 @@ def test_cholmod_many_right_hand_sides():
     assert np.array_equal(f.solve(B), before) and f._sn is not None
 
 
+@pytest.mark.parametrize("backend", ["cholmod", "superlu"])
+def test_solve_few_columns(backend):
+    """``solve_few`` (the few-column products of the condensation by partial factorisations)
+    gives LAPACK's solution to TOL for real and complex right-hand sides of more than MANY
+    columns, and for CHOLMOD without making the supernodal panels of the many-column solves."""
+    if backend == "cholmod":
+        pytest.importorskip("kvxopt")
+    A, _ = _spd(seed=2)
+    f = sparse_lu.factor(A, "spd", backend=backend)
+    assert f.name == backend
+    B = np.random.default_rng(5).standard_normal((A.shape[0], sparse_lu.MANY + 4))
+    for rhs in (B, B + 1j * B[:, ::-1], B[:, 0]):
+        X = _dense(A, rhs)
+        assert np.abs(f.solve_few(rhs) - X).max() <= TOL * np.abs(X).max()
+    assert getattr(f, "_sn", None) is None
+
+
 def test_cholmod_when_installed():
     """With the extra installed, a real SPD matrix gets CHOLMOD by default."""
     pytest.importorskip("kvxopt")

@@ -44,7 +44,7 @@ import scipy.sparse.linalg as spla
 from numba import njit
 
 from fretwear.errors import InputError
-from fretwear.hb import hmatrix
+from fretwear.hb import hmatrix, schur, sparse_lu
 from fretwear.hb.modal_operator import ReducedOperator
 from fretwear.hb.reduce import (
     BLOCK,
@@ -178,6 +178,9 @@ class ModalCondenser(Condenser):
     ``"dense"``, ``"operator"`` (``"compressed"`` among them) or ``"auto"``; compress : the
     compression's bound (``"compressed"``; None otherwise).
     """
+
+    #: how the projections were made (logged by :func:`modal_condenser`)
+    path = "static modes (m solves with K_ii)"
 
     def __init__(self, model: Model, f_max: float, max_order: int, *, modes: int | None = None,
                  cutoff: float = CUTOFF, tol: float = TOL, raise_modes: bool = False,
@@ -445,7 +448,7 @@ class ModalCondenser(Condenser):
             if rows.size:
                 # u_i = Psi u_c + V q, q = qF - Y u_c (Y taking the local u_loc = R u_c):
                 # rows at the interior observed DOFs
-                A = self.Psi[rows] @ R.T - self.V[rows] @ Y
+                A = self._psi_at(rows) @ R.T - self.V[rows] @ Y
                 for (j, _), a, bo in zip(self.obs_i, A, self.V[rows] @ qF, strict=True):
                     oA[b, j], ob[b, j] = a, bo
             if static and int(n) == 0:  # K alone: real, whatever the storage of this call
@@ -653,24 +656,59 @@ def modal_condenser(model: Model, f_max: float, max_order: int, *, modes: int | 
     :func:`~fretwear.hb.reduce.exact_condenser`'s condenser is passed; it refuses another
     model, or this one after an edit of its matrices.
 
-    Where the dense storage (:func:`dense_storage_gib`) exceeds :data:`DENSE_STORAGE_GIB`
-    it is a :class:`BlockedModalCondenser` (the same condensation
-    without ``Psi`` or dense blocks per harmonic).
+    Which condenser (its ``path``, also logged): with CHOLMOD (``fretwear[fast]``), no
+    ``residual`` and symmetric matrices, from :data:`SCHUR_MIN_CONTACT` contact DOFs on, a
+    :class:`SchurModalCondenser` (the projected contact blocks by partial factorisations,
+    no ``m`` solves); otherwise, where the dense storage (:func:`dense_storage_gib`) exceeds
+    :data:`DENSE_STORAGE_GIB`, a :class:`BlockedModalCondenser` (the same condensation
+    without ``Psi`` or dense blocks per harmonic), else a :class:`ModalCondenser`.
     """
     max_order = whole(max_order, "max_order", low=0)
     if modes is not None:
         modes = whole(modes, "modes", low=0)  # 0: the static modes and load responses alone
     f_max = number(f_max, "f_max", low=0.0, open_low=True, unit="Hz")
     compress = _compress_bound(compress)
-    if dense_storage_gib(model, max_order) > DENSE_STORAGE_GIB:
+    rep = "auto" if compress is None else Representation("compressed", compress)
+    if _partial_factorisations_apply(model, residual):
+        out = SchurModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff,
+                                  tol=tol, raise_modes=raise_modes, representation=rep)
+    elif dense_storage_gib(model, max_order) > DENSE_STORAGE_GIB:
         # the blocked condenser keeps every mode below the cutoff (or ``modes``) and adds no
         # residual vectors: their m extra solves are what it cannot afford at this size
-        return BlockedModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff,
-                                     tol=tol, compress=compress)
-    return ModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff, tol=tol,
-                          raise_modes=raise_modes, residual=residual,
-                          representation=("auto" if compress is None
-                                          else Representation("compressed", compress)))
+        out = BlockedModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff,
+                                    tol=tol, compress=compress)
+    else:
+        out = ModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff, tol=tol,
+                             raise_modes=raise_modes, residual=residual, representation=rep)
+    sparse_lu.log.info("modal condensation by %s", out.path)
+    return out
+
+
+#: contact DOFs from which :func:`modal_condenser` takes the partial factorisations
+#: (:class:`SchurModalCondenser`) where they apply: measured on the pad of
+#: benchmarks/scale_3d.py (docs/studies/large-interface-solve.md, "The contact blocks by
+#: partial factorisations")
+SCHUR_MIN_CONTACT = 3072
+
+
+def _partial_factorisations_apply(model: Model, residual: bool) -> bool:
+    """Whether :func:`modal_condenser` builds a :class:`SchurModalCondenser`: CHOLMOD here,
+    no residual vectors, at least :data:`SCHUR_MIN_CONTACT` contact DOFs and symmetric
+    ``K, M, C, D`` (CHOLMOD factorises symmetric matrices)."""
+    m = int(np.asarray(model.contact.dofs).size)
+    if residual or m < SCHUR_MIN_CONTACT or not schur.available():
+        return False
+    return _symmetric_matrices(model)
+
+
+def _symmetric_matrices(model: Model) -> bool:
+    """Whether ``K, M, C, D`` of ``model`` are symmetric (to 1e-12 of their largest entry)."""
+    for A in (model.K, model.M, model.C, model.D):
+        if A is not None and A.shape[0]:
+            A = sp.csr_matrix(A)
+            if abs(A - A.T).max() > 1e-12 * abs(A).max():
+                return False
+    return True
 
 
 def _compress_bound(compress) -> float | None:
@@ -758,6 +796,7 @@ class BlockedModalCondenser(ModalCondenser):
     :func:`fretwear.hb.modal.modal_condenser` for large interfaces."""
 
     representation = "operator"  # it holds no Psi to form dense blocks from
+    path = "blocked static modes (2 m solves with K_ii)"
 
     def __init__(self, model: Model, f_max: float, max_order: int, *, modes: int | None = None,
                  cutoff: float = CUTOFF, tol: float = TOL, compress: float | None = None):
@@ -865,3 +904,111 @@ class BlockedModalCondenser(ModalCondenser):
         nodes = F[js.start // d : js.stop // d]
         out = np.einsum("rpj,pij->rpi", A.reshape(A.shape[0], -1, d), nodes)
         return out.reshape(A.shape)
+
+
+# -- the modal condensation by partial factorisations (large interfaces, CHOLMOD) ------------
+class _FewColumns:
+    """A factorisation whose ``solve`` takes :meth:`~fretwear.hb.sparse_lu._Factor.solve_few`
+    (the products with ``Psi`` of :class:`SchurModalCondenser` are of a few columns)."""
+
+    def __init__(self, lu):
+        self.lu = lu
+
+    def solve(self, B):
+        return self.lu.solve_few(B)
+
+
+class SchurModalCondenser(BlockedModalCondenser):
+    """:class:`ModalCondenser` whose projected contact blocks ``X^cc`` come from partial
+    Cholesky factorisations of ``K`` and ``K -/+ h X`` (:mod:`fretwear.hb.schur`: ``K^cc``
+    exact, the others by a central difference, error :data:`schur.Difference`), not from
+    ``Psi``: no ``m`` solves. ``Psi`` is never formed (as :class:`BlockedModalCondenser`);
+    ``X^cq = X_ci V + Psi^T X_ii V`` takes a solve of ``q`` columns. The same parameters as
+    :class:`ModalCondenser` but ``residual`` (its ``m`` solves are what this path avoids), the
+    same modes, error check and interface; ``representation`` as :class:`ModalCondenser`
+    (the dense blocks apply ``Psi`` by solves). Needs CHOLMOD (``fretwear[fast]``) and
+    symmetric ``K, M, C, D``. Made by :func:`modal_condenser` where it is faster.
+
+    Attributes (besides :class:`ModalCondenser`'s): ``contact``: the
+    :class:`~fretwear.hb.schur.ContactBlocks` record (its ``differences``: the step and
+    estimated error of each ``X^cc`` by difference; ``cc`` emptied once rotated into
+    ``proj_local``)."""
+
+    path = "partial factorisations (CHOLMOD)"
+
+    def __init__(self, model: Model, f_max: float, max_order: int, *, modes: int | None = None,
+                 cutoff: float = CUTOFF, tol: float = TOL, raise_modes: bool = False,
+                 representation: str | Representation = "auto"):
+        self._check_args(f_max, modes)
+        rep = Representation.of(representation)
+        self._set_compress(model, rep.compress)
+        self.representation = "operator" if rep.kind == "compressed" else rep.kind
+        Condenser.__init__(self, _structure(model), dense=False)
+        if not self.ni:
+            raise InputError("the model has no interior DOFs: nothing to represent by modes")
+        if not schur.available():
+            raise InputError("a modal condensation by partial factorisations needs CHOLMOD "
+                             "(pip install 'fretwear[fast]'); modal_condenser falls back to "
+                             "the static modes without it")
+        if not _symmetric_matrices(model):
+            raise InputError("a modal condensation by partial factorisations needs symmetric "
+                             "K, M, C, D (CHOLMOD factorises K -/+ h X); build a "
+                             "ModalCondenser instead")
+        names = [nm for nm in NAMES if getattr(self, nm) is not None]
+        # the projected X^cc (m x m each), the product L_cc L_cc^T and its copy, and the
+        # factor's contact block as kvxopt copies it out (values and int64 rows, m^2 / 2)
+        require_memory(8.0 * (len(names) + 3) * self.m**2,
+                       f"a modal condensation by partial factorisations of {self.ni:,} "
+                       f"interior and {self.m:,} contact DOFs (its projected blocks, m x m)")
+        self.f_max, self.max_order, self.tol = float(f_max), int(max_order), float(tol)
+        lu = self.factor(0.0, 0, True)  # CHOLMOD's Cholesky of K_ii, kept
+        self._lu0, self._exact, self._cc_local = lu, None, None
+        self.residual = False
+        few = _FewColumns(lu)
+        self.Psi = _StaticModes(few, self.K)
+        self.contact = schur.contact_blocks(
+            self.K, {nm: getattr(self, nm) for nm in names if nm != "K"}, few)
+        rows = np.array([i for _, i in self.obs_i], dtype=np.int64)
+        self._psi_rows = self.Psi.rows(rows) if rows.size else np.zeros((0, self.m))
+        vecs = self.structure.load_vectors
+        Fl = (np.column_stack([v[self.idofs] for v in vecs]) if vecs
+              else np.zeros((self.ni, 0)))
+        Xl = few.solve(Fl) if Fl.shape[1] else Fl
+        f_cut = cutoff * self.max_order * self.f_max
+        self._set_basis(*self._modes(lu, modes, f_cut), Xl)
+        while raise_modes and self.error > self.tol:
+            k = next_mode_count(self.n_modes, self.ni)
+            if k is None:
+                break
+            self._set_basis(*self._modes(lu, k, f_cut), Xl)
+        self._raise_if_inaccurate(f_max, tol)
+
+    def _set_basis(self, mode_frequencies, Phi, Xl):
+        """The basis of the modes ``Phi`` and load responses ``Xl``, its projections and the
+        error check (the ``X^cc`` found once: they do not depend on the basis)."""
+        self.mode_frequencies, self.n_modes = mode_frequencies, Phi.shape[1]
+        self.V = self._basis(Phi, Xl)
+        self.q = self.V.shape[1]
+        self._static = {}
+        self._project()
+        self.error = self._check()
+
+    def _project(self):
+        """``proj_local`` (as :class:`ModalCondenser`): ``X^cc`` from the partial
+        factorisations rotated once into the contact-local frames; ``X^cq = X_ci V +
+        Psi^T (X_ii V)`` by a solve of ``q`` columns, ``X^qc = (X^cq)^T`` (``X`` symmetric;
+        ``K^qc = 0``), ``X^qq = V^T X_ii V``."""
+        V, R = self.V, self.R
+        if self._cc_local is None:
+            self._cc_local = {}
+            for nm in list(self.contact.cc):
+                self._cc_local[nm] = self._rotate(self.contact.cc.pop(nm))
+        self.proj_local = {}
+        for nm in NAMES:
+            B = getattr(self, nm)
+            if B is None:
+                continue
+            XiiV = np.asarray(B.ii @ V)
+            cq = np.asarray(B.ci @ V) + (self.Psi.T @ XiiV if self.q else 0.0)
+            qc = np.zeros((self.q, self.m)) if nm == "K" else cq.T
+            self.proj_local[nm] = (self._cc_local[nm], R @ cq, (R @ qc.T).T, V.T @ XiiV)

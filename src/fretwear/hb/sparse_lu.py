@@ -134,6 +134,11 @@ class _Factor:
     def _solve(self, B):
         raise NotImplementedError
 
+    def solve_few(self, B):
+        """``solve(B)`` for a ``B`` of a few columns (a dozen): through the backend's own
+        solve, without making what only the solves of many columns use."""
+        return self.solve(B)
+
     def release(self) -> None:
         """Drop what only the solves of many columns use (nothing here)."""
 
@@ -195,6 +200,19 @@ class _Cholmod(_Factor):
         if not one and B.shape[1] >= MANY:
             return self._supernodal().solve(B)
         X = self._kvx.matrix(np.asfortranarray(B.reshape(self.n, -1)))
+        self._cholmod.solve(self.F, X)
+        X = np.array(X)
+        return X[:, 0] if one else X
+
+    def solve_few(self, B):
+        """``solve(B)`` by CHOLMOD's own solve whatever the number of columns: the supernodal
+        panels of :meth:`_supernodal` cost a second factorisation (25 s at 4096 contact
+        nodes of benchmarks/scale_3d.py), more than a dozen columns solved here."""
+        B = np.asarray(B)
+        if B.dtype.kind == "c":
+            return self.solve_few(B.real) + 1j * self.solve_few(B.imag)
+        one = B.ndim == 1
+        X = self._kvx.matrix(np.asfortranarray(B.reshape(self.n, -1), dtype=float))
         self._cholmod.solve(self.F, X)
         X = np.array(X)
         return X[:, 0] if one else X

@@ -1,0 +1,179 @@
+"""The projected contact blocks by partial Cholesky factorisations (fretwear.hb.schur) and the
+modal condenser built on them (fretwear.hb.modal.SchurModalCondenser), against the
+projections through the static modes Psi (ModalCondenser, itself checked against the exact
+condensation in test_modal.py), dense NumPy algebra and the exact condensation.
+
+Tolerances: ``K^cc`` is the Schur complement itself (no difference): rounding of a
+factorisation, measured 1e-15 relative, asserted 1e-12. The other ``X^cc`` come from a central
+difference whose estimated error (truncation plus rounding, ``schur.Difference.error``) is
+3e-10 on this block; measured 1e-10 to 4e-10; asserted 1e-7 and below ten times the estimate
+(the estimate is an order of magnitude, not a bound). Everything else is the same algebra as
+the dense condenser in another order (1e-12, as test_modal_blocked.py; 1e-10 for ``X^cq``:
+the stiffness-proportional damping's ``C^cq, D^cq`` hold ``K^cq``, which vanishes, so they
+are differences of terms up to 1e3 larger, measured 1.2e-12), but ``Z_r`` and what
+is made from it carry ``M^cc``'s error scaled by ``(n w)^2 |M^cc| / |Z_r|``: asserted 1e-8.
+"""
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+from helpers.operator_models import F_MAX, ORDERS, block, rel
+
+from fretwear.errors import InputError
+from fretwear.hb import modal, schur
+from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.modal import ModalCondenser, SchurModalCondenser, modal_condenser
+from fretwear.hb.periodic import solve_periodic
+from fretwear.hb.preload import static_anchor
+from fretwear.hb.reduce import _Blocks, exact_condenser
+from fretwear.model import Damping
+
+pytest.importorskip("kvxopt")
+
+DAMPED = Damping(loss_factor=0.02, rayleigh_mass=100.0, rayleigh_stiffness=1e-7)
+
+
+@pytest.mark.parametrize("damping", [None, DAMPED], ids=["undamped", "damped"])
+def test_partial_factorisations_equal_the_static_modes(damping):
+    """Every projected block, Z_r at every harmonic, the loads, the observed rows, the
+    recovery and the error check of the condenser by partial factorisations against the dense
+    condenser through Psi (tolerances: module docstring); harmonic 0 against the exact
+    condensation (the static part is exact on both paths)."""
+    model = block(damping)
+    mc = ModalCondenser(model, F_MAX, 7, tol=1e-2)
+    sc = SchurModalCondenser(model, F_MAX, 7, tol=1e-2)
+    assert sc.n_modes == mc.n_modes and abs(sc.error - mc.error) <= 1e-6 * mc.error
+    assert set(sc.proj_local) == set(mc.proj_local)
+    assert set(sc.contact.differences) == set(mc.proj_local) - {"K"}
+    assert sc.contact.factorisations == 1 + 2 * len(sc.contact.differences)
+    assert rel(sc.proj_local["K"][0], mc.proj_local["K"][0]) < 1e-12
+    for nm, d in sc.contact.differences.items():
+        err = rel(sc.proj_local[nm][0], mc.proj_local[nm][0])
+        assert err < 1e-7 and err < 10 * d.error, (nm, err, d)
+        for i in (1, 2, 3):
+            assert rel(sc.proj_local[nm][i], mc.proj_local[nm][i]) < 1e-10, (nm, i)
+    w = 2 * np.pi * 15e3
+    a, b = mc.reduced(w, ORDERS), sc.reduced(w, ORDERS)
+    for n in range(ORDERS.size):
+        assert rel(b.Z[n], a.Z[n]) < 1e-8, n
+    for name in ("F", "obs_A", "obs_b"):
+        assert rel(getattr(b, name), getattr(a, name)) < 1e-8, name
+    u = np.random.default_rng(1).standard_normal((ORDERS.size, a.m)) + 0j
+    assert rel(sc.recover(w, ORDERS, u), mc.recover(w, ORDERS, u)) < 1e-8
+    ex = exact_condenser(model).reduced(w, ORDERS[:1])
+    assert rel(b.Z[0], ex.Z[0]) < 1e-10 and rel(b.F[0], ex.F[0]) < 1e-10
+
+
+def _blocks(A, c):
+    """The contact/interior blocks of the dense ``A`` (contact DOFs ``c`` last)."""
+    i = np.setdiff1d(np.arange(A.shape[0]), c)
+    S = sp.csr_matrix
+    return _Blocks(A[np.ix_(c, c)], S(A[np.ix_(c, i)]), S(A[np.ix_(i, c)]).tocsc(),
+                   S(A[np.ix_(i, i)]).tocsc())
+
+
+def test_schur_complement_and_its_derivative_against_dense_algebra():
+    """On a random sparse chain (a semi-definite K with a rigid motion, as a structure
+    carried by its interface): the partial factorisation gives K_cc - K_ci K_ii^-1 K_ic of
+    NumPy's dense solve to 1e-12 (rounding); the central difference of the Schur complements
+    of K -/+ h X gives T^T X T, T = [Psi; I], to 1e-7 (its estimated error, 1e-9 here, with
+    margin), for a mass-like X and an indefinite one (dS/dsigma = -X^cc holds for any
+    symmetric X)."""
+    rng = np.random.default_rng(3)
+    n, c = 40, np.arange(30, 40)
+    # a chain of springs (one rigid translation) plus random symmetric coupling of neighbours
+    k = 1e8 * (1 + rng.random(n - 1))
+    K = np.zeros((n, n))
+    for j, kj in enumerate(k):
+        K[np.ix_([j, j + 1], [j, j + 1])] += kj * np.array([[1, -1], [-1, 1]])
+    M = np.diag(1e-3 * (1 + rng.random(n))) + 1e-4 * (np.eye(n, k=1) + np.eye(n, k=-1))
+    X2 = 1e-4 * (np.eye(n, k=2) + np.eye(n, k=-2)) - 2e-4 * np.eye(n)
+    Kb = _blocks(K, c)
+    i = np.setdiff1d(np.arange(n), c)
+    Psi = -np.linalg.solve(K[np.ix_(i, i)], K[np.ix_(i, c)])
+    pf = schur.PartialFactor(Kb)
+    S = pf.schur(Kb.ii, Kb.ic, Kb.ci, Kb.cc)
+    ref = K[np.ix_(c, c)] + K[np.ix_(c, i)] @ Psi
+    assert rel(S, ref) < 1e-12
+    assert np.linalg.eigvalsh(ref)[0] < 1e-6 * np.abs(ref).max()  # semi-definite
+    from fretwear.hb.sparse_lu import factor
+
+    lu = factor(Kb.ii, "spd")
+    out = schur.contact_blocks(Kb, {"M": _blocks(M, c), "X": _blocks(X2, c)}, lu)
+    for name, X in (("M", M), ("X", X2)):
+        T = np.vstack([np.eye(c.size), Psi])  # rows: contact, then interior
+        order = np.concatenate([c, i])
+        Xcc = T.T @ X[np.ix_(order, order)] @ T
+        assert rel(out.cc[name], Xcc) < 1e-7, name
+        assert out.differences[name].error < 1e-7
+    assert rel(out.cc["K"], ref) < 1e-12
+
+
+@pytest.mark.parametrize("dense", [True, False], ids=["front", "scattered"])
+def test_lower_product(dense):
+    """``L L^T`` of a lower triangle given by compressed columns, against NumPy's product
+    (rounding: 1e-13): a dense front (CHOLMOD's) and a pattern with holes."""
+    rng = np.random.default_rng(0)
+    m = 70
+    L = np.tril(rng.standard_normal((m, m)))
+    if not dense:
+        L[rng.random((m, m)) < 0.3] = 0.0
+        np.fill_diagonal(L, 1.0 + rng.random(m))
+    C = sp.csc_matrix(L) if not dense else sp.csc_matrix(np.where(np.tril(np.ones((m, m))),
+                                                                 L + 0.0, 0.0))
+    if dense:  # every entry of the triangle stored, as a dense front
+        rows = np.concatenate([np.arange(j, m) for j in range(m)])
+        ptr = np.concatenate([[0], np.cumsum(m - np.arange(m))])
+        vals = np.concatenate([L[j:, j] for j in range(m)])
+    else:
+        rows, ptr, vals = C.indices.astype(np.int64), C.indptr.astype(np.int64), C.data
+    assert rel(schur._lower_product(ptr, rows, vals, m), L @ L.T) < 1e-13
+
+
+def test_modal_condenser_chooses_the_path(monkeypatch):
+    """``modal_condenser`` takes the partial factorisations from SCHUR_MIN_CONTACT contact
+    DOFs on (lowered here to the block's), not with residual vectors, and says which path
+    ran; without CHOLMOD (forced off) it keeps the static modes, and the class refuses in
+    one line."""
+    model = block()
+    monkeypatch.setattr(modal, "SCHUR_MIN_CONTACT", 1)
+    sc = modal_condenser(model, F_MAX, 7, tol=1e-2)
+    assert isinstance(sc, SchurModalCondenser) and sc.path.startswith("partial")
+    mc = modal_condenser(model, F_MAX, 7, tol=1e-2, residual=True)
+    assert type(mc) is ModalCondenser and mc.path.startswith("static modes")
+    monkeypatch.setattr(modal, "SCHUR_MIN_CONTACT", 10**9)
+    assert type(modal_condenser(model, F_MAX, 7, tol=1e-2)) is ModalCondenser
+    monkeypatch.setattr(modal, "SCHUR_MIN_CONTACT", 1)
+    monkeypatch.setenv("FRETWEAR_SPARSE_LU", "superlu")
+    assert not schur.available()
+    assert type(modal_condenser(model, F_MAX, 7, tol=1e-2)) is ModalCondenser
+    with pytest.raises(InputError, match="needs CHOLMOD"):
+        SchurModalCondenser(model, F_MAX, 7, tol=1e-2)
+
+
+def test_modes_raised_as_the_dense_condenser():
+    """With ``raise_modes`` from two modes (the check fails there, test_modal.py), the
+    condenser by partial factorisations raises them as the dense one does and passes with
+    the same number of modes and the same error (to the difference's 1e-6 relative)."""
+    model = block()
+    a = ModalCondenser(model, F_MAX, 7, modes=2, tol=1e-2, raise_modes=True)
+    b = SchurModalCondenser(model, F_MAX, 7, modes=2, tol=1e-2, raise_modes=True)
+    assert a.n_modes == b.n_modes > 2
+    assert abs(a.error - b.error) <= 1e-6 * a.error <= 1e-2
+
+
+def test_periodic_solve_in_partial_slip_equals_the_static_modes_path():
+    """A periodic solve in partial slip through the condenser by partial factorisations
+    reaches the dense modal condenser's solution (1e-8: both stop at the solver's tolerance,
+    1e-9 of |Z U|, and Z_r differs by less than 1e-8)."""
+    model = block(traction=4.5e5)
+    basis = FourierBasis.up_to(3, 64)
+    out = []
+    for cls in (ModalCondenser, SchurModalCondenser):
+        c = cls(model, F_MAX, 7, tol=1e-2)
+        sol = solve_periodic(model, basis, frequency=12e3, condenser=c,
+                             anchor=static_anchor(model, condenser=c))
+        assert sol.success
+        out.append(sol)
+    assert 0.02 < out[1].state_fractions().mean(axis=0)[2] < 0.98  # partial slip
+    assert rel(out[1].U, out[0].U) < 1e-8
