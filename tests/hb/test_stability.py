@@ -31,6 +31,7 @@ from fretwear.hb.stability import (
     _companion_eigen,
     _components,
     _inverse_iteration,
+    _inverse_iteration_py,
     _pair,
     _pair_lapack,
     _shifted_copy,
@@ -331,6 +332,34 @@ def test_compiled_inverse_iteration_finds_the_dense_eigenvalue(monkeypatch):
         s2, _, ok2 = _inverse_iteration(B0, B1, B2, start, y0)
         monkeypatch.undo()
         assert ok2 and abs(s1 - s2) <= 1e-12 * max(1.0, abs(s2))
+
+
+def test_lapack_kernel_inverse_iteration_is_the_python_steps():
+    """``_inverse_iteration`` above ``PAIR_COMPILED_MAX`` unknowns (compiled, LAPACK's solve
+    called from the kernel) against the same steps from Python (``_inverse_iteration_py``,
+    ``zgetrf``/``zgetrs``) and the companion eigensolve, on a random quadratic problem of 60
+    coordinates from 1e-3 off three of its eigenvalues: the same eigenvalue within 1e-12 of
+    ``max(1, |s|)`` (both stop at a Newton step below 1e-14 of it; the eigenvalues are simple
+    and O(1) apart, so the rounding of the two LU orders stays at that level). At a singular
+    ``P(s)`` (``s`` an eigenvalue of a diagonal problem) it falls back on the Python steps,
+    which report no convergence instead of raising."""
+    rng = np.random.default_rng(11)
+    n = 60
+    B0, B1 = rng.standard_normal((2, n, n))
+    B2 = np.eye(n)
+    vals, Y = _companion_eigen(B0, B1, B2)
+    for i in np.argsort(-np.abs(vals.imag))[:6:2]:
+        start = vals[i] + 1e-3 * (1 + 1j)
+        y0 = Y[:, i] + 1e-3 * rng.standard_normal(n)
+        s1, x1, ok = _inverse_iteration(B0, B1, B2, start, y0)
+        s2, x2, ok2 = _inverse_iteration_py(B0 + 0j, B1 + 0j, B2 + 0j, start, y0 + 0j)
+        assert ok and ok2
+        assert abs(s1 - vals[i]) <= 1e-12 * max(1.0, abs(vals[i]))
+        assert abs(s1 - s2) <= 1e-12 * max(1.0, abs(s2))
+        assert abs(abs(np.vdot(x1, x2)) - 1.0) <= 1e-10
+    D = np.diag(np.arange(1.0, n + 1.0))  # P(0) = D - D singular: the Python steps' answer
+    s, _, ok = _inverse_iteration(-D, np.zeros((n, n)), D, 1.0, np.ones(n))
+    assert not ok and s == 1.0
 
 
 def test_hill_matrix_at_zero_is_the_solve_jacobian():
