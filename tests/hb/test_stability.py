@@ -202,6 +202,30 @@ def test_shifted_gain_at_zero_is_the_solve_s_gain():
     assert np.abs(G - ref).max() <= 1e-12 * np.abs(ref).max()
 
 
+@pytest.mark.parametrize("d", [2, 3])
+def test_shifted_gain_with_a_prescribed_normal_force(d):
+    """With a prescribed normal force (the normal row of every sample is the inverse
+    transform's, which ``_shifted_gain`` takes as ``P Q`` without the samples' product):
+    ``z = 1`` gives :func:`fretwear.hb.contact.dlft_jacobian` with the same ``normal`` (the
+    solve's recursion, every row by the samples) to rounding (1e-12), with stick and slip;
+    at ``z != 1`` the normal rows are ``z``-free (``P Q`` and zeros: no memory)."""
+    rng = np.random.default_rng(9)
+    basis = FourierBasis.up_to(3, 40)
+    P, Q = basis.matrices()
+    H = basis.size
+    lu = _samples(rng, 2, d, basis.n_samples)
+    mu = np.array([0.4, 0.6])
+    normal = 1.0 + 0.5 * np.cos(2 * np.pi * np.arange(basis.n_samples) / basis.n_samples)
+    normal = np.vstack([normal, 2.0 * normal])
+    lx, state, _ = law.dlft_time(lu, mu, np.zeros((2, d - 1)), 1e-14, 200, normal)
+    assert np.any(state == law.STICK) and np.any(state == law.SLIP)
+    ref = law.dlft_jacobian(lu, lx, state, mu, P, Q, normal=normal)
+    G = shifted_gain(lu, lx, state, mu, P, Q, 1.0, normal)
+    assert np.abs(G - ref).max() <= 1e-12 * np.abs(ref).max()
+    Gz = shifted_gain(lu, lx, state, mu, P, Q, np.exp(-0.3j), normal)
+    assert np.abs(Gz[:, :H, :H] - P @ Q).max() <= 1e-14 and np.all(Gz[:, :H, H:] == 0)
+
+
 # --- Hill's matrix and the exponents --------------------------------------------------------
 def _jenkins_hysteretic():
     """A Jenkins oscillator (m = k = 1, kt 0.5, mu N 0.5) with viscous and hysteretic
