@@ -273,6 +273,35 @@ def test_compiled_hill_matrix_is_its_parts(case, compiled, monkeypatch):
         assert np.abs(hp.matrix(sigma) - ref).max() <= 1e-13 * np.abs(ref).max()
 
 
+@pytest.mark.parametrize("case", ["jenkins-hysteretic", "unilateral-two-dof"])
+def test_compiled_refinement_step_is_its_parts(case):
+    """``HillProblem.evaluate`` (one compiled call: ``G(s)``, ``Z_r``, ``T(s)``, the pair
+    and the residuals) against ``matrix`` and ``_pair_lapack`` (LAPACK's LU, two solves)
+    with the residuals by numpy's norms: the eigenvalue estimate and the residuals to 1e-11
+    (``T`` within 1e-13 by the test above, then the same two solves amplified by the
+    conditioning of ``T - mu0 I``, as the compiled pair's test), ``T`` bit for bit (the same
+    kernels), at points of both half-planes and a shift."""
+    if case == "jenkins-hysteretic":
+        model, basis, w = _jenkins_hysteretic(), FourierBasis.up_to(5, 64), 1.18
+    else:
+        model, basis, w = two_dof(), FourierBasis.up_to(5, 64), 0.7
+    prob, hp = _hill_problem(model, basis, w / (2 * np.pi))
+    rng = np.random.default_rng(4)
+    for sigma, mu0 in ((0.3j, 0.0), (-0.02 + 0.47j, 0.01 - 0.02j), (0.1 - 0.2j, 0.0)):
+        v = rng.standard_normal(prob.m * prob.H) + 1j * rng.standard_normal(prob.m * prob.H)
+        count = hp.evaluations
+        T, mu, y, lu, res, pair = hp.evaluate(sigma, v, mu0)
+        assert lu is None and hp.evaluations == count + 1
+        T_ref = hp.matrix(sigma)
+        assert np.array_equal(T, T_ref)
+        mu_ref, y_ref, _ = _pair_lapack(T_ref, v, mu0)
+        scale = np.linalg.norm(T_ref, 1)
+        pair_ref = np.linalg.norm(T_ref @ y_ref - mu_ref * y_ref) / scale
+        assert abs(mu - mu_ref) <= 1e-11 * abs(mu_ref)
+        assert abs(pair - pair_ref) <= 1e-11 * max(pair_ref, 1e-3)
+        assert abs(res - max(abs(mu_ref) / scale, pair_ref)) <= 1e-11 * max(res, 1e-3)
+
+
 @pytest.mark.parametrize("case", ["jenkins-hysteretic", "unilateral-two-dof", "oscillator-2d"])
 def test_pencil_condensed_is_the_frozen_memory_hill_matrix(case):
     """``HillProblem.pencil`` (compiled) with its interior coordinates ``q`` eliminated (the

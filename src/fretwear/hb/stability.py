@@ -673,6 +673,34 @@ class HillProblem:
                              "interface)")
         return _hill_matrix(self.gain(sigma), Zr, float(self.prob.eps))
 
+    def evaluate(self, sigma: complex, v: np.ndarray, mu0: complex):
+        """One step of the refinement (:func:`_track`) at ``s = sigma w``: ``T(s)``, the
+        eigenpair ``(mu, y)`` of :func:`_pair` from ``v`` shifted by ``mu0``, and the
+        residuals ``|mu| / |T|``, ``|T y - mu y| / |T|`` (1-norm of ``T``). Returns
+        ``(T, mu, y, lu, res, pair)`` (``lu`` as :func:`_pair` returns it). On a small
+        problem (interior up to :data:`CONDENSED_COMPILED_MAX` coordinates, ``m H`` up to
+        :data:`PAIR_COMPILED_MAX`) in one compiled call (:func:`_evaluate`: ``G(s)``,
+        ``Z_r``, the product, the pair and the norms, the same kernels in the same order)."""
+        n = self.prob.m * self.prob.H
+        small = (n <= PAIR_COMPILED_MAX and sigma != 0
+                 and self._structure[0].shape[0] - self.prob.m <= CONDENSED_COMPILED_MAX)
+        if small:
+            mu_, P, Q, normal = self._law
+            T, mu, y, res, pair, ok = _evaluate(
+                *self._structure, self.prob.m, self.harmonics, self.omega, self.N, self.lu,
+                self.lx, self.state, mu_, P, Q, normal, float(self.prob.eps), complex(sigma),
+                np.ascontiguousarray(v, dtype=complex), complex(mu0))
+            if ok == 1:
+                self.evaluations += 1
+                return T, complex(mu), y, None, float(res), float(pair)
+            if ok == 0:  # the held structure singular: the message of matrix()
+                self.matrix(sigma)
+        T = self.matrix(sigma)  # (a zero pivot of the compiled pair: LAPACK's, as _pair)
+        scale = np.linalg.norm(T, 1)
+        mu, y, lu = _pair(T, v, mu0)
+        pair = float(np.linalg.norm(T @ y - mu * y) / scale)
+        return T, mu, y, lu, max(float(abs(mu) / scale), pair), pair
+
     def jacobian(self) -> np.ndarray:
         """``J = T(0)`` (m H, m H) real: the balance's Jacobian from the solve's own ``G``
         and its problem's ``Z~`` (eq. 22-28), not re-assembled from the structure (the same
@@ -1370,6 +1398,41 @@ def _pair_small(T, v, mu0, steps):
 
 
 @njit(cache=True)
+def _evaluate(Kf, Mf, Cf, Df, m, harmonics, omega, N, lu, lx, state, mu, P, Q, normal, eps,
+              sigma, v, mu0):
+    """:meth:`HillProblem.evaluate` compiled: ``G(s)`` (:func:`_shifted_gain`), ``Z_r``
+    (:func:`_condensed_at`), ``T(s)`` (:func:`_hill_matrix`), the pair
+    (:func:`_pair_small`, two solves) and the residuals. Returns ``(T, mu, y, res, pair,
+    ok)``: ``ok`` 1, 0 where the held structure is singular, -1 at a zero pivot of the
+    pair."""
+    z = np.exp(-2.0 * np.pi * sigma / N)
+    G = _shifted_gain(lu, lx, state, mu, P, Q, z, normal)
+    Zr, good = _condensed_at(Kf, Mf, Cf, Df, m, harmonics, omega, sigma)
+    if not good:
+        return np.zeros((1, 1), dtype=np.complex128), 0j, v, np.inf, np.inf, 0
+    T = _hill_matrix(G, Zr, eps)
+    ev, y, good = _pair_small(T, v, mu0, 2)
+    if not good:
+        return T, 0j, v, np.inf, np.inf, -1
+    n = T.shape[0]
+    scale = 0.0
+    for j in range(n):
+        col = 0.0
+        for i in range(n):
+            col += abs(T[i, j])
+        scale = max(scale, col)
+    r2 = 0.0
+    for i in range(n):
+        acc = 0j
+        for j in range(n):
+            acc += T[i, j] * y[j]
+        acc -= ev * y[i]
+        r2 += acc.real * acc.real + acc.imag * acc.imag
+    pair = np.sqrt(r2) / scale
+    return T, ev, y, max(abs(ev) / scale, pair), pair, 1
+
+
+@njit(cache=True)
 def _ruhe_small(B0, B1, B2, sigma, y, max_iter):
     """:func:`_inverse_iteration` compiled (the same steps, the LU by :func:`_lu_small`):
     ``(sigma, y, converged)``."""
@@ -1510,11 +1573,7 @@ def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions,
         if abs(sigma - start) > 0.5 or 2.0 * np.pi * sigma.real < np.log(NEGLIGIBLE) or (
                 deflate is not None and abs(sigma - deflate) <= ON_REAL):
             break  # left the neighbourhood of the candidate (or back on the root deflated)
-        T = hp.matrix(sigma)
-        scale = np.linalg.norm(T, 1)
-        mu, v, lu = _pair(T, v, mu0)
-        pair = float(np.linalg.norm(T @ v - mu * v) / scale)
-        res = max(float(abs(mu) / scale), pair)
+        T, mu, v, lu, res, pair = hp.evaluate(sigma, v, mu0)
         if res <= opt.newton_tol:
             return sigma, v, res, True, slope
         f = mu if deflate is None else mu / (sigma - deflate)
