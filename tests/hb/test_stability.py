@@ -39,6 +39,7 @@ from fretwear.hb.stability import (
     jacobian_form,
     problem_of,
     quadratic_eigen,
+    reduce_quadratic,
     shifted_gain,
     stability,
 )
@@ -572,6 +573,35 @@ def test_shifted_copy_moves_the_coefficients_by_one_harmonic():
         np.testing.assert_allclose(got, ref / np.linalg.norm(ref), rtol=0, atol=1e-14)
         assert centroid(got.reshape(2, H), k) == pytest.approx(
             centroid(y.reshape(2, H), k) - side, abs=1e-12)
+
+
+@pytest.mark.parametrize("diagonal", [True, False])
+def test_algebraic_coordinates_eliminated_by_the_schur_complement(diagonal):
+    """``reduce_quadratic`` on 30 coordinates of which 12 (scattered) have no mass nor
+    damping: ``B0`` is the Schur complement ``A0[d, d] - A0[d, a] A0[a, a]^-1 A0[a, d]``
+    formed by numpy's solve and product, ``back`` its ``-A0[a, a]^-1 A0[a, d]``, to 1e-13
+    (the compiled elimination over the nonzero terms when ``A0[a, a]`` is diagonal,
+    LAPACK's solve when not: the same terms summed in another order; the pivots are O(1)
+    apart from zero), and ``B1``, ``B2`` the rows and columns of ``d`` exactly."""
+    rng = np.random.default_rng(8)
+    n = 30
+    alg = np.sort(rng.choice(n, 12, replace=False))
+    dyn = np.setdiff1d(np.arange(n), alg)
+    A0 = rng.standard_normal((n, n))
+    A0[np.ix_(alg, alg)] = np.diag(2.0 + rng.random(12)) if diagonal else (
+        3.0 * np.eye(12) + 0.3 * rng.standard_normal((12, 12)))
+    A0[np.ix_(dyn, alg)] *= rng.random((dyn.size, 12)) < 0.3  # sparse couplings
+    A1, A2 = np.zeros((n, n)), np.zeros((n, n))
+    A1[np.ix_(dyn, dyn)] = rng.standard_normal((dyn.size, dyn.size))
+    A2[np.ix_(dyn, dyn)] = np.eye(dyn.size)
+    red = reduce_quadratic(A0, A1, A2)
+    assert np.array_equal(red.dyn, dyn) and np.array_equal(red.alg, alg)
+    back = -np.linalg.solve(A0[np.ix_(alg, alg)], A0[np.ix_(alg, dyn)])
+    ref = A0[np.ix_(dyn, dyn)] + A0[np.ix_(dyn, alg)] @ back
+    assert np.abs(red.back - back).max() <= 1e-13 * np.abs(back).max()
+    assert np.abs(red.B0 - ref).max() <= 1e-13 * np.abs(ref).max()
+    assert np.array_equal(red.B1, A1[np.ix_(dyn, dyn)])
+    assert np.array_equal(red.B2, A2[np.ix_(dyn, dyn)])
 
 
 def test_quadratic_problem_split_into_its_blocks_keeps_every_eigenpair():

@@ -888,39 +888,101 @@ def reduce_quadratic(A0: np.ndarray, A1: np.ndarray, A2: np.ndarray,
     behind springs, rows the law holds) are algebraic: eliminated exactly by the Schur
     complement of ``A0`` (their blocks do not depend on ``s``); the rest split into the blocks
     it decouples into (:func:`_components`; ``hint``: a neighbour's, kept when the problem
-    decouples into them by the same test, which costs less than finding them)."""
-    n = A0.shape[0]
-    moving = (A1 != 0) | (A2 != 0)
-    has = np.any(moving, axis=1) | np.any(moving, axis=0)
-    dyn_, alg = np.flatnonzero(has), np.flatnonzero(~has)  # both sorted, as setdiff1d's
-    B0, B1, B2 = (X[np.ix_(dyn_, dyn_)] for X in (A0, A1, A2))
-    back = None
-    if alg.size:
+    decouples into them by the same test, which costs less than finding them). Where the
+    algebraic block of ``A0`` is diagonal (the contact points' own rows: the two-DOF
+    oscillator's 62 of 155 coordinates) the elimination runs compiled, over the nonzero
+    couplings (:func:`_reduce_diagonal`: 0.65 -> 0.2 ms there, the same Schur complement
+    summed over its nonzero terms only)."""
+    dyn_, alg, B0, B1, B2, back, done = _reduce_diagonal(A0, A1, A2)
+    if alg.size and not done:
         try:
             back = -np.linalg.solve(A0[np.ix_(alg, alg)], A0[np.ix_(alg, dyn_)])
         except np.linalg.LinAlgError:
             back = -np.linalg.lstsq(A0[np.ix_(alg, alg)], A0[np.ix_(alg, dyn_)],
                                     rcond=None)[0]
         B0 = B0 + A0[np.ix_(dyn_, alg)] @ back
+    if not alg.size:
+        back = None
     blocks = None
-    if hint is not None and np.array_equal(hint.dyn, dyn_):
+    if dyn_.size <= MIN_BLOCK:  # _components' answer, whatever the hint
+        blocks = [np.arange(dyn_.size)] if dyn_.size else []
+    elif hint is not None and np.array_equal(hint.dyn, dyn_):
         blocks = hint.blocks if _decouples(B0, B1, B2, hint.blocks) else None
     if blocks is None:
         blocks = _components(B0, B1, B2) if dyn_.size else []
-    return QuadraticReduction(n, dyn_, alg, back, B0, B1, B2, blocks)
+    return QuadraticReduction(A0.shape[0], dyn_, alg, back, B0, B1, B2, blocks)
+
+
+@njit(cache=True)
+def _reduce_diagonal(A0, A1, A2):
+    """:func:`reduce_quadratic`'s coordinate sets ``dyn`` (a row or column of ``A1`` or
+    ``A2`` nonzero) and ``alg``, the three matrices on ``dyn``, and where ``A0``'s algebraic
+    block is diagonal with no zero on it, the elimination: ``back = -A0[alg, alg]^-1
+    A0[alg, dyn]`` and ``B0 += A0[dyn, alg] back`` over the nonzero entries of
+    ``A0[dyn, alg]``. Returns ``(dyn, alg, B0, B1, B2, back, done)``; ``done`` False (``B0``
+    not yet reduced) where the block is not diagonal."""
+    n = A0.shape[0]
+    has = np.zeros(n, dtype=np.bool_)
+    for i in range(n):
+        for j in range(n):
+            if A1[i, j] != 0 or A2[i, j] != 0:
+                has[i] = True
+                has[j] = True
+    dyn = np.flatnonzero(has)
+    alg = np.flatnonzero(~has)
+    nd, na = dyn.size, alg.size
+    B0 = np.empty((nd, nd))
+    B1 = np.empty((nd, nd))
+    B2 = np.empty((nd, nd))
+    for a in range(nd):
+        for b in range(nd):
+            B0[a, b] = A0[dyn[a], dyn[b]]
+            B1[a, b] = A1[dyn[a], dyn[b]]
+            B2[a, b] = A2[dyn[a], dyn[b]]
+    back = np.zeros((na, nd))
+    for a in range(na):
+        if A0[alg[a], alg[a]] == 0:
+            return dyn, alg, B0, B1, B2, back, na == 0
+        for b in range(na):
+            if a != b and A0[alg[a], alg[b]] != 0:
+                return dyn, alg, B0, B1, B2, back, False
+    for a in range(na):
+        piv = A0[alg[a], alg[a]]
+        for b in range(nd):
+            back[a, b] = -(A0[alg[a], dyn[b]] / piv)
+    for i in range(nd):
+        for a in range(na):
+            f = A0[dyn[i], alg[a]]
+            if f != 0:
+                for b in range(nd):
+                    B0[i, b] += f * back[a, b]
+    return dyn, alg, B0, B1, B2, back, True
 
 
 def _decouples(B0: np.ndarray, B1: np.ndarray, B2: np.ndarray, blocks: list) -> bool:
     """Whether ``B0 + s B1 + s^2 B2`` has no entry coupling two of ``blocks`` (the test of
     :func:`_components`: none above :data:`DECOUPLED_TOL` times the largest of its matrix)."""
-    label = np.empty(B0.shape[0], dtype=int)
+    label = np.empty(B0.shape[0], dtype=np.int64)
     for i, b in enumerate(blocks):
         label[b] = i
-    off = label[:, None] != label[None, :]
-    for X in (B0, B1, B2):
-        big = np.abs(X).max(initial=0.0)
-        if big > 0 and np.any(np.abs(X[off]) > DECOUPLED_TOL * big):
-            return False
+    return all(_decoupled(X, label, DECOUPLED_TOL) for X in (B0, B1, B2))
+
+
+@njit(cache=True)
+def _decoupled(X, label, tol):
+    """No entry of ``X`` between coordinates of different ``label`` above ``tol`` times
+    its largest (:func:`_decouples` compiled, one matrix)."""
+    n = X.shape[0]
+    big = 0.0
+    for i in range(n):
+        for j in range(n):
+            big = max(big, abs(X[i, j]))
+    if big == 0:
+        return True
+    for i in range(n):
+        for j in range(n):
+            if label[i] != label[j] and abs(X[i, j]) > tol * big:
+                return False
     return True
 
 
