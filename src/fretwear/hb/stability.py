@@ -1283,18 +1283,17 @@ def _track_record(red: QuadraticReduction, vals: np.ndarray, vecs: np.ndarray,
     magnitude cut ``cut``, or one spread over two blocks)."""
     if red.dyn.size == 0 or np.any(edge) or np.any(np.abs(kap) > 0.5):
         return None
-    line = np.array([_on_line(v) for v in vals], dtype=object)
-    if np.any(np.abs(vals) > 0.9 * cut) or np.any(line == None):  # noqa: E711
+    line = [_on_line(complex(v)) for v in vals]
+    if np.any(np.abs(vals) > 0.9 * cut) or None in line:
         return None
     real = np.abs(vals.imag) <= 1e-12 * np.maximum(np.abs(vals), 1.0)
-    families = int(np.sum(np.where(real | (line == "on"), 1, 2)))
+    families = sum(1 if (r or ln == "on") else 2 for r, ln in zip(real, line, strict=True))
     Y = vecs[red.dyn]
-    block = np.empty(vals.size, dtype=int)
-    for j in range(vals.size):
-        share = [np.linalg.norm(Y[c, j]) for c in red.blocks]
-        block[j] = int(np.argmax(share))
-        if share[block[j]] < (1.0 - 1e-12) * np.linalg.norm(Y[:, j]):
-            return None
+    sq = Y.real ** 2 + Y.imag ** 2  # each member's share of each block (squared norms)
+    share = np.array([sq[c].sum(axis=0) for c in red.blocks]).reshape(len(red.blocks), vals.size)
+    block = np.argmax(share, axis=0)
+    if np.any(share[block, np.arange(vals.size)] < (1.0 - 1e-12) ** 2 * sq.sum(axis=0)):
+        return None
     complete = 2 * red.dyn.size == families * H
     return HillTrack(vals.copy(), Y.copy(), block, red.dyn.size, red.dyn.copy(),
                      [b.copy() for b in red.blocks], complete)
