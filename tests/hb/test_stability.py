@@ -275,13 +275,13 @@ def test_compiled_hill_matrix_is_its_parts(case, compiled, monkeypatch):
 
 
 @pytest.mark.parametrize("case", ["jenkins-hysteretic", "unilateral-two-dof"])
-def test_compiled_refinement_step_is_its_parts(case):
-    """``HillProblem.evaluate`` (one compiled call: ``G(s)``, ``Z_r``, ``T(s)``, the pair
-    and the residuals) against ``matrix`` and ``_pair_lapack`` (LAPACK's LU, two solves)
-    with the residuals by numpy's norms: the eigenvalue estimate and the residuals to 1e-11
-    (``T`` within 1e-13 by the test above, then the same two solves amplified by the
-    conditioning of ``T - mu0 I``, as the compiled pair's test), ``T`` bit for bit (the same
-    kernels), at points of both half-planes and a shift."""
+def test_refinement_step_is_its_parts(case):
+    """``HillProblem.evaluate`` (``T(s)``, the compiled pair and the compiled residuals)
+    against ``matrix`` and ``_pair_lapack`` (LAPACK's LU, two solves) with the residuals by
+    numpy's norms: the eigenvalue estimate and the residuals to 1e-11 (the same two solves
+    in another elimination order, amplified by the conditioning of ``T - mu0 I``, as the
+    compiled pair's test), ``T`` bit for bit (the same kernels), at points of both
+    half-planes and a shift."""
     if case == "jenkins-hysteretic":
         model, basis, w = _jenkins_hysteretic(), FourierBasis.up_to(5, 64), 1.18
     else:

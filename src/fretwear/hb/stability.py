@@ -89,8 +89,8 @@ exponent (3-5 from a neighbour's exponent, 4-9 from a candidate); along a sweep,
 candidates are tracked, a few LU factorisations of the blocks of the quadratic problem per
 candidate instead of its dense eigensolve. ``det J`` is read from the solve's own ``G`` and
 ``Z~`` (:meth:`HillProblem.jacobian`). Measured on the benchmark's small models
-(docs/studies/method-costs.md, "Hill's method"): about 1.2-2.2 times a warm-started point's
-solve along a sweep, which hands each point's own problem
+(docs/studies/method-costs.md, "Hill's method"): about 1.5-2 times the CPU a sweep spends
+on the point (median), along a sweep, which hands each point's own problem
 (:func:`fretwear.hb.sweep_stability.point_problem`; :func:`stability` rebuilds it from the
 solution, about 1.1-1.5 ms more there); the evaluations of ``T(s)`` (a law with a memory),
 the inverse iterations of the tracked candidates and the dense eigensolve at the points that
@@ -674,30 +674,17 @@ class HillProblem:
         return _hill_matrix(self.gain(sigma), Zr, float(self.prob.eps))
 
     def evaluate(self, sigma: complex, v: np.ndarray, mu0: complex):
-        """One step of the refinement (:func:`_track`) at ``s = sigma w``: ``T(s)``, the
-        eigenpair ``(mu, y)`` of :func:`_pair` from ``v`` shifted by ``mu0``, and the
-        residuals ``|mu| / |T|``, ``|T y - mu y| / |T|`` (1-norm of ``T``). Returns
-        ``(T, mu, y, lu, res, pair)`` (``lu`` as :func:`_pair` returns it). On a small
-        problem (interior up to :data:`CONDENSED_COMPILED_MAX` coordinates, ``m H`` up to
-        :data:`PAIR_COMPILED_MAX`) in one compiled call (:func:`_evaluate`: ``G(s)``,
-        ``Z_r``, the product, the pair and the norms, the same kernels in the same order)."""
-        n = self.prob.m * self.prob.H
-        small = (n <= PAIR_COMPILED_MAX and sigma != 0
-                 and self._structure[0].shape[0] - self.prob.m <= CONDENSED_COMPILED_MAX)
-        if small:
-            mu_, P, Q, normal = self._law
-            T, mu, y, res, pair, ok = _evaluate(
-                *self._structure, self.prob.m, self.harmonics, self.omega, self.N, self.lu,
-                self.lx, self.state, mu_, P, Q, normal, float(self.prob.eps), complex(sigma),
-                np.ascontiguousarray(v, dtype=complex), complex(mu0))
-            if ok == 1:
-                self.evaluations += 1
-                return T, complex(mu), y, None, float(res), float(pair)
-            if ok == 0:  # the held structure singular: the message of matrix()
-                self.matrix(sigma)
-        T = self.matrix(sigma)  # (a zero pivot of the compiled pair: LAPACK's, as _pair)
-        scale = np.linalg.norm(T, 1)
+        """One step of the refinement (:func:`_track`) at ``s = sigma w``: ``T(s)``
+        (:meth:`matrix`), the eigenpair ``(mu, y)`` of :func:`_pair` from ``v`` shifted by
+        ``mu0``, and the residuals ``|mu| / |T|``, ``|T y - mu y| / |T|`` (1-norm of ``T``;
+        compiled, :func:`_residuals`, where the pair ran compiled). Returns
+        ``(T, mu, y, lu, res, pair)`` (``lu`` as :func:`_pair` returns it)."""
+        T = self.matrix(sigma)
         mu, y, lu = _pair(T, v, mu0)
+        if lu is None:
+            res, pair = _residuals(T, y, complex(mu))
+            return T, mu, y, None, float(res), float(pair)
+        scale = np.linalg.norm(T, 1)
         pair = float(np.linalg.norm(T @ y - mu * y) / scale)
         return T, mu, y, lu, max(float(abs(mu) / scale), pair), pair
 
@@ -1459,22 +1446,9 @@ def _pair_small(T, v, mu0, steps):
 
 
 @njit(cache=True)
-def _evaluate(Kf, Mf, Cf, Df, m, harmonics, omega, N, lu, lx, state, mu, P, Q, normal, eps,
-              sigma, v, mu0):
-    """:meth:`HillProblem.evaluate` compiled: ``G(s)`` (:func:`_shifted_gain`), ``Z_r``
-    (:func:`_condensed_at`), ``T(s)`` (:func:`_hill_matrix`), the pair
-    (:func:`_pair_small`, two solves) and the residuals. Returns ``(T, mu, y, res, pair,
-    ok)``: ``ok`` 1, 0 where the held structure is singular, -1 at a zero pivot of the
-    pair."""
-    z = np.exp(-2.0 * np.pi * sigma / N)
-    G = _shifted_gain(lu, lx, state, mu, P, Q, z, normal)
-    Zr, good = _condensed_at(Kf, Mf, Cf, Df, m, harmonics, omega, sigma)
-    if not good:
-        return np.zeros((1, 1), dtype=np.complex128), 0j, v, np.inf, np.inf, 0
-    T = _hill_matrix(G, Zr, eps)
-    ev, y, good = _pair_small(T, v, mu0, 2)
-    if not good:
-        return T, 0j, v, np.inf, np.inf, -1
+def _residuals(T, y, mu):
+    """``(max(|mu|, |T y - mu y|) / |T|, |T y - mu y| / |T|)`` with the 1-norm of ``T``
+    (:meth:`HillProblem.evaluate`: the stopping rule of :func:`_track`) in one call."""
     n = T.shape[0]
     scale = 0.0
     for j in range(n):
@@ -1487,10 +1461,10 @@ def _evaluate(Kf, Mf, Cf, Df, m, harmonics, omega, N, lu, lx, state, mu, P, Q, n
         acc = 0j
         for j in range(n):
             acc += T[i, j] * y[j]
-        acc -= ev * y[i]
+        acc -= mu * y[i]
         r2 += acc.real * acc.real + acc.imag * acc.imag
     pair = np.sqrt(r2) / scale
-    return T, ev, y, max(abs(ev) / scale, pair), pair, 1
+    return max(abs(mu) / scale, pair), pair
 
 
 @njit(cache=True)
