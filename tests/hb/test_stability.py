@@ -31,6 +31,7 @@ from fretwear.hb.stability import (
     _companion_eigen,
     _components,
     _inverse_iteration,
+    _inverse_iteration_py,
     _pair,
     _pair_lapack,
     _shifted_copy,
@@ -38,6 +39,7 @@ from fretwear.hb.stability import (
     jacobian_form,
     problem_of,
     quadratic_eigen,
+    reduce_quadratic,
     shifted_gain,
     stability,
 )
@@ -201,6 +203,30 @@ def test_shifted_gain_at_zero_is_the_solve_s_gain():
     assert np.abs(G - ref).max() <= 1e-12 * np.abs(ref).max()
 
 
+@pytest.mark.parametrize("d", [2, 3])
+def test_shifted_gain_with_a_prescribed_normal_force(d):
+    """With a prescribed normal force (the normal row of every sample is the inverse
+    transform's, which ``_shifted_gain`` takes as ``P Q`` without the samples' product):
+    ``z = 1`` gives :func:`fretwear.hb.contact.dlft_jacobian` with the same ``normal`` (the
+    solve's recursion, every row by the samples) to rounding (1e-12), with stick and slip;
+    at ``z != 1`` the normal rows are ``z``-free (``P Q`` and zeros: no memory)."""
+    rng = np.random.default_rng(9)
+    basis = FourierBasis.up_to(3, 40)
+    P, Q = basis.matrices()
+    H = basis.size
+    lu = _samples(rng, 2, d, basis.n_samples)
+    mu = np.array([0.4, 0.6])
+    normal = 1.0 + 0.5 * np.cos(2 * np.pi * np.arange(basis.n_samples) / basis.n_samples)
+    normal = np.vstack([normal, 2.0 * normal])
+    lx, state, _ = law.dlft_time(lu, mu, np.zeros((2, d - 1)), 1e-14, 200, normal)
+    assert np.any(state == law.STICK) and np.any(state == law.SLIP)
+    ref = law.dlft_jacobian(lu, lx, state, mu, P, Q, normal=normal)
+    G = shifted_gain(lu, lx, state, mu, P, Q, 1.0, normal)
+    assert np.abs(G - ref).max() <= 1e-12 * np.abs(ref).max()
+    Gz = shifted_gain(lu, lx, state, mu, P, Q, np.exp(-0.3j), normal)
+    assert np.abs(Gz[:, :H, :H] - P @ Q).max() <= 1e-14 and np.all(Gz[:, :H, H:] == 0)
+
+
 # --- Hill's matrix and the exponents --------------------------------------------------------
 def _jenkins_hysteretic():
     """A Jenkins oscillator (m = k = 1, kt 0.5, mu N 0.5) with viscous and hysteretic
@@ -246,6 +272,35 @@ def test_compiled_hill_matrix_is_its_parts(case, compiled, monkeypatch):
     for sigma in (0.0, 0.3j, -0.02 + 0.47j, 0.1 - 0.2j):
         ref = jacobian_form(hp.gain(sigma), hp.stiffness(sigma), prob.eps)
         assert np.abs(hp.matrix(sigma) - ref).max() <= 1e-13 * np.abs(ref).max()
+
+
+@pytest.mark.parametrize("case", ["jenkins-hysteretic", "unilateral-two-dof"])
+def test_refinement_step_is_its_parts(case):
+    """``HillProblem.evaluate`` (``T(s)``, the compiled pair and the compiled residuals)
+    against ``matrix`` and ``_pair_lapack`` (LAPACK's LU, two solves) with the residuals by
+    numpy's norms: the eigenvalue estimate and the residuals to 1e-11 (the same two solves
+    in another elimination order, amplified by the conditioning of ``T - mu0 I``, as the
+    compiled pair's test), ``T`` bit for bit (the same kernels), at points of both
+    half-planes and a shift."""
+    if case == "jenkins-hysteretic":
+        model, basis, w = _jenkins_hysteretic(), FourierBasis.up_to(5, 64), 1.18
+    else:
+        model, basis, w = two_dof(), FourierBasis.up_to(5, 64), 0.7
+    prob, hp = _hill_problem(model, basis, w / (2 * np.pi))
+    rng = np.random.default_rng(4)
+    for sigma, mu0 in ((0.3j, 0.0), (-0.02 + 0.47j, 0.01 - 0.02j), (0.1 - 0.2j, 0.0)):
+        v = rng.standard_normal(prob.m * prob.H) + 1j * rng.standard_normal(prob.m * prob.H)
+        count = hp.evaluations
+        T, mu, y, lu, res, pair = hp.evaluate(sigma, v, mu0)
+        assert lu is None and hp.evaluations == count + 1
+        T_ref = hp.matrix(sigma)
+        assert np.array_equal(T, T_ref)
+        mu_ref, y_ref, _ = _pair_lapack(T_ref, v, mu0)
+        scale = np.linalg.norm(T_ref, 1)
+        pair_ref = np.linalg.norm(T_ref @ y_ref - mu_ref * y_ref) / scale
+        assert abs(mu - mu_ref) <= 1e-11 * abs(mu_ref)
+        assert abs(pair - pair_ref) <= 1e-11 * max(pair_ref, 1e-3)
+        assert abs(res - max(abs(mu_ref) / scale, pair_ref)) <= 1e-11 * max(res, 1e-3)
 
 
 @pytest.mark.parametrize("case", ["jenkins-hysteretic", "unilateral-two-dof", "oscillator-2d"])
@@ -331,6 +386,34 @@ def test_compiled_inverse_iteration_finds_the_dense_eigenvalue(monkeypatch):
         s2, _, ok2 = _inverse_iteration(B0, B1, B2, start, y0)
         monkeypatch.undo()
         assert ok2 and abs(s1 - s2) <= 1e-12 * max(1.0, abs(s2))
+
+
+def test_lapack_kernel_inverse_iteration_is_the_python_steps():
+    """``_inverse_iteration`` above ``PAIR_COMPILED_MAX`` unknowns (compiled, LAPACK's solve
+    called from the kernel) against the same steps from Python (``_inverse_iteration_py``,
+    ``zgetrf``/``zgetrs``) and the companion eigensolve, on a random quadratic problem of 60
+    coordinates from 1e-3 off three of its eigenvalues: the same eigenvalue within 1e-12 of
+    ``max(1, |s|)`` (both stop at a Newton step below 1e-14 of it; the eigenvalues are simple
+    and O(1) apart, so the rounding of the two LU orders stays at that level). At a singular
+    ``P(s)`` (``s`` an eigenvalue of a diagonal problem) it falls back on the Python steps,
+    which report no convergence instead of raising."""
+    rng = np.random.default_rng(11)
+    n = 60
+    B0, B1 = rng.standard_normal((2, n, n))
+    B2 = np.eye(n)
+    vals, Y = _companion_eigen(B0, B1, B2)
+    for i in np.argsort(-np.abs(vals.imag))[:6:2]:
+        start = vals[i] + 1e-3 * (1 + 1j)
+        y0 = Y[:, i] + 1e-3 * rng.standard_normal(n)
+        s1, x1, ok = _inverse_iteration(B0, B1, B2, start, y0)
+        s2, x2, ok2 = _inverse_iteration_py(B0 + 0j, B1 + 0j, B2 + 0j, start, y0 + 0j)
+        assert ok and ok2
+        assert abs(s1 - vals[i]) <= 1e-12 * max(1.0, abs(vals[i]))
+        assert abs(s1 - s2) <= 1e-12 * max(1.0, abs(s2))
+        assert abs(abs(np.vdot(x1, x2)) - 1.0) <= 1e-10
+    D = np.diag(np.arange(1.0, n + 1.0))  # P(0) = D - D singular: the Python steps' answer
+    s, _, ok = _inverse_iteration(-D, np.zeros((n, n)), D, 1.0, np.ones(n))
+    assert not ok and s == 1.0
 
 
 def test_hill_matrix_at_zero_is_the_solve_jacobian():
@@ -490,6 +573,35 @@ def test_shifted_copy_moves_the_coefficients_by_one_harmonic():
         np.testing.assert_allclose(got, ref / np.linalg.norm(ref), rtol=0, atol=1e-14)
         assert centroid(got.reshape(2, H), k) == pytest.approx(
             centroid(y.reshape(2, H), k) - side, abs=1e-12)
+
+
+@pytest.mark.parametrize("diagonal", [True, False])
+def test_algebraic_coordinates_eliminated_by_the_schur_complement(diagonal):
+    """``reduce_quadratic`` on 30 coordinates of which 12 (scattered) have no mass nor
+    damping: ``B0`` is the Schur complement ``A0[d, d] - A0[d, a] A0[a, a]^-1 A0[a, d]``
+    formed by numpy's solve and product, ``back`` its ``-A0[a, a]^-1 A0[a, d]``, to 1e-13
+    (the compiled elimination over the nonzero terms when ``A0[a, a]`` is diagonal,
+    LAPACK's solve when not: the same terms summed in another order; the pivots are O(1)
+    apart from zero), and ``B1``, ``B2`` the rows and columns of ``d`` exactly."""
+    rng = np.random.default_rng(8)
+    n = 30
+    alg = np.sort(rng.choice(n, 12, replace=False))
+    dyn = np.setdiff1d(np.arange(n), alg)
+    A0 = rng.standard_normal((n, n))
+    A0[np.ix_(alg, alg)] = np.diag(2.0 + rng.random(12)) if diagonal else (
+        3.0 * np.eye(12) + 0.3 * rng.standard_normal((12, 12)))
+    A0[np.ix_(dyn, alg)] *= rng.random((dyn.size, 12)) < 0.3  # sparse couplings
+    A1, A2 = np.zeros((n, n)), np.zeros((n, n))
+    A1[np.ix_(dyn, dyn)] = rng.standard_normal((dyn.size, dyn.size))
+    A2[np.ix_(dyn, dyn)] = np.eye(dyn.size)
+    red = reduce_quadratic(A0, A1, A2)
+    assert np.array_equal(red.dyn, dyn) and np.array_equal(red.alg, alg)
+    back = -np.linalg.solve(A0[np.ix_(alg, alg)], A0[np.ix_(alg, dyn)])
+    ref = A0[np.ix_(dyn, dyn)] + A0[np.ix_(dyn, alg)] @ back
+    assert np.abs(red.back - back).max() <= 1e-13 * np.abs(back).max()
+    assert np.abs(red.B0 - ref).max() <= 1e-13 * np.abs(ref).max()
+    assert np.array_equal(red.B1, A1[np.ix_(dyn, dyn)])
+    assert np.array_equal(red.B2, A2[np.ix_(dyn, dyn)])
 
 
 def test_quadratic_problem_split_into_its_blocks_keeps_every_eigenpair():

@@ -89,8 +89,8 @@ exponent (3-5 from a neighbour's exponent, 4-9 from a candidate); along a sweep,
 candidates are tracked, a few LU factorisations of the blocks of the quadratic problem per
 candidate instead of its dense eigensolve. ``det J`` is read from the solve's own ``G`` and
 ``Z~`` (:meth:`HillProblem.jacobian`). Measured on the benchmark's small models
-(docs/studies/method-costs.md, "Hill's method"): about 1.2-2.2 times a warm-started point's
-solve along a sweep, which hands each point's own problem
+(docs/studies/method-costs.md, "Hill's method"): about 1.5-2 times the CPU a sweep spends
+on the point (median), along a sweep, which hands each point's own problem
 (:func:`fretwear.hb.sweep_stability.point_problem`; :func:`stability` rebuilds it from the
 solution, about 1.1-1.5 ms more there); the evaluations of ``T(s)`` (a law with a memory),
 the inverse iterations of the tracked candidates and the dense eigensolve at the points that
@@ -338,13 +338,17 @@ def _shifted_gain(lam_u, lam_x, state, mu, P, Q, z, normal):
     G = np.zeros((nc, dH, dH), dtype=np.complex128)
     A0 = np.zeros((d, dH), dtype=np.complex128)
     S = np.zeros((d, dt), dtype=np.complex128)
-    Abuf = np.empty((d, N, dH), dtype=np.complex128)
-    Sbuf = np.empty((d, N, dt), dtype=np.complex128)
+    # the samples' rows, real and imaginary parts apart: P is real, so P times each is
+    # half the flops of a complex product, a quarter of the complex P's
+    Are = np.empty((d, N, dH))
+    Aim = np.empty((d, N, dH))
+    Sre = np.empty((d, N, dt))
+    Sim = np.empty((d, N, dt))
     tmpA = np.zeros((dt, dH), dtype=np.complex128)
     tmpS = np.zeros((dt, dt), dtype=np.complex128)
     that = np.zeros(dt)
     B = np.zeros((dt, dt))
-    Pc = np.ascontiguousarray(P).astype(np.complex128)
+    Pr = np.ascontiguousarray(P)
     for p in range(nc):
         A0[:, :] = 0.0
         S[:, :] = 0.0
@@ -404,14 +408,20 @@ def _shifted_gain(lam_u, lam_x, state, mu, P, Q, z, normal):
                         A0[0, h] = Q[n, h]
             for c in range(d):
                 for j in range(dH):
-                    Abuf[c, n, j] = A0[c, j]
+                    Are[c, n, j] = A0[c, j].real
+                    Aim[c, n, j] = A0[c, j].imag
                 for j in range(dt):
-                    Sbuf[c, n, j] = S[c, j]
+                    Sre[c, n, j] = S[c, j].real
+                    Sim[c, n, j] = S[c, j].imag
         Gp = G[p]
         PS = np.zeros((dH, dt), dtype=np.complex128)
         for c in range(d):
-            Gp[c * H:(c + 1) * H, :] = np.dot(Pc, Abuf[c])
-            PS[c * H:(c + 1) * H, :] = np.dot(Pc, Sbuf[c])
+            if c == 0 and fixed:  # a prescribed normal force: the normal row of every
+                # sample is Q's (no memory, S's row zero), so P times it is P Q
+                Gp[:H, :H] = np.dot(Pr, Q)
+                continue
+            Gp[c * H:(c + 1) * H, :] = np.dot(Pr, Are[c]) + 1j * np.dot(Pr, Aim[c])
+            PS[c * H:(c + 1) * H, :] = np.dot(Pr, Sre[c]) + 1j * np.dot(Pr, Sim[c])
         Mw = np.eye(dt).astype(np.complex128)
         for a in range(dt):
             for b in range(dt):
@@ -663,6 +673,21 @@ class HillProblem:
                              "interface)")
         return _hill_matrix(self.gain(sigma), Zr, float(self.prob.eps))
 
+    def evaluate(self, sigma: complex, v: np.ndarray, mu0: complex):
+        """One step of the refinement (:func:`_track`) at ``s = sigma w``: ``T(s)``
+        (:meth:`matrix`), the eigenpair ``(mu, y)`` of :func:`_pair` from ``v`` shifted by
+        ``mu0``, and the residuals ``|mu| / |T|``, ``|T y - mu y| / |T|`` (1-norm of ``T``;
+        compiled, :func:`_residuals`, where the pair ran compiled). Returns
+        ``(T, mu, y, lu, res, pair)`` (``lu`` as :func:`_pair` returns it)."""
+        T = self.matrix(sigma)
+        mu, y, lu = _pair(T, v, mu0)
+        if lu is None:
+            res, pair = _residuals(T, y, complex(mu))
+            return T, mu, y, None, float(res), float(pair)
+        scale = np.linalg.norm(T, 1)
+        pair = float(np.linalg.norm(T @ y - mu * y) / scale)
+        return T, mu, y, lu, max(float(abs(mu) / scale), pair), pair
+
     def jacobian(self) -> np.ndarray:
         """``J = T(0)`` (m H, m H) real: the balance's Jacobian from the solve's own ``G``
         and its problem's ``Z~`` (eq. 22-28), not re-assembled from the structure (the same
@@ -850,39 +875,101 @@ def reduce_quadratic(A0: np.ndarray, A1: np.ndarray, A2: np.ndarray,
     behind springs, rows the law holds) are algebraic: eliminated exactly by the Schur
     complement of ``A0`` (their blocks do not depend on ``s``); the rest split into the blocks
     it decouples into (:func:`_components`; ``hint``: a neighbour's, kept when the problem
-    decouples into them by the same test, which costs less than finding them)."""
-    n = A0.shape[0]
-    moving = (A1 != 0) | (A2 != 0)
-    has = np.any(moving, axis=1) | np.any(moving, axis=0)
-    dyn_, alg = np.flatnonzero(has), np.flatnonzero(~has)  # both sorted, as setdiff1d's
-    B0, B1, B2 = (X[np.ix_(dyn_, dyn_)] for X in (A0, A1, A2))
-    back = None
-    if alg.size:
+    decouples into them by the same test, which costs less than finding them). Where the
+    algebraic block of ``A0`` is diagonal (the contact points' own rows: the two-DOF
+    oscillator's 62 of 155 coordinates) the elimination runs compiled, over the nonzero
+    couplings (:func:`_reduce_diagonal`: 0.65 -> 0.2 ms there, the same Schur complement
+    summed over its nonzero terms only)."""
+    dyn_, alg, B0, B1, B2, back, done = _reduce_diagonal(A0, A1, A2)
+    if alg.size and not done:
         try:
             back = -np.linalg.solve(A0[np.ix_(alg, alg)], A0[np.ix_(alg, dyn_)])
         except np.linalg.LinAlgError:
             back = -np.linalg.lstsq(A0[np.ix_(alg, alg)], A0[np.ix_(alg, dyn_)],
                                     rcond=None)[0]
         B0 = B0 + A0[np.ix_(dyn_, alg)] @ back
+    if not alg.size:
+        back = None
     blocks = None
-    if hint is not None and np.array_equal(hint.dyn, dyn_):
+    if dyn_.size <= MIN_BLOCK:  # _components' answer, whatever the hint
+        blocks = [np.arange(dyn_.size)] if dyn_.size else []
+    elif hint is not None and np.array_equal(hint.dyn, dyn_):
         blocks = hint.blocks if _decouples(B0, B1, B2, hint.blocks) else None
     if blocks is None:
         blocks = _components(B0, B1, B2) if dyn_.size else []
-    return QuadraticReduction(n, dyn_, alg, back, B0, B1, B2, blocks)
+    return QuadraticReduction(A0.shape[0], dyn_, alg, back, B0, B1, B2, blocks)
+
+
+@njit(cache=True)
+def _reduce_diagonal(A0, A1, A2):
+    """:func:`reduce_quadratic`'s coordinate sets ``dyn`` (a row or column of ``A1`` or
+    ``A2`` nonzero) and ``alg``, the three matrices on ``dyn``, and where ``A0``'s algebraic
+    block is diagonal with no zero on it, the elimination: ``back = -A0[alg, alg]^-1
+    A0[alg, dyn]`` and ``B0 += A0[dyn, alg] back`` over the nonzero entries of
+    ``A0[dyn, alg]``. Returns ``(dyn, alg, B0, B1, B2, back, done)``; ``done`` False (``B0``
+    not yet reduced) where the block is not diagonal."""
+    n = A0.shape[0]
+    has = np.zeros(n, dtype=np.bool_)
+    for i in range(n):
+        for j in range(n):
+            if A1[i, j] != 0 or A2[i, j] != 0:
+                has[i] = True
+                has[j] = True
+    dyn = np.flatnonzero(has)
+    alg = np.flatnonzero(~has)
+    nd, na = dyn.size, alg.size
+    B0 = np.empty((nd, nd))
+    B1 = np.empty((nd, nd))
+    B2 = np.empty((nd, nd))
+    for a in range(nd):
+        for b in range(nd):
+            B0[a, b] = A0[dyn[a], dyn[b]]
+            B1[a, b] = A1[dyn[a], dyn[b]]
+            B2[a, b] = A2[dyn[a], dyn[b]]
+    back = np.zeros((na, nd))
+    for a in range(na):
+        if A0[alg[a], alg[a]] == 0:
+            return dyn, alg, B0, B1, B2, back, na == 0
+        for b in range(na):
+            if a != b and A0[alg[a], alg[b]] != 0:
+                return dyn, alg, B0, B1, B2, back, False
+    for a in range(na):
+        piv = A0[alg[a], alg[a]]
+        for b in range(nd):
+            back[a, b] = -(A0[alg[a], dyn[b]] / piv)
+    for i in range(nd):
+        for a in range(na):
+            f = A0[dyn[i], alg[a]]
+            if f != 0:
+                for b in range(nd):
+                    B0[i, b] += f * back[a, b]
+    return dyn, alg, B0, B1, B2, back, True
 
 
 def _decouples(B0: np.ndarray, B1: np.ndarray, B2: np.ndarray, blocks: list) -> bool:
     """Whether ``B0 + s B1 + s^2 B2`` has no entry coupling two of ``blocks`` (the test of
     :func:`_components`: none above :data:`DECOUPLED_TOL` times the largest of its matrix)."""
-    label = np.empty(B0.shape[0], dtype=int)
+    label = np.empty(B0.shape[0], dtype=np.int64)
     for i, b in enumerate(blocks):
         label[b] = i
-    off = label[:, None] != label[None, :]
-    for X in (B0, B1, B2):
-        big = np.abs(X).max(initial=0.0)
-        if big > 0 and np.any(np.abs(X[off]) > DECOUPLED_TOL * big):
-            return False
+    return all(_decoupled(X, label, DECOUPLED_TOL) for X in (B0, B1, B2))
+
+
+@njit(cache=True)
+def _decoupled(X, label, tol):
+    """No entry of ``X`` between coordinates of different ``label`` above ``tol`` times
+    its largest (:func:`_decouples` compiled, one matrix)."""
+    n = X.shape[0]
+    big = 0.0
+    for i in range(n):
+        for j in range(n):
+            big = max(big, abs(X[i, j]))
+    if big == 0:
+        return True
+    for i in range(n):
+        for j in range(n):
+            if label[i] != label[j] and abs(X[i, j]) > tol * big:
+                return False
     return True
 
 
@@ -922,13 +1009,24 @@ def _inverse_iteration(B0, B1, B2, sigma: complex, y: np.ndarray, max_iter: int 
     quadratically convergent to a simple eigenvalue), one LU of ``P(s)`` a step. Returns
     ``(sigma, y, converged)``; converged when the step is below 1e-14 of ``max(1, |sigma|)``
     (the rounding of the dense eigensolver's eigenvalue, whose backward error is of the same
-    order)."""
-    B0, B1, B2 = (np.asarray(b, dtype=complex) for b in (B0, B1, B2))
-    if B0.shape[0] <= PAIR_COMPILED_MAX:  # compiled, the same steps (:func:`_ruhe_small`)
-        s1, x1, ok = _ruhe_small(*(np.ascontiguousarray(b) for b in (B0, B1, B2)),
-                                 complex(sigma), np.ascontiguousarray(y, dtype=complex),
-                                 max_iter)
-        return complex(s1), x1, bool(ok)
+    order). Compiled: up to :data:`PAIR_COMPILED_MAX` unknowns with its own LU
+    (:func:`_ruhe_small`), beyond with LAPACK's solve called from the kernel
+    (:func:`_ruhe_lapack`: 0.40 against 0.63 ms for the steps called from Python on the
+    two-DOF oscillator's block of 62 unknowns); the steps from Python
+    (:func:`_inverse_iteration_py`) where that solve meets a singular ``P(s)``."""
+    B0, B1, B2 = (np.ascontiguousarray(b, dtype=complex) for b in (B0, B1, B2))
+    y = np.ascontiguousarray(y, dtype=complex)
+    kernel = _ruhe_small if B0.shape[0] <= PAIR_COMPILED_MAX else _ruhe_lapack
+    try:
+        s1, x1, ok = kernel(B0, B1, B2, complex(sigma), y, max_iter)
+    except np.linalg.LinAlgError:  # _ruhe_lapack at a singular P(s)
+        return _inverse_iteration_py(B0, B1, B2, sigma, y, max_iter)
+    return complex(s1), x1, bool(ok)
+
+
+def _inverse_iteration_py(B0, B1, B2, sigma: complex, y: np.ndarray, max_iter: int = 10):
+    """:func:`_inverse_iteration`'s steps from Python with LAPACK's ``zgetrf``/``zgetrs``
+    (not converged at a zero pivot)."""
     x = y / np.linalg.norm(y)
     first = True
     for _ in range(max_iter):
@@ -1172,18 +1270,17 @@ def _track_record(red: QuadraticReduction, vals: np.ndarray, vecs: np.ndarray,
     magnitude cut ``cut``, or one spread over two blocks)."""
     if red.dyn.size == 0 or np.any(edge) or np.any(np.abs(kap) > 0.5):
         return None
-    line = np.array([_on_line(v) for v in vals], dtype=object)
-    if np.any(np.abs(vals) > 0.9 * cut) or np.any(line == None):  # noqa: E711
+    line = [_on_line(complex(v)) for v in vals]
+    if np.any(np.abs(vals) > 0.9 * cut) or None in line:
         return None
     real = np.abs(vals.imag) <= 1e-12 * np.maximum(np.abs(vals), 1.0)
-    families = int(np.sum(np.where(real | (line == "on"), 1, 2)))
+    families = sum(1 if (r or ln == "on") else 2 for r, ln in zip(real, line, strict=True))
     Y = vecs[red.dyn]
-    block = np.empty(vals.size, dtype=int)
-    for j in range(vals.size):
-        share = [np.linalg.norm(Y[c, j]) for c in red.blocks]
-        block[j] = int(np.argmax(share))
-        if share[block[j]] < (1.0 - 1e-12) * np.linalg.norm(Y[:, j]):
-            return None
+    sq = Y.real ** 2 + Y.imag ** 2  # each member's share of each block (squared norms)
+    share = np.array([sq[c].sum(axis=0) for c in red.blocks]).reshape(len(red.blocks), vals.size)
+    block = np.argmax(share, axis=0)
+    if np.any(share[block, np.arange(vals.size)] < (1.0 - 1e-12) ** 2 * sq.sum(axis=0)):
+        return None
     complete = 2 * red.dyn.size == families * H
     return HillTrack(vals.copy(), Y.copy(), block, red.dyn.size, red.dyn.copy(),
                      [b.copy() for b in red.blocks], complete)
@@ -1349,6 +1446,28 @@ def _pair_small(T, v, mu0, steps):
 
 
 @njit(cache=True)
+def _residuals(T, y, mu):
+    """``(max(|mu|, |T y - mu y|) / |T|, |T y - mu y| / |T|)`` with the 1-norm of ``T``
+    (:meth:`HillProblem.evaluate`: the stopping rule of :func:`_track`) in one call."""
+    n = T.shape[0]
+    scale = 0.0
+    for j in range(n):
+        col = 0.0
+        for i in range(n):
+            col += abs(T[i, j])
+        scale = max(scale, col)
+    r2 = 0.0
+    for i in range(n):
+        acc = 0j
+        for j in range(n):
+            acc += T[i, j] * y[j]
+        acc -= mu * y[i]
+        r2 += acc.real * acc.real + acc.imag * acc.imag
+    pair = np.sqrt(r2) / scale
+    return max(abs(mu) / scale, pair), pair
+
+
+@njit(cache=True)
 def _ruhe_small(B0, B1, B2, sigma, y, max_iter):
     """:func:`_inverse_iteration` compiled (the same steps, the LU by :func:`_lu_small`):
     ``(sigma, y, converged)``."""
@@ -1375,6 +1494,44 @@ def _ruhe_small(B0, B1, B2, sigma, y, max_iter):
                 acc += (B1[i, j] + two * B2[i, j]) * x[j]
             r[i] = acc
         u = _lu_solve_small(A, piv, r)
+        den = 0j
+        for i in range(n):
+            den += np.conj(x[i]) * u[i]
+        if not np.isfinite(den.real) or not np.isfinite(den.imag) or den == 0:
+            return sigma, x, False
+        step = 1.0 / den
+        sigma = sigma - step
+        x = _unit(u)
+        if abs(step) <= 1e-14 * max(1.0, abs(sigma)):
+            return sigma, x, True
+    return sigma, x, False
+
+
+@njit(cache=True)
+def _ruhe_lapack(B0, B1, B2, sigma, y, max_iter):
+    """:func:`_inverse_iteration` compiled for larger blocks: the same steps as
+    :func:`_ruhe_small` with LAPACK's ``zgesv`` (``np.linalg.solve``) for each solve (two at
+    the first step, one LU each; raises ``LinAlgError`` at a singular ``P(s)``)."""
+    n = B0.shape[0]
+    x = _unit(y)
+    first = True
+    A = np.empty((n, n), dtype=np.complex128)
+    r = np.empty(n, dtype=np.complex128)
+    for _ in range(max_iter):
+        s2 = sigma * sigma
+        for i in range(n):
+            for j in range(n):
+                A[i, j] = B0[i, j] + sigma * B1[i, j] + s2 * B2[i, j]
+        if first:  # towards the eigenvector of the eigenvalue nearest sigma
+            x = _unit(np.linalg.solve(A, x))
+            first = False
+        two = 2.0 * sigma
+        for i in range(n):
+            acc = 0j
+            for j in range(n):
+                acc += (B1[i, j] + two * B2[i, j]) * x[j]
+            r[i] = acc
+        u = np.linalg.solve(A, r)
         den = 0j
         for i in range(n):
             den += np.conj(x[i]) * u[i]
@@ -1451,11 +1608,7 @@ def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions,
         if abs(sigma - start) > 0.5 or 2.0 * np.pi * sigma.real < np.log(NEGLIGIBLE) or (
                 deflate is not None and abs(sigma - deflate) <= ON_REAL):
             break  # left the neighbourhood of the candidate (or back on the root deflated)
-        T = hp.matrix(sigma)
-        scale = np.linalg.norm(T, 1)
-        mu, v, lu = _pair(T, v, mu0)
-        pair = float(np.linalg.norm(T @ v - mu * v) / scale)
-        res = max(float(abs(mu) / scale), pair)
+        T, mu, v, lu, res, pair = hp.evaluate(sigma, v, mu0)
         if res <= opt.newton_tol:
             return sigma, v, res, True, slope
         f = mu if deflate is None else mu / (sigma - deflate)
