@@ -26,6 +26,7 @@ from fretwear.hb.modal import ModalCondenser, SchurModalCondenser, modal_condens
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.preload import static_anchor
 from fretwear.hb.reduce import _Blocks, exact_condenser
+from fretwear.hb.sparse_lu import factor
 from fretwear.model import Damping
 
 pytest.importorskip("kvxopt")
@@ -107,6 +108,39 @@ def test_schur_complement_and_its_derivative_against_dense_algebra():
         assert rel(out.cc[name], Xcc) < 1e-7, name
         assert out.differences[name].error < 1e-7
     assert rel(out.cc["K"], ref) < 1e-12
+
+
+def _chain(stiffness):
+    """A chain of 40 springs of about ``stiffness`` [N/m] (one rigid translation, its last 10
+    DOFs the contact ``c``): ``K``, its blocks, the static modes ``Psi`` (NumPy's dense
+    solve), ``c`` and the interior DOFs ``i``."""
+    n, c = 40, np.arange(30, 40)
+    rng = np.random.default_rng(3)
+    K = np.zeros((n, n))
+    for j, kj in enumerate(stiffness * (1 + rng.random(n - 1))):
+        K[np.ix_([j, j + 1], [j, j + 1])] += kj * np.array([[1, -1], [-1, 1]])
+    i = np.setdiff1d(np.arange(n), c)
+    return K, _blocks(K, c), -np.linalg.solve(K[np.ix_(i, i)], K[np.ix_(i, c)]), c, i
+
+
+@pytest.mark.parametrize("stiffness", [1e6, 1e8])
+def test_derivative_of_a_matrix_on_the_contact_dofs_alone(stiffness):
+    """A damping matrix on the contact DOFs alone (dashpots at the interface and between a
+    contact and an interior DOF: ``X_ii = 0``, indefinite): ``S(sigma)`` is then quadratic
+    and its central difference exact, so ``X^cc = T^T X T`` of dense algebra is met to the
+    rounding (estimated 1e-10; asserted 1e-9 and below ten times the estimate, as above).
+    The step once came from the interior block alone: a relative error of 1.0 at 1e6 N/m
+    (a step of 1e201), 2e-6 at 1e8 (a step not scaled to K / X)."""
+    K, Kb, Psi, c, i = _chain(stiffness)
+    X = np.zeros(K.shape)
+    X[c, c] = 5.0 * (1 + np.random.default_rng(4).random(c.size))
+    X[c[0], i[-1]] = X[i[-1], c[0]] = 2.0
+    out = schur.contact_blocks(Kb, {"C": _blocks(X, c)}, factor(Kb.ii, "spd"))
+    T = np.vstack([np.eye(c.size), Psi])  # rows: contact, then interior
+    order = np.concatenate([c, i])
+    err = rel(out.cc["C"], T.T @ X[np.ix_(order, order)] @ T)
+    d = out.differences["C"]
+    assert err < 1e-9 and err < 10 * d.error, (err, d)
 
 
 @pytest.mark.parametrize("dense", [True, False], ids=["front", "scattered"])

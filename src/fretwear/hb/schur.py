@@ -74,7 +74,8 @@ def available() -> bool:
 @dataclass(frozen=True)
 class Difference:
     """How one ``X^cc`` (``X`` not ``K``) was found: ``step`` ``h`` of the central difference,
-    ``nu`` the estimate of the largest ``|eig(K_ii^-1 X_ii)|``, ``error`` the estimated
+    ``nu`` the estimate of the largest ``|eig(K_ii^-1 X_ii)|`` (at least ``X``'s largest
+    entry over ``K``'s: :func:`contact_blocks`), ``error`` the estimated
     relative error ``TRUNCATION (h nu)^2 + ROUNDING eps rho / (h nu)`` with the achieved
     ``rho = (|S| + alpha) nu / |X^cc|`` (max-norms)."""
 
@@ -212,6 +213,14 @@ def _nu(lu, Xii, rng) -> float:
     return MARGIN * nu
 
 
+def _largest(B) -> float:
+    """The largest ``|entry|`` of the blocks ``B`` (``ii``, ``ic``, ``cc``; ``ci`` is
+    ``ic``'s transpose: the matrices are symmetric), 0 for none."""
+    vals = [sp.csr_matrix(b).data if sp.issparse(b) else np.asarray(b)
+            for b in (B.ii, B.ic, B.cc)]
+    return max(float(np.max(np.abs(v), initial=0.0)) for v in vals)
+
+
 def step(nu: float, rho: float) -> float:
     """The step ``h`` of the central difference that balances its truncation
     ``TRUNCATION (h nu)^2`` and rounding ``ROUNDING eps rho / (h nu)``:
@@ -235,9 +244,13 @@ def contact_blocks(K, others: dict, lu) -> ContactBlocks:
         # block where the contact block has a zero diagonal)
         xcc = (float(np.max(np.abs(np.diag(np.asarray(X.cc))), initial=0.0))
                or float(np.max(np.abs(X.ii.diagonal()), initial=0.0)))
-        kx = float(abs(K.ii).max()) / max(float(abs(X.ii).max()), 1e-300)
-        if nu <= 0.0:  # no interior part: S(sigma) is quadratic, the difference is exact
-            nu = 1.0 / kx if np.isfinite(kx) and kx > 0 else 1.0
+        # X's largest entry over K's bounds nu from below: where X lives on the contact DOFs
+        # alone (dashpots at the interface: X_ii = 0, the power iterations give 0, S(sigma)
+        # is quadratic and its central difference exact) or mostly, the step keeps h X a
+        # small fraction of K, so that K -/+ h X stays positive definite and the rounding
+        # small; where X is carried by the interior, nu is the larger (its largest entry is
+        # on its diagonal, X_jj / K_jj <= nu)
+        nu = max(nu, _largest(X) / _largest(K)) or 1.0  # X = 0: X^cc = 0 at any step
         h = step(nu, scale * nu / max(xcc, 1e-300 * scale))
         Sm = pf.schur(K.ii + h * X.ii, K.ic + h * X.ic, K.ci + h * X.ci,
                       np.asarray(K.cc) + h * np.asarray(X.cc))
