@@ -211,3 +211,14 @@ def test_periodic_solve_in_partial_slip_equals_the_static_modes_path():
         out.append(sol)
     assert 0.02 < out[1].state_fractions().mean(axis=0)[2] < 0.98  # partial slip
     assert rel(out[1].U, out[0].U) < 1e-8
+
+
+@pytest.mark.parametrize("cls", [modal.BlockedModalCondenser, SchurModalCondenser])
+@pytest.mark.parametrize("name, value", [("cutoff", -1.0), ("tol", float("nan")),
+                                         ("tol", 0.0)])
+def test_bad_cutoff_or_tol_is_one_input_error(cls, name, value):
+    """The large-interface condensers check ``cutoff`` and ``tol`` as
+    :class:`ModalCondenser` does (one InputError naming the argument, before any solve):
+    they once built with a NaN ``tol`` (no error ever exceeds it) and a negative ``cutoff``."""
+    with pytest.raises(InputError, match=f"{name} = {value!r}: expected a positive number"):
+        cls(block(), F_MAX, 7, **{name: value})

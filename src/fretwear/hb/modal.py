@@ -185,14 +185,10 @@ class ModalCondenser(Condenser):
     def __init__(self, model: Model, f_max: float, max_order: int, *, modes: int | None = None,
                  cutoff: float = CUTOFF, tol: float = TOL, raise_modes: bool = False,
                  residual: bool = False, representation: str | Representation = "auto"):
-        self._check_args(f_max, modes)
+        self._check_args(f_max, modes, cutoff, tol)
         rep = Representation.of(representation)
         self._set_compress(model, rep.compress)
         self.representation = "operator" if rep.kind == "compressed" else rep.kind
-        for name, value in (("cutoff", cutoff), ("tol", tol)):
-            if (isinstance(value, bool) or not isinstance(value, int | float)
-                    or not math.isfinite(value) or value <= 0):
-                raise InputError(f"{name} = {value!r}: expected a positive number")
         super().__init__(_structure(model), dense=False)
         if not self.ni:
             raise InputError("the model has no interior DOFs: nothing to represent by modes")
@@ -238,14 +234,18 @@ class ModalCondenser(Condenser):
 
     # -- construction -------------------------------------------------------------------------
     @staticmethod
-    def _check_args(f_max, modes):
-        """One InputError for an ``f_max`` that is not a positive frequency or ``modes`` that
-        is not None or a number of modes."""
+    def _check_args(f_max, modes, cutoff, tol):
+        """One InputError for an ``f_max`` that is not a positive frequency, ``modes`` that
+        is not None or a number of modes, or a ``cutoff`` or ``tol`` not a positive number."""
         if not (isinstance(f_max, int | float) and math.isfinite(f_max) and f_max > 0):
             raise InputError(f"f_max = {f_max!r}: expected a positive frequency [Hz]")
         if modes is not None and (isinstance(modes, bool) or not isinstance(modes, int)
                                   or modes < 0):
             raise InputError(f"modes = {modes!r}: expected a number of modes >= 0")
+        for name, value in (("cutoff", cutoff), ("tol", tol)):
+            if (isinstance(value, bool) or not isinstance(value, int | float)
+                    or not math.isfinite(value) or value <= 0):
+                raise InputError(f"{name} = {value!r}: expected a positive number")
 
     def _basis(self, mode_frequencies, Phi, extra):
         """Interior basis ``V``: the modes ``Phi`` and the static vectors ``extra``, scaled and
@@ -800,7 +800,7 @@ class BlockedModalCondenser(ModalCondenser):
 
     def __init__(self, model: Model, f_max: float, max_order: int, *, modes: int | None = None,
                  cutoff: float = CUTOFF, tol: float = TOL, compress: float | None = None):
-        self._check_args(f_max, modes)
+        self._check_args(f_max, modes, cutoff, tol)
         self._set_compress(model, compress)
         Condenser.__init__(self, _structure(model), dense=False)
         if not self.ni:
@@ -939,7 +939,7 @@ class SchurModalCondenser(BlockedModalCondenser):
     def __init__(self, model: Model, f_max: float, max_order: int, *, modes: int | None = None,
                  cutoff: float = CUTOFF, tol: float = TOL, raise_modes: bool = False,
                  representation: str | Representation = "auto"):
-        self._check_args(f_max, modes)
+        self._check_args(f_max, modes, cutoff, tol)
         rep = Representation.of(representation)
         self._set_compress(model, rep.compress)
         self.representation = "operator" if rep.kind == "compressed" else rep.kind
