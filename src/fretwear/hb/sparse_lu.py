@@ -196,13 +196,9 @@ class _Cholmod(_Factor):
         self._A, self._sn = A, None
 
     def _solve(self, B):
-        one = B.ndim == 1
-        if not one and B.shape[1] >= MANY:
+        if B.ndim > 1 and B.shape[1] >= MANY:
             return self._supernodal().solve(B)
-        X = self._kvx.matrix(np.asfortranarray(B.reshape(self.n, -1)))
-        self._cholmod.solve(self.F, X)
-        X = np.array(X)
-        return X[:, 0] if one else X
+        return self._own_solve(B)
 
     def solve_few(self, B):
         """``solve(B)`` by CHOLMOD's own solve whatever the number of columns: the supernodal
@@ -211,6 +207,10 @@ class _Cholmod(_Factor):
         B = np.asarray(B)
         if B.dtype.kind == "c":
             return self.solve_few(B.real) + 1j * self.solve_few(B.imag)
+        return self._own_solve(B)
+
+    def _own_solve(self, B):
+        """CHOLMOD's own solve of a real ``B`` (n,) or (n, k)."""
         one = B.ndim == 1
         X = self._kvx.matrix(np.asfortranarray(B.reshape(self.n, -1), dtype=float))
         self._cholmod.solve(self.F, X)
