@@ -77,9 +77,9 @@ def test_schur_complement_and_its_derivative_against_dense_algebra():
     """On a random sparse chain (a semi-definite K with a rigid motion, as a structure
     carried by its interface): the partial factorisation gives K_cc - K_ci K_ii^-1 K_ic of
     NumPy's dense solve to 1e-12 (rounding); the central difference of the Schur complements
-    of K -/+ h X gives T^T X T, T = [Psi; I], to 1e-7 (its estimated error, 1e-9 here, with
-    margin), for a mass-like X and an indefinite one (dS/dsigma = -X^cc holds for any
-    symmetric X)."""
+    of K -/+ h X gives T^T X T, T = [I; Psi] (contact DOFs first), to 1e-7 (its estimated
+    error, 1e-9 here, with margin), for a mass-like X and an indefinite one (dS/dsigma =
+    -X^cc holds for any symmetric X)."""
     rng = np.random.default_rng(3)
     n, c = 40, np.arange(30, 40)
     # a chain of springs (one rigid translation) plus random symmetric coupling of neighbours
