@@ -17,15 +17,18 @@ is made from it carry ``M^cc``'s error scaled by ``(n w)^2 |M^cc| / |Z_r|``: ass
 import numpy as np
 import pytest
 import scipy.sparse as sp
-from helpers.operator_models import F_MAX, ORDERS, block, rel
+from helpers.operator_models import (
+    F_MAX,
+    block,
+    rel,
+    same_partial_slip_solution,
+    same_reductions,
+)
 
 from fretwear.errors import InputError
 from fretwear.hb import modal, schur
-from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.modal import ModalCondenser, SchurModalCondenser, modal_condenser
-from fretwear.hb.periodic import solve_periodic
-from fretwear.hb.preload import static_anchor
-from fretwear.hb.reduce import _Blocks, exact_condenser
+from fretwear.hb.reduce import _Blocks
 from fretwear.hb.sparse_lu import factor
 from fretwear.model import Damping
 
@@ -53,16 +56,7 @@ def test_partial_factorisations_equal_the_static_modes(damping):
         assert err < 1e-7 and err < 10 * d.error, (nm, err, d)
         for i in (1, 2, 3):
             assert rel(sc.proj_local[nm][i], mc.proj_local[nm][i]) < 1e-10, (nm, i)
-    w = 2 * np.pi * 15e3
-    a, b = mc.reduced(w, ORDERS), sc.reduced(w, ORDERS)
-    for n in range(ORDERS.size):
-        assert rel(b.Z[n], a.Z[n]) < 1e-8, n
-    for name in ("F", "obs_A", "obs_b"):
-        assert rel(getattr(b, name), getattr(a, name)) < 1e-8, name
-    u = np.random.default_rng(1).standard_normal((ORDERS.size, a.m)) + 0j
-    assert rel(sc.recover(w, ORDERS, u), mc.recover(w, ORDERS, u)) < 1e-8
-    ex = exact_condenser(model).reduced(w, ORDERS[:1])
-    assert rel(b.Z[0], ex.Z[0]) < 1e-10 and rel(b.F[0], ex.F[0]) < 1e-10
+    same_reductions(model, mc, sc, 1e-8)
 
 
 def _blocks(A, c):
@@ -200,17 +194,8 @@ def test_periodic_solve_in_partial_slip_equals_the_static_modes_path():
     """A periodic solve in partial slip through the condenser by partial factorisations
     reaches the dense modal condenser's solution (1e-8: both stop at the solver's tolerance,
     1e-9 of |Z U|, and Z_r differs by less than 1e-8)."""
-    model = block(traction=4.5e5)
-    basis = FourierBasis.up_to(3, 64)
-    out = []
-    for cls in (ModalCondenser, SchurModalCondenser):
-        c = cls(model, F_MAX, 7, tol=1e-2)
-        sol = solve_periodic(model, basis, frequency=12e3, condenser=c,
-                             anchor=static_anchor(model, condenser=c))
-        assert sol.success
-        out.append(sol)
-    assert 0.02 < out[1].state_fractions().mean(axis=0)[2] < 0.98  # partial slip
-    assert rel(out[1].U, out[0].U) < 1e-8
+    same_partial_slip_solution(lambda m: ModalCondenser(m, F_MAX, 7, tol=1e-2),
+                               lambda m: SchurModalCondenser(m, F_MAX, 7, tol=1e-2))
 
 
 @pytest.mark.parametrize("cls", [modal.BlockedModalCondenser, SchurModalCondenser])
