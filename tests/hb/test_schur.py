@@ -207,3 +207,24 @@ def test_bad_cutoff_or_tol_is_one_input_error(cls, name, value):
     they once built with a NaN ``tol`` (no error ever exceeds it) and a negative ``cutoff``."""
     with pytest.raises(InputError, match=f"{name} = {value!r}: expected a positive number"):
         cls(block(), F_MAX, 7, **{name: value})
+
+
+def test_indefinite_interior_stiffness_keeps_the_static_modes(monkeypatch):
+    """A symmetric ``K_ii`` that is not positive definite (one interior diagonal entry
+    negated; the static modes handle it, SuperLU factorising ``K_ii``): the condenser by
+    partial factorisations refuses it in one InputError that says why, and
+    ``modal_condenser`` (its threshold lowered to the block's) keeps the static modes. It
+    once raised a RuntimeError blaming CHOLMOD's ordering (the probe of an incomplete
+    factor)."""
+    import dataclasses
+
+    model = block()
+    K = sp.lil_matrix(model.K)
+    taken = set(np.asarray(model.contact.dofs).ravel()) | set(np.asarray(model.fixed_dofs))
+    j = next(i for i in range(K.shape[0]) if i not in taken)
+    K[j, j] = -0.5 * K[j, j]
+    model = dataclasses.replace(model, K=sp.csr_matrix(K))
+    with pytest.raises(InputError, match="positive definite K_ii"):
+        SchurModalCondenser(model, F_MAX, 7, tol=1e-2)
+    monkeypatch.setattr(modal, "SCHUR_MIN_CONTACT", 1)
+    assert type(modal_condenser(model, F_MAX, 7, tol=1e-2)) is ModalCondenser

@@ -123,7 +123,8 @@ class PartialFactor:
         """``cc - ci ii^-1 ic`` (m, m), dense, symmetric, from the partial factorisation of
         ``[[ii, ic], [ci, cc + alpha I]]`` with the interior first in its AMD order. Raises
         ``ArithmeticError``/``ValueError`` when ``ii`` is not positive definite (CHOLMOD's)
-        and RuntimeError when CHOLMOD did not keep the ordering."""
+        and RuntimeError when its factor does not reproduce the matrix (the ordering not kept,
+        or a factorisation left incomplete)."""
         ni, m, cholmod = self.ni, self.m, self._cholmod
         A = sp.bmat([[ii, ic], [ci, sp.csr_matrix(np.asarray(cc))
                                 + self.alpha * sp.identity(m)]], format="csc")
@@ -153,7 +154,9 @@ class PartialFactor:
         y[p] = x
         Ax = (A @ y)[p]  # P A P^T x
         if not np.linalg.norm(L @ (L.T @ x) - Ax) <= 1e-10 * np.linalg.norm(Ax):
-            raise RuntimeError("CHOLMOD's factor does not have the ordering it was given")
+            raise RuntimeError("CHOLMOD's factor does not reproduce the matrix: another "
+                               "ordering than the one given, or a matrix not positive "
+                               "definite (a factorisation left incomplete)")
         del L
         # the contact rows: L_ci (sparse, its fill measured) and L_cc (dense lower triangle)
         self.nnz_contact_rows = int(np.count_nonzero(rows[:ptr[ni]] >= ni))
