@@ -228,3 +228,48 @@ def test_indefinite_interior_stiffness_keeps_the_static_modes(monkeypatch):
         SchurModalCondenser(model, F_MAX, 7, tol=1e-2)
     monkeypatch.setattr(modal, "SCHUR_MIN_CONTACT", 1)
     assert type(modal_condenser(model, F_MAX, 7, tol=1e-2)) is ModalCondenser
+
+
+def test_cholmod_options_are_restored_when_threads_factorise_at_once(monkeypatch):
+    """Two threads make partial factorisations at once, the first held inside CHOLMOD's
+    symbolic analysis until the second enters it too (or 0.5 s have passed: with the lock it
+    cannot), the second then until the first is done: kvxopt's options, one dict for the
+    process, end as they began, and both Schur complements equal the one made alone
+    (bitwise: the same ordering, the same arithmetic). Without the lock the second thread
+    saved the first's changed options and restored them: every later CHOLMOD factorisation
+    of the process ran with one ordering method and no postordering."""
+    import threading
+
+    cholmod = pytest.importorskip("kvxopt.cholmod")
+    _, Kb, _, _, _ = _chain(1e8)
+    ref = schur.PartialFactor(Kb).schur(Kb.ii, Kb.ic, Kb.ci, Kb.cc)
+    before = dict(cholmod.options)
+    real, calls = cholmod.symbolic, []
+    second, first_done = threading.Event(), threading.Event()
+
+    def symbolic(*args, **kwargs):
+        calls.append(threading.current_thread().name)
+        if len(calls) == 1:
+            second.wait(0.5)  # the first thread in waits for the second
+        else:
+            second.set()
+            first_done.wait(0.5)  # which then finishes after the first
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(cholmod, "symbolic", symbolic)
+    out = {}
+
+    def work(name):
+        out[name] = schur.PartialFactor(Kb).schur(Kb.ii, Kb.ic, Kb.ci, Kb.cc)
+        if name == "a":
+            first_done.set()
+
+    threads = [threading.Thread(target=work, args=(name,), name=name) for name in "ab"]
+    threads[0].start()
+    while not calls:  # the first is inside the symbolic analysis
+        second.wait(0.001)
+    threads[1].start()
+    for t in threads:
+        t.join()
+    assert dict(cholmod.options) == before
+    assert np.array_equal(out["a"], ref) and np.array_equal(out["b"], ref)

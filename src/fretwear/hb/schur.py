@@ -130,18 +130,21 @@ class PartialFactor:
                                 + self.alpha * sp.identity(m)]], format="csc")
         p = np.concatenate([self.p_i, ni + np.arange(m, dtype=np.int64)])
         Ak = self._spmatrix(A)
-        saved = dict(cholmod.options)
-        # kvxopt's options are global (restored below): one ordering method (the given one:
-        # by default CHOLMOD also tries its own and keeps the best) and no postordering
-        cholmod.options["nmethods"] = 1
-        cholmod.options["postorder"] = False
-        try:
-            F = cholmod.symbolic(Ak, p=self._kvx.matrix(p))
-            cholmod.numeric(Ak, F)
-            Lk = cholmod.getfactor(F)
-        finally:
-            cholmod.options.clear()
-            cholmod.options.update(saved)
+        # kvxopt's options are global (restored below, under a lock: another thread's
+        # factorisation would see them, or save them changed and restore them so): one
+        # ordering method (the given one: by default CHOLMOD also tries its own and keeps the
+        # best) and no postordering
+        with sparse_lu.CHOLMOD_OPTIONS:
+            saved = dict(cholmod.options)
+            cholmod.options["nmethods"] = 1
+            cholmod.options["postorder"] = False
+            try:
+                F = cholmod.symbolic(Ak, p=self._kvx.matrix(p))
+                cholmod.numeric(Ak, F)
+                Lk = cholmod.getfactor(F)
+            finally:
+                cholmod.options.clear()
+                cholmod.options.update(saved)
         del F, Ak
         ptr, rows, vals = Lk.CCS
         del Lk

@@ -31,6 +31,7 @@ from __future__ import annotations
 import importlib
 import logging
 import os
+import threading
 
 import numpy as np
 import scipy.sparse as sp
@@ -53,6 +54,9 @@ ENV = "FRETWEAR_SPARSE_LU"
 MANY = 8
 #: pivots spanning more than this ratio: a nearly singular matrix (as reduce's dense check)
 NEAR_SINGULAR = 1e-13
+#: held while kvxopt's CHOLMOD options (one dict for the process) are changed or read by a
+#: symbolic analysis (here and :mod:`fretwear.hb.schur`): no state, a lock between threads
+CHOLMOD_OPTIONS = threading.Lock()
 
 
 class SingularError(RuntimeError):
@@ -185,7 +189,8 @@ class _Cholmod(_Factor):
         self.A = kvx.spmatrix(kvx.matrix(np.ascontiguousarray(C.data, dtype=float)),
                               kvx.matrix(C.row.astype(np.int64)),
                               kvx.matrix(C.col.astype(np.int64)), A.shape)
-        self.F = cholmod.symbolic(self.A)
+        with CHOLMOD_OPTIONS:  # CHOLMOD's default options (no other thread's changes)
+            self.F = cholmod.symbolic(self.A)
         cholmod.numeric(self.A, self.F)  # ArithmeticError: not positive definite
         # ValueError: not positive definite (the factor is left incomplete)
         d = np.abs(np.asarray(cholmod.diag(self.F))).ravel() ** 2
@@ -232,15 +237,16 @@ class _Cholmod(_Factor):
                           kvx.matrix(C.row.astype(np.int64)),
                           kvx.matrix(C.col.astype(np.int64)), self._A.shape)
         p = np.array(amd.order(Ak), dtype=np.int64).ravel()
-        saved = dict(cholmod.options)
-        cholmod.options["postorder"] = False  # kvxopt's options are global: restored below
-        try:
-            F = cholmod.symbolic(Ak, p=kvx.matrix(p))
-            cholmod.numeric(Ak, F)
-            Lk = cholmod.getfactor(F)
-        finally:
-            cholmod.options.clear()
-            cholmod.options.update(saved)
+        with CHOLMOD_OPTIONS:  # kvxopt's options are global: restored below
+            saved = dict(cholmod.options)
+            cholmod.options["postorder"] = False
+            try:
+                F = cholmod.symbolic(Ak, p=kvx.matrix(p))
+                cholmod.numeric(Ak, F)
+                Lk = cholmod.getfactor(F)
+            finally:
+                cholmod.options.clear()
+                cholmod.options.update(saved)
         ptr, rows, vals = Lk.CCS  # compressed columns as they are (no triplets: 4096
         del Lk, F  # contact nodes' factor holds 1e8 entries)
         L = sp.csc_matrix((np.asarray(vals, dtype=float).ravel(),
