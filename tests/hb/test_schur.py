@@ -206,7 +206,7 @@ def test_bad_cutoff_or_tol_is_one_input_error(cls, name, value):
     :class:`ModalCondenser` does (one InputError naming the argument, before any solve):
     they once built with a NaN ``tol`` (no error ever exceeds it) and a negative ``cutoff``."""
     with pytest.raises(InputError, match=f"{name} = {value!r}: expected a positive number"):
-        cls(block(), F_MAX, 7, **{name: value})
+        cls(None, F_MAX, 7, **{name: value})  # refused before the model is read
 
 
 def test_indefinite_interior_stiffness_keeps_the_static_modes(monkeypatch):
