@@ -224,7 +224,8 @@ def _largest(B) -> float:
     ``ic``'s transpose: the matrices are symmetric), 0 for none."""
     vals = [sp.csr_matrix(b).data if sp.issparse(b) else np.asarray(b)
             for b in (B.ii, B.ic, B.cc)]
-    return max(float(np.max(np.abs(v), initial=0.0)) for v in vals)
+    # max and -min: no |.| copy of the dense m x m contact block
+    return max(max(float(v.max()), -float(v.min())) if v.size else 0.0 for v in vals)
 
 
 def step(nu: float, rho: float) -> float:
