@@ -147,13 +147,12 @@ def test_lower_product(dense):
     if not dense:
         L[rng.random((m, m)) < 0.3] = 0.0
         np.fill_diagonal(L, 1.0 + rng.random(m))
-    C = sp.csc_matrix(L) if not dense else sp.csc_matrix(np.where(np.tril(np.ones((m, m))),
-                                                                 L + 0.0, 0.0))
     if dense:  # every entry of the triangle stored, as a dense front
         rows = np.concatenate([np.arange(j, m) for j in range(m)])
         ptr = np.concatenate([[0], np.cumsum(m - np.arange(m))])
         vals = np.concatenate([L[j:, j] for j in range(m)])
     else:
+        C = sp.csc_matrix(L)
         rows, ptr, vals = C.indices.astype(np.int64), C.indptr.astype(np.int64), C.data
     assert rel(schur._lower_product(ptr, rows, vals, m), L @ L.T) < 1e-13
 
