@@ -148,3 +148,30 @@ def test_a_jump_at_a_fold_is_the_sweeps_path_and_listed_in_the_summary():
     assert cost.jumps == ["38476.5 Hz -> 41016.8 Hz"]
     assert cost.continuation_line().endswith(
         "1 frequencies needed nothing else; jumps at folds: 38476.5 Hz -> 41016.8 Hz")
+
+
+def test_a_jump_resumed_from_an_earlier_checkpoint_is_listed():
+    """A sweep checkpoint written before ``Attempt.from_hz`` existed (the same format
+    version: its jump's record has no ``from_hz``) resumes to the same continuation line as
+    the run that wrote it (the fold's frequency read back from the message, as that run did),
+    and a jump with no fold frequency at all is listed as from "a fold": the summary once
+    raised a TypeError on formatting None. Counted by hand, as above."""
+    import dataclasses
+
+    from fretwear.hb.branch import rebuild_point
+    from fretwear.hb.solvers import SolveStats
+
+    st = SolveStats(True, 1e-14, 27, 30, 3, 0.2, "converged", "powell")
+    old = {"method": "jump", "solver": "powell", "eps": 1.0, "success": True,
+           "residual": 1e-14, "iterations": 27, "wall_time": 0.2,
+           "message": "converged (from the fold at 38476.5 Hz)"}
+    rec = {"frequency_hz": 41016.8, "how": "jump", "flags": [], "on_grid": True,
+           "time_domain": None, "stats": dataclasses.asdict(st),
+           "attempts": [{**old, "method": "arclength", "success": False, "message": ""}, old]}
+    pt = rebuild_point(None, {"record": rec})  # not converged here: no solution to assemble
+    assert pt.attempts[1].from_hz == 38476.5
+    bare = SimpleNamespace(frequency_hz=0.1225, attempts=[
+        Attempt("grid", "powell", 1.0, False, 0.1, 40, 0.1, ""),
+        Attempt("jump", "powell", 1.0, True, 1e-14, 27, 0.2, "converged")])
+    cost = fallbacks.of_solutions([pt, bare], total=20.0)
+    assert cost.jumps == ["38476.5 Hz -> 41016.8 Hz", "a fold -> 0.1225 Hz"]

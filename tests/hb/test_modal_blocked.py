@@ -12,7 +12,14 @@ rounding of 1e-16 leave a margin of 1e3). The periodic solves stop at the solver
 
 import numpy as np
 import pytest
-from helpers.operator_models import F_MAX, ORDERS, block, rel
+from helpers.operator_models import (
+    F_MAX,
+    ORDERS,
+    block,
+    rel,
+    same_partial_slip_solution,
+    same_reductions,
+)
 
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.modal import BlockedModalCondenser, ModalCondenser
@@ -20,7 +27,6 @@ from fretwear.hb.modal_operator import ReducedOperator
 from fretwear.hb.options import SolveOptions
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.preload import static_anchor
-from fretwear.hb.reduce import exact_condenser
 from fretwear.model import Damping
 
 
@@ -34,20 +40,11 @@ def test_blocked_equals_dense_modal_condensation(damping):
     mc = ModalCondenser(model, F_MAX, 7, tol=1e-2)
     bc = BlockedModalCondenser(model, F_MAX, 7, tol=1e-2)
     assert bc.n_modes == mc.n_modes and abs(bc.error - mc.error) <= 1e-9 * mc.error
-    w = 2 * np.pi * 15e3
-    a, b = mc.reduced(w, ORDERS), bc.reduced(w, ORDERS)
+    a, b = same_reductions(model, mc, bc, 1e-12)
     assert isinstance(b.Z, ReducedOperator) and b.Z.shape == a.Z.shape
     assert b.Z.real == (damping is None)
     # m x m storage: K^cc and M^cc (+ C^cc, D^cc when damped), not one block per harmonic
     assert len(b.Z.mats) == (2 if damping is None else 4)
-    for n in ORDERS:
-        assert rel(b.Z[n], a.Z[n]) < 1e-12, n
-    for name in ("F", "obs_A", "obs_b"):
-        assert rel(getattr(b, name), getattr(a, name)) < 1e-12, name
-    u = np.random.default_rng(1).standard_normal((ORDERS.size, a.m)) + 0j
-    assert rel(bc.recover(w, ORDERS, u), mc.recover(w, ORDERS, u)) < 1e-12
-    ex = exact_condenser(model).reduced(w, ORDERS[:1])
-    assert rel(b.Z[0], ex.Z[0]) < 1e-10 and rel(b.F[0], ex.F[0]) < 1e-10
     # a slice is the operator of those harmonics (the one-harmonic start takes Z[:2])
     assert rel(b.Z[:2][1], a.Z[1]) < 1e-12
 
@@ -90,17 +87,9 @@ def test_dense_condenser_as_operator_equals_its_blocks(damping):
         assert rel(getattr(b, name), getattr(a, name)) < 1e-12, name
     if damping is not None:
         return
-    model = block(traction=4.5e5)
-    basis = FourierBasis.up_to(3, 64)
-    out = []
-    for rep in ("dense", "operator"):
-        c = ModalCondenser(model, F_MAX, 7, tol=1e-2, representation=rep)
-        sol = solve_periodic(model, basis, frequency=12e3, condenser=c,
-                             anchor=static_anchor(model, condenser=c))
-        assert sol.success
-        out.append(sol)
-    assert 0.02 < out[1].state_fractions().mean(axis=0)[2] < 0.98  # partial slip
-    assert rel(out[1].U, out[0].U) < 1e-8
+    same_partial_slip_solution(
+        lambda m: ModalCondenser(m, F_MAX, 7, tol=1e-2, representation="dense"),
+        lambda m: ModalCondenser(m, F_MAX, 7, tol=1e-2, representation="operator"))
 
 
 def test_representation_is_checked():

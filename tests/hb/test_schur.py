@@ -17,15 +17,19 @@ is made from it carry ``M^cc``'s error scaled by ``(n w)^2 |M^cc| / |Z_r|``: ass
 import numpy as np
 import pytest
 import scipy.sparse as sp
-from helpers.operator_models import F_MAX, ORDERS, block, rel
+from helpers.operator_models import (
+    F_MAX,
+    block,
+    rel,
+    same_partial_slip_solution,
+    same_reductions,
+)
 
 from fretwear.errors import InputError
 from fretwear.hb import modal, schur
-from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.modal import ModalCondenser, SchurModalCondenser, modal_condenser
-from fretwear.hb.periodic import solve_periodic
-from fretwear.hb.preload import static_anchor
-from fretwear.hb.reduce import _Blocks, exact_condenser
+from fretwear.hb.reduce import _Blocks
+from fretwear.hb.sparse_lu import factor
 from fretwear.model import Damping
 
 pytest.importorskip("kvxopt")
@@ -52,16 +56,7 @@ def test_partial_factorisations_equal_the_static_modes(damping):
         assert err < 1e-7 and err < 10 * d.error, (nm, err, d)
         for i in (1, 2, 3):
             assert rel(sc.proj_local[nm][i], mc.proj_local[nm][i]) < 1e-10, (nm, i)
-    w = 2 * np.pi * 15e3
-    a, b = mc.reduced(w, ORDERS), sc.reduced(w, ORDERS)
-    for n in range(ORDERS.size):
-        assert rel(b.Z[n], a.Z[n]) < 1e-8, n
-    for name in ("F", "obs_A", "obs_b"):
-        assert rel(getattr(b, name), getattr(a, name)) < 1e-8, name
-    u = np.random.default_rng(1).standard_normal((ORDERS.size, a.m)) + 0j
-    assert rel(sc.recover(w, ORDERS, u), mc.recover(w, ORDERS, u)) < 1e-8
-    ex = exact_condenser(model).reduced(w, ORDERS[:1])
-    assert rel(b.Z[0], ex.Z[0]) < 1e-10 and rel(b.F[0], ex.F[0]) < 1e-10
+    same_reductions(model, mc, sc, 1e-8)
 
 
 def _blocks(A, c):
@@ -76,9 +71,9 @@ def test_schur_complement_and_its_derivative_against_dense_algebra():
     """On a random sparse chain (a semi-definite K with a rigid motion, as a structure
     carried by its interface): the partial factorisation gives K_cc - K_ci K_ii^-1 K_ic of
     NumPy's dense solve to 1e-12 (rounding); the central difference of the Schur complements
-    of K -/+ h X gives T^T X T, T = [Psi; I], to 1e-7 (its estimated error, 1e-9 here, with
-    margin), for a mass-like X and an indefinite one (dS/dsigma = -X^cc holds for any
-    symmetric X)."""
+    of K -/+ h X gives T^T X T, T = [I; Psi] (contact DOFs first), to 1e-7 (its estimated
+    error, 1e-9 here, with margin), for a mass-like X and an indefinite one (dS/dsigma =
+    -X^cc holds for any symmetric X)."""
     rng = np.random.default_rng(3)
     n, c = 40, np.arange(30, 40)
     # a chain of springs (one rigid translation) plus random symmetric coupling of neighbours
@@ -109,6 +104,39 @@ def test_schur_complement_and_its_derivative_against_dense_algebra():
     assert rel(out.cc["K"], ref) < 1e-12
 
 
+def _chain(stiffness):
+    """A chain of 40 springs of about ``stiffness`` [N/m] (one rigid translation, its last 10
+    DOFs the contact ``c``): ``K``, its blocks, the static modes ``Psi`` (NumPy's dense
+    solve), ``c`` and the interior DOFs ``i``."""
+    n, c = 40, np.arange(30, 40)
+    rng = np.random.default_rng(3)
+    K = np.zeros((n, n))
+    for j, kj in enumerate(stiffness * (1 + rng.random(n - 1))):
+        K[np.ix_([j, j + 1], [j, j + 1])] += kj * np.array([[1, -1], [-1, 1]])
+    i = np.setdiff1d(np.arange(n), c)
+    return K, _blocks(K, c), -np.linalg.solve(K[np.ix_(i, i)], K[np.ix_(i, c)]), c, i
+
+
+@pytest.mark.parametrize("stiffness", [1e6, 1e8])
+def test_derivative_of_a_matrix_on_the_contact_dofs_alone(stiffness):
+    """A damping matrix on the contact DOFs alone (dashpots at the interface and between a
+    contact and an interior DOF: ``X_ii = 0``, indefinite): ``S(sigma)`` is then quadratic
+    and its central difference exact, so ``X^cc = T^T X T`` of dense algebra is met to the
+    rounding (estimated 1e-10; asserted 1e-9 and below ten times the estimate, as above).
+    The step once came from the interior block alone: a relative error of 1.0 at 1e6 N/m
+    (a step of 1e201), 2e-6 at 1e8 (a step not scaled to K / X)."""
+    K, Kb, Psi, c, i = _chain(stiffness)
+    X = np.zeros(K.shape)
+    X[c, c] = 5.0 * (1 + np.random.default_rng(4).random(c.size))
+    X[c[0], i[-1]] = X[i[-1], c[0]] = 2.0
+    out = schur.contact_blocks(Kb, {"C": _blocks(X, c)}, factor(Kb.ii, "spd"))
+    T = np.vstack([np.eye(c.size), Psi])  # rows: contact, then interior
+    order = np.concatenate([c, i])
+    err = rel(out.cc["C"], T.T @ X[np.ix_(order, order)] @ T)
+    d = out.differences["C"]
+    assert err < 1e-9 and err < 10 * d.error, (err, d)
+
+
 @pytest.mark.parametrize("dense", [True, False], ids=["front", "scattered"])
 def test_lower_product(dense):
     """``L L^T`` of a lower triangle given by compressed columns, against NumPy's product
@@ -119,13 +147,12 @@ def test_lower_product(dense):
     if not dense:
         L[rng.random((m, m)) < 0.3] = 0.0
         np.fill_diagonal(L, 1.0 + rng.random(m))
-    C = sp.csc_matrix(L) if not dense else sp.csc_matrix(np.where(np.tril(np.ones((m, m))),
-                                                                 L + 0.0, 0.0))
     if dense:  # every entry of the triangle stored, as a dense front
         rows = np.concatenate([np.arange(j, m) for j in range(m)])
         ptr = np.concatenate([[0], np.cumsum(m - np.arange(m))])
         vals = np.concatenate([L[j:, j] for j in range(m)])
     else:
+        C = sp.csc_matrix(L)
         rows, ptr, vals = C.indices.astype(np.int64), C.indptr.astype(np.int64), C.data
     assert rel(schur._lower_product(ptr, rows, vals, m), L @ L.T) < 1e-13
 
@@ -166,14 +193,82 @@ def test_periodic_solve_in_partial_slip_equals_the_static_modes_path():
     """A periodic solve in partial slip through the condenser by partial factorisations
     reaches the dense modal condenser's solution (1e-8: both stop at the solver's tolerance,
     1e-9 of |Z U|, and Z_r differs by less than 1e-8)."""
-    model = block(traction=4.5e5)
-    basis = FourierBasis.up_to(3, 64)
-    out = []
-    for cls in (ModalCondenser, SchurModalCondenser):
-        c = cls(model, F_MAX, 7, tol=1e-2)
-        sol = solve_periodic(model, basis, frequency=12e3, condenser=c,
-                             anchor=static_anchor(model, condenser=c))
-        assert sol.success
-        out.append(sol)
-    assert 0.02 < out[1].state_fractions().mean(axis=0)[2] < 0.98  # partial slip
-    assert rel(out[1].U, out[0].U) < 1e-8
+    same_partial_slip_solution(lambda m: ModalCondenser(m, F_MAX, 7, tol=1e-2),
+                               lambda m: SchurModalCondenser(m, F_MAX, 7, tol=1e-2))
+
+
+@pytest.mark.parametrize("cls", [modal.BlockedModalCondenser, SchurModalCondenser])
+@pytest.mark.parametrize("name, value", [("cutoff", -1.0), ("tol", float("nan")),
+                                         ("tol", 0.0)])
+def test_bad_cutoff_or_tol_is_one_input_error(cls, name, value):
+    """The large-interface condensers check ``cutoff`` and ``tol`` as
+    :class:`ModalCondenser` does (one InputError naming the argument, before any solve):
+    they once built with a NaN ``tol`` (no error ever exceeds it) and a negative ``cutoff``."""
+    with pytest.raises(InputError, match=f"{name} = {value!r}: expected a positive number"):
+        cls(None, F_MAX, 7, **{name: value})  # refused before the model is read
+
+
+def test_indefinite_interior_stiffness_keeps_the_static_modes(monkeypatch):
+    """A symmetric ``K_ii`` that is not positive definite (one interior diagonal entry
+    negated; the static modes handle it, SuperLU factorising ``K_ii``): the condenser by
+    partial factorisations refuses it in one InputError that says why, and
+    ``modal_condenser`` (its threshold lowered to the block's) keeps the static modes. It
+    once raised a RuntimeError blaming CHOLMOD's ordering (the probe of an incomplete
+    factor)."""
+    import dataclasses
+
+    model = block()
+    K = sp.lil_matrix(model.K)
+    taken = set(np.asarray(model.contact.dofs).ravel()) | set(np.asarray(model.fixed_dofs))
+    j = next(i for i in range(K.shape[0]) if i not in taken)
+    K[j, j] = -0.5 * K[j, j]
+    model = dataclasses.replace(model, K=sp.csr_matrix(K))
+    with pytest.raises(InputError, match="positive definite K_ii"):
+        SchurModalCondenser(model, F_MAX, 7, tol=1e-2)
+    monkeypatch.setattr(modal, "SCHUR_MIN_CONTACT", 1)
+    assert type(modal_condenser(model, F_MAX, 7, tol=1e-2)) is ModalCondenser
+
+
+def test_cholmod_options_are_restored_when_threads_factorise_at_once(monkeypatch):
+    """Two threads make partial factorisations at once, the first held inside CHOLMOD's
+    symbolic analysis until the second enters it too (or 0.5 s have passed: with the lock it
+    cannot), the second then until the first is done: kvxopt's options, one dict for the
+    process, end as they began, and both Schur complements equal the one made alone
+    (bitwise: the same ordering, the same arithmetic). Without the lock the second thread
+    saved the first's changed options and restored them: every later CHOLMOD factorisation
+    of the process ran with one ordering method and no postordering."""
+    import threading
+
+    cholmod = pytest.importorskip("kvxopt.cholmod")
+    _, Kb, _, _, _ = _chain(1e8)
+    ref = schur.PartialFactor(Kb).schur(Kb.ii, Kb.ic, Kb.ci, Kb.cc)
+    before = dict(cholmod.options)
+    real, calls = cholmod.symbolic, []
+    second, first_done = threading.Event(), threading.Event()
+
+    def symbolic(*args, **kwargs):
+        calls.append(threading.current_thread().name)
+        if len(calls) == 1:
+            second.wait(0.5)  # the first thread in waits for the second
+        else:
+            second.set()
+            first_done.wait(0.5)  # which then finishes after the first
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(cholmod, "symbolic", symbolic)
+    out = {}
+
+    def work(name):
+        out[name] = schur.PartialFactor(Kb).schur(Kb.ii, Kb.ic, Kb.ci, Kb.cc)
+        if name == "a":
+            first_done.set()
+
+    threads = [threading.Thread(target=work, args=(name,), name=name) for name in "ab"]
+    threads[0].start()
+    while not calls:  # the first is inside the symbolic analysis
+        second.wait(0.001)
+    threads[1].start()
+    for t in threads:
+        t.join()
+    assert dict(cholmod.options) == before
+    assert np.array_equal(out["a"], ref) and np.array_equal(out["b"], ref)

@@ -109,3 +109,32 @@ def test_agreeing_early_jumps_that_land_elsewhere_are_refused(tmp_path):
     fast = worn_state(model, basis, quasi_static=True, options=WornStateOptions(stick_set=True))
     assert fast.success and "stick-set jump" in fast.message, fast.message
     assert np.max(np.abs(fast.wear - Wm)) <= 0.01 * top
+
+
+def test_a_resumed_run_takes_the_jump_of_the_run_never_stopped(tmp_path):
+    """``stick_set = True`` on the Winkler punch, interrupted (a callback raising
+    KeyboardInterrupt) after the last path step before its jump, then resumed from its
+    checkpoint: the same records, the same state bit for bit and the same message as the run
+    never stopped (the target jump of the rule is found again from the resumed records; a
+    run that started with no target took its jump a step later, 8e-22 m away)."""
+    from fretwear.wear import RunControl
+
+    model, options = winkler(), WornStateOptions(stick_set=True)
+    ref = worn_state(model, BASIS, quasi_static=True, options=options)
+    assert "stick-set jump" in ref.message
+    last_path_step = ref.history.wear_depth.shape[0] - 2  # the last record is the jump's
+    ck = tmp_path / "worn.npz"
+
+    def stop(step, record):
+        if step == last_path_step:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        worn_state(model, BASIS, quasi_static=True, options=options,
+                   run=RunControl(checkpoint=ck, callback=stop))
+    res = worn_state(model, BASIS, quasi_static=True, options=options,
+                     run=RunControl(checkpoint=ck, resume=True))
+    assert res.resumed_from == last_path_step
+    assert res.history.wear_depth.shape == ref.history.wear_depth.shape
+    np.testing.assert_array_equal(res.wear, ref.wear)
+    assert res.message == ref.message

@@ -200,10 +200,24 @@ def rebuild_point(probs: Problems, entry: dict) -> SweepPoint:
         sol = assemble_solution(prob, np.array(entry["U"], float), model, stats)
     pt = SweepPoint(rec["frequency_hz"], sol, stats, rec["how"], list(rec["flags"]),
                     bool(rec["on_grid"]), rec["time_domain"],
-                    [Attempt(**a) for a in rec.get("attempts", [])])
+                    [_attempt(a) for a in rec.get("attempts", [])])
     if sol is not None:
         sol.attempts = pt.attempts
     return pt
+
+
+def _attempt(rec: dict) -> Attempt:
+    """An attempt from its checkpoint record. A jump recorded before :class:`Attempt` had
+    ``from_hz`` (a checkpoint of an earlier fretwear, of the same format version) gets the
+    fold's frequency back from its message, "... (from the fold at <f> Hz)"."""
+    a = Attempt(**rec)
+    tag = "(from the fold at "
+    if a.method == "jump" and a.from_hz is None and tag in a.message:
+        try:
+            a.from_hz = float(a.message.rsplit(tag, 1)[1].split(" Hz", 1)[0])
+        except ValueError:
+            pass  # not a number: the summary says "a fold"
+    return a
 
 
 class Branch:

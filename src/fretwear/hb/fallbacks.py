@@ -104,7 +104,8 @@ def of_solutions(points, total: float) -> FallbackCost:
         attempts = getattr(p, "attempts", [])
         for a in attempts:  # a jump at a fold (fretwear.hb.attempts.jump): where from, to
             if a.method == "jump" and a.success and hasattr(p, "frequency_hz"):
-                cost.jumps.append(f"{a.from_hz:.6g} Hz -> {p.frequency_hz:.6g} Hz")
+                fold = "a fold" if a.from_hz is None else f"{a.from_hz:.6g} Hz"
+                cost.jumps.append(f"{fold} -> {p.frequency_hz:.6g} Hz")
         if len(attempts) > 1 or (attempts and not attempts[0].success):
             seconds = float(getattr(p, "fallback_seconds", 0.0))
             later = attempts[1:]

@@ -185,14 +185,10 @@ class ModalCondenser(Condenser):
     def __init__(self, model: Model, f_max: float, max_order: int, *, modes: int | None = None,
                  cutoff: float = CUTOFF, tol: float = TOL, raise_modes: bool = False,
                  residual: bool = False, representation: str | Representation = "auto"):
-        self._check_args(f_max, modes)
+        self._check_args(f_max, modes, cutoff, tol)
         rep = Representation.of(representation)
         self._set_compress(model, rep.compress)
         self.representation = "operator" if rep.kind == "compressed" else rep.kind
-        for name, value in (("cutoff", cutoff), ("tol", tol)):
-            if (isinstance(value, bool) or not isinstance(value, int | float)
-                    or not math.isfinite(value) or value <= 0):
-                raise InputError(f"{name} = {value!r}: expected a positive number")
         super().__init__(_structure(model), dense=False)
         if not self.ni:
             raise InputError("the model has no interior DOFs: nothing to represent by modes")
@@ -238,14 +234,18 @@ class ModalCondenser(Condenser):
 
     # -- construction -------------------------------------------------------------------------
     @staticmethod
-    def _check_args(f_max, modes):
-        """One InputError for an ``f_max`` that is not a positive frequency or ``modes`` that
-        is not None or a number of modes."""
+    def _check_args(f_max, modes, cutoff, tol):
+        """One InputError for an ``f_max`` that is not a positive frequency, ``modes`` that
+        is not None or a number of modes, or a ``cutoff`` or ``tol`` not a positive number."""
         if not (isinstance(f_max, int | float) and math.isfinite(f_max) and f_max > 0):
             raise InputError(f"f_max = {f_max!r}: expected a positive frequency [Hz]")
         if modes is not None and (isinstance(modes, bool) or not isinstance(modes, int)
                                   or modes < 0):
             raise InputError(f"modes = {modes!r}: expected a number of modes >= 0")
+        for name, value in (("cutoff", cutoff), ("tol", tol)):
+            if (isinstance(value, bool) or not isinstance(value, int | float)
+                    or not math.isfinite(value) or value <= 0):
+                raise InputError(f"{name} = {value!r}: expected a positive number")
 
     def _basis(self, mode_frequencies, Phi, extra):
         """Interior basis ``V``: the modes ``Phi`` and the static vectors ``extra``, scaled and
@@ -657,11 +657,12 @@ def modal_condenser(model: Model, f_max: float, max_order: int, *, modes: int | 
     model, or this one after an edit of its matrices.
 
     Which condenser (its ``path``, also logged): with CHOLMOD (``fretwear[fast]``), no
-    ``residual`` and symmetric matrices, from :data:`SCHUR_MIN_CONTACT` contact DOFs on, a
-    :class:`SchurModalCondenser` (the projected contact blocks by partial factorisations,
-    no ``m`` solves); otherwise, where the dense storage (:func:`dense_storage_gib`) exceeds
-    :data:`DENSE_STORAGE_GIB`, a :class:`BlockedModalCondenser` (the same condensation
-    without ``Psi`` or dense blocks per harmonic), else a :class:`ModalCondenser`.
+    ``residual``, symmetric matrices and a positive definite ``K_ii``, from
+    :data:`SCHUR_MIN_CONTACT` contact DOFs on, a :class:`SchurModalCondenser` (the projected
+    contact blocks by partial factorisations, no ``m`` solves); otherwise, where the dense
+    storage (:func:`dense_storage_gib`) exceeds :data:`DENSE_STORAGE_GIB`, a
+    :class:`BlockedModalCondenser` (the same condensation without ``Psi`` or dense blocks per
+    harmonic), else a :class:`ModalCondenser`.
     """
     max_order = whole(max_order, "max_order", low=0)
     if modes is not None:
@@ -669,19 +670,28 @@ def modal_condenser(model: Model, f_max: float, max_order: int, *, modes: int | 
     f_max = number(f_max, "f_max", low=0.0, open_low=True, unit="Hz")
     compress = _compress_bound(compress)
     rep = "auto" if compress is None else Representation("compressed", compress)
+    out = None
     if _partial_factorisations_apply(model, residual):
-        out = SchurModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff,
-                                  tol=tol, raise_modes=raise_modes, representation=rep)
-    elif dense_storage_gib(model, max_order) > DENSE_STORAGE_GIB:
+        try:
+            out = SchurModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff,
+                                      tol=tol, raise_modes=raise_modes, representation=rep)
+        except NotDefinite:  # an indefinite K_ii (its LU is SuperLU's): the static modes
+            sparse_lu.log.info("K_ii not positive definite: no partial factorisations")
+    if out is None and dense_storage_gib(model, max_order) > DENSE_STORAGE_GIB:
         # the blocked condenser keeps every mode below the cutoff (or ``modes``) and adds no
         # residual vectors: their m extra solves are what it cannot afford at this size
         out = BlockedModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff,
                                     tol=tol, compress=compress)
-    else:
+    elif out is None:
         out = ModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff, tol=tol,
                              raise_modes=raise_modes, residual=residual, representation=rep)
     sparse_lu.log.info("modal condensation by %s", out.path)
     return out
+
+
+class NotDefinite(InputError):
+    """:class:`SchurModalCondenser` of a model whose ``K_ii`` CHOLMOD does not factorise
+    (not positive definite): :func:`modal_condenser` then takes the static modes."""
 
 
 #: contact DOFs from which :func:`modal_condenser` takes the partial factorisations
@@ -800,7 +810,7 @@ class BlockedModalCondenser(ModalCondenser):
 
     def __init__(self, model: Model, f_max: float, max_order: int, *, modes: int | None = None,
                  cutoff: float = CUTOFF, tol: float = TOL, compress: float | None = None):
-        self._check_args(f_max, modes)
+        self._check_args(f_max, modes, cutoff, tol)
         self._set_compress(model, compress)
         Condenser.__init__(self, _structure(model), dense=False)
         if not self.ni:
@@ -939,7 +949,7 @@ class SchurModalCondenser(BlockedModalCondenser):
     def __init__(self, model: Model, f_max: float, max_order: int, *, modes: int | None = None,
                  cutoff: float = CUTOFF, tol: float = TOL, raise_modes: bool = False,
                  representation: str | Representation = "auto"):
-        self._check_args(f_max, modes)
+        self._check_args(f_max, modes, cutoff, tol)
         rep = Representation.of(representation)
         self._set_compress(model, rep.compress)
         self.representation = "operator" if rep.kind == "compressed" else rep.kind
@@ -962,6 +972,10 @@ class SchurModalCondenser(BlockedModalCondenser):
                        f"interior and {self.m:,} contact DOFs (its projected blocks, m x m)")
         self.f_max, self.max_order, self.tol = float(f_max), int(max_order), float(tol)
         lu = self.factor(0.0, 0, True)  # CHOLMOD's Cholesky of K_ii, kept
+        if getattr(lu, "name", "") != "cholmod":  # CHOLMOD refused K_ii: not definite
+            raise NotDefinite("a modal condensation by partial factorisations needs a positive "
+                              "definite K_ii (CHOLMOD refused it; the factorisations of K -/+ "
+                              "h X would fail); build a ModalCondenser instead")
         self._lu0, self._exact, self._cc_local = lu, None, None
         self.residual = False
         few = _FewColumns(lu)

@@ -74,7 +74,8 @@ def available() -> bool:
 @dataclass(frozen=True)
 class Difference:
     """How one ``X^cc`` (``X`` not ``K``) was found: ``step`` ``h`` of the central difference,
-    ``nu`` the estimate of the largest ``|eig(K_ii^-1 X_ii)|``, ``error`` the estimated
+    ``nu`` the estimate of the largest ``|eig(K_ii^-1 X_ii)|`` (at least ``X``'s largest
+    entry over ``K``'s: :func:`contact_blocks`), ``error`` the estimated
     relative error ``TRUNCATION (h nu)^2 + ROUNDING eps rho / (h nu)`` with the achieved
     ``rho = (|S| + alpha) nu / |X^cc|`` (max-norms)."""
 
@@ -122,24 +123,28 @@ class PartialFactor:
         """``cc - ci ii^-1 ic`` (m, m), dense, symmetric, from the partial factorisation of
         ``[[ii, ic], [ci, cc + alpha I]]`` with the interior first in its AMD order. Raises
         ``ArithmeticError``/``ValueError`` when ``ii`` is not positive definite (CHOLMOD's)
-        and RuntimeError when CHOLMOD did not keep the ordering."""
+        and RuntimeError when its factor does not reproduce the matrix (the ordering not kept,
+        or a factorisation left incomplete)."""
         ni, m, cholmod = self.ni, self.m, self._cholmod
         A = sp.bmat([[ii, ic], [ci, sp.csr_matrix(np.asarray(cc))
                                 + self.alpha * sp.identity(m)]], format="csc")
         p = np.concatenate([self.p_i, ni + np.arange(m, dtype=np.int64)])
         Ak = self._spmatrix(A)
-        saved = dict(cholmod.options)
-        # kvxopt's options are global (restored below): one ordering method (the given one:
-        # by default CHOLMOD also tries its own and keeps the best) and no postordering
-        cholmod.options["nmethods"] = 1
-        cholmod.options["postorder"] = False
-        try:
-            F = cholmod.symbolic(Ak, p=self._kvx.matrix(p))
-            cholmod.numeric(Ak, F)
-            Lk = cholmod.getfactor(F)
-        finally:
-            cholmod.options.clear()
-            cholmod.options.update(saved)
+        # kvxopt's options are global (restored below, under a lock: another thread's
+        # factorisation would see them, or save them changed and restore them so): one
+        # ordering method (the given one: by default CHOLMOD also tries its own and keeps the
+        # best) and no postordering
+        with sparse_lu.CHOLMOD_OPTIONS:
+            saved = dict(cholmod.options)
+            cholmod.options["nmethods"] = 1
+            cholmod.options["postorder"] = False
+            try:
+                F = cholmod.symbolic(Ak, p=self._kvx.matrix(p))
+                cholmod.numeric(Ak, F)
+                Lk = cholmod.getfactor(F)
+            finally:
+                cholmod.options.clear()
+                cholmod.options.update(saved)
         del F, Ak
         ptr, rows, vals = Lk.CCS
         del Lk
@@ -152,7 +157,9 @@ class PartialFactor:
         y[p] = x
         Ax = (A @ y)[p]  # P A P^T x
         if not np.linalg.norm(L @ (L.T @ x) - Ax) <= 1e-10 * np.linalg.norm(Ax):
-            raise RuntimeError("CHOLMOD's factor does not have the ordering it was given")
+            raise RuntimeError("CHOLMOD's factor does not reproduce the matrix: another "
+                               "ordering than the one given, or a matrix not positive "
+                               "definite (a factorisation left incomplete)")
         del L
         # the contact rows: L_ci (sparse, its fill measured) and L_cc (dense lower triangle)
         self.nnz_contact_rows = int(np.count_nonzero(rows[:ptr[ni]] >= ni))
@@ -212,6 +219,15 @@ def _nu(lu, Xii, rng) -> float:
     return MARGIN * nu
 
 
+def _largest(B) -> float:
+    """The largest ``|entry|`` of the blocks ``B`` (``ii``, ``ic``, ``cc``; ``ci`` is
+    ``ic``'s transpose: the matrices are symmetric), 0 for none."""
+    vals = [sp.csr_matrix(b).data if sp.issparse(b) else np.asarray(b)
+            for b in (B.ii, B.ic, B.cc)]
+    # max and -min: no |.| copy of the dense m x m contact block
+    return max(max(float(v.max()), -float(v.min())) if v.size else 0.0 for v in vals)
+
+
 def step(nu: float, rho: float) -> float:
     """The step ``h`` of the central difference that balances its truncation
     ``TRUNCATION (h nu)^2`` and rounding ``ROUNDING eps rho / (h nu)``:
@@ -235,9 +251,13 @@ def contact_blocks(K, others: dict, lu) -> ContactBlocks:
         # block where the contact block has a zero diagonal)
         xcc = (float(np.max(np.abs(np.diag(np.asarray(X.cc))), initial=0.0))
                or float(np.max(np.abs(X.ii.diagonal()), initial=0.0)))
-        kx = float(abs(K.ii).max()) / max(float(abs(X.ii).max()), 1e-300)
-        if nu <= 0.0:  # no interior part: S(sigma) is quadratic, the difference is exact
-            nu = 1.0 / kx if np.isfinite(kx) and kx > 0 else 1.0
+        # X's largest entry over K's bounds nu from below: where X lives on the contact DOFs
+        # alone (dashpots at the interface: X_ii = 0, the power iterations give 0, S(sigma)
+        # is quadratic and its central difference exact) or mostly, the step keeps h X a
+        # small fraction of K, so that K -/+ h X stays positive definite and the rounding
+        # small; where X is carried by the interior, nu is the larger (its largest entry is
+        # on its diagonal, X_jj / K_jj <= nu)
+        nu = max(nu, _largest(X) / _largest(K)) or 1.0  # X = 0: X^cc = 0 at any step
         h = step(nu, scale * nu / max(xcc, 1e-300 * scale))
         Sm = pf.schur(K.ii + h * X.ii, K.ic + h * X.ic, K.ci + h * X.ci,
                       np.asarray(K.cc) + h * np.asarray(X.cc))

@@ -199,6 +199,7 @@ class Attempt:
         iterations).
     solver : the nonlinear solver; eps : the penalty of the answer [N/m]; success, residual
     (relative), iterations, wall_time [s], message : as :class:`~fretwear.hb.solvers.SolveStats`.
+    from_hz : for a ``"jump"``, the frequency of the fold it left [Hz]; None otherwise.
     """
 
     method: str

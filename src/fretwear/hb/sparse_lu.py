@@ -31,6 +31,7 @@ from __future__ import annotations
 import importlib
 import logging
 import os
+import threading
 
 import numpy as np
 import scipy.sparse as sp
@@ -53,6 +54,9 @@ ENV = "FRETWEAR_SPARSE_LU"
 MANY = 8
 #: pivots spanning more than this ratio: a nearly singular matrix (as reduce's dense check)
 NEAR_SINGULAR = 1e-13
+#: held while kvxopt's CHOLMOD options (one dict for the process) are changed or read by a
+#: symbolic analysis (here and :mod:`fretwear.hb.schur`): no state, a lock between threads
+CHOLMOD_OPTIONS = threading.Lock()
 
 
 class SingularError(RuntimeError):
@@ -185,7 +189,8 @@ class _Cholmod(_Factor):
         self.A = kvx.spmatrix(kvx.matrix(np.ascontiguousarray(C.data, dtype=float)),
                               kvx.matrix(C.row.astype(np.int64)),
                               kvx.matrix(C.col.astype(np.int64)), A.shape)
-        self.F = cholmod.symbolic(self.A)
+        with CHOLMOD_OPTIONS:  # CHOLMOD's default options (no other thread's changes)
+            self.F = cholmod.symbolic(self.A)
         cholmod.numeric(self.A, self.F)  # ArithmeticError: not positive definite
         # ValueError: not positive definite (the factor is left incomplete)
         d = np.abs(np.asarray(cholmod.diag(self.F))).ravel() ** 2
@@ -196,13 +201,9 @@ class _Cholmod(_Factor):
         self._A, self._sn = A, None
 
     def _solve(self, B):
-        one = B.ndim == 1
-        if not one and B.shape[1] >= MANY:
+        if B.ndim > 1 and B.shape[1] >= MANY:
             return self._supernodal().solve(B)
-        X = self._kvx.matrix(np.asfortranarray(B.reshape(self.n, -1)))
-        self._cholmod.solve(self.F, X)
-        X = np.array(X)
-        return X[:, 0] if one else X
+        return self._own_solve(B)
 
     def solve_few(self, B):
         """``solve(B)`` by CHOLMOD's own solve whatever the number of columns: the supernodal
@@ -211,6 +212,10 @@ class _Cholmod(_Factor):
         B = np.asarray(B)
         if B.dtype.kind == "c":
             return self.solve_few(B.real) + 1j * self.solve_few(B.imag)
+        return self._own_solve(B)
+
+    def _own_solve(self, B):
+        """CHOLMOD's own solve of a real ``B`` (n,) or (n, k)."""
         one = B.ndim == 1
         X = self._kvx.matrix(np.asfortranarray(B.reshape(self.n, -1), dtype=float))
         self._cholmod.solve(self.F, X)
@@ -232,15 +237,16 @@ class _Cholmod(_Factor):
                           kvx.matrix(C.row.astype(np.int64)),
                           kvx.matrix(C.col.astype(np.int64)), self._A.shape)
         p = np.array(amd.order(Ak), dtype=np.int64).ravel()
-        saved = dict(cholmod.options)
-        cholmod.options["postorder"] = False  # kvxopt's options are global: restored below
-        try:
-            F = cholmod.symbolic(Ak, p=kvx.matrix(p))
-            cholmod.numeric(Ak, F)
-            Lk = cholmod.getfactor(F)
-        finally:
-            cholmod.options.clear()
-            cholmod.options.update(saved)
+        with CHOLMOD_OPTIONS:  # kvxopt's options are global: restored below
+            saved = dict(cholmod.options)
+            cholmod.options["postorder"] = False
+            try:
+                F = cholmod.symbolic(Ak, p=kvx.matrix(p))
+                cholmod.numeric(Ak, F)
+                Lk = cholmod.getfactor(F)
+            finally:
+                cholmod.options.clear()
+                cholmod.options.update(saved)
         ptr, rows, vals = Lk.CCS  # compressed columns as they are (no triplets: 4096
         del Lk, F  # contact nodes' factor holds 1e8 entries)
         L = sp.csc_matrix((np.asarray(vals, dtype=float).ravel(),

@@ -507,7 +507,9 @@ class _Jumps:
     ``W_k-1`` to ``J``, the jump from ``k`` is computed; it is accepted when it gives the
     same state as ``J``, to ``depth_tolerance`` of the deepest wear, else it becomes the new
     target (a step that covered less computes no jump: the jumps cost balances). A resumed
-    run starts with no target. Agreement alone is not enough: on Stromberg's beam the jumps
+    run first replays the rule over the records it resumed with (the jumps the run before
+    computed are computed again), so that it takes the same jump as a run never stopped.
+    Agreement alone is not enough: on Stromberg's beam the jumps
     from 23 successive records agree on a state 8.1 % of the deepest wear from the march's,
     where two loaded nodes that stick through them slip and wear 1e6 cycles later, once their
     neighbours have unloaded; those records' steps covered 11-22 % of the way to the jump
@@ -521,6 +523,7 @@ class _Jumps:
         self.sp, self.options, self.opts = sp, options, opts
         self.found: dict[int, object] = {}
         self.latest = None  # (record, jump) of the last jump tried
+        self.replayed = False  # the records a run resumed with seen (accept)
         self.iterations = 0  # Newton iterations of every jump tried
 
     def of(self, records: list[StepRecord], k: int):
@@ -535,15 +538,13 @@ class _Jumps:
             self.found[k] = jump
         return self.found[k]
 
-    def accept(self, state: SlowStep, records: list[StepRecord]
-               ) -> tuple[SlowStep, _Found] | None:
-        """The state of the jump from the last record when the class's conditions hold (its
-        record appended to ``records``), else None."""
-        k = len(records) - 1
+    def _consider(self, records: list[StepRecord], k: int):
+        """Record ``k`` seen by the rule of the class: the target updated, and ``(j, jump, c,
+        progress)`` when the jump from ``k`` agrees with the target's from ``j`` (else None).
+        Reads ``records[:k + 1]`` only, so a resumed run replays the run before it."""
         if (k < 1 or not records[k].has_balance or not records[k - 1].has_balance
                 or records[k].volume_rate > TRY_RATE * records[0].volume_rate):
             return None
-        t0 = time.perf_counter()
         if self.latest is None:  # the first jump: the target the path's progress is measured to
             self.latest = k, self.of(records, k)
             return None
@@ -560,8 +561,22 @@ class _Jumps:
         if last is None:
             return None
         c, _ = agreement(W0, W1, before.W, last.W)
-        if c > self.options.depth_tolerance:
+        return None if c > self.options.depth_tolerance else (j, last, c, progress)
+
+    def accept(self, state: SlowStep, records: list[StepRecord]
+               ) -> tuple[SlowStep, _Found] | None:
+        """The state of the jump from the last record when the class's conditions hold (its
+        record appended to ``records``), else None."""
+        k = len(records) - 1
+        t0 = time.perf_counter()
+        if not self.replayed:  # a resumed run: the targets the run before it set, from its
+            self.replayed = True  # records (the jumps it computed are computed again)
+            for i in range(1, k):
+                self._consider(records, i)
+        hit = self._consider(records, k)
+        if hit is None:
             return None
+        j, last, c, progress = hit
         sp, r = self.sp, records[k]
         st = SolveStats(True, 0.0, 0, 0, 0, time.perf_counter() - t0, "stick-set jump", "")
         sol = sp.solution(last.U, last.W, r.anchor, st)
