@@ -229,6 +229,29 @@ def test_indefinite_interior_stiffness_keeps_the_static_modes(monkeypatch):
     assert type(modal_condenser(model, F_MAX, 7, tol=1e-2)) is ModalCondenser
 
 
+def test_nonsymmetric_matrices_keep_the_static_modes(monkeypatch):
+    """A nonsymmetric damping matrix (one off-diagonal entry of a Rayleigh ``C`` doubled):
+    the condenser by partial factorisations refuses it in one InputError (CHOLMOD factorises
+    symmetric matrices), and ``modal_condenser`` (its threshold lowered to the block's)
+    catches that refusal and keeps the static modes, which project any ``C``; the symmetric
+    model next to it takes the partial factorisations."""
+    import dataclasses
+
+    model = block()
+    C = sp.lil_matrix(1e-5 * model.K)
+    rows, cols = sp.triu(model.K, 1).nonzero()
+    i, j = int(rows[0]), int(cols[0])
+    C[i, j] = 2 * C[i, j]
+    assert C[i, j] != C[j, i]
+    unsym = dataclasses.replace(model, C=sp.csr_matrix(C))
+    with pytest.raises(InputError, match="needs symmetric"):
+        SchurModalCondenser(unsym, F_MAX, 7, tol=1e-2)
+    monkeypatch.setattr(modal, "SCHUR_MIN_CONTACT", 1)
+    assert type(modal_condenser(unsym, F_MAX, 7, tol=1e-2)) is ModalCondenser
+    sym = dataclasses.replace(model, C=sp.csr_matrix(1e-5 * model.K))
+    assert type(modal_condenser(sym, F_MAX, 7, tol=1e-2)) is SchurModalCondenser
+
+
 def test_cholmod_options_are_restored_when_threads_factorise_at_once(monkeypatch):
     """Two threads make partial factorisations at once, the first held inside CHOLMOD's
     symbolic analysis until the second enters it too (or 0.5 s have passed: with the lock it

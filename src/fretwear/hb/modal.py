@@ -34,6 +34,7 @@ LU and ``m`` complex solves per harmonic and frequency for the exact condensatio
 
 from __future__ import annotations
 
+import logging
 import math
 from dataclasses import dataclass
 
@@ -44,7 +45,7 @@ import scipy.sparse.linalg as spla
 from numba import njit
 
 from fretwear.errors import InputError
-from fretwear.hb import hmatrix, schur, sparse_lu
+from fretwear.hb import hmatrix, schur
 from fretwear.hb.modal_operator import ReducedOperator
 from fretwear.hb.reduce import (
     BLOCK,
@@ -59,6 +60,8 @@ from fretwear.model.checks import model_argument
 from fretwear.model.core import Model
 from fretwear.resources import require_memory
 from fretwear.validate import number, whole
+
+log = logging.getLogger(__name__)
 
 #: keep the fixed-interface modes up to this multiple of the highest harmonic frequency
 CUTOFF = 3.0
@@ -675,8 +678,8 @@ def modal_condenser(model: Model, f_max: float, max_order: int, *, modes: int | 
         try:
             out = SchurModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff,
                                       tol=tol, raise_modes=raise_modes, representation=rep)
-        except NotDefinite:  # an indefinite K_ii (its LU is SuperLU's): the static modes
-            sparse_lu.log.info("K_ii not positive definite: no partial factorisations")
+        except NotFactorisable as e:  # nonsymmetric, or K_ii indefinite: the static modes
+            log.info("no partial factorisations: %s", e)
     if out is None and dense_storage_gib(model, max_order) > DENSE_STORAGE_GIB:
         # the blocked condenser keeps every mode below the cutoff (or ``modes``) and adds no
         # residual vectors: their m extra solves are what it cannot afford at this size
@@ -685,13 +688,14 @@ def modal_condenser(model: Model, f_max: float, max_order: int, *, modes: int | 
     elif out is None:
         out = ModalCondenser(model, f_max, max_order, modes=modes, cutoff=cutoff, tol=tol,
                              raise_modes=raise_modes, residual=residual, representation=rep)
-    sparse_lu.log.info("modal condensation by %s", out.path)
+    log.info("modal condensation by %s", out.path)
     return out
 
 
-class NotDefinite(InputError):
-    """:class:`SchurModalCondenser` of a model whose ``K_ii`` CHOLMOD does not factorise
-    (not positive definite): :func:`modal_condenser` then takes the static modes."""
+class NotFactorisable(InputError):
+    """:class:`SchurModalCondenser` of a model whose matrices CHOLMOD cannot factorise (not
+    symmetric, or ``K_ii`` not positive definite): :func:`modal_condenser` then takes the
+    static modes."""
 
 
 #: contact DOFs from which :func:`modal_condenser` takes the partial factorisations
@@ -702,13 +706,11 @@ SCHUR_MIN_CONTACT = 3072
 
 
 def _partial_factorisations_apply(model: Model, residual: bool) -> bool:
-    """Whether :func:`modal_condenser` builds a :class:`SchurModalCondenser`: CHOLMOD here,
-    no residual vectors, at least :data:`SCHUR_MIN_CONTACT` contact DOFs and symmetric
-    ``K, M, C, D`` (CHOLMOD factorises symmetric matrices)."""
+    """Whether :func:`modal_condenser` tries a :class:`SchurModalCondenser`: CHOLMOD here,
+    no residual vectors and at least :data:`SCHUR_MIN_CONTACT` contact DOFs (the class
+    itself refuses nonsymmetric matrices and an indefinite ``K_ii``: :class:`NotFactorisable`)."""
     m = int(np.asarray(model.contact.dofs).size)
-    if residual or m < SCHUR_MIN_CONTACT or not schur.available():
-        return False
-    return _symmetric_matrices(model)
+    return not residual and m >= SCHUR_MIN_CONTACT and schur.available()
 
 
 def _symmetric_matrices(model: Model) -> bool:
@@ -961,7 +963,7 @@ class SchurModalCondenser(BlockedModalCondenser):
                              "(pip install 'fretwear[fast]'); modal_condenser falls back to "
                              "the static modes without it")
         if not _symmetric_matrices(model):
-            raise InputError("a modal condensation by partial factorisations needs symmetric "
+            raise NotFactorisable("a modal condensation by partial factorisations needs symmetric "
                              "K, M, C, D (CHOLMOD factorises K -/+ h X); build a "
                              "ModalCondenser instead")
         names = [nm for nm in NAMES if getattr(self, nm) is not None]
@@ -973,7 +975,7 @@ class SchurModalCondenser(BlockedModalCondenser):
         self.f_max, self.max_order, self.tol = float(f_max), int(max_order), float(tol)
         lu = self.factor(0.0, 0, True)  # CHOLMOD's Cholesky of K_ii, kept
         if getattr(lu, "name", "") != "cholmod":  # CHOLMOD refused K_ii: not definite
-            raise NotDefinite("a modal condensation by partial factorisations needs a positive "
+            raise NotFactorisable("a modal condensation by partial factorisations needs a positive "
                               "definite K_ii (CHOLMOD refused it; the factorisations of K -/+ "
                               "h X would fail); build a ModalCondenser instead")
         self._lu0, self._exact, self._cc_local = lu, None, None
