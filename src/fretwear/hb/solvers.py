@@ -17,11 +17,14 @@ callers never turn it into a result.
 
 from __future__ import annotations
 
+import numbers
 import time
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.optimize as so
+
+from fretwear.errors import InputError
 
 SOLVERS = ("powell", "newton", "hybr")
 
@@ -114,6 +117,74 @@ def _column_norms(J):
     if isinstance(J, np.ndarray):
         return np.linalg.norm(J, axis=0)
     return J.column_norms()
+
+
+#: preconditioners of the Newton step's GMRES when the operator carries compressed forms
+#: (:class:`KrylovOptions`)
+PRECONDITIONERS = ("mean-gain", "nearfield")
+
+
+@dataclass(frozen=True)
+class KrylovOptions:
+    """The linear algebra of the Newton step on the operator path (``jacobian = "krylov"``,
+    :mod:`fretwear.hb.krylov`; large interfaces): settings that change how fast a step is
+    solved, never the converged answer (GMRES multiplies by the operator in double and
+    solves each step to the forcing term's relative residual).
+
+    Attributes
+    ----------
+    single_factors : the mean-gain preconditioner's LU factors in single precision
+        (float32, complex64 when damped; default True): half the memory traffic of its
+        triangular solves and LAPACK's ``sgetrf`` for its builds. A preconditioner in single
+        precision is rebuilt in double after a GMRES failure, and once a GMRES solve with it
+        needs more than ``single_max_iterations`` iterations.
+    single_max_iterations : that bound (GMRES iterations of one Newton step; default 60, one
+        restart cycle of :data:`fretwear.hb.krylov.GMRES_RESTART`: on the partial-slip pad
+        of benchmarks/scale_3d.py a step took 4-40 with single factors,
+        docs/studies/large-interface-solve.md). From then on the problem's preconditioners
+        are factored in double.
+    preconditioner : for an operator that carries compressed forms (``compress=`` of the
+        modal condenser): ``"mean-gain"`` (default: dense LU factors of the active block,
+        faster up to 1024 contact nodes) or ``"nearfield"``
+        (:class:`fretwear.hb.nearfield_preconditioner.NearFieldPreconditioner`: no dense
+        ``m_a x m_a`` factors, for interfaces whose dense factors do not fit). Without
+        compressed forms the mean gain is used whatever this says.
+    """
+
+    single_factors: bool = True
+    single_max_iterations: int = 60
+    preconditioner: str = "mean-gain"
+
+    def __post_init__(self):
+        self.check()
+
+    def check(self) -> KrylovOptions:
+        """Validate (also done at construction): one InputError naming the option."""
+        if not isinstance(self.single_factors, bool):
+            raise InputError(f"krylov.single_factors = {self.single_factors!r}: expected "
+                             "True or False")
+        n = self.single_max_iterations
+        if not (isinstance(n, numbers.Integral) and not isinstance(n, bool)
+                and 1 <= n <= 2**62):
+            raise InputError(f"krylov.single_max_iterations = {n!r}: expected a whole "
+                             "number of GMRES iterations >= 1")
+        if not (isinstance(self.preconditioner, str)
+                and self.preconditioner in PRECONDITIONERS):
+            raise InputError(f"krylov.preconditioner = {self.preconditioner!r}: expected "
+                             f"one of {PRECONDITIONERS}")
+        return self
+
+    def key(self) -> dict:
+        """The settings as plain values (checkpoint fingerprints)."""
+        return {"single_factors": self.single_factors,
+                "single_max_iterations": int(self.single_max_iterations),
+                "preconditioner": self.preconditioner}
+
+
+#: the linear algebra of the operator path by default (:class:`KrylovOptions`; defined with
+#: the solvers so that fretwear.hb.krylov reads it, exported by fretwear.hb.options with the
+#: other option records)
+KRYLOV = KrylovOptions()
 
 
 #: a decrease of ``|f|^2`` by less than this fraction in an iteration is slow progress
@@ -432,8 +503,6 @@ def solve(fun, x0, scale, *, method="powell", tol=1e-8, max_iter=200, callback=N
     :func:`powell` and :func:`newton` (``"hybr"`` has MINPACK's own)."""
     table = {"powell": powell, "newton": newton, "hybr": hybr}
     if method not in table:
-        from fretwear.errors import InputError
-
         raise InputError(f"solver = {method!r}: expected one of {SOLVERS}")
     extra = {} if max_slow is None or method == "hybr" else {"max_slow": max_slow}
     return table[method](fun, x0, scale, tol=tol, max_iter=max_iter, callback=callback,
