@@ -172,6 +172,12 @@ class HarmonicBlocks:
         idx = np.arange(nc)
         return Zb.reshape(nc, d, nc, d)[idx, :, idx, :]
 
+    def single(self):
+        """The blocks in single precision for GMRES's loose products, or None: stored
+        blocks keep their one (double) copy (an operator's, hb/operator_blocks.py, have
+        one)."""
+        return None
+
     def leading(self, nb: int) -> HarmonicBlocks:
         """The blocks of the first ``nb`` harmonics, sharing this object's arrays (and its
         real copies)."""
@@ -716,17 +722,34 @@ class KrylovJacobian:
             owner._precond = pc
         return pc
 
+    def _single_blocks(self, Za):
+        """The single-precision twin of the active blocks ``Za`` (their ``single()``), kept
+        by the owner while ``Za`` is the same object; None where there is none."""
+        kept = getattr(self.owner, "_single_Z", None)
+        if kept is not None and kept[0] is Za:
+            return kept[1]
+        twin = Za.single() if hasattr(Za, "single") else None
+        self.owner._single_Z = (Za, twin)
+        return twin
+
     def _gmres_active(self, rhs, act, dofs, rtol=GMRES_RTOL) -> np.ndarray:
-        """GMRES on the active system, one right-hand side at a time."""
+        """GMRES on the active system, one right-hand side at a time; its products with
+        ``Z_aa`` in single precision when the options ask for it and ``rtol`` is at least
+        ``KrylovOptions.single_products_rtol`` (a loose Newton step: the single products'
+        ``1e-7`` relative error is far below it)."""
         eps, dH = self.eps, self.dH
         Za = self._active_blocks(dofs)
+        opts = self.options
+        Zp = Za
+        if opts.single_products and rtol >= opts.single_products_rtol:
+            Zp = self._single_blocks(Za) or Za
         Ga = self.G[act]
         na = act.size
         n = na * dH
 
         def matvec(v):
             v = np.asarray(v, float).reshape(-1)
-            y = (Za.apply(v).reshape(-1) - eps * v).reshape(na, dH)
+            y = (Zp.apply(v).reshape(-1) - eps * v).reshape(na, dH)
             return eps * v + np.matmul(Ga, y[:, :, None])[:, :, 0].reshape(-1)
 
         A = spla.LinearOperator((n, n), matvec=matvec, dtype=float)
@@ -810,6 +833,11 @@ class _ActiveView:
         ``ReducedOperator.block(b, rows, cols)`` would hold two more m_a x m arrays)."""
         Zb = self.Z.Z0 if b == 0 else self.Z.block(b)
         return Zb[np.ix_(self.dofs, self.dofs)]
+
+    def single(self):
+        """The same view of ``Z``'s single-precision blocks (``Z.single()``), or None."""
+        twin = self.Z.single()
+        return None if twin is None else _ActiveView(twin, self.dofs)
 
     def apply(self, U) -> np.ndarray:
         """``Z_aa U`` for ``U`` (m_a H,) or (m_a, H) on the real Fourier basis."""

@@ -149,11 +149,23 @@ class KrylovOptions:
         (:class:`fretwear.hb.nearfield_preconditioner.NearFieldPreconditioner`: no dense
         ``m_a x m_a`` factors, for interfaces whose dense factors do not fit). Without
         compressed forms the mean gain is used whatever this says.
+    single_products : GMRES multiplies by a single-precision copy of the condensed
+        operator's matrices (:meth:`fretwear.hb.modal_operator.ReducedOperator.single`:
+        half the memory traffic, twice the BLAS rate; the copy adds half of their memory)
+        where a Newton step is solved to a relative residual of at least
+        ``single_products_rtol`` (default True; operators of the modal condensation
+        without compressed forms only). The step is then that of an operator off by about
+        ``1e-7`` relative, far below its tolerance: the residual, the dog-leg and the
+        convergence test stay in double, so the converged answer is the same to the
+        solve's tolerance.
+    single_products_rtol : that bound (default ``1e-5``).
     """
 
     single_factors: bool = True
     single_max_iterations: int = 60
     preconditioner: str = "mean-gain"
+    single_products: bool = True
+    single_products_rtol: float = 1e-5
 
     def __post_init__(self):
         self.check()
@@ -172,13 +184,22 @@ class KrylovOptions:
                 and self.preconditioner in PRECONDITIONERS):
             raise InputError(f"krylov.preconditioner = {self.preconditioner!r}: expected "
                              f"one of {PRECONDITIONERS}")
+        if not isinstance(self.single_products, bool):
+            raise InputError(f"krylov.single_products = {self.single_products!r}: expected "
+                             "True or False")
+        t = self.single_products_rtol
+        if not (isinstance(t, numbers.Real) and not isinstance(t, bool) and 1e-6 <= t < 1):
+            raise InputError(f"krylov.single_products_rtol = {t!r}: expected a relative "
+                             "residual between 1e-6 (single precision's reach) and 1")
         return self
 
     def key(self) -> dict:
         """The settings as plain values (checkpoint fingerprints)."""
         return {"single_factors": self.single_factors,
                 "single_max_iterations": int(self.single_max_iterations),
-                "preconditioner": self.preconditioner}
+                "preconditioner": self.preconditioner,
+                "single_products": self.single_products,
+                "single_products_rtol": float(self.single_products_rtol)}
 
 
 #: the linear algebra of the operator path by default (:class:`KrylovOptions`; defined with
