@@ -701,7 +701,8 @@ class KrylovJacobian:
         owner = self.owner
         pc = getattr(owner, "_precond", None)
         if (pc is None or rebuild or pc.m != Za.m
-                or not np.array_equal(getattr(pc, "nodes", None), act)):
+                or not np.array_equal(getattr(pc, "nodes", None), act)
+                or (getattr(pc, "single", False) and getattr(owner, "_double", False))):
             gbar, gosc = harmonic_gains(self.G[act], self.d,
                                         not getattr(owner, "_mean_gain", False))
             from fretwear.hb.nearfield_preconditioner import preconditioner_for
@@ -794,8 +795,7 @@ class KrylovJacobian:
                 rate = count[0] / max(-np.log10(rtol), 1.0)  # iterations per decade
                 if (getattr(pc, "single", False)
                         and count[0] > self.options.single_max_iterations):
-                    self.owner._precond = None  # slow in single precision: double from now
-                    self.owner._double = True
+                    self.owner._double = True  # slow in single precision: double from now
                 elif pc.first_iterations is None:
                     pc.first_iterations = rate
                 elif (count[0] > REBUILD_AFTER
