@@ -93,7 +93,8 @@ def main():
         print(f"{t['it']:3d} {t['f']:10.4e} {t['delta']:9.3e} {t['pred'] / t['f'] ** 2:10.3e} "
               f"{t['actual'] / t['f'] ** 2:10.3e} {t['ratio']:7.3f} "
               f"{'N' if t['newton'] else 'd'} {t['gmres']:3d} {t['lin']:8.2e} "
-              f"{'+' if t['accepted'] else '-'}{'w' if t['watchdog'] else ' '} {ch:4d}",
+              f"{'+' if t['accepted'] else '-'}{'w' if t['watchdog'] else ' '}"
+              f"{'F' if t.get('forced') else ' '}{ch:4d}",
               flush=True)
 
     c0, w0 = time.process_time(), time.perf_counter()

@@ -243,6 +243,17 @@ WATCHDOG_DECREASE = 1e-4
 #: stretch led Powell to where it stalled at a relative residual of 0.06 for 200 iterations,
 #: where the monotone test converges in 55 (tests/test_examples.py, the 79 kHz wear run)
 WATCHDOG_FORMED = False
+#: a watchdog stretch from the full Newton step also once this many iterations in a row took
+#: a dog-leg step because the Newton step did not fit the trust region, without ``|f|``
+#: falling below :data:`WATCHDOG_CLIPPED_PROGRESS` times its value when they began (then
+#: again after as many more): on the partial-slip pad of benchmarks/scale_3d.py at 1024
+#: contact nodes, with the GMRES products in single precision or the variable scales of the
+#: first Jacobian, the trust region had shrunk below the Newton step (0.004 against 0.67 in
+#: the scaled variables) at ``|f|`` 1e-4 and the dog-leg steps crawled for 150 iterations
+#: with no Newton step rejected, so the stretches of :data:`WATCHDOG_AFTER` never began
+#: (docs/studies/large-interface-solve.md, "Iteration counts and per-call terms")
+WATCHDOG_CLIPPED = 4
+WATCHDOG_CLIPPED_PROGRESS = 0.5
 #: the value a stretch must get below: the largest ``|f|`` of this many iterates before it
 #: (1: the iterate where it began; more: nonmonotone, as Grippo, Lampariello and Lucidi 1986)
 WATCHDOG_MEMORY = 1
@@ -283,7 +294,10 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
     On an operator Jacobian (or on any with :data:`WATCHDOG_FORMED`), after
     :data:`WATCHDOG_AFTER` rejected Newton steps without ``|f|`` falling a decade, a
     rejected Newton step starts a watchdog stretch (:data:`WATCHDOG_STEPS` Newton steps
-    from its point, kept if ``|f|`` ends below its start, else undone).
+    from its point, kept if ``|f|`` ends below its start, else undone); so does the full
+    Newton step tried after :data:`WATCHDOG_CLIPPED` dog-leg steps in a row that it did not
+    fit and that did not halve ``|f|`` (kept with the radius widened to it if it decreases
+    ``|f|``).
     ``max_slow``: stop (unconverged) after that many iterations on a new Jacobian
     in a row without one that decreased ``|f|^2`` by :data:`SLOW_DECREASE` (MINPACK's "not
     making good progress" test, ``info = 4`` of ``hybrj`` with 5); None: no such test.
@@ -316,6 +330,7 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
     watch = None  # the checkpoint of a watchdog stretch (nonmonotone Newton steps)
     rejected, ref = 0, fn  # rejected Newton steps since |f| fell below ref / 10
     kept = [fn]  # |f| of the iterates (a stretch's only once it is kept)
+    clipped, clip_ref = 0, fn  # dog-leg steps in a row (Newton step too long), |f| before
     while True:
         target = tol * scale(x)
         if fn <= target:
@@ -340,9 +355,17 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
         snd = vector_norm(dscale * sn)
         if delta is None:
             delta = snd
-        if snd <= delta or watch is not None:  # (a watchdog stretch: Newton steps)
+        forced = (watch is None and snd > delta and (WATCHDOG_FORMED or not exact)
+                  and clipped >= WATCHDOG_CLIPPED
+                  and fn > WATCHDOG_CLIPPED_PROGRESS * clip_ref)
+        if forced:  # the dog-leg steps crawl: the full Newton step tried (a stretch)
+            clipped, clip_ref = 0, fn
+        if snd <= delta or watch is not None or forced:  # (a watchdog stretch: Newton steps)
             s = sn
+            if not forced:
+                clipped, clip_ref = 0, fn
         else:
+            clipped += 1
             g = (J.T @ f) / dscale  # gradient in scaled variables
             Jg = J @ (g / dscale)
             alpha = (g @ g) / max(Jg @ Jg, 1e-300)
@@ -413,11 +436,16 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
                 dscale = np.maximum(dscale, _column_norms(J))
                 stall = 0
                 kept.append(fn)
+                if forced:  # the trust region admits the Newton step that served
+                    delta = max(delta, pnorm)
             else:
                 stall += 1
                 if (newton_step and (WATCHDOG_FORMED or not exact)
-                        and rejected + 1 >= WATCHDOG_AFTER):  # a watchdog stretch
-                    watch = _Checkpoint(x, f, fn, J, sn, dscale.copy(), delta, WATCHDOG_STEPS,
+                        and sn is not None  # (not when the step is redone exactly)
+                        and (forced or rejected + 1 >= WATCHDOG_AFTER)):  # a stretch
+                    # (after a forced trial the radius of before it: the crawl's own)
+                    watch = _Checkpoint(x, f, fn, J, sn, dscale.copy(),
+                                        delta_old if forced else delta, WATCHDOG_STEPS,
                                         max(kept[-WATCHDOG_MEMORY:]))
                     x, f, fn = xn, fnew, fnn
                     _, J = fun(x, True)
@@ -434,7 +462,7 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
                           "pred": pred, "actual": actual, "ratio": ratio,
                           "newton": newton_step, "lin": lin / fn_old, "new_step": new_step,
                           "gmres": getattr(J_old, "gmres_iterations", 0) - gm0,
-                          "accepted": fnn < fn_old, "watchdog": watching})
+                          "accepted": fnn < fn_old, "watchdog": watching, "forced": forced})
         if callback is not None:
             callback(it, x, fn)
         if delta <= 1e-14 * max(vector_norm(dscale * x), 1e-300) or stall > 40:
