@@ -297,10 +297,9 @@ def test_powell_watchdog_crosses_kinks_where_the_monotone_test_crawls(monkeypatc
     operator Jacobians).
 
     The stretches from the full Newton step after dog-leg steps that crawl
-    (``WATCHDOG_CLIPPED``, off in the first two runs) cut the 40 solves to 386 iterations in
-    all (recorded; at most 35 for one draw, where the watchdog alone took up to 123), every
-    one reaching ``x*``; two draws take 3 iterations more than with the watchdog alone (19
-    to 22, 32 to 35), none more than that."""
+    (``WATCHDOG_CLIPPED``, off in the first two runs) cut the 40 solves to 368 iterations in
+    all (recorded; at most 20 for one draw, where the watchdog alone took up to 123), every
+    one reaching ``x*``, none taking more iterations than with the watchdog alone."""
     from fretwear.hb import solvers
 
     monkeypatch.setattr(solvers, "WATCHDOG_FORMED", True)
@@ -321,5 +320,5 @@ def test_powell_watchdog_crosses_kinks_where_the_monotone_test_crawls(monkeypatc
     old, new, clip = counts["monotone"], counts["watchdog"], counts["clipped"]
     assert old[7] >= 40 and new[7] <= 20
     assert all(b <= a for a, b in zip(old, new, strict=True)) and sum(new) < sum(old)
-    assert sum(clip) < 0.3 * sum(new) and max(clip) <= 40
-    assert all(c <= b + 3 for b, c in zip(new, clip, strict=True))
+    assert sum(clip) < 0.3 * sum(new) and max(clip) <= 25
+    assert all(c <= b for b, c in zip(new, clip, strict=True))

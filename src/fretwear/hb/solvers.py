@@ -243,15 +243,15 @@ WATCHDOG_DECREASE = 1e-4
 #: stretch led Powell to where it stalled at a relative residual of 0.06 for 200 iterations,
 #: where the monotone test converges in 55 (tests/test_examples.py, the 79 kHz wear run)
 WATCHDOG_FORMED = False
-#: a watchdog stretch from the full Newton step also once this many iterations in a row took
-#: a dog-leg step because the Newton step did not fit the trust region, without ``|f|``
-#: falling below :data:`WATCHDOG_CLIPPED_PROGRESS` times its value when they began (then
-#: again after as many more): on the partial-slip pad of benchmarks/scale_3d.py at 1024
-#: contact nodes, with the GMRES products in single precision or the variable scales of the
-#: first Jacobian, the trust region had shrunk below the Newton step (0.004 against 0.67 in
-#: the scaled variables) at ``|f|`` 1e-4 and the dog-leg steps crawled for 150 iterations
-#: with no Newton step rejected, so the stretches of :data:`WATCHDOG_AFTER` never began
-#: (docs/studies/large-interface-solve.md, "Iteration counts and per-call terms")
+#: a watchdog stretch from the full Newton step also once this many iterations in a row took a dog-
+#: leg step because the Newton step did not fit the trust region, without ``|f|`` falling below
+#: :data:`WATCHDOG_CLIPPED_PROGRESS` times its value when they began (every so many such iterations
+#: are judged anew): on the partial-slip pad of benchmarks/scale_3d.py at 1024 contact nodes, with
+#: the GMRES products in single precision or the variable scales of the first Jacobian, the trust
+#: region had shrunk below the Newton step (0.004 against 0.67 in the scaled variables) at ``|f|``
+#: 1e-4 and the dog-leg steps crawled for 150 iterations with no Newton step rejected, so the
+#: stretches of :data:`WATCHDOG_AFTER` never began (docs/studies/large-interface-solve.md,
+#: "Iteration counts and per-call terms")
 WATCHDOG_CLIPPED = 4
 WATCHDOG_CLIPPED_PROGRESS = 0.5
 #: the value a stretch must get below: the largest ``|f|`` of this many iterates before it
@@ -355,10 +355,11 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
         snd = vector_norm(dscale * sn)
         if delta is None:
             delta = snd
-        forced = (watch is None and snd > delta and (WATCHDOG_FORMED or not exact)
-                  and clipped >= WATCHDOG_CLIPPED
-                  and fn > WATCHDOG_CLIPPED_PROGRESS * clip_ref)
-        if forced:  # the dog-leg steps crawl: the full Newton step tried (a stretch)
+        forced = False
+        if watch is None and snd > delta and clipped >= WATCHDOG_CLIPPED:
+            # the dog-leg steps crawl (|f| not halved by the last ones): the full Newton step
+            # tried (a stretch); else the next ones are judged from here
+            forced = (WATCHDOG_FORMED or not exact) and fn > WATCHDOG_CLIPPED_PROGRESS * clip_ref
             clipped, clip_ref = 0, fn
         if snd <= delta or watch is not None or forced:  # (a watchdog stretch: Newton steps)
             s = sn
