@@ -254,6 +254,12 @@ WATCHDOG_FORMED = False
 #: "Iteration counts and per-call terms")
 WATCHDOG_CLIPPED = 4
 WATCHDOG_CLIPPED_PROGRESS = 0.5
+#: such a stretch takes at most this many Newton steps, each of which must reduce ``|f|`` by
+#: this factor: at 1024 contact nodes the full Newton step from ``|f|`` 1.4e-4 raised it to
+#: 4.7e-2 (17 nodes changing regime) and the Newton steps from there fell by a decade each
+#: (4.4e-3 after two: the two steps of :data:`WATCHDOG_STEPS` did not get back below the start)
+WATCHDOG_CLIPPED_STEPS = 5
+WATCHDOG_CLIPPED_RATE = 0.5
 #: the value a stretch must get below: the largest ``|f|`` of this many iterates before it
 #: (1: the iterate where it began; more: nonmonotone, as Grippo, Lampariello and Lucidi 1986)
 WATCHDOG_MEMORY = 1
@@ -274,6 +280,7 @@ class _Checkpoint:
     delta: float
     left: int
     ref: float
+    rate: float = 1.0  # each Newton step must bring |f| below rate x |f| before it
 
 
 def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=None,
@@ -297,6 +304,7 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
     from its point, kept if ``|f|`` ends below its start, else undone); so does the full
     Newton step tried after :data:`WATCHDOG_CLIPPED` dog-leg steps in a row that it did not
     fit and that did not halve ``|f|`` (kept with the radius widened to it if it decreases
+    ``|f|``; else up to :data:`WATCHDOG_CLIPPED_STEPS` Newton steps from it, each halving
     ``|f|``).
     ``max_slow``: stop (unconverged) after that many iterations on a new Jacobian
     in a row without one that decreased ``|f|^2`` by :data:`SLOW_DECREASE` (MINPACK's "not
@@ -395,7 +403,7 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
         ratio = actual / pred if pred > 0 else -1.0
         if watch is not None:  # a watchdog stretch: measured against its start
             done = fnn <= (1.0 - WATCHDOG_DECREASE) * watch.ref
-            if done or (fnn < fn and watch.left > 1):
+            if done or (fnn < watch.rate * fn and watch.left > 1):
                 watch.left -= 1
                 eta = FORCING_MAX
                 x, f, fn = xn, fnew, fnn
@@ -446,8 +454,10 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
                         and (forced or rejected + 1 >= WATCHDOG_AFTER)):  # a stretch
                     # (after a forced trial the radius of before it: the crawl's own)
                     watch = _Checkpoint(x, f, fn, J, sn, dscale.copy(),
-                                        delta_old if forced else delta, WATCHDOG_STEPS,
-                                        max(kept[-WATCHDOG_MEMORY:]))
+                                        delta_old if forced else delta,
+                                        WATCHDOG_CLIPPED_STEPS if forced else WATCHDOG_STEPS,
+                                        max(kept[-WATCHDOG_MEMORY:]),
+                                        WATCHDOG_CLIPPED_RATE if forced else 1.0)
                     x, f, fn = xn, fnew, fnn
                     _, J = fun(x, True)
                     njev += 1
