@@ -153,18 +153,21 @@ class KrylovOptions:
         operator's matrices (:meth:`fretwear.hb.modal_operator.ReducedOperator.single`:
         half the memory traffic, twice the BLAS rate; the copy adds half of their memory)
         where a Newton step is solved to a relative residual of at least
-        ``single_products_rtol`` (default True; operators of the modal condensation
-        without compressed forms only). The step is then that of an operator off by about
-        ``1e-7`` relative, far below its tolerance: the residual, the dog-leg and the
-        convergence test stay in double, so the converged answer is the same to the
-        solve's tolerance.
+        ``single_products_rtol`` (operators of the modal condensation without compressed
+        forms only). The step is then that of an operator off by about ``1e-7`` relative,
+        far below its tolerance: the residual, the dog-leg and the convergence test stay in
+        double, so a converged answer is the same to the solve's tolerance. Default False:
+        on the partial-slip pad of benchmarks/scale_3d.py the 256-node solve took the same
+        iterations (solution 6e-12 from the double one's, products 0.39 to 0.30 s), but at
+        1024 nodes the other rounding took Powell onto a path that crawls at ``|f|`` 1e-4
+        (docs/studies/large-interface-solve.md, "Iteration counts and per-call terms").
     single_products_rtol : that bound (default ``1e-5``).
     """
 
     single_factors: bool = True
     single_max_iterations: int = 60
     preconditioner: str = "mean-gain"
-    single_products: bool = True
+    single_products: bool = False
     single_products_rtol: float = 1e-5
 
     def __post_init__(self):
