@@ -246,15 +246,15 @@ WATCHDOG_DECREASE = 1e-4
 #: stretch led Powell to where it stalled at a relative residual of 0.06 for 200 iterations,
 #: where the monotone test converges in 55 (tests/test_examples.py, the 79 kHz wear run)
 WATCHDOG_FORMED = False
-#: a watchdog stretch from the full Newton step also once this many iterations in a row took a dog-
-#: leg step because the Newton step did not fit the trust region, without ``|f|`` falling below
-#: :data:`WATCHDOG_CLIPPED_PROGRESS` times its value when they began (every so many such iterations
-#: are judged anew): on the partial-slip pad of benchmarks/scale_3d.py at 1024 contact nodes, with
-#: the GMRES products in single precision or the variable scales of the first Jacobian, the trust
-#: region had shrunk below the Newton step (0.004 against 0.67 in the scaled variables) at ``|f|``
-#: 1e-4 and the dog-leg steps crawled for 150 iterations with no Newton step rejected, so the
-#: stretches of :data:`WATCHDOG_AFTER` never began (docs/studies/large-interface-solve.md,
-#: "Iteration counts and per-call terms")
+#: a watchdog stretch from the full Newton step also once this many iterations in a row took
+#: a dog-leg step because the Newton step did not fit the trust region, without ``|f|``
+#: falling below :data:`WATCHDOG_CLIPPED_PROGRESS` times its value when they began (every so
+#: many such iterations are judged anew): on the partial-slip pad of benchmarks/scale_3d.py
+#: at 1024 contact nodes, with the GMRES products in single precision or the variable scales
+#: of the first Jacobian, the trust region had shrunk below the Newton step (0.004 against
+#: 0.67 in the scaled variables) at ``|f|`` 1e-4 and the dog-leg steps crawled for 150
+#: iterations with no Newton step rejected, so the stretches of :data:`WATCHDOG_AFTER` never
+#: began (docs/studies/large-interface-solve.md, "Iteration counts and per-call terms")
 WATCHDOG_CLIPPED = 4
 WATCHDOG_CLIPPED_PROGRESS = 0.5
 #: such a stretch takes at most this many Newton steps, each of which must reduce ``|f|`` by
