@@ -183,8 +183,8 @@ def solves(n: int, tols, dense: bool = True, reference: str = "operator",
     """The periodic solve with dense and compressed products (module docstring); the
     compressed ones with each preconditioner of ``preconds`` ("nearfield": from the
     compressed forms, hb/nearfield_preconditioner.py; "mean-gain": the dense LU)."""
-    from fretwear.hb import nearfield_preconditioner
     from fretwear.hb.fourier import FourierBasis
+    from fretwear.hb.options import KrylovOptions
     from fretwear.hb.periodic import solve_periodic
     from fretwear.hb.preload import static_anchor
 
@@ -197,14 +197,14 @@ def solves(n: int, tols, dense: bool = True, reference: str = "operator",
             [None, *tols] if dense else list(tols))
     runs = [(t, p) for t in runs for p in ((None,) if t is None else preconds)]
     for tol, pname in runs:
-        nearfield_preconditioner.COMPRESSED = pname or "nearfield"
+        opts = options(load).replace(krylov=KrylovOptions(preconditioner=pname or "nearfield"))
         before = os.getloadavg()[0]
         with Clock() as cc:
             mc = _condenser(model, load, tol, reference)
             red = mc.reduced(2 * np.pi * load.freq, basis.orders, frequency=load.freq)
         with Counts() as counts, Clock() as c, PrecondClock() as pcc:
             anchor = static_anchor(model, condenser=mc)
-            sol = solve_periodic(model, basis, frequency=load.freq, options=options(load),
+            sol = solve_periodic(model, basis, frequency=load.freq, options=opts,
                                  reduced=red, anchor=anchor, condenser=mc)
         U = np.asarray(sol.U)
         if ref is None and tol is None:

@@ -177,12 +177,11 @@ def condenser(model, load: Load):
 def options(load: Load):
     """The SolveOptions of the periodic solve for ``load`` (PERIODIC with the load's
     ``strategy`` when it names one)."""
-    from fretwear.hb.options import PERIODIC, SolveOptions
+    from fretwear.hb.options import PERIODIC
 
     if not load.strategy:
         return PERIODIC
-    return SolveOptions(**{**asdict(PERIODIC),
-                           "strategy": tuple(load.strategy.split(","))})
+    return PERIODIC.replace(strategy=tuple(load.strategy.split(",")))
 
 
 def slip_report(sol) -> dict:

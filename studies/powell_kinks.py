@@ -12,7 +12,9 @@ regime (stick / slip / separation at some sample) between the iterate and the tr
         [max_iter] [monotone | memory=M]
 
 (``monotone``: without the watchdog stretches of fretwear.hb.solvers.powell, as before them;
-``memory=M``: their reference the largest ``|f|`` of the last M iterates.)
+``memory=M``: their reference the largest ``|f|`` of the last M iterates; ``norms=first``:
+the variable scales of the first Jacobian only; ``unclipped``: without the stretches after
+crawling dog-leg steps, ``WATCHDOG_CLIPPED``.)
 """
 
 from __future__ import annotations
@@ -48,6 +50,19 @@ def main():
         solvers.WATCHDOG_AFTER = 10**9
     elif variant.startswith("memory="):  # the stretches' reference over more iterates
         solvers.WATCHDOG_MEMORY = int(variant.split("=")[1])
+    elif variant == "norms=first":  # the variable scales of the first Jacobian only
+        first = {}
+        norms = solvers._column_norms
+
+        def kept(J):  # per problem (the static preload's is another)
+            key = (id(getattr(J, "owner", None)), J.shape)
+            if key not in first:
+                first[key] = norms(J)
+            return first[key].copy()
+
+        solvers._column_norms = kept
+    elif variant == "unclipped":  # without the stretches after crawling dog-leg steps
+        solvers.WATCHDOG_CLIPPED = 10**9
     load = LOADS["slip"]
     warm_up(load)
     model = pad(n, load)
@@ -93,7 +108,8 @@ def main():
         print(f"{t['it']:3d} {t['f']:10.4e} {t['delta']:9.3e} {t['pred'] / t['f'] ** 2:10.3e} "
               f"{t['actual'] / t['f'] ** 2:10.3e} {t['ratio']:7.3f} "
               f"{'N' if t['newton'] else 'd'} {t['gmres']:3d} {t['lin']:8.2e} "
-              f"{'+' if t['accepted'] else '-'}{'w' if t['watchdog'] else ' '} {ch:4d}",
+              f"{'+' if t['accepted'] else '-'}{'w' if t['watchdog'] else ' '}"
+              f"{'F' if t.get('forced') else ' '}{ch:4d}",
               flush=True)
 
     c0, w0 = time.process_time(), time.perf_counter()

@@ -10,11 +10,19 @@ copies, the penalty estimate and the static preload; what is left of the solve i
 own work (orthogonalisation, the node-block products) and Powell's bookkeeping. A timer
 inside another pauses it (the parts add up to the solve). Prints one JSON line.
 
-    PYTHONPATH=$PWD/src OPENBLAS_NUM_THREADS=1 python studies/solve_split.py 32
+    PYTHONPATH=$PWD/src OPENBLAS_NUM_THREADS=1 python studies/solve_split.py 32 [VARIANT ...]
+
+Variants (for the measurements of docs/studies/large-interface-solve.md, "Iteration counts
+and per-call terms"): ``solver=newton`` (the line-search Newton instead of Powell),
+``norms=first`` (Powell's variable scales from the first Jacobian's column norms only, not
+renewed at every Jacobian), ``single=0|1`` (the preconditioner's factors in double or single),
+``sprod=0|1`` (GMRES's products in double or single, KrylovOptions.single_products).
+The solution is saved to ``/tmp/solve_split_<n><SPLIT_TAG>_U.npy`` for comparisons.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import resource
@@ -72,6 +80,26 @@ def main():
     from fretwear.hb.fourier import FourierBasis
 
     n = int(sys.argv[1])
+    variants = dict(a.split("=", 1) for a in sys.argv[2:])
+    opts = options(LOADS["slip"])
+    if "solver" in variants:
+        opts = opts.replace(solver=variants["solver"])
+    kry = {"single": "single_factors", "sprod": "single_products"}
+    for key, field in kry.items():
+        if key in variants:
+            opts = opts.replace(krylov=dataclasses.replace(opts.krylov,
+                                                           **{field: variants[key] == "1"}))
+    if variants.get("norms") == "first":  # the first Jacobian's column norms kept
+        first = {}
+        norms = solvers._column_norms
+
+        def kept(J):  # per problem (the static preload's is another)
+            key = (id(getattr(J, "owner", None)), J.shape)
+            if key not in first:
+                first[key] = norms(J)
+            return first[key].copy()
+
+        solvers._column_norms = kept
     load = LOADS["slip"]
     warm_up(load)
     model = pad(n, load)
@@ -98,18 +126,19 @@ def main():
     for mod in (penalty, periodic):
         sp.wrap(mod, "penalty", "penalty")
     sp.wrap(preload, "static_anchor", "static_preload")
-    del fourier, solvers
+    del fourier
     load0 = os.getloadavg()[0]
     with Counts() as counts:
         c0, w0 = time.process_time(), time.perf_counter()
         anchor = preload.static_anchor(model, condenser=mc)
         sol = periodic.solve_periodic(model, basis, frequency=load.freq,
-                                      options=options(load), reduced=red, anchor=anchor,
+                                      options=opts, reduced=red, anchor=anchor,
                                       condenser=mc)
         cpu, wall = time.process_time() - c0, time.perf_counter() - w0
     parts = {k: round(v, 3) for k, v in sorted(sp.cpu.items())}
     parts["powell_and_rest"] = round(cpu - sum(sp.cpu.values()), 3)
-    out = {"n": n, "nodes": n * n, "unknowns": 3 * n * n * basis.size, "condense_cpu": cond,
+    out = {"n": n, "variants": variants, "nodes": n * n, "unknowns": 3 * n * n * basis.size,
+           "condense_cpu": cond,
            "solve_cpu": cpu, "solve_wall": wall, "success": sol.success,
            "residual": sol.stats.residual,
            "attempts": [f"{a.method} ({a.iterations})" for a in sol.attempts],

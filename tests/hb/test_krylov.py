@@ -21,6 +21,7 @@ from fretwear.hb import contact as law
 from fretwear.hb import krylov
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.krylov import KrylovJacobian
+from fretwear.hb.options import KRYLOV, KrylovOptions
 from fretwear.hb.preload import static_anchor
 from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.reduce import condense
@@ -294,17 +295,17 @@ def test_failed_shared_preconditioner_is_rebuilt_unshared(case, monkeypatch):
 
 def test_single_factors_fall_back_to_double(case, monkeypatch):
     """The mean-gain preconditioner's factors are float32 (complex64 when damped) with
-    SINGLE_FACTORS, the default, and the Newton step equals the LU solution of the formed
-    Jacobian (1e-9, as test_step_equals_lu_step, which runs with them: GMRES multiplies by
-    the operator in double and stops at 1e-10 of the residual whatever the preconditioner's
-    precision). When GMRES fails with single factors (forced here: a failure reported
-    whenever the preconditioner is single), one factored in double follows and the step is
-    the same. The 2D cases only (real and complex factors; the 3D ones cost 5 s more)."""
+    ``KrylovOptions.single_factors``, the default, and the Newton step equals the LU solution of
+    the formed Jacobian (1e-9, as test_step_equals_lu_step, which runs with them: GMRES
+    multiplies by the operator in double and stops at 1e-10 of the residual whatever the
+    preconditioner's precision). When GMRES fails with single factors (forced here: a failure
+    reported whenever the preconditioner is single), one factored in double follows and the step
+    is the same. The 2D cases only (real and complex factors; the 3D ones cost 5 s more)."""
     model, x = case
     if model.dim == 3:
         pytest.skip("the 2D cases cover real and complex factors")
     monkeypatch.setattr(krylov, "ACTIVE_DENSE_MAX", -1)
-    assert krylov.SINGLE_FACTORS
+    assert KRYLOV.single_factors and problem(model, "krylov").krylov is KRYLOV
     used = []
     pick, gmres = krylov.KrylovJacobian._preconditioner, krylov.spla.gmres
 
@@ -331,6 +332,98 @@ def test_single_factors_fall_back_to_double(case, monkeypatch):
     assert np.abs(Jo.solve(f) - ref).max() <= 1e-9 * np.abs(ref).max()
     assert used[0][0] and not used[-1][0]
     assert used[-1][1] <= {"float64", "complex128"}
+
+
+def test_slow_single_factors_are_rebuilt_in_double(case, monkeypatch):
+    """A GMRES run with single-precision factors that converges in more than
+    ``KrylovOptions.single_max_iterations`` iterations (a bound of 1 here: every run of these
+    cases takes more, asserted) has the preconditioner rebuilt in double at the next solve,
+    and in double from then on; with ``single_factors=False`` every factorisation is double
+    from the start, and with a bound no run reaches the factors stay single. Every step equals
+    the LU solution of the formed Jacobian (1e-9, as test_step_equals_lu_step: GMRES
+    multiplies by the operator in double whatever the factors). The 2D cases only (real and
+    complex factors)."""
+    model, x = case
+    if model.dim == 3:
+        pytest.skip("the 2D cases cover real and complex factors")
+    monkeypatch.setattr(krylov, "ACTIVE_DENSE_MAX", -1)
+    used, runs = [], []
+    pick, gmres = krylov.KrylovJacobian._preconditioner, krylov.spla.gmres
+
+    def pick_spy(self, *a, **k):
+        pc = pick(self, *a, **k)
+        used.append({lu[0].dtype.name for lu in pc.factors})
+        return pc
+
+    def counting(A, b, **k):
+        n0 = len(runs)
+        runs.append(0)
+        cb = k.pop("callback")
+
+        def count(r):
+            runs[n0] += 1
+            cb(r)
+
+        return gmres(A, b, callback=count, **k)
+
+    monkeypatch.setattr(krylov.KrylovJacobian, "_preconditioner", pick_spy)
+    monkeypatch.setattr(krylov.spla, "gmres", counting)
+    dense = problem(model, "dense")
+    points = [(0.9 + 0.02 * i) * x for i in range(3)]
+    single, double = {"float32", "complex64"}, {"float64", "complex128"}
+    for opts, first, later in ((KrylovOptions(single_max_iterations=1), single, double),
+                               (KrylovOptions(single_factors=False), double, double),
+                               (KrylovOptions(single_max_iterations=10**6), single, single)):
+        op = problem(model, "krylov")
+        op.krylov = opts
+        used[:], runs[:] = [], []
+        for xi in points:
+            f, J = dense.residual(xi.reshape(dense.m, dense.H), True)
+            _, Jo = op.residual(xi.reshape(op.m, op.H), True)
+            op._precond = None  # a fresh preconditioner at every point
+            ref = np.linalg.solve(J, f)
+            assert np.abs(Jo.solve(f) - ref).max() <= 1e-9 * np.abs(ref).max()
+        assert min(runs) > 1 and len(used) == len(points)
+        assert used[0] <= first and all(u <= later for u in used[1:]), (opts, used)
+
+
+def test_solve_periodic_passes_the_krylov_options(monkeypatch):
+    """``SolveOptions.krylov`` reaches the Newton steps of solve_periodic on the operator path
+    (the 2D block of the module's cases, 3 harmonics, GMRES forced): with
+    ``single_factors=False`` every preconditioner is factored in double, by default the first
+    in single precision; both converge to the dense path's answer (1e-8 relative, as
+    test_converged_answer_equals_dense_path)."""
+    from fretwear.hb.options import PERIODIC
+    from fretwear.hb.periodic import solve_periodic
+
+    monkeypatch.setattr(krylov, "ACTIVE_DENSE_MAX", -1)
+    used = []
+    pick = krylov.KrylovJacobian._preconditioner
+
+    def pick_spy(self, *a, **k):
+        pc = pick(self, *a, **k)
+        used.append(pc.single)
+        return pc
+
+    monkeypatch.setattr(krylov.KrylovJacobian, "_preconditioner", pick_spy)
+    model = block(2)
+    basis = FourierBasis.up_to(3, 32)
+    anchor = static_anchor(model)
+    sols = {}
+    for name, opts in (("dense", PERIODIC.replace(jacobian="dense", tol=1e-12)),
+                       ("single", PERIODIC.replace(jacobian="krylov", tol=1e-12)),
+                       ("double", PERIODIC.replace(jacobian="krylov", tol=1e-12,
+                                                   krylov=KrylovOptions(single_factors=False)))):
+        used[:] = []
+        sols[name] = solve_periodic(model, basis, frequency=2000.0, options=opts,
+                                    anchor=anchor, raise_on_failure=True).U
+        if name == "single":
+            assert used and used[0]
+        elif name == "double":
+            assert used and not any(used)
+    ref = sols["dense"]
+    for name in ("single", "double"):
+        assert np.abs(sols[name] - ref).max() <= 1e-8 * np.abs(ref).max()
 
 
 def test_single_factor_solves_keep_what_is_complex():

@@ -16,6 +16,7 @@ from fretwear.hb.nearfield_preconditioner import (
     preconditioner_for,
 )
 from fretwear.hb.operator_blocks import OperatorBlocks
+from fretwear.hb.options import KrylovOptions
 
 
 def _kernel(n, d, seed=0, a=0.05):
@@ -45,7 +46,7 @@ def test_near_field_is_the_dense_leaf_blocks():
 
 
 @pytest.mark.parametrize("real", [True, False], ids=["real", "damped"])
-def test_apply_is_the_inverse_of_near_field_plus_modal_term(real, monkeypatch):
+def test_apply_is_the_inverse_of_near_field_plus_modal_term(real):
     """``apply`` against the LAPACK solve with the formed ``P_n = eps I + g_n (sum_X c_X N_X
     - U_n Y_n - eps I)`` per harmonic on the real Fourier basis (harmonic ``n``: ``P_n (a - i
     b)``), on the active rows of a compressed two-matrix operator with a rank-4 modal term:
@@ -66,9 +67,10 @@ def test_apply_is_the_inverse_of_near_field_plus_modal_term(real, monkeypatch):
     dofs = (act[:, None] * 3 + np.arange(3)).reshape(-1)
     Za = Z.sub(dofs)
     assert preconditioner_for(Za) is None  # the default: the mean gain
-    monkeypatch.setattr("fretwear.hb.nearfield_preconditioner.COMPRESSED", "nearfield")
-    assert preconditioner_for(Za) is NearFieldPreconditioner
-    assert preconditioner_for(OperatorBlocks(ReducedOperator([K, M], coef, U, Y))) is None
+    assert preconditioner_for(Za, "mean-gain") is None
+    assert preconditioner_for(Za, "nearfield") is NearFieldPreconditioner
+    assert preconditioner_for(OperatorBlocks(ReducedOperator([K, M], coef, U, Y)),
+                              "nearfield") is None
     na, ma, eps = act.size, dofs.size, 2.0
     g0 = 0.5 * np.eye(3) + 0.1 * rng.standard_normal((na, 3, 3))
     gn = 0.3 * np.eye(3) + 0.1 * rng.standard_normal((na, 3, 3))
@@ -128,7 +130,7 @@ def test_newton_step_equals_the_mean_gain_one(monkeypatch):
     assert 0 < J.active_nodes().size
     steps = {}
     for name in ("nearfield", "mean-gain"):
-        monkeypatch.setattr("fretwear.hb.nearfield_preconditioner.COMPRESSED", name)
+        prob.krylov = KrylovOptions(preconditioner=name)
         J.owner._precond = None
         s = J.solve(f)
         assert type(J.owner._precond).__name__ == {"nearfield": "NearFieldPreconditioner",

@@ -183,3 +183,61 @@ def test_every_dof_active_shares_the_stored_matrices():
     y = x[:dofs.size * Z.H]
     assert rel(view.apply(y), sub.apply(y)) < 1e-13
     assert np.array_equal(view.Z0, sub.Z0) and rel(view.block(2), sub.block(2)) < 1e-13
+
+
+@pytest.mark.parametrize("damping", [None, Damping(loss_factor=0.02)])
+def test_single_precision_products_and_the_loose_steps_that_take_them(damping, monkeypatch):
+    """OperatorBlocks.single() (made once, then kept) multiplies as the double operator does to
+    single precision (1e-6 relative: float32's 6e-8 times the rounding of sums over a few
+    hundred terms; measured 1e-7), and the same for the view of active DOFs. GMRES takes it
+    (KrylovOptions.single_products) on a Newton step solved to rtol 1e-3 (asserted: its
+    products go through the single blocks), whose residual with the double Jacobian is then
+    within 1.01 x rtol (the single products' 1e-7 error added to GMRES's own); a step solved
+    to 1e-9, below single_products_rtol, takes the double blocks only and equals the dense
+    solve of the formed Jacobian to 1e-7 (as test_bounded_preconditioner_factors_give_the_
+    same_step's 1e-8 with GMRES at 1e-9 instead of 1e-10). Off (the default), the loose
+    step takes the double blocks too."""
+    from fretwear.hb.options import KrylovOptions
+
+    model = block(damping, traction=4.5e5)
+    bc = BlockedModalCondenser(model, F_MAX, 7, tol=1e-2)
+    basis = FourierBasis.up_to(3, 32)
+    red = bc.reduced(2 * np.pi * 12e3, basis.orders)
+    ob = OperatorBlocks(red.Z)
+    tw = ob.single()
+    assert tw is ob.single() and tw.op.mats[0].dtype == np.float32
+    x = np.random.default_rng(4).standard_normal((ob.m, ob.H))
+    assert rel(tw.apply(x), ob.apply(x)) < 1e-6
+    dofs = np.arange(ob.m)[np.arange(ob.m) % 5 != 1]
+    view = krylov._ActiveView(ob, dofs)
+    assert rel(view.single().apply(x[dofs]), view.apply(x[dofs])) < 1e-6
+    monkeypatch.setattr(krylov, "ACTIVE_DENSE_MAX", 0)  # GMRES whatever the size
+    prob = DLFTProblem(red, model.contact, basis, eps="auto",
+                       anchor=static_anchor(model, condenser=bc), jacobian="krylov")
+    dense = DLFTProblem(red, model.contact, basis, eps=prob.eps, anchor=prob.anchor,
+                        jacobian="dense")
+    U = 0.5 * prob.initial_guess()
+    f, J = prob.residual(U)
+    _, Jd = dense.residual(U)
+    assert J.active_nodes().size
+    used = []
+    single_apply = OperatorBlocks.apply
+
+    def spy(self, V):
+        used.append(self.op.mats[0].dtype == np.float32)
+        return single_apply(self, V)
+
+    monkeypatch.setattr(OperatorBlocks, "apply", spy)
+    assert not prob.krylov.single_products  # (off by default)
+    prob.krylov = KrylovOptions(single_products=True)
+    s = J.solve(f, rtol=1e-3)
+    assert used and all(used)
+    assert np.linalg.norm(Jd @ s - f) <= 1.01e-3 * np.linalg.norm(f)
+    used[:] = []
+    s = J.solve(f, rtol=1e-9)
+    assert used and not any(used)
+    assert rel(s, np.linalg.solve(Jd, f)) < 1e-7
+    prob.krylov = KrylovOptions(single_products=False)
+    used[:] = []
+    J.solve(f, rtol=1e-3)
+    assert used and not any(used)

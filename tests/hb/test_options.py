@@ -10,12 +10,14 @@ import pytest
 
 from fretwear.errors import InputError
 from fretwear.hb.options import (
+    KRYLOV,
     OTHER_SOLVER,
     PERIODIC,
     STRATEGY,
     SWEEP,
     SWEEP_POINT,
     WEAR_STEP,
+    KrylovOptions,
     SolveOptions,
     SweepOptions,
     sweep_options,
@@ -27,7 +29,8 @@ from fretwear.hb.options import (
     ("tol", True), ("tol", "1e-8"), ("max_iter", 0), ("max_iter", 40.0), ("max_iter", True),
     ("solver", "newton?"), ("solver", None), ("jacobian", "sparse"),
     ("strategy", ()), ("strategy", ("start", "restart")), ("strategy", ("start", "start")),
-    ("time_domain_periods", 0), ("time_domain_periods", 30.5),
+    ("time_domain_periods", 0), ("time_domain_periods", 30.5), ("krylov", "single"),
+    ("krylov", {"single": True}),
 ])
 def test_solve_options_refuse_bad_values(name, value):
     with pytest.raises(InputError, match=f"^{name} = ") as err:
@@ -35,6 +38,32 @@ def test_solve_options_refuse_bad_values(name, value):
     assert "\n" not in str(err.value)
     with pytest.raises(InputError, match=f"^{name} = "):
         PERIODIC.replace(**{name: value})
+
+
+@pytest.mark.parametrize("name, value", [
+    ("single_factors", 1), ("single_factors", "yes"), ("single_max_iterations", 0),
+    ("single_max_iterations", 10.0), ("single_max_iterations", True),
+    ("preconditioner", "ilu"), ("preconditioner", None),
+])
+def test_krylov_options_refuse_bad_values(name, value):
+    with pytest.raises(InputError, match=f"^krylov.{name} = ") as err:
+        KrylovOptions(**{name: value})
+    assert "\n" not in str(err.value)
+    with pytest.raises(InputError, match=f"^krylov.{name} = "):
+        SolveOptions(krylov={name: value})
+
+
+def test_krylov_options_are_a_field_of_the_solve_record():
+    """The operator path's switches (single-precision factors, their bound, the
+    preconditioner of compressed operators) are one record held by SolveOptions, a dict of its
+    fields taken too; the defaults are those of every preset; a checkpoint key names them only
+    when they differ from the preset's."""
+    o = SolveOptions(krylov={"single_factors": False, "preconditioner": "nearfield"})
+    assert o.krylov == KrylovOptions(single_factors=False, preconditioner="nearfield")
+    assert PERIODIC.krylov is KRYLOV == KrylovOptions() and WEAR_STEP.krylov == KRYLOV
+    assert KRYLOV.single_factors and KRYLOV.preconditioner == "mean-gain"
+    assert "krylov" not in PERIODIC.key_changes(PERIODIC)
+    assert o.key_changes(PERIODIC)["krylov"]["single_factors"] is False
 
 
 def test_solve_options_accept_numpy_numbers_and_lists():

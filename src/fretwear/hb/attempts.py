@@ -122,6 +122,7 @@ def first_harmonic_start(prob: DLFTProblem, options: SolveOptions):
         cut.update(node_A=reduced.node_A[:2], node_b=reduced.node_b[:2])
     red = dataclasses.replace(reduced, **cut)
     p1 = DLFTProblem(red, prob.contact, sub, gap=prob.gap, eps=prob.eps, anchor=prob.anchor)
+    p1.krylov = prob.krylov
     if p1.jacobian == "krylov":  # the full problem's blocks (and their real copies), shared
         p1.blocks = prob.blocks.leading(2)
 
@@ -331,6 +332,7 @@ def time_start(t: Trial) -> bool:
         return False
     prob2 = DLFTProblem(ts.reduced, ts.model.contact, prob.basis, gap=prob.gap, eps=prob.eps,
                         anchor=anchor, jacobian=prob.jacobian)
+    prob2.krylov = prob.krylov
     x, st = run(prob2, np.asarray(Ut, float).reshape(prob2.m, prob2.H),
                 opts.replace(max_iter=2 * opts.max_iter))
     st.wall_time = time.perf_counter() - t0

@@ -130,6 +130,8 @@ class Problems:
         if self.template is None:
             prob = DLFTProblem(red, self.model.contact, self.basis, gap=self.gap,
                                eps=self.eps, anchor=anchor, jacobian=self.jacobian)
+            if self.solve is not None:  # (the operator path's linear algebra)
+                prob.krylov = self.solve.krylov
             # the set-up the other frequencies share (DLFTProblem.at), without this
             # frequency's reduced model and blocks: they are not pinned for the whole sweep
             self.template = object.__new__(DLFTProblem)

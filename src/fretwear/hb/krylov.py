@@ -15,7 +15,8 @@ with per-harmonic factorisations of the active block: replacing each node's time
 by its mean over the period (``gbar_p``, the (0, 0) coefficient block of ``G_p``) makes it
 block-diagonal per harmonic, ``P_n = eps I + gbar (Z_aa(n w) - eps I)`` (``gbar``
 block-diagonal per node), so the preconditioner is ``k + 1`` dense LUs of ``m_a x m_a``
-(``m_a`` = active DOFs; in single precision, :data:`SINGLE_FACTORS`). It is exact for
+(``m_a`` = active DOFs; in single precision by default,
+:class:`fretwear.hb.options.KrylovOptions`). It is exact for
 nodes whose gain does not vary over the period and for a linear interface; it is kept
 while the active set does not change and rebuilt when GMRES slows down. The contact law and
 the residual are those of the dense path: only the linear algebra of the step differs, so
@@ -29,6 +30,8 @@ import scipy.linalg as sla
 import scipy.sparse.linalg as spla
 from numba import njit
 
+from fretwear.hb.solvers import KRYLOV
+
 #: relative residual to which GMRES solves the Newton step (the dense LU is exact to rounding;
 #: an inexact step changes the iterates, not the converged answer, which the residual test of
 #: the nonlinear solver decides)
@@ -37,15 +40,6 @@ GMRES_RTOL = 1e-10
 #: another, and the estimate below which they are shared (MeanGainPreconditioner._close)
 SHARE_PROBES = 2
 SHARE_BELOW = 0.25
-#: the mean-gain preconditioner's LU factors in single precision (half the memory traffic
-#: of its triangular solves and half their memory, LAPACK's sgetrf for its builds): the
-#: preconditioner approximates the active block whatever its precision and GMRES multiplies
-#: by the operator in double, so the step is solved to ``rtol`` all the same; a rebuild after
-#: a GMRES failure factors in double. On benchmarks/scale_3d.py's partial-slip pad at 1024
-#: contact nodes: the preconditioner's applies 9.6 to 5.9-6.1 s CPU, its builds 6.1-6.4 to
-#: 4.6-5.7 s, the solution the double one's to 3e-9 (docs/studies/large-interface-solve.md,
-#: "The growth's terms, measured")
-SINGLE_FACTORS = True
 #: Krylov vectors kept before a restart, and restarts allowed
 GMRES_RESTART = 60
 GMRES_MAXITER = 4
@@ -177,6 +171,12 @@ class HarmonicBlocks:
         nc = self.m // d
         idx = np.arange(nc)
         return Zb.reshape(nc, d, nc, d)[idx, :, idx, :]
+
+    def single(self):
+        """The blocks in single precision for GMRES's loose products, or None: stored
+        blocks keep their one (double) copy (an operator's, hb/operator_blocks.py, have
+        one)."""
+        return None
 
     def leading(self, nb: int) -> HarmonicBlocks:
         """The blocks of the first ``nb`` harmonics, sharing this object's arrays (and its
@@ -350,8 +350,9 @@ def harmonic_gains(G: np.ndarray, d: int, oscillating: bool = True):
 
 def _lu_solve(lu, b):
     """``P^-1 b`` by LAPACK factors ``lu``, in their precision (single factors,
-    :data:`SINGLE_FACTORS`: the right-hand side rounded to the single type of the factors and
-    of ``b`` together, the result returned in double, complex where either is)."""
+    ``KrylovOptions.single_factors``: the right-hand side rounded to the single type of the
+    factors and of ``b`` together, the result returned in double, complex where either
+    is)."""
     if lu[0].dtype not in (np.float32, np.complex64):
         return sla.lu_solve(lu, b, check_finite=False)
     kind = np.result_type(lu[0].dtype, np.complex64 if np.iscomplexobj(b) else np.float32)
@@ -369,7 +370,8 @@ class MeanGainPreconditioner:
     when they precondition it well (:meth:`_close`): below the structure's first resonances
     ``Z_n`` hardly differs from ``Z_0`` (``-(n w)^2 M_r`` against the stiffness) and one LU
     serves several harmonics. A rebuild after a GMRES failure does not share. single :
-    the factors in single precision (:data:`SINGLE_FACTORS`; a rebuild after a GMRES failure
+    the factors in single precision (``KrylovOptions.single_factors``; a rebuild after a GMRES
+    failure or a slow GMRES run
     factors in double).
     """
 
@@ -685,21 +687,34 @@ class KrylovJacobian:
         Ja[np.diag_indices(na * dH)] += eps
         return solve_identity_rows(Ja, rhs.reshape(na * dH, r)).reshape(na, dH, r)
 
+    @property
+    def options(self):
+        """The owner's :class:`fretwear.hb.options.KrylovOptions` (its ``krylov``; the
+        defaults when it has none)."""
+        return getattr(self.owner, "krylov", None) or KRYLOV
+
     def _preconditioner(self, act, Za, rebuild=False):
         """The kept preconditioner, or a new one for the active nodes ``act``: sharing
-        factors between harmonics unless ``rebuild`` (GMRES failed with the kept one)."""
+        factors between harmonics unless ``rebuild`` (GMRES failed with the kept one); in
+        single precision when the options ask for it, unless ``rebuild`` or once a GMRES
+        run with single factors was slow on this owner (``_double``)."""
         owner = self.owner
         pc = getattr(owner, "_precond", None)
         if (pc is None or rebuild or pc.m != Za.m
-                or not np.array_equal(getattr(pc, "nodes", None), act)):
+                or not np.array_equal(getattr(pc, "nodes", None), act)
+                or (getattr(pc, "single", False) and getattr(owner, "_double", False))):
             gbar, gosc = harmonic_gains(self.G[act], self.d,
                                         not getattr(owner, "_mean_gain", False))
             from fretwear.hb.nearfield_preconditioner import preconditioner_for
 
-            cls = preconditioner_for(Za)  # compressed forms: the near field when asked
+            opts = self.options
+            # compressed forms: the near field when asked
+            cls = preconditioner_for(Za, opts.preconditioner)
             if cls is None:
+                single = (opts.single_factors and not rebuild
+                          and not getattr(owner, "_double", False))
                 pc = MeanGainPreconditioner(gbar, Za, self.eps, share=not rebuild, gosc=gosc,
-                                            single=SINGLE_FACTORS and not rebuild)
+                                            single=single)
             else:
                 pc = cls(gbar, Za, self.eps, share=not rebuild, gosc=gosc)
             pc.oscillating = gosc is not gbar
@@ -708,17 +723,34 @@ class KrylovJacobian:
             owner._precond = pc
         return pc
 
+    def _single_blocks(self, Za):
+        """The single-precision twin of the active blocks ``Za`` (their ``single()``), kept
+        by the owner while ``Za`` is the same object; None where there is none."""
+        kept = getattr(self.owner, "_single_Z", None)
+        if kept is not None and kept[0] is Za:
+            return kept[1]
+        twin = Za.single() if hasattr(Za, "single") else None
+        self.owner._single_Z = (Za, twin)
+        return twin
+
     def _gmres_active(self, rhs, act, dofs, rtol=GMRES_RTOL) -> np.ndarray:
-        """GMRES on the active system, one right-hand side at a time."""
+        """GMRES on the active system, one right-hand side at a time; its products with
+        ``Z_aa`` in single precision when the options ask for it and ``rtol`` is at least
+        ``KrylovOptions.single_products_rtol`` (a loose Newton step: the single products'
+        ``1e-7`` relative error is far below it)."""
         eps, dH = self.eps, self.dH
         Za = self._active_blocks(dofs)
+        opts = self.options
+        Zp = Za
+        if opts.single_products and rtol >= opts.single_products_rtol:
+            Zp = self._single_blocks(Za) or Za
         Ga = self.G[act]
         na = act.size
         n = na * dH
 
         def matvec(v):
             v = np.asarray(v, float).reshape(-1)
-            y = (Za.apply(v).reshape(-1) - eps * v).reshape(na, dH)
+            y = (Zp.apply(v).reshape(-1) - eps * v).reshape(na, dH)
             return eps * v + np.matmul(Ga, y[:, :, None])[:, :, 0].reshape(-1)
 
         A = spla.LinearOperator((n, n), matvec=matvec, dtype=float)
@@ -732,14 +764,17 @@ class KrylovJacobian:
         """GMRES on one right-hand side. When it fails with a preconditioner kept from an
         earlier Jacobian or with shared factors, one more run from its last iterate with a
         preconditioner rebuilt from this Jacobian without sharing; when a fresh unshared one
-        or with single-precision factors (:data:`SINGLE_FACTORS`) the same with a
-        double-precision one; when a fresh unshared one in double
+        or with single-precision factors (``KrylovOptions.single_factors``) the same with
+        a double-precision one; when a fresh unshared one in double
         with the oscillating gains of :func:`harmonic_gains` fails, the owner takes the mean
         gain from then on and one more run follows with it; a fresh unshared one with the
         mean gain is the best at hand (GMRES's last iterate is returned). A kept
         preconditioner that needs more than :data:`REBUILD_AFTER` iterations and more than
         :data:`REBUILD_GROWTH` times those of its first run (per decade of the residual:
-        ``rtol`` varies) is rebuilt at the next Jacobian."""
+        ``rtol`` varies) is rebuilt at the next Jacobian; one with single-precision factors
+        whose run converged in more than ``KrylovOptions.single_max_iterations``
+        iterations is rebuilt in double at the next Jacobian, and the owner's
+        preconditioners are factored in double from then on."""
         x = None
         for attempt in range(3):
             pc0 = getattr(self.owner, "_precond", None)
@@ -758,7 +793,10 @@ class KrylovJacobian:
             self.gmres_iterations += count[0]
             if info == 0:
                 rate = count[0] / max(-np.log10(rtol), 1.0)  # iterations per decade
-                if pc.first_iterations is None:
+                if (getattr(pc, "single", False)
+                        and count[0] > self.options.single_max_iterations):
+                    self.owner._double = True  # slow in single precision: double from now
+                elif pc.first_iterations is None:
                     pc.first_iterations = rate
                 elif (count[0] > REBUILD_AFTER
                       and rate > REBUILD_GROWTH * pc.first_iterations):
@@ -795,6 +833,11 @@ class _ActiveView:
         ``ReducedOperator.block(b, rows, cols)`` would hold two more m_a x m arrays)."""
         Zb = self.Z.Z0 if b == 0 else self.Z.block(b)
         return Zb[np.ix_(self.dofs, self.dofs)]
+
+    def single(self):
+        """The same view of ``Z``'s single-precision blocks (``Z.single()``), or None."""
+        twin = self.Z.single()
+        return None if twin is None else _ActiveView(twin, self.dofs)
 
     def apply(self, U) -> np.ndarray:
         """``Z_aa U`` for ``U`` (m_a H,) or (m_a, H) on the real Fourier basis."""

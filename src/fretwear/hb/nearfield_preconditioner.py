@@ -36,12 +36,6 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-#: which preconditioner the operator path takes when its operator carries compressed forms
-#: (:func:`preconditioner_for`): "mean-gain" (the dense LU of hb/krylov.py, the default:
-#: faster up to 1024 contact nodes, docs/studies/large-interface-solve.md) or "nearfield"
-#: (this module: no dense ``m_a x m_a`` factors, for the interfaces whose dense factors do
-#: not fit)
-COMPRESSED = "mean-gain"
 #: SuperLU's column ordering: the near field's pattern is symmetric (a leaf with its
 #: neighbours both ways), for which the minimum degree on ``A^T + A`` left 15 % less fill
 #: than COLAMD and factored 20 % faster at 576 contact nodes
@@ -230,11 +224,14 @@ class NearFieldPreconditioner:
         return out.reshape(-1)
 
 
-def preconditioner_for(Z):
+def preconditioner_for(Z, name: str = "mean-gain"):
     """The preconditioner class for the active blocks ``Z``: :class:`NearFieldPreconditioner`
-    when they are an operator with compressed forms and :data:`COMPRESSED` asks for it,
-    else None (the caller's default)."""
+    when they are an operator with compressed forms and ``name`` (the solve's
+    ``KrylovOptions.preconditioner``) is ``"nearfield"``, else None (the caller's default,
+    the mean gain: faster up to 1024 contact nodes, docs/studies/large-interface-solve.md;
+    the near field holds no dense ``m_a x m_a`` factors, for interfaces whose dense factors
+    do not fit)."""
     op = getattr(Z, "op", None)
-    if COMPRESSED == "nearfield" and getattr(op, "products", None) is not None:
+    if name == "nearfield" and getattr(op, "products", None) is not None:
         return NearFieldPreconditioner
     return None

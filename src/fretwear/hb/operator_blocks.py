@@ -39,6 +39,7 @@ class OperatorBlocks(HarmonicBlocks):
         self._rows = None  # (dofs, the operator of those rows): row_block
         self._symmetric = op.symmetric
         self._real = op.real
+        self._single = None  # single(): the single-precision twin, once made
 
     @property
     def real(self) -> bool:
@@ -97,6 +98,16 @@ class OperatorBlocks(HarmonicBlocks):
             return super().node_diagonal(0, d)
         out = self.op.node_diagonal(b, d)
         return out.real if self.real else out
+
+    def single(self):
+        """The same blocks in single precision (:meth:`ReducedOperator.single`, made once
+        and kept by this object), for GMRES's products on loosely solved Newton steps; None
+        when the operator carries compressed forms (their products are already approximate)."""
+        if self.op.products is not None:
+            return None
+        if self._single is None:
+            self._single = OperatorBlocks(self.op.single())
+        return self._single
 
     def leading(self, nb: int) -> OperatorBlocks:
         return OperatorBlocks(self.op[:nb])

@@ -21,7 +21,9 @@ from dataclasses import dataclass
 
 from fretwear.errors import InputError
 from fretwear.hb.fallback import TimeDomainFallback
-from fretwear.hb.solvers import SOLVERS
+from fretwear.hb.solvers import KRYLOV as KRYLOV
+from fretwear.hb.solvers import PRECONDITIONERS as PRECONDITIONERS
+from fretwear.hb.solvers import SOLVERS, KrylovOptions
 
 #: how the Newton step is computed: ``"dense"`` (LAPACK LU of the formed Jacobian),
 #: ``"krylov"`` (GMRES on the Jacobian as an operator, :mod:`fretwear.hb.krylov`), ``"auto"``
@@ -57,6 +59,8 @@ class SolveOptions:
     time_domain_periods : forcing periods allowed to the time integration of the rung
         ``"time-start"`` (single solves and sweep points, when the driver is given a
         time-domain fallback).
+    krylov : :class:`KrylovOptions`, the linear algebra of the Newton step on the operator
+        path (a dict of its fields is taken too); default :data:`KRYLOV`.
     """
 
     solver: str = "powell"
@@ -65,10 +69,18 @@ class SolveOptions:
     strategy: tuple = STRATEGY
     jacobian: str = "auto"
     time_domain_periods: int = 3000
+    krylov: KrylovOptions = KRYLOV
 
     def __post_init__(self):
         if isinstance(self.strategy, list):
             object.__setattr__(self, "strategy", tuple(self.strategy))
+        if isinstance(self.krylov, dict):
+            names = [f.name for f in dataclasses.fields(KrylovOptions)]
+            unknown = sorted(set(self.krylov) - set(names))
+            if unknown:
+                raise InputError(f"krylov = {self.krylov!r}: unknown field(s) {unknown}; "
+                                 f"expected fields from {names}")
+            object.__setattr__(self, "krylov", KrylovOptions(**self.krylov))
         self.check()
 
     def check(self) -> SolveOptions:
@@ -100,6 +112,8 @@ class SolveOptions:
         if not (_is_integer(p) and p >= 1):
             raise InputError(f"time_domain_periods = {p!r}: expected a whole number of "
                              "periods >= 1")
+        if not isinstance(self.krylov, KrylovOptions):
+            raise InputError(f"krylov = {self.krylov!r}: expected a KrylovOptions record")
         return self
 
     def replace(self, **changes) -> SolveOptions:
@@ -115,7 +129,8 @@ class SolveOptions:
         """The settings as plain values, for checkpoint fingerprints."""
         return {"solver": self.solver, "tol": float(self.tol), "max_iter": int(self.max_iter),
                 "strategy": list(self.strategy), "jacobian": self.jacobian,
-                "time_domain_periods": int(self.time_domain_periods)}
+                "time_domain_periods": int(self.time_domain_periods),
+                "krylov": self.krylov.key()}
 
     def key_changes(self, preset: SolveOptions, always=("solver", "tol", "max_iter")) -> dict:
         """The part of :meth:`key` that a checkpoint fingerprint takes: the settings

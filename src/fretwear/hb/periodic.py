@@ -95,6 +95,7 @@ def solve_periodic(model: Model, basis: FourierBasis, *, frequency: float | None
     prob = DLFTProblem(reduced, model.contact, basis, gap=gap,
                        eps=eps, anchor=anchor if preload is None else preload.values,
                        jacobian=options.jacobian)
+    prob.krylov = options.krylov
     trial = Trial(prob, cold_start(prob, U0, options), options,
                   time_start=_time_start(model, frequency, reduced, time_domain, quasi_static,
                                          gap))

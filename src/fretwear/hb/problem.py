@@ -24,7 +24,7 @@ from fretwear.hb.connectors import connect, springs
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.krylov import KrylovJacobian
 from fretwear.hb.operator_blocks import harmonic_blocks
-from fretwear.hb.options import JACOBIANS
+from fretwear.hb.options import JACOBIANS, KRYLOV
 from fretwear.hb.penalty import penalty
 from fretwear.hb.reduce import Reduced, loads_to_real, to_real_blocks
 from fretwear.hb.solvers import vector_norm
@@ -58,6 +58,11 @@ class DLFTProblem:
     contact points in series with the springs. Nodes with a prescribed normal load
     (``contact.normal_load``) take ``lambda_N = N(t)`` and the slip threshold ``mu N(t)``.
     """
+
+    #: the linear algebra of the Newton step on the operator path
+    #: (:class:`fretwear.hb.options.KrylovOptions`; a driver sets ``options.krylov``, and the
+    #: problems made from this one by :meth:`at` and :meth:`with_eps` keep it)
+    krylov = KRYLOV
 
     def __init__(self, reduced: Reduced, contact: ContactInterface, basis: FourierBasis,
                  gap=None, eps="auto", anchor=None, periodicity_tol=1e-12, max_sweeps=200,
@@ -107,9 +112,11 @@ class DLFTProblem:
         prescribed normal forces, a numeric eps, the contact springs) is shared, not rebuilt:
         a sweep makes one problem per frequency."""
         if isinstance(self._eps_rule, str):  # a rule evaluated on each reduced model
-            return DLFTProblem(reduced, self.contact, self.basis, gap=self.gap,
-                               eps=self._eps_rule, anchor=anchor, periodicity_tol=self.tol,
-                               max_sweeps=self.max_sweeps, jacobian=self.jacobian)
+            out = DLFTProblem(reduced, self.contact, self.basis, gap=self.gap,
+                              eps=self._eps_rule, anchor=anchor, periodicity_tol=self.tol,
+                              max_sweeps=self.max_sweeps, jacobian=self.jacobian)
+            out.krylov = self.krylov
+            return out
         new = object.__new__(DLFTProblem)  # a shallow copy (copy.copy: slower)
         new.__dict__.update(self.__dict__)
         if self._springs is not None:
@@ -126,9 +133,11 @@ class DLFTProblem:
 
     def with_eps(self, eps: float) -> DLFTProblem:
         """The same problem (reduced model, gap, anchors) with the penalty ``eps`` [N/m]."""
-        return DLFTProblem(self.reduced, self.contact, self.basis, gap=self.gap, eps=eps,
-                           anchor=self.anchor, periodicity_tol=self.tol,
-                           max_sweeps=self.max_sweeps, jacobian=self.jacobian)
+        out = DLFTProblem(self.reduced, self.contact, self.basis, gap=self.gap, eps=eps,
+                          anchor=self.anchor, periodicity_tol=self.tol,
+                          max_sweeps=self.max_sweeps, jacobian=self.jacobian)
+        out.krylov = self.krylov
+        return out
 
     def set_gap(self, gap):
         gap = np.broadcast_to(np.asarray(gap, dtype=float), (self.nc,))

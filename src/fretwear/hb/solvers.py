@@ -17,11 +17,14 @@ callers never turn it into a result.
 
 from __future__ import annotations
 
+import numbers
 import time
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.optimize as so
+
+from fretwear.errors import InputError
 
 SOLVERS = ("powell", "newton", "hybr")
 
@@ -116,6 +119,98 @@ def _column_norms(J):
     return J.column_norms()
 
 
+#: preconditioners of the Newton step's GMRES when the operator carries compressed forms
+#: (:class:`KrylovOptions`)
+PRECONDITIONERS = ("mean-gain", "nearfield")
+
+
+@dataclass(frozen=True)
+class KrylovOptions:
+    """The linear algebra of the Newton step on the operator path (``jacobian = "krylov"``,
+    :mod:`fretwear.hb.krylov`; large interfaces): settings that change how fast a step is
+    solved, never the converged answer (GMRES multiplies by the operator in double and
+    solves each step to the forcing term's relative residual).
+
+    Attributes
+    ----------
+    single_factors : the mean-gain preconditioner's LU factors in single precision
+        (float32, complex64 when damped; default True): half the memory traffic of its
+        triangular solves and LAPACK's ``sgetrf`` for its builds. A preconditioner in single
+        precision is rebuilt in double after a GMRES failure, and once a GMRES solve with it
+        needs more than ``single_max_iterations`` iterations.
+    single_max_iterations : that bound (GMRES iterations of one Newton step; default 60, one
+        restart cycle of :data:`fretwear.hb.krylov.GMRES_RESTART`: on the partial-slip pad
+        of benchmarks/scale_3d.py a step took 4-40 with single factors,
+        docs/studies/large-interface-solve.md). From then on the problem's preconditioners
+        are factored in double.
+    preconditioner : for an operator that carries compressed forms (``compress=`` of the
+        modal condenser): ``"mean-gain"`` (default: dense LU factors of the active block,
+        faster up to 1024 contact nodes) or ``"nearfield"``
+        (:class:`fretwear.hb.nearfield_preconditioner.NearFieldPreconditioner`: no dense
+        ``m_a x m_a`` factors, for interfaces whose dense factors do not fit). Without
+        compressed forms the mean gain is used whatever this says.
+    single_products : GMRES multiplies by a single-precision copy of the condensed
+        operator's matrices (:meth:`fretwear.hb.modal_operator.ReducedOperator.single`:
+        half the memory traffic, twice the BLAS rate; the copy adds half of their memory)
+        where a Newton step is solved to a relative residual of at least
+        ``single_products_rtol`` (operators of the modal condensation without compressed
+        forms only). The step is then that of an operator off by about ``1e-7`` relative,
+        far below its tolerance: the residual, the dog-leg and the convergence test stay in
+        double, so a converged answer is the same to the solve's tolerance. Default False:
+        on the partial-slip pad of benchmarks/scale_3d.py the 256-node solve took the same
+        iterations (solution 6e-12 from the double one's, products 0.39 to 0.30 s), but at
+        1024 nodes the other rounding took Powell onto a path that crawls at ``|f|`` 1e-4
+        (docs/studies/large-interface-solve.md, "Iteration counts and per-call terms").
+    single_products_rtol : that bound (default ``1e-5``).
+    """
+
+    single_factors: bool = True
+    single_max_iterations: int = 60
+    preconditioner: str = "mean-gain"
+    single_products: bool = False
+    single_products_rtol: float = 1e-5
+
+    def __post_init__(self):
+        self.check()
+
+    def check(self) -> KrylovOptions:
+        """Validate (also done at construction): one InputError naming the option."""
+        if not isinstance(self.single_factors, bool):
+            raise InputError(f"krylov.single_factors = {self.single_factors!r}: expected "
+                             "True or False")
+        n = self.single_max_iterations
+        if not (isinstance(n, numbers.Integral) and not isinstance(n, bool)
+                and 1 <= n <= 2**62):
+            raise InputError(f"krylov.single_max_iterations = {n!r}: expected a whole "
+                             "number of GMRES iterations >= 1")
+        if not (isinstance(self.preconditioner, str)
+                and self.preconditioner in PRECONDITIONERS):
+            raise InputError(f"krylov.preconditioner = {self.preconditioner!r}: expected "
+                             f"one of {PRECONDITIONERS}")
+        if not isinstance(self.single_products, bool):
+            raise InputError(f"krylov.single_products = {self.single_products!r}: expected "
+                             "True or False")
+        t = self.single_products_rtol
+        if not (isinstance(t, numbers.Real) and not isinstance(t, bool) and 1e-6 <= t < 1):
+            raise InputError(f"krylov.single_products_rtol = {t!r}: expected a relative "
+                             "residual between 1e-6 (single precision's reach) and 1")
+        return self
+
+    def key(self) -> dict:
+        """The settings as plain values (checkpoint fingerprints)."""
+        return {"single_factors": self.single_factors,
+                "single_max_iterations": int(self.single_max_iterations),
+                "preconditioner": self.preconditioner,
+                "single_products": self.single_products,
+                "single_products_rtol": float(self.single_products_rtol)}
+
+
+#: the linear algebra of the operator path by default (:class:`KrylovOptions`; defined with
+#: the solvers so that fretwear.hb.krylov reads it, exported by fretwear.hb.options with the
+#: other option records)
+KRYLOV = KrylovOptions()
+
+
 #: a decrease of ``|f|^2`` by less than this fraction in an iteration is slow progress
 #: (MINPACK ``hybrj``'s test on its ``actred``)
 SLOW_DECREASE = 0.1
@@ -151,6 +246,26 @@ WATCHDOG_DECREASE = 1e-4
 #: stretch led Powell to where it stalled at a relative residual of 0.06 for 200 iterations,
 #: where the monotone test converges in 55 (tests/test_examples.py, the 79 kHz wear run)
 WATCHDOG_FORMED = False
+#: a watchdog stretch from the full Newton step also once this many iterations in a row took
+#: a dog-leg step because the Newton step did not fit the trust region, without ``|f|``
+#: falling below :data:`WATCHDOG_CLIPPED_PROGRESS` times its value when they began (every so
+#: many such iterations are judged anew): on the partial-slip pad of benchmarks/scale_3d.py
+#: at 1024 contact nodes, with the GMRES products in single precision or the variable scales
+#: of the first Jacobian, the trust region had shrunk below the Newton step (0.004 against
+#: 0.67 in the scaled variables) at ``|f|`` 1e-4 and the dog-leg steps crawled for 150
+#: iterations with no Newton step rejected, so the stretches of :data:`WATCHDOG_AFTER` never
+#: began (docs/studies/large-interface-solve.md, "Iteration counts and per-call terms").
+#: It does not rescue that crawl (the Newton steps from the full step stall near 1e-3 there:
+#: undone), and never begins on the converging paths measured; on the 40 piecewise-linear
+#: problems of tests/hb/test_solvers.py it cuts Powell's iterations from 1690 to 370
+WATCHDOG_CLIPPED = 4
+WATCHDOG_CLIPPED_PROGRESS = 0.5
+#: such a stretch takes at most this many Newton steps, each of which must reduce ``|f|`` by
+#: this factor: at 1024 contact nodes the full Newton step from ``|f|`` 1.4e-4 raised it to
+#: 4.7e-2 (17 nodes changing regime) and the Newton steps from there fell by a decade each
+#: (4.4e-3 after two: the two steps of :data:`WATCHDOG_STEPS` did not get back below the start)
+WATCHDOG_CLIPPED_STEPS = 5
+WATCHDOG_CLIPPED_RATE = 0.5
 #: the value a stretch must get below: the largest ``|f|`` of this many iterates before it
 #: (1: the iterate where it began; more: nonmonotone, as Grippo, Lampariello and Lucidi 1986)
 WATCHDOG_MEMORY = 1
@@ -171,6 +286,7 @@ class _Checkpoint:
     delta: float
     left: int
     ref: float
+    rate: float = 1.0  # each Newton step must bring |f| below rate x |f| before it
 
 
 def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=None,
@@ -191,7 +307,11 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
     On an operator Jacobian (or on any with :data:`WATCHDOG_FORMED`), after
     :data:`WATCHDOG_AFTER` rejected Newton steps without ``|f|`` falling a decade, a
     rejected Newton step starts a watchdog stretch (:data:`WATCHDOG_STEPS` Newton steps
-    from its point, kept if ``|f|`` ends below its start, else undone).
+    from its point, kept if ``|f|`` ends below its start, else undone); so does the full
+    Newton step tried after :data:`WATCHDOG_CLIPPED` dog-leg steps in a row that it did not
+    fit and that did not halve ``|f|`` (kept with the radius widened to it if it decreases
+    ``|f|``; else up to :data:`WATCHDOG_CLIPPED_STEPS` Newton steps from it, each halving
+    ``|f|``).
     ``max_slow``: stop (unconverged) after that many iterations on a new Jacobian
     in a row without one that decreased ``|f|^2`` by :data:`SLOW_DECREASE` (MINPACK's "not
     making good progress" test, ``info = 4`` of ``hybrj`` with 5); None: no such test.
@@ -224,6 +344,7 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
     watch = None  # the checkpoint of a watchdog stretch (nonmonotone Newton steps)
     rejected, ref = 0, fn  # rejected Newton steps since |f| fell below ref / 10
     kept = [fn]  # |f| of the iterates (a stretch's only once it is kept)
+    clipped, clip_ref = 0, fn  # dog-leg steps in a row (Newton step too long), |f| before
     while True:
         target = tol * scale(x)
         if fn <= target:
@@ -248,9 +369,18 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
         snd = vector_norm(dscale * sn)
         if delta is None:
             delta = snd
-        if snd <= delta or watch is not None:  # (a watchdog stretch: Newton steps)
+        forced = False
+        if watch is None and snd > delta and clipped >= WATCHDOG_CLIPPED:
+            # the dog-leg steps crawl (|f| not halved by the last ones): the full Newton step
+            # tried (a stretch); else the next ones are judged from here
+            forced = (WATCHDOG_FORMED or not exact) and fn > WATCHDOG_CLIPPED_PROGRESS * clip_ref
+            clipped, clip_ref = 0, fn
+        if snd <= delta or watch is not None or forced:  # (a watchdog stretch: Newton steps)
             s = sn
+            if not forced:
+                clipped, clip_ref = 0, fn
         else:
+            clipped += 1
             g = (J.T @ f) / dscale  # gradient in scaled variables
             Jg = J @ (g / dscale)
             alpha = (g @ g) / max(Jg @ Jg, 1e-300)
@@ -279,7 +409,7 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
         ratio = actual / pred if pred > 0 else -1.0
         if watch is not None:  # a watchdog stretch: measured against its start
             done = fnn <= (1.0 - WATCHDOG_DECREASE) * watch.ref
-            if done or (fnn < fn and watch.left > 1):
+            if done or (fnn < watch.rate * fn and watch.left > 1):
                 watch.left -= 1
                 eta = FORCING_MAX
                 x, f, fn = xn, fnew, fnn
@@ -321,12 +451,19 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
                 dscale = np.maximum(dscale, _column_norms(J))
                 stall = 0
                 kept.append(fn)
+                if forced:  # the trust region admits the Newton step that served
+                    delta = max(delta, pnorm)
             else:
                 stall += 1
                 if (newton_step and (WATCHDOG_FORMED or not exact)
-                        and rejected + 1 >= WATCHDOG_AFTER):  # a watchdog stretch
-                    watch = _Checkpoint(x, f, fn, J, sn, dscale.copy(), delta, WATCHDOG_STEPS,
-                                        max(kept[-WATCHDOG_MEMORY:]))
+                        and sn is not None  # (not when the step is redone exactly)
+                        and (forced or rejected + 1 >= WATCHDOG_AFTER)):  # a stretch
+                    # (after a forced trial the radius of before it: the crawl's own)
+                    watch = _Checkpoint(x, f, fn, J, sn, dscale.copy(),
+                                        delta_old if forced else delta,
+                                        WATCHDOG_CLIPPED_STEPS if forced else WATCHDOG_STEPS,
+                                        max(kept[-WATCHDOG_MEMORY:]),
+                                        WATCHDOG_CLIPPED_RATE if forced else 1.0)
                     x, f, fn = xn, fnew, fnn
                     _, J = fun(x, True)
                     njev += 1
@@ -342,7 +479,7 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
                           "pred": pred, "actual": actual, "ratio": ratio,
                           "newton": newton_step, "lin": lin / fn_old, "new_step": new_step,
                           "gmres": getattr(J_old, "gmres_iterations", 0) - gm0,
-                          "accepted": fnn < fn_old, "watchdog": watching})
+                          "accepted": fnn < fn_old, "watchdog": watching, "forced": forced})
         if callback is not None:
             callback(it, x, fn)
         if delta <= 1e-14 * max(vector_norm(dscale * x), 1e-300) or stall > 40:
@@ -432,8 +569,6 @@ def solve(fun, x0, scale, *, method="powell", tol=1e-8, max_iter=200, callback=N
     :func:`powell` and :func:`newton` (``"hybr"`` has MINPACK's own)."""
     table = {"powell": powell, "newton": newton, "hybr": hybr}
     if method not in table:
-        from fretwear.errors import InputError
-
         raise InputError(f"solver = {method!r}: expected one of {SOLVERS}")
     extra = {} if max_slow is None or method == "hybr" else {"max_slow": max_slow}
     return table[method](fun, x0, scale, tol=tol, max_iter=max_iter, callback=callback,
