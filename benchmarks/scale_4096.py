@@ -1,4 +1,4 @@
-"""Memory and time of the blocked modal condensation (fretwear.hb.modal) and the
+"""Memory and time of the modal condensation of a large interface (fretwear.hb.modal) and the
 periodic solve on the pad of benchmarks/scale_3d.py (its model and loads, imported: the
 partial-slip load by default, ``--load stuck`` the earlier one) at n x n
 contact nodes: 64 x 64 (4096 contact nodes, 7 harmonics, 172 032 unknowns) by default.
@@ -9,13 +9,17 @@ projections block by block and the error check; then the reduced model of the fr
 the memory of its parts (the shared ``m x m`` matrices, the low-rank factors, the kept
 sparse LU), the static preload solve and the periodic solve (operator Jacobian), contact
 states, CPU seconds of the process beside wall seconds, the peak resident memory, and the
-load before and after (the machine is shared). ``--dense`` builds the dense
-:class:`~fretwear.hb.modal.ModalCondenser` instead, for comparison at the sizes where it fits.
+load before and after (the machine is shared). The condenser is the one
+:func:`~fretwear.hb.modal.modal_condenser` chooses (``--path auto``: the partial
+factorisations where CHOLMOD is present), or ``--path blocked`` / ``--path dense`` the
+blocked or the dense static-modes condenser, for comparison. ``--condense-only`` stops after
+the condensation (``solve_4096_s=not-run``).
 
 The last lines read ``solve_4096_s=``, ``condense_4096_s=`` (CPU seconds) and
 ``peak_rss_4096_gib=`` (named after 4096 whatever ``--n``; the size is printed above).
 
-Run: ``python benchmarks/scale_4096.py [--n 64] [--dense] [--limit-gib 20]``.
+Run: ``python benchmarks/scale_4096.py [--n 64] [--path auto|blocked|dense] [--condense-only]
+[--limit-gib 20]``.
 """
 
 from __future__ import annotations
@@ -34,7 +38,10 @@ from scale_3d import LOADS, Clock, H, pad, peak_gib  # noqa: E402
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=64, help="contact nodes per side")
-    ap.add_argument("--dense", action="store_true", help="the dense ModalCondenser instead")
+    ap.add_argument("--path", choices=("auto", "blocked", "dense"), default="auto",
+                    help="the condenser: modal_condenser's choice, or the blocked or dense "
+                         "static modes")
+    ap.add_argument("--condense-only", action="store_true", help="no periodic solve")
     ap.add_argument("--limit-gib", type=float, default=20.0, help="address-space limit")
     ap.add_argument("--load", choices=sorted(LOADS), default="slip",
                     help="the load case of scale_3d.py (default: partial slip)")
@@ -46,7 +53,7 @@ def main():
     resource.setrlimit(resource.RLIMIT_AS, (cap, cap))
 
     from fretwear.hb.fourier import FourierBasis
-    from fretwear.hb.modal import BlockedModalCondenser, ModalCondenser
+    from fretwear.hb.modal import BlockedModalCondenser, ModalCondenser, modal_condenser
     from fretwear.hb.periodic import solve_periodic
     from fretwear.hb.preload import static_anchor
 
@@ -60,16 +67,17 @@ def main():
     print(f"{n * n} contact nodes, {model.ndof} DOFs: model built in {c} (not counted)",
           flush=True)
     basis = FourierBasis.up_to(H, 128)
-    cls = ModalCondenser if args.dense else BlockedModalCondenser
+    make = {"auto": modal_condenser, "blocked": BlockedModalCondenser,
+            "dense": ModalCondenser}[args.path]
     with Clock() as cc:
-        mc = cls(model, FREQ * 1.2, H, modes=load.modes)
+        mc = make(model, FREQ * 1.2, H, modes=load.modes)
         red = mc.reduced(2 * np.pi * FREQ, basis.orders, frequency=FREQ)
     m = mc.m
-    print(f"condensation ({cls.__name__}, {mc.n_modes} modes, q = {mc.q}, checked error "
-          f"{mc.error:.2g}): {cc}; peak {peak_gib():.2f} GiB", flush=True)
+    print(f"condensation ({type(mc).__name__}: {mc.path}; {mc.n_modes} modes, q = {mc.q}, "
+          f"checked error {mc.error:.2g}): {cc}; peak {peak_gib():.2f} GiB", flush=True)
     lu = mc._lus.get(("static",))
     lu_gib = getattr(lu, "nbytes", float("nan") * 2**30) / 2**30
-    if args.dense:
+    if args.path == "dense":
         parts = {"Z_r blocks": red.Z.nbytes, "Psi": mc.Psi.nbytes,
                  "proj (local frames)": sum(x.nbytes for p in (mc.proj_local,)
                                            for v in p.values() for x in v)}
@@ -81,6 +89,13 @@ def main():
     parts["sparse LU of K_ii"] = lu_gib
     print(f"  m = {m}: one m x m real {8 * m * m / 2**30:.2f} GiB; parts [GiB]: "
           + ", ".join(f"{k} {v:.2f}" for k, v in parts.items()), flush=True)
+    if args.condense_only:
+        print(f"load: {os.getloadavg()}")
+        print(f"contact_nodes={n * n}")
+        print("solve_4096_s=not-run")
+        print(f"condense_4096_s={cc.cpu:.1f}")
+        print(f"peak_rss_4096_gib={peak_gib():.2f}")
+        return
     with Clock() as cs:
         anchor = static_anchor(model, condenser=mc)
         sol = solve_periodic(model, basis, frequency=FREQ, reduced=red, anchor=anchor,
