@@ -307,8 +307,9 @@ def _symmetric(z: np.ndarray, rel: float = 1e-13) -> bool:
         for j in range(i, m, TILE):
             rj = slice(j, min(j + TILE, m))
             a, b = z[ri, rj], z[rj, ri]
-            now = (float(np.abs(a - b.T).max()), float(np.abs(a).max()),
-                   float(np.abs(b).max()))
+            with np.errstate(invalid="ignore"):  # inf - inf: NaN, refused below
+                now = (float(np.abs(a - b.T).max()), float(np.abs(a).max()),
+                       float(np.abs(b).max()))
             if not np.all(np.isfinite(now)):  # (Python's max() would drop a NaN)
                 return False
             diff, top = max(diff, now[0]), max(top, now[1], now[2])
