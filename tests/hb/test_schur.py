@@ -252,6 +252,27 @@ def test_nonsymmetric_matrices_keep_the_static_modes(monkeypatch):
     assert type(modal_condenser(sym, F_MAX, 7, tol=1e-2)) is SchurModalCondenser
 
 
+def test_memory_estimate_counts_the_factor_of_k():
+    """The memory the condenser by partial factorisations checks before it runs counts the
+    factor of ``K`` (contact rows and front, CHOLMOD's and kvxopt's copies), not only its
+    ``m x m`` blocks: at 4096 contact nodes of the pad of benchmarks/scale_3d.py (n_i =
+    98,304, m = 12,288, K and M) it is within 10 % of the 16.7 GiB peak measured there
+    (docs/studies/large-interface-solve.md; the blocks alone counted 5.6 GiB, and the
+    condensation would have started on a 16 GiB machine and run out). On the test
+    block, a machine that holds the blocks but not the factor refuses it in one InputError."""
+    from helpers.hostile_sizes import machine_of
+
+    assert abs(modal.schur_bytes(98_304, 12_288, 2) / 2**30 - 16.7) <= 0.1 * 16.7
+    model = block()
+    probe = SchurModalCondenser(model, F_MAX, 7, tol=1e-2)
+    k = sum(getattr(probe, nm) is not None for nm in modal.NAMES)
+    blocks = 8.0 * (k + 3) * probe.m**2
+    full = modal.schur_bytes(probe.ni, probe.m, k)
+    with machine_of(int((blocks + full) / 2 / 0.9)), \
+            pytest.raises(InputError, match="partial factorisations .* needs about"):
+        SchurModalCondenser(model, F_MAX, 7, tol=1e-2)
+
+
 def test_cholmod_options_are_restored_when_threads_factorise_at_once(monkeypatch):
     """Two threads make partial factorisations at once, the first held inside CHOLMOD's
     symbolic analysis until the second enters it too (or 0.5 s have passed: with the lock it

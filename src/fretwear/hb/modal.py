@@ -703,6 +703,22 @@ class NotFactorisable(InputError):
 #: benchmarks/scale_3d.py (docs/studies/large-interface-solve.md, "The contact blocks by
 #: partial factorisations")
 SCHUR_MIN_CONTACT = 3072
+#: the contact rows ``L_ci`` of the factor of ``K`` (contact DOFs last) hold at most this
+#: fraction of ``n_i m``: 24 %, 16 %, 12 % measured on the pad at 256, 1024, 2304 contact
+#: nodes (docs/studies/large-interface-solve.md)
+SCHUR_FILL = 0.25
+
+
+def schur_bytes(ni: int, m: int, matrices: int) -> float:
+    """Estimated peak memory [bytes] of a :class:`SchurModalCondenser` of ``ni`` interior and
+    ``m`` contact DOFs projecting ``matrices`` of ``K, M, C, D``: the projected ``X^cc``
+    (``m x m`` each), the product ``L_cc L_cc^T`` and its copies (three more), and the factor
+    of ``K``'s contact rows and front (:data:`SCHUR_FILL` of ``ni m`` and ``m^2 / 2``) twice,
+    CHOLMOD's and kvxopt's copy (values and int64 rows, 16 bytes an entry). At 4096 contact
+    nodes of the pad (``ni`` = 98,304, ``m`` = 12,288, K and M) 16.9 GiB against the 16.7
+    GiB peak measured (docs/studies/large-interface-solve.md)."""
+    factor = 2 * 16.0 * (SCHUR_FILL * ni * m + m * m / 2)
+    return 8.0 * (matrices + 3) * m * m + factor
 
 
 def _partial_factorisations_apply(model: Model, residual: bool) -> bool:
@@ -963,15 +979,14 @@ class SchurModalCondenser(BlockedModalCondenser):
                              "(pip install 'fretwear[fast]'); modal_condenser falls back to "
                              "the static modes without it")
         if not _symmetric_matrices(model):
-            raise NotFactorisable("a modal condensation by partial factorisations needs symmetric "
-                             "K, M, C, D (CHOLMOD factorises K -/+ h X); build a "
-                             "ModalCondenser instead")
+            raise NotFactorisable("a modal condensation by partial factorisations needs "
+                                  "symmetric K, M, C, D (CHOLMOD factorises K -/+ h X); build "
+                                  "a ModalCondenser instead")
         names = [nm for nm in NAMES if getattr(self, nm) is not None]
-        # the projected X^cc (m x m each), the product L_cc L_cc^T and its copy, and the
-        # factor's contact block as kvxopt copies it out (values and int64 rows, m^2 / 2)
-        require_memory(8.0 * (len(names) + 3) * self.m**2,
+        require_memory(schur_bytes(self.ni, self.m, len(names)),
                        f"a modal condensation by partial factorisations of {self.ni:,} "
-                       f"interior and {self.m:,} contact DOFs (its projected blocks, m x m)")
+                       f"interior and {self.m:,} contact DOFs (its projected blocks, m x m, "
+                       f"and the factor of K)")
         self.f_max, self.max_order, self.tol = float(f_max), int(max_order), float(tol)
         lu = self.factor(0.0, 0, True)  # CHOLMOD's Cholesky of K_ii, kept
         if getattr(lu, "name", "") != "cholmod":  # CHOLMOD refused K_ii: not definite
