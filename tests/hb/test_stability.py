@@ -372,16 +372,10 @@ def test_compiled_inverse_iteration_finds_the_dense_eigenvalue(monkeypatch):
     simple and O(1) apart)."""
     from fretwear.hb import stability as hs
 
-    rng = np.random.default_rng(7)
-    n = 20
-    B0, B1 = rng.standard_normal((2, n, n))
-    B2 = np.eye(n)
-    vals, Y = _companion_eigen(B0, B1, B2)
-    for i in np.argsort(-np.abs(vals.imag))[:6:2]:
-        start = vals[i] + 1e-3 * (1 + 1j)
-        y0 = Y[:, i] + 1e-3 * rng.standard_normal(n)
+    B0, B1, B2, starts = _quadratic_starts(7, 20)
+    for value, start, y0 in starts:
         s1, _, ok = _inverse_iteration(B0, B1, B2, start, y0)
-        assert ok and abs(s1 - vals[i]) <= 1e-12 * max(1.0, abs(vals[i]))
+        assert ok and abs(s1 - value) <= 1e-12 * max(1.0, abs(value))
         monkeypatch.setattr(hs, "PAIR_COMPILED_MAX", 0)
         s2, _, ok2 = _inverse_iteration(B0, B1, B2, start, y0)
         monkeypatch.undo()
@@ -397,18 +391,13 @@ def test_lapack_kernel_inverse_iteration_is_the_python_steps():
     and O(1) apart, so the rounding of the two LU orders stays at that level). At a singular
     ``P(s)`` (``s`` an eigenvalue of a diagonal problem) it falls back on the Python steps,
     which report no convergence instead of raising."""
-    rng = np.random.default_rng(11)
     n = 60
-    B0, B1 = rng.standard_normal((2, n, n))
-    B2 = np.eye(n)
-    vals, Y = _companion_eigen(B0, B1, B2)
-    for i in np.argsort(-np.abs(vals.imag))[:6:2]:
-        start = vals[i] + 1e-3 * (1 + 1j)
-        y0 = Y[:, i] + 1e-3 * rng.standard_normal(n)
+    B0, B1, B2, starts = _quadratic_starts(11, n)
+    for value, start, y0 in starts:
         s1, x1, ok = _inverse_iteration(B0, B1, B2, start, y0)
         s2, x2, ok2 = _inverse_iteration_py(B0 + 0j, B1 + 0j, B2 + 0j, start, y0 + 0j)
         assert ok and ok2
-        assert abs(s1 - vals[i]) <= 1e-12 * max(1.0, abs(vals[i]))
+        assert abs(s1 - value) <= 1e-12 * max(1.0, abs(value))
         assert abs(s1 - s2) <= 1e-12 * max(1.0, abs(s2))
         assert abs(abs(np.vdot(x1, x2)) - 1.0) <= 1e-10
     D = np.diag(np.arange(1.0, n + 1.0))  # P(0) = D - D singular: the Python steps' answer
@@ -632,3 +621,17 @@ def test_quadratic_problem_split_into_its_blocks_keeps_every_eigenpair():
         scale = (np.linalg.norm(A0) + abs(s) * np.linalg.norm(A1)
                  + abs(s) ** 2 * np.linalg.norm(A2)) * np.linalg.norm(y)
         assert np.linalg.norm(r) < 1e-9 * scale
+
+
+def _quadratic_starts(seed: int, n: int):
+    """A random quadratic problem ``B0 + s B1 + s^2 I`` of ``n`` coordinates and three starts
+    ``(eigenvalue, start, y0)`` of an inverse iteration: 1e-3 off three of its eigenvalues
+    (every other one by decreasing imaginary part, from the companion eigensolve), the
+    eigenvector perturbed by 1e-3."""
+    rng = np.random.default_rng(seed)
+    B0, B1 = rng.standard_normal((2, n, n))
+    B2 = np.eye(n)
+    vals, Y = _companion_eigen(B0, B1, B2)
+    starts = [(vals[i], vals[i] + 1e-3 * (1 + 1j), Y[:, i] + 1e-3 * rng.standard_normal(n))
+              for i in np.argsort(-np.abs(vals.imag))[:6:2]]
+    return B0, B1, B2, starts

@@ -1477,34 +1477,59 @@ def _ruhe_small(B0, B1, B2, sigma, y, max_iter):
     A = np.empty((n, n), dtype=np.complex128)
     r = np.empty(n, dtype=np.complex128)
     for _ in range(max_iter):
-        s2 = sigma * sigma
-        for i in range(n):
-            for j in range(n):
-                A[i, j] = B0[i, j] + sigma * B1[i, j] + s2 * B2[i, j]
+        _pencil_into(B0, B1, B2, sigma, A)
         piv, ok = _lu_small(A)
         if not ok:
             return sigma, x, False
         if first:  # towards the eigenvector of the eigenvalue nearest sigma
             x = _unit(_lu_solve_small(A, piv, x))
             first = False
-        two = 2.0 * sigma
-        for i in range(n):
-            acc = 0j
-            for j in range(n):
-                acc += (B1[i, j] + two * B2[i, j]) * x[j]
-            r[i] = acc
-        u = _lu_solve_small(A, piv, r)
-        den = 0j
-        for i in range(n):
-            den += np.conj(x[i]) * u[i]
-        if not np.isfinite(den.real) or not np.isfinite(den.imag) or den == 0:
-            return sigma, x, False
-        step = 1.0 / den
-        sigma = sigma - step
-        x = _unit(u)
-        if abs(step) <= 1e-14 * max(1.0, abs(sigma)):
-            return sigma, x, True
+        _slope_into(B1, B2, sigma, x, r)
+        sigma, x, state = _ruhe_update(sigma, x, _lu_solve_small(A, piv, r))
+        if state != 0:
+            return sigma, x, state > 0
     return sigma, x, False
+
+
+@njit(cache=True)
+def _pencil_into(B0, B1, B2, sigma, A):
+    """``A = P(sigma) = B0 + sigma B1 + sigma^2 B2`` (in place)."""
+    n = B0.shape[0]
+    s2 = sigma * sigma
+    for i in range(n):
+        for j in range(n):
+            A[i, j] = B0[i, j] + sigma * B1[i, j] + s2 * B2[i, j]
+
+
+@njit(cache=True)
+def _slope_into(B1, B2, sigma, x, r):
+    """``r = P'(sigma) x = (B1 + 2 sigma B2) x`` (in place)."""
+    n = B1.shape[0]
+    two = 2.0 * sigma
+    for i in range(n):
+        acc = 0j
+        for j in range(n):
+            acc += (B1[i, j] + two * B2[i, j]) * x[j]
+        r[i] = acc
+
+
+@njit(cache=True)
+def _ruhe_update(sigma, x, u):
+    """Ruhe's step from ``u = P(sigma)^-1 P'(sigma) x``: ``sigma - 1 / (x^H u)`` and the
+    normalised ``u``, with ``state`` 1 (the step below 1e-14 of ``max(1, |sigma|)``:
+    converged), -1 (``x^H u`` zero or not finite: failed, ``sigma`` and ``x`` unchanged) or 0
+    (go on)."""
+    den = 0j
+    for i in range(x.shape[0]):
+        den += np.conj(x[i]) * u[i]
+    if not np.isfinite(den.real) or not np.isfinite(den.imag) or den == 0:
+        return sigma, x, -1
+    step = 1.0 / den
+    sigma = sigma - step
+    x = _unit(u)
+    if abs(step) <= 1e-14 * max(1.0, abs(sigma)):
+        return sigma, x, 1
+    return sigma, x, 0
 
 
 @njit(cache=True)
@@ -1518,30 +1543,14 @@ def _ruhe_lapack(B0, B1, B2, sigma, y, max_iter):
     A = np.empty((n, n), dtype=np.complex128)
     r = np.empty(n, dtype=np.complex128)
     for _ in range(max_iter):
-        s2 = sigma * sigma
-        for i in range(n):
-            for j in range(n):
-                A[i, j] = B0[i, j] + sigma * B1[i, j] + s2 * B2[i, j]
+        _pencil_into(B0, B1, B2, sigma, A)
         if first:  # towards the eigenvector of the eigenvalue nearest sigma
             x = _unit(np.linalg.solve(A, x))
             first = False
-        two = 2.0 * sigma
-        for i in range(n):
-            acc = 0j
-            for j in range(n):
-                acc += (B1[i, j] + two * B2[i, j]) * x[j]
-            r[i] = acc
-        u = np.linalg.solve(A, r)
-        den = 0j
-        for i in range(n):
-            den += np.conj(x[i]) * u[i]
-        if not np.isfinite(den.real) or not np.isfinite(den.imag) or den == 0:
-            return sigma, x, False
-        step = 1.0 / den
-        sigma = sigma - step
-        x = _unit(u)
-        if abs(step) <= 1e-14 * max(1.0, abs(sigma)):
-            return sigma, x, True
+        _slope_into(B1, B2, sigma, x, r)
+        sigma, x, state = _ruhe_update(sigma, x, np.linalg.solve(A, r))
+        if state != 0:
+            return sigma, x, state > 0
     return sigma, x, False
 
 
