@@ -31,6 +31,22 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
                                 "benchmarks"))
 
 
+def keep_first_column_norms(solvers) -> None:
+    """Powell's variable scales from each problem's first Jacobian only: ``solvers``'
+    column norms replaced by those of the first Jacobian of the same problem (keyed by its
+    owner and shape: the static preload's problem is another)."""
+    first = {}
+    norms = solvers._column_norms
+
+    def kept(J):
+        key = (id(getattr(J, "owner", None)), J.shape)
+        if key not in first:
+            first[key] = norms(J)
+        return first[key].copy()
+
+    solvers._column_norms = kept
+
+
 def main():
     from scale_3d import LOADS, H, condenser, pad, warm_up
 
@@ -51,16 +67,7 @@ def main():
     elif variant.startswith("memory="):  # the stretches' reference over more iterates
         solvers.WATCHDOG_MEMORY = int(variant.split("=")[1])
     elif variant == "norms=first":  # the variable scales of the first Jacobian only
-        first = {}
-        norms = solvers._column_norms
-
-        def kept(J):  # per problem (the static preload's is another)
-            key = (id(getattr(J, "owner", None)), J.shape)
-            if key not in first:
-                first[key] = norms(J)
-            return first[key].copy()
-
-        solvers._column_norms = kept
+        keep_first_column_norms(solvers)
     elif variant == "unclipped":  # without the stretches after crawling dog-leg steps
         solvers.WATCHDOG_CLIPPED = 10**9
     load = LOADS["slip"]

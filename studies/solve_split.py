@@ -90,16 +90,9 @@ def main():
             opts = opts.replace(krylov=dataclasses.replace(opts.krylov,
                                                            **{field: variants[key] == "1"}))
     if variants.get("norms") == "first":  # the first Jacobian's column norms kept
-        first = {}
-        norms = solvers._column_norms
+        from powell_kinks import keep_first_column_norms
 
-        def kept(J):  # per problem (the static preload's is another)
-            key = (id(getattr(J, "owner", None)), J.shape)
-            if key not in first:
-                first[key] = norms(J)
-            return first[key].copy()
-
-        solvers._column_norms = kept
+        keep_first_column_norms(solvers)
     load = LOADS["slip"]
     warm_up(load)
     model = pad(n, load)
