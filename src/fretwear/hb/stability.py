@@ -1010,16 +1010,16 @@ def _inverse_iteration(B0, B1, B2, sigma: complex, y: np.ndarray, max_iter: int 
     ``(sigma, y, converged)``; converged when the step is below 1e-14 of ``max(1, |sigma|)``
     (the rounding of the dense eigensolver's eigenvalue, whose backward error is of the same
     order). Compiled: up to :data:`PAIR_COMPILED_MAX` unknowns with its own LU
-    (:func:`_ruhe_small`), beyond with LAPACK's solve called from the kernel
-    (:func:`_ruhe_lapack`: 0.40 against 0.63 ms for the steps called from Python on the
+    (:func:`_ruhe`), beyond with LAPACK's solve called from the kernel
+    (:func:`_ruhe` with ``lapack``: 0.40 against 0.63 ms for the steps called from Python on the
     two-DOF oscillator's block of 62 unknowns); the steps from Python
     (:func:`_inverse_iteration_py`) where that solve meets a singular ``P(s)``."""
     B0, B1, B2 = (np.ascontiguousarray(b, dtype=complex) for b in (B0, B1, B2))
     y = np.ascontiguousarray(y, dtype=complex)
-    kernel = _ruhe_small if B0.shape[0] <= PAIR_COMPILED_MAX else _ruhe_lapack
+    lapack = B0.shape[0] > PAIR_COMPILED_MAX
     try:
-        s1, x1, ok = kernel(B0, B1, B2, complex(sigma), y, max_iter)
-    except np.linalg.LinAlgError:  # _ruhe_lapack at a singular P(s)
+        s1, x1, ok = _ruhe(B0, B1, B2, complex(sigma), y, max_iter, lapack)
+    except np.linalg.LinAlgError:  # LAPACK's solve at a singular P(s)
         return _inverse_iteration_py(B0, B1, B2, sigma, y, max_iter)
     return complex(s1), x1, bool(ok)
 
@@ -1468,27 +1468,40 @@ def _residuals(T, y, mu):
 
 
 @njit(cache=True)
-def _ruhe_small(B0, B1, B2, sigma, y, max_iter):
-    """:func:`_inverse_iteration` compiled (the same steps, the LU by :func:`_lu_small`):
-    ``(sigma, y, converged)``."""
+def _ruhe(B0, B1, B2, sigma, y, max_iter, lapack):
+    """:func:`_inverse_iteration` compiled (the same steps): ``(sigma, y, converged)``. Each
+    step solves with ``P(sigma)`` by :func:`_lu_small` (one LU a step; not converged at a
+    zero pivot) or, with ``lapack`` (larger blocks), by LAPACK's ``zgesv``
+    (``np.linalg.solve``: one LU a solve, two at the first step; raises ``LinAlgError`` at a
+    singular ``P(s)``)."""
     n = B0.shape[0]
     x = _unit(y)
     first = True
     A = np.empty((n, n), dtype=np.complex128)
     r = np.empty(n, dtype=np.complex128)
+    piv = np.arange(n)
     for _ in range(max_iter):
         _pencil_into(B0, B1, B2, sigma, A)
-        piv, ok = _lu_small(A)
-        if not ok:
-            return sigma, x, False
+        if not lapack:
+            piv, ok = _lu_small(A)
+            if not ok:
+                return sigma, x, False
         if first:  # towards the eigenvector of the eigenvalue nearest sigma
-            x = _unit(_lu_solve_small(A, piv, x))
+            x = _unit(_solve_pencil(A, piv, x, lapack))
             first = False
         _slope_into(B1, B2, sigma, x, r)
-        sigma, x, state = _ruhe_update(sigma, x, _lu_solve_small(A, piv, r))
+        sigma, x, state = _ruhe_update(sigma, x, _solve_pencil(A, piv, r, lapack))
         if state != 0:
             return sigma, x, state > 0
     return sigma, x, False
+
+
+@njit(cache=True)
+def _solve_pencil(A, piv, b, lapack):
+    """``A^-1 b``: by LAPACK (``lapack``) or from ``A``'s LU in place (:func:`_lu_small`)."""
+    if lapack:
+        return np.linalg.solve(A, b)
+    return _lu_solve_small(A, piv, b)
 
 
 @njit(cache=True)
@@ -1530,28 +1543,6 @@ def _ruhe_update(sigma, x, u):
     if abs(step) <= 1e-14 * max(1.0, abs(sigma)):
         return sigma, x, 1
     return sigma, x, 0
-
-
-@njit(cache=True)
-def _ruhe_lapack(B0, B1, B2, sigma, y, max_iter):
-    """:func:`_inverse_iteration` compiled for larger blocks: the same steps as
-    :func:`_ruhe_small` with LAPACK's ``zgesv`` (``np.linalg.solve``) for each solve (two at
-    the first step, one LU each; raises ``LinAlgError`` at a singular ``P(s)``)."""
-    n = B0.shape[0]
-    x = _unit(y)
-    first = True
-    A = np.empty((n, n), dtype=np.complex128)
-    r = np.empty(n, dtype=np.complex128)
-    for _ in range(max_iter):
-        _pencil_into(B0, B1, B2, sigma, A)
-        if first:  # towards the eigenvector of the eigenvalue nearest sigma
-            x = _unit(np.linalg.solve(A, x))
-            first = False
-        _slope_into(B1, B2, sigma, x, r)
-        sigma, x, state = _ruhe_update(sigma, x, np.linalg.solve(A, r))
-        if state != 0:
-            return sigma, x, state > 0
-    return sigma, x, False
 
 
 def _pair(T: np.ndarray, v: np.ndarray, mu0: complex, steps: int = 2):
