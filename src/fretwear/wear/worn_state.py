@@ -545,13 +545,10 @@ class _Jumps:
         if (k < 1 or not records[k].has_balance or not records[k - 1].has_balance
                 or records[k].volume_rate > TRY_RATE * records[0].volume_rate):
             return None
-        if self.latest is None:  # the first jump: the target the path's progress is measured to
-            self.latest = k, self.of(records, k)
-            return None
+        if self.latest is None or self.latest[1] is None:  # no target yet (none, or the
+            self.latest = k, self.of(records, k)  # last jump found none): the path's
+            return None  # progress is measured to the jump from here
         j, before = self.latest
-        if before is None:
-            self.latest = k, self.of(records, k)
-            return None
         W0, W1 = records[k - 1].wear_depth, records[k].wear_depth
         _, progress = agreement(W0, W1, before.W, before.W)
         if progress < PROGRESS:  # the path is not heading there yet: no jump tried
