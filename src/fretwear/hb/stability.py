@@ -118,6 +118,7 @@ from fretwear.hb import contact as law
 from fretwear.hb.contact import SEPARATION, STICK, _slip_gain
 from fretwear.hb.dynamics import StructureDynamics, structure_dynamics
 from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.memory_gain import memory_gain
 from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.reduce import condense
 from fretwear.hb.solution import PeriodicSolution
@@ -628,6 +629,9 @@ class HillProblem:
         # the law's arrays as the kernel of :func:`shifted_gain` takes them, made once
         self._law = (np.ascontiguousarray(prob.mu, dtype=float), np.ascontiguousarray(prob.P),
                      np.ascontiguousarray(prob.Q), law._normal(prob.normal, self.lu))
+        # in 2D, G(s) split once into its part free of s and one outer product per stick
+        # interval (:mod:`fretwear.hb.memory_gain`; None: the recursion at every s)
+        self._memory = memory_gain(self.lu, self.lx, self.state, *self._law)
         # the structure's whole matrices as :func:`_condensed_at` takes them (zeros for a
         # damping the model has not)
         full = dyn.full
@@ -640,6 +644,8 @@ class HillProblem:
         if sigma == 0:
             return self.G0.astype(complex)
         z = np.exp(-2.0 * np.pi * complex(sigma) / self.N)  # e^{-s h}: h = T / N
+        if self._memory is not None:
+            return self._memory.at(z)
         mu, P, Q, normal = self._law
         return _shifted_gain(self.lu, self.lx, self.state, mu, P, Q, z, normal)
 
