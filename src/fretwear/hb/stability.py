@@ -623,15 +623,20 @@ class HillProblem:
         self.lu = np.ascontiguousarray(lu)
         self.lx = np.ascontiguousarray(lx)
         self.state = state
-        self.G0 = law.dlft_jacobian(self.lu, self.lx, self.state, prob.mu, prob.P, prob.Q,
-                                    prob.eps * prob.anchor, prob.tol, prob.max_sweeps,
-                                    prob.normal)
         # the law's arrays as the kernel of :func:`shifted_gain` takes them, made once
         self._law = (np.ascontiguousarray(prob.mu, dtype=float), np.ascontiguousarray(prob.P),
                      np.ascontiguousarray(prob.Q), law._normal(prob.normal, self.lu))
         # in 2D, G(s) split once into its part free of s and one outer product per stick
         # interval (:mod:`fretwear.hb.memory_gain`; None: the recursion at every s)
         self._memory = memory_gain(self.lu, self.lx, self.state, *self._law)
+        if self._memory is not None:  # G(0) from the split: the solve's recursion's terms
+            # summed in another order (no node sticks all period, so the solve's wrap-around
+            # is exact in one sweep and its anchors do not enter): equal to rounding
+            self.G0 = self._memory.at(1.0).real
+        else:
+            self.G0 = law.dlft_jacobian(self.lu, self.lx, self.state, prob.mu, prob.P, prob.Q,
+                                        prob.eps * prob.anchor, prob.tol, prob.max_sweeps,
+                                        prob.normal)
         # the structure's whole matrices as :func:`_condensed_at` takes them (zeros for a
         # damping the model has not)
         full = dyn.full
@@ -714,8 +719,9 @@ class HillProblem:
         candidates are not continued from the neighbour's (:func:`hill_stability`)."""
         st = self.state
         prev = np.concatenate([st[..., -1:], st[..., :-1]], axis=-1)  # np.roll's, cheaper
-        changes = np.count_nonzero(st != prev, axis=-1)
-        return tuple((tuple(sorted(set(st[p].ravel().tolist()))), int(changes[p]))
+        changes = np.count_nonzero(st != prev, axis=-1).tolist()
+        # the states taken, in increasing order (they are 0, 1, 2: a count per value)
+        return tuple((tuple(np.flatnonzero(np.bincount(st[p].ravel())).tolist()), changes[p])
                      for p in range(st.shape[0]))
 
     def memoryless(self) -> bool:
