@@ -51,7 +51,7 @@ from fretwear.hb.options import SweepOptions
 from fretwear.hb.reduce import exact_condenser
 from fretwear.hb.stability import hill_stability, stability
 from fretwear.hb.sweep import sweep
-from fretwear.hb.sweep_stability import nearest, point_problem, sweep_stability
+from fretwear.hb.sweep_stability import Computed, nearest, point_problem, sweep_stability
 from fretwear.model.beam import cantilever_matrices, modal_damping
 from fretwear.model.build import Damping
 from fretwear.model.core import Load
@@ -166,7 +166,7 @@ def hill_ratios(model, basis, f_min, f_max, n_points, label):
     res = sweep(model, basis, f_min, f_max, n_points, options=SweepOptions(spacing="linear"),
                 condenser=cond)
     dyn = structure_dynamics(model, cond)
-    ratios, cpu_ratios, unstable, evals, tracked, seen = [], [], 0, 0, 0, []
+    ratios, cpu_ratios, unstable, evals, tracked, seen = [], [], 0, 0, 0, Computed()
     hill_grid = solve_grid = hill_all = solve_all = 0.0
     for p in res.points:
         if p.solution is None:

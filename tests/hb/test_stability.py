@@ -30,6 +30,7 @@ from fretwear.hb.stability import (
     QuadraticReduction,
     _companion_eigen,
     _components,
+    _det_sign,
     _inverse_iteration,
     _inverse_iteration_py,
     _pair,
@@ -420,6 +421,27 @@ def test_hill_matrix_at_zero_is_the_solve_jacobian():
     assert np.abs(T - J).max() <= 1e-10 * np.abs(J).max()
     J0 = hp.jacobian()
     assert J0.dtype == float and np.abs(J0 - J).max() <= 1e-10 * np.abs(J).max()
+    assert hp.det_sign() == int(np.sign(np.linalg.slogdet(J)[0])) != 0
+
+
+def test_det_sign_is_lapack_s():
+    """The compiled sign of ``det(eps I - G (eps I - Z))`` (:func:`_det_sign`) against
+    LAPACK's ``slogdet`` of :func:`jacobian_form` on random block-diagonal ``G`` (two nodes)
+    and ``Z`` of both signs (well conditioned: the sign cannot hinge on rounding), and 0
+    where a row of ``J`` is zero."""
+    rng = np.random.default_rng(4)
+    n, dH = 12, 6
+    signs = set()
+    for _ in range(20):
+        G = rng.standard_normal((2, dH, dH))
+        Z = rng.standard_normal((n, n))
+        J = jacobian_form(G, Z, 0.7)
+        ref = int(np.sign(np.linalg.slogdet(J)[0]))
+        signs.add(ref)
+        assert _det_sign(G, Z, 0.7) == ref
+    assert signs == {-1, 1}
+    G = np.zeros((2, dH, dH))
+    assert _det_sign(G, rng.standard_normal((n, n)), 0.0) == 0
 
 
 def test_exponents_of_a_linear_response_are_the_structure_s_eigenvalues():

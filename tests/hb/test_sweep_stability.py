@@ -31,7 +31,13 @@ from fretwear.hb.stability import (
     stability,
 )
 from fretwear.hb.sweep import sweep
-from fretwear.hb.sweep_stability import branch_events, nearest, point_problem, sweep_stability
+from fretwear.hb.sweep_stability import (
+    Computed,
+    branch_events,
+    nearest,
+    point_problem,
+    sweep_stability,
+)
 from fretwear.model.build import Damping
 from fretwear.model.core import Load
 from fretwear.model.matrices import ContactDofs, from_matrices
@@ -257,3 +263,23 @@ def test_nearest_is_the_closest_solution_that_can_be_continued(folded):
     assert nearest(U, seen) is with_track[1]
     assert nearest(U + 2.0, seen) is with_track[0]
     assert nearest(U, seen[2:]) is None and nearest(U, []) is None
+
+
+def test_computed_points_give_the_lists_nearest(folded):
+    """:class:`Computed` (the sweep's stacked record) returns what the list of pairs does:
+    the same result object for queries near each point, past its first growth (8 rows), with
+    results without a track and of another size skipped; ``len`` counts every point."""
+    _, st = folded
+    with_track = [fl for fl in st.floquet if fl is not None and fl.track is not None]
+    without = [fl for fl in st.floquet if fl is not None and fl.track is None]
+    rng = np.random.default_rng(2)
+    pairs = [(rng.standard_normal((2, 3)), with_track[i % len(with_track)]) for i in range(11)]
+    pairs += [(np.zeros((2, 3)), without[0]), (np.zeros(4), with_track[0])]
+    comp = Computed()
+    for item in pairs:
+        comp.append(item)
+    assert len(comp) == len(pairs)
+    for U, _ in pairs[:11]:
+        for q in (U, U + 0.1 * rng.standard_normal(U.shape)):
+            assert nearest(q, comp) is nearest(q, pairs)
+    assert nearest(np.zeros(5), comp) is None and nearest(np.zeros(5), Computed()) is None

@@ -486,6 +486,49 @@ def jacobian_form(G: np.ndarray, Z: np.ndarray, eps: float) -> np.ndarray:
 
 
 @njit(cache=True)
+def _det_sign(G, Z, eps):
+    """Sign of ``det(eps I - G (eps I - Z))`` (:func:`jacobian_form`, real; ``G`` (nc, dH,
+    dH) block-diagonal per node, ``Z`` (n, n)): the form, then its LU with partial pivoting
+    (the pivots' signs and the permutation's parity); 0 at a zero pivot."""
+    nc, dH, _ = G.shape
+    n = Z.shape[0]
+    J = np.empty((n, n))
+    for p in range(nc):
+        lo = p * dH
+        for i in range(dH):
+            for j in range(n):
+                acc = 0.0
+                for r in range(dH):
+                    acc += G[p, i, r] * Z[lo + r, j]
+                J[lo + i, j] = acc
+            for j in range(dH):
+                J[lo + i, lo + j] -= eps * G[p, i, j]
+    for i in range(n):
+        J[i, i] += eps
+    sign = 1
+    for col in range(n):
+        piv = col
+        big = abs(J[col, col])
+        for r in range(col + 1, n):
+            if abs(J[r, col]) > big:
+                piv, big = r, abs(J[r, col])
+        if big == 0.0:
+            return 0
+        if piv != col:
+            for j in range(n):
+                J[col, j], J[piv, j] = J[piv, j], J[col, j]
+            sign = -sign
+        d = J[col, col]
+        if d < 0.0:
+            sign = -sign
+        for r in range(col + 1, n):
+            f = J[r, col] / d
+            for j in range(col + 1, n):
+                J[r, j] -= f * J[col, j]
+    return sign
+
+
+@njit(cache=True)
 def _hill_matrix(G, Zr, eps):
     """``T(s) = eps I - G(s) (eps I - Z(s))`` (m H, m H) complex (:func:`jacobian_form` of
     :func:`hill_blocks`) from ``G(s)`` (nc, dH, dH) and ``Z_r`` (1 + 2k, m, m) at ``s``,
@@ -704,6 +747,14 @@ class HillProblem:
         and its problem's ``Z~`` (eq. 22-28), not re-assembled from the structure (the same
         matrix to rounding, tests/hb/test_stability.py)."""
         return jacobian_form(self.G0, self.prob.Z, self.prob.eps)
+
+    def det_sign(self) -> int:
+        """Sign of ``det J`` (:meth:`jacobian`), from its LU with partial pivoting in one
+        compiled call (:func:`_det_sign`; ``np.linalg.slogdet``'s sign to rounding: the same
+        pivots)."""
+        return int(_det_sign(np.ascontiguousarray(self.G0, dtype=float),
+                             np.ascontiguousarray(self.prob.Z, dtype=float),
+                             float(self.prob.eps)))
 
     def neutral(self) -> int:
         """Tangential directions of the nodes that stick all period (multiplier 1)."""
@@ -1703,7 +1754,7 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
     opt = HillOptions() if options is None else options
     t0 = time.perf_counter()
     hp = HillProblem(prob, U, dyn)
-    det_sign = int(np.sign(np.linalg.slogdet(hp.jacobian())[0]))
+    det_sign = hp.det_sign()
     m, H, k = prob.m, prob.H, len(prob.basis.harmonics)
     q = dyn.q
     prev = previous.track if (previous is not None and opt.track) else None

@@ -129,7 +129,7 @@ def sweep_stability(model: Model, result: SweepResult, *, options: HillOptions |
         except InputError as exc:
             notes.append(f"stability not computed: {exc}")
             return SweepStability(stable, rho, det, floquet, [], wall, notes)
-    seen: list = []  # (U, result) of the points computed, for the nearest one's candidates
+    seen = Computed()  # the points computed, for the nearest one's candidates
     for i, p in enumerate(result.points):
         if not p.success:
             continue
@@ -165,13 +165,54 @@ def point_problem(model: Model, point, condenser=None) -> DLFTProblem:
     return problem_of(model, point.solution, condenser=condenser)
 
 
-def nearest(U, seen: list) -> FloquetResult | None:
+class Computed:
+    """The points of a sweep already computed, for :func:`nearest`: ``append((U, result))``
+    as a list of pairs takes them; the harmonics of those whose candidates can be continued
+    are kept stacked (one array per size, grown by doubling), so that the nearest is one
+    array operation instead of a norm a point (owned by the caller: :func:`sweep_stability`
+    makes one per sweep)."""
+
+    def __init__(self):
+        self._groups: dict = {}  # size -> [array (rows, size), rows used, results]
+        self._count = 0
+
+    def __len__(self) -> int:
+        return self._count
+
+    def append(self, item) -> None:
+        U, fl = item
+        self._count += 1
+        if fl.track is None:
+            return
+        U = np.ravel(U)
+        group = self._groups.setdefault(U.size, [np.empty((8, U.size), dtype=U.dtype), 0, []])
+        X, n, results = group
+        if n == X.shape[0]:
+            X = group[0] = np.concatenate([X, np.empty_like(X)])
+        X[n] = U
+        group[1] = n + 1
+        results.append(fl)
+
+    def nearest(self, U) -> FloquetResult | None:
+        """:func:`nearest` among the points appended."""
+        U = np.ravel(U)
+        group = self._groups.get(U.size)
+        if group is None:
+            return None
+        X, n, results = group
+        gaps = X[:n] - U
+        return results[int(np.argmin(np.einsum("ij,ij->i", gaps, gaps)))]
+
+
+def nearest(U, seen) -> FloquetResult | None:
     """The result, among ``seen`` (``(U, FloquetResult)`` of the points already computed),
     at the solution nearest ``U`` (Euclidean norm of the harmonics) of those whose candidates
     can be continued (:attr:`FloquetResult.track`): the previous point of the sweep's list
     is not always the neighbour on the branch (the arclength through a fold records points
     of two branches in turn; on the benchmark's unilateral two-DOF sweep, 25 of 46 points
     tracked from the nearest against 15 from the previous, the same multipliers)."""
+    if isinstance(seen, Computed):
+        return seen.nearest(U)
     U = np.ravel(U)
     cands = [(np.ravel(V), fl) for V, fl in seen if fl.track is not None]
     cands = [(V, fl) for V, fl in cands if V.shape == U.shape]
