@@ -1,13 +1,25 @@
 """The split ``G(s) = G_c + sum_I w_I(z) r_I^T`` (fretwear.hb.memory_gain) against the
-recursion of :func:`fretwear.hb.stability.shifted_gain`."""
+recursion of :func:`fretwear.hb.stability.shifted_gain`, and the evaluation of ``T(s)`` in one
+compiled call that it allows against the pieces one by one."""
 
 import numpy as np
 import pytest
 
 from fretwear.hb import contact as law
+from fretwear.hb.dynamics import structure_dynamics
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.memory_gain import memory_gain
-from fretwear.hb.stability import shifted_gain
+from fretwear.hb.periodic import solve_periodic
+from fretwear.hb.stability import (
+    HillProblem,
+    _pair,
+    _residuals,
+    problem_of,
+    shifted_gain,
+)
+from fretwear.model.build import Damping
+from fretwear.model.core import Load
+from fretwear.model.matrices import ContactDofs, from_matrices
 
 
 def _law_samples(rng, normal_force: bool, N: int):
@@ -62,3 +74,31 @@ def test_split_gain_refuses_what_it_does_not_cover():
     assert memory_gain(lu, lu.copy(), state, np.array([0.5]), P, Q, normal) is None
     lu3 = np.zeros((1, 3, N))
     assert memory_gain(lu3, lu3, state, np.array([0.5]), P, Q, normal) is None
+
+
+def test_fused_evaluation_is_the_pieces_one_by_one():
+    """:meth:`HillProblem.evaluate` by the one compiled call (:func:`_evaluate`, which a 2D
+    Jenkins solution that sticks and slips takes) equals the pieces called one by one
+    (:meth:`HillProblem.matrix`, :func:`_pair`, :func:`_residuals`): the same kernels, so
+    the same values bit for bit, at ``s = 0``, on and off the imaginary axis; and it counts
+    its evaluations."""
+    model = from_matrices([[1.0]], [[1.0]],
+                          contact=ContactDofs(normal_dofs=None, tangential_dofs=[0], mu=0.5,
+                                              normal_load=1.0, kt=0.5),
+                          damping=Damping(C=[[0.02]]), loads=[Load(np.array([0.2]), "cos")])
+    sol = solve_periodic(model, FourierBasis.up_to(3, 32), frequency=1.18 / (2 * np.pi),
+                         time_domain=None)
+    prob = problem_of(model, sol)
+    hp = HillProblem(prob, sol.U.reshape(prob.m, prob.H), structure_dynamics(model))
+    assert hp._fused is not None and law.STICK in hp.state and law.SLIP in hp.state
+    rng = np.random.default_rng(1)
+    v = rng.standard_normal(prob.m * prob.H) + 1j * rng.standard_normal(prob.m * prob.H)
+    for sigma, mu0 in ((0.0, 0.0), (0.9j, 0.01), (-0.03 + 1.02j, 0.0)):
+        T, mu, y, lu, res, pair = hp.evaluate(sigma, v, mu0)
+        T1 = hp.matrix(sigma)
+        mu1, y1, lu1 = _pair(T1, v, mu0)
+        res1, pair1 = _residuals(T1, y1, complex(mu1))
+        assert lu is None and lu1 is None
+        assert np.array_equal(T, T1) and mu == mu1 and np.array_equal(y, y1)
+        assert res == res1 and pair == pair1
+    assert hp.evaluations == 6

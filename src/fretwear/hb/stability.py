@@ -118,7 +118,7 @@ from fretwear.hb import contact as law
 from fretwear.hb.contact import SEPARATION, STICK, _slip_gain
 from fretwear.hb.dynamics import StructureDynamics, structure_dynamics
 from fretwear.hb.fourier import FourierBasis
-from fretwear.hb.memory_gain import memory_gain
+from fretwear.hb.memory_gain import _gain_at, memory_gain
 from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.reduce import condense
 from fretwear.hb.solution import PeriodicSolution
@@ -685,6 +685,12 @@ class HillProblem:
         full = dyn.full
         zero = np.zeros_like(full["K"])
         self._structure = tuple(full.get(nm, zero) for nm in ("K", "M", "C", "D"))
+        # the split G(s) as :func:`_evaluate` takes it, where every piece of an evaluation
+        # runs compiled (None: the pieces one by one, :meth:`matrix` and :func:`_pair`)
+        mg = self._memory
+        small = (dyn.q <= CONDENSED_COMPILED_MAX and n <= PAIR_COMPILED_MAX)
+        self._fused = ((mg.constant, mg.node, mg.start, mg.length, mg.rows, mg.P)
+                       if mg is not None and small else None)
         self.evaluations = 0
 
     def gain(self, sigma: complex) -> np.ndarray:
@@ -733,14 +739,35 @@ class HillProblem:
         ``mu0``, and the residuals ``|mu| / |T|``, ``|T y - mu y| / |T|`` (1-norm of ``T``;
         compiled, :func:`_residuals`, where the pair ran compiled). Returns
         ``(T, mu, y, lu, res, pair)`` (``lu`` as :func:`_pair` returns it)."""
-        T = self.matrix(sigma)
-        mu, y, lu = _pair(T, v, mu0)
+        if self._fused is not None:
+            T, mu, y, status, res, pair = self._evaluate(sigma, v, mu0)
+            if status == 0:
+                return T, complex(mu), y, None, float(res), float(pair)
+            mu, y, lu = _pair_lapack(T, v, mu0)  # a zero pivot: as :func:`_pair` does
+        else:
+            T = self.matrix(sigma)
+            mu, y, lu = _pair(T, v, mu0)
         if lu is None:
             res, pair = _residuals(T, y, complex(mu))
             return T, mu, y, None, float(res), float(pair)
         scale = np.linalg.norm(T, 1)
         pair = float(np.linalg.norm(T @ y - mu * y) / scale)
         return T, mu, y, lu, max(float(abs(mu) / scale), pair), pair
+
+    def _evaluate(self, sigma: complex, v: np.ndarray, mu0: complex):
+        """The compiled evaluation (:func:`_evaluate`): ``(T, mu, y, status, res, pair)``;
+        raises where the held structure is singular (as :meth:`matrix`)."""
+        self.evaluations += 1
+        sigma = complex(sigma)
+        z = (1.0 + 0j if sigma == 0 else np.exp(-2.0 * np.pi * sigma / self.N))
+        out = _evaluate(*self._fused, complex(z), *self._structure, self.prob.m,
+                        self.harmonics, self.omega, sigma, float(self.prob.eps),
+                        np.ascontiguousarray(v, dtype=complex), complex(mu0), 2)
+        if out[3] == 2:
+            raise InputError("the structure with its contact points held is singular at a "
+                             "value of the Laplace variable (an eigenvalue of the held "
+                             "interface)")
+        return out
 
     def jacobian(self) -> np.ndarray:
         """``J = T(0)`` (m H, m H) real: the balance's Jacobian from the solve's own ``G``
@@ -1528,6 +1555,29 @@ def _residuals(T, y, mu):
         r2 += acc.real * acc.real + acc.imag * acc.imag
     pair = np.sqrt(r2) / scale
     return max(abs(mu) / scale, pair), pair
+
+
+@njit(cache=True)
+def _evaluate(Gc, node, start, length, rows, P, z, Kf, Mf, Cf, Df, m, harmonics, omega,
+              sigma, eps, v, mu0, steps):
+    """:meth:`HillProblem.evaluate` in one compiled call where ``G(s)`` is split
+    (:mod:`fretwear.hb.memory_gain`) and every piece runs compiled: ``G(s)``
+    (:func:`fretwear.hb.memory_gain._gain_at`, ``z = e^{-s h}``), ``Z_r``
+    (:func:`_condensed_at`), ``T(s)`` (:func:`_hill_matrix`), the pair (:func:`_pair_small`)
+    and the residuals (:func:`_residuals`): the same kernels as the calls one by one (the same
+    values), one call's overhead instead of five. Returns ``(T, mu, y, status, res, pair)``,
+    ``status`` 0, 1 (a zero pivot in the pair's LU: LAPACK's then runs) or 2 (the held
+    structure is singular at this ``s``)."""
+    G = _gain_at(Gc, node, start, length, rows, P, z)
+    Zr, ok = _condensed_at(Kf, Mf, Cf, Df, m, harmonics, omega, sigma)
+    if not ok:
+        return np.zeros((1, 1), dtype=np.complex128), 0j, v, 2, 0.0, 0.0
+    T = _hill_matrix(G, Zr, eps)
+    mu, y, ok = _pair_small(T, v, mu0, steps)
+    if not ok:
+        return T, 0j, v, 1, 0.0, 0.0
+    res, pair = _residuals(T, y, mu)
+    return T, mu, y, 0, res, pair
 
 
 @njit(cache=True)
