@@ -102,3 +102,41 @@ def test_fused_evaluation_is_the_pieces_one_by_one():
         assert np.array_equal(T, T1) and mu == mu1 and np.array_equal(y, y1)
         assert res == res1 and pair == pair1
     assert hp.evaluations == 6
+
+
+def test_compiled_refinement_is_the_python_steps():
+    """The refinement from a neighbour's start in one compiled call (:func:`_refine`) takes
+    the steps of :func:`_track` one by one (the same kernels and arithmetic): along a Jenkins
+    sweep's neighbouring points, the exponent, eigenvector, residual, slope and number of
+    evaluations equal, bit for bit, those of the Python steps (the compiled path switched off
+    on a copy of the problem)."""
+    import copy
+
+    from fretwear.hb.stability import HillOptions, Refined, _track, hill_stability
+
+    model = from_matrices([[1.0]], [[1.0]],
+                          contact=ContactDofs(normal_dofs=None, tangential_dofs=[0], mu=0.5,
+                                              normal_load=1.0, kt=0.5),
+                          damping=Damping(C=[[0.02]]), loads=[Load(np.array([0.2]), "cos")])
+    dyn = structure_dynamics(model)
+    opt = HillOptions()
+    prev = None
+    checked = 0
+    for w in (1.16, 1.17, 1.18):
+        sol = solve_periodic(model, FourierBasis.up_to(3, 32), frequency=w / (2 * np.pi),
+                             time_domain=None)
+        prob = problem_of(model, sol)
+        U = sol.U.reshape(prob.m, prob.H)
+        if prev is not None:
+            r = next(x for x in prev.track.refined if x is not None)
+            warm = Refined(r.candidate, r.sigma, r.v, r.slope)
+            hp = HillProblem(prob, U, dyn)
+            slow = copy.copy(hp)
+            slow._fused = None
+            a = _track(hp, r.candidate, r.v, opt, warm)
+            b = _track(slow, r.candidate, r.v, opt, warm)
+            assert a[3] and b[3] and a[0] == b[0] and np.array_equal(a[1], b[1])
+            assert a[2] == b[2] and a[4] == b[4] and hp.evaluations == slow.evaluations >= 2
+            checked += 1
+        prev = hill_stability(prob, U, dyn)
+    assert checked == 2

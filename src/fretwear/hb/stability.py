@@ -1581,6 +1581,51 @@ def _evaluate(Gc, node, start, length, rows, P, z, Kf, Mf, Cf, Df, m, harmonics,
 
 
 @njit(cache=True)
+def _refine(Gc, node, start, length, rows, P, Kf, Mf, Cf, Df, m, harmonics, omega, eps, N,
+            s0, sigma, v, slope, tol, max_iter, floor):
+    """:func:`_track` from a neighbour's start (``sigma``, ``v``, ``slope`` nonzero; no
+    deflation) in one compiled call, each step one :func:`_evaluate`: the secant method on
+    the eigenvalue ``mu`` of ``T(sigma)`` that continues ``v``, the same steps and stopping
+    rule (``|mu| / |T|`` below ``tol``; the iterates kept within 0.5 of the candidate ``s0``
+    and above ``2 pi Re sigma = floor``, the logarithm of :data:`NEGLIGIBLE`). Returns
+    ``(sigma, v, res, converged, slope, evaluations, status)``, ``status`` 0, or 1 / 2 as
+    :func:`_evaluate`'s (then :func:`_track` runs the steps one by one, which take LAPACK's
+    pair or raise)."""
+    res = np.inf
+    real = s0.imag == 0.0
+    mu0 = 0j
+    have_prev = False
+    sp = 0j
+    fp = 0j
+    count = 0
+    for _ in range(max_iter):
+        if abs(sigma - s0) > 0.5 or 2.0 * np.pi * sigma.real < floor:
+            break
+        z = 1.0 + 0j if sigma == 0 else np.exp(-2.0 * np.pi * sigma / N)
+        T, mu, y, status, res, pair = _evaluate(Gc, node, start, length, rows, P, z, Kf, Mf,
+                                                Cf, Df, m, harmonics, omega, sigma, eps, v,
+                                                mu0, 2)
+        count += 1
+        if status != 0:
+            return sigma, v, res, False, slope, count, status
+        v = y
+        if res <= tol:
+            return sigma, v, res, True, slope, count, 0
+        f = mu
+        if have_prev:
+            slope = (f - fp) / (sigma - sp) if f != fp else 0j
+        new = sigma - f / slope if slope != 0 else sigma
+        sp, fp, have_prev = sigma, f, True
+        mu0 = 0j if pair < 1e-3 else mu
+        if real:
+            new = complex(new.real, 0.0)
+        if not (np.isfinite(new.real) and np.isfinite(new.imag)) or new == sigma:
+            break
+        sigma = new
+    return sigma, v, res, res <= tol, slope, count, 0
+
+
+@njit(cache=True)
 def _ruhe(B0, B1, B2, sigma, y, max_iter, lapack):
     """:func:`_inverse_iteration` compiled (the same steps): ``(sigma, y, converged)``. Each
     step solves with ``P(sigma)`` by :func:`_lu_small` (one LU a step; not converged at a
@@ -1708,6 +1753,16 @@ def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions,
     ``deflate``: a real root already found, the equation ``mu(sigma) / (sigma - deflate) = 0``
     instead (another crossing of the same eigenvalue branch, :func:`_landed_real`; not
     converged back on ``deflate``, within :data:`ON_REAL`)."""
+    if warm is not None and deflate is None and hp._fused is not None and warm.slope != 0:
+        out = _refine(*hp._fused, *hp._structure, hp.prob.m, hp.harmonics, hp.omega,
+                      float(hp.prob.eps), float(hp.N), complex(sigma), complex(warm.sigma),
+                      np.ascontiguousarray(warm.v, dtype=complex), complex(warm.slope),
+                      float(opt.newton_tol), int(opt.newton_max_iter),
+                      float(np.log(NEGLIGIBLE)))
+        if out[6] == 0:  # (else: the steps one by one, which take LAPACK's pair or raise)
+            hp.evaluations += out[5]
+            s1, v1, r1, conv, slope1 = out[:5]
+            return complex(s1), v1, float(r1), bool(conv), complex(slope1)
     prev = None
     res = np.inf
     start = sigma
