@@ -36,6 +36,7 @@ from fretwear.hb.stability import (
     _pair,
     _pair_lapack,
     _shifted_copy,
+    _state_summary,
     centroid,
     jacobian_form,
     problem_of,
@@ -442,6 +443,21 @@ def test_det_sign_is_lapack_s():
     assert signs == {-1, 1}
     G = np.zeros((2, dH, dH))
     assert _det_sign(G, rng.standard_normal((n, n)), 0.0) == 0
+
+
+def test_state_summary_is_numpy_s():
+    """The states per node and their changes over the period (:func:`_state_summary`, one
+    compiled pass) against numpy's ``np.unique`` and ``np.roll`` on random runs of the three
+    states, with a node that sticks all period and one that changes at the period's end."""
+    rng = np.random.default_rng(6)
+    state = np.repeat(rng.integers(0, 3, (5, 8)), 6, axis=1).astype(np.int8)
+    state[0] = law.STICK
+    state[1, -1] = (state[1, 0] + 1) % 3
+    present, changes = _state_summary(state)
+    for p in range(state.shape[0]):
+        assert np.flatnonzero(present[p]).tolist() == np.unique(state[p]).tolist()
+        assert changes[p] == np.count_nonzero(state[p] != np.roll(state[p], 1))
+    assert changes[0] == 0 and changes[1] >= 2
 
 
 def test_exponents_of_a_linear_response_are_the_structure_s_eigenvalues():

@@ -85,7 +85,10 @@ mass, ``q`` other coordinates; at most :data:`PENCIL_MAX` before the companion f
 where coordinates whose law does not vary over the period split off, harmonic by harmonic,
 :func:`_components`) and,
 with a memory, a few evaluations of ``T(s)`` and ``m H`` LU factorisations per refined
-exponent (3-5 from a neighbour's exponent, 4-9 from a candidate); along a sweep, where the
+exponent (3-5 from a neighbour's exponent, 4-9 from a candidate; in 2D ``G(s)`` is split
+once per solution into its part free of ``s`` and one outer product per stick interval,
+:mod:`fretwear.hb.memory_gain`, and a refinement from a neighbour's exponent is one compiled
+call, :func:`_refine`); along a sweep, where the
 candidates are tracked, a few LU factorisations of the blocks of the quadratic problem per
 candidate instead of its dense eigensolve. ``det J`` is read from the solve's own ``G`` and
 ``Z~`` (:meth:`HillProblem.jacobian`). Measured on the benchmark's small models
@@ -486,6 +489,25 @@ def jacobian_form(G: np.ndarray, Z: np.ndarray, eps: float) -> np.ndarray:
 
 
 @njit(cache=True)
+def _state_summary(state):
+    """Per node of ``state`` (nc, N) (the law's samples' states, 0 separation, 1 stick, 2
+    slip): ``present`` (nc, 3) the states it takes and ``changes`` (nc,) how many times it
+    changes state over the period (the last sample to the first included), in one pass."""
+    nc, N = state.shape
+    present = np.zeros((nc, 3), dtype=np.bool_)
+    changes = np.zeros(nc, dtype=np.int64)
+    for p in range(nc):
+        last = state[p, N - 1]
+        for n in range(N):
+            st = state[p, n]
+            present[p, st] = True
+            if st != last:
+                changes[p] += 1
+            last = st
+    return present, changes
+
+
+@njit(cache=True)
 def _det_sign(G, Z, eps):
     """Sign of ``det(eps I - G (eps I - Z))`` (:func:`jacobian_form`, real; ``G`` (nc, dH,
     dH) block-diagonal per node, ``Z`` (n, n)): the form, then its LU with partial pivoting
@@ -692,6 +714,7 @@ class HillProblem:
         self._fused = ((mg.constant, mg.node, mg.start, mg.length, mg.rows, mg.P)
                        if mg is not None and small else None)
         self.evaluations = 0
+        self._summary = None  # the contact states per node (:meth:`_states`)
 
     def gain(self, sigma: complex) -> np.ndarray:
         """``G(s)`` at ``s = sigma w`` (the solve's own ``G`` at 0)."""
@@ -783,9 +806,17 @@ class HillProblem:
                              np.ascontiguousarray(self.prob.Z, dtype=float),
                              float(self.prob.eps)))
 
+    def _states(self):
+        """``(present, changes)`` of :func:`_state_summary`, made at the first call (the
+        state does not change)."""
+        if self._summary is None:
+            self._summary = _state_summary(np.ascontiguousarray(self.state))
+        return self._summary
+
     def neutral(self) -> int:
         """Tangential directions of the nodes that stick all period (multiplier 1)."""
-        stuck = np.all(self.state == STICK, axis=1)
+        present, _ = self._states()
+        stuck = present[:, STICK] & ~present[:, SEPARATION] & ~present[:, law.SLIP]
         return int(stuck.sum()) * (self.prob.d - 1)
 
     def regime(self) -> tuple:
@@ -795,18 +826,15 @@ class HillProblem:
         structure and the frozen-memory problem's families with it (a held pair goes, real
         exponents come: measured on a Jenkins oscillator leaving full stick), so the
         candidates are not continued from the neighbour's (:func:`hill_stability`)."""
-        st = self.state
-        prev = np.concatenate([st[..., -1:], st[..., :-1]], axis=-1)  # np.roll's, cheaper
-        changes = np.count_nonzero(st != prev, axis=-1).tolist()
-        # the states taken, in increasing order (they are 0, 1, 2: a count per value)
-        return tuple((tuple(np.flatnonzero(np.bincount(st[p].ravel())).tolist()), changes[p])
-                     for p in range(st.shape[0]))
+        present, changes = self._states()
+        return tuple((tuple(k for k in range(3) if present[p, k]), int(changes[p]))
+                     for p in range(present.shape[0]))
 
     def memoryless(self) -> bool:
         """No node sticks at any instant nor slips in 3D: ``G(s) = G(0)`` for every ``s``
         (separation and 2D slip carry nothing from the previous instant)."""
-        return not (np.any(self.state == STICK)
-                    or (self.prob.d > 2 and np.any(self.state == law.SLIP)))
+        present, _ = self._states()
+        return not (present[:, STICK].any() or (self.prob.d > 2 and present[:, law.SLIP].any()))
 
     def pencil(self):
         """``(A0, A1, A2)``: Hill's matrix on the structure's coordinates ``(x, q)`` (every
