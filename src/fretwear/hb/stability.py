@@ -691,9 +691,13 @@ class HillProblem:
         # the law's arrays as the kernel of :func:`shifted_gain` takes them, made once
         self._law = (np.ascontiguousarray(prob.mu, dtype=float), np.ascontiguousarray(prob.P),
                      np.ascontiguousarray(prob.Q), law._normal(prob.normal, self.lu))
+        self._summary = None  # the contact states per node (:meth:`_states`)
         # in 2D, G(s) split once into its part free of s and one outer product per stick
-        # interval (:mod:`fretwear.hb.memory_gain`; None: the recursion at every s)
-        self._memory = memory_gain(self.lu, self.lx, self.state, *self._law)
+        # interval (:mod:`fretwear.hb.memory_gain`; None: the recursion at every s), where
+        # a node sticks (otherwise nothing is refined: G(0) as the solve has it)
+        sticks = bool(self._states()[0][:, STICK].any())
+        self._memory = (memory_gain(self.lu, self.lx, self.state, *self._law) if sticks
+                        else None)
         if self._memory is not None:  # G(0) from the split: the solve's recursion's terms
             # summed in another order (no node sticks all period, so the solve's wrap-around
             # is exact in one sweep and its anchors do not enter): equal to rounding
@@ -714,7 +718,6 @@ class HillProblem:
         self._fused = ((mg.constant, mg.node, mg.start, mg.length, mg.rows, mg.P)
                        if mg is not None and small else None)
         self.evaluations = 0
-        self._summary = None  # the contact states per node (:meth:`_states`)
 
     def gain(self, sigma: complex) -> np.ndarray:
         """``G(s)`` at ``s = sigma w`` (the solve's own ``G`` at 0)."""
@@ -799,9 +802,11 @@ class HillProblem:
         return jacobian_form(self.G0, self.prob.Z, self.prob.eps)
 
     def det_sign(self) -> int:
-        """Sign of ``det J`` (:meth:`jacobian`), from its LU with partial pivoting in one
-        compiled call (:func:`_det_sign`; ``np.linalg.slogdet``'s sign to rounding: the same
-        pivots)."""
+        """Sign of ``det J`` (:meth:`jacobian`), from its LU with partial pivoting: in one
+        compiled call up to :data:`PAIR_COMPILED_MAX` unknowns (:func:`_det_sign`;
+        ``np.linalg.slogdet``'s sign to rounding: the same pivots), LAPACK's beyond."""
+        if self.prob.m * self.prob.H > PAIR_COMPILED_MAX:
+            return int(np.sign(np.linalg.slogdet(self.jacobian())[0]))
         return int(_det_sign(np.ascontiguousarray(self.G0, dtype=float),
                              np.ascontiguousarray(self.prob.Z, dtype=float),
                              float(self.prob.eps)))
