@@ -14,7 +14,9 @@ regime (stick / slip / separation at some sample) between the iterate and the tr
 (``monotone``: without the watchdog stretches of fretwear.hb.solvers.powell, as before them;
 ``memory=M``: their reference the largest ``|f|`` of the last M iterates; ``norms=first``:
 the variable scales of the first Jacobian only; ``unclipped``: without the stretches after
-crawling dog-leg steps, ``WATCHDOG_CLIPPED``.)
+crawling dog-leg steps, ``WATCHDOG_CLIPPED``.) With ``KINKS_SAVE=<folder>`` every iterate is
+saved there as ``xNNN.npy`` (N the Powell iteration), for the local methods of
+``studies/kinks_local.py``.
 """
 
 from __future__ import annotations
@@ -110,8 +112,12 @@ def main():
     trace = []
     print(" it        |f|     delta   pred/|f|^2 act/|f|^2   ratio  N  gm    lin   acc chg")
 
+    save = os.environ.get("KINKS_SAVE")  # a folder: each iterate saved there
+
     def line(it, x, fn):
         t, ch = trace[-1], changed[-1]
+        if save:
+            np.save(os.path.join(save, f"x{t['it']:03d}.npy"), x)
         print(f"{t['it']:3d} {t['f']:10.4e} {t['delta']:9.3e} {t['pred'] / t['f'] ** 2:10.3e} "
               f"{t['actual'] / t['f'] ** 2:10.3e} {t['ratio']:7.3f} "
               f"{'N' if t['newton'] else 'd'} {t['gmres']:3d} {t['lin']:8.2e} "
