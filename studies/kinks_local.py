@@ -23,7 +23,9 @@ Lampariello and Lucidi 1986; M = 1 is Armijo's monotone search); ``newton``: ful
 steps; ``elim``: nonlinear elimination (the worst nodes' balance solved alone by Powell on
 their formed Jacobian, the others held, then a Newton step of the whole); ``trial``: the
 Newton step from the iterate with the Jacobian of the trial point, its regime (a
-primal-dual active set iteration on the regimes).
+primal-dual active set iteration on the regimes); ``rootjac``: the Newton step from the
+iterate with the law's derivative ``G`` of the root (given as the last argument) at every
+node, and at the two worst nodes only.
 """
 
 from __future__ import annotations
@@ -249,6 +251,29 @@ def trial(fun, x, tries=4):
         s = -Jt.solve(f, rtol=1e-8)
 
 
+def rootjac(fun, x0, root):
+    from fretwear.hb import contact as law
+    from fretwear.hb.krylov import KrylovJacobian
+
+    prob = fun.prob
+
+    def G(x):
+        lu, lx, st, _ = fun.law(x.reshape(prob.m, prob.H))
+        return law.dlft_jacobian(lu, lx, st, prob.mu, prob.P, prob.Q, prob.eps * prob.anchor,
+                                 prob.tol, prob.max_sweeps, prob.normal)
+
+    f, _ = fun(x0)
+    Gx, Gr = G(x0), G(root)
+    worst = np.argsort(per_node(f, prob.nc))[::-1][:2]
+    mixed = Gx.copy()
+    mixed[worst] = Gr[worst]
+    for name, g in (("at every node", Gr), (f"at nodes {np.sort(worst)}", mixed)):
+        s = -KrylovJacobian(g, prob.blocks, prob.eps, prob.d, owner=prob).solve(f, rtol=1e-10)
+        ft, _ = fun(x0 + s, False)
+        print(f"rootjac, the root's G {name}: |f| {norm(f):.3e} -> {norm(ft):.3e}, distance "
+              f"to the root {norm(x0 - root):.3e} -> {norm(x0 + s - root):.3e}", flush=True)
+
+
 def main():
     n, path, methods = int(sys.argv[1]), sys.argv[2], sys.argv[3].split(",")
     root = np.load(sys.argv[4]) if len(sys.argv) > 4 else None
@@ -270,6 +295,8 @@ def main():
             elim(fun, x0.copy())
         elif m == "trial":
             trial(fun, x0.copy())
+        elif m == "rootjac":
+            rootjac(fun, x0, root)
 
 
 if __name__ == "__main__":

@@ -14,9 +14,11 @@ regime (stick / slip / separation at some sample) between the iterate and the tr
 (``monotone``: without the watchdog stretches of fretwear.hb.solvers.powell, as before them;
 ``memory=M``: their reference the largest ``|f|`` of the last M iterates; ``norms=first``:
 the variable scales of the first Jacobian only; ``unclipped``: without the stretches after
-crawling dog-leg steps, ``WATCHDOG_CLIPPED``.) With ``KINKS_SAVE=<folder>`` every iterate is
-saved there as ``xNNN.npy`` (N the Powell iteration), for the local methods of
-``studies/kinks_local.py``.
+crawling dog-leg steps, ``WATCHDOG_CLIPPED``; a sixth argument and on: ``nolocal`` without
+the local phase of fretwear.hb.kinks, ``single`` with single-precision GMRES products;
+``KINKS_ROOT=<file>`` prints the distance to a root saved before.) With
+``KINKS_SAVE=<folder>`` every iterate is saved there as ``xNNN.npy`` (N the Powell
+iteration), for the local methods of ``studies/kinks_local.py``.
 """
 
 from __future__ import annotations
@@ -126,8 +128,19 @@ def main():
               flush=True)
 
     c0, w0 = time.process_time(), time.perf_counter()
+    from fretwear.hb.kinks import local_phase
+
+    local = None if "nolocal" in sys.argv[6:] else local_phase(prob)
+    if "single" in sys.argv[6:]:  # single-precision GMRES products
+        from fretwear.hb.options import KrylovOptions
+
+        prob.krylov = KrylovOptions(single_products=True)
     x, f, st = powell(fun, x0, lambda x: prob.scale(x.reshape(prob.m, prob.H)),
-                      tol=PERIODIC.tol, max_iter=max_iter, trace=trace, callback=line)
+                      tol=PERIODIC.tol, max_iter=max_iter, trace=trace, callback=line,
+                      local=local)
+    if os.environ.get("KINKS_ROOT"):  # the distance to a root saved before
+        root = np.load(os.environ["KINKS_ROOT"])
+        print(f"|x - root| {np.linalg.norm(x - root):.3e} (|root| {np.linalg.norm(root):.3e})")
     cpu, wall = time.process_time() - c0, time.perf_counter() - w0
     newton = sum(t["new_step"] for t in trace)
     gm = sum(t["gmres"] for t in trace)
