@@ -1,23 +1,25 @@
-"""Nonlinear elimination of the contact nodes that hold a DLFT residual near its root.
+"""Nonlinear elimination of the contact nodes that hold a DLFT residual near its root: the
+local phase of Powell's solve where its steps crawl.
 
 Near the root of a large interface in partial slip, Powell's iteration can crawl (dog-leg
-steps reducing ``|f|`` by a few per cent each) while almost all of the residual sits on one or
-two contact nodes whose regime differs from the root's (on the 1024-node partial-slip pad of
-benchmarks/scale_3d.py: two nodes slipping at 2 samples where the root has them slip at 7,
-99 % of ``|f|``, the other nodes within ``1e-10`` of the root). On such a node the residual
-bends within ``1e-4`` of the Newton step (its periodic start state in 3D is the fixed point of
-a pass with ``I - S`` nearly singular, :mod:`fretwear.hb.contact`), so neither the trust
-region nor line searches on the whole system get through
-(docs/studies/large-interface-solve.md, "Nonlinear elimination of the last kinks").
+steps reducing ``|f|`` by a few per cent each) while almost all of the residual sits on a few
+contact nodes (on the 1024-node partial-slip pad of benchmarks/scale_3d.py: two nodes holding
+94 % of ``|f|^2``, sticking all period with their start state at the corner of a closing stick
+set, where the root has them slip at 7 samples; the other nodes within ``1e-10`` of the root).
+There the residual has a square-root branch: it leaves its linear model within ``2e-4`` of
+the Newton step with no node changing regime, and no Newton-type step of the whole system gets
+through (docs/studies/large-interface-solve.md, "The crawl's iterate: a square-root branch of
+the law").
 
-:func:`eliminate` solves the balance of those nodes alone, the other unknowns held: their
-``lambda_u`` is linear in their own unknowns (eq. 23, ``lambda_u = F - Z U + eps (U - W)``,
-the coupling through the held nodes a constant), their law the one of the whole problem, so
-the subproblem's residual is that of the full problem on those rows, exactly. Its Jacobian is
-formed (a few nodes: ``k d H`` unknowns) and solved by Powell. After it, a Newton step of the
-whole system is the Newton step of the system with those nodes eliminated (the rows of
-eliminated nodes hold ``f = 0``), which is smooth where they were the kinks (Lanzkron, Rose and
-Wilkes 1996, nonlinear elimination).
+:func:`eliminate` solves the balance of those nodes and their neighbours alone, the other
+unknowns held: their ``lambda_u`` is linear in their own unknowns (eq. 23, ``lambda_u = F - Z
+U + eps (U - W)``, the coupling through the held nodes a constant) and their law the one of
+the whole problem, so the subproblem's residual is that of the full problem on those rows,
+exactly. Its Jacobian is formed (a few nodes: ``k d H`` unknowns) and the subproblem solved by
+Powell. After it, a Newton step of the whole system is the Newton step of the system with
+those nodes eliminated (their rows hold ``f = 0``), on which their branch no longer acts
+(Lanzkron, Rose and Wilkes 1996, nonlinear elimination). :func:`local_phase` makes the rounds
+of both that :func:`fretwear.hb.solvers.powell` calls as its ``local``.
 """
 
 from __future__ import annotations
