@@ -10,7 +10,8 @@ callers never turn it into a result.
   at every accepted step. MINPACK factorises with its own unblocked QR, which dominates the cost
   at ~1000 unknowns; this keeps the algorithm at LAPACK speed. Where the Newton step keeps
   crossing the contact law's kinks, watchdog stretches of nonmonotone Newton steps
-  (:data:`WATCHDOG_AFTER`).
+  (:data:`WATCHDOG_AFTER`); where its dog-leg steps crawl, a local phase the caller gives
+  (``local``: :func:`fretwear.hb.kinks.local_phase` for the DLFT balance).
 * ``"hybr"``: MINPACK ``hybrj`` itself through :func:`scipy.optimize.root` (what the paper used).
 * ``"newton"``: Newton with a backtracking line search on ``|f|^2``.
 """
