@@ -111,7 +111,9 @@ def test_powell_takes_a_better_point_of_the_local_phase(monkeypatch):
     stretches on formed Jacobians: a local phase that returns the root ends every solve that
     calls it at the root in fewer iterations than without it, and one that returns its
     input (no better point) leaves every solve as without it, iterate for iterate (the
-    default path where the local phase finds nothing: unchanged)."""
+    default path where the local phase finds nothing: unchanged). Recorded: 36 of the 40
+    draws reach the crawl that calls it (370 iterations in all without, 226 with the
+    root's local phase)."""
     monkeypatch.setattr(solvers, "WATCHDOG_FORMED", True)
     called = 0
     for seed in range(40):
@@ -130,4 +132,4 @@ def test_powell_takes_a_better_point_of_the_local_phase(monkeypatch):
         if runs["root"] != runs["none"]:
             called += 1
             assert runs["root"][0] < runs["none"][0]
-    assert called >= 5
+    assert called >= 30
