@@ -118,6 +118,16 @@ from fretwear.hb import contact as law
 from fretwear.hb.contact import SEPARATION, STICK, _slip_gain
 from fretwear.hb.dynamics import StructureDynamics, structure_dynamics
 from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.hill_tracking import (
+    _lu_small,
+    _lu_solve_small,
+    _demote,
+    _split_factor,
+    _split_solve,
+    harmonic_split,
+    no_split,
+    split_work,
+)
 from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.reduce import condense
 from fretwear.hb.solution import PeriodicSolution
@@ -1001,7 +1011,8 @@ def dense_eigen(red: QuadraticReduction):
     return vals, red.full(Y)
 
 
-def _inverse_iteration(B0, B1, B2, sigma: complex, y: np.ndarray, max_iter: int = 10):
+def _inverse_iteration(B0, B1, B2, sigma: complex, y: np.ndarray, max_iter: int = 10,
+                       split: tuple | None = None):
     """The eigenpair of ``(B0 + s B1 + s^2 B2) y = 0`` nearest ``(sigma, y)``: one step of
     inverse iteration with ``P(sigma)`` (the start vector turned towards the eigenvector of
     the eigenvalue nearest ``sigma``), then the nonlinear inverse iteration (Ruhe, SIAM J.
@@ -1017,8 +1028,9 @@ def _inverse_iteration(B0, B1, B2, sigma: complex, y: np.ndarray, max_iter: int 
     B0, B1, B2 = (np.ascontiguousarray(b, dtype=complex) for b in (B0, B1, B2))
     y = np.ascontiguousarray(y, dtype=complex)
     lapack = B0.shape[0] > PAIR_COMPILED_MAX
+    split = no_split() if split is None else split
     try:
-        s1, x1, ok = _ruhe(B0, B1, B2, complex(sigma), y, max_iter, lapack)
+        s1, x1, ok = _ruhe(B0, B1, B2, complex(sigma), y, max_iter, lapack, split)
     except np.linalg.LinAlgError:  # LAPACK's solve at a singular P(s)
         return _inverse_iteration_py(B0, B1, B2, sigma, y, max_iter)
     return complex(s1), x1, bool(ok)
@@ -1201,11 +1213,14 @@ def _member(red: QuadraticReduction, b: int, s0: complex, y0: np.ndarray, shape:
     comp = red.blocks[b]
     if b not in mats:
         ix = np.ix_(comp, comp)
-        mats[b] = tuple(np.asarray(X[ix], dtype=complex) for X in (red.B0, red.B1, red.B2))
-    B = mats[b]
+        real = tuple(np.ascontiguousarray(X[ix]) for X in (red.B0, red.B1, red.B2))
+        c = red.dyn[comp] % H  # coefficient index: 0, a_1..a_k, b_1..b_k
+        split = harmonic_split(*real, np.where(c > k, c - k, c), DECOUPLED_TOL)
+        mats[b] = tuple(X.astype(complex) for X in real) + (split,)
+    *B, split = mats[b]
     nd = red.dyn.size
     for again in (False, True):
-        s1, y, ok = _inverse_iteration(*B, s0, y0)
+        s1, y, ok = _inverse_iteration(*B, s0, y0, split=split)
         if not ok:
             return None
         if fold and abs(s1.imag) <= 1e-12 * max(abs(s1), 1.0):
@@ -1366,53 +1381,6 @@ PAIR_COMPILED_MAX = 48
 
 
 @njit(cache=True)
-def _lu_small(A):
-    """LU with partial pivoting of ``A`` (n, n) complex in place (``L`` unit lower below the
-    diagonal, ``U`` on and above): ``(piv, ok)``, ``ok`` False at a zero pivot (where
-    LAPACK's ``zgetrf`` reports a singular ``U``)."""
-    n = A.shape[0]
-    piv = np.arange(n)
-    for col in range(n):
-        p = col
-        for r in range(col + 1, n):
-            if abs(A[r, col]) > abs(A[p, col]):
-                p = r
-        if A[p, col] == 0:
-            return piv, False
-        if p != col:
-            for j in range(n):
-                A[col, j], A[p, j] = A[p, j], A[col, j]
-            piv[col], piv[p] = piv[p], piv[col]
-        d = A[col, col]
-        for r in range(col + 1, n):
-            f = A[r, col] / d
-            A[r, col] = f
-            for j in range(col + 1, n):
-                A[r, j] -= f * A[col, j]
-    return piv, True
-
-
-@njit(cache=True)
-def _lu_solve_small(A, piv, b):
-    """``x`` with ``A0 x = b`` from the LU of ``A0`` by :func:`_lu_small`."""
-    n = A.shape[0]
-    x = np.empty(n, dtype=np.complex128)
-    for i in range(n):
-        x[i] = b[piv[i]]
-    for i in range(n):
-        acc = x[i]
-        for j in range(i):
-            acc -= A[i, j] * x[j]
-        x[i] = acc
-    for i in range(n - 1, -1, -1):
-        acc = x[i]
-        for j in range(i + 1, n):
-            acc -= A[i, j] * x[j]
-        x[i] = acc / A[i, i]
-    return x
-
-
-@njit(cache=True)
 def _unit(y):
     """``y / |y|`` (2-norm)."""
     nrm = 0.0
@@ -1468,39 +1436,58 @@ def _residuals(T, y, mu):
 
 
 @njit(cache=True)
-def _ruhe(B0, B1, B2, sigma, y, max_iter, lapack):
+def _ruhe(B0, B1, B2, sigma, y, max_iter, lapack, split):
     """:func:`_inverse_iteration` compiled (the same steps): ``(sigma, y, converged)``. Each
-    step solves with ``P(sigma)`` by :func:`_lu_small` (one LU a step; not converged at a
-    zero pivot) or, with ``lapack`` (larger blocks), by LAPACK's ``zgesv``
-    (``np.linalg.solve``: one LU a solve, two at the first step; raises ``LinAlgError`` at a
-    singular ``P(s)``)."""
+    step solves with ``P(sigma)`` by the harmonic split (:func:`~fretwear.hb.hill_tracking.
+    _split_factor`: the LU of the core's Schur complement, where ``split`` has local
+    unknowns or a core; a step whose split refuses is solved as without one), by
+    :func:`_lu_small` (one LU a step; not converged at a zero pivot) or, with ``lapack``
+    (larger blocks), by LAPACK's ``zgesv`` (``np.linalg.solve``: one LU a solve, two at the
+    first step; raises ``LinAlgError`` at a singular ``P(s)``)."""
     n = B0.shape[0]
     x = _unit(y)
     first = True
     A = np.empty((n, n), dtype=np.complex128)
     r = np.empty(n, dtype=np.complex128)
     piv = np.arange(n)
+    use = split[0].size + split[2].size > 0
+    work = split_work(split, n)
     for _ in range(max_iter):
         _pencil_into(B0, B1, B2, sigma, A)
-        if not lapack:
+        how = 1 if lapack else 0
+        while use:  # a group near singular at sigma joins the core (kept for the next steps)
+            piv, bad = _split_factor(A, split, work)
+            if bad == -1:
+                how = 2
+                break
+            if bad == -2 or 2 * split[2].size > n:
+                use = False
+                break
+            split = _demote(split, bad)
+            work = split_work(split, n)
+        if how == 0:
             piv, ok = _lu_small(A)
             if not ok:
                 return sigma, x, False
         if first:  # towards the eigenvector of the eigenvalue nearest sigma
-            x = _unit(_solve_pencil(A, piv, x, lapack))
+            x = _unit(_solve_pencil(A, piv, x, how, split, work))
             first = False
         _slope_into(B1, B2, sigma, x, r)
-        sigma, x, state = _ruhe_update(sigma, x, _solve_pencil(A, piv, r, lapack))
+        sigma, x, state = _ruhe_update(sigma, x, _solve_pencil(A, piv, r, how, split, work))
         if state != 0:
             return sigma, x, state > 0
     return sigma, x, False
 
 
 @njit(cache=True)
-def _solve_pencil(A, piv, b, lapack):
-    """``A^-1 b``: by LAPACK (``lapack``) or from ``A``'s LU in place (:func:`_lu_small`)."""
-    if lapack:
+def _solve_pencil(A, piv, b, how, split, work):
+    """``A^-1 b``: from ``A``'s LU in place (``how`` 0, :func:`_lu_small`), by LAPACK (1),
+    or by the harmonic split's factors (2, :func:`~fretwear.hb.hill_tracking._split_solve`;
+    ``A`` unchanged)."""
+    if how == 1:
         return np.linalg.solve(A, b)
+    if how == 2:
+        return _split_solve(A, split, work, piv, b)
     return _lu_solve_small(A, piv, b)
 
 
