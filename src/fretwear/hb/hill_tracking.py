@@ -303,3 +303,41 @@ def _split_solve(A, split, work, piv, b):
                 acc -= W[a + i, u - ca] * xc[cpos[u]]
             x[loc[a + i]] = acc
     return x
+
+
+@njit(cache=True)
+def shift_block(y, idx, H, k, side):
+    """The vector ``y`` on the pencil's unknowns ``idx`` (DOF-major: ``coordinate H + c``,
+    coefficient ``c`` of ``[a0, a_1..a_k, b_1..b_k]``) with each coordinate's
+    complex-exponential coefficient ``n`` taken from ``n + side`` (``p e^{-i side w t}``, the
+    copy of an eigenvector at ``s + i side``; :func:`fretwear.hb.stability._shifted_copy`),
+    on the same unknowns (zero where the source lies outside them or the kept harmonics).
+    The shift acts on each coordinate alone, so the unknowns outside ``idx`` do not enter."""
+    r = 0
+    for i in range(idx.size):
+        r = max(r, idx[i] // H + 1)
+    p = np.zeros((r, H), dtype=np.complex128)
+    for i in range(idx.size):
+        p[idx[i] // H, idx[i] % H] = y[i]
+    c = np.zeros(2 * k + 1, dtype=np.complex128)  # orders -k..k
+    out = np.zeros(2 * k + 1, dtype=np.complex128)
+    q = np.zeros((r, H), dtype=np.complex128)
+    for j in range(r):
+        c[k] = p[j, 0]
+        for n in range(k):
+            a, b = p[j, 1 + n], p[j, 1 + k + n]
+            c[k + 1 + n] = (a - 1j * b) / 2.0
+            c[k - 1 - n] = (a + 1j * b) / 2.0
+        out[:] = 0.0
+        if side > 0:
+            out[:-1] = c[1:]
+        else:
+            out[1:] = c[:-1]
+        q[j, 0] = out[k]
+        for n in range(k):
+            q[j, 1 + n] = out[k + 1 + n] + out[k - 1 - n]
+            q[j, 1 + k + n] = 1j * (out[k + 1 + n] - out[k - 1 - n])
+    v = np.empty(idx.size, dtype=np.complex128)
+    for i in range(idx.size):
+        v[i] = q[idx[i] // H, idx[i] % H]
+    return v

@@ -126,6 +126,7 @@ from fretwear.hb.hill_tracking import (
     _split_solve,
     harmonic_split,
     no_split,
+    shift_block,
     split_work,
 )
 from fretwear.hb.problem import DLFTProblem
@@ -1175,27 +1176,12 @@ def _shifted_copy(red: QuadraticReduction, b: int, y: np.ndarray, shape: tuple,
     ``s + i side`` (``p e^{-i side w t}``: complex-exponential coefficient ``n`` from
     ``n + side``, harmonic orders as their index among the kept harmonics, as
     :func:`centroid` takes them): the copy's eigenvector up to the truncation, the start of
-    the inverse iteration that finds the copy (:func:`track_eigen`)."""
+    the inverse iteration that finds the copy (:func:`track_eigen`). Compiled, on the block's
+    coordinates only (:func:`~fretwear.hb.hill_tracking.shift_block`: the shift acts on each
+    coordinate alone; the same vector as shifting the whole eigenvector and restricting)."""
     r, H, k = shape
-    comp = red.blocks[b]
-    Yj = np.zeros((red.dyn.size, 1), dtype=complex)
-    Yj[comp, 0] = y
-    p = red.full(Yj)[:, 0].reshape(r, H)
-    a, bb = p[:, 1:1 + k], p[:, 1 + k:]
-    c = np.zeros((r, 2 * k + 1), dtype=complex)  # orders -k..k
-    c[:, k] = p[:, 0]
-    c[:, k + 1:] = (a - 1j * bb) / 2.0
-    c[:, :k] = ((a + 1j * bb) / 2.0)[:, ::-1]
-    out = np.zeros_like(c)
-    if side > 0:
-        out[:, :-1] = c[:, 1:]
-    else:
-        out[:, 1:] = c[:, :-1]
-    q = np.empty_like(p)
-    q[:, 0] = out[:, k]
-    q[:, 1:1 + k] = out[:, k + 1:] + out[:, :k][:, ::-1]
-    q[:, 1 + k:] = 1j * (out[:, k + 1:] - out[:, :k][:, ::-1])
-    v = q.reshape(-1)[red.dyn][comp]
+    idx = np.ascontiguousarray(red.dyn[red.blocks[b]], dtype=np.int64)
+    v = shift_block(np.ascontiguousarray(y, dtype=complex), idx, H, k, side)
     nrm = np.linalg.norm(v)
     return v / nrm if nrm > 0 else y
 
@@ -1216,9 +1202,9 @@ def _member(red: QuadraticReduction, b: int, s0: complex, y0: np.ndarray, shape:
         real = tuple(np.ascontiguousarray(X[ix]) for X in (red.B0, red.B1, red.B2))
         c = red.dyn[comp] % H  # coefficient index: 0, a_1..a_k, b_1..b_k
         split = harmonic_split(*real, np.where(c > k, c - k, c), DECOUPLED_TOL)
-        mats[b] = tuple(X.astype(complex) for X in real) + (split,)
-    *B, split = mats[b]
-    nd = red.dyn.size
+        back = None if red.back is None else np.ascontiguousarray(red.back[:, comp])
+        mats[b] = tuple(X.astype(complex) for X in real) + (split, red.dyn[comp], back)
+    *B, split, at, back = mats[b]
     for again in (False, True):
         s1, y, ok = _inverse_iteration(*B, s0, y0, split=split)
         if not ok:
@@ -1227,9 +1213,11 @@ def _member(red: QuadraticReduction, b: int, s0: complex, y0: np.ndarray, shape:
             s1 = complex(s1.real, 0.0)
         if fold and s1.imag < 0:  # the conjugate pair's other member
             s1, y = s1.conjugate(), y.conj()
-        Yj = np.zeros((nd, 1), dtype=complex)
-        Yj[comp, 0] = y
-        kp = centroid(red.full(Yj).T.reshape(r, H), k)
+        p = np.zeros(red.n, dtype=complex)  # red.full of y on block b, with fewer calls
+        p[at] = y
+        if back is not None:
+            p[red.alg] = back @ y
+        kp = float(_centroids(p.reshape(1, r, H), k)[0])
         if again or not fold or abs(kp) <= 0.5:
             return s1, y, kp
         s0, y0 = s1 + 1j * round(kp), y  # the centre moved to the next copy
