@@ -790,24 +790,42 @@ def _pencil(K, M, C, D, G, eps, nw, w):
                 X[0, a, ca], X[0, a, cb], X[0, b, ca], X[0, b, cb] = re0, im0, -im0, re0
                 X[1, a, ca], X[1, a, cb], X[1, b, ca], X[1, b, cb] = re1, im1, -im1, re1
                 X[2, a, ca], X[2, b, cb] = re2, re2
+    lo = np.empty(n, dtype=np.int64)  # per column, its coefficient's harmonic pair
+    hi = np.empty(n, dtype=np.int64)
+    for col in range(n):
+        c = col % H
+        if c == 0:
+            lo[col], hi[col] = 0, 0
+        elif c <= k:
+            lo[col], hi[col] = c, c + k
+        else:
+            lo[col], hi[col] = c - k, c
+    zl = np.zeros((d, n))  # per column, the two entries of Z's rows of x it meets (gathered
+    zh = np.zeros((d, n))  # once: the rows' scattered reads cost most of the product)
     for pw in range(3):
         for p in range(nc):
+            cols = np.zeros(n, dtype=np.int64)  # the columns these rows meet (the others'
+            nz = 0  # products are zeros: A keeps its)
+            for col in range(n):
+                hit = False
+                for jj in range(d):
+                    base = (p * d + jj) * H
+                    zl[jj, col] = Z[pw, base + lo[col], col]
+                    zh[jj, col] = Z[pw, base + hi[col], col]
+                    hit = hit or zl[jj, col] != 0 or zh[jj, col] != 0
+                if hit:
+                    cols[nz] = col
+                    nz += 1
             for i in range(dH):
                 row = p * dH + i
-                for col in range(n):
-                    c = col % H  # the column's coefficient, and its harmonic's pair
-                    if c == 0:
-                        lo, hi = 0, 0
-                    elif c <= k:
-                        lo, hi = c, c + k
-                    else:
-                        lo, hi = c - k, c
+                for t in range(nz):
+                    col = cols[t]
+                    a, b = lo[col], hi[col]
                     acc = 0.0
                     for jj in range(d):
-                        base = (p * d + jj) * H
-                        acc += G[p, i, jj * H + lo] * Z[pw, base + lo, col]
-                        if hi != lo:
-                            acc += G[p, i, jj * H + hi] * Z[pw, base + hi, col]
+                        acc += G[p, i, jj * H + a] * zl[jj, col]
+                        if b != a:
+                            acc += G[p, i, jj * H + b] * zh[jj, col]
                     A[pw, row, col] = acc
     for p in range(nc):
         for i in range(dH):
