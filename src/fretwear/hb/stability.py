@@ -119,9 +119,9 @@ from fretwear.hb.contact import SEPARATION, STICK, _slip_gain
 from fretwear.hb.dynamics import StructureDynamics, structure_dynamics
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.hill_tracking import (
+    _demote,
     _lu_small,
     _lu_solve_small,
-    _demote,
     _split_factor,
     _split_solve,
     harmonic_split,
