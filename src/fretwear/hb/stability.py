@@ -87,7 +87,9 @@ where coordinates whose law does not vary over the period split off, harmonic by
 with a memory, a few evaluations of ``T(s)`` and ``m H`` LU factorisations per refined
 exponent (3-5 from a neighbour's exponent, 4-9 from a candidate); along a sweep, where the
 candidates are tracked, a few LU factorisations of the blocks of the quadratic problem per
-candidate instead of its dense eigensolve. ``det J`` is read from the solve's own ``G`` and
+candidate instead of its dense eigensolve (each solved by the LU of the Schur complement
+on the unknowns that couple harmonics, the others eliminated harmonic by harmonic:
+:mod:`fretwear.hb.hill_tracking`). ``det J`` is read from the solve's own ``G`` and
 ``Z~`` (:meth:`HillProblem.jacobian`). Measured on the benchmark's small models
 (docs/studies/method-costs.md, "Hill's method"): about 1.5-2 times the CPU a sweep spends
 on the point (median), along a sweep, which hands each point's own problem
@@ -1039,10 +1041,13 @@ def _inverse_iteration(B0, B1, B2, sigma: complex, y: np.ndarray, max_iter: int 
     quadratically convergent to a simple eigenvalue), one LU of ``P(s)`` a step. Returns
     ``(sigma, y, converged)``; converged when the step is below 1e-14 of ``max(1, |sigma|)``
     (the rounding of the dense eigensolver's eigenvalue, whose backward error is of the same
-    order). Compiled: up to :data:`PAIR_COMPILED_MAX` unknowns with its own LU
-    (:func:`_ruhe`), beyond with LAPACK's solve called from the kernel
-    (:func:`_ruhe` with ``lapack``: 0.40 against 0.63 ms for the steps called from Python on the
-    two-DOF oscillator's block of 62 unknowns); the steps from Python
+    order). Compiled: with ``split`` (:func:`~fretwear.hb.hill_tracking.harmonic_split` of
+    the block: unknowns that couple only their own harmonic), each step by the LU of the
+    core's Schur complement (:func:`_ruhe`: 31 instead of 62 unknowns on the two-DOF
+    oscillator's block, 0.18 against 0.38 ms a call there); otherwise up to
+    :data:`PAIR_COMPILED_MAX` unknowns with its own LU, beyond with LAPACK's solve called
+    from the kernel (:func:`_ruhe` with ``lapack``: 0.40 against 0.63 ms for the steps
+    called from Python on that block); the steps from Python
     (:func:`_inverse_iteration_py`) where that solve meets a singular ``P(s)``."""
     B0, B1, B2 = (np.ascontiguousarray(b, dtype=complex) for b in (B0, B1, B2))
     y = np.ascontiguousarray(y, dtype=complex)
