@@ -91,8 +91,9 @@ candidate instead of its dense eigensolve (each solved by the LU of the Schur co
 on the unknowns that couple harmonics, the others eliminated harmonic by harmonic:
 :mod:`fretwear.hb.hill_tracking`). ``det J`` is read from the solve's own ``G`` and
 ``Z~`` (:meth:`HillProblem.jacobian`). Measured on the benchmark's small models
-(docs/studies/method-costs.md, "Hill's method"): about 1.5-2 times the CPU a sweep spends
-on the point (median), along a sweep, which hands each point's own problem
+(docs/studies/method-costs.md, "Hill's method"): about 1.2-2 times the CPU a sweep spends
+on the point (median; a tracked point of the two-DOF oscillator about 4 ms), along a
+sweep, which hands each point's own problem
 (:func:`fretwear.hb.sweep_stability.point_problem`; :func:`stability` rebuilds it from the
 solution, about 1.1-1.5 ms more there); the evaluations of ``T(s)`` (a law with a memory),
 the inverse iterations of the tracked candidates and the dense eigensolve at the points that
