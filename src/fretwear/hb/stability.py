@@ -1042,8 +1042,10 @@ def _inverse_iteration(B0, B1, B2, sigma: complex, y: np.ndarray, max_iter: int 
     quadratically convergent to a simple eigenvalue), one LU of ``P(s)`` a step. Returns
     ``(sigma, y, converged)``; converged when the step is below 1e-14 of ``max(1, |sigma|)``
     (the rounding of the dense eigensolver's eigenvalue, whose backward error is of the same
-    order). Compiled: with ``split`` (:func:`~fretwear.hb.hill_tracking.harmonic_split` of
-    the block: unknowns that couple only their own harmonic), each step by the LU of the
+    order), or when the quadratic convergence predicts the next step below 1e-15 of it
+    (:func:`_settled`: the step that would only confirm it is not taken). Compiled: with
+    ``split`` (:func:`~fretwear.hb.hill_tracking.harmonic_split` of the block: unknowns
+    that couple only their own harmonic), each step by the LU of the
     core's Schur complement (:func:`_ruhe`: 31 instead of 62 unknowns on the two-DOF
     oscillator's block, 0.18 against 0.38 ms a call there); otherwise up to
     :data:`PAIR_COMPILED_MAX` unknowns with its own LU, beyond with LAPACK's solve called
@@ -1066,6 +1068,7 @@ def _inverse_iteration_py(B0, B1, B2, sigma: complex, y: np.ndarray, max_iter: i
     (not converged at a zero pivot)."""
     x = y / np.linalg.norm(y)
     first = True
+    last = np.inf
     for _ in range(max_iter):
         P = sigma * B1  # B0 + sigma B1 + sigma^2 B2, the same sums without temporaries
         P += B0
@@ -1084,8 +1087,9 @@ def _inverse_iteration_py(B0, B1, B2, sigma: complex, y: np.ndarray, max_iter: i
         step = 1.0 / den
         sigma = complex(sigma - step)
         x = u / np.linalg.norm(u)
-        if abs(step) <= 1e-14 * max(1.0, abs(sigma)):
+        if _settled(abs(step), last, max(1.0, abs(sigma))):
             return sigma, x, True
+        last = abs(step)
     return sigma, x, False
 
 
@@ -1464,6 +1468,7 @@ def _ruhe(B0, B1, B2, sigma, y, max_iter, lapack, split):
     piv = np.arange(n)
     use = split[0].size + split[2].size > 0
     work = split_work(split, n)
+    last = np.inf
     for _ in range(max_iter):
         _pencil_into(B0, B1, B2, sigma, A)
         how = 1 if lapack else 0
@@ -1485,7 +1490,8 @@ def _ruhe(B0, B1, B2, sigma, y, max_iter, lapack, split):
             x = _unit(_solve_pencil(A, piv, x, how, split, work))
             first = False
         _slope_into(B1, B2, sigma, x, r)
-        sigma, x, state = _ruhe_update(sigma, x, _solve_pencil(A, piv, r, how, split, work))
+        sigma, x, state, last = _ruhe_update(sigma, x, _solve_pencil(A, piv, r, how, split,
+                                                                      work), last)
         if state != 0:
             return sigma, x, state > 0
     return sigma, x, False
@@ -1526,22 +1532,39 @@ def _slope_into(B1, B2, sigma, x, r):
 
 
 @njit(cache=True)
-def _ruhe_update(sigma, x, u):
+def _ruhe_update(sigma, x, u, last):
     """Ruhe's step from ``u = P(sigma)^-1 P'(sigma) x``: ``sigma - 1 / (x^H u)`` and the
-    normalised ``u``, with ``state`` 1 (the step below 1e-14 of ``max(1, |sigma|)``:
-    converged), -1 (``x^H u`` zero or not finite: failed, ``sigma`` and ``x`` unchanged) or 0
-    (go on)."""
+    normalised ``u``, with ``state`` 1 (converged, :func:`_settled`; ``last`` the previous
+    step's size), -1 (``x^H u`` zero or not finite: failed, ``sigma`` and ``x`` unchanged) or
+    0 (go on), and this step's size."""
     den = 0j
     for i in range(x.shape[0]):
         den += np.conj(x[i]) * u[i]
     if not np.isfinite(den.real) or not np.isfinite(den.imag) or den == 0:
-        return sigma, x, -1
+        return sigma, x, -1, last
     step = 1.0 / den
     sigma = sigma - step
     x = _unit(u)
-    if abs(step) <= 1e-14 * max(1.0, abs(sigma)):
-        return sigma, x, 1
-    return sigma, x, 0
+    if _settled(abs(step), last, max(1.0, abs(sigma))):
+        return sigma, x, 1, abs(step)
+    return sigma, x, 0, abs(step)
+
+
+@njit(cache=True)
+def _settled(size, last, scale):
+    """Whether Ruhe's iteration has converged after a step of ``size`` (``last`` the one
+    before, ``scale = max(1, |sigma|)``): the step below 1e-14 of ``scale``, or below 1e-7
+    of it and the next one predicted below 1e-15 of it. Near a simple eigenvalue the error
+    after a step is ``C size^2`` (quadratic convergence), ``C`` estimated by
+    ``size / last^2``; the prediction is trusted where the step contracted by 1e3 at least
+    (the quadratic regime), and then the step that would confirm it (one LU) is not taken:
+    the eigenvalue is within the prediction of the one that step would give, and the vector,
+    from a solve at ``sigma`` already ``size`` from the eigenvalue, as accurate."""
+    if size <= 1e-14 * scale:
+        return True
+    if size > 1e-7 * scale or size > 1e-3 * last:
+        return False
+    return size * size * (size / (last * last)) <= 1e-15 * scale
 
 
 def _pair(T: np.ndarray, v: np.ndarray, mu0: complex, steps: int = 2):
