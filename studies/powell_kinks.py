@@ -14,7 +14,11 @@ regime (stick / slip / separation at some sample) between the iterate and the tr
 (``monotone``: without the watchdog stretches of fretwear.hb.solvers.powell, as before them;
 ``memory=M``: their reference the largest ``|f|`` of the last M iterates; ``norms=first``:
 the variable scales of the first Jacobian only; ``unclipped``: without the stretches after
-crawling dog-leg steps, ``WATCHDOG_CLIPPED``.)
+crawling dog-leg steps, ``WATCHDOG_CLIPPED``; a sixth argument and on: ``nolocal`` without
+the local phase of fretwear.hb.kinks, ``single`` with single-precision GMRES products;
+``KINKS_ROOT=<file>`` prints the distance to a root saved before.) With
+``KINKS_SAVE=<folder>`` every iterate is saved there as ``xNNN.npy`` (N the Powell
+iteration), for the local methods of ``studies/kinks_local.py``.
 """
 
 from __future__ import annotations
@@ -110,8 +114,12 @@ def main():
     trace = []
     print(" it        |f|     delta   pred/|f|^2 act/|f|^2   ratio  N  gm    lin   acc chg")
 
+    save = os.environ.get("KINKS_SAVE")  # a folder: each iterate saved there
+
     def line(it, x, fn):
         t, ch = trace[-1], changed[-1]
+        if save:
+            np.save(os.path.join(save, f"x{t['it']:03d}.npy"), x)
         print(f"{t['it']:3d} {t['f']:10.4e} {t['delta']:9.3e} {t['pred'] / t['f'] ** 2:10.3e} "
               f"{t['actual'] / t['f'] ** 2:10.3e} {t['ratio']:7.3f} "
               f"{'N' if t['newton'] else 'd'} {t['gmres']:3d} {t['lin']:8.2e} "
@@ -120,8 +128,19 @@ def main():
               flush=True)
 
     c0, w0 = time.process_time(), time.perf_counter()
+    from fretwear.hb.kinks import local_phase
+
+    local = None if "nolocal" in sys.argv[6:] else local_phase(prob)
+    if "single" in sys.argv[6:]:  # single-precision GMRES products
+        from fretwear.hb.options import KrylovOptions
+
+        prob.krylov = KrylovOptions(single_products=True)
     x, f, st = powell(fun, x0, lambda x: prob.scale(x.reshape(prob.m, prob.H)),
-                      tol=PERIODIC.tol, max_iter=max_iter, trace=trace, callback=line)
+                      tol=PERIODIC.tol, max_iter=max_iter, trace=trace, callback=line,
+                      local=local)
+    if os.environ.get("KINKS_ROOT"):  # the distance to a root saved before
+        root = np.load(os.environ["KINKS_ROOT"])
+        print(f"|x - root| {np.linalg.norm(x - root):.3e} (|root| {np.linalg.norm(root):.3e})")
     cpu, wall = time.process_time() - c0, time.perf_counter() - w0
     newton = sum(t["new_step"] for t in trace)
     gm = sum(t["gmres"] for t in trace)

@@ -10,6 +10,8 @@ beam), the march to its plateau is the reference.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from helpers.wear_runs import reduced_example
@@ -21,7 +23,7 @@ from fretwear.wear import WearOptions, simulate_wear
 from fretwear.wear.schemes import first_state
 from fretwear.wear.simulate import BalanceSetup, slow_setup
 from fretwear.wear.stick_set import separation, stick_set_state
-from fretwear.wear.worn_state import PROGRESS, WornStateOptions, agreement, worn_state
+from fretwear.wear.worn_state import WornStateOptions, agreement, worn_state
 
 
 def _unworn():
@@ -71,9 +73,13 @@ def test_worn_state_with_the_jump_is_the_analytic_state_for_fewer_solves():
 
 
 def test_stick_set_option_is_checked():
-    """A stick_set that is not a boolean: one InputError naming it."""
+    """A stick_set that is not a boolean, a jump threshold outside (0, 1]: one InputError
+    naming it."""
     with pytest.raises(InputError, match="stick_set = 'yes'"):
         WornStateOptions(stick_set="yes")
+    for name, bad in (("jump_rate", 0.0), ("jump_progress", 1.5), ("jump_rate", float("nan"))):
+        with pytest.raises(InputError, match=name):
+            WornStateOptions(stick_set=True, **{name: bad})
 
 
 def test_agreeing_early_jumps_that_land_elsewhere_are_refused(tmp_path):
@@ -82,8 +88,8 @@ def test_agreeing_early_jumps_that_land_elsewhere_are_refused(tmp_path):
     first two records of the direct path agree with each other (within ``depth_tolerance``;
     measured 1e-12) but land on another null-wear-rate state, more than half the deepest
     wear from the march's (measured 103 %), so agreement alone would end the run there.
-    The path's step between them covers under a tenth of :data:`PROGRESS` of the way to the
-    jump (measured 0.09 %), and the run with ``stick_set = True`` goes on along the path and
+    The path's step between them covers under a tenth of ``jump_progress`` (0.25) of the way
+    to the jump (measured 0.09 %), and the run with ``stick_set = True`` goes on along the path and
     ends on the march's state, by a jump, within 1 % of the deepest wear (issue 29's
     tolerance; measured 4e-9)."""
     model, basis = reduced_example("stromberg1997", 30, tmp_path)
@@ -105,7 +111,7 @@ def test_agreeing_early_jumps_that_land_elsewhere_are_refused(tmp_path):
         jumps.append(jump.W)
     c, progress = agreement(path.wear_depth[1], path.wear_depth[2], *jumps)
     assert c <= WornStateOptions().depth_tolerance
-    assert progress < 0.1 * PROGRESS
+    assert progress < 0.1 * WornStateOptions().jump_progress
     fast = worn_state(model, basis, quasi_static=True, options=WornStateOptions(stick_set=True))
     assert fast.success and "stick-set jump" in fast.message, fast.message
     assert np.max(np.abs(fast.wear - Wm)) <= 0.01 * top
@@ -132,6 +138,12 @@ def test_a_resumed_run_takes_the_jump_of_the_run_never_stopped(tmp_path):
     with pytest.raises(KeyboardInterrupt):
         worn_state(model, BASIS, quasi_static=True, options=options,
                    run=RunControl(checkpoint=ck, callback=stop))
+    # the jump rule's thresholds decide where the run ends: a resume with another one is
+    # refused (they were module constants outside the checkpoint's fingerprint before)
+    for other in (replace(options, jump_progress=0.5), replace(options, jump_rate=0.2)):
+        with pytest.raises(InputError, match="different wear settings"):
+            worn_state(model, BASIS, quasi_static=True, options=other,
+                       run=RunControl(checkpoint=ck, resume=True))
     res = worn_state(model, BASIS, quasi_static=True, options=options,
                      run=RunControl(checkpoint=ck, resume=True))
     assert res.resumed_from == last_path_step

@@ -10,6 +10,7 @@ import time
 
 import numpy as np
 
+from fretwear.hb.kinks import local_phase
 from fretwear.hb.options import SolveOptions
 from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.solvers import solve
@@ -19,7 +20,8 @@ def run(prob: DLFTProblem, x0, options: SolveOptions, max_slow: int | None = Non
     """One run of ``options.solver`` on ``prob`` from ``x0`` (m, H) to ``options.tol`` in at
     most ``options.max_iter`` iterations: ``(x (m, H), stats)`` (converged or the last
     iterate; ``stats.wall_time`` the whole run's). ``max_slow``: the solver's progress test
-    (:func:`fretwear.hb.solvers.solve`; None: none)."""
+    (:func:`fretwear.hb.solvers.solve`; None: none). Powell's local phase where its steps
+    crawl: :func:`fretwear.hb.kinks.local_phase`."""
 
     def fun(x, jac=True):
         return prob.residual(x.reshape(prob.m, prob.H), jac)
@@ -27,6 +29,7 @@ def run(prob: DLFTProblem, x0, options: SolveOptions, max_slow: int | None = Non
     t0 = time.perf_counter()
     x, _, st = solve(fun, np.asarray(x0, float).reshape(-1),
                      lambda x: prob.scale(x.reshape(prob.m, prob.H)), method=options.solver,
-                     tol=options.tol, max_iter=options.max_iter, max_slow=max_slow)
+                     tol=options.tol, max_iter=options.max_iter, max_slow=max_slow,
+                     local=local_phase(prob))
     st.wall_time = time.perf_counter() - t0
     return x.reshape(prob.m, prob.H), st

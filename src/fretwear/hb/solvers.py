@@ -10,7 +10,8 @@ callers never turn it into a result.
   at every accepted step. MINPACK factorises with its own unblocked QR, which dominates the cost
   at ~1000 unknowns; this keeps the algorithm at LAPACK speed. Where the Newton step keeps
   crossing the contact law's kinks, watchdog stretches of nonmonotone Newton steps
-  (:data:`WATCHDOG_AFTER`).
+  (:data:`WATCHDOG_AFTER`); where its dog-leg steps crawl, a local phase the caller gives
+  (``local``: :func:`fretwear.hb.kinks.local_phase` for the DLFT balance).
 * ``"hybr"``: MINPACK ``hybrj`` itself through :func:`scipy.optimize.root` (what the paper used).
 * ``"newton"``: Newton with a backtracking line search on ``|f|^2``.
 """
@@ -290,7 +291,7 @@ class _Checkpoint:
 
 
 def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=None,
-           trace=None):
+           trace=None, local=None):
     """Powell's hybrid dog-leg trust region on ``f(x) = 0`` with analytic Jacobian.
 
     As MINPACK ``hybrj``: the variables are scaled by the running maximum of the Jacobian's
@@ -312,6 +313,13 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
     fit and that did not halve ``|f|`` (kept with the radius widened to it if it decreases
     ``|f|``; else up to :data:`WATCHDOG_CLIPPED_STEPS` Newton steps from it, each halving
     ``|f|``).
+    ``local``: a local phase for that crawl, ``local(x, f, target) -> x'`` (``target`` the
+    convergence test's ``|f|``; for the DLFT balance
+    :func:`fretwear.hb.kinks.local_phase`, nonlinear elimination of the nodes that hold the
+    residual): where the full Newton step would be forced it is called first, and a point
+    it returns with a smaller ``|f|`` is taken as the iterate (its full Newton step tried
+    next, the trust radius set to it as at the start); else the forced step as before.
+    Its own evaluations are not counted in ``nfev``, ``njev``.
     ``max_slow``: stop (unconverged) after that many iterations on a new Jacobian
     in a row without one that decreased ``|f|^2`` by :data:`SLOW_DECREASE` (MINPACK's "not
     making good progress" test, ``info = 4`` of ``hybrj`` with 5); None: no such test.
@@ -375,6 +383,26 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
             # tried (a stretch); else the next ones are judged from here
             forced = (WATCHDOG_FORMED or not exact) and fn > WATCHDOG_CLIPPED_PROGRESS * clip_ref
             clipped, clip_ref = 0, fn
+            if forced and local is not None:  # the local phase first
+                xl = np.array(local(x, f, target), dtype=float)
+                fl, Jl = fun(xl, True)
+                nfev += 1
+                njev += 1
+                fnl = vector_norm(fl)
+                if fnl < fn:  # its point the iterate, its full Newton step tried next
+                    if trace is not None:
+                        trace.append({"it": it, "f": fn, "f_trial": fnl, "delta": delta,
+                                      "pred": 0.0, "actual": fn * fn - fnl * fnl,
+                                      "ratio": 1.0, "newton": False, "lin": 1.0,
+                                      "new_step": False, "gmres": 0, "accepted": True,
+                                      "watchdog": False, "forced": False, "local": True})
+                    x, f, fn, J = xl, fl, fnl, Jl
+                    dscale = np.maximum(dscale, _column_norms(J))
+                    eta, sn, delta, stall, clip_ref = FORCING_MAX, None, None, 0, fn
+                    kept.append(fn)
+                    if callback is not None:
+                        callback(it, x, fn)
+                    continue
         if snd <= delta or watch is not None or forced:  # (a watchdog stretch: Newton steps)
             s = sn
             if not forced:
@@ -564,12 +592,15 @@ def hybr(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None):
 
 
 def solve(fun, x0, scale, *, method="powell", tol=1e-8, max_iter=200, callback=None,
-          max_slow=None):
+          max_slow=None, local=None):
     """Dispatch to one of :data:`SOLVERS`. ``max_slow``: the progress test of
-    :func:`powell` and :func:`newton` (``"hybr"`` has MINPACK's own)."""
+    :func:`powell` and :func:`newton` (``"hybr"`` has MINPACK's own); ``local``: the local
+    phase of :func:`powell` (the other methods have none)."""
     table = {"powell": powell, "newton": newton, "hybr": hybr}
     if method not in table:
         raise InputError(f"solver = {method!r}: expected one of {SOLVERS}")
     extra = {} if max_slow is None or method == "hybr" else {"max_slow": max_slow}
+    if local is not None and method == "powell":
+        extra["local"] = local
     return table[method](fun, x0, scale, tol=tol, max_iter=max_iter, callback=callback,
                          **extra)

@@ -90,10 +90,13 @@ once per solution into its part free of ``s`` and one outer product per stick in
 :mod:`fretwear.hb.memory_gain`, and a refinement from a neighbour's exponent is one compiled
 call, :func:`_refine`); along a sweep, where the
 candidates are tracked, a few LU factorisations of the blocks of the quadratic problem per
-candidate instead of its dense eigensolve. ``det J`` is read from the solve's own ``G`` and
+candidate instead of its dense eigensolve (each solved by the LU of the Schur complement
+on the unknowns that couple harmonics, the others eliminated harmonic by harmonic:
+:mod:`fretwear.hb.hill_tracking`). ``det J`` is read from the solve's own ``G`` and
 ``Z~`` (:meth:`HillProblem.jacobian`). Measured on the benchmark's small models
-(docs/studies/method-costs.md, "Hill's method"): about 1.5-2 times the CPU a sweep spends
-on the point (median), along a sweep, which hands each point's own problem
+(docs/studies/method-costs.md, "Hill's method"): about 1.2-2 times the CPU a sweep spends
+on the point (median; a tracked point of the two-DOF oscillator about 4 ms), along a
+sweep, which hands each point's own problem
 (:func:`fretwear.hb.sweep_stability.point_problem`; :func:`stability` rebuilds it from the
 solution, about 1.1-1.5 ms more there); the evaluations of ``T(s)`` (a law with a memory),
 the inverse iterations of the tracked candidates and the dense eigensolve at the points that
@@ -121,6 +124,17 @@ from fretwear.hb import contact as law
 from fretwear.hb.contact import SEPARATION, STICK, _slip_gain
 from fretwear.hb.dynamics import StructureDynamics, structure_dynamics
 from fretwear.hb.fourier import FourierBasis
+from fretwear.hb.hill_tracking import (
+    _demote,
+    _lu_small,
+    _lu_solve_small,
+    _split_factor,
+    _split_solve,
+    harmonic_split,
+    no_split,
+    shift_block,
+    split_work,
+)
 from fretwear.hb.memory_gain import _gain_at, memory_gain
 from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.reduce import condense
@@ -902,24 +916,42 @@ def _pencil(K, M, C, D, G, eps, nw, w):
                 X[0, a, ca], X[0, a, cb], X[0, b, ca], X[0, b, cb] = re0, im0, -im0, re0
                 X[1, a, ca], X[1, a, cb], X[1, b, ca], X[1, b, cb] = re1, im1, -im1, re1
                 X[2, a, ca], X[2, b, cb] = re2, re2
+    lo = np.empty(n, dtype=np.int64)  # per column, its coefficient's harmonic pair
+    hi = np.empty(n, dtype=np.int64)
+    for col in range(n):
+        c = col % H
+        if c == 0:
+            lo[col], hi[col] = 0, 0
+        elif c <= k:
+            lo[col], hi[col] = c, c + k
+        else:
+            lo[col], hi[col] = c - k, c
+    zl = np.zeros((d, n))  # per column, the two entries of Z's rows of x it meets (gathered
+    zh = np.zeros((d, n))  # once: the rows' scattered reads cost most of the product)
     for pw in range(3):
         for p in range(nc):
+            cols = np.zeros(n, dtype=np.int64)  # the columns these rows meet (the others'
+            nz = 0  # products are zeros: A keeps its)
+            for col in range(n):
+                hit = False
+                for jj in range(d):
+                    base = (p * d + jj) * H
+                    zl[jj, col] = Z[pw, base + lo[col], col]
+                    zh[jj, col] = Z[pw, base + hi[col], col]
+                    hit = hit or zl[jj, col] != 0 or zh[jj, col] != 0
+                if hit:
+                    cols[nz] = col
+                    nz += 1
             for i in range(dH):
                 row = p * dH + i
-                for col in range(n):
-                    c = col % H  # the column's coefficient, and its harmonic's pair
-                    if c == 0:
-                        lo, hi = 0, 0
-                    elif c <= k:
-                        lo, hi = c, c + k
-                    else:
-                        lo, hi = c - k, c
+                for t in range(nz):
+                    col = cols[t]
+                    a, b = lo[col], hi[col]
                     acc = 0.0
                     for jj in range(d):
-                        base = (p * d + jj) * H
-                        acc += G[p, i, jj * H + lo] * Z[pw, base + lo, col]
-                        if hi != lo:
-                            acc += G[p, i, jj * H + hi] * Z[pw, base + hi, col]
+                        acc += G[p, i, jj * H + a] * zl[jj, col]
+                        if b != a:
+                            acc += G[p, i, jj * H + b] * zh[jj, col]
                     A[pw, row, col] = acc
     for p in range(nc):
         for i in range(dH):
@@ -1124,7 +1156,8 @@ def dense_eigen(red: QuadraticReduction):
     return vals, red.full(Y)
 
 
-def _inverse_iteration(B0, B1, B2, sigma: complex, y: np.ndarray, max_iter: int = 10):
+def _inverse_iteration(B0, B1, B2, sigma: complex, y: np.ndarray, max_iter: int = 10,
+                       split: tuple | None = None):
     """The eigenpair of ``(B0 + s B1 + s^2 B2) y = 0`` nearest ``(sigma, y)``: one step of
     inverse iteration with ``P(sigma)`` (the start vector turned towards the eigenvector of
     the eigenvalue nearest ``sigma``), then the nonlinear inverse iteration (Ruhe, SIAM J.
@@ -1132,16 +1165,22 @@ def _inverse_iteration(B0, B1, B2, sigma: complex, y: np.ndarray, max_iter: int 
     quadratically convergent to a simple eigenvalue), one LU of ``P(s)`` a step. Returns
     ``(sigma, y, converged)``; converged when the step is below 1e-14 of ``max(1, |sigma|)``
     (the rounding of the dense eigensolver's eigenvalue, whose backward error is of the same
-    order). Compiled: up to :data:`PAIR_COMPILED_MAX` unknowns with its own LU
-    (:func:`_ruhe`), beyond with LAPACK's solve called from the kernel
-    (:func:`_ruhe` with ``lapack``: 0.40 against 0.63 ms for the steps called from Python on the
-    two-DOF oscillator's block of 62 unknowns); the steps from Python
+    order), or when the quadratic convergence predicts the next step below 1e-15 of it
+    (:func:`_settled`: the step that would only confirm it is not taken). Compiled: with
+    ``split`` (:func:`~fretwear.hb.hill_tracking.harmonic_split` of the block: unknowns
+    that couple only their own harmonic), each step by the LU of the
+    core's Schur complement (:func:`_ruhe`: 31 instead of 62 unknowns on the two-DOF
+    oscillator's block, 0.18 against 0.38 ms a call there); otherwise up to
+    :data:`PAIR_COMPILED_MAX` unknowns with its own LU, beyond with LAPACK's solve called
+    from the kernel (:func:`_ruhe` with ``lapack``: 0.40 against 0.63 ms for the steps
+    called from Python on that block); the steps from Python
     (:func:`_inverse_iteration_py`) where that solve meets a singular ``P(s)``."""
     B0, B1, B2 = (np.ascontiguousarray(b, dtype=complex) for b in (B0, B1, B2))
     y = np.ascontiguousarray(y, dtype=complex)
     lapack = B0.shape[0] > PAIR_COMPILED_MAX
+    split = no_split() if split is None else split
     try:
-        s1, x1, ok = _ruhe(B0, B1, B2, complex(sigma), y, max_iter, lapack)
+        s1, x1, ok = _ruhe(B0, B1, B2, complex(sigma), y, max_iter, lapack, split)
     except np.linalg.LinAlgError:  # LAPACK's solve at a singular P(s)
         return _inverse_iteration_py(B0, B1, B2, sigma, y, max_iter)
     return complex(s1), x1, bool(ok)
@@ -1152,6 +1191,7 @@ def _inverse_iteration_py(B0, B1, B2, sigma: complex, y: np.ndarray, max_iter: i
     (not converged at a zero pivot)."""
     x = y / np.linalg.norm(y)
     first = True
+    last = np.inf
     for _ in range(max_iter):
         P = sigma * B1  # B0 + sigma B1 + sigma^2 B2, the same sums without temporaries
         P += B0
@@ -1170,8 +1210,9 @@ def _inverse_iteration_py(B0, B1, B2, sigma: complex, y: np.ndarray, max_iter: i
         step = 1.0 / den
         sigma = complex(sigma - step)
         x = u / np.linalg.norm(u)
-        if abs(step) <= 1e-14 * max(1.0, abs(sigma)):
+        if _settled(abs(step), last, max(1.0, abs(sigma))):
             return sigma, x, True
+        last = abs(step)
     return sigma, x, False
 
 
@@ -1286,27 +1327,12 @@ def _shifted_copy(red: QuadraticReduction, b: int, y: np.ndarray, shape: tuple,
     ``s + i side`` (``p e^{-i side w t}``: complex-exponential coefficient ``n`` from
     ``n + side``, harmonic orders as their index among the kept harmonics, as
     :func:`centroid` takes them): the copy's eigenvector up to the truncation, the start of
-    the inverse iteration that finds the copy (:func:`track_eigen`)."""
+    the inverse iteration that finds the copy (:func:`track_eigen`). Compiled, on the block's
+    coordinates only (:func:`~fretwear.hb.hill_tracking.shift_block`: the shift acts on each
+    coordinate alone; the same vector as shifting the whole eigenvector and restricting)."""
     r, H, k = shape
-    comp = red.blocks[b]
-    Yj = np.zeros((red.dyn.size, 1), dtype=complex)
-    Yj[comp, 0] = y
-    p = red.full(Yj)[:, 0].reshape(r, H)
-    a, bb = p[:, 1:1 + k], p[:, 1 + k:]
-    c = np.zeros((r, 2 * k + 1), dtype=complex)  # orders -k..k
-    c[:, k] = p[:, 0]
-    c[:, k + 1:] = (a - 1j * bb) / 2.0
-    c[:, :k] = ((a + 1j * bb) / 2.0)[:, ::-1]
-    out = np.zeros_like(c)
-    if side > 0:
-        out[:, :-1] = c[:, 1:]
-    else:
-        out[:, 1:] = c[:, :-1]
-    q = np.empty_like(p)
-    q[:, 0] = out[:, k]
-    q[:, 1:1 + k] = out[:, k + 1:] + out[:, :k][:, ::-1]
-    q[:, 1 + k:] = 1j * (out[:, k + 1:] - out[:, :k][:, ::-1])
-    v = q.reshape(-1)[red.dyn][comp]
+    idx = np.ascontiguousarray(red.dyn[red.blocks[b]], dtype=np.int64)
+    v = shift_block(np.ascontiguousarray(y, dtype=complex), idx, H, k, side)
     nrm = np.linalg.norm(v)
     return v / nrm if nrm > 0 else y
 
@@ -1324,20 +1350,25 @@ def _member(red: QuadraticReduction, b: int, s0: complex, y0: np.ndarray, shape:
     comp = red.blocks[b]
     if b not in mats:
         ix = np.ix_(comp, comp)
-        mats[b] = tuple(np.asarray(X[ix], dtype=complex) for X in (red.B0, red.B1, red.B2))
-    B = mats[b]
-    nd = red.dyn.size
+        real = tuple(np.ascontiguousarray(X[ix]) for X in (red.B0, red.B1, red.B2))
+        c = red.dyn[comp] % H  # coefficient index: 0, a_1..a_k, b_1..b_k
+        split = harmonic_split(*real, np.where(c > k, c - k, c), DECOUPLED_TOL)
+        back = None if red.back is None else np.ascontiguousarray(red.back[:, comp])
+        mats[b] = tuple(X.astype(complex) for X in real) + (split, red.dyn[comp], back)
+    *B, split, at, back = mats[b]
     for again in (False, True):
-        s1, y, ok = _inverse_iteration(*B, s0, y0)
+        s1, y, ok = _inverse_iteration(*B, s0, y0, split=split)
         if not ok:
             return None
         if fold and abs(s1.imag) <= 1e-12 * max(abs(s1), 1.0):
             s1 = complex(s1.real, 0.0)
         if fold and s1.imag < 0:  # the conjugate pair's other member
             s1, y = s1.conjugate(), y.conj()
-        Yj = np.zeros((nd, 1), dtype=complex)
-        Yj[comp, 0] = y
-        kp = centroid(red.full(Yj).T.reshape(r, H), k)
+        p = np.zeros(red.n, dtype=complex)  # red.full of y on block b, with fewer calls
+        p[at] = y
+        if back is not None:
+            p[red.alg] = back @ y
+        kp = float(_centroids(p.reshape(1, r, H), k)[0])
         if again or not fold or abs(kp) <= 0.5:
             return s1, y, kp
         s0, y0 = s1 + 1j * round(kp), y  # the centre moved to the next copy
@@ -1489,53 +1520,6 @@ PAIR_COMPILED_MAX = 48
 
 
 @njit(cache=True)
-def _lu_small(A):
-    """LU with partial pivoting of ``A`` (n, n) complex in place (``L`` unit lower below the
-    diagonal, ``U`` on and above): ``(piv, ok)``, ``ok`` False at a zero pivot (where
-    LAPACK's ``zgetrf`` reports a singular ``U``)."""
-    n = A.shape[0]
-    piv = np.arange(n)
-    for col in range(n):
-        p = col
-        for r in range(col + 1, n):
-            if abs(A[r, col]) > abs(A[p, col]):
-                p = r
-        if A[p, col] == 0:
-            return piv, False
-        if p != col:
-            for j in range(n):
-                A[col, j], A[p, j] = A[p, j], A[col, j]
-            piv[col], piv[p] = piv[p], piv[col]
-        d = A[col, col]
-        for r in range(col + 1, n):
-            f = A[r, col] / d
-            A[r, col] = f
-            for j in range(col + 1, n):
-                A[r, j] -= f * A[col, j]
-    return piv, True
-
-
-@njit(cache=True)
-def _lu_solve_small(A, piv, b):
-    """``x`` with ``A0 x = b`` from the LU of ``A0`` by :func:`_lu_small`."""
-    n = A.shape[0]
-    x = np.empty(n, dtype=np.complex128)
-    for i in range(n):
-        x[i] = b[piv[i]]
-    for i in range(n):
-        acc = x[i]
-        for j in range(i):
-            acc -= A[i, j] * x[j]
-        x[i] = acc
-    for i in range(n - 1, -1, -1):
-        acc = x[i]
-        for j in range(i + 1, n):
-            acc -= A[i, j] * x[j]
-        x[i] = acc / A[i, i]
-    return x
-
-
-@njit(cache=True)
 def _unit(y):
     """``y / |y|`` (2-norm)."""
     nrm = 0.0
@@ -1659,39 +1643,60 @@ def _refine(Gc, node, start, length, rows, P, Kf, Mf, Cf, Df, m, harmonics, omeg
 
 
 @njit(cache=True)
-def _ruhe(B0, B1, B2, sigma, y, max_iter, lapack):
+def _ruhe(B0, B1, B2, sigma, y, max_iter, lapack, split):
     """:func:`_inverse_iteration` compiled (the same steps): ``(sigma, y, converged)``. Each
-    step solves with ``P(sigma)`` by :func:`_lu_small` (one LU a step; not converged at a
-    zero pivot) or, with ``lapack`` (larger blocks), by LAPACK's ``zgesv``
-    (``np.linalg.solve``: one LU a solve, two at the first step; raises ``LinAlgError`` at a
-    singular ``P(s)``)."""
+    step solves with ``P(sigma)`` by the harmonic split (:func:`~fretwear.hb.hill_tracking.
+    _split_factor`: the LU of the core's Schur complement, where ``split`` has local
+    unknowns or a core; a step whose split refuses is solved as without one), by
+    :func:`_lu_small` (one LU a step; not converged at a zero pivot) or, with ``lapack``
+    (larger blocks), by LAPACK's ``zgesv`` (``np.linalg.solve``: one LU a solve, two at the
+    first step; raises ``LinAlgError`` at a singular ``P(s)``)."""
     n = B0.shape[0]
     x = _unit(y)
     first = True
     A = np.empty((n, n), dtype=np.complex128)
     r = np.empty(n, dtype=np.complex128)
     piv = np.arange(n)
+    use = split[0].size + split[2].size > 0
+    work = split_work(split, n)
+    last = np.inf
     for _ in range(max_iter):
         _pencil_into(B0, B1, B2, sigma, A)
-        if not lapack:
+        how = 1 if lapack else 0
+        while use:  # a group near singular at sigma joins the core (kept for the next steps)
+            piv, bad = _split_factor(A, split, work)
+            if bad == -1:
+                how = 2
+                break
+            if bad == -2 or 2 * split[2].size > n:
+                use = False
+                break
+            split = _demote(split, bad)
+            work = split_work(split, n)
+        if how == 0:
             piv, ok = _lu_small(A)
             if not ok:
                 return sigma, x, False
         if first:  # towards the eigenvector of the eigenvalue nearest sigma
-            x = _unit(_solve_pencil(A, piv, x, lapack))
+            x = _unit(_solve_pencil(A, piv, x, how, split, work))
             first = False
         _slope_into(B1, B2, sigma, x, r)
-        sigma, x, state = _ruhe_update(sigma, x, _solve_pencil(A, piv, r, lapack))
+        sigma, x, state, last = _ruhe_update(sigma, x, _solve_pencil(A, piv, r, how, split,
+                                                                      work), last)
         if state != 0:
             return sigma, x, state > 0
     return sigma, x, False
 
 
 @njit(cache=True)
-def _solve_pencil(A, piv, b, lapack):
-    """``A^-1 b``: by LAPACK (``lapack``) or from ``A``'s LU in place (:func:`_lu_small`)."""
-    if lapack:
+def _solve_pencil(A, piv, b, how, split, work):
+    """``A^-1 b``: from ``A``'s LU in place (``how`` 0, :func:`_lu_small`), by LAPACK (1),
+    or by the harmonic split's factors (2, :func:`~fretwear.hb.hill_tracking._split_solve`;
+    ``A`` unchanged)."""
+    if how == 1:
         return np.linalg.solve(A, b)
+    if how == 2:
+        return _split_solve(A, split, work, piv, b)
     return _lu_solve_small(A, piv, b)
 
 
@@ -1718,22 +1723,39 @@ def _slope_into(B1, B2, sigma, x, r):
 
 
 @njit(cache=True)
-def _ruhe_update(sigma, x, u):
+def _ruhe_update(sigma, x, u, last):
     """Ruhe's step from ``u = P(sigma)^-1 P'(sigma) x``: ``sigma - 1 / (x^H u)`` and the
-    normalised ``u``, with ``state`` 1 (the step below 1e-14 of ``max(1, |sigma|)``:
-    converged), -1 (``x^H u`` zero or not finite: failed, ``sigma`` and ``x`` unchanged) or 0
-    (go on)."""
+    normalised ``u``, with ``state`` 1 (converged, :func:`_settled`; ``last`` the previous
+    step's size), -1 (``x^H u`` zero or not finite: failed, ``sigma`` and ``x`` unchanged) or
+    0 (go on), and this step's size."""
     den = 0j
     for i in range(x.shape[0]):
         den += np.conj(x[i]) * u[i]
     if not np.isfinite(den.real) or not np.isfinite(den.imag) or den == 0:
-        return sigma, x, -1
+        return sigma, x, -1, last
     step = 1.0 / den
     sigma = sigma - step
     x = _unit(u)
-    if abs(step) <= 1e-14 * max(1.0, abs(sigma)):
-        return sigma, x, 1
-    return sigma, x, 0
+    if _settled(abs(step), last, max(1.0, abs(sigma))):
+        return sigma, x, 1, abs(step)
+    return sigma, x, 0, abs(step)
+
+
+@njit(cache=True)
+def _settled(size, last, scale):
+    """Whether Ruhe's iteration has converged after a step of ``size`` (``last`` the one
+    before, ``scale = max(1, |sigma|)``): the step below 1e-14 of ``scale``, or below 1e-7
+    of it and the next one predicted below 1e-15 of it. Near a simple eigenvalue the error
+    after a step is ``C size^2`` (quadratic convergence), ``C`` estimated by
+    ``size / last^2``; the prediction is trusted where the step contracted by 1e3 at least
+    (the quadratic regime), and then the step that would confirm it (one LU) is not taken:
+    the eigenvalue is within the prediction of the one that step would give, and the vector,
+    from a solve at ``sigma`` already ``size`` from the eigenvalue, as accurate."""
+    if size <= 1e-14 * scale:
+        return True
+    if size > 1e-7 * scale or size > 1e-3 * last:
+        return False
+    return size * size * (size / (last * last)) <= 1e-15 * scale
 
 
 def _pair(T: np.ndarray, v: np.ndarray, mu0: complex, steps: int = 2):

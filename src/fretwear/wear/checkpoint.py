@@ -234,8 +234,10 @@ def load_checkpoint(path: Path | str, key: str, shape: tuple[int, int, int] | No
     data = _read_checkpoint(path)
     if str(data["fingerprint"]) != key:
         raise InputError(f"wear checkpoint {str(path)!r} was written for a different model or "
-                         "different wear settings; delete it (or run without --resume) to start "
-                         "again")
+                         "different wear settings (the model as condensed counts: a modal "
+                         "condensation by another path, e.g. partial factorisations where "
+                         "kvxopt is installed and static modes where it is not, differs in its "
+                         "last digits); delete it (or run without --resume) to start again")
     dims = _dims(data)
     if shape is not None and (dims["nc"], dims["d"], dims["H"]) != tuple(shape):
         raise InputError(f"wear checkpoint {str(path)!r} was written for a different model "

@@ -35,13 +35,14 @@ the residual and the steps tried; the state is never claimed from a plateau of t
 
 The stick-set jump (``stick_set``, :mod:`fretwear.wear.stick_set`) characterises the state
 by its stick set instead: the nodes that wear unloaded until they just touch, every other
-node sticking, one balance. Once the worn-volume rate has fallen to :data:`TRY_RATE` of the
-initial one it is tried from the path's states, and the run ends on it when the jumps from
-two states agree AND the path step between them covered at least :data:`PROGRESS` of the way
-to the first (:class:`_Jumps`): agreement alone is not enough, the jumps from many successive
-states of Stromberg's beam agree on a state 8.1 % of the deepest wear from the march's (two
-loaded nodes that stick there slip and wear a million cycles later). It is off by default:
-the rule is measured on three cases, not proved, and gains little (docs/theory.md).
+node sticking, one balance. Once the worn-volume rate has fallen to ``jump_rate`` (0.3) of
+the initial one it is tried from the path's states, and the run ends on it when the jumps
+from two states agree AND the path step between them covered at least ``jump_progress``
+(0.25) of the way to the first (:class:`_Jumps`): agreement alone is not enough, the jumps
+from many successive states of Stromberg's beam agree on a state 8.1 % of the deepest wear
+from the march's (two loaded nodes that stick there slip and wear a million cycles later).
+It is off by default: the rule is measured on three cases, not proved, and gains little
+(docs/theory.md).
 
 Wear that goes on (gross slip) has no null-rate state; when the rate stops changing (``max
 |g_{k+1} - g_k| <= tolerance max g``) over a step that moved the profile by
@@ -123,6 +124,15 @@ class WornStateOptions:
         Off by default: the rule that says when the jump lands on the march's state is
         measured on three quasi-static examples (safe on each, 0.94-1.56 times the march's
         speed in DLFT solves), not proved; the result then warns.
+    jump_rate : with ``stick_set``, the jumps are tried once the worn-volume rate has fallen
+        to this fraction of the initial one (before, the jumps from successive states keep
+        moving: docs/studies/worn-state-cost.md, "The stick-set jump along the path").
+    jump_progress : with ``stick_set``, a jump is taken when the last path step covered at
+        least this fraction of the way from the state before to the jump from there (and the
+        jumps from both states agree): the path is heading for the jump's state. Measured on
+        the three quasi-static examples: the jumps that land away from the march's state
+        (Stromberg's beam, 8.1 %) had 0.11-0.22 with agreeing jumps; the first taken jumps
+        0.26-0.33 (a margin of 1.2, not a proof).
     exponential : where a growing mode of the slow Jacobian would cut the step (wear moving
         load onto a stuck neighbour until it slips), take the exponential Euler step, which
         follows it exactly (:mod:`fretwear.wear.exponential_step`; on Stromberg's beam 51
@@ -156,6 +166,8 @@ class WornStateOptions:
     min_growth: float = 5.0
     path_tolerance: float = 1e-2
     stick_set: bool = False
+    jump_rate: float = 0.3
+    jump_progress: float = 0.25
     exponential: bool = True
     order: int = 1
     settle_rate: float = 0.01
@@ -179,6 +191,8 @@ class WornStateOptions:
                 raise InputError(f"{name} = {getattr(self, name)!r}: expected true or false")
         number(self.max_growth, "max_growth", low=1.0, open_low=True, high=1e6)
         number(self.settle_rate, "settle_rate", low=0.0, open_low=True, high=1.0)
+        number(self.jump_rate, "jump_rate", low=0.0, open_low=True, high=1.0)
+        number(self.jump_progress, "jump_progress", low=0.0, open_low=True, high=1.0)
 
     def march_options(self, path: bool = False) -> WearOptions:
         """The wear options of the steps: linearly implicit, no stop criterion of the march;
@@ -199,6 +213,8 @@ class WornStateOptions:
             key["order"] = self.order
         if self.events:
             key["events"] = True
+        if self.stick_set:  # the jump rule's thresholds change where the run ends
+            key["jump_rate"], key["jump_progress"] = self.jump_rate, self.jump_progress
         return key
 
 
@@ -485,25 +501,13 @@ def _path_step(sp: SlowProblem, state: SlowStep, opts: WearOptions, exponential:
     return _step(sp, state, opts)
 
 
-#: the stick-set jumps are tried once the worn-volume rate has fallen to this fraction of the
-#: initial one (before, the jumps from successive states keep moving: docs/studies/
-#: worn-state-cost.md, "The stick-set jump along the path")
-TRY_RATE = 0.3
-#: a jump is taken when the last path step covered at least this fraction of the way from the
-#: state before to the jump from there (and the jumps from both states agree): the path is
-#: heading for the jump's state. Measured on the three quasi-static examples: the jumps that
-#: land away from the march's state (Stromberg's beam, 8.1 %) had progress 0.11-0.22 with
-#: agreeing jumps; the first taken jumps had 0.26-0.33 (a margin of 1.2, not a proof).
-PROGRESS = 0.25
-
-
 class _Jumps:
     """The stick-set jumps (:func:`~fretwear.wear.stick_set.stick_set_state`) from the
     recorded states, each computed once (by record index).
 
-    Once the worn-volume rate is at most :data:`TRY_RATE` of the initial one, the jump from
+    Once the worn-volume rate is at most ``options.jump_rate`` of the initial one, the jump from
     that record is the target ``J``. At each later record ``k`` the path step from ``k - 1``
-    is measured against it: when it covered at least :data:`PROGRESS` of the way from
+    is measured against it: when it covered at least ``options.jump_progress`` of the way from
     ``W_k-1`` to ``J``, the jump from ``k`` is computed; it is accepted when it gives the
     same state as ``J``, to ``depth_tolerance`` of the deepest wear, else it becomes the new
     target (a step that covered less computes no jump: the jumps cost balances). A resumed
@@ -543,7 +547,7 @@ class _Jumps:
         progress)`` when the jump from ``k`` agrees with the target's from ``j`` (else None).
         Reads ``records[:k + 1]`` only, so a resumed run replays the run before it."""
         if (k < 1 or not records[k].has_balance or not records[k - 1].has_balance
-                or records[k].volume_rate > TRY_RATE * records[0].volume_rate):
+                or records[k].volume_rate > self.options.jump_rate * records[0].volume_rate):
             return None
         if self.latest is None or self.latest[1] is None:  # no target yet (none, or the
             self.latest = k, self.of(records, k)  # last jump found none): the path's
@@ -551,7 +555,7 @@ class _Jumps:
         j, before = self.latest
         W0, W1 = records[k - 1].wear_depth, records[k].wear_depth
         _, progress = agreement(W0, W1, before.W, before.W)
-        if progress < PROGRESS:  # the path is not heading there yet: no jump tried
+        if progress < self.options.jump_progress:  # not heading there yet: no jump tried
             return None
         last = self.of(records, k)
         self.latest = k, last
@@ -588,7 +592,8 @@ class _Jumps:
             f"touch, every other node sticking): null-wear-rate residual max g / max g0 = "
             f"{res:.3g} <= {self.options.tolerance:g}; the jumps from steps {j} and {k} "
             f"agree within {c:.3g} of the deepest wear <= {self.options.depth_tolerance:g}, "
-            f"the last step covered {progress:.2f} of the way to the first (>= {PROGRESS:g})",
+            f"the last step covered {progress:.2f} of the way to the first "
+            f"(>= {self.options.jump_progress:g})",
             res, c, self.iterations, True)
 
 
