@@ -15,6 +15,7 @@ value), so the roots are compared to 1e-9 relative.
 
 import numpy as np
 import pytest
+from helpers.kinked import kinked
 
 from fretwear.errors import InputError
 from fretwear.hb.solvers import SOLVERS, SolveStats, solve, solve_identity_rows
@@ -261,25 +262,6 @@ def test_powell_keeps_inexact_steps_after_a_poor_step_by_default():
     assert not st.success and len(asked) > 4
     assert all(a is not None for a in asked)
     assert all(at[i + 1] != at[i] for i in range(len(at) - 1))
-
-
-def kinked(seed, n=20, slope=1000.0):
-    """A piecewise-linear strongly monotone problem of n unknowns with a kink per unknown
-    and its root: ``A x + D max(x - t, 0) = A x* + D max(x* - t, 0)`` with ``A`` symmetric
-    positive definite and ``D >= 0`` diagonal (slopes up to ``slope``: the gradient of a
-    strongly convex function, so ``x*`` is its only root); the Jacobian is that of the piece
-    of ``x`` (as the DLFT law's kinks, stick / slip / separation, give)."""
-    rng = np.random.default_rng(seed)
-    B = rng.standard_normal((n, n))
-    A = B @ B.T / n + 0.1 * np.eye(n)
-    t, D, x_star = rng.standard_normal(n), slope * rng.random(n), rng.standard_normal(n)
-    rhs = A @ x_star + D * np.maximum(x_star - t, 0.0)
-
-    def fun(x, need_jacobian):
-        f = A @ x + D * np.maximum(x - t, 0.0) - rhs
-        return f, (A + np.diag(D * (x > t))) if need_jacobian else None
-
-    return fun, x_star, np.abs(rhs).max()
 
 
 def test_powell_watchdog_crosses_kinks_where_the_monotone_test_crawls(monkeypatch):
