@@ -15,7 +15,9 @@ regime (stick / slip / separation at some sample) between the iterate and the tr
 ``memory=M``: their reference the largest ``|f|`` of the last M iterates; ``norms=first``:
 the variable scales of the first Jacobian only; ``unclipped``: without the stretches after
 crawling dog-leg steps, ``WATCHDOG_CLIPPED``; a sixth argument and on: ``nolocal`` without
-the local phase of fretwear.hb.kinks, ``single`` with single-precision GMRES products;
+the local phase of fretwear.hb.kinks, ``single`` with single-precision GMRES products,
+``NAME=value`` a constant of fretwear.hb.kinks or fretwear.hb.solvers set, e.g.
+``LOCAL_CLIPPED=2``;
 ``KINKS_ROOT=<file>`` prints the distance to a root saved before.) With
 ``KINKS_SAVE=<folder>`` every iterate is saved there as ``xNNN.npy`` (N the Powell
 iteration), for the local methods of ``studies/kinks_local.py``.
@@ -128,8 +130,15 @@ def main():
               flush=True)
 
     c0, w0 = time.process_time(), time.perf_counter()
+    from fretwear.hb import kinks
     from fretwear.hb.kinks import local_phase
 
+    for arg in sys.argv[6:]:  # NAME=value: a constant of fretwear.hb.kinks or of solvers
+        if "=" in arg:
+            name, value = arg.split("=")
+            owner = kinks if hasattr(kinks, name) else solvers
+            setattr(owner, name, type(getattr(owner, name))(float(value)))
+            print(f"{owner.__name__}.{name} = {getattr(owner, name)}", flush=True)
     local = None if "nolocal" in sys.argv[6:] else local_phase(prob)
     if "single" in sys.argv[6:]:  # single-precision GMRES products
         from fretwear.hb.options import KrylovOptions

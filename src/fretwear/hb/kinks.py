@@ -37,6 +37,8 @@ from fretwear.hb.solvers import _lu_step, powell, solve_identity_rows, vector_no
 #: two worst alone, 94 % of ``|f|^2``, the neighbours took the residual up and the Newton
 #: steps after the elimination did not converge)
 SHARE = 0.999
+#: at least this many nodes (the largest per-node residuals)
+MIN_NODES = 1
 #: at most this many nodes (their subproblem's Jacobian is formed: ``k d H`` unknowns)
 MAX_NODES = 32
 #: the subproblem is solved to this fraction of the whole residual's norm on its rows
@@ -74,7 +76,7 @@ def worst_nodes(f: np.ndarray, nc: int, share: float | None = None,
     order = np.argsort(per)[::-1]
     cum = np.cumsum(per[order])
     k = int(np.searchsorted(cum, share * cum[-1])) + 1
-    return np.sort(order[:min(k, max_nodes)])
+    return np.sort(order[:min(max(k, MIN_NODES), max_nodes)])
 
 
 def _block(prob, dofs: np.ndarray) -> np.ndarray:

@@ -261,6 +261,10 @@ WATCHDOG_FORMED = False
 #: problems of tests/hb/test_solvers.py it cuts Powell's iterations from 1690 to 370
 WATCHDOG_CLIPPED = 4
 WATCHDOG_CLIPPED_PROGRESS = 0.5
+#: the local phase (``local`` of :func:`powell`) is called once this many dog-leg steps in a
+#: row have not fitted the Newton step nor halved ``|f|`` (at most once in such a run of
+#: them; the stretch of :data:`WATCHDOG_CLIPPED` follows if it did not reduce ``|f|``)
+LOCAL_CLIPPED = 4
 #: such a stretch takes at most this many Newton steps, each of which must reduce ``|f|`` by
 #: this factor: at 1024 contact nodes the full Newton step from ``|f|`` 1.4e-4 raised it to
 #: 4.7e-2 (17 nodes changing regime) and the Newton steps from there fell by a decade each
@@ -353,6 +357,7 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
     rejected, ref = 0, fn  # rejected Newton steps since |f| fell below ref / 10
     kept = [fn]  # |f| of the iterates (a stretch's only once it is kept)
     clipped, clip_ref = 0, fn  # dog-leg steps in a row (Newton step too long), |f| before
+    local_tried = False  # the local phase called since the dog-leg steps began
     while True:
         target = tol * scale(x)
         if fn <= target:
@@ -378,35 +383,41 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
         if delta is None:
             delta = snd
         forced = False
+        crawl = (watch is None and snd > delta and (WATCHDOG_FORMED or not exact)
+                 and fn > WATCHDOG_CLIPPED_PROGRESS * clip_ref)
+        if (crawl and local is not None and not local_tried
+                and clipped >= min(LOCAL_CLIPPED, WATCHDOG_CLIPPED)):
+            # the dog-leg steps crawl: the local phase (once in a crawl)
+            local_tried = True
+            xl = np.array(local(x, f, target), dtype=float)
+            fl, Jl = fun(xl, True)
+            nfev += 1
+            njev += 1
+            fnl = vector_norm(fl)
+            if fnl < fn:  # its point the iterate, its full Newton step tried next
+                if trace is not None:
+                    trace.append({"it": it, "f": fn, "f_trial": fnl, "delta": delta,
+                                  "pred": 0.0, "actual": fn * fn - fnl * fnl,
+                                  "ratio": 1.0, "newton": False, "lin": 1.0,
+                                  "new_step": False, "gmres": 0, "accepted": True,
+                                  "watchdog": False, "forced": False, "local": True})
+                x, f, fn, J = xl, fl, fnl, Jl
+                dscale = np.maximum(dscale, _column_norms(J))
+                eta, sn, delta, stall = FORCING_MAX, None, None, 0
+                clipped, clip_ref, local_tried = 0, fn, False
+                kept.append(fn)
+                if callback is not None:
+                    callback(it, x, fn)
+                continue
         if watch is None and snd > delta and clipped >= WATCHDOG_CLIPPED:
             # the dog-leg steps crawl (|f| not halved by the last ones): the full Newton step
             # tried (a stretch); else the next ones are judged from here
-            forced = (WATCHDOG_FORMED or not exact) and fn > WATCHDOG_CLIPPED_PROGRESS * clip_ref
-            clipped, clip_ref = 0, fn
-            if forced and local is not None:  # the local phase first
-                xl = np.array(local(x, f, target), dtype=float)
-                fl, Jl = fun(xl, True)
-                nfev += 1
-                njev += 1
-                fnl = vector_norm(fl)
-                if fnl < fn:  # its point the iterate, its full Newton step tried next
-                    if trace is not None:
-                        trace.append({"it": it, "f": fn, "f_trial": fnl, "delta": delta,
-                                      "pred": 0.0, "actual": fn * fn - fnl * fnl,
-                                      "ratio": 1.0, "newton": False, "lin": 1.0,
-                                      "new_step": False, "gmres": 0, "accepted": True,
-                                      "watchdog": False, "forced": False, "local": True})
-                    x, f, fn, J = xl, fl, fnl, Jl
-                    dscale = np.maximum(dscale, _column_norms(J))
-                    eta, sn, delta, stall, clip_ref = FORCING_MAX, None, None, 0, fn
-                    kept.append(fn)
-                    if callback is not None:
-                        callback(it, x, fn)
-                    continue
+            forced = crawl
+            clipped, clip_ref, local_tried = 0, fn, False
         if snd <= delta or watch is not None or forced:  # (a watchdog stretch: Newton steps)
             s = sn
             if not forced:
-                clipped, clip_ref = 0, fn
+                clipped, clip_ref, local_tried = 0, fn, False
         else:
             clipped += 1
             g = (J.T @ f) / dscale  # gradient in scaled variables
