@@ -323,9 +323,11 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
     ``local``: a local phase for that crawl, ``local(x, f, target) -> x'`` (``target`` the
     convergence test's ``|f|``; for the DLFT balance
     :func:`fretwear.hb.kinks.local_phase`, nonlinear elimination of the nodes that hold the
-    residual): where the full Newton step would be forced it is called first, and a point
-    it returns with a smaller ``|f|`` is taken as the iterate (its full Newton step tried
-    next, the trust radius set to it as at the start); else the forced step as before.
+    residual): called once :data:`LOCAL_CLIPPED` dog-leg steps in a row have not fitted the
+    Newton step nor halved ``|f|`` (once in such a run), and a point it returns with a
+    smaller ``|f|`` is taken as the iterate (its full Newton step tried next, the trust
+    radius set to it as at the start); else the dog-leg steps and the forced step go on as
+    without it.
     Its own evaluations are not counted in ``nfev``, ``njev``.
     ``max_slow``: stop (unconverged) after that many iterations on a new Jacobian
     in a row without one that decreased ``|f|^2`` by :data:`SLOW_DECREASE` (MINPACK's "not
