@@ -120,6 +120,25 @@ def _column_norms(J):
     return J.column_norms()
 
 
+#: Powell's variable scales on an operator (Krylov) Jacobian from its first Jacobian only (the
+#: column norms of each new one cost as much as a Newton step's GMRES on a large interface:
+#: 10 s of the 1024-node partial-slip solve's 50); formed Jacobians renew them at every
+#: Jacobian as MINPACK. With :attr:`KrylovOptions.single_products` it took the 1024-node solve
+#: of benchmarks/scale_3d.py from 51-52 s to 38-42 s CPU, to main's root (within the spread
+#: of the default from perturbed starts), once the local phase ended its crawl
+#: (docs/studies/large-interface-solve.md, "Entering the local phase sooner")
+FIRST_SCALES_OPERATOR = True
+
+
+def _rescaled(dscale, J):
+    """Powell's variable scales after a new Jacobian ``J``: the running maximum of the
+    column norms (MINPACK), or ``dscale`` itself on an operator Jacobian if
+    :data:`FIRST_SCALES_OPERATOR`."""
+    if FIRST_SCALES_OPERATOR and not isinstance(J, np.ndarray):
+        return dscale
+    return np.maximum(dscale, _column_norms(J))
+
+
 #: preconditioners of the Newton step's GMRES when the operator carries compressed forms
 #: (:class:`KrylovOptions`)
 PRECONDITIONERS = ("mean-gain", "nearfield")
@@ -157,18 +176,21 @@ class KrylovOptions:
         ``single_products_rtol`` (operators of the modal condensation without compressed
         forms only). The step is then that of an operator off by about ``1e-7`` relative,
         far below its tolerance: the residual, the dog-leg and the convergence test stay in
-        double, so a converged answer is the same to the solve's tolerance. Default False:
+        double, so a converged answer is the same to the solve's tolerance. Default True:
         on the partial-slip pad of benchmarks/scale_3d.py the 256-node solve took the same
-        iterations (solution 6e-12 from the double one's, products 0.39 to 0.30 s), but at
-        1024 nodes the other rounding took Powell onto a path that crawls at ``|f|`` 1e-4
-        (docs/studies/large-interface-solve.md, "Iteration counts and per-call terms").
+        iterations (solution 6e-12 from the double one's, products 0.39 to 0.30 s); at 1024
+        nodes the other rounding took Powell onto a path that crawled at ``|f|`` 1e-4
+        (docs/studies/large-interface-solve.md, "Iteration counts and per-call terms"),
+        which the local phase of :mod:`fretwear.hb.kinks` now ends; with the first
+        Jacobian's variable scales (:data:`FIRST_SCALES_OPERATOR`) the solve took 38-42 s
+        CPU against 51-52 s ("Entering the local phase sooner").
     single_products_rtol : that bound (default ``1e-5``).
     """
 
     single_factors: bool = True
     single_max_iterations: int = 60
     preconditioner: str = "mean-gain"
-    single_products: bool = False
+    single_products: bool = True
     single_products_rtol: float = 1e-5
 
     def __post_init__(self):
@@ -410,7 +432,7 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
                                   "new_step": False, "gmres": 0, "accepted": True,
                                   "watchdog": False, "forced": False, "local": True})
                 x, f, fn, J = xl, fl, fnl, Jl
-                dscale = np.maximum(dscale, _column_norms(J))
+                dscale = _rescaled(dscale, J)
                 eta, sn, delta, stall = FORCING_MAX, None, None, 0
                 clipped, clip_ref, local_tried = 0, fn, False
                 kept.append(fn)
@@ -465,7 +487,7 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
                 _, J = fun(x, True)
                 njev += 1
                 sn = None
-                dscale = np.maximum(dscale, _column_norms(J))
+                dscale = _rescaled(dscale, J)
                 if done:  # the stretch succeeded: the trust region admits its last step
                     delta, watch, stall, nsuc = max(watch.delta, 2.0 * pnorm), None, 0, 0
                     kept.append(fn)
@@ -497,7 +519,7 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
                 _, J = fun(x, True)
                 njev += 1
                 sn = None
-                dscale = np.maximum(dscale, _column_norms(J))
+                dscale = _rescaled(dscale, J)
                 stall = 0
                 kept.append(fn)
                 if forced:  # the trust region admits the Newton step that served
@@ -517,7 +539,7 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
                     _, J = fun(x, True)
                     njev += 1
                     sn = None
-                    dscale = np.maximum(dscale, _column_norms(J))
+                    dscale = _rescaled(dscale, J)
                     eta = FORCING_MAX
                 if newton_step:
                     rejected += 1
