@@ -16,8 +16,9 @@ regime (stick / slip / separation at some sample) between the iterate and the tr
 the variable scales of the first Jacobian only; ``unclipped``: without the stretches after
 crawling dog-leg steps, ``WATCHDOG_CLIPPED``; a sixth argument and on: ``nolocal`` without
 the local phase of fretwear.hb.kinks, ``single`` / ``double`` with single- /
-double-precision GMRES products (single by default; the default before it: ``double
-FIRST_SCALES_OPERATOR=0``),
+double-precision GMRES products (single by default), ``renew`` the variable scales renewed
+at every Jacobian (``KrylovOptions(first_scales=False)``; the defaults before them: ``double
+renew``),
 ``NAME=value`` a constant of fretwear.hb.kinks or fretwear.hb.solvers set, e.g.
 ``LOCAL_CLIPPED=2``;
 ``KINKS_ROOT=<file>`` prints the distance to a root saved before.) With
@@ -142,14 +143,11 @@ def main():
             setattr(owner, name, type(getattr(owner, name))(float(value)))
             print(f"{owner.__name__}.{name} = {getattr(owner, name)}", flush=True)
     local = None if "nolocal" in sys.argv[6:] else local_phase(prob)
-    if "single" in sys.argv[6:]:  # single-precision GMRES products
-        from fretwear.hb.options import KrylovOptions
+    from fretwear.hb.options import KrylovOptions
 
-        prob.krylov = KrylovOptions(single_products=True)
-    if "double" in sys.argv[6:]:  # double-precision GMRES products (the default before)
-        from fretwear.hb.options import KrylovOptions
-
-        prob.krylov = KrylovOptions(single_products=False)
+    prob.krylov = KrylovOptions(  # products in single precision unless "double"; the
+        single_products="double" not in sys.argv[6:],  # first Jacobian's scales unless
+        first_scales="renew" not in sys.argv[6:])  # "renew" (the defaults before: both)
     x, f, st = powell(fun, x0, lambda x: prob.scale(x.reshape(prob.m, prob.H)),
                       tol=PERIODIC.tol, max_iter=max_iter, trace=trace, callback=line,
                       local=local)

@@ -215,6 +215,36 @@ def test_powell_inexact_newton_steps_reach_the_same_root(seed):
     assert min(a for a, _ in loose) < 1e-3
 
 
+@pytest.mark.parametrize("first", [True, False])
+def test_powell_keeps_the_first_scales_on_an_operator_that_asks(first):
+    """An operator Jacobian whose options keep the first Jacobian's variable scales
+    (``KrylovOptions.first_scales``) has its column norms computed once; one that does not,
+    at every new Jacobian (MINPACK's running maximum). Either way Powell reaches the root of
+    the smooth monotone problem (closed form: the x* it was built from; 1e-9 relative as
+    above): the scales change the path, not the root."""
+    fun, x_star, scale = monotone(rng=np.random.default_rng(7))
+    calls, jacobians = [], []
+
+    class Scaled(InexactOperator):
+        first_scales = first
+
+        def column_norms(self):
+            calls.append(1)
+            return super().column_norms()
+
+    def op(x, need_jacobian):
+        f, J = fun(x, need_jacobian)
+        if need_jacobian:
+            jacobians.append(1)
+        return f, (Scaled(J, []) if need_jacobian else None)
+
+    x, _, st = solve(op, np.zeros_like(x_star), lambda x: scale, tol=1e-12)
+    assert st.success, st.message
+    np.testing.assert_allclose(x, x_star, rtol=1e-9, atol=1e-9 * np.abs(x_star).max())
+    assert len(jacobians) > 2
+    assert len(calls) == (1 if first else len(jacobians))
+
+
 def _powell_without_root():
     """Powell on x^2 + 1 = 0 (no root: every step is poor) from x = 0.3 with an inexact
     operator Jacobian: ``(stats, asked, at)``, the ``rtol`` of every solve request (None:

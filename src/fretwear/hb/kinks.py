@@ -102,6 +102,10 @@ class FormedOperator:
     iterations to 7 % of the start; with the stretches 12 iterations to 6e-6)."""
 
     gmres_iterations = 0
+    #: Powell keeps the first Jacobian's variable scales, as on the operator Jacobians of
+    #: the default :class:`~fretwear.hb.options.KrylovOptions` (what the phase was measured
+    #: with)
+    first_scales = True
 
     def __init__(self, J: np.ndarray):
         self.J = J

@@ -120,21 +120,11 @@ def _column_norms(J):
     return J.column_norms()
 
 
-#: Powell's variable scales on an operator (Krylov) Jacobian from its first Jacobian only (the
-#: column norms of each new one cost as much as a Newton step's GMRES on a large interface:
-#: 10 s of the 1024-node partial-slip solve's 50); formed Jacobians renew them at every
-#: Jacobian as MINPACK. With :attr:`KrylovOptions.single_products` it took the 1024-node solve
-#: of benchmarks/scale_3d.py from 51-52 s to 38-42 s CPU, to main's root (within the spread
-#: of the default from perturbed starts), once the local phase ended its crawl
-#: (docs/studies/large-interface-solve.md, "Entering the local phase sooner")
-FIRST_SCALES_OPERATOR = True
-
-
 def _rescaled(dscale, J):
     """Powell's variable scales after a new Jacobian ``J``: the running maximum of the
-    column norms (MINPACK), or ``dscale`` itself on an operator Jacobian if
-    :data:`FIRST_SCALES_OPERATOR`."""
-    if FIRST_SCALES_OPERATOR and not isinstance(J, np.ndarray):
+    column norms (MINPACK), or ``dscale`` itself on an operator Jacobian whose options keep
+    the first Jacobian's scales (:attr:`KrylovOptions.first_scales`)."""
+    if not isinstance(J, np.ndarray) and getattr(J, "first_scales", False):
         return dscale
     return np.maximum(dscale, _column_norms(J))
 
@@ -182,9 +172,16 @@ class KrylovOptions:
         nodes the other rounding took Powell onto a path that crawled at ``|f|`` 1e-4
         (docs/studies/large-interface-solve.md, "Iteration counts and per-call terms"),
         which the local phase of :mod:`fretwear.hb.kinks` now ends; with the first
-        Jacobian's variable scales (:data:`FIRST_SCALES_OPERATOR`) the solve took 38-42 s
-        CPU against 51-52 s ("Entering the local phase sooner").
+        Jacobian's variable scales (``first_scales``) the solve took 38-42 s CPU against
+        51-52 s ("Entering the local phase sooner").
     single_products_rtol : that bound (default ``1e-5``).
+    first_scales : Powell's variable scales from the first Jacobian only (default True);
+        False: renewed at every Jacobian as MINPACK (the running maximum of its column
+        norms), as formed Jacobians always are. The column norms of each new Jacobian cost
+        as much as a Newton step's GMRES on a large interface (10 s of the 1024-node
+        partial-slip solve's 50); with ``single_products`` this took that solve from
+        51-52 s to 38-42 s CPU, to the same root within the spread of the old defaults from
+        perturbed starts, once the local phase ended its crawl.
     """
 
     single_factors: bool = True
@@ -192,6 +189,7 @@ class KrylovOptions:
     preconditioner: str = "mean-gain"
     single_products: bool = True
     single_products_rtol: float = 1e-5
+    first_scales: bool = True
 
     def __post_init__(self):
         self.check()
@@ -212,6 +210,9 @@ class KrylovOptions:
                              f"one of {PRECONDITIONERS}")
         if not isinstance(self.single_products, bool):
             raise InputError(f"krylov.single_products = {self.single_products!r}: expected "
+                             "True or False")
+        if not isinstance(self.first_scales, bool):
+            raise InputError(f"krylov.first_scales = {self.first_scales!r}: expected "
                              "True or False")
         t = self.single_products_rtol
         if not (isinstance(t, numbers.Real) and not isinstance(t, bool) and 1e-6 <= t < 1):
@@ -431,6 +432,8 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
                                   "ratio": 1.0, "newton": False, "lin": 1.0,
                                   "new_step": False, "gmres": 0, "accepted": True,
                                   "watchdog": False, "forced": False, "local": True})
+                if fnl * fnl <= (1.0 - SLOW_DECREASE) * fn * fn:  # progress, as a step's
+                    slow = 0
                 x, f, fn, J = xl, fl, fnl, Jl
                 dscale = _rescaled(dscale, J)
                 eta, sn, delta, stall = FORCING_MAX, None, None, 0
