@@ -190,6 +190,7 @@ class KrylovOptions:
     single_products: bool = True
     single_products_rtol: float = 1e-5
     first_scales: bool = True
+    local_phase: bool = True
 
     def __post_init__(self):
         self.check()
@@ -210,6 +211,9 @@ class KrylovOptions:
                              f"one of {PRECONDITIONERS}")
         if not isinstance(self.single_products, bool):
             raise InputError(f"krylov.single_products = {self.single_products!r}: expected "
+                             "True or False")
+        if not isinstance(self.local_phase, bool):
+            raise InputError(f"krylov.local_phase = {self.local_phase!r}: expected "
                              "True or False")
         if not isinstance(self.first_scales, bool):
             raise InputError(f"krylov.first_scales = {self.first_scales!r}: expected "
