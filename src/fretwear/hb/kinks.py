@@ -15,10 +15,10 @@ the law").
 unknowns held: their ``lambda_u`` is linear in their own unknowns (eq. 23, ``lambda_u = F - Z
 U + eps (U - W)``, the coupling through the held nodes a constant) and their law the one of
 the whole problem, so the subproblem's residual is that of the full problem on those rows,
-exactly (up to the compression's bound where the operator carries compressed forms: the
-full residual's products are then the compressed ones, the subproblem's block is cut from
-the exact matrices). Its Jacobian is formed (a few nodes: ``k d H`` unknowns) and the subproblem solved by
-Powell. After it, a Newton step of the whole system is the Newton step of the system with
+exactly (up to the compression's bound where the operator carries compressed forms: the full
+residual's products are then the compressed ones, the subproblem's block is cut from the exact
+matrices). Its Jacobian is formed (a few nodes: ``k d H`` unknowns) and the subproblem solved
+by Powell. After it, a Newton step of the whole system is the Newton step of the system with
 those nodes eliminated (their rows hold ``f = 0``), on which their branch no longer acts
 (Lanzkron, Rose and Wilkes 1996, nonlinear elimination). :func:`local_phase` makes the rounds
 of both that :func:`fretwear.hb.solvers.powell` calls as its ``local``.
