@@ -164,6 +164,11 @@ DECOUPLED_TOL = 1e-13
 #: decoupled blocks of the quadratic problem are gathered up to at least this many unknowns
 #: per dense eigensolve (below, the call's overhead exceeds the flops saved)
 MIN_BLOCK = 48
+#: a neighbouring copy whose start (the member's eigenvector moved by one harmonic) has a
+#: backward error below this is taken as it is, without its inverse iteration
+#: (:func:`_copy_kernel`: rounding; the blocks whose laws do not vary over the period give
+#: 2e-17 to 4e-17 on the two-DOF oscillator, the truncated copies 1e-4 to 1e-3)
+COPY_EXACT = 1e-15
 #: exponents whose multiplier is below this are not refined (they decay within a period; the
 #: factor e^{-s h} of the law's memory would overflow over a period)
 NEGLIGIBLE = 1e-8
@@ -1165,7 +1170,7 @@ def track_eigen(red: QuadraticReduction, track: HillTrack | None, shape: tuple,
     while todo:  # each member's neighbouring copy, and the mirror of those near the line
         s1, y, kp, b, j = members[todo.pop(0)]
         side = 1 if kp >= 0 else -1
-        starts = [(s1 + 1j * side, _shifted_copy(red, b, y, shape, side), False)]
+        starts = [(s1, y, False)]  # the copy, from the member itself (_copy)
         if _on_line(s1) != "off":
             starts.append((s1.conjugate() + 1j, y.conj(), True))
         if _on_line(s1) == "on" and j >= 0 and _on_line(complex(track.sigma[j])) != "on":
@@ -1174,10 +1179,13 @@ def track_eigen(red: QuadraticReduction, track: HillTrack | None, shape: tuple,
             y0 = track.Y[red.blocks[b], j]
             starts.append((complex(track.sigma[j]).conjugate() + 1j, y0.conj(), True))
         for sn, y0, mirror in starts:
-            got = _member(red, b, sn, y0, shape, mats, fold=False)
+            if mirror:
+                got = _member(red, b, sn, y0, shape, mats, fold=False)
+            else:  # the copy s + i side
+                got = _copy(red, b, sn, y0, shape, mats, side)
             if got is None:
                 return None
-            s2, y2, kn = got
+            s2, y2, kn = got[:3]
             vals = np.array([m[0] for m in members])
             if np.min(np.abs(vals - s2)) <= 1e-8 * max(1.0, abs(s2)):
                 continue  # a member (the mirror of one on the line is itself)
@@ -1214,25 +1222,53 @@ def _shifted_copy(red: QuadraticReduction, b: int, y: np.ndarray, shape: tuple,
     return v / nrm if nrm > 0 else y
 
 
+def _block_mats(red: QuadraticReduction, b: int, shape: tuple, mats: dict) -> tuple:
+    """Block ``b``'s arrays for the compiled member and copy kernels (made on the block's
+    first use, kept in ``mats``): its complex ``B0, B1, B2``, the harmonic split, the
+    block's coordinates, the algebraic coordinates' ``back`` restricted to the block (an
+    empty one without), the algebraic coordinates, and whether LAPACK solves the steps."""
+    if b not in mats:
+        r, H, k = shape
+        comp = red.blocks[b]
+        ix = np.ix_(comp, comp)
+        real = tuple(np.ascontiguousarray(X[ix]) for X in (red.B0, red.B1, red.B2))
+        c = red.dyn[comp] % H  # coefficient index: 0, a_1..a_k, b_1..b_k
+        split = harmonic_split(*real, np.where(c > k, c - k, c), DECOUPLED_TOL)
+        at = np.ascontiguousarray(red.dyn[comp], dtype=np.int64)
+        back = (np.zeros((0, comp.size)) if red.back is None
+                else np.ascontiguousarray(red.back[:, comp], dtype=float))
+        alg = np.ascontiguousarray(red.alg, dtype=np.int64)
+        lapack = comp.size > PAIR_COMPILED_MAX
+        mats[b] = (tuple(X.astype(complex) for X in real), split, at, back, alg, lapack)
+    return mats[b]
+
+
 def _member(red: QuadraticReduction, b: int, s0: complex, y0: np.ndarray, shape: tuple,
             mats: dict, fold: bool = True):
     """The eigenpair of block ``b`` of ``red`` nearest ``(s0, y0)`` by inverse iteration
     (:func:`_inverse_iteration`), and its centroid. ``fold`` (a member): a real one made
     exactly real, one below the real axis replaced by its conjugate, and where the centre
     moved to the next copy (``|kappa| > 1/2``), that copy ``s + i round(kappa)`` instead;
-    otherwise (a neighbouring copy or a mirror) the eigenpair as found. None where an
-    iteration does not converge. ``mats``: the blocks' complex matrices made so far (one
-    block's are made on its first use)."""
+    otherwise (a mirror) the eigenpair as found. None where an iteration does not converge.
+    ``mats``: the blocks' arrays made so far (:func:`_block_mats`). One compiled call
+    (:func:`_member_kernel`); the steps from Python where LAPACK's solve in the kernel meets
+    a singular ``P(s)`` (:func:`_inverse_iteration`)."""
     r, H, k = shape
-    comp = red.blocks[b]
-    if b not in mats:
-        ix = np.ix_(comp, comp)
-        real = tuple(np.ascontiguousarray(X[ix]) for X in (red.B0, red.B1, red.B2))
-        c = red.dyn[comp] % H  # coefficient index: 0, a_1..a_k, b_1..b_k
-        split = harmonic_split(*real, np.where(c > k, c - k, c), DECOUPLED_TOL)
-        back = None if red.back is None else np.ascontiguousarray(red.back[:, comp])
-        mats[b] = tuple(X.astype(complex) for X in real) + (split, red.dyn[comp], back)
-    *B, split, at, back = mats[b]
+    B, split, at, back, alg, lapack = _block_mats(red, b, shape, mats)
+    y0 = np.ascontiguousarray(y0, dtype=complex)
+    try:
+        s1, y, kp, ok = _member_kernel(*B, complex(s0), y0, lapack, split, fold, at, back, alg,
+                                       red.n, r, H, k)
+    except np.linalg.LinAlgError:  # LAPACK's solve at a singular P(s): the Python steps
+        return _member_py(red, b, s0, y0, shape, mats, fold)
+    return (complex(s1), y, float(kp)) if ok else None
+
+
+def _member_py(red: QuadraticReduction, b: int, s0: complex, y0: np.ndarray, shape: tuple,
+               mats: dict, fold: bool):
+    """:func:`_member` with the inverse iterations called from Python."""
+    r, H, k = shape
+    B, split, at, back, alg, _ = _block_mats(red, b, shape, mats)
     for again in (False, True):
         s1, y, ok = _inverse_iteration(*B, s0, y0, split=split)
         if not ok:
@@ -1241,14 +1277,130 @@ def _member(red: QuadraticReduction, b: int, s0: complex, y0: np.ndarray, shape:
             s1 = complex(s1.real, 0.0)
         if fold and s1.imag < 0:  # the conjugate pair's other member
             s1, y = s1.conjugate(), y.conj()
-        p = np.zeros(red.n, dtype=complex)  # red.full of y on block b, with fewer calls
-        p[at] = y
-        if back is not None:
-            p[red.alg] = back @ y
-        kp = float(_centroids(p.reshape(1, r, H), k)[0])
+        kp = float(_block_centroid(y, at, back, alg, red.n, r, H, k))
         if again or not fold or abs(kp) <= 0.5:
             return s1, y, kp
         s0, y0 = s1 + 1j * round(kp), y  # the centre moved to the next copy
+
+
+def _copy(red: QuadraticReduction, b: int, s1: complex, y: np.ndarray, shape: tuple,
+          mats: dict, side: int):
+    """The neighbouring copy ``s + i side`` of the member ``(s1, y)`` of block ``b``:
+    ``(s, y, kappa, certified)``, None where its inverse iteration does not converge.
+    Its start is the member's eigenvector moved by one harmonic (:func:`_shifted_copy`);
+    where that pair's backward error is below :data:`COPY_EXACT`, the pair itself is the
+    copy (:func:`_copy_kernel`, which gives the argument), otherwise the inverse iteration
+    from it. One compiled call; the Python steps at a singular ``P(s)``."""
+    r, H, k = shape
+    B, split, at, back, alg, lapack = _block_mats(red, b, shape, mats)
+    y = np.ascontiguousarray(y, dtype=complex)
+    try:
+        s2, y2, kn, ok, cert = _copy_kernel(*B, complex(s1), y, side, lapack, split, at, back,
+                                            alg, red.n, r, H, k)
+    except np.linalg.LinAlgError:
+        got = _member_py(red, b, s1 + 1j * side, _shifted_copy(red, b, y, shape, side), shape,
+                         mats, False)
+        return None if got is None else got + (False,)
+    return (complex(s2), y2, float(kn), bool(cert)) if ok else None
+
+
+@njit(cache=True)
+def _block_centroid(y, at, back, alg, n, r, H, k):
+    """:func:`centroid` of the eigenvector ``y`` on a block's coordinates ``at`` with the
+    algebraic coordinates ``alg`` recovered as ``back @ y`` (:meth:`QuadraticReduction.full`
+    restricted to the block)."""
+    p = np.zeros(n, dtype=np.complex128)
+    for i in range(at.size):
+        p[at[i]] = y[i]
+    for a in range(alg.size):
+        acc = 0j
+        for j in range(y.size):
+            acc += back[a, j] * y[j]
+        p[alg[a]] = acc
+    return _centroids(p.reshape(1, r, H), k)[0]
+
+
+@njit(cache=True)
+def _member_kernel(B0, B1, B2, s0, y0, lapack, split, fold, at, back, alg, n, r, H, k):
+    """:func:`_member` compiled: Ruhe's iteration (:func:`_ruhe`, ten steps at most), the
+    folding of a member and its centroid (:func:`_block_centroid`), the next copy where the
+    centre moved. Returns ``(s, y, kappa, converged)``."""
+    y = y0
+    s1 = s0
+    kp = 0.0
+    for again in range(2):
+        s1, y, ok = _ruhe(B0, B1, B2, s0, y0, 10, lapack, split)
+        if not ok:
+            return s1, y, 0.0, False
+        if fold and abs(s1.imag) <= 1e-12 * max(abs(s1), 1.0):
+            s1 = complex(s1.real, 0.0)
+        if fold and s1.imag < 0:  # the conjugate pair's other member
+            s1, y = np.conj(s1), np.conj(y)
+        kp = _block_centroid(y, at, back, alg, n, r, H, k)
+        if again == 1 or not fold or abs(kp) <= 0.5:
+            return s1, y, kp, True
+        s0, y0 = s1 + 1j * np.rint(kp), y  # the centre moved to the next copy
+    return s1, y, kp, True
+
+
+@njit(cache=True)
+def _backward_error(B0, B1, B2, sigma, v):
+    """The backward error of the pair ``(sigma, v)`` of ``B0 + s B1 + s^2 B2`` (Tisseur,
+    Linear Algebra Appl. 309, 2000, theorem 1: ``|P(sigma) v| / ((|B0| + |sigma| |B1| +
+    |sigma|^2 |B2|) |v|)``), with each matrix's largest column 2-norm for its 2-norm (a lower
+    bound of it: the error is not under-estimated)."""
+    n = B0.shape[0]
+    s2 = sigma * sigma
+    res = 0.0
+    for i in range(n):
+        acc = 0j
+        for j in range(n):
+            acc += (B0[i, j] + sigma * B1[i, j] + s2 * B2[i, j]) * v[j]
+        res += acc.real * acc.real + acc.imag * acc.imag
+    c0, c1, c2, nv = 0.0, 0.0, 0.0, 0.0
+    for j in range(n):
+        a0, a1, a2 = 0.0, 0.0, 0.0
+        for i in range(n):
+            a0 += abs(B0[i, j]) ** 2
+            a1 += abs(B1[i, j]) ** 2
+            a2 += abs(B2[i, j]) ** 2
+        c0, c1, c2 = max(c0, a0), max(c1, a1), max(c2, a2)
+        nv += v[j].real * v[j].real + v[j].imag * v[j].imag
+    den = (np.sqrt(c0) + abs(sigma) * np.sqrt(c1) + abs(sigma) ** 2 * np.sqrt(c2)) * np.sqrt(nv)
+    return np.sqrt(res) / den if den > 0 else np.inf
+
+
+@njit(cache=True)
+def _copy_kernel(B0, B1, B2, s1, y, side, lapack, split, at, back, alg, n, r, H, k):
+    """:func:`_copy` compiled. The copy's start ``(sigma, v)``: ``sigma = s1 + i side``, ``v``
+    the member's ``y`` moved by one harmonic (:func:`~fretwear.hb.hill_tracking.shift_block`,
+    normalised). The shift maps the untruncated Hill problem at ``s`` onto itself at
+    ``s + i``, so ``P(sigma) v`` is the truncation's part only: the member's residual
+    (rounding) plus the rows where the law couples the harmonic that left or entered the
+    kept ones. Where the law does not reach them (a block whose coordinates' laws do not
+    vary over the period, or an eigenvector with no weight at the edge harmonics) that is
+    rounding too. Where the backward error of ``(sigma, v)`` (:func:`_backward_error`) is
+    below :data:`COPY_EXACT` the pair is an exact eigenpair of a pencil ``P + E`` with
+    ``|E| <= COPY_EXACT |P|``, no further from ``P`` than the eigenpairs that the dense
+    eigensolver (backward stable on the companion form) or the inverse iteration (stopped at
+    a step below 1e-14) return: the copy is certified as it is, with its centroid, and no
+    inverse iteration is run. Otherwise Ruhe's iteration from it (:func:`_ruhe`). Returns
+    ``(s, y, kappa, converged, certified)``."""
+    v = shift_block(y, at, H, k, side)
+    nrm = 0.0
+    for i in range(v.size):
+        nrm += v[i].real * v[i].real + v[i].imag * v[i].imag
+    if nrm > 0:
+        v = v / np.sqrt(nrm)
+    else:
+        v = y
+    sigma = s1 + 1j * side
+    if _backward_error(B0, B1, B2, sigma, v) <= COPY_EXACT:
+        return sigma, v, _block_centroid(v, at, back, alg, n, r, H, k), True, True
+    s2, y2, ok = _ruhe(B0, B1, B2, sigma, v, 10, lapack, split)
+    if not ok:
+        return s2, y2, 0.0, False, False
+    return s2, y2, _block_centroid(y2, at, back, alg, n, r, H, k), True, False
 
 
 def _on_line(s: complex) -> str | None:
