@@ -1229,17 +1229,14 @@ def _block_mats(red: QuadraticReduction, b: int, shape: tuple, mats: dict) -> tu
     empty one without), the algebraic coordinates, and whether LAPACK solves the steps."""
     if b not in mats:
         r, H, k = shape
-        comp = red.blocks[b]
-        ix = np.ix_(comp, comp)
-        real = tuple(np.ascontiguousarray(X[ix]) for X in (red.B0, red.B1, red.B2))
-        c = red.dyn[comp] % H  # coefficient index: 0, a_1..a_k, b_1..b_k
-        split = harmonic_split(*real, np.where(c > k, c - k, c), DECOUPLED_TOL)
-        at = np.ascontiguousarray(red.dyn[comp], dtype=np.int64)
-        back = (np.zeros((0, comp.size)) if red.back is None
-                else np.ascontiguousarray(red.back[:, comp], dtype=float))
+        comp = np.ascontiguousarray(red.blocks[b], dtype=np.int64)
+        back = np.zeros((0, red.dyn.size)) if red.back is None else red.back
+        *real, cplx, back, at, harm = _gather_block(red.B0, red.B1, red.B2, comp, back,
+                                                    red.dyn, H, k)
+        split = harmonic_split(*real, harm, DECOUPLED_TOL)
         alg = np.ascontiguousarray(red.alg, dtype=np.int64)
         lapack = comp.size > PAIR_COMPILED_MAX
-        mats[b] = (tuple(X.astype(complex) for X in real), split, at, back, alg, lapack)
+        mats[b] = (cplx, split, at, back, alg, lapack)
     return mats[b]
 
 
@@ -1302,6 +1299,33 @@ def _copy(red: QuadraticReduction, b: int, s1: complex, y: np.ndarray, shape: tu
                          mats, False)
         return None if got is None else got + (False,)
     return (complex(s2), y2, float(kn), bool(cert)) if ok else None
+
+
+@njit(cache=True)
+def _gather_block(B0, B1, B2, comp, back, dyn, H, k):
+    """Block ``comp`` (indices into ``dyn``) of the reduction's matrices in one compiled
+    call (:func:`_block_mats`): the three real blocks, the same complex, the columns
+    ``comp`` of ``back``, the block's coordinates ``dyn[comp]`` and their harmonics (the
+    coefficient index ``0, a_1..a_k, b_1..b_k`` of each, folded to ``0..k``)."""
+    nb = comp.size
+    R0, R1, R2 = np.empty((nb, nb)), np.empty((nb, nb)), np.empty((nb, nb))
+    for a in range(nb):
+        for c in range(nb):
+            R0[a, c] = B0[comp[a], comp[c]]
+            R1[a, c] = B1[comp[a], comp[c]]
+            R2[a, c] = B2[comp[a], comp[c]]
+    bk = np.empty((back.shape[0], nb))
+    for a in range(back.shape[0]):
+        for c in range(nb):
+            bk[a, c] = back[a, comp[c]]
+    at = np.empty(nb, dtype=np.int64)
+    harm = np.empty(nb, dtype=np.int64)
+    for a in range(nb):
+        at[a] = dyn[comp[a]]
+        c = at[a] % H
+        harm[a] = c - k if c > k else c
+    cplx = (R0.astype(np.complex128), R1.astype(np.complex128), R2.astype(np.complex128))
+    return R0, R1, R2, cplx, bk, at, harm
 
 
 @njit(cache=True)
