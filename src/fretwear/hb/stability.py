@@ -1127,7 +1127,13 @@ def track_eigen(red: QuadraticReduction, track: HillTrack | None, shape: tuple,
       that the dense path would not keep (:func:`_may_keep`: ``|kappa| > 1/2`` and not a
       period-doubling member that :func:`_edge_members` may add, with a margin for
       rounding): no family has a second member that the rule keeps (copies further off
-      have ``|kappa| >= 3/2`` less their truncation).
+      have ``|kappa| >= 3/2`` less their truncation). The copy is the member's eigenvector
+      moved by one harmonic, taken as it is where that pair's backward error is at rounding
+      (:data:`COPY_EXACT`, :func:`_copy_kernel`), otherwise iterated from there.
+
+    Each member, mirror and copy is one compiled call (:func:`_member_kernel`,
+    :func:`_copy_kernel`) on its block's arrays, gathered once per point
+    (:func:`_block_mats`).
 
     ``omega``: the solution's circular frequency, with the track's velocities the start of
     each member's iteration (a member moved 2-3e-2 a step on the benchmark's two-DOF sweep:
