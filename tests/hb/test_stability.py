@@ -36,7 +36,7 @@ from fretwear.hb.stability import (
     _copy,
     _inverse_iteration,
     _inverse_iteration_py,
-    _member_py,
+    _member,
     _pair,
     _pair_lapack,
     _shifted_copy,
@@ -574,13 +574,13 @@ def test_certified_copies_are_the_iterated_copies():
     its inverse iteration where the shifted eigenvector's backward error is below
     ``COPY_EXACT`` (the copy exact to rounding: a block whose law does not vary over the
     period, here the two-DOF oscillator's frictionless tangential DOF); the reference is the
-    copy found by the inverse iteration from the same start, called from Python
-    (:func:`_member_py`). On the members of a point of the unilateral oscillator's resonance:
-    some copies certified and some not (the contact block's, truncated), so both paths are
+    copy found by the inverse iteration from the same start (:func:`_member`, not folded).
+    On the members of a point of the unilateral oscillator's resonance: some copies certified
+    and some not (the contact block's, truncated), so both paths are
     covered; a certified copy's eigenvalue equal to the iterated one within 1e-13 of
     ``max(1, |s|)`` and its centroid within 1e-12 (both pairs are exact for pencils within
     rounding of the problem's, and the copies are simple eigenvalues far from the others);
-    an iterated one the same within 1e-12 (the same steps compiled). The backward error is
+    an iterated one the same within 1e-12 (the same steps). The backward error is
     checked against Tisseur's formula with the matrices' 2-norms: never below it (the column
     norms are lower bounds of the 2-norm), within a factor ``sqrt(n)`` above it."""
     model = two_dof()
@@ -604,7 +604,7 @@ def test_certified_copies_are_the_iterated_copies():
         side = 1 if kp >= 0 else -1
         s2, y2, k2, cert = _copy(red, b, complex(s), y, shape, mats, side)
         start = _shifted_copy(red, b, y, shape, side)
-        ref = _member_py(red, b, complex(s) + 1j * side, start, shape, mats, False)
+        ref = _member(red, b, complex(s) + 1j * side, start, shape, mats, fold=False)
         assert ref is not None
         B0, B1, B2 = _block_mats(red, b, shape, mats)[0]
         sigma = complex(s) + 1j * side

@@ -166,7 +166,7 @@ DECOUPLED_TOL = 1e-13
 MIN_BLOCK = 48
 #: a neighbouring copy whose start (the member's eigenvector moved by one harmonic) has a
 #: backward error below this is taken as it is, without its inverse iteration
-#: (:func:`_ruhe`: rounding; the blocks whose laws do not vary over the period give
+#: (:func:`_copy`: rounding; the blocks whose laws do not vary over the period give
 #: 2e-17 to 4e-17 on the two-DOF oscillator, the truncated copies 1e-4 to 1e-3)
 COPY_EXACT = 1e-15
 #: exponents whose multiplier is below this are not refined (they decay within a period; the
@@ -1062,10 +1062,7 @@ def _inverse_iteration(B0, B1, B2, sigma: complex, y: np.ndarray, max_iter: int 
     lapack = B0.shape[0] > PAIR_COMPILED_MAX
     split = no_split() if split is None else split
     try:
-        n = B0.shape[0]
-        s1, x1, _, ok, _ = _ruhe(B0, B1, B2, complex(sigma), y, max_iter, lapack, split, 3,
-                                 np.arange(n), np.zeros((0, n)), np.zeros(0, dtype=np.int64),
-                                 n, 1, n, 0)
+        s1, x1, ok = _ruhe(B0, B1, B2, complex(sigma), y, max_iter, lapack, split)
     except np.linalg.LinAlgError:  # LAPACK's solve at a singular P(s)
         return _inverse_iteration_py(B0, B1, B2, sigma, y, max_iter)
     return complex(s1), x1, bool(ok)
@@ -1132,11 +1129,9 @@ def track_eigen(red: QuadraticReduction, track: HillTrack | None, shape: tuple,
       rounding): no family has a second member that the rule keeps (copies further off
       have ``|kappa| >= 3/2`` less their truncation). The copy is the member's eigenvector
       moved by one harmonic, taken as it is where that pair's backward error is at rounding
-      (:data:`COPY_EXACT`, :func:`_ruhe`), otherwise iterated from there.
+      (:data:`COPY_EXACT`, :func:`_copy`), otherwise iterated from there.
 
-    Each member, mirror and copy is one compiled call (:func:`_ruhe`) on its
-    block's arrays, gathered once per point
-    (:func:`_block_mats`).
+    The blocks' arrays are gathered once per point (:func:`_block_mats`).
 
     ``omega``: the solution's circular frequency, with the track's velocities the start of
     each member's iteration (a member moved 2-3e-2 a step on the benchmark's two-DOF sweep:
@@ -1252,27 +1247,12 @@ def _block_mats(red: QuadraticReduction, b: int, shape: tuple, mats: dict) -> tu
 def _member(red: QuadraticReduction, b: int, s0: complex, y0: np.ndarray, shape: tuple,
             mats: dict, fold: bool = True):
     """The eigenpair of block ``b`` of ``red`` nearest ``(s0, y0)`` by inverse iteration
-    (:func:`_inverse_iteration`), and its centroid. ``fold`` (a member): a real one made
-    exactly real, one below the real axis replaced by its conjugate, and where the centre
-    moved to the next copy (``|kappa| > 1/2``), that copy ``s + i round(kappa)`` instead;
-    otherwise (a mirror) the eigenpair as found. None where an iteration does not converge.
-    ``mats``: the blocks' arrays made so far (:func:`_block_mats`). One compiled call
-    (:func:`_ruhe`); the steps from Python where LAPACK's solve in the kernel meets
-    a singular ``P(s)`` (:func:`_inverse_iteration`)."""
-    r, H, k = shape
-    B, split, at, back, alg, lapack = _block_mats(red, b, shape, mats)
-    y0 = np.ascontiguousarray(y0, dtype=complex)
-    try:
-        s1, y, kp, ok, _ = _ruhe(*B, complex(s0), y0, 10, lapack, split, 0 if fold else 2, at,
-                                 back, alg, red.n, r, H, k)
-    except np.linalg.LinAlgError:  # LAPACK's solve at a singular P(s): the Python steps
-        return _member_py(red, b, s0, y0, shape, mats, fold)
-    return (complex(s1), y, float(kp)) if ok else None
-
-
-def _member_py(red: QuadraticReduction, b: int, s0: complex, y0: np.ndarray, shape: tuple,
-               mats: dict, fold: bool):
-    """:func:`_member` with the inverse iterations called from Python."""
+    (:func:`_inverse_iteration`), and its centroid (:func:`_block_centroid`). ``fold`` (a
+    member): a real one made exactly real, one below the real axis replaced by its
+    conjugate, and where the centre moved to the next copy (``|kappa| > 1/2``), that copy
+    ``s + i round(kappa)`` instead; otherwise (a neighbouring copy or a mirror) the
+    eigenpair as found. None where an iteration does not converge. ``mats``: the blocks'
+    arrays made so far (:func:`_block_mats`)."""
     r, H, k = shape
     B, split, at, back, alg, _ = _block_mats(red, b, shape, mats)
     for again in (False, True):
@@ -1293,21 +1273,41 @@ def _copy(red: QuadraticReduction, b: int, s1: complex, y: np.ndarray, shape: tu
           mats: dict, side: int):
     """The neighbouring copy ``s + i side`` of the member ``(s1, y)`` of block ``b``:
     ``(s, y, kappa, certified)``, None where its inverse iteration does not converge.
-    Its start is the member's eigenvector moved by one harmonic (:func:`_shifted_copy`);
-    where that pair's backward error is below :data:`COPY_EXACT`, the pair itself is the
-    copy (:func:`_ruhe`, which gives the argument), otherwise the inverse iteration
-    from it. One compiled call; the Python steps at a singular ``P(s)``."""
+    Its start ``(sigma, v)`` (:func:`_copy_start`): ``sigma = s1 + i side``, ``v`` the
+    member's eigenvector moved by one harmonic (:func:`_shifted_copy`, normalised). The
+    shift maps the untruncated Hill problem at ``s`` onto itself at ``s + i``, so
+    ``P(sigma) v`` is the truncation's part only: the member's residual (rounding) plus the
+    rows where the law couples the harmonic that left or entered the kept ones. Where the
+    law does not reach them (a block whose coordinates' laws do not vary over the period,
+    or an eigenvector with no weight at the edge harmonics) that is rounding too. Where the
+    backward error of ``(sigma, v)`` (:func:`_backward_error`) is below :data:`COPY_EXACT`
+    the pair is an exact eigenpair of a pencil ``P + E`` with ``|E| <= COPY_EXACT |P|``,
+    no further from ``P`` than the eigenpairs that the dense eigensolver (backward stable
+    on the companion form) or the inverse iteration (stopped at a step below 1e-14)
+    return: the copy is certified as it is, with its centroid, and no inverse iteration is
+    run; otherwise the inverse iteration from it (:func:`_member`, not folded)."""
     r, H, k = shape
-    B, split, at, back, alg, lapack = _block_mats(red, b, shape, mats)
-    y = np.ascontiguousarray(y, dtype=complex)
-    try:
-        s2, y2, kn, ok, cert = _ruhe(*B, complex(s1), y, 10, lapack, split, side, at, back,
-                                     alg, red.n, r, H, k)
-    except np.linalg.LinAlgError:
-        got = _member_py(red, b, s1 + 1j * side, _shifted_copy(red, b, y, shape, side), shape,
-                         mats, False)
-        return None if got is None else got + (False,)
-    return (complex(s2), y2, float(kn), bool(cert)) if ok else None
+    B, split, at, back, alg, _ = _block_mats(red, b, shape, mats)
+    sigma, v, eta = _copy_start(*B, complex(s1), np.ascontiguousarray(y, dtype=complex), side,
+                                at, H, k)
+    if eta <= COPY_EXACT:
+        return complex(sigma), v, float(_block_centroid(v, at, back, alg, red.n, r, H, k)), True
+    got = _member(red, b, sigma, v, shape, mats, fold=False)
+    return None if got is None else got + (False,)
+
+
+@njit(cache=True)
+def _copy_start(B0, B1, B2, s1, y, side, at, H, k):
+    """:func:`_copy`'s start ``(sigma, v)`` and its backward error, compiled: ``v``
+    :func:`~fretwear.hb.hill_tracking.shift_block` of ``y`` normalised (``y`` where the
+    shift leaves nothing), ``sigma = s1 + i side``."""
+    v = shift_block(y, at, H, k, side)
+    nrm = 0.0
+    for i in range(v.size):
+        nrm += v[i].real * v[i].real + v[i].imag * v[i].imag
+    v = v / np.sqrt(nrm) if nrm > 0 else y.copy()
+    sigma = s1 + 1j * side
+    return sigma, v, _backward_error(B0, B1, B2, sigma, v)
 
 
 @njit(cache=True)
@@ -1581,105 +1581,49 @@ def _residuals(T, y, mu):
 
 
 @njit(cache=True)
-def _ruhe(B0, B1, B2, s0, y0, max_iter, lapack, split0, side, at, back, alg, nfull, rr, H, k):
-    """:func:`_inverse_iteration` compiled (the same steps), and the whole of one eigenpair
-    of :func:`track_eigen` in the same call (one kernel: a caller of a compiled function
-    compiles it again on a cold cache). Returns ``(s, y, kappa, converged, certified)``.
-
-    ``side`` 3: Ruhe's iteration from ``(s0, y0)``, at most ``max_iter`` steps, alone
-    (``kappa`` 0). 0: a member (:func:`_member` with ``fold``): the iteration, a real
-    result made exactly real, one below the real axis replaced by its conjugate, its
-    centroid (:func:`_block_centroid`: ``y`` on the block's coordinates ``at`` of a
-    reduction with ``nfull`` coordinates, ``back`` its algebraic ones ``alg``; ``rr, H,
-    k`` of :func:`centroid`), and where the centre moved to the next copy
-    (``|kappa| > 1/2``), that copy ``s + i round(kappa)`` instead. 2: a mirror (the same,
-    not folded). 1 or -1: the copy ``s0 + i side`` of the member ``(s0, y0)``
-    (:func:`_copy`). The copy's start ``(sigma, v)``: ``sigma = s0 + i side``, ``v`` the
-    member's eigenvector moved by one harmonic
-    (:func:`~fretwear.hb.hill_tracking.shift_block`, normalised). The shift maps the
-    untruncated Hill problem at ``s`` onto itself at ``s + i``, so ``P(sigma) v`` is the
-    truncation's part only: the member's residual (rounding) plus the rows where the law
-    couples the harmonic that left or entered the kept ones. Where the law does not reach
-    them (a block whose coordinates' laws do not vary over the period, or an eigenvector
-    with no weight at the edge harmonics) that is rounding too. Where the backward error of
-    ``(sigma, v)`` (:func:`_backward_error`) is below :data:`COPY_EXACT` the pair is an
-    exact eigenpair of a pencil ``P + E`` with ``|E| <= COPY_EXACT |P|``, no further from
-    ``P`` than the eigenpairs that the dense eigensolver (backward stable on the companion
-    form) or this iteration (stopped at a step below 1e-14) return: the copy is certified
-    as it is, with its centroid, and no iteration is run; otherwise the iteration from it.
-
-    Each step solves with ``P(sigma)`` by the harmonic split (:func:`~fretwear.hb.
-    hill_tracking._split_factor`: the LU of the core's Schur complement, where ``split0``
-    has local unknowns or a core; a step whose split refuses is solved as without one), by
+def _ruhe(B0, B1, B2, sigma, y, max_iter, lapack, split):
+    """:func:`_inverse_iteration` compiled (the same steps): ``(sigma, y, converged)``. Each
+    step solves with ``P(sigma)`` by the harmonic split (:func:`~fretwear.hb.hill_tracking.
+    _split_factor`: the LU of the core's Schur complement, where ``split`` has local
+    unknowns or a core; a step whose split refuses is solved as without one), by
     :func:`_lu_small` (one LU a step; not converged at a zero pivot) or, with ``lapack``
     (larger blocks), by LAPACK's ``zgesv`` (``np.linalg.solve``: one LU a solve, two at the
     first step; raises ``LinAlgError`` at a singular ``P(s)``)."""
-    fold = side == 0
-    if side == 1 or side == -1:
-        v = shift_block(y0, at, H, k, side)
-        nrm = 0.0
-        for i in range(v.size):
-            nrm += v[i].real * v[i].real + v[i].imag * v[i].imag
-        v = v / np.sqrt(nrm) if nrm > 0 else y0.copy()
-        s0 = s0 + 1j * side
-        if _backward_error(B0, B1, B2, s0, v) <= COPY_EXACT:
-            return s0, v, _block_centroid(v, at, back, alg, nfull, rr, H, k), True, True
-        y0 = v
     n = B0.shape[0]
+    x = _unit(y)
+    first = True
     A = np.empty((n, n), dtype=np.complex128)
     r = np.empty(n, dtype=np.complex128)
-    sigma = s0
-    x = _unit(y0)
-    rounds = 2 if fold else 1  # not a constant: the loop is not unrolled (compile time)
-    for again in range(rounds):
-        sigma = s0
-        x = _unit(y0)
-        split = split0
-        first = True
-        piv = np.arange(n)
-        use = split[0].size + split[2].size > 0
-        work = split_work(split, n)
-        last = np.inf
-        state = 0
-        for _ in range(max_iter):
-            _pencil_into(B0, B1, B2, sigma, A)
-            how = 1 if lapack else 0
-            while use:  # a group near singular at sigma joins the core (kept for next steps)
-                piv, bad = _split_factor(A, split, work)
-                if bad == -1:
-                    how = 2
-                    break
-                if bad == -2 or 2 * split[2].size > n:
-                    use = False
-                    break
-                split = _demote(split, bad)
-                work = split_work(split, n)
-            if how == 0:
-                piv, ok = _lu_small(A)
-                if not ok:
-                    state = -1
-                    break
-            if first:  # towards the eigenvector of the eigenvalue nearest sigma
-                x = _unit(_solve_pencil(A, piv, x, how, split, work))
-                first = False
-            _slope_into(B1, B2, sigma, x, r)
-            sigma, x, state, last = _ruhe_update(sigma, x, _solve_pencil(A, piv, r, how, split,
-                                                                          work), last)
-            if state != 0:
+    piv = np.arange(n)
+    use = split[0].size + split[2].size > 0
+    work = split_work(split, n)
+    last = np.inf
+    for _ in range(max_iter):
+        _pencil_into(B0, B1, B2, sigma, A)
+        how = 1 if lapack else 0
+        while use:  # a group near singular at sigma joins the core (kept for the next steps)
+            piv, bad = _split_factor(A, split, work)
+            if bad == -1:
+                how = 2
                 break
-        if state <= 0:
-            return sigma, x, 0.0, False, False
-        if side == 3:
-            return sigma, x, 0.0, True, False
-        if fold and abs(sigma.imag) <= 1e-12 * max(abs(sigma), 1.0):
-            sigma = complex(sigma.real, 0.0)
-        if fold and sigma.imag < 0:  # the conjugate pair's other member
-            sigma, x = np.conj(sigma), np.conj(x)
-        kp = _block_centroid(x, at, back, alg, nfull, rr, H, k)
-        if again == rounds - 1 or abs(kp) <= 0.5:
-            return sigma, x, kp, True, False
-        s0, y0 = sigma + 1j * np.rint(kp), x  # the centre moved to the next copy
-    return sigma, x, 0.0, False, False
+            if bad == -2 or 2 * split[2].size > n:
+                use = False
+                break
+            split = _demote(split, bad)
+            work = split_work(split, n)
+        if how == 0:
+            piv, ok = _lu_small(A)
+            if not ok:
+                return sigma, x, False
+        if first:  # towards the eigenvector of the eigenvalue nearest sigma
+            x = _unit(_solve_pencil(A, piv, x, how, split, work))
+            first = False
+        _slope_into(B1, B2, sigma, x, r)
+        sigma, x, state, last = _ruhe_update(sigma, x, _solve_pencil(A, piv, r, how, split,
+                                                                      work), last)
+        if state != 0:
+            return sigma, x, state > 0
+    return sigma, x, False
 
 
 @njit(cache=True)
