@@ -608,7 +608,7 @@ def test_certified_copies_are_the_iterated_copies():
         assert ref is not None
         B0, B1, B2 = _block_mats(red, b, shape, mats)[0]
         sigma = complex(s) + 1j * side
-        eta = _backward_error(B0, B1, B2, sigma, start)
+        eta = _backward_error(B0, B1, B2, sigma, start, _block_mats(red, b, shape, mats)[5])
         tis = np.linalg.norm((B0 + sigma * B1 + sigma ** 2 * B2) @ start) / (
             np.linalg.norm(B0, 2) + abs(sigma) * np.linalg.norm(B1, 2)
             + abs(sigma) ** 2 * np.linalg.norm(B2, 2)) / np.linalg.norm(start)

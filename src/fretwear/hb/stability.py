@@ -1227,10 +1227,11 @@ def _shifted_copy(red: QuadraticReduction, b: int, y: np.ndarray, shape: tuple,
 
 
 def _block_mats(red: QuadraticReduction, b: int, shape: tuple, mats: dict) -> tuple:
-    """Block ``b``'s arrays for the compiled member and copy kernels (made on the block's
-    first use, kept in ``mats``): its complex ``B0, B1, B2``, the harmonic split, the
-    block's coordinates, the algebraic coordinates' ``back`` restricted to the block (an
-    empty one without), the algebraic coordinates, and whether LAPACK solves the steps."""
+    """Block ``b``'s arrays for :func:`_member` and :func:`_copy` (made on the block's first
+    use, kept in ``mats``): its complex ``B0, B1, B2``, the harmonic split, the block's
+    coordinates, the algebraic coordinates' ``back`` restricted to the block (an empty one
+    without), the algebraic coordinates, and the matrices' column norms
+    (:func:`_column_norms`)."""
     if b not in mats:
         r, H, k = shape
         comp = np.ascontiguousarray(red.blocks[b], dtype=np.int64)
@@ -1239,8 +1240,7 @@ def _block_mats(red: QuadraticReduction, b: int, shape: tuple, mats: dict) -> tu
                                                     red.dyn, H, k)
         split = harmonic_split(*real, harm, DECOUPLED_TOL)
         alg = np.ascontiguousarray(red.alg, dtype=np.int64)
-        lapack = comp.size > PAIR_COMPILED_MAX
-        mats[b] = (cplx, split, at, back, alg, lapack)
+        mats[b] = (cplx, split, at, back, alg, _column_norms(*cplx))
     return mats[b]
 
 
@@ -1287,9 +1287,9 @@ def _copy(red: QuadraticReduction, b: int, s1: complex, y: np.ndarray, shape: tu
     return: the copy is certified as it is, with its centroid, and no inverse iteration is
     run; otherwise the inverse iteration from it (:func:`_member`, not folded)."""
     r, H, k = shape
-    B, split, at, back, alg, _ = _block_mats(red, b, shape, mats)
-    sigma, v, eta = _copy_start(*B, complex(s1), np.ascontiguousarray(y, dtype=complex), side,
-                                at, H, k)
+    B, split, at, back, alg, norms = _block_mats(red, b, shape, mats)
+    sigma, v, eta = _copy_start(*B, norms, complex(s1), np.ascontiguousarray(y, dtype=complex),
+                                side, at, H, k)
     if eta <= COPY_EXACT:
         return complex(sigma), v, float(_block_centroid(v, at, back, alg, red.n, r, H, k)), True
     got = _member(red, b, sigma, v, shape, mats, fold=False)
@@ -1297,7 +1297,7 @@ def _copy(red: QuadraticReduction, b: int, s1: complex, y: np.ndarray, shape: tu
 
 
 @njit(cache=True)
-def _copy_start(B0, B1, B2, s1, y, side, at, H, k):
+def _copy_start(B0, B1, B2, norms, s1, y, side, at, H, k):
     """:func:`_copy`'s start ``(sigma, v)`` and its backward error, compiled: ``v``
     :func:`~fretwear.hb.hill_tracking.shift_block` of ``y`` normalised (``y`` where the
     shift leaves nothing), ``sigma = s1 + i side``."""
@@ -1307,7 +1307,7 @@ def _copy_start(B0, B1, B2, s1, y, side, at, H, k):
         nrm += v[i].real * v[i].real + v[i].imag * v[i].imag
     v = v / np.sqrt(nrm) if nrm > 0 else y.copy()
     sigma = s1 + 1j * side
-    return sigma, v, _backward_error(B0, B1, B2, sigma, v)
+    return sigma, v, _backward_error(B0, B1, B2, sigma, v, norms)
 
 
 @njit(cache=True)
@@ -1354,29 +1354,39 @@ def _block_centroid(y, at, back, alg, n, r, H, k):
 
 
 @njit(cache=True)
-def _backward_error(B0, B1, B2, sigma, v):
+def _column_norms(B0, B1, B2):
+    """The largest column 2-norm of each of ``B0, B1, B2``: a lower bound of its 2-norm
+    (:func:`_backward_error`'s denominator, made once per block)."""
+    n = B0.shape[0]
+    c0, c1, c2 = 0.0, 0.0, 0.0
+    for j in range(n):
+        a0, a1, a2 = 0.0, 0.0, 0.0
+        for i in range(n):
+            a0 += B0[i, j].real ** 2 + B0[i, j].imag ** 2
+            a1 += B1[i, j].real ** 2 + B1[i, j].imag ** 2
+            a2 += B2[i, j].real ** 2 + B2[i, j].imag ** 2
+        c0, c1, c2 = max(c0, a0), max(c1, a1), max(c2, a2)
+    return np.array([np.sqrt(c0), np.sqrt(c1), np.sqrt(c2)])
+
+
+@njit(cache=True)
+def _backward_error(B0, B1, B2, sigma, v, norms):
     """The backward error of the pair ``(sigma, v)`` of ``B0 + s B1 + s^2 B2`` (Tisseur,
     Linear Algebra Appl. 309, 2000, theorem 1: ``|P(sigma) v| / ((|B0| + |sigma| |B1| +
-    |sigma|^2 |B2|) |v|)``), with each matrix's largest column 2-norm for its 2-norm (a lower
-    bound of it: the error is not under-estimated)."""
+    |sigma|^2 |B2|) |v|)``), with ``norms`` (:func:`_column_norms`: each matrix's largest
+    column 2-norm, a lower bound of its 2-norm, so the error is not under-estimated) for
+    the matrices' 2-norms."""
     n = B0.shape[0]
     s2 = sigma * sigma
     res = 0.0
+    nv = 0.0
     for i in range(n):
         acc = 0j
         for j in range(n):
             acc += (B0[i, j] + sigma * B1[i, j] + s2 * B2[i, j]) * v[j]
         res += acc.real * acc.real + acc.imag * acc.imag
-    c0, c1, c2, nv = 0.0, 0.0, 0.0, 0.0
-    for j in range(n):
-        a0, a1, a2 = 0.0, 0.0, 0.0
-        for i in range(n):
-            a0 += abs(B0[i, j]) ** 2
-            a1 += abs(B1[i, j]) ** 2
-            a2 += abs(B2[i, j]) ** 2
-        c0, c1, c2 = max(c0, a0), max(c1, a1), max(c2, a2)
-        nv += v[j].real * v[j].real + v[j].imag * v[j].imag
-    den = (np.sqrt(c0) + abs(sigma) * np.sqrt(c1) + abs(sigma) ** 2 * np.sqrt(c2)) * np.sqrt(nv)
+        nv += v[i].real * v[i].real + v[i].imag * v[i].imag
+    den = (norms[0] + abs(sigma) * norms[1] + abs(sigma) ** 2 * norms[2]) * np.sqrt(nv)
     return np.sqrt(res) / den if den > 0 else np.inf
 
 
