@@ -1889,10 +1889,11 @@ def _settled(size, last, scale):
     ``size / last^2``; the prediction is trusted where the step contracted by 1e3 at least
     (the quadratic regime), and then the step that would confirm it (one LU) is not taken:
     the eigenvalue is within the prediction of the one that step would give, and the vector,
-    from a solve at ``sigma`` already ``size`` from the eigenvalue, as accurate."""
+    from a solve at ``sigma`` already ``size`` from the eigenvalue, as accurate. A first
+    step (``last`` infinite) has no contraction to judge: only the 1e-14 test ends it."""
     if size <= 1e-14 * scale:
         return True
-    if size > 1e-7 * scale or size > 1e-3 * last:
+    if size > 1e-7 * scale or not last < np.inf or size > 1e-3 * last:
         return False
     return size * size * (size / (last * last)) <= 1e-15 * scale
 
