@@ -710,12 +710,13 @@ class HillProblem:
         # interval (:mod:`fretwear.hb.memory_gain`; None: the recursion at every s), where
         # a node sticks (otherwise nothing is refined: G(0) as the solve has it)
         sticks = bool(self._states()[0][:, STICK].any())
-        self._memory = (memory_gain(self.lu, self.lx, self.state, *self._law) if sticks
-                        else None)
-        if self._memory is not None:  # G(0) from the split: the solve's recursion's terms
-            # summed in another order (no node sticks all period, so the solve's wrap-around
-            # is exact in one sweep and its anchors do not enter): equal to rounding
-            self.G0 = self._memory.at(1.0).real
+        split = memory_gain(self.lu, self.lx, self.state, *self._law)
+        self._memory = split if sticks else None
+        if split is not None:  # G(0) from the split: the solve's recursion's terms summed
+            # in another order (no node sticks all period, so the solve's wrap-around is
+            # exact in one sweep and its anchors do not enter): equal to rounding; without a
+            # stick interval the split is G(0) itself, made at 0.6 of the recursion's cost
+            self.G0 = split.at(1.0).real
         else:
             self.G0 = law.dlft_jacobian(self.lu, self.lx, self.state, prob.mu, prob.P, prob.Q,
                                         prob.eps * prob.anchor, prob.tol, prob.max_sweeps,
@@ -1902,6 +1903,12 @@ def _mu_derivative(hp: HillProblem, sigma: complex, v: np.ndarray, T: np.ndarray
     return complex(np.vdot(w, dT @ v) / den) if den != 0 else 0.0
 
 
+def _centroid_of(v: np.ndarray, m: int, H: int, k: int) -> float:
+    """:func:`centroid` of one refined eigenvector ``v`` (m H,): its kernel called directly
+    (the wrapper's reshapes and checks cost as much as the kernel on one vector)."""
+    return float(_centroids(np.ascontiguousarray(v, dtype=complex).reshape(1, m, H), k)[0])
+
+
 def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
                    options: HillOptions | None = None,
                    previous: FloquetResult | None = None) -> FloquetResult:
@@ -1960,7 +1967,7 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
         s0 = complex(vals[i])
         y = vecs[:, i]
         vx = y[:m * H]
-        held = np.linalg.norm(vx) < 1e-8 * np.linalg.norm(y)
+        held = np.vdot(vx, vx).real < 1e-16 * np.vdot(y, y).real  # |vx| < 1e-8 |y|
         negligible = 2.0 * np.pi * s0.real < np.log(NEGLIGIBLE)
         if held or exact or negligible or refined >= opt.refine:  # refined: successes
             sig.append(s0)
@@ -1982,41 +1989,70 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
             a = s0.real if abs(s0.real - s1.real) > 10 * ON_REAL else s1.real - 0.01
             s2, v2, r2, conv2, _ = _track(hp, complex(a, 0.0), vx, opt, deflate=s1.real)
             sig.append(complex(s2.real, 0.0) if conv2 else np.conj(s0))
-            kaps.append(centroid(v2.reshape(m, H), k) if conv2 else -kp)
+            kaps.append(_centroid_of(v2, m, H, k) if conv2 else -kp)
             res.append(r2 if conv2 else np.nan)
             kind.append("refined" if conv2 else "candidate")
         done[pos] = Refined(s0, s1, v1, slope)
         sig.append(s1)
-        kaps.append(centroid(v1.reshape(m, H), k))
+        kaps.append(_centroid_of(v1, m, H, k))
         res.append(r1)
         kind.append("refined")
     if track is not None:
         track.refined = done
-    sig = np.array(sig, dtype=complex)
-    kaps = np.array(kaps)
-    res = np.array(res)
-    kind = np.array(kind, dtype=object)
-    # one multiplier per family: the conjugate of a complex exponent is another family,
-    # except at Im s = w/2, where s and its conjugate s - i w are the two members of one
-    # family with a real negative multiplier (a period-doubling direction)
-    edge = np.abs(np.abs(sig.imag) - 0.5) <= EDGE_TOL
-    cplx = (np.abs(sig.imag) > 1e-9 * np.maximum(np.abs(sig), 1.0)) & ~edge
-    allsig = np.concatenate([sig, np.conj(sig[cplx])])
-    allkap = np.concatenate([kaps, -kaps[cplx]])
-    allres = np.concatenate([res, res[cplx]])
-    allkind = np.concatenate([kind, kind[cplx]])
-    mult = np.exp(2.0 * np.pi * allsig)
-    redge = np.concatenate([edge, np.zeros(int(cplx.sum()), dtype=bool)])
-    mult[redge] = -np.exp(2.0 * np.pi * allsig[redge].real)
-    chosen = np.argsort(-allsig.real, kind="stable")
+    # one multiplier per family (:func:`_families`), sorted by decreasing real part
+    allsig, mult, allkap, allres, src = _families(np.array(sig, dtype=complex),
+                                                  np.array(kaps, dtype=float),
+                                                  np.array(res, dtype=float), EDGE_TOL)
     w = hp.omega
-    return FloquetResult(exponents=allsig[chosen] * w, multipliers=mult[chosen],
-                         centroid=allkap[chosen], residual=allres[chosen],
-                         kind=allkind[chosen], neutral=hp.neutral(), omega=w,
+    return FloquetResult(exponents=allsig * w, multipliers=mult, centroid=allkap,
+                         residual=allres, kind=np.array(kind, dtype=object)[src],
+                         neutral=hp.neutral(), omega=w,
                          spurious=np.array(spurious, dtype=complex) * w,
                          evaluations=hp.evaluations, wall_time=time.perf_counter() - t0,
                          stable_tol=opt.stable_tol, det_sign=det_sign,
                          tracked=got is not None, track=track)
+
+
+@njit(cache=True)
+def _families(sig, kap, res, edge_tol):
+    """The exponents ``sig`` (``s / w``, one member per family with ``Im s >= 0``), their
+    centroids ``kap`` and residuals ``res`` completed and sorted as
+    :class:`FloquetResult` holds them, in one compiled call: one multiplier per family (the
+    conjugate of a complex exponent is another family, centroid negated, except at
+    ``Im s = w/2``, within ``edge_tol``, where ``s`` and its conjugate ``s - i w`` are the two
+    members of one family with a real negative multiplier ``-e^{2 pi Re sigma}``: a
+    period-doubling direction), ordered by decreasing real part (a stable sort: the order of
+    ``sig`` among equal real parts, each conjugate after the exponents). Returns ``(sigma,
+    multipliers, centroid, residual, source)``, ``source`` the index in ``sig`` each came
+    from."""
+    n = sig.size
+    edge = np.empty(n, dtype=np.bool_)
+    cplx = np.empty(n, dtype=np.bool_)
+    extra = 0
+    for i in range(n):
+        edge[i] = abs(abs(sig[i].imag) - 0.5) <= edge_tol
+        cplx[i] = abs(sig[i].imag) > 1e-9 * max(abs(sig[i]), 1.0) and not edge[i]
+        extra += cplx[i]
+    total = n + extra
+    s = np.empty(total, dtype=np.complex128)
+    k = np.empty(total)
+    r = np.empty(total)
+    src = np.empty(total, dtype=np.int64)
+    mult = np.empty(total, dtype=np.complex128)
+    j = n
+    for i in range(n):
+        s[i], k[i], r[i], src[i] = sig[i], kap[i], res[i], i
+        if edge[i]:
+            mult[i] = -np.exp(2.0 * np.pi * sig[i].real)
+        else:
+            mult[i] = np.exp(2.0 * np.pi * sig[i])
+        if cplx[i]:
+            c = np.conj(sig[i])
+            s[j], k[j], r[j], src[j] = c, -kap[i], res[i], i
+            mult[j] = np.exp(2.0 * np.pi * c)
+            j += 1
+    order = np.argsort(-s.real, kind="mergesort")
+    return s[order], mult[order], k[order], r[order], src[order]
 
 
 def stability(model: Model, sol: PeriodicSolution, *, options: HillOptions | None = None,
