@@ -92,8 +92,9 @@ call, :func:`_refine`); along a sweep, where the
 candidates are tracked, a few LU factorisations of the blocks of the quadratic problem per
 candidate instead of its dense eigensolve (each solved by the LU of the Schur complement
 on the unknowns that couple harmonics, the others eliminated harmonic by harmonic:
-:mod:`fretwear.hb.hill_tracking`). ``det J`` is read from the solve's own ``G`` and
-``Z~`` (:meth:`HillProblem.jacobian`). Measured on the benchmark's small models
+:mod:`fretwear.hb.hill_tracking`). ``det J`` is read from the solve's ``G`` (made again from
+the split of :mod:`fretwear.hb.memory_gain` where it applies: equal to rounding) and ``Z~``
+(:meth:`HillProblem.jacobian`). Measured on the benchmark's small models
 (docs/studies/method-costs.md, "Hill's method"): about 1.2-2 times the CPU a sweep spends
 on the point (median; a tracked point of the two-DOF oscillator about 4 ms), along a
 sweep, which hands each point's own problem
@@ -708,7 +709,8 @@ class HillProblem:
         self._summary = None  # the contact states per node (:meth:`_states`)
         # in 2D, G(s) split once into its part free of s and one outer product per stick
         # interval (:mod:`fretwear.hb.memory_gain`; None: the recursion at every s), where
-        # a node sticks (otherwise nothing is refined: G(0) as the solve has it)
+        # a node sticks (otherwise nothing is refined); G(0) from the split wherever it
+        # applies, the solve's recursion elsewhere
         sticks = bool(self._states()[0][:, STICK].any())
         split = memory_gain(self.lu, self.lx, self.state, *self._law)
         self._memory = split if sticks else None
