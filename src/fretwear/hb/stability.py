@@ -734,6 +734,9 @@ class HillProblem:
         small = (dyn.q <= CONDENSED_COMPILED_MAX and n <= PAIR_COMPILED_MAX)
         self._fused = ((mg.constant, mg.node, mg.start, mg.length, mg.rows, mg.P)
                        if mg is not None and small else None)
+        # the unknowns the compiled pair works on (:func:`_decoupled_normals`)
+        self._keep = (_decoupled_normals(mg, self._structure, prob.H, float(prob.eps))
+                      if self._fused is not None else None)
         self.evaluations = 0
 
     def gain(self, sigma: complex) -> np.ndarray:
@@ -805,7 +808,7 @@ class HillProblem:
         z = (1.0 + 0j if sigma == 0 else np.exp(-2.0 * np.pi * sigma / self.N))
         out = _evaluate(*self._fused, complex(z), *self._structure, self.prob.m,
                         self.harmonics, self.omega, sigma, float(self.prob.eps),
-                        np.ascontiguousarray(v, dtype=complex), complex(mu0), 2)
+                        np.ascontiguousarray(v, dtype=complex), complex(mu0), 2, self._keep)
         if out[3] == 2:
             raise InputError("the structure with its contact points held is singular at a "
                              "value of the Laplace variable (an eigenvalue of the held "
@@ -1556,11 +1559,12 @@ def _pair_small(T, v, mu0, steps):
 
 
 @njit(cache=True)
-def _residuals(T, y, mu):
+def _residuals(T, y, mu, floor=0.0):
     """``(max(|mu|, |T y - mu y|) / |T|, |T y - mu y| / |T|)`` with the 1-norm of ``T``
-    (:meth:`HillProblem.evaluate`: the stopping rule of :func:`_track`) in one call."""
+    (:meth:`HillProblem.evaluate`: the stopping rule of :func:`_track`) in one call; the
+    1-norm at least ``floor`` (the column sums of a block left out, :func:`_evaluate`)."""
     n = T.shape[0]
-    scale = 0.0
+    scale = floor
     for j in range(n):
         col = 0.0
         for i in range(n):
@@ -1579,30 +1583,104 @@ def _residuals(T, y, mu):
 
 @njit(cache=True)
 def _evaluate(Gc, node, start, length, rows, P, z, Kf, Mf, Cf, Df, m, harmonics, omega,
-              sigma, eps, v, mu0, steps):
+              sigma, eps, v, mu0, steps, keep):
     """:meth:`HillProblem.evaluate` in one compiled call where ``G(s)`` is split
     (:mod:`fretwear.hb.memory_gain`) and every piece runs compiled: ``G(s)``
     (:func:`fretwear.hb.memory_gain._gain_at`, ``z = e^{-s h}``), ``Z_r``
     (:func:`_condensed_at`), ``T(s)`` (:func:`_hill_matrix`), the pair (:func:`_pair_small`)
     and the residuals (:func:`_residuals`): the same kernels as the calls one by one (the same
-    values), one call's overhead instead of five. Returns ``(T, mu, y, status, res, pair)``,
-    ``status`` 0, 1 (a zero pivot in the pair's LU: LAPACK's then runs) or 2 (the held
-    structure is singular at this ``s``)."""
+    values), one call's overhead instead of five. ``keep``: the unknowns the pair and the
+    residuals work on where the others are decoupled (:func:`_decoupled_normals`: ``T(s)``
+    block-diagonal, a block that does not vanish on the others) and the start ``v`` is zero
+    on the others: the pair's LU with partial pivoting, its solves and the residuals then
+    take the same values as on the whole matrix (the dropped block factored apart, its
+    exact zeros adding nothing; the dropped columns' sums in the 1-norm), on a quarter of
+    the entries (a Jenkins point's pair 38 -> 10 us). Returns ``(T, mu, y, status,
+    res, pair)``, ``status`` 0, 1 (a zero pivot in the pair's LU: LAPACK's then runs) or 2
+    (the held structure is singular at this ``s``)."""
     G = _gain_at(Gc, node, start, length, rows, P, z)
     Zr, ok = _condensed_at(Kf, Mf, Cf, Df, m, harmonics, omega, sigma)
     if not ok:
         return np.zeros((1, 1), dtype=np.complex128), 0j, v, 2, 0.0, 0.0
     T = _hill_matrix(G, Zr, eps)
-    mu, y, ok = _pair_small(T, v, mu0, steps)
+    n = T.shape[0]
+    nk = keep.size
+    kept = np.zeros(n, dtype=np.bool_)
+    for i in range(nk):
+        kept[keep[i]] = True
+    whole = nk == n
+    floor = 0.0  # the dropped columns' sums, as the whole matrix's 1-norm takes them
+    for j in range(n):
+        if kept[j]:
+            continue
+        if v[j] != 0:  # a start with a part on the dropped unknowns: the whole matrix
+            whole = True
+            break
+        col = 0.0
+        for i in range(n):
+            col += abs(T[i, j])
+        floor = max(floor, col)
+    if whole:
+        mu, y, ok = _pair_small(T, v, mu0, steps)
+        if not ok:
+            return T, 0j, v, 1, 0.0, 0.0
+        res, pair = _residuals(T, y, mu, 0.0)
+        return T, mu, y, 0, res, pair
+    Tk = np.empty((nk, nk), dtype=np.complex128)
+    vk = np.empty(nk, dtype=np.complex128)
+    for i in range(nk):
+        vk[i] = v[keep[i]]
+        for j in range(nk):
+            Tk[i, j] = T[keep[i], keep[j]]
+    mu, yk, ok = _pair_small(Tk, vk, mu0, steps)
     if not ok:
         return T, 0j, v, 1, 0.0, 0.0
-    res, pair = _residuals(T, y, mu)
+    res, pair = _residuals(Tk, yk, mu, floor)
+    y = np.zeros(n, dtype=np.complex128)
+    for i in range(nk):
+        y[keep[i]] = yk[i]
     return T, mu, y, 0, res, pair
+
+
+def _decoupled_normals(mg, structure, H: int, eps: float):
+    """``keep`` for :func:`_evaluate`: where every node's normal coordinate is
+    decoupled (a prescribed normal force on a coordinate of its own: in the structure's
+    matrices its row and column zero off the diagonal, no mass nor damping on it, a stiffness
+    ``k``; in ``G`` no coupling between its block ``G_N`` and the tangential one, the split's
+    rows none either), ``T(s)`` is block-diagonal with ``eps I - (eps - k) G_N`` on those
+    unknowns, the same at every ``s`` (the split touches tangential rows only): no exponent
+    there where that block is well conditioned, and the eigenpair that vanishes lives on the
+    others (a start without a normal part stays without one): the tangential unknowns
+    (DOF-major, ``H`` per DOF); all unknowns where any node's normal is not decoupled."""
+    Kf, Mf, Cf, Df = structure
+    nc, dH, _ = mg.constant.shape
+    every = np.arange(nc * dH, dtype=np.int64)
+    if dH != 2 * H:
+        return every
+    for p in range(nc):
+        a = 2 * p
+        Gp = mg.constant[p]
+        if Gp[:H, H:].any() or Gp[H:, :H].any() or np.any(mg.rows[mg.node == p][:, :H]):
+            return every
+        for M in Kf, Mf, Cf, Df:
+            off = M[a].copy()
+            off[a] = 0.0
+            col = M[:, a].copy()
+            col[a] = 0.0
+            if off.any() or col.any():
+                return every
+        if Mf[a, a] != 0.0 or Cf[a, a] != 0.0 or Df[a, a] != 0.0:
+            return every
+        block = eps * np.eye(H) - (eps - Kf[a, a]) * Gp[:H, :H]
+        if not np.linalg.cond(block) < 1e8:
+            return every
+    keep = np.concatenate([np.arange((2 * p + 1) * H, (2 * p + 2) * H) for p in range(nc)])
+    return keep.astype(np.int64)
 
 
 @njit(cache=True)
 def _refine(Gc, node, start, length, rows, P, Kf, Mf, Cf, Df, m, harmonics, omega, eps, N,
-            s0, sigma, v, slope, tol, max_iter, floor):
+            s0, sigma, v, slope, tol, max_iter, floor, keep):
     """:func:`_track` from a neighbour's start (``sigma``, ``v``, ``slope`` nonzero; no
     deflation) in one compiled call, each step one :func:`_evaluate`: the secant method on
     the eigenvalue ``mu`` of ``T(sigma)`` that continues ``v``, the same steps and stopping
@@ -1610,7 +1688,7 @@ def _refine(Gc, node, start, length, rows, P, Kf, Mf, Cf, Df, m, harmonics, omeg
     and above ``2 pi Re sigma = floor``, the logarithm of :data:`NEGLIGIBLE`). Returns
     ``(sigma, v, res, converged, slope, evaluations, status)``, ``status`` 0, or 1 / 2 as
     :func:`_evaluate`'s (then :func:`_track` runs the steps one by one, which take LAPACK's
-    pair or raise)."""
+    pair or raise). ``keep``: :func:`_evaluate`'s."""
     res = np.inf
     real = s0.imag == 0.0
     mu0 = 0j
@@ -1624,7 +1702,7 @@ def _refine(Gc, node, start, length, rows, P, Kf, Mf, Cf, Df, m, harmonics, omeg
         z = 1.0 + 0j if sigma == 0 else np.exp(-2.0 * np.pi * sigma / N)
         T, mu, y, status, res, pair = _evaluate(Gc, node, start, length, rows, P, z, Kf, Mf,
                                                 Cf, Df, m, harmonics, omega, sigma, eps, v,
-                                                mu0, 2)
+                                                mu0, 2, keep)
         count += 1
         if status != 0:
             return sigma, v, res, False, slope, count, status
@@ -1816,7 +1894,7 @@ def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions,
                       float(hp.prob.eps), float(hp.N), complex(sigma), complex(warm.sigma),
                       np.ascontiguousarray(warm.v, dtype=complex), complex(warm.slope),
                       float(opt.newton_tol), int(opt.newton_max_iter),
-                      float(np.log(NEGLIGIBLE)))
+                      float(np.log(NEGLIGIBLE)), hp._keep)
         if out[6] == 0:  # (else: the steps one by one, which take LAPACK's pair or raise)
             hp.evaluations += out[5]
             s1, v1, r1, conv, slope1 = out[:5]
