@@ -99,7 +99,7 @@ def test_fused_evaluation_is_the_pieces_one_by_one():
         T, mu, y, lu, res, pair = hp.evaluate(sigma, v, mu0)
         T1 = hp.matrix(sigma)
         mu1, y1, lu1 = _pair(T1, v, mu0)
-        res1, pair1 = _residuals(T1, y1, complex(mu1))
+        res1, pair1 = _residuals(T1, y1, complex(mu1), 0.0)
         assert lu is None and lu1 is None
         assert np.array_equal(T, T1) and mu == mu1 and np.array_equal(y, y1)
         assert res == res1 and pair == pair1
