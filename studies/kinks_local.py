@@ -274,14 +274,61 @@ def rootjac(fun, x0, root):
               f"to the root {norm(x0 - root):.3e} -> {norm(x0 + s - root):.3e}", flush=True)
 
 
+def phase(fun, x, settings=""):
+    """``fretwear.hb.kinks.local_phase`` from ``x`` as Powell calls it (its ``target`` the
+    periodic test's), the module's constants set from ``settings`` (``NAME=value;...``):
+    its rounds, its CPU seconds split into the eliminations and the rest."""
+    from fretwear.hb import kinks
+    from fretwear.hb.options import PERIODIC
+
+    saved = {}
+    for item in filter(None, settings.split(";")):
+        name, value = item.split("=")
+        saved[name] = getattr(kinks, name)
+        setattr(kinks, name, type(saved[name])(float(value)))
+    prob, record = fun.prob, []
+    spent = {"elim": 0.0}
+    eliminate = kinks.eliminate
+
+    def timed(*a, **k):
+        c = time.process_time()
+        out = eliminate(*a, **k)
+        spent["elim"] += time.process_time() - c
+        return out
+
+    kinks.eliminate = timed
+    f, _ = fun(x, False)
+    target = PERIODIC.tol * fun.scale(x)
+    c0 = time.process_time()
+    xl = kinks.local_phase(prob, record)(x, f, target)
+    cpu = time.process_time() - c0
+    kinks.eliminate = eliminate
+    for name, value in saved.items():
+        setattr(kinks, name, value)
+    for rep, fe, fn in record:
+        print(f"phase [{settings}]: {rep.nodes.size} nodes, their |f| {rep.before:.3e} -> "
+              f"{rep.after:.3e} ({rep.iterations} Powell), whole {fe:.3e}, after the Newton "
+              f"step {fn:.3e}", flush=True)
+    print(f"phase [{settings}]: |f| {norm(f):.3e} -> {norm(fun(xl, False)[0]):.3e} (target "
+          f"{target:.3e}), {len(record)} rounds, {cpu:.1f} s CPU ({spent['elim']:.1f} s in "
+          f"the eliminations)", flush=True)
+
+
 def main():
-    n, path, methods = int(sys.argv[1]), sys.argv[2], sys.argv[3].split(",")
+    n, paths, methods = int(sys.argv[1]), sys.argv[2], sys.argv[3].split(",")
     root = np.load(sys.argv[4]) if len(sys.argv) > 4 else None
     fun = Probe(build(n))
+    for path in paths.split(","):
+        run(fun, path, methods, root)
+
+
+def run(fun, path, methods, root):
     x0 = np.load(path)
     print(f"{path}: |f| {norm(fun(x0, False)[0]):.3e}", flush=True)
     for m in methods:
-        if m == "fd":
+        if m.startswith("phase"):  # phase or phase:NAME=value;NAME=value
+            phase(fun, x0.copy(), m[6:])
+        elif m == "fd":
             fd(fun, x0)
         elif m == "nodes":
             nodes(fun, x0)

@@ -15,7 +15,12 @@ regime (stick / slip / separation at some sample) between the iterate and the tr
 ``memory=M``: their reference the largest ``|f|`` of the last M iterates; ``norms=first``:
 the variable scales of the first Jacobian only; ``unclipped``: without the stretches after
 crawling dog-leg steps, ``WATCHDOG_CLIPPED``; a sixth argument and on: ``nolocal`` without
-the local phase of fretwear.hb.kinks, ``single`` with single-precision GMRES products;
+the local phase of fretwear.hb.kinks, ``single`` / ``double`` with single- /
+double-precision GMRES products (single by default), ``renew`` the variable scales renewed
+at every Jacobian (``KrylovOptions(first_scales=False)``; the defaults before them: ``double
+renew``),
+``NAME=value`` a constant of fretwear.hb.kinks or fretwear.hb.solvers set, e.g.
+``LOCAL_CLIPPED=2``;
 ``KINKS_ROOT=<file>`` prints the distance to a root saved before.) With
 ``KINKS_SAVE=<folder>`` every iterate is saved there as ``xNNN.npy`` (N the Powell
 iteration), for the local methods of ``studies/kinks_local.py``.
@@ -128,13 +133,21 @@ def main():
               flush=True)
 
     c0, w0 = time.process_time(), time.perf_counter()
+    from fretwear.hb import kinks
     from fretwear.hb.kinks import local_phase
 
+    for arg in sys.argv[6:]:  # NAME=value: a constant of fretwear.hb.kinks or of solvers
+        if "=" in arg:
+            name, value = arg.split("=")
+            owner = kinks if hasattr(kinks, name) else solvers
+            setattr(owner, name, type(getattr(owner, name))(float(value)))
+            print(f"{owner.__name__}.{name} = {getattr(owner, name)}", flush=True)
     local = None if "nolocal" in sys.argv[6:] else local_phase(prob)
-    if "single" in sys.argv[6:]:  # single-precision GMRES products
-        from fretwear.hb.options import KrylovOptions
+    from fretwear.hb.options import KrylovOptions
 
-        prob.krylov = KrylovOptions(single_products=True)
+    prob.krylov = KrylovOptions(  # products in single precision unless "double"; the
+        single_products="double" not in sys.argv[6:],  # first Jacobian's scales unless
+        first_scales="renew" not in sys.argv[6:])  # "renew" (the defaults before: both)
     x, f, st = powell(fun, x0, lambda x: prob.scale(x.reshape(prob.m, prob.H)),
                       tol=PERIODIC.tol, max_iter=max_iter, trace=trace, callback=line,
                       local=local)

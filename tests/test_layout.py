@@ -42,3 +42,21 @@ def test_the_allowance_names_only_modules_without_tests():
     stale = sorted(m for m in PENDING if m not in modules() or mirror_of(m).is_file())
     assert not stale, ("remove from PENDING in tests/test_layout.py (the module has its test "
                        "module now, or is gone): " + ", ".join(stale))
+
+
+def test_the_hb_layers_in_the_docs_are_the_contract():
+    """docs/architecture.md's diagram of the layers inside ``hb`` lists the layers of
+    pyproject.toml's import-linter contract for ``fretwear.hb``, in the same order (what
+    lint-imports enforces is what a reader is told). Reference: the two files, parsed."""
+    import tomllib
+
+    conf = tomllib.loads((ROOT / "pyproject.toml").read_text())
+    contract = next(c for c in conf["tool"]["importlinter"]["contracts"]
+                    if c.get("containers") == ["fretwear.hb"])
+    text = (ROOT / "docs" / "architecture.md").read_text()
+    start = text.index("```", text.index("Inside `hb`, a module imports only the layers"))
+    block = text[start + 3:text.index("```", start + 3)]
+    shown = [" | ".join(m.strip() for m in layer.split("|")) for layer in
+             " ".join(block.split()).split(">")]
+    assert len(contract["layers"]) > 5  # the contract was found
+    assert shown == contract["layers"]

@@ -104,8 +104,10 @@ def test_inverse_iteration_with_the_split_finds_the_dense_eigenvalues():
     """Inverse iteration by the split, from 1e-3 off each of six eigenvalues of the
     structured problem (start vectors perturbed), converges to the companion eigensolve's
     eigenvalue within 1e-11 of ``max(1, |s|)`` and to the same eigenvalue as without the
-    split within 1e-12: both stop at a Newton step below 1e-14, the eigenvalues are simple
-    (the closest two are checked 1e-2 apart) and the dense ones backward stable."""
+    split within 1e-12: both stop at a Newton step below 1e-14 or where the quadratic
+    convergence predicts the next one below 1e-15 (stability._settled; from 1e-3 off, no
+    first step is small enough to stop on the prediction), the eigenvalues are simple (the
+    closest two are checked 1e-2 apart) and the dense ones backward stable."""
     B0, B1, B2, harm = _structured(7)
     split = harmonic_split(B0, B1, B2, harm, 1e-13)
     vals, Y = _companion_eigen(B0, B1, B2)
@@ -157,3 +159,32 @@ def test_shift_block_is_the_shift_of_the_complex_exponential_coefficients():
         np.testing.assert_array_equal(shift_block(p.reshape(-1)[part], part, H, k, side),
                                       got[part])
     assert sla.norm(p) > 0
+
+
+def test_inverse_iteration_demotes_a_group_held_near_its_eigenvalue():
+    """Started 1e-7 from an eigenvalue of one local group held (its 2 x 2 block
+    ``P_LL(s)`` singular there: the split's pivot test refuses it, checked), the inverse
+    iteration with the split (which moves that group to the core inside the compiled
+    iteration) converges to the same eigenvalue as without the split, within 1e-12 of
+    ``max(1, |s|)`` (both stop by the same rule from the same start; the eigenvalue is the
+    companion eigensolve's, checked within 1e-10: the iterations' stopping rule, not the
+    start, bounds their error)."""
+    B0, B1, B2, harm = _structured(4)
+    n = harm.size
+    split = harmonic_split(B0, B1, B2, harm, 1e-13)
+    loc, lptr = split[0], split[1]
+    g = 2
+    rows = loc[lptr[g]:lptr[g + 1]]
+    held = [X[np.ix_(rows, rows)] for X in (B0, B1, B2)]
+    s_held = _companion_eigen(*held)[0]
+    start = complex(s_held[np.argmax(np.abs(s_held.imag))]) + 1e-7
+    A = np.empty((n, n), dtype=complex)
+    _pencil_into(*(X.astype(complex) for X in (B0, B1, B2)), start, A)
+    assert _split_factor(A, split, split_work(split, n))[1] == g
+    vals, _ = _companion_eigen(B0, B1, B2)
+    y0 = np.random.default_rng(3).standard_normal(n) + 0j
+    s1, _, ok = _inverse_iteration(B0, B1, B2, start, y0, split=split)
+    s2, _, ok2 = _inverse_iteration(B0, B1, B2, start, y0)
+    assert ok and ok2
+    assert abs(s1 - s2) <= 1e-12 * max(1.0, abs(s2))
+    assert np.min(np.abs(vals - s1)) <= 1e-10 * max(1.0, abs(s1))

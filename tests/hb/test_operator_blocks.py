@@ -195,7 +195,7 @@ def test_single_precision_products_and_the_loose_steps_that_take_them(damping, m
     within 1.01 x rtol (the single products' 1e-7 error added to GMRES's own); a step solved
     to 1e-9, below single_products_rtol, takes the double blocks only and equals the dense
     solve of the formed Jacobian to 1e-7 (as test_bounded_preconditioner_factors_give_the_
-    same_step's 1e-8 with GMRES at 1e-9 instead of 1e-10). Off (the default), the loose
+    same_step's 1e-8 with GMRES at 1e-9 instead of 1e-10). Off (on by default), the loose
     step takes the double blocks too."""
     from fretwear.hb.options import KrylovOptions
 
@@ -228,7 +228,7 @@ def test_single_precision_products_and_the_loose_steps_that_take_them(damping, m
         return single_apply(self, V)
 
     monkeypatch.setattr(OperatorBlocks, "apply", spy)
-    assert not prob.krylov.single_products  # (off by default)
+    assert prob.krylov.single_products  # (on by default)
     prob.krylov = KrylovOptions(single_products=True)
     s = J.solve(f, rtol=1e-3)
     assert used and all(used)

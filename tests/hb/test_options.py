@@ -43,7 +43,8 @@ def test_solve_options_refuse_bad_values(name, value):
 @pytest.mark.parametrize("name, value", [
     ("single_factors", 1), ("single_factors", "yes"), ("single_max_iterations", 0),
     ("single_max_iterations", 10.0), ("single_max_iterations", True),
-    ("preconditioner", "ilu"), ("preconditioner", None),
+    ("preconditioner", "ilu"), ("preconditioner", None), ("first_scales", 1),
+    ("single_products", "no"), ("local_phase", 0),
 ])
 def test_krylov_options_refuse_bad_values(name, value):
     with pytest.raises(InputError, match=f"^krylov.{name} = ") as err:

@@ -44,3 +44,25 @@ def test_a_run_is_the_solver_on_the_balance_from_either_shape_of_start():
     assert np.array_equal(run(prob, x0.reshape(-1), opts)[0], x)
     x1, st1 = run(prob, x0, opts.replace(max_iter=1))
     assert not st1.success and st1.iterations <= 1 and x1.shape == x.shape
+
+
+def test_the_local_phase_is_offered_unless_the_krylov_options_turn_it_off(monkeypatch):
+    """A run hands Powell the local phase of fretwear.hb.kinks (a callable) by default and
+    none with ``KrylovOptions(local_phase=False)``; the solve itself is the same call (the
+    solver is replaced by one that records its ``local`` and returns the start)."""
+    from fretwear.hb import runs
+    from fretwear.hb.options import KrylovOptions
+    from fretwear.hb.solvers import SolveStats
+
+    seen = []
+
+    def record(fun, x0, scale, **kw):
+        seen.append(kw["local"])
+        return x0, fun(x0, False)[0], SolveStats(False, 1.0, 0, 0, 0, 0.0, "recorded", "")
+
+    monkeypatch.setattr(runs, "solve", record)
+    prob = _balance()
+    run(prob, prob.initial_guess(), SolveOptions())
+    prob.krylov = KrylovOptions(local_phase=False)
+    run(prob, prob.initial_guess(), SolveOptions())
+    assert callable(seen[0]) and seen[1] is None

@@ -15,6 +15,7 @@ value), so the roots are compared to 1e-9 relative.
 
 import numpy as np
 import pytest
+from helpers.kinked import kinked
 
 from fretwear.errors import InputError
 from fretwear.hb.solvers import SOLVERS, SolveStats, solve, solve_identity_rows
@@ -214,6 +215,36 @@ def test_powell_inexact_newton_steps_reach_the_same_root(seed):
     assert min(a for a, _ in loose) < 1e-3
 
 
+@pytest.mark.parametrize("first", [True, False])
+def test_powell_keeps_the_first_scales_on_an_operator_that_asks(first):
+    """An operator Jacobian whose options keep the first Jacobian's variable scales
+    (``KrylovOptions.first_scales``) has its column norms computed once; one that does not,
+    at every new Jacobian (MINPACK's running maximum). Either way Powell reaches the root of
+    the smooth monotone problem (closed form: the x* it was built from; 1e-9 relative as
+    above): the scales change the path, not the root."""
+    fun, x_star, scale = monotone(rng=np.random.default_rng(7))
+    calls, jacobians = [], []
+
+    class Scaled(InexactOperator):
+        first_scales = first
+
+        def column_norms(self):
+            calls.append(1)
+            return super().column_norms()
+
+    def op(x, need_jacobian):
+        f, J = fun(x, need_jacobian)
+        if need_jacobian:
+            jacobians.append(1)
+        return f, (Scaled(J, []) if need_jacobian else None)
+
+    x, _, st = solve(op, np.zeros_like(x_star), lambda x: scale, tol=1e-12)
+    assert st.success, st.message
+    np.testing.assert_allclose(x, x_star, rtol=1e-9, atol=1e-9 * np.abs(x_star).max())
+    assert len(jacobians) > 2
+    assert len(calls) == (1 if first else len(jacobians))
+
+
 def _powell_without_root():
     """Powell on x^2 + 1 = 0 (no root: every step is poor) from x = 0.3 with an inexact
     operator Jacobian: ``(stats, asked, at)``, the ``rtol`` of every solve request (None:
@@ -261,25 +292,6 @@ def test_powell_keeps_inexact_steps_after_a_poor_step_by_default():
     assert not st.success and len(asked) > 4
     assert all(a is not None for a in asked)
     assert all(at[i + 1] != at[i] for i in range(len(at) - 1))
-
-
-def kinked(seed, n=20, slope=1000.0):
-    """A piecewise-linear strongly monotone problem of n unknowns with a kink per unknown
-    and its root: ``A x + D max(x - t, 0) = A x* + D max(x* - t, 0)`` with ``A`` symmetric
-    positive definite and ``D >= 0`` diagonal (slopes up to ``slope``: the gradient of a
-    strongly convex function, so ``x*`` is its only root); the Jacobian is that of the piece
-    of ``x`` (as the DLFT law's kinks, stick / slip / separation, give)."""
-    rng = np.random.default_rng(seed)
-    B = rng.standard_normal((n, n))
-    A = B @ B.T / n + 0.1 * np.eye(n)
-    t, D, x_star = rng.standard_normal(n), slope * rng.random(n), rng.standard_normal(n)
-    rhs = A @ x_star + D * np.maximum(x_star - t, 0.0)
-
-    def fun(x, need_jacobian):
-        f = A @ x + D * np.maximum(x - t, 0.0) - rhs
-        return f, (A + np.diag(D * (x > t))) if need_jacobian else None
-
-    return fun, x_star, np.abs(rhs).max()
 
 
 def test_powell_watchdog_crosses_kinks_where_the_monotone_test_crawls(monkeypatch):

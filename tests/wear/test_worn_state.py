@@ -17,6 +17,7 @@ References, each independent of the code under test:
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -153,6 +154,41 @@ def test_options_are_checked():
         WornStateOptions(max_steps=0)
     with pytest.raises(InputError, match="wear = 1"):
         WornStateOptions(wear=1)
+
+
+@pytest.mark.parametrize("name, bad", [("min_growth", -3.0), ("min_growth", float("nan")),
+                                       ("path_tolerance", -1e-2), ("path_tolerance", 2.0),
+                                       ("path_tolerance", "1e-2")])
+def test_growth_and_path_options_are_checked(name, bad):
+    """``min_growth`` (a factor of the step: positive and finite) and ``path_tolerance`` (a
+    relative error per step, in (0, 1], as the case files' ``path_tolerance`` key): one
+    InputError naming the option, instead of a step rule that takes NaN or a negative
+    factor (the growth then held at 0.5 or at ``max_growth`` whatever the rate does)."""
+    with pytest.raises(InputError, match=name):
+        WornStateOptions(**{name: bad})
+
+
+def test_every_option_is_in_the_user_docs():
+    """Every field of WornStateOptions is named in docs/wear.md's list of the options (as
+    `name`), and in docs/api.md's signature: a new option (``jump_rate``, ``jump_progress``)
+    is documented where users read the others."""
+    from dataclasses import fields
+    from pathlib import Path
+
+    docs = Path(__file__).resolve().parents[2] / "docs"
+    wear, api = (docs / "wear.md").read_text(), (docs / "api.md").read_text()
+    missing = [f.name for f in fields(WornStateOptions) if f"`{f.name}`" not in wear]
+    assert not missing, f"not in docs/wear.md: {missing}"
+    start = api.index("# WornStateOptions(")
+    shown = dict(re.findall(r"(\w+)=([\w.+-]+)", api[start:api.index("docs/wear.md", start)]))
+    defaults = WornStateOptions()
+    for f in fields(WornStateOptions):
+        if f.name in ("wear", "initial_jump", "max_growth", "min_growth"):  # (not shown)
+            continue
+        assert f.name in shown, f"{f.name} not in docs/api.md's WornStateOptions"
+        value = getattr(defaults, f.name)
+        assert str(value) == shown[f.name] or (
+            not isinstance(value, bool) and float(shown[f.name]) == value), f.name
 
 
 @pytest.mark.parametrize("name, nx, orders",

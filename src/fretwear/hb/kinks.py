@@ -15,8 +15,10 @@ the law").
 unknowns held: their ``lambda_u`` is linear in their own unknowns (eq. 23, ``lambda_u = F - Z
 U + eps (U - W)``, the coupling through the held nodes a constant) and their law the one of
 the whole problem, so the subproblem's residual is that of the full problem on those rows,
-exactly. Its Jacobian is formed (a few nodes: ``k d H`` unknowns) and the subproblem solved by
-Powell. After it, a Newton step of the whole system is the Newton step of the system with
+exactly (up to the compression's bound where the operator carries compressed forms: the full
+residual's products are then the compressed ones, the subproblem's block is cut from the exact
+matrices). Its Jacobian is formed (a few nodes: ``k d H`` unknowns) and the subproblem solved
+by Powell. After it, a Newton step of the whole system is the Newton step of the system with
 those nodes eliminated (their rows hold ``f = 0``), on which their branch no longer acts
 (Lanzkron, Rose and Wilkes 1996, nonlinear elimination). :func:`local_phase` makes the rounds
 of both that :func:`fretwear.hb.solvers.powell` calls as its ``local``.
@@ -37,6 +39,11 @@ from fretwear.hb.solvers import _lu_step, powell, solve_identity_rows, vector_no
 #: two worst alone, 94 % of ``|f|^2``, the neighbours took the residual up and the Newton
 #: steps after the elimination did not converge)
 SHARE = 0.999
+#: at least this many nodes (the largest per-node residuals): from the 1024-node crawl's
+#: iterate at ``|f|`` 1.6e-3, where 3 nodes held 99.9 %, their elimination moved the
+#: residual to the neighbours and two rounds ended above the start; with 16, four rounds
+#: converged (docs/studies/large-interface-solve.md, "Entering the local phase sooner")
+MIN_NODES = 16
 #: at most this many nodes (their subproblem's Jacobian is formed: ``k d H`` unknowns)
 MAX_NODES = 32
 #: the subproblem is solved to this fraction of the whole residual's norm on its rows
@@ -48,8 +55,9 @@ LOCAL_MAX_ITER = 200
 ROUNDS = 4
 ROUND_RATE = 0.5
 #: the relative residual of the Newton step after an elimination (GMRES on an operator
-#: Jacobian; a formed one is solved exactly)
-NEWTON_RTOL = 1e-6
+#: Jacobian; a formed one is solved exactly): 1e-3 halved the phase's CPU from the
+#: 1024-node crawl (12 to 6 s) against 1e-6, ending at 6e-9 (the test asked 3e-7)
+NEWTON_RTOL = 1e-3
 
 
 @dataclass
@@ -74,7 +82,7 @@ def worst_nodes(f: np.ndarray, nc: int, share: float | None = None,
     order = np.argsort(per)[::-1]
     cum = np.cumsum(per[order])
     k = int(np.searchsorted(cum, share * cum[-1])) + 1
-    return np.sort(order[:min(k, max_nodes)])
+    return np.sort(order[:min(max(k, MIN_NODES), max_nodes)])
 
 
 def _block(prob, dofs: np.ndarray) -> np.ndarray:
@@ -96,6 +104,10 @@ class FormedOperator:
     iterations to 7 % of the start; with the stretches 12 iterations to 6e-6)."""
 
     gmres_iterations = 0
+    #: Powell keeps the first Jacobian's variable scales, as on the operator Jacobians of
+    #: the default :class:`~fretwear.hb.options.KrylovOptions` (what the phase was measured
+    #: with)
+    first_scales = True
 
     def __init__(self, J: np.ndarray):
         self.J = J

@@ -689,6 +689,12 @@ class KrylovJacobian:
         return solve_identity_rows(Ja, rhs.reshape(na * dH, r)).reshape(na, dH, r)
 
     @property
+    def first_scales(self) -> bool:
+        """Whether Powell keeps the first Jacobian's variable scales
+        (:attr:`fretwear.hb.options.KrylovOptions.first_scales`)."""
+        return self.options.first_scales
+
+    @property
     def options(self):
         """The owner's :class:`fretwear.hb.options.KrylovOptions` (its ``krylov``; the
         defaults when it has none)."""

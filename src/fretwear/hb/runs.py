@@ -11,7 +11,7 @@ import time
 import numpy as np
 
 from fretwear.hb.kinks import local_phase
-from fretwear.hb.options import SolveOptions
+from fretwear.hb.options import KRYLOV, SolveOptions
 from fretwear.hb.problem import DLFTProblem
 from fretwear.hb.solvers import solve
 
@@ -21,7 +21,8 @@ def run(prob: DLFTProblem, x0, options: SolveOptions, max_slow: int | None = Non
     most ``options.max_iter`` iterations: ``(x (m, H), stats)`` (converged or the last
     iterate; ``stats.wall_time`` the whole run's). ``max_slow``: the solver's progress test
     (:func:`fretwear.hb.solvers.solve`; None: none). Powell's local phase where its steps
-    crawl: :func:`fretwear.hb.kinks.local_phase`."""
+    crawl: :func:`fretwear.hb.kinks.local_phase`, unless the problem's Krylov options turn
+    it off (:attr:`~fretwear.hb.options.KrylovOptions.local_phase`)."""
 
     def fun(x, jac=True):
         return prob.residual(x.reshape(prob.m, prob.H), jac)
@@ -30,6 +31,6 @@ def run(prob: DLFTProblem, x0, options: SolveOptions, max_slow: int | None = Non
     x, _, st = solve(fun, np.asarray(x0, float).reshape(-1),
                      lambda x: prob.scale(x.reshape(prob.m, prob.H)), method=options.solver,
                      tol=options.tol, max_iter=options.max_iter, max_slow=max_slow,
-                     local=local_phase(prob))
+                     local=local_phase(prob) if (prob.krylov or KRYLOV).local_phase else None)
     st.wall_time = time.perf_counter() - t0
     return x.reshape(prob.m, prob.H), st

@@ -120,6 +120,15 @@ def _column_norms(J):
     return J.column_norms()
 
 
+def _rescaled(dscale, J):
+    """Powell's variable scales after a new Jacobian ``J``: the running maximum of the
+    column norms (MINPACK), or ``dscale`` itself on an operator Jacobian whose options keep
+    the first Jacobian's scales (:attr:`KrylovOptions.first_scales`)."""
+    if not isinstance(J, np.ndarray) and getattr(J, "first_scales", False):
+        return dscale
+    return np.maximum(dscale, _column_norms(J))
+
+
 #: preconditioners of the Newton step's GMRES when the operator carries compressed forms
 #: (:class:`KrylovOptions`)
 PRECONDITIONERS = ("mean-gain", "nearfield")
@@ -157,19 +166,31 @@ class KrylovOptions:
         ``single_products_rtol`` (operators of the modal condensation without compressed
         forms only). The step is then that of an operator off by about ``1e-7`` relative,
         far below its tolerance: the residual, the dog-leg and the convergence test stay in
-        double, so a converged answer is the same to the solve's tolerance. Default False:
+        double, so a converged answer is the same to the solve's tolerance. Default True:
         on the partial-slip pad of benchmarks/scale_3d.py the 256-node solve took the same
-        iterations (solution 6e-12 from the double one's, products 0.39 to 0.30 s), but at
-        1024 nodes the other rounding took Powell onto a path that crawls at ``|f|`` 1e-4
-        (docs/studies/large-interface-solve.md, "Iteration counts and per-call terms").
+        iterations (solution 6e-12 from the double one's, products 0.39 to 0.30 s); at 1024
+        nodes the other rounding took Powell onto a path that crawled at ``|f|`` 1e-4
+        (docs/studies/large-interface-solve.md, "Iteration counts and per-call terms"),
+        which the local phase of :mod:`fretwear.hb.kinks` now ends; with the first
+        Jacobian's variable scales (``first_scales``) the solve took 38-42 s CPU against
+        51-52 s ("Entering the local phase sooner").
     single_products_rtol : that bound (default ``1e-5``).
+    first_scales : Powell's variable scales from the first Jacobian only (default True);
+        False: renewed at every Jacobian as MINPACK (the running maximum of its column
+        norms), as formed Jacobians always are. The column norms of each new Jacobian cost
+        as much as a Newton step's GMRES on a large interface (10 s of the 1024-node
+        partial-slip solve's 50); with ``single_products`` this took that solve from
+        51-52 s to 38-42 s CPU, to the same root within the spread of the old defaults from
+        perturbed starts, once the local phase ended its crawl.
     """
 
     single_factors: bool = True
     single_max_iterations: int = 60
     preconditioner: str = "mean-gain"
-    single_products: bool = False
+    single_products: bool = True
     single_products_rtol: float = 1e-5
+    first_scales: bool = True
+    local_phase: bool = True
 
     def __post_init__(self):
         self.check()
@@ -190,6 +211,12 @@ class KrylovOptions:
                              f"one of {PRECONDITIONERS}")
         if not isinstance(self.single_products, bool):
             raise InputError(f"krylov.single_products = {self.single_products!r}: expected "
+                             "True or False")
+        if not isinstance(self.local_phase, bool):
+            raise InputError(f"krylov.local_phase = {self.local_phase!r}: expected "
+                             "True or False")
+        if not isinstance(self.first_scales, bool):
+            raise InputError(f"krylov.first_scales = {self.first_scales!r}: expected "
                              "True or False")
         t = self.single_products_rtol
         if not (isinstance(t, numbers.Real) and not isinstance(t, bool) and 1e-6 <= t < 1):
@@ -261,6 +288,13 @@ WATCHDOG_FORMED = False
 #: problems of tests/hb/test_solvers.py it cuts Powell's iterations from 1690 to 370
 WATCHDOG_CLIPPED = 4
 WATCHDOG_CLIPPED_PROGRESS = 0.5
+#: the local phase (``local`` of :func:`powell`) is called once this many dog-leg steps in a
+#: row have not fitted the Newton step nor halved ``|f|`` (from its value at the first of
+#: them or at the start of :data:`WATCHDOG_CLIPPED`'s count, the smaller), at most once in
+#: such a run of them (the stretch of :data:`WATCHDOG_CLIPPED` follows if it did not reduce
+#: ``|f|``). Two: on the 1024-node crawls of docs/studies/large-interface-solve.md
+#: ("Entering the local phase sooner") it was called 2-6 iterations sooner than at four
+LOCAL_CLIPPED = 2
 #: such a stretch takes at most this many Newton steps, each of which must reduce ``|f|`` by
 #: this factor: at 1024 contact nodes the full Newton step from ``|f|`` 1.4e-4 raised it to
 #: 4.7e-2 (17 nodes changing regime) and the Newton steps from there fell by a decade each
@@ -316,9 +350,11 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
     ``local``: a local phase for that crawl, ``local(x, f, target) -> x'`` (``target`` the
     convergence test's ``|f|``; for the DLFT balance
     :func:`fretwear.hb.kinks.local_phase`, nonlinear elimination of the nodes that hold the
-    residual): where the full Newton step would be forced it is called first, and a point
-    it returns with a smaller ``|f|`` is taken as the iterate (its full Newton step tried
-    next, the trust radius set to it as at the start); else the forced step as before.
+    residual): called once :data:`LOCAL_CLIPPED` dog-leg steps in a row have not fitted the
+    Newton step nor halved ``|f|`` (once in such a run), and a point it returns with a
+    smaller ``|f|`` is taken as the iterate (its full Newton step tried next, the trust
+    radius set to it as at the start); else the dog-leg steps and the forced step go on as
+    without it.
     Its own evaluations are not counted in ``nfev``, ``njev``.
     ``max_slow``: stop (unconverged) after that many iterations on a new Jacobian
     in a row without one that decreased ``|f|^2`` by :data:`SLOW_DECREASE` (MINPACK's "not
@@ -353,6 +389,8 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
     rejected, ref = 0, fn  # rejected Newton steps since |f| fell below ref / 10
     kept = [fn]  # |f| of the iterates (a stretch's only once it is kept)
     clipped, clip_ref = 0, fn  # dog-leg steps in a row (Newton step too long), |f| before
+    local_tried = False  # the local phase called since the dog-leg steps began
+    local_ref = fn  # |f| at the first dog-leg step of the run
     while True:
         target = tol * scale(x)
         if fn <= target:
@@ -378,36 +416,48 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
         if delta is None:
             delta = snd
         forced = False
+        crawl = (watch is None and snd > delta and (WATCHDOG_FORMED or not exact)
+                 and fn > WATCHDOG_CLIPPED_PROGRESS * clip_ref)
+        if (local is not None and not local_tried and watch is None and snd > delta
+                and (WATCHDOG_FORMED or not exact)
+                and clipped >= min(LOCAL_CLIPPED, WATCHDOG_CLIPPED)
+                and fn > WATCHDOG_CLIPPED_PROGRESS * min(local_ref, clip_ref)):
+            # the dog-leg steps crawl: the local phase (once in a crawl)
+            local_tried = True
+            xl = np.array(local(x, f, target), dtype=float)
+            fl, Jl = fun(xl, True)
+            nfev += 1
+            njev += 1
+            fnl = vector_norm(fl)
+            if fnl < fn:  # its point the iterate, its full Newton step tried next
+                if trace is not None:
+                    trace.append({"it": it, "f": fn, "f_trial": fnl, "delta": delta,
+                                  "pred": 0.0, "actual": fn * fn - fnl * fnl,
+                                  "ratio": 1.0, "newton": False, "lin": 1.0,
+                                  "new_step": False, "gmres": 0, "accepted": True,
+                                  "watchdog": False, "forced": False, "local": True})
+                if fnl * fnl <= (1.0 - SLOW_DECREASE) * fn * fn:  # progress, as a step's
+                    slow = 0
+                x, f, fn, J = xl, fl, fnl, Jl
+                dscale = _rescaled(dscale, J)
+                eta, sn, delta, stall = FORCING_MAX, None, None, 0
+                clipped, clip_ref, local_tried = 0, fn, False
+                kept.append(fn)
+                if callback is not None:
+                    callback(it, x, fn)
+                continue
         if watch is None and snd > delta and clipped >= WATCHDOG_CLIPPED:
             # the dog-leg steps crawl (|f| not halved by the last ones): the full Newton step
             # tried (a stretch); else the next ones are judged from here
-            forced = (WATCHDOG_FORMED or not exact) and fn > WATCHDOG_CLIPPED_PROGRESS * clip_ref
-            clipped, clip_ref = 0, fn
-            if forced and local is not None:  # the local phase first
-                xl = np.array(local(x, f, target), dtype=float)
-                fl, Jl = fun(xl, True)
-                nfev += 1
-                njev += 1
-                fnl = vector_norm(fl)
-                if fnl < fn:  # its point the iterate, its full Newton step tried next
-                    if trace is not None:
-                        trace.append({"it": it, "f": fn, "f_trial": fnl, "delta": delta,
-                                      "pred": 0.0, "actual": fn * fn - fnl * fnl,
-                                      "ratio": 1.0, "newton": False, "lin": 1.0,
-                                      "new_step": False, "gmres": 0, "accepted": True,
-                                      "watchdog": False, "forced": False, "local": True})
-                    x, f, fn, J = xl, fl, fnl, Jl
-                    dscale = np.maximum(dscale, _column_norms(J))
-                    eta, sn, delta, stall, clip_ref = FORCING_MAX, None, None, 0, fn
-                    kept.append(fn)
-                    if callback is not None:
-                        callback(it, x, fn)
-                    continue
+            forced = crawl
+            clipped, clip_ref, local_tried = 0, fn, False
         if snd <= delta or watch is not None or forced:  # (a watchdog stretch: Newton steps)
             s = sn
             if not forced:
-                clipped, clip_ref = 0, fn
+                clipped, clip_ref, local_tried = 0, fn, False
         else:
+            if clipped == 0:  # the first dog-leg step of a run: the local phase's reference
+                local_ref = fn
             clipped += 1
             g = (J.T @ f) / dscale  # gradient in scaled variables
             Jg = J @ (g / dscale)
@@ -444,7 +494,7 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
                 _, J = fun(x, True)
                 njev += 1
                 sn = None
-                dscale = np.maximum(dscale, _column_norms(J))
+                dscale = _rescaled(dscale, J)
                 if done:  # the stretch succeeded: the trust region admits its last step
                     delta, watch, stall, nsuc = max(watch.delta, 2.0 * pnorm), None, 0, 0
                     kept.append(fn)
@@ -476,7 +526,7 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
                 _, J = fun(x, True)
                 njev += 1
                 sn = None
-                dscale = np.maximum(dscale, _column_norms(J))
+                dscale = _rescaled(dscale, J)
                 stall = 0
                 kept.append(fn)
                 if forced:  # the trust region admits the Newton step that served
@@ -496,7 +546,7 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
                     _, J = fun(x, True)
                     njev += 1
                     sn = None
-                    dscale = np.maximum(dscale, _column_norms(J))
+                    dscale = _rescaled(dscale, J)
                     eta = FORCING_MAX
                 if newton_step:
                     rejected += 1

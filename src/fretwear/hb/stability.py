@@ -169,6 +169,11 @@ DECOUPLED_TOL = 1e-13
 #: decoupled blocks of the quadratic problem are gathered up to at least this many unknowns
 #: per dense eigensolve (below, the call's overhead exceeds the flops saved)
 MIN_BLOCK = 48
+#: a neighbouring copy whose start (the member's eigenvector moved by one harmonic) has a
+#: backward error below this is taken as it is, without its inverse iteration
+#: (:func:`_copy`: rounding; the blocks whose laws do not vary over the period give
+#: 2e-17 to 4e-17 on the two-DOF oscillator, the truncated copies 1e-4 to 1e-3)
+COPY_EXACT = 1e-15
 #: exponents whose multiplier is below this are not refined (they decay within a period; the
 #: factor e^{-s h} of the law's memory would overflow over a period)
 NEGLIGIBLE = 1e-8
@@ -1251,7 +1256,11 @@ def track_eigen(red: QuadraticReduction, track: HillTrack | None, shape: tuple,
       that the dense path would not keep (:func:`_may_keep`: ``|kappa| > 1/2`` and not a
       period-doubling member that :func:`_edge_members` may add, with a margin for
       rounding): no family has a second member that the rule keeps (copies further off
-      have ``|kappa| >= 3/2`` less their truncation).
+      have ``|kappa| >= 3/2`` less their truncation). The copy is the member's eigenvector
+      moved by one harmonic, taken as it is where that pair's backward error is at rounding
+      (:data:`COPY_EXACT`, :func:`_copy`), otherwise iterated from there.
+
+    The blocks' arrays are gathered once per point (:func:`_block_mats`).
 
     ``omega``: the solution's circular frequency, with the track's velocities the start of
     each member's iteration (a member moved 2-3e-2 a step on the benchmark's two-DOF sweep:
@@ -1294,7 +1303,7 @@ def track_eigen(red: QuadraticReduction, track: HillTrack | None, shape: tuple,
     while todo:  # each member's neighbouring copy, and the mirror of those near the line
         s1, y, kp, b, j = members[todo.pop(0)]
         side = 1 if kp >= 0 else -1
-        starts = [(s1 + 1j * side, _shifted_copy(red, b, y, shape, side), False)]
+        starts = [(s1, y, False)]  # the copy, from the member itself (_copy)
         if _on_line(s1) != "off":
             starts.append((s1.conjugate() + 1j, y.conj(), True))
         if _on_line(s1) == "on" and j >= 0 and _on_line(complex(track.sigma[j])) != "on":
@@ -1303,10 +1312,13 @@ def track_eigen(red: QuadraticReduction, track: HillTrack | None, shape: tuple,
             y0 = track.Y[red.blocks[b], j]
             starts.append((complex(track.sigma[j]).conjugate() + 1j, y0.conj(), True))
         for sn, y0, mirror in starts:
-            got = _member(red, b, sn, y0, shape, mats, fold=False)
+            if mirror:
+                got = _member(red, b, sn, y0, shape, mats, fold=False)
+            else:  # the copy s + i side
+                got = _copy(red, b, sn, y0, shape, mats, side)
             if got is None:
                 return None
-            s2, y2, kn = got
+            s2, y2, kn = got[:3]
             vals = np.array([m[0] for m in members])
             if np.min(np.abs(vals - s2)) <= 1e-8 * max(1.0, abs(s2)):
                 continue  # a member (the mirror of one on the line is itself)
@@ -1343,25 +1355,35 @@ def _shifted_copy(red: QuadraticReduction, b: int, y: np.ndarray, shape: tuple,
     return v / nrm if nrm > 0 else y
 
 
+def _block_mats(red: QuadraticReduction, b: int, shape: tuple, mats: dict) -> tuple:
+    """Block ``b``'s arrays for :func:`_member` and :func:`_copy` (made on the block's first
+    use, kept in ``mats``): its complex ``B0, B1, B2``, the harmonic split, the block's
+    coordinates, the algebraic coordinates' ``back`` restricted to the block (an empty one
+    without), the algebraic coordinates, and the matrices' column norms
+    (:func:`_column_norms`)."""
+    if b not in mats:
+        r, H, k = shape
+        comp = np.ascontiguousarray(red.blocks[b], dtype=np.int64)
+        back = np.zeros((0, red.dyn.size)) if red.back is None else red.back
+        *real, cplx, back, at, harm = _gather_block(red.B0, red.B1, red.B2, comp, back,
+                                                    red.dyn, H, k)
+        split = harmonic_split(*real, harm, DECOUPLED_TOL)
+        alg = np.ascontiguousarray(red.alg, dtype=np.int64)
+        mats[b] = (cplx, split, at, back, alg, _column_norms(*cplx))
+    return mats[b]
+
+
 def _member(red: QuadraticReduction, b: int, s0: complex, y0: np.ndarray, shape: tuple,
             mats: dict, fold: bool = True):
     """The eigenpair of block ``b`` of ``red`` nearest ``(s0, y0)`` by inverse iteration
-    (:func:`_inverse_iteration`), and its centroid. ``fold`` (a member): a real one made
-    exactly real, one below the real axis replaced by its conjugate, and where the centre
-    moved to the next copy (``|kappa| > 1/2``), that copy ``s + i round(kappa)`` instead;
-    otherwise (a neighbouring copy or a mirror) the eigenpair as found. None where an
-    iteration does not converge. ``mats``: the blocks' complex matrices made so far (one
-    block's are made on its first use)."""
+    (:func:`_inverse_iteration`), and its centroid (:func:`_block_centroid`). ``fold`` (a
+    member): a real one made exactly real, one below the real axis replaced by its
+    conjugate, and where the centre moved to the next copy (``|kappa| > 1/2``), that copy
+    ``s + i round(kappa)`` instead; otherwise (a neighbouring copy or a mirror) the
+    eigenpair as found. None where an iteration does not converge. ``mats``: the blocks'
+    arrays made so far (:func:`_block_mats`)."""
     r, H, k = shape
-    comp = red.blocks[b]
-    if b not in mats:
-        ix = np.ix_(comp, comp)
-        real = tuple(np.ascontiguousarray(X[ix]) for X in (red.B0, red.B1, red.B2))
-        c = red.dyn[comp] % H  # coefficient index: 0, a_1..a_k, b_1..b_k
-        split = harmonic_split(*real, np.where(c > k, c - k, c), DECOUPLED_TOL)
-        back = None if red.back is None else np.ascontiguousarray(red.back[:, comp])
-        mats[b] = tuple(X.astype(complex) for X in real) + (split, red.dyn[comp], back)
-    *B, split, at, back = mats[b]
+    B, split, at, back, alg, _ = _block_mats(red, b, shape, mats)
     for again in (False, True):
         s1, y, ok = _inverse_iteration(*B, s0, y0, split=split)
         if not ok:
@@ -1370,14 +1392,131 @@ def _member(red: QuadraticReduction, b: int, s0: complex, y0: np.ndarray, shape:
             s1 = complex(s1.real, 0.0)
         if fold and s1.imag < 0:  # the conjugate pair's other member
             s1, y = s1.conjugate(), y.conj()
-        p = np.zeros(red.n, dtype=complex)  # red.full of y on block b, with fewer calls
-        p[at] = y
-        if back is not None:
-            p[red.alg] = back @ y
-        kp = float(_centroids(p.reshape(1, r, H), k)[0])
+        kp = float(_block_centroid(y, at, back, alg, red.n, r, H, k))
         if again or not fold or abs(kp) <= 0.5:
             return s1, y, kp
         s0, y0 = s1 + 1j * round(kp), y  # the centre moved to the next copy
+
+
+def _copy(red: QuadraticReduction, b: int, s1: complex, y: np.ndarray, shape: tuple,
+          mats: dict, side: int):
+    """The neighbouring copy ``s + i side`` of the member ``(s1, y)`` of block ``b``:
+    ``(s, y, kappa, certified)``, None where its inverse iteration does not converge.
+    Its start ``(sigma, v)`` (:func:`_copy_start`): ``sigma = s1 + i side``, ``v`` the
+    member's eigenvector moved by one harmonic (:func:`_shifted_copy`, normalised). The
+    shift maps the untruncated Hill problem at ``s`` onto itself at ``s + i``, so
+    ``P(sigma) v`` is the truncation's part only: the member's residual (rounding) plus the
+    rows where the law couples the harmonic that left or entered the kept ones. Where the
+    law does not reach them (a block whose coordinates' laws do not vary over the period,
+    or an eigenvector with no weight at the edge harmonics) that is rounding too. Where the
+    backward error of ``(sigma, v)`` (:func:`_backward_error`) is below :data:`COPY_EXACT`
+    the pair is an exact eigenpair of a pencil ``P + E`` with ``|E| <= COPY_EXACT |P|``,
+    no further from ``P`` than the eigenpairs that the dense eigensolver (backward stable
+    on the companion form) or the inverse iteration (stopped at a step below 1e-14)
+    return: the copy is certified as it is, with its centroid, and no inverse iteration is
+    run; otherwise the inverse iteration from it (:func:`_member`, not folded)."""
+    r, H, k = shape
+    B, split, at, back, alg, norms = _block_mats(red, b, shape, mats)
+    sigma, v, eta = _copy_start(*B, norms, complex(s1), np.ascontiguousarray(y, dtype=complex),
+                                side, at, H, k)
+    if eta <= COPY_EXACT:
+        return complex(sigma), v, float(_block_centroid(v, at, back, alg, red.n, r, H, k)), True
+    got = _member(red, b, sigma, v, shape, mats, fold=False)
+    return None if got is None else got + (False,)
+
+
+@njit(cache=True)
+def _copy_start(B0, B1, B2, norms, s1, y, side, at, H, k):
+    """:func:`_copy`'s start ``(sigma, v)`` and its backward error, compiled: ``v``
+    :func:`~fretwear.hb.hill_tracking.shift_block` of ``y`` normalised (``y`` where the
+    shift leaves nothing), ``sigma = s1 + i side``."""
+    v = shift_block(y, at, H, k, side)
+    nrm = 0.0
+    for i in range(v.size):
+        nrm += v[i].real * v[i].real + v[i].imag * v[i].imag
+    v = v / np.sqrt(nrm) if nrm > 0 else y.copy()
+    sigma = s1 + 1j * side
+    return sigma, v, _backward_error(B0, B1, B2, sigma, v, norms)
+
+
+@njit(cache=True)
+def _gather_block(B0, B1, B2, comp, back, dyn, H, k):
+    """Block ``comp`` (indices into ``dyn``) of the reduction's matrices in one compiled
+    call (:func:`_block_mats`): the three real blocks, the same complex, the columns
+    ``comp`` of ``back``, the block's coordinates ``dyn[comp]`` and their harmonics (the
+    coefficient index ``0, a_1..a_k, b_1..b_k`` of each, folded to ``0..k``)."""
+    nb = comp.size
+    R0, R1, R2 = np.empty((nb, nb)), np.empty((nb, nb)), np.empty((nb, nb))
+    for a in range(nb):
+        for c in range(nb):
+            R0[a, c] = B0[comp[a], comp[c]]
+            R1[a, c] = B1[comp[a], comp[c]]
+            R2[a, c] = B2[comp[a], comp[c]]
+    bk = np.empty((back.shape[0], nb))
+    for a in range(back.shape[0]):
+        for c in range(nb):
+            bk[a, c] = back[a, comp[c]]
+    at = np.empty(nb, dtype=np.int64)
+    harm = np.empty(nb, dtype=np.int64)
+    for a in range(nb):
+        at[a] = dyn[comp[a]]
+        c = at[a] % H
+        harm[a] = c - k if c > k else c
+    cplx = (R0.astype(np.complex128), R1.astype(np.complex128), R2.astype(np.complex128))
+    return R0, R1, R2, cplx, bk, at, harm
+
+
+@njit(cache=True)
+def _block_centroid(y, at, back, alg, n, r, H, k):
+    """:func:`centroid` of the eigenvector ``y`` on a block's coordinates ``at`` with the
+    algebraic coordinates ``alg`` recovered as ``back @ y`` (:meth:`QuadraticReduction.full`
+    restricted to the block)."""
+    p = np.zeros(n, dtype=np.complex128)
+    for i in range(at.size):
+        p[at[i]] = y[i]
+    for a in range(alg.size):
+        acc = 0j
+        for j in range(y.size):
+            acc += back[a, j] * y[j]
+        p[alg[a]] = acc
+    return _centroids(p.reshape(1, r, H), k)[0]
+
+
+@njit(cache=True)
+def _column_norms(B0, B1, B2):
+    """The largest column 2-norm of each of ``B0, B1, B2``: a lower bound of its 2-norm
+    (:func:`_backward_error`'s denominator, made once per block)."""
+    n = B0.shape[0]
+    c0, c1, c2 = 0.0, 0.0, 0.0
+    for j in range(n):
+        a0, a1, a2 = 0.0, 0.0, 0.0
+        for i in range(n):
+            a0 += B0[i, j].real ** 2 + B0[i, j].imag ** 2
+            a1 += B1[i, j].real ** 2 + B1[i, j].imag ** 2
+            a2 += B2[i, j].real ** 2 + B2[i, j].imag ** 2
+        c0, c1, c2 = max(c0, a0), max(c1, a1), max(c2, a2)
+    return np.array([np.sqrt(c0), np.sqrt(c1), np.sqrt(c2)])
+
+
+@njit(cache=True)
+def _backward_error(B0, B1, B2, sigma, v, norms):
+    """The backward error of the pair ``(sigma, v)`` of ``B0 + s B1 + s^2 B2`` (Tisseur,
+    Linear Algebra Appl. 309, 2000, theorem 1: ``|P(sigma) v| / ((|B0| + |sigma| |B1| +
+    |sigma|^2 |B2|) |v|)``), with ``norms`` (:func:`_column_norms`: each matrix's largest
+    column 2-norm, a lower bound of its 2-norm, so the error is not under-estimated) for
+    the matrices' 2-norms."""
+    n = B0.shape[0]
+    s2 = sigma * sigma
+    res = 0.0
+    nv = 0.0
+    for i in range(n):
+        acc = 0j
+        for j in range(n):
+            acc += (B0[i, j] + sigma * B1[i, j] + s2 * B2[i, j]) * v[j]
+        res += acc.real * acc.real + acc.imag * acc.imag
+        nv += v[i].real * v[i].real + v[i].imag * v[i].imag
+    den = (norms[0] + abs(sigma) * norms[1] + abs(sigma) ** 2 * norms[2]) * np.sqrt(nv)
+    return np.sqrt(res) / den if den > 0 else np.inf
 
 
 def _on_line(s: complex) -> str | None:

@@ -119,8 +119,9 @@ class WornStateOptions:
         changed the set of slipping nodes is not followed by a larger one (the stick
         events decide where the state ends).
     stick_set : try the stick-set jump (:mod:`fretwear.wear.stick_set`) from the states of
-        the path once the worn-volume rate has fallen to 0.3 of the initial one, and end there
-        when the jumps from two states agree and the path heads for them (module docstring).
+        the path once the worn-volume rate has fallen to ``jump_rate`` of the initial one, and
+        end there when the jumps from two states agree and the path heads for them (module
+        docstring).
         Off by default: the rule that says when the jump lands on the march's state is
         measured on three quasi-static examples (safe on each, 0.94-1.56 times the march's
         speed in DLFT solves), not proved; the result then warns.
@@ -190,6 +191,8 @@ class WornStateOptions:
             if not isinstance(getattr(self, name), bool):
                 raise InputError(f"{name} = {getattr(self, name)!r}: expected true or false")
         number(self.max_growth, "max_growth", low=1.0, open_low=True, high=1e6)
+        number(self.min_growth, "min_growth", low=0.0, open_low=True, high=1e6)
+        number(self.path_tolerance, "path_tolerance", low=0.0, open_low=True, high=1.0)
         number(self.settle_rate, "settle_rate", low=0.0, open_low=True, high=1.0)
         number(self.jump_rate, "jump_rate", low=0.0, open_low=True, high=1.0)
         number(self.jump_progress, "jump_progress", low=0.0, open_low=True, high=1.0)
