@@ -12,6 +12,8 @@ from fretwear.hb.memory_gain import memory_gain
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.stability import (
     HillProblem,
+    _decoupled_normals,
+    _evaluate,
     _pair,
     _residuals,
     problem_of,
@@ -97,11 +99,52 @@ def test_fused_evaluation_is_the_pieces_one_by_one():
         T, mu, y, lu, res, pair = hp.evaluate(sigma, v, mu0)
         T1 = hp.matrix(sigma)
         mu1, y1, lu1 = _pair(T1, v, mu0)
-        res1, pair1 = _residuals(T1, y1, complex(mu1))
+        res1, pair1 = _residuals(T1, y1, complex(mu1), 0.0)
         assert lu is None and lu1 is None
         assert np.array_equal(T, T1) and mu == mu1 and np.array_equal(y, y1)
         assert res == res1 and pair == pair1
     assert hp.evaluations == 6
+
+
+def test_pair_on_the_tangential_unknowns_is_the_whole_matrix_s():
+    """A Jenkins oscillator's normal coordinate (a prescribed normal force on a coordinate of
+    its own) is decoupled: ``T(s)`` block-diagonal (the off-diagonal blocks exactly zero) and
+    :func:`_evaluate` works on the tangential unknowns (``HillProblem._keep``). From a start
+    without a normal part its pair, eigenvector and residuals equal, bit for bit, those on
+    the whole matrix (``keep`` every unknown): partial pivoting never leaves the tangential
+    block, the exact zeros add nothing, the 1-norm takes the dropped columns' sums; a start
+    with a normal part takes the whole matrix; a structure that couples the normal
+    coordinate keeps every unknown."""
+    model = from_matrices([[1.0]], [[1.0]],
+                          contact=ContactDofs(normal_dofs=None, tangential_dofs=[0], mu=0.5,
+                                              normal_load=1.0, kt=0.5),
+                          damping=Damping(C=[[0.02]]), loads=[Load(np.array([0.2]), "cos")])
+    sol = solve_periodic(model, FourierBasis.up_to(3, 32), frequency=1.18 / (2 * np.pi),
+                         time_domain=None)
+    prob = problem_of(model, sol)
+    hp = HillProblem(prob, sol.U.reshape(prob.m, prob.H), structure_dynamics(model))
+    n, H = prob.m * prob.H, prob.H
+    assert hp._fused is not None and np.array_equal(hp._keep, np.arange(H, n))
+    every = np.arange(n, dtype=np.int64)
+    rng = np.random.default_rng(2)
+    v = rng.standard_normal(n) + 1j * rng.standard_normal(n)
+    vt = v.copy()
+    vt[:H] = 0.0
+    for sigma, mu0 in ((0.0, 0.0), (0.9j, 0.01), (-0.03 + 1.02j, 0.0)):
+        z = np.exp(-2.0 * np.pi * sigma / hp.N)
+        args = (*hp._fused, complex(z), *hp._structure, prob.m, hp.harmonics, hp.omega,
+                complex(sigma), float(prob.eps))
+        T = _evaluate(*args, vt, complex(mu0), 2, every)[0]
+        assert not T[:H, H:].any() and not T[H:, :H].any()
+        for start in (vt, v):
+            a = _evaluate(*args, start, complex(mu0), 2, hp._keep)
+            b = _evaluate(*args, start, complex(mu0), 2, every)
+            assert a[3] == b[3] == 0 and a[1] == b[1] and np.array_equal(a[2], b[2])
+            assert a[4] == b[4] and a[5] == b[5]
+            assert start is v or not a[2][:H].any()
+    K, M, C, D = (x.copy() for x in hp._structure)
+    K[0, 1] = K[1, 0] = 0.1
+    assert np.array_equal(_decoupled_normals(hp._memory, (K, M, C, D), H, prob.eps), every)
 
 
 def test_compiled_refinement_is_the_python_steps():

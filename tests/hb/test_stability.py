@@ -27,6 +27,7 @@ from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.stability import (
     COPY_EXACT,
+    EDGE_TOL,
     HillProblem,
     QuadraticReduction,
     _backward_error,
@@ -35,6 +36,7 @@ from fretwear.hb.stability import (
     _components,
     _copy,
     _det_sign,
+    _families,
     _inverse_iteration,
     _inverse_iteration_py,
     _member,
@@ -448,6 +450,63 @@ def test_det_sign_is_lapack_s():
     assert signs == {-1, 1}
     G = np.zeros((2, dH, dH))
     assert _det_sign(G, rng.standard_normal((n, n)), 0.0) == 0
+
+
+def test_gain_without_stick_from_the_split_is_the_recursion():
+    """On the unilateral two-DOF oscillator (contact and separation, no stick: the law has
+    no memory) ``G(0)`` is taken from the split (:func:`fretwear.hb.memory_gain.memory_gain`,
+    nothing but its constant part there) instead of the solve's recursion: the same terms
+    summed in another order, so equal to rounding (1e-14 of the largest entry; measured
+    2e-16), with no stick interval kept for the refinement, and the same ``det J`` sign."""
+    model, basis = two_dof(), FourierBasis.up_to(5, 64)
+    prob, hp = _hill_problem(model, basis, 0.7 / (2 * np.pi))
+    assert hp.memoryless() and hp._memory is None
+    ref = law.dlft_jacobian(hp.lu, hp.lx, hp.state, prob.mu, prob.P, prob.Q,
+                            prob.eps * prob.anchor, prob.tol, prob.max_sweeps, prob.normal)
+    assert np.abs(hp.G0 - ref).max() <= 1e-14 * np.abs(ref).max()
+    J = jacobian_form(ref, prob.Z, prob.eps)
+    assert hp.det_sign() == int(np.sign(np.linalg.slogdet(J)[0])) != 0
+
+
+def _families_numpy(sig, kaps, res):
+    """The result's families as :func:`hill_stability` assembled them with numpy before
+    :func:`_families` (kept here as the reference)."""
+    edge = np.abs(np.abs(sig.imag) - 0.5) <= EDGE_TOL
+    cplx = (np.abs(sig.imag) > 1e-9 * np.maximum(np.abs(sig), 1.0)) & ~edge
+    allsig = np.concatenate([sig, np.conj(sig[cplx])])
+    allkap = np.concatenate([kaps, -kaps[cplx]])
+    allres = np.concatenate([res, res[cplx]])
+    src = np.concatenate([np.arange(sig.size), np.flatnonzero(cplx)])
+    mult = np.exp(2.0 * np.pi * allsig)
+    redge = np.concatenate([edge, np.zeros(int(cplx.sum()), dtype=bool)])
+    mult[redge] = -np.exp(2.0 * np.pi * allsig[redge].real)
+    chosen = np.argsort(-allsig.real, kind="stable")
+    return allsig[chosen], mult[chosen], allkap[chosen], allres[chosen], src[chosen]
+
+
+def test_compiled_families_are_numpy_s():
+    """:func:`_families` (the result's conjugates, period-doubling members and order in one
+    compiled call) against the numpy assembly it replaced, on exponents that are real,
+    complex, on the period-doubling line (within ``EDGE_TOL``), with equal real parts (the
+    stable order) and NaN residuals: the same order and sources exactly, the same exponents,
+    centroids and residuals bit for bit, multipliers to 1e-15 (numba's and numpy's complex
+    ``exp`` may differ in the last bit; measured equal), and none at all for no exponent."""
+    rng = np.random.default_rng(8)
+    for _ in range(20):
+        n = int(rng.integers(1, 9))
+        re = np.round(rng.uniform(-0.3, 0.1, n), 1)  # ties between real parts
+        im = rng.choice([0.0, 0.5, 0.5 + 0.5 * EDGE_TOL, 0.2, 0.37, 1e-12], n)
+        sig = re + 1j * im
+        kaps = rng.uniform(-0.5, 0.5, n)
+        res = np.where(rng.uniform(size=n) < 0.3, np.nan, rng.uniform(0, 1e-10, n))
+        got, ref = _families(sig, kaps, res, EDGE_TOL), _families_numpy(sig, kaps, res)
+        assert np.array_equal(got[4], ref[4])
+        for a, b in zip(got[:4:2], ref[:4:2], strict=True):
+            assert np.array_equal(a, b)
+        assert np.array_equal(got[3], ref[3], equal_nan=True)
+        assert np.abs(got[1] - ref[1]).max() <= 1e-15 * np.abs(ref[1]).max()
+    empty = np.zeros(0)
+    assert _families(empty.astype(complex), empty, empty, EDGE_TOL)[0].size == 0
 
 
 def test_state_summary_is_numpy_s():

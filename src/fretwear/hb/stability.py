@@ -92,8 +92,9 @@ call, :func:`_refine`); along a sweep, where the
 candidates are tracked, a few LU factorisations of the blocks of the quadratic problem per
 candidate instead of its dense eigensolve (each solved by the LU of the Schur complement
 on the unknowns that couple harmonics, the others eliminated harmonic by harmonic:
-:mod:`fretwear.hb.hill_tracking`). ``det J`` is read from the solve's own ``G`` and
-``Z~`` (:meth:`HillProblem.jacobian`). Measured on the benchmark's small models
+:mod:`fretwear.hb.hill_tracking`). ``det J`` is read from the solve's ``G`` (made again from
+the split of :mod:`fretwear.hb.memory_gain` where it applies: equal to rounding) and ``Z~``
+(:meth:`HillProblem.jacobian`). Measured on the benchmark's small models
 (docs/studies/method-costs.md, "Hill's method"): about 1.2-2 times the CPU a sweep spends
 on the point (median; a tracked point of the two-DOF oscillator about 4 ms), along a
 sweep, which hands each point's own problem
@@ -713,14 +714,16 @@ class HillProblem:
         self._summary = None  # the contact states per node (:meth:`_states`)
         # in 2D, G(s) split once into its part free of s and one outer product per stick
         # interval (:mod:`fretwear.hb.memory_gain`; None: the recursion at every s), where
-        # a node sticks (otherwise nothing is refined: G(0) as the solve has it)
+        # a node sticks (otherwise nothing is refined); G(0) from the split wherever it
+        # applies, the solve's recursion elsewhere
         sticks = bool(self._states()[0][:, STICK].any())
-        self._memory = (memory_gain(self.lu, self.lx, self.state, *self._law) if sticks
-                        else None)
-        if self._memory is not None:  # G(0) from the split: the solve's recursion's terms
-            # summed in another order (no node sticks all period, so the solve's wrap-around
-            # is exact in one sweep and its anchors do not enter): equal to rounding
-            self.G0 = self._memory.at(1.0).real
+        split = memory_gain(self.lu, self.lx, self.state, *self._law)
+        self._memory = split if sticks else None
+        if split is not None:  # G(0) from the split: the solve's recursion's terms summed
+            # in another order (no node sticks all period, so the solve's wrap-around is
+            # exact in one sweep and its anchors do not enter): equal to rounding; without a
+            # stick interval the split is G(0) itself, made at 0.6 of the recursion's cost
+            self.G0 = split.at(1.0).real
         else:
             self.G0 = law.dlft_jacobian(self.lu, self.lx, self.state, prob.mu, prob.P, prob.Q,
                                         prob.eps * prob.anchor, prob.tol, prob.max_sweeps,
@@ -736,6 +739,9 @@ class HillProblem:
         small = (dyn.q <= CONDENSED_COMPILED_MAX and n <= PAIR_COMPILED_MAX)
         self._fused = ((mg.constant, mg.node, mg.start, mg.length, mg.rows, mg.P)
                        if mg is not None and small else None)
+        # the unknowns the compiled pair works on (:func:`_decoupled_normals`)
+        self._keep = (_decoupled_normals(mg, self._structure, prob.H, float(prob.eps))
+                      if self._fused is not None else None)
         self.evaluations = 0
 
     def gain(self, sigma: complex) -> np.ndarray:
@@ -793,7 +799,7 @@ class HillProblem:
             T = self.matrix(sigma)
             mu, y, lu = _pair(T, v, mu0)
         if lu is None:
-            res, pair = _residuals(T, y, complex(mu))
+            res, pair = _residuals(T, y, complex(mu), 0.0)
             return T, mu, y, None, float(res), float(pair)
         scale = np.linalg.norm(T, 1)
         pair = float(np.linalg.norm(T @ y - mu * y) / scale)
@@ -807,7 +813,7 @@ class HillProblem:
         z = (1.0 + 0j if sigma == 0 else np.exp(-2.0 * np.pi * sigma / self.N))
         out = _evaluate(*self._fused, complex(z), *self._structure, self.prob.m,
                         self.harmonics, self.omega, sigma, float(self.prob.eps),
-                        np.ascontiguousarray(v, dtype=complex), complex(mu0), 2)
+                        np.ascontiguousarray(v, dtype=complex), complex(mu0), 2, self._keep)
         if out[3] == 2:
             raise InputError("the structure with its contact points held is singular at a "
                              "value of the Laplace variable (an eigenvalue of the held "
@@ -1692,11 +1698,12 @@ def _pair_small(T, v, mu0, steps):
 
 
 @njit(cache=True)
-def _residuals(T, y, mu):
+def _residuals(T, y, mu, floor):
     """``(max(|mu|, |T y - mu y|) / |T|, |T y - mu y| / |T|)`` with the 1-norm of ``T``
-    (:meth:`HillProblem.evaluate`: the stopping rule of :func:`_track`) in one call."""
+    (:meth:`HillProblem.evaluate`: the stopping rule of :func:`_track`) in one call; the
+    1-norm at least ``floor`` (the column sums of a block left out, :func:`_evaluate`)."""
     n = T.shape[0]
-    scale = 0.0
+    scale = floor
     for j in range(n):
         col = 0.0
         for i in range(n):
@@ -1715,30 +1722,104 @@ def _residuals(T, y, mu):
 
 @njit(cache=True)
 def _evaluate(Gc, node, start, length, rows, P, z, Kf, Mf, Cf, Df, m, harmonics, omega,
-              sigma, eps, v, mu0, steps):
+              sigma, eps, v, mu0, steps, keep):
     """:meth:`HillProblem.evaluate` in one compiled call where ``G(s)`` is split
     (:mod:`fretwear.hb.memory_gain`) and every piece runs compiled: ``G(s)``
     (:func:`fretwear.hb.memory_gain._gain_at`, ``z = e^{-s h}``), ``Z_r``
     (:func:`_condensed_at`), ``T(s)`` (:func:`_hill_matrix`), the pair (:func:`_pair_small`)
     and the residuals (:func:`_residuals`): the same kernels as the calls one by one (the same
-    values), one call's overhead instead of five. Returns ``(T, mu, y, status, res, pair)``,
-    ``status`` 0, 1 (a zero pivot in the pair's LU: LAPACK's then runs) or 2 (the held
-    structure is singular at this ``s``)."""
+    values), one call's overhead instead of five. ``keep``: the unknowns the pair and the
+    residuals work on where the others are decoupled (:func:`_decoupled_normals`: ``T(s)``
+    block-diagonal, a block that does not vanish on the others) and the start ``v`` is zero
+    on the others: the pair's LU with partial pivoting, its solves and the residuals then
+    take the same values as on the whole matrix (the dropped block factored apart, its
+    exact zeros adding nothing; the dropped columns' sums in the 1-norm), on a quarter of
+    the entries (a Jenkins point's pair 38 -> 10 us). Returns ``(T, mu, y, status,
+    res, pair)``, ``status`` 0, 1 (a zero pivot in the pair's LU: LAPACK's then runs) or 2
+    (the held structure is singular at this ``s``)."""
     G = _gain_at(Gc, node, start, length, rows, P, z)
     Zr, ok = _condensed_at(Kf, Mf, Cf, Df, m, harmonics, omega, sigma)
     if not ok:
         return np.zeros((1, 1), dtype=np.complex128), 0j, v, 2, 0.0, 0.0
     T = _hill_matrix(G, Zr, eps)
-    mu, y, ok = _pair_small(T, v, mu0, steps)
+    n = T.shape[0]
+    nk = keep.size
+    kept = np.zeros(n, dtype=np.bool_)
+    for i in range(nk):
+        kept[keep[i]] = True
+    whole = nk == n
+    floor = 0.0  # the dropped columns' sums, as the whole matrix's 1-norm takes them
+    for j in range(n):
+        if kept[j]:
+            continue
+        if v[j] != 0:  # a start with a part on the dropped unknowns: the whole matrix
+            whole = True
+            break
+        col = 0.0
+        for i in range(n):
+            col += abs(T[i, j])
+        floor = max(floor, col)
+    if whole:
+        mu, y, ok = _pair_small(T, v, mu0, steps)
+        if not ok:
+            return T, 0j, v, 1, 0.0, 0.0
+        res, pair = _residuals(T, y, mu, 0.0)
+        return T, mu, y, 0, res, pair
+    Tk = np.empty((nk, nk), dtype=np.complex128)
+    vk = np.empty(nk, dtype=np.complex128)
+    for i in range(nk):
+        vk[i] = v[keep[i]]
+        for j in range(nk):
+            Tk[i, j] = T[keep[i], keep[j]]
+    mu, yk, ok = _pair_small(Tk, vk, mu0, steps)
     if not ok:
         return T, 0j, v, 1, 0.0, 0.0
-    res, pair = _residuals(T, y, mu)
+    res, pair = _residuals(Tk, yk, mu, floor)
+    y = np.zeros(n, dtype=np.complex128)
+    for i in range(nk):
+        y[keep[i]] = yk[i]
     return T, mu, y, 0, res, pair
+
+
+def _decoupled_normals(mg, structure, H: int, eps: float):
+    """``keep`` for :func:`_evaluate`: where every node's normal coordinate is
+    decoupled (a prescribed normal force on a coordinate of its own: in the structure's
+    matrices its row and column zero off the diagonal, no mass nor damping on it, a stiffness
+    ``k``; in ``G`` no coupling between its block ``G_N`` and the tangential one, the split's
+    rows none either), ``T(s)`` is block-diagonal with ``eps I - (eps - k) G_N`` on those
+    unknowns, the same at every ``s`` (the split touches tangential rows only): no exponent
+    there where that block is well conditioned, and the eigenpair that vanishes lives on the
+    others (a start without a normal part stays without one): the tangential unknowns
+    (DOF-major, ``H`` per DOF); all unknowns where any node's normal is not decoupled."""
+    Kf, Mf, Cf, Df = structure
+    nc, dH, _ = mg.constant.shape
+    every = np.arange(nc * dH, dtype=np.int64)
+    if dH != 2 * H:
+        return every
+    for p in range(nc):
+        a = 2 * p
+        Gp = mg.constant[p]
+        if Gp[:H, H:].any() or Gp[H:, :H].any() or np.any(mg.rows[mg.node == p][:, :H]):
+            return every
+        for M in Kf, Mf, Cf, Df:
+            off = M[a].copy()
+            off[a] = 0.0
+            col = M[:, a].copy()
+            col[a] = 0.0
+            if off.any() or col.any():
+                return every
+        if Mf[a, a] != 0.0 or Cf[a, a] != 0.0 or Df[a, a] != 0.0:
+            return every
+        block = eps * np.eye(H) - (eps - Kf[a, a]) * Gp[:H, :H]
+        if not np.linalg.cond(block) < 1e8:
+            return every
+    keep = np.concatenate([np.arange((2 * p + 1) * H, (2 * p + 2) * H) for p in range(nc)])
+    return keep.astype(np.int64)
 
 
 @njit(cache=True)
 def _refine(Gc, node, start, length, rows, P, Kf, Mf, Cf, Df, m, harmonics, omega, eps, N,
-            s0, sigma, v, slope, tol, max_iter, floor):
+            s0, sigma, v, slope, tol, max_iter, floor, keep):
     """:func:`_track` from a neighbour's start (``sigma``, ``v``, ``slope`` nonzero; no
     deflation) in one compiled call, each step one :func:`_evaluate`: the secant method on
     the eigenvalue ``mu`` of ``T(sigma)`` that continues ``v``, the same steps and stopping
@@ -1746,7 +1827,7 @@ def _refine(Gc, node, start, length, rows, P, Kf, Mf, Cf, Df, m, harmonics, omeg
     and above ``2 pi Re sigma = floor``, the logarithm of :data:`NEGLIGIBLE`). Returns
     ``(sigma, v, res, converged, slope, evaluations, status)``, ``status`` 0, or 1 / 2 as
     :func:`_evaluate`'s (then :func:`_track` runs the steps one by one, which take LAPACK's
-    pair or raise)."""
+    pair or raise). ``keep``: :func:`_evaluate`'s."""
     res = np.inf
     real = s0.imag == 0.0
     mu0 = 0j
@@ -1760,7 +1841,7 @@ def _refine(Gc, node, start, length, rows, P, Kf, Mf, Cf, Df, m, harmonics, omeg
         z = 1.0 + 0j if sigma == 0 else np.exp(-2.0 * np.pi * sigma / N)
         T, mu, y, status, res, pair = _evaluate(Gc, node, start, length, rows, P, z, Kf, Mf,
                                                 Cf, Df, m, harmonics, omega, sigma, eps, v,
-                                                mu0, 2)
+                                                mu0, 2, keep)
         count += 1
         if status != 0:
             return sigma, v, res, False, slope, count, status
@@ -1953,7 +2034,7 @@ def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions,
                       float(hp.prob.eps), float(hp.N), complex(sigma), complex(warm.sigma),
                       np.ascontiguousarray(warm.v, dtype=complex), complex(warm.slope),
                       float(opt.newton_tol), int(opt.newton_max_iter),
-                      float(np.log(NEGLIGIBLE)))
+                      float(np.log(NEGLIGIBLE)), hp._keep)
         if out[6] == 0:  # (else: the steps one by one, which take LAPACK's pair or raise)
             hp.evaluations += out[5]
             s1, v1, r1, conv, slope1 = out[:5]
@@ -2042,6 +2123,12 @@ def _mu_derivative(hp: HillProblem, sigma: complex, v: np.ndarray, T: np.ndarray
     return complex(np.vdot(w, dT @ v) / den) if den != 0 else 0.0
 
 
+def _centroid_of(v: np.ndarray, m: int, H: int, k: int) -> float:
+    """:func:`centroid` of one refined eigenvector ``v`` (m H,): its kernel called directly
+    (the wrapper's reshapes and checks cost as much as the kernel on one vector)."""
+    return float(_centroids(np.ascontiguousarray(v, dtype=complex).reshape(1, m, H), k)[0])
+
+
 def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
                    options: HillOptions | None = None,
                    previous: FloquetResult | None = None) -> FloquetResult:
@@ -2100,7 +2187,7 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
         s0 = complex(vals[i])
         y = vecs[:, i]
         vx = y[:m * H]
-        held = np.linalg.norm(vx) < 1e-8 * np.linalg.norm(y)
+        held = np.vdot(vx, vx).real < 1e-16 * np.vdot(y, y).real  # |vx| < 1e-8 |y|
         negligible = 2.0 * np.pi * s0.real < np.log(NEGLIGIBLE)
         if held or exact or negligible or refined >= opt.refine:  # refined: successes
             sig.append(s0)
@@ -2122,41 +2209,93 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
             a = s0.real if abs(s0.real - s1.real) > 10 * ON_REAL else s1.real - 0.01
             s2, v2, r2, conv2, _ = _track(hp, complex(a, 0.0), vx, opt, deflate=s1.real)
             sig.append(complex(s2.real, 0.0) if conv2 else np.conj(s0))
-            kaps.append(centroid(v2.reshape(m, H), k) if conv2 else -kp)
+            kaps.append(_centroid_of(v2, m, H, k) if conv2 else -kp)
             res.append(r2 if conv2 else np.nan)
             kind.append("refined" if conv2 else "candidate")
         done[pos] = Refined(s0, s1, v1, slope)
         sig.append(s1)
-        kaps.append(centroid(v1.reshape(m, H), k))
+        kaps.append(_centroid_of(v1, m, H, k))
         res.append(r1)
         kind.append("refined")
     if track is not None:
         track.refined = done
-    sig = np.array(sig, dtype=complex)
-    kaps = np.array(kaps)
-    res = np.array(res)
-    kind = np.array(kind, dtype=object)
-    # one multiplier per family: the conjugate of a complex exponent is another family,
-    # except at Im s = w/2, where s and its conjugate s - i w are the two members of one
-    # family with a real negative multiplier (a period-doubling direction)
-    edge = np.abs(np.abs(sig.imag) - 0.5) <= EDGE_TOL
-    cplx = (np.abs(sig.imag) > 1e-9 * np.maximum(np.abs(sig), 1.0)) & ~edge
-    allsig = np.concatenate([sig, np.conj(sig[cplx])])
-    allkap = np.concatenate([kaps, -kaps[cplx]])
-    allres = np.concatenate([res, res[cplx]])
-    allkind = np.concatenate([kind, kind[cplx]])
-    mult = np.exp(2.0 * np.pi * allsig)
-    redge = np.concatenate([edge, np.zeros(int(cplx.sum()), dtype=bool)])
-    mult[redge] = -np.exp(2.0 * np.pi * allsig[redge].real)
-    chosen = np.argsort(-allsig.real, kind="stable")
+    # one multiplier per family (:func:`_families`), sorted by decreasing real part
+    allsig, mult, allkap, allres, src = _families(np.array(sig, dtype=complex),
+                                                  np.array(kaps, dtype=float),
+                                                  np.array(res, dtype=float), EDGE_TOL)
     w = hp.omega
-    return FloquetResult(exponents=allsig[chosen] * w, multipliers=mult[chosen],
-                         centroid=allkap[chosen], residual=allres[chosen],
-                         kind=allkind[chosen], neutral=hp.neutral(), omega=w,
+    return FloquetResult(exponents=allsig * w, multipliers=mult, centroid=allkap,
+                         residual=allres, kind=np.array(kind, dtype=object)[src],
+                         neutral=hp.neutral(), omega=w,
                          spurious=np.array(spurious, dtype=complex) * w,
                          evaluations=hp.evaluations, wall_time=time.perf_counter() - t0,
                          stable_tol=opt.stable_tol, det_sign=det_sign,
                          tracked=got is not None, track=track)
+
+
+@njit(cache=True)
+def _families(sig, kap, res, edge_tol):
+    """The exponents ``sig`` (``s / w``, one member per family with ``Im s >= 0``), their
+    centroids ``kap`` and residuals ``res`` completed and sorted as
+    :class:`FloquetResult` holds them, in one compiled call: one multiplier per family (the
+    conjugate of a complex exponent is another family, centroid negated, except at
+    ``Im s = w/2``, within ``edge_tol``, where ``s`` and its conjugate ``s - i w`` are the two
+    members of one family with a real negative multiplier ``-e^{2 pi Re sigma}``: a
+    period-doubling direction), ordered by decreasing real part (a stable sort, by insertion:
+    the families are few and it compiles in less time than numba's merge sort; the order of
+    ``sig`` among equal real parts, each conjugate after the exponents). Returns ``(sigma,
+    multipliers, centroid, residual, source)``, ``source`` the index in ``sig`` each came
+    from."""
+    n = sig.size
+    edge = np.empty(n, dtype=np.bool_)
+    extra = 0
+    for i in range(n):
+        edge[i] = abs(abs(sig[i].imag) - 0.5) <= edge_tol
+        if abs(sig[i].imag) > 1e-9 * max(abs(sig[i]), 1.0) and not edge[i]:
+            extra += 1
+    total = n + extra
+    src = np.empty(total, dtype=np.int64)
+    conj = np.zeros(total, dtype=np.bool_)
+    key = np.empty(total)
+    j = n
+    for i in range(n):
+        src[i] = i
+        key[i] = -sig[i].real
+        if abs(sig[i].imag) > 1e-9 * max(abs(sig[i]), 1.0) and not edge[i]:
+            src[j] = i
+            conj[j] = True
+            key[j] = -sig[i].real
+            j += 1
+    order = np.arange(total)
+    for a in range(1, total):
+        o = order[a]
+        b = a - 1
+        while b >= 0 and key[order[b]] > key[o]:
+            order[b + 1] = order[b]
+            b -= 1
+        order[b + 1] = o
+    s = np.empty(total, dtype=np.complex128)
+    mult = np.empty(total, dtype=np.complex128)
+    k = np.empty(total)
+    r = np.empty(total)
+    out = np.empty(total, dtype=np.int64)
+    for a in range(total):
+        i = src[order[a]]
+        out[a] = i
+        r[a] = res[i]
+        if conj[order[a]]:
+            s[a] = np.conj(sig[i])
+            k[a] = -kap[i]
+            mult[a] = np.exp(2.0 * np.pi * s[a])
+        elif edge[i]:
+            s[a] = sig[i]
+            k[a] = kap[i]
+            mult[a] = -np.exp(2.0 * np.pi * sig[i].real)
+        else:
+            s[a] = sig[i]
+            k[a] = kap[i]
+            mult[a] = np.exp(2.0 * np.pi * sig[i])
+    return s, mult, k, r, out
 
 
 def stability(model: Model, sol: PeriodicSolution, *, options: HillOptions | None = None,
