@@ -151,6 +151,20 @@ def test_local_phase_returns_to_the_root(solved):
     np.testing.assert_allclose(out, x, rtol=0, atol=1e-9 * np.abs(x).max())
 
 
+
+def _three_locals(fun, x_star, scale):
+    """Powell on a kinked problem from 0 with no local phase, one that returns its input and
+    one that returns the known root: ``{name: (x, stats, |f| of every iterate)}``."""
+    out = {}
+    for name, local in (("none", None), ("same", lambda x, f, t: x),
+                        ("root", lambda x, f, t, r=x_star: r)):
+        seen = []
+        x, _, st = solvers.powell(fun, np.zeros_like(x_star), lambda x, s=scale: s,
+                                  tol=1e-12, local=local,
+                                  callback=lambda i, x, fn, seen=seen: seen.append(fn))
+        out[name] = (x, st, seen)
+    return out
+
 def test_powell_takes_a_better_point_of_the_local_phase(monkeypatch):
     """On the kinked piecewise-linear problems of test_solvers (their roots known), with the
     stretches on formed Jacobians: a local phase that returns the root ends every solve that
@@ -164,12 +178,7 @@ def test_powell_takes_a_better_point_of_the_local_phase(monkeypatch):
     for seed in range(40):
         fun, x_star, scale = kinked(seed)
         runs = {}
-        for name, local in (("none", None), ("same", lambda x, f, t: x),
-                            ("root", lambda x, f, t, r=x_star: r)):
-            seen = []
-            x, _, st = solvers.powell(fun, np.zeros_like(x_star), lambda x, s=scale: s,
-                                      tol=1e-12, local=local,
-                                      callback=lambda i, x, fn, seen=seen: seen.append(fn))
+        for name, (x, st, seen) in _three_locals(fun, x_star, scale).items():
             assert st.success, (seed, name, st.message)
             np.testing.assert_allclose(x, x_star, rtol=0, atol=1e-11 * np.abs(x_star).max())
             runs[name] = (st.iterations, seen)
@@ -213,12 +222,7 @@ def test_local_phase_entered_after_two_crawling_steps(monkeypatch):
         totals[after] = {"none": [], "same": [], "root": []}
         for seed in range(40):
             fun, x_star, scale = kinked(seed)
-            for name, local in (("none", None), ("same", lambda x, f, t: x),
-                                ("root", lambda x, f, t, r=x_star: r)):
-                seen = []
-                x, _, st = solvers.powell(fun, np.zeros_like(x_star), lambda x, s=scale: s,
-                                          tol=1e-12, local=local,
-                                          callback=lambda i, x, fn, seen=seen: seen.append(fn))
+            for name, (_, st, seen) in _three_locals(fun, x_star, scale).items():
                 assert st.success, (after, seed, name, st.message)
                 totals[after][name].append((st.iterations, seen))
         assert totals[after]["same"] == totals[after]["none"]

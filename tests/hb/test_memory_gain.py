@@ -78,12 +78,9 @@ def test_split_gain_refuses_what_it_does_not_cover():
     assert memory_gain(lu3, lu3, state, np.array([0.5]), P, Q, normal) is None
 
 
-def test_fused_evaluation_is_the_pieces_one_by_one():
-    """:meth:`HillProblem.evaluate` by the one compiled call (:func:`_evaluate`, which a 2D
-    Jenkins solution that sticks and slips takes) equals the pieces called one by one
-    (:meth:`HillProblem.matrix`, :func:`_pair`, :func:`_residuals`): the same kernels, so
-    the same values bit for bit, at ``s = 0``, on and off the imaginary axis; and it counts
-    its evaluations."""
+def _jenkins_point():
+    """A damped Jenkins oscillator (mu N 0.5, kt 0.5) forced near its resonance, 3
+    harmonics, 32 samples: its periodic problem and Hill problem (it sticks and slips)."""
     model = from_matrices([[1.0]], [[1.0]],
                           contact=ContactDofs(normal_dofs=None, tangential_dofs=[0], mu=0.5,
                                               normal_load=1.0, kt=0.5),
@@ -91,7 +88,16 @@ def test_fused_evaluation_is_the_pieces_one_by_one():
     sol = solve_periodic(model, FourierBasis.up_to(3, 32), frequency=1.18 / (2 * np.pi),
                          time_domain=None)
     prob = problem_of(model, sol)
-    hp = HillProblem(prob, sol.U.reshape(prob.m, prob.H), structure_dynamics(model))
+    return prob, HillProblem(prob, sol.U.reshape(prob.m, prob.H), structure_dynamics(model))
+
+
+def test_fused_evaluation_is_the_pieces_one_by_one():
+    """:meth:`HillProblem.evaluate` by the one compiled call (:func:`_evaluate`, which a 2D
+    Jenkins solution that sticks and slips takes) equals the pieces called one by one
+    (:meth:`HillProblem.matrix`, :func:`_pair`, :func:`_residuals`): the same kernels, so
+    the same values bit for bit, at ``s = 0``, on and off the imaginary axis; and it counts
+    its evaluations."""
+    prob, hp = _jenkins_point()
     assert hp._fused is not None and law.STICK in hp.state and law.SLIP in hp.state
     rng = np.random.default_rng(1)
     v = rng.standard_normal(prob.m * prob.H) + 1j * rng.standard_normal(prob.m * prob.H)
@@ -115,14 +121,7 @@ def test_pair_on_the_tangential_unknowns_is_the_whole_matrix_s():
     block, the exact zeros add nothing, the 1-norm takes the dropped columns' sums; a start
     with a normal part takes the whole matrix; a structure that couples the normal
     coordinate keeps every unknown."""
-    model = from_matrices([[1.0]], [[1.0]],
-                          contact=ContactDofs(normal_dofs=None, tangential_dofs=[0], mu=0.5,
-                                              normal_load=1.0, kt=0.5),
-                          damping=Damping(C=[[0.02]]), loads=[Load(np.array([0.2]), "cos")])
-    sol = solve_periodic(model, FourierBasis.up_to(3, 32), frequency=1.18 / (2 * np.pi),
-                         time_domain=None)
-    prob = problem_of(model, sol)
-    hp = HillProblem(prob, sol.U.reshape(prob.m, prob.H), structure_dynamics(model))
+    prob, hp = _jenkins_point()
     n, H = prob.m * prob.H, prob.H
     assert hp._fused is not None and np.array_equal(hp._keep, np.arange(H, n))
     every = np.arange(n, dtype=np.int64)
