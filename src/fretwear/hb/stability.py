@@ -95,8 +95,9 @@ on the unknowns that couple harmonics, the others eliminated harmonic by harmoni
 :mod:`fretwear.hb.hill_tracking`). ``det J`` is read from the solve's ``G`` (made again from
 the split of :mod:`fretwear.hb.memory_gain` where it applies: equal to rounding) and ``Z~``
 (:meth:`HillProblem.jacobian`). Measured on the benchmark's small models
-(docs/studies/method-costs.md, "Hill's method"): about 1.2-2 times the CPU a sweep spends
-on the point (median; a tracked point of the two-DOF oscillator about 4 ms), along a
+(docs/studies/method-costs.md, "Hill's method"): about 0.9-1.3 times the CPU a sweep
+spends on the point (median over both sweeps, quiet; the Jenkins oscillator's points
+0.66-0.77, the two-DOF oscillator's 1.2-1.8, a tracked one there about 2-4 ms), along a
 sweep, which hands each point's own problem
 (:func:`fretwear.hb.sweep_stability.point_problem`; :func:`stability` rebuilds it from the
 solution, about 1.1-1.5 ms more there); the evaluations of ``T(s)`` (a law with a memory),
