@@ -23,12 +23,15 @@ LU of ``S`` (the core's size) instead of that of ``P``: on the benchmark's two-D
 unilateral oscillator (15 harmonics) a block of 62 unknowns has a core of 31 (the coordinate
 behind the contact spring; the other mass is local).
 
-The elimination is exact (the same linear system, eliminated in another order): the result
-differs from the LU of the whole ``P`` by rounding. Pivots are not chosen across the local
-groups, so where a group's LU (partial pivoting within the group) has a pivot below
-:data:`SPLIT_PIVOT` times the group's largest entry the factorisation refuses, and the
-caller factors the whole ``P`` (``sigma`` near an eigenvalue of a local coordinate held:
-the growth of that group's elimination is then bounded by ``1 / SPLIT_PIVOT``).
+The elimination is exact (the same linear system, eliminated in another order) up to the
+entries that the local/core test takes as zero (below ``DECOUPLED_TOL`` of the block's
+largest, :mod:`fretwear.hb.stability`): the result differs from the LU of the whole ``P``
+by rounding and by those. Pivots are not chosen across the local groups, so where a group's
+LU (partial pivoting within the group) has a pivot below :data:`SPLIT_PIVOT` times the
+group's largest entry that group joins the core (``sigma`` near an eigenvalue of a local
+coordinate held). For the usual group, a coordinate's cosine and sine (2 x 2), this bounds
+the growth of its elimination by about ``1 / SPLIT_PIVOT``; for a larger group the test is
+a guard against a near-singular block, not a proved bound.
 """
 
 from __future__ import annotations
@@ -37,7 +40,8 @@ import numpy as np
 from numba import njit
 
 #: a local group's LU whose smallest pivot is below this times the group's largest entry
-#: makes :func:`_split_factor` refuse (the elimination's growth stays below its inverse)
+#: makes :func:`_split_factor` refuse, and the group joins the core (:func:`_demote`; for a
+#: cosine-sine group of 2 x 2 its elimination's growth stays below about the inverse)
 SPLIT_PIVOT = 1e-3
 #: the split is used where the core has at most this fraction of the block's unknowns (the
 #: LU's cost goes with the cube of its size; a large core saves less than the bookkeeping)
