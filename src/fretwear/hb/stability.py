@@ -2036,8 +2036,8 @@ def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions,
                       np.ascontiguousarray(warm.v, dtype=complex), complex(warm.slope),
                       float(opt.newton_tol), int(opt.newton_max_iter),
                       float(np.log(NEGLIGIBLE)), hp._keep)
+        hp.evaluations += out[5]  # (made, whether or not the steps are then taken again)
         if out[6] == 0:  # (else: the steps one by one, which take LAPACK's pair or raise)
-            hp.evaluations += out[5]
             s1, v1, r1, conv, slope1 = out[:5]
             return complex(s1), v1, float(r1), bool(conv), complex(slope1)
     prev = None
