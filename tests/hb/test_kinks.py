@@ -145,11 +145,12 @@ def test_local_phase_returns_to_the_root(solved):
     target = 1e-12 * prob.scale(U)
     assert np.linalg.norm(f) > 1e3 * target
     assert {1, 2} <= set(kinks.worst_nodes(f, prob.nc))
-    out = kinks.local_phase(prob)(U.reshape(-1), f, target)
+    local = kinks.local_phase(prob)
+    out = local(U.reshape(-1), f, target)
+    assert local.njev >= 1 and local.nfev == 2 * local.njev  # a residual after each step
     fo, _ = prob.residual(out.reshape(prob.m, prob.H), False)
     assert np.linalg.norm(fo) <= target
     np.testing.assert_allclose(out, x, rtol=0, atol=1e-9 * np.abs(x).max())
-
 
 
 def _three_locals(fun, x_star, scale):
@@ -164,6 +165,7 @@ def _three_locals(fun, x_star, scale):
                                   callback=lambda i, x, fn, seen=seen: seen.append(fn))
         out[name] = (x, st, seen)
     return out
+
 
 def test_powell_takes_a_better_point_of_the_local_phase(monkeypatch):
     """On the kinked piecewise-linear problems of test_solvers (their roots known), with the
@@ -251,3 +253,33 @@ def test_a_local_phase_that_made_progress_resets_the_progress_test(monkeypatch):
                                   max_slow=3)
         stopped += "not making good progress" in st.message
     assert stopped == 1
+
+
+def test_powell_counts_the_evaluations_the_local_phase_says(monkeypatch):
+    """A local phase that keeps its evaluations in ``nfev`` / ``njev`` (as kinks.local_phase
+    does) has them added to Powell's: on the kinked problems whose solves call it, the
+    stats exceed those of the same phase without the attributes by exactly what it says
+    (7 and 3 a call; the paths are the same, the phase returning the root either way)."""
+    monkeypatch.setattr(solvers, "WATCHDOG_FORMED", True)
+    compared = 0
+    for seed in range(40):
+        fun, x_star, scale = kinked(seed)
+
+        def plain(x, f, t, r=x_star):
+            plain.calls += 1
+            return r
+
+        def counting(x, f, t, r=x_star):
+            counting.nfev += 7
+            counting.njev += 3
+            return r
+
+        plain.calls, counting.nfev, counting.njev = 0, 0, 0
+        runs = [solvers.powell(fun, np.zeros_like(x_star), lambda x, s=scale: s, tol=1e-12,
+                               local=local)[2] for local in (plain, counting)]
+        if plain.calls:
+            compared += 1
+            assert runs[1].iterations == runs[0].iterations
+            assert runs[1].nfev - runs[0].nfev == 7 * plain.calls
+            assert runs[1].njev - runs[0].njev == 3 * plain.calls
+    assert compared == 36  # the draws whose crawl calls the phase (as above)

@@ -194,7 +194,9 @@ def local_phase(prob, record=None):
     returns the best point reached (``x`` itself if none was better). On the 1024-node
     crawl (docs/studies/large-interface-solve.md) it ended the crawl. ``record``: a list to
     which each round appends ``(Elimination, |f| after it, |f| after the Newton step)``
-    (studies)."""
+    (studies). The callable counts its evaluations of the whole balance in its attributes
+    ``nfev`` and ``njev`` (residuals, Jacobians; the subproblems' are not: a few nodes'),
+    which Powell adds to its own."""
     shape = (prob.m, prob.H)
 
     def local(x, f, target):
@@ -206,6 +208,8 @@ def local_phase(prob, record=None):
             x = U.reshape(-1) + _lu_step(J, fe, None if isinstance(J, np.ndarray)
                                         else NEWTON_RTOL)
             f, _ = prob.residual(x.reshape(shape), False)
+            local.nfev += 2
+            local.njev += 1
             fn = vector_norm(f)
             if record is not None:
                 record.append((rep, vector_norm(fe), fn))
@@ -216,4 +220,5 @@ def local_phase(prob, record=None):
             last = fn
         return best
 
+    local.nfev = local.njev = 0
     return local

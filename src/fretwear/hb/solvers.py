@@ -355,7 +355,8 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
     smaller ``|f|`` is taken as the iterate (its full Newton step tried next, the trust
     radius set to it as at the start); else the dog-leg steps and the forced step go on as
     without it.
-    Its own evaluations are not counted in ``nfev``, ``njev``.
+    Its own evaluations are counted in ``nfev``, ``njev`` where it keeps them in attributes
+    of the same names (as :func:`fretwear.hb.kinks.local_phase` does).
     ``max_slow``: stop (unconverged) after that many iterations on a new Jacobian
     in a row without one that decreased ``|f|^2`` by :data:`SLOW_DECREASE` (MINPACK's "not
     making good progress" test, ``info = 4`` of ``hybrj`` with 5); None: no such test.
@@ -424,10 +425,11 @@ def powell(fun, x0, scale, *, tol=1e-8, max_iter=200, callback=None, max_slow=No
                 and fn > WATCHDOG_CLIPPED_PROGRESS * min(local_ref, clip_ref)):
             # the dog-leg steps crawl: the local phase (once in a crawl)
             local_tried = True
+            counts = getattr(local, "nfev", 0), getattr(local, "njev", 0)
             xl = np.array(local(x, f, target), dtype=float)
             fl, Jl = fun(xl, True)
-            nfev += 1
-            njev += 1
+            nfev += 1 + getattr(local, "nfev", 0) - counts[0]
+            njev += 1 + getattr(local, "njev", 0) - counts[1]
             fnl = vector_norm(fl)
             if fnl < fn:  # its point the iterate, its full Newton step tried next
                 if trace is not None:
