@@ -1411,8 +1411,8 @@ def _copy(red: QuadraticReduction, b: int, s1: complex, y: np.ndarray, shape: tu
     law does not reach them (a block whose coordinates' laws do not vary over the period,
     or an eigenvector with no weight at the edge harmonics) that is rounding too. Where the
     backward error of ``(sigma, v)`` (:func:`_backward_error`) is below :data:`COPY_EXACT`
-    the pair is an exact eigenpair of a pencil ``P + E`` with ``|E| <= COPY_EXACT |P|``,
-    no further from ``P`` than the eigenpairs that the dense eigensolver (backward stable
+    the pair is an exact eigenpair of a pencil ``P + E`` with ``|E| <= COPY_EXACT |P|`` (to
+    the rounding of the computed residual itself, about ``n u |P| |v|``), no further from ``P`` than the eigenpairs that the dense eigensolver (backward stable
     on the companion form) or the inverse iteration (stopped at a step below 1e-14)
     return: the copy is certified as it is, with its centroid, and no inverse iteration is
     run; otherwise the inverse iteration from it (:func:`_member`, not folded)."""
@@ -1504,8 +1504,10 @@ def _backward_error(B0, B1, B2, sigma, v, norms):
     """The backward error of the pair ``(sigma, v)`` of ``B0 + s B1 + s^2 B2`` (Tisseur,
     Linear Algebra Appl. 309, 2000, theorem 1: ``|P(sigma) v| / ((|B0| + |sigma| |B1| +
     |sigma|^2 |B2|) |v|)``), with ``norms`` (:func:`_column_norms`: each matrix's largest
-    column 2-norm, a lower bound of its 2-norm, so the error is not under-estimated) for
-    the matrices' 2-norms."""
+    column 2-norm, a lower bound of its 2-norm, so the error is not under-estimated by the
+    norms; the computed residual ``P(sigma) v`` carries its own rounding, about ``n u`` of
+    the denominator, so the value is Tisseur's to that rounding) for the matrices' 2-norms.
+    """
     n = B0.shape[0]
     s2 = sigma * sigma
     res = 0.0
