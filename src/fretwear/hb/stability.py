@@ -1412,9 +1412,10 @@ def _copy(red: QuadraticReduction, b: int, s1: complex, y: np.ndarray, shape: tu
     or an eigenvector with no weight at the edge harmonics) that is rounding too. Where the
     backward error of ``(sigma, v)`` (:func:`_backward_error`) is below :data:`COPY_EXACT`
     the pair is an exact eigenpair of a pencil ``P + E`` with ``|E| <= COPY_EXACT |P|`` (to
-    the rounding of the computed residual itself, about ``n u |P| |v|``), no further from ``P`` than the eigenpairs that the dense eigensolver (backward stable
-    on the companion form) or the inverse iteration (stopped at a step below 1e-14)
-    return: the copy is certified as it is, with its centroid, and no inverse iteration is
+    the rounding of the computed residual itself, about ``n u |P| |v|``), no further from
+    ``P`` than the eigenpairs that the dense eigensolver (backward stable on the companion
+    form) or the inverse iteration (stopped at a step below 1e-14) return: the copy is
+    certified as it is, with its centroid, and no inverse iteration is
     run; otherwise the inverse iteration from it (:func:`_member`, not folded)."""
     r, H, k = shape
     B, split, at, back, alg, norms = _block_mats(red, b, shape, mats)
