@@ -165,6 +165,14 @@ class HarmonicBlocks:
         stored block here (``buf`` unused); an operator forms the panel into ``buf``."""
         return self.row_block(b, dofs)
 
+    def block_products(self, blocks, V: np.ndarray) -> np.ndarray:
+        """``Z_b V[:, j]`` with ``b = blocks[j]`` (``Z_0`` its real part, as :attr:`Z0`;
+        real or complex ``V`` (m, r)): (m, r), complex where a block or ``V`` is. The
+        stored blocks here; an operator multiplies without forming them (the sharing
+        test of :class:`MeanGainPreconditioner`)."""
+        cols = [(self.Z0 if b == 0 else self.block(b)) @ V[:, j] for j, b in enumerate(blocks)]
+        return np.stack(cols, axis=1)
+
     def node_diagonal(self, b: int, d: int) -> np.ndarray:
         """The (m / d, d, d) diagonal node blocks of block ``b`` (as :meth:`block`)."""
         Zb = self.Z0 if b == 0 else self.block(b)
@@ -383,29 +391,32 @@ class MeanGainPreconditioner:
         gosc = gbar if gosc is None else gosc
         self.factors = []  # per harmonic block: LAPACK LU of P_n or of a close P_b
         self.shared = 0
-        last = None  # (Z_b, g_b, its LU) of the last factored harmonic
+        last = None  # (b, g_b, its LU) of the last factored harmonic
         # blocks held as an operator (hb/operator_blocks.py) bound the factors' memory: past
         # the bound every further harmonic shares the last factors
         budget = getattr(Z, "factor_budget", None)
         most = Z.nb if budget is None else max(1, int(budget // (8 * Z.m * Z.m)))
+        probe = {}  # the sharing test's first products, made once (_close)
         for b in range(Z.nb):
             full = last is not None and len({id(f) for f in self.factors}) >= most
             if full:  # (the block is not formed: m^2 memory and time for nothing)
                 self.factors.append(last[2])
                 self.shared += 1
                 continue
-            Zb = Z.Z0 if b == 0 else Z.block(b)
             g = gbar if b == 0 else gosc
-            if share and last is not None and self._close(g, Zb, last, eps):
+            # (the test by products: a block is formed only to be factored)
+            if share and last is not None and self._close(g, b, last, eps, Z, probe):
                 self.factors.append(last[2])
                 self.shared += 1
                 continue
+            Zb = Z.Z0 if b == 0 else Z.block(b)
             P = self._block(g, Zb, eps)
             if single:
                 P = P.astype(np.complex64 if np.iscomplexobj(P) else np.float32)
+            del Zb
             lu = sla.lu_factor(P, overwrite_a=True, check_finite=False)
             self.factors.append(lu)
-            last = (Zb, g, lu)
+            last = (b, g, lu)
         # the harmonics of each set of factors, solved together by apply()
         groups: dict = {}
         for b, lu in enumerate(self.factors):
@@ -434,26 +445,41 @@ class MeanGainPreconditioner:
         return _lu_solve(lu, b)
 
     @classmethod
-    def _close(cls, gn, Zn, last, eps) -> bool:
-        """Whether the factors of ``P_b`` (``last`` = ``(Z_b, g_b, LU)``) precondition ``P_n``
+    def _close(cls, gn, n, last, eps, Z, probe) -> bool:
+        """Whether the factors of ``P_b`` (``last`` = ``(b, g_b, LU)``) precondition ``P_n``
         (gain ``gn``) well: ``P_b^-1 P_n = I + E`` with ``E = P_b^-1 (P_n - P_b)``, which is
         ``P_b^-1 g (Z_n - Z_b)`` when both take the same gain ``g``, and GMRES on it
         converges about as fast as on ``I`` when ``E`` is small. Its size is estimated by
         :data:`SHARE_PROBES` steps of the power iteration from a fixed random vector
         (``2 SHARE_PROBES`` products and solves of ``m^2`` operations, against the ``m^3``
         of an LU): shared when below :data:`SHARE_BELOW`. An isolated large eigenvalue of
-        ``E`` that the probe misses costs GMRES about one iteration."""
-        Zb, gb, lu = last
+        ``E`` that the probe misses costs GMRES about one iteration.
+
+        The products ``Z_n v``, ``Z_b v`` are taken from ``Z`` (its ``block_products``)
+        without forming the blocks: on an operator's blocks (hb/operator_blocks.py) a
+        formed block costs several passes over ``m x m`` arrays and its page faults, a
+        product one pass over the stored matrices. The first step's are made for every
+        harmonic in one product, kept in ``probe`` (the same vector for all)."""
+        b, gb, lu = last
         nc, d, _ = gn.shape
-        m = Zn.shape[0]
-        v = np.random.default_rng(0).standard_normal(m)
+        m = Z.m
+        if not probe:
+            v0 = np.random.default_rng(0).standard_normal(m)
+            probe["v"] = v0
+            probe["Zv"] = Z.block_products(np.arange(Z.nb), np.repeat(v0[:, None], Z.nb, 1))
+        v = probe["v"]
         size = 0.0
-        for _ in range(SHARE_PROBES):
-            if gn is gb:
-                y = np.matmul(gn, (Zn @ v - Zb @ v).reshape(nc, d, 1))
+        for step in range(SHARE_PROBES):
+            if step == 0:
+                zn, zb = probe["Zv"][:, n], probe["Zv"][:, b]
             else:
-                y = (np.matmul(gn, (Zn @ v - eps * v).reshape(nc, d, 1))
-                     - np.matmul(gb, (Zb @ v - eps * v).reshape(nc, d, 1)))
+                zz = Z.block_products([n, b], np.column_stack([v, v]))
+                zn, zb = zz[:, 0], zz[:, 1]
+            if gn is gb:
+                y = np.matmul(gn, (zn - zb).reshape(nc, d, 1))
+            else:
+                y = (np.matmul(gn, (zn - eps * v).reshape(nc, d, 1))
+                     - np.matmul(gb, (zb - eps * v).reshape(nc, d, 1)))
             w = cls._solve(lu, y[:, :, 0].reshape(-1))
             size = float(np.linalg.norm(w) / np.linalg.norm(v))
             v = w
@@ -840,6 +866,14 @@ class _ActiveView:
         ``ReducedOperator.block(b, rows, cols)`` would hold two more m_a x m arrays)."""
         Zb = self.Z.Z0 if b == 0 else self.Z.block(b)
         return Zb[np.ix_(self.dofs, self.dofs)]
+
+    def block_products(self, blocks, V: np.ndarray) -> np.ndarray:
+        """As :meth:`HarmonicBlocks.block_products` on ``dofs``: ``V`` scattered into the
+        whole operator's DOFs, multiplied there (no block formed), the rows ``dofs``
+        gathered."""
+        full = np.zeros((self.Z.m, V.shape[1]), dtype=V.dtype)
+        full[self.dofs] = V
+        return self.Z.block_products(blocks, full)[self.dofs]
 
     def single(self):
         """The same view of ``Z``'s single-precision blocks (``Z.single()``), or None."""
