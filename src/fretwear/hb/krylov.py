@@ -52,6 +52,12 @@ REBUILD_GROWTH = 2.0
 #: the step is solved by a LAPACK LU of the active block up to this many unknowns (slipping
 #: or separating nodes x d x H), by GMRES above (docs/theory.md, "Large interfaces")
 ACTIVE_DENSE_MAX = 3000
+#: the node-local correction of the preconditioner (KrylovOptions.node_correction,
+#: :func:`node_local_inverse`) is used from this many active DOFs (contact nodes x d): it
+#: halves the GMRES iterations of the partial-slip pad at every size, but adds a product per
+#: iteration and a batched inverse per Jacobian, which paid at 1024 contact nodes (3072 DOFs)
+#: and not at 256 or 576 (1728 DOFs; docs/studies/large-interface-solve.md)
+NODE_CORRECTION_MIN_DOFS = 2048
 #: rows of a block formed at a time by :meth:`KrylovJacobian.column_norms` (an operator's
 #: blocks, hb/operator_blocks.py: a panel of 2.4 MB at 1024 contact nodes, reused, in place of
 #: a fresh m x m block per harmonic)
@@ -355,6 +361,43 @@ def harmonic_gains(G: np.ndarray, d: int, oscillating: bool = True):
     for b in range(1, 2 * k + 1):
         gosc += Gr[:, :, b, :, b]
     return gbar, gosc / (2 * k)
+
+
+def node_local_inverse(G: np.ndarray, diag: list, eps: float) -> np.ndarray | None:
+    """``Q^-1`` (na, dH, dH) of the node-local part of the Jacobian, ``Q = eps I + G
+    (Z_D - eps I)``, with ``Z_D`` the diagonal node blocks of ``Z~`` (each node's own ``d x
+    d`` block of every harmonic, ``diag[b]`` (na, d, d), on the real Fourier basis: harmonic
+    ``n`` maps ``(a_n, b_n)`` by ``[[X, Y], [-Y, X]]``, ``Z_n = X + i Y``, as
+    :func:`fretwear.hb.reduce.to_real_blocks`) and ``G`` (na, dH, dH) the node blocks of the
+    law (eq. 22-28). ``Q`` is exact in what :class:`MeanGainPreconditioner` drops, the
+    coupling of a node's harmonics by its time-varying gain, and drops what that keeps, the
+    coupling of the nodes through ``Z``: the two combined (:meth:`KrylovJacobian.
+    _two_level`) halved the GMRES iterations of the partial-slip pad
+    (docs/studies/large-interface-solve.md, "A node-local correction of the
+    preconditioner"). None where a ``Q`` is singular or not finite."""
+    na, dH, _ = G.shape
+    d = diag[0].shape[1]
+    H = dH // d
+    k = (H - 1) // 2
+    W = np.zeros((na, d, H, d, H))
+    W[:, :, 0, :, 0] = diag[0].real
+    for b in range(1, k + 1):
+        X = diag[b].real
+        W[:, :, b, :, b] = X
+        W[:, :, k + b, :, k + b] = X
+        if np.iscomplexobj(diag[b]):
+            Y = diag[b].imag
+            W[:, :, b, :, k + b] = Y
+            W[:, :, k + b, :, b] = -Y
+    W = W.reshape(na, dH, dH)
+    W[:, np.arange(dH), np.arange(dH)] -= eps
+    Q = np.matmul(G, W)
+    Q[:, np.arange(dH), np.arange(dH)] += eps
+    try:
+        Qi = np.linalg.inv(Q)
+    except np.linalg.LinAlgError:
+        return None
+    return Qi if np.all(np.isfinite(Qi)) else None
 
 
 def _lu_solve(lu, b):
@@ -787,11 +830,46 @@ class KrylovJacobian:
             return eps * v + np.matmul(Ga, y[:, :, None])[:, :, 0].reshape(-1)
 
         A = spla.LinearOperator((n, n), matvec=matvec, dtype=float)
+        self._qinv = None
+        if opts.node_correction and na * self.d >= NODE_CORRECTION_MIN_DOFS:
+            Zs = self._single_blocks(Za) or Za  # (the correction's product: approximate)
+
+            def rough(v):
+                y = (Zs.apply(v).reshape(-1) - eps * v).reshape(na, dH)
+                return eps * v + np.matmul(Ga, y[:, :, None])[:, :, 0].reshape(-1)
+
+            self._qinv = node_local_inverse(Ga, self._node_diagonals(act), eps)
+            self._rough = rough
         out = np.empty_like(rhs)
         for c in range(rhs.shape[2]):
             out[:, :, c] = self._gmres(A, rhs[:, :, c].reshape(-1), act, Za,
                                        rtol).reshape(na, dH)
         return out
+
+    def _node_diagonals(self, act) -> list:
+        """Every harmonic block's diagonal node blocks on the active nodes ``act``: a list
+        of (na, d, d) arrays (real or complex), from ``Z.node_diagonal`` (no block
+        formed)."""
+        return [self.Z.node_diagonal(b, self.d)[act] for b in range(self.Z.nb)]
+
+    def _two_level(self, apply):
+        """The preconditioner's ``apply`` followed by the node-local correction when the
+        options ask for it (:func:`node_local_inverse`; ``_qinv`` set by
+        :meth:`_gmres_active`): ``x = Q^-1 r``, then ``x + P^-1 (r - J x)`` (a
+        multiplicative two-level preconditioner: ``Q`` exact in the coupling of a node's
+        harmonics by its time-varying gain, ``P`` in the coupling of the nodes through
+        ``Z``; the product ``J x`` in single precision where there is a single twin)."""
+        qinv = getattr(self, "_qinv", None)
+        if qinv is None:
+            return apply
+        na, dH = qinv.shape[0], qinv.shape[1]
+
+        def both(r):
+            r = np.asarray(r, float).reshape(-1)
+            x = np.matmul(qinv, r.reshape(na, dH, 1))[:, :, 0].reshape(-1)
+            return x + apply(r - self._rough(x))
+
+        return both
 
     def _gmres(self, A, b, act, Za, rtol=GMRES_RTOL) -> np.ndarray:
         """GMRES on one right-hand side. When it fails with a preconditioner kept from an
@@ -814,7 +892,7 @@ class KrylovJacobian:
             fresh = attempt > 0 or pc0 is None or not np.array_equal(
                 getattr(pc0, "nodes", None), act)
             pc = self._preconditioner(act, Za, rebuild=attempt > 0)
-            M = spla.LinearOperator(A.shape, matvec=pc.apply, dtype=float)
+            M = spla.LinearOperator(A.shape, matvec=self._two_level(pc.apply), dtype=float)
             count = [0]
 
             def cb(_r, count=count):
