@@ -18,7 +18,14 @@ block-diagonal per node), so the preconditioner is ``k + 1`` dense LUs of ``m_a 
 (``m_a`` = active DOFs; in single precision by default,
 :class:`fretwear.hb.options.KrylovOptions`). It is exact for
 nodes whose gain does not vary over the period and for a linear interface; it is kept
-while the active set does not change and rebuilt when GMRES slows down. The contact law and
+while the active set does not change and rebuilt when GMRES slows down. Its sharing test
+multiplies by the blocks without forming them (``block_products``): a block is formed only
+to be factored. On large active sets it is followed by a node-local correction
+(:func:`node_local_inverse`, ``KrylovOptions.node_correction``): ``Q = eps I + G (Z_D - eps
+I)`` with each node's own blocks of ``Z~``, exact in the coupling of a node's harmonics by
+its time-varying gain, which the mean gain drops; the two combined multiplicatively halved
+the GMRES iterations of the partial-slip pad (docs/studies/large-interface-solve.md, "The
+preconditioner's builds and a node-local correction"). The contact law and
 the residual are those of the dense path: only the linear algebra of the step differs, so
 the converged answer is the same (tests/hb/test_krylov.py).
 """
@@ -373,8 +380,8 @@ def node_local_inverse(G: np.ndarray, diag: list, eps: float) -> np.ndarray | No
     coupling of a node's harmonics by its time-varying gain, and drops what that keeps, the
     coupling of the nodes through ``Z``: the two combined (:meth:`KrylovJacobian.
     _two_level`) halved the GMRES iterations of the partial-slip pad
-    (docs/studies/large-interface-solve.md, "A node-local correction of the
-    preconditioner"). None where a ``Q`` is singular or not finite."""
+    (docs/studies/large-interface-solve.md, "The preconditioner's builds and a node-local
+    correction"). None where a ``Q`` is singular or not finite."""
     na, dH, _ = G.shape
     d = diag[0].shape[1]
     H = dH // d

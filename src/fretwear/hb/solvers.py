@@ -190,9 +190,9 @@ class KrylovOptions:
         iteration and a batched ``dH x dH`` inverse per Jacobian. Used from
         :data:`fretwear.hb.krylov.NODE_CORRECTION_MIN_DOFS` active DOFs: on the
         partial-slip pad of benchmarks/scale_3d.py it halved the GMRES iterations per
-        Newton step at 256, 576 and 1024 contact nodes, and paid at 1024 only (solve 35 to
-        25 s CPU; docs/studies/large-interface-solve.md, "A node-local correction of the
-        preconditioner").
+        Newton step at 256, 576 and 1024 contact nodes (40-55 %), and paid at 1024 only
+        (solve 35 to 25 s CPU; docs/studies/large-interface-solve.md, "The
+        preconditioner's builds and a node-local correction").
     """
 
     single_factors: bool = True
