@@ -16,7 +16,9 @@ Variants (for the measurements of docs/studies/large-interface-solve.md, "Iterat
 and per-call terms"): ``solver=newton`` (the line-search Newton instead of Powell),
 ``norms=first`` (Powell's variable scales from the first Jacobian's column norms only, not
 renewed at every Jacobian), ``single=0|1`` (the preconditioner's factors in double or single),
-``sprod=0|1`` (GMRES's products in double or single, KrylovOptions.single_products).
+``sprod=0|1`` (GMRES's products in double or single, KrylovOptions.single_products),
+``nodecorr=0|1`` (the node-local correction of the preconditioner,
+KrylovOptions.node_correction).
 The solution is saved to ``/tmp/solve_split_<n><SPLIT_TAG>_U.npy`` for comparisons.
 """
 
@@ -84,7 +86,8 @@ def main():
     opts = options(LOADS["slip"])
     if "solver" in variants:
         opts = opts.replace(solver=variants["solver"])
-    kry = {"single": "single_factors", "sprod": "single_products"}
+    kry = {"single": "single_factors", "sprod": "single_products",
+           "nodecorr": "node_correction"}
     for key, field in kry.items():
         if key in variants:
             opts = opts.replace(krylov=dataclasses.replace(opts.krylov,

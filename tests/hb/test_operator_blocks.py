@@ -62,6 +62,66 @@ def test_operator_blocks_products_equal_stored_blocks(damping):
                 assert np.shares_memory(A, buf)  # formed into the buffer, no new array
 
 
+@pytest.mark.parametrize("damping", [None, Damping(loss_factor=0.02)])
+def test_block_products_equal_the_formed_blocks(damping):
+    """``block_products`` (the preconditioner's sharing test multiplies by the blocks without
+    forming them) of OperatorBlocks, of HarmonicBlocks and of the active view on a subset of
+    DOFs: column ``j`` equals the formed block ``blocks[j]`` (its real part for block 0, as
+    ``Z0``) times ``V[:, j]`` by numpy, for real and complex ``V`` and blocks repeated and out
+    of order, to rounding (a sum of the same terms in another order: 1e-13)."""
+    model = block(damping)
+    red = BlockedModalCondenser(model, F_MAX, 7, tol=1e-2).reduced(2 * np.pi * 15e3, ORDERS)
+    ob = OperatorBlocks(red.Z)
+    formed = np.stack(list(red.Z))
+    hb = HarmonicBlocks(formed)
+    rng = np.random.default_rng(5)
+    blocks = [3, 0, 1, 3, 2, 0]
+    dofs = np.flatnonzero(rng.random(ob.m) < 0.8)
+    for V in (rng.standard_normal((ob.m, 6)),
+              rng.standard_normal((ob.m, 6)) + 1j * rng.standard_normal((ob.m, 6))):
+        ref = np.stack([(formed[b].real if b == 0 else formed[b]) @ V[:, j]
+                        for j, b in enumerate(blocks)], axis=1)
+        for Z in (ob, hb):
+            assert rel(Z.block_products(blocks, V), ref) < 1e-13
+        sub = np.stack([(formed[b].real if b == 0 else formed[b])[np.ix_(dofs, dofs)]
+                        @ V[dofs, j] for j, b in enumerate(blocks)], axis=1)
+        view = krylov._ActiveView(ob, dofs)
+        assert rel(view.block_products(blocks, V[dofs]), sub) < 1e-13
+
+
+@pytest.mark.parametrize("damping", [None, Damping(loss_factor=0.02)])
+def test_preconditioner_on_operator_blocks_equals_the_formed_blocks(damping):
+    """The mean-gain preconditioner's sharing test multiplies by the operator's blocks
+    (block_products) instead of formed blocks: on OperatorBlocks, on the active view of a
+    subset of DOFs and on the same blocks stored formed (HarmonicBlocks: the products by
+    numpy's matrix product, the former path), the same harmonics share factors and the
+    factors are equal to rounding (1e-12 of their largest entry: the same LU of blocks
+    formed by the same operations), with gains that make some harmonics share and others
+    not (asserted)."""
+    model = block(damping)
+    red = BlockedModalCondenser(model, F_MAX, 7, tol=1e-2).reduced(2 * np.pi * 15e3, ORDERS)
+    ob = OperatorBlocks(red.Z)
+    formed = np.stack(list(red.Z))
+    nc = ob.m // 3
+    rng = np.random.default_rng(6)
+    gbar = np.tile(0.6 * np.eye(3), (nc, 1, 1)) + 0.05 * rng.standard_normal((nc, 3, 3))
+    gosc = np.tile(0.3 * np.eye(3), (nc, 1, 1))
+    eps = 0.5 * np.abs(np.diagonal(formed[0])).max()
+    keep = np.flatnonzero(rng.random(nc) < 0.8)
+    dofs = (keep[:, None] * 3 + np.arange(3)).reshape(-1)
+    cases = [(ob, HarmonicBlocks(formed), gbar, gosc),
+             (krylov._ActiveView(ob, dofs), HarmonicBlocks(formed).sub(dofs), gbar[keep],
+              gosc[keep])]
+    for Zo, Zh, g0, g1 in cases:
+        po = krylov.MeanGainPreconditioner(g0, Zo, eps, gosc=g1)
+        ph = krylov.MeanGainPreconditioner(g0, Zh, eps, gosc=g1)
+        assert [h for _, h in po.groups] == [h for _, h in ph.groups]
+        assert 0 < po.shared < ob.nb - 1, [h for _, h in po.groups]
+        for (a, _), (b, _) in zip(po.groups, ph.groups, strict=True):
+            assert np.array_equal(a[1], b[1])
+            assert np.abs(a[0] - b[0]).max() <= 1e-12 * np.abs(b[0]).max()
+
+
 def test_operator_jacobian_against_dense_and_finite_differences():
     """In partial slip: the operator Jacobian's products, transposed products, column norms
     and Newton step on the ReducedOperator equal the formed dense Jacobian of the same

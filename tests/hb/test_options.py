@@ -44,7 +44,7 @@ def test_solve_options_refuse_bad_values(name, value):
     ("single_factors", 1), ("single_factors", "yes"), ("single_max_iterations", 0),
     ("single_max_iterations", 10.0), ("single_max_iterations", True),
     ("preconditioner", "ilu"), ("preconditioner", None), ("first_scales", 1),
-    ("single_products", "no"), ("local_phase", 0),
+    ("single_products", "no"), ("local_phase", 0), ("node_correction", 1),
 ])
 def test_krylov_options_refuse_bad_values(name, value):
     with pytest.raises(InputError, match=f"^krylov.{name} = ") as err:

@@ -18,7 +18,14 @@ block-diagonal per node), so the preconditioner is ``k + 1`` dense LUs of ``m_a 
 (``m_a`` = active DOFs; in single precision by default,
 :class:`fretwear.hb.options.KrylovOptions`). It is exact for
 nodes whose gain does not vary over the period and for a linear interface; it is kept
-while the active set does not change and rebuilt when GMRES slows down. The contact law and
+while the active set does not change and rebuilt when GMRES slows down. Its sharing test
+multiplies by the blocks without forming them (``block_products``): a block is formed only
+to be factored. On large active sets it is followed by a node-local correction
+(:func:`node_local_inverse`, ``KrylovOptions.node_correction``): ``Q = eps I + G (Z_D - eps
+I)`` with each node's own blocks of ``Z~``, exact in the coupling of a node's harmonics by
+its time-varying gain, which the mean gain drops; the two combined multiplicatively halved
+the GMRES iterations of the partial-slip pad (docs/studies/large-interface-solve.md, "The
+preconditioner's builds and a node-local correction"). The contact law and
 the residual are those of the dense path: only the linear algebra of the step differs, so
 the converged answer is the same (tests/hb/test_krylov.py).
 """
@@ -52,6 +59,12 @@ REBUILD_GROWTH = 2.0
 #: the step is solved by a LAPACK LU of the active block up to this many unknowns (slipping
 #: or separating nodes x d x H), by GMRES above (docs/theory.md, "Large interfaces")
 ACTIVE_DENSE_MAX = 3000
+#: the node-local correction of the preconditioner (KrylovOptions.node_correction,
+#: :func:`node_local_inverse`) is used from this many active DOFs (contact nodes x d): it
+#: halves the GMRES iterations of the partial-slip pad at every size, but adds a product per
+#: iteration and a batched inverse per Jacobian, which paid at 1024 contact nodes (3072 DOFs)
+#: and not at 256 or 576 (1728 DOFs; docs/studies/large-interface-solve.md)
+NODE_CORRECTION_MIN_DOFS = 2048
 #: rows of a block formed at a time by :meth:`KrylovJacobian.column_norms` (an operator's
 #: blocks, hb/operator_blocks.py: a panel of 2.4 MB at 1024 contact nodes, reused, in place of
 #: a fresh m x m block per harmonic)
@@ -164,6 +177,14 @@ class HarmonicBlocks:
         """As :meth:`row_block`, for a panel of rows taken in turn (the column norms): the
         stored block here (``buf`` unused); an operator forms the panel into ``buf``."""
         return self.row_block(b, dofs)
+
+    def block_products(self, blocks, V: np.ndarray) -> np.ndarray:
+        """``Z_b V[:, j]`` with ``b = blocks[j]`` (``Z_0`` its real part, as :attr:`Z0`;
+        real or complex ``V`` (m, r)): (m, r), complex where a block or ``V`` is. The
+        stored blocks here; an operator multiplies without forming them (the sharing
+        test of :class:`MeanGainPreconditioner`)."""
+        cols = [(self.Z0 if b == 0 else self.block(b)) @ V[:, j] for j, b in enumerate(blocks)]
+        return np.stack(cols, axis=1)
 
     def node_diagonal(self, b: int, d: int) -> np.ndarray:
         """The (m / d, d, d) diagonal node blocks of block ``b`` (as :meth:`block`)."""
@@ -349,6 +370,43 @@ def harmonic_gains(G: np.ndarray, d: int, oscillating: bool = True):
     return gbar, gosc / (2 * k)
 
 
+def node_local_inverse(G: np.ndarray, diag: list, eps: float) -> np.ndarray | None:
+    """``Q^-1`` (na, dH, dH) of the node-local part of the Jacobian, ``Q = eps I + G
+    (Z_D - eps I)``, with ``Z_D`` the diagonal node blocks of ``Z~`` (each node's own ``d x
+    d`` block of every harmonic, ``diag[b]`` (na, d, d), on the real Fourier basis: harmonic
+    ``n`` maps ``(a_n, b_n)`` by ``[[X, Y], [-Y, X]]``, ``Z_n = X + i Y``, as
+    :func:`fretwear.hb.reduce.to_real_blocks`) and ``G`` (na, dH, dH) the node blocks of the
+    law (eq. 22-28). ``Q`` is exact in what :class:`MeanGainPreconditioner` drops, the
+    coupling of a node's harmonics by its time-varying gain, and drops what that keeps, the
+    coupling of the nodes through ``Z``: the two combined (:meth:`KrylovJacobian.
+    _two_level`) halved the GMRES iterations of the partial-slip pad
+    (docs/studies/large-interface-solve.md, "The preconditioner's builds and a node-local
+    correction"). None where a ``Q`` is singular or not finite."""
+    na, dH, _ = G.shape
+    d = diag[0].shape[1]
+    H = dH // d
+    k = (H - 1) // 2
+    W = np.zeros((na, d, H, d, H))
+    W[:, :, 0, :, 0] = diag[0].real
+    for b in range(1, k + 1):
+        X = diag[b].real
+        W[:, :, b, :, b] = X
+        W[:, :, k + b, :, k + b] = X
+        if np.iscomplexobj(diag[b]):
+            Y = diag[b].imag
+            W[:, :, b, :, k + b] = Y
+            W[:, :, k + b, :, b] = -Y
+    W = W.reshape(na, dH, dH)
+    W[:, np.arange(dH), np.arange(dH)] -= eps
+    Q = np.matmul(G, W)
+    Q[:, np.arange(dH), np.arange(dH)] += eps
+    try:
+        Qi = np.linalg.inv(Q)
+    except np.linalg.LinAlgError:
+        return None
+    return Qi if np.all(np.isfinite(Qi)) else None
+
+
 def _lu_solve(lu, b):
     """``P^-1 b`` by LAPACK factors ``lu``, in their precision (single factors,
     ``KrylovOptions.single_factors``: the right-hand side rounded to the single type of the
@@ -383,29 +441,32 @@ class MeanGainPreconditioner:
         gosc = gbar if gosc is None else gosc
         self.factors = []  # per harmonic block: LAPACK LU of P_n or of a close P_b
         self.shared = 0
-        last = None  # (Z_b, g_b, its LU) of the last factored harmonic
+        last = None  # (b, g_b, its LU) of the last factored harmonic
         # blocks held as an operator (hb/operator_blocks.py) bound the factors' memory: past
         # the bound every further harmonic shares the last factors
         budget = getattr(Z, "factor_budget", None)
         most = Z.nb if budget is None else max(1, int(budget // (8 * Z.m * Z.m)))
+        probe = {}  # the sharing test's first products, made once (_close)
         for b in range(Z.nb):
             full = last is not None and len({id(f) for f in self.factors}) >= most
             if full:  # (the block is not formed: m^2 memory and time for nothing)
                 self.factors.append(last[2])
                 self.shared += 1
                 continue
-            Zb = Z.Z0 if b == 0 else Z.block(b)
             g = gbar if b == 0 else gosc
-            if share and last is not None and self._close(g, Zb, last, eps):
+            # (the test by products: a block is formed only to be factored)
+            if share and last is not None and self._close(g, b, last, eps, Z, probe):
                 self.factors.append(last[2])
                 self.shared += 1
                 continue
+            Zb = Z.Z0 if b == 0 else Z.block(b)
             P = self._block(g, Zb, eps)
             if single:
                 P = P.astype(np.complex64 if np.iscomplexobj(P) else np.float32)
+            del Zb
             lu = sla.lu_factor(P, overwrite_a=True, check_finite=False)
             self.factors.append(lu)
-            last = (Zb, g, lu)
+            last = (b, g, lu)
         # the harmonics of each set of factors, solved together by apply()
         groups: dict = {}
         for b, lu in enumerate(self.factors):
@@ -434,26 +495,41 @@ class MeanGainPreconditioner:
         return _lu_solve(lu, b)
 
     @classmethod
-    def _close(cls, gn, Zn, last, eps) -> bool:
-        """Whether the factors of ``P_b`` (``last`` = ``(Z_b, g_b, LU)``) precondition ``P_n``
+    def _close(cls, gn, n, last, eps, Z, probe) -> bool:
+        """Whether the factors of ``P_b`` (``last`` = ``(b, g_b, LU)``) precondition ``P_n``
         (gain ``gn``) well: ``P_b^-1 P_n = I + E`` with ``E = P_b^-1 (P_n - P_b)``, which is
         ``P_b^-1 g (Z_n - Z_b)`` when both take the same gain ``g``, and GMRES on it
         converges about as fast as on ``I`` when ``E`` is small. Its size is estimated by
         :data:`SHARE_PROBES` steps of the power iteration from a fixed random vector
         (``2 SHARE_PROBES`` products and solves of ``m^2`` operations, against the ``m^3``
         of an LU): shared when below :data:`SHARE_BELOW`. An isolated large eigenvalue of
-        ``E`` that the probe misses costs GMRES about one iteration."""
-        Zb, gb, lu = last
+        ``E`` that the probe misses costs GMRES about one iteration.
+
+        The products ``Z_n v``, ``Z_b v`` are taken from ``Z`` (its ``block_products``)
+        without forming the blocks: on an operator's blocks (hb/operator_blocks.py) a
+        formed block costs several passes over ``m x m`` arrays and its page faults, a
+        product one pass over the stored matrices. The first step's are made for every
+        harmonic in one product, kept in ``probe`` (the same vector for all)."""
+        b, gb, lu = last
         nc, d, _ = gn.shape
-        m = Zn.shape[0]
-        v = np.random.default_rng(0).standard_normal(m)
+        m = Z.m
+        if not probe:
+            v0 = np.random.default_rng(0).standard_normal(m)
+            probe["v"] = v0
+            probe["Zv"] = Z.block_products(np.arange(Z.nb), np.repeat(v0[:, None], Z.nb, 1))
+        v = probe["v"]
         size = 0.0
-        for _ in range(SHARE_PROBES):
-            if gn is gb:
-                y = np.matmul(gn, (Zn @ v - Zb @ v).reshape(nc, d, 1))
+        for step in range(SHARE_PROBES):
+            if step == 0:
+                zn, zb = probe["Zv"][:, n], probe["Zv"][:, b]
             else:
-                y = (np.matmul(gn, (Zn @ v - eps * v).reshape(nc, d, 1))
-                     - np.matmul(gb, (Zb @ v - eps * v).reshape(nc, d, 1)))
+                zz = Z.block_products([n, b], np.column_stack([v, v]))
+                zn, zb = zz[:, 0], zz[:, 1]
+            if gn is gb:
+                y = np.matmul(gn, (zn - zb).reshape(nc, d, 1))
+            else:
+                y = (np.matmul(gn, (zn - eps * v).reshape(nc, d, 1))
+                     - np.matmul(gb, (zb - eps * v).reshape(nc, d, 1)))
             w = cls._solve(lu, y[:, :, 0].reshape(-1))
             size = float(np.linalg.norm(w) / np.linalg.norm(v))
             v = w
@@ -761,11 +837,46 @@ class KrylovJacobian:
             return eps * v + np.matmul(Ga, y[:, :, None])[:, :, 0].reshape(-1)
 
         A = spla.LinearOperator((n, n), matvec=matvec, dtype=float)
+        self._qinv = None
+        if opts.node_correction and na * self.d >= NODE_CORRECTION_MIN_DOFS:
+            Zs = self._single_blocks(Za) or Za  # (the correction's product: approximate)
+
+            def rough(v):
+                y = (Zs.apply(v).reshape(-1) - eps * v).reshape(na, dH)
+                return eps * v + np.matmul(Ga, y[:, :, None])[:, :, 0].reshape(-1)
+
+            self._qinv = node_local_inverse(Ga, self._node_diagonals(act), eps)
+            self._rough = rough
         out = np.empty_like(rhs)
         for c in range(rhs.shape[2]):
             out[:, :, c] = self._gmres(A, rhs[:, :, c].reshape(-1), act, Za,
                                        rtol).reshape(na, dH)
         return out
+
+    def _node_diagonals(self, act) -> list:
+        """Every harmonic block's diagonal node blocks on the active nodes ``act``: a list
+        of (na, d, d) arrays (real or complex), from ``Z.node_diagonal`` (no block
+        formed)."""
+        return [self.Z.node_diagonal(b, self.d)[act] for b in range(self.Z.nb)]
+
+    def _two_level(self, apply):
+        """The preconditioner's ``apply`` followed by the node-local correction when the
+        options ask for it (:func:`node_local_inverse`; ``_qinv`` set by
+        :meth:`_gmres_active`): ``x = Q^-1 r``, then ``x + P^-1 (r - J x)`` (a
+        multiplicative two-level preconditioner: ``Q`` exact in the coupling of a node's
+        harmonics by its time-varying gain, ``P`` in the coupling of the nodes through
+        ``Z``; the product ``J x`` in single precision where there is a single twin)."""
+        qinv = getattr(self, "_qinv", None)
+        if qinv is None:
+            return apply
+        na, dH = qinv.shape[0], qinv.shape[1]
+
+        def both(r):
+            r = np.asarray(r, float).reshape(-1)
+            x = np.matmul(qinv, r.reshape(na, dH, 1))[:, :, 0].reshape(-1)
+            return x + apply(r - self._rough(x))
+
+        return both
 
     def _gmres(self, A, b, act, Za, rtol=GMRES_RTOL) -> np.ndarray:
         """GMRES on one right-hand side. When it fails with a preconditioner kept from an
@@ -788,7 +899,7 @@ class KrylovJacobian:
             fresh = attempt > 0 or pc0 is None or not np.array_equal(
                 getattr(pc0, "nodes", None), act)
             pc = self._preconditioner(act, Za, rebuild=attempt > 0)
-            M = spla.LinearOperator(A.shape, matvec=pc.apply, dtype=float)
+            M = spla.LinearOperator(A.shape, matvec=self._two_level(pc.apply), dtype=float)
             count = [0]
 
             def cb(_r, count=count):
@@ -840,6 +951,14 @@ class _ActiveView:
         ``ReducedOperator.block(b, rows, cols)`` would hold two more m_a x m arrays)."""
         Zb = self.Z.Z0 if b == 0 else self.Z.block(b)
         return Zb[np.ix_(self.dofs, self.dofs)]
+
+    def block_products(self, blocks, V: np.ndarray) -> np.ndarray:
+        """As :meth:`HarmonicBlocks.block_products` on ``dofs``: ``V`` scattered into the
+        whole operator's DOFs, multiplied there (no block formed), the rows ``dofs``
+        gathered."""
+        full = np.zeros((self.Z.m, V.shape[1]), dtype=V.dtype)
+        full[self.dofs] = V
+        return self.Z.block_products(blocks, full)[self.dofs]
 
     def single(self):
         """The same view of ``Z``'s single-precision blocks (``Z.single()``), or None."""

@@ -93,6 +93,19 @@ class OperatorBlocks(HarmonicBlocks):
             return self.op.block_rows(b, r0, r1, buf[: r1 - r0]), dofs - r0
         return self.op.block(b, rows=dofs), np.arange(dofs.size)
 
+    def block_products(self, blocks, V: np.ndarray) -> np.ndarray:
+        """As :meth:`HarmonicBlocks.block_products`, through
+        :meth:`ReducedOperator.matmat` (each stored matrix read once for all columns, no
+        block formed); block 0 by the formed :attr:`Z0` (its real part)."""
+        blocks = np.asarray(blocks)
+        out = np.empty(V.shape, dtype=np.result_type(V, complex if not self.real else float))
+        zero = blocks == 0
+        if np.any(zero):
+            out[:, zero] = self.Z0 @ V[:, zero]
+        if not np.all(zero):
+            out[:, ~zero] = self.op.matmat(blocks[~zero], V[:, ~zero])
+        return out
+
     def node_diagonal(self, b: int, d: int) -> np.ndarray:
         if b == 0:
             return super().node_diagonal(0, d)

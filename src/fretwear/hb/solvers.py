@@ -182,6 +182,17 @@ class KrylovOptions:
         partial-slip solve's 50); with ``single_products`` this took that solve from
         51-52 s to 38-42 s CPU, to the same root within the spread of the old defaults from
         perturbed starts, once the local phase ended its crawl.
+    node_correction : the mean-gain preconditioner followed by a node-local correction
+        (default True; :func:`fretwear.hb.krylov.node_local_inverse`): ``Q = eps I + G (Z_D -
+        eps I)`` with ``Z_D`` each node's own blocks of ``Z~``, exact in the coupling of a
+        node's harmonics by its time-varying gain, which the mean gain drops; ``x = Q^-1 r``,
+        then ``x + P^-1 (r - J x)``, one more product (in single precision) per GMRES
+        iteration and a batched ``dH x dH`` inverse per Jacobian. Used from
+        :data:`fretwear.hb.krylov.NODE_CORRECTION_MIN_DOFS` active DOFs: on the
+        partial-slip pad of benchmarks/scale_3d.py it halved the GMRES iterations per
+        Newton step at 256, 576 and 1024 contact nodes (40-55 %), and paid at 1024 only
+        (solve 35 to 25 s CPU; docs/studies/large-interface-solve.md, "The
+        preconditioner's builds and a node-local correction").
     """
 
     single_factors: bool = True
@@ -191,6 +202,7 @@ class KrylovOptions:
     single_products_rtol: float = 1e-5
     first_scales: bool = True
     local_phase: bool = True
+    node_correction: bool = True
 
     def __post_init__(self):
         self.check()
@@ -214,6 +226,9 @@ class KrylovOptions:
                              "True or False")
         if not isinstance(self.local_phase, bool):
             raise InputError(f"krylov.local_phase = {self.local_phase!r}: expected "
+                             "True or False")
+        if not isinstance(self.node_correction, bool):
+            raise InputError(f"krylov.node_correction = {self.node_correction!r}: expected "
                              "True or False")
         if not isinstance(self.first_scales, bool):
             raise InputError(f"krylov.first_scales = {self.first_scales!r}: expected "
