@@ -178,6 +178,8 @@ COPY_EXACT = 1e-15
 #: exponents whose multiplier is below this are not refined (they decay within a period; the
 #: factor e^{-s h} of the law's memory would overflow over a period)
 NEGLIGIBLE = 1e-8
+#: its logarithm (the floor of ``2 pi Re sigma``)
+LOG_NEGLIGIBLE = float(np.log(NEGLIGIBLE))
 
 
 @dataclass(frozen=True)
@@ -219,6 +221,10 @@ class HillOptions:
         n = self.newton_max_iter
         if isinstance(n, bool) or not isinstance(n, int) or n < 1:
             raise InputError(f"newton_max_iter = {n!r}: expected a whole number >= 1")
+
+
+#: the settings :func:`hill_stability` takes without ``options`` (frozen: shared)
+_DEFAULT_OPTIONS = HillOptions()
 
 
 @dataclass
@@ -710,8 +716,11 @@ class HillProblem:
         self.lx = np.ascontiguousarray(lx)
         self.state = state
         # the law's arrays as the kernel of :func:`shifted_gain` takes them, made once
+        normal = getattr(prob, "_normal", None)  # (the problem's own, made once)
+        if normal is None or normal.shape != self.lu.shape[::2]:
+            normal = law._normal(prob.normal, self.lu)
         self._law = (np.ascontiguousarray(prob.mu, dtype=float), np.ascontiguousarray(prob.P),
-                     np.ascontiguousarray(prob.Q), law._normal(prob.normal, self.lu))
+                     np.ascontiguousarray(prob.Q), normal)
         self._summary = None  # the contact states per node (:meth:`_states`)
         # in 2D, G(s) split once into its part free of s and one outer product per stick
         # interval (:mod:`fretwear.hb.memory_gain`; None: the recursion at every s), where
@@ -1570,23 +1579,35 @@ def _track_record(red: QuadraticReduction, vals: np.ndarray, vecs: np.ndarray,
     """The :class:`HillTrack` of the kept members ``vals`` (``Im s >= 0``) with their
     eigenvectors ``vecs`` (n, k), centroids ``kap`` and edge flags, None where it cannot be
     continued (an edge member or one near the period-doubling line, a member near the
-    magnitude cut ``cut``, or one spread over two blocks)."""
-    if red.dyn.size == 0 or np.any(edge) or np.any(np.abs(kap) > 0.5):
+    magnitude cut ``cut``, or one spread over two blocks). The members are few (a handful):
+    their tests run on Python scalars, and where the problem is one block every member lies
+    in it (no shares to compare)."""
+    nd = red.dyn.size
+    if nd == 0 or edge.any():
         return None
-    line = [_on_line(complex(v)) for v in vals]
-    if np.any(np.abs(vals) > 0.9 * cut) or None in line:
-        return None
-    real = np.abs(vals.imag) <= 1e-12 * np.maximum(np.abs(vals), 1.0)
-    families = sum(1 if (r or ln == "on") else 2 for r, ln in zip(real, line, strict=True))
+    for x in kap.tolist():
+        if abs(x) > 0.5:
+            return None
+    families = 0
+    for v in vals.tolist():
+        line = _on_line(v)
+        if line is None or abs(v) > 0.9 * cut:
+            return None
+        real = abs(v.imag) <= 1e-12 * max(abs(v), 1.0)
+        families += 1 if (real or line == "on") else 2
     Y = vecs[red.dyn]
-    sq = Y.real ** 2 + Y.imag ** 2  # each member's share of each block (squared norms)
-    share = np.array([sq[c].sum(axis=0) for c in red.blocks]).reshape(len(red.blocks), vals.size)
-    block = np.argmax(share, axis=0)
-    if np.any(share[block, np.arange(vals.size)] < (1.0 - 1e-12) ** 2 * sq.sum(axis=0)):
-        return None
-    complete = 2 * red.dyn.size == families * H
-    return HillTrack(vals.copy(), Y.copy(), block, red.dyn.size, red.dyn.copy(),
-                     [b.copy() for b in red.blocks], complete)
+    blocks = red.blocks
+    if len(blocks) == 1 and blocks[0].size == nd:  # the whole of every member: its share
+        block = np.zeros(vals.size, dtype=np.intp)  # is its squared norm
+    else:
+        sq = Y.real ** 2 + Y.imag ** 2  # each member's share of each block (squared norms)
+        share = np.array([sq[c].sum(axis=0) for c in blocks]).reshape(len(blocks), vals.size)
+        block = np.argmax(share, axis=0)
+        if np.any(share[block, np.arange(vals.size)] < (1.0 - 1e-12) ** 2 * sq.sum(axis=0)):
+            return None
+    complete = 2 * nd == families * H
+    return HillTrack(vals.copy(), Y, block, nd, red.dyn.copy(), [b.copy() for b in blocks],
+                     complete)
 
 
 def _components(B0: np.ndarray, B1: np.ndarray, B2: np.ndarray) -> list:
@@ -1792,33 +1813,92 @@ def _decoupled_normals(mg, structure, H: int, eps: float):
     ``k``; in ``G`` no coupling between its block ``G_N`` and the tangential one, the split's
     rows none either), ``T(s)`` is block-diagonal with ``eps I - (eps - k) G_N`` on those
     unknowns, the same at every ``s`` (the split touches tangential rows only): no exponent
-    there where that block is well conditioned, and the eigenpair that vanishes lives on the
-    others (a start without a normal part stays without one): the tangential unknowns
-    (DOF-major, ``H`` per DOF); all unknowns where any node's normal is not decoupled."""
+    there where that block is well conditioned (2-norm condition number below 1e8), and the
+    eigenpair that vanishes lives on the others (a start without a normal part stays without
+    one): the tangential unknowns (DOF-major, ``H`` per DOF); all unknowns where any node's
+    normal is not decoupled. The tests and the blocks in one compiled call
+    (:func:`_normal_blocks`, which also settles the condition of a block near a multiple of
+    the identity); the singular values by LAPACK only for a block it leaves open."""
     Kf, Mf, Cf, Df = structure
     nc, dH, _ = mg.constant.shape
     every = np.arange(nc * dH, dtype=np.int64)
     if dH != 2 * H:
         return every
+    ok, blocks, verdict = _normal_blocks(mg.constant, mg.node, mg.rows, Kf, Mf, Cf, Df, H,
+                                         float(eps))
+    if ok == 0:
+        return every
+    if ok == 2:  # a block the bound leaves open: its condition number as np.linalg.cond's
+        for p in range(nc):
+            if verdict[p] < 0:
+                sv = np.linalg.svd(blocks[p], compute_uv=False)
+                if not (sv[-1] > 0 and sv[0] / sv[-1] < 1e8):  # (a zero: infinite)
+                    return every
+    keep = np.empty(nc * H, dtype=np.int64)
     for p in range(nc):
+        keep[p * H:(p + 1) * H] = np.arange((2 * p + 1) * H, (2 * p + 2) * H)
+    return keep
+
+
+#: :func:`_normal_blocks` settles a block ``c I + E`` as well conditioned where
+#: ``(|c| + |E|_F) / (|c| - |E|_F)`` is below this: its condition number is at most that
+#: (Weyl: every singular value within ``|E|_2 <= |E|_F`` of ``|c|``), ten times below the
+#: threshold of 1e8, far above the rounding of the bound's few sums
+NORMAL_COND_BOUND = 1e7
+
+
+@njit(cache=True)
+def _normal_blocks(Gc, node, rows, Kf, Mf, Cf, Df, H, eps):
+    """:func:`_decoupled_normals`' tests on plain arrays: ``(ok, blocks, verdict)``,
+    ``blocks`` (nc, H, H) the normal blocks ``eps I - (eps - k) G_N`` and ``verdict`` (nc,)
+    int: 1 the node's normal is decoupled and its block well conditioned (the bound of
+    :data:`NORMAL_COND_BOUND` on the block written ``c I + E``, ``c`` its mean diagonal
+    entry), -1 decoupled, its condition left to the singular values; ``ok`` 1 (every node
+    decoupled and settled), 2 (decoupled, some condition left open) or 0 where any node's
+    normal is coupled (its rows of ``G_c`` or of a stick interval's ``r_I`` meet the
+    other block, or the structure's row or column of that coordinate has an entry off the
+    diagonal, or it has a mass or a damping)."""
+    nc, dH, _ = Gc.shape
+    ns = Kf.shape[0]
+    blocks = np.empty((nc, H, H))
+    verdict = np.ones(nc, dtype=np.int64)
+    none = np.zeros(0, dtype=np.int64)
+    for p in range(nc):
+        for i in range(H):
+            for j in range(H, dH):
+                if Gc[p, i, j] != 0.0 or Gc[p, j, i] != 0.0:
+                    return 0, blocks, none
+        for t in range(node.size):
+            if node[t] == p:
+                for j in range(H):
+                    if rows[t, j] != 0.0:
+                        return 0, blocks, none
         a = 2 * p
-        Gp = mg.constant[p]
-        if Gp[:H, H:].any() or Gp[H:, :H].any() or np.any(mg.rows[mg.node == p][:, :H]):
-            return every
-        for M in Kf, Mf, Cf, Df:
-            off = M[a].copy()
-            off[a] = 0.0
-            col = M[:, a].copy()
-            col[a] = 0.0
-            if off.any() or col.any():
-                return every
+        for j in range(ns):
+            if j == a:
+                continue
+            if (Kf[a, j] != 0.0 or Kf[j, a] != 0.0 or Mf[a, j] != 0.0 or Mf[j, a] != 0.0
+                    or Cf[a, j] != 0.0 or Cf[j, a] != 0.0 or Df[a, j] != 0.0
+                    or Df[j, a] != 0.0):
+                return 0, blocks, none
         if Mf[a, a] != 0.0 or Cf[a, a] != 0.0 or Df[a, a] != 0.0:
-            return every
-        block = eps * np.eye(H) - (eps - Kf[a, a]) * Gp[:H, :H]
-        if not np.linalg.cond(block) < 1e8:
-            return every
-    keep = np.concatenate([np.arange((2 * p + 1) * H, (2 * p + 2) * H) for p in range(nc)])
-    return keep.astype(np.int64)
+            return 0, blocks, none
+        f = eps - Kf[a, a]
+        c = 0.0
+        for i in range(H):
+            for j in range(H):
+                blocks[p, i, j] = (eps if i == j else 0.0) - f * Gc[p, i, j]
+            c += blocks[p, i, i]
+        c /= H
+        e2 = 0.0
+        for i in range(H):
+            for j in range(H):
+                x = blocks[p, i, j] - (c if i == j else 0.0)
+                e2 += x * x
+        e = np.sqrt(e2)
+        if not (e < abs(c) and abs(c) + e < NORMAL_COND_BOUND * (abs(c) - e)):
+            verdict[p] = -1
+    return (2 if (verdict < 0).any() else 1), blocks, verdict
 
 
 @njit(cache=True)
@@ -2038,7 +2118,7 @@ def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions,
                       float(hp.prob.eps), float(hp.N), complex(sigma), complex(warm.sigma),
                       np.ascontiguousarray(warm.v, dtype=complex), complex(warm.slope),
                       float(opt.newton_tol), int(opt.newton_max_iter),
-                      float(np.log(NEGLIGIBLE)), hp._keep)
+                      LOG_NEGLIGIBLE, hp._keep)
         hp.evaluations += out[5]  # (made, whether or not the steps are then taken again)
         if out[6] == 0:  # (else: the steps one by one, which take LAPACK's pair or raise)
             s1, v1, r1, conv, slope1 = out[:5]
@@ -2053,7 +2133,7 @@ def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions,
     # meets another one, which the frozen-memory candidates would show as a pair)
     mu0 = 0.0
     for _ in range(opt.newton_max_iter):
-        if abs(sigma - start) > 0.5 or 2.0 * np.pi * sigma.real < np.log(NEGLIGIBLE) or (
+        if abs(sigma - start) > 0.5 or 2.0 * np.pi * sigma.real < LOG_NEGLIGIBLE or (
                 deflate is not None and abs(sigma - deflate) <= ON_REAL):
             break  # left the neighbourhood of the candidate (or back on the root deflated)
         T, mu, v, lu, res, pair = hp.evaluate(sigma, v, mu0)
@@ -2142,7 +2222,7 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
     at a neighbouring solution of the same model and basis (the previous point of a sweep),
     whose candidates are continued where that gives the dense eigensolve's
     (:func:`track_eigen`, ``options.track``)."""
-    opt = HillOptions() if options is None else options
+    opt = _DEFAULT_OPTIONS if options is None else options
     t0 = time.perf_counter()
     hp = HillProblem(prob, U, dyn)
     det_sign = hp.det_sign()
@@ -2192,7 +2272,7 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
         y = vecs[:, i]
         vx = y[:m * H]
         held = np.vdot(vx, vx).real < 1e-16 * np.vdot(y, y).real  # |vx| < 1e-8 |y|
-        negligible = 2.0 * np.pi * s0.real < np.log(NEGLIGIBLE)
+        negligible = 2.0 * np.pi * s0.real < LOG_NEGLIGIBLE
         if held or exact or negligible or refined >= opt.refine:  # refined: successes
             sig.append(s0)
             kaps.append(kp)
