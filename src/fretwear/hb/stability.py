@@ -541,15 +541,14 @@ def _det_sign(G, Z, eps):
     (the pivots' signs and the permutation's parity); 0 at a zero pivot."""
     nc, dH, _ = G.shape
     n = Z.shape[0]
-    J = np.empty((n, n))
+    J = np.zeros((n, n))
     for p in range(nc):
         lo = p * dH
-        for i in range(dH):
-            for j in range(n):
-                acc = 0.0
-                for r in range(dH):
-                    acc += G[p, i, r] * Z[lo + r, j]
-                J[lo + i, j] = acc
+        for i in range(dH):  # each entry's terms summed in r's order, the rows of Z read
+            for r in range(dH):  # contiguously
+                g = G[p, i, r]
+                for j in range(n):
+                    J[lo + i, j] += g * Z[lo + r, j]
             for j in range(dH):
                 J[lo + i, lo + j] -= eps * G[p, i, j]
     for i in range(n):
@@ -726,14 +725,14 @@ class HillProblem:
         # interval (:mod:`fretwear.hb.memory_gain`; None: the recursion at every s), where
         # a node sticks (otherwise nothing is refined); G(0) from the split wherever it
         # applies, the solve's recursion elsewhere
-        sticks = bool(self._states()[0][:, STICK].any())
+        sticks = any(f[STICK] for f in self._states()[0])
         split = memory_gain(self.lu, self.lx, self.state, *self._law)
         self._memory = split if sticks else None
         if split is not None:  # G(0) from the split: the solve's recursion's terms summed
             # in another order (no node sticks all period, so the solve's wrap-around is
             # exact in one sweep and its anchors do not enter): equal to rounding; without a
             # stick interval the split is G(0) itself, made at 0.6 of the recursion's cost
-            self.G0 = split.at(1.0).real
+            self.G0 = np.ascontiguousarray(split.at(1.0).real)
         else:
             self.G0 = law.dlft_jacobian(self.lu, self.lx, self.state, prob.mu, prob.P, prob.Q,
                                         prob.eps * prob.anchor, prob.tol, prob.max_sweeps,
@@ -842,22 +841,24 @@ class HillProblem:
         ``np.linalg.slogdet``'s sign to rounding: the same pivots), LAPACK's beyond."""
         if self.prob.m * self.prob.H > PAIR_COMPILED_MAX:
             return int(np.sign(np.linalg.slogdet(self.jacobian())[0]))
-        return int(_det_sign(np.ascontiguousarray(self.G0, dtype=float),
-                             np.ascontiguousarray(self.prob.Z, dtype=float),
+        return int(_det_sign(self.G0, np.ascontiguousarray(self.prob.Z, dtype=float),
                              float(self.prob.eps)))
 
     def _states(self):
-        """``(present, changes)`` of :func:`_state_summary`, made at the first call (the
-        state does not change)."""
+        """``(present, changes)`` of :func:`_state_summary` as lists (per node, the three
+        flags and the count: the nodes are few, and the questions below are cheaper on
+        Python's scalars than on arrays), made at the first call (the state does not
+        change)."""
         if self._summary is None:
-            self._summary = _state_summary(np.ascontiguousarray(self.state))
+            present, changes = _state_summary(np.ascontiguousarray(self.state))
+            self._summary = (present.tolist(), changes.tolist())
         return self._summary
 
     def neutral(self) -> int:
         """Tangential directions of the nodes that stick all period (multiplier 1)."""
         present, _ = self._states()
-        stuck = present[:, STICK] & ~present[:, SEPARATION] & ~present[:, law.SLIP]
-        return int(stuck.sum()) * (self.prob.d - 1)
+        stuck = sum(1 for f in present if f[STICK] and not f[SEPARATION] and not f[law.SLIP])
+        return stuck * (self.prob.d - 1)
 
     def regime(self) -> tuple:
         """Per node, the contact states it takes over the period and how many times it
@@ -867,14 +868,14 @@ class HillProblem:
         exponents come: measured on a Jenkins oscillator leaving full stick), so the
         candidates are not continued from the neighbour's (:func:`hill_stability`)."""
         present, changes = self._states()
-        return tuple((tuple(k for k in range(3) if present[p, k]), int(changes[p]))
-                     for p in range(present.shape[0]))
+        return tuple((tuple(k for k in range(3) if f[k]), c)
+                     for f, c in zip(present, changes, strict=True))
 
     def memoryless(self) -> bool:
         """No node sticks at any instant nor slips in 3D: ``G(s) = G(0)`` for every ``s``
         (separation and 2D slip carry nothing from the previous instant)."""
         present, _ = self._states()
-        return not (present[:, STICK].any() or (self.prob.d > 2 and present[:, law.SLIP].any()))
+        return not any(f[STICK] or (self.prob.d > 2 and f[law.SLIP]) for f in present)
 
     def pencil(self):
         """``(A0, A1, A2)``: Hill's matrix on the structure's coordinates ``(x, q)`` (every
@@ -2238,8 +2239,8 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
     origin = None
     if got is not None:  # member j continues member origin[j] of the neighbour's track
         vals, vecs, kap, origin = got
-        idx = np.arange(vals.size)
-        edge = np.zeros(vals.size, dtype=bool)
+        idx = np.argsort(-vals.real, kind="stable")
+        kap, edge = kap[idx], np.zeros(vals.size, dtype=bool)
     else:
         vals, vecs = dense_eigen(red)
         finite = np.flatnonzero(np.isfinite(vals) & (np.abs(vals) < cut))
@@ -2250,9 +2251,10 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
         idx, kap, edge = finite[keep], kap[keep], edge[keep]
         half = vals[idx].imag >= -1e-12 * np.maximum(np.abs(vals[idx]), 1.0)
         idx, kap, edge = idx[half], kap[half], edge[half]
-    order = np.argsort(-vals[idx].real, kind="stable")
-    idx, kap, edge = idx[order], kap[order], edge[order]
-    track = _track_record(red, vals[idx], vecs[:, idx], kap, edge, H, cut)
+        order = np.argsort(-vals[idx].real, kind="stable")
+        idx, kap, edge = idx[order], kap[order], edge[order]
+    kept = vals[idx]  # (sorted by decreasing real part)
+    track = _track_record(red, kept, vecs[:, idx], kap, edge, H, cut)
     if track is not None:
         track.regime = regime
         track.omega = hp.omega
@@ -2260,15 +2262,15 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
             src = origin[idx]
             vel = np.zeros(idx.size, dtype=complex)
             ok = src >= 0
-            moved = vals[idx][ok] - prev.sigma[src[ok]]
+            moved = kept[ok] - prev.sigma[src[ok]]
             vel[ok] = np.where(np.abs(moved) < 0.1, moved, 0.0) / (hp.omega - prev.omega)
             track.velocity = vel
     exact = hp.memoryless() and dyn.exact
     sig, kaps, res, kind, spurious = [], [], [], [], []
     refined = 0
     done: list = [None] * idx.size  # the refinements, for the neighbour's warm starts
-    for pos, (i, kp) in enumerate(zip(idx, kap, strict=True)):
-        s0 = complex(vals[i])
+    for pos, (i, kp, s0) in enumerate(zip(idx.tolist(), kap.tolist(), kept.tolist(),
+                                          strict=True)):
         y = vecs[:, i]
         vx = y[:m * H]
         held = np.vdot(vx, vx).real < 1e-16 * np.vdot(y, y).real  # |vx| < 1e-8 |y|
