@@ -120,7 +120,9 @@ def test_pair_on_the_tangential_unknowns_is_the_whole_matrix_s():
     the whole matrix (``keep`` every unknown): partial pivoting never leaves the tangential
     block, the exact zeros add nothing, the 1-norm takes the dropped columns' sums; a start
     with a normal part takes the whole matrix; a structure that couples the normal
-    coordinate keeps every unknown."""
+    coordinate keeps every unknown. The dropped columns' largest sum is the same number at
+    every ``s`` (the block does not depend on it): given, it is not computed again and the
+    evaluation is the same bit for bit."""
     prob, hp = _jenkins_point()
     n, H = prob.m * prob.H, prob.H
     assert hp._fused is not None and np.array_equal(hp._keep, np.arange(H, n))
@@ -129,18 +131,28 @@ def test_pair_on_the_tangential_unknowns_is_the_whole_matrix_s():
     v = rng.standard_normal(n) + 1j * rng.standard_normal(n)
     vt = v.copy()
     vt[:H] = 0.0
+    sums = []
     for sigma, mu0 in ((0.0, 0.0), (0.9j, 0.01), (-0.03 + 1.02j, 0.0)):
         z = np.exp(-2.0 * np.pi * sigma / hp.N)
         args = (*hp._fused, complex(z), *hp._structure, prob.m, hp.harmonics, hp.omega,
                 complex(sigma), float(prob.eps))
-        T = _evaluate(*args, vt, complex(mu0), 2, every)[0]
+        T = _evaluate(*args, vt, complex(mu0), 2, every, -1.0)[0]
         assert not T[:H, H:].any() and not T[H:, :H].any()
         for start in (vt, v):
-            a = _evaluate(*args, start, complex(mu0), 2, hp._keep)
-            b = _evaluate(*args, start, complex(mu0), 2, every)
+            a = _evaluate(*args, start, complex(mu0), 2, hp._keep, -1.0)
+            b = _evaluate(*args, start, complex(mu0), 2, every, -1.0)
             assert a[3] == b[3] == 0 and a[1] == b[1] and np.array_equal(a[2], b[2])
             assert a[4] == b[4] and a[5] == b[5]
             assert start is v or not a[2][:H].any()
+        fresh = _evaluate(*args, vt, complex(mu0), 2, hp._keep, -1.0)
+        sums.append(fresh[6])
+        given = _evaluate(*args, vt, complex(mu0), 2, hp._keep, sums[0])
+        assert fresh[6] > 0 and given[6] == sums[0]
+        assert given[1] == fresh[1] and np.array_equal(given[2], fresh[2])
+        assert given[4] == fresh[4] and given[5] == fresh[5]
+    assert sums[0] == sums[1] == sums[2]
+    T = _evaluate(*args, vt, 0j, 2, every, -1.0)[0]  # the dropped block's sums, directly
+    assert sums[0] == pytest.approx(np.abs(T[:, :H]).sum(axis=0).max(), rel=1e-14)  # (order)
     K, M, C, D = (x.copy() for x in hp._structure)
     K[0, 1] = K[1, 0] = 0.1
     assert np.array_equal(_decoupled_normals(hp._memory, (K, M, C, D), H, prob.eps), every)

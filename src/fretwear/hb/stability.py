@@ -751,6 +751,7 @@ class HillProblem:
         # the unknowns the compiled pair works on (:func:`_decoupled_normals`)
         self._keep = (_decoupled_normals(mg, self._structure, prob.H, float(prob.eps))
                       if self._fused is not None else None)
+        self._dropped = -1.0  # the dropped columns' largest sum, once known (:func:`_evaluate`)
         self.evaluations = 0
 
     def gain(self, sigma: complex) -> np.ndarray:
@@ -822,12 +823,14 @@ class HillProblem:
         z = (1.0 + 0j if sigma == 0 else np.exp(-2.0 * np.pi * sigma / self.N))
         out = _evaluate(*self._fused, complex(z), *self._structure, self.prob.m,
                         self.harmonics, self.omega, sigma, float(self.prob.eps),
-                        np.ascontiguousarray(v, dtype=complex), complex(mu0), 2, self._keep)
+                        np.ascontiguousarray(v, dtype=complex), complex(mu0), 2, self._keep,
+                        self._dropped)
         if out[3] == 2:
             raise InputError("the structure with its contact points held is singular at a "
                              "value of the Laplace variable (an eigenvalue of the held "
                              "interface)")
-        return out
+        self._dropped = out[6]
+        return out[:6]
 
     def jacobian(self) -> np.ndarray:
         """``J = T(0)`` (m H, m H) real: the balance's Jacobian from the solve's own ``G``
@@ -1748,7 +1751,7 @@ def _residuals(T, y, mu, floor):
 
 @njit(cache=True)
 def _evaluate(Gc, node, start, length, rows, P, z, Kf, Mf, Cf, Df, m, harmonics, omega,
-              sigma, eps, v, mu0, steps, keep):
+              sigma, eps, v, mu0, steps, keep, dropped):
     """:meth:`HillProblem.evaluate` in one compiled call where ``G(s)`` is split
     (:mod:`fretwear.hb.memory_gain`) and every piece runs compiled: ``G(s)``
     (:func:`fretwear.hb.memory_gain._gain_at`, ``z = e^{-s h}``), ``Z_r``
@@ -1760,13 +1763,17 @@ def _evaluate(Gc, node, start, length, rows, P, z, Kf, Mf, Cf, Df, m, harmonics,
     on the others: the pair's LU with partial pivoting, its solves and the residuals then
     take the same values as on the whole matrix (the dropped block factored apart, its
     exact zeros adding nothing; the dropped columns' sums in the 1-norm), on a quarter of
-    the entries (a Jenkins point's pair 38 -> 10 us). Returns ``(T, mu, y, status,
-    res, pair)``, ``status`` 0, 1 (a zero pivot in the pair's LU: LAPACK's then runs) or 2
-    (the held structure is singular at this ``s``)."""
+    the entries (a Jenkins point's pair 38 -> 10 us). ``dropped``: the largest of the
+    dropped columns' sums where already known (the dropped block is the same at every ``s``:
+    ``G_N`` and the normal stiffness do not depend on it, nor do the exact zeros around it,
+    so its sums are the same numbers at every evaluation), negative to compute it here.
+    Returns ``(T, mu, y, status, res, pair, dropped)``, ``status`` 0, 1 (a zero pivot in the
+    pair's LU: LAPACK's then runs) or 2 (the held structure is singular at this ``s``),
+    ``dropped`` as computed (negative where the whole matrix was taken)."""
     G = _gain_at(Gc, node, start, length, rows, P, z)
     Zr, ok = _condensed_at(Kf, Mf, Cf, Df, m, harmonics, omega, sigma)
     if not ok:
-        return np.zeros((1, 1), dtype=np.complex128), 0j, v, 2, 0.0, 0.0
+        return np.zeros((1, 1), dtype=np.complex128), 0j, v, 2, 0.0, 0.0, dropped
     T = _hill_matrix(G, Zr, eps)
     n = T.shape[0]
     nk = keep.size
@@ -1774,23 +1781,25 @@ def _evaluate(Gc, node, start, length, rows, P, z, Kf, Mf, Cf, Df, m, harmonics,
     for i in range(nk):
         kept[keep[i]] = True
     whole = nk == n
-    floor = 0.0  # the dropped columns' sums, as the whole matrix's 1-norm takes them
-    for j in range(n):
-        if kept[j]:
-            continue
-        if v[j] != 0:  # a start with a part on the dropped unknowns: the whole matrix
+    for j in range(n):  # a start with a part on the dropped unknowns: the whole matrix
+        if not kept[j] and v[j] != 0:
             whole = True
             break
-        col = 0.0
-        for i in range(n):
-            col += abs(T[i, j])
-        floor = max(floor, col)
     if whole:
         mu, y, ok = _pair_small(T, v, mu0, steps)
         if not ok:
-            return T, 0j, v, 1, 0.0, 0.0
+            return T, 0j, v, 1, 0.0, 0.0, dropped
         res, pair = _residuals(T, y, mu, 0.0)
-        return T, mu, y, 0, res, pair
+        return T, mu, y, 0, res, pair, dropped
+    if dropped < 0.0:  # the dropped columns' sums, as the whole matrix's 1-norm takes them
+        dropped = 0.0
+        for j in range(n):
+            if kept[j]:
+                continue
+            col = 0.0
+            for i in range(n):
+                col += abs(T[i, j])
+            dropped = max(dropped, col)
     Tk = np.empty((nk, nk), dtype=np.complex128)
     vk = np.empty(nk, dtype=np.complex128)
     for i in range(nk):
@@ -1799,12 +1808,12 @@ def _evaluate(Gc, node, start, length, rows, P, z, Kf, Mf, Cf, Df, m, harmonics,
             Tk[i, j] = T[keep[i], keep[j]]
     mu, yk, ok = _pair_small(Tk, vk, mu0, steps)
     if not ok:
-        return T, 0j, v, 1, 0.0, 0.0
-    res, pair = _residuals(Tk, yk, mu, floor)
+        return T, 0j, v, 1, 0.0, 0.0, dropped
+    res, pair = _residuals(Tk, yk, mu, dropped)
     y = np.zeros(n, dtype=np.complex128)
     for i in range(nk):
         y[keep[i]] = yk[i]
-    return T, mu, y, 0, res, pair
+    return T, mu, y, 0, res, pair, dropped
 
 
 def _decoupled_normals(mg, structure, H: int, eps: float):
@@ -1904,15 +1913,16 @@ def _normal_blocks(Gc, node, rows, Kf, Mf, Cf, Df, H, eps):
 
 @njit(cache=True)
 def _refine(Gc, node, start, length, rows, P, Kf, Mf, Cf, Df, m, harmonics, omega, eps, N,
-            s0, sigma, v, slope, tol, max_iter, floor, keep):
+            s0, sigma, v, slope, tol, max_iter, floor, keep, dropped):
     """:func:`_track` from a neighbour's start (``sigma``, ``v``, ``slope`` nonzero; no
     deflation) in one compiled call, each step one :func:`_evaluate`: the secant method on
     the eigenvalue ``mu`` of ``T(sigma)`` that continues ``v``, the same steps and stopping
     rule (``|mu| / |T|`` below ``tol``; the iterates kept within 0.5 of the candidate ``s0``
     and above ``2 pi Re sigma = floor``, the logarithm of :data:`NEGLIGIBLE`). Returns
-    ``(sigma, v, res, converged, slope, evaluations, status)``, ``status`` 0, or 1 / 2 as
-    :func:`_evaluate`'s (then :func:`_track` runs the steps one by one, which take LAPACK's
-    pair or raise). ``keep``: :func:`_evaluate`'s."""
+    ``(sigma, v, res, converged, slope, evaluations, status, dropped)``, ``status`` 0, or
+    1 / 2 as :func:`_evaluate`'s (then :func:`_track` runs the steps one by one, which take
+    LAPACK's pair or raise). ``keep``, ``dropped``: :func:`_evaluate`'s (the latter as the
+    first step computed it, for the next refinement)."""
     res = np.inf
     real = s0.imag == 0.0
     mu0 = 0j
@@ -1924,15 +1934,15 @@ def _refine(Gc, node, start, length, rows, P, Kf, Mf, Cf, Df, m, harmonics, omeg
         if abs(sigma - s0) > 0.5 or 2.0 * np.pi * sigma.real < floor:
             break
         z = 1.0 + 0j if sigma == 0 else np.exp(-2.0 * np.pi * sigma / N)
-        T, mu, y, status, res, pair = _evaluate(Gc, node, start, length, rows, P, z, Kf, Mf,
-                                                Cf, Df, m, harmonics, omega, sigma, eps, v,
-                                                mu0, 2, keep)
+        T, mu, y, status, res, pair, dropped = _evaluate(Gc, node, start, length, rows, P, z,
+                                                         Kf, Mf, Cf, Df, m, harmonics, omega,
+                                                         sigma, eps, v, mu0, 2, keep, dropped)
         count += 1
         if status != 0:
-            return sigma, v, res, False, slope, count, status
+            return sigma, v, res, False, slope, count, status, dropped
         v = y
         if res <= tol:
-            return sigma, v, res, True, slope, count, 0
+            return sigma, v, res, True, slope, count, 0, dropped
         f = mu
         if have_prev:
             slope = (f - fp) / (sigma - sp) if f != fp else 0j
@@ -1944,7 +1954,7 @@ def _refine(Gc, node, start, length, rows, P, Kf, Mf, Cf, Df, m, harmonics, omeg
         if not (np.isfinite(new.real) and np.isfinite(new.imag)) or new == sigma:
             break
         sigma = new
-    return sigma, v, res, res <= tol, slope, count, 0
+    return sigma, v, res, res <= tol, slope, count, 0, dropped
 
 
 @njit(cache=True)
@@ -2119,8 +2129,9 @@ def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions,
                       float(hp.prob.eps), float(hp.N), complex(sigma), complex(warm.sigma),
                       np.ascontiguousarray(warm.v, dtype=complex), complex(warm.slope),
                       float(opt.newton_tol), int(opt.newton_max_iter),
-                      LOG_NEGLIGIBLE, hp._keep)
+                      LOG_NEGLIGIBLE, hp._keep, hp._dropped)
         hp.evaluations += out[5]  # (made, whether or not the steps are then taken again)
+        hp._dropped = out[7]
         if out[6] == 0:  # (else: the steps one by one, which take LAPACK's pair or raise)
             s1, v1, r1, conv, slope1 = out[:5]
             return complex(s1), v1, float(r1), bool(conv), complex(slope1)
