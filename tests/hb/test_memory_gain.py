@@ -136,22 +136,24 @@ def test_pair_on_the_tangential_unknowns_is_the_whole_matrix_s():
         z = np.exp(-2.0 * np.pi * sigma / hp.N)
         args = (*hp._fused, complex(z), *hp._structure, prob.m, hp.harmonics, hp.omega,
                 complex(sigma), float(prob.eps))
-        T = _evaluate(*args, vt, complex(mu0), 2, every, -1.0)[0]
+        T = _evaluate(*args, vt, complex(mu0), 2, every, -1.0, True)[0]
         assert not T[:H, H:].any() and not T[H:, :H].any()
         for start in (vt, v):
-            a = _evaluate(*args, start, complex(mu0), 2, hp._keep, -1.0)
-            b = _evaluate(*args, start, complex(mu0), 2, every, -1.0)
+            a = _evaluate(*args, start, complex(mu0), 2, hp._keep, -1.0, True)
+            b = _evaluate(*args, start, complex(mu0), 2, every, -1.0, True)
             assert a[3] == b[3] == 0 and a[1] == b[1] and np.array_equal(a[2], b[2])
             assert a[4] == b[4] and a[5] == b[5]
             assert start is v or not a[2][:H].any()
-        fresh = _evaluate(*args, vt, complex(mu0), 2, hp._keep, -1.0)
+        fresh = _evaluate(*args, vt, complex(mu0), 2, hp._keep, -1.0, True)
         sums.append(fresh[6])
-        given = _evaluate(*args, vt, complex(mu0), 2, hp._keep, sums[0])
-        assert fresh[6] > 0 and given[6] == sums[0]
-        assert given[1] == fresh[1] and np.array_equal(given[2], fresh[2])
-        assert given[4] == fresh[4] and given[5] == fresh[5]
+        for form in (True, False):  # (without: only the kept block formed)
+            given = _evaluate(*args, vt, complex(mu0), 2, hp._keep, sums[0], form)
+            assert fresh[6] > 0 and given[6] == sums[0]
+            assert given[1] == fresh[1] and np.array_equal(given[2], fresh[2])
+            assert given[4] == fresh[4] and given[5] == fresh[5]
+            assert given[0].shape == ((n, n) if form else (0, 0))
     assert sums[0] == sums[1] == sums[2]
-    T = _evaluate(*args, vt, 0j, 2, every, -1.0)[0]  # the dropped block's sums, directly
+    T = _evaluate(*args, vt, 0j, 2, every, -1.0, True)[0]  # the dropped block's sums
     assert sums[0] == pytest.approx(np.abs(T[:, :H]).sum(axis=0).max(), rel=1e-14)  # (order)
     K, M, C, D = (x.copy() for x in hp._structure)
     K[0, 1] = K[1, 0] = 0.1
@@ -194,3 +196,27 @@ def test_compiled_refinement_is_the_python_steps():
             checked += 1
         prev = hill_stability(prob, U, dyn)
     assert checked == 2
+
+
+def test_kept_rows_of_hill_matrix_are_the_whole_matrix_s():
+    """:func:`_hill_rows` forms the rows and columns it keeps as :func:`_hill_matrix` forms
+    the whole ``T(s)`` (the same operations per entry): bit for bit its submatrix, for the
+    tangential unknowns of a Jenkins point and for a scattered subset, at several ``s``."""
+    from fretwear.hb.memory_gain import _gain_at
+    from fretwear.hb.stability import _condensed_at, _hill_matrix, _hill_rows
+
+    prob, hp = _jenkins_point()
+    n, H = prob.m * prob.H, prob.H
+    scattered = np.array([0, 3, H, H + 2, n - 1], dtype=np.int64)
+    for sigma in (0.0, 0.9j, -0.03 + 1.02j):
+        z = complex(np.exp(-2.0 * np.pi * sigma / hp.N))
+        G = _gain_at(*hp._fused, z)
+        Zr, ok = _condensed_at(*hp._structure, prob.m, hp.harmonics, hp.omega, complex(sigma))
+        assert ok
+        T = _hill_matrix(G, Zr, float(prob.eps))
+        for keep in (hp._keep, scattered):
+            at = np.full(n, -1, dtype=np.int64)
+            at[keep] = np.arange(keep.size)
+            Tk = _hill_rows(G, Zr, float(prob.eps), at, keep.size)
+            assert np.array_equal(Tk, T[np.ix_(keep, keep)])
+        assert np.abs(T[np.ix_(hp._keep, hp._keep)]).max() > 0

@@ -585,22 +585,41 @@ def _hill_matrix(G, Zr, eps):
     own coefficient and its cosine/sine partner of every DOF: ``2 m`` terms, not ``m H``),
     which at the sizes of a refinement (tens of unknowns) costs less than the calls of the
     numpy form. The same terms as the dense product, summed in another order: equal to a
-    few units of rounding."""
+    few units of rounding. :func:`_hill_rows` on every unknown."""
+    n = Zr.shape[1] * Zr.shape[0]
+    return _hill_rows(G, Zr, eps, np.arange(n), n)
+
+
+@njit(cache=True)
+def _hill_rows(G, Zr, eps, at, nk):
+    """The rows and columns of :func:`_hill_matrix`'s ``T(s)`` that ``at`` (m H,) keeps:
+    ``T[i, j]`` goes to ``[at[i], at[j]]`` of the (nk, nk) result, a negative ``at`` drops
+    it; each kept entry computed as the whole matrix's (the same values), the dropped ones
+    not at all (:func:`_evaluate`: the tangential block, a quarter of the entries)."""
     nl, m, _ = Zr.shape
     k = (nl - 1) // 2
     H = 1 + 2 * k
     n = m * H
     nc, dH, _ = G.shape
-    T = np.zeros((n, n), dtype=np.complex128)
+    T = np.zeros((nk, nk), dtype=np.complex128)
+    some = np.zeros(m, dtype=np.bool_)  # a DOF with a column kept
+    for c in range(m):
+        for h in range(H):
+            some[c] = some[c] or at[c * H + h] >= 0
     for p in range(nc):
         lo = p * dH
         for i in range(dH):
-            row = lo + i
+            row = at[lo + i]
+            if row < 0:
+                continue
             for c in range(m):
+                if not some[c]:
+                    continue
                 acc = 0.0 + 0.0j
                 for r in range(m):
                     acc += G[p, i, r * H - lo] * Zr[0, r, c] if lo <= r * H < lo + dH else 0.0
-                T[row, c * H] = acc
+                if at[c * H] >= 0:
+                    T[row, at[c * H]] = acc
                 for j in range(k):
                     ia, ib = 1 + j, 1 + k + j
                     acc_a = 0.0 + 0.0j
@@ -615,13 +634,20 @@ def _hill_matrix(G, Zr, eps):
                         ga, gb = G[p, i, ca], G[p, i, cb]
                         acc_a += ga * half + gb * (0.5j * (zp - zm))
                         acc_b += ga * (0.5j * (zm - zp)) + gb * half
-                    T[row, c * H + ia] = acc_a
-                    T[row, c * H + ib] = acc_b
+                    if at[c * H + ia] >= 0:
+                        T[row, at[c * H + ia]] = acc_a
+                    if at[c * H + ib] >= 0:
+                        T[row, at[c * H + ib]] = acc_b
         for i in range(dH):
+            row = at[lo + i]
+            if row < 0:
+                continue
             for j in range(dH):
-                T[lo + i, lo + j] -= eps * G[p, i, j]
+                if at[lo + j] >= 0:
+                    T[row, at[lo + j]] -= eps * G[p, i, j]
     for i in range(n):
-        T[i, i] += eps
+        if at[i] >= 0:
+            T[at[i], at[i]] += eps
     return T
 
 
@@ -649,8 +675,9 @@ def _condensed_at(Kf, Mf, Cf, Df, m, harmonics, omega, sigma):
     Zr = np.empty((1 + 2 * k, m, m), dtype=np.complex128)
     Z = np.empty((ns, ns), dtype=np.complex128)
     A = np.empty((q, q), dtype=np.complex128)
-    B = np.empty((q, m), dtype=np.complex128)
     X = np.empty((q, m), dtype=np.complex128)
+    x = np.empty(q, dtype=np.complex128)
+    piv = np.empty(q, dtype=np.int64)
     for idx in range(1 + 2 * k):
         if idx == 0:
             lam = s
@@ -667,12 +694,44 @@ def _condensed_at(Kf, Mf, Cf, Df, m, harmonics, omega, sigma):
             for j in range(q):
                 A[i, j] = Z[m + i, m + j]
             for j in range(m):
-                B[i, j] = Z[m + i, j]
-        piv, ok = _lu_small(A)
-        if not ok:
-            return Zr, False
+                X[i, j] = Z[m + i, j]
+        # X = A^-1 X in place: :func:`_lu_small` and :func:`_lu_solve_small`'s steps (the
+        # same operations in the same order), the pivots and the columns solved in the
+        # arrays made once (the calls allocated three arrays a value of lambda)
+        for col in range(q):
+            piv[col] = col
+        for col in range(q):
+            p = col
+            for r in range(col + 1, q):
+                if abs(A[r, col]) > abs(A[p, col]):
+                    p = r
+            if A[p, col] == 0:
+                return Zr, False
+            if p != col:
+                for j in range(q):
+                    A[col, j], A[p, j] = A[p, j], A[col, j]
+                piv[col], piv[p] = piv[p], piv[col]
+            d = A[col, col]
+            for r in range(col + 1, q):
+                f = A[r, col] / d
+                A[r, col] = f
+                for j in range(col + 1, q):
+                    A[r, j] -= f * A[col, j]
         for j in range(m):
-            X[:, j] = _lu_solve_small(A, piv, B[:, j])
+            for i in range(q):
+                x[i] = X[piv[i], j]
+            for i in range(q):
+                acc = x[i]
+                for t in range(i):
+                    acc -= A[i, t] * x[t]
+                x[i] = acc
+            for i in range(q - 1, -1, -1):
+                acc = x[i]
+                for t in range(i + 1, q):
+                    acc -= A[i, t] * x[t]
+                x[i] = acc / A[i, i]
+            for i in range(q):
+                X[i, j] = x[i]
         for i in range(m):
             for j in range(m):
                 acc = Z[i, j]
@@ -824,7 +883,7 @@ class HillProblem:
         out = _evaluate(*self._fused, complex(z), *self._structure, self.prob.m,
                         self.harmonics, self.omega, sigma, float(self.prob.eps),
                         np.ascontiguousarray(v, dtype=complex), complex(mu0), 2, self._keep,
-                        self._dropped)
+                        self._dropped, True)
         if out[3] == 2:
             raise InputError("the structure with its contact points held is singular at a "
                              "value of the Laplace variable (an eigenvalue of the held "
@@ -1751,7 +1810,7 @@ def _residuals(T, y, mu, floor):
 
 @njit(cache=True)
 def _evaluate(Gc, node, start, length, rows, P, z, Kf, Mf, Cf, Df, m, harmonics, omega,
-              sigma, eps, v, mu0, steps, keep, dropped):
+              sigma, eps, v, mu0, steps, keep, dropped, form):
     """:meth:`HillProblem.evaluate` in one compiled call where ``G(s)`` is split
     (:mod:`fretwear.hb.memory_gain`) and every piece runs compiled: ``G(s)``
     (:func:`fretwear.hb.memory_gain._gain_at`, ``z = e^{-s h}``), ``Z_r``
@@ -1767,6 +1826,9 @@ def _evaluate(Gc, node, start, length, rows, P, z, Kf, Mf, Cf, Df, m, harmonics,
     dropped columns' sums where already known (the dropped block is the same at every ``s``:
     ``G_N`` and the normal stiffness do not depend on it, nor do the exact zeros around it,
     so its sums are the same numbers at every evaluation), negative to compute it here.
+    ``form``: return the whole ``T(s)`` (for :func:`_track`'s steps one by one); without,
+    where the dropped sums are known, only the kept block is formed (:func:`_hill_rows`, the
+    same values; :func:`_refine`, which does not use ``T``) and an empty ``T`` returned.
     Returns ``(T, mu, y, status, res, pair, dropped)``, ``status`` 0, 1 (a zero pivot in the
     pair's LU: LAPACK's then runs) or 2 (the held structure is singular at this ``s``),
     ``dropped`` as computed (negative where the whole matrix was taken)."""
@@ -1774,38 +1836,44 @@ def _evaluate(Gc, node, start, length, rows, P, z, Kf, Mf, Cf, Df, m, harmonics,
     Zr, ok = _condensed_at(Kf, Mf, Cf, Df, m, harmonics, omega, sigma)
     if not ok:
         return np.zeros((1, 1), dtype=np.complex128), 0j, v, 2, 0.0, 0.0, dropped
-    T = _hill_matrix(G, Zr, eps)
-    n = T.shape[0]
+    n = m * Zr.shape[0]
     nk = keep.size
-    kept = np.zeros(n, dtype=np.bool_)
+    at = np.full(n, -1, dtype=np.int64)  # each unknown's place among the kept ones
     for i in range(nk):
-        kept[keep[i]] = True
+        at[keep[i]] = i
     whole = nk == n
     for j in range(n):  # a start with a part on the dropped unknowns: the whole matrix
-        if not kept[j] and v[j] != 0:
+        if at[j] < 0 and v[j] != 0:
             whole = True
             break
     if whole:
+        T = _hill_matrix(G, Zr, eps)
         mu, y, ok = _pair_small(T, v, mu0, steps)
         if not ok:
             return T, 0j, v, 1, 0.0, 0.0, dropped
         res, pair = _residuals(T, y, mu, 0.0)
         return T, mu, y, 0, res, pair, dropped
-    if dropped < 0.0:  # the dropped columns' sums, as the whole matrix's 1-norm takes them
-        dropped = 0.0
-        for j in range(n):
-            if kept[j]:
-                continue
-            col = 0.0
-            for i in range(n):
-                col += abs(T[i, j])
-            dropped = max(dropped, col)
-    Tk = np.empty((nk, nk), dtype=np.complex128)
+    if form or dropped < 0.0:
+        T = _hill_matrix(G, Zr, eps)
+        if dropped < 0.0:  # the dropped columns' sums, as the whole matrix's 1-norm takes them
+            dropped = 0.0
+            for j in range(n):
+                if at[j] >= 0:
+                    continue
+                col = 0.0
+                for i in range(n):
+                    col += abs(T[i, j])
+                dropped = max(dropped, col)
+        Tk = np.empty((nk, nk), dtype=np.complex128)
+        for i in range(nk):
+            for j in range(nk):
+                Tk[i, j] = T[keep[i], keep[j]]
+    else:
+        T = np.zeros((0, 0), dtype=np.complex128)
+        Tk = _hill_rows(G, Zr, eps, at, nk)
     vk = np.empty(nk, dtype=np.complex128)
     for i in range(nk):
         vk[i] = v[keep[i]]
-        for j in range(nk):
-            Tk[i, j] = T[keep[i], keep[j]]
     mu, yk, ok = _pair_small(Tk, vk, mu0, steps)
     if not ok:
         return T, 0j, v, 1, 0.0, 0.0, dropped
@@ -1936,7 +2004,8 @@ def _refine(Gc, node, start, length, rows, P, Kf, Mf, Cf, Df, m, harmonics, omeg
         z = 1.0 + 0j if sigma == 0 else np.exp(-2.0 * np.pi * sigma / N)
         T, mu, y, status, res, pair, dropped = _evaluate(Gc, node, start, length, rows, P, z,
                                                          Kf, Mf, Cf, Df, m, harmonics, omega,
-                                                         sigma, eps, v, mu0, 2, keep, dropped)
+                                                         sigma, eps, v, mu0, 2, keep, dropped,
+                                                         False)
         count += 1
         if status != 0:
             return sigma, v, res, False, slope, count, status, dropped
@@ -2270,12 +2339,7 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
         track.regime = regime
         track.omega = hp.omega
         if got is not None and prev.omega is not None and hp.omega != prev.omega:
-            src = origin[idx]
-            vel = np.zeros(idx.size, dtype=complex)
-            ok = src >= 0
-            moved = kept[ok] - prev.sigma[src[ok]]
-            vel[ok] = np.where(np.abs(moved) < 0.1, moved, 0.0) / (hp.omega - prev.omega)
-            track.velocity = vel
+            track.velocity = _velocity(kept, origin[idx], prev.sigma, hp.omega - prev.omega)
     exact = hp.memoryless() and dyn.exact
     sig, kaps, res, kind, spurious = [], [], [], [], []
     refined = 0
@@ -2328,6 +2392,21 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
                          evaluations=hp.evaluations, wall_time=time.perf_counter() - t0,
                          stable_tol=opt.stable_tol, det_sign=det_sign,
                          tracked=got is not None, track=track)
+
+
+def _velocity(kept: np.ndarray, src: np.ndarray, before: np.ndarray, dw: float) -> np.ndarray:
+    """:attr:`HillTrack.velocity`: per member ``kept`` (``s / w``), its motion from the
+    neighbour's member ``before[src]`` over the step ``dw`` of ``w`` (times ``1 / dw``), 0
+    where it was not continued (``src`` -1) or moved 0.1 or more (another member's start).
+    The members are few: a loop on Python's scalars."""
+    vel = np.zeros(kept.size, dtype=complex)
+    inv = 1.0 / dw
+    for pos, (j, s) in enumerate(zip(src.tolist(), kept.tolist(), strict=True)):
+        if j >= 0:
+            moved = s - complex(before[j])
+            if abs(moved) < 0.1:
+                vel[pos] = complex(moved.real * inv, moved.imag * inv)
+    return vel
 
 
 @njit(cache=True)
