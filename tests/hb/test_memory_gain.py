@@ -220,3 +220,80 @@ def test_kept_rows_of_hill_matrix_are_the_whole_matrix_s():
             Tk = _hill_rows(G, Zr, float(prob.eps), at, keep.size)
             assert np.array_equal(Tk, T[np.ix_(keep, keep)])
         assert np.abs(T[np.ix_(hp._keep, hp._keep)]).max() > 0
+
+
+def _decoupled_normals_steps(mg, structure, H, eps):
+    """The tests of :func:`_decoupled_normals` as numpy steps (the previous code path, with
+    ``np.linalg.cond``), for the compiled one to be compared with."""
+    Kf, Mf, Cf, Df = structure
+    nc, dH, _ = mg.constant.shape
+    every = np.arange(nc * dH, dtype=np.int64)
+    if dH != 2 * H:
+        return every
+    for p in range(nc):
+        a = 2 * p
+        Gp = mg.constant[p]
+        if Gp[:H, H:].any() or Gp[H:, :H].any() or np.any(mg.rows[mg.node == p][:, :H]):
+            return every
+        for M in Kf, Mf, Cf, Df:
+            off = M[a].copy()
+            off[a] = 0.0
+            col = M[:, a].copy()
+            col[a] = 0.0
+            if off.any() or col.any():
+                return every
+        if Mf[a, a] != 0.0 or Cf[a, a] != 0.0 or Df[a, a] != 0.0:
+            return every
+        block = eps * np.eye(H) - (eps - Kf[a, a]) * Gp[:H, :H]
+        if not np.linalg.cond(block) < 1e8:
+            return every
+    return np.concatenate([np.arange((2 * p + 1) * H, (2 * p + 2) * H) for p in range(nc)])
+
+
+def test_decoupled_normals_compiled_is_the_numpy_steps():
+    """:func:`_decoupled_normals` (its tests in one compiled call, a bound on the condition
+    number of a normal block near a multiple of the identity, LAPACK's singular values for
+    the others) keeps the unknowns the numpy steps with ``np.linalg.cond`` keep, on a Jenkins
+    point (its normal block ``k I`` settled by the bound) and on variants of it that take
+    each branch: a normal block of condition number 100 (the bound leaves it open, the
+    singular values keep it), 1e9 and singular (every unknown), and a coupling in ``G``, in
+    a stick interval's row, in the stiffness and a mass on the normal coordinate."""
+    import dataclasses
+
+    prob, hp = _jenkins_point()
+    mg, st, H, eps = hp._memory, hp._structure, prob.H, float(prob.eps)
+    n = prob.m * H
+    k = st[0][0, 0]
+
+    def with_block(B):  # G_N such that eps I - (eps - k) G_N = B
+        G = mg.constant.copy()
+        G[0, :H, :H] = (eps * np.eye(H) - B) / (eps - k)
+        return dataclasses.replace(mg, constant=G)
+
+    def coupled_g():
+        G = mg.constant.copy()
+        G[0, 2, H + 1] = 1e-3
+        return dataclasses.replace(mg, constant=G)
+
+    def coupled_row():
+        R = mg.rows.copy()
+        R[0, 1] = 1e-3
+        return dataclasses.replace(mg, rows=R)
+
+    def changed(i, a, b, x):
+        out = [M.copy() for M in st]
+        out[i][a, b] = x
+        return tuple(out)
+
+    spread = np.diag(np.linspace(1.0, 100.0, H))
+    ill = np.diag(np.r_[np.ones(H - 1), 1e-9])
+    singular = np.diag(np.r_[np.ones(H - 1), 0.0])
+    cases = [(mg, st, True), (with_block(spread), st, True), (with_block(ill), st, False),
+             (with_block(singular), st, False), (coupled_g(), st, False),
+             (coupled_row(), st, False), (mg, changed(0, 0, 1, 0.1), False),
+             (mg, changed(0, 1, 0, 0.1), False), (mg, changed(1, 0, 0, 1.0), False)]
+    assert mg.node.size >= 1
+    for m_, s_, kept in cases:
+        got = _decoupled_normals(m_, s_, H, eps)
+        assert np.array_equal(got, _decoupled_normals_steps(m_, s_, H, eps))
+        assert np.array_equal(got, np.arange(H, n) if kept else np.arange(n))

@@ -1902,16 +1902,16 @@ def _decoupled_normals(mg, structure, H: int, eps: float):
     every = np.arange(nc * dH, dtype=np.int64)
     if dH != 2 * H:
         return every
-    ok, blocks, verdict = _normal_blocks(mg.constant, mg.node, mg.rows, Kf, Mf, Cf, Df, H,
-                                         float(eps))
-    if ok == 0:
+    blocks = np.empty((nc, H, H))
+    verdict = _normal_blocks(mg.constant, mg.node, mg.rows, Kf, Mf, Cf, Df, H, float(eps),
+                             blocks)
+    if verdict == 0:
         return every
-    if ok == 2:  # a block the bound leaves open: its condition number as np.linalg.cond's
-        for p in range(nc):
-            if verdict[p] < 0:
-                sv = np.linalg.svd(blocks[p], compute_uv=False)
-                if not (sv[-1] > 0 and sv[0] / sv[-1] < 1e8):  # (a zero: infinite)
-                    return every
+    if verdict == 2:  # a block the bound leaves open: the condition numbers as np.linalg.cond
+        for p in range(nc):  # has them (the bound's are below)
+            sv = np.linalg.svd(blocks[p], compute_uv=False)
+            if not (sv[-1] > 0 and sv[0] / sv[-1] < 1e8):  # (a zero: infinite)
+                return every
     keep = np.empty(nc * H, dtype=np.int64)
     for p in range(nc):
         keep[p * H:(p + 1) * H] = np.arange((2 * p + 1) * H, (2 * p + 2) * H)
@@ -1926,41 +1926,36 @@ NORMAL_COND_BOUND = 1e7
 
 
 @njit(cache=True)
-def _normal_blocks(Gc, node, rows, Kf, Mf, Cf, Df, H, eps):
-    """:func:`_decoupled_normals`' tests on plain arrays: ``(ok, blocks, verdict)``,
-    ``blocks`` (nc, H, H) the normal blocks ``eps I - (eps - k) G_N`` and ``verdict`` (nc,)
-    int: 1 the node's normal is decoupled and its block well conditioned (the bound of
-    :data:`NORMAL_COND_BOUND` on the block written ``c I + E``, ``c`` its mean diagonal
-    entry), -1 decoupled, its condition left to the singular values; ``ok`` 1 (every node
-    decoupled and settled), 2 (decoupled, some condition left open) or 0 where any node's
-    normal is coupled (its rows of ``G_c`` or of a stick interval's ``r_I`` meet the
-    other block, or the structure's row or column of that coordinate has an entry off the
-    diagonal, or it has a mass or a damping)."""
+def _normal_blocks(Gc, node, rows, Kf, Mf, Cf, Df, H, eps, blocks):
+    """:func:`_decoupled_normals`' tests on plain arrays, the normal blocks
+    ``eps I - (eps - k) G_N`` written into ``blocks`` (nc, H, H): 0 where a node's normal is
+    coupled (its rows of ``G_c`` or of a stick interval's ``r_I`` meet the other block, or
+    the structure's row or column of that coordinate has an entry off the diagonal, or it
+    has a mass or a damping), 1 where every node's is decoupled and its block well
+    conditioned by the bound of :data:`NORMAL_COND_BOUND` (the block written ``c I + E``,
+    ``c`` its mean diagonal entry), 2 where decoupled but a block's condition is left to its
+    singular values."""
     nc, dH, _ = Gc.shape
     ns = Kf.shape[0]
-    blocks = np.empty((nc, H, H))
-    verdict = np.ones(nc, dtype=np.int64)
-    none = np.zeros(0, dtype=np.int64)
+    verdict = 1
     for p in range(nc):
         for i in range(H):
             for j in range(H, dH):
                 if Gc[p, i, j] != 0.0 or Gc[p, j, i] != 0.0:
-                    return 0, blocks, none
+                    return 0
         for t in range(node.size):
             if node[t] == p:
                 for j in range(H):
                     if rows[t, j] != 0.0:
-                        return 0, blocks, none
+                        return 0
         a = 2 * p
         for j in range(ns):
-            if j == a:
-                continue
-            if (Kf[a, j] != 0.0 or Kf[j, a] != 0.0 or Mf[a, j] != 0.0 or Mf[j, a] != 0.0
-                    or Cf[a, j] != 0.0 or Cf[j, a] != 0.0 or Df[a, j] != 0.0
-                    or Df[j, a] != 0.0):
-                return 0, blocks, none
+            if j != a and (Kf[a, j] != 0.0 or Kf[j, a] != 0.0 or Mf[a, j] != 0.0
+                           or Mf[j, a] != 0.0 or Cf[a, j] != 0.0 or Cf[j, a] != 0.0
+                           or Df[a, j] != 0.0 or Df[j, a] != 0.0):
+                return 0
         if Mf[a, a] != 0.0 or Cf[a, a] != 0.0 or Df[a, a] != 0.0:
-            return 0, blocks, none
+            return 0
         f = eps - Kf[a, a]
         c = 0.0
         for i in range(H):
@@ -1975,8 +1970,8 @@ def _normal_blocks(Gc, node, rows, Kf, Mf, Cf, Df, H, eps):
                 e2 += x * x
         e = np.sqrt(e2)
         if not (e < abs(c) and abs(c) + e < NORMAL_COND_BOUND * (abs(c) - e)):
-            verdict[p] = -1
-    return (2 if (verdict < 0).any() else 1), blocks, verdict
+            verdict = 2
+    return verdict
 
 
 @njit(cache=True)
