@@ -538,7 +538,10 @@ def _state_summary(state):
 def _det_sign(G, Z, eps):
     """Sign of ``det(eps I - G (eps I - Z))`` (:func:`jacobian_form`, real; ``G`` (nc, dH,
     dH) block-diagonal per node, ``Z`` (n, n)): the form, then its LU with partial pivoting
-    (the pivots' signs and the permutation's parity); 0 at a zero pivot."""
+    (the pivots' signs and the permutation's parity); 0 at a zero pivot. A zero of ``G``
+    and a zero multiplier of the elimination add only zeros (``Z`` and ``J`` finite): they
+    are skipped, the same numbers (where a normal block is decoupled, as a Jenkins
+    oscillator's, ``J`` is block-diagonal and the elimination runs on its blocks)."""
     nc, dH, _ = G.shape
     n = Z.shape[0]
     J = np.zeros((n, n))
@@ -547,6 +550,8 @@ def _det_sign(G, Z, eps):
         for i in range(dH):  # each entry's terms summed in r's order, the rows of Z read
             for r in range(dH):  # contiguously
                 g = G[p, i, r]
+                if g == 0.0:
+                    continue
                 for j in range(n):
                     J[lo + i, j] += g * Z[lo + r, j]
             for j in range(dH):
@@ -571,6 +576,8 @@ def _det_sign(G, Z, eps):
             sign = -sign
         for r in range(col + 1, n):
             f = J[r, col] / d
+            if f == 0.0:
+                continue
             for j in range(col + 1, n):
                 J[r, j] -= f * J[col, j]
     return sign
