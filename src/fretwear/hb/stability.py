@@ -94,11 +94,15 @@ candidate instead of its dense eigensolve (each solved by the LU of the Schur co
 on the unknowns that couple harmonics, the others eliminated harmonic by harmonic:
 :mod:`fretwear.hb.hill_tracking`). ``det J`` is read from the solve's ``G`` (made again from
 the split of :mod:`fretwear.hb.memory_gain` where it applies: equal to rounding) and ``Z~``
-(:meth:`HillProblem.jacobian`). Measured on the benchmark's small models
-(docs/studies/method-costs.md, "Hill's method"): about 0.9-1.3 times the CPU a sweep
-spends on the point (median over both sweeps, quiet; the Jenkins oscillator's points
-0.66-0.77, the two-DOF oscillator's 1.2-1.8, a tracked one there about 2-4 ms), along a
-sweep, which hands each point's own problem
+(:meth:`HillProblem.jacobian`). Where every node's normal coordinate is decoupled (a
+prescribed normal force on a coordinate of its own), a refinement's evaluation forms and
+factors only the tangential block of ``T(s)`` (:func:`_evaluate`, :func:`_hill_rows`; the
+dropped block's column sums, the same at every ``s``, taken once a solution). Measured on
+the benchmark's small models (docs/studies/method-costs.md, "Hill's method"): about
+0.75-0.85 times the CPU a sweep spends on the point (median over both sweeps, load 2; the
+Jenkins oscillator's points 0.37-0.54, about 0.4-0.5 ms against a solve of 0.8-1.4 ms, the
+two-DOF oscillator's 1.0-1.5, a tracked one there about 1.5-2.5 ms), along a sweep, which
+hands each point's own problem
 (:func:`fretwear.hb.sweep_stability.point_problem`; :func:`stability` rebuilds it from the
 solution, about 1.1-1.5 ms more there); the evaluations of ``T(s)`` (a law with a memory),
 the inverse iterations of the tracked candidates and the dense eigensolve at the points that
