@@ -120,7 +120,9 @@ def test_pair_on_the_tangential_unknowns_is_the_whole_matrix_s():
     the whole matrix (``keep`` every unknown): partial pivoting never leaves the tangential
     block, the exact zeros add nothing, the 1-norm takes the dropped columns' sums; a start
     with a normal part takes the whole matrix; a structure that couples the normal
-    coordinate keeps every unknown."""
+    coordinate keeps every unknown. The dropped columns' largest sum is the same number at
+    every ``s`` (the block does not depend on it): given, it is not computed again and the
+    evaluation is the same bit for bit."""
     prob, hp = _jenkins_point()
     n, H = prob.m * prob.H, prob.H
     assert hp._fused is not None and np.array_equal(hp._keep, np.arange(H, n))
@@ -129,18 +131,30 @@ def test_pair_on_the_tangential_unknowns_is_the_whole_matrix_s():
     v = rng.standard_normal(n) + 1j * rng.standard_normal(n)
     vt = v.copy()
     vt[:H] = 0.0
+    sums = []
     for sigma, mu0 in ((0.0, 0.0), (0.9j, 0.01), (-0.03 + 1.02j, 0.0)):
         z = np.exp(-2.0 * np.pi * sigma / hp.N)
         args = (*hp._fused, complex(z), *hp._structure, prob.m, hp.harmonics, hp.omega,
                 complex(sigma), float(prob.eps))
-        T = _evaluate(*args, vt, complex(mu0), 2, every)[0]
+        T = _evaluate(*args, vt, complex(mu0), 2, every, -1.0, True)[0]
         assert not T[:H, H:].any() and not T[H:, :H].any()
         for start in (vt, v):
-            a = _evaluate(*args, start, complex(mu0), 2, hp._keep)
-            b = _evaluate(*args, start, complex(mu0), 2, every)
+            a = _evaluate(*args, start, complex(mu0), 2, hp._keep, -1.0, True)
+            b = _evaluate(*args, start, complex(mu0), 2, every, -1.0, True)
             assert a[3] == b[3] == 0 and a[1] == b[1] and np.array_equal(a[2], b[2])
             assert a[4] == b[4] and a[5] == b[5]
             assert start is v or not a[2][:H].any()
+        fresh = _evaluate(*args, vt, complex(mu0), 2, hp._keep, -1.0, True)
+        sums.append(fresh[6])
+        for form in (True, False):  # (without: only the kept block formed)
+            given = _evaluate(*args, vt, complex(mu0), 2, hp._keep, sums[0], form)
+            assert fresh[6] > 0 and given[6] == sums[0]
+            assert given[1] == fresh[1] and np.array_equal(given[2], fresh[2])
+            assert given[4] == fresh[4] and given[5] == fresh[5]
+            assert given[0].shape == ((n, n) if form else (0, 0))
+    assert sums[0] == sums[1] == sums[2]
+    T = _evaluate(*args, vt, 0j, 2, every, -1.0, True)[0]  # the dropped block's sums
+    assert sums[0] == pytest.approx(np.abs(T[:, :H]).sum(axis=0).max(), rel=1e-14)  # (order)
     K, M, C, D = (x.copy() for x in hp._structure)
     K[0, 1] = K[1, 0] = 0.1
     assert np.array_equal(_decoupled_normals(hp._memory, (K, M, C, D), H, prob.eps), every)
@@ -182,3 +196,104 @@ def test_compiled_refinement_is_the_python_steps():
             checked += 1
         prev = hill_stability(prob, U, dyn)
     assert checked == 2
+
+
+def test_kept_rows_of_hill_matrix_are_the_whole_matrix_s():
+    """:func:`_hill_rows` forms the rows and columns it keeps as :func:`_hill_matrix` forms
+    the whole ``T(s)`` (the same operations per entry): bit for bit its submatrix, for the
+    tangential unknowns of a Jenkins point and for a scattered subset, at several ``s``."""
+    from fretwear.hb.memory_gain import _gain_at
+    from fretwear.hb.stability import _condensed_at, _hill_matrix, _hill_rows
+
+    prob, hp = _jenkins_point()
+    n, H = prob.m * prob.H, prob.H
+    scattered = np.array([0, 3, H, H + 2, n - 1], dtype=np.int64)
+    for sigma in (0.0, 0.9j, -0.03 + 1.02j):
+        z = complex(np.exp(-2.0 * np.pi * sigma / hp.N))
+        G = _gain_at(*hp._fused, z)
+        Zr, ok = _condensed_at(*hp._structure, prob.m, hp.harmonics, hp.omega, complex(sigma))
+        assert ok
+        T = _hill_matrix(G, Zr, float(prob.eps))
+        for keep in (hp._keep, scattered):
+            at = np.full(n, -1, dtype=np.int64)
+            at[keep] = np.arange(keep.size)
+            Tk = _hill_rows(G, Zr, float(prob.eps), at, keep.size)
+            assert np.array_equal(Tk, T[np.ix_(keep, keep)])
+        assert np.abs(T[np.ix_(hp._keep, hp._keep)]).max() > 0
+
+
+def _decoupled_normals_steps(mg, structure, H, eps):
+    """The tests of :func:`_decoupled_normals` as numpy steps (the previous code path, with
+    ``np.linalg.cond``), for the compiled one to be compared with."""
+    Kf, Mf, Cf, Df = structure
+    nc, dH, _ = mg.constant.shape
+    every = np.arange(nc * dH, dtype=np.int64)
+    if dH != 2 * H:
+        return every
+    for p in range(nc):
+        a = 2 * p
+        Gp = mg.constant[p]
+        if Gp[:H, H:].any() or Gp[H:, :H].any() or np.any(mg.rows[mg.node == p][:, :H]):
+            return every
+        for M in Kf, Mf, Cf, Df:
+            off = M[a].copy()
+            off[a] = 0.0
+            col = M[:, a].copy()
+            col[a] = 0.0
+            if off.any() or col.any():
+                return every
+        if Mf[a, a] != 0.0 or Cf[a, a] != 0.0 or Df[a, a] != 0.0:
+            return every
+        block = eps * np.eye(H) - (eps - Kf[a, a]) * Gp[:H, :H]
+        if not np.linalg.cond(block) < 1e8:
+            return every
+    return np.concatenate([np.arange((2 * p + 1) * H, (2 * p + 2) * H) for p in range(nc)])
+
+
+def test_decoupled_normals_compiled_is_the_numpy_steps():
+    """:func:`_decoupled_normals` (its tests in one compiled call, a bound on the condition
+    number of a normal block near a multiple of the identity, LAPACK's singular values for
+    the others) keeps the unknowns the numpy steps with ``np.linalg.cond`` keep, on a Jenkins
+    point (its normal block ``k I`` settled by the bound) and on variants of it that take
+    each branch: a normal block of condition number 100 (the bound leaves it open, the
+    singular values keep it), 1e9 and singular (every unknown), and a coupling in ``G``, in
+    a stick interval's row, in the stiffness and a mass on the normal coordinate."""
+    import dataclasses
+
+    prob, hp = _jenkins_point()
+    mg, st, H, eps = hp._memory, hp._structure, prob.H, float(prob.eps)
+    n = prob.m * H
+    k = st[0][0, 0]
+
+    def with_block(B):  # G_N such that eps I - (eps - k) G_N = B
+        G = mg.constant.copy()
+        G[0, :H, :H] = (eps * np.eye(H) - B) / (eps - k)
+        return dataclasses.replace(mg, constant=G)
+
+    def coupled_g():
+        G = mg.constant.copy()
+        G[0, 2, H + 1] = 1e-3
+        return dataclasses.replace(mg, constant=G)
+
+    def coupled_row():
+        R = mg.rows.copy()
+        R[0, 1] = 1e-3
+        return dataclasses.replace(mg, rows=R)
+
+    def changed(i, a, b, x):
+        out = [M.copy() for M in st]
+        out[i][a, b] = x
+        return tuple(out)
+
+    spread = np.diag(np.linspace(1.0, 100.0, H))
+    ill = np.diag(np.r_[np.ones(H - 1), 1e-9])
+    singular = np.diag(np.r_[np.ones(H - 1), 0.0])
+    cases = [(mg, st, True), (with_block(spread), st, True), (with_block(ill), st, False),
+             (with_block(singular), st, False), (coupled_g(), st, False),
+             (coupled_row(), st, False), (mg, changed(0, 0, 1, 0.1), False),
+             (mg, changed(0, 1, 0, 0.1), False), (mg, changed(1, 0, 0, 1.0), False)]
+    assert mg.node.size >= 1
+    for m_, s_, kept in cases:
+        got = _decoupled_normals(m_, s_, H, eps)
+        assert np.array_equal(got, _decoupled_normals_steps(m_, s_, H, eps))
+        assert np.array_equal(got, np.arange(H, n) if kept else np.arange(n))

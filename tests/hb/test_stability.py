@@ -435,19 +435,25 @@ def test_hill_matrix_at_zero_is_the_solve_jacobian():
 def test_det_sign_is_lapack_s():
     """The compiled sign of ``det(eps I - G (eps I - Z))`` (:func:`_det_sign`) against
     LAPACK's ``slogdet`` of :func:`jacobian_form` on random block-diagonal ``G`` (two nodes)
-    and ``Z`` of both signs (well conditioned: the sign cannot hinge on rounding), and 0
-    where a row of ``J`` is zero."""
+    and ``Z`` of both signs (well conditioned: the sign cannot hinge on rounding), dense and
+    with zeros (half of ``G``'s entries, and ``Z`` block-diagonal per node with a decoupled
+    block inside, as a Jenkins oscillator's: the zeros the kernel skips), and 0 where a row
+    of ``J`` is zero."""
     rng = np.random.default_rng(4)
     n, dH = 12, 6
     signs = set()
-    for _ in range(20):
+    for trial in range(40):
         G = rng.standard_normal((2, dH, dH))
         Z = rng.standard_normal((n, n))
+        if trial % 2:
+            G[rng.random(G.shape) < 0.5] = 0.0
+            Z[:dH, dH:] = Z[dH:, :dH] = 0.0
+            Z[:3, 3:dH] = Z[3:dH, :3] = G[0, :3, 3:] = G[0, 3:, :3] = 0.0
         J = jacobian_form(G, Z, 0.7)
         ref = int(np.sign(np.linalg.slogdet(J)[0]))
-        signs.add(ref)
+        signs.add((trial % 2, ref))
         assert _det_sign(G, Z, 0.7) == ref
-    assert signs == {-1, 1}
+    assert signs == {(0, -1), (0, 1), (1, -1), (1, 1)}
     G = np.zeros((2, dH, dH))
     assert _det_sign(G, rng.standard_normal((n, n)), 0.0) == 0
 

@@ -94,11 +94,15 @@ candidate instead of its dense eigensolve (each solved by the LU of the Schur co
 on the unknowns that couple harmonics, the others eliminated harmonic by harmonic:
 :mod:`fretwear.hb.hill_tracking`). ``det J`` is read from the solve's ``G`` (made again from
 the split of :mod:`fretwear.hb.memory_gain` where it applies: equal to rounding) and ``Z~``
-(:meth:`HillProblem.jacobian`). Measured on the benchmark's small models
-(docs/studies/method-costs.md, "Hill's method"): about 0.9-1.3 times the CPU a sweep
-spends on the point (median over both sweeps, quiet; the Jenkins oscillator's points
-0.66-0.77, the two-DOF oscillator's 1.2-1.8, a tracked one there about 2-4 ms), along a
-sweep, which hands each point's own problem
+(:meth:`HillProblem.jacobian`). Where every node's normal coordinate is decoupled (a
+prescribed normal force on a coordinate of its own), a refinement's evaluation forms and
+factors only the tangential block of ``T(s)`` (:func:`_evaluate`, :func:`_hill_rows`; the
+dropped block's column sums, the same at every ``s``, taken once a solution). Measured on
+the benchmark's small models (docs/studies/method-costs.md, "Hill's method"): about
+0.75-0.85 times the CPU a sweep spends on the point (median over both sweeps, load 2; the
+Jenkins oscillator's points 0.37-0.54, about 0.4-0.5 ms against a solve of 0.8-1.4 ms, the
+two-DOF oscillator's 1.0-1.5, a tracked one there about 1.5-2.5 ms), along a sweep, which
+hands each point's own problem
 (:func:`fretwear.hb.sweep_stability.point_problem`; :func:`stability` rebuilds it from the
 solution, about 1.1-1.5 ms more there); the evaluations of ``T(s)`` (a law with a memory),
 the inverse iterations of the tracked candidates and the dense eigensolve at the points that
@@ -178,6 +182,8 @@ COPY_EXACT = 1e-15
 #: exponents whose multiplier is below this are not refined (they decay within a period; the
 #: factor e^{-s h} of the law's memory would overflow over a period)
 NEGLIGIBLE = 1e-8
+#: its logarithm (the floor of ``2 pi Re sigma``)
+LOG_NEGLIGIBLE = float(np.log(NEGLIGIBLE))
 
 
 @dataclass(frozen=True)
@@ -219,6 +225,10 @@ class HillOptions:
         n = self.newton_max_iter
         if isinstance(n, bool) or not isinstance(n, int) or n < 1:
             raise InputError(f"newton_max_iter = {n!r}: expected a whole number >= 1")
+
+
+#: the settings :func:`hill_stability` takes without ``options`` (frozen: shared)
+_DEFAULT_OPTIONS = HillOptions()
 
 
 @dataclass
@@ -532,18 +542,22 @@ def _state_summary(state):
 def _det_sign(G, Z, eps):
     """Sign of ``det(eps I - G (eps I - Z))`` (:func:`jacobian_form`, real; ``G`` (nc, dH,
     dH) block-diagonal per node, ``Z`` (n, n)): the form, then its LU with partial pivoting
-    (the pivots' signs and the permutation's parity); 0 at a zero pivot."""
+    (the pivots' signs and the permutation's parity); 0 at a zero pivot. A zero of ``G``
+    and a zero multiplier of the elimination add only zeros (``Z`` and ``J`` finite): they
+    are skipped, the same numbers (where a normal block is decoupled, as a Jenkins
+    oscillator's, ``J`` is block-diagonal and the elimination runs on its blocks)."""
     nc, dH, _ = G.shape
     n = Z.shape[0]
-    J = np.empty((n, n))
+    J = np.zeros((n, n))
     for p in range(nc):
         lo = p * dH
-        for i in range(dH):
-            for j in range(n):
-                acc = 0.0
-                for r in range(dH):
-                    acc += G[p, i, r] * Z[lo + r, j]
-                J[lo + i, j] = acc
+        for i in range(dH):  # each entry's terms summed in r's order, the rows of Z read
+            for r in range(dH):  # contiguously
+                g = G[p, i, r]
+                if g == 0.0:
+                    continue
+                for j in range(n):
+                    J[lo + i, j] += g * Z[lo + r, j]
             for j in range(dH):
                 J[lo + i, lo + j] -= eps * G[p, i, j]
     for i in range(n):
@@ -566,6 +580,8 @@ def _det_sign(G, Z, eps):
             sign = -sign
         for r in range(col + 1, n):
             f = J[r, col] / d
+            if f == 0.0:
+                continue
             for j in range(col + 1, n):
                 J[r, j] -= f * J[col, j]
     return sign
@@ -580,22 +596,41 @@ def _hill_matrix(G, Zr, eps):
     own coefficient and its cosine/sine partner of every DOF: ``2 m`` terms, not ``m H``),
     which at the sizes of a refinement (tens of unknowns) costs less than the calls of the
     numpy form. The same terms as the dense product, summed in another order: equal to a
-    few units of rounding."""
+    few units of rounding. :func:`_hill_rows` on every unknown."""
+    n = Zr.shape[1] * Zr.shape[0]
+    return _hill_rows(G, Zr, eps, np.arange(n), n)
+
+
+@njit(cache=True)
+def _hill_rows(G, Zr, eps, at, nk):
+    """The rows and columns of :func:`_hill_matrix`'s ``T(s)`` that ``at`` (m H,) keeps:
+    ``T[i, j]`` goes to ``[at[i], at[j]]`` of the (nk, nk) result, a negative ``at`` drops
+    it; each kept entry computed as the whole matrix's (the same values), the dropped ones
+    not at all (:func:`_evaluate`: the tangential block, a quarter of the entries)."""
     nl, m, _ = Zr.shape
     k = (nl - 1) // 2
     H = 1 + 2 * k
     n = m * H
     nc, dH, _ = G.shape
-    T = np.zeros((n, n), dtype=np.complex128)
+    T = np.zeros((nk, nk), dtype=np.complex128)
+    some = np.zeros(m, dtype=np.bool_)  # a DOF with a column kept
+    for c in range(m):
+        for h in range(H):
+            some[c] = some[c] or at[c * H + h] >= 0
     for p in range(nc):
         lo = p * dH
         for i in range(dH):
-            row = lo + i
+            row = at[lo + i]
+            if row < 0:
+                continue
             for c in range(m):
+                if not some[c]:
+                    continue
                 acc = 0.0 + 0.0j
                 for r in range(m):
                     acc += G[p, i, r * H - lo] * Zr[0, r, c] if lo <= r * H < lo + dH else 0.0
-                T[row, c * H] = acc
+                if at[c * H] >= 0:
+                    T[row, at[c * H]] = acc
                 for j in range(k):
                     ia, ib = 1 + j, 1 + k + j
                     acc_a = 0.0 + 0.0j
@@ -610,13 +645,20 @@ def _hill_matrix(G, Zr, eps):
                         ga, gb = G[p, i, ca], G[p, i, cb]
                         acc_a += ga * half + gb * (0.5j * (zp - zm))
                         acc_b += ga * (0.5j * (zm - zp)) + gb * half
-                    T[row, c * H + ia] = acc_a
-                    T[row, c * H + ib] = acc_b
+                    if at[c * H + ia] >= 0:
+                        T[row, at[c * H + ia]] = acc_a
+                    if at[c * H + ib] >= 0:
+                        T[row, at[c * H + ib]] = acc_b
         for i in range(dH):
+            row = at[lo + i]
+            if row < 0:
+                continue
             for j in range(dH):
-                T[lo + i, lo + j] -= eps * G[p, i, j]
+                if at[lo + j] >= 0:
+                    T[row, at[lo + j]] -= eps * G[p, i, j]
     for i in range(n):
-        T[i, i] += eps
+        if at[i] >= 0:
+            T[at[i], at[i]] += eps
     return T
 
 
@@ -644,8 +686,9 @@ def _condensed_at(Kf, Mf, Cf, Df, m, harmonics, omega, sigma):
     Zr = np.empty((1 + 2 * k, m, m), dtype=np.complex128)
     Z = np.empty((ns, ns), dtype=np.complex128)
     A = np.empty((q, q), dtype=np.complex128)
-    B = np.empty((q, m), dtype=np.complex128)
     X = np.empty((q, m), dtype=np.complex128)
+    x = np.empty(q, dtype=np.complex128)
+    piv = np.empty(q, dtype=np.int64)
     for idx in range(1 + 2 * k):
         if idx == 0:
             lam = s
@@ -662,12 +705,44 @@ def _condensed_at(Kf, Mf, Cf, Df, m, harmonics, omega, sigma):
             for j in range(q):
                 A[i, j] = Z[m + i, m + j]
             for j in range(m):
-                B[i, j] = Z[m + i, j]
-        piv, ok = _lu_small(A)
-        if not ok:
-            return Zr, False
+                X[i, j] = Z[m + i, j]
+        # X = A^-1 X in place: :func:`_lu_small` and :func:`_lu_solve_small`'s steps (the
+        # same operations in the same order), the pivots and the columns solved in the
+        # arrays made once (the calls allocated three arrays a value of lambda)
+        for col in range(q):
+            piv[col] = col
+        for col in range(q):
+            p = col
+            for r in range(col + 1, q):
+                if abs(A[r, col]) > abs(A[p, col]):
+                    p = r
+            if A[p, col] == 0:
+                return Zr, False
+            if p != col:
+                for j in range(q):
+                    A[col, j], A[p, j] = A[p, j], A[col, j]
+                piv[col], piv[p] = piv[p], piv[col]
+            d = A[col, col]
+            for r in range(col + 1, q):
+                f = A[r, col] / d
+                A[r, col] = f
+                for j in range(col + 1, q):
+                    A[r, j] -= f * A[col, j]
         for j in range(m):
-            X[:, j] = _lu_solve_small(A, piv, B[:, j])
+            for i in range(q):
+                x[i] = X[piv[i], j]
+            for i in range(q):
+                acc = x[i]
+                for t in range(i):
+                    acc -= A[i, t] * x[t]
+                x[i] = acc
+            for i in range(q - 1, -1, -1):
+                acc = x[i]
+                for t in range(i + 1, q):
+                    acc -= A[i, t] * x[t]
+                x[i] = acc / A[i, i]
+            for i in range(q):
+                X[i, j] = x[i]
         for i in range(m):
             for j in range(m):
                 acc = Z[i, j]
@@ -710,21 +785,24 @@ class HillProblem:
         self.lx = np.ascontiguousarray(lx)
         self.state = state
         # the law's arrays as the kernel of :func:`shifted_gain` takes them, made once
+        normal = getattr(prob, "_normal", None)  # (the problem's own, made once)
+        if normal is None or normal.shape != self.lu.shape[::2]:
+            normal = law._normal(prob.normal, self.lu)
         self._law = (np.ascontiguousarray(prob.mu, dtype=float), np.ascontiguousarray(prob.P),
-                     np.ascontiguousarray(prob.Q), law._normal(prob.normal, self.lu))
+                     np.ascontiguousarray(prob.Q), normal)
         self._summary = None  # the contact states per node (:meth:`_states`)
         # in 2D, G(s) split once into its part free of s and one outer product per stick
         # interval (:mod:`fretwear.hb.memory_gain`; None: the recursion at every s), where
         # a node sticks (otherwise nothing is refined); G(0) from the split wherever it
         # applies, the solve's recursion elsewhere
-        sticks = bool(self._states()[0][:, STICK].any())
+        sticks = any(f[STICK] for f in self._states()[0])
         split = memory_gain(self.lu, self.lx, self.state, *self._law)
         self._memory = split if sticks else None
         if split is not None:  # G(0) from the split: the solve's recursion's terms summed
             # in another order (no node sticks all period, so the solve's wrap-around is
             # exact in one sweep and its anchors do not enter): equal to rounding; without a
             # stick interval the split is G(0) itself, made at 0.6 of the recursion's cost
-            self.G0 = split.at(1.0).real
+            self.G0 = np.ascontiguousarray(split.at(1.0).real)
         else:
             self.G0 = law.dlft_jacobian(self.lu, self.lx, self.state, prob.mu, prob.P, prob.Q,
                                         prob.eps * prob.anchor, prob.tol, prob.max_sweeps,
@@ -743,6 +821,7 @@ class HillProblem:
         # the unknowns the compiled pair works on (:func:`_decoupled_normals`)
         self._keep = (_decoupled_normals(mg, self._structure, prob.H, float(prob.eps))
                       if self._fused is not None else None)
+        self._dropped = -1.0  # the dropped columns' largest sum, once known (:func:`_evaluate`)
         self.evaluations = 0
 
     def gain(self, sigma: complex) -> np.ndarray:
@@ -814,12 +893,14 @@ class HillProblem:
         z = (1.0 + 0j if sigma == 0 else np.exp(-2.0 * np.pi * sigma / self.N))
         out = _evaluate(*self._fused, complex(z), *self._structure, self.prob.m,
                         self.harmonics, self.omega, sigma, float(self.prob.eps),
-                        np.ascontiguousarray(v, dtype=complex), complex(mu0), 2, self._keep)
+                        np.ascontiguousarray(v, dtype=complex), complex(mu0), 2, self._keep,
+                        self._dropped, True)
         if out[3] == 2:
             raise InputError("the structure with its contact points held is singular at a "
                              "value of the Laplace variable (an eigenvalue of the held "
                              "interface)")
-        return out
+        self._dropped = out[6]
+        return out[:6]
 
     def jacobian(self) -> np.ndarray:
         """``J = T(0)`` (m H, m H) real: the balance's Jacobian from the solve's own ``G``
@@ -833,22 +914,24 @@ class HillProblem:
         ``np.linalg.slogdet``'s sign to rounding: the same pivots), LAPACK's beyond."""
         if self.prob.m * self.prob.H > PAIR_COMPILED_MAX:
             return int(np.sign(np.linalg.slogdet(self.jacobian())[0]))
-        return int(_det_sign(np.ascontiguousarray(self.G0, dtype=float),
-                             np.ascontiguousarray(self.prob.Z, dtype=float),
+        return int(_det_sign(self.G0, np.ascontiguousarray(self.prob.Z, dtype=float),
                              float(self.prob.eps)))
 
     def _states(self):
-        """``(present, changes)`` of :func:`_state_summary`, made at the first call (the
-        state does not change)."""
+        """``(present, changes)`` of :func:`_state_summary` as lists (per node, the three
+        flags and the count: the nodes are few, and the questions below are cheaper on
+        Python's scalars than on arrays), made at the first call (the state does not
+        change)."""
         if self._summary is None:
-            self._summary = _state_summary(np.ascontiguousarray(self.state))
+            present, changes = _state_summary(np.ascontiguousarray(self.state))
+            self._summary = (present.tolist(), changes.tolist())
         return self._summary
 
     def neutral(self) -> int:
         """Tangential directions of the nodes that stick all period (multiplier 1)."""
         present, _ = self._states()
-        stuck = present[:, STICK] & ~present[:, SEPARATION] & ~present[:, law.SLIP]
-        return int(stuck.sum()) * (self.prob.d - 1)
+        stuck = sum(1 for f in present if f[STICK] and not f[SEPARATION] and not f[law.SLIP])
+        return stuck * (self.prob.d - 1)
 
     def regime(self) -> tuple:
         """Per node, the contact states it takes over the period and how many times it
@@ -858,14 +941,14 @@ class HillProblem:
         exponents come: measured on a Jenkins oscillator leaving full stick), so the
         candidates are not continued from the neighbour's (:func:`hill_stability`)."""
         present, changes = self._states()
-        return tuple((tuple(k for k in range(3) if present[p, k]), int(changes[p]))
-                     for p in range(present.shape[0]))
+        return tuple((tuple(k for k in range(3) if f[k]), c)
+                     for f, c in zip(present, changes, strict=True))
 
     def memoryless(self) -> bool:
         """No node sticks at any instant nor slips in 3D: ``G(s) = G(0)`` for every ``s``
         (separation and 2D slip carry nothing from the previous instant)."""
         present, _ = self._states()
-        return not (present[:, STICK].any() or (self.prob.d > 2 and present[:, law.SLIP].any()))
+        return not any(f[STICK] or (self.prob.d > 2 and f[law.SLIP]) for f in present)
 
     def pencil(self):
         """``(A0, A1, A2)``: Hill's matrix on the structure's coordinates ``(x, q)`` (every
@@ -1570,23 +1653,35 @@ def _track_record(red: QuadraticReduction, vals: np.ndarray, vecs: np.ndarray,
     """The :class:`HillTrack` of the kept members ``vals`` (``Im s >= 0``) with their
     eigenvectors ``vecs`` (n, k), centroids ``kap`` and edge flags, None where it cannot be
     continued (an edge member or one near the period-doubling line, a member near the
-    magnitude cut ``cut``, or one spread over two blocks)."""
-    if red.dyn.size == 0 or np.any(edge) or np.any(np.abs(kap) > 0.5):
+    magnitude cut ``cut``, or one spread over two blocks). The members are few (a handful):
+    their tests run on Python scalars, and where the problem is one block every member lies
+    in it (no shares to compare)."""
+    nd = red.dyn.size
+    if nd == 0 or edge.any():
         return None
-    line = [_on_line(complex(v)) for v in vals]
-    if np.any(np.abs(vals) > 0.9 * cut) or None in line:
-        return None
-    real = np.abs(vals.imag) <= 1e-12 * np.maximum(np.abs(vals), 1.0)
-    families = sum(1 if (r or ln == "on") else 2 for r, ln in zip(real, line, strict=True))
+    for x in kap.tolist():
+        if abs(x) > 0.5:
+            return None
+    families = 0
+    for v in vals.tolist():
+        line = _on_line(v)
+        if line is None or abs(v) > 0.9 * cut:
+            return None
+        real = abs(v.imag) <= 1e-12 * max(abs(v), 1.0)
+        families += 1 if (real or line == "on") else 2
     Y = vecs[red.dyn]
-    sq = Y.real ** 2 + Y.imag ** 2  # each member's share of each block (squared norms)
-    share = np.array([sq[c].sum(axis=0) for c in red.blocks]).reshape(len(red.blocks), vals.size)
-    block = np.argmax(share, axis=0)
-    if np.any(share[block, np.arange(vals.size)] < (1.0 - 1e-12) ** 2 * sq.sum(axis=0)):
-        return None
-    complete = 2 * red.dyn.size == families * H
-    return HillTrack(vals.copy(), Y.copy(), block, red.dyn.size, red.dyn.copy(),
-                     [b.copy() for b in red.blocks], complete)
+    blocks = red.blocks
+    if len(blocks) == 1 and blocks[0].size == nd:  # the whole of every member: its share
+        block = np.zeros(vals.size, dtype=np.intp)  # is its squared norm
+    else:
+        sq = Y.real ** 2 + Y.imag ** 2  # each member's share of each block (squared norms)
+        share = np.array([sq[c].sum(axis=0) for c in blocks]).reshape(len(blocks), vals.size)
+        block = np.argmax(share, axis=0)
+        if np.any(share[block, np.arange(vals.size)] < (1.0 - 1e-12) ** 2 * sq.sum(axis=0)):
+            return None
+    complete = 2 * nd == families * H
+    return HillTrack(vals.copy(), Y, block, nd, red.dyn.copy(), [b.copy() for b in blocks],
+                     complete)
 
 
 def _components(B0: np.ndarray, B1: np.ndarray, B2: np.ndarray) -> list:
@@ -1726,7 +1821,7 @@ def _residuals(T, y, mu, floor):
 
 @njit(cache=True)
 def _evaluate(Gc, node, start, length, rows, P, z, Kf, Mf, Cf, Df, m, harmonics, omega,
-              sigma, eps, v, mu0, steps, keep):
+              sigma, eps, v, mu0, steps, keep, dropped, form):
     """:meth:`HillProblem.evaluate` in one compiled call where ``G(s)`` is split
     (:mod:`fretwear.hb.memory_gain`) and every piece runs compiled: ``G(s)``
     (:func:`fretwear.hb.memory_gain._gain_at`, ``z = e^{-s h}``), ``Z_r``
@@ -1738,51 +1833,66 @@ def _evaluate(Gc, node, start, length, rows, P, z, Kf, Mf, Cf, Df, m, harmonics,
     on the others: the pair's LU with partial pivoting, its solves and the residuals then
     take the same values as on the whole matrix (the dropped block factored apart, its
     exact zeros adding nothing; the dropped columns' sums in the 1-norm), on a quarter of
-    the entries (a Jenkins point's pair 38 -> 10 us). Returns ``(T, mu, y, status,
-    res, pair)``, ``status`` 0, 1 (a zero pivot in the pair's LU: LAPACK's then runs) or 2
-    (the held structure is singular at this ``s``)."""
+    the entries (a Jenkins point's pair 38 -> 10 us). ``dropped``: the largest of the
+    dropped columns' sums where already known (the dropped block is the same at every ``s``:
+    ``G_N`` and the normal stiffness do not depend on it, nor do the exact zeros around it,
+    so its sums are the same numbers at every evaluation), negative to compute it here.
+    ``form``: return the whole ``T(s)`` (for :func:`_track`'s steps one by one); without,
+    where the dropped sums are known, only the kept block is formed (:func:`_hill_rows`, the
+    same values; :func:`_refine`, which does not use ``T``) and an empty ``T`` returned.
+    Returns ``(T, mu, y, status, res, pair, dropped)``, ``status`` 0, 1 (a zero pivot in the
+    pair's LU: LAPACK's then runs) or 2 (the held structure is singular at this ``s``),
+    ``dropped`` as computed (negative where the whole matrix was taken)."""
     G = _gain_at(Gc, node, start, length, rows, P, z)
     Zr, ok = _condensed_at(Kf, Mf, Cf, Df, m, harmonics, omega, sigma)
     if not ok:
-        return np.zeros((1, 1), dtype=np.complex128), 0j, v, 2, 0.0, 0.0
-    T = _hill_matrix(G, Zr, eps)
-    n = T.shape[0]
+        return np.zeros((1, 1), dtype=np.complex128), 0j, v, 2, 0.0, 0.0, dropped
+    n = m * Zr.shape[0]
     nk = keep.size
-    kept = np.zeros(n, dtype=np.bool_)
+    at = np.full(n, -1, dtype=np.int64)  # each unknown's place among the kept ones
     for i in range(nk):
-        kept[keep[i]] = True
+        at[keep[i]] = i
     whole = nk == n
-    floor = 0.0  # the dropped columns' sums, as the whole matrix's 1-norm takes them
-    for j in range(n):
-        if kept[j]:
-            continue
-        if v[j] != 0:  # a start with a part on the dropped unknowns: the whole matrix
+    for j in range(n):  # a start with a part on the dropped unknowns: the whole matrix
+        if at[j] < 0 and v[j] != 0:
             whole = True
             break
-        col = 0.0
-        for i in range(n):
-            col += abs(T[i, j])
-        floor = max(floor, col)
     if whole:
+        T = _hill_matrix(G, Zr, eps)
         mu, y, ok = _pair_small(T, v, mu0, steps)
         if not ok:
-            return T, 0j, v, 1, 0.0, 0.0
+            return T, 0j, v, 1, 0.0, 0.0, dropped
         res, pair = _residuals(T, y, mu, 0.0)
-        return T, mu, y, 0, res, pair
-    Tk = np.empty((nk, nk), dtype=np.complex128)
+        return T, mu, y, 0, res, pair, dropped
+    if form or dropped < 0.0:
+        T = _hill_matrix(G, Zr, eps)
+        if dropped < 0.0:  # the dropped columns' sums, as the whole matrix's 1-norm takes them
+            dropped = 0.0
+            for j in range(n):
+                if at[j] >= 0:
+                    continue
+                col = 0.0
+                for i in range(n):
+                    col += abs(T[i, j])
+                dropped = max(dropped, col)
+        Tk = np.empty((nk, nk), dtype=np.complex128)
+        for i in range(nk):
+            for j in range(nk):
+                Tk[i, j] = T[keep[i], keep[j]]
+    else:
+        T = np.zeros((0, 0), dtype=np.complex128)
+        Tk = _hill_rows(G, Zr, eps, at, nk)
     vk = np.empty(nk, dtype=np.complex128)
     for i in range(nk):
         vk[i] = v[keep[i]]
-        for j in range(nk):
-            Tk[i, j] = T[keep[i], keep[j]]
     mu, yk, ok = _pair_small(Tk, vk, mu0, steps)
     if not ok:
-        return T, 0j, v, 1, 0.0, 0.0
-    res, pair = _residuals(Tk, yk, mu, floor)
+        return T, 0j, v, 1, 0.0, 0.0, dropped
+    res, pair = _residuals(Tk, yk, mu, dropped)
     y = np.zeros(n, dtype=np.complex128)
     for i in range(nk):
         y[keep[i]] = yk[i]
-    return T, mu, y, 0, res, pair
+    return T, mu, y, 0, res, pair, dropped
 
 
 def _decoupled_normals(mg, structure, H: int, eps: float):
@@ -1792,46 +1902,101 @@ def _decoupled_normals(mg, structure, H: int, eps: float):
     ``k``; in ``G`` no coupling between its block ``G_N`` and the tangential one, the split's
     rows none either), ``T(s)`` is block-diagonal with ``eps I - (eps - k) G_N`` on those
     unknowns, the same at every ``s`` (the split touches tangential rows only): no exponent
-    there where that block is well conditioned, and the eigenpair that vanishes lives on the
-    others (a start without a normal part stays without one): the tangential unknowns
-    (DOF-major, ``H`` per DOF); all unknowns where any node's normal is not decoupled."""
+    there where that block is well conditioned (2-norm condition number below 1e8), and the
+    eigenpair that vanishes lives on the others (a start without a normal part stays without
+    one): the tangential unknowns (DOF-major, ``H`` per DOF); all unknowns where any node's
+    normal is not decoupled. The tests and the blocks in one compiled call
+    (:func:`_normal_blocks`, which also settles the condition of a block near a multiple of
+    the identity); the singular values by LAPACK only for a block it leaves open."""
     Kf, Mf, Cf, Df = structure
     nc, dH, _ = mg.constant.shape
     every = np.arange(nc * dH, dtype=np.int64)
     if dH != 2 * H:
         return every
-    for p in range(nc):
-        a = 2 * p
-        Gp = mg.constant[p]
-        if Gp[:H, H:].any() or Gp[H:, :H].any() or np.any(mg.rows[mg.node == p][:, :H]):
-            return every
-        for M in Kf, Mf, Cf, Df:
-            off = M[a].copy()
-            off[a] = 0.0
-            col = M[:, a].copy()
-            col[a] = 0.0
-            if off.any() or col.any():
+    blocks = np.empty((nc, H, H))
+    verdict = _normal_blocks(mg.constant, mg.node, mg.rows, Kf, Mf, Cf, Df, H, float(eps),
+                             blocks)
+    if verdict == 0:
+        return every
+    if verdict == 2:  # a block the bound leaves open: the condition numbers as np.linalg.cond
+        for p in range(nc):  # has them (the bound's are below)
+            sv = np.linalg.svd(blocks[p], compute_uv=False)
+            if not (sv[-1] > 0 and sv[0] / sv[-1] < 1e8):  # (a zero: infinite)
                 return every
+    keep = np.empty(nc * H, dtype=np.int64)
+    for p in range(nc):
+        keep[p * H:(p + 1) * H] = np.arange((2 * p + 1) * H, (2 * p + 2) * H)
+    return keep
+
+
+#: :func:`_normal_blocks` settles a block ``c I + E`` as well conditioned where
+#: ``(|c| + |E|_F) / (|c| - |E|_F)`` is below this: its condition number is at most that
+#: (Weyl: every singular value within ``|E|_2 <= |E|_F`` of ``|c|``), ten times below the
+#: threshold of 1e8, far above the rounding of the bound's few sums
+NORMAL_COND_BOUND = 1e7
+
+
+@njit(cache=True)
+def _normal_blocks(Gc, node, rows, Kf, Mf, Cf, Df, H, eps, blocks):
+    """:func:`_decoupled_normals`' tests on plain arrays, the normal blocks
+    ``eps I - (eps - k) G_N`` written into ``blocks`` (nc, H, H): 0 where a node's normal is
+    coupled (its rows of ``G_c`` or of a stick interval's ``r_I`` meet the other block, or
+    the structure's row or column of that coordinate has an entry off the diagonal, or it
+    has a mass or a damping), 1 where every node's is decoupled and its block well
+    conditioned by the bound of :data:`NORMAL_COND_BOUND` (the block written ``c I + E``,
+    ``c`` its mean diagonal entry), 2 where decoupled but a block's condition is left to its
+    singular values."""
+    nc, dH, _ = Gc.shape
+    ns = Kf.shape[0]
+    verdict = 1
+    for p in range(nc):
+        for i in range(H):
+            for j in range(H, dH):
+                if Gc[p, i, j] != 0.0 or Gc[p, j, i] != 0.0:
+                    return 0
+        for t in range(node.size):
+            if node[t] == p:
+                for j in range(H):
+                    if rows[t, j] != 0.0:
+                        return 0
+        a = 2 * p
+        for j in range(ns):
+            if j != a and (Kf[a, j] != 0.0 or Kf[j, a] != 0.0 or Mf[a, j] != 0.0
+                           or Mf[j, a] != 0.0 or Cf[a, j] != 0.0 or Cf[j, a] != 0.0
+                           or Df[a, j] != 0.0 or Df[j, a] != 0.0):
+                return 0
         if Mf[a, a] != 0.0 or Cf[a, a] != 0.0 or Df[a, a] != 0.0:
-            return every
-        block = eps * np.eye(H) - (eps - Kf[a, a]) * Gp[:H, :H]
-        if not np.linalg.cond(block) < 1e8:
-            return every
-    keep = np.concatenate([np.arange((2 * p + 1) * H, (2 * p + 2) * H) for p in range(nc)])
-    return keep.astype(np.int64)
+            return 0
+        f = eps - Kf[a, a]
+        c = 0.0
+        for i in range(H):
+            for j in range(H):
+                blocks[p, i, j] = (eps if i == j else 0.0) - f * Gc[p, i, j]
+            c += blocks[p, i, i]
+        c /= H
+        e2 = 0.0
+        for i in range(H):
+            for j in range(H):
+                x = blocks[p, i, j] - (c if i == j else 0.0)
+                e2 += x * x
+        e = np.sqrt(e2)
+        if not (e < abs(c) and abs(c) + e < NORMAL_COND_BOUND * (abs(c) - e)):
+            verdict = 2
+    return verdict
 
 
 @njit(cache=True)
 def _refine(Gc, node, start, length, rows, P, Kf, Mf, Cf, Df, m, harmonics, omega, eps, N,
-            s0, sigma, v, slope, tol, max_iter, floor, keep):
+            s0, sigma, v, slope, tol, max_iter, floor, keep, dropped):
     """:func:`_track` from a neighbour's start (``sigma``, ``v``, ``slope`` nonzero; no
     deflation) in one compiled call, each step one :func:`_evaluate`: the secant method on
     the eigenvalue ``mu`` of ``T(sigma)`` that continues ``v``, the same steps and stopping
     rule (``|mu| / |T|`` below ``tol``; the iterates kept within 0.5 of the candidate ``s0``
     and above ``2 pi Re sigma = floor``, the logarithm of :data:`NEGLIGIBLE`). Returns
-    ``(sigma, v, res, converged, slope, evaluations, status)``, ``status`` 0, or 1 / 2 as
-    :func:`_evaluate`'s (then :func:`_track` runs the steps one by one, which take LAPACK's
-    pair or raise). ``keep``: :func:`_evaluate`'s."""
+    ``(sigma, v, res, converged, slope, evaluations, status, dropped)``, ``status`` 0, or
+    1 / 2 as :func:`_evaluate`'s (then :func:`_track` runs the steps one by one, which take
+    LAPACK's pair or raise). ``keep``, ``dropped``: :func:`_evaluate`'s (the latter as the
+    first step computed it, for the next refinement)."""
     res = np.inf
     real = s0.imag == 0.0
     mu0 = 0j
@@ -1843,15 +2008,16 @@ def _refine(Gc, node, start, length, rows, P, Kf, Mf, Cf, Df, m, harmonics, omeg
         if abs(sigma - s0) > 0.5 or 2.0 * np.pi * sigma.real < floor:
             break
         z = 1.0 + 0j if sigma == 0 else np.exp(-2.0 * np.pi * sigma / N)
-        T, mu, y, status, res, pair = _evaluate(Gc, node, start, length, rows, P, z, Kf, Mf,
-                                                Cf, Df, m, harmonics, omega, sigma, eps, v,
-                                                mu0, 2, keep)
+        T, mu, y, status, res, pair, dropped = _evaluate(Gc, node, start, length, rows, P, z,
+                                                         Kf, Mf, Cf, Df, m, harmonics, omega,
+                                                         sigma, eps, v, mu0, 2, keep, dropped,
+                                                         False)
         count += 1
         if status != 0:
-            return sigma, v, res, False, slope, count, status
+            return sigma, v, res, False, slope, count, status, dropped
         v = y
         if res <= tol:
-            return sigma, v, res, True, slope, count, 0
+            return sigma, v, res, True, slope, count, 0, dropped
         f = mu
         if have_prev:
             slope = (f - fp) / (sigma - sp) if f != fp else 0j
@@ -1863,7 +2029,7 @@ def _refine(Gc, node, start, length, rows, P, Kf, Mf, Cf, Df, m, harmonics, omeg
         if not (np.isfinite(new.real) and np.isfinite(new.imag)) or new == sigma:
             break
         sigma = new
-    return sigma, v, res, res <= tol, slope, count, 0
+    return sigma, v, res, res <= tol, slope, count, 0, dropped
 
 
 @njit(cache=True)
@@ -2038,8 +2204,9 @@ def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions,
                       float(hp.prob.eps), float(hp.N), complex(sigma), complex(warm.sigma),
                       np.ascontiguousarray(warm.v, dtype=complex), complex(warm.slope),
                       float(opt.newton_tol), int(opt.newton_max_iter),
-                      float(np.log(NEGLIGIBLE)), hp._keep)
+                      LOG_NEGLIGIBLE, hp._keep, hp._dropped)
         hp.evaluations += out[5]  # (made, whether or not the steps are then taken again)
+        hp._dropped = out[7]
         if out[6] == 0:  # (else: the steps one by one, which take LAPACK's pair or raise)
             s1, v1, r1, conv, slope1 = out[:5]
             return complex(s1), v1, float(r1), bool(conv), complex(slope1)
@@ -2053,7 +2220,7 @@ def _track(hp: HillProblem, sigma: complex, v: np.ndarray, opt: HillOptions,
     # meets another one, which the frozen-memory candidates would show as a pair)
     mu0 = 0.0
     for _ in range(opt.newton_max_iter):
-        if abs(sigma - start) > 0.5 or 2.0 * np.pi * sigma.real < np.log(NEGLIGIBLE) or (
+        if abs(sigma - start) > 0.5 or 2.0 * np.pi * sigma.real < LOG_NEGLIGIBLE or (
                 deflate is not None and abs(sigma - deflate) <= ON_REAL):
             break  # left the neighbourhood of the candidate (or back on the root deflated)
         T, mu, v, lu, res, pair = hp.evaluate(sigma, v, mu0)
@@ -2142,7 +2309,7 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
     at a neighbouring solution of the same model and basis (the previous point of a sweep),
     whose candidates are continued where that gives the dense eigensolve's
     (:func:`track_eigen`, ``options.track``)."""
-    opt = HillOptions() if options is None else options
+    opt = _DEFAULT_OPTIONS if options is None else options
     t0 = time.perf_counter()
     hp = HillProblem(prob, U, dyn)
     det_sign = hp.det_sign()
@@ -2158,8 +2325,8 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
     origin = None
     if got is not None:  # member j continues member origin[j] of the neighbour's track
         vals, vecs, kap, origin = got
-        idx = np.arange(vals.size)
-        edge = np.zeros(vals.size, dtype=bool)
+        idx = np.argsort(-vals.real, kind="stable")
+        kap, edge = kap[idx], np.zeros(vals.size, dtype=bool)
     else:
         vals, vecs = dense_eigen(red)
         finite = np.flatnonzero(np.isfinite(vals) & (np.abs(vals) < cut))
@@ -2170,29 +2337,25 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
         idx, kap, edge = finite[keep], kap[keep], edge[keep]
         half = vals[idx].imag >= -1e-12 * np.maximum(np.abs(vals[idx]), 1.0)
         idx, kap, edge = idx[half], kap[half], edge[half]
-    order = np.argsort(-vals[idx].real, kind="stable")
-    idx, kap, edge = idx[order], kap[order], edge[order]
-    track = _track_record(red, vals[idx], vecs[:, idx], kap, edge, H, cut)
+        order = np.argsort(-vals[idx].real, kind="stable")
+        idx, kap, edge = idx[order], kap[order], edge[order]
+    kept = vals[idx]  # (sorted by decreasing real part)
+    track = _track_record(red, kept, vecs[:, idx], kap, edge, H, cut)
     if track is not None:
         track.regime = regime
         track.omega = hp.omega
         if got is not None and prev.omega is not None and hp.omega != prev.omega:
-            src = origin[idx]
-            vel = np.zeros(idx.size, dtype=complex)
-            ok = src >= 0
-            moved = vals[idx][ok] - prev.sigma[src[ok]]
-            vel[ok] = np.where(np.abs(moved) < 0.1, moved, 0.0) / (hp.omega - prev.omega)
-            track.velocity = vel
+            track.velocity = _velocity(kept, origin[idx], prev.sigma, hp.omega - prev.omega)
     exact = hp.memoryless() and dyn.exact
     sig, kaps, res, kind, spurious = [], [], [], [], []
     refined = 0
     done: list = [None] * idx.size  # the refinements, for the neighbour's warm starts
-    for pos, (i, kp) in enumerate(zip(idx, kap, strict=True)):
-        s0 = complex(vals[i])
+    for pos, (i, kp, s0) in enumerate(zip(idx.tolist(), kap.tolist(), kept.tolist(),
+                                          strict=True)):
         y = vecs[:, i]
         vx = y[:m * H]
         held = np.vdot(vx, vx).real < 1e-16 * np.vdot(y, y).real  # |vx| < 1e-8 |y|
-        negligible = 2.0 * np.pi * s0.real < np.log(NEGLIGIBLE)
+        negligible = 2.0 * np.pi * s0.real < LOG_NEGLIGIBLE
         if held or exact or negligible or refined >= opt.refine:  # refined: successes
             sig.append(s0)
             kaps.append(kp)
@@ -2235,6 +2398,21 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
                          evaluations=hp.evaluations, wall_time=time.perf_counter() - t0,
                          stable_tol=opt.stable_tol, det_sign=det_sign,
                          tracked=got is not None, track=track)
+
+
+def _velocity(kept: np.ndarray, src: np.ndarray, before: np.ndarray, dw: float) -> np.ndarray:
+    """:attr:`HillTrack.velocity`: per member ``kept`` (``s / w``), its motion from the
+    neighbour's member ``before[src]`` over the step ``dw`` of ``w`` (times ``1 / dw``), 0
+    where it was not continued (``src`` -1) or moved 0.1 or more (another member's start).
+    The members are few: a loop on Python's scalars."""
+    vel = np.zeros(kept.size, dtype=complex)
+    inv = 1.0 / dw
+    for pos, (j, s) in enumerate(zip(src.tolist(), kept.tolist(), strict=True)):
+        if j >= 0:
+            moved = s - complex(before[j])
+            if abs(moved) < 0.1:
+                vel[pos] = complex(moved.real * inv, moved.imag * inv)
+    return vel
 
 
 @njit(cache=True)
