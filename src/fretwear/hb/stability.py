@@ -1179,7 +1179,10 @@ def _inverse_iteration(B0, B1, B2, sigma: complex, y: np.ndarray, max_iter: int 
     ``(sigma, y, converged)``; converged when the step is below 1e-14 of ``max(1, |sigma|)``
     (the rounding of the dense eigensolver's eigenvalue, whose backward error is of the same
     order), or when the quadratic convergence predicts the next step below 1e-15 of it
-    (:func:`_settled`: the step that would only confirm it is not taken). Compiled: with
+    (:func:`_settled`: the step that would only confirm it is not taken); after a step
+    within 1e-7 of it, the next steps on that step's LU (:data:`REUSE_MAX`, the compiled
+    path: :func:`_ruhe`'s ``reuse``; the same eigenvalue to 5e-16 and vector to 1.2e-13
+    on the benchmark's two-DOF sweep, the LU that only confirmed it not made). Compiled: with
     ``split`` (:func:`~fretwear.hb.hill_tracking.harmonic_split` of the block: unknowns
     that couple only their own harmonic), each step by the LU of the
     core's Schur complement (:func:`_ruhe`: 31 instead of 62 unknowns on the two-DOF
@@ -1193,7 +1196,7 @@ def _inverse_iteration(B0, B1, B2, sigma: complex, y: np.ndarray, max_iter: int 
     lapack = B0.shape[0] > PAIR_COMPILED_MAX
     split = no_split() if split is None else split
     try:
-        s1, x1, ok = _ruhe(B0, B1, B2, complex(sigma), y, max_iter, lapack, split)
+        s1, x1, ok = _ruhe(B0, B1, B2, complex(sigma), y, max_iter, lapack, split, REUSE_MAX)
     except np.linalg.LinAlgError:  # LAPACK's solve at a singular P(s)
         return _inverse_iteration_py(B0, B1, B2, sigma, y, max_iter)
     return complex(s1), x1, bool(ok)
@@ -1405,7 +1408,7 @@ def _member(red: QuadraticReduction, b: int, s0: complex, y0: np.ndarray, shape:
     try:
         s1, y, kp, ok = _member_steps(*B, split, at, back, alg, red.n, r, H, k, complex(s0),
                                       np.ascontiguousarray(y0, dtype=complex), fold, 10,
-                                      lapack)
+                                      lapack, REUSE_MAX)
     except np.linalg.LinAlgError:
         return _member_py(red, b, s0, y0, shape, mats, fold)
     return (complex(s1), y, float(kp)) if ok else None
@@ -1433,11 +1436,11 @@ def _member_py(red: QuadraticReduction, b: int, s0: complex, y0: np.ndarray, sha
 
 @njit(cache=True)
 def _member_steps(B0, B1, B2, split, at, back, alg, n, r, H, k, s0, y0, fold, max_iter,
-                  lapack):
+                  lapack, reuse):
     """:func:`_member_py` compiled (the same steps: :func:`_ruhe`, the folding,
     :func:`_block_centroid`): ``(sigma, y, kappa, converged)``."""
     for again in range(2):
-        s1, y, ok = _ruhe(B0, B1, B2, s0, y0, max_iter, lapack, split)
+        s1, y, ok = _ruhe(B0, B1, B2, s0, y0, max_iter, lapack, split, reuse)
         if not ok:
             return s1, y, 0.0, False
         if fold and abs(s1.imag) <= 1e-12 * max(abs(s1), 1.0):
@@ -1477,7 +1480,8 @@ def _copy(red: QuadraticReduction, b: int, s1: complex, y: np.ndarray, shape: tu
     lapack = B[0].shape[0] > PAIR_COMPILED_MAX
     try:
         s2, v, kp, ok, cert = _copy_steps(*B, norms, split, at, back, alg, red.n, r, H, k,
-                                          complex(s1), y, side, COPY_EXACT, 10, lapack)
+                                          complex(s1), y, side, COPY_EXACT, 10, lapack,
+                                          REUSE_MAX)
     except np.linalg.LinAlgError:
         sigma, v, eta = _copy_start(*B, norms, complex(s1), y, side, at, H, k)
         got = _member_py(red, b, complex(sigma), v, shape, mats, fold=False)
@@ -1487,7 +1491,7 @@ def _copy(red: QuadraticReduction, b: int, s1: complex, y: np.ndarray, shape: tu
 
 @njit(cache=True)
 def _copy_steps(B0, B1, B2, norms, split, at, back, alg, n, r, H, k, s1, y, side, exact,
-                max_iter, lapack):
+                max_iter, lapack, reuse):
     """:func:`_copy` compiled: the start (:func:`_copy_start`), taken as it is where its
     backward error is at most ``exact``, else iterated (:func:`_member_steps`, not
     folded). Returns ``(sigma, v, kappa, converged, certified)``."""
@@ -1495,7 +1499,7 @@ def _copy_steps(B0, B1, B2, norms, split, at, back, alg, n, r, H, k, s1, y, side
     if eta <= exact:
         return sigma, v, _block_centroid(v, at, back, alg, n, r, H, k), True, True
     s2, y2, kp, ok = _member_steps(B0, B1, B2, split, at, back, alg, n, r, H, k, sigma, v,
-                                   False, max_iter, lapack)
+                                   False, max_iter, lapack, reuse)
     return s2, y2, kp, ok, False
 
 
@@ -1732,6 +1736,9 @@ def _edge_members(vals: np.ndarray, kap: np.ndarray, keep: np.ndarray) -> np.nda
     return out
 
 
+#: steps of Ruhe's iteration on the LU of the step before, after a contraction
+#: (:func:`_reused_step`), before a new LU is made
+REUSE_MAX = 2
 #: :func:`_pair` runs compiled (:func:`_pair_small`) up to this many unknowns (a refinement
 #: on a small model, where the calls of an LU and its solves cost more than their flops:
 #: 2.4 against 30 us at 5 unknowns, 25 against 54 us at 30), LAPACK's LU beyond (as fast
@@ -1938,14 +1945,18 @@ def _refine(Gc, node, start, length, rows, P, Kf, Mf, Cf, Df, m, harmonics, omeg
 
 
 @njit(cache=True)
-def _ruhe(B0, B1, B2, sigma, y, max_iter, lapack, split):
+def _ruhe(B0, B1, B2, sigma, y, max_iter, lapack, split, reuse):
     """:func:`_inverse_iteration` compiled (the same steps): ``(sigma, y, converged)``. Each
     step solves with ``P(sigma)`` by the harmonic split (:func:`~fretwear.hb.hill_tracking.
     _split_factor`: the LU of the core's Schur complement, where ``split`` has local
     unknowns or a core; a step whose split refuses is solved as without one), by
     :func:`_lu_small` (one LU a step; not converged at a zero pivot) or, with ``lapack``
     (larger blocks), by LAPACK's ``zgesv`` (``np.linalg.solve``: one LU a solve, two at the
-    first step; raises ``LinAlgError`` at a singular ``P(s)``)."""
+    first step; raises ``LinAlgError`` at a singular ``P(s)``). ``reuse``: after a step that
+    contracted to within 1e-7 of the eigenvalue (:func:`_may_reuse`), up to this many steps
+    on its LU (:func:`_reused_step`, ended by :func:`_reused_settled`) before a new one (not
+    with LAPACK's solve, which keeps no LU); they count in ``max_iter``. 0: Ruhe's steps
+    only."""
     n = B0.shape[0]
     x = _unit(y)
     first = True
@@ -1955,7 +1966,9 @@ def _ruhe(B0, B1, B2, sigma, y, max_iter, lapack, split):
     use = split[0].size + split[2].size > 0
     work = split_work(split, n)
     last = np.inf
-    for _ in range(max_iter):
+    count = 0  # the steps taken, on a new LU or a kept one
+    while count < max_iter:
+        count += 1
         _pencil_into(B0, B1, B2, sigma, A)
         how = 1 if lapack else 0
         while use:  # a group near singular at sigma joins the core (kept for the next steps)
@@ -1976,11 +1989,86 @@ def _ruhe(B0, B1, B2, sigma, y, max_iter, lapack, split):
             x = _unit(_solve_pencil(A, piv, x, how, split, work))
             first = False
         _slope_into(B1, B2, sigma, x, r)
+        prev = last
         sigma, x, state, last = _ruhe_update(sigma, x, _solve_pencil(A, piv, r, how, split,
                                                                       work), last)
         if state != 0:
             return sigma, x, state > 0
+        if how == 1 or reuse == 0 or not _may_reuse(last, prev, max(1.0, abs(sigma))):
+            continue
+        for _ in range(min(reuse, max_iter - count)):  # after a contraction, on this LU
+            s3, x3, t = _reused_step(B0, B1, B2, sigma, x, A, piv, how, split, work, r)
+            if not 0 <= t <= last:
+                break
+            sigma, x = s3, x3
+            count += 1
+            if _reused_settled(t, last, prev, max(1.0, abs(sigma))):
+                return sigma, x, True
+        last = np.inf  # the next LU's step has no contraction to judge
     return sigma, x, False
+
+
+@njit(cache=True)
+def _may_reuse(size, last, scale):
+    """Whether the LU of Ruhe's last step (at ``tau``, a step of ``size`` from the new
+    ``sigma``, after one of ``last``) is kept for the next steps (:func:`_reused_step`): the
+    iteration contracted (``size`` below 1e-2 of ``last``: the quadratic regime) and
+    ``tau`` is within 1e-7 of ``scale`` of the eigenvalue (about ``size``; the threshold of
+    :func:`_settled`'s prediction). The vector of a step on the kept LU is an inverse
+    iteration with the shift ``tau``, whose error contracts by ``|tau - lambda|`` over the
+    gap to the next eigenvalue: at 1e-4 the eigenvectors of the benchmark's two-DOF sweep
+    differed from the new LU's by up to 1.7e-9 (their centroids by 2.5e-9), at 1e-7 by
+    1.2e-13 and the eigenvalues by 5e-16."""
+    return last < np.inf and size <= 1e-2 * last and size <= 1e-7 * scale
+
+
+@njit(cache=True)
+def _reused_step(B0, B1, B2, sigma, x, A, piv, how, split, work, r):
+    """Ruhe's step at ``sigma`` with the factors of ``P(tau)`` of the step before (``A``,
+    ``piv`` and ``work`` as :func:`_solve_pencil` takes them): ``sigma - (x^H P(tau)^-1
+    P(sigma) x) / (x^H P(tau)^-1 P'(sigma) x)`` and ``x`` <- ``P(tau)^-1 P'(sigma) x``
+    normalised; with ``tau = sigma`` (``P(sigma)^-1 P(sigma) x = x``, ``x^H x = 1``) it is
+    Ruhe's step itself. Near the simple eigenvalue ``lambda``, ``P(tau)^-1 = x1 w1^H /
+    mu(tau) + R`` with ``mu(tau)`` about ``(tau - lambda) w1^H P' x1`` and ``R`` bounded: the
+    ratio is the two-sided Newton correction ``w1^H P(sigma) x / w1^H P'(sigma) x`` (``w1``
+    the left eigenvector, which the dominant term brings) up to terms of order ``|tau -
+    lambda|`` times the vector's error, and the vector is an inverse iteration with the shift
+    ``tau``. Costs two solves and two products instead of an LU. Returns ``(sigma, x,
+    size)``, ``size`` -1 where the denominator is zero or not finite (``sigma``, ``x``
+    unchanged). ``r``: work array (n,)."""
+    n = x.size
+    s2 = sigma * sigma
+    for i in range(n):
+        acc = 0j
+        for j in range(n):
+            acc += (B0[i, j] + sigma * B1[i, j] + s2 * B2[i, j]) * x[j]
+        r[i] = acc
+    a = _solve_pencil(A, piv, r, how, split, work)
+    _slope_into(B1, B2, sigma, x, r)
+    u = _solve_pencil(A, piv, r, how, split, work)
+    num = 0j
+    den = 0j
+    for i in range(n):
+        num += np.conj(x[i]) * a[i]
+        den += np.conj(x[i]) * u[i]
+    if (not np.isfinite(den.real) or not np.isfinite(den.imag) or den == 0
+            or not np.isfinite(num.real) or not np.isfinite(num.imag)):
+        return sigma, x, -1.0
+    step = num / den
+    return sigma - step, _unit(u), abs(step)
+
+
+@njit(cache=True)
+def _reused_settled(t, size, last, scale):
+    """Whether a step of ``t`` on a kept LU (:func:`_reused_step`) ends the iteration: ``t``
+    below 1e-14 of ``scale``, or the error after it predicted below 1e-15 of it. Its error
+    goes with the distance of the LU's ``tau`` to the eigenvalue (about ``size``, Ruhe's
+    last step, after one of ``last``): a contraction of ``C size`` with ``C = size /
+    last^2`` (:func:`_settled`'s estimate of the quadratic constant), i.e. ``(size /
+    last)^2``."""
+    if t <= 1e-14 * scale:
+        return True
+    return t * (size / last) ** 2 <= 1e-15 * scale
 
 
 @njit(cache=True)
