@@ -35,13 +35,11 @@ from fretwear.hb.stability import (
     _companion_eigen,
     _components,
     _copy,
-    _copy_start,
     _det_sign,
     _families,
     _inverse_iteration,
     _inverse_iteration_py,
     _member,
-    _member_py,
     _pair,
     _pair_lapack,
     _shifted_copy,
@@ -725,51 +723,6 @@ def test_certified_copies_are_the_iterated_copies():
         assert abs(s2 - ref[0]) <= tol * max(1.0, abs(s2))
         assert abs(k2 - ref[2]) <= 1e-12
     assert 0 < certified < track.sigma.size
-
-
-def test_compiled_member_and_copy_are_the_python_steps():
-    """A member (:func:`_member`, one compiled call: the inverse iteration, the folding, the
-    centroid) and a neighbouring copy (:func:`_copy`: the shifted start, its backward error,
-    the iteration where it is not certified) against the same steps from Python
-    (:func:`_member_py`, :func:`_copy_start` then :func:`_member_py`), on the members of a
-    point of the unilateral oscillator's resonance, from 1e-3 off each member with its
-    conjugate vector (so the fold acts) and folded or not: equal (the same operations on the
-    same arrays: the kernels run the same compiled iteration)."""
-    model = two_dof()
-    basis = FourierBasis.up_to(5, 64)
-    sol = solve_periodic(model, basis, frequency=0.6 / (2 * np.pi), time_domain=None)
-    prob = problem_of(model, sol)
-    hp = HillProblem(prob, sol.U.reshape(prob.m, prob.H), structure_dynamics(model))
-    red = reduce_quadratic(*hp.pencil())
-    track = hill_module.hill_stability(prob, sol.U.reshape(prob.m, prob.H),
-                                       structure_dynamics(model)).track
-    shape = (prob.m + hp.dyn.q, prob.H, len(basis.harmonics))
-    mats: dict = {}
-    folded = 0
-    for j, (s, b) in enumerate(zip(track.sigma, track.block, strict=True)):
-        y = track.Y[red.blocks[b], j]
-        found = {}
-        for fold in (True, False):
-            start = complex(s).conjugate() + 1e-3
-            got = _member(red, b, start, y.conj(), shape, mats, fold=fold)
-            ref = _member_py(red, b, start, y.conj(), shape, mats, fold=fold)
-            assert got[0] == ref[0] and got[2] == ref[2]
-            np.testing.assert_array_equal(got[1], ref[1])
-            found[fold] = got[0]
-        if s.imag > 1e-6:  # folded: the member above the real axis, its conjugate below
-            assert found[True].imag > 0 > found[False].imag
-            folded += 1
-        for side in (1, -1):
-            got = _copy(red, b, complex(s), y, shape, mats, side)
-            B, _, at, _, _, norms = _block_mats(red, b, shape, mats)
-            sigma, v, eta = _copy_start(*B, norms, complex(s), y + 0j, side, at, shape[1],
-                                        shape[2])
-            assert got[3] == (eta <= COPY_EXACT)
-            if not got[3]:
-                ref = _member_py(red, b, complex(sigma), v, shape, mats, fold=False)
-                assert got[0] == ref[0] and got[2] == ref[2]
-                np.testing.assert_array_equal(got[1], ref[1])
-    assert folded > 0
 
 
 @pytest.mark.parametrize("diagonal", [True, False])

@@ -115,9 +115,8 @@ def harmonic_split(B0: np.ndarray, B1: np.ndarray, B2: np.ndarray, harm: np.ndar
 
 @njit(cache=True)
 def split_of(B0, B1, B2, harm, tol, share):
-    """:func:`harmonic_split` compiled (``share``: :data:`SPLIT_MAX_SHARE`), for the
-    kernels that gather a block's arrays in one call
-    (:func:`fretwear.hb.stability._block_data`)."""
+    """:func:`harmonic_split` compiled (``share``: :data:`SPLIT_MAX_SHARE`): one call from
+    Python (:func:`fretwear.hb.stability._block_mats`)."""
     local = _local_unknowns(B0, B1, B2, harm, tol)
     nc = 0
     for i in range(local.size):

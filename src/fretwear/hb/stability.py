@@ -1191,7 +1191,9 @@ def _inverse_iteration(B0, B1, B2, sigma: complex, y: np.ndarray, max_iter: int 
     from the kernel (:func:`_ruhe` with ``lapack``: 0.40 against 0.63 ms for the steps
     called from Python on that block); the steps from Python
     (:func:`_inverse_iteration_py`) where that solve meets a singular ``P(s)``."""
-    B0, B1, B2 = (np.ascontiguousarray(b, dtype=complex) for b in (B0, B1, B2))
+    real = all(np.isrealobj(b) for b in (B0, B1, B2))  # real: half the work a product
+    B0, B1, B2 = (np.ascontiguousarray(b, dtype=float if real else complex)
+                  for b in (B0, B1, B2))
     y = np.ascontiguousarray(y, dtype=complex)
     lapack = B0.shape[0] > PAIR_COMPILED_MAX
     split = no_split() if split is None else split
@@ -1362,33 +1364,19 @@ def _shifted_copy(red: QuadraticReduction, b: int, y: np.ndarray, shape: tuple,
 
 def _block_mats(red: QuadraticReduction, b: int, shape: tuple, mats: dict) -> tuple:
     """Block ``b``'s arrays for :func:`_member` and :func:`_copy` (made on the block's first
-    use, kept in ``mats``): its ``B0, B1, B2`` (real: the pencil's sums in the kernels
-    take a real matrix entry times a complex ``sigma``, half the work of a complex one, to
-    the same rounding), the harmonic split, the block's
-    coordinates, the algebraic coordinates' ``back`` restricted to the block (an empty one
-    without), the algebraic coordinates, and the matrices' column norms
-    (:func:`_column_norms`); all in one compiled call (:func:`_block_data`)."""
+    use, kept in ``mats``): its ``B0, B1, B2`` (real: in the kernels the pencil's sums take
+    a real entry times the complex ``sigma``), the harmonic split, the block's coordinates,
+    the algebraic coordinates' ``back`` restricted to the block (an empty one without), the
+    algebraic coordinates, and the matrices' column norms (:func:`_column_norms`)."""
     if b not in mats:
         r, H, k = shape
         comp = np.ascontiguousarray(red.blocks[b], dtype=np.int64)
         back = np.zeros((0, red.dyn.size)) if red.back is None else red.back
-        mat, split, at, back, norms = _block_data(red.B0, red.B1, red.B2, comp, back,
-                                                  red.dyn, H, k, DECOUPLED_TOL,
-                                                  SPLIT_MAX_SHARE)
+        *real, back, at, harm = _gather_block(red.B0, red.B1, red.B2, comp, back, red.dyn, H, k)
+        split = split_of(*real, harm, DECOUPLED_TOL, SPLIT_MAX_SHARE)
         alg = np.ascontiguousarray(red.alg, dtype=np.int64)
-        mats[b] = (mat, split, at, back, alg, norms)
+        mats[b] = (tuple(real), split, at, back, alg, _column_norms(*real))
     return mats[b]
-
-
-@njit(cache=True)
-def _block_data(B0, B1, B2, comp, back, dyn, H, k, tol, share):
-    """:func:`_block_mats`' arrays in one compiled call: the block gathered
-    (:func:`_gather_block`), its harmonic split (:func:`~fretwear.hb.hill_tracking.
-    harmonic_split`, ``tol`` and ``share`` its thresholds) and column norms
-    (:func:`_column_norms`). Returns ``(cplx, split, at, back, norms)``."""
-    R0, R1, R2, bk, at, harm = _gather_block(B0, B1, B2, comp, back, dyn, H, k)
-    split = split_of(R0, R1, R2, harm, tol, share)
-    return (R0, R1, R2), split, at, bk, _column_norms(R0, R1, R2)
 
 
 def _member(red: QuadraticReduction, b: int, s0: complex, y0: np.ndarray, shape: tuple,
@@ -1399,25 +1387,7 @@ def _member(red: QuadraticReduction, b: int, s0: complex, y0: np.ndarray, shape:
     conjugate, and where the centre moved to the next copy (``|kappa| > 1/2``), that copy
     ``s + i round(kappa)`` instead; otherwise (a neighbouring copy or a mirror) the
     eigenpair as found. None where an iteration does not converge. ``mats``: the blocks'
-    arrays made so far (:func:`_block_mats`). One compiled call (:func:`_member_steps`);
-    the steps from Python (:func:`_member_py`) where LAPACK's solve meets a singular
-    ``P(s)``."""
-    r, H, k = shape
-    B, split, at, back, alg, _ = _block_mats(red, b, shape, mats)
-    lapack = B[0].shape[0] > PAIR_COMPILED_MAX
-    try:
-        s1, y, kp, ok = _member_steps(*B, split, at, back, alg, red.n, r, H, k, complex(s0),
-                                      np.ascontiguousarray(y0, dtype=complex), fold, 10,
-                                      lapack, REUSE_MAX)
-    except np.linalg.LinAlgError:
-        return _member_py(red, b, s0, y0, shape, mats, fold)
-    return (complex(s1), y, float(kp)) if ok else None
-
-
-def _member_py(red: QuadraticReduction, b: int, s0: complex, y0: np.ndarray, shape: tuple,
-               mats: dict, fold: bool = True):
-    """:func:`_member`'s steps from Python, each iteration by :func:`_inverse_iteration`
-    (which falls back to :func:`_inverse_iteration_py` at a singular ``P(s)``)."""
+    arrays made so far (:func:`_block_mats`)."""
     r, H, k = shape
     B, split, at, back, alg, _ = _block_mats(red, b, shape, mats)
     for again in (False, True):
@@ -1432,26 +1402,6 @@ def _member_py(red: QuadraticReduction, b: int, s0: complex, y0: np.ndarray, sha
         if again or not fold or abs(kp) <= 0.5:
             return s1, y, kp
         s0, y0 = s1 + 1j * round(kp), y  # the centre moved to the next copy
-
-
-@njit(cache=True)
-def _member_steps(B0, B1, B2, split, at, back, alg, n, r, H, k, s0, y0, fold, max_iter,
-                  lapack, reuse):
-    """:func:`_member_py` compiled (the same steps: :func:`_ruhe`, the folding,
-    :func:`_block_centroid`): ``(sigma, y, kappa, converged)``."""
-    for again in range(2):
-        s1, y, ok = _ruhe(B0, B1, B2, s0, y0, max_iter, lapack, split, reuse)
-        if not ok:
-            return s1, y, 0.0, False
-        if fold and abs(s1.imag) <= 1e-12 * max(abs(s1), 1.0):
-            s1 = complex(s1.real, 0.0)
-        if fold and s1.imag < 0:  # the conjugate pair's other member
-            s1, y = s1.conjugate(), np.conj(y)
-        kp = _block_centroid(y, at, back, alg, n, r, H, k)
-        if again == 1 or not fold or abs(kp) <= 0.5:
-            return s1, y, kp, True
-        s0, y0 = s1 + 1j * np.rint(kp), y  # the centre moved to the next copy
-    return s0, y0, 0.0, False
 
 
 def _copy(red: QuadraticReduction, b: int, s1: complex, y: np.ndarray, shape: tuple,
@@ -1471,36 +1421,15 @@ def _copy(red: QuadraticReduction, b: int, s1: complex, y: np.ndarray, shape: tu
     ``P`` than the eigenpairs that the dense eigensolver (backward stable on the companion
     form) or the inverse iteration (stopped at a step below 1e-14) return: the copy is
     certified as it is, with its centroid, and no inverse iteration is
-    run; otherwise the inverse iteration from it (:func:`_member`, not folded). One
-    compiled call (:func:`_copy_steps`); from Python where LAPACK's solve meets a singular
-    ``P(s)``."""
+    run; otherwise the inverse iteration from it (:func:`_member`, not folded)."""
     r, H, k = shape
     B, split, at, back, alg, norms = _block_mats(red, b, shape, mats)
-    y = np.ascontiguousarray(y, dtype=complex)
-    lapack = B[0].shape[0] > PAIR_COMPILED_MAX
-    try:
-        s2, v, kp, ok, cert = _copy_steps(*B, norms, split, at, back, alg, red.n, r, H, k,
-                                          complex(s1), y, side, COPY_EXACT, 10, lapack,
-                                          REUSE_MAX)
-    except np.linalg.LinAlgError:
-        sigma, v, eta = _copy_start(*B, norms, complex(s1), y, side, at, H, k)
-        got = _member_py(red, b, complex(sigma), v, shape, mats, fold=False)
-        return None if got is None else got + (False,)
-    return (complex(s2), v, float(kp), bool(cert)) if ok else None
-
-
-@njit(cache=True)
-def _copy_steps(B0, B1, B2, norms, split, at, back, alg, n, r, H, k, s1, y, side, exact,
-                max_iter, lapack, reuse):
-    """:func:`_copy` compiled: the start (:func:`_copy_start`), taken as it is where its
-    backward error is at most ``exact``, else iterated (:func:`_member_steps`, not
-    folded). Returns ``(sigma, v, kappa, converged, certified)``."""
-    sigma, v, eta = _copy_start(B0, B1, B2, norms, s1, y, side, at, H, k)
-    if eta <= exact:
-        return sigma, v, _block_centroid(v, at, back, alg, n, r, H, k), True, True
-    s2, y2, kp, ok = _member_steps(B0, B1, B2, split, at, back, alg, n, r, H, k, sigma, v,
-                                   False, max_iter, lapack, reuse)
-    return s2, y2, kp, ok, False
+    sigma, v, eta = _copy_start(*B, norms, complex(s1), np.ascontiguousarray(y, dtype=complex),
+                                side, at, H, k)
+    if eta <= COPY_EXACT:
+        return complex(sigma), v, float(_block_centroid(v, at, back, alg, red.n, r, H, k)), True
+    got = _member(red, b, sigma, v, shape, mats, fold=False)
+    return None if got is None else got + (False,)
 
 
 @njit(cache=True)
@@ -2038,19 +1967,26 @@ def _reused_step(B0, B1, B2, sigma, x, A, piv, how, split, work, r):
     unchanged). ``r``: work array (n,)."""
     n = x.size
     s2 = sigma * sigma
-    for i in range(n):
-        acc = 0j
-        for j in range(n):
-            acc += (B0[i, j] + sigma * B1[i, j] + s2 * B2[i, j]) * x[j]
-        r[i] = acc
-    a = _solve_pencil(A, piv, r, how, split, work)
-    _slope_into(B1, B2, sigma, x, r)
-    u = _solve_pencil(A, piv, r, how, split, work)
     num = 0j
     den = 0j
-    for i in range(n):
-        num += np.conj(x[i]) * a[i]
-        den += np.conj(x[i]) * u[i]
+    u = r
+    for part in range(2):  # x^H P(tau)^-1 P(sigma) x, then x^H P(tau)^-1 P'(sigma) x (one
+        if part == 0:  # call site of the solve: its code is compiled once)
+            for i in range(n):
+                acc = 0j
+                for j in range(n):
+                    acc += (B0[i, j] + sigma * B1[i, j] + s2 * B2[i, j]) * x[j]
+                r[i] = acc
+        else:
+            _slope_into(B1, B2, sigma, x, r)
+        u = _solve_pencil(A, piv, r, how, split, work)
+        acc = 0j
+        for i in range(n):
+            acc += np.conj(x[i]) * u[i]
+        if part == 0:
+            num = acc
+        else:
+            den = acc
     if (not np.isfinite(den.real) or not np.isfinite(den.imag) or den == 0
             or not np.isfinite(num.real) or not np.isfinite(num.imag)):
         return sigma, x, -1.0
