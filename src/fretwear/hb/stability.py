@@ -1954,17 +1954,17 @@ def _may_reuse(size, last, scale):
 @njit(cache=True)
 def _reused_step(B0, B1, B2, sigma, x, A, piv, how, split, work, r):
     """Ruhe's step at ``sigma`` with the factors of ``P(tau)`` of the step before (``A``,
-    ``piv`` and ``work`` as :func:`_solve_pencil` takes them): ``sigma - (x^H P(tau)^-1
-    P(sigma) x) / (x^H P(tau)^-1 P'(sigma) x)`` and ``x`` <- ``P(tau)^-1 P'(sigma) x``
-    normalised; with ``tau = sigma`` (``P(sigma)^-1 P(sigma) x = x``, ``x^H x = 1``) it is
-    Ruhe's step itself. Near the simple eigenvalue ``lambda``, ``P(tau)^-1 = x1 w1^H /
-    mu(tau) + R`` with ``mu(tau)`` about ``(tau - lambda) w1^H P' x1`` and ``R`` bounded: the
-    ratio is the two-sided Newton correction ``w1^H P(sigma) x / w1^H P'(sigma) x`` (``w1``
-    the left eigenvector, which the dominant term brings) up to terms of order ``|tau -
-    lambda|`` times the vector's error, and the vector is an inverse iteration with the shift
-    ``tau``. Costs two solves and two products instead of an LU. Returns ``(sigma, x,
-    size)``, ``size`` -1 where the denominator is zero or not finite (``sigma``, ``x``
-    unchanged). ``r``: work array (n,)."""
+    ``piv`` and ``work`` as :func:`_solve_pencil` takes them, ``how`` 0 or 2):
+    ``sigma - (x^H P(tau)^-1 P(sigma) x) / (x^H P(tau)^-1 P'(sigma) x)`` and ``x`` <-
+    ``P(tau)^-1 P'(sigma) x`` normalised; with ``tau = sigma`` (``P(sigma)^-1 P(sigma) x =
+    x``, ``x^H x = 1``) it is Ruhe's step itself. Near the simple eigenvalue ``lambda``,
+    ``P(tau)^-1 = x1 w1^H / mu(tau) + R`` with ``mu(tau)`` about ``(tau - lambda) w1^H P'
+    x1`` and ``R`` bounded: the ratio is the two-sided Newton correction ``w1^H P(sigma) x /
+    w1^H P'(sigma) x`` (``w1`` the left eigenvector, which the dominant term brings) up to
+    terms of order ``|tau - lambda|`` times the vector's error, and the vector is an inverse
+    iteration with the shift ``tau``. Costs two solves and two products instead of an LU.
+    Returns ``(sigma, x, size)``, ``size`` -1 where the denominator is zero or not finite
+    (``sigma``, ``x`` unchanged). ``r``: work array (n,)."""
     n = x.size
     s2 = sigma * sigma
     num = 0j
@@ -1979,7 +1979,8 @@ def _reused_step(B0, B1, B2, sigma, x, A, piv, how, split, work, r):
                 r[i] = acc
         else:
             _slope_into(B1, B2, sigma, x, r)
-        u = _solve_pencil(A, piv, r, how, split, work)
+        # (never LAPACK's solve, which keeps no LU: that code is not compiled in again)
+        u = _split_solve(A, split, work, piv, r) if how == 2 else _lu_solve_small(A, piv, r)
         acc = 0j
         for i in range(n):
             acc += np.conj(x[i]) * u[i]
