@@ -59,11 +59,12 @@ How they are computed
    (:attr:`FloquetResult.spurious`).
 4. **Along a sweep** (``previous``: the neighbouring point's result), the candidates of step 1
    are continued from the neighbour's by inverse iteration on the quadratic problem
-   (:func:`track_eigen`) instead of its dense eigensolve, where that is shown to give the
-   same set: the same contact regime (:meth:`HillProblem.regime`), every family represented
-   at the neighbour and here (they number ``2 nd / H``), each member converged with
-   ``|kappa| <= 1/2``, and its neighbouring copy on the side of the tie outside
-   ``|kappa| <= 1/2``. On and near the period-doubling line (:func:`_on_line`) the mirror
+   (:func:`track_eigen`; Ruhe's steps, the last ones on a kept LU where the iteration has
+   contracted to within 1e-7, :func:`_ruhe`) instead of its dense eigensolve, where that is
+   shown to give the same set: the same contact regime (:meth:`HillProblem.regime`), every
+   family represented at the neighbour and here (they number ``2 nd / H``), each member
+   converged with ``|kappa| <= 1/2``, and its neighbouring copy on the side of the tie
+   outside ``|kappa| <= 1/2``. On and near the period-doubling line (:func:`_on_line`) the mirror
    ``conj(s) + i`` of a member is checked too: there the two real negative multipliers of a
    period doubling are two simple eigenvalues ``a + i/2``, ``b + i/2``, each continued
    alone; where a complex pair lands on the line the mirror search may find the second one,
@@ -92,7 +93,9 @@ call, :func:`_refine`); along a sweep, where the
 candidates are tracked, a few LU factorisations of the blocks of the quadratic problem per
 candidate instead of its dense eigensolve (each solved by the LU of the Schur complement
 on the unknowns that couple harmonics, the others eliminated harmonic by harmonic:
-:mod:`fretwear.hb.hill_tracking`). ``det J`` is read from the solve's ``G`` (made again from
+:mod:`fretwear.hb.hill_tracking`; after a step within 1e-7 of the eigenvalue the next ones
+on that step's LU, two solves each, :func:`_reused_step`: Ruhe's kernel 0.69 of its CPU on
+the two-DOF sweep's calls). ``det J`` is read from the solve's ``G`` (made again from
 the split of :mod:`fretwear.hb.memory_gain` where it applies: equal to rounding) and ``Z~``
 (:meth:`HillProblem.jacobian`). Measured on the benchmark's small models
 (docs/studies/method-costs.md, "Hill's method"): about 0.9-1.3 times the CPU a sweep
