@@ -110,9 +110,20 @@ def harmonic_split(B0: np.ndarray, B1: np.ndarray, B2: np.ndarray, harm: np.ndar
     core unknowns of group ``g``'s harmonic; :func:`no_split` where the core holds more than
     :data:`SPLIT_MAX_SHARE` of the unknowns."""
     harm = np.ascontiguousarray(harm, dtype=np.int64)
-    local = _local_unknowns(B0, B1, B2, harm, float(tol))
-    if harm.size == 0 or np.count_nonzero(~local) > SPLIT_MAX_SHARE * harm.size:
-        return no_split()
+    return split_of(B0, B1, B2, harm, float(tol), SPLIT_MAX_SHARE)
+
+
+@njit(cache=True)
+def split_of(B0, B1, B2, harm, tol, share):
+    """:func:`harmonic_split` compiled (``share``: :data:`SPLIT_MAX_SHARE`): one call from
+    Python (:func:`fretwear.hb.stability._block_mats`)."""
+    local = _local_unknowns(B0, B1, B2, harm, tol)
+    nc = 0
+    for i in range(local.size):
+        nc += not local[i]
+    if harm.size == 0 or nc > share * harm.size:
+        e = np.zeros(0, dtype=np.int64)
+        return e, np.zeros(1, dtype=np.int64), e.copy(), e.copy(), np.zeros(1, dtype=np.int64)
     return _groups(local, harm)
 
 
@@ -155,7 +166,7 @@ def _groups(local, harm):
                 c += 1
         lptr[g + 1], cptr[g + 1] = a, c
         g += 1
-    return loc, lptr, core.astype(np.int64), cpos[:cptr[ng]], cptr
+    return loc, lptr, core.astype(np.int64), cpos[:cptr[ng]].copy(), cptr
 
 
 @njit(cache=True)
@@ -204,7 +215,9 @@ def _split_factor(A, split, work):
     ``S`` and its LU (in place). ``A`` is not changed. Returns ``(piv, bad)``: ``S``'s
     pivots, and ``bad`` -1 (factored), the first group whose LU has a pivot below
     :data:`SPLIT_PIVOT` of its largest entry (:func:`_demote` moves it to the core), or -2
-    where ``S`` has a zero pivot."""
+    where ``S`` has a zero pivot. The groups are factored and solved in the work arrays
+    (:func:`_group_lu`, :func:`_group_solve`: :func:`_lu_small`'s and
+    :func:`_lu_solve_small`'s operations, without a temporary per group)."""
     loc, lptr, core, cpos, cptr = split
     F, fpiv, W, S = work
     nc = core.size
@@ -215,29 +228,21 @@ def _split_factor(A, split, work):
         a, b = lptr[g], lptr[g + 1]
         ca, cb = cptr[g], cptr[g + 1]
         s = b - a
-        G = np.empty((s, s), dtype=np.complex128)
         big = 0.0
         for i in range(s):
             for j in range(s):
-                G[i, j] = A[loc[a + i], loc[a + j]]
-                big = max(big, abs(G[i, j]))
-        piv, ok = _lu_small(G)
-        if not ok:
+                F[a + i, j] = A[loc[a + i], loc[a + j]]
+                big = max(big, abs(F[a + i, j]))
+        if not _group_lu(F, fpiv, a, s):
             return np.arange(nc), g
         for i in range(s):
-            if abs(G[i, i]) < SPLIT_PIVOT * big:
+            if abs(F[a + i, i]) < SPLIT_PIVOT * big:
                 return np.arange(nc), g
-            fpiv[a + i] = piv[i]
-            for j in range(s):
-                F[a + i, j] = G[i, j]
-        rhs = np.empty(s, dtype=np.complex128)
         for t in range(ca, cb):
             col = core[cpos[t]]
             for i in range(s):
-                rhs[i] = A[loc[a + i], col]
-            w = _lu_solve_small(G, piv, rhs)
-            for i in range(s):
-                W[a + i, t - ca] = w[i]
+                W[a + i, t - ca] = A[loc[a + fpiv[a + i]], col]
+            _group_solve(F, a, s, W, t - ca)
         for u in range(ca, cb):
             row = core[cpos[u]]
             for t in range(ca, cb):
@@ -247,6 +252,50 @@ def _split_factor(A, split, work):
                 S[cpos[u], cpos[t]] -= acc
     piv, ok = _lu_small(S)
     return piv, -1 if ok else -2
+
+
+@njit(cache=True)
+def _group_lu(F, fpiv, a, s):
+    """:func:`_lu_small` of the group held in rows ``a..a+s`` (columns ``0..s``) of ``F``,
+    in place, its row permutation in ``fpiv[a:a+s]`` (positions within the group); False at
+    a zero pivot."""
+    for i in range(s):
+        fpiv[a + i] = i
+    for col in range(s):
+        p = col
+        for r in range(col + 1, s):
+            if abs(F[a + r, col]) > abs(F[a + p, col]):
+                p = r
+        if F[a + p, col] == 0:
+            return False
+        if p != col:
+            for j in range(s):
+                F[a + col, j], F[a + p, j] = F[a + p, j], F[a + col, j]
+            fpiv[a + col], fpiv[a + p] = fpiv[a + p], fpiv[a + col]
+        d = F[a + col, col]
+        for r in range(col + 1, s):
+            f = F[a + r, col] / d
+            F[a + r, col] = f
+            for j in range(col + 1, s):
+                F[a + r, j] -= f * F[a + col, j]
+    return True
+
+
+@njit(cache=True)
+def _group_solve(F, a, s, X, c):
+    """Column ``c`` of rows ``a..a+s`` of ``X`` (the right side, already permuted by the
+    group's pivots) overwritten by the solution with the group's LU (:func:`_group_lu`;
+    :func:`_lu_solve_small`'s operations)."""
+    for i in range(s):
+        acc = X[a + i, c]
+        for j in range(i):
+            acc -= F[a + i, j] * X[a + j, c]
+        X[a + i, c] = acc
+    for i in range(s - 1, -1, -1):
+        acc = X[a + i, c]
+        for j in range(i + 1, s):
+            acc -= F[a + i, j] * X[a + j, c]
+        X[a + i, c] = acc / F[a + i, i]
 
 
 @njit(cache=True)
@@ -275,7 +324,7 @@ def _split_solve(A, split, work, piv, b):
     F, fpiv, W, S = work
     n = b.size
     x = np.empty(n, dtype=np.complex128)
-    t = np.empty(max(loc.size, 1), dtype=np.complex128)
+    t = np.empty((max(loc.size, 1), 1), dtype=np.complex128)
     r = np.empty(core.size, dtype=np.complex128)
     for i in range(core.size):
         r[i] = b[core[i]]
@@ -283,17 +332,14 @@ def _split_solve(A, split, work, piv, b):
         a, bb = lptr[g], lptr[g + 1]
         ca, cb = cptr[g], cptr[g + 1]
         s = bb - a
-        rhs = np.empty(s, dtype=np.complex128)
         for i in range(s):
-            rhs[i] = b[loc[a + i]]
-        tg = _lu_solve_small(F[a:bb, :s], fpiv[a:bb], rhs)
-        for i in range(s):
-            t[a + i] = tg[i]
+            t[a + i, 0] = b[loc[a + fpiv[a + i]]]
+        _group_solve(F, a, s, t, 0)
         for u in range(ca, cb):
             row = core[cpos[u]]
             acc = 0j
             for i in range(s):
-                acc += A[row, loc[a + i]] * tg[i]
+                acc += A[row, loc[a + i]] * t[a + i, 0]
             r[cpos[u]] -= acc
     xc = _lu_solve_small(S, piv, r)
     for i in range(core.size):
@@ -302,7 +348,7 @@ def _split_solve(A, split, work, piv, b):
         a, bb = lptr[g], lptr[g + 1]
         ca, cb = cptr[g], cptr[g + 1]
         for i in range(bb - a):
-            acc = t[a + i]
+            acc = t[a + i, 0]
             for u in range(ca, cb):
                 acc -= W[a + i, u - ca] * xc[cpos[u]]
             x[loc[a + i]] = acc

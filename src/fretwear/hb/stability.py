@@ -59,11 +59,12 @@ How they are computed
    (:attr:`FloquetResult.spurious`).
 4. **Along a sweep** (``previous``: the neighbouring point's result), the candidates of step 1
    are continued from the neighbour's by inverse iteration on the quadratic problem
-   (:func:`track_eigen`) instead of its dense eigensolve, where that is shown to give the
-   same set: the same contact regime (:meth:`HillProblem.regime`), every family represented
-   at the neighbour and here (they number ``2 nd / H``), each member converged with
-   ``|kappa| <= 1/2``, and its neighbouring copy on the side of the tie outside
-   ``|kappa| <= 1/2``. On and near the period-doubling line (:func:`_on_line`) the mirror
+   (:func:`track_eigen`; Ruhe's steps, the last ones on a kept LU where the iteration has
+   contracted to within 1e-7, :func:`_ruhe`) instead of its dense eigensolve, where that is
+   shown to give the same set: the same contact regime (:meth:`HillProblem.regime`), every
+   family represented at the neighbour and here (they number ``2 nd / H``), each member
+   converged with ``|kappa| <= 1/2``, and its neighbouring copy on the side of the tie
+   outside ``|kappa| <= 1/2``. On and near the period-doubling line (:func:`_on_line`) the mirror
    ``conj(s) + i`` of a member is checked too: there the two real negative multipliers of a
    period doubling are two simple eigenvalues ``a + i/2``, ``b + i/2``, each continued
    alone; where a complex pair lands on the line the mirror search may find the second one,
@@ -92,7 +93,9 @@ call, :func:`_refine`); along a sweep, where the
 candidates are tracked, a few LU factorisations of the blocks of the quadratic problem per
 candidate instead of its dense eigensolve (each solved by the LU of the Schur complement
 on the unknowns that couple harmonics, the others eliminated harmonic by harmonic:
-:mod:`fretwear.hb.hill_tracking`). ``det J`` is read from the solve's ``G`` (made again from
+:mod:`fretwear.hb.hill_tracking`; after a step within 1e-7 of the eigenvalue the next ones
+on that step's LU, two solves each, :func:`_reused_step`: Ruhe's kernel 0.69 of its CPU on
+the two-DOF sweep's calls). ``det J`` is read from the solve's ``G`` (made again from
 the split of :mod:`fretwear.hb.memory_gain` where it applies: equal to rounding) and ``Z~``
 (:meth:`HillProblem.jacobian`). Where every node's normal coordinate is decoupled (a
 prescribed normal force on a coordinate of its own), a refinement's evaluation forms and
@@ -131,14 +134,15 @@ from fretwear.hb.contact import SEPARATION, STICK, _slip_gain
 from fretwear.hb.dynamics import StructureDynamics, structure_dynamics
 from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.hill_tracking import (
+    SPLIT_MAX_SHARE,
     _demote,
     _lu_small,
     _lu_solve_small,
     _split_factor,
     _split_solve,
-    harmonic_split,
     no_split,
     shift_block,
+    split_of,
     split_work,
 )
 from fretwear.hb.memory_gain import _gain_at, memory_gain
@@ -1261,7 +1265,10 @@ def _inverse_iteration(B0, B1, B2, sigma: complex, y: np.ndarray, max_iter: int 
     ``(sigma, y, converged)``; converged when the step is below 1e-14 of ``max(1, |sigma|)``
     (the rounding of the dense eigensolver's eigenvalue, whose backward error is of the same
     order), or when the quadratic convergence predicts the next step below 1e-15 of it
-    (:func:`_settled`: the step that would only confirm it is not taken). Compiled: with
+    (:func:`_settled`: the step that would only confirm it is not taken); after a step
+    within 1e-7 of it, the next steps on that step's LU (:data:`REUSE_MAX`, the compiled
+    path: :func:`_ruhe`'s ``reuse``; the same eigenvalue to 5e-16 and vector to 1.2e-13
+    on the benchmark's two-DOF sweep, the LU that only confirmed it not made). Compiled: with
     ``split`` (:func:`~fretwear.hb.hill_tracking.harmonic_split` of the block: unknowns
     that couple only their own harmonic), each step by the LU of the
     core's Schur complement (:func:`_ruhe`: 31 instead of 62 unknowns on the two-DOF
@@ -1270,12 +1277,14 @@ def _inverse_iteration(B0, B1, B2, sigma: complex, y: np.ndarray, max_iter: int 
     from the kernel (:func:`_ruhe` with ``lapack``: 0.40 against 0.63 ms for the steps
     called from Python on that block); the steps from Python
     (:func:`_inverse_iteration_py`) where that solve meets a singular ``P(s)``."""
-    B0, B1, B2 = (np.ascontiguousarray(b, dtype=complex) for b in (B0, B1, B2))
+    real = all(np.isrealobj(b) for b in (B0, B1, B2))  # real: half the work a product
+    B0, B1, B2 = (np.ascontiguousarray(b, dtype=float if real else complex)
+                  for b in (B0, B1, B2))
     y = np.ascontiguousarray(y, dtype=complex)
     lapack = B0.shape[0] > PAIR_COMPILED_MAX
     split = no_split() if split is None else split
     try:
-        s1, x1, ok = _ruhe(B0, B1, B2, complex(sigma), y, max_iter, lapack, split)
+        s1, x1, ok = _ruhe(B0, B1, B2, complex(sigma), y, max_iter, lapack, split, REUSE_MAX)
     except np.linalg.LinAlgError:  # LAPACK's solve at a singular P(s)
         return _inverse_iteration_py(B0, B1, B2, sigma, y, max_iter)
     return complex(s1), x1, bool(ok)
@@ -1441,19 +1450,18 @@ def _shifted_copy(red: QuadraticReduction, b: int, y: np.ndarray, shape: tuple,
 
 def _block_mats(red: QuadraticReduction, b: int, shape: tuple, mats: dict) -> tuple:
     """Block ``b``'s arrays for :func:`_member` and :func:`_copy` (made on the block's first
-    use, kept in ``mats``): its complex ``B0, B1, B2``, the harmonic split, the block's
-    coordinates, the algebraic coordinates' ``back`` restricted to the block (an empty one
-    without), the algebraic coordinates, and the matrices' column norms
-    (:func:`_column_norms`)."""
+    use, kept in ``mats``): its ``B0, B1, B2`` (real: in the kernels the pencil's sums take
+    a real entry times the complex ``sigma``), the harmonic split, the block's coordinates,
+    the algebraic coordinates' ``back`` restricted to the block (an empty one without), the
+    algebraic coordinates, and the matrices' column norms (:func:`_column_norms`)."""
     if b not in mats:
         r, H, k = shape
         comp = np.ascontiguousarray(red.blocks[b], dtype=np.int64)
         back = np.zeros((0, red.dyn.size)) if red.back is None else red.back
-        *real, cplx, back, at, harm = _gather_block(red.B0, red.B1, red.B2, comp, back,
-                                                    red.dyn, H, k)
-        split = harmonic_split(*real, harm, DECOUPLED_TOL)
+        *real, back, at, harm = _gather_block(red.B0, red.B1, red.B2, comp, back, red.dyn, H, k)
+        split = split_of(*real, harm, DECOUPLED_TOL, SPLIT_MAX_SHARE)
         alg = np.ascontiguousarray(red.alg, dtype=np.int64)
-        mats[b] = (cplx, split, at, back, alg, _column_norms(*cplx))
+        mats[b] = (tuple(real), split, at, back, alg, _column_norms(*real))
     return mats[b]
 
 
@@ -1527,7 +1535,7 @@ def _copy_start(B0, B1, B2, norms, s1, y, side, at, H, k):
 @njit(cache=True)
 def _gather_block(B0, B1, B2, comp, back, dyn, H, k):
     """Block ``comp`` (indices into ``dyn``) of the reduction's matrices in one compiled
-    call (:func:`_block_mats`): the three real blocks, the same complex, the columns
+    call (:func:`_block_mats`): the three (real) blocks, the columns
     ``comp`` of ``back``, the block's coordinates ``dyn[comp]`` and their harmonics (the
     coefficient index ``0, a_1..a_k, b_1..b_k`` of each, folded to ``0..k``)."""
     nb = comp.size
@@ -1547,8 +1555,7 @@ def _gather_block(B0, B1, B2, comp, back, dyn, H, k):
         at[a] = dyn[comp[a]]
         c = at[a] % H
         harm[a] = c - k if c > k else c
-    cplx = (R0.astype(np.complex128), R1.astype(np.complex128), R2.astype(np.complex128))
-    return R0, R1, R2, cplx, bk, at, harm
+    return R0, R1, R2, bk, at, harm
 
 
 @njit(cache=True)
@@ -1756,6 +1763,9 @@ def _edge_members(vals: np.ndarray, kap: np.ndarray, keep: np.ndarray) -> np.nda
     return out
 
 
+#: steps of Ruhe's iteration on the LU of the step before, after a contraction
+#: (:func:`_reused_step`), before a new LU is made
+REUSE_MAX = 2
 #: :func:`_pair` runs compiled (:func:`_pair_small`) up to this many unknowns (a refinement
 #: on a small model, where the calls of an LU and its solves cost more than their flops:
 #: 2.4 against 30 us at 5 unknowns, 25 against 54 us at 30), LAPACK's LU beyond (as fast
@@ -2033,14 +2043,18 @@ def _refine(Gc, node, start, length, rows, P, Kf, Mf, Cf, Df, m, harmonics, omeg
 
 
 @njit(cache=True)
-def _ruhe(B0, B1, B2, sigma, y, max_iter, lapack, split):
+def _ruhe(B0, B1, B2, sigma, y, max_iter, lapack, split, reuse):
     """:func:`_inverse_iteration` compiled (the same steps): ``(sigma, y, converged)``. Each
     step solves with ``P(sigma)`` by the harmonic split (:func:`~fretwear.hb.hill_tracking.
     _split_factor`: the LU of the core's Schur complement, where ``split`` has local
     unknowns or a core; a step whose split refuses is solved as without one), by
     :func:`_lu_small` (one LU a step; not converged at a zero pivot) or, with ``lapack``
     (larger blocks), by LAPACK's ``zgesv`` (``np.linalg.solve``: one LU a solve, two at the
-    first step; raises ``LinAlgError`` at a singular ``P(s)``)."""
+    first step; raises ``LinAlgError`` at a singular ``P(s)``). ``reuse``: after a step that
+    contracted to within 1e-7 of the eigenvalue (:func:`_may_reuse`), up to this many steps
+    on its LU (:func:`_reused_step`, ended by :func:`_reused_settled`) before a new one (not
+    with LAPACK's solve, which keeps no LU); they count in ``max_iter``. 0: Ruhe's steps
+    only."""
     n = B0.shape[0]
     x = _unit(y)
     first = True
@@ -2050,7 +2064,9 @@ def _ruhe(B0, B1, B2, sigma, y, max_iter, lapack, split):
     use = split[0].size + split[2].size > 0
     work = split_work(split, n)
     last = np.inf
-    for _ in range(max_iter):
+    count = 0  # the steps taken, on a new LU or a kept one
+    while count < max_iter:
+        count += 1
         _pencil_into(B0, B1, B2, sigma, A)
         how = 1 if lapack else 0
         while use:  # a group near singular at sigma joins the core (kept for the next steps)
@@ -2071,11 +2087,94 @@ def _ruhe(B0, B1, B2, sigma, y, max_iter, lapack, split):
             x = _unit(_solve_pencil(A, piv, x, how, split, work))
             first = False
         _slope_into(B1, B2, sigma, x, r)
+        prev = last
         sigma, x, state, last = _ruhe_update(sigma, x, _solve_pencil(A, piv, r, how, split,
                                                                       work), last)
         if state != 0:
             return sigma, x, state > 0
+        if how == 1 or reuse == 0 or not _may_reuse(last, prev, max(1.0, abs(sigma))):
+            continue
+        for _ in range(min(reuse, max_iter - count)):  # after a contraction, on this LU
+            s3, x3, t = _reused_step(B0, B1, B2, sigma, x, A, piv, how, split, work, r)
+            if not 0 <= t <= last:
+                break
+            sigma, x = s3, x3
+            count += 1
+            if _reused_settled(t, last, prev, max(1.0, abs(sigma))):
+                return sigma, x, True
+        last = np.inf  # the next LU's step has no contraction to judge
     return sigma, x, False
+
+
+@njit(cache=True)
+def _may_reuse(size, last, scale):
+    """Whether the LU of Ruhe's last step (at ``tau``, a step of ``size`` from the new
+    ``sigma``, after one of ``last``) is kept for the next steps (:func:`_reused_step`): the
+    iteration contracted (``size`` below 1e-2 of ``last``: the quadratic regime) and
+    ``tau`` is within 1e-7 of ``scale`` of the eigenvalue (about ``size``; the threshold of
+    :func:`_settled`'s prediction). The vector of a step on the kept LU is an inverse
+    iteration with the shift ``tau``, whose error contracts by ``|tau - lambda|`` over the
+    gap to the next eigenvalue: at 1e-4 the eigenvectors of the benchmark's two-DOF sweep
+    differed from the new LU's by up to 1.7e-9 (their centroids by 2.5e-9), at 1e-7 by
+    1.2e-13 and the eigenvalues by 5e-16."""
+    return last < np.inf and size <= 1e-2 * last and size <= 1e-7 * scale
+
+
+@njit(cache=True)
+def _reused_step(B0, B1, B2, sigma, x, A, piv, how, split, work, r):
+    """Ruhe's step at ``sigma`` with the factors of ``P(tau)`` of the step before (``A``,
+    ``piv`` and ``work`` as :func:`_solve_pencil` takes them, ``how`` 0 or 2):
+    ``sigma - (x^H P(tau)^-1 P(sigma) x) / (x^H P(tau)^-1 P'(sigma) x)`` and ``x`` <-
+    ``P(tau)^-1 P'(sigma) x`` normalised; with ``tau = sigma`` (``P(sigma)^-1 P(sigma) x =
+    x``, ``x^H x = 1``) it is Ruhe's step itself. Near the simple eigenvalue ``lambda``,
+    ``P(tau)^-1 = x1 w1^H / mu(tau) + R`` with ``mu(tau)`` about ``(tau - lambda) w1^H P'
+    x1`` and ``R`` bounded: the ratio is the two-sided Newton correction ``w1^H P(sigma) x /
+    w1^H P'(sigma) x`` (``w1`` the left eigenvector, which the dominant term brings) up to
+    terms of order ``|tau - lambda|`` times the vector's error, and the vector is an inverse
+    iteration with the shift ``tau``. Costs two solves and two products instead of an LU.
+    Returns ``(sigma, x, size)``, ``size`` -1 where the denominator is zero or not finite
+    (``sigma``, ``x`` unchanged). ``r``: work array (n,)."""
+    n = x.size
+    s2 = sigma * sigma
+    num = 0j
+    den = 0j
+    u = r
+    for part in range(2):  # x^H P(tau)^-1 P(sigma) x, then x^H P(tau)^-1 P'(sigma) x (one
+        if part == 0:  # call site of the solve: its code is compiled once)
+            for i in range(n):
+                acc = 0j
+                for j in range(n):
+                    acc += (B0[i, j] + sigma * B1[i, j] + s2 * B2[i, j]) * x[j]
+                r[i] = acc
+        else:
+            _slope_into(B1, B2, sigma, x, r)
+        # (never LAPACK's solve, which keeps no LU: that code is not compiled in again)
+        u = _split_solve(A, split, work, piv, r) if how == 2 else _lu_solve_small(A, piv, r)
+        acc = 0j
+        for i in range(n):
+            acc += np.conj(x[i]) * u[i]
+        if part == 0:
+            num = acc
+        else:
+            den = acc
+    if (not np.isfinite(den.real) or not np.isfinite(den.imag) or den == 0
+            or not np.isfinite(num.real) or not np.isfinite(num.imag)):
+        return sigma, x, -1.0
+    step = num / den
+    return sigma - step, _unit(u), abs(step)
+
+
+@njit(cache=True)
+def _reused_settled(t, size, last, scale):
+    """Whether a step of ``t`` on a kept LU (:func:`_reused_step`) ends the iteration: ``t``
+    below 1e-14 of ``scale``, or the error after it predicted below 1e-15 of it. Its error
+    goes with the distance of the LU's ``tau`` to the eigenvalue (about ``size``, Ruhe's
+    last step, after one of ``last``): a contraction of ``C size`` with ``C = size /
+    last^2`` (:func:`_settled`'s estimate of the quadratic constant), i.e. ``(size /
+    last)^2``."""
+    if t <= 1e-14 * scale:
+        return True
+    return t * (size / last) ** 2 <= 1e-15 * scale
 
 
 @njit(cache=True)
