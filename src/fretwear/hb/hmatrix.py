@@ -32,6 +32,10 @@ symmetric ``A`` only the blocks on and above the diagonal are compressed; the mi
 block is the transpose, sharing the arrays (an asymmetry of rounding's size is added to the
 stated error: then a bound, by the triangle inequality).
 
+:meth:`HMatrix.astype` keeps the blocks in float32 (half the bytes a product reads), the
+stored entries' rounding added to the stated error: GMRES's compressed twin of the condensed
+operator (:meth:`fretwear.hb.modal_operator.ReducedOperator.single`).
+
 A product ``A X`` (``X`` of ``r`` columns) costs ``sum_b k_b (b_r + b_c) r`` for the
 low-rank blocks plus the dense leaves: ``O(m log m)`` per column for a fixed rank, against
 ``m^2`` dense.

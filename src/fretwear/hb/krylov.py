@@ -25,7 +25,11 @@ to be factored. On large active sets it is followed by a node-local correction
 I)`` with each node's own blocks of ``Z~``, exact in the coupling of a node's harmonics by
 its time-varying gain, which the mean gain drops; the two combined multiplicatively halved
 the GMRES iterations of the partial-slip pad (docs/studies/large-interface-solve.md, "The
-preconditioner's builds and a node-local correction"). The contact law and
+preconditioner's builds and a node-local correction"). GMRES's products on loosely solved
+steps go through a single-precision twin of ``Z`` (``KrylovOptions.single_products``), on
+large interfaces a compressed one (``KrylovOptions.compressed_products_min_dofs``,
+:func:`twin_tolerance`: hierarchical low-rank blocks in float32, products below ``m^2``);
+the residual keeps the exact operator. The contact law and
 the residual are those of the dense path: only the linear algebra of the step differs, so
 the converged answer is the same (tests/hb/test_krylov.py).
 """
