@@ -367,6 +367,12 @@ class _Plan:
         off = np.cumsum([0] + [b.U.shape[1] for b in far])
         self.k = int(off[-1])
         rowg, colg = {}, {}
+        # each factor's rank in the blocks' order: the stacks' order, the same in every run
+        # (an order by memory address changed the sums' rounding from run to run)
+        rank = {}
+        for b in far:
+            for a in (b.U, b.V):
+                rank.setdefault(id(a), len(rank))
         for b, o in zip(far, off[:-1], strict=True):
             idx = np.arange(o, o + b.U.shape[1])
             rowg.setdefault((b.r0, b.r1), []).append((b.U, idx))
@@ -374,7 +380,7 @@ class _Plan:
         stacks = {}
 
         def stack(entries):
-            entries = sorted(entries, key=lambda e: id(e[0]))
+            entries = sorted(entries, key=lambda e: rank[id(e[0])])
             key = tuple(id(a) for a, _ in entries)
             if key not in stacks:  # the same factors in the same order: one stack
                 W = np.hstack([a for a, _ in entries])

@@ -183,14 +183,17 @@ class KrylovOptions:
         ``m^2`` per column; the compression is made once per condensation, on the first
         step that needs it). Operators that know their contact nodes' positions only (those
         of the modal condensers); the residual stays the dense operator's, so the converged
-        answer is the same to the solve's tolerance. None: never. Default 2048: on the
+        answer is the same to the solve's tolerance. None (the default): never. On the
         partial-slip pad of benchmarks/scale_3d.py a product with 15 columns took 11.0 ms
         against the dense single copy's 22.8 ms at 1024 contact nodes (3072 DOFs;
         compression 0.72 s CPU, once), 5.1 against 7.0 ms at 576 and 1.2 against 1.5 ms
-        at 256, but the solve gained only at 1024 (products 11.3 to 7.7 s plus 0.75 s of
-        compression); at 576 and 256 the compression and the active sub-operators' cuts
-        ate the gain (docs/studies/large-interface-solve.md, "GMRES's products through a
-        compressed twin").
+        at 256; the 1024-node solve's CPU per Powell iteration fell by a fifth, but its
+        Powell path (17 iterations against 13: the other rounding of the steps) took
+        the gain (25.7 against 25.8 s CPU), and at 576 and 256 nodes the compression and
+        the active sub-operators' cuts ate it; hence off by default. It holds 0.125 of the
+        double matrices' bytes against the dense copy's 0.5: for interfaces where that
+        copy does not fit (docs/studies/large-interface-solve.md, "GMRES's products
+        through a compressed twin").
     first_scales : Powell's variable scales from the first Jacobian only (default True);
         False: renewed at every Jacobian as MINPACK (the running maximum of its column
         norms), as formed Jacobians always are. The column norms of each new Jacobian cost
@@ -219,7 +222,7 @@ class KrylovOptions:
     first_scales: bool = True
     local_phase: bool = True
     node_correction: bool = True
-    compressed_products_min_dofs: int | None = 2048
+    compressed_products_min_dofs: int | None = None
 
     def __post_init__(self):
         self.check()
