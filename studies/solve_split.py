@@ -18,7 +18,9 @@ and per-call terms"): ``solver=newton`` (the line-search Newton instead of Powel
 renewed at every Jacobian), ``single=0|1`` (the preconditioner's factors in double or single),
 ``sprod=0|1`` (GMRES's products in double or single, KrylovOptions.single_products),
 ``nodecorr=0|1`` (the node-local correction of the preconditioner,
-KrylovOptions.node_correction).
+KrylovOptions.node_correction), ``ctwin=N`` (GMRES's single products through the compressed
+twin from N contact DOFs, KrylovOptions.compressed_products_min_dofs; 0: never). The
+compressed twin's compression and cuts are the part ``twin``.
 The solution is saved to ``/tmp/solve_split_<n><SPLIT_TAG>_U.npy`` for comparisons.
 """
 
@@ -92,6 +94,10 @@ def main():
         if key in variants:
             opts = opts.replace(krylov=dataclasses.replace(opts.krylov,
                                                            **{field: variants[key] == "1"}))
+    if "ctwin" in variants:
+        least = int(variants["ctwin"]) or None
+        opts = opts.replace(krylov=dataclasses.replace(
+            opts.krylov, compressed_products_min_dofs=least))
     if variants.get("norms") == "first":  # the first Jacobian's column norms kept
         from powell_kinks import keep_first_column_norms
 
@@ -122,6 +128,9 @@ def main():
     for mod in (penalty, periodic):
         sp.wrap(mod, "penalty", "penalty")
     sp.wrap(preload, "static_anchor", "static_preload")
+    from fretwear.hb.modal_operator import ReducedOperator
+
+    sp.wrap(ReducedOperator, "_compressed_twin", "twin")
     del fourier
     load0 = os.getloadavg()[0]
     with Counts() as counts:

@@ -168,3 +168,32 @@ def test_condenser_compress_option():
         BlockedModalCondenser(model, F_MAX, 7, compress="1e-6")
     with pytest.raises(InputError, match="representation"):
         ModalCondenser(model, F_MAX, 7, representation="hmatrix")
+
+
+def test_float32_copy_states_its_rounding():
+    """HMatrix.astype(float32): the formed blocks (in float64, A_H32) differ from A by at
+    most the stated error (the compression's plus the stored entries' rounding, Higham's
+    entrywise bound, 2^-24 per entry), at a bound where the compression dominates (1e-6)
+    and one where the rounding does (1e-9); the stated error stays within the tolerance
+    plus a few float32 roundoffs (6e-8 each). Products: A_H32 X in float32 against the
+    formed A_H32 X in float64, to float32's accumulated rounding (a sum of m terms: 1e-5
+    relative is generous; measured ~1e-7)."""
+    rng = np.random.default_rng(3)
+    xy = rng.random((400, 2))
+    D = np.linalg.norm(xy[:, None] - xy[None], axis=2)
+    A = np.kron(1.0 / (D + 0.2), np.eye(3))
+    A = 0.5 * (A + A.T)
+    X = rng.standard_normal((A.shape[0], 5))
+    for tol in (1e-6, 1e-9):
+        H = compress(A, xy, tol, leaf=8)
+        H32 = H.astype(np.float32)
+        assert H32.dtype == np.float32 and H32.ranks().size and H32.ranks().max() > 0
+        F = H32.toarray().astype(float)
+        formed = np.linalg.norm(F - A) / np.linalg.norm(A)
+        assert formed <= H32.error, (tol, formed, H32.error)
+        assert H32.error <= tol + 5 * 2.0**-24, (tol, H32.error)
+        Y = H32 @ X
+        assert Y.dtype == np.float32
+        assert np.linalg.norm(Y - F @ X) <= 1e-5 * np.linalg.norm(F @ X)
+        Xc = X + 1j * X[::-1]
+        assert np.linalg.norm(H32.T @ Xc - F.T @ Xc) <= 1e-5 * np.linalg.norm(F @ Xc)

@@ -4,6 +4,8 @@ stored dense (fretwear.hb.krylov.HarmonicBlocks), the formed dense Jacobian and 
 differences (tolerances in each test; the blocked and dense condensations agree to rounding:
 tests/hb/test_modal_blocked.py)."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 from helpers.operator_models import F_MAX, ORDERS, block, rel
@@ -301,3 +303,92 @@ def test_single_precision_products_and_the_loose_steps_that_take_them(damping, m
     used[:] = []
     J.solve(f, rtol=1e-3)
     assert used and not any(used)
+
+
+@pytest.mark.parametrize("damping", [None, Damping(loss_factor=0.02)])
+def test_compressed_twin_within_its_stated_bound(damping, monkeypatch):
+    """OperatorBlocks.single(compress) (a face of 13 x 13 nodes, leaves of 8 nodes, so that
+    the matrices have low-rank blocks at 1e-7, asserted): each compressed matrix formed
+    (float32 blocks, in float64)
+    differs from the stored X^cc by at most its stated relative error (the compression's
+    plus float32's rounding, hb/hmatrix.py; tol 1e-7), and that error is within the bound
+    plus a few float32 roundoffs; the twin's products equal those of the operator on the
+    formed compressed matrices (the same sums in float32: 1e-5, measured 1e-7) and differ
+    from the double operator's by less than the single twin's 1e-6 (test above) allows.
+    The compression is made once per condensation: an operator of the same condenser at
+    another frequency takes the same compressed matrices. An active sub-operator's twin is
+    the cut of the whole one's, against the double sub-operator the same way."""
+    from fretwear.hb import hmatrix
+    from fretwear.hb.modal_operator import ReducedOperator
+
+    monkeypatch.setattr(hmatrix, "LEAF", 8)
+    model = block(damping, traction=4.5e5, cells=12)
+    bc = BlockedModalCondenser(model, F_MAX, 7, tol=1e-2)
+    basis = FourierBasis.up_to(3, 32)
+    ob = OperatorBlocks(bc.reduced(2 * np.pi * 12e3, basis.orders).Z)
+    tw = ob.single(1e-7)
+    assert tw is ob.single(1e-7) and tw is not ob.single()
+    assert all(isinstance(A, hmatrix.HMatrix) and A.dtype == np.float32
+               for A in tw.op.mats)
+    assert all(A.ranks().size and A.ranks().min() > 0 for A in tw.op.mats)
+    other = OperatorBlocks(bc.reduced(2 * np.pi * 9e3, basis.orders).Z).single(1e-7)
+    assert all(a is b for a, b in zip(other.op.mats, tw.op.mats, strict=True))
+    rng = np.random.default_rng(6)
+
+    def check(Z, T, mats):
+        formed = [A.toarray().astype(float) for A in T.op.mats]
+        for F, D, A in zip(formed, mats, T.op.mats, strict=True):
+            assert np.linalg.norm(F - D) <= A.error * np.linalg.norm(D)
+            assert A.error <= 1e-7 + 5 * 2.0**-24
+        on_formed = OperatorBlocks(ReducedOperator(formed, Z.op.coef, Z.op.U, Z.op.Y,
+                                                   Z.op.symmetric))
+        x = rng.standard_normal((Z.m, Z.H))
+        assert rel(T.apply(x), on_formed.apply(x)) < 1e-5
+        assert rel(T.apply(x), Z.apply(x)) < 1e-6
+
+    check(ob, tw, ob.op.mats)
+    dofs = np.arange(ob.m)[np.arange(ob.m) % 5 != 1]
+    sub = ob.sub(dofs)
+    check(sub, sub.single(1e-7), [A[np.ix_(dofs, dofs)] for A in ob.op.mats])
+    view = krylov._ActiveView(ob, dofs)
+    x = rng.standard_normal((dofs.size, ob.H))
+    assert rel(view.single(1e-7).apply(x), view.apply(x)) < 1e-6
+
+
+def test_solve_with_the_compressed_twin_has_the_dense_root(monkeypatch):
+    """solve_periodic on GMRES steps (every size) whose loose products go through the
+    compressed twin (KrylovOptions.compressed_products_min_dofs = 1; a face of 13 x 13
+    nodes, leaves of 8: low-rank blocks; asserted to be used) converges to the root of the
+    solve with the dense single twin:
+    the residual is the dense operator's in both, so the roots differ by about the solve's
+    tolerance times the Jacobian's amplification (1e-10 relative residual; measured 4.6e-9
+    between the two: 1e-7 bounds it; a residual through the twin's float32 compressed
+    matrices cannot reach 1e-10 at all: the solve did not converge in 10 min)."""
+    from fretwear.hb import hmatrix
+    from fretwear.hb.options import PERIODIC, KrylovOptions
+
+    monkeypatch.setattr(hmatrix, "LEAF", 8)
+    monkeypatch.setattr(krylov, "ACTIVE_DENSE_MAX", 0)  # GMRES whatever the size
+    model = block(traction=4.5e5, cells=12)
+    bc = BlockedModalCondenser(model, F_MAX, 7, tol=1e-2)
+    basis = FourierBasis.up_to(3, 64)
+    anchor = static_anchor(model, condenser=bc)
+    used = []
+    single = OperatorBlocks.single
+
+    def spy(self, compress=None):
+        used.append(compress)
+        return single(self, compress)
+
+    monkeypatch.setattr(OperatorBlocks, "single", spy)
+    out = {}
+    for least in (None, 1):
+        used[:] = []
+        opts = dataclasses.replace(PERIODIC, tol=1e-10,
+                                   krylov=KrylovOptions(compressed_products_min_dofs=least))
+        sol = solve_periodic(model, basis, frequency=12e3, anchor=anchor, condenser=bc,
+                             options=opts)
+        assert sol.success
+        assert used and all((c is None) == (least is None) for c in used), used
+        out[least] = sol.U
+    assert rel(out[1], out[None]) < 1e-7

@@ -45,6 +45,8 @@ def test_solve_options_refuse_bad_values(name, value):
     ("single_max_iterations", 10.0), ("single_max_iterations", True),
     ("preconditioner", "ilu"), ("preconditioner", None), ("first_scales", 1),
     ("single_products", "no"), ("local_phase", 0), ("node_correction", 1),
+    ("compressed_products_min_dofs", 0), ("compressed_products_min_dofs", 1728.0),
+    ("compressed_products_min_dofs", True),
 ])
 def test_krylov_options_refuse_bad_values(name, value):
     with pytest.raises(InputError, match=f"^krylov.{name} = ") as err:

@@ -14,9 +14,10 @@ F_MAX = 20e3  # Hz (as test_modal.py)
 ORDERS = np.arange(8)
 
 
-def block(damping=None, traction=3e5):
-    """test_modal.py's 10 x 10 x 5 mm steel block on a rigid flat, optionally damped."""
-    return from_mesh(box(0.01, 0.01, 0.005, 4, 4, 2), Material(210e9, 0.3, 7800.0),
+def block(damping=None, traction=3e5, cells=4):
+    """test_modal.py's 10 x 10 x 5 mm steel block on a rigid flat, optionally damped;
+    ``cells`` elements along each side of the contact face (4: 25 contact nodes)."""
+    return from_mesh(box(0.01, 0.01, 0.005, cells, cells, 2), Material(210e9, 0.3, 7800.0),
                      damping=damping,
                      supports=[Spring("zmax", "x", 1e7), Spring("zmax", "y", 1e7)],
                      loads=[Traction("zmax", pressure=1e6),

@@ -32,6 +32,10 @@ symmetric ``A`` only the blocks on and above the diagonal are compressed; the mi
 block is the transpose, sharing the arrays (an asymmetry of rounding's size is added to the
 stated error: then a bound, by the triangle inequality).
 
+:meth:`HMatrix.astype` keeps the blocks in float32 (half the bytes a product reads), the
+stored entries' rounding added to the stated error: GMRES's compressed twin of the condensed
+operator (:meth:`fretwear.hb.modal_operator.ReducedOperator.single`).
+
 A product ``A X`` (``X`` of ``r`` columns) costs ``sum_b k_b (b_r + b_c) r`` for the
 low-rank blocks plus the dense leaves: ``O(m log m)`` per column for a fixed rank, against
 ``m^2`` dense.
@@ -193,13 +197,13 @@ class HMatrix:
     """
 
     ndim = 2
-    dtype = np.dtype(float)
 
     def __init__(self, rows, cols, blocks, error: float = 0.0, tol: float = 0.0):
         self.rows, self.cols = np.asarray(rows), np.asarray(cols)
         self.blocks = list(blocks)
         self.error, self.tol = float(error), float(tol)
         self._plan = _Plan(self.blocks)
+        self.dtype = self._plan.dtype
         self._transposed = False
 
     @property
@@ -224,16 +228,56 @@ class HMatrix:
         return np.array([b.rank for b in self.blocks if b.D is None], dtype=np.int64)
 
     def __matmul__(self, X):
+        """``A X`` in the blocks' precision (:attr:`dtype`: float64, or float32 for
+        :meth:`astype`'s copy); a complex ``X`` as its real and imaginary parts side by side
+        (one pass over the blocks)."""
         X = np.asarray(X)
-        if np.iscomplexobj(X):
-            return self @ X.real + 1j * (self @ X.imag)
         one = X.ndim == 1
+        X2 = X.reshape(X.shape[0], -1)
+        if np.iscomplexobj(X2):
+            r = X2.shape[1]
+            Y = self @ np.hstack([X2.real, X2.imag])
+            out = Y[:, :r] + 1j * Y[:, r:]
+            return out[:, 0] if one else out
         rows, cols = (self.cols, self.rows) if self._transposed else (self.rows, self.cols)
-        Xp = np.ascontiguousarray(X[cols].reshape(cols.size, -1), dtype=float)
+        Xp = np.ascontiguousarray(X2[cols], dtype=self.dtype)
         Yp = self._plan.apply(Xp, rows.size, self._transposed)
         Y = np.empty_like(Yp)
         Y[rows] = Yp
         return Y[:, 0] if one else Y
+
+    def astype(self, dtype) -> HMatrix:
+        """A copy with every block in the real ``dtype`` (float32: half the bytes a product
+        reads, products in float32 arithmetic). The stated :attr:`error` adds the
+        rounding of the stored entries: an entry moves by at most ``u |a|`` (``u`` the unit
+        roundoff, ``2^-24`` for float32), so a dense block ``D`` by ``u ||D||_F`` and a
+        low-rank block ``U V^T`` by at most ``u (2 + u) || |U| |V|^T ||_F`` (Higham,
+        *Accuracy and Stability of Numerical Algorithms*, 2002, sec. 3.5); the blocks
+        partition the matrix, so the squares add, relative to ``||A_H||_F`` (that of
+        ``A`` to within the stated error). The products' own rounding (``k u`` per entry
+        of a length-``k`` sum) is that of any product in that precision, not counted."""
+        dtype = np.dtype(dtype)
+        u = float(np.finfo(dtype).eps) / 2
+        mirrored = {id(b.of) for b in self.blocks if b.of is not None}
+        new, out, err2, norm2 = {}, [], 0.0, 0.0
+        for b in sorted(self.blocks, key=lambda b: b.of is not None):  # originals first
+            w = 2.0 if id(b) in mirrored else 1.0  # it and its mirror
+            if b.of is not None:
+                nb = new[id(b.of)].mirror()
+            elif b.D is not None:
+                nb = Block(b.r0, b.r1, b.c0, b.c1, D=np.array(b.D, dtype=dtype))
+                err2 += w * (u * float(np.linalg.norm(b.D))) ** 2
+                norm2 += w * float(np.linalg.norm(b.D)) ** 2
+            else:
+                nb = Block(b.r0, b.r1, b.c0, b.c1, U=np.array(b.U, dtype=dtype),
+                           V=np.array(b.V, dtype=dtype))
+                bound = float(np.linalg.norm(np.abs(b.U) @ np.abs(b.V).T))
+                err2 += w * (u * (2 + u) * bound) ** 2
+                norm2 += w * float(np.linalg.norm(b.U @ b.V.T)) ** 2
+            new[id(b)] = nb
+            out.append(nb)
+        rounding = np.sqrt(err2 / norm2) if norm2 else 0.0
+        return HMatrix(self.rows, self.cols, out, self.error + rounding, self.tol)
 
     def toarray(self) -> np.ndarray:
         """The matrix ``A_H`` formed (for checks)."""
@@ -323,6 +367,12 @@ class _Plan:
         off = np.cumsum([0] + [b.U.shape[1] for b in far])
         self.k = int(off[-1])
         rowg, colg = {}, {}
+        # each factor's rank in the blocks' order: the stacks' order, the same in every run
+        # (an order by memory address changed the sums' rounding from run to run)
+        rank = {}
+        for b in far:
+            for a in (b.U, b.V):
+                rank.setdefault(id(a), len(rank))
         for b, o in zip(far, off[:-1], strict=True):
             idx = np.arange(o, o + b.U.shape[1])
             rowg.setdefault((b.r0, b.r1), []).append((b.U, idx))
@@ -330,7 +380,7 @@ class _Plan:
         stacks = {}
 
         def stack(entries):
-            entries = sorted(entries, key=lambda e: id(e[0]))
+            entries = sorted(entries, key=lambda e: rank[id(e[0])])
             key = tuple(id(a) for a, _ in entries)
             if key not in stacks:  # the same factors in the same order: one stack
                 W = np.hstack([a for a, _ in entries])
@@ -343,6 +393,8 @@ class _Plan:
 
         self.rows = [(r0, r1, *stack(e)) for (r0, r1), e in rowg.items()]
         self.cols = [(c0, c1, *stack(e)) for (c0, c1), e in colg.items()]
+        arrays = [D for _, _, D, _, _ in self.near] + list(stacks.values())
+        self.dtype = arrays[0].dtype if arrays else np.dtype(float)
         self.nbytes = int(sum(W.nbytes for W in stacks.values())
                           + sum(D.nbytes + g.nbytes for _, _, D, g, _ in self.near)
                           + sum(i.nbytes for *_, i in self.rows + self.cols))
@@ -352,10 +404,10 @@ class _Plan:
     def apply(self, Xp: np.ndarray, nout: int, transposed: bool) -> np.ndarray:
         """``A_p Xp`` (or ``A_p^T Xp``) on the reordered rows and columns."""
         r = Xp.shape[1]
-        Y = np.zeros((nout, r))
+        Y = np.zeros((nout, r), dtype=self.dtype)
         if self.k:
             src, dst = (self.rows, self.cols) if transposed else (self.cols, self.rows)
-            C = np.empty((self.k, r))
+            C = np.empty((self.k, r), dtype=self.dtype)
             for a0, a1, W, idx in src:
                 C[idx] = W.T @ Xp[a0:a1]
             for a0, a1, W, idx in dst:

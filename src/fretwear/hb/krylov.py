@@ -25,7 +25,11 @@ to be factored. On large active sets it is followed by a node-local correction
 I)`` with each node's own blocks of ``Z~``, exact in the coupling of a node's harmonics by
 its time-varying gain, which the mean gain drops; the two combined multiplicatively halved
 the GMRES iterations of the partial-slip pad (docs/studies/large-interface-solve.md, "The
-preconditioner's builds and a node-local correction"). The contact law and
+preconditioner's builds and a node-local correction"). GMRES's products on loosely solved
+steps go through a single-precision twin of ``Z`` (``KrylovOptions.single_products``), on
+large interfaces a compressed one (``KrylovOptions.compressed_products_min_dofs``,
+:func:`twin_tolerance`: hierarchical low-rank blocks in float32, products below ``m^2``);
+the residual keeps the exact operator. The contact law and
 the residual are those of the dense path: only the linear algebra of the step differs, so
 the converged answer is the same (tests/hb/test_krylov.py).
 """
@@ -65,6 +69,9 @@ ACTIVE_DENSE_MAX = 3000
 #: iteration and a batched inverse per Jacobian, which paid at 1024 contact nodes (3072 DOFs)
 #: and not at 256 or 576 (1728 DOFs; docs/studies/large-interface-solve.md)
 NODE_CORRECTION_MIN_DOFS = 2048
+#: the compressed twin of GMRES's products (KrylovOptions.compressed_products_min_dofs) is
+#: compressed to this fraction of the smallest GMRES rtol it serves (:func:`twin_tolerance`)
+TWIN_MARGIN = 1e-2
 #: rows of a block formed at a time by :meth:`KrylovJacobian.column_norms` (an operator's
 #: blocks, hb/operator_blocks.py: a panel of 2.4 MB at 1024 contact nodes, reused, in place of
 #: a fresh m x m block per harmonic)
@@ -193,10 +200,10 @@ class HarmonicBlocks:
         idx = np.arange(nc)
         return Zb.reshape(nc, d, nc, d)[idx, :, idx, :]
 
-    def single(self):
-        """The blocks in single precision for GMRES's loose products, or None: stored
-        blocks keep their one (double) copy (an operator's, hb/operator_blocks.py, have
-        one)."""
+    def single(self, compress: float | None = None):
+        """The blocks in single precision for GMRES's loose products (``compress``: their
+        matrices compressed to that relative error), or None: stored blocks keep their one
+        (double) copy (an operator's, hb/operator_blocks.py, have one)."""
         return None
 
     def leading(self, nb: int) -> HarmonicBlocks:
@@ -808,11 +815,19 @@ class KrylovJacobian:
 
     def _single_blocks(self, Za):
         """The single-precision twin of the active blocks ``Za`` (their ``single()``), kept
-        by the owner while ``Za`` is the same object; None where there is none."""
+        by the owner while ``Za`` is the same object; None where there is none. Compressed
+        (``single(compress)``, :func:`twin_tolerance`) from
+        ``KrylovOptions.compressed_products_min_dofs`` DOFs of the whole operator."""
         kept = getattr(self.owner, "_single_Z", None)
         if kept is not None and kept[0] is Za:
             return kept[1]
-        twin = Za.single() if hasattr(Za, "single") else None
+        twin = None
+        if hasattr(Za, "single"):
+            opts = self.options
+            least = opts.compressed_products_min_dofs
+            tol = (twin_tolerance(opts.single_products_rtol)
+                   if least is not None and self.Z.m >= least else None)
+            twin = Za.single(tol)
         self.owner._single_Z = (Za, twin)
         return twin
 
@@ -927,6 +942,26 @@ class KrylovJacobian:
         return x
 
 
+def twin_tolerance(rtol: float) -> float:
+    """The relative Frobenius error to which the compressed twin of GMRES's products is
+    compressed when it serves steps solved to ``rtol`` or looser
+    (``KrylovOptions.single_products_rtol``): ``TWIN_MARGIN rtol``.
+
+    Why: GMRES on the twin ``J_H = J + E`` returns ``s`` with ``|J_H s + f| <= rtol |f|``,
+    so the step's true residual is ``|J s + f| <= rtol |f| + |E s|`` and ``|E s| <=
+    ||E||_2 |s|``. ``E = -G (Z~ - Z~_H)`` carries the twin's error ``sum_X |c_X(n)| e_X
+    ||X^cc||_F`` (``||.||_2 <= ||.||_F``), relative to the operator as the single twin's
+    rounding (``2^-24`` per entry, about ``6e-8`` relative) is. With the default
+    ``rtol >= 1e-5`` the bound is ``1e-7``: of the order of the single twin's rounding,
+    which the same rule admits, and two decades below the loosest step's ``rtol``, so the
+    twin moves the step's residual by about one percent of what GMRES already leaves (an
+    amplification ``|s| ||Z~|| / |f|`` of up to a few tens, measured as the ratio of a
+    compressed solve's error to the compression's, docs/studies/large-interface-solve.md,
+    keeps it within ``rtol``). The residual ``f(U)`` is the dense operator's: the root the
+    solve converges to is not moved, only the steps towards it."""
+    return TWIN_MARGIN * float(rtol)
+
+
 class _ActiveView:
     """The harmonic blocks of an operator ``Z`` (hb/operator_blocks.py) on the DOFs ``dofs``
     as the GMRES path and :class:`MeanGainPreconditioner` use them (``apply``, ``block``,
@@ -960,9 +995,10 @@ class _ActiveView:
         full[self.dofs] = V
         return self.Z.block_products(blocks, full)[self.dofs]
 
-    def single(self):
-        """The same view of ``Z``'s single-precision blocks (``Z.single()``), or None."""
-        twin = self.Z.single()
+    def single(self, compress: float | None = None):
+        """The same view of ``Z``'s single-precision blocks (``Z.single(compress)``), or
+        None."""
+        twin = self.Z.single(compress)
         return None if twin is None else _ActiveView(twin, self.dofs)
 
     def apply(self, U) -> np.ndarray:

@@ -503,8 +503,11 @@ class ModalCondenser(Condenser):
     def _operator(self, parts) -> ReducedOperator:
         """The :class:`ReducedOperator` of the blocks ``parts`` (:meth:`_op_parts` each)."""
         mats = [self.proj_local[nm][0] for nm in self.proj_local]
+        if getattr(self, "_twins", None) is None:  # GMRES's compressed twins, made once
+            self._twins = {}
         return ReducedOperator(mats, np.array([p[0] for p in parts]), [p[1] for p in parts],
-                               [p[2] for p in parts], symmetric=self._symmetric())
+                               [p[2] for p in parts], symmetric=self._symmetric(),
+                               coords=self._coords, twins=self._twins)
 
     def _symmetric(self) -> bool:
         """Whether ``K, M, C, D`` are symmetric (then so is every ``Z_r(n)``), found once."""

@@ -31,8 +31,8 @@ import scipy.linalg as sla
 
 def _times(A: np.ndarray, X: np.ndarray) -> np.ndarray:
     """``A @ X`` for a real ``A`` and a real or complex ``X`` without a complex copy of
-    ``A``."""
-    if np.iscomplexobj(X) and not np.iscomplexobj(A):
+    ``A`` (a compressed ``A`` takes a complex ``X`` in one pass itself)."""
+    if np.iscomplexobj(X) and isinstance(A, np.ndarray) and not np.iscomplexobj(A):
         return A @ X.real + 1j * (A @ X.imag)
     return A @ X
 
@@ -89,6 +89,12 @@ class ReducedOperator:
     products : None, or per stored matrix a compressed form taken by :meth:`matmat` (``@``,
         ``.T``, ``sub(rows, cols)``, ``tol``: :class:`~fretwear.hb.hmatrix.HMatrix`); the
         blocks formed (:meth:`block`, :meth:`node_diagonal`) stay those of ``mats``.
+    coords : None, or the (m / d, dim) positions of the contact nodes (``d`` DOFs each):
+        what :meth:`single` needs to compress ``mats`` for a compressed twin.
+    twins : a dict that holds the compressed twins' matrices made by :meth:`single`, shared
+        by the operators on the same ``mats`` (its slices; a condenser passes one dict to
+        every operator it makes, so that the compression is made once per condensation);
+        None: a new one.
 
     It has the array interface the solvers use: ``shape``, ``dtype``, ``ndim``, ``nbytes``,
     ``len``; an integer index forms that block (dense, (m, m)), a slice gives the operator of
@@ -97,8 +103,12 @@ class ReducedOperator:
 
     ndim = 3
 
-    def __init__(self, mats, coef, U, Y, symmetric: bool = True, products=None):
+    def __init__(self, mats, coef, U, Y, symmetric: bool = True, products=None,
+                 coords=None, twins: dict | None = None):
         self.mats = list(mats)
+        self.coords = coords
+        self.twins = {} if twins is None else twins
+        self._cut_of = None  # (operator, dofs) of a sub-operator: single() cuts its twin
         self.products = None if products is None else list(products)
         self.coef = np.asarray(coef)
         self.U, self.Y = list(U), list(Y)
@@ -147,7 +157,7 @@ class ReducedOperator:
             idx = range(self.nb)[key]
             return ReducedOperator(self.mats, self.coef[list(idx)].reshape(len(idx), -1),
                                    [self.U[b] for b in idx], [self.Y[b] for b in idx],
-                                   self.symmetric, self.products)
+                                   self.symmetric, self.products, self.coords, self.twins)
         return self.block(int(key))
 
     def __iter__(self):
@@ -221,27 +231,64 @@ class ReducedOperator:
         if dofs.size == self.m and np.array_equal(dofs, np.arange(self.m)):
             return self
         ix = np.ix_(dofs, dofs)
-        return ReducedOperator(
-            [np.ascontiguousarray(A[ix]) for A in self.mats], self.coef,
+        out = ReducedOperator(
+            [A.sub(dofs) if hasattr(A, "sub") else np.ascontiguousarray(A[ix])
+             for A in self.mats], self.coef,
             [None if u is None else np.ascontiguousarray(u[dofs]) for u in self.U],
             [None if y is None else np.ascontiguousarray(y[:, dofs]) for y in self.Y],
             self.symmetric, self.cut(dofs, dofs))
+        out._cut_of = (self, dofs)
+        return out
 
-    def single(self) -> ReducedOperator:
+    def single(self, compress: float | None = None) -> ReducedOperator:
         """This operator in single precision: the stored matrices in float32, the low-rank
         factors in float32 or complex64, no compressed forms; its products are those of
         this operator to single precision (about ``1e-7`` relative), at half the memory
         traffic (:meth:`matmat` multiplies in the matrices' precision). For products whose
         accuracy needs no more: GMRES on a loosely solved Newton step
-        (:class:`fretwear.hb.options.KrylovOptions`)."""
+        (:class:`fretwear.hb.options.KrylovOptions`).
+
+        ``compress`` (a relative error, with :attr:`coords` known and no ``products``):
+        the stored matrices instead compressed (:func:`fretwear.hb.hmatrix.compress` to
+        ``compress``) and held in float32 (:meth:`HMatrix.astype`): products below
+        ``m^2`` per column whose matrices differ from ``mats`` by at most their stated
+        errors (``error``: the compression's plus float32's rounding, relative Frobenius;
+        :meth:`compressed_error`). The compressed matrices are made once and kept in
+        :attr:`twins` (shared with every operator on the same matrices); a sub-operator's
+        are those of the operator it was cut from, cut (:meth:`HMatrix.sub`)."""
         def one(a):
             if a is None:
                 return None
             return np.asarray(a, np.complex64 if np.iscomplexobj(a) else np.float32)
 
-        return ReducedOperator([one(A) for A in self.mats], self.coef,
-                               [one(u) for u in self.U], [one(y) for y in self.Y],
-                               self.symmetric)
+        U, Y = [one(u) for u in self.U], [one(y) for y in self.Y]
+        if compress is not None and self.products is None:
+            mats = self._compressed_twin(float(compress))
+            if mats is not None:
+                return ReducedOperator(mats, self.coef, U, Y, self.symmetric)
+        return ReducedOperator([one(A) for A in self.mats], self.coef, U, Y, self.symmetric)
+
+    def _compressed_twin(self, tol: float) -> list | None:
+        """The float32 compressed forms of :attr:`mats` to ``tol`` (:meth:`single`), made
+        once (kept in :attr:`twins`), or None without :attr:`coords`."""
+        if self._cut_of is not None:
+            parent, dofs = self._cut_of
+            full = parent._compressed_twin(tol)
+            return None if full is None else [A.sub(dofs) for A in full]
+        if self.coords is None:
+            return None
+        from fretwear.hb import hmatrix
+
+        key = (tuple(id(A) for A in self.mats), tol)
+        if key not in self.twins:
+            self.twins[key] = [hmatrix.compress(A, self.coords, tol, leaf=hmatrix.LEAF)
+                               .astype(np.float32) for A in self.mats]
+        return self.twins[key]
+
+    def compressed_error(self) -> float:
+        """The largest stated relative error of the compressed stored matrices (those of a
+        compressed twin, :meth:`single`), 0 for dense ones."""
+        return max([float(getattr(A, "error", 0.0)) for A in self.mats], default=0.0)
 
     def cut(self, rows: np.ndarray, cols: np.ndarray):
         """The compressed forms (``products``) restricted to ``rows`` and ``cols``, or

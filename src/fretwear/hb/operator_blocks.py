@@ -34,12 +34,14 @@ class OperatorBlocks(HarmonicBlocks):
         self.H = 1 + 2 * self.k
         c0 = op.coef[0]
         plain = op.U[0] is None and c0[0] == 1 and not np.any(c0[1:])
-        self.Z0 = op.mats[0] if plain else np.ascontiguousarray(op.block(0).real)
+        dense = all(isinstance(A, np.ndarray) for A in op.mats)  # (not a compressed twin's)
+        self.Z0 = (op.mats[0] if plain else np.ascontiguousarray(op.block(0).real) if dense
+                   else None)
         self._ZcH = None
         self._rows = None  # (dofs, the operator of those rows): row_block
         self._symmetric = op.symmetric
         self._real = op.real
-        self._single = None  # single(): the single-precision twin, once made
+        self._single = {}  # single(): the single-precision twins, once made (per bound)
 
     @property
     def real(self) -> bool:
@@ -112,15 +114,17 @@ class OperatorBlocks(HarmonicBlocks):
         out = self.op.node_diagonal(b, d)
         return out.real if self.real else out
 
-    def single(self):
+    def single(self, compress: float | None = None):
         """The same blocks in single precision (:meth:`ReducedOperator.single`, made once
-        and kept by this object), for GMRES's products on loosely solved Newton steps; None
-        when the operator carries compressed forms (their products are already approximate)."""
+        and kept by this object), for GMRES's products on loosely solved Newton steps; with
+        ``compress`` their stored matrices compressed to that relative error where the
+        operator knows its nodes' positions (the compressed twin); None when the operator
+        carries compressed forms (their products are already approximate)."""
         if self.op.products is not None:
             return None
-        if self._single is None:
-            self._single = OperatorBlocks(self.op.single())
-        return self._single
+        if compress not in self._single:
+            self._single[compress] = OperatorBlocks(self.op.single(compress))
+        return self._single[compress]
 
     def leading(self, nb: int) -> OperatorBlocks:
         return OperatorBlocks(self.op[:nb])

@@ -175,6 +175,25 @@ class KrylovOptions:
         Jacobian's variable scales (``first_scales``) the solve took 38-42 s CPU against
         51-52 s ("Entering the local phase sooner").
     single_products_rtol : that bound (default ``1e-5``).
+    compressed_products_min_dofs : from this many contact DOFs (``m`` of the whole
+        operator) the single-precision copy of ``single_products`` is a compressed one:
+        the operator's matrices compressed hierarchically (:mod:`fretwear.hb.hmatrix`) to
+        ``1e-2 single_products_rtol`` relative (:func:`fretwear.hb.krylov.twin_tolerance`:
+        of the order of float32's own rounding) and held in float32 (products below
+        ``m^2`` per column; the compression is made once per condensation, on the first
+        step that needs it). Operators that know their contact nodes' positions only (those
+        of the modal condensers); the residual stays the dense operator's, so the converged
+        answer is the same to the solve's tolerance. None (the default): never. On the
+        partial-slip pad of benchmarks/scale_3d.py a product with 15 columns took 11.0 ms
+        against the dense single copy's 22.8 ms at 1024 contact nodes (3072 DOFs;
+        compression 0.72 s CPU, once), 5.1 against 7.0 ms at 576 and 1.2 against 1.5 ms
+        at 256; the 1024-node solve's CPU per Powell iteration fell by a fifth, but its
+        Powell path (17 iterations against 13: the other rounding of the steps) took
+        the gain (25.7 against 25.8 s CPU), and at 576 and 256 nodes the compression and
+        the active sub-operators' cuts ate it; hence off by default. It holds 0.125 of the
+        double matrices' bytes against the dense copy's 0.5: for interfaces where that
+        copy does not fit (docs/studies/large-interface-solve.md, "GMRES's products
+        through a compressed twin").
     first_scales : Powell's variable scales from the first Jacobian only (default True);
         False: renewed at every Jacobian as MINPACK (the running maximum of its column
         norms), as formed Jacobians always are. The column norms of each new Jacobian cost
@@ -203,6 +222,7 @@ class KrylovOptions:
     first_scales: bool = True
     local_phase: bool = True
     node_correction: bool = True
+    compressed_products_min_dofs: int | None = None
 
     def __post_init__(self):
         self.check()
@@ -233,6 +253,11 @@ class KrylovOptions:
         if not isinstance(self.first_scales, bool):
             raise InputError(f"krylov.first_scales = {self.first_scales!r}: expected "
                              "True or False")
+        n = self.compressed_products_min_dofs
+        if n is not None and not (isinstance(n, numbers.Integral) and not isinstance(n, bool)
+                                  and n >= 1):
+            raise InputError(f"krylov.compressed_products_min_dofs = {n!r}: expected a whole "
+                             "number of contact DOFs >= 1, or None (never)")
         t = self.single_products_rtol
         if not (isinstance(t, numbers.Real) and not isinstance(t, bool) and 1e-6 <= t < 1):
             raise InputError(f"krylov.single_products_rtol = {t!r}: expected a relative "
