@@ -717,9 +717,11 @@ def _condensed_at(Kf, Mf, Cf, Df, m, harmonics, omega, sigma):
             piv[col] = col
         for col in range(q):
             p = col
+            big = abs(A[col, col])
             for r in range(col + 1, q):
-                if abs(A[r, col]) > abs(A[p, col]):
-                    p = r
+                mag = abs(A[r, col])
+                if mag > big:
+                    p, big = r, mag
             if A[p, col] == 0:
                 return Zr, False
             if p != col:
