@@ -307,3 +307,55 @@ def test_steps_on_a_kept_lu_end_where_ruhe_s_steps_end():
                 assert max(abs(s1 - s), abs(s2 - s)) <= 1e-13 * max(1.0, abs(s))
                 differ += s1 != s2
     assert differ > 0
+
+
+def _lu_reference(A):
+    """Partial pivoting written from its definition, in Python: at each column the first row
+    of largest magnitude at or below the diagonal (``np.argmax`` of ``abs``), rows swapped,
+    the column's multipliers stored below the diagonal. Returns the factors and the row of
+    ``A`` each row of ``L U`` holds."""
+    A = A.copy()
+    n = A.shape[0]
+    perm = np.arange(n)
+    for col in range(n):
+        p = col + int(np.argmax(np.abs(A[col:, col])))
+        A[[col, p]] = A[[p, col]]
+        perm[[col, p]] = perm[[p, col]]
+        A[col + 1:, col] /= A[col, col]
+        A[col + 1:, col + 1:] -= np.outer(A[col + 1:, col], A[col, col + 1:])
+    return A, perm
+
+
+def test_compiled_lu_pivots_as_partial_pivoting_defines():
+    """The compiled LU (hill_tracking._lu_small, whose pivot search keeps the largest
+    magnitude found so far) and a group's LU (_group_lu, rows ``a..a+s`` of a work array)
+    against partial pivoting written from its definition (_lu_reference): the same row
+    permutation, exactly (the same magnitudes compared; ties, planted as rows of equal
+    magnitude below the diagonal, go to the first), and ``L U`` equal to the permuted
+    matrix within 1e-13 of its norm (rounding of a 31 x 31 elimination of entries O(1)).
+    A search that keeps the last larger entry, or compares with the diagonal only, picks
+    other rows and fails the permutation."""
+    from fretwear.hb.hill_tracking import _group_lu, _lu_small
+
+    rng = np.random.default_rng(11)
+    for n in (2, 5, 31):
+        A = rng.standard_normal((n, n)) + 1j * rng.standard_normal((n, n))
+        if n > 2:  # ties: rows 1 and 2 of the first column of equal magnitude, above row 0
+            A[0, 0] = 0.1
+            A[1, 0] = 2.0
+            A[2, 0] = -2.0j
+        ref, perm = _lu_reference(A)
+        X = A.copy()
+        piv, ok = _lu_small(X)
+        assert ok
+        np.testing.assert_array_equal(piv, perm)
+        L = np.tril(X, -1) + np.eye(n)
+        np.testing.assert_allclose(L @ np.triu(X), A[piv], rtol=0,
+                                   atol=1e-13 * np.linalg.norm(A))
+        np.testing.assert_allclose(X, ref, rtol=0, atol=1e-13 * np.linalg.norm(A))
+        F = np.zeros((n + 3, n), dtype=complex)
+        F[3:] = A
+        fpiv = np.zeros(n + 3, dtype=np.int64)
+        assert _group_lu(F, fpiv, 3, n)
+        np.testing.assert_array_equal(fpiv[3:], perm)
+        np.testing.assert_allclose(F[3:], X, rtol=0, atol=1e-13 * np.linalg.norm(A))

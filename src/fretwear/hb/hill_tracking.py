@@ -52,14 +52,18 @@ SPLIT_MAX_SHARE = 0.75
 def _lu_small(A):
     """LU with partial pivoting of ``A`` (n, n) complex in place (``L`` unit lower below the
     diagonal, ``U`` on and above): ``(piv, ok)``, ``ok`` False at a zero pivot (where
-    LAPACK's ``zgetrf`` reports a singular ``U``)."""
+    LAPACK's ``zgetrf`` reports a singular ``U``). The pivot search keeps the largest
+    magnitude found so far (one ``abs`` per entry: the same pivots as comparing both
+    magnitudes at every step, half the square roots)."""
     n = A.shape[0]
     piv = np.arange(n)
     for col in range(n):
         p = col
+        big = abs(A[col, col])
         for r in range(col + 1, n):
-            if abs(A[r, col]) > abs(A[p, col]):
-                p = r
+            a = abs(A[r, col])
+            if a > big:
+                p, big = r, a
         if A[p, col] == 0:
             return piv, False
         if p != col:
@@ -263,9 +267,11 @@ def _group_lu(F, fpiv, a, s):
         fpiv[a + i] = i
     for col in range(s):
         p = col
+        big = abs(F[a + col, col])
         for r in range(col + 1, s):
-            if abs(F[a + r, col]) > abs(F[a + p, col]):
-                p = r
+            m = abs(F[a + r, col])
+            if m > big:
+                p, big = r, m
         if F[a + p, col] == 0:
             return False
         if p != col:
