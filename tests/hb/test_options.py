@@ -45,6 +45,7 @@ def test_solve_options_refuse_bad_values(name, value):
     ("single_max_iterations", 10.0), ("single_max_iterations", True),
     ("preconditioner", "ilu"), ("preconditioner", None), ("first_scales", 1),
     ("single_products", "no"), ("local_phase", 0), ("node_correction", 1),
+    ("node_correction_min_dofs", -1), ("node_correction_min_dofs", 2048.0),
     ("compressed_products_min_dofs", 0), ("compressed_products_min_dofs", 1728.0),
     ("compressed_products_min_dofs", True),
 ])

@@ -63,12 +63,6 @@ REBUILD_GROWTH = 2.0
 #: the step is solved by a LAPACK LU of the active block up to this many unknowns (slipping
 #: or separating nodes x d x H), by GMRES above (docs/theory.md, "Large interfaces")
 ACTIVE_DENSE_MAX = 3000
-#: the node-local correction of the preconditioner (KrylovOptions.node_correction,
-#: :func:`node_local_inverse`) is used from this many active DOFs (contact nodes x d): it
-#: halves the GMRES iterations of the partial-slip pad at every size, but adds a product per
-#: iteration and a batched inverse per Jacobian, which paid at 1024 contact nodes (3072 DOFs)
-#: and not at 256 or 576 (1728 DOFs; docs/studies/large-interface-solve.md)
-NODE_CORRECTION_MIN_DOFS = 2048
 #: the compressed twin of GMRES's products (KrylovOptions.compressed_products_min_dofs) is
 #: compressed to this fraction of the smallest GMRES rtol it serves (:func:`twin_tolerance`)
 TWIN_MARGIN = 1e-2
@@ -386,7 +380,7 @@ def node_local_inverse(G: np.ndarray, diag: list, eps: float) -> np.ndarray | No
     law (eq. 22-28). ``Q`` is exact in what :class:`MeanGainPreconditioner` drops, the
     coupling of a node's harmonics by its time-varying gain, and drops what that keeps, the
     coupling of the nodes through ``Z``: the two combined (:meth:`KrylovJacobian.
-    _two_level`) halved the GMRES iterations of the partial-slip pad
+    _node_correction`) halved the GMRES iterations of the partial-slip pad
     (docs/studies/large-interface-solve.md, "The preconditioner's builds and a node-local
     correction"). None where a ``Q`` is singular or not finite."""
     na, dH, _ = G.shape
@@ -579,6 +573,7 @@ class KrylovJacobian:
         self.shape = (self.n, self.n)
         self.owner = owner if owner is not None else self
         self.gmres_iterations = 0
+        self.node_corrected = False  # the last GMRES step used the node-local correction
 
     # -- products -----------------------------------------------------------------------------
     def matvec(self, x) -> np.ndarray:
@@ -852,20 +847,14 @@ class KrylovJacobian:
             return eps * v + np.matmul(Ga, y[:, :, None])[:, :, 0].reshape(-1)
 
         A = spla.LinearOperator((n, n), matvec=matvec, dtype=float)
-        self._qinv = None
-        if opts.node_correction and na * self.d >= NODE_CORRECTION_MIN_DOFS:
-            Zs = self._single_blocks(Za) or Za  # (the correction's product: approximate)
-
-            def rough(v):
-                y = (Zs.apply(v).reshape(-1) - eps * v).reshape(na, dH)
-                return eps * v + np.matmul(Ga, y[:, :, None])[:, :, 0].reshape(-1)
-
-            self._qinv = node_local_inverse(Ga, self._node_diagonals(act), eps)
-            self._rough = rough
+        correct = None
+        if opts.node_correction and na * self.d >= opts.node_correction_min_dofs:
+            correct = self._node_correction(act, Ga, Za)
+        self.node_corrected = correct is not None
         out = np.empty_like(rhs)
         for c in range(rhs.shape[2]):
             out[:, :, c] = self._gmres(A, rhs[:, :, c].reshape(-1), act, Za,
-                                       rtol).reshape(na, dH)
+                                       rtol, correct).reshape(na, dH)
         return out
 
     def _node_diagonals(self, act) -> list:
@@ -874,26 +863,36 @@ class KrylovJacobian:
         formed)."""
         return [self.Z.node_diagonal(b, self.d)[act] for b in range(self.Z.nb)]
 
-    def _two_level(self, apply):
-        """The preconditioner's ``apply`` followed by the node-local correction when the
-        options ask for it (:func:`node_local_inverse`; ``_qinv`` set by
-        :meth:`_gmres_active`): ``x = Q^-1 r``, then ``x + P^-1 (r - J x)`` (a
+    def _node_correction(self, act, Ga, Za):
+        """The node-local correction of the preconditioner on the active nodes ``act``
+        (:func:`node_local_inverse`), as a function of the preconditioner's ``apply``
+        returning the two combined: ``x = Q^-1 r``, then ``x + P^-1 (r - J x)`` (a
         multiplicative two-level preconditioner: ``Q`` exact in the coupling of a node's
         harmonics by its time-varying gain, ``P`` in the coupling of the nodes through
-        ``Z``; the product ``J x`` in single precision where there is a single twin)."""
-        qinv = getattr(self, "_qinv", None)
+        ``Z``; the product ``J x`` in single precision where there is a single twin). None
+        where ``Q`` is singular."""
+        eps, dH = self.eps, self.dH
+        na = act.size
+        qinv = node_local_inverse(Ga, self._node_diagonals(act), eps)
         if qinv is None:
-            return apply
-        na, dH = qinv.shape[0], qinv.shape[1]
+            return None
+        Zs = self._single_blocks(Za) or Za  # (the correction's product: approximate)
 
-        def both(r):
-            r = np.asarray(r, float).reshape(-1)
-            x = np.matmul(qinv, r.reshape(na, dH, 1))[:, :, 0].reshape(-1)
-            return x + apply(r - self._rough(x))
+        def rough(v):
+            y = (Zs.apply(v).reshape(-1) - eps * v).reshape(na, dH)
+            return eps * v + np.matmul(Ga, y[:, :, None])[:, :, 0].reshape(-1)
 
-        return both
+        def wrap(apply):
+            def both(r):
+                r = np.asarray(r, float).reshape(-1)
+                x = np.matmul(qinv, r.reshape(na, dH, 1))[:, :, 0].reshape(-1)
+                return x + apply(r - rough(x))
 
-    def _gmres(self, A, b, act, Za, rtol=GMRES_RTOL) -> np.ndarray:
+            return both
+
+        return wrap
+
+    def _gmres(self, A, b, act, Za, rtol=GMRES_RTOL, correct=None) -> np.ndarray:
         """GMRES on one right-hand side. When it fails with a preconditioner kept from an
         earlier Jacobian or with shared factors, one more run from its last iterate with a
         preconditioner rebuilt from this Jacobian without sharing; when a fresh unshared one
@@ -914,7 +913,8 @@ class KrylovJacobian:
             fresh = attempt > 0 or pc0 is None or not np.array_equal(
                 getattr(pc0, "nodes", None), act)
             pc = self._preconditioner(act, Za, rebuild=attempt > 0)
-            M = spla.LinearOperator(A.shape, matvec=self._two_level(pc.apply), dtype=float)
+            apply = pc.apply if correct is None else correct(pc.apply)
+            M = spla.LinearOperator(A.shape, matvec=apply, dtype=float)
             count = [0]
 
             def cb(_r, count=count):

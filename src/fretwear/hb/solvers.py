@@ -207,11 +207,14 @@ class KrylovOptions:
         node's harmonics by its time-varying gain, which the mean gain drops; ``x = Q^-1 r``,
         then ``x + P^-1 (r - J x)``, one more product (in single precision) per GMRES
         iteration and a batched ``dH x dH`` inverse per Jacobian. Used from
-        :data:`fretwear.hb.krylov.NODE_CORRECTION_MIN_DOFS` active DOFs: on the
+        ``node_correction_min_dofs`` active DOFs: on the
         partial-slip pad of benchmarks/scale_3d.py it halved the GMRES iterations per
         Newton step at 256, 576 and 1024 contact nodes (40-55 %), and paid at 1024 only
         (solve 35 to 25 s CPU; docs/studies/large-interface-solve.md, "The
         preconditioner's builds and a node-local correction").
+    node_correction_min_dofs : the active DOFs (contact nodes x d) from which the
+        correction is used (default 2048: it paid at 1024 contact nodes of the pad, 3072
+        DOFs, and not at 576, 1728 DOFs; the break-even between them was not measured).
     """
 
     single_factors: bool = True
@@ -222,6 +225,7 @@ class KrylovOptions:
     first_scales: bool = True
     local_phase: bool = True
     node_correction: bool = True
+    node_correction_min_dofs: int = 2048
     compressed_products_min_dofs: int | None = None
 
     def __post_init__(self):
@@ -253,6 +257,10 @@ class KrylovOptions:
         if not isinstance(self.first_scales, bool):
             raise InputError(f"krylov.first_scales = {self.first_scales!r}: expected "
                              "True or False")
+        n = self.node_correction_min_dofs
+        if not (isinstance(n, numbers.Integral) and not isinstance(n, bool) and n >= 0):
+            raise InputError(f"krylov.node_correction_min_dofs = {n!r}: expected a whole "
+                             "number of active DOFs >= 0")
         n = self.compressed_products_min_dofs
         if n is not None and not (isinstance(n, numbers.Integral) and not isinstance(n, bool)
                                   and n >= 1):
