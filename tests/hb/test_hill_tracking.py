@@ -23,6 +23,7 @@ from fretwear.hb.stability import (
     _companion_eigen,
     _inverse_iteration,
     _pencil_into,
+    _reused_settled,
     _ruhe,
     hill_stability,
     problem_of,
@@ -307,6 +308,25 @@ def test_steps_on_a_kept_lu_end_where_ruhe_s_steps_end():
                 assert max(abs(s1 - s), abs(s2 - s)) <= 1e-13 * max(1.0, abs(s))
                 differ += s1 != s2
     assert differ > 0
+
+
+def test_kept_lu_stop_rule_is_the_quadratic_contraction():
+    """stability._reused_settled, the stop after a step on a kept LU, against the rule its
+    docstring derives: a step ``t`` ends the iteration when it is below 1e-14 of the scale, or
+    when the error after it, ``t (size / last)^2`` (the kept LU's shift about ``size`` from
+    the eigenvalue, the quadratic constant ``size / last^2``), is predicted below 1e-15 of the
+    scale; values either side of each bound by a factor 10 (the sweeps' own results do not
+    reach the second branch's boundary, so only this test holds it: ``return True`` fails
+    it)."""
+    for scale in (1.0, 7.0):
+        assert _reused_settled(1e-15 * scale, 1e-8, 1e-6, scale)  # below 1e-14 of the scale
+        # contraction (1e-8 / 1e-6)^2 = 1e-4: predicted 1e-16 of the scale, settled
+        assert _reused_settled(1e-12 * scale, 1e-8, 1e-6, scale)
+        # predicted 1e-14: another step
+        assert not _reused_settled(1e-10 * scale, 1e-8, 1e-6, scale)
+        # a slower contraction, (1e-7 / 1e-6)^2 = 1e-2: 1e-12 predicts 1e-14, not settled
+        assert not _reused_settled(1e-12 * scale, 1e-7, 1e-6, scale)
+        assert _reused_settled(1e-14 * scale, 1e-7, 1e-6, scale)
 
 
 def _lu_reference(A):

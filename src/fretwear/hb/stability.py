@@ -1857,7 +1857,8 @@ def _evaluate(Gc, node, start, length, rows, P, z, Kf, Mf, Cf, Df, m, harmonics,
     same values; :func:`_refine`, which does not use ``T``) and an empty ``T`` returned.
     Returns ``(T, mu, y, status, res, pair, dropped)``, ``status`` 0, 1 (a zero pivot in the
     pair's LU: LAPACK's then runs) or 2 (the held structure is singular at this ``s``),
-    ``dropped`` as computed (negative where the whole matrix was taken)."""
+    ``dropped`` the largest of the dropped columns' sums: the one given where it was known
+    (or where the whole matrix was taken, which needs none), else computed from this ``T``."""
     G = _gain_at(Gc, node, start, length, rows, P, z)
     Zr, ok = _condensed_at(Kf, Mf, Cf, Df, m, harmonics, omega, sigma)
     if not ok:
