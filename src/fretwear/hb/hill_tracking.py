@@ -49,14 +49,15 @@ SPLIT_MAX_SHARE = 0.75
 
 
 @njit(cache=True)
-def _lu_small(A):
+def _lu_into(A, piv):
     """LU with partial pivoting of ``A`` (n, n) complex in place (``L`` unit lower below the
-    diagonal, ``U`` on and above): ``(piv, ok)``, ``ok`` False at a zero pivot (where
-    LAPACK's ``zgetrf`` reports a singular ``U``). The pivot search keeps the largest
-    magnitude found so far (one ``abs`` per entry: the same pivots as comparing both
+    diagonal, ``U`` on and above), the row order written into ``piv`` (n,): False at a zero
+    pivot (where LAPACK's ``zgetrf`` reports a singular ``U``). The pivot search keeps the
+    largest magnitude found so far (one ``abs`` per entry: the same pivots as comparing both
     magnitudes at every step, half the square roots)."""
     n = A.shape[0]
-    piv = np.arange(n)
+    for col in range(n):
+        piv[col] = col
     for col in range(n):
         p = col
         big = abs(A[col, col])
@@ -65,7 +66,7 @@ def _lu_small(A):
             if a > big:
                 p, big = r, a
         if A[p, col] == 0:
-            return piv, False
+            return False
         if p != col:
             for j in range(n):
                 A[col, j], A[p, j] = A[p, j], A[col, j]
@@ -76,14 +77,21 @@ def _lu_small(A):
             A[r, col] = f
             for j in range(col + 1, n):
                 A[r, j] -= f * A[col, j]
-    return piv, True
+    return True
 
 
 @njit(cache=True)
-def _lu_solve_small(A, piv, b):
-    """``x`` with ``A0 x = b`` from the LU of ``A0`` by :func:`_lu_small`."""
+def _lu_small(A):
+    """:func:`_lu_into` with its pivots made here: ``(piv, ok)``."""
+    piv = np.empty(A.shape[0], dtype=np.int64)
+    ok = _lu_into(A, piv)
+    return piv, ok
+
+
+@njit(cache=True)
+def _lu_solve_into(A, piv, b, x):
+    """``x`` (n,), written, with ``A0 x = b`` from the LU of ``A0`` by :func:`_lu_into`."""
     n = A.shape[0]
-    x = np.empty(n, dtype=np.complex128)
     for i in range(n):
         x[i] = b[piv[i]]
     for i in range(n):
@@ -96,6 +104,13 @@ def _lu_solve_small(A, piv, b):
         for j in range(i + 1, n):
             acc -= A[i, j] * x[j]
         x[i] = acc / A[i, i]
+
+
+@njit(cache=True)
+def _lu_solve_small(A, piv, b):
+    """``x`` with ``A0 x = b`` from the LU of ``A0`` by :func:`_lu_small`."""
+    x = np.empty(A.shape[0], dtype=np.complex128)
+    _lu_solve_into(A, piv, b, x)
     return x
 
 

@@ -139,7 +139,9 @@ from fretwear.hb.fourier import FourierBasis
 from fretwear.hb.hill_tracking import (
     SPLIT_MAX_SHARE,
     _demote,
+    _lu_into,
     _lu_small,
+    _lu_solve_into,
     _lu_solve_small,
     _split_factor,
     _split_solve,
@@ -695,6 +697,7 @@ def _condensed_at(Kf, Mf, Cf, Df, m, harmonics, omega, sigma):
     A = np.empty((q, q), dtype=np.complex128)
     X = np.empty((q, m), dtype=np.complex128)
     x = np.empty(q, dtype=np.complex128)
+    b = np.empty(q, dtype=np.complex128)
     piv = np.empty(q, dtype=np.int64)
     for idx in range(1 + 2 * k):
         if idx == 0:
@@ -713,43 +716,14 @@ def _condensed_at(Kf, Mf, Cf, Df, m, harmonics, omega, sigma):
                 A[i, j] = Z[m + i, m + j]
             for j in range(m):
                 X[i, j] = Z[m + i, j]
-        # X = A^-1 X in place: :func:`_lu_small` and :func:`_lu_solve_small`'s steps (the
-        # same operations in the same order), the pivots and the columns solved in the
-        # arrays made once (the calls allocated three arrays a value of lambda)
-        for col in range(q):
-            piv[col] = col
-        for col in range(q):
-            p = col
-            big = abs(A[col, col])
-            for r in range(col + 1, q):
-                mag = abs(A[r, col])
-                if mag > big:
-                    p, big = r, mag
-            if A[p, col] == 0:
-                return Zr, False
-            if p != col:
-                for j in range(q):
-                    A[col, j], A[p, j] = A[p, j], A[col, j]
-                piv[col], piv[p] = piv[p], piv[col]
-            d = A[col, col]
-            for r in range(col + 1, q):
-                f = A[r, col] / d
-                A[r, col] = f
-                for j in range(col + 1, q):
-                    A[r, j] -= f * A[col, j]
+        # X = A^-1 X in place by :func:`_lu_into` and :func:`_lu_solve_into` on the arrays
+        # made once (_lu_small and _lu_solve_small allocate: three arrays a value of lambda)
+        if not _lu_into(A, piv):
+            return Zr, False
         for j in range(m):
             for i in range(q):
-                x[i] = X[piv[i], j]
-            for i in range(q):
-                acc = x[i]
-                for t in range(i):
-                    acc -= A[i, t] * x[t]
-                x[i] = acc
-            for i in range(q - 1, -1, -1):
-                acc = x[i]
-                for t in range(i + 1, q):
-                    acc -= A[i, t] * x[t]
-                x[i] = acc / A[i, i]
+                b[i] = X[i, j]
+            _lu_solve_into(A, piv, b, x)
             for i in range(q):
                 X[i, j] = x[i]
         for i in range(m):
