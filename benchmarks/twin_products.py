@@ -24,20 +24,12 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from hmatrix import _median_time  # noqa: E402
 from scale_3d import LOADS, H, pad  # noqa: E402
 
 from fretwear.hb.krylov import twin_tolerance  # noqa: E402
 from fretwear.hb.operator_blocks import OperatorBlocks  # noqa: E402
 from fretwear.hb.solvers import KRYLOV  # noqa: E402
-
-
-def _median(f, reps):
-    out = []
-    for _ in range(reps):
-        t = time.process_time()
-        f()
-        out.append(time.process_time() - t)
-    return float(np.median(out))
 
 
 def _cpu(f):
@@ -73,7 +65,7 @@ def size(n: int, reps: int) -> None:
         t = {k: [] for k in ("double", "single", "compressed")}
         for _ in range(2):
             for k, X in (("double", B), ("single", Bs), ("compressed", Bc)):
-                t[k].append(_median(lambda X=X, U=U: X.apply(U), reps))
+                t[k].append(_median_time(lambda X=X, U=U: X.apply(U), reps))
         d = {k: float(np.linalg.norm(X.apply(U) - ref) / np.linalg.norm(ref))
              for k, X in (("single", Bs), ("compressed", Bc))}
         print(f"  {label} DOFs{'' if dofs is None else f' (cut {tcut:.3f} s CPU)'}: Z~ U "
