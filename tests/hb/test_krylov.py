@@ -526,20 +526,35 @@ def test_oscillating_gains_precondition_partial_slip(monkeypatch):
     the GMRES iterations the mean gain alone needs (21 against 51 measured: the mean gain
     treats the oscillating harmonics of nodes that stick most of the period as if they
     slipped; krylov.harmonic_gains)."""
+    def mean_gain(prob, mean):
+        prob._mean_gain = mean
+
+    its = {}
+    for mean, (J, pc) in _partial_slip_steps(monkeypatch, (False, True), mean_gain).items():
+        its[mean] = J.gmres_iterations
+        assert pc.oscillating is not mean
+    assert its[False] < 0.5 * its[True]
+
+
+def _partial_slip_steps(monkeypatch, variants, configure) -> dict:
+    """The step by GMRES on the Jacobian in partial slip of pad_in_partial_slip for each of
+    ``variants`` (``configure(prob, variant)`` sets it; a fresh preconditioner each), each
+    checked against the LU solution of the formed Jacobian (1e-9, as
+    test_step_equals_lu_step): ``{variant: (its KrylovJacobian, the preconditioner the step
+    used)}``."""
     monkeypatch.setattr(krylov, "ACTIVE_DENSE_MAX", -1)
     prob, x = pad_in_partial_slip()
     f, J = prob.residual(x.reshape(prob.m, prob.H), True)
     ref = np.linalg.solve(J.toarray(), f)
-    its = {}
-    for mean in (False, True):
+    out = {}
+    for v in variants:
         prob._precond = None
-        prob._mean_gain = mean
+        configure(prob, v)
         _, J = prob.residual(x.reshape(prob.m, prob.H), True)
         s = J.solve(f)
         assert np.abs(s - ref).max() <= 1e-9 * np.abs(ref).max()
-        its[mean] = J.gmres_iterations
-        assert prob._precond.oscillating is not mean
-    assert its[False] < 0.5 * its[True]
+        out[v] = (J, prob._precond)
+    return out
 
 
 def test_failed_oscillating_gains_fall_back_to_the_mean_gain(case, monkeypatch):
@@ -626,17 +641,11 @@ def test_node_correction_halves_gmres_and_keeps_the_step(monkeypatch):
     9 against 32; 6-19 against 8-33 per Newton step on the 1024-node pad of
     benchmarks/scale_3d.py), and without the option the same step with that preconditioner
     alone."""
-    monkeypatch.setattr(krylov, "ACTIVE_DENSE_MAX", -1)
-    prob, x = pad_in_partial_slip()
-    f, J = prob.residual(x.reshape(prob.m, prob.H), True)
-    ref = np.linalg.solve(J.toarray(), f)
-    its = {}
-    for on in (True, False):
-        prob._precond = None
+    def correction(prob, on):
         prob.krylov = KrylovOptions(node_correction=on, node_correction_min_dofs=0)
-        _, J = prob.residual(x.reshape(prob.m, prob.H), True)
-        s = J.solve(f)
-        assert np.abs(s - ref).max() <= 1e-9 * np.abs(ref).max()
+
+    its = {}
+    for on, (J, _) in _partial_slip_steps(monkeypatch, (True, False), correction).items():
         assert J.node_corrected is on
         its[on] = J.gmres_iterations
     assert its[True] < 2 / 3 * its[False], its
