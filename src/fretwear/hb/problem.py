@@ -100,7 +100,8 @@ class DLFTProblem:
         self.P, self.Q = (law.kernel_array(a) for a in basis.matrices())
         # small problems: residual and Jacobian in one compiled call (hb/small.py)
         self.small = self.jacobian == "dense" and self.m * self.H <= small.SMALL_MAX
-        self._normal = law._normal(self.normal, np.empty((nc, d, basis.n_samples)))
+        # the normal force at every sample (the law's kernels take it; Hill's method too)
+        self.normal_samples = law._normal(self.normal, np.empty((nc, d, basis.n_samples)))
         self.tol = periodicity_tol
         self.max_sweeps = max_sweeps
         self.nfev = 0
@@ -179,7 +180,7 @@ class DLFTProblem:
         if self.small:
             return small.time_law(self._flat(U), self.Z, self.F.reshape(-1),
                                   self.W.reshape(-1), self.eps, self.Q, self.mu,
-                                  self._x_start(), self.tol, self.max_sweeps, self._normal,
+                                  self._x_start(), self.tol, self.max_sweeps, self.normal_samples,
                                   self.nc, self.d)
         lu = self.basis.to_time(self.lambda_u(U)).reshape(self.nc, self.d, -1)
         lu = np.ascontiguousarray(lu)
@@ -207,7 +208,7 @@ class DLFTProblem:
         if self.small:
             f, J = small.residual(self._flat(U), self.Z, self.F.reshape(-1),
                                   self.W.reshape(-1), self.eps, self.P, self.Q, self.mu,
-                                  self._x_start(), self.tol, self.max_sweeps, self._normal,
+                                  self._x_start(), self.tol, self.max_sweeps, self.normal_samples,
                                   self.nc, self.d, bool(jacobian))
             return f, (J if jacobian else None)
         lu, lx, state, _ = self.time_law(U)

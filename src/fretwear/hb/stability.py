@@ -768,11 +768,8 @@ class HillProblem:
         self.lx = np.ascontiguousarray(lx)
         self.state = state
         # the law's arrays as the kernel of :func:`shifted_gain` takes them, made once
-        normal = getattr(prob, "_normal", None)  # (the problem's own, made once)
-        if normal is None or normal.shape != self.lu.shape[::2]:
-            normal = law._normal(prob.normal, self.lu)
         self._law = (np.ascontiguousarray(prob.mu, dtype=float), np.ascontiguousarray(prob.P),
-                     np.ascontiguousarray(prob.Q), normal)
+                     np.ascontiguousarray(prob.Q), prob.normal_samples)
         self._summary = None  # the contact states per node (:meth:`_states`)
         # in 2D, G(s) split once into its part free of s and one outer product per stick
         # interval (:mod:`fretwear.hb.memory_gain`; None: the recursion at every s), where
