@@ -99,6 +99,23 @@ class StructureDynamics:
                          if self.q else np.ascontiguousarray(xx, dtype=float))
         return out
 
+    @cached_property
+    def held_modes(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """``(w2, Phi)``: the undamped modes of the structure with its contact points held,
+        ``K^qq Phi = M^qq Phi diag(w2)`` with ``Phi^T M^qq Phi = I``, ascending (made once);
+        None where ``q`` is empty or ``M^qq`` is not positive definite (a massless interior
+        coordinate: no modal basis spans it). The basis in which Hill's method truncates the
+        interior for its candidates (:meth:`fretwear.hb.stability.HillProblem.pencil`)."""
+        if not self.q:
+            return None
+        Kqq = self.blocks["K"][3]
+        Mqq = self.blocks["M"][3]
+        try:
+            w2, Phi = sla.eigh((Kqq + Kqq.T) / 2.0, (Mqq + Mqq.T) / 2.0)
+        except (np.linalg.LinAlgError, ValueError):
+            return None
+        return w2, np.ascontiguousarray(Phi)
+
     def assemble(self, mass, visc, hyst):
         """The blocks ``(xx, xq, qx, qq)`` of ``Z = K + a M + b C + c D`` for the coefficient
         arrays ``a``, ``b``, ``c`` (nl,): complex arrays (nl, ...), each C-ordered."""
