@@ -29,7 +29,10 @@ that the blocks stay quadratic in ``lambda`` (Hill's quadratic problem) and the 
 modes with the contact points held are those of ``(K_qq, M_qq)`` (the nonlinear modes' master
 coordinates). The blocks are dense: ``Z_r(lambda) = Z^xx - Z^xq (Z^qq)^-1 Z^qx`` costs a
 ``q x q`` solve with ``m`` right-hand sides per value of ``lambda`` (batched), and equals the
-balance's condensation through the springs (tests/hb/test_stability.py).
+balance's condensation through the springs (tests/hb/test_stability.py). From
+:data:`MODAL_FROM` interior coordinates, where the modes of the structure with its contact
+points held diagonalise every interior block (proportional or modal damping), the same
+Schur complement is summed over those modes instead (:meth:`StructureDynamics.condensed`).
 """
 
 from __future__ import annotations
