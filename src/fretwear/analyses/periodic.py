@@ -614,8 +614,9 @@ PERIODIC = Analysis.define(
                                 "balance's Jacobian: stable, unstable (and how), or one member "
                                 "of a family of stuck states; in the summary and the "
                                 "attributes `hill_stable`, `floquet_multipliers`, "
-                                "`neutral_directions`, `stability_notes`. Dense: small models "
-                                "(a few hundred DOFs, or a modal condensation)",
+                                "`neutral_directions`, `stability_notes`. Dense on the contact "
+                                "DOFs (a few hundred, times the harmonics; a large interior "
+                                "enters through its low modes)",
                                 default=False),
         **harmonic_balance_fields(PERIODIC_SOLVE, default_of(solve_periodic, "eps"),
                                   "DLFT penalty: " + _EPS_RULES),

@@ -513,9 +513,10 @@ SWEEP = Analysis.define(
                                 "Hill's method on the balance's Jacobian: `stable`, the "
                                 "largest multiplier, the sign of det J, and the folds, "
                                 "period-doubling and Neimark-Sacker points between "
-                                "neighbours; unstable stretches dashed in the figure. Dense: "
-                                "small models (a few hundred DOFs); a point it cannot treat "
-                                "is left unknown with the reason in `stability_notes`",
+                                "neighbours; unstable stretches dashed in the figure. Dense on "
+                                "the contact DOFs (a few hundred, times the harmonics; a large "
+                                "interior enters through its low modes); a point it cannot "
+                                "treat is left unknown with the reason in `stability_notes`",
                                 default=False),
         "points": Field(ListOf(Text(), non_empty=True, unique=True),
                         "observed points to report (default: all)"),

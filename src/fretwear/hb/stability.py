@@ -39,7 +39,14 @@ How they are computed
    whose eigenvalues are computed densely (:func:`quadratic_eigen`: massless coordinates
    eliminated, the blocks the problem decouples into solved apart, a standard eigenvalue
    problem of twice each block's size). Where no node sticks (nor
-   slips in 3D) and the structure is exact, they are the exponents.
+   slips in 3D) and the structure is exact, they are the exponents. On a large structure
+   (:data:`TRUNCATE_FROM` unknowns ``(m + q) H``) the interior is first truncated to the
+   modes of the structure with its contact points held below twice the magnitude cut and
+   the static constraint modes (Craig-Bampton, :func:`truncated_structure`): the modes above
+   only give exponents beyond the cut, and the candidates of the truncated pencil are
+   refined on the exact ``T(s)`` as those of a law with memory are (step 3) (on the virtual
+   beam of benchmarks/nonlinear_modes.py, 28 DOFs at 7 harmonics, the pencil 420 -> 60
+   unknowns: a point's Hill 150-300 -> 10-30 ms).
 2. **Sorting**: the truncated Hill problem has, for every exponent ``s``, copies
    ``s + i j w`` with the eigenvectors ``p e^{-i j w t}``, accurate only while the shifted
    eigenvector still fits in the kept harmonics. Each eigenvector has a harmonic centroid
@@ -49,7 +56,8 @@ How they are computed
    member per family but, for a mode far above ``w``, the member whose eigenvector sits
    ``j`` harmonics off centre, where the truncation acts. At ``Im s = +-w/2`` (a real negative
    multiplier) the two members tie and count once (:data:`EDGE_TOL`).
-3. **Refinement** (a node sticks: the memory matters): in decreasing order of their real
+3. **Refinement** (a node sticks: the memory matters; or the pencil was truncated): in
+   decreasing order of their real
    parts, candidates are refined on the exact ``T(s)`` (condensed on the contact points,
    ``m H`` unknowns) until ``options.refine`` have converged (:func:`_track`: the secant
    method on the eigenvalue of ``T(s)`` whose eigenvector continues the candidate's,
@@ -127,7 +135,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 from numba import njit
-from scipy.linalg.lapack import zgetrf, zgetrs
+from scipy.linalg.lapack import dgecon, dgetrf, dgetrs, zgetrf, zgetrs
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
 
@@ -164,6 +172,17 @@ DENSE_MAX = 1500
 #: this many unknowns ``(m + q) H`` (its companion form has twice as many; beyond, a dense
 #: eigensolve takes minutes)
 PENCIL_MAX = 1500
+#: from this many unknowns ``(m + q) H`` of the candidates' quadratic problem on, its interior
+#: coordinates are truncated to the modes of the structure with its contact points held below
+#: :data:`HELD_CUTOFF` (:func:`truncated_structure`; below, the dense eigensolve is cheap: the
+#: two-DOF oscillator's 155 unknowns take 3 ms)
+TRUNCATE_FROM = 240
+#: the held structure's modes kept for the candidates: circular frequency at most this times
+#: the magnitude cut ``2 (k + 1) + 10`` (in units of ``w``) of the exponents reported; the
+#: modes above would only give exponents beyond the cut, and their omission moves the kept
+#: candidates by about ``(w_candidate / w_dropped)^2`` of their coupling (measured on the
+#: virtual beam: docs/studies/method-costs.md, "Hill's method on a beam")
+HELD_CUTOFF = 2.0
 #: an exponent within this of Im s = +-w/2 (in units of w) is a real negative multiplier: its
 #: conjugate is the other member of its family (the truncated problem puts the two a little
 #: off the line: 1e-4 and 2.1e-3 measured on two two-DOF oscillators near period doubling)
@@ -199,7 +218,8 @@ LOG_NEGLIGIBLE = float(np.log(NEGLIGIBLE))
 class HillOptions:
     """Settings of :func:`hill_stability`.
 
-    refine : when the law has a memory, the candidates are refined on the exact ``T(s)`` in
+    refine : when the law has a memory (or the candidates' pencil is truncated,
+        :func:`truncated_structure`), the candidates are refined on the exact ``T(s)`` in
         decreasing order of their real parts until this many have converged (each with its
         conjugate; the rest stay candidates; 0: none refined).
     step : step of the forward difference of ``T`` in ``s / w`` (Newton's derivative).
@@ -295,10 +315,11 @@ class FloquetResult:
     multipliers : (k,) complex ``e^{s T}`` [-].
     centroid : (k,) harmonic centroid of each eigenvector [-] (:func:`centroid`).
     residual : (k,) relative residual ``|T(s) v| / (|T(s)| |v|)`` (NaN unless refined).
-    kind : (k,) ``"exact"`` (the law has no memory at this solution: the quadratic problem
-        is exact), ``"refined"`` (refined on the exact ``T(s)``), ``"held"`` (a mode in which
-        the contact points do not move: exact, not coupled to the law) or ``"candidate"`` (an
-        eigenvalue of the quadratic problem with the memory frozen, not refined: its
+    kind : (k,) ``"exact"`` (the law has no memory at this solution and the quadratic
+        problem is on the whole structure: it is exact), ``"refined"`` (refined on the exact
+        ``T(s)``), ``"held"`` (a mode in which the contact points do not move: exact, not
+        coupled to the law) or ``"candidate"`` (an eigenvalue of the quadratic problem with
+        the memory frozen, or on a truncated interior, not refined: its
         multiplier is below :data:`NEGLIGIBLE`, or ``options.refine`` exponents with larger
         real parts were refined before it).
     spurious : candidates of the frozen-memory problem near which the exact ``T(s)`` has no
@@ -803,6 +824,25 @@ class HillProblem:
                       if self._fused is not None else None)
         self._dropped = -1.0  # the dropped columns' largest sum, once known (:func:`_evaluate`)
         self.evaluations = 0
+        # the structure the candidates' pencil is formed on, and its interior coordinates'
+        # count (:func:`truncated_structure`), made at the first :meth:`pencil`
+        self._candidates: tuple | None = None
+
+    @property
+    def candidate_structure(self) -> tuple[tuple, int]:
+        """``((K, M, C, D), q)``: the structure the candidates' pencil (:meth:`pencil`) is
+        formed on and its number of interior coordinates: the structure itself, or its
+        interior truncated to the held modes below the cutoff (:func:`truncated_structure`)."""
+        if self._candidates is None:
+            self._candidates = truncated_structure(self._structure, self.dyn, self.prob.H,
+                                                   self.harmonics.size, self.omega)
+        return self._candidates
+
+    @property
+    def truncated(self) -> bool:
+        """The candidates' pencil is on a truncated interior (:attr:`candidate_structure`):
+        its eigenvalues are candidates even where the law has no memory."""
+        return self.candidate_structure[1] < self.dyn.q
 
     def gain(self, sigma: complex) -> np.ndarray:
         """``G(s)`` at ``s = sigma w`` (the solve's own ``G`` at 0)."""
@@ -936,19 +976,70 @@ class HillProblem:
         ``A0 + sigma A1 + sigma^2 A2`` in ``sigma = s / w`` when the law's memory is frozen
         (``G(s) = G(0)``): rows of ``x``: ``eps x - G (eps x - Z^xx x - Z^xq q)``, rows of
         ``q``: ``Z^qx x + Z^qq q``, with ``Z^ab(lambda)`` of ``lambda = w (sigma + i n)``.
-        Exact for a law without memory (:meth:`memoryless`); the hysteretic damping keeps
-        the sign of ``n`` (none on the static coefficient). Compiled (:func:`_pencil`)."""
+        Exact for a law without memory (:meth:`memoryless`) on the whole structure; the
+        hysteretic damping keeps the sign of ``n`` (none on the static coefficient). Formed
+        on :attr:`candidate_structure`: on a large problem (:data:`TRUNCATE_FROM`) ``q`` the
+        held structure's modes below the cutoff only. Compiled (:func:`_pencil`)."""
         dyn, prob, w = self.dyn, self.prob, self.omega
-        if (dyn.m + dyn.q) * prob.H > PENCIL_MAX:
+        (K, M, C, D), q = self.candidate_structure
+        if (dyn.m + q) * prob.H > PENCIL_MAX:
             raise InputError(f"Hill's method solves its quadratic eigenvalue problem densely "
                              f"up to {PENCIL_MAX} unknowns (structure coordinates x kept "
-                             f"harmonics); this one has {(dyn.m + dyn.q) * prob.H}: use fewer "
+                             f"harmonics); this one has {(dyn.m + q) * prob.H}: use fewer "
                              "harmonics or a modal condenser with fewer modes")
         nw = np.ascontiguousarray(prob.basis.orders * w, dtype=float)
-        K, M, C, D = self._structure
         A = _pencil(K, M, C, D, np.ascontiguousarray(self.G0, dtype=float),
                     float(prob.eps), nw, w)
         return A[0], A[1], A[2]
+
+
+def truncated_structure(structure: tuple, dyn: StructureDynamics, H: int, k: int,
+                        omega: float) -> tuple[tuple, int]:
+    """``((K, M, C, D), r)``: the structure's whole matrices (``structure``, on ``(x, q)``)
+    with the interior ``q`` truncated for the candidates' pencil to ``r`` coordinates: the
+    held structure's modes (:attr:`~fretwear.hb.dynamics.StructureDynamics.held_modes`,
+    mass-normalised) of circular frequency at most :data:`HELD_CUTOFF` times the magnitude
+    cut ``2 (k + 1) + 10`` times ``omega`` (``k`` kept harmonics), and the interior's static
+    response to the contact coordinates, ``Psi = -(K^qq)^-1 K^qx`` (zero where ``q`` is
+    already the motion relative to the static shape, :mod:`fretwear.hb.dynamics`; not where
+    contact springs put the structure's DOFs in ``q``): ``[x; q] = [[I, 0], [Psi, Phi_r]]
+    [x; eta]`` (Craig and Bampton's transformation, AIAA J. 6, 1968), each matrix ``T^T X T``
+    (a Galerkin projection: the statics exact, the couplings and the damping projected as
+    they are).
+
+    Why it serves: the family of a mode far from the contact's influence sits near
+    ``i w_j``, so the modes above the cutoff only give exponents beyond the cut, which are not
+    reported; what their omission changes in the kept candidates (the dynamic part of their
+    coupling, of the order of ``(s / w_j)^2``: 1e-4 relative on the beam of
+    tests/hb/test_stability_truncated.py) the refinement on the exact ``T(s)`` removes: every
+    candidate of a truncated pencil is refined or reported as a candidate
+    (:func:`hill_stability`). Without ``Psi`` the same beam's candidates were 5-14 % off and
+    their refinements failed.
+
+    The structure as it is (``r = q``) below :data:`TRUNCATE_FROM` unknowns ``(m + q) H``,
+    without a modal basis of the interior (a massless interior coordinate), with a singular
+    ``K^qq``, or where every mode is kept."""
+    m, q = dyn.m, dyn.q
+    if q == 0 or (m + q) * H < TRUNCATE_FROM:
+        return structure, q
+    modes = dyn.held_modes
+    if modes is None:
+        return structure, q
+    w2, Phi = modes
+    keep = w2 <= (HELD_CUTOFF * (2.0 * (k + 1) + 10.0) * omega) ** 2
+    r = int(np.count_nonzero(keep))
+    if r == q:
+        return structure, q
+    K = structure[0]
+    try:  # the static response of the interior to each contact coordinate
+        Psi = -np.linalg.solve(K[m:, m:], K[m:, :m])
+    except np.linalg.LinAlgError:
+        return structure, q
+    T = np.zeros((m + q, m + r))
+    T[:m, :m] = np.eye(m)
+    T[m:, :m] = Psi
+    T[m:, m:] = Phi[:, keep]
+    return tuple(np.ascontiguousarray(T.T @ X @ T) for X in structure), r
 
 
 @njit(cache=True)
@@ -1704,12 +1795,16 @@ def _companion_eigen(B0: np.ndarray, B1: np.ndarray, B2: np.ndarray):
     a mass): the companion linearisation (:func:`quadratic_eigen`)."""
     nd = B0.shape[0]
     eye, nil = np.eye(nd), np.zeros((nd, nd))
-    try:
-        cond = np.linalg.cond(B2)
-    except np.linalg.LinAlgError:
-        cond = np.inf
+    lu, piv, info = dgetrf(B2)
+    cond = np.inf
+    if info == 0 and np.all(np.isfinite(lu)):
+        # LAPACK's estimate of the 1-norm condition number from the LU that the solve below
+        # reuses (an SVD's 2-norm one cost as much as the eigensolve on a truncated beam's
+        # blocks of 105 unknowns); the two differ by at most a factor nd
+        rcond, _ = dgecon(lu, np.linalg.norm(B2, 1), norm="1")
+        cond = 1.0 / rcond if rcond > 0 else np.inf
     if cond < 1e10:
-        top = np.linalg.solve(B2, np.hstack([B0, B1]))
+        top, _ = dgetrs(lu, piv, np.hstack([B0, B1]))
         vals, Y = np.linalg.eig(np.block([[nil, eye], [-top[:, :nd], -top[:, nd:]]]))
     else:
         vals, Y = sla.eig(np.block([[nil, eye], [-B0, -B1]]),
@@ -2390,7 +2485,7 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
     hp = HillProblem(prob, U, dyn)
     det_sign = hp.det_sign()
     m, H, k = prob.m, prob.H, len(prob.basis.harmonics)
-    q = dyn.q
+    q = hp.candidate_structure[1]  # the interior coordinates of the candidates' pencil
     prev = previous.track if (previous is not None and opt.track) else None
     regime = hp.regime()
     if prev is not None and prev.regime != regime:
@@ -2422,7 +2517,7 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
         track.omega = hp.omega
         if got is not None and prev.omega is not None and hp.omega != prev.omega:
             track.velocity = _velocity(kept, origin[idx], prev.sigma, hp.omega - prev.omega)
-    exact = hp.memoryless() and dyn.exact
+    exact = hp.memoryless() and dyn.exact and not hp.truncated
     sig, kaps, res, kind, spurious = [], [], [], [], []
     refined = 0
     done: list = [None] * idx.size  # the refinements, for the neighbour's warm starts
