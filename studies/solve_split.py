@@ -125,6 +125,14 @@ def main():
     sp.wrap(krylov.KrylovJacobian, "column_norms", "column_norms")
     sp.wrap(krylov.KrylovJacobian, "_active_blocks", "active_blocks")
     sp.wrap(krylov.KrylovJacobian, "solve", "gmres_other")
+    # GMRES's own work, finer: the node-local correction's inverses, the single twin's
+    # making, SciPy's GMRES (its Arnoldi process and what GMRES's operators do beside the
+    # timed products and applies: the node-block products with G); the penalty's power
+    # iterations
+    sp.wrap(krylov, "node_local_inverse", "node_inverse")
+    sp.wrap(krylov.KrylovJacobian, "_single_blocks", "single_twin")
+    sp.wrap(krylov.spla, "gmres", "gmres_arnoldi")
+    sp.wrap(penalty, "_radius", "penalty_power")
     for mod in (penalty, periodic):
         sp.wrap(mod, "penalty", "penalty")
     sp.wrap(preload, "static_anchor", "static_preload")
