@@ -614,6 +614,14 @@ class MeanGainPreconditioner:
         harmonic in one product, kept in ``probe`` (the same vector for all); each later
         step's for every harmonic of ``ns`` in one product and their solves in one call
         (each stored matrix and the factors read once per step, not once per harmonic)."""
+        sizes = cls._probe_sizes(gn, ns, last, eps, Z, probe)
+        return {n: bool(np.isfinite(x) and x <= SHARE_BELOW) for n, x in sizes.items()}
+
+    @classmethod
+    def _probe_sizes(cls, gn, ns, last, eps, Z, probe) -> dict:
+        """``{n: size}``: the power estimate of ``|E|`` of :meth:`_close_all` for each
+        harmonic of ``ns`` (the ratio of the norms of the last two iterates; 0 or not
+        finite where an iterate vanished or overflowed)."""
         b, gb, lu = last
         nc, d, _ = gn.shape
         m = Z.m
@@ -653,7 +661,7 @@ class MeanGainPreconditioner:
                 if np.isfinite(size[ns[i]]) and size[ns[i]] != 0.0:
                     kept.append(i)
             going = kept
-        return {n: bool(np.isfinite(x) and x <= SHARE_BELOW) for n, x in size.items()}
+        return size
 
     def apply(self, r) -> np.ndarray:
         """``P^-1 r``: the harmonics that share factors are solved together, one call with
