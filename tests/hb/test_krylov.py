@@ -669,13 +669,16 @@ def test_gain_block_equals_the_numpy_form(d):
     rows = (nodes[:, None] * d + np.arange(d)).reshape(-1)
     gbar = rng.standard_normal((nodes.size, d, d))
     ref = krylov.MeanGainPreconditioner._block(gbar, Zb[np.ix_(rows, rows)], eps)
-    out = krylov._gain_block(Zb, rows, gbar, eps, np.empty_like(ref))
     scale = np.abs(gbar).max() * np.abs(Zb).max() * d + eps * (1 + np.abs(gbar).max())
-    assert np.abs(out - ref).max() <= 4 * d * np.finfo(float).eps * scale
-    out32 = krylov._gain_block(Zb, rows, gbar, eps, np.empty(ref.shape, np.float32))
-    assert out32.dtype == np.float32
-    np.testing.assert_allclose(out32, ref.astype(np.float32), rtol=2 * np.finfo(np.float32).eps,
-                               atol=4 * d * np.finfo(float).eps * scale)
+    for order in ("C", "F"):  # (the preconditioner's is F: factored in place)
+        out = krylov._gain_block(Zb, rows, gbar, eps, np.empty(ref.shape, order=order))
+        assert np.abs(out - ref).max() <= 4 * d * np.finfo(float).eps * scale
+        out32 = krylov._gain_block(Zb, rows, gbar, eps,
+                                   np.empty(ref.shape, np.float32, order=order))
+        assert out32.dtype == np.float32
+        np.testing.assert_allclose(out32, ref.astype(np.float32),
+                                   rtol=2 * np.finfo(np.float32).eps,
+                                   atol=4 * d * np.finfo(float).eps * scale)
 
 
 def test_preconditioner_on_an_active_view_equals_the_copied_blocks():

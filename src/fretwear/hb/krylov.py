@@ -76,6 +76,9 @@ COLUMN_NORM_PANEL = 96
 #: operator) instead of copies of its m x m matrices (2 x 1.125 GiB at 4096 contact nodes);
 #: a product costs at most (1 / 0.75)^2 = 1.8 times the copy's
 VIEW_FRACTION = 0.75
+#: rows of the preconditioner's block formed at a time by :func:`_gain_block` before they are
+#: written column by column (a buffer of 16 x 3054 doubles, 0.4 MB, at 1024 contact nodes)
+GAIN_ROWS = 16
 
 
 @njit(cache=True)
@@ -143,35 +146,41 @@ def _fma(typingctx, a, b, c):
 def _gain_block(Zb, rows, gbar, eps, out):
     """``out = eps I + gbar (Z - eps I)`` (:meth:`MeanGainPreconditioner._block`) with
     ``Z = Zb[rows][:, rows]`` (``Zb`` real (M, M), ``rows`` (m,); ``gbar`` (nc, d, d), m = nc
-    d), formed in one pass into ``out`` (m, m) of its own type (float32 for single factors):
-    no gathered copy of the block, no double ``P`` and no cast after. Each entry in double,
-    with the operations of the NumPy form (the ``d``-term product as BLAS forms it, the
-    first product rounded, then fused multiply-adds; then ``- eps gbar`` on a node's own
-    block, ``+ eps`` on the diagonal), so that ``out`` is that form's ``P`` rounded to its
-    type (tests/hb/test_krylov.py)."""
+    d), formed in one pass into ``out`` (m, m) of its own type (float32 for single factors)
+    and layout (Fortran order: LAPACK factors it in place): no gathered copy of the block,
+    no double ``P`` and no cast or copy after. Each entry in double, with the operations of
+    the NumPy form (the ``d``-term product as BLAS forms it, the first product rounded, then
+    fused multiply-adds; then ``- eps gbar`` on a node's own block, ``+ eps`` on the
+    diagonal), so that ``out`` is that form's ``P`` rounded to its type (tests/hb/
+    test_krylov.py). The rows of a few nodes at a time (:data:`GAIN_ROWS`) are formed in
+    a buffer and written column by column: contiguous in Fortran order."""
     nc, d = gbar.shape[0], gbar.shape[1]
     m = rows.size
-    acc = np.empty(m)
-    for p in range(nc):
-        for i in range(d):
-            a = p * d + i
-            g = gbar[p, i, 0]
-            z = Zb[rows[p * d]]
-            for c in range(m):
-                acc[c] = g * z[rows[c]]
-            for j in range(1, d):
-                g = gbar[p, i, j]
-                z = Zb[rows[p * d + j]]
+    per = max(1, GAIN_ROWS // d)  # nodes per buffer
+    acc = np.empty((per * d, m))
+    for p0 in range(0, nc, per):
+        p1 = min(p0 + per, nc)
+        for p in range(p0, p1):
+            for i in range(d):
+                a = (p - p0) * d + i
+                g = gbar[p, i, 0]
+                z = Zb[rows[p * d]]
+                t = acc[a]
                 for c in range(m):
-                    acc[c] = _fma(g, z[rows[c]], acc[c])
-            for j in range(d):
-                acc[p * d + j] = acc[p * d + j] - eps * gbar[p, i, j]
-            acc[a] = acc[a] + eps
-            o = out[a]
-            for c in range(m):
-                o[c] = acc[c]
+                    t[c] = g * z[rows[c]]
+                for j in range(1, d):
+                    g = gbar[p, i, j]
+                    z = Zb[rows[p * d + j]]
+                    for c in range(m):
+                        t[c] = _fma(g, z[rows[c]], t[c])
+                for j in range(d):
+                    t[p * d + j] = t[p * d + j] - eps * gbar[p, i, j]
+                t[p * d + i] = t[p * d + i] + eps
+        r0, nr = p0 * d, (p1 - p0) * d
+        for c in range(m):
+            for a in range(nr):
+                out[r0 + a, c] = acc[a, c]
     return out
-
 
 class HarmonicBlocks:
     """``Z~`` of the real Fourier basis held as its complex per-harmonic blocks (nb, m, m).
@@ -567,7 +576,7 @@ class MeanGainPreconditioner:
         else by :meth:`_block` and a cast."""
         if Z.real and hasattr(Z, "block_source"):
             src, rows = Z.block_source(b)
-            P = np.empty((Z.m, Z.m), dtype=np.float32 if single else np.float64)
+            P = np.empty((Z.m, Z.m), dtype=np.float32 if single else np.float64, order="F")
             return _gain_block(src, np.ascontiguousarray(rows, dtype=np.int64),
                                np.ascontiguousarray(g, dtype=np.float64), float(eps), P)
         P = cls._block(g, Z.Z0 if b == 0 else Z.block(b), eps)
