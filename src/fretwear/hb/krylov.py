@@ -19,8 +19,10 @@ block-diagonal per node), so the preconditioner is ``k + 1`` dense LUs of ``m_a 
 :class:`fretwear.hb.options.KrylovOptions`). It is exact for
 nodes whose gain does not vary over the period and for a linear interface; it is kept
 while the active set does not change and rebuilt when GMRES slows down. Its sharing test
-multiplies by the blocks without forming them (``block_products``): a block is formed only
-to be factored. On large active sets it is followed by a node-local correction
+multiplies by the blocks without forming them (``block_products``, the later harmonics'
+probes in one product per step): a block is formed only to be factored, in one compiled
+pass from the whole block and the active rows into the factors' type and layout
+(:func:`_gain_block`). On large active sets it is followed by a node-local correction
 (:func:`node_local_inverse`, ``KrylovOptions.node_correction``): ``Q = eps I + G (Z_D - eps
 I)`` with each node's own blocks of ``Z~``, exact in the coupling of a node's harmonics by
 its time-varying gain, which the mean gain drops; the two combined multiplicatively halved
