@@ -6,8 +6,12 @@ One size in one process, as ``scale_3d.py`` runs it (warm-up, condensation, stat
 the products with the condensed operator (``Z~ U``, ``Z~^T U``, the stuck part's
 ``apply_sub``), the preconditioner's builds and applies, the contact law's evaluations
 (time samples and their Jacobian blocks), the FFTs, the column norms, the active blocks'
-copies, the penalty estimate and the static preload; what is left of the solve is GMRES's
-own work (orthogonalisation, the node-block products) and Powell's bookkeeping. A timer
+copies, the penalty estimate (its power iterations apart: ``penalty_power``) and the static
+preload; GMRES's own work split into the node-local correction's inverses
+(``node_inverse``), the single-precision twin's making (``single_twin``), SciPy's GMRES
+with what its operators do beside the timed products and applies (``gmres_arnoldi``: the
+Arnoldi process and the node-block products with ``G``) and the rest (``gmres_other``: the
+reduction to the active nodes); what is left of the solve is Powell's bookkeeping. A timer
 inside another pauses it (the parts add up to the solve). Prints one JSON line.
 
     PYTHONPATH=$PWD/src OPENBLAS_NUM_THREADS=1 python studies/solve_split.py 32 [VARIANT ...]
@@ -125,6 +129,14 @@ def main():
     sp.wrap(krylov.KrylovJacobian, "column_norms", "column_norms")
     sp.wrap(krylov.KrylovJacobian, "_active_blocks", "active_blocks")
     sp.wrap(krylov.KrylovJacobian, "solve", "gmres_other")
+    # GMRES's own work, finer: the node-local correction's inverses, the single twin's
+    # making, SciPy's GMRES (its Arnoldi process and what GMRES's operators do beside the
+    # timed products and applies: the node-block products with G); the penalty's power
+    # iterations
+    sp.wrap(krylov, "node_local_inverse", "node_inverse")
+    sp.wrap(krylov.KrylovJacobian, "_single_blocks", "single_twin")
+    sp.wrap(krylov.spla, "gmres", "gmres_arnoldi")
+    sp.wrap(penalty, "_radius", "penalty_power")
     for mod in (penalty, periodic):
         sp.wrap(mod, "penalty", "penalty")
     sp.wrap(preload, "static_anchor", "static_preload")

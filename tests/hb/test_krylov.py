@@ -649,3 +649,109 @@ def test_node_correction_halves_gmres_and_keeps_the_step(monkeypatch):
         assert J.node_corrected is on
         its[on] = J.gmres_iterations
     assert its[True] < 2 / 3 * its[False], its
+
+
+@pytest.mark.parametrize("d", [2, 3])
+def test_gain_block_equals_the_numpy_form(d):
+    """``krylov._gain_block`` (the compiled one-pass form of the preconditioner's block from
+    a whole block and the active rows) against ``MeanGainPreconditioner._block`` (NumPy's
+    batched product, then the eps terms) on the gathered block ``Zb[rows][:, rows]``: the
+    previous code path. In double to ``4 d`` roundings of the largest term (both sum ``d``
+    products; on the machine of docs/studies/large-interface-solve.md they are equal bit for
+    bit, which the solves there show), in single as that double block cast (one rounding of
+    float32). A fault in the gather (rows or columns), the eps terms or the gain's index
+    moves entries by O(1)."""
+    rng = np.random.default_rng(11)
+    nc_all, eps = 30, 3.0
+    M = nc_all * d
+    Zb = rng.standard_normal((M, M))
+    nodes = np.sort(rng.choice(nc_all, size=22, replace=False))
+    rows = (nodes[:, None] * d + np.arange(d)).reshape(-1)
+    gbar = rng.standard_normal((nodes.size, d, d))
+    ref = krylov.MeanGainPreconditioner._block(gbar, Zb[np.ix_(rows, rows)], eps)
+    scale = np.abs(gbar).max() * np.abs(Zb).max() * d + eps * (1 + np.abs(gbar).max())
+    for order in ("C", "F"):  # (the preconditioner's is F: factored in place)
+        out = krylov._gain_block(Zb, rows, gbar, eps, np.empty(ref.shape, order=order))
+        assert np.abs(out - ref).max() <= 4 * d * np.finfo(float).eps * scale
+        out32 = krylov._gain_block(Zb, rows, gbar, eps,
+                                   np.empty(ref.shape, np.float32, order=order))
+        assert out32.dtype == np.float32
+        np.testing.assert_allclose(out32, ref.astype(np.float32),
+                                   rtol=2 * np.finfo(np.float32).eps,
+                                   atol=4 * d * np.finfo(float).eps * scale)
+
+
+def test_preconditioner_on_an_active_view_equals_the_copied_blocks():
+    """The preconditioner built on an active view of an operator's blocks (``_ActiveView``:
+    ``P_b`` formed from the whole block and the active DOFs by ``block_source``) has the
+    factors of the one built on the copied active blocks (``HarmonicBlocks.sub``), bit for
+    bit in single and double: the same entries formed from the same numbers; and its
+    applies equal the dense solves of ``P_n`` formed by ``_block`` from the copied blocks
+    (1e-10: condition numbers below 1e3). A wrong row or column of the view moves the
+    factors."""
+    rng = np.random.default_rng(5)
+    nc, d, nb = 24, 3, 3
+    m = nc * d
+    A = rng.standard_normal((m, m))
+    K = A @ A.T / m + 3 * np.eye(m)
+    Zr = np.stack([K - 0.2 * b * np.eye(m) for b in range(nb)])
+    Z = krylov.HarmonicBlocks(Zr)
+    act = np.array([0, 2, 3, 5, 7, 8, 11, 13, 14, 17, 19, 20, 21, 23])
+    dofs = (act[:, None] * d + np.arange(d)).reshape(-1)
+    view, sub = krylov._ActiveView(Z, dofs), Z.sub(dofs)
+    gbar = rng.uniform(0.2, 1.0, (act.size, 1, 1)) * np.eye(d)
+    eps = 2.0
+    for single in (False, True):  # (_gain_block casts to the factors' type)
+        pv = krylov.MeanGainPreconditioner(gbar, view, eps, share=False, single=single)
+        ps = krylov.MeanGainPreconditioner(gbar, sub, eps, share=False, single=single)
+        for a, b in zip(pv.factors, ps.factors, strict=True):
+            assert a[0].dtype == (np.float32 if single else np.float64)
+            assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1])
+    r = rng.standard_normal((dofs.size, sub.H))
+    pd = krylov.MeanGainPreconditioner(gbar, view, eps, share=False)
+    out = pd.apply(r).reshape(-1, sub.H)
+    for b, cols in ((0, [0]), (1, [1, 3]), (2, [2, 4])):
+        P = krylov.MeanGainPreconditioner._block(gbar, Zr[b][np.ix_(dofs, dofs)], eps)
+        ref = np.linalg.solve(P, r[:, cols])
+        np.testing.assert_allclose(out[:, cols], ref, rtol=0, atol=1e-10 * np.abs(ref).max())
+
+
+@pytest.mark.parametrize("same_gain", [True, False])
+def test_probe_sizes_equal_the_dense_power_estimate(same_gain):
+    """``MeanGainPreconditioner._probe_sizes`` (the sharing test's two power steps for
+    several harmonics at once, their products in one call and their solves in one) against
+    the same two steps with ``E = P_b^-1 (P_n - P_b)`` formed densely (numpy's solve of the
+    blocks formed by ``_block``), from the same start vector: to 1e-10 (condition numbers
+    below 1e2: rounding of a few 1e-15); and the batch equals the harmonics probed one at a
+    time (``_close``'s call) to 1e-12. With one gain for both or the mean gain on ``P_b``
+    and another on ``P_n`` (harmonic 0 against 1). A column of another harmonic, a product
+    with the wrong block or a stale iterate changes the sizes by O(1)."""
+    rng = np.random.default_rng(7)
+    nc, d = 20, 2
+    m = nc * d
+    A = rng.standard_normal((m, m))
+    K = A @ A.T / m + 2 * np.eye(m)
+    Mm = np.eye(m) + 0.1 * np.diag(rng.uniform(size=m))
+    w2 = np.array([0.0, 0.05, 0.1, 1.2, 1.3])
+    Zr = np.stack([K - x * Mm for x in w2])
+    Z = krylov.HarmonicBlocks(Zr)
+    eps = 3.0
+    gbar = rng.uniform(0.3, 1.0, (nc, 1, 1)) * np.eye(d)
+    gosc = gbar if same_gain else rng.uniform(0.1, 0.9, (nc, 1, 1)) * np.eye(d)
+    b = 0 if not same_gain else 1
+    gb = gbar if b == 0 else gosc
+    Pb = krylov.MeanGainPreconditioner._block(gb, Zr[b], eps)
+    lu = krylov.sla.lu_factor(Pb)
+    ns = [2, 3, 4] if same_gain else [1, 2, 3, 4]
+    sizes = krylov.MeanGainPreconditioner._probe_sizes(gosc, ns, (b, gb, lu), eps, Z, {})
+    v0 = np.random.default_rng(0).standard_normal(m)  # the probe's start
+    for n in ns:
+        E = np.linalg.solve(Pb, krylov.MeanGainPreconditioner._block(gosc, Zr[n], eps) - Pb)
+        w1 = E @ v0
+        ref = np.linalg.norm(E @ w1) / np.linalg.norm(w1)
+        assert krylov.SHARE_PROBES == 2
+        assert abs(sizes[n] - ref) <= 1e-10 * ref, (n, sizes[n], ref)
+        one = krylov.MeanGainPreconditioner._probe_sizes(gosc, [n], (b, gb, lu), eps, Z, {})
+        assert abs(one[n] - sizes[n]) <= 1e-12 * ref
+    # both sides of the threshold occur (the test would not see a wrong decision otherwise)
+    assert min(sizes.values()) < krylov.SHARE_BELOW < max(sizes.values())

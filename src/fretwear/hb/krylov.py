@@ -19,8 +19,10 @@ block-diagonal per node), so the preconditioner is ``k + 1`` dense LUs of ``m_a 
 :class:`fretwear.hb.options.KrylovOptions`). It is exact for
 nodes whose gain does not vary over the period and for a linear interface; it is kept
 while the active set does not change and rebuilt when GMRES slows down. Its sharing test
-multiplies by the blocks without forming them (``block_products``): a block is formed only
-to be factored. On large active sets it is followed by a node-local correction
+multiplies by the blocks without forming them (``block_products``, the later harmonics'
+probes in one product per step): a block is formed only to be factored, in one compiled
+pass from the whole block and the active rows into the factors' type and layout
+(:func:`_gain_block`). On large active sets it is followed by a node-local correction
 (:func:`node_local_inverse`, ``KrylovOptions.node_correction``): ``Q = eps I + G (Z_D - eps
 I)`` with each node's own blocks of ``Z~``, exact in the coupling of a node's harmonics by
 its time-varying gain, which the mean gain drops; the two combined multiplicatively halved
@@ -39,7 +41,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse.linalg as spla
-from numba import njit
+from numba import njit, types
+from numba.extending import intrinsic
 
 from fretwear.hb.solvers import KRYLOV
 
@@ -75,6 +78,9 @@ COLUMN_NORM_PANEL = 96
 #: operator) instead of copies of its m x m matrices (2 x 1.125 GiB at 4096 contact nodes);
 #: a product costs at most (1 / 0.75)^2 = 1.8 times the copy's
 VIEW_FRACTION = 0.75
+#: rows of the preconditioner's block formed at a time by :func:`_gain_block` before they are
+#: written column by column (a buffer of 16 x 3054 doubles, 0.4 MB, at 1024 contact nodes)
+GAIN_ROWS = 16
 
 
 @njit(cache=True)
@@ -127,6 +133,57 @@ def _gram_quad_real3(A, rows, M, c0, c1, out):
     return out
 
 
+@intrinsic
+def _fma(typingctx, a, b, c):
+    """``a b + c`` rounded once (LLVM's ``fma``), for float64 arguments."""
+    sig = types.float64(types.float64, types.float64, types.float64)
+
+    def codegen(context, builder, signature, args):
+        return builder.fma(*args)
+
+    return sig, codegen
+
+
+@njit(cache=True)
+def _gain_block(Zb, rows, gbar, eps, out):
+    """``out = eps I + gbar (Z - eps I)`` (:meth:`MeanGainPreconditioner._block`) with
+    ``Z = Zb[rows][:, rows]`` (``Zb`` real (M, M), ``rows`` (m,); ``gbar`` (nc, d, d), m = nc
+    d), formed in one pass into ``out`` (m, m) of its own type (float32 for single factors)
+    and layout (Fortran order: LAPACK factors it in place): no gathered copy of the block,
+    no double ``P`` and no cast or copy after. Each entry in double, with the operations of
+    the NumPy form (the ``d``-term product as BLAS forms it, the first product rounded, then
+    fused multiply-adds; then ``- eps gbar`` on a node's own block, ``+ eps`` on the
+    diagonal), so that ``out`` is that form's ``P`` rounded to its type (tests/hb/
+    test_krylov.py). The rows of a few nodes at a time (:data:`GAIN_ROWS`) are formed in
+    a buffer and written column by column: contiguous in Fortran order."""
+    nc, d = gbar.shape[0], gbar.shape[1]
+    m = rows.size
+    per = max(1, GAIN_ROWS // d)  # nodes per buffer
+    acc = np.empty((per * d, m))
+    for p0 in range(0, nc, per):
+        p1 = min(p0 + per, nc)
+        for p in range(p0, p1):
+            for i in range(d):
+                a = (p - p0) * d + i
+                g = gbar[p, i, 0]
+                z = Zb[rows[p * d]]
+                t = acc[a]
+                for c in range(m):
+                    t[c] = g * z[rows[c]]
+                for j in range(1, d):
+                    g = gbar[p, i, j]
+                    z = Zb[rows[p * d + j]]
+                    for c in range(m):
+                        t[c] = _fma(g, z[rows[c]], t[c])
+                for j in range(d):
+                    t[p * d + j] = t[p * d + j] - eps * gbar[p, i, j]
+                t[p * d + i] = t[p * d + i] + eps
+        r0, nr = p0 * d, (p1 - p0) * d
+        for c in range(m):
+            for a in range(nr):
+                out[r0 + a, c] = acc[a, c]
+    return out
+
 class HarmonicBlocks:
     """``Z~`` of the real Fourier basis held as its complex per-harmonic blocks (nb, m, m).
 
@@ -167,6 +224,12 @@ class HarmonicBlocks:
     def block(self, b: int) -> np.ndarray:
         """Block ``b`` as the products use it: real (:attr:`Zr`) when :attr:`real`."""
         return self.Zr[b] if self.real else self.Zc[b]
+
+    def block_source(self, b: int) -> tuple[np.ndarray, np.ndarray]:
+        """``(A, r)`` with block ``b`` (as :meth:`block`, ``Z0`` for 0) equal to ``A[r][:, r]``:
+        the block itself and every row here; an active view gives its operator's block and
+        its DOFs (:class:`MeanGainPreconditioner` forms ``P_b`` from it without a copy)."""
+        return (self.Z0 if b == 0 else self.block(b)), np.arange(self.m)
 
     def row_block(self, b: int, dofs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(A, r)`` with row ``r[i]`` of ``A`` the row ``dofs[i]`` of block ``b`` (as
@@ -374,18 +437,32 @@ def harmonic_gains(G: np.ndarray, d: int, oscillating: bool = True):
 def node_local_inverse(G: np.ndarray, diag: list, eps: float) -> np.ndarray | None:
     """``Q^-1`` (na, dH, dH) of the node-local part of the Jacobian, ``Q = eps I + G
     (Z_D - eps I)``, with ``Z_D`` the diagonal node blocks of ``Z~`` (each node's own ``d x
-    d`` block of every harmonic, ``diag[b]`` (na, d, d), on the real Fourier basis: harmonic
-    ``n`` maps ``(a_n, b_n)`` by ``[[X, Y], [-Y, X]]``, ``Z_n = X + i Y``, as
-    :func:`fretwear.hb.reduce.to_real_blocks`) and ``G`` (na, dH, dH) the node blocks of the
-    law (eq. 22-28). ``Q`` is exact in what :class:`MeanGainPreconditioner` drops, the
-    coupling of a node's harmonics by its time-varying gain, and drops what that keeps, the
-    coupling of the nodes through ``Z``: the two combined (:meth:`KrylovJacobian.
-    _node_correction`) halved the GMRES iterations of the partial-slip pad
-    (docs/studies/large-interface-solve.md, "The preconditioner's builds and a node-local
-    correction"). None where a ``Q`` is singular or not finite."""
+    d`` block of every harmonic, ``diag[b]`` (na, d, d), on the real Fourier basis:
+    :func:`_node_diagonal_real`) and ``G`` (na, dH, dH) the node blocks of the law (eq.
+    22-28). ``Q`` is exact in what :class:`MeanGainPreconditioner` drops, the coupling of a
+    node's harmonics by its time-varying gain, and drops what that keeps, the coupling of
+    the nodes through ``Z``: the two combined (:meth:`KrylovJacobian._node_correction`)
+    halved the GMRES iterations of the partial-slip pad (docs/studies/
+    large-interface-solve.md, "The preconditioner's builds and a node-local correction").
+    None where a ``Q`` is singular or not finite."""
     na, dH, _ = G.shape
     d = diag[0].shape[1]
-    H = dH // d
+    W = _node_diagonal_real(diag, d, dH // d)
+    W[:, np.arange(dH), np.arange(dH)] -= eps
+    Q = np.matmul(G, W)
+    Q[:, np.arange(dH), np.arange(dH)] += eps
+    try:
+        Qi = np.linalg.inv(Q)
+    except np.linalg.LinAlgError:
+        return None
+    return Qi if np.all(np.isfinite(Qi)) else None
+
+
+def _node_diagonal_real(diag: list, d: int, H: int) -> np.ndarray:
+    """``Z~_D`` (na, dH, dH): the diagonal node blocks ``diag[b]`` (na, d, d) of every
+    harmonic on the real Fourier basis (harmonic ``n`` maps ``(a_n, b_n)`` by ``[[X, Y], [-Y,
+    X]]``, ``Z_n = X + i Y``, as :func:`fretwear.hb.reduce.to_real_blocks`)."""
+    na = diag[0].shape[0]
     k = (H - 1) // 2
     W = np.zeros((na, d, H, d, H))
     W[:, :, 0, :, 0] = diag[0].real
@@ -397,15 +474,20 @@ def node_local_inverse(G: np.ndarray, diag: list, eps: float) -> np.ndarray | No
             Y = diag[b].imag
             W[:, :, b, :, k + b] = Y
             W[:, :, k + b, :, b] = -Y
-    W = W.reshape(na, dH, dH)
-    W[:, np.arange(dH), np.arange(dH)] -= eps
-    Q = np.matmul(G, W)
-    Q[:, np.arange(dH), np.arange(dH)] += eps
-    try:
-        Qi = np.linalg.inv(Q)
-    except np.linalg.LinAlgError:
-        return None
-    return Qi if np.all(np.isfinite(Qi)) else None
+    return W.reshape(na, d * H, d * H)
+
+
+def _step_operator(Z, G, eps, na, dH):
+    """``v -> J_aa v = eps v + G_a (Z_aa v - eps v)`` (eq. 22 on the active nodes) for
+    GMRES: ``Z`` the active blocks (``apply``), ``G`` the active node blocks (na, dH,
+    dH)."""
+
+    def matvec(v):
+        v = np.asarray(v, float).reshape(-1)
+        y = (Z.apply(v).reshape(-1) - eps * v).reshape(na, dH)
+        return eps * v + np.matmul(G, y[:, :, None])[:, :, 0].reshape(-1)
+
+    return matvec
 
 
 def _lu_solve(lu, b):
@@ -447,7 +529,8 @@ class MeanGainPreconditioner:
         # the bound every further harmonic shares the last factors
         budget = getattr(Z, "factor_budget", None)
         most = Z.nb if budget is None else max(1, int(budget // (8 * Z.m * Z.m)))
-        probe = {}  # the sharing test's first products, made once (_close)
+        probe = {}  # the sharing test's first products, made once (_close_all)
+        close = {}  # the sharing test's answers for the last factors, made at once
         for b in range(Z.nb):
             full = last is not None and len({id(f) for f in self.factors}) >= most
             if full:  # (the block is not formed: m^2 memory and time for nothing)
@@ -455,19 +538,20 @@ class MeanGainPreconditioner:
                 self.shared += 1
                 continue
             g = gbar if b == 0 else gosc
-            # (the test by products: a block is formed only to be factored)
-            if share and last is not None and self._close(g, b, last, eps, Z, probe):
+            # (the test by products: a block is formed only to be factored; the harmonics
+            # after b that take the same gain are tested with it, against the same factors)
+            if share and last is not None and b not in close:
+                later = [n for n in range(b, Z.nb) if (gbar if n == 0 else gosc) is g]
+                close = self._close_all(g, later, last, eps, Z, probe)
+            if share and last is not None and close[b]:
                 self.factors.append(last[2])
                 self.shared += 1
                 continue
-            Zb = Z.Z0 if b == 0 else Z.block(b)
-            P = self._block(g, Zb, eps)
-            if single:
-                P = P.astype(np.complex64 if np.iscomplexobj(P) else np.float32)
-            del Zb
+            P = self._gain_block(g, Z, b, eps, single)
             lu = sla.lu_factor(P, overwrite_a=True, check_finite=False)
             self.factors.append(lu)
             last = (b, g, lu)
+            close = {}  # (answers for the factors before)
         # the harmonics of each set of factors, solved together by apply()
         groups: dict = {}
         for b, lu in enumerate(self.factors):
@@ -486,31 +570,69 @@ class MeanGainPreconditioner:
         P[np.diag_indices(m)] += eps
         return P
 
+    @classmethod
+    def _gain_block(cls, g, Z, b, eps, single):
+        """``P_b`` (:meth:`_block`) of the gain ``g``, in single precision if ``single``:
+        on real blocks by the compiled :func:`_gain_block` from the block's source
+        (``Z.block_source``: an active view's whole block and its rows, no gathered copy),
+        else by :meth:`_block` and a cast."""
+        if Z.real and hasattr(Z, "block_source"):
+            src, rows = Z.block_source(b)
+            P = np.empty((Z.m, Z.m), dtype=np.float32 if single else np.float64, order="F")
+            return _gain_block(src, np.ascontiguousarray(rows, dtype=np.int64),
+                               np.ascontiguousarray(g, dtype=np.float64), float(eps), P)
+        P = cls._block(g, Z.Z0 if b == 0 else Z.block(b), eps)
+        if single:
+            P = P.astype(np.complex64 if np.iscomplexobj(P) else np.float32)
+        return P
+
     @staticmethod
     def _solve(lu, b):
-        """``P^-1 b`` by the factors ``lu``; a complex ``b`` with real factors as its real and
-        imaginary parts (a mixed call would copy the factors to complex)."""
+        """``P^-1 b`` by the factors ``lu`` (``b`` (m,) or (m, r)); a complex ``b`` with real
+        factors as its real and imaginary parts (a mixed call would copy the factors to
+        complex)."""
         if np.iscomplexobj(b) and not np.iscomplexobj(lu[0]):
-            y = _lu_solve(lu, np.column_stack([b.real, b.imag]))
-            return y[:, 0] + 1j * y[:, 1]
+            if b.ndim == 1:
+                y = _lu_solve(lu, np.column_stack([b.real, b.imag]))
+                return y[:, 0] + 1j * y[:, 1]
+            r = b.shape[1]
+            y = _lu_solve(lu, np.hstack([b.real, b.imag]))
+            return y[:, :r] + 1j * y[:, r:]
         return _lu_solve(lu, b)
 
     @classmethod
     def _close(cls, gn, n, last, eps, Z, probe) -> bool:
         """Whether the factors of ``P_b`` (``last`` = ``(b, g_b, LU)``) precondition ``P_n``
-        (gain ``gn``) well: ``P_b^-1 P_n = I + E`` with ``E = P_b^-1 (P_n - P_b)``, which is
-        ``P_b^-1 g (Z_n - Z_b)`` when both take the same gain ``g``, and GMRES on it
-        converges about as fast as on ``I`` when ``E`` is small. Its size is estimated by
-        :data:`SHARE_PROBES` steps of the power iteration from a fixed random vector
-        (``2 SHARE_PROBES`` products and solves of ``m^2`` operations, against the ``m^3``
-        of an LU): shared when below :data:`SHARE_BELOW`. An isolated large eigenvalue of
-        ``E`` that the probe misses costs GMRES about one iteration.
+        (gain ``gn``) well (:meth:`_close_all` for the one harmonic ``n``)."""
+        return cls._close_all(gn, [n], last, eps, Z, probe)[n]
+
+    @classmethod
+    def _close_all(cls, gn, ns, last, eps, Z, probe) -> dict:
+        """``{n: close}`` for the harmonics ``ns`` (of one gain ``gn``): whether the factors
+        of ``P_b`` (``last`` = ``(b, g_b, LU)``) precondition ``P_n`` well: ``P_b^-1 P_n = I
+        + E`` with ``E = P_b^-1 (P_n - P_b)``, which is ``P_b^-1 g (Z_n - Z_b)`` when both
+        take the same gain ``g``, and GMRES on it converges about as fast as on ``I`` when
+        ``E`` is small. Its size is estimated by :data:`SHARE_PROBES` steps of the power
+        iteration from a fixed random vector (``2 SHARE_PROBES`` products and solves of
+        ``m^2`` operations, against the ``m^3`` of an LU): shared when below
+        :data:`SHARE_BELOW`. An isolated large eigenvalue of ``E`` that the probe misses
+        costs GMRES about one iteration.
 
         The products ``Z_n v``, ``Z_b v`` are taken from ``Z`` (its ``block_products``)
         without forming the blocks: on an operator's blocks (hb/operator_blocks.py) a
         formed block costs several passes over ``m x m`` arrays and its page faults, a
         product one pass over the stored matrices. The first step's are made for every
-        harmonic in one product, kept in ``probe`` (the same vector for all)."""
+        harmonic in one product, kept in ``probe`` (the same vector for all); each later
+        step's for every harmonic of ``ns`` in one product and their solves in one call
+        (each stored matrix and the factors read once per step, not once per harmonic)."""
+        sizes = cls._probe_sizes(gn, ns, last, eps, Z, probe)
+        return {n: bool(np.isfinite(x) and x <= SHARE_BELOW) for n, x in sizes.items()}
+
+    @classmethod
+    def _probe_sizes(cls, gn, ns, last, eps, Z, probe) -> dict:
+        """``{n: size}``: the power estimate of ``|E|`` of :meth:`_close_all` for each
+        harmonic of ``ns`` (the ratio of the norms of the last two iterates; 0 or not
+        finite where an iterate vanished or overflowed)."""
         b, gb, lu = last
         nc, d, _ = gn.shape
         m = Z.m
@@ -518,25 +640,39 @@ class MeanGainPreconditioner:
             v0 = np.random.default_rng(0).standard_normal(m)
             probe["v"] = v0
             probe["Zv"] = Z.block_products(np.arange(Z.nb), np.repeat(v0[:, None], Z.nb, 1))
-        v = probe["v"]
-        size = 0.0
+        ns = list(ns)
+        V = np.repeat(probe["v"][:, None], len(ns), 1)
+        size = dict.fromkeys(ns, 0.0)
+        going = list(range(len(ns)))  # columns of V still iterated
         for step in range(SHARE_PROBES):
-            if step == 0:
-                zn, zb = probe["Zv"][:, n], probe["Zv"][:, b]
-            else:
-                zz = Z.block_products([n, b], np.column_stack([v, v]))
-                zn, zb = zz[:, 0], zz[:, 1]
-            if gn is gb:
-                y = np.matmul(gn, (zn - zb).reshape(nc, d, 1))
-            else:
-                y = (np.matmul(gn, (zn - eps * v).reshape(nc, d, 1))
-                     - np.matmul(gb, (zb - eps * v).reshape(nc, d, 1)))
-            w = cls._solve(lu, y[:, :, 0].reshape(-1))
-            size = float(np.linalg.norm(w) / np.linalg.norm(v))
-            v = w
-            if not np.isfinite(size) or size == 0.0:
+            if not going:
                 break
-        return bool(np.isfinite(size) and size <= SHARE_BELOW)
+            if step == 0:
+                zn = probe["Zv"][:, [ns[i] for i in going]]
+                zb = np.repeat(probe["Zv"][:, [b]], len(going), 1)
+            else:
+                blocks = [x for i in going for x in (ns[i], b)]
+                zz = Z.block_products(blocks, np.repeat(V[:, going], 2, axis=1))
+                zn, zb = zz[:, 0::2], zz[:, 1::2]
+            Vg = V[:, going]
+            r = len(going)
+            if gn is gb:
+                y = np.matmul(gn, (zn - zb).reshape(nc, d, r))
+            else:
+                y = (np.matmul(gn, (zn - eps * Vg).reshape(nc, d, r))
+                     - np.matmul(gb, (zb - eps * Vg).reshape(nc, d, r)))
+            W = cls._solve(lu, y.reshape(m, r))
+            if np.iscomplexobj(W) and not np.iscomplexobj(V):
+                V = V.astype(W.dtype)
+            kept = []
+            for t, i in enumerate(going):
+                w = W[:, t]
+                size[ns[i]] = float(np.linalg.norm(w) / np.linalg.norm(V[:, i]))
+                V[:, i] = w
+                if np.isfinite(size[ns[i]]) and size[ns[i]] != 0.0:
+                    kept.append(i)
+            going = kept
+        return size
 
     def apply(self, r) -> np.ndarray:
         """``P^-1 r``: the harmonics that share factors are solved together, one call with
@@ -840,13 +976,8 @@ class KrylovJacobian:
         Ga = self.G[act]
         na = act.size
         n = na * dH
-
-        def matvec(v):
-            v = np.asarray(v, float).reshape(-1)
-            y = (Zp.apply(v).reshape(-1) - eps * v).reshape(na, dH)
-            return eps * v + np.matmul(Ga, y[:, :, None])[:, :, 0].reshape(-1)
-
-        A = spla.LinearOperator((n, n), matvec=matvec, dtype=float)
+        A = spla.LinearOperator((n, n), matvec=_step_operator(Zp, Ga, eps, na, dH),
+                                dtype=float)
         correct = None
         if opts.node_correction and na * self.d >= opts.node_correction_min_dofs:
             correct = self._node_correction(act, Ga, Za)
@@ -865,22 +996,19 @@ class KrylovJacobian:
 
     def _node_correction(self, act, Ga, Za):
         """The node-local correction of the preconditioner on the active nodes ``act``
-        (:func:`node_local_inverse`), as a function of the preconditioner's ``apply``
-        returning the two combined: ``x = Q^-1 r``, then ``x + P^-1 (r - J x)`` (a
-        multiplicative two-level preconditioner: ``Q`` exact in the coupling of a node's
-        harmonics by its time-varying gain, ``P`` in the coupling of the nodes through
-        ``Z``; the product ``J x`` in single precision where there is a single twin). None
-        where ``Q`` is singular."""
+        (:func:`node_local_inverse` of their node blocks ``Ga``), as a function of the
+        preconditioner's ``apply`` returning the two combined: ``x = Q^-1 r``, then ``x +
+        P^-1 (r - J x)`` (a multiplicative two-level preconditioner: ``Q`` exact in the
+        coupling of a node's harmonics by its time-varying gain, ``P`` in the coupling of
+        the nodes through ``Z``; the product ``J x`` in single precision where there is a
+        single twin). None where ``Q`` is singular."""
         eps, dH = self.eps, self.dH
         na = act.size
         qinv = node_local_inverse(Ga, self._node_diagonals(act), eps)
         if qinv is None:
             return None
         Zs = self._single_blocks(Za) or Za  # (the correction's product: approximate)
-
-        def rough(v):
-            y = (Zs.apply(v).reshape(-1) - eps * v).reshape(na, dH)
-            return eps * v + np.matmul(Ga, y[:, :, None])[:, :, 0].reshape(-1)
+        rough = _step_operator(Zs, Ga, eps, na, dH)
 
         def wrap(apply):
             def both(r):
@@ -986,6 +1114,11 @@ class _ActiveView:
         ``ReducedOperator.block(b, rows, cols)`` would hold two more m_a x m arrays)."""
         Zb = self.Z.Z0 if b == 0 else self.Z.block(b)
         return Zb[np.ix_(self.dofs, self.dofs)]
+
+    def block_source(self, b: int) -> tuple[np.ndarray, np.ndarray]:
+        """As :meth:`HarmonicBlocks.block_source`: the whole block ``b`` of ``Z`` (formed)
+        and ``dofs``."""
+        return (self.Z.Z0 if b == 0 else self.Z.block(b)), self.dofs
 
     def block_products(self, blocks, V: np.ndarray) -> np.ndarray:
         """As :meth:`HarmonicBlocks.block_products` on ``dofs``: ``V`` scattered into the
