@@ -38,7 +38,13 @@ operator (:meth:`fretwear.hb.modal_operator.ReducedOperator.single`).
 
 A product ``A X`` (``X`` of ``r`` columns) costs ``sum_b k_b (b_r + b_c) r`` for the
 low-rank blocks plus the dense leaves: ``O(m log m)`` per column for a fixed rank, against
-``m^2`` dense.
+``m^2`` dense. It is made by compiled kernels (:func:`_apply`) over the packed stacks: one
+BLAS ``gemm`` per stack (SciPy's, called by symbol so that the kernels are cached), the
+gathers and scatters between them compiled, in the blocks' order (the same sums in every
+run). Its rounding is that of any product in the blocks' precision: every entry of the
+result within ``g_N |A_H| |X|`` of the exact one (``|U| |V|^T`` for a low-rank block,
+``g_N = N u / (1 - N u)``, ``N`` the terms and partial sums of a row; Higham 2002, sec. 3.5);
+the near field's diagonal blocks and its mirrored ones are summed apart (shorter sums).
 """
 
 from __future__ import annotations
@@ -186,10 +192,11 @@ class HMatrix:
     """A compressed real matrix (module docstring): ``A @ X``, ``A.T @ X`` for ``X`` (n,)
     or (n, r), real or complex; :meth:`sub` restricts it to rows and columns.
 
-    The blocks are stored in stacks that make a product a few BLAS calls per cluster, not
-    one per block (:class:`_Plan`): the dense blocks of a block row side by side, the low-rank
-    factors of every block on a cluster side by side (one stack per cluster when the matrix
-    is symmetric: the ``U`` of block ``(s, t)`` is the ``V`` of its mirror ``(t, s)``).
+    The blocks are stored in stacks that make a product one BLAS call per stack, not one
+    per block, all stacks packed in one array and multiplied by a compiled loop
+    (:class:`_Plan`): the dense blocks of a block row side by side, the low-rank factors of
+    every block on a cluster side by side (one stack per cluster when the matrix is
+    symmetric: the ``U`` of block ``(s, t)`` is the ``V`` of its mirror ``(t, s)``).
 
     Attributes
     ----------
