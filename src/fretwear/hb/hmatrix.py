@@ -536,12 +536,12 @@ def _gather(src, idx, out):
 
 
 @njit(cache=True)
-def _scatter(rows, idx, dst, add):
-    """``dst[idx[j]] = rows[j]``, or ``+=`` (``add``) (rows)."""
+def _scatter(rows, idx, dst):
+    """``dst[idx[j]] += rows[j]`` (rows)."""
     for j in range(idx.size):
         i = idx[j]
         for c in range(rows.shape[1]):
-            dst[i, c] = dst[i, c] + rows[j, c] if add else rows[j, c]
+            dst[i, c] += rows[j, c]
 
 
 @njit(cache=True)
@@ -549,13 +549,13 @@ def _apply(vals, src, dst, fidx, k, near, gidx, X, Y, transposed, width):
     """``Y += A_p X`` of :class:`_Plan`'s packed blocks (``src``, ``dst``: the far field's
     tables in the order of the product: ``cols, rows``, or ``rows, cols`` transposed)."""
     r = X.shape[1]
-    C = np.empty((k, r), dtype=X.dtype)
+    C = np.zeros((k, r), dtype=X.dtype)  # (each row set once: 0 + t = t)
     T = np.empty((width, r), dtype=X.dtype)  # one stack's product
     G = np.empty((width, r), dtype=X.dtype)  # gathered rows
     for e in range(src.shape[0]):  # C[idx] = W^T x[a0:a1]
         a0, a1, off, kk, io = src[e]
         _gemm(_block(vals, off, a1 - a0, kk), X[a0:a1], T[:kk], True, 0)
-        _scatter(T[:kk], fidx[io : io + kk], C, False)
+        _scatter(T[:kk], fidx[io : io + kk], C)
     for e in range(dst.shape[0]):  # y[a0:a1] += W C[idx]
         a0, a1, off, kk, io = dst[e]
         _gather(C, fidx[io : io + kk], G[:kk])
@@ -575,7 +575,7 @@ def _near(D1, D2, g1, g2, X, Yr, Xr, Y, T, G, transposed):
     j0, w2 = g1.size, g2.size
     if transposed:
         _gemm(D1, Xr, T[:j0], True, 0)
-        _scatter(T[:j0], g1, Y, True)
+        _scatter(T[:j0], g1, Y)
     else:
         _gather(X, g1, G[:j0])
         _gemm(D1, G[:j0], Yr, False, 1)
@@ -583,7 +583,7 @@ def _near(D1, D2, g1, g2, X, Yr, Xr, Y, T, G, transposed):
         _gather(X, g2, G[:w2])
         _gemm(D2, G[:w2], Yr, False, 1)  # the blocks (and, transposed, their mirrors)
         _gemm(D2, Xr, T[:w2], True, 0)  # their mirrors (and, transposed, the blocks)
-        _scatter(T[:w2], g2, Y, True)
+        _scatter(T[:w2], g2, Y)
 
 
 def _restrict(perm: np.ndarray, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
