@@ -475,8 +475,12 @@ class _Plan:
         if Xp.shape[1] == 0 or Xp.shape[0] == 0:
             return Y
         src, dst = (self.rows, self.cols) if transposed else (self.cols, self.rows)
-        _apply(self.vals, src, dst, self.fidx, self.k, self.near, self.gidx, Xp, Y,
-               transposed, self.width)
+        r = Xp.shape[1]
+        work = (np.zeros((self.k, r), dtype=self.dtype),  # the far field's coefficients
+                np.empty((self.width, r), dtype=self.dtype),  # one stack's product
+                np.empty((self.width, r), dtype=self.dtype))  # gathered rows
+        _apply(self.vals, src, dst, self.fidx, self.near, self.gidx, Xp, Y, transposed,
+               *work)
         return Y
 
 
@@ -545,13 +549,11 @@ def _scatter(rows, idx, dst):
 
 
 @njit(cache=True)
-def _apply(vals, src, dst, fidx, k, near, gidx, X, Y, transposed, width):
+def _apply(vals, src, dst, fidx, near, gidx, X, Y, transposed, C, T, G):
     """``Y += A_p X`` of :class:`_Plan`'s packed blocks (``src``, ``dst``: the far field's
-    tables in the order of the product: ``cols, rows``, or ``rows, cols`` transposed)."""
-    r = X.shape[1]
-    C = np.zeros((k, r), dtype=X.dtype)  # (each row set once: 0 + t = t)
-    T = np.empty((width, r), dtype=X.dtype)  # one stack's product
-    G = np.empty((width, r), dtype=X.dtype)  # gathered rows
+    tables in the order of the product: ``cols, rows``, or ``rows, cols`` transposed; ``C``
+    the far field's coefficients, zero, each row set once: ``0 + t = t``; ``T``, ``G`` work
+    rows; made by the caller: an allocation compiled costs a second of compile time)."""
     for e in range(src.shape[0]):  # C[idx] = W^T x[a0:a1]
         a0, a1, off, kk, io = src[e]
         _gemm(_block(vals, off, a1 - a0, kk), X[a0:a1], T[:kk], True, 0)
