@@ -188,9 +188,9 @@ class KrylovOptions:
         :mod:`fretwear.hb.hmatrix`) took 9.2 ms against the dense single copy's 22.2 ms at
         1024 contact nodes (3072 DOFs; compression 0.72 s CPU, once), 29.1 against 111.1
         ms at 2304 and 3.1 against 8.2 ms at 576; the 1024-node solve's CPU per Powell
-        iteration fell by a fifth to a half, but its Powell path was longer from four of
-        five starts (12-32 iterations against the dense copy's 13 from four: the other
-        rounding of the steps) and the solve slower on average (26.7 against 25.1 s CPU), and at
+        iteration fell by a fifth to a half, but its Powell path was longer from five of
+        six starts (12-32 iterations against the dense copy's 13 from six: the other
+        rounding of the steps) and the solve slower on average (26.5 against 25.0 s CPU), and at
         576 nodes the gain was 0.3 s in 4.6; hence off by default. It holds 0.125 (1024
         nodes) to 0.074 (2304) of the double matrices' bytes against the dense copy's
         0.5: for interfaces where that copy does not fit (docs/studies/
