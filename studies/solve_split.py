@@ -24,7 +24,9 @@ renewed at every Jacobian), ``single=0|1`` (the preconditioner's factors in doub
 ``nodecorr=0|1`` (the node-local correction of the preconditioner,
 KrylovOptions.node_correction), ``ctwin=N`` (GMRES's single products through the compressed
 twin from N contact DOFs, KrylovOptions.compressed_products_min_dofs; 0: never). The
-compressed twin's compression and cuts are the part ``twin``.
+compressed twin's compression and cuts are the part ``twin``. ``pert=E``: the contact-closed
+start (``DLFTProblem.initial_guess``) times ``1 + E`` (e.g. 1e-15: another rounding of the
+same input, for Powell's spread of paths, "Powell near the law's kinks").
 The solution is saved to ``/tmp/solve_split_<n><SPLIT_TAG>_U.npy`` for comparisons.
 """
 
@@ -102,6 +104,11 @@ def main():
         least = int(variants["ctwin"]) or None
         opts = opts.replace(krylov=dataclasses.replace(
             opts.krylov, compressed_products_min_dofs=least))
+    if "pert" in variants:
+        from fretwear.hb.problem import DLFTProblem
+
+        guess, scale = DLFTProblem.initial_guess, 1.0 + float(variants["pert"])
+        DLFTProblem.initial_guess = lambda self: guess(self) * scale
     if variants.get("norms") == "first":  # the first Jacobian's column norms kept
         from powell_kinks import keep_first_column_norms
 

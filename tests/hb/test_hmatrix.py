@@ -197,3 +197,97 @@ def test_float32_copy_states_its_rounding():
         assert np.linalg.norm(Y - F @ X) <= 1e-5 * np.linalg.norm(F @ X)
         Xc = X + 1j * X[::-1]
         assert np.linalg.norm(H32.T @ Xc - F.T @ Xc) <= 1e-5 * np.linalg.norm(F @ Xc)
+
+
+def _abs_blocks(H):
+    """``|A_H|`` with each low-rank block as ``|U| |V|^T`` (the magnitudes a product's
+    rounding is bounded by; Higham 2002, sec. 3.5), formed in float64 in ``H``'s order."""
+    out = np.zeros((H.rows.size, H.cols.size))
+    for b in H.blocks:
+        out[b.r0 : b.r1, b.c0 : b.c1] = (np.abs(b.D) if b.D is not None
+                                         else np.abs(b.U).astype(float) @ np.abs(b.V).T)
+    full = np.empty_like(out)
+    full[np.ix_(H.rows, H.cols)] = out
+    return full
+
+
+def _blockwise(H, X):
+    """``A_H X`` one block at a time in ``H``'s precision (``D x`` or ``U (V^T x)`` per
+    block, in NumPy): the arithmetic of the per-cluster products before the compiled
+    kernels, grouped differently."""
+    Xp = X[H.cols].astype(H.dtype)
+    Yp = np.zeros((H.rows.size, X.shape[1]), dtype=H.dtype)
+    for b in H.blocks:
+        x = Xp[b.c0 : b.c1]
+        Yp[b.r0 : b.r1] += b.D @ x if b.D is not None else b.U @ (b.V.T @ x)
+    Y = np.empty_like(Yp)
+    Y[H.rows] = Yp
+    return Y
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_compiled_product_within_rounding_of_formed_and_blockwise(dtype):
+    """The compiled product (packed stacks, one BLAS gemm each, the near field's mirrored
+    blocks applied transposed) against two references: the formed ``A_H`` times ``X`` in
+    float64, and the product one block at a time in NumPy (:func:`_blockwise`). Any order
+    of summation keeps ``|fl(A_H X) - A_H X| <= g_N |A_H| |X|`` entrywise (Higham, sec. 3.5;
+    ``g_N = N u / (1 - N u)``, ``N`` the longest chain of roundings: ``2 m`` covers a row's
+    ``m`` terms, the ranks and the partial sums' additions; ``|A_H|`` with ``|U| |V|^T`` for a
+    low-rank block), so the two references are within that bound and each other within
+    twice it: a bound independent of the kernels' order. On a symmetric matrix (mirrored
+    near and far blocks), a non-symmetric one, their transposes, a symmetric cut and a
+    rectangular cut in unsorted order; near and far fields both present, and products not
+    all zero."""
+    A, P = _kernel(240, 3, seed=6)
+    x = np.repeat(P[:, 0], 3)
+    B = A * (1 + 0.3 * (x[:, None] - x[None, :]))  # not symmetric, as smooth as A
+    rng = np.random.default_rng(7)
+    rows = rng.permutation(A.shape[0])[:500]
+    cols = rng.permutation(A.shape[0])[:300]
+    Hs = compress(A, P, 1e-5, leaf=8).astype(dtype)
+    Hn = compress(B, P, 1e-5, leaf=8).astype(dtype)
+    cases = [Hs, Hs.T, Hn, Hn.T, Hs.sub(rows), Hn.sub(rows, cols), Hn.sub(rows, cols).T]
+    u = float(np.finfo(dtype).eps) / 2
+    for H in cases:
+        assert H.ranks().size and any(b.D is not None for b in H.blocks)
+        X = rng.standard_normal((H.shape[1], 7))
+        F = H.toarray().astype(float)
+        N = 2 * max(H.shape)
+        absH = _abs_blocks(H).T if H._transposed else _abs_blocks(H)
+        bound = N * u / (1 - N * u) * absH @ np.abs(X)
+        Y = H @ X
+        assert Y.dtype == dtype and np.linalg.norm(Y) > 0
+        assert np.all(np.abs(Y - F @ X) <= bound)
+        if not H._transposed:
+            assert np.all(np.abs(Y - _blockwise(H, X)) <= 2 * bound)
+    assert any(b.of is not None and b.D is not None for b in Hs.blocks)  # mirrored near
+
+
+def test_compiled_product_same_bits_every_time():
+    """Two products of one matrix, of two compressions of one input, of two cuts of it,
+    and of the same blocks whose arrays were made in the reverse order, are the same bit
+    for bit: the packed stacks follow the blocks' order, not the arrays' memory addresses
+    (which an order by address would follow, changing the sums' rounding from run to run;
+    a solve repeated must give the same path)."""
+    from fretwear.hb.hmatrix import Block, HMatrix
+
+    A, P = _kernel(240, 3, seed=8, a=0.3)
+    x = np.repeat(P[:, 0], 3)
+    A = A * (1 + 0.3 * (x[:, None] - x[None, :]))  # not symmetric: no shared factors
+    rng = np.random.default_rng(9)
+    X = rng.standard_normal((A.shape[0], 15)).astype(np.float32)
+    dofs = np.sort(rng.permutation(A.shape[0])[:500])
+    H1, H2 = (compress(A, P, 1e-5, leaf=8).astype(np.float32) for _ in range(2))
+    assert H1.ranks().size > 10
+    assert np.array_equal(H1 @ X, H1 @ X) and np.array_equal(H1 @ X, H2 @ X)
+    S1, S2 = H1.sub(dofs), H2.sub(dofs)
+    assert np.array_equal(S1 @ X[dofs], S2 @ X[dofs])
+    assert np.array_equal(S1.T @ X[dofs], S2.T @ X[dofs])
+    made = {}
+    for i in reversed(range(len(H1.blocks))):  # the copies' arrays made last block first
+        b = H1.blocks[i]
+        made[i] = ({"D": b.D.copy()} if b.D is not None
+                   else {"U": b.U.copy(), "V": b.V.copy()})
+    R = HMatrix(H1.rows, H1.cols, [Block(b.r0, b.r1, b.c0, b.c1, **made[i])
+                                   for i, b in enumerate(H1.blocks)])
+    assert np.array_equal(R @ X, H1 @ X)

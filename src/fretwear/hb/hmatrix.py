@@ -38,7 +38,13 @@ operator (:meth:`fretwear.hb.modal_operator.ReducedOperator.single`).
 
 A product ``A X`` (``X`` of ``r`` columns) costs ``sum_b k_b (b_r + b_c) r`` for the
 low-rank blocks plus the dense leaves: ``O(m log m)`` per column for a fixed rank, against
-``m^2`` dense.
+``m^2`` dense. It is made by compiled kernels (:func:`_apply`) over the packed stacks: one
+BLAS ``gemm`` per stack (SciPy's, called by symbol so that the kernels are cached), the
+gathers and scatters between them compiled, in the blocks' order (the same sums in every
+run). Its rounding is that of any product in the blocks' precision: every entry of the
+result within ``g_N |A_H| |X|`` of the exact one (``|U| |V|^T`` for a low-rank block,
+``g_N = N u / (1 - N u)``, ``N`` the terms and partial sums of a row; Higham 2002, sec. 3.5);
+the near field's diagonal blocks and its mirrored ones are summed apart (shorter sums).
 """
 
 from __future__ import annotations
@@ -46,6 +52,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from llvmlite import binding as _llvm
+from numba import njit, types
+from numba.extending import get_cython_function_address
 
 from fretwear.errors import InputError
 
@@ -183,10 +192,11 @@ class HMatrix:
     """A compressed real matrix (module docstring): ``A @ X``, ``A.T @ X`` for ``X`` (n,)
     or (n, r), real or complex; :meth:`sub` restricts it to rows and columns.
 
-    The blocks are stored in stacks that make a product a few BLAS calls per cluster, not
-    one per block (:class:`_Plan`): the dense blocks of a block row side by side, the low-rank
-    factors of every block on a cluster side by side (one stack per cluster when the matrix
-    is symmetric: the ``U`` of block ``(s, t)`` is the ``V`` of its mirror ``(t, s)``).
+    The blocks are stored in stacks that make a product one BLAS call per stack, not one
+    per block, all stacks packed in one array and multiplied by a compiled loop
+    (:class:`_Plan`): the dense blocks of a block row side by side, the low-rank factors of
+    every block on a cluster side by side (one stack per cluster when the matrix is
+    symmetric: the ``U`` of block ``(s, t)`` is the ``V`` of its mirror ``(t, s)``).
 
     Attributes
     ----------
@@ -329,46 +339,86 @@ class HMatrix:
 
 
 class _Plan:
-    """The stacks of an :class:`HMatrix`'s blocks and their products. Far field: each
-    low-rank block ``b`` owns coefficient rows ``o_b .. o_b + k_b`` of ``C``; per column
-    range the ``V`` stack gives ``C[idx] = V_s^T x_s``, per row range the ``U`` stack adds
-    ``U_s C[idx]`` (the transpose swaps the two). Near field: per row range the dense blocks
-    side by side times the gathered ``x``, those whose mirror is a block below the diagonal
-    last, applied transposed too (a symmetric near field is stored once). The blocks' arrays
-    are replaced by views into the stacks (nothing is held twice)."""
+    """The packed storage of an :class:`HMatrix`'s blocks and their product by compiled
+    kernels (:func:`_apply`): every stack in one array ``vals`` of the blocks' precision, with
+    integer tables of where each stack sits and which rows and columns it touches.
+
+    Far field: the low-rank factors of the blocks on one cluster side by side (a *stack*
+    ``W``, ``(a1 - a0, k)``), each block ``b`` owning coefficient rows ``o_b .. o_b + k_b`` of
+    ``C``; ``cols`` lists per column range its ``V`` stack (``C[idx] = V_s^T x_s``), ``rows``
+    per row range its ``U`` stack (``y_s += U_s C[idx]``); the transpose swaps the two. A
+    symmetric matrix shares one stack per cluster between the two tables. Near field: per row
+    range the dense blocks side by side in two arrays, ``D1`` those that are not mirrored and
+    ``D2`` those whose mirror is a block below the diagonal (applied transposed too: a
+    symmetric near field is stored once). Table rows are ``(a0, a1, offset, k, index
+    offset)`` and ``(r0, r1, offset of D1, j0, offset of D2, w, index offset)``, ``D1`` of
+    ``j0`` and ``D2`` of ``w - j0`` columns. The blocks' arrays are replaced by views into
+    ``vals`` (nothing is held twice).
+
+    Each stack's product is one BLAS ``gemm`` on contiguous operands, called from the
+    compiled loop with the gathers and scatters beside it (no Python per cluster); the
+    tables are in the blocks' order, so the sums are made in the same order in every run
+    (an order by memory address changed their rounding from run to run)."""
 
     def __init__(self, blocks: list[Block]):
-        views = {}  # id of a block's array -> its view in a stack
+        self._parts, self._size = [], 0  # the arrays of vals, in order, and its length
+        mirrored = {id(b.of) for b in blocks if b.D is not None and b.of is not None}
+        self.near, self.gidx = self._pack_near(blocks, mirrored)
+        far = [b for b in blocks if b.D is None and b.U.shape[1]]
+        self.k = int(sum(b.U.shape[1] for b in far))
+        self.rows, self.cols, self.fidx, views = self._pack_far(far)
+        self.dtype = self._parts[0].dtype if self._parts else np.dtype(float)
+        self.vals = (np.concatenate([a.ravel() for a in self._parts]) if self._parts
+                     else np.zeros(0))
+        del self._parts
+        self._point(blocks, far, views)
+        self.width = int(max([1, *(self.near[:, 1] - self.near[:, 0]), *self.near[:, 5],
+                              *(self.rows[:, 1] - self.rows[:, 0]), *self.rows[:, 3],
+                              *(self.cols[:, 1] - self.cols[:, 0]), *self.cols[:, 3]]))
+        self.nbytes = int(self.vals.nbytes + self.near.nbytes + self.gidx.nbytes
+                          + self.rows.nbytes + self.cols.nbytes + self.fidx.nbytes)
 
-        near = {}  # row range -> its dense blocks, the mirrors' originals last
+    def _put(self, a: np.ndarray) -> int:
+        """Append ``a`` (C order) to ``vals``; its offset."""
+        off = self._size
+        self._parts.append(np.ascontiguousarray(a))
+        self._size += a.size
+        return off
+
+    def _pack_near(self, blocks, mirrored):
+        """The near field's table and column indices (class docstring); each dense block's
+        array becomes a view into its group's ``D1`` or ``D2`` (set by :meth:`_point`)."""
+        groups = {}  # row range -> its dense blocks, the mirrors' originals last
         for b in blocks:
             if b.D is not None and b.of is None:
-                near.setdefault((b.r0, b.r1), []).append(b)
-        mirrored = {id(b.of) for b in blocks if b.D is not None and b.of is not None}
-        self.near = []
-        for (r0, r1), group in near.items():
+                groups.setdefault((b.r0, b.r1), []).append(b)
+        table, gidx, go = [], [], 0
+        self._near_views = {}
+        for (r0, r1), group in groups.items():
             group.sort(key=lambda b: id(b) in mirrored)
-            D = np.hstack([b.D for b in group])
-            gidx = np.concatenate([np.arange(b.c0, b.c1) for b in group])
-            o, j0 = 0, D.shape[1]
-            for b in group:
-                w = b.c1 - b.c0
-                if id(b) in mirrored:
-                    j0 = min(j0, o)
-                b.D = D[:, o : o + w]
-                o += w
-            # columns j0: of D also act transposed (the mirrors below the diagonal)
-            self.near.append((r0, r1, D, gidx, j0))
-        for b in blocks:
-            if b.D is not None and b.of is not None:
-                b.D = b.of.D.T
+            plain = [b for b in group if id(b) not in mirrored]
+            mirr = [b for b in group if id(b) in mirrored]
+            j0, w = sum(b.c1 - b.c0 for b in plain), sum(b.c1 - b.c0 for b in group)
+            offs = []
+            for part in (plain, mirr):
+                D = np.hstack([b.D for b in part]) if part else np.zeros((r1 - r0, 0))
+                offs.append(self._put(D.astype(group[0].D.dtype, copy=False)))
+                o = 0
+                for b in part:
+                    self._near_views[id(b)] = (offs[-1], D.shape[1], o, b.c1 - b.c0)
+                    o += b.c1 - b.c0
+            table.append((r0, r1, offs[0], j0, offs[1], w, go))
+            gidx.append(np.concatenate([np.arange(b.c0, b.c1) for b in group]))
+            go += w
+        return (np.array(table, dtype=np.int64).reshape(-1, 7),
+                np.concatenate(gidx).astype(np.int64) if gidx else np.zeros(0, np.int64))
 
-        far = [b for b in blocks if b.D is None and b.U.shape[1]]
+    def _pack_far(self, far):
+        """The far field's tables (rows, cols), coefficient indices and, per factor, where
+        its view lies in ``vals`` (offset, stack width, first column)."""
         off = np.cumsum([0] + [b.U.shape[1] for b in far])
-        self.k = int(off[-1])
         rowg, colg = {}, {}
         # each factor's rank in the blocks' order: the stacks' order, the same in every run
-        # (an order by memory address changed the sums' rounding from run to run)
         rank = {}
         for b in far:
             for a in (b.U, b.V):
@@ -377,51 +427,165 @@ class _Plan:
             idx = np.arange(o, o + b.U.shape[1])
             rowg.setdefault((b.r0, b.r1), []).append((b.U, idx))
             colg.setdefault((b.c0, b.c1), []).append((b.V, idx))
-        stacks = {}
+        stacks, views, fidx, fo = {}, {}, [], 0
 
-        def stack(entries):
-            entries = sorted(entries, key=lambda e: rank[id(e[0])])
-            key = tuple(id(a) for a, _ in entries)
-            if key not in stacks:  # the same factors in the same order: one stack
-                W = np.hstack([a for a, _ in entries])
-                o = 0
-                for a, _ in entries:
-                    views[id(a)] = W[:, o : o + a.shape[1]]
-                    o += a.shape[1]
-                stacks[key] = W
-            return stacks[key], np.concatenate([i for _, i in entries])
+        def table(groups):
+            nonlocal fo
+            out = []
+            for (a0, a1), entries in groups.items():
+                entries = sorted(entries, key=lambda e: rank[id(e[0])])
+                key = tuple(id(a) for a, _ in entries)
+                if key not in stacks:  # the same factors in the same order: one stack
+                    W = np.hstack([a for a, _ in entries])
+                    stacks[key] = self._put(W)
+                    o = 0
+                    for a, _ in entries:
+                        views[id(a)] = (stacks[key], W.shape[1], o, a.shape[1])
+                        o += a.shape[1]
+                idx = np.concatenate([i for _, i in entries])
+                out.append((a0, a1, stacks[key], idx.size, fo))
+                fidx.append(idx)
+                fo += idx.size
+            return np.array(out, dtype=np.int64).reshape(-1, 5)
 
-        self.rows = [(r0, r1, *stack(e)) for (r0, r1), e in rowg.items()]
-        self.cols = [(c0, c1, *stack(e)) for (c0, c1), e in colg.items()]
-        arrays = [D for _, _, D, _, _ in self.near] + list(stacks.values())
-        self.dtype = arrays[0].dtype if arrays else np.dtype(float)
-        self.nbytes = int(sum(W.nbytes for W in stacks.values())
-                          + sum(D.nbytes + g.nbytes for _, _, D, g, _ in self.near)
-                          + sum(i.nbytes for *_, i in self.rows + self.cols))
+        rows, cols = table(rowg), table(colg)
+        fidx = np.concatenate(fidx).astype(np.int64) if fidx else np.zeros(0, np.int64)
+        return rows, cols, fidx, views
+
+    def _point(self, blocks, far, views):
+        """Replace the blocks' arrays by their views into ``vals``."""
+        def view(spec, nrows):
+            off, width, o, w = spec
+            return self.vals[off : off + nrows * width].reshape(nrows, width)[:, o : o + w]
+
+        for b in blocks:
+            if b.D is not None and b.of is None:
+                b.D = view(self._near_views[id(b)], b.r1 - b.r0)
+        for b in blocks:
+            if b.D is not None and b.of is not None:
+                b.D = b.of.D.T
         for b in far:
-            b.U, b.V = views[id(b.U)], views[id(b.V)]
+            b.U, b.V = view(views[id(b.U)], b.r1 - b.r0), view(views[id(b.V)], b.c1 - b.c0)
+        del self._near_views
 
     def apply(self, Xp: np.ndarray, nout: int, transposed: bool) -> np.ndarray:
-        """``A_p Xp`` (or ``A_p^T Xp``) on the reordered rows and columns."""
+        """``A_p Xp`` (or ``A_p^T Xp``) on the reordered rows and columns (``Xp``
+        C-contiguous, in :attr:`dtype`)."""
+        Y = np.zeros((nout, Xp.shape[1]), dtype=self.dtype)
+        if Xp.shape[1] == 0 or Xp.shape[0] == 0:
+            return Y
+        src, dst = (self.rows, self.cols) if transposed else (self.cols, self.rows)
         r = Xp.shape[1]
-        Y = np.zeros((nout, r), dtype=self.dtype)
-        if self.k:
-            src, dst = (self.rows, self.cols) if transposed else (self.cols, self.rows)
-            C = np.empty((self.k, r), dtype=self.dtype)
-            for a0, a1, W, idx in src:
-                C[idx] = W.T @ Xp[a0:a1]
-            for a0, a1, W, idx in dst:
-                Y[a0:a1] += W @ C[idx]
-        for r0, r1, D, gidx, j0 in self.near:
-            if transposed:
-                Y[gidx] += D.T @ Xp[r0:r1]
-                if j0 < D.shape[1]:
-                    Y[r0:r1] += D[:, j0:] @ Xp[gidx[j0:]]
-            else:
-                Y[r0:r1] += D @ Xp[gidx]
-                if j0 < D.shape[1]:
-                    Y[gidx[j0:]] += D[:, j0:].T @ Xp[r0:r1]
+        work = (np.zeros((self.k, r), dtype=self.dtype),  # the far field's coefficients
+                np.empty((self.width, r), dtype=self.dtype),  # one stack's product
+                np.empty((self.width, r), dtype=self.dtype))  # gathered rows
+        _apply(self.vals, src, dst, self.fidx, self.near, self.gidx, Xp, Y, transposed,
+               *work)
         return Y
+
+
+# BLAS gemm of the SciPy build NumPy's arrays are multiplied with elsewhere in the package,
+# called from the compiled kernels by name (a symbol, not a pointer held by the function:
+# the kernels stay cacheable)
+for _name in ("sgemm", "dgemm"):
+    _llvm.add_symbol(f"fretwear_{_name}",
+                     get_cython_function_address("scipy.linalg.cython_blas", _name))
+_SGEMM = types.ExternalFunction("fretwear_sgemm", types.void(*[types.voidptr] * 13))
+_DGEMM = types.ExternalFunction("fretwear_dgemm", types.void(*[types.voidptr] * 13))
+
+
+@njit(cache=True)
+def _gemm(A, B, C, trans_a, beta):
+    """``C = op(A) B + beta C`` (``beta`` 0 or 1) on C-ordered contiguous arrays of one real
+    precision, ``op(A)`` = ``A`` or ``A^T`` (``trans_a``): one BLAS ``gemm`` on the
+    column-major views, ``C^T = B^T op(A)^T``."""
+    p, r = C.shape
+    q = B.shape[0]
+    if p == 0 or r == 0:
+        return
+    if q == 0:
+        if beta == 0:
+            for i in range(p):
+                for c in range(r):
+                    C[i, c] = 0
+        return
+    ints = np.empty(6, np.int32)  # m, n, k, ldb, lda, ldc of the column-major call
+    ints[0], ints[1], ints[2], ints[3], ints[4], ints[5] = r, p, q, r, p if trans_a else q, r
+    chars = np.empty(2, np.uint8)
+    chars[0], chars[1] = 78, 84 if trans_a else 78  # 'N', 'T' or 'N'
+    scal = np.empty(2, C.dtype)
+    scal[0], scal[1] = 1, beta
+    args = (chars[0:].ctypes, chars[1:].ctypes, ints[0:].ctypes, ints[1:].ctypes,
+            ints[2:].ctypes, scal[0:].ctypes, B.ctypes, ints[3:].ctypes, A.ctypes,
+            ints[4:].ctypes, scal[1:].ctypes, C.ctypes, ints[5:].ctypes)
+    if C.itemsize == 4:
+        _SGEMM(*args)
+    else:
+        _DGEMM(*args)
+
+
+@njit(cache=True)
+def _block(vals, off, nrows, ncols):
+    """The C-ordered ``(nrows, ncols)`` array at ``vals[off]``."""
+    return vals[off : off + nrows * ncols].reshape((nrows, ncols))
+
+
+@njit(cache=True)
+def _gather(src, idx, out):
+    """``out[j] = src[idx[j]]`` (rows)."""
+    for j in range(idx.size):
+        i = idx[j]
+        for c in range(out.shape[1]):
+            out[j, c] = src[i, c]
+
+
+@njit(cache=True)
+def _scatter(rows, idx, dst):
+    """``dst[idx[j]] += rows[j]`` (rows)."""
+    for j in range(idx.size):
+        i = idx[j]
+        for c in range(rows.shape[1]):
+            dst[i, c] += rows[j, c]
+
+
+@njit(cache=True)
+def _apply(vals, src, dst, fidx, near, gidx, X, Y, transposed, C, T, G):
+    """``Y += A_p X`` of :class:`_Plan`'s packed blocks (``src``, ``dst``: the far field's
+    tables in the order of the product: ``cols, rows``, or ``rows, cols`` transposed; ``C``
+    the far field's coefficients, zero, each row set once: ``0 + t = t``; ``T``, ``G`` work
+    rows; made by the caller: an allocation compiled costs a second of compile time)."""
+    for e in range(src.shape[0]):  # C[idx] = W^T x[a0:a1]
+        a0, a1, off, kk, io = src[e]
+        _gemm(_block(vals, off, a1 - a0, kk), X[a0:a1], T[:kk], True, 0)
+        _scatter(T[:kk], fidx[io : io + kk], C)
+    for e in range(dst.shape[0]):  # y[a0:a1] += W C[idx]
+        a0, a1, off, kk, io = dst[e]
+        _gather(C, fidx[io : io + kk], G[:kk])
+        _gemm(_block(vals, off, a1 - a0, kk), G[:kk], Y[a0:a1], False, 1)
+    for e in range(near.shape[0]):
+        r0, r1, o1, j0, o2, w, go = near[e]
+        _near(_block(vals, o1, r1 - r0, j0), _block(vals, o2, r1 - r0, w - j0),
+              gidx[go : go + j0], gidx[go + j0 : go + w], X, Y[r0:r1], X[r0:r1], Y, T, G,
+              transposed)
+
+
+@njit(cache=True)
+def _near(D1, D2, g1, g2, X, Yr, Xr, Y, T, G, transposed):
+    """One near-field row range ``r`` (:class:`_Plan`; ``Yr``, ``Xr`` its rows of ``Y`` and
+    ``X``): ``D1`` on the columns ``g1``, ``D2`` on ``g2`` and, mirrored, ``D2^T`` on the
+    rows ``g2`` and the columns ``r``; ``Y += A_p X`` (or ``A_p^T X``) of these blocks."""
+    j0, w2 = g1.size, g2.size
+    if transposed:
+        _gemm(D1, Xr, T[:j0], True, 0)
+        _scatter(T[:j0], g1, Y)
+    else:
+        _gather(X, g1, G[:j0])
+        _gemm(D1, G[:j0], Yr, False, 1)
+    if w2:
+        _gather(X, g2, G[:w2])
+        _gemm(D2, G[:w2], Yr, False, 1)  # the blocks (and, transposed, their mirrors)
+        _gemm(D2, Xr, T[:w2], True, 0)  # their mirrors (and, transposed, the blocks)
+        _scatter(T[:w2], g2, Y)
 
 
 def _restrict(perm: np.ndarray, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

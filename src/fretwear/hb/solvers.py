@@ -184,16 +184,17 @@ class KrylovOptions:
         step that needs it). Operators that know their contact nodes' positions only (those
         of the modal condensers); the residual stays the dense operator's, so the converged
         answer is the same to the solve's tolerance. None (the default): never. On the
-        partial-slip pad of benchmarks/scale_3d.py a product with 15 columns took 11.0 ms
-        against the dense single copy's 22.8 ms at 1024 contact nodes (3072 DOFs;
-        compression 0.72 s CPU, once), 5.1 against 7.0 ms at 576 and 1.2 against 1.5 ms
-        at 256; the 1024-node solve's CPU per Powell iteration fell by a fifth, but its
-        Powell path (17 iterations against 13: the other rounding of the steps) took
-        the gain (25.7 against 25.8 s CPU), and at 576 and 256 nodes the compression and
-        the active sub-operators' cuts ate it; hence off by default. It holds 0.125 of the
-        double matrices' bytes against the dense copy's 0.5: for interfaces where that
-        copy does not fit (docs/studies/large-interface-solve.md, "GMRES's products
-        through a compressed twin").
+        partial-slip pad of benchmarks/scale_3d.py a product with 15 columns (compiled,
+        :mod:`fretwear.hb.hmatrix`) took 9.2 ms against the dense single copy's 22.2 ms at
+        1024 contact nodes (3072 DOFs; compression 0.72 s CPU, once), 29.1 against 111.1
+        ms at 2304 and 3.1 against 8.2 ms at 576; the 1024-node solve's CPU per Powell
+        iteration fell by a fifth to a half, but its Powell path was longer from five of
+        six starts (12-32 iterations against the dense copy's 13 from six: the other
+        rounding of the steps) and the solve slower on average (26.5 against 25.0 s CPU), and at
+        576 nodes the gain was 0.3 s in 4.6; hence off by default. It holds 0.125 (1024
+        nodes) to 0.074 (2304) of the double matrices' bytes against the dense copy's
+        0.5: for interfaces where that copy does not fit (docs/studies/
+        large-interface-solve.md, "The compressed twin's product compiled").
     first_scales : Powell's variable scales from the first Jacobian only (default True);
         False: renewed at every Jacobian as MINPACK (the running maximum of its column
         norms), as formed Jacobians always are. The column norms of each new Jacobian cost
