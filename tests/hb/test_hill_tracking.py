@@ -20,10 +20,11 @@ from fretwear.hb.periodic import solve_periodic
 from fretwear.hb.stability import (
     HillProblem,
     _block_mats,
+    _column_norms,
     _companion_eigen,
     _inverse_iteration,
+    _kept_settled,
     _pencil_into,
-    _reused_settled,
     _ruhe,
     hill_stability,
     problem_of,
@@ -228,58 +229,122 @@ def test_a_first_small_step_is_not_taken_for_convergence():
             assert ok and abs(s - lam[0]) <= 1e-14, (gap, it.__name__, abs(s - lam[0]))
 
 
-def test_reused_step_is_its_formula_with_lapack():
-    """A step on a kept LU (stability._reused_step) against its formula with LAPACK's solves
-    of the whole ``P(tau)``: ``sigma - (x^H P(tau)^-1 P(sigma) x) / (x^H P(tau)^-1 P'(sigma)
-    x)`` and ``P(tau)^-1 P'(sigma) x`` normalised, with the factors of the split (``how``
-    2) and of the compiled LU (``how`` 0), on the structured problem at ``tau`` 1e-3 from
-    ``sigma``: within 1e-12 (the same quantities, the solves eliminated in another order;
-    ``P(tau)`` well conditioned there, checked). With ``tau = sigma`` it is Ruhe's step
-    (stability._ruhe_update): ``x^H P(sigma)^-1 P(sigma) x = 1`` to rounding."""
+def test_kept_step_is_its_formula_with_lapack():
+    """A step on a kept LU (stability._kept_step, Neumaier's residual inverse iteration)
+    against its formula with LAPACK's solves of the whole ``P(tau)``: ``u0 = P(tau)^-1
+    P(sigma) x``, ``u1 = P(tau)^-1 P'(sigma) x``, ``sigma' = sigma - (x^H u0) / (x^H u1)``
+    and ``x - (u0 + (sigma' - sigma) u1)`` normalised, with the factors of the split
+    (``how`` 2) and of the compiled LU (``how`` 0), on the structured problem at ``tau``
+    1e-3 from ``sigma``: within 1e-12 (the same quantities, the solves eliminated in another
+    order; ``P(tau)`` well conditioned there, checked). With ``tau = sigma`` the eigenvalue
+    is Ruhe's step (stability._ruhe_update): ``x^H P(sigma)^-1 P(sigma) x = 1`` to rounding.
+    The backward error that stability._residual_into measures on the way is
+    stability._backward_error's (the residual summed from the three products) to 1e-14 of
+    it."""
     from fretwear.hb.hill_tracking import _lu_small
-    from fretwear.hb.stability import _reused_step, _ruhe_update
+    from fretwear.hb.stability import (
+        _backward_error,
+        _kept_step,
+        _residual_into,
+        _ruhe_update,
+        _transposes,
+    )
 
     B0, B1, B2, harm = _structured(5)
     n = harm.size
     split = harmonic_split(B0, B1, B2, harm, 1e-13)
+    norms = _column_norms(B0, B1, B2)
+    T = _transposes(B0, B1, B2)
     rng = np.random.default_rng(4)
     x = rng.standard_normal(n) + 1j * rng.standard_normal(n)
     x /= np.linalg.norm(x)
-    r = np.empty(n, dtype=complex)
+    vecs = np.empty((4, n), dtype=complex)
     for sigma in (0.3 + 0.2j, -0.1 + 1.4j):
         for tau in (sigma + 1e-3 * (1 - 1j), sigma):
             P = B0 + tau * B1 + tau ** 2 * B2
             assert np.linalg.cond(P) < 1e3
-            a = np.linalg.solve(P, (B0 + sigma * B1 + sigma ** 2 * B2) @ x)
-            u = np.linalg.solve(P, (B1 + 2 * sigma * B2) @ x)
-            ref = sigma - np.vdot(x, a) / np.vdot(x, u)
+            u0 = np.linalg.solve(P, (B0 + sigma * B1 + sigma ** 2 * B2) @ x)
+            u1 = np.linalg.solve(P, (B1 + 2 * sigma * B2) @ x)
+            step = np.vdot(x, u0) / np.vdot(x, u1)
+            ref = sigma - step
+            v = x - (u0 - step * u1)
+            v /= np.linalg.norm(v)
             for how in (0, 2):
                 A = np.empty((n, n), dtype=complex)
                 _pencil_into(B0, B1, B2, tau, A)
                 work = split_work(split, n)
                 piv = _split_factor(A, split, work)[0] if how == 2 else _lu_small(A)[0]
-                s, y, t = _reused_step(B0, B1, B2, sigma, x, A, piv, how, split, work, r)
+                eta = _residual_into(T, sigma, x, vecs, norms)
+                assert abs(eta - _backward_error(B0, B1, B2, sigma, x, norms)) <= 1e-14 * eta
+                s, y, t = _kept_step(A, piv, how, split, work, sigma, x, vecs)
                 assert abs(s - ref) <= 1e-12 * max(1.0, abs(ref)), (how, abs(s - ref))
                 assert abs(t - abs(sigma - ref)) <= 1e-12 * max(1.0, abs(ref))
-                np.testing.assert_allclose(y, u / np.linalg.norm(u), rtol=0, atol=1e-12)
+                np.testing.assert_allclose(y, v, rtol=0, atol=1e-12)
                 if tau == sigma:
-                    ruhe = _ruhe_update(sigma, x, u, np.inf)[0]
+                    ruhe = _ruhe_update(sigma, x, u1, np.inf)[0]
                     assert abs(s - ruhe) <= 1e-12 * max(1.0, abs(ruhe))
 
 
+def test_kept_lu_converges_to_the_dense_eigenpair():
+    """Steps on ONE kept LU (stability._kept_step, ``tau`` 1e-4 and 1e-5 off an eigenvalue
+    of the structured problem, the start pair perturbed by 1e-6) converge to the companion
+    eigensolve's eigenpair: the backward error at or below ``COPY_EXACT`` within 8 steps,
+    the eigenvalue within 1e-12 of the dense one and the vector's direction within 1e-10
+    (the dense eigensolve's own rounding; the eigenvalues are simple, the nearest other one
+    checked 3e-2 away). The fixed point of Neumaier's step is an eigenpair of ``P`` itself:
+    with the vector moved by the inverse iteration ``P(tau)^-1 P'(sigma) x`` instead (the
+    kept LU's step before), the backward error stalls near ``|tau - lambda|^2`` (2e-11 to
+    4e-9 measured here) and the test fails (planted, checked)."""
+    from fretwear.hb.hill_tracking import _lu_small
+    from fretwear.hb.stability import COPY_EXACT, _kept_step, _residual_into, _transposes
+
+    B0, B1, B2, harm = _structured(7)
+    n = harm.size
+    split = harmonic_split(B0, B1, B2, harm, 1e-13)
+    norms = _column_norms(B0, B1, B2)
+    T = _transposes(B0, B1, B2)
+    vals, Y = _companion_eigen(B0, B1, B2)
+    gap = (np.abs(vals[:, None] - vals[None, :]) + np.eye(vals.size)).min(axis=1)
+    chosen = np.flatnonzero((gap > 3e-2) & (np.abs(vals) < 5))
+    assert chosen.size >= 4
+    rng = np.random.default_rng(8)
+    vecs = np.empty((4, n), dtype=complex)
+    for i in chosen[:4]:
+        lam, y = vals[i], Y[:, i] / np.linalg.norm(Y[:, i])
+        for off in (1e-4, 1e-5):
+            tau = lam + off * np.exp(2j * np.pi * rng.random())
+            for how in (0, 2):
+                A = np.empty((n, n), dtype=complex)
+                _pencil_into(B0, B1, B2, tau, A)
+                work = split_work(split, n)
+                piv = _split_factor(A, split, work)[0] if how == 2 else _lu_small(A)[0]
+                sigma = lam + 1e-6 * (1 + 1j)
+                x = y + 1e-6 * (rng.standard_normal(n) + 1j * rng.standard_normal(n))
+                x /= np.linalg.norm(x)
+                for _ in range(8):
+                    if _residual_into(T, sigma, x, vecs, norms) <= COPY_EXACT:
+                        break
+                    sigma, x, t = _kept_step(A, piv, how, split, work, sigma, x, vecs)
+                    assert t >= 0
+                assert _residual_into(T, sigma, x, vecs, norms) <= COPY_EXACT, (i, off, how)
+                assert abs(sigma - lam) <= 1e-12 * max(1.0, abs(lam))
+                ph = np.vdot(y, x)
+                assert np.linalg.norm(x - ph / abs(ph) * y) <= 1e-10
+
+
 def test_steps_on_a_kept_lu_end_where_ruhe_s_steps_end():
-    """The iteration with steps on the LU of the step before (stability._ruhe, ``reuse`` 2:
-    after a step within 1e-7 of the eigenvalue) against Ruhe's steps alone (``reuse`` 0),
-    on the blocks of a point of the two-DOF unilateral oscillator (15 harmonics, the
-    contact closing and opening: its 62-unknown block split, its 31-unknown block whole),
-    from 3e-3 and 1e-4 off each member found by the dense eigensolve (the track of
-    ``hill_stability``), start vectors perturbed as much: the same eigenvalue within 4e-15
-    of ``max(1, |s|)`` and eigenvector within 1e-12 (both iterations end converged to
-    rounding: measured 2.5e-16 and 1.6e-13), both within 1e-13 of the dense eigenvalue
-    (measured 9e-15). The kept LU's steps are taken (some results differ from Ruhe's alone in
-    their last bits). A step scaled by 0.9 fails it; the kept LU's threshold at 1e-4 instead
-    of 1e-7 does not (here), but fails the comparison of the benchmark's sweeps with the
-    previous code (vectors 1.7e-9 apart, centroids 2.5e-9)."""
+    """The iteration with steps on the LU of a step before (stability._ruhe, ``reuse`` 6:
+    after a Ruhe step within ``KEPT_FROM`` of the eigenvalue, ended by the pair's backward
+    error at rounding) against Ruhe's steps alone (``reuse`` 0), on the blocks of a point of
+    the two-DOF unilateral oscillator (15 harmonics, the contact closing and opening: its
+    62-unknown block split, its 31-unknown block whole), from 3e-3 and 1e-4 off each member
+    found by the dense eigensolve (the track of ``hill_stability``), start vectors perturbed
+    as much: the same eigenvalue within 4e-15 of ``max(1, |s|)`` and eigenvector within
+    1e-12 (both iterations end converged to rounding), both within 1e-13 of the dense
+    eigenvalue. The kept LU's steps are taken (some results differ from Ruhe's alone in
+    their last bits). A kept step scaled by 0.9 fails it (the kept step's vector moved by
+    the inverse iteration instead does not: the iteration then ends on Ruhe's own rule;
+    test_kept_lu_converges_to_the_dense_eigenpair catches that one)."""
     model = two_dof()
     basis = FourierBasis.up_to(15, 256)
     sol = solve_periodic(model, basis, frequency=0.6 / (2 * np.pi), time_domain=None)
@@ -293,14 +358,14 @@ def test_steps_on_a_kept_lu_end_where_ruhe_s_steps_end():
     rng = np.random.default_rng(3)
     differ = 0
     for j, (s, b) in enumerate(zip(track.sigma, track.block, strict=True)):
-        B, split = _block_mats(red, b, shape, mats)[:2]
+        B, split, _, _, _, norms = _block_mats(red, b, shape, mats)
         y = track.Y[red.blocks[b], j]
         for off in (3e-3, 1e-4):
             for _ in range(3):
                 y0 = y + off * (rng.standard_normal(y.size) + 1j * rng.standard_normal(y.size))
                 start = s + off * np.exp(2j * np.pi * rng.random())
-                s1, x1, ok1 = _ruhe(*B, start, y0, 10, False, split, 2)
-                s2, x2, ok2 = _ruhe(*B, start, y0, 10, False, split, 0)
+                s1, x1, ok1 = _ruhe(*B, start, y0, 10, split, 6, norms)
+                s2, x2, ok2 = _ruhe(*B, start, y0, 10, split, 0, norms)
                 assert ok1 and ok2
                 assert abs(s1 - s2) <= 4e-15 * max(1.0, abs(s)), abs(s1 - s2)
                 ph = np.vdot(x2, x1)
@@ -310,23 +375,24 @@ def test_steps_on_a_kept_lu_end_where_ruhe_s_steps_end():
     assert differ > 0
 
 
-def test_kept_lu_stop_rule_is_the_quadratic_contraction():
-    """stability._reused_settled, the stop after a step on a kept LU, against the rule its
-    docstring derives: a step ``t`` ends the iteration when it is below 1e-14 of the scale, or
-    when the error after it, ``t (size / last)^2`` (the kept LU's shift about ``size`` from
-    the eigenvalue, the quadratic constant ``size / last^2``), is predicted below 1e-15 of the
-    scale; values either side of each bound by a factor 10 (the sweeps' own results do not
-    reach the second branch's boundary, so only this test holds it: ``return True`` fails
-    it)."""
+def test_kept_lu_stop_rule_is_the_linear_contraction():
+    """stability._kept_settled, the stop of a pair certified by its backward error, against
+    the rule its docstring derives: a step ``t`` ends the iteration when it is below 1e-14 of
+    the scale, or when the error after it, ``t^2 / before`` (the contraction ``t / before``
+    once more), is predicted below 1e-15 of the scale; after a first step (``before``
+    infinite) the first test only. Values either side of each bound by a factor 10
+    (``return True`` fails it, and so does the quadratic prediction ``t^3 / before^2``)."""
     for scale in (1.0, 7.0):
-        assert _reused_settled(1e-15 * scale, 1e-8, 1e-6, scale)  # below 1e-14 of the scale
-        # contraction (1e-8 / 1e-6)^2 = 1e-4: predicted 1e-16 of the scale, settled
-        assert _reused_settled(1e-12 * scale, 1e-8, 1e-6, scale)
+        assert _kept_settled(1e-15 * scale, 1e-8, scale)  # below 1e-14 of the scale
+        assert _kept_settled(1e-15 * scale, np.inf, scale)
+        assert not _kept_settled(1e-13 * scale, np.inf, scale)  # a first step: no prediction
+        # contraction 1e-12 / 1e-8 = 1e-4: predicted 1e-16 of the scale, settled
+        assert _kept_settled(1e-12 * scale, 1e-8 * scale, scale)
         # predicted 1e-14: another step
-        assert not _reused_settled(1e-10 * scale, 1e-8, 1e-6, scale)
-        # a slower contraction, (1e-7 / 1e-6)^2 = 1e-2: 1e-12 predicts 1e-14, not settled
-        assert not _reused_settled(1e-12 * scale, 1e-7, 1e-6, scale)
-        assert _reused_settled(1e-14 * scale, 1e-7, 1e-6, scale)
+        assert not _kept_settled(1e-11 * scale, 1e-8 * scale, scale)
+        # a slower contraction, 1e-12 / 1e-10 = 1e-2: predicted 1e-14, not settled
+        assert not _kept_settled(1e-12 * scale, 1e-10 * scale, scale)
+        assert _kept_settled(1e-13 * scale, 1e-10 * scale, scale)
 
 
 def _lu_reference(A):
