@@ -108,7 +108,8 @@ def test_modal_condensation_equals_the_interior_solve(damping, monkeypatch):
     modes, and ``Z_r`` through them (``m^2 q`` a value) equals the one by a solve with
     ``Z^qq`` (the path below ``MODAL_FROM`` interior DOFs, forced here) to 1e-12 of its
     largest entry at three complex values (both are backward stable; the truss's ``Z^qq``
-    is far from singular there). A damper on one interior DOF (not diagonal in the modes)
+    is far from singular there), and its Schur correction ``Z^xx - Z_r`` to 1e-10 of the
+    correction's own size. A damper on one interior DOF (not diagonal in the modes)
     takes the solve."""
     dyn = structure_dynamics(truss(damping=damping))
     assert dyn.q >= dynamics.MODAL_FROM and dyn._modal_interior is not None
@@ -118,6 +119,11 @@ def test_modal_condensation_equals_the_interior_solve(damping, monkeypatch):
     monkeypatch.setattr(dynamics, "MODAL_FROM", 10**9)
     ref = dyn.condensed(*args)
     assert np.abs(got - ref).max() <= 1e-12 * np.abs(ref).max()
+    # and the Schur correction alone (1e-5 to 1e-3 of Z_r on the truss), to 1e-10 of its own
+    # size: a dropped mode moves it by 3e-9 (the highest) to 1e-5 (the lowest)
+    xx = dyn.assemble(*args)[0]
+    corr = xx - ref
+    assert np.abs((xx - got) - corr).max() <= 1e-10 * np.abs(corr).max()
     C = dyn.blocks["C"]
     damper = C[3].copy()
     damper[0, 0] += 10.0 * np.abs(C[3]).max()

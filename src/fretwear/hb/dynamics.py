@@ -148,6 +148,12 @@ class StructureDynamics:
             out[name] = (xx, xq @ Phi, Phi.T @ qx, d)
         return out
 
+    @property
+    def held_diagonal(self) -> bool:
+        """The held structure's modes diagonalise every interior block (:attr:`_modal_interior`
+        exists): a mode of a truncated interior that the contact does not see is then exact."""
+        return self._modal_interior is not None
+
     def _condensed_modal(self, mass, visc, hyst) -> np.ndarray:
         """:meth:`condensed` through the held modes (:attr:`_modal_interior`): with ``q =
         Phi eta`` (every mode: the same Schur complement), ``Z^qq`` is diagonal, so ``Z_r =

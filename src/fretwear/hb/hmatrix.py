@@ -367,9 +367,12 @@ class _Plan:
         far = [b for b in blocks if b.D is None and b.U.shape[1]]
         self.k = int(sum(b.U.shape[1] for b in far))
         self.rows, self.cols, self.fidx, views = self._pack_far(far)
-        self.dtype = self._parts[0].dtype if self._parts else np.dtype(float)
-        self.vals = (np.concatenate([a.ravel() for a in self._parts]) if self._parts
-                     else np.zeros(0))
+        # one precision for every stored entry (the kernels' gemm is chosen by it): a block
+        # of another precision is cast, as NumPy's products would have promoted it
+        self.dtype = (np.result_type(*self._parts) if self._parts else np.dtype(float))
+        self.vals = (np.concatenate([a.ravel() for a in self._parts]).astype(self.dtype,
+                                                                              copy=False)
+                     if self._parts else np.zeros(0))
         del self._parts
         self._point(blocks, far, views)
         self.width = int(max([1, *(self.near[:, 1] - self.near[:, 0]), *self.near[:, 5],
@@ -470,7 +473,8 @@ class _Plan:
 
     def apply(self, Xp: np.ndarray, nout: int, transposed: bool) -> np.ndarray:
         """``A_p Xp`` (or ``A_p^T Xp``) on the reordered rows and columns (``Xp``
-        C-contiguous, in :attr:`dtype`)."""
+        made C-contiguous in :attr:`dtype`: the kernels read it raw)."""
+        Xp = np.ascontiguousarray(Xp, dtype=self.dtype)
         Y = np.zeros((nout, Xp.shape[1]), dtype=self.dtype)
         if Xp.shape[1] == 0 or Xp.shape[0] == 0:
             return Y

@@ -578,6 +578,11 @@ class MeanGainPreconditioner:
         else by :meth:`_block` and a cast."""
         if Z.real and hasattr(Z, "block_source"):
             src, rows = Z.block_source(b)
+            # the kernel does not check bounds: the gains must cover the block's rows
+            if not (g.shape[0] * g.shape[1] == rows.size == Z.m and src.ndim == 2
+                    and src.shape[0] == src.shape[1] and rows.max(initial=-1) < src.shape[0]):
+                raise ValueError(f"gains of {g.shape[0]} x {g.shape[1]} DOFs for a block of "
+                                 f"{rows.size} rows of {Z.m}")
             P = np.empty((Z.m, Z.m), dtype=np.float32 if single else np.float64, order="F")
             return _gain_block(src, np.ascontiguousarray(rows, dtype=np.int64),
                                np.ascontiguousarray(g, dtype=np.float64), float(eps), P)

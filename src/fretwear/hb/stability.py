@@ -221,10 +221,10 @@ LOG_NEGLIGIBLE = float(np.log(NEGLIGIBLE))
 class HillOptions:
     """Settings of :func:`hill_stability`.
 
-    refine : when the law has a memory (or the candidates' pencil is truncated,
-        :func:`truncated_structure`), the candidates are refined on the exact ``T(s)`` in
+    refine : when the law has a memory, the candidates are refined on the exact ``T(s)`` in
         decreasing order of their real parts until this many have converged (each with its
-        conjugate; the rest stay candidates; 0: none refined).
+        conjugate; the rest stay candidates; 0: none refined). A law without memory on a
+        truncated pencil (:func:`truncated_structure`) has every candidate refined.
     step : step of the forward difference of ``T`` in ``s / w`` (Newton's derivative).
     newton_tol : relative residual ``|T v| / (|T| |v|)`` at which a refinement stops.
     newton_max_iter : iterations of one refinement.
@@ -321,10 +321,11 @@ class FloquetResult:
     kind : (k,) ``"exact"`` (the law has no memory at this solution and the quadratic
         problem is on the whole structure: it is exact), ``"refined"`` (refined on the exact
         ``T(s)``), ``"held"`` (a mode in which the contact points do not move: exact, not
-        coupled to the law) or ``"candidate"`` (an eigenvalue of the quadratic problem with
-        the memory frozen, or on a truncated interior, not refined: its
-        multiplier is below :data:`NEGLIGIBLE`, or ``options.refine`` exponents with larger
-        real parts were refined before it).
+        coupled to the law) or ``"candidate"`` (an eigenvalue of the quadratic problem, with
+        the memory frozen or on a truncated interior, that was not refined: its multiplier is
+        below :data:`NEGLIGIBLE`, or ``options.refine`` exponents with larger real parts were
+        refined before it, or, on a truncated pencil of a law without memory, its refinement
+        did not converge).
     spurious : candidates of the frozen-memory problem near which the exact ``T(s)`` has no
         exponent (their refinement did not converge) [1/s]: not exponents, listed for
         inspection.
@@ -2604,7 +2605,15 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
         track.omega = hp.omega
         if got is not None and prev.omega is not None and hp.omega != prev.omega:
             track.velocity = _velocity(kept, origin[idx], prev.sigma, hp.omega - prev.omega)
-    exact = hp.memoryless() and dyn.exact and not hp.truncated
+    memoryless = hp.memoryless()
+    exact = memoryless and dyn.exact and not hp.truncated
+    # a law without memory on a truncated pencil: every candidate is an exponent of the whole
+    # problem moved by the truncation alone (about 1e-4), so every one is refined, and one
+    # whose refinement fails stays a candidate (the truncation, not an artefact)
+    budget = idx.size if (memoryless and hp.truncated) else opt.refine
+    # a held member of a truncated pencil is exact only where the kept modes diagonalise
+    # the interior (proportional or modal damping)
+    held_exact = not hp.truncated or dyn.held_diagonal
     sig, kaps, res, kind, spurious = [], [], [], [], []
     refined = 0
     done: list = [None] * idx.size  # the refinements, for the neighbour's warm starts
@@ -2614,11 +2623,11 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
         vx = y[:m * H]
         held = np.vdot(vx, vx).real < 1e-16 * np.vdot(y, y).real  # |vx| < 1e-8 |y|
         negligible = 2.0 * np.pi * s0.real < LOG_NEGLIGIBLE
-        if held or exact or negligible or refined >= opt.refine:  # refined: successes
+        if held or exact or negligible or refined >= budget:  # refined: successes
             sig.append(s0)
             kaps.append(kp)
             res.append(np.nan)
-            kind.append("held" if held else "exact" if exact else "candidate")
+            kind.append("held" if held and held_exact else "exact" if exact else "candidate")
             continue
         j = None if origin is None or origin[i] < 0 else int(origin[i])
         warm = _warm_start(prev, j, s0)
@@ -2626,6 +2635,12 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
         if not conv and warm is not None:  # from the candidate, as without a neighbour
             s1, v1, r1, conv, slope = _track(hp, s0, vx, opt)
         refined += conv
+        if not conv and memoryless:  # (a truncated pencil's: see budget) a candidate
+            sig.append(s0)
+            kaps.append(kp)
+            res.append(np.nan)
+            kind.append("candidate")
+            continue
         if not conv:  # no exponent of the exact problem near it: an artefact of the frozen
             spurious.append(s0)  # memory (a node that sticks part of the period)
             continue
