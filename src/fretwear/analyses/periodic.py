@@ -324,8 +324,9 @@ def hill_verdict(model, sol: PeriodicSolution, cond) -> tuple[str, dict]:
     if not fl.stable and not confirmed:
         line = (f"stability UNDECIDED by Hill's method: the largest multiplier, |rho| = "
                 f"{fl.max_multiplier:.4g}, is an unrefined candidate of the frozen-memory "
-                "problem (raise the refinement, fretwear.hb.stability.HillOptions(refine=), "
-                "or integrate in time from the state: fretwear.timedomain.check_periodic)")
+                "problem or of the truncated interior (raise the refinement, "
+                "fretwear.hb.stability.HillOptions(refine=), or integrate in time from the "
+                "state: fretwear.timedomain.check_periodic)")
         attrs["hill_stable"] = -1
     elif not fl.stable:
         r = crit[0]
