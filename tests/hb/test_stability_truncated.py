@@ -143,3 +143,17 @@ def test_refined_exponents_of_a_law_with_memory_are_zeros_of_the_exact_problem()
     for s in refined:
         sv = np.linalg.svd(hp.matrix(s / fl.omega), compute_uv=False)
         assert sv[-1] <= 1e-9 * sv[0]
+
+
+def test_a_modal_condensers_interior_is_not_truncated():
+    """The same structure marked as a modal condenser's (``exact`` False: fixed-interface
+    modes and residual vectors, whose truncation gave a doubtful refined exponent on the
+    dovetail, docs/studies/dovetail-fold-stability.md) keeps its whole interior, while the
+    exact one is truncated (the comparison that makes the test able to fail)."""
+    model, w1 = _unilateral_beam()
+    prob, U, dyn = _solved(model, 1.2 * w1 / (2 * np.pi))
+    hp = HillProblem(prob, U, dyn)
+    k = hp.harmonics.size
+    assert st.truncated_structure(hp._structure, dyn, prob.H, k, hp.omega)[1] < dyn.q
+    modal = type(dyn)(dyn.blocks, dyn.load_x, dyn.load_q, False)
+    assert st.truncated_structure(hp._structure, modal, prob.H, k, hp.omega)[1] == dyn.q
