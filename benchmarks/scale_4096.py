@@ -19,7 +19,8 @@ The last lines read ``solve_4096_s=``, ``condense_4096_s=`` (CPU seconds) and
 ``peak_rss_4096_gib=`` (named after 4096 whatever ``--n``; the size is printed above).
 
 Run: ``python benchmarks/scale_4096.py [--n 64] [--path auto|blocked|dense] [--condense-only]
-[--limit-gib 20]``.
+[--compressed-twin DOFS] [--limit-gib 20]`` (``--compressed-twin``: GMRES's products through
+the compressed twin from that many contact DOFs, which is off by default).
 """
 
 from __future__ import annotations
@@ -35,6 +36,19 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from scale_3d import LOADS, Clock, H, pad, peak_gib  # noqa: E402
 
 
+def solve_options(twin: int | None):
+    """The periodic solve's options: the defaults, with GMRES's compressed twin from ``twin``
+    contact DOFs where given."""
+    import dataclasses
+
+    from fretwear.hb.options import PERIODIC
+
+    if twin is None:
+        return PERIODIC
+    return PERIODIC.replace(krylov=dataclasses.replace(PERIODIC.krylov,
+                                                       compressed_products_min_dofs=twin))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=64, help="contact nodes per side")
@@ -42,6 +56,10 @@ def main():
                     help="the condenser: modal_condenser's choice, or the blocked or dense "
                          "static modes")
     ap.add_argument("--condense-only", action="store_true", help="no periodic solve")
+    ap.add_argument("--compressed-twin", type=int, default=None, metavar="DOFS",
+                    help="GMRES's products through the compressed twin from this many contact "
+                         "DOFs (KrylovOptions.compressed_products_min_dofs; default: the "
+                         "option's own default)")
     ap.add_argument("--limit-gib", type=float, default=20.0, help="address-space limit")
     ap.add_argument("--load", choices=sorted(LOADS), default="slip",
                     help="the load case of scale_3d.py (default: partial slip)")
@@ -99,7 +117,7 @@ def main():
     with Clock() as cs:
         anchor = static_anchor(model, condenser=mc)
         sol = solve_periodic(model, basis, frequency=FREQ, reduced=red, anchor=anchor,
-                             condenser=mc)
+                             condenser=mc, options=solve_options(args.compressed_twin))
     st = sol.stats
     frac = sol.state_fractions().mean(axis=0)
     active = int(np.sum(np.any(sol.state != 1, axis=1)))
