@@ -46,7 +46,9 @@ How they are computed
    only give exponents beyond the cut, and the candidates of the truncated pencil are
    refined on the exact ``T(s)`` as those of a law with memory are (step 3) (on the virtual
    beam of benchmarks/nonlinear_modes.py, 28 DOFs at 7 harmonics, the pencil 420 -> 60
-   unknowns: a point's Hill 150-300 -> 10-30 ms).
+   unknowns: a point's Hill 180 -> 8-11 ms with the condensation through the held modes).
+   Only on an exact interior (the structure's own coordinates): a modal condenser's is kept
+   whole (:func:`truncated_structure`).
 2. **Sorting**: the truncated Hill problem has, for every exponent ``s``, copies
    ``s + i j w`` with the eigenvectors ``p e^{-i j w t}``, accurate only while the shifted
    eigenvector still fits in the kept harmonics. Each eigenvector has a harmonic centroid
