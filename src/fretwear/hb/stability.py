@@ -326,8 +326,8 @@ class FloquetResult:
         coupled to the law) or ``"candidate"`` (an eigenvalue of the quadratic problem, with
         the memory frozen or on a truncated interior, that was not refined: its multiplier is
         below :data:`NEGLIGIBLE`, or ``options.refine`` exponents with larger real parts were
-        refined before it, or, on a truncated pencil of a law without memory, its refinement
-        did not converge).
+        refined before it, or, for a law without memory, its refinement did not converge:
+        the truncation of the interior moved it, it is no frozen-memory artefact).
     spurious : candidates of the frozen-memory problem near which the exact ``T(s)`` has no
         exponent (their refinement did not converge) [1/s]: not exponents, listed for
         inspection.
@@ -2621,6 +2621,13 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
     # the interior (proportional or modal damping)
     held_exact = not hp.truncated or dyn.held_diagonal
     sig, kaps, res, kind, spurious = [], [], [], [], []
+
+    def report(s, kp, r, how):
+        sig.append(s)
+        kaps.append(kp)
+        res.append(r)
+        kind.append(how)
+
     refined = 0
     done: list = [None] * idx.size  # the refinements, for the neighbour's warm starts
     for pos, (i, kp, s0) in enumerate(zip(idx.tolist(), kap.tolist(), kept.tolist(),
@@ -2630,10 +2637,8 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
         held = np.vdot(vx, vx).real < 1e-16 * np.vdot(y, y).real  # |vx| < 1e-8 |y|
         negligible = 2.0 * np.pi * s0.real < LOG_NEGLIGIBLE
         if held or exact or negligible or refined >= budget:  # refined: successes
-            sig.append(s0)
-            kaps.append(kp)
-            res.append(np.nan)
-            kind.append("held" if held and held_exact else "exact" if exact else "candidate")
+            report(s0, kp, np.nan,
+                   "held" if held and held_exact else "exact" if exact else "candidate")
             continue
         j = None if origin is None or origin[i] < 0 else int(origin[i])
         warm = _warm_start(prev, j, s0)
@@ -2641,11 +2646,8 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
         if not conv and warm is not None:  # from the candidate, as without a neighbour
             s1, v1, r1, conv, slope = _track(hp, s0, vx, opt)
         refined += conv
-        if not conv and memoryless:  # (a truncated pencil's: see budget) a candidate
-            sig.append(s0)
-            kaps.append(kp)
-            res.append(np.nan)
-            kind.append("candidate")
+        if not conv and memoryless:  # not a frozen-memory artefact: the candidate of a
+            report(s0, kp, np.nan, "candidate")  # truncated (or modal) interior, kept
             continue
         if not conv:  # no exponent of the exact problem near it: an artefact of the frozen
             spurious.append(s0)  # memory (a node that sticks part of the period)
@@ -2654,15 +2656,12 @@ def hill_stability(prob: DLFTProblem, U, dyn: StructureDynamics, *,
             s1 = complex(s1.real, 0.0)  # that it is missing (the conjugate candidate)
             a = s0.real if abs(s0.real - s1.real) > 10 * ON_REAL else s1.real - 0.01
             s2, v2, r2, conv2, _ = _track(hp, complex(a, 0.0), vx, opt, deflate=s1.real)
-            sig.append(complex(s2.real, 0.0) if conv2 else np.conj(s0))
-            kaps.append(_centroid_of(v2, m, H, k) if conv2 else -kp)
-            res.append(r2 if conv2 else np.nan)
-            kind.append("refined" if conv2 else "candidate")
+            if conv2:
+                report(complex(s2.real, 0.0), _centroid_of(v2, m, H, k), r2, "refined")
+            else:
+                report(np.conj(s0), -kp, np.nan, "candidate")
         done[pos] = Refined(s0, s1, v1, slope)
-        sig.append(s1)
-        kaps.append(_centroid_of(v1, m, H, k))
-        res.append(r1)
-        kind.append("refined")
+        report(s1, _centroid_of(v1, m, H, k), r1, "refined")
     if track is not None:
         track.refined = done
     # one multiplier per family (:func:`_families`), sorted by decreasing real part
